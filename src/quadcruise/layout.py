@@ -1,0 +1,91 @@
+"""The engine's data layout: named columns of the state, reference and command vectors,
+and the compiled signatures that controllers and missions must have.
+
+Everything the compiled engine touches is a flat ``float64`` vector (one vehicle) or a
+2-D array with a leading batch axis (N vehicles). The names below are the column indices;
+use them instead of bare numbers, e.g. ``state[:, PHI]``.
+
+A controller or mission written by a user plugs into the same cached engine as the
+built-in ones if it is compiled with the signature given here::
+
+    from numba import njit
+    from quadcruise.layout import CONTROLLER_SIG
+
+    @njit(CONTROLLER_SIG, cache=True)
+    def my_controller(t, dt, x, ref, vp, gains, mem, cmd):
+        ...
+
+Units are SI throughout: metres, seconds, radians, newtons.
+"""
+
+from __future__ import annotations
+
+from numba import types
+
+# --- state: 16 columns -------------------------------------------------------------
+# position and velocity in the earth frame (z up), the paper's Euler angles and body
+# rates, and the four rotor thrusts (the actuator state).
+X, Y, Z, VX, VY, VZ, PHI, THETA, PSI, P, Q, R, F1, F2, F3, F4 = range(16)
+STATE_SIZE = 16
+STATE_NAMES = (
+    "x", "y", "z", "vx", "vy", "vz", "phi", "theta", "psi",
+    "p", "q", "r", "F1", "F2", "F3", "F4",
+)
+STATE_UNITS = (
+    "m", "m", "m", "m/s", "m/s", "m/s", "rad", "rad", "rad",
+    "rad/s", "rad/s", "rad/s", "N", "N", "N", "N",
+)
+
+# --- reference: 11 columns -----------------------------------------------------------
+# what a mission asks for at time t: position, velocity, acceleration, yaw and yaw rate.
+(REF_X, REF_Y, REF_Z, REF_VX, REF_VY, REF_VZ,
+ REF_AX, REF_AY, REF_AZ, REF_PSI, REF_PSI_DOT) = range(11)
+REF_SIZE = 11
+REF_NAMES = (
+    "x_ref", "y_ref", "z_ref", "vx_ref", "vy_ref", "vz_ref",
+    "ax_ref", "ay_ref", "az_ref", "psi_ref", "psi_dot_ref",
+)
+
+# --- command: 12 columns -------------------------------------------------------------
+# what a controller returns each control period. Only the four duties drive the plant;
+# the rest is for logging and metrics. The engine clips the duties to [0, 1] and counts
+# the periods in which it had to (never silently).
+(CMD_U1, CMD_U2, CMD_U3, CMD_U4,            # PWM duties asked of rotors 1..4 [-]
+ CMD_THRUST, CMD_TAU_PHI, CMD_TAU_THETA, CMD_TAU_PSI,  # desired U1 [N], U2 [N], U3 [N], U4 [N m]
+ CMD_PHI_D, CMD_THETA_D, CMD_PSI_D,          # attitude setpoints [rad]
+ CMD_FLAGS) = range(12)                      # controller saturation bit mask
+CMD_SIZE = 12
+CMD_NAMES = (
+    "u1", "u2", "u3", "u4", "U1_d", "U2_d", "U3_d", "U4_d",
+    "phi_d", "theta_d", "psi_d", "flags",
+)
+
+# Bits a controller may set in cmd[CMD_FLAGS]; the engine counts periods with any bit set.
+FLAG_TILT_LIMIT = 1      # a roll/pitch setpoint was limited to the tilt limit
+FLAG_ASIN_CLIP = 2       # an inverse-model asin argument left [-1, 1] and was clipped
+FLAG_THRUST_LIMIT = 4    # the collective thrust was limited
+FLAG_INTEGRATOR_HOLD = 8  # anti-windup held an integrator
+
+# --- vehicle parameter row: 15 columns -------------------------------------------------
+# The first nine are the physical parameters; k1..k6 (Section III of the paper) are
+# derived from them when the row is built, so the compiled step never divides.
+(P_M, P_JXX, P_JYY, P_JZZ, P_L, P_K, P_OMEGA, P_D, P_G,
+ P_K1, P_K2, P_K3, P_K4, P_K5, P_K6) = range(15)
+PARAM_SIZE = 15
+
+# --- compiled signatures ---------------------------------------------------------------
+_f8 = types.float64
+_vec = types.float64[::1]
+
+#: ``controller(t, dt, x, ref, vp, gains, mem, cmd) -> None``
+#: t: time at the start of the control period [s]; dt: its length [s]; x: the state the
+#: controller sees (STATE_SIZE); ref: the mission's reference at t (REF_SIZE); vp: the
+#: vehicle parameter row (PARAM_SIZE); gains: the controller's parameters (any length);
+#: mem: the controller's memory, kept between periods (any length); cmd: output (CMD_SIZE).
+CONTROLLER_SIG = types.void(_f8, _f8, _vec, _vec, _vec, _vec, _vec, _vec)
+ControllerType = types.FunctionType(CONTROLLER_SIG)
+
+#: ``mission(t, mp, ref) -> None``: writes the reference at time t [s] into ref (REF_SIZE);
+#: mp is the mission's parameter vector.
+MISSION_SIG = types.void(_f8, _vec, _vec)
+MissionType = types.FunctionType(MISSION_SIG)
