@@ -1,0 +1,297 @@
+"""The simulation engine: fixed-step RK4 for one vehicle or N, in one compiled function.
+
+Time runs on a grid of control instants t_0 < t_1 < ... < t_M shared by the batch. At
+each t_k the engine asks the mission for the reference and the controller for a command,
+then holds the command over [t_k, t_{k+1}] while RK4 integrates the plant in equal
+substeps no longer than ``max_step``. After every period it checks the state; a vehicle
+whose state turns non-finite or leaves the bounds in :class:`Limits` stops there, with its
+status, time and reason recorded, while the rest of the batch flies on.
+
+The single-vehicle flight is the N = 1 case of the same kernel. Vehicles are independent,
+so the kernel runs them in parallel (numba ``prange``); each vehicle's arithmetic does not
+depend on the batch it is in, so a batch reproduces single flights bit for bit.
+
+Controllers and missions are compiled functions with the signatures in
+:mod:`quadcruise.layout`, passed as first-class function values: one cached kernel
+serves every controller, a user's own included.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit, prange, types
+
+from .errors import InputError
+from .layout import (
+    CMD_FLAGS, CMD_SIZE, ControllerType, MissionType, P, PHI, Q, R, REF_SIZE, STATE_SIZE,
+    THETA, VX, VY, VZ, X, Y, Z,
+)
+from .model.plant import derivative
+from .result import STATUS_REASONS, SimResult
+
+# exit status of each vehicle (the reasons live in result.STATUS_REASONS)
+FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, TILT_BOUND, BAD_COMMAND = range(7)
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Bounds beyond which a flight counts as diverged (and stops).
+
+    Attributes
+    ----------
+    max_position : float
+        |x|, |y| or |z| above this [m] ends the flight.
+    max_speed : float
+        any velocity component above this [m/s].
+    max_rate : float
+        any body rate above this [rad/s].
+    max_tilt : float
+        |roll| or |pitch| above this [rad]; infinite by default, since the paper's
+        model has no singularity at 90 degrees.
+    """
+
+    max_position: float = 1.0e4
+    max_speed: float = 1.0e3
+    max_rate: float = 1.0e3
+    max_tilt: float = math.inf
+
+    def __post_init__(self) -> None:
+        for name in ("max_position", "max_speed", "max_rate", "max_tilt"):
+            value = getattr(self, name)
+            if not value > 0:
+                raise InputError(f"limit '{name}' must be > 0, got {value!r}")
+
+    def array(self) -> np.ndarray:
+        return np.array([self.max_position, self.max_speed, self.max_rate, self.max_tilt])
+
+
+@njit(cache=True, inline="always")
+def rk4_step(x, u, vp, ext, h, k1, k2, k3, k4, xt):
+    """One classical Runge-Kutta step of length h [s], in place on x."""
+    n = x.shape[0]
+    derivative(x, u, vp, ext, k1)
+    for j in range(n):
+        xt[j] = x[j] + 0.5 * h * k1[j]
+    derivative(xt, u, vp, ext, k2)
+    for j in range(n):
+        xt[j] = x[j] + 0.5 * h * k2[j]
+    derivative(xt, u, vp, ext, k3)
+    for j in range(n):
+        xt[j] = x[j] + h * k3[j]
+    derivative(xt, u, vp, ext, k4)
+    c = h / 6.0
+    for j in range(n):
+        x[j] += c * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j])
+
+
+@njit(cache=True, inline="always")
+def check_state(x, limits):
+    """0 if the state is sound, else the divergence status code."""
+    for j in range(x.shape[0]):
+        if not math.isfinite(x[j]):
+            return NONFINITE
+    if abs(x[X]) > limits[0] or abs(x[Y]) > limits[0] or abs(x[Z]) > limits[0]:
+        return POSITION_BOUND
+    if abs(x[VX]) > limits[1] or abs(x[VY]) > limits[1] or abs(x[VZ]) > limits[1]:
+        return SPEED_BOUND
+    if abs(x[P]) > limits[2] or abs(x[Q]) > limits[2] or abs(x[R]) > limits[2]:
+        return RATE_BOUND
+    if abs(x[PHI]) > limits[3] or abs(x[THETA]) > limits[3]:
+        return TILT_BOUND
+    return FINISHED
+
+
+@njit(cache=True, inline="always")
+def hold_duties(cmd, u):
+    """Clip the commanded duties into u (in [0, 1]); return (clipped?, finite?)."""
+    clipped = False
+    for j in range(4):
+        v = cmd[j]
+        if not math.isfinite(v):
+            return clipped, False
+        if v < 0.0:
+            v = 0.0
+            clipped = True
+        elif v > 1.0:
+            v = 1.0
+            clipped = True
+        u[j] = v
+    return clipped, True
+
+
+_f8v = types.float64[::1]
+_f8m = types.float64[:, ::1]
+_f8c = types.float64[:, :, ::1]
+_i8v = types.int64[::1]
+
+KERNEL_SIG = types.void(
+    _f8v, _f8m, _f8m, ControllerType, _f8m, _f8m, MissionType, _f8m,
+    types.float64, types.int64, _f8v,
+    _f8c, _f8c, _f8c, _f8m, _i8v, _f8v, _f8m,
+)
+
+
+@njit(KERNEL_SIG, cache=True, parallel=True)
+def _kernel(t_grid, x0, vp, controller, gains, mem, mission, mp, max_step, log_every, limits,
+            log_x, log_cmd, log_ref, x_final, status, t_stop, saturated):
+    n_vehicles = x0.shape[0]
+    n_periods = t_grid.shape[0] - 1
+    for i in prange(n_vehicles):
+        x = x0[i].copy()
+        seen = np.empty(STATE_SIZE)
+        ref = np.zeros(REF_SIZE)
+        cmd = np.zeros(CMD_SIZE)
+        u = np.zeros(4)
+        ext = np.zeros(6)
+        k1 = np.empty(STATE_SIZE)
+        k2 = np.empty(STATE_SIZE)
+        k3 = np.empty(STATE_SIZE)
+        k4 = np.empty(STATE_SIZE)
+        xt = np.empty(STATE_SIZE)
+        vpi, gi, mi, mpi = vp[i], gains[i], mem[i], mp[i]
+        code = FINISHED
+        t_end = t_grid[n_periods]
+        for k in range(n_periods + 1):
+            t = t_grid[k]
+            dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
+            mission(t, mpi, ref)
+            for j in range(STATE_SIZE):
+                seen[j] = x[j]
+            for j in range(CMD_SIZE):
+                cmd[j] = 0.0
+            controller(t, dt, seen, ref, vpi, gi, mi, cmd)
+            if k % log_every == 0:
+                row = k // log_every
+                log_x[i, row, :] = x
+                log_cmd[i, row, :] = cmd
+                log_ref[i, row, :] = ref
+            if k == n_periods:
+                break
+            clipped, finite = hold_duties(cmd, u)
+            if not finite:
+                code = BAD_COMMAND
+                t_end = t
+                break
+            if clipped:
+                saturated[i, 0] += dt
+            if cmd[CMD_FLAGS] != 0.0:
+                saturated[i, 1] += dt
+            n_sub = max(1, int(math.ceil(dt / max_step - 1e-9)))
+            h = dt / n_sub
+            for _ in range(n_sub):
+                rk4_step(x, u, vpi, ext, h, k1, k2, k3, k4, xt)
+            code = check_state(x, limits)
+            if code != FINISHED:
+                t_end = t_grid[k + 1]
+                if (k + 1) % log_every == 0:   # keep the state that broke the bound
+                    log_x[i, (k + 1) // log_every, :] = x
+                break
+        x_final[i, :] = x
+        status[i] = code
+        t_stop[i] = t_end
+
+
+def time_grid(duration: float, dt: float, t0: float = 0.0) -> np.ndarray:
+    """Uniform control instants t0, t0 + dt, ..., t0 + duration.
+
+    ``duration`` must be a whole number of periods (to 1e-9 relative) so the grid ends
+    exactly at t0 + duration.
+    """
+    if not (math.isfinite(duration) and duration > 0):
+        raise InputError(f"duration must be a positive number of seconds, got {duration!r}")
+    if not (math.isfinite(dt) and dt > 0):
+        raise InputError(f"dt must be a positive number of seconds, got {dt!r}")
+    if dt > duration:
+        raise InputError(f"dt ({dt:g} s) is larger than the duration ({duration:g} s)")
+    n = round(duration / dt)
+    if abs(n * dt - duration) > 1e-9 * max(1.0, duration):
+        raise InputError(f"duration ({duration:g} s) is not a whole number of dt ({dt:g} s) periods")
+    return t0 + dt * np.arange(n + 1, dtype=float)
+
+
+def _batch(name: str, a, n: int, width: int | None) -> np.ndarray:
+    """Broadcast a vector or (N, w) array to a C-contiguous (n, w) float64 array."""
+    arr = np.asarray(a, dtype=float)
+    if arr.ndim == 1:
+        arr = np.broadcast_to(arr, (n, arr.shape[0]))
+    if arr.ndim != 2 or arr.shape[0] != n or (width is not None and arr.shape[1] != width):
+        want = f"({n}, {width})" if width is not None else f"({n}, w)"
+        raise InputError(f"{name} has shape {np.shape(a)}, expected {want} or one row")
+    return np.array(arr, dtype=float, order="C")  # a writable copy, never a broadcast view
+
+
+def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
+             max_step: float = 1e-3, log_every: int = 1, limits: Limits | None = None,
+             meta: dict | None = None) -> SimResult:
+    """Fly N vehicles over the control instants ``t_grid`` and return a :class:`SimResult`.
+
+    This is the array-level entry point that :func:`quadcruise.fly` and
+    :func:`quadcruise.replay` build on.
+
+    Parameters
+    ----------
+    t_grid : (M+1,) array
+        Strictly increasing control instants [s]; the command is held in between.
+    x0 : (16,) or (N, 16) array
+        Initial states (one row is shared by all vehicles).
+    vp : (N, PARAM_SIZE) array
+        Vehicle parameter rows, from :meth:`Vehicle.rows`.
+    controller : compiled function with ``CONTROLLER_SIG``
+    gains : (G,) or (N, G) array
+        The controller's parameters.
+    mission : compiled function with ``MISSION_SIG``
+    mp : (Mp,) or (N, Mp) array
+        The mission's parameters.
+    memory : (C,) or (N, C) array, optional
+        The controller's initial memory (integrators); zeros of width 0 by default.
+    max_step : float
+        Longest RK4 substep [s]; each period is split into equal substeps.
+    log_every : int
+        Log every this many control periods (1: all). The first instant is always logged.
+    limits : Limits
+        Divergence bounds.
+    meta : dict
+        Recorded in the result (config, seed, version).
+    """
+    t_grid = np.ascontiguousarray(t_grid, dtype=float)
+    if t_grid.ndim != 1 or t_grid.shape[0] < 2:
+        raise InputError("the time grid needs at least two instants")
+    if not np.all(np.isfinite(t_grid)) or np.any(np.diff(t_grid) <= 0):
+        raise InputError("the time grid must be finite and strictly increasing")
+    if not (math.isfinite(max_step) and max_step > 0):
+        raise InputError(f"max_step must be a positive number of seconds, got {max_step!r}")
+    if int(log_every) != log_every or log_every < 1:
+        raise InputError(f"log_every must be a positive integer, got {log_every!r}")
+    vp = np.ascontiguousarray(vp, dtype=float)
+    n = vp.shape[0]
+    x0 = _batch("initial state", x0, n, STATE_SIZE)
+    if not np.all(np.isfinite(x0)):
+        raise InputError("the initial state must be finite")
+    gains = _batch("controller gains", gains, n, None)
+    mp = _batch("mission parameters", mp, n, None)
+    mem = _batch("controller memory", np.zeros(0) if memory is None else memory, n, None)
+    limits = limits or Limits()
+
+    n_periods = t_grid.shape[0] - 1
+    n_log = n_periods // log_every + 1
+    log_x = np.full((n, n_log, STATE_SIZE), np.nan)
+    log_cmd = np.full((n, n_log, CMD_SIZE), np.nan)
+    log_ref = np.full((n, n_log, REF_SIZE), np.nan)
+    x_final = np.empty((n, STATE_SIZE))
+    status = np.zeros(n, dtype=np.int64)
+    t_stop = np.empty(n)
+    saturated = np.zeros((n, 2))
+    _kernel(t_grid, x0, vp, controller, gains, mem, mission, mp, float(max_step), int(log_every),
+            limits.array(), log_x, log_cmd, log_ref, x_final, status, t_stop, saturated)
+    return SimResult(
+        t=t_grid[::log_every][:n_log].copy(), states=log_x, commands=log_cmd, references=log_ref,
+        final_state=x_final, status=status, t_stop=t_stop, memory=mem,
+        duty_clipped_s=saturated[:, 0].copy(), controller_limited_s=saturated[:, 1].copy(),
+        meta=dict(meta or {}),
+    )
+
+
+__all__ = ["Limits", "simulate", "time_grid", "rk4_step", "STATUS_REASONS"]

@@ -1,0 +1,1 @@
+"""The paper's quadrotor: plant dynamics and rotor actuators."""

@@ -1,0 +1,27 @@
+"""An independent, plain-numpy statement of the paper's model for cross-checks.
+
+Written from the equations, not from quadcruise's compiled code, so that agreement
+between the two is evidence about both.
+"""
+
+import numpy as np
+
+
+def rhs(x, u, m=3.499, Jxx=0.03, Jyy=0.03, Jzz=0.04, l=0.2, K=120.0, w=15.0, d=4 / 120, g=9.81):
+    phi, th, psi = x[6:9]
+    p, q, r = x[9:12]
+    F = x[12:16]
+    U1 = F.sum()
+    U2 = F[1] - F[3]
+    U3 = F[0] - F[2]
+    U4 = d * (F[0] + F[2] - F[1] - F[3])
+    acc = np.array([
+        (np.sin(phi) * np.sin(psi) + np.cos(phi) * np.sin(th) * np.cos(psi)) * U1 / m,
+        (-np.sin(phi) * np.cos(psi) + np.cos(phi) * np.sin(th) * np.sin(psi)) * U1 / m,
+        np.cos(phi) * np.cos(th) * U1 / m - g,
+    ])
+    # Euler's equations for a rigid body (the k1..k6 form)
+    pdot = ((Jyy - Jzz) * q * r + l * U2) / Jxx
+    qdot = ((Jzz - Jxx) * p * r + l * U3) / Jyy
+    rdot = ((Jxx - Jyy) * p * q + U4) / Jzz
+    return np.concatenate([x[3:6], acc, [p, q, r], [pdot, qdot, rdot], w * (K * np.asarray(u) - F)])

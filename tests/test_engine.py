@@ -1,0 +1,163 @@
+"""The engine: accuracy (RK4 order, agreement with solve_ivp), batching, divergence."""
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import quadcruise as qc
+from quadcruise.control.openloop import duty_schedule, pack_schedule
+from quadcruise.layout import F1, STATE_SIZE, X, Z
+from quadcruise.replay import no_reference
+from reference_model import rhs
+
+V = qc.Vehicle.paper()
+
+
+def wobbly_schedule(duration=4.0, rate=50.0, seed=3):
+    """Hover duties with small random differential and collective changes."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, duration + 1e-9, 1.0 / rate)
+    h = V.hover_duty
+    u = h + 0.002 * rng.standard_normal((t.size, 4)) + 0.003 * np.sin(t)[:, None]
+    return qc.DutySchedule(t=t, duties=u)
+
+
+def solve_ivp_replay(schedule, **vehicle):
+    """Integrate the reference model interval by interval with DOP853, rtol 1e-10."""
+    x = np.zeros(STATE_SIZE)
+    x[12:] = vehicle.get("K", 120.0) * schedule.duties[0]
+    out = [x.copy()]
+    for k in range(len(schedule.t) - 1):
+        u = schedule.duties[k]
+        sol = solve_ivp(lambda _t, s: rhs(s, u, **vehicle), (schedule.t[k], schedule.t[k + 1]), x,
+                        method="DOP853", rtol=1e-10, atol=1e-12)
+        x = sol.y[:, -1]
+        out.append(x.copy())
+    return np.array(out)
+
+
+def test_replay_matches_solve_ivp_to_a_micrometre():
+    schedule = wobbly_schedule()
+    res = qc.replay(schedule)
+    ref = solve_ivp_replay(schedule)
+    assert res.ok[0]
+    moved = np.max(np.abs(ref[:, :3]))
+    assert moved > 0.05, "the test flight should go somewhere"
+    err = np.max(np.abs(res.states[0, :, :3] - ref[:, :3]))
+    assert err < 1e-6, err
+    np.testing.assert_allclose(res.states[0, :, 6:9], ref[:, 6:9], atol=1e-7)
+
+
+def test_rk4_error_falls_sixteen_fold_when_step_halves():
+    schedule = wobbly_schedule(duration=2.0, rate=10.0)
+    exact = qc.replay(schedule, max_step=0.02 / 32).final_state[0]
+    e1 = np.abs(qc.replay(schedule, max_step=0.02).final_state[0] - exact)
+    e2 = np.abs(qc.replay(schedule, max_step=0.01).final_state[0] - exact)
+    ratio = np.linalg.norm(e1[:6]) / np.linalg.norm(e2[:6])
+    assert 14.0 < ratio < 18.0, ratio
+
+
+def test_batch_equals_one_by_one():
+    masses = np.array([3.0, 3.499, 3.8, 4.2, 2.5])
+    jzz = np.array([0.04, 0.05, 0.035, 0.04, 0.045])
+    schedule = wobbly_schedule(duration=2.0)
+    batch = qc.replay(schedule, vehicle=qc.Vehicle(m=masses, Jzz=jzz))
+    assert batch.n == 5
+    for i in range(5):
+        single = qc.replay(schedule, vehicle=qc.Vehicle(m=masses[i], Jzz=jzz[i]))
+        np.testing.assert_allclose(batch.states[i], single.states[0], rtol=0, atol=1e-12)
+    # and different vehicles really flew differently
+    assert np.ptp(batch.final_state[:, Z]) > 0.1
+
+
+def test_batched_initial_states_and_schedules_through_simulate():
+    schedule = wobbly_schedule(duration=1.0)
+    gains = pack_schedule(schedule.t, schedule.duties)
+    x0 = np.zeros((3, STATE_SIZE))
+    x0[:, F1:] = V.K * schedule.duties[0]
+    x0[:, X] = [0.0, 1.0, -2.0]
+    res = qc.simulate(schedule.t, x0, V.rows(3), duty_schedule, gains, no_reference, np.zeros(1),
+                      memory=np.zeros(1))
+    np.testing.assert_allclose(res.states[1, :, X] - res.states[0, :, X], 1.0, atol=1e-12)
+    np.testing.assert_allclose(res.states[2, :, X] - res.states[0, :, X], -2.0, atol=1e-12)
+
+
+def test_decimated_logging_keeps_every_kth_instant():
+    schedule = wobbly_schedule(duration=1.0)
+    gains = pack_schedule(schedule.t, schedule.duties)
+    x0 = np.zeros(STATE_SIZE)
+    x0[F1:] = V.K * schedule.duties[0]
+    args = (schedule.t, x0, V.rows(), duty_schedule, gains, no_reference, np.zeros(1))
+    full = qc.simulate(*args, memory=np.zeros(1))
+    every5 = qc.simulate(*args, memory=np.zeros(1), log_every=5)
+    assert every5.states.shape[1] == (len(schedule.t) - 1) // 5 + 1
+    np.testing.assert_array_equal(every5.states[0], full.states[0, ::5])
+    np.testing.assert_array_equal(every5.t, full.t[::5])
+    np.testing.assert_array_equal(every5.final_state, full.final_state)
+
+
+def test_divergence_stops_the_vehicle_and_says_why_and_when():
+    # one rotor at full power, the opposite one off: the vehicle spins up in pitch
+    t = np.linspace(0, 10, 1001)
+    u = np.tile([1.0, 0.07, 0.0, 0.07], (t.size, 1))
+    res = qc.replay(qc.DutySchedule(t=t, duties=u), limits=qc.Limits(max_rate=50.0))
+    assert not res.ok[0]
+    assert res.status[0] == 4
+    assert 0 < res.t_stop[0] < 10
+    assert "body rate" in res.status_text(0) and "t = " in res.status_text(0)
+    stop = np.searchsorted(res.t, res.t_stop[0])
+    assert np.all(np.isnan(res.states[0, stop + 1:]))
+    assert np.all(np.isfinite(res.states[0, :stop + 1]))
+
+
+def test_nonfinite_controller_command_stops_cleanly():
+    from numba import njit
+
+    from quadcruise.layout import CONTROLLER_SIG
+
+    @njit(CONTROLLER_SIG)
+    def broken(t, dt, x, ref, vp, gains, mem, cmd):
+        for j in range(4):
+            cmd[j] = np.nan if t >= 0.5 else 0.1
+
+    res = qc.simulate(np.linspace(0, 1, 11), np.zeros(STATE_SIZE), V.rows(), broken, np.zeros(0),
+                      no_reference, np.zeros(1))
+    assert res.status[0] == 6 and res.t_stop[0] == pytest.approx(0.5)
+    assert "non-finite command" in res.status_text(0)
+
+
+def test_user_controller_plugs_in_and_engine_clips_and_reports_duties():
+    from numba import njit
+
+    from quadcruise.layout import CONTROLLER_SIG
+
+    @njit(CONTROLLER_SIG)
+    def too_much(t, dt, x, ref, vp, gains, mem, cmd):
+        for j in range(4):
+            cmd[j] = 1.5
+
+    res = qc.simulate(np.linspace(0, 1, 101), np.zeros(STATE_SIZE), V.rows(), too_much, np.zeros(0),
+                      no_reference, np.zeros(1))
+    assert res.duty_clipped_s[0] == pytest.approx(1.0)
+    assert res.final_state[0, F1] < V.K * 1.0 + 1e-9   # the plant saw duty 1, not 1.5
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    ({"max_step": 0.0}, "max_step"),
+    ({"log_every": 0}, "log_every"),
+])
+def test_bad_engine_options(kwargs, words):
+    schedule = wobbly_schedule(duration=0.2)
+    gains = pack_schedule(schedule.t, schedule.duties)
+    with pytest.raises(qc.InputError, match=words):
+        qc.simulate(schedule.t, np.zeros(STATE_SIZE), V.rows(), duty_schedule, gains, no_reference,
+                    np.zeros(1), memory=np.zeros(1), **kwargs)
+
+
+def test_time_grid():
+    g = qc.time_grid(1.0, 0.001)
+    assert g.shape == (1001,) and g[-1] == pytest.approx(1.0)
+    with pytest.raises(qc.InputError, match="larger than the duration"):
+        qc.time_grid(0.1, 0.2)
+    with pytest.raises(qc.InputError, match="duration"):
+        qc.time_grid(-1.0, 0.01)
