@@ -16,11 +16,12 @@ except _metadata.PackageNotFoundError:  # running from a source tree
 
 from .engine import Limits, simulate, time_grid  # noqa: E402
 from .errors import InputError  # noqa: E402
+from .flight import fly  # noqa: E402
 from .params import Vehicle  # noqa: E402
 from .replay import DutySchedule, read_duty_csv, replay, write_states_csv  # noqa: E402
 from .result import SimResult  # noqa: E402
 
 __all__ = [
     "DutySchedule", "InputError", "Limits", "SimResult", "Vehicle", "__version__",
-    "read_duty_csv", "replay", "simulate", "time_grid", "write_states_csv",
+    "fly", "read_duty_csv", "replay", "simulate", "time_grid", "write_states_csv",
 ]

@@ -68,7 +68,7 @@ class Limits:
         return np.array([self.max_position, self.max_speed, self.max_rate, self.max_tilt])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def rk4_step(x, u, vp, ext, h, k1, k2, k3, k4, xt):
     """One classical Runge-Kutta step of length h [s], in place on x."""
     n = x.shape[0]
@@ -134,7 +134,7 @@ KERNEL_SIG = types.void(
 )
 
 
-@njit(KERNEL_SIG, cache=True, parallel=True)
+@njit(KERNEL_SIG, cache=True, parallel=True, error_model="numpy")
 def _kernel(t_grid, x0, vp, controller, gains, mem, mission, mp, max_step, log_every, limits,
             log_x, log_cmd, log_ref, x_final, status, t_stop, saturated):
     n_vehicles = x0.shape[0]

@@ -1,0 +1,28 @@
+"""Controllers: compiled functions with the engine's controller signature, and their design.
+
+Built-in controllers by name (see :func:`controller_from_name`):
+
+- ``nlpd``: the paper's inverse-model nonlinear PD over decoupled attitude PID.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..errors import InputError
+from .base import Controller
+from .position import NLPD
+
+CONTROLLERS: dict[str, type[Controller]] = {NLPD.name: NLPD}
+
+
+def controller_from_name(name: str, **params: Any) -> Controller:
+    """A built-in controller by name, with optional parameters."""
+    try:
+        cls = CONTROLLERS[name]
+    except KeyError:
+        raise InputError(f"unknown controller {name!r}; choose one of {', '.join(CONTROLLERS)}") from None
+    return cls(**params)
+
+
+__all__ = ["CONTROLLERS", "NLPD", "Controller", "controller_from_name"]

@@ -39,7 +39,7 @@ from ..layout import (
 from .actuators import mix
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def derivative(x, u, vp, ext, dx):
     """Write dx/dt of one vehicle into ``dx``.
 

@@ -1,0 +1,139 @@
+"""``fly``: a mission flown by a controller on one vehicle or N, through the engine.
+
+Examples
+--------
+>>> import quadcruise as qc
+>>> res = qc.fly("step", duration=6.0)
+>>> res.ok.tolist()
+[True]
+>>> abs(res.final_state[0, 0] - 1.0) < 0.02      # the 1 m step in x is reached
+True
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+
+from . import __version__
+from .control import Controller, controller_from_name
+from .engine import Limits, simulate, time_grid
+from .errors import InputError
+from .layout import F1, PSI, REF_PSI, REF_X, REF_Y, REF_Z, STATE_SIZE, X, Y, Z
+from .missions import Circle, Hover, Mission, Square, Step, mission_from_name, stack_params
+from .params import Vehicle
+from .result import SimResult
+
+
+def default_duration(mission: Mission) -> float:
+    """One lap of a circle or square, 10 s after a step, 5 s of hover [s]."""
+    if isinstance(mission, Circle):
+        return mission.period
+    if isinstance(mission, Square):
+        return mission.lap_time
+    if isinstance(mission, Step):
+        return mission.time + 10.0
+    return 5.0
+
+
+def hover_state(vehicle: Vehicle, n: int, mission: Mission) -> np.ndarray:
+    """(N, 16): hovering level at the origin's x, y at the mission's start altitude and yaw,
+    each rotor at the hover thrust m g / 4."""
+    vp = vehicle.rows(n)
+    ref0 = mission.reference(0.0)[0]
+    x0 = np.zeros((n, STATE_SIZE))
+    x0[:, Z] = ref0[REF_Z]
+    x0[:, PSI] = ref0[REF_PSI]
+    x0[:, F1:F1 + 4] = (vp[:, 0] * vp[:, 8] / 4.0)[:, None]
+    return x0
+
+
+def fly(mission: Mission | str = "circle", controller: Controller | str = "nlpd", *,
+        vehicle: Vehicle | None = None, duration: float | None = None, dt: float = 1e-3,
+        max_step: float | None = None, n: int | None = None, x0: Any = None,
+        log_every: int = 1, limits: Limits | None = None, missions: list[Mission] | None = None,
+        ) -> SimResult:
+    """Fly a mission with a controller and return the logged flight.
+
+    Parameters
+    ----------
+    mission : Mission or str
+        A mission object, or a name ('hover', 'step', 'circle', 'square') for its defaults.
+    controller : Controller or str
+        A controller object, or a name ('nlpd', ...) for its defaults.
+    vehicle : Vehicle, optional
+        Table I by default; a batched Vehicle gives each of the N vehicles its own values.
+    duration : float, optional
+        Flight time [s]; one lap (circle, square), step time + 10 s, or 5 s by default.
+    dt : float
+        Control period [s] (1 kHz by default); the command is held in between.
+    max_step : float, optional
+        Longest RK4 substep [s]; ``dt`` by default.
+    n : int, optional
+        Number of vehicles; taken from ``vehicle``, ``x0`` or ``missions`` if they are batched.
+    x0 : (16,) or (N, 16) array, optional
+        Initial states; by default each vehicle hovers at x = y = 0 at the mission's
+        starting altitude and yaw.
+    log_every : int
+        Log every this many control periods.
+    limits : Limits, optional
+        Divergence bounds.
+    missions : list of Mission, optional
+        One mission of the same kind per vehicle (instead of ``mission``).
+
+    Returns
+    -------
+    SimResult
+        With ``metrics()``, ``to_pandas()`` and ``plot()``. A vehicle that diverged stops
+        and its status says why and when (a warning says so too), as does any clipping
+        of the rotor duties.
+    """
+    if isinstance(mission, str):
+        mission = mission_from_name(mission)
+    if isinstance(controller, str):
+        controller = controller_from_name(controller)
+    if not isinstance(controller, Controller):
+        raise InputError(f"controller must be a name or a Controller, got {type(controller).__name__}")
+    vehicle = vehicle or Vehicle.paper()
+    sizes = {s for s in (vehicle.batch_size, None if x0 is None or np.ndim(x0) < 2 else np.shape(x0)[0],
+                         None if missions is None else len(missions), n) if s is not None}
+    if len(sizes) > 1:
+        raise InputError(f"the number of vehicles is ambiguous: {sorted(sizes)}")
+    n = sizes.pop() if sizes else 1
+    if n < 1:
+        raise InputError(f"the number of vehicles must be at least 1, got {n}")
+    mp = stack_params(missions if missions is not None else mission, n=None if missions else n)
+    first = missions[0] if missions else mission
+    duration = default_duration(first) if duration is None else duration
+    grid = time_grid(float(duration), float(dt))
+    x0 = hover_state(vehicle, n, first) if x0 is None else x0
+    meta = {
+        "workflow": "fly",
+        "mission": [m.to_dict() for m in missions] if missions else mission.to_dict(),
+        "controller": controller.to_dict(),
+        "vehicle": vehicle.to_dict(),
+        "duration_s": float(duration), "dt_s": float(dt),
+        "max_step_s": float(max_step or dt), "n": n, "version": __version__,
+    }
+    result = simulate(grid, x0, vehicle.rows(n), controller.function, controller.gains(),
+                      first.function, mp, memory=controller.memory(), max_step=max_step or dt,
+                      log_every=log_every, limits=limits, meta=meta)
+    _warn_about(result)
+    return result
+
+
+def _warn_about(result: SimResult) -> None:
+    bad = np.flatnonzero(~result.ok)
+    if bad.size:
+        first = int(bad[0])
+        more = f" ({bad.size} of {result.n} vehicles)" if result.n > 1 else ""
+        warnings.warn(f"vehicle {first} {result.status_text(first)}{more}", stacklevel=3)
+    clipped = result.duty_clipped_s
+    if np.any(clipped > 0):
+        warnings.warn(f"rotor duties were clipped to [0, 1] for up to {clipped.max():.3f} s "
+                      f"({np.count_nonzero(clipped)} of {result.n} vehicles)", stacklevel=3)
+
+
+__all__ = ["fly", "default_duration", "hover_state"]
