@@ -13,6 +13,7 @@ import click
 
 from . import __version__
 from .errors import InputError
+from .io import check_output_dir
 
 
 def _friendly(func):
@@ -64,5 +65,120 @@ def replay(pwm_csv: str, out: str, max_step: float) -> None:
                f"(t = {result.t[0]:g} .. {result.t[-1]:g} s, final z = {result.final_state[0, 2]:.4f} m)")
 
 
+def _assignments(items: tuple[str, ...], option: str) -> dict:
+    """Parse KEY=VALUE pairs: numbers, comma-separated pairs of numbers, or words."""
+    out = {}
+    for item in items:
+        key, sep, raw = item.partition("=")
+        if not sep or not key.strip():
+            raise InputError(f"{option} {item!r}: expected KEY=VALUE")
+        parts = [p.strip() for p in raw.split(",")]
+        try:
+            values = [float(p) for p in parts]
+            out[key.strip()] = values[0] if len(values) == 1 else tuple(values)
+        except ValueError:
+            out[key.strip()] = raw.strip()
+    return out
+
+
+def _poles(text: str | None, option: str):
+    if text is None:
+        return None
+    try:
+        return [complex(p.replace(" ", "").replace("i", "j")) for p in text.split(",")]
+    except ValueError:
+        raise InputError(f"{option} {text!r}: expected comma-separated poles, e.g. -0.7,-4.3") from None
+
+
+def _metrics_table(frame) -> str:
+    """The metrics of each vehicle as aligned text; a missing settling time of a measured
+    transient reads "did not settle", any other missing value "-"."""
+    shown = frame.drop(columns=["vehicle"]).astype(object)
+    for col in shown.columns:
+        for i, value in shown[col].items():
+            if isinstance(value, float):
+                missing = "did not settle" if col.startswith("settling") and frame.at[i, "axis"] else "-"
+                shown.at[i, col] = missing if value != value else f"{value:.4g}"
+            elif value is None:
+                shown.at[i, col] = "-"
+    shown = shown.T
+    shown.columns = [f"vehicle {c}" for c in frame["vehicle"]]
+    return shown.to_string()
+
+
+@main.command()
+@click.argument("mission", type=click.Choice(["circle", "square", "step", "hover"]))
+@click.option("--controller", default="nlpd", show_default=True, help="Controller name.")
+@click.option("--duration", type=float, help="Flight time [s] (default: one lap, or 10 s after a step).")
+@click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
+@click.option("--max-step", type=float, help="Longest RK4 substep [s] (default: dt).")
+@click.option("-m", "--mission-param", "mission_params", multiple=True, metavar="KEY=VALUE",
+              help="Mission parameter, e.g. -m radius=3 -m period=30 (repeatable).")
+@click.option("-c", "--controller-param", "controller_params", multiple=True, metavar="KEY=VALUE",
+              help="Controller parameter, e.g. -c max_tilt=0.5 (repeatable).")
+@click.option("--poles", "position_poles", metavar="P1,P2",
+              help="Closed-loop poles of the x/y loops [rad/s], e.g. -0.7,-4.3 (the paper's).")
+@click.option("--out", "out", type=click.Path(file_okay=False), help="Folder for traces, figure and metrics.")
+@click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv", show_default=True,
+              help="Format of the traces.")
+@click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
+@_friendly
+def fly(mission, controller, duration, dt, max_step, mission_params, controller_params, position_poles,
+        out, fmt, force):
+    """Fly a MISSION with a controller on the paper's vehicle and print its metrics.
+
+    With --out, also write the traces, a figure of the flight, the metrics and the
+    configuration (quadcruise.json) to that folder, atomically.
+    """
+    from .control import controller_from_name
+    from .control.design import pd_from_poles
+    from .flight import fly as run_fly
+    from .missions import mission_from_name
+
+    the_mission = mission_from_name(mission, **_assignments(mission_params, "--mission-param"))
+    cparams = _assignments(controller_params, "--controller-param")
+    poles = _poles(position_poles, "--poles")
+    if poles is not None:
+        cparams["position"] = pd_from_poles(poles)
+    the_controller = controller_from_name(controller, **cparams)
+    if out is not None:
+        check_output_dir(out, force)
+    result = run_fly(the_mission, the_controller, duration=duration, dt=dt, max_step=max_step)
+    metrics = result.metrics()
+    click.echo(f"{the_controller.name} on {the_mission.name}: {result.t[-1]:g} s at dt = {dt:g} s")
+    click.echo(_metrics_table(metrics))
+    if out is not None:
+        write_flight(result, metrics, out, fmt)
+        click.echo(f"wrote traces, figure and metrics to {out}")
+
+
+def write_flight(result, metrics, out: str, fmt: str) -> None:
+    """The --out folder of ``fly``: traces, metrics, figure, configuration."""
+    from pathlib import Path
+
+    from .io import MARKER, atomic_dir, write_table
+    from .plots import plot_flight, save_figure
+
+    with atomic_dir(out) as tmp:
+        tmp = Path(tmp)
+        write_table(result.to_pandas(), tmp / "traces", fmt)
+        metrics.to_csv(tmp / "metrics.csv", index=False)
+        save_figure(plot_flight(result), tmp / "flight.png")
+        (tmp / MARKER).write_text(result.meta_json() + "\n")
+
+
+def run() -> None:
+    """Entry point: click's own usage errors become one line with exit status 2 too."""
+    try:
+        code = main(standalone_mode=False)
+    except click.exceptions.UsageError as exc:
+        click.echo(f"error: {exc.format_message()}", err=True)
+        sys.exit(2)
+    except click.exceptions.Abort:
+        click.echo("error: aborted", err=True)
+        sys.exit(130)
+    sys.exit(code if isinstance(code, int) else 0)
+
+
 if __name__ == "__main__":  # pragma: no cover
-    main()
+    run()

@@ -3,10 +3,10 @@
 Examples
 --------
 >>> import quadcruise as qc
->>> res = qc.fly("step", duration=6.0)
+>>> res = qc.fly("step", duration=10.0)
 >>> res.ok.tolist()
 [True]
->>> abs(res.final_state[0, 0] - 1.0) < 0.02      # the 1 m step in x is reached
+>>> bool(abs(res.final_state[0, 0] - 1.0) < 0.02)      # the 1 m step in x is reached
 True
 """
 

@@ -50,3 +50,39 @@ def atomic_dir(path: str | os.PathLike):
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+
+
+MARKER = "quadcruise.json"
+"""Every output folder quadcruise writes holds this file (the config, seed and version)."""
+
+
+def check_output_dir(path: str | os.PathLike, force: bool = False) -> Path:
+    """Refuse a non-empty folder that quadcruise did not write, unless ``force``."""
+    from .errors import InputError
+
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise InputError(f"{path}: exists and is not a folder")
+    if path.is_dir() and any(path.iterdir()) and not (path / MARKER).is_file() and not force:
+        raise InputError(f"{path}: folder is not empty and was not written by quadcruise "
+                         "(use --force to replace it)")
+    return path
+
+
+def write_table(frame, path: Path, fmt: str) -> Path:
+    """Write a DataFrame as CSV or Parquet; returns the file written."""
+    from .errors import InputError
+
+    if fmt == "csv":
+        out = path.with_suffix(".csv")
+        frame.to_csv(out, index=False, float_format="%.10g")
+    elif fmt == "parquet":
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError:
+            raise InputError("writing Parquet needs pyarrow: pip install 'quadcruise[parquet]'") from None
+        out = path.with_suffix(".parquet")
+        frame.to_parquet(out, index=False)
+    else:
+        raise InputError(f"unknown table format {fmt!r}; choose csv or parquet")
+    return out

@@ -25,7 +25,7 @@ import numpy as np
 from .errors import InputError
 
 __all__ = ["StepInfo", "step_info", "step_info_batch", "transient_info",
-           "tracking_errors", "control_effort", "time_in_saturation"]
+           "tracking_errors", "control_effort", "time_in_saturation", "flight_metrics"]
 
 
 @dataclass(frozen=True)
@@ -367,3 +367,74 @@ def time_in_saturation(t, flags) -> dict[str, np.ndarray]:
         raise InputError("flags contain NaN or inf")
     seconds = ((f[..., :-1] != 0) * np.diff(t)).sum(axis=-1)
     return {"seconds": seconds, "fraction": seconds / (t[-1] - t[0])}
+
+
+# --- a whole flight --------------------------------------------------------------------
+_AXIS_NAMES = ("x", "y", "z")
+TRANSIENT_MIN_ERROR = 0.01
+"""An axis whose initial tracking error is below this [m] has no transient to measure."""
+
+
+def flight_metrics(result, *, transient_axis: str | None = None):
+    """Per-vehicle metrics of a :class:`~quadcruise.result.SimResult`, as a DataFrame.
+
+    Columns: ``vehicle``, ``status``, ``rmse_m`` and ``max_error_m`` (3-D position error
+    over the whole flight), the transient of one axis (``axis``, ``rise_time_s``,
+    ``settling_time_s`` (2 %), ``settling_time_5pct_s``, ``overshoot_pct``), ``effort``
+    (integral of the sum of squared duties [s]), ``duty_clipped_s`` and
+    ``controller_limited_s``.
+
+    The transient is measured on ``transient_axis``, or else on the stepped axis of a
+    step mission (as a step response from the reference before the step to the one
+    after, so a response that never arrives reads "did not settle"), or else on the
+    axis with the largest initial tracking error (the circle's start offset, say), if it
+    exceeds TRANSIENT_MIN_ERROR; otherwise those columns are empty. A settling time that
+    does not exist (still outside the band at the end) is NaN, and so is every metric of
+    a vehicle that stopped early.
+    """
+    import pandas as pd
+
+    from .layout import CMD_U1, REF_X, X
+
+    t = result.t
+    mission = result.meta.get("mission") if isinstance(result.meta.get("mission"), dict) else {}
+    rows = []
+    for i in range(result.n):
+        row = {"vehicle": i, "status": result.status_text(i), "rmse_m": np.nan, "max_error_m": np.nan,
+               "axis": None, "rise_time_s": np.nan, "settling_time_s": np.nan,
+               "settling_time_5pct_s": np.nan, "overshoot_pct": np.nan, "effort": np.nan,
+               "duty_clipped_s": float(result.duty_clipped_s[i]),
+               "controller_limited_s": float(result.controller_limited_s[i])}
+        rows.append(row)
+        if result.status[i] != 0:
+            continue
+        pos, ref = result.states[i, :, X:X + 3], result.references[i, :, REF_X:REF_X + 3]
+        if np.all(np.isfinite(ref)):
+            err = tracking_errors(t, pos, ref)
+            row["rmse_m"], row["max_error_m"] = float(err["rmse"]), float(err["max_error"])
+            info, axis = _flight_transient(t, pos, ref, mission, transient_axis)
+            if info is not None:
+                row.update(axis=axis, rise_time_s=_nan(info.rise_time), settling_time_s=_nan(info.settling_time),
+                           settling_time_5pct_s=_nan(info.settling_time_5pct), overshoot_pct=info.overshoot_pct)
+        row["effort"] = float(control_effort(t, result.commands[i, :, CMD_U1:CMD_U1 + 4])["integral"])
+    return pd.DataFrame(rows)
+
+
+def _flight_transient(t, pos, ref, mission: dict, axis: str | None):
+    if axis is None and mission.get("kind") == "step" and mission.get("axis") in _AXIS_NAMES:
+        j = _AXIS_NAMES.index(mission["axis"])
+        t_step = float(mission["time"])
+        if t[0] <= t_step < t[-1]:
+            before = float(mission[mission["axis"]])   # the hover point the step leaves
+            return step_info(t, pos[:, j], y_initial=before, y_final=before + float(mission["size"]),
+                             t_step=t_step), mission["axis"]
+        return None, None
+    e0 = np.abs(ref[0] - pos[0])
+    j = _AXIS_NAMES.index(axis) if axis is not None else int(np.argmax(e0))
+    if e0[j] < TRANSIENT_MIN_ERROR:
+        return None, None
+    return transient_info(t, pos[:, j], ref[:, j]), _AXIS_NAMES[j]
+
+
+def _nan(value):
+    return np.nan if value is None else float(value)

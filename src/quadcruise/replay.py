@@ -11,7 +11,7 @@ Examples
 >>> v = qc.Vehicle.paper()
 >>> hover = [[float(v.hover_duty)] * 4] * 3
 >>> res = qc.replay(qc.DutySchedule(t=[0.0, 1.0, 2.0], duties=hover), vehicle=v)
->>> abs(res.final_state[0, 2]) < 1e-9    # hover stays put
+>>> bool(abs(res.final_state[0, 2]) < 1e-9)    # hover stays put
 True
 """
 

@@ -114,6 +114,18 @@ class SimResult:
         frame.insert(0, "vehicle", np.repeat(np.asarray(list(picks)), n_log))
         return frame
 
+    def metrics(self):
+        """Per-vehicle metrics as a DataFrame: see :func:`quadcruise.metrics.flight_metrics`."""
+        from .metrics import flight_metrics
+
+        return flight_metrics(self)
+
+    def plot(self, vehicle: int = 0, **kwargs):
+        """Figure of one vehicle's flight: see :func:`quadcruise.plots.plot_flight`."""
+        from .plots import plot_flight
+
+        return plot_flight(self, vehicle=vehicle, **kwargs)
+
     def summary(self) -> dict:
         """Counts of vehicles by exit status, and the saturation times."""
         reasons: dict[str, int] = {}

@@ -3,6 +3,8 @@
 Built-in controllers by name (see :func:`controller_from_name`):
 
 - ``nlpd``: the paper's inverse-model nonlinear PD over decoupled attitude PID.
+- ``gonzalez``: a reconstruction of the paper's baseline [5]: saturated (tanh) PD with the
+  small-angle attitude mapping over the same attitude PID (see :mod:`.baselines`).
 """
 
 from __future__ import annotations
@@ -11,9 +13,10 @@ from typing import Any
 
 from ..errors import InputError
 from .base import Controller
+from .baselines import Gonzalez
 from .position import NLPD
 
-CONTROLLERS: dict[str, type[Controller]] = {NLPD.name: NLPD}
+CONTROLLERS: dict[str, type[Controller]] = {NLPD.name: NLPD, Gonzalez.name: Gonzalez}
 
 
 def controller_from_name(name: str, **params: Any) -> Controller:
@@ -25,4 +28,4 @@ def controller_from_name(name: str, **params: Any) -> Controller:
     return cls(**params)
 
 
-__all__ = ["CONTROLLERS", "NLPD", "Controller", "controller_from_name"]
+__all__ = ["CONTROLLERS", "NLPD", "Gonzalez", "Controller", "controller_from_name"]

@@ -7,11 +7,12 @@ Eq (11) couples the axes through k1 q r, k3 p r and k5 p q. Eq (13) chooses
 so that eq (15) holds: phi'' = U2*, theta'' = U3*, psi'' = U4*, three independent double
 integrators. Each is closed by
 
-    U* = Kp e + Ki int(e) dt + Kd (angle_d' - rate),      e = angle_d - angle
+    U* = Kp e + Ki int(e) dt - Kd rate,      e = angle_d - angle
 
-with the derivative acting on the *error* (setpoint rate from a filtered difference of
-the setpoint), which the cascade with the 15 rad/s rotor lag needs for damping (see
-:func:`quadcruise.control.design.attitude_pid_design`). Anti-windup clamps each
+with the derivative acting on the measured body rate (p, q or r), not on the error: the
+setpoint comes from the position loop and changes every period, and a derivative of it
+would both kick and, through the 15 rad/s rotor lag, erode the damping of the cascade
+(see :func:`quadcruise.control.design.attitude_pid_design`). Anti-windup clamps each
 integral so that Ki * int(e) stays within ``i_limit`` [rad/s^2], and flags it.
 
 These are compiled building blocks called by the position controllers; they are not
@@ -27,11 +28,10 @@ from numba import njit
 from ..layout import FLAG_INTEGRATOR_HOLD, P, P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, PHI, PSI, Q, R, THETA
 
 # gains layout shared by every controller built on this loop (offsets into ``gains``)
-ATT_KP, ATT_KI, ATT_KD, YAW_KP, YAW_KI, YAW_KD, ATT_I_LIMIT, ATT_RATE_FILTER = range(8)
-ATT_GAINS = 8
-# memory layout (offsets into ``mem``)
-M_STARTED, M_INT, M_PREV, M_RATE = 0, 1, 4, 7     # int/prev/rate: 3 angles each
-ATT_MEMORY = 10
+ATT_KP, ATT_KI, ATT_KD, YAW_KP, YAW_KI, YAW_KD, ATT_I_LIMIT = range(7)
+ATT_GAINS = 7
+# memory: the integral of the roll, pitch and yaw errors [rad s]
+ATT_MEMORY = 3
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -41,38 +41,32 @@ def wrap_angle(a):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _axis_pid(j, e, setpoint, rate, kp, ki, kd, dt, g, mem):
+def _axis_pid(j, e, rate, kp, ki, kd, i_limit, dt, mem):
     """PID on one angle j (0 roll, 1 pitch, 2 yaw); returns (U*, integrator held?)."""
-    # setpoint rate: first-order filtered difference of the setpoint (eq 15 loop)
-    if mem[M_STARTED] != 0.0:
-        raw = wrap_angle(setpoint - mem[M_PREV + j]) / dt
-        alpha = min(1.0, dt * g[ATT_RATE_FILTER])
-        mem[M_RATE + j] += alpha * (raw - mem[M_RATE + j])
-    mem[M_PREV + j] = setpoint
     held = False
     if ki > 0.0:
-        integral = mem[M_INT + j] + e * dt
-        bound = g[ATT_I_LIMIT] / ki
+        integral = mem[j] + e * dt
+        bound = i_limit / ki
         if integral > bound:
             integral, held = bound, True
         elif integral < -bound:
             integral, held = -bound, True
-        mem[M_INT + j] = integral
-    return kp * e + ki * mem[M_INT + j] + kd * (mem[M_RATE + j] - rate), held
+        mem[j] = integral
+    return kp * e + ki * mem[j] - kd * rate, held
 
 
 @njit(cache=True, error_model="numpy")
 def decoupled_attitude(x, phi_d, theta_d, psi_d, vp, g, mem, dt):
     """Eqs (13)-(15) with PID: the roll, pitch and yaw inputs (U2, U3, U4) and a flag word.
 
-    ``g`` and ``mem`` are the attitude slices of the controller's gains and memory
-    (layouts ATT_* and M_* above).
+    ``g`` and ``mem`` are the controller's gains and memory, whose first ATT_GAINS and
+    ATT_MEMORY entries belong to the attitude loop (layout ATT_* above).
     """
     p, q, r = x[P], x[Q], x[R]
-    u2s, h1 = _axis_pid(0, phi_d - x[PHI], phi_d, p, g[ATT_KP], g[ATT_KI], g[ATT_KD], dt, g, mem)
-    u3s, h2 = _axis_pid(1, theta_d - x[THETA], theta_d, q, g[ATT_KP], g[ATT_KI], g[ATT_KD], dt, g, mem)
-    u4s, h3 = _axis_pid(2, wrap_angle(psi_d - x[PSI]), psi_d, r, g[YAW_KP], g[YAW_KI], g[YAW_KD], dt, g, mem)
-    mem[M_STARTED] = 1.0
+    lim = g[ATT_I_LIMIT]
+    u2s, h1 = _axis_pid(0, phi_d - x[PHI], p, g[ATT_KP], g[ATT_KI], g[ATT_KD], lim, dt, mem)
+    u3s, h2 = _axis_pid(1, theta_d - x[THETA], q, g[ATT_KP], g[ATT_KI], g[ATT_KD], lim, dt, mem)
+    u4s, h3 = _axis_pid(2, wrap_angle(psi_d - x[PSI]), r, g[YAW_KP], g[YAW_KI], g[YAW_KD], lim, dt, mem)
     U2 = (u2s - vp[P_K1] * q * r) / vp[P_K2]                                 # (13)
     U3 = (u3s - vp[P_K3] * p * r) / vp[P_K4]                                 # (13)
     U4 = (u4s - vp[P_K5] * p * q) / vp[P_K6]                                 # (13)

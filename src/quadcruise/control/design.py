@@ -25,7 +25,7 @@ from ..errors import InputError
 
 __all__ = ["PAPER_POSITION_POLES", "PDGains", "PIDGains", "pd_from_poles", "pid_from_poles",
            "position_pd_design", "altitude_pd_design", "attitude_pid_design",
-           "loop_transfer", "loop_margins", "check_with_control"]
+           "loop_transfer", "loop_margins", "check_with_control", "cascade_state_space"]
 
 PAPER_POSITION_POLES = (-0.7, -4.3)
 """Closed-loop poles of the paper's x/y PD loops [rad/s] (section III.B, eq 18)."""
@@ -205,31 +205,41 @@ def altitude_pd_design(poles=PAPER_POSITION_POLES) -> PDGains:
     return pd_from_poles(poles)
 
 
+ATTITUDE_WN_RATIO = 0.6
+"""Natural frequency of the attitude pair as a fraction of the actuator bandwidth."""
+ATTITUDE_ZETA = 0.8
+"""Damping ratio of the attitude pair."""
+ATTITUDE_INTEGRATOR_RATIO = 1.0 / 30.0
+"""Integrator pole as a fraction of the actuator bandwidth."""
+
+
 def attitude_pid_design(actuator_bandwidth: float = 15.0) -> PIDGains:
-    """PID gains of a decoupled attitude loop phi'' = U2* (eq 15), rotor lag included in the check.
+    """PID gains of a decoupled attitude loop phi'' = U2* (eq 15), chosen for the cascade.
 
-    The paper gives no attitude gains. The poles, on the double integrator, are a critically
-    damped pair at 7/15 of the actuator bandwidth and an integrator pole at 1/15 of it: for
-    15 rad/s, s = -7, -7, -1, so Kp = 63, Ki = 49, Kd = 15. Why:
+    The paper gives no attitude gains. Poles on the double integrator: a pair at
+    wn = 0.6 w with zeta = 0.8 and an integrator pole at w / 30, w the actuator bandwidth;
+    for the Qball's 15 rad/s, wn = 9 rad/s and s = -0.5, so Kp = 88.2, Ki = 40.5, Kd = 14.9.
+    The derivative acts on the measured rate. Why:
 
-    * faster than the position loop (poles 0.7 and 4.3 rad/s): 7 rad/s is 1.6x its fast pole
-      and 10x its dominant one; the integrator pole (1 rad/s) only removes steady offsets;
-    * the 15 rad/s lag limits the speed: with L(s) = C(s) 15/(s+15) / s^2 the phase margin is
-      31.6 deg at 12.1 rad/s, and it drops below 30 deg for a faster pair (wn = 8-10 rad/s
-      gives 20-28 deg); zeta = 1 gives more margin than zeta = 0.8-0.9 at the same wn;
-    * the loop is conditionally stable (phase -270 deg at low frequency): its gain may rise
-      without limit but not fall below 0.072 (-22.9 dB, at 2.1 rad/s);
-    * closed loop with the lag: poles -4.83 +/- 12.07j, -4.34, -1.00; step (error PID) rise
-      0.10 s, settling 0.85 s, overshoot 52 %; with the derivative on the measurement only:
-      rise 0.21 s, settling 3.0 s, overshoot 13 %.
+    * the position loop (poles 0.7 and 4.3 rad/s) needs an attitude loop about twice as
+      fast as its fast pole, or the cascade loses stability; designs that place all four
+      poles of attitude + rotor lag are forced (their sum is -w) to about 4-5 rad/s and
+      make the cascade with the paper's position gains unstable;
+    * the 15 rad/s rotor lag caps the speed: with it, this loop has a 24.5 deg phase margin
+      (crossover ~12 rad/s) and closed-loop poles -3.54 +/- 12.3j, -7.42, -0.5;
+    * among pairs wn = 3-10 rad/s, zeta = 0.7-1, integrator poles 0.3-2 rad/s, derivative on
+      the error or on the measurement, this choice maximises the worst damping ratio of the
+      whole linearised cascade of :func:`cascade_state_space` with the paper's position
+      gains (0.37; the earlier -7, -7, -1 with the derivative on the error gave 0.08);
+    * the integrator (slow, 0.5 rad/s) only removes steady offsets, e.g. from a mass error.
 
     Scaling every pole with the bandwidth leaves the margins unchanged (time scaling).
 
     >>> g = attitude_pid_design()
-    >>> g.kp, g.ki, g.kd
-    (63.0, 49.0, 15.0)
+    >>> round(g.kp, 2), round(g.ki, 2), round(g.kd, 2)
+    (88.2, 40.5, 14.9)
     >>> round(loop_margins(g, 15.0)["phase_margin"], 1)
-    31.6
+    24.5
     """
     try:
         w = float(actuator_bandwidth)
@@ -237,7 +247,39 @@ def attitude_pid_design(actuator_bandwidth: float = 15.0) -> PIDGains:
         raise InputError(f"actuator_bandwidth must be a number, got {actuator_bandwidth!r}") from None
     if not (np.isfinite(w) and w > 0):
         raise InputError(f"actuator_bandwidth = {w:g} rad/s must be finite and > 0")
-    return pid_from_poles(np.array([-7.0, -7.0, -1.0]) * (w / 15.0))
+    wn, zeta = ATTITUDE_WN_RATIO * w, ATTITUDE_ZETA
+    pair = complex(-zeta * wn, wn * np.sqrt(1.0 - zeta**2))
+    return pid_from_poles([pair, pair.conjugate(), -ATTITUDE_INTEGRATOR_RATIO * w])
+
+
+def cascade_state_space(position: PDGains, attitude: PIDGains, actuator_bandwidth: float = 15.0,
+                        g: float = 9.81) -> control.StateSpace:
+    """The x loop of the paper's controller linearised about hover, from x_r to x.
+
+    States (x, x', theta, q, theta'' (the lagged attitude input), int(theta_d - theta)):
+    u_x = Kp (x_r - x) - Kd x' (a step reference has no velocity), theta_d = u_x / g (the
+    inverse model at hover), U3* = Kp_a e + Ki_a int(e) - Kd_a q (attitude PID, derivative
+    on the rate), theta'' lags U3* at the actuator bandwidth w, and x'' = g theta.
+
+    >>> from quadcruise.control.design import position_pd_design
+    >>> sys = cascade_state_space(position_pd_design(), attitude_pid_design())
+    >>> bool(np.all(sys.poles().real < 0)), round(float(sys.dcgain()), 6)
+    (True, 1.0)
+    """
+    w = float(actuator_bandwidth)
+    kp, kd = position.kp, position.kd
+    kpa, kia, kda = attitude.kp, attitude.ki, attitude.kd
+    theta_d = np.array([-kp, -kd, 0.0, 0.0, 0.0, 0.0]) / g          # theta_d as a row over the states
+    e = np.eye(6)
+    u_star = kpa * (theta_d - e[2]) + kia * e[5] - kda * e[3]
+    A = np.zeros((6, 6))
+    A[0, 1], A[1, 2], A[2, 3], A[3, 4] = 1.0, g, 1.0, 1.0
+    A[4] = w * u_star - w * e[4]
+    A[5] = theta_d - e[2]
+    B = np.zeros((6, 1))
+    B[4, 0] = w * kpa * kp / g
+    B[5, 0] = kp / g
+    return control.ss(A, B, e[:1], 0.0)
 
 
 def loop_transfer(gains: PDGains | PIDGains, actuator_bandwidth: float | None = None):

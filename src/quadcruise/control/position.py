@@ -45,7 +45,7 @@ from ..layout import (
 )
 from ..model.actuators import duties_from_inputs
 from .attitude import (
-    ATT_GAINS, ATT_I_LIMIT, ATT_KD, ATT_KI, ATT_KP, ATT_MEMORY, ATT_RATE_FILTER, YAW_KD,
+    ATT_GAINS, ATT_I_LIMIT, ATT_KD, ATT_KI, ATT_KP, ATT_MEMORY, YAW_KD,
     YAW_KI, YAW_KP, decoupled_attitude,
 )
 from .base import Controller
@@ -162,12 +162,12 @@ def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
     finish(U1, phi_d, theta_d, ref[REF_PSI], flags, dt, x, vp, gains, mem, cmd)
 
 
-def attitude_block(attitude: PIDGains, yaw: PIDGains, i_limit: float, rate_filter: float) -> list[float]:
+def attitude_block(attitude: PIDGains, yaw: PIDGains, i_limit: float) -> list[float]:
     """The first ATT_GAINS entries of a controller's gains vector."""
     block = [0.0] * ATT_GAINS
     block[ATT_KP], block[ATT_KI], block[ATT_KD] = attitude.kp, attitude.ki, attitude.kd
     block[YAW_KP], block[YAW_KI], block[YAW_KD] = yaw.kp, yaw.ki, yaw.kd
-    block[ATT_I_LIMIT], block[ATT_RATE_FILTER] = i_limit, rate_filter
+    block[ATT_I_LIMIT] = i_limit
     return block
 
 
@@ -196,8 +196,6 @@ class NLPD(Controller):
         roll and pitch setpoint limit [rad]; 45 degrees by default.
     i_limit : float
         anti-windup bound on the integral term Ki int(e) [rad/s^2].
-    rate_filter : float
-        bandwidth of the setpoint-rate filter of the attitude D term [rad/s].
     accel_feedforward : bool
         add the reference acceleration to u_x, u_y, u_z (off: the paper's eq 16 has none).
 
@@ -208,7 +206,7 @@ class NLPD(Controller):
     >>> round(c.position.kp, 2), round(c.position.kd, 2)
     (3.01, 5.0)
     >>> c.gains().shape, c.memory().shape
-    ((14,), (10,))
+    ((13,), (3,))
     """
 
     name = "nlpd"
@@ -220,11 +218,10 @@ class NLPD(Controller):
     yaw: PIDGains = field(default_factory=attitude_pid_design)
     max_tilt: float = math.radians(45.0)
     i_limit: float = 5.0
-    rate_filter: float = 100.0
     accel_feedforward: bool = False
 
     def __post_init__(self) -> None:
-        check_positive(self.name, max_tilt=self.max_tilt, i_limit=self.i_limit, rate_filter=self.rate_filter)
+        check_positive(self.name, max_tilt=self.max_tilt, i_limit=self.i_limit)
         if self.max_tilt >= math.pi / 2:
             raise InputError(f"{self.name} parameter 'max_tilt' must be below pi/2 rad, got {self.max_tilt!r}")
 
@@ -235,4 +232,4 @@ class NLPD(Controller):
     def gains(self) -> np.ndarray:
         tail = [self.position.kp, self.position.kd, self.altitude.kp, self.altitude.kd,
                 self.max_tilt, 1.0 if self.accel_feedforward else 0.0]
-        return np.array(attitude_block(self.attitude, self.yaw, self.i_limit, self.rate_filter) + tail)
+        return np.array(attitude_block(self.attitude, self.yaw, self.i_limit) + tail)

@@ -1,0 +1,155 @@
+"""Baseline controllers; ``gonzalez`` is a RECONSTRUCTION of the paper's comparison controller.
+
+What is known: the paper (Section IV) compares its inverse-model PD with "a nonlinear PD
+controller based on Gonzalez's paper [5]" and reports for it rise 6 s, settling 12 s,
+overshoot 11 %. Nothing else: no law, no gains. Reference [5] could not be found; its most
+likely source (S. Gonzalez-Vazquez, J. Moreno-Valenzuela, "A new nonlinear PI/PID controller
+for quadrotor posture regulation", IEEE CERMA 2010) builds its laws from saturating tanh
+terms. What is assumed (everything below): the form, the mapping and the gains.
+
+Control law, per axis (e = x_r - x, e_v = x_r' - x')::
+
+    u_x = a_p tanh(k_p e_x / a_p) + a_d tanh(k_d e_vx / a_d)        [m/s^2], same for y
+
+Each term has slope k_p (k_d) at zero and level a_p (a_d): for small errors the law *is* the
+linear PD u = k_p e + k_d e_v, so pole placement keeps its meaning, and |u| < a_p + a_d
+always. (The CERMA-style k tanh(e) is the case a_p = k_p with a 1 m saturation width; the
+normalisation above separates the gain from the level.) The output is mapped to setpoints by
+the SMALL-ANGLE relation of eqs (5)-(6) at yaw ~ 0 and U1 ~ m g,
+
+    theta_d = u_x / g,   phi_d = -u_y / g,
+
+i.e. without the paper's inverse model (eqs 16, 19): at large tilt the vehicle gets
+g tan(u/g) > u, and at yaw away from 0 the axes mix (the mapping is for yaw holds near 0,
+like the paper's own design). Setpoints are limited to ``max_tilt`` (FLAG_TILT_LIMIT). Altitude
+is the same linear PD with tilt-compensated thrust as ``nlpd``, yaw holds the mission's yaw,
+and the attitude loop is the same decoupled PID (eqs 13-15).
+
+Gain rule (chosen before looking at any result, not fitted to the paper's numbers):
+
+* k_p, k_d: the SAME poles as the paper (-0.7, -4.3: k_p = 3.01, k_d = 5.0), so that the two
+  controllers are identical to first order and differ only in the nonlinearity (saturation
+  plus small-angle mapping). The slower poles typical of saturated designs would mix a gain
+  change into the comparison.
+* a_p = a_d = g max_tilt / 2 (3.85 m/s^2 each at 45 deg): with theta_d = u/g the setpoint
+  stays within max_tilt exactly when a_p + a_d <= g max_tilt, so the tanh saturation, not
+  the tilt limit, shapes large manoeuvres; the budget is split evenly between P and D.
+
+Consequence for the comparison: near the reference (tracking a gentle circle) the two laws
+coincide; they part only during large transients (steps of metres, where k_p e or k_d e_v
+approach a_p, a_d), where the saturated law accelerates less and brakes with a bounded D.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+
+from ..errors import InputError
+from ..layout import (
+    CONTROLLER_SIG, P_G, REF_PSI, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y, REF_Z, VX, VY, VZ, X, Y, Z,
+)
+from .attitude import ATT_GAINS, ATT_MEMORY
+from .base import Controller
+from .design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
+from .position import attitude_block, check_positive, collective_thrust, finish, tilt_setpoint
+
+# gains layout after the attitude block
+KP_XY, KD_XY, SAT_P, SAT_D, KP_Z, KD_Z, MAX_TILT = range(ATT_GAINS, ATT_GAINS + 7)
+GONZALEZ_GAINS = ATT_GAINS + 7
+G0 = 9.81
+"""Gravity [m/s^2] of the default saturation levels (Table I vehicle)."""
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def saturated_pd(e, ev, kp, kd, ap, ad):
+    """a_p tanh(k_p e / a_p) + a_d tanh(k_d e_v / a_d): slopes k_p, k_d at 0, |.| < a_p + a_d."""
+    return ap * math.tanh(kp * e / ap) + ad * math.tanh(kd * ev / ad)
+
+
+@njit(CONTROLLER_SIG, cache=True, error_model="numpy")
+def gonzalez(t, dt, x, ref, vp, gains, mem, cmd):
+    """Reconstructed Gonzalez baseline: saturated PD, small-angle mapping, decoupled PID."""
+    kp, kd, ap, ad, tilt = gains[KP_XY], gains[KD_XY], gains[SAT_P], gains[SAT_D], gains[MAX_TILT]
+    ux = saturated_pd(ref[REF_X] - x[X], ref[REF_VX] - x[VX], kp, kd, ap, ad)
+    uy = saturated_pd(ref[REF_Y] - x[Y], ref[REF_VY] - x[VY], kp, kd, ap, ad)
+    uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ])
+    U1, flags = collective_thrust(uz, x, vp, tilt)
+    theta_d, flags = tilt_setpoint(ux / vp[P_G], False, tilt, flags)     # eq (5), small angle
+    phi_d, flags = tilt_setpoint(-uy / vp[P_G], False, tilt, flags)      # eq (6), small angle
+    finish(U1, phi_d, theta_d, ref[REF_PSI], flags, dt, x, vp, gains, mem, cmd)
+
+
+@dataclass(frozen=True)
+class Gonzalez(Controller):
+    """Reconstruction of the paper's baseline [5]: saturated (tanh) PD on x, y mapped to
+    roll/pitch by the small-angle relation, PD altitude, decoupled PID attitude (eqs 13-15).
+
+    Parameters
+    ----------
+    position : PDGains
+        small-signal gains k_p [1/s^2], k_d [1/s] of x and y; the paper's poles by default.
+    accel_p, accel_d : float or None
+        saturation levels a_p, a_d of the P and D terms [m/s^2]; None: g max_tilt / 2 each
+        (g = 9.81 m/s^2).
+    altitude : PDGains
+        z loop (linear PD, tilt-compensated thrust).
+    attitude, yaw : PIDGains
+        decoupled attitude loops, as for ``nlpd``.
+    max_tilt : float
+        roll and pitch setpoint limit [rad]; 45 degrees by default.
+    i_limit : float
+        anti-windup bound on the attitude integral term [rad/s^2].
+
+    Examples
+    --------
+    >>> from quadcruise.control.baselines import Gonzalez
+    >>> c = Gonzalez()
+    >>> round(c.position.kp, 2), round(c.position.kd, 2), round(c.accel_p, 3), round(c.accel_d, 3)
+    (3.01, 5.0, 3.852, 3.852)
+    >>> c.gains().shape, c.memory().shape
+    ((14,), (3,))
+    >>> Gonzalez(accel_d=-1.0)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: gonzalez parameter 'accel_d' must be a positive number, got -1.0
+    """
+
+    name = "gonzalez"
+    memory_size = ATT_MEMORY
+
+    position: PDGains = field(default_factory=position_pd_design)
+    accel_p: float | None = None
+    accel_d: float | None = None
+    altitude: PDGains = field(default_factory=altitude_pd_design)
+    attitude: PIDGains = field(default_factory=attitude_pid_design)
+    yaw: PIDGains = field(default_factory=attitude_pid_design)
+    max_tilt: float = math.radians(45.0)
+    i_limit: float = 5.0
+
+    def __post_init__(self) -> None:
+        check_positive(self.name, max_tilt=self.max_tilt, i_limit=self.i_limit)
+        if self.max_tilt >= math.pi / 2:
+            raise InputError(f"{self.name} parameter 'max_tilt' must be below pi/2 rad, got {self.max_tilt!r}")
+        for name in ("accel_p", "accel_d"):
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, G0 * self.max_tilt / 2.0)
+            check_positive(self.name, **{name: getattr(self, name)})
+        for name in ("position", "altitude"):
+            if not isinstance(getattr(self, name), PDGains):
+                raise InputError(f"{self.name} parameter '{name}' must be PDGains, got {getattr(self, name)!r}")
+        for name in ("attitude", "yaw"):
+            if not isinstance(getattr(self, name), PIDGains):
+                raise InputError(f"{self.name} parameter '{name}' must be PIDGains, got {getattr(self, name)!r}")
+
+    @property
+    def function(self):
+        return gonzalez
+
+    def gains(self) -> np.ndarray:
+        tail = [self.position.kp, self.position.kd, self.accel_p, self.accel_d,
+                self.altitude.kp, self.altitude.kd, self.max_tilt]
+        return np.array(attitude_block(self.attitude, self.yaw, self.i_limit) + tail)
