@@ -375,7 +375,7 @@ TRANSIENT_MIN_ERROR = 0.01
 """An axis whose initial tracking error is below this [m] has no transient to measure."""
 
 
-def flight_metrics(result, *, transient_axis: str | None = None):
+def flight_metrics(result, *, transient_axis: str | None = None, transient_until: float | None = None):
     """Per-vehicle metrics of a :class:`~quadcruise.result.SimResult`, as a DataFrame.
 
     Columns: ``vehicle``, ``status``, ``rmse_m`` and ``max_error_m`` (3-D position error
@@ -390,7 +390,9 @@ def flight_metrics(result, *, transient_axis: str | None = None):
     axis with the largest initial tracking error (the circle's start offset, say), if it
     exceeds TRANSIENT_MIN_ERROR; otherwise those columns are empty. A settling time that
     does not exist (still outside the band at the end) is NaN, and so is every metric of
-    a vehicle that stopped early.
+    a vehicle that stopped early. ``transient_until`` [s] ends the window in which the
+    transient is measured (e.g. the first corner of a square, after which the reference
+    turns and the error grows again).
     """
     import pandas as pd
 
@@ -412,7 +414,8 @@ def flight_metrics(result, *, transient_axis: str | None = None):
         if np.all(np.isfinite(ref)):
             err = tracking_errors(t, pos, ref)
             row["rmse_m"], row["max_error_m"] = float(err["rmse"]), float(err["max_error"])
-            info, axis = _flight_transient(t, pos, ref, mission, transient_axis)
+            keep = slice(None) if transient_until is None else t <= transient_until
+            info, axis = _flight_transient(t[keep], pos[keep], ref[keep], mission, transient_axis)
             if info is not None:
                 row.update(axis=axis, rise_time_s=_nan(info.rise_time), settling_time_s=_nan(info.settling_time),
                            settling_time_5pct_s=_nan(info.settling_time_5pct), overshoot_pct=info.overshoot_pct)

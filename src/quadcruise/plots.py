@@ -25,7 +25,6 @@ from .io import atomic_path
 
 REF_STYLE = dict(color="k", ls="--", lw=1.0, label="reference")
 STOP_STYLE = dict(color="tab:red", ls=":", lw=1.5)
-DUTY_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:purple")
 
 
 def _has(trace: np.ndarray) -> bool:
@@ -60,9 +59,7 @@ def _mark_stop(ax, t_stop: float, label: bool = False) -> None:
 
 
 def _legend(ax, **kwargs) -> None:
-    kw = dict(fontsize="small", framealpha=0.85)
-    kw.update(kwargs)
-    ax.legend(**kw)
+    ax.legend(**{"fontsize": "small", "framealpha": 0.85, **kwargs})
 
 
 def _path3d(ax, result, vehicle: int) -> None:
@@ -88,12 +85,13 @@ def _path3d(ax, result, vehicle: int) -> None:
     mid = (lo + hi) / 2
     for setter, m, h in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), mid, half):
         setter(m - h, m + h)
-    ax.set_box_aspect(tuple(half), zoom=0.88)
-    for axis, n in ((ax.xaxis, 5), (ax.yaxis, 5), (ax.zaxis, 4)):
-        axis.set_major_locator(MaxNLocator(n))
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_zlabel("z [m]")
+    ax.set_box_aspect(tuple(half), zoom=0.8)
+    # x ends and y starts at the front corner in the default view: prune both there
+    for axis, prune in ((ax.xaxis, "upper"), (ax.yaxis, "lower"), (ax.zaxis, None)):
+        axis.set_major_locator(MaxNLocator(4, prune=prune))
+    ax.set(xlabel="x [m]", ylabel="y [m]", zlabel="z [m]")
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.labelpad = 9
     _legend(ax, loc="upper center", ncols=4, title="3-D path", bbox_to_anchor=(0.5, 0.98))
 
 
@@ -184,7 +182,8 @@ def _duties(ax, result, vehicle: int) -> None:
     t = result.t
     duties = result.commands[vehicle, :, :4]
     for j in range(4):
-        ax.plot(t, duties[:, j], color=DUTY_COLORS[j], lw=1.0, label=f"u{j + 1}")
+        ax.plot(t, duties[:, j], color=("tab:blue", "tab:orange", "tab:green", "tab:purple")[j],
+                lw=1.0, label=f"u{j + 1}")
     flags = result.state("flags")[vehicle]
     flagged = np.isfinite(flags) & (flags != 0)
     if flagged.any():
@@ -276,13 +275,10 @@ def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None) -> 
 def _pick_paths(ok: np.ndarray, max_paths: int) -> np.ndarray:
     """Up to max_paths vehicle indices: every stopped one first (as many as fit), then
     evenly spread finished ones."""
-    bad, good = np.flatnonzero(~ok), np.flatnonzero(ok)
-    bad = bad[:max(1, max_paths)]
-    room = max(1, max_paths) - bad.size
-    if room > 0 and good.size:
-        good = good[np.unique(np.linspace(0, good.size - 1, min(room, good.size)).round().astype(int))]
-    else:
-        good = good[:0]
+    max_paths = max(1, max_paths)
+    bad, good = np.flatnonzero(~ok)[:max_paths], np.flatnonzero(ok)
+    room = min(max_paths - bad.size, good.size)
+    good = good[np.unique(np.linspace(0, good.size - 1, room).round().astype(int))] if room > 0 else good[:0]
     return np.sort(np.concatenate([bad, good]))
 
 
@@ -319,12 +315,11 @@ def plot_envelope(result, *, title: str | None = None, max_paths: int = 50) -> F
             live = np.flatnonzero(np.isfinite(x[i]) & np.isfinite(y[i]))
             if live.size:
                 top.plot(x[i, live[-1]], y[i, live[-1]], "x", color="tab:red", ms=6)
-    n_bad = int((~result.ok).sum())
-    top.plot([], [], color="tab:blue", lw=1, label=f"finished ({np.count_nonzero(result.ok[picks])} "
-             f"drawn of {n - n_bad})")
-    if n_bad:
-        top.plot([], [], color="tab:red", lw=1, label=f"stopped early ({np.count_nonzero(~result.ok[picks])} "
-                 f"drawn of {n_bad})")
+    for ok, c, what in ((True, "tab:blue", "finished"), (False, "tab:red", "stopped early")):
+        total = int(np.count_nonzero(result.ok == ok))
+        if total:   # legend proxies: how many of each kind are drawn
+            drawn = int(np.count_nonzero(result.ok[picks] == ok))
+            top.plot([], [], color=c, lw=1, label=f"{what} ({drawn} drawn of {total})")
     ref = _reference_xy([(result, 0)])
     if ref is not None:
         top.plot(ref[1], ref[2], **REF_STYLE)

@@ -15,6 +15,7 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from dataclasses import dataclass, field
 
@@ -114,11 +115,19 @@ class SimResult:
         frame.insert(0, "vehicle", np.repeat(np.asarray(list(picks)), n_log))
         return frame
 
-    def metrics(self):
+    def decimate(self, every: int) -> "SimResult":
+        """A result holding every ``every``-th logged instant (the end state stays exact)."""
+        if int(every) != every or every < 1:
+            raise InputError(f"decimation step must be a positive integer, got {every!r}")
+        keep = slice(None, None, int(every))
+        return dataclasses.replace(self, t=self.t[keep], states=self.states[:, keep],
+                                   commands=self.commands[:, keep], references=self.references[:, keep])
+
+    def metrics(self, **kwargs):
         """Per-vehicle metrics as a DataFrame: see :func:`quadcruise.metrics.flight_metrics`."""
         from .metrics import flight_metrics
 
-        return flight_metrics(self)
+        return flight_metrics(self, **kwargs)
 
     def plot(self, vehicle: int = 0, **kwargs):
         """Figure of one vehicle's flight: see :func:`quadcruise.plots.plot_flight`."""

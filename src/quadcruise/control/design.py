@@ -18,10 +18,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import control
 import numpy as np
 
 from ..errors import InputError
+
+
+def _control():
+    """python-control, imported on first use (it costs about a second at start-up)."""
+    import control
+
+    return control
 
 __all__ = ["PAPER_POSITION_POLES", "PDGains", "PIDGains", "pd_from_poles", "pid_from_poles",
            "position_pd_design", "altitude_pd_design", "attitude_pid_design",
@@ -43,13 +49,13 @@ class _Gains:
         p = np.where(np.abs(p.imag) <= 1e-6 * np.abs(p), p.real, p)
         return np.real_if_close(np.array(sorted(p, key=lambda z: (-z.real, z.imag))))
 
-    def controller(self) -> control.TransferFunction:
+    def controller(self):
         """C(s) from error to u: ``Kd s + Kp`` (PD) or ``(Kd s^2 + Kp s + Ki) / s`` (PID)."""
-        return control.tf(self._char[1:], [1.0] + [0.0] * (len(self._char) - 3))
+        return _control().tf(self._char[1:], [1.0] + [0.0] * (len(self._char) - 3))
 
-    def closed_loop(self) -> control.TransferFunction:
+    def closed_loop(self):
         """y/r with the law acting on the error, e.g. ``(Kd s + Kp) / (s^2 + Kd s + Kp)``."""
-        return control.tf(self._char[1:], self._char)
+        return _control().tf(self._char[1:], self._char)
 
 
 def _check_gains(obj, names) -> None:
@@ -253,7 +259,7 @@ def attitude_pid_design(actuator_bandwidth: float = 15.0) -> PIDGains:
 
 
 def cascade_state_space(position: PDGains, attitude: PIDGains, actuator_bandwidth: float = 15.0,
-                        g: float = 9.81) -> control.StateSpace:
+                        g: float = 9.81):
     """The x loop of the paper's controller linearised about hover, from x_r to x.
 
     States (x, x', theta, q, theta'' (the lagged attitude input), int(theta_d - theta)):
@@ -279,12 +285,12 @@ def cascade_state_space(position: PDGains, attitude: PIDGains, actuator_bandwidt
     B = np.zeros((6, 1))
     B[4, 0] = w * kpa * kp / g
     B[5, 0] = kp / g
-    return control.ss(A, B, e[:1], 0.0)
+    return _control().ss(A, B, e[:1], 0.0)
 
 
 def loop_transfer(gains: PDGains | PIDGains, actuator_bandwidth: float | None = None):
     """Open loop L(s) = C(s) w/(s+w) / s^2 (without the lag factor when the bandwidth is None)."""
-    s = control.tf("s")
+    s = _control().tf("s")
     lag = 1 if actuator_bandwidth is None else actuator_bandwidth / (s + actuator_bandwidth)
     return gains.controller() * lag / s**2
 
@@ -301,8 +307,8 @@ def loop_margins(gains: PDGains | PIDGains, actuator_bandwidth: float | None = 1
     (83.2, inf, True)
     """
     L = loop_transfer(gains, actuator_bandwidth)
-    gm, pm, _, wpc, wgc, _ = control.stability_margins(L)
-    stable = bool(np.all(control.feedback(L, 1).poles().real < 0))
+    gm, pm, _, wpc, wgc, _ = _control().stability_margins(L)
+    stable = bool(np.all(_control().feedback(L, 1).poles().real < 0))
     return {"gain_margin": float(gm), "phase_margin": float(pm), "phase_crossover": float(wpc),
             "gain_crossover": float(wgc), "stable": stable}
 
@@ -324,15 +330,15 @@ def check_with_control(gains: PDGains | PIDGains) -> dict:
     """
     n = len(gains._char) - 1
     A, B = np.eye(n, k=1), np.eye(n)[:, -1:]
-    sys = control.ss(A, B, np.eye(n)[-2:-1], 0)
+    sys = _control().ss(A, B, np.eye(n)[-2:-1], 0)
     poles = gains.poles
     try:
-        K = np.asarray(control.place(sys.A, sys.B, poles)).ravel()
+        K = np.asarray(_control().place(sys.A, sys.B, poles)).ravel()
     except ValueError:
-        K = np.asarray(control.acker(sys.A, sys.B, poles)).ravel()
+        K = np.asarray(_control().acker(sys.A, sys.B, poles)).ravel()
     want = gains._char[:0:-1]
     cl = np.linalg.eigvals(sys.A - sys.B @ K[None, :])
     dist = np.abs(cl[:, None] - poles[None, :])
     return {"place_gain": K, "gain_error": float(np.max(np.abs(K - want)) / np.max(np.abs(want))),
             "closed_loop_poles": cl, "pole_error": float(max(dist.min(0).max(), dist.min(1).max())),
-            "step_info": control.step_info(gains.closed_loop())}
+            "step_info": _control().step_info(gains.closed_loop())}

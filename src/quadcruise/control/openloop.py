@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..layout import CONTROLLER_SIG
+from ..layout import CMD_FLAGS, CONTROLLER_SIG
 
 
 @njit(CONTROLLER_SIG, cache=True)
@@ -25,6 +25,8 @@ def duty_schedule(t, dt, x, ref, vp, gains, mem, cmd):
     base = 1 + n + 4 * row
     for j in range(4):
         cmd[j] = gains[base + j]
+    for j in range(4, CMD_FLAGS):      # no generalized inputs or setpoints: open loop
+        cmd[j] = np.nan
 
 
 def pack_schedule(t: np.ndarray, duties: np.ndarray) -> np.ndarray:

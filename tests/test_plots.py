@@ -1,0 +1,219 @@
+"""Tests of quadcruise.plots: figure structure, labels with units, that the drawn data
+are the result's traces, early-stop marking, NaN references, and atomic PNG writing."""
+
+from __future__ import annotations
+
+import dataclasses
+import doctest
+import os
+import threading
+import warnings
+
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+import quadcruise as qc
+from quadcruise import plots
+from quadcruise.flight import hover_state
+from quadcruise.layout import CMD_FLAGS
+from quadcruise.missions import Step
+from quadcruise.plots import plot_envelope, plot_flight, plot_paths, save_figure
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture(scope="module")
+def step():
+    return qc.fly("step", duration=3.0, log_every=10)
+
+
+@pytest.fixture(scope="module")
+def circle():
+    return qc.fly("circle", duration=3.0, log_every=10)
+
+
+@pytest.fixture(scope="module")
+def diverged():
+    # one rotor at full power, the opposite one off: the body rate leaves the bound
+    t = np.linspace(0, 10, 1001)
+    u = np.tile([1.0, 0.07, 0.0, 0.07], (t.size, 1))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = qc.replay(qc.DutySchedule(t=t, duties=u), limits=qc.Limits(max_rate=50.0))
+    assert not res.ok[0]
+    return res
+
+
+def axis_by_ylabel(fig, start):
+    hits = [ax for ax in fig.axes if ax.name != "3d" and ax.get_ylabel().startswith(start)]
+    assert len(hits) == 1, [ax.get_ylabel() for ax in fig.axes]
+    return hits[0]
+
+
+def line(ax, label):
+    hits = [ln for ln in ax.get_lines() if ln.get_label() == label]
+    assert len(hits) == 1, [ln.get_label() for ln in ax.get_lines()]
+    return hits[0]
+
+
+def labels(ax):
+    return [ln.get_label() for ln in ax.get_lines()]
+
+
+def test_plot_flight_structure_labels_and_data(step):
+    fig = plot_flight(step)
+    assert isinstance(fig, Figure)
+    assert len(fig.axes) == 8
+    path = fig.axes[0]
+    assert path.name == "3d"
+    assert [path.get_xlabel(), path.get_ylabel(), path.get_zlabel()] == ["x [m]", "y [m]", "z [m]"]
+    for name in "xyz":
+        ax = axis_by_ylabel(fig, f"{name} [m]")
+        np.testing.assert_array_equal(line(ax, name).get_xdata(), step.t)
+        np.testing.assert_array_equal(line(ax, name).get_ydata(), step.state(name)[0])
+        np.testing.assert_array_equal(line(ax, "reference").get_ydata(), step.state(f"{name}_ref")[0])
+    for name, sp, label in (("phi", "phi_d", "roll"), ("theta", "theta_d", "pitch"), ("psi", "psi_d", "yaw")):
+        ax = axis_by_ylabel(fig, label)
+        assert ax.get_ylabel().endswith("[deg]")
+        trace = [ln for ln in ax.get_lines() if ln.get_label().startswith(label)][0]
+        np.testing.assert_allclose(trace.get_ydata(), np.degrees(step.state(name)[0]))
+        np.testing.assert_allclose(line(ax, "setpoint").get_ydata(), np.degrees(step.state(sp)[0]))
+    duty = axis_by_ylabel(fig, "rotor duty")
+    assert duty.get_ylabel().endswith("[-]")
+    for j in range(1, 5):
+        np.testing.assert_array_equal(line(duty, f"u{j}").get_ydata(), step.state(f"u{j}")[0])
+    limits = [ln for ln in duty.get_lines() if ln.get_linestyle() == "-."]
+    assert sorted(ln.get_ydata()[0] for ln in limits) == [0.0, 1.0]
+    time_axes = [ax for ax in fig.axes[1:] if ax.get_xlabel()]
+    assert len(time_axes) == 3 and all(ax.get_xlabel() == "time [s]" for ax in time_axes)
+    assert duty.get_xlim() == (step.t[0], step.t[-1])
+    assert "nlpd" in fig._suptitle.get_text() and "step" in fig._suptitle.get_text()
+    assert not any(ln.get_label().startswith("stopped") for ax in fig.axes for ln in ax.get_lines())
+
+
+def test_plot_flight_path_3d_has_markers_and_dashed_reference(circle):
+    fig = circle.plot(title="my title")          # SimResult.plot delegates here
+    assert fig._suptitle.get_text() == "my title"
+    path = fig.axes[0]
+    ref = line(path, "reference")
+    assert ref.get_linestyle() == "--"
+    xs, ys, zs = line(path, "actual").get_data_3d()
+    np.testing.assert_array_equal(xs, circle.state("x")[0])
+    np.testing.assert_array_equal(zs, circle.state("z")[0])
+    legend = [t.get_text() for t in path.get_legend().get_texts()]
+    assert {"actual", "reference", "start", "end"} <= set(legend)
+
+
+def test_flagged_controller_limits_are_shaded(step):
+    commands = step.commands.copy()
+    commands[0, 5:9, CMD_FLAGS] = 1.0
+    flagged = dataclasses.replace(step, commands=commands)
+    duty = axis_by_ylabel(plot_flight(flagged), "rotor duty")
+    assert "controller limit flagged" in [c.get_label() for c in duty.collections]
+    duty = axis_by_ylabel(plot_flight(step), "rotor duty")
+    assert "controller limit flagged" not in [c.get_label() for c in duty.collections]
+
+
+def test_early_stop_is_marked_and_explained(diverged):
+    fig = plot_flight(diverged)
+    t_stop = diverged.t_stop[0]
+    time_axes = fig.axes[1:]
+    for ax in time_axes:
+        stops = [ln for ln in ax.get_lines() if ln.get_color() == "tab:red" and ln.get_linestyle() == ":"]
+        assert len(stops) == 1
+        assert np.all(np.asarray(stops[0].get_xdata()) == t_stop)
+    assert any(lb.startswith("stopped, t = ") for lb in labels(axis_by_ylabel(fig, "rotor duty")))
+    title = fig._suptitle.get_text()
+    assert diverged.status_text(0) in title and "body rate" in title
+    # the time axes end shortly after the stop instead of at the scheduled end
+    assert t_stop < time_axes[0].get_xlim()[1] < diverged.t[-1]
+
+
+def test_nan_references_are_skipped(diverged):
+    assert np.all(np.isnan(diverged.references))
+    fig = plot_flight(diverged)
+    for ax in fig.axes:
+        assert "reference" not in labels(ax) and "setpoint" not in labels(ax)
+    assert "x [m]" in fig.axes[0].get_xlabel()
+    fig = plot_paths({"replay": diverged})
+    assert all("reference" not in labels(ax) for ax in fig.axes)
+    fig = plot_envelope(diverged)
+    assert any("no reference" in t.get_text() for t in fig.axes[1].texts)
+
+
+def test_plot_paths_overlays_flights_with_one_reference(step, circle, diverged):
+    x0 = hover_state(qc.Vehicle.paper(), 1, Step())
+    x0[0, 1] = 0.3                                  # start 0.3 m off in y
+    other = qc.fly("step", duration=3.0, log_every=10, x0=x0)
+    fig = plot_paths({"A": step, "B": other, "bad": diverged})
+    assert len(fig.axes) == 3
+    top, ax_x, ax_y = fig.axes
+    assert (top.get_xlabel(), top.get_ylabel()) == ("x [m]", "y [m]")
+    assert ax_x.get_ylabel() == "x [m]" and ax_y.get_ylabel() == "y [m]" and ax_y.get_xlabel() == "time [s]"
+    for ax in fig.axes:
+        assert labels(ax).count("reference") == 1
+    np.testing.assert_array_equal(line(top, "B").get_xdata(), other.state("x")[0])
+    np.testing.assert_array_equal(line(top, "B").get_ydata(), other.state("y")[0])
+    np.testing.assert_array_equal(line(ax_y, "A").get_ydata(), step.state("y")[0])
+    assert any(lb.startswith("bad (stopped at") for lb in labels(top))
+    assert "A vs B vs bad" in fig._suptitle.get_text()
+    with pytest.raises(ValueError):
+        plot_paths({})
+
+
+def test_plot_envelope_median_band_and_path_cap():
+    n = 12
+    x0 = hover_state(qc.Vehicle.paper(), n, Step())
+    x0[:, 0] = np.linspace(-0.5, 0.5, n)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = qc.fly("step", duration=2.0, log_every=20, x0=x0)
+    fig = plot_envelope(res, max_paths=5)
+    assert len(fig.axes) == 2
+    top, ax_e = fig.axes
+    assert (top.get_xlabel(), top.get_ylabel()) == ("x [m]", "y [m]")
+    assert ax_e.get_xlabel() == "time [s]" and ax_e.get_ylabel().endswith("[m]")
+    drawn = [ln for ln in top.get_lines() if ln.get_label().startswith("_") and len(ln.get_xdata()) > 1]
+    assert len(drawn) == 5
+    err = np.linalg.norm(res.states[:, :, :3] - res.references[:, :, :3], axis=2)
+    np.testing.assert_allclose(line(ax_e, "median").get_ydata(), np.median(err, axis=0))
+    assert "5-95 %" in [c.get_label() for c in ax_e.collections]
+    assert plots._pick_paths(np.array([True, False, True, True, False]), 3).tolist() == [0, 1, 4]
+
+
+def test_save_figure_writes_png_atomically(tmp_path, step):
+    target = tmp_path / "sub" / "flight.png"
+    save_figure(plot_flight(step), target)
+    data = target.read_bytes()
+    assert data[:8] == PNG_MAGIC and len(data) > 10_000
+    assert os.listdir(target.parent) == ["flight.png"]
+    # a failing draw leaves neither the file nor a temporary behind
+    broken = Figure()
+    broken.add_subplot().plot([0, 1], [0, 1])
+    broken.savefig = lambda *a, **k: (_ for _ in ()).throw(RuntimeError("boom"))
+    with pytest.raises(RuntimeError):
+        save_figure(broken, tmp_path / "sub" / "broken.png")
+    assert os.listdir(target.parent) == ["flight.png"]
+
+
+def test_figures_can_be_drawn_in_threads(step, tmp_path):
+    errors = []
+
+    def work(i):
+        try:
+            save_figure(plot_flight(step), tmp_path / f"f{i}.png")
+        except Exception as exc:   # pragma: no cover - reported below
+            errors.append(exc)
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(3)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    assert not errors
+    assert sorted(os.listdir(tmp_path)) == ["f0.png", "f1.png", "f2.png"]
+
+
+def test_docstring_examples():
+    assert doctest.testmod(plots, raise_on_error=False).failed == 0

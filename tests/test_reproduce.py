@@ -1,0 +1,85 @@
+"""`quadcruise reproduce`: end to end, its metrics.json, its figures, its folder policy."""
+
+import json
+
+import pytest
+from click.testing import CliRunner
+
+from quadcruise import __version__
+from quadcruise.cli import main
+from quadcruise.reproduce import FIGURES, PAPER, SCENARIOS
+
+
+@pytest.fixture(scope="module")
+def out(tmp_path_factory):
+    path = tmp_path_factory.mktemp("repro") / "out"
+    result = CliRunner().invoke(main, ["reproduce", "--out", str(path)])
+    assert result.exit_code == 0, result.output
+    assert "[9/9] flew step with nlpd+ff" in result.output
+    return path
+
+
+def load(out):
+    return json.loads((out / "metrics.json").read_text())
+
+
+def test_metrics_json_has_the_documented_format(out):
+    doc = load(out)
+    assert set(doc) == {"runs", "paper", "config", "version"}
+    assert doc["version"] == __version__ and doc["paper"] == PAPER
+    assert len(doc["runs"]) == 9
+    keys = {"scenario", "controller", "axis", "rise_time_s", "settling_time_s", "overshoot_pct", "rmse_m"}
+    for run in doc["runs"]:
+        assert keys <= set(run)
+        assert run["scenario"] in SCENARIOS
+        assert run["status"] == "finished"
+        for k in ("rise_time_s", "settling_time_s", "overshoot_pct", "rmse_m"):
+            assert run[k] is None or (isinstance(run[k], float) and run[k] >= 0)
+    assert doc["config"]["dt_s"] == 1e-3 and doc["config"]["seed"] is None
+    assert doc["config"]["vehicle"]["m"] == 3.499
+
+
+def test_circle_does_not_settle_to_two_percent_and_says_so(out):
+    """The PD law of eq (16) leaves a steady lag on the circle: null, not a wrong number."""
+    circle = next(r for r in load(out)["runs"] if r["scenario"] == "circle" and r["controller"] == "nlpd")
+    assert circle["settling_time_s"] is None
+    assert circle["settling_time_5pct_s"] is not None
+    ff = next(r for r in load(out)["runs"] if r["scenario"] == "circle" and r["controller"] == "nlpd+ff")
+    assert ff["settling_time_s"] is not None
+
+
+def test_nlpd_beats_the_baseline_on_settling_and_overshoot(out):
+    runs = {(r["scenario"], r["controller"]): r for r in load(out)["runs"]}
+    for scen in SCENARIOS:
+        ours, base = runs[(scen, "nlpd")], runs[(scen, "gonzalez")]
+        assert ours["settling_time_5pct_s"] < base["settling_time_5pct_s"], scen
+        if ours["settling_time_s"] is not None:
+            assert ours["settling_time_s"] < base["settling_time_s"], scen
+        assert ours["overshoot_pct"] <= base["overshoot_pct"] + 1e-9, scen
+
+
+def test_figures_report_and_traces_are_written(out):
+    for name in FIGURES:
+        data = (out / name).read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 20_000, name
+    report = (out / "report.md").read_text()
+    assert "| circle | nlpd |" in report and "(paper)" in report
+    assert "Where our numbers differ from the paper's" in report
+    for name in FIGURES:
+        assert f"]({name})" in report
+    assert len(list((out / "traces").glob("*.csv"))) == 9
+    header = (out / "traces" / "circle_nlpd.csv").read_text().splitlines()[0]
+    assert header.startswith("vehicle,t,x,y,z")
+    assert json.loads((out / "quadcruise.json").read_text())["workflow"] == "reproduce"
+    assert not [p for p in out.parent.iterdir() if p.name.startswith(".")]
+
+
+def test_refuses_a_foreign_folder_unless_forced(tmp_path):
+    foreign = tmp_path / "mine"
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("keep me")
+    result = CliRunner().invoke(main, ["reproduce", "--out", str(foreign)])
+    assert result.exit_code == 2
+    assert "not empty and was not written by quadcruise" in result.output
+    assert (foreign / "notes.txt").read_text() == "keep me"
+    assert not (foreign / "metrics.json").exists()
