@@ -25,3 +25,12 @@ def rhs(x, u, m=3.499, Jxx=0.03, Jyy=0.03, Jzz=0.04, l=0.2, K=120.0, w=15.0, d=4
     qdot = ((Jzz - Jxx) * p * r + l * U3) / Jyy
     rdot = ((Jxx - Jyy) * p * q + U4) / Jzz
     return np.concatenate([x[3:6], acc, [p, q, r], [pdot, qdot, rdot], w * (K * np.asarray(u) - F)])
+
+
+def still_air_ext():
+    """The plant's external-input vector with no disturbance: healthy rotors, no wind."""
+    from quadcruise.layout import EXT_E1, EXT_SIZE
+
+    ext = np.zeros(EXT_SIZE)
+    ext[EXT_E1:EXT_E1 + 4] = 1.0
+    return ext

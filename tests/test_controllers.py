@@ -18,6 +18,7 @@ from quadcruise.layout import (
 )
 from quadcruise.missions import Circle, Hover, Step
 from quadcruise.model.plant import derivative
+from reference_model import still_air_ext
 
 V = qc.Vehicle.paper()
 
@@ -87,7 +88,7 @@ def test_decoupling_cancels_gyroscopic_terms():
     from quadcruise.model.actuators import unmix
     x[12:] = unmix(30.0, U2, U3, U4, vp[7])          # thrusts that realise (U1, U2, U3, U4)
     dx = np.empty(STATE_SIZE)
-    derivative(x, x[12:] / vp[5], vp, np.zeros(6), dx)
+    derivative(x, x[12:] / vp[5], vp, still_air_ext(), False, dx)
     assert dx[P] == pytest.approx(10.0 * (0.3 - 0.1))
     assert dx[Q] == pytest.approx(10.0 * (0.1 + 0.05))
     assert dx[R] == pytest.approx(4.0 * (-0.1 - 0.2))

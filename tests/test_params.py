@@ -12,7 +12,9 @@ def test_paper_preset_is_table_one():
     assert (v.m, v.Jxx, v.Jyy, v.Jzz, v.l, v.K, v.omega) == (3.499, 0.03, 0.03, 0.04, 0.2, 120.0, 15.0)
     assert v.d == pytest.approx(4 / 120)
     assert v.hover_duty == pytest.approx(3.499 * 9.81 / 480)
-    assert set(Vehicle.units()) == {"m", "Jxx", "Jyy", "Jzz", "l", "K", "omega", "d", "g"}
+    assert set(Vehicle.units()) == {"m", "Jxx", "Jyy", "Jzz", "l", "K", "omega", "d", "g",
+                                    "drag_linear", "drag_quadratic"}
+    assert v.drag_linear == 0.0 and v.drag_quadratic == 0.0   # the paper's model has no drag
 
 
 def test_rows_carry_k_coefficients_of_section_three():

@@ -7,6 +7,7 @@ import quadcruise as qc
 from quadcruise.layout import F1, P_K1, P_K3, P_K5, PHI, STATE_SIZE, P, Q, R
 from quadcruise.model.actuators import mix, unmix
 from quadcruise.model.plant import derivative
+from reference_model import still_air_ext
 
 V = qc.Vehicle.paper()
 
@@ -60,7 +61,7 @@ def test_gyroscopic_terms_are_eulers_equations():
     x = np.zeros(STATE_SIZE)
     x[P], x[Q], x[R] = 1.0, -2.0, 3.0
     dx = np.empty(STATE_SIZE)
-    derivative(x, np.zeros(4), vp, np.zeros(6), dx)
+    derivative(x, np.zeros(4), vp, still_air_ext(), False, dx)
     assert dx[P] == pytest.approx(vp[P_K1] * -2.0 * 3.0)
     assert dx[Q] == pytest.approx(vp[P_K3] * 1.0 * 3.0)
     assert dx[R] == pytest.approx(vp[P_K5] * 1.0 * -2.0)
@@ -84,5 +85,5 @@ def test_matches_independent_model_pointwise():
         x = rng.normal(size=STATE_SIZE)
         u = rng.uniform(0, 1, size=4)
         dx = np.empty(STATE_SIZE)
-        derivative(x, u, vp, np.zeros(6), dx)
+        derivative(x, u, vp, still_air_ext(), False, dx)
         np.testing.assert_allclose(dx, rhs(x, u), rtol=1e-13, atol=1e-13)

@@ -26,10 +26,11 @@ from numba import njit, prange, types
 
 from .errors import InputError
 from .layout import (
-    CMD_FLAGS, CMD_SIZE, ControllerType, MissionType, P, PHI, Q, R, REF_SIZE, STATE_SIZE,
-    THETA, VX, VY, VZ, X, Y, Z,
+    CMD_FLAGS, CMD_SIZE, DISTURBANCE_SIG, EXT_E1, EXT_SIZE, ControllerType, DisturbanceType,
+    MissionType, P, PHI, Q, R, REF_SIZE, STATE_SIZE, THETA, VX, VY, VZ, X, Y, Z,
 )
 from .model.plant import derivative
+from .rng import gauss, vehicle_states
 from .result import STATUS_REASONS, SimResult
 
 # exit status of each vehicle (the reasons live in result.STATUS_REASONS)
@@ -69,22 +70,31 @@ class Limits:
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def rk4_step(x, u, vp, ext, h, k1, k2, k3, k4, xt):
+def rk4_step(x, u, vp, ext, full, h, k1, k2, k3, k4, xt):
     """One classical Runge-Kutta step of length h [s], in place on x."""
     n = x.shape[0]
-    derivative(x, u, vp, ext, k1)
+    derivative(x, u, vp, ext, full, k1)
     for j in range(n):
         xt[j] = x[j] + 0.5 * h * k1[j]
-    derivative(xt, u, vp, ext, k2)
+    derivative(xt, u, vp, ext, full, k2)
     for j in range(n):
         xt[j] = x[j] + 0.5 * h * k2[j]
-    derivative(xt, u, vp, ext, k3)
+    derivative(xt, u, vp, ext, full, k3)
     for j in range(n):
         xt[j] = x[j] + h * k3[j]
-    derivative(xt, u, vp, ext, k4)
+    derivative(xt, u, vp, ext, full, k4)
     c = h / 6.0
     for j in range(n):
         x[j] += c * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j])
+
+
+@njit(DISTURBANCE_SIG, cache=True)
+def still_air(t, dt, x, dp, dmem, rng, ext):
+    """No disturbance: no force, torque or wind; every rotor healthy."""
+    for j in range(EXT_SIZE):
+        ext[j] = 0.0
+    for j in range(EXT_E1, EXT_E1 + 4):
+        ext[j] = 1.0
 
 
 @njit(cache=True, inline="always")
@@ -126,43 +136,64 @@ _f8v = types.float64[::1]
 _f8m = types.float64[:, ::1]
 _f8c = types.float64[:, :, ::1]
 _i8v = types.int64[::1]
+_u8m = types.uint64[:, ::1]
 
 KERNEL_SIG = types.void(
-    _f8v, _f8m, _f8m, ControllerType, _f8m, _f8m, MissionType, _f8m,
+    _f8v, _f8m, _f8m, _f8m, ControllerType, _f8m, _f8m, MissionType, _f8m,
+    DisturbanceType, _f8m, _f8m, _u8m, _f8m, types.int64, types.boolean,
     types.float64, types.int64, _f8v,
     _f8c, _f8c, _f8c, _f8m, _i8v, _f8v, _f8m,
 )
 
 
 @njit(KERNEL_SIG, cache=True, parallel=True, error_model="numpy")
-def _kernel(t_grid, x0, vp, controller, gains, mem, mission, mp, max_step, log_every, limits,
+def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
+            disturbance, dp, dmem, rng, sensor_std, sensor_delay, full,
+            max_step, log_every, limits,
             log_x, log_cmd, log_ref, x_final, status, t_stop, saturated):
     n_vehicles = x0.shape[0]
     n_periods = t_grid.shape[0] - 1
     for i in prange(n_vehicles):
         x = x0[i].copy()
         seen = np.empty(STATE_SIZE)
+        history = np.empty((sensor_delay + 1, STATE_SIZE))   # ring buffer of past states
+        for d in range(sensor_delay + 1):
+            history[d, :] = x
         ref = np.zeros(REF_SIZE)
         cmd = np.zeros(CMD_SIZE)
         u = np.zeros(4)
-        ext = np.zeros(6)
+        ext = np.zeros(EXT_SIZE)
         k1 = np.empty(STATE_SIZE)
         k2 = np.empty(STATE_SIZE)
         k3 = np.empty(STATE_SIZE)
         k4 = np.empty(STATE_SIZE)
         xt = np.empty(STATE_SIZE)
-        vpi, gi, mi, mpi = vp[i], gains[i], mem[i], mp[i]
+        vpi, vci, gi, mi, mpi = vp[i], vp_ctrl[i], gains[i], mem[i], mp[i]
+        dpi, dmi, rngi, stdi = dp[i], dmem[i], rng[i], sensor_std[i]
+        noisy = False
+        for j in range(STATE_SIZE):
+            if stdi[j] != 0.0:
+                noisy = True
         code = FINISHED
         t_end = t_grid[n_periods]
         for k in range(n_periods + 1):
             t = t_grid[k]
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
             mission(t, mpi, ref)
+            # what the controller sees: the state sensor_delay periods ago, plus noise
+            slot = k % (sensor_delay + 1)
             for j in range(STATE_SIZE):
-                seen[j] = x[j]
+                history[slot, j] = x[j]
+            old = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
+            for j in range(STATE_SIZE):
+                seen[j] = history[old, j]
+            if noisy:
+                for j in range(STATE_SIZE):
+                    if stdi[j] != 0.0:
+                        seen[j] += stdi[j] * gauss(rngi)
             for j in range(CMD_SIZE):
                 cmd[j] = 0.0
-            controller(t, dt, seen, ref, vpi, gi, mi, cmd)
+            controller(t, dt, seen, ref, vci, gi, mi, cmd)
             if k % log_every == 0:
                 row = k // log_every
                 log_x[i, row, :] = x
@@ -179,10 +210,11 @@ def _kernel(t_grid, x0, vp, controller, gains, mem, mission, mp, max_step, log_e
                 saturated[i, 0] += dt
             if cmd[CMD_FLAGS] != 0.0:
                 saturated[i, 1] += dt
+            disturbance(t, dt, x, dpi, dmi, rngi, ext)
             n_sub = max(1, int(math.ceil(dt / max_step - 1e-9)))
             h = dt / n_sub
             for _ in range(n_sub):
-                rk4_step(x, u, vpi, ext, h, k1, k2, k3, k4, xt)
+                rk4_step(x, u, vpi, ext, full, h, k1, k2, k3, k4, xt)
             code = check_state(x, limits)
             if code != FINISHED:
                 t_end = t_grid[k + 1]
@@ -224,6 +256,9 @@ def _batch(name: str, a, n: int, width: int | None) -> np.ndarray:
 
 
 def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
+             vp_ctrl=None, disturbance=None, disturbance_params=None, disturbance_memory=None,
+             seed: int = 0, first_vehicle: int = 0, sensor_std=None, sensor_delay: int = 0,
+             full_dynamics: bool = False,
              max_step: float = 1e-3, log_every: int = 1, limits: Limits | None = None,
              meta: dict | None = None) -> SimResult:
     """Fly N vehicles over the control instants ``t_grid`` and return a :class:`SimResult`.
@@ -247,6 +282,22 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
         The mission's parameters.
     memory : (C,) or (N, C) array, optional
         The controller's initial memory (integrators); zeros of width 0 by default.
+    vp_ctrl : (N, PARAM_SIZE) array, optional
+        The parameters the controller believes in (its model); ``vp`` by default. With
+        model error the plant flies ``vp`` while the controller computes with these.
+    disturbance : compiled function with ``DISTURBANCE_SIG``, optional
+        External force, torque, wind and rotor effectiveness; still air by default.
+    disturbance_params, disturbance_memory : (D,) / (N, D) arrays, optional
+        Its parameters and initial state.
+    seed, first_vehicle : int
+        Vehicle i's random stream is seeded from (seed, first_vehicle + i) only, so a
+        population split into chunks draws the same numbers (see :mod:`quadcruise.rng`).
+    sensor_std : (16,) or (N, 16) array, optional
+        Standard deviation of white noise added to each state the controller sees.
+    sensor_delay : int
+        The controller sees the state this many control periods late.
+    full_dynamics : bool
+        Exact Euler-angle kinematics instead of the paper's phi' = p, theta' = q, psi' = r.
     max_step : float
         Longest RK4 substep [s]; each period is split into equal substeps.
     log_every : int
@@ -273,6 +324,15 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
     gains = _batch("controller gains", gains, n, None)
     mp = _batch("mission parameters", mp, n, None)
     mem = _batch("controller memory", np.zeros(0) if memory is None else memory, n, None)
+    vp_ctrl = vp if vp_ctrl is None else _batch("controller parameters", vp_ctrl, n, vp.shape[1])
+    dp = _batch("disturbance parameters", np.zeros(0) if disturbance_params is None else disturbance_params, n, None)
+    dmem = _batch("disturbance memory", np.zeros(0) if disturbance_memory is None else disturbance_memory, n, None)
+    std = _batch("sensor noise", np.zeros(STATE_SIZE) if sensor_std is None else sensor_std, n, STATE_SIZE)
+    if not np.all(np.isfinite(std)) or np.any(std < 0):
+        raise InputError("sensor noise standard deviations must be finite and >= 0")
+    if int(sensor_delay) != sensor_delay or sensor_delay < 0:
+        raise InputError(f"sensor delay must be a whole number of periods >= 0, got {sensor_delay!r}")
+    rng = vehicle_states(seed, n, first_vehicle)
     limits = limits or Limits()
 
     n_periods = t_grid.shape[0] - 1
@@ -284,11 +344,13 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
     status = np.zeros(n, dtype=np.int64)
     t_stop = np.empty(n)
     saturated = np.zeros((n, 2))
-    _kernel(t_grid, x0, vp, controller, gains, mem, mission, mp, float(max_step), int(log_every),
-            limits.array(), log_x, log_cmd, log_ref, x_final, status, t_stop, saturated)
+    _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
+            disturbance or still_air, dp, dmem, rng, std, int(sensor_delay), bool(full_dynamics),
+            float(max_step), int(log_every), limits.array(),
+            log_x, log_cmd, log_ref, x_final, status, t_stop, saturated)
     return SimResult(
         t=t_grid[::log_every][:n_log].copy(), states=log_x, commands=log_cmd, references=log_ref,
-        final_state=x_final, status=status, t_stop=t_stop, memory=mem,
+        final_state=x_final, status=status, t_stop=t_stop, memory=mem, disturbance_memory=dmem,
         duty_clipped_s=saturated[:, 0].copy(), controller_limited_s=saturated[:, 1].copy(),
         meta=dict(meta or {}),
     )

@@ -54,7 +54,8 @@ def fly(mission: Mission | str = "circle", controller: Controller | str = "nlpd"
         vehicle: Vehicle | None = None, duration: float | None = None, dt: float = 1e-3,
         max_step: float | None = None, n: int | None = None, x0: Any = None,
         log_every: int = 1, limits: Limits | None = None, missions: list[Mission] | None = None,
-        ) -> SimResult:
+        controller_vehicle: Vehicle | None = None, full_dynamics: bool = False,
+        **environment: Any) -> SimResult:
     """Fly a mission with a controller and return the logged flight.
 
     Parameters
@@ -82,6 +83,14 @@ def fly(mission: Mission | str = "circle", controller: Controller | str = "nlpd"
         Divergence bounds.
     missions : list of Mission, optional
         One mission of the same kind per vehicle (instead of ``mission``).
+    controller_vehicle : Vehicle, optional
+        The vehicle the controller believes it flies (its model); ``vehicle`` by default.
+        Give the nominal vehicle here and a perturbed one as ``vehicle`` to fly with model error.
+    full_dynamics : bool
+        Fly the higher-fidelity plant (exact Euler-angle kinematics) instead of the paper's.
+    **environment
+        Passed to :func:`quadcruise.engine.simulate`: ``disturbance``, ``disturbance_params``,
+        ``disturbance_memory``, ``seed``, ``first_vehicle``, ``sensor_std``, ``sensor_delay``.
 
     Returns
     -------
@@ -116,10 +125,15 @@ def fly(mission: Mission | str = "circle", controller: Controller | str = "nlpd"
         "vehicle": vehicle.to_dict(),
         "duration_s": float(duration), "dt_s": float(dt),
         "max_step_s": float(max_step or dt), "n": n, "version": __version__,
+        "full_dynamics": bool(full_dynamics), "seed": environment.get("seed", 0),
     }
+    if controller_vehicle is not None:
+        meta["controller_vehicle"] = controller_vehicle.to_dict()
+    vp_ctrl = None if controller_vehicle is None else controller_vehicle.rows(n)
     result = simulate(grid, x0, vehicle.rows(n), controller.function, controller.gains(),
                       first.function, mp, memory=controller.memory(), max_step=max_step or dt,
-                      log_every=log_every, limits=limits, meta=meta)
+                      log_every=log_every, limits=limits, meta=meta, vp_ctrl=vp_ctrl,
+                      full_dynamics=full_dynamics, **environment)
     _warn_about(result)
     return result
 

@@ -66,12 +66,12 @@ FLAG_ASIN_CLIP = 2       # an inverse-model asin argument left [-1, 1] and was c
 FLAG_THRUST_LIMIT = 4    # the collective thrust was limited
 FLAG_INTEGRATOR_HOLD = 8  # anti-windup held an integrator
 
-# --- vehicle parameter row: 15 columns -------------------------------------------------
-# The first nine are the physical parameters; k1..k6 (Section III of the paper) are
-# derived from them when the row is built, so the compiled step never divides.
+# --- vehicle parameter row: 17 columns -------------------------------------------------
+# The physical parameters; k1..k6 (Section III of the paper) are derived from them when the
+# row is built, so the compiled step never divides; then the drag coefficients.
 (P_M, P_JXX, P_JYY, P_JZZ, P_L, P_K, P_OMEGA, P_D, P_G,
- P_K1, P_K2, P_K3, P_K4, P_K5, P_K6) = range(15)
-PARAM_SIZE = 15
+ P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, P_CD1, P_CD2) = range(17)
+PARAM_SIZE = 17
 
 # --- compiled signatures ---------------------------------------------------------------
 _f8 = types.float64
@@ -89,3 +89,19 @@ ControllerType = types.FunctionType(CONTROLLER_SIG)
 #: mp is the mission's parameter vector.
 MISSION_SIG = types.void(_f8, _vec, _vec)
 MissionType = types.FunctionType(MISSION_SIG)
+
+# --- external inputs: 13 columns ---------------------------------------------------------
+# what a disturbance model supplies each control period (held over the period): an external
+# force in the earth frame [N], a torque in the body frame [N m], the wind velocity in the
+# earth frame [m/s] (it acts through the vehicle's drag) and each rotor's effectiveness
+# (1 = healthy, 0.7 = lost 30 % of its thrust).
+(EXT_FX, EXT_FY, EXT_FZ, EXT_TX, EXT_TY, EXT_TZ, EXT_WX, EXT_WY, EXT_WZ,
+ EXT_E1, EXT_E2, EXT_E3, EXT_E4) = range(13)
+EXT_SIZE = 13
+
+#: ``disturbance(t, dt, x, dp, dmem, rng, ext) -> None``: writes the external inputs held
+#: over [t, t + dt] into ext (EXT_SIZE). dp: its parameters; dmem: its state (e.g. the
+#: turbulence filters), kept between periods; rng: the vehicle's random generator state
+#: (see :mod:`quadcruise.rng`); x: the true state.
+DISTURBANCE_SIG = types.void(_f8, _f8, _vec, _vec, _vec, types.uint64[::1], _vec)
+DisturbanceType = types.FunctionType(DISTURBANCE_SIG)

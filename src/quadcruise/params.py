@@ -2,7 +2,9 @@
 
 The default is the paper's Table I (the Quanser Qball-X4 of its reference [8]), with the
 yaw moment arm ``d`` the paper leaves out derived from the Qball-X4's documented yaw
-torque gain (4 N m per unit duty) divided by the thrust gain K: d = 4/120 m.
+torque gain (4 N m per unit duty) divided by the thrust gain K: d = 4/120 m. The paper's
+model has no aerodynamic drag, so both drag coefficients default to zero; wind acts on the
+vehicle only through them (see :mod:`quadcruise.disturbances`).
 
 A field may be a scalar (every vehicle alike) or a 1-D array of length N (each vehicle its
 own value). :meth:`Vehicle.rows` turns either into the ``(N, PARAM_SIZE)`` array the
@@ -19,7 +21,7 @@ Examples
 >>> import numpy as np
 >>> batch = v.replace(m=np.array([3.0, 3.5, 4.0]))
 >>> batch.batch_size, batch.rows().shape
-(3, (3, 15))
+(3, (3, 17))
 >>> Vehicle.paper().replace(m=0.0)
 Traceback (most recent call last):
     ...
@@ -36,8 +38,8 @@ import numpy as np
 
 from .errors import InputError
 from .layout import (
-    P_D, P_G, P_JXX, P_JYY, P_JZZ, P_K, P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, P_L, P_M,
-    P_OMEGA, PARAM_SIZE,
+    P_CD1, P_CD2, P_D, P_G, P_JXX, P_JYY, P_JZZ, P_K, P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, P_L,
+    P_M, P_OMEGA, PARAM_SIZE,
 )
 
 
@@ -61,6 +63,8 @@ class Vehicle:
     omega: Any = _field(15.0, "rad/s", "actuator bandwidth (first-order rotor lag)")
     d: Any = _field(4.0 / 120.0, "m", "yaw moment per unit thrust, eq (4)")
     g: Any = _field(9.81, "m/s^2", "gravitational acceleration", strict=False)
+    drag_linear: Any = _field(0.0, "N s/m", "linear drag coefficient (air-relative velocity)", strict=False)
+    drag_quadratic: Any = _field(0.0, "N s^2/m^2", "quadratic drag coefficient", strict=False)
 
     def __post_init__(self) -> None:
         sizes = set()
@@ -149,6 +153,8 @@ class Vehicle:
             out[:, col] = getattr(self, name)
         for col, value in zip((P_K1, P_K2, P_K3, P_K4, P_K5, P_K6), self.k):
             out[:, col] = value
+        out[:, P_CD1] = self.drag_linear
+        out[:, P_CD2] = self.drag_quadratic
         return out
 
     def to_dict(self) -> dict:

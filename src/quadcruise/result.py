@@ -52,6 +52,7 @@ class SimResult:
     duty_clipped_s : (N,) time [s] during which a commanded duty was clipped to [0, 1]
     controller_limited_s : (N,) time [s] during which the controller flagged a limit
     meta : dict, the configuration, seed and version that produced the result
+    disturbance_memory : (N, D) the disturbance models' state at the end
     """
 
     t: np.ndarray
@@ -65,6 +66,7 @@ class SimResult:
     duty_clipped_s: np.ndarray
     controller_limited_s: np.ndarray
     meta: dict = field(default_factory=dict)
+    disturbance_memory: np.ndarray | None = None
 
     @property
     def n(self) -> int:

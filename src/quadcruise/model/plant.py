@@ -22,8 +22,19 @@ above is the standard one (Bouabdallah and Siegwart, 2007) and is what we integr
 Like the paper, we take the Euler-angle rates equal to the body rates (phi' = p, ...),
 a small-angle simplification.
 
-``ext`` is an external force [N] (earth frame) and torque [N m] (body frame) per vehicle,
-(fx, fy, fz, tx, ty, tz); zero unless a disturbance model supplies one.
+``ext`` (:data:`quadcruise.layout.EXT_SIZE`) holds what a disturbance model supplies: an
+external force [N] (earth frame), torque [N m] (body frame), the wind velocity [m/s] and each
+rotor's effectiveness. Beyond the paper's model, and zero unless the vehicle has them:
+
+    aerodynamic drag  F_d = -(c1 + c2 |v - w|) (v - w)   (v - w: air-relative velocity)
+    rotor damage      F_i' = omega (e_i K u_i - F_i)      (e_i = 1 when healthy)
+
+With ``full`` set, the kinematics are the exact ZYX Euler-angle rates instead of the
+paper's phi' = p, theta' = q, psi' = r:
+
+    phi'   = p + (q sin phi + r cos phi) tan theta
+    theta' = q cos phi - r sin phi
+    psi'   = (q sin phi + r cos phi) / cos theta
 """
 
 from __future__ import annotations
@@ -33,6 +44,8 @@ import math
 from numba import njit
 
 from ..layout import (
+    EXT_E1, EXT_E2, EXT_E3, EXT_E4, EXT_FX, EXT_FY, EXT_FZ, EXT_TX, EXT_TY, EXT_TZ, EXT_WX,
+    EXT_WY, EXT_WZ, P_CD1, P_CD2,
     F1, F2, F3, F4, P, PHI, PSI, Q, R, THETA, VX, VY, VZ, X, Y, Z,
     P_D, P_G, P_JXX, P_JYY, P_JZZ, P_K, P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, P_M, P_OMEGA,
 )
@@ -40,13 +53,14 @@ from .actuators import mix
 
 
 @njit(cache=True, error_model="numpy")
-def derivative(x, u, vp, ext, dx):
+def derivative(x, u, vp, ext, full, dx):
     """Write dx/dt of one vehicle into ``dx``.
 
     Parameters
     ----------
     x : (16,) state; u : (4,) PWM duties, already in [0, 1];
-    vp : (PARAM_SIZE,) vehicle parameter row; ext : (6,) external force and torque;
+    vp : (PARAM_SIZE,) vehicle parameter row; ext : (EXT_SIZE,) external inputs;
+    full : bool, exact Euler-angle kinematics instead of the paper's simplification;
     dx : (16,) output.
     """
     m = vp[P_M]
@@ -59,20 +73,35 @@ def derivative(x, u, vp, ext, dx):
     spsi, cpsi = math.sin(psi), math.cos(psi)
     a = U1 / m
 
+    fx, fy, fz = ext[EXT_FX], ext[EXT_FY], ext[EXT_FZ]
+    c1, c2 = vp[P_CD1], vp[P_CD2]
+    if c1 != 0.0 or c2 != 0.0:                                              # drag, air-relative
+        rx, ry, rz = x[VX] - ext[EXT_WX], x[VY] - ext[EXT_WY], x[VZ] - ext[EXT_WZ]
+        c = c1 + c2 * math.sqrt(rx * rx + ry * ry + rz * rz)
+        fx -= c * rx
+        fy -= c * ry
+        fz -= c * rz
+
     dx[X] = x[VX]
     dx[Y] = x[VY]
     dx[Z] = x[VZ]
-    dx[VX] = (sphi * spsi + cphi * sth * cpsi) * a + ext[0] / m             # (5)
-    dx[VY] = (-sphi * cpsi + cphi * sth * spsi) * a + ext[1] / m            # (6)
-    dx[VZ] = cphi * cth * a - vp[P_G] + ext[2] / m                          # (7)
-    dx[PHI] = p
-    dx[THETA] = q
-    dx[PSI] = r
-    dx[P] = vp[P_K1] * q * r + vp[P_K2] * U2 + ext[3] / vp[P_JXX]           # (11) roll
-    dx[Q] = vp[P_K3] * p * r + vp[P_K4] * U3 + ext[4] / vp[P_JYY]           # (11) pitch
-    dx[R] = vp[P_K5] * p * q + vp[P_K6] * U4 + ext[5] / vp[P_JZZ]           # (11) yaw
+    dx[VX] = (sphi * spsi + cphi * sth * cpsi) * a + fx / m                 # (5)
+    dx[VY] = (-sphi * cpsi + cphi * sth * spsi) * a + fy / m                # (6)
+    dx[VZ] = cphi * cth * a - vp[P_G] + fz / m                              # (7)
+    if full:
+        s = q * sphi + r * cphi
+        dx[PHI] = p + s * sth / cth
+        dx[THETA] = q * cphi - r * sphi
+        dx[PSI] = s / cth
+    else:                                                                   # the paper's
+        dx[PHI] = p
+        dx[THETA] = q
+        dx[PSI] = r
+    dx[P] = vp[P_K1] * q * r + vp[P_K2] * U2 + ext[EXT_TX] / vp[P_JXX]      # (11) roll
+    dx[Q] = vp[P_K3] * p * r + vp[P_K4] * U3 + ext[EXT_TY] / vp[P_JYY]      # (11) pitch
+    dx[R] = vp[P_K5] * p * q + vp[P_K6] * U4 + ext[EXT_TZ] / vp[P_JZZ]      # (11) yaw
     w, K = vp[P_OMEGA], vp[P_K]
-    dx[F1] = w * (K * u[0] - x[F1])                                         # rotor lag
-    dx[F2] = w * (K * u[1] - x[F2])
-    dx[F3] = w * (K * u[2] - x[F3])
-    dx[F4] = w * (K * u[3] - x[F4])
+    dx[F1] = w * (ext[EXT_E1] * K * u[0] - x[F1])                           # rotor lag
+    dx[F2] = w * (ext[EXT_E2] * K * u[1] - x[F2])
+    dx[F3] = w * (ext[EXT_E3] * K * u[2] - x[F3])
+    dx[F4] = w * (ext[EXT_E4] * K * u[3] - x[F4])
