@@ -107,7 +107,7 @@ def _metrics_table(frame) -> str:
 
 
 @main.command()
-@click.argument("mission", type=click.Choice(["circle", "square", "step", "hover"]))
+@click.argument("mission", metavar="MISSION")
 @click.option("--controller", default="nlpd", show_default=True, help="Controller name.")
 @click.option("--duration", type=float, help="Flight time [s] (default: one lap, or 10 s after a step).")
 @click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
@@ -122,11 +122,14 @@ def _metrics_table(frame) -> str:
 @click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv", show_default=True,
               help="Format of the traces.")
 @click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
+@click.option("--smooth", is_flag=True, help="Fly a waypoint file as a minimum-snap path instead of legs.")
 @_friendly
 def fly(mission, controller, duration, dt, max_step, mission_params, controller_params, position_poles,
-        out, fmt, force):
+        out, fmt, force, smooth):
     """Fly a MISSION with a controller on the paper's vehicle and print its metrics.
 
+    MISSION is circle, square, step, hover, or a waypoint CSV (columns x,y,z and optional
+    yaw and t or speed), flown as constant-speed legs or, with --smooth, a minimum-snap path.
     With --out, also write the traces, a figure of the flight, the metrics and the
     configuration (quadcruise.json) to that folder, atomically.
     """
@@ -135,7 +138,11 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
     from .flight import fly as run_fly
     from .missions import mission_from_name
 
-    the_mission = mission_from_name(mission, **_assignments(mission_params, "--mission-param"))
+    mparams = _assignments(mission_params, "--mission-param")
+    if mission.lower().endswith(".csv"):
+        mparams["table"] = mission
+        mission = "minsnap" if smooth else "waypoints"
+    the_mission = mission_from_name(mission, **mparams)
     cparams = _assignments(controller_params, "--controller-param")
     poles = _poles(position_poles, "--poles")
     if poles is not None:

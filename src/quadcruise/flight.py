@@ -28,7 +28,11 @@ from .result import SimResult
 
 
 def default_duration(mission: Mission) -> float:
-    """One lap of a circle or square, 10 s after a step, 5 s of hover [s]."""
+    """The mission's own ``duration`` if it has one (waypoint kinds), one lap of a circle or
+    square, 10 s after a step, 5 s of hover [s]."""
+    own = getattr(mission, "duration", None)
+    if own is not None:
+        return float(own)
     if isinstance(mission, Circle):
         return mission.period
     if isinstance(mission, Square):

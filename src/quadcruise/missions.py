@@ -205,7 +205,7 @@ class Mission:
 
     def reference(self, t: Any) -> np.ndarray:
         """The reference at times ``t`` [s], shape (len(t), REF_SIZE), from the compiled function."""
-        ts = np.ascontiguousarray(np.atleast_1d(np.asarray(t, dtype=np.float64)))
+        ts = np.array(np.atleast_1d(t), dtype=np.float64)    # a writable C-ordered copy
         if ts.ndim != 1 or not np.all(np.isfinite(ts)):
             raise InputError("mission reference times must be a 1-D array of finite numbers")
         out = np.empty((ts.shape[0], REF_SIZE))
@@ -377,6 +377,7 @@ def stack_params(missions: Mission | Sequence[Mission], n: int | None = None) ->
     """The (N, M) mp array of a batch: one row per mission, all of the same kind.
 
     A single mission (or a list of one) is broadcast to ``n`` rows when ``n`` is given.
+    Rows of different lengths (waypoint tables of different sizes) are padded with zeros.
 
     >>> stack_params([Circle(radius=1.0), Circle(radius=2.0)])[:, 0]
     array([1., 2.])
@@ -389,10 +390,20 @@ def stack_params(missions: Mission | Sequence[Mission], n: int | None = None) ->
     kinds = sorted({type(m).name for m in missions})
     if len(kinds) > 1:
         raise InputError(f"a batch flies one mission kind, got {', '.join(kinds)}")
-    rows = np.vstack([m.params() for m in missions])
+    params = [m.params() for m in missions]
+    width = max(p.shape[0] for p in params)      # tables of waypoints differ in length:
+    rows = np.zeros((len(params), width))        # pad; each function reads its own count
+    for i, p in enumerate(params):
+        rows[i, :p.shape[0]] = p
     if n is not None:
         if len(missions) == 1:
             rows = np.repeat(rows, n, axis=0)
         elif len(missions) != n:
             raise InputError(f"{len(missions)} missions given but {n} vehicles were asked for")
     return np.ascontiguousarray(rows)
+
+
+# --- waypoint kinds (defined in waypoints.py, which builds on Mission above) ----------------
+from .waypoints import MinimumSnap, Waypoints  # noqa: E402
+
+MISSIONS.update({cls.name: cls for cls in (Waypoints, MinimumSnap)})
