@@ -110,7 +110,7 @@ def _metrics_table(frame) -> str:
 @click.argument("mission", metavar="MISSION")
 @click.option("--controller", default="nlpd", show_default=True, help="Controller name.")
 @click.option("--duration", type=float, help="Flight time [s] (default: one lap, or 10 s after a step).")
-@click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
+@click.option("--dt", type=float, help="Control period [s] (default 0.001).")
 @click.option("--max-step", type=float, help="Longest RK4 substep [s] (default: dt).")
 @click.option("-m", "--mission-param", "mission_params", multiple=True, metavar="KEY=VALUE",
               help="Mission parameter, e.g. -m radius=3 -m period=30 (repeatable).")
@@ -128,31 +128,54 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
         out, fmt, force, smooth):
     """Fly a MISSION with a controller on the paper's vehicle and print its metrics.
 
-    MISSION is circle, square, step, hover, or a waypoint CSV (columns x,y,z and optional
-    yaw and t or speed), flown as constant-speed legs or, with --smooth, a minimum-snap path.
+    MISSION is circle, square, step, hover, a waypoint CSV (columns x,y,z and optional yaw
+    and t or speed), flown as constant-speed legs or, with --smooth, a minimum-snap path, or
+    a TOML scenario file describing the whole run (options given here override it).
     With --out, also write the traces, a figure of the flight, the metrics and the
     configuration (quadcruise.json) to that folder, atomically.
     """
-    from .control import controller_from_name
-    from .control.design import pd_from_poles
-    from .flight import fly as run_fly
     from .missions import mission_from_name
 
+    if mission.lower().endswith(".toml"):
+        from .scenario import load_scenario
+
+        scenario = load_scenario(mission)
+        kwargs = scenario.fly_kwargs()
+        kwargs.update({k: v for k, v in (("duration", duration), ("dt", dt), ("max_step", max_step)) if v is not None})
+        the_mission, the_controller = scenario.mission or mission_from_name("circle"), scenario.controller
+        if the_controller is None or controller_params or position_poles or controller != "nlpd":
+            the_controller = _controller_from_options(controller, controller_params, position_poles)
+        _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force)
+        return
     mparams = _assignments(mission_params, "--mission-param")
     if mission.lower().endswith(".csv"):
         mparams["table"] = mission
         mission = "minsnap" if smooth else "waypoints"
     the_mission = mission_from_name(mission, **mparams)
-    cparams = _assignments(controller_params, "--controller-param")
-    poles = _poles(position_poles, "--poles")
+    the_controller = _controller_from_options(controller, controller_params, position_poles)
+    _fly_and_report(the_mission, the_controller, {"duration": duration, "dt": dt or 1e-3, "max_step": max_step},
+                    out, fmt, force)
+
+
+def _controller_from_options(name: str, params: tuple[str, ...], poles_text: str | None):
+    from .control import controller_from_name
+    from .control.design import pd_from_poles
+
+    cparams = _assignments(params, "--controller-param")
+    poles = _poles(poles_text, "--poles")
     if poles is not None:
         cparams["position"] = pd_from_poles(poles)
-    the_controller = controller_from_name(controller, **cparams)
+    return controller_from_name(name, **cparams)
+
+
+def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force) -> None:
+    from .flight import fly as run_fly
+
     if out is not None:
         check_output_dir(out, force)
-    result = run_fly(the_mission, the_controller, duration=duration, dt=dt, max_step=max_step)
+    result = run_fly(mission, controller, **kwargs)
     metrics = result.metrics()
-    click.echo(f"{the_controller.name} on {the_mission.name}: {result.t[-1]:g} s at dt = {dt:g} s")
+    click.echo(f"{controller.name} on {mission.name}: {result.t[-1]:g} s at dt = {kwargs.get('dt') or 1e-3:g} s")
     click.echo(_metrics_table(metrics))
     if out is not None:
         write_flight(result, metrics, out, fmt)

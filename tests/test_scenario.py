@@ -1,0 +1,116 @@
+"""TOML scenario files: loading, validation messages, flying, the CLI."""
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import quadcruise as qc
+from quadcruise.cli import main
+from quadcruise.scenario import load_scenario
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def write(tmp_path, text, name="s.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in (EXAMPLES / "scenarios").glob("*.toml")))
+def test_shipped_scenarios_load_and_fly(name):
+    sc = load_scenario(EXAMPLES / "scenarios" / name)
+    assert sc.title
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")     # brief duty clipping is reported, not an error
+        res = sc.fly()
+    assert res.ok.all()
+    assert res.meta["scenario"]["source"].endswith(name)
+
+
+def test_paper_scenario_equals_the_default_flight():
+    res = load_scenario(EXAMPLES / "scenarios" / "circle_paper.toml").fly()
+    ref = qc.fly("circle")
+    np.testing.assert_array_equal(res.states, ref.states)
+
+
+def test_everything_a_scenario_sets_reaches_the_flight(tmp_path):
+    path = write(tmp_path, """
+title = "t"
+[vehicle]
+m = 2.0
+[controller]
+name = "gonzalez"
+position_poles = [-1.0, -2.0]
+altitude = { kp = 4.0, kd = 4.0 }
+attitude_poles = [-8.0, -8.0, -1.0]
+max_tilt = 0.5
+[mission]
+kind = "square"
+side = 3.0
+corner = [1.0, -1.0]
+[simulation]
+duration = 4.0
+dt = 0.002
+full_dynamics = true
+""")
+    sc = load_scenario(path)
+    assert sc.vehicle.m == 2.0
+    c = sc.controller
+    assert c.name == "gonzalez" and (c.position.kp, c.position.kd) == pytest.approx((2.0, 3.0))
+    assert (c.altitude.kp, c.altitude.kd) == (4.0, 4.0) and c.max_tilt == 0.5
+    assert (c.attitude.kp, c.attitude.ki, c.attitude.kd) == pytest.approx((80.0, 64.0, 17.0))
+    assert sc.mission.corner == (1.0, -1.0)
+    res = sc.fly()
+    assert res.t[-1] == pytest.approx(4.0) and res.t[1] == pytest.approx(0.002)
+    assert res.meta["full_dynamics"] is True and res.meta["vehicle"]["m"] == 2.0
+
+
+def test_waypoint_table_is_relative_to_the_scenario(tmp_path):
+    (tmp_path / "path.csv").write_text("x,y,z,speed\n0,0,1,\n1,0,1,0.5\n")
+    sc = load_scenario(write(tmp_path, '[mission]\nkind = "waypoints"\ntable = "path.csv"\n'))
+    assert sc.mission.name == "waypoints"
+    assert sc.mission.reference([2.0])[0, 0] == pytest.approx(1.0)
+
+
+BAD = [
+    ("[mision]\nkind = 'circle'\n", "unknown key 'mision'"),
+    ("[mission]\nkind = 'circle'\nradiu = 2\n", "[mission] unknown key 'radiu'"),
+    ("[mission]\nkind = 'loop'\n", "[mission] 'kind' must be one of"),
+    ("[mission]\nkind = 'circle'\nradius = 0.0\n", "[mission] circle field 'radius' (circle radius, m) must be > 0"),
+    ("[simulation]\nduration = 'long'\n", "[simulation] 'duration' must be a number, got 'long'"),
+    ("[simulation]\nduration = -1.0\n", "[simulation] 'duration' must be > 0"),
+    ("[simulation]\nseed = 1.5\n", "[simulation] 'seed' must be an integer"),
+    ("[simulation]\nfull_dynamics = 1\n", "'full_dynamics' must be true or false"),
+    ("[vehicle]\nm = -3.0\n", "[vehicle] vehicle field 'm' (mass, kg) must be > 0"),
+    ("[vehicle]\nmass = 3.0\n", "[vehicle] unknown key 'mass'"),
+    ("[controller]\nname = 'pid'\n", "[controller] unknown controller name 'pid'"),
+    ("[controller]\nposition_poles = [0.7, -4.3]\n", "[controller] pd_from_poles: pole 0.7 is not in the open left half plane"),
+    ("[controller]\nposition = { kp = 3.0, kx = 1.0 }\n", "[controller] unknown key 'position.kx'"),
+    ("[controller]\ngain = 3.0\n", "[controller] unknown key 'gain'"),
+    ("vehicle = 3\n", "[vehicle] must be a table"),
+    ("[mission\nkind = 'circle'\n", "not valid TOML"),
+]
+
+
+@pytest.mark.parametrize("text, words", BAD)
+def test_bad_scenarios_name_file_key_and_problem(tmp_path, text, words):
+    path = write(tmp_path, text)
+    with pytest.raises(qc.InputError) as info:
+        load_scenario(path)
+    message = str(info.value)
+    assert message.startswith(str(path)) and words in message and "\n" not in message
+
+
+def test_cli_flies_a_scenario_and_refuses_a_bad_one(tmp_path):
+    runner = CliRunner()
+    ok = runner.invoke(main, ["fly", str(EXAMPLES / "scenarios" / "circle_paper.toml"), "--duration", "2"])
+    assert ok.exit_code == 0 and "nlpd on circle: 2 s" in ok.output
+    bad = write(tmp_path, "[mission]\nkind = 'circle'\nradius = -1.0\n")
+    res = runner.invoke(main, ["fly", str(bad)])
+    assert res.exit_code == 2 and res.output.count("\n") == 1 and "radius" in res.output
+    missing = runner.invoke(main, ["fly", str(tmp_path / "none.toml")])
+    assert missing.exit_code == 2 and "no such file" in missing.output
