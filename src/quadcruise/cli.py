@@ -147,11 +147,7 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
             the_controller = _controller_from_options(controller, controller_params, position_poles)
         _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force)
         return
-    mparams = _assignments(mission_params, "--mission-param")
-    if mission.lower().endswith(".csv"):
-        mparams["table"] = mission
-        mission = "minsnap" if smooth else "waypoints"
-    the_mission = mission_from_name(mission, **mparams)
+    the_mission = _mission(mission, mission_params, smooth)
     the_controller = _controller_from_options(controller, controller_params, position_poles)
     _fly_and_report(the_mission, the_controller, {"duration": duration, "dt": dt or 1e-3, "max_step": max_step},
                     out, fmt, force)
@@ -224,6 +220,42 @@ def reproduce(out, fmt, force):
     click.echo(results_table(rep))
     write_reproduction(rep, out, force=force, fmt=fmt, progress=lambda name: click.echo(f"drew {name}", err=True))
     click.echo(f"wrote {out}/report.md, metrics.json, figures and traces in {time.perf_counter() - start:.1f} s")
+
+
+@main.command()
+@click.argument("mission", metavar="MISSION")
+@click.option("--controllers", default="nlpd,gonzalez,se3,cascade", show_default=True,
+              help="Comma-separated controller names.")
+@click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
+@click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
+@click.option("-m", "--mission-param", "mission_params", multiple=True, metavar="KEY=VALUE",
+              help="Mission parameter (repeatable).")
+@click.option("--out", type=click.Path(file_okay=False), help="Folder for metrics.csv and comparison.png.")
+@click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
+@_friendly
+def compare(mission, controllers, duration, dt, mission_params, out, force):
+    """Fly MISSION (a name or a waypoint CSV) with several controllers; one table, one figure."""
+    from .compare import compare as run_compare
+
+    if out is not None:
+        check_output_dir(out, force)
+    cmp = run_compare(_mission(mission, mission_params, smooth=False), controllers.split(","),
+                      duration=duration, dt=dt)
+    click.echo(cmp.text())
+    if out is not None:
+        cmp.write(out, force=force)
+        click.echo(f"wrote metrics.csv and comparison.png to {out}")
+
+
+def _mission(text: str, params: tuple[str, ...], smooth: bool):
+    """A mission from a name or a waypoint CSV, with KEY=VALUE parameters."""
+    from .missions import mission_from_name
+
+    mparams = _assignments(params, "--mission-param")
+    if text.lower().endswith(".csv"):
+        mparams["table"] = text
+        text = "minsnap" if smooth else "waypoints"
+    return mission_from_name(text, **mparams)
 
 
 def run() -> None:

@@ -1,0 +1,290 @@
+"""State-of-the-art controllers on the paper's plant: geometric control on SE(3) and a
+PX4-style cascade, both flying the same model, missions and engine as ``nlpd``.
+
+``se3`` (:class:`SE3`): Lee, Leok and McClamroch, "Geometric tracking control of a quadrotor
+UAV on SE(3)", CDC 2010, in the form RotorPy and crazyflow fly it. With e = ref - actual::
+
+    F = m (kx e_x + kv e_v + a_ref + g e3)           desired force, earth frame [N]
+    b3_d = F / |F|,  b1_d from the yaw reference,    R_d = [b1_d, b2_d, b3_d]
+    U1 = F . R e3                                    thrust along the current b3 [N]
+    e_R = vee(R_d^T R - R^T R_d) / 2,  e_w = w - R^T R_d w_d,  w_d = 0
+    M = J (-kR e_R - kw e_w) + w x J w               moments, body frame [N m]
+    U2 = M_x / l,  U3 = M_y / l,  U4 = M_z
+
+R = Rz(psi) Ry(theta) Rx(phi) from the state's angles (so R e3 is eqs 5-7's thrust
+direction), w = (p, q, r) the state's body rates. w_d = 0: the missions' yaw references are
+holds and steps (no yaw rate) and the rate of a tilting R_d is left out, as RotorPy does by
+default. kR and kw multiply the inertia (RotorPy's form), i.e. they are per unit inertia; the
+w x J w term cancels the gyroscopic terms of eq (11) exactly, so J w' = J (-kR e_R - kw w).
+Added to Lee's law: the horizontal part of F is scaled down to keep b3_d within ``max_tilt``
+(FLAG_TILT_LIMIT) and U1 is limited to [0, 4 K] (FLAG_THRUST_LIMIT); neither acts in the
+default missions.
+
+Gain rule, for a fair comparison with ``nlpd``: kx, kv place the paper's position poles
+(-0.7, -4.3: kx = 3.01 1/s^2, kv = 5.0 1/s), and so do the altitude gains; kR, kw put each
+attitude axis (a double integrator per unit inertia behind the 15 rad/s rotor lag) at the
+attitude design's pair wn = 0.6 w = 9 rad/s, zeta = 0.8: kR = 81 1/s^2, kw = 14.4 1/s
+(:func:`se3_attitude_design`; ``nlpd``'s attitude PID without its slow integrator). With
+the rotor lag each attitude axis keeps a 26 deg phase margin at a 12.3 rad/s crossover.
+
+``cascade`` (:class:`Cascade`): PX4's multicopter cascade, P position -> PID velocity -> P
+attitude -> PID body rate; the law is in :mod:`quadcruise.control.px4`. Its gains are
+PX4's defaults where they are in SI units; the rate gains, which PX4 gives in normalized
+torque, are designed for this vehicle's rotor lag (:func:`rate_pid_design`).
+
+Examples
+--------
+>>> import quadcruise as qc
+>>> res = qc.fly("step", Cascade(), duration=12.0)
+>>> bool(abs(res.final_state[0, 0] - 1.0) < 0.02)
+True
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+
+from ..errors import InputError
+from ..layout import (
+    CONTROLLER_SIG, FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT, P, P_G, P_JXX, P_JYY, P_JZZ, P_K, P_L,
+    P_M, PHI, PSI, Q, R, REF_AX, REF_AY, REF_AZ, REF_PSI, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y,
+    REF_Z, THETA, VX, VY, VZ, X, Y, Z,
+)
+from .base import Controller
+from .design import ATTITUDE_WN_RATIO, ATTITUDE_ZETA, PDGains, altitude_pd_design, position_pd_design
+from .position import check_positive
+from .px4 import (
+    C_ATT_RP, C_ATT_YAW, C_MAX_TILT, C_POS_XY, C_POS_Z, C_RATE_D, C_RATE_D_LP, C_RATE_I,
+    C_RATE_I_LIM, C_RATE_P, C_RMAX_RP, C_RMAX_YAW, C_THR_MAX, C_THR_MIN, C_VEL_D_LP, C_VEL_D_XY,
+    C_VEL_D_Z, C_VEL_I_XY, C_VEL_I_Z, C_VEL_P_XY, C_VEL_P_Z, C_VMAX_DOWN, C_VMAX_UP, C_VMAX_XY,
+    C_YRATE_D, C_YRATE_I, C_YRATE_P, CASCADE_GAINS, CASCADE_MEMORY, RateGains, cascade,
+    rate_loops, rate_pid_design,
+)
+from .so3 import attitude_lee, clamp, command_from_rotation, error_lee, limit_tilt, rotation_zyx
+
+__all__ = ["SE3", "Cascade", "RateGains", "se3", "cascade", "se3_attitude_design",
+           "rate_pid_design", "rate_loops"]
+
+# gains layout of se3
+KX, KV, KX_Z, KV_Z, K_R, K_W, SE3_MAX_TILT = range(7)
+
+
+@njit(CONTROLLER_SIG, cache=True, error_model="numpy")
+def se3(t, dt, x, ref, vp, gains, mem, cmd):
+    """Geometric tracking control on SE(3) (Lee et al. 2010), moments per unit inertia."""
+    m = vp[P_M]
+    fx = m * (gains[KX] * (ref[REF_X] - x[X]) + gains[KV] * (ref[REF_VX] - x[VX]) + ref[REF_AX])
+    fy = m * (gains[KX] * (ref[REF_Y] - x[Y]) + gains[KV] * (ref[REF_VY] - x[VY]) + ref[REF_AY])
+    fz = m * (gains[KX_Z] * (ref[REF_Z] - x[Z]) + gains[KV_Z] * (ref[REF_VZ] - x[VZ])
+              + ref[REF_AZ] + vp[P_G])
+    fx, fy, tilted = limit_tilt(fx, fy, fz, gains[SE3_MAX_TILT])
+    flags = FLAG_TILT_LIMIT if tilted else 0
+    Rm, Rd = np.empty((3, 3)), np.empty((3, 3))
+    rotation_zyx(x[PHI], x[THETA], x[PSI], Rm)
+    n = math.sqrt(fx * fx + fy * fy + fz * fz) if fz > 0.0 else 0.0
+    if n > 0.0:
+        attitude_lee(fx / n, fy / n, fz / n, ref[REF_PSI], Rd)
+    else:                                                  # F points down: b3_d = e3, U1 -> 0
+        attitude_lee(0.0, 0.0, 1.0, ref[REF_PSI], Rd)
+    U1, limited = clamp(fx * Rm[0, 2] + fy * Rm[1, 2] + fz * Rm[2, 2], 0.0, 4.0 * vp[P_K])
+    if limited:
+        flags |= FLAG_THRUST_LIMIT
+    ex, ey, ez = error_lee(Rm, Rd)
+    p, q, r = x[P], x[Q], x[R]
+    jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
+    kr, kw = gains[K_R], gains[K_W]
+    mx = -jx * (kr * ex + kw * p) + (jz - jy) * q * r          # + (w x J w)_x
+    my = -jy * (kr * ey + kw * q) + (jx - jz) * p * r
+    mz = -jz * (kr * ez + kw * r) + (jy - jx) * p * q
+    command_from_rotation(U1, mx / vp[P_L], my / vp[P_L], mz, Rd, flags, vp, cmd)
+
+
+def se3_attitude_design(actuator_bandwidth: float = 15.0) -> PDGains:
+    """kR = wn^2 [1/s^2], kw = 2 zeta wn [1/s] per unit inertia at the attitude design's
+    wn = 0.6 w, zeta = 0.8 (see :func:`quadcruise.control.design.attitude_pid_design`).
+
+    >>> from quadcruise.control.design import loop_margins
+    >>> g = se3_attitude_design()
+    >>> round(g.kp, 6), round(g.kd, 6), round(loop_margins(g, 15.0)["phase_margin"], 1)
+    (81.0, 14.4, 26.1)
+    """
+    check_positive("se3_attitude_design", actuator_bandwidth=actuator_bandwidth)
+    wn = ATTITUDE_WN_RATIO * actuator_bandwidth
+    return PDGains(kp=wn * wn, kd=2.0 * ATTITUDE_ZETA * wn)
+
+
+def _check_type(owner: str, obj, names, cls) -> None:
+    for name in names:
+        if not isinstance(getattr(obj, name), cls):
+            raise InputError(f"{owner} parameter '{name}' must be {cls.__name__}, got {getattr(obj, name)!r}")
+
+
+def _check_tilt(owner: str, max_tilt) -> None:
+    check_positive(owner, max_tilt=max_tilt)
+    if max_tilt >= math.pi / 2:
+        raise InputError(f"{owner} parameter 'max_tilt' must be below pi/2 rad, got {max_tilt!r}")
+
+
+@dataclass(frozen=True)
+class SE3(Controller):
+    """Geometric tracking control on SE(3) (Lee, Leok, McClamroch 2010).
+
+    Parameters
+    ----------
+    position : PDGains
+        kx (kp) [1/s^2] and kv (kd) [1/s] of x and y, per unit mass; the paper's poles.
+    altitude : PDGains
+        the same for z; the paper's poles.
+    attitude : PDGains
+        kR (kp) [1/s^2] and kw (kd) [1/s] per unit inertia, all three axes; 81 and 14.4.
+    max_tilt : float
+        largest angle of b3_d from the vertical [rad]; 45 degrees.
+
+    Examples
+    --------
+    >>> c = SE3()
+    >>> c.gains().round(3).tolist()
+    [3.01, 5.0, 3.01, 5.0, 81.0, 14.4, 0.785]
+    >>> SE3(max_tilt=-1.0)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: se3 parameter 'max_tilt' must be a positive number, got -1.0
+    """
+
+    name = "se3"
+    memory_size = 0
+
+    position: PDGains = field(default_factory=position_pd_design)
+    altitude: PDGains = field(default_factory=altitude_pd_design)
+    attitude: PDGains = field(default_factory=se3_attitude_design)
+    max_tilt: float = math.radians(45.0)
+
+    def __post_init__(self) -> None:
+        _check_type(self.name, self, ("position", "altitude", "attitude"), PDGains)
+        _check_tilt(self.name, self.max_tilt)
+
+    @property
+    def function(self):
+        return se3
+
+    def gains(self) -> np.ndarray:
+        return np.array([self.position.kp, self.position.kd, self.altitude.kp, self.altitude.kd,
+                         self.attitude.kp, self.attitude.kd, self.max_tilt])
+
+
+@dataclass(frozen=True)
+class Cascade(Controller):
+    """PX4-style multicopter cascade (see :mod:`quadcruise.control.px4` for the law).
+
+    Defaults are PX4's parameters (names in brackets), in SI units.
+
+    Parameters
+    ----------
+    xy_p, z_p : float
+        position P [1/s] (MPC_XY_P = 0.95, MPC_Z_P = 1).
+    xy_vel_p, xy_vel_i, xy_vel_d : float
+        horizontal velocity PID: [1/s], [1/s^2], [-] (MPC_XY_VEL_P/I/D_ACC = 1.8, 0.4, 0.2).
+    z_vel_p, z_vel_i, z_vel_d : float
+        vertical velocity PID (MPC_Z_VEL_P/I/D_ACC = 4, 2, 0).
+    max_speed_xy, max_speed_up, max_speed_down : float
+        velocity setpoint limits [m/s] (MPC_XY_VEL_MAX = 12, MPC_Z_VEL_MAX_UP = 3,
+        MPC_Z_VEL_MAX_DN = 1.5; 1 in older PX4 releases).
+    max_tilt : float
+        thrust tilt limit [rad] (MPC_TILTMAX_AIR = 45 deg).
+    thrust_min : float
+        least thrust as a fraction of the weight m g [-]: PX4's MPC_THR_MIN = 0.12 of full
+        thrust at its default hover thrust MPC_THR_HOVER = 0.5 is 0.24 of the weight (this
+        vehicle hovers at 7 % of its full thrust, so 0.12 of full would not let it descend).
+    thrust_max : float
+        most thrust as a fraction of the full thrust 4 K [-] (MPC_THR_MAX = 1).
+    roll_p, yaw_p : float
+        attitude P [1/s], roll and pitch, yaw (MC_ROLL_P = MC_PITCH_P = 6.5, MC_YAW_P = 2.8).
+    max_rate_rp, max_rate_yaw : float
+        rate setpoint limits [rad/s] (MC_ROLLRATE_MAX = 220 deg/s, MC_YAWRATE_MAX = 200 deg/s).
+    rate, yaw_rate : RateGains
+        rate PID per unit inertia, roll and pitch, yaw: :func:`rate_pid_design` (PX4's I/P
+        ratios MC_ROLLRATE_I / MC_ROLLRATE_P = 0.2 / 0.15, MC_YAWRATE_I / MC_YAWRATE_P = 0.1 / 0.2).
+    rate_i_limit : float
+        rate integral bound as a fraction of the axis' full torque [-] (MC_RR_INT_LIM = 0.3).
+    vel_d_cutoff, rate_d_cutoff : float
+        low-pass cutoffs of the differenced velocity and rate [Hz] (MPC_VELD_LP = 5,
+        IMU_DGYRO_CUTOFF = 30).
+
+    Examples
+    --------
+    >>> c = Cascade()
+    >>> c.gains().shape, c.memory().shape
+    ((27,), (19,))
+    >>> Cascade(thrust_min=1.5)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: cascade parameter 'thrust_min' must be in [0, 1), got 1.5
+    """
+
+    name = "cascade"
+    memory_size = CASCADE_MEMORY
+
+    xy_p: float = 0.95
+    z_p: float = 1.0
+    xy_vel_p: float = 1.8
+    xy_vel_i: float = 0.4
+    xy_vel_d: float = 0.2
+    z_vel_p: float = 4.0
+    z_vel_i: float = 2.0
+    z_vel_d: float = 0.0
+    max_speed_xy: float = 12.0
+    max_speed_up: float = 3.0
+    max_speed_down: float = 1.5
+    max_tilt: float = math.radians(45.0)
+    thrust_min: float = 0.24
+    thrust_max: float = 1.0
+    roll_p: float = 6.5
+    yaw_p: float = 2.8
+    max_rate_rp: float = math.radians(220.0)
+    max_rate_yaw: float = math.radians(200.0)
+    rate: RateGains = field(default_factory=rate_pid_design)
+    yaw_rate: RateGains = field(default_factory=lambda: rate_pid_design(yaw=True))
+    rate_i_limit: float = 0.3
+    vel_d_cutoff: float = 5.0
+    rate_d_cutoff: float = 30.0
+
+    def __post_init__(self) -> None:
+        check_positive(self.name, **{k: getattr(self, k) for k in (
+            "xy_p", "z_p", "xy_vel_p", "z_vel_p", "max_speed_xy", "max_speed_up", "max_speed_down",
+            "roll_p", "yaw_p", "max_rate_rp", "max_rate_yaw", "rate_i_limit", "vel_d_cutoff",
+            "rate_d_cutoff")})
+        for k in ("xy_vel_i", "xy_vel_d", "z_vel_i", "z_vel_d"):
+            v = getattr(self, k)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
+                raise InputError(f"{self.name} parameter '{k}' must be a number >= 0, got {v!r}")
+        _check_tilt(self.name, self.max_tilt)
+        if not (isinstance(self.thrust_min, (int, float)) and 0 <= self.thrust_min < 1):
+            raise InputError(f"{self.name} parameter 'thrust_min' must be in [0, 1), got {self.thrust_min!r}")
+        if not (isinstance(self.thrust_max, (int, float)) and 0 < self.thrust_max <= 1):
+            raise InputError(f"{self.name} parameter 'thrust_max' must be in (0, 1], got {self.thrust_max!r}")
+        _check_type(self.name, self, ("rate", "yaw_rate"), RateGains)
+
+    @property
+    def function(self):
+        return cascade
+
+    def gains(self) -> np.ndarray:
+        g = np.zeros(CASCADE_GAINS)
+        for col, value in ((C_POS_XY, self.xy_p), (C_POS_Z, self.z_p), (C_VEL_P_XY, self.xy_vel_p),
+                           (C_VEL_I_XY, self.xy_vel_i), (C_VEL_D_XY, self.xy_vel_d),
+                           (C_VEL_P_Z, self.z_vel_p), (C_VEL_I_Z, self.z_vel_i), (C_VEL_D_Z, self.z_vel_d),
+                           (C_VMAX_XY, self.max_speed_xy), (C_VMAX_UP, self.max_speed_up),
+                           (C_VMAX_DOWN, self.max_speed_down), (C_MAX_TILT, self.max_tilt),
+                           (C_THR_MIN, self.thrust_min), (C_THR_MAX, self.thrust_max),
+                           (C_ATT_RP, self.roll_p), (C_ATT_YAW, self.yaw_p),
+                           (C_RMAX_RP, self.max_rate_rp), (C_RMAX_YAW, self.max_rate_yaw),
+                           (C_RATE_P, self.rate.kp), (C_RATE_I, self.rate.ki), (C_RATE_D, self.rate.kd),
+                           (C_YRATE_P, self.yaw_rate.kp), (C_YRATE_I, self.yaw_rate.ki),
+                           (C_YRATE_D, self.yaw_rate.kd), (C_RATE_I_LIM, self.rate_i_limit),
+                           (C_VEL_D_LP, self.vel_d_cutoff), (C_RATE_D_LP, self.rate_d_cutoff)):
+            g[col] = value
+        return g

@@ -1,0 +1,253 @@
+"""The PX4 multicopter cascade on the paper's plant: the compiled law of
+:class:`quadcruise.control.modern.Cascade` and its building blocks.
+
+PX4's ``PositionControl``, ``AttitudeControl`` and ``RateControl``, in SI units with z up
+(PX4 works in NED; every sign below is re-derived for z up and eqs 5-7):
+
+1. Position P: v_sp = K_pos (p_ref - p) + v_ref. The horizontal part is limited to
+   ``max_speed_xy`` with the position term taking priority over the feedforward (PX4's
+   ``ControlMath::constrainXY``), the vertical part to [-max_speed_down, max_speed_up].
+2. Velocity PID: a_sp = K_p e_v + int(K_i e_v) - K_d v' + a_ref, v' the measured velocity
+   differenced and low-passed at MPC_VELD_LP. Thrust direction b3_d = (a_x, a_y, g) / |.|
+   (PX4's decoupled horizontal and vertical acceleration, MPC_ACC_DECOUPLE), turned towards
+   the vertical to at most ``max_tilt`` (FLAG_TILT_LIMIT); U1 = m (g + a_z) / b3_d,z within
+   [thrust_min m g, thrust_max 4 K] (FLAG_THRUST_LIMIT). Anti-windup as PX4: the vertical
+   integral stops while the thrust limit acts against its error (FLAG_INTEGRATOR_HOLD) and
+   stays within +/- g; the horizontal error is corrected by 2 / K_p times the acceleration
+   the limited thrust cannot give (tracking anti-windup, Rundqwist 1990).
+3. Attitude P: R_d from b3_d and the yaw reference as PX4's ``bodyzToAttitude`` (its ZYX yaw
+   is the reference), the error 2 sign(w) (x, y, z) of the quaternion of R^T R_d (body
+   frame), rate setpoint (K_roll e1, K_pitch e2, K_yaw e3) plus the yaw rate reference
+   expressed in the body frame, each limited to its maximum rate.
+4. Rate PID per unit inertia: alpha = K_p e_w + int(i_f K_i e_w) - K_d w' with the derivative
+   on the measured rate (differenced, low-passed at IMU_DGYRO_CUTOFF), PX4's
+   i_f = max(0, 1 - (e_w / 400 deg/s)^2), the integral within ``rate_i_limit`` times the
+   axis' full torque (l K for roll and pitch, 2 d K for yaw) over its inertia
+   (FLAG_INTEGRATOR_HOLD). Torques J alpha: U2 = Jxx alpha_x / l, U3 = Jyy alpha_y / l,
+   U4 = Jzz alpha_z. No gyroscopic compensation (PX4 has none).
+
+The derivatives are zero in the first period (no previous sample). Not modelled: PX4's yaw
+weight (MC_YAW_WEIGHT; the full attitude error is used), its hover-thrust estimator (the
+vehicle row's m g is used), the xy thrust margin, and flags for the speed and rate limits
+(the command layout has no bit for them).
+
+Rate gains. PX4's are in normalized torque (1 = the full torque) per rad/s. Converted with
+this vehicle's full roll torque l K / Jxx = 800 rad/s^2, MC_ROLLRATE_P = 0.15 would be
+120 1/s: a rate-loop crossover eight times above the 15 rad/s rotor lag, which is unstable.
+So they are designed for the lag instead (:func:`rate_pid_design`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from ..layout import (
+    CONTROLLER_SIG, FLAG_INTEGRATOR_HOLD, FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT, P, P_D, P_G, P_JXX,
+    P_JYY, P_JZZ, P_K, P_L, P_M, PHI, PSI, Q, R, REF_AX, REF_AY, REF_AZ, REF_PSI, REF_PSI_DOT,
+    REF_VX, REF_VY, REF_VZ, REF_X, REF_Y, REF_Z, THETA, VX, VY, VZ, X, Y, Z,
+)
+from .design import _check_gains, _control
+from .position import check_positive, limit
+from .so3 import attitude_px4, clamp, command_from_rotation, error_quaternion, limit_tilt, rotation_zyx
+
+# gains layout
+(C_POS_XY, C_POS_Z, C_VEL_P_XY, C_VEL_I_XY, C_VEL_D_XY, C_VEL_P_Z, C_VEL_I_Z, C_VEL_D_Z,
+ C_VMAX_XY, C_VMAX_UP, C_VMAX_DOWN, C_MAX_TILT, C_THR_MIN, C_THR_MAX, C_ATT_RP, C_ATT_YAW,
+ C_RMAX_RP, C_RMAX_YAW, C_RATE_P, C_RATE_I, C_RATE_D, C_YRATE_P, C_YRATE_I, C_YRATE_D,
+ C_RATE_I_LIM, C_VEL_D_LP, C_RATE_D_LP) = range(27)
+CASCADE_GAINS = 27
+# memory: velocity integral [m/s^2], rate integral [rad/s^2], last velocity and rate, their
+# low-passed derivatives (6 slots after the last values), and a flag set after period one
+M_VI, M_RI, M_V, M_W, M_VD, M_WD, M_INIT = 0, 3, 6, 9, 12, 15, 18
+CASCADE_MEMORY = 19
+I_FACTOR_RATE = math.radians(400.0)
+"""PX4's rate error at which the rate integral stops growing [rad/s]."""
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _derivative(mem, j, value, dt, alpha, first):
+    """Low-passed backward difference of ``value``; its last sample is mem[j], the filter
+    state mem[j + 6]. Zero in the first period."""
+    if not first:
+        mem[j + 6] += alpha * ((value - mem[j]) / dt - mem[j + 6])
+    mem[j] = value
+    return mem[j + 6]
+
+
+@njit(cache=True, error_model="numpy")
+def constrain_xy(v0x, v0y, v1x, v1y, vmax):
+    """PX4 ``ControlMath::constrainXY``: v0 + v1 limited to norm vmax, v0 taking priority.
+
+    >>> constrain_xy(3.0, 0.0, 0.0, 5.0, 5.0)         # v0 kept, v1 scaled to fit
+    (3.0, 4.0)
+    """
+    sx, sy = v0x + v1x, v0y + v1y
+    if math.hypot(sx, sy) <= vmax:
+        return sx, sy
+    n0 = math.hypot(v0x, v0y)
+    if n0 >= vmax:
+        return v0x / n0 * vmax, v0y / n0 * vmax
+    n1 = math.hypot(v1x, v1y)
+    if n0 < 1e-3:
+        return v1x / n1 * vmax, v1y / n1 * vmax
+    ux, uy = v1x / n1, v1y / n1
+    mm = ux * v0x + uy * v0y
+    s = -mm + math.sqrt(mm * mm - (n0 * n0 - vmax * vmax))
+    return v0x + ux * s, v0y + uy * s
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _rate_axis(mem, j, setpoint, rate, dt, alpha, first, kp, ki, kd, i_limit):
+    """PX4 rate PID on axis j, per unit inertia [rad/s^2]; the integral updates after use."""
+    e = setpoint - rate
+    out = kp * e + mem[M_RI + j] - kd * _derivative(mem, M_W + j, rate, dt, alpha, first)
+    i_factor = max(0.0, 1.0 - (e / I_FACTOR_RATE) ** 2)
+    mem[M_RI + j], held = clamp(mem[M_RI + j] + i_factor * ki * e * dt, -i_limit, i_limit)
+    return out, held
+
+
+@njit(CONTROLLER_SIG, cache=True, error_model="numpy")
+def cascade(t, dt, x, ref, vp, gains, mem, cmd):
+    """PX4-style cascade: P position, PID velocity, P attitude, PID body rate."""
+    m, g, G = vp[P_M], vp[P_G], gains
+    first = mem[M_INIT] == 0.0
+    mem[M_INIT] = 1.0
+    av = dt / (dt + 1.0 / (2.0 * math.pi * G[C_VEL_D_LP]))
+    aw = dt / (dt + 1.0 / (2.0 * math.pi * G[C_RATE_D_LP]))
+    flags = 0
+    # 1. position P -> velocity setpoint
+    vsx, vsy = constrain_xy(G[C_POS_XY] * (ref[REF_X] - x[X]), G[C_POS_XY] * (ref[REF_Y] - x[Y]),
+                            ref[REF_VX], ref[REF_VY], G[C_VMAX_XY])
+    vsz, _ = clamp(G[C_POS_Z] * (ref[REF_Z] - x[Z]) + ref[REF_VZ], -G[C_VMAX_DOWN], G[C_VMAX_UP])
+    # 2. velocity PID -> acceleration -> thrust vector
+    ex, ey, ez = vsx - x[VX], vsy - x[VY], vsz - x[VZ]
+    ax = G[C_VEL_P_XY] * ex + mem[M_VI] - G[C_VEL_D_XY] * _derivative(mem, M_V, x[VX], dt, av, first)
+    ay = G[C_VEL_P_XY] * ey + mem[M_VI + 1] - G[C_VEL_D_XY] * _derivative(mem, M_V + 1, x[VY], dt, av, first)
+    az = G[C_VEL_P_Z] * ez + mem[M_VI + 2] - G[C_VEL_D_Z] * _derivative(mem, M_V + 2, x[VZ], dt, av, first)
+    ax, ay, az = ax + ref[REF_AX], ay + ref[REF_AY], az + ref[REF_AZ]
+    hx, hy, tilted = limit_tilt(ax, ay, g, G[C_MAX_TILT])
+    if tilted:
+        flags |= FLAG_TILT_LIMIT
+    n = math.sqrt(hx * hx + hy * hy + g * g)
+    b3x, b3y, b3z = hx / n, hy / n, g / n
+    u_min, u_max = G[C_THR_MIN] * m * g, G[C_THR_MAX] * 4.0 * vp[P_K]
+    U1, limited = clamp(m * (g + az) / b3z, u_min, u_max)
+    if limited:
+        flags |= FLAG_THRUST_LIMIT
+        if (U1 == u_min and ez <= 0.0) or (U1 == u_max and ez >= 0.0):
+            ez = 0.0                                      # vertical anti-windup
+            flags |= FLAG_INTEGRATOR_HOLD
+    px, py = U1 * b3x / m, U1 * b3y / m                   # horizontal acceleration produced
+    if ax * ax + ay * ay > px * px + py * py:             # tracking anti-windup
+        ex -= 2.0 / G[C_VEL_P_XY] * (ax - px)
+        ey -= 2.0 / G[C_VEL_P_XY] * (ay - py)
+    mem[M_VI] += G[C_VEL_I_XY] * ex * dt
+    mem[M_VI + 1] += G[C_VEL_I_XY] * ey * dt
+    mem[M_VI + 2], _ = clamp(mem[M_VI + 2] + G[C_VEL_I_Z] * ez * dt, -g, g)
+    # 3. attitude P -> body-rate setpoints (+ the yaw rate reference in the body frame)
+    Rm, Rd = np.empty((3, 3)), np.empty((3, 3))
+    rotation_zyx(x[PHI], x[THETA], x[PSI], Rm)
+    attitude_px4(b3x, b3y, b3z, ref[REF_PSI], Rd)
+    e1, e2, e3 = error_quaternion(Rm, Rd)
+    yr = ref[REF_PSI_DOT]
+    sp1, _ = limit(G[C_ATT_RP] * e1 + Rm[2, 0] * yr, G[C_RMAX_RP])
+    sp2, _ = limit(G[C_ATT_RP] * e2 + Rm[2, 1] * yr, G[C_RMAX_RP])
+    sp3, _ = limit(G[C_ATT_YAW] * e3 + Rm[2, 2] * yr, G[C_RMAX_YAW])
+    # 4. rate PID -> torques
+    full = vp[P_L] * vp[P_K]                              # full roll/pitch torque [N m]
+    a1, h1 = _rate_axis(mem, 0, sp1, x[P], dt, aw, first, G[C_RATE_P], G[C_RATE_I], G[C_RATE_D],
+                        G[C_RATE_I_LIM] * full / vp[P_JXX])
+    a2, h2 = _rate_axis(mem, 1, sp2, x[Q], dt, aw, first, G[C_RATE_P], G[C_RATE_I], G[C_RATE_D],
+                        G[C_RATE_I_LIM] * full / vp[P_JYY])
+    a3, h3 = _rate_axis(mem, 2, sp3, x[R], dt, aw, first, G[C_YRATE_P], G[C_YRATE_I], G[C_YRATE_D],
+                        G[C_RATE_I_LIM] * 2.0 * vp[P_D] * vp[P_K] / vp[P_JZZ])
+    if h1 or h2 or h3:
+        flags |= FLAG_INTEGRATOR_HOLD
+    command_from_rotation(U1, vp[P_JXX] * a1 / vp[P_L], vp[P_JYY] * a2 / vp[P_L], vp[P_JZZ] * a3,
+                          Rd, flags, vp, cmd)
+
+
+@dataclass(frozen=True)
+class RateGains:
+    """Body-rate PID per unit inertia: alpha = kp e + ki int(e) - kd w' [rad/s^2], torque J alpha.
+
+    kp [1/s], ki [1/s^2], kd [-]; the derivative acts on the measured rate.
+    """
+
+    kp: float
+    ki: float
+    kd: float
+
+    def __post_init__(self):
+        _check_gains(self, ("kp", "ki", "kd"))
+
+
+RATE_ZETA = 0.8
+"""Damping of the rate loop over the rotor lag (the attitude design's zeta)."""
+PX4_RATE_I_RATIO = 0.2 / 0.15
+"""MC_ROLLRATE_I / MC_ROLLRATE_P [1/s], PX4 defaults (the same for pitch)."""
+PX4_YAW_RATE_I_RATIO = 0.1 / 0.2
+"""MC_YAWRATE_I / MC_YAWRATE_P [1/s], PX4 defaults (MC_YAWRATE_D = 0)."""
+
+
+def rate_pid_design(actuator_bandwidth: float = 15.0, yaw: bool = False) -> RateGains:
+    """Rate gains for a rotor lag of bandwidth w: w' = alpha, alpha' = w (alpha_c - alpha).
+
+    With alpha_c = kp e - kd w' the rate loop is s^2 + w (1 + kd) s + w kp. Roll and pitch:
+    its pair at wn = w, zeta = 0.8, so kp = w, kd = 2 zeta - 1 = 0.6. Yaw keeps PX4's shape
+    without D: zeta = 0.8 gives kp = w / (4 zeta^2). The integral keeps PX4's I/P ratio (its
+    zero at 1.3 rad/s, 0.5 rad/s for yaw, far below the crossovers).
+
+    For the Qball's w = 15 rad/s (:func:`rate_loops`, D low-passed at 30 Hz): the roll/pitch
+    rate loop crosses over at 12.7 rad/s, below the lag, with a 71 deg phase margin, and the
+    attitude loop around it (MC_ROLL_P = 6.5) at 6.9 rad/s with 45 deg and a gain margin of
+    3.2; its closed-loop poles are -3.3 +/- 9.0j (zeta 0.34), -17.4, -1.3, -178. Yaw: 5.5
+    rad/s and 65 deg, attitude (MC_YAW_P = 2.8) 3.0 rad/s and 60 deg. PX4's attitude gain
+    6.5 expects a rate loop faster than this lag allows, hence the modest attitude damping;
+    with the position and velocity loops the whole linearised x loop has a worst damping
+    ratio of 0.22 and a 1 m step overshoots 13 % (PX4's position P on a raw step).
+
+    >>> g = rate_pid_design()
+    >>> round(g.kp, 6), round(g.ki, 6), round(g.kd, 6)
+    (15.0, 20.0, 0.6)
+    >>> g = rate_pid_design(yaw=True)
+    >>> round(g.kp, 3), round(g.ki, 3), g.kd
+    (5.859, 2.93, 0.0)
+    """
+    check_positive("rate_pid_design", actuator_bandwidth=actuator_bandwidth)
+    w = float(actuator_bandwidth)
+    if yaw:
+        kp = w / (4.0 * RATE_ZETA**2)
+        return RateGains(kp=kp, ki=PX4_YAW_RATE_I_RATIO * kp, kd=0.0)
+    return RateGains(kp=w, ki=PX4_RATE_I_RATIO * w, kd=2.0 * RATE_ZETA - 1.0)
+
+
+def rate_loops(controller, actuator_bandwidth: float = 15.0, axis: str = "roll") -> dict:
+    """Linearised single-axis loops of a Cascade at hover, as python-control transfer functions.
+
+    ``rate``: open loop of the rate PID (D low-passed at ``rate_d_cutoff``) over the rotor
+    lag and w' = alpha; ``attitude``: open loop K_att T_rate / s with T_rate the closed rate
+    loop; ``closed``: angle / angle setpoint. ``axis``: 'roll' (= 'pitch') or 'yaw'.
+
+    >>> from quadcruise.control.modern import Cascade
+    >>> import control
+    >>> loops = rate_loops(Cascade())
+    >>> [round(float(v), 1) for v in control.stability_margins(loops["rate"])[1::3]]
+    [70.9, 12.7]
+    >>> [round(float(v), 1) for v in control.stability_margins(loops["attitude"])[1::3]]
+    [45.1, 6.9]
+    """
+    ct = _control()
+    s = ct.tf("s")
+    g, k_att = (controller.yaw_rate, controller.yaw_p) if axis == "yaw" else (controller.rate, controller.roll_p)
+    fc = 2.0 * math.pi * controller.rate_d_cutoff
+    plant = actuator_bandwidth / (s + actuator_bandwidth) / s
+    pi_part = g.kp + g.ki / s
+    rate = plant * (pi_part + g.kd * s * fc / (s + fc))
+    t_rate = ct.minreal(plant * pi_part / (1 + rate), verbose=False)
+    attitude = k_att * t_rate / s
+    return {"rate": rate, "attitude": attitude, "closed": ct.feedback(attitude, 1)}

@@ -1,0 +1,163 @@
+"""Rotations for the geometric (SE(3)) and the PX4-style cascade controllers.
+
+The model's attitude (eqs 5-7) is the ZYX Euler rotation R = Rz(psi) Ry(theta) Rx(phi),
+body to earth coordinates, z up; its third column b3 = R e3 is the thrust direction,
+
+    b3 = (sin phi sin psi + cos phi sin theta cos psi,
+          -sin phi cos psi + cos phi sin theta sin psi,  cos phi cos theta),
+
+exactly the factors of U1/m in eqs (5)-(7). Roll torque l U2 acts about body x, pitch l U3
+about body y and yaw U4 about body z (eq 11), so (p, q, r) is the body angular velocity.
+
+Compiled scalar code; a matrix is a (3, 3) float64 array filled in place (``out``). Also
+here: :func:`command_from_rotation`, the shared tail of these controllers (duties, logged
+inputs and setpoints), and :func:`clamp`.
+
+>>> import numpy as np
+>>> R = np.empty((3, 3))
+>>> rotation_zyx(0.1, -0.2, 0.3, R)
+>>> bool(np.allclose(R.T @ R, np.eye(3))), [round(float(a), 12) for a in euler_zyx(R)]
+(True, [0.1, -0.2, 0.3])
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from ..layout import (
+    CMD_FLAGS, CMD_PHI_D, CMD_PSI_D, CMD_TAU_PHI, CMD_TAU_PSI, CMD_TAU_THETA, CMD_THETA_D, CMD_THRUST,
+)
+from ..model.actuators import duties_from_inputs
+
+
+@njit(cache=True, error_model="numpy")
+def rotation_zyx(phi, theta, psi, out):
+    """out = Rz(psi) Ry(theta) Rx(phi): the body-to-earth rotation of the paper's angles."""
+    sf, cf = math.sin(phi), math.cos(phi)
+    st, ct = math.sin(theta), math.cos(theta)
+    sp, cp = math.sin(psi), math.cos(psi)
+    out[0, 0], out[0, 1], out[0, 2] = cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf
+    out[1, 0], out[1, 1], out[1, 2] = sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf
+    out[2, 0], out[2, 1], out[2, 2] = -st, ct * sf, ct * cf
+
+
+@njit(cache=True, error_model="numpy")
+def euler_zyx(Rm):
+    """(phi, theta, psi) of a rotation R = Rz(psi) Ry(theta) Rx(phi), |theta| <= pi/2."""
+    s = min(1.0, max(-1.0, -Rm[2, 0]))
+    return math.atan2(Rm[2, 1], Rm[2, 2]), math.asin(s), math.atan2(Rm[1, 0], Rm[0, 0])
+
+
+@njit(cache=True, error_model="numpy")
+def limit_tilt(hx, hy, vz, max_tilt):
+    """Scale the horizontal part (hx, hy) of a vector with vertical part vz so that the
+    vector is at most ``max_tilt`` from the vertical; returns (hx, hy, limited).
+
+    A vector pointing level or down (vz <= 0) loses its horizontal part (and counts as
+    limited): the thrust direction then falls back to straight up.
+    """
+    if vz <= 0.0:
+        return 0.0, 0.0, True
+    h = math.hypot(hx, hy)
+    hmax = vz * math.tan(max_tilt)
+    if h > hmax:
+        k = hmax / h
+        return hx * k, hy * k, True
+    return hx, hy, False
+
+
+@njit(cache=True, error_model="numpy")
+def attitude_lee(b3x, b3y, b3z, psi, out):
+    """Desired rotation of Lee et al. (2010): b3 given (unit), b1 the projection of the
+    heading c1 = (cos psi, sin psi, 0) on the plane normal to b3: b2 = b3 x c1 / |b3 x c1|,
+    b1 = b2 x b3. Needs b3 away from the horizontal heading (true for any tilt < 90 deg)."""
+    cx, cy = math.cos(psi), math.sin(psi)
+    b2x, b2y, b2z = -b3z * cy, b3z * cx, b3x * cy - b3y * cx        # b3 x c1, c1z = 0
+    n = math.sqrt(b2x * b2x + b2y * b2y + b2z * b2z)
+    b2x, b2y, b2z = b2x / n, b2y / n, b2z / n
+    _columns(b2y * b3z - b2z * b3y, b2z * b3x - b2x * b3z, b2x * b3y - b2y * b3x,
+             b2x, b2y, b2z, b3x, b3y, b3z, out)
+
+
+@njit(cache=True, error_model="numpy")
+def attitude_px4(b3x, b3y, b3z, psi, out):
+    """Desired rotation as PX4's ``bodyzToAttitude``: b3 given (unit), b1 normal to the
+    yaw frame's y axis c2 = (-sin psi, cos psi, 0): b1 = c2 x b3 / |c2 x b3|, b2 = b3 x b1.
+    Its ZYX yaw is exactly psi (b1 stays in the vertical plane of the heading)."""
+    cx, cy = -math.sin(psi), math.cos(psi)
+    b1x, b1y, b1z = cy * b3z, -cx * b3z, cx * b3y - cy * b3x        # c2 x b3, c2z = 0
+    n = math.sqrt(b1x * b1x + b1y * b1y + b1z * b1z)
+    b1x, b1y, b1z = b1x / n, b1y / n, b1z / n
+    _columns(b1x, b1y, b1z, b3y * b1z - b3z * b1y, b3z * b1x - b3x * b1z, b3x * b1y - b3y * b1x,
+             b3x, b3y, b3z, out)
+
+
+@njit(cache=True, inline="always")
+def _columns(ax, ay, az, bx, by, bz, cx, cy, cz, out):
+    out[0, 0], out[1, 0], out[2, 0] = ax, ay, az
+    out[0, 1], out[1, 1], out[2, 1] = bx, by, bz
+    out[0, 2], out[1, 2], out[2, 2] = cx, cy, cz
+
+
+@njit(cache=True, inline="always")
+def _tn(A, B, i, j):
+    """(A^T B)[i, j]."""
+    return A[0, i] * B[0, j] + A[1, i] * B[1, j] + A[2, i] * B[2, j]
+
+
+@njit(cache=True, error_model="numpy")
+def error_lee(Rm, Rd):
+    """Lee's attitude error e_R = vee(Rd^T R - R^T Rd) / 2 (body frame): sin(angle) times
+    the axis of the rotation from the desired to the current attitude."""
+    return (0.5 * (_tn(Rd, Rm, 2, 1) - _tn(Rd, Rm, 1, 2)),
+            0.5 * (_tn(Rd, Rm, 0, 2) - _tn(Rd, Rm, 2, 0)),
+            0.5 * (_tn(Rd, Rm, 1, 0) - _tn(Rd, Rm, 0, 1)))
+
+
+@njit(cache=True, error_model="numpy")
+def error_quaternion(Rm, Rd):
+    """PX4's attitude error 2 sign(w) (x, y, z) of the quaternion of R^T Rd (body frame):
+    2 sin(angle / 2) times the axis of the rotation from the current to the desired
+    attitude, angle in [0, pi]. The quaternion is taken by Shepperd's method."""
+    m00, m11, m22 = _tn(Rm, Rd, 0, 0), _tn(Rm, Rd, 1, 1), _tn(Rm, Rd, 2, 2)
+    d21, d02, d10 = _tn(Rm, Rd, 2, 1) - _tn(Rm, Rd, 1, 2), _tn(Rm, Rd, 0, 2) - _tn(Rm, Rd, 2, 0), \
+        _tn(Rm, Rd, 1, 0) - _tn(Rm, Rd, 0, 1)
+    s01, s02, s12 = _tn(Rm, Rd, 0, 1) + _tn(Rm, Rd, 1, 0), _tn(Rm, Rd, 0, 2) + _tn(Rm, Rd, 2, 0), \
+        _tn(Rm, Rd, 1, 2) + _tn(Rm, Rd, 2, 1)
+    tr = m00 + m11 + m22
+    if tr > 0.0:
+        S = 2.0 * math.sqrt(tr + 1.0)
+        w, x, y, z = 0.25 * S, d21 / S, d02 / S, d10 / S
+    elif m00 >= m11 and m00 >= m22:
+        S = 2.0 * math.sqrt(1.0 + m00 - m11 - m22)
+        w, x, y, z = d21 / S, 0.25 * S, s01 / S, s02 / S
+    elif m11 >= m22:
+        S = 2.0 * math.sqrt(1.0 + m11 - m00 - m22)
+        w, x, y, z = d02 / S, s01 / S, 0.25 * S, s12 / S
+    else:
+        S = 2.0 * math.sqrt(1.0 + m22 - m00 - m11)
+        w, x, y, z = d10 / S, s02 / S, s12 / S, 0.25 * S
+    k = 2.0 if w >= 0.0 else -2.0
+    return k * x, k * y, k * z
+
+
+@njit(cache=True, error_model="numpy")
+def command_from_rotation(U1, U2, U3, U4, Rd, flags, vp, cmd):
+    """Write the command: the duties for (U1..U4) (:func:`duties_from_inputs`), the desired
+    inputs, the ZYX angles of the desired rotation Rd as (phi_d, theta_d, psi_d), the flags."""
+    duties_from_inputs(U1, U2, U3, U4, vp, cmd)
+    cmd[CMD_THRUST], cmd[CMD_TAU_PHI], cmd[CMD_TAU_THETA], cmd[CMD_TAU_PSI] = U1, U2, U3, U4
+    cmd[CMD_PHI_D], cmd[CMD_THETA_D], cmd[CMD_PSI_D] = euler_zyx(Rd)
+    cmd[CMD_FLAGS] = flags
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def clamp(value, low, high):
+    """value within [low, high], and whether it had to be moved."""
+    if value < low:
+        return low, True
+    if value > high:
+        return high, True
+    return value, False
