@@ -247,6 +247,41 @@ def compare(mission, controllers, duration, dt, mission_params, out, force):
         click.echo(f"wrote metrics.csv and comparison.png to {out}")
 
 
+@main.command()
+@click.option("--controller", default="nlpd", show_default=True, help="Controller name.")
+@click.option("-c", "--controller-param", "controller_params", multiple=True, metavar="KEY=VALUE",
+              help="Controller parameter (repeatable).")
+@click.option("--poles", "position_poles", metavar="P1,P2", help="Closed-loop poles of the x/y loops [rad/s].")
+@click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
+@click.option("--out", type=click.Path(file_okay=False), help="Folder for analysis.json and Bode plots.")
+@click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
+@_friendly
+def analyze(controller, controller_params, position_poles, dt, out, force):
+    """Linearise the closed loop about hover: poles, damping, margins of each loop, Bode plots."""
+    import json
+    from pathlib import Path
+
+    from .analysis import bode, linearize, report, summary, to_json
+    from .io import MARKER, atomic_dir
+    from .plots import save_figure
+
+    the_controller = _controller_from_options(controller, controller_params, position_poles)
+    if out is not None:
+        check_output_dir(out, force)
+    lin = linearize(the_controller, dt=dt)
+    rep = report(the_controller, lin=lin)
+    click.echo(summary(rep))
+    if out is not None:
+        with atomic_dir(out) as tmp:
+            tmp = Path(tmp)
+            (tmp / "analysis.json").write_text(to_json(rep) + "\n")
+            save_figure(bode(lin, loops=True), tmp / "bode.png")
+            save_figure(bode(lin, loops=True, at="output"), tmp / "bode_output.png")
+            (tmp / MARKER).write_text(json.dumps({"workflow": "analyze", "controller": the_controller.to_dict(),
+                                                  "dt_s": dt, "version": __version__}, default=str) + "\n")
+        click.echo(f"wrote analysis.json and Bode plots to {out}")
+
+
 def _mission(text: str, params: tuple[str, ...], smooth: bool):
     """A mission from a name or a waypoint CSV, with KEY=VALUE parameters."""
     from .missions import mission_from_name

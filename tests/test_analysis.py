@@ -1,0 +1,222 @@
+"""Linear analysis about hover, checked against the hand-built cascade, the nonlinear flight,
+the design's loop margins and itself (closing a broken loop gives the closed loop back)."""
+
+from __future__ import annotations
+
+import json
+import warnings
+
+import control
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+from numba import njit
+
+import quadcruise as qc
+from quadcruise.analysis import (
+    LOOPS, HoverError, bode, linearize, loop_margins, loop_transfer, report, summary, to_json,
+)
+from quadcruise.control.baselines import Gonzalez
+from quadcruise.control.design import (
+    cascade_state_space, loop_margins as design_margins, loop_transfer as design_loop, pd_from_poles,
+)
+from quadcruise.control.position import NLPD
+from quadcruise.errors import InputError
+from quadcruise.layout import CONTROLLER_SIG
+from quadcruise.missions import Step
+
+
+@pytest.fixture(scope="module")
+def lin():
+    return linearize("nlpd")
+
+
+def _matched(found, wanted):
+    """Largest relative distance from each wanted pole to the found poles, one to one."""
+    found, worst = list(np.asarray(found, complex)), 0.0
+    for p in np.asarray(wanted, complex):
+        i = int(np.argmin([abs(q - p) for q in found]))
+        worst = max(worst, abs(found.pop(i) - p) / abs(p))
+    return worst, found
+
+
+# (a) the full loop against design.cascade_state_space -----------------------------------------
+
+@pytest.mark.parametrize("dt, tol", [(1e-3, 0.02), (1e-4, 0.002)])
+def test_x_loop_poles_are_those_of_the_hand_built_cascade(dt, tol):
+    c = NLPD()
+    cascade = cascade_state_space(c.position, c.attitude).poles()
+    full = linearize(c, dt=dt)
+    worst, left = _matched(full.poles_continuous(), cascade)
+    assert worst < tol                           # and the gap shrinks with dt: it is the sampling
+    worst_x, left_x = _matched(full.loop_poles("x"), cascade)
+    assert worst_x < tol and left_x == []        # the x loop is exactly the cascade's 6 states
+
+
+def test_yaw_and_z_loops_are_the_design_loops_with_rotor_lag(lin):
+    """Broken at U4 and U1, the yaw and z loops are design.loop_margins' C(s) w/(s+w)/s^2."""
+    for loop, gains in (("yaw", NLPD().yaw), ("z", NLPD().altitude)):
+        ours, theirs = loop_margins(lin, loop), design_margins(gains, 15.0)
+        assert ours["phase_margin"] == pytest.approx(theirs["phase_margin"], abs=1.0)
+        assert ours["gain_crossover"] == pytest.approx(theirs["gain_crossover"], rel=0.02)
+    closed = control.feedback(design_loop(NLPD().yaw, 15.0), 1).poles()
+    assert _matched(lin.loop_poles("yaw"), closed)[0] < 0.02
+
+
+# (b) stability, and the baseline is the paper's controller to first order ---------------------
+
+@pytest.mark.parametrize("name", ["nlpd", "gonzalez"])
+def test_discrete_closed_loop_is_stable(name):
+    lin = linearize(name)
+    assert lin.stable and np.all(np.abs(lin.poles()) < 1.0)
+    assert np.all(lin.poles_continuous().real < 0)
+    assert lin.sys.nstates == 19 and lin.residual < 1e-9
+
+
+def test_gonzalez_is_nlpd_to_first_order(lin):
+    """Same small-signal poles by the baseline's gain rule: tanh slope k_p, u/g = asin(u/a)."""
+    other = linearize(Gonzalez())
+    np.testing.assert_allclose(other.sys.A, lin.sys.A, atol=1e-9)
+    np.testing.assert_allclose(other.sys.B, lin.sys.B, atol=1e-9)
+
+
+def test_continuous_equivalent_has_the_same_poles_and_unit_dc_gain(lin):
+    cont = lin.continuous()
+    assert _matched(cont.poles(), lin.poles_continuous())[0] < 1e-6
+    dc = cont.dcgain()
+    np.testing.assert_allclose([dc[0, 0], dc[1, 1], dc[2, 2], dc[5, 3]], 1.0, atol=1e-6)
+
+
+def test_loops_partition_the_state(lin):
+    idx = np.concatenate([lin.loops[k] for k in LOOPS])
+    assert sorted(idx) == list(range(19))
+    assert [len(lin.loops[k]) for k in LOOPS] == [6, 6, 3, 4]
+
+
+# (c) the linear model predicts the nonlinear flight -------------------------------------------
+
+def test_linear_step_follows_nonlinear_small_step(lin):
+    res = qc.fly(Step(axis="x", size=0.01, time=1.0), duration=11.0)
+    k0 = int(np.searchsorted(res.t, 1.0))
+    T = lin.dt * np.arange(len(res.t) - k0)
+    y = control.step_response(lin.sys, T=T, input=0, output=0).outputs
+    assert np.max(np.abs(res.state("x")[0, k0:] / 0.01 - y)) < 1e-4
+    assert abs(y[-1] - 1.0) < 0.01
+
+
+# (d) margins -----------------------------------------------------------------------------------
+
+def test_closing_a_broken_loop_gives_the_closed_loop_back(lin):
+    want = lin.poles()
+    for loop in LOOPS:
+        for at in ("input", "output"):
+            L = loop_transfer(lin, loop, at)
+            closed = np.linalg.eigvals(L.A - L.B @ L.C)        # w = -L w: negative unity feedback
+            assert _matched(closed, want)[0] < 1e-8, (loop, at)
+
+
+def test_faster_position_poles_erode_the_margins():
+    rows = []
+    for k in (0.8, 1.0, 1.2, 1.4, 2.0):
+        c = NLPD(position=pd_from_poles((-0.7 * k, -4.3 * k)))
+        lin = linearize(c)
+        rows.append((lin.stable, loop_margins(lin, "x")["phase_margin"],
+                     loop_margins(lin, "x", "output")["gain_increase"]))
+    stable, pm, gm = map(np.array, zip(*rows))
+    assert np.all(np.diff(pm) < 0) and np.all(np.diff(gm[:4]) < 0)
+    assert stable[:4].all() and pm[3] > 5.0
+    assert not stable[4] and pm[4] < 0                         # twice as fast: unstable
+
+
+def test_unknown_loop_or_break_point_is_refused(lin):
+    with pytest.raises(InputError, match="unknown loop 'pitch'"):
+        loop_margins(lin, "pitch")
+    with pytest.raises(InputError, match="at must be"):
+        loop_transfer(lin, "x", at="middle")
+
+
+# (e) no hover, no linearisation ---------------------------------------------------------------
+
+@njit(CONTROLLER_SIG)
+def _idle(t, dt, x, ref, vp, gains, mem, cmd):
+    for j in range(4):
+        cmd[j] = 0.0
+
+
+class Idle:
+    name = "idle"
+    function = staticmethod(_idle)
+
+    def gains(self):
+        return np.zeros(0)
+
+    def memory(self):
+        return np.zeros(0)
+
+
+def test_a_controller_that_cannot_hover_is_refused():
+    with pytest.raises(HoverError, match="idle does not hold hover at z = 1 m: 'F1' moves"):
+        linearize(Idle())
+    assert issubclass(HoverError, InputError)
+    with pytest.raises(InputError, match="lacks function, gains, memory"):
+        linearize(object())
+
+
+class FirstCallFlag:
+    """nlpd plus a memory entry set in its first period (as a derivative's first sample is):
+    a plain Python function, which linearize can call as well as a compiled one."""
+    name = "flagged"
+
+    @staticmethod
+    def function(t, dt, x, ref, vp, gains, mem, cmd):
+        inner = np.ascontiguousarray(mem[:3])
+        NLPD().function(t, dt, x, ref, vp, gains, inner, cmd)
+        mem[:3], mem[3] = inner, 1.0
+
+    def gains(self):
+        return NLPD().gains()
+
+    def memory(self):
+        return np.zeros(4)
+
+
+def test_memory_set_in_the_first_period_settles(lin):
+    with pytest.raises(HoverError, match="'mem3' moves at 1e\\+03 per second"):
+        linearize(FirstCallFlag(), settle=0)
+    flagged = linearize(FirstCallFlag())
+    np.testing.assert_allclose(flagged.sys.A[:19, :19], lin.sys.A, atol=1e-12)
+    assert flagged.stable and flagged.poles_continuous()[-1].real == -np.inf   # the flag: z = 0
+    with pytest.raises(InputError, match="no continuous equivalent"):
+        flagged.continuous()
+    np.testing.assert_allclose(flagged.loop_poles("x"), lin.loop_poles("x"), rtol=1e-9)
+
+
+def test_hover_elsewhere_and_heavier_vehicle_still_linearise():
+    lin = linearize("nlpd", qc.Vehicle.paper().replace(m=1.4), hover_z=3.0)
+    assert lin.stable
+
+
+# report and figure -----------------------------------------------------------------------------
+
+def test_report_compares_with_the_design_poles(lin):
+    r = report("nlpd", lin=lin)
+    assert json.loads(to_json(r)) == json.loads(json.dumps(r))           # all finite here
+    assert "nlpd about hover, dt = 0.001 s: stable" in summary(r) and "-4.3:85%" in summary(r)
+    assert json.loads(to_json({"gm": float("inf")})) == {"gm": None}
+    x = r["loops"]["x"]
+    assert x["design_poles"] == [-0.7, -4.3]
+    assert x["dominant"] == pytest.approx([-0.658, 0.0], abs=1e-3)   # the design's slow pole survives
+    assert x["nearest_rel_distance"][0] < 0.1 < 0.5 < x["nearest_rel_distance"][1]   # its -4.3 does not
+    assert 0.3 < x["min_damping"] < 0.45                    # design.py: worst damping 0.37
+    assert r["loops"]["y"]["poles"] == x["poles"]
+    assert r["loops"]["yaw"]["margins_input"]["gain_decrease"] > 0   # PID on a double integrator
+    assert all(e["margins_input"]["open_loop_unstable_poles"] == 0 for e in r["loops"].values())
+
+
+def test_bode_draws_closed_loops_and_loop_transfers(lin):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert len(bode(lin).axes) == 2
+        fig = bode(lin, loops=True, at="output")
+    assert isinstance(fig, Figure) and len(fig.axes) == 4
+    assert len(fig.axes[0].lines) == 4 + 1                   # four loops and the 0 dB line
