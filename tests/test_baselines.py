@@ -11,12 +11,11 @@ import pytest
 import quadcruise as qc
 from quadcruise.control import CONTROLLERS, Gonzalez, controller_from_name
 from quadcruise.control.attitude import ATT_GAINS
-from quadcruise.control.baselines import G0, gonzalez, saturated_pd
+from quadcruise.control.baselines import gonzalez, saturated_pd
 from quadcruise.control.position import NLPD, nlpd
 from quadcruise.errors import InputError
 from quadcruise.layout import (
-    CMD_FLAGS, CMD_PHI_D, CMD_SIZE, CMD_THETA_D, F1, FLAG_TILT_LIMIT, P_G, P_M, REF_SIZE, REF_VX,
-    REF_VY, REF_X, REF_Y, REF_Z, STATE_SIZE, VX, VY, Z,
+    CMD_FLAGS, CMD_PHI_D, CMD_SIZE, CMD_THETA_D, F1, FLAG_TILT_LIMIT, P_G, P_M, REF_SIZE, REF_X, REF_Y, REF_Z, STATE_SIZE, VX, VY, Z,
 )
 from quadcruise.params import Vehicle
 

@@ -38,5 +38,5 @@ def test_quick_benchmark_writes_positive_figures(tmp_path):
 
     startup = results["startup"]
     assert positive(startup["python_warm_s"]), startup
-    assert "python_cold_s" not in startup                               # no --cold: the cache is kept
+    assert "python_cold_s" not in startup                               # no --cold: warm only
     assert positive(startup["cli_warm_s"]) or "cli_skipped" in startup, startup

@@ -14,7 +14,7 @@ from quadcruise.control.design import PIDGains, attitude_pid_design, cascade_sta
 from quadcruise.control.position import nlpd, phi_from_eq6, theta_from_eq5
 from quadcruise.layout import (
     CMD_FLAGS, CMD_PHI_D, CMD_SIZE, CMD_THETA_D, FLAG_TILT_LIMIT, P, PHI, PSI, Q, R, REF_SIZE,
-    REF_X, REF_Z, STATE_SIZE, THETA,
+    REF_X, STATE_SIZE, THETA,
 )
 from quadcruise.missions import Circle, Hover, Step
 from quadcruise.model.plant import derivative

@@ -1,7 +1,6 @@
 """The engine's environment: sensor delay and noise, model error, wind through drag,
 rotor damage, and the full-kinematics plant."""
 
-import math
 
 import numpy as np
 import pytest
@@ -13,7 +12,7 @@ import quadcruise as qc
 from quadcruise.control.openloop import duty_schedule, pack_schedule
 from quadcruise.layout import (
     CMD_PHI_D, CMD_THETA_D, CONTROLLER_SIG, DISTURBANCE_SIG, EXT_E1, EXT_SIZE, EXT_WX, F1, P,
-    PHI, PSI, Q, R, STATE_SIZE, THETA, VX, X, Z,
+    PHI, PSI, R, STATE_SIZE, VX, X, Z,
 )
 from quadcruise.missions import Hover
 from quadcruise.replay import no_reference

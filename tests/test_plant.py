@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import quadcruise as qc
-from quadcruise.layout import F1, P_K1, P_K3, P_K5, PHI, STATE_SIZE, P, Q, R
+from quadcruise.layout import F1, P_K1, P_K3, P_K5, STATE_SIZE, P, Q, R
 from quadcruise.model.actuators import mix, unmix
 from quadcruise.model.plant import derivative
 from reference_model import still_air_ext

@@ -34,7 +34,7 @@ def test_example_replays_and_writes_states(tmp_path):
 
 
 BAD = {
-    "missing_column": ("t,u1,u2,u3\n0,0.1,0.1,0.1\n1,0.1,0.1,0.1\n", "missing column(s) u4"),
+    "missing_column": ("t,u1,u2,u3\n0,0.1,0.1,0.1\n1,0.1,0.1,0.1\n", "column(s) 'u4': missing"),
     "not_a_number": ("t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,0.1,abc,0.1,0.1\n", "line 3, column 'u2': 'abc' is not a number"),
     "nan": ("t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,0.1,0.1,nan,0.1\n", "line 3, column 'u3': value is NaN"),
     "time_not_increasing": ("t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,0.1,0.1,0.1,0.1\n1,0.1,0.1,0.1,0.1\n",

@@ -21,8 +21,8 @@ from . import __version__
 from .control import Controller, controller_from_name
 from .engine import Limits, simulate, time_grid
 from .errors import InputError
-from .layout import F1, PSI, REF_PSI, REF_X, REF_Y, REF_Z, STATE_SIZE, X, Y, Z
-from .missions import Circle, Hover, Mission, Square, Step, mission_from_name, stack_params
+from .layout import F1, PSI, REF_PSI, REF_Z, STATE_SIZE, Z
+from .missions import Circle, Mission, Square, Step, mission_from_name, stack_params
 from .params import Vehicle
 from .result import SimResult
 

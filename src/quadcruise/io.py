@@ -90,7 +90,7 @@ def write_table(frame, path: Path, fmt: str) -> Path:
                    header=",".join(map(str, frame.columns)), comments="")
     elif fmt == "parquet":
         try:
-            import pyarrow  # noqa: F401
+            import pyarrow  # noqa: F401  (pandas needs it for Parquet)
         except ImportError:
             raise InputError("writing Parquet needs pyarrow: pip install 'quadcruise[parquet]'") from None
         out = path.with_suffix(".parquet")
@@ -98,3 +98,64 @@ def write_table(frame, path: Path, fmt: str) -> Path:
     else:
         raise InputError(f"unknown table format {fmt!r}; choose csv or parquet")
     return out
+
+
+def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optional: tuple[str, ...] = (), *,
+                     blank_ok=None):
+    """Read a CSV of numbers with a header; any problem is one InputError naming the file,
+    the line and the column.
+
+    Returns ``(header_line, columns, data, lines)``: the columns used (required ones, then
+    the optional ones present, in that order), the (rows, columns) float array, and the file
+    line of each row. Blank lines are skipped but counted. Unknown columns are ignored with
+    a warning. A blank cell is an error unless ``blank_ok(column, row_index)`` says otherwise;
+    it then reads as NaN.
+    """
+    import csv
+    import math
+    import warnings
+
+    import numpy as np
+
+    from .errors import InputError
+
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: no such file")
+    try:
+        with path.open(newline="") as f:
+            rows = [(n, r) for n, r in enumerate(csv.reader(f), start=1) if any(c.strip() for c in r)]
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        raise InputError(f"{path}: cannot be read ({exc.__class__.__name__}: {exc})") from None
+    names = ",".join(required + tuple(f"[{c}]" for c in optional))
+    if not rows:
+        raise InputError(f"{path}: the file is empty (expected a header {names})")
+    head, header = rows[0][0], [h.strip() for h in rows[0][1]]
+    missing = [c for c in required if c not in header]
+    if missing:
+        raise InputError(f"{path}, line {head}, column(s) {', '.join(map(repr, missing))}: missing "
+                         f"(the header must name {names})")
+    dupes = sorted({h for h in header if header.count(h) > 1})
+    if dupes:
+        raise InputError(f"{path}, line {head}, column(s) {', '.join(map(repr, dupes))}: appear more than once")
+    extra = [h for h in header if h not in required + optional]
+    if extra:
+        warnings.warn(f"{path}: ignoring column(s) {', '.join(extra)}", stacklevel=3)
+    used = [c for c in required + optional if c in header]
+    data = np.empty((len(rows) - 1, len(used)))
+    for k, (line, row) in enumerate(rows[1:]):
+        if len(row) != len(header):
+            raise InputError(f"{path}, line {line}: has {len(row)} cells, the header has {len(header)}")
+        for j, name in enumerate(used):
+            cell = row[header.index(name)].strip()
+            if not cell and blank_ok is not None and blank_ok(name, k):
+                data[k, j] = math.nan
+                continue
+            try:
+                value = float(cell)
+            except ValueError:
+                raise InputError(f"{path}, line {line}, column '{name}': {cell!r} is not a number") from None
+            if math.isnan(value):
+                raise InputError(f"{path}, line {line}, column '{name}': value is NaN")
+            data[k, j] = value
+    return head, used, data, [line for line, _ in rows[1:]]

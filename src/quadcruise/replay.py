@@ -17,12 +17,9 @@ True
 
 from __future__ import annotations
 
-import csv
 import math
 import os
-import warnings
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from numba import njit
@@ -31,7 +28,7 @@ from . import __version__
 from .control.openloop import duty_schedule, pack_schedule
 from .engine import Limits, simulate
 from .errors import InputError
-from .io import atomic_path
+from .io import atomic_path, read_numeric_csv
 from .layout import F1, MISSION_SIG, P_K, STATE_NAMES, STATE_SIZE
 from .params import Vehicle
 from .result import SimResult
@@ -92,46 +89,10 @@ def _validated(t, duties, source: str, lines: list[int] | None = None):
 
 def read_duty_csv(path: str | os.PathLike) -> DutySchedule:
     """Read a ``t,u1,u2,u3,u4`` CSV; errors name the file, line and column."""
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: no such file")
-    try:
-        with path.open(newline="") as f:
-            rows = list(csv.reader(f))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: cannot be read ({exc.__class__.__name__}: {exc})") from None
-    rows = [(n, r) for n, r in enumerate(rows, start=1) if any(cell.strip() for cell in r)]
-    if not rows:
-        raise InputError(f"{path}: the file is empty (expected a header {','.join(INPUT_COLUMNS)})")
-    header = [h.strip() for h in rows[0][1]]
-    missing = [c for c in INPUT_COLUMNS if c not in header]
-    if missing:
-        raise InputError(f"{path}, line {rows[0][0]}: missing column(s) {', '.join(missing)} "
-                         f"(header must name {','.join(INPUT_COLUMNS)})")
-    dupes = sorted({h for h in header if header.count(h) > 1})
-    if dupes:
-        raise InputError(f"{path}, line {rows[0][0]}: column(s) {', '.join(dupes)} appear more than once")
-    extra = [h for h in header if h not in INPUT_COLUMNS]
-    if extra:
-        warnings.warn(f"{path}: ignoring column(s) {', '.join(extra)}", stacklevel=2)
-    cols = [header.index(c) for c in INPUT_COLUMNS]
-    data = np.empty((len(rows) - 1, 5))
-    for k, (line, row) in enumerate(rows[1:]):
-        if len(row) != len(header):
-            raise InputError(f"{path}, line {line}: has {len(row)} cells, the header has {len(header)}")
-        for j, c in enumerate(cols):
-            cell = row[c].strip()
-            try:
-                value = float(cell)
-            except ValueError:
-                raise InputError(f"{path}, line {line}, column '{INPUT_COLUMNS[j]}': "
-                                 f"{cell!r} is not a number") from None
-            if math.isnan(value):
-                raise InputError(f"{path}, line {line}, column '{INPUT_COLUMNS[j]}': value is NaN")
-            data[k, j] = value
+    _, _, data, lines = read_numeric_csv(path, INPUT_COLUMNS)
     if data.shape[0] < 2:
         raise InputError(f"{path}: needs at least two data rows (a start and an end time), found {data.shape[0]}")
-    _validated(data[:, 0], data[:, 1:], str(path), [line for line, _ in rows[1:]])
+    _validated(data[:, 0], data[:, 1:], str(path), lines)
     return DutySchedule(t=data[:, 0], duties=data[:, 1:], source=str(path))
 
 

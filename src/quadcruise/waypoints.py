@@ -45,14 +45,11 @@ array([[0., 0., 1.],
 
 from __future__ import annotations
 
-import csv
 import math
 import os
-import warnings
 from dataclasses import dataclass, field
 from functools import cached_property
-from pathlib import Path
-from typing import Any, ClassVar, Sequence
+from typing import Any, ClassVar
 
 import numpy as np
 import scipy.sparse
@@ -60,6 +57,7 @@ import scipy.sparse.linalg
 from numba import njit
 
 from .errors import InputError
+from .io import read_numeric_csv
 from .layout import MISSION_SIG, REF_AX, REF_PSI, REF_PSI_DOT, REF_SIZE, REF_VX, REF_X
 from .missions import Mission, _number
 
@@ -215,52 +213,17 @@ def read_waypoints_csv(path: str | os.PathLike) -> WaypointTable:
     Errors are one line naming the file, line and column; unknown columns are ignored with a
     warning. The first row's ``speed`` cell may be empty.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"{path}: no such file")
-    try:
-        with path.open(newline="") as f:
-            rows = list(csv.reader(f))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: cannot be read ({exc.__class__.__name__}: {exc})") from None
-    rows = [(n, r) for n, r in enumerate(rows, start=1) if any(cell.strip() for cell in r)]
-    if not rows:
-        raise InputError(f"{path}: the file is empty (expected a header x,y,z[,yaw][,t|speed])")
-    head_line, header = rows[0][0], [h.strip() for h in rows[0][1]]
-    missing = [c for c in ("x", "y", "z") if c not in header]
-    if missing:
-        raise InputError(f"{path}, line {head_line}, column(s) {', '.join(repr(c) for c in missing)}: "
-                         f"missing (the header must name x,y,z)")
-    dupes = sorted({h for h in header if header.count(h) > 1})
-    if dupes:
-        raise InputError(f"{path}, line {head_line}, column(s) {', '.join(map(repr, dupes))}: appear more than once")
-    if "t" in header and "speed" in header:
+    head_line, used, data, lines = read_numeric_csv(
+        path, ("x", "y", "z"), tuple(c for c in COLUMNS if c not in "xyz"),
+        blank_ok=lambda name, k: name == "speed" and k == 0)       # the first point ends no leg
+    if "t" in used and "speed" in used:
         raise InputError(f"{path}, line {head_line}, columns 't' and 'speed': give arrival times or leg speeds, not both")
-    extra = [h for h in header if h not in COLUMNS]
-    if extra:
-        warnings.warn(f"{path}: ignoring column(s) {', '.join(extra)}", stacklevel=2)
-    used = [c for c in COLUMNS if c in header]
-    data = np.full((len(rows) - 1, len(used)), np.nan)
-    for k, (line, row) in enumerate(rows[1:]):
-        if len(row) != len(header):
-            raise InputError(f"{path}, line {line}: has {len(row)} cells, the header has {len(header)}")
-        for j, name in enumerate(used):
-            cell = row[header.index(name)].strip()
-            if name == "speed" and k == 0 and not cell:
-                continue                      # the first point ends no leg
-            try:
-                value = float(cell)
-            except ValueError:
-                raise InputError(f"{path}, line {line}, column '{name}': {cell!r} is not a number") from None
-            if math.isnan(value):
-                raise InputError(f"{path}, line {line}, column '{name}': value is NaN")
-            data[k, j] = value
     if data.shape[0] < 2:
-        raise InputError(f"{path}, line {rows[-1][0]}: needs at least two waypoints, found {data.shape[0]}")
+        raise InputError(f"{path}, line {lines[-1] if lines else head_line}: needs at least two waypoints, found {data.shape[0]}")
     col = {name: data[:, j] for j, name in enumerate(used)}
     return WaypointTable(np.column_stack([col["x"], col["y"], col["z"]]), yaw=col.get("yaw"),
                          t=col.get("t"), speed=col.get("speed"), source=str(path),
-                         lines=tuple(line for line, _ in rows[1:]))
+                         lines=tuple(lines))
 
 
 # --- compiled references ---------------------------------------------------------------------
