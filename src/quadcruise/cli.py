@@ -123,9 +123,13 @@ def _metrics_table(frame) -> str:
               help="Format of the traces.")
 @click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
 @click.option("--smooth", is_flag=True, help="Fly a waypoint file as a minimum-snap path instead of legs.")
+@click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html",
+              help="Also write a self-contained HTML report (tables, figures, interactive 3-D view, configuration).")
+@click.option("--animate", type=click.Path(dir_okay=False), metavar="PATH.gif",
+              help="Also write an animation of the flight (.gif; .mp4 needs ffmpeg).")
 @_friendly
 def fly(mission, controller, duration, dt, max_step, mission_params, controller_params, position_poles,
-        out, fmt, force, smooth):
+        out, fmt, force, smooth, report, animate):
     """Fly a MISSION with a controller on the paper's vehicle and print its metrics.
 
     MISSION is circle, square, step, hover, a waypoint CSV (columns x,y,z and optional yaw
@@ -145,12 +149,12 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
         the_mission, the_controller = scenario.mission or mission_from_name("circle"), scenario.controller
         if the_controller is None or controller_params or position_poles or controller != "nlpd":
             the_controller = _controller_from_options(controller, controller_params, position_poles)
-        _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force)
+        _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate)
         return
     the_mission = _mission(mission, mission_params, smooth)
     the_controller = _controller_from_options(controller, controller_params, position_poles)
     _fly_and_report(the_mission, the_controller, {"duration": duration, "dt": dt or 1e-3, "max_step": max_step},
-                    out, fmt, force)
+                    out, fmt, force, report, animate)
 
 
 def _controller_from_options(name: str, params: tuple[str, ...], poles_text: str | None):
@@ -164,9 +168,11 @@ def _controller_from_options(name: str, params: tuple[str, ...], poles_text: str
     return controller_from_name(name, **cparams)
 
 
-def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force) -> None:
+def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=None, animate=None) -> None:
     from .flight import fly as run_fly
 
+    if animate is not None and not animate.lower().endswith((".gif", ".mp4")):
+        raise InputError(f"--animate {animate}: the animation must be a .gif (or .mp4, with ffmpeg)")
     if out is not None:
         check_output_dir(out, force)
     result = run_fly(mission, controller, **kwargs)
@@ -176,6 +182,16 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force) -> None:
     if out is not None:
         write_flight(result, metrics, out, fmt)
         click.echo(f"wrote traces, figure and metrics to {out}")
+    if report is not None:
+        from .report import flight_report, write_html_report
+
+        write_html_report(report, **flight_report(result))
+        click.echo(f"wrote report {report}")
+    if animate is not None:
+        from .animate import animate_flight
+
+        animate_flight(result, animate)
+        click.echo(f"wrote animation {animate}")
 
 
 def write_flight(result, metrics, out: str, fmt: str) -> None:
@@ -199,8 +215,10 @@ def write_flight(result, metrics, out: str, fmt: str) -> None:
 @click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv", show_default=True,
               help="Format of the traces.")
 @click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
+@click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html",
+              help="Also write a self-contained HTML report (tables, figures, interactive 3-D view, configuration).")
 @_friendly
-def reproduce(out, fmt, force):
+def reproduce(out, fmt, force, report):
     """Reproduce the paper: both controllers on the circle, square and step, beside its numbers.
 
     Writes OUT/metrics.json, one figure per paper figure, the traces and OUT/report.md,
@@ -219,6 +237,15 @@ def reproduce(out, fmt, force):
     rep = run_reproduce(progress=flown)
     click.echo(results_table(rep))
     write_reproduction(rep, out, force=force, fmt=fmt, progress=lambda name: click.echo(f"drew {name}", err=True))
+    if report is not None:
+        from pathlib import Path
+
+        from .report import reproduction_report, write_html_report
+        from .reproduce import FIGURES
+
+        figures = {cap: Path(out) / name for name, cap in FIGURES.items() if (Path(out) / name).is_file()}
+        write_html_report(report, **reproduction_report(rep, figures))
+        click.echo(f"wrote report {report}")
     click.echo(f"wrote {out}/report.md, metrics.json, figures and traces in {time.perf_counter() - start:.1f} s")
 
 
@@ -232,8 +259,10 @@ def reproduce(out, fmt, force):
               help="Mission parameter (repeatable).")
 @click.option("--out", type=click.Path(file_okay=False), help="Folder for metrics.csv and comparison.png.")
 @click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
+@click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html",
+              help="Also write a self-contained HTML report (tables, figures, interactive 3-D view, configuration).")
 @_friendly
-def compare(mission, controllers, duration, dt, mission_params, out, force):
+def compare(mission, controllers, duration, dt, mission_params, out, force, report):
     """Fly MISSION (a name or a waypoint CSV) with several controllers; one table, one figure."""
     from .compare import compare as run_compare
 
@@ -245,6 +274,11 @@ def compare(mission, controllers, duration, dt, mission_params, out, force):
     if out is not None:
         cmp.write(out, force=force)
         click.echo(f"wrote metrics.csv and comparison.png to {out}")
+    if report is not None:
+        from .report import comparison_report, write_html_report
+
+        write_html_report(report, **comparison_report(cmp))
+        click.echo(f"wrote report {report}")
 
 
 @main.command()

@@ -1,0 +1,89 @@
+"""The command line: fly, compare, analyze; outputs and one-line errors."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+
+from quadcruise.cli import main
+
+
+def run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def test_fly_prints_metrics_and_writes_the_folder(tmp_path):
+    out = tmp_path / "flight"
+    res = run("fly", "step", "--duration", "4", "--out", out, "--report", tmp_path / "r.html",
+              "--animate", tmp_path / "a.gif")
+    assert res.exit_code == 0, res.output
+    assert "nlpd on step: 4 s" in res.output and "rise_time_s" in res.output
+    assert sorted(p.name for p in out.iterdir()) == ["flight.png", "metrics.csv", "quadcruise.json", "traces.csv"]
+    traces = pd.read_csv(out / "traces.csv")
+    assert len(traces) == 4001 and list(traces.columns[:5]) == ["vehicle", "t", "x", "y", "z"]
+    meta = json.loads((out / "quadcruise.json").read_text())
+    assert meta["controller"]["name"] == "nlpd" and meta["mission"]["kind"] == "step" and meta["version"]
+    assert (tmp_path / "r.html").read_text().startswith("<!DOCTYPE html>")
+    assert (tmp_path / "a.gif").read_bytes()[:6] == b"GIF89a"
+
+
+def test_fly_parquet(tmp_path):
+    pytest.importorskip("pyarrow")
+    res = run("fly", "hover", "--duration", "1", "--out", tmp_path / "o", "--format", "parquet")
+    assert res.exit_code == 0, res.output
+    frame = pd.read_parquet(tmp_path / "o" / "traces.parquet")
+    assert np.allclose(frame["z"], 1.0)
+
+
+def test_fly_controller_options_reach_the_controller(tmp_path):
+    res = run("fly", "step", "--duration", "3", "--controller", "gonzalez", "--poles", "-1,-2",
+              "-c", "max_tilt=0.3", "-m", "size=0.5", "--out", tmp_path / "o")
+    assert res.exit_code == 0, res.output
+    meta = json.loads((tmp_path / "o" / "quadcruise.json").read_text())
+    assert meta["controller"]["position"] == {"kp": 2.0, "kd": 3.0}
+    assert meta["controller"]["max_tilt"] == 0.3 and meta["mission"]["size"] == 0.5
+
+
+@pytest.mark.parametrize("args, words", [
+    (["fly", "loop"], "unknown mission 'loop'"),
+    (["fly", "circle", "--duration", "-1"], "duration must be a positive number"),
+    (["fly", "circle", "--dt", "30"], "dt (30 s) is larger than the duration (20 s)"),
+    (["fly", "circle", "--poles", "0.7,-4.3"], "pole 0.7 is not in the open left half plane"),
+    (["fly", "circle", "--poles", "fast"], "--poles 'fast': expected comma-separated poles"),
+    (["fly", "circle", "--controller", "pid"], "unknown controller 'pid'"),
+    (["fly", "circle", "-m", "radius"], "--mission-param 'radius': expected KEY=VALUE"),
+    (["fly", "circle", "-m", "radius=-2"], "circle field 'radius' (circle radius, m) must be > 0"),
+    (["fly", "circle", "--animate", "a.png"], "the animation must be a .gif"),
+    (["fly", "circle", "--bogus"], "No such option '--bogus'"),
+    (["compare", "circle", "--controllers", "nlpd,pid"], "unknown controller 'pid'"),
+    (["analyze", "--poles", "0.7,-4"], "pole 0.7 is not in the open left half plane"),
+])
+def test_bad_options_are_one_line_with_status_two(args, words):
+    """Through the real entry point (click's own usage errors included), as a process."""
+    proc = subprocess.run([sys.executable, "-m", "quadcruise", *args], capture_output=True, text=True)
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and words in lines[0], proc.stderr
+
+
+def test_fly_refuses_a_foreign_out_folder(tmp_path):
+    (tmp_path / "keep.txt").write_text("mine")
+    res = run("fly", "hover", "--duration", "1", "--out", tmp_path)
+    assert res.exit_code == 2 and "not written by quadcruise" in res.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.txt"]
+
+
+def test_compare_and_analyze(tmp_path):
+    res = run("compare", "step", "--duration", "3", "--controllers", "nlpd,gonzalez", "--out", tmp_path / "c")
+    assert res.exit_code == 0, res.output
+    assert "nlpd" in res.output and "gonzalez" in res.output
+    assert (tmp_path / "c" / "comparison.png").stat().st_size > 10_000
+    res = run("analyze", "--out", tmp_path / "a")
+    assert res.exit_code == 0, res.output
+    assert "PM at the input" in res.output
+    doc = json.loads((tmp_path / "a" / "analysis.json").read_text())
+    assert doc
