@@ -27,6 +27,17 @@ REF_STYLE = dict(color="k", ls="--", lw=1.0, label="reference")
 STOP_STYLE = dict(color="tab:red", ls=":", lw=1.5)
 
 
+MAX_DRAWN = 3000
+"""Figures draw at most this many instants of a flight (a 60 s flight at 1 kHz has 60,001):
+more are invisible at screen resolution and only slow the drawing down."""
+
+
+def drawable(result):
+    """The result, decimated to at most MAX_DRAWN logged instants for drawing."""
+    every = -(-len(result.t) // MAX_DRAWN)
+    return result if every <= 1 else result.decimate(every)
+
+
 def _has(trace: np.ndarray) -> bool:
     return bool(np.any(np.isfinite(trace)))
 
@@ -136,6 +147,7 @@ def plot_flight(result, vehicle: int = 0, *, title: str | None = None) -> Figure
         has none); periods in which the controller flagged a limit are shaded on the duty
         panel. An early stop is marked on every time panel, which then end shortly after it.
     """
+    result = drawable(result)
     t = result.t
     fig = Figure(figsize=(16, 10), layout="constrained")
     gs = fig.add_gridspec(4, 3, width_ratios=(1.3, 1, 1), height_ratios=(1, 1, 1, 1.1))
@@ -234,6 +246,7 @@ def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None) -> 
     """
     if not results:
         raise ValueError("plot_paths needs at least one result")
+    results = {label: drawable(r) for label, r in results.items()}
     fig = Figure(figsize=(13, 6.5), layout="constrained")
     gs = fig.add_gridspec(2, 2, width_ratios=(1, 1.3))
     top = fig.add_subplot(gs[:, 0])

@@ -76,21 +76,21 @@ def limit(value, bound):
     return value, False
 
 
-@njit(cache=True, error_model="numpy")
-def theta_from_eq5(ux, phi, psi, a):
-    """Eq (16): the pitch that gives x'' = ux at roll phi, yaw psi and a = U1/m [m/s^2]."""
-    den = math.cos(phi) * math.cos(psi) * a
+@njit(cache=True, inline="always", error_model="numpy")
+def pitch_eq16(ux, sphi, cphi, spsi, cpsi, a):
+    """Eq (16) from the sines and cosines of roll and yaw (see :func:`theta_from_eq5`)."""
+    den = cphi * cpsi * a
     if abs(den) < 1e-9:
         return 0.0, True
-    s, clipped = clip_unit((ux - math.sin(phi) * math.sin(psi) * a) / den)
+    s, clipped = clip_unit((ux - sphi * spsi * a) / den)
     return math.asin(s), clipped
 
 
-@njit(cache=True, error_model="numpy")
-def phi_from_eq6(uy, theta, psi, a):
-    """Eq (19), sign-preserving: the roll that gives y'' = uy at pitch theta, yaw psi."""
-    A = math.cos(psi)
-    B = math.sin(theta) * math.sin(psi)
+@njit(cache=True, inline="always", error_model="numpy")
+def roll_eq19(uy, stheta, spsi, cpsi, a):
+    """Eq (19), sign kept, from sin(theta) and the yaw's sine and cosine (see :func:`phi_from_eq6`)."""
+    A = cpsi
+    B = stheta * spsi
     R = math.hypot(A, B)
     if R * a < 1e-9:
         return 0.0, True
@@ -104,13 +104,29 @@ def phi_from_eq6(uy, theta, psi, a):
     return (phi1 if abs(phi1) <= abs(phi2) else phi2), clipped
 
 
+@njit(cache=True, error_model="numpy")
+def theta_from_eq5(ux, phi, psi, a):
+    """Eq (16): the pitch that gives x'' = ux at roll phi, yaw psi and a = U1/m [m/s^2]."""
+    return pitch_eq16(ux, math.sin(phi), math.cos(phi), math.sin(psi), math.cos(psi), a)
+
+
+@njit(cache=True, error_model="numpy")
+def phi_from_eq6(uy, theta, psi, a):
+    """Eq (19), sign-preserving: the roll that gives y'' = uy at pitch theta, yaw psi."""
+    return roll_eq19(uy, math.sin(theta), math.sin(psi), math.cos(psi), a)
+
+
 @njit(cache=True, inline="always", error_model="numpy")
 def collective_thrust(uz, x, vp, max_tilt):
-    """Altitude law: U1 = m (g + u_z) / (cos phi cos theta), limited to [0, 4 K] [N].
+    """Altitude law: U1 = m (g + u_z) / (cos phi cos theta), limited to [0, 4 K] [N]."""
+    return thrust_for_tilt(uz, math.cos(x[PHI]) * math.cos(x[THETA]), vp, max_tilt)
 
-    The tilt compensation uses at most 1/cos(max_tilt) so that it cannot blow up.
-    """
-    c = max(math.cos(x[PHI]) * math.cos(x[THETA]), math.cos(max_tilt))
+
+@njit(cache=True, inline="always", error_model="numpy")
+def thrust_for_tilt(uz, cos_tilt, vp, max_tilt):
+    """The altitude law given cos phi cos theta. The tilt compensation uses at most
+    1/cos(max_tilt) so that it cannot blow up."""
+    c = max(cos_tilt, math.cos(max_tilt))
     U1 = vp[P_M] * (vp[P_G] + uz) / c
     if U1 < 0.0:
         return 0.0, FLAG_THRUST_LIMIT
@@ -153,11 +169,13 @@ def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
     ux = gains[KP_XY] * (ref[REF_X] - x[X]) + gains[KD_XY] * (ref[REF_VX] - x[VX]) + ff * ref[REF_AX]
     uy = gains[KP_XY] * (ref[REF_Y] - x[Y]) + gains[KD_XY] * (ref[REF_VY] - x[VY]) + ff * ref[REF_AY]
     uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ]) + ff * ref[REF_AZ]
-    U1, flags = collective_thrust(uz, x, vp, gains[MAX_TILT])
+    sphi, cphi = math.sin(x[PHI]), math.cos(x[PHI])          # each computed once, shared
+    spsi, cpsi = math.sin(x[PSI]), math.cos(x[PSI])
+    U1, flags = thrust_for_tilt(uz, cphi * math.cos(x[THETA]), vp, gains[MAX_TILT])
     a = U1 / vp[P_M]
-    theta_d, clipped = theta_from_eq5(ux, x[PHI], x[PSI], a)                  # (16)
+    theta_d, clipped = pitch_eq16(ux, sphi, cphi, spsi, cpsi, a)              # (16)
     theta_d, flags = tilt_setpoint(theta_d, clipped, gains[MAX_TILT], flags)
-    phi_d, clipped = phi_from_eq6(uy, theta_d, x[PSI], a)                     # (19), sign kept
+    phi_d, clipped = roll_eq19(uy, math.sin(theta_d), spsi, cpsi, a)          # (19), sign kept
     phi_d, flags = tilt_setpoint(phi_d, clipped, gains[MAX_TILT], flags)
     finish(U1, phi_d, theta_d, ref[REF_PSI], flags, dt, x, vp, gains, mem, cmd)
 
