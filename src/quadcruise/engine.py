@@ -171,8 +171,10 @@ def _kernel_body(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
         k3 = np.empty(STATE_SIZE)
         k4 = np.empty(STATE_SIZE)
         xt = np.empty(STATE_SIZE)
-        vpi, vci, gi, mi, mpi = vp[i], vp_ctrl[i], gains[i], mem[i], mp[i]
-        dpi, dmi, rngi, stdi = dp[i], dmem[i], rng[i], sensor_std[i]
+        # private copies of this vehicle's rows: views would share their parent's reference
+        # count with the other threads, and every call that counts references would contend
+        vpi, vci, gi, mi, mpi = vp[i].copy(), vp_ctrl[i].copy(), gains[i].copy(), mem[i].copy(), mp[i].copy()
+        dpi, dmi, rngi, stdi = dp[i].copy(), dmem[i].copy(), rng[i].copy(), sensor_std[i].copy()
         noisy = False
         for j in range(STATE_SIZE):
             if stdi[j] != 0.0:
@@ -230,6 +232,8 @@ def _kernel_body(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
                     log_x[i, (k + 1) // log_every, :] = x
                 break
         x_final[i, :] = x
+        mem[i, :] = mi                          # the memories go back to the caller
+        dmem[i, :] = dmi
         status[i] = code
         t_stop[i] = t_end
 
