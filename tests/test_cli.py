@@ -87,3 +87,32 @@ def test_compare_and_analyze(tmp_path):
     assert "PM at the input" in res.output
     doc = json.loads((tmp_path / "a" / "analysis.json").read_text())
     assert doc
+
+
+def test_montecarlo_runs_writes_and_replays_a_case(tmp_path):
+    out = tmp_path / "mc"
+    args = ["montecarlo", "-n", "6", "--duration", "2", "--mass-spread", "0.05", "--seed", "3",
+            "--scheduler", "none", "--quiet"]
+    res = run(*args, "--out", out)
+    assert res.exit_code == 0, res.output
+    assert "6 flights of nlpd on circle, seed 3" in res.output
+    flights = pd.read_csv(out / "flights.csv")
+    assert sorted(flights["vehicle"]) == list(range(6))
+    assert json.loads((out / "summary.json").read_text())
+    case = run(*args, "--case", "4")
+    assert case.exit_code == 0, case.output
+    row = flights[flights["vehicle"] == 4].iloc[0]
+    assert f"{row['rmse_m']:.4g}" in case.output
+
+
+@pytest.mark.parametrize("args, words", [
+    (["montecarlo", "-n", "0"], "the number of flights must be a whole number >= 1"),
+    (["montecarlo", "--mass-spread", "-0.1"], "'mass_spread' must be a number >= 0"),
+    (["montecarlo", "--wind", "tornado:3"], "unknown model 'tornado'"),
+    (["montecarlo", "-n", "4", "--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "1"], "scheduler"),
+])
+def test_montecarlo_bad_input(tmp_path, args, words):
+    res = run(*args, "--out", tmp_path / "mc")
+    assert res.exit_code == 2 and words in res.output, res.output
+    assert res.output.count("error:") == 1
+    assert not (tmp_path / "mc").exists()

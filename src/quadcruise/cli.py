@@ -316,6 +316,54 @@ def analyze(controller, controller_params, position_poles, dt, out, force):
         click.echo(f"wrote analysis.json and Bode plots to {out}")
 
 
+@main.command()
+@click.option("--mission", default="circle", show_default=True, help="Mission name.")
+@click.option("--controller", default="nlpd", show_default=True, help="Controller name.")
+@click.option("-n", "--n", "n", type=int, default=1000, show_default=True, help="Number of flights.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of every random draw.")
+@click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
+@click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
+@click.option("--wind", metavar="SPEC", help="Wind: constant:WX,WY,WZ | gust:AX,AY,AZ@START+DURATION | "
+              "dryden:light|moderate|severe@ALTITUDE (comma-separable).")
+@click.option("--wind-spread", type=float, default=0.0, show_default=True,
+              help="Std of a random steady horizontal wind per flight [m/s].")
+@click.option("--mass-spread", type=float, default=0.0, show_default=True, help="Relative std of the mass.")
+@click.option("--inertia-spread", type=float, default=0.0, show_default=True, help="Relative std of each inertia.")
+@click.option("--thrust-spread", type=float, default=0.0, show_default=True, help="Relative std of K.")
+@click.option("--bandwidth-spread", type=float, default=0.0, show_default=True,
+              help="Relative std of the actuator bandwidth.")
+@click.option("--yaw-arm-spread", type=float, default=0.0, show_default=True, help="Relative std of d.")
+@click.option("--distribution", type=click.Choice(["normal", "uniform"]), default="normal", show_default=True)
+@click.option("--offset", type=float, default=0.0, show_default=True, help="Std of the start position [m].")
+@click.option("--noise", metavar="position=STD,velocity=STD,angle=STD,rate=STD,delay=S",
+              help="Sensor noise and delay.")
+@click.option("--model-error/--no-model-error", default=True, show_default=True,
+              help="The controller flies with the nominal model, not each vehicle's own.")
+@click.option("--chunk-size", default="auto", show_default=True, help="Flights per task.")
+@click.option("--scheduler", default="local", show_default=True,
+              help="local (a Dask cluster of processes here), none (in this process) or a Dask address.")
+@click.option("--workers", type=int, help="Workers of the local cluster.")
+@click.option("--connect-timeout", type=float, default=10.0, show_default=True, help="[s] for --scheduler ADDRESS.")
+@click.option("--out", type=click.Path(file_okay=False), help="Folder: chunks stream here, so a rerun resumes.")
+@click.option("--force", is_flag=True, help="Replace a folder holding something else.")
+@click.option("--resume/--no-resume", default=True, show_default=True)
+@click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv", show_default=True)
+@click.option("--case", type=int, help="Fly flight I alone (replays a worst case exactly).")
+@click.option("--worst", type=int, default=5, show_default=True, help="How many worst cases to list.")
+@click.option("--quiet", is_flag=True, help="No progress bar.")
+@_friendly
+def montecarlo(**options):
+    """Fly a population of perturbed vehicles and report the distribution of every metric.
+
+    Runs on Dask (a local cluster of processes by default); results stream to --out as
+    chunks finish, so an interrupted sweep resumes where it stopped. Every draw comes from
+    --seed, whatever the chunking or the machine.
+    """
+    from .montecarlo import montecarlo_command
+
+    montecarlo_command(**options, echo=click.echo)
+
+
 def _mission(text: str, params: tuple[str, ...], smooth: bool):
     """A mission from a name or a waypoint CSV, with KEY=VALUE parameters."""
     from .missions import mission_from_name
@@ -334,8 +382,8 @@ def run() -> None:
     except click.exceptions.UsageError as exc:
         click.echo(f"error: {exc.format_message()}", err=True)
         sys.exit(2)
-    except click.exceptions.Abort:
-        click.echo("error: aborted", err=True)
+    except (click.exceptions.Abort, KeyboardInterrupt):
+        click.echo("error: interrupted (a montecarlo sweep with --out resumes if run again)", err=True)
         sys.exit(130)
     sys.exit(code if isinstance(code, int) else 0)
 

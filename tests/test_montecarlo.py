@@ -1,0 +1,296 @@
+"""Monte Carlo sweeps: determinism whatever the chunking, replay of one case, metrics equal
+to flight_metrics, a real Dask LocalCluster (with a worker killed mid-run), resume after an
+interruption, and bad input."""
+
+import dataclasses
+import io
+import json
+import os
+import signal
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from quadcruise.disturbances import ConstantWind, Environment, SensorNoise, Turbulence, with_drag
+from quadcruise.errors import InputError
+from quadcruise.metrics import flight_metrics
+from quadcruise.montecarlo import (
+    COLUMNS, MonteCarloSpec, Population, montecarlo, montecarlo_case, montecarlo_command, replay_case,
+)
+from quadcruise.sweep import ProgressBar, fly_chunk, sweep_metrics
+from quadcruise.params import Vehicle
+
+POP = Population(mass_spread=0.15, inertia_spread=0.1, thrust_spread=0.1, bandwidth_spread=0.1,
+                 yaw_arm_spread=0.1, offset=0.2)
+# and the world: turbulence and sensor noise draw from the engine's per-vehicle streams
+WORLD = dataclasses.replace(POP, environment=Environment(turbulence=Turbulence(intensity="light", altitude=5.0)),
+                            wind_spread=0.5, noise=SensorNoise(position_std=0.005, rate_std=0.01, delay=0.002))
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    DRAG = with_drag(Vehicle.paper())
+FAST = dict(duration=3.0, dt=2e-3)          # short flights: 1,500 periods
+FIGURES = ("histograms.png", "envelope.png")
+
+
+def sweep(n=24, **kw):
+    """A small in-process sweep of the circle, in turbulence, with sensor noise."""
+    options = dict(seed=1, scheduler="none", chunk_size=7, vehicle=DRAG, **FAST)
+    options.update(kw)
+    return montecarlo("circle", "nlpd", options.pop("population", WORLD), n, **options)
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """The in-process sweep every distributed run must equal, written to a folder."""
+    out = tmp_path_factory.mktemp("ref") / "sweep"
+    return sweep(out=out), out
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
+                      env={"NUMBA_NUM_THREADS": "1"}) as c:
+        yield c
+
+
+def same_outputs(a, b):
+    """Two result folders hold the same table, summary and figures (byte for byte)."""
+    pd.testing.assert_frame_equal(pd.read_csv(a / "flights.csv"), pd.read_csv(b / "flights.csv"), check_exact=True)
+    sa, sb = (json.loads((p / "summary.json").read_text()) for p in (a, b))
+    sa.pop("info"), sb.pop("info")
+    assert sa == sb
+    for name in FIGURES:
+        assert (a / name).read_bytes() == (b / name).read_bytes(), name
+
+
+def same_row(a: dict, b: dict) -> bool:
+    """Equal keys and values (NaN equal to NaN)."""
+    return a.keys() == b.keys() and all(a[k] == b[k] or (a[k] != a[k] and b[k] != b[k]) for k in a)
+
+
+# --- population ---------------------------------------------------------------------------
+def test_draws_depend_on_seed_and_index_only():
+    v = Vehicle.paper()
+    whole = POP.draw(seed=5, first=0, count=10, nominal=v)
+    part = POP.draw(seed=5, first=6, count=3, nominal=v)
+    for name, col in part.columns.items():
+        assert np.array_equal(col, whole.columns[name][6:9]), name
+    # one spread changes only its own quantity
+    more = dataclasses.replace(POP, mass_spread=0.05).draw(5, 0, 10, v)
+    assert not np.array_equal(more.columns["m"], whole.columns["m"])
+    for name in ("Jxx", "K", "omega", "dx0"):
+        assert np.array_equal(more.columns[name], whole.columns[name])
+    assert not np.array_equal(POP.draw(6, 0, 10, v).columns["m"], whole.columns["m"])
+    # normal draws are clipped at 3 sigma: every value positive and within the band
+    m = Population(mass_spread=0.3).draw(0, 0, 2000, v).columns["m"]
+    assert m.min() >= v.m * (1 - 0.9) - 1e-12 and m.max() <= v.m * (1 + 0.9) + 1e-12
+    u = Population(mass_spread=0.1, distribution="uniform").draw(0, 0, 4000, v).columns["m"]
+    assert abs(np.std(u / v.m) - 0.1) < 0.005 and np.all(np.abs(u / v.m - 1) <= 0.1 * 3 ** 0.5)
+
+
+@pytest.mark.parametrize("kw, words", [
+    (dict(mass_spread=-0.1), "mass_spread"), (dict(inertia_spread=0.4), "too large"),
+    (dict(thrust_spread=0.6, distribution="uniform"), "too large"), (dict(offset=float("nan")), "offset"),
+    (dict(distribution="cauchy"), "distribution"),
+    (dict(environment=Environment(wind=ConstantWind(velocity=([1.0, 2.0], 0.0, 0.0)))), "same for every vehicle"),
+])
+def test_population_rejects_bad_values(kw, words):
+    with pytest.raises(InputError, match=words) as err:
+        Population(**kw)
+    assert "\n" not in str(err.value)
+
+
+# --- determinism, cases, metrics ------------------------------------------------------------
+def test_table_does_not_depend_on_chunking(reference):
+    res = reference[0]
+    other = sweep(chunk_size=25)
+    pd.testing.assert_frame_equal(res.table, other.table, check_exact=True)
+    assert res.table["vehicle"].tolist() == list(range(24))
+    assert list(res.table.columns[:len(COLUMNS)]) == list(COLUMNS)
+    assert not sweep(seed=2).table["m"].equals(res.table["m"])
+    # memory stays bounded: paths of the first max_traces vehicles and of the first
+    # max_failure_traces failed ones (3 s is mostly too short for the transient to settle)
+    failed = res.table.query("failure > 0 and vehicle >= 5")["vehicle"].tolist()
+    assert len(failed) > 3
+    small = sweep(max_traces=5, max_failure_traces=3)
+    assert small.traces.vehicle.tolist() == [0, 1, 2, 3, 4] + failed[:3]
+    assert small.traces.sample.tolist() == [True] * 5 + [False] * 3
+
+
+def test_a_case_flown_alone_equals_its_row(reference):
+    res = reference[0]
+    worst = res.worst(3)
+    assert list(worst.columns[:2]) == ["vehicle", "seed"] and (worst["seed"] == 1).all()
+    for i in (int(worst["vehicle"][0]), 17):
+        case = replay_case(res, i)
+        assert same_row(case.row, res.table.iloc[i].to_dict()), i
+    full = montecarlo_case(res.spec, 3, log_every=1)          # every period, for a close look
+    assert full.result.t.size == res.spec.periods + 1 and same_row(full.row, res.table.iloc[3].to_dict())
+
+
+def test_sweep_metrics_equal_flight_metrics():
+    for mission in ("circle", "step"):
+        spec = MonteCarloSpec(mission, population=POP, seed=3, duration=4.0, dt=2e-3)
+        res, _ = fly_chunk(spec, 0, 6)
+        # vehicle 2 "diverged" half way: its metrics are NaN in both
+        states = res.states.copy()
+        states[2, states.shape[1] // 2:] = np.nan
+        res = dataclasses.replace(res, states=states, status=np.where(np.arange(6) == 2, 2, res.status))
+        fast, slow = sweep_metrics(res, spec), flight_metrics(res)
+        for k in ("rmse_m", "max_error_m", "rise_time_s", "settling_time_s", "settling_time_5pct_s",
+                  "overshoot_pct", "effort", "duty_clipped_s", "controller_limited_s"):
+            np.testing.assert_allclose(fast[k], slow[k].to_numpy(dtype=float), rtol=1e-12, atol=1e-15,
+                                       err_msg=f"{mission} {k}")
+        assert np.isnan(fast["rmse_m"][2]) and fast["diverged"].tolist() == [False, False, True, False, False, False]
+        axes = [-1 if not isinstance(a, str) else "xyz".index(a) for a in slow["axis"]]
+        assert fast["transient_axis"].tolist() == axes
+
+
+def test_metrics_on_the_decimated_log_are_close_to_full_rate():
+    spec = MonteCarloSpec("circle", population=POP, seed=2, duration=8.0)
+    fast = sweep_metrics(fly_chunk(spec, 0, 5)[0], spec)              # 10 ms log
+    full = flight_metrics(fly_chunk(spec, 0, 5, log_every=1)[0])      # every 1 ms period
+    for k, tol in (("rmse_m", 1e-5), ("max_error_m", 1e-4), ("rise_time_s", 1e-4), ("settling_time_5pct_s", 1e-4)):
+        np.testing.assert_allclose(fast[k], full[k].to_numpy(dtype=float), rtol=tol, err_msg=k)
+
+
+def test_the_world_acts_and_drag_is_added_with_a_warning():
+    with pytest.warns(UserWarning, match="no drag"):
+        spec = MonteCarloSpec("circle", population=WORLD, seed=1, **FAST)
+    assert spec.vehicle.drag_quadratic > 0
+    res = sweep(n=12)
+    still = sweep(n=12, population=POP)
+    assert res.table["wind_x"].std() > 0.2 and (still.table["wind_x"] == 0).all()
+    assert not np.allclose(res.table["rmse_m"], still.table["rmse_m"])
+    pd.testing.assert_frame_equal(res.table, sweep(n=12, chunk_size=12).table, check_exact=True)
+
+
+# --- Dask ---------------------------------------------------------------------------------
+def test_local_cluster_equals_in_process(reference, tmp_path):
+    ref, ref_out = reference
+    res = sweep(scheduler="local", workers=2, out=tmp_path / "dask")
+    assert "local Dask cluster of 2 processes" in res.info["scheduler"]
+    pd.testing.assert_frame_equal(res.table, ref.table, check_exact=True)
+    same_outputs(tmp_path / "dask", ref_out)
+
+
+def test_a_worker_killed_mid_run_costs_nothing(reference, cluster, tmp_path):
+    from distributed import Client
+
+    ref, ref_out = reference
+    killed = []
+    with Client(cluster.scheduler_address) as client:
+        def kill_a_busy_worker(done, total):
+            if killed or done == 0:
+                return
+            busy = {w: len(keys) for w, keys in client.processing().items() if keys}
+            victim = max(busy, key=busy.get) if busy else next(iter(client.nthreads()))
+            pid = client.run(os.getpid, workers=[victim])[victim]
+            os.kill(pid, signal.SIGKILL)
+            killed.append((victim, busy.get(victim, 0)))
+
+        res = sweep(scheduler=cluster.scheduler_address, out=tmp_path / "killed", chunk_size=3, progress=kill_a_busy_worker)
+    assert killed and killed[0][1] >= 1, killed         # it died holding work
+    assert res.table["vehicle"].tolist() == list(range(24))
+    pd.testing.assert_frame_equal(res.table, ref.table, check_exact=True)
+    same_outputs(tmp_path / "killed", ref_out)
+    assert len(list((tmp_path / "killed" / "chunks").glob("*.npz"))) == 8
+
+
+# --- on disk: resume, refusal -----------------------------------------------------------------
+def test_an_interrupted_sweep_resumes_where_it_stopped(reference, tmp_path):
+    ref, ref_out = reference
+    out = tmp_path / "sweep"
+    calls = []
+
+    def stop_after_two_chunks(done, total):
+        calls.append(done)
+        if len(calls) == 3:                  # the start, then two chunks
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        sweep(out=out, progress=stop_after_two_chunks)
+    assert sorted(p.name for p in (out / "chunks").iterdir()) == ["chunk-000000000.npz", "chunk-000000007.npz"]
+    assert json.loads((out / "quadcruise.json").read_text())["complete"] is False
+    assert not (out / "flights.csv").exists()
+    seen = []
+    res = sweep(out=out, progress=lambda d, t: seen.append(d))
+    assert res.info["resumed"] == 14 and res.info["flown"] == 10 and res.info["chunks_flown"] == 2
+    assert seen[0] == 14 and seen[-1] == 24
+    pd.testing.assert_frame_equal(res.table, ref.table, check_exact=True)
+    same_outputs(out, ref_out)
+    assert json.loads((out / "quadcruise.json").read_text())["complete"] is True
+    again = sweep(out=out)                                   # complete: nothing to fly
+    assert again.info["flown"] == 0 and again.info["resumed"] == 24
+
+
+def test_a_folder_of_another_sweep_is_refused_unless_forced(reference, tmp_path):
+    out = tmp_path / "sweep"
+    sweep(n=7, out=out)
+    with pytest.raises(InputError, match="different sweep"):
+        sweep(n=7, out=out, seed=9)
+    assert json.loads((out / "quadcruise.json").read_text())["seed"] == 1
+    res = sweep(n=7, out=out, seed=9, force=True)
+    assert res.info["flown"] == 7 and json.loads((out / "quadcruise.json").read_text())["seed"] == 9
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("keep")
+    with pytest.raises(InputError, match="not empty"):
+        sweep(n=7, out=tmp_path / "mine")
+    assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"
+
+
+# --- bad input ------------------------------------------------------------------------------
+@pytest.mark.parametrize("kw, words", [
+    (dict(mass_spread=-0.1), "mass_spread"),
+    (dict(n=0), "number of flights"),
+    (dict(wind="hurricane:3"), "unknown model 'hurricane'"),
+    (dict(scheduler="tcp://127.0.0.1:9", connect_timeout=1.0), "cannot reach the Dask scheduler"),
+    (dict(chunk_size="many"), "chunk-size"),
+    (dict(noise="jitter=1"), "noise spec"),
+])
+def test_bad_input_is_one_line_and_writes_nothing(tmp_path, kw, words):
+    out = tmp_path / "out"
+    options = dict(n=4, seed=1, duration=1.0, scheduler="none", out=str(out), quiet=True, echo=lambda s: None)
+    options.update(kw)
+    with pytest.raises(InputError, match=words) as err:
+        montecarlo_command(**options)
+    assert "\n" not in str(err.value)
+    assert not out.exists()
+
+
+# --- command ----------------------------------------------------------------------------------
+@pytest.mark.filterwarnings("ignore:the vehicle has no drag")
+def test_command_prints_the_summary_and_replays_a_case(tmp_path):
+    lines = []
+    res = montecarlo_command(mission="hover", n=6, seed=4, duration=1.0, offset=0.05, mass_spread=0.1,
+                             wind="constant:1,0,0", scheduler="none", out=str(tmp_path / "mc"), quiet=True,
+                             echo=lines.append)
+    text = "\n".join(lines)
+    assert "6 flights of nlpd on hover, seed 4" in text and "worst 5" in text
+    for name in ("flights.csv", "summary.json", "worst.csv", "report.md", "quadcruise.json", *FIGURES):
+        assert (tmp_path / "mc" / name).is_file(), name
+    assert "## Worst flights" in (tmp_path / "mc" / "report.md").read_text()
+    worst = int(res.worst(1)["vehicle"][0])
+    same = dict(mission="hover", n=6, seed=4, duration=1.0, offset=0.05, mass_spread=0.1, wind="constant:1,0,0")
+    case = montecarlo_command(**same, case=worst, out=str(tmp_path / "mc"), echo=lines.append)
+    assert case.row["rmse_m"] == res.table["rmse_m"][worst]
+    folder = tmp_path / "mc" / f"case-{worst:06d}"             # beside the sweep's results, which stay
+    assert (folder / "flight.png").is_file() and (folder / "case.json").is_file()
+    assert (tmp_path / "mc" / "flights.csv").is_file()
+    with pytest.raises(InputError, match="other options"):
+        montecarlo_command(**{**same, "seed": 5}, case=worst, out=str(tmp_path / "mc"), echo=lines.append)
+
+
+def test_progress_bar_reports_rate_and_eta():
+    buf = io.StringIO()
+    bar = ProgressBar(buf, log_interval=0.0)
+    bar(100, 1000)
+    bar(400, 1000)
+    bar(1000, 1000)
+    bar.close()
+    last = buf.getvalue().splitlines()[-1]
+    assert last.startswith("1,000/1,000 flights (100.0 %)") and "flights/s" in last and "ETA" in last
