@@ -114,3 +114,20 @@ def test_cli_flies_a_scenario_and_refuses_a_bad_one(tmp_path):
     assert res.exit_code == 2 and res.output.count("\n") == 1 and "radius" in res.output
     missing = runner.invoke(main, ["fly", str(tmp_path / "none.toml")])
     assert missing.exit_code == 2 and "no such file" in missing.output
+
+
+def test_disturbances_reach_the_flight_and_the_seed_makes_it_repeatable(tmp_path):
+    sc = load_scenario(EXAMPLES / "scenarios" / "circle_turbulence.toml")
+    assert sc.environment.needs_drag and sc.sensor_noise is not None
+    kw = sc.fly_kwargs()
+    assert kw["sensor_delay"] == 4 and kw["seed"] == 7 and "disturbance" in kw
+    a, b = sc.fly(), sc.fly()
+    np.testing.assert_array_equal(a.states, b.states)
+    calm = load_scenario(EXAMPLES / "scenarios" / "circle_paper.toml").fly()
+    assert a.ok[0] and np.abs(a.states[0, -1, :3] - calm.states[0, -1, :3]).max() > 0.01
+    bad = write(tmp_path, "[disturbances]\nturbulence = { intensity = 'hurricane' }\n")
+    with pytest.raises(qc.InputError, match=r"\[disturbances\].*intensity"):
+        load_scenario(bad)
+    bad = write(tmp_path, "[disturbances]\nstorm = 3\n", name="b.toml")
+    with pytest.raises(qc.InputError, match=r"\[disturbances\] unknown key 'storm'"):
+        load_scenario(bad)
