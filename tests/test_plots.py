@@ -33,18 +33,6 @@ def circle():
     return qc.fly("circle", duration=3.0, log_every=10)
 
 
-@pytest.fixture(scope="module")
-def diverged():
-    # one rotor at full power, the opposite one off: the body rate leaves the bound
-    t = np.linspace(0, 10, 1001)
-    u = np.tile([1.0, 0.07, 0.0, 0.07], (t.size, 1))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        res = qc.replay(qc.DutySchedule(t=t, duties=u), limits=qc.Limits(max_rate=50.0))
-    assert not res.ok[0]
-    return res
-
-
 def axis_by_ylabel(fig, start):
     hits = [ax for ax in fig.axes if ax.name != "3d" and ax.get_ylabel().startswith(start)]
     assert len(hits) == 1, [ax.get_ylabel() for ax in fig.axes]

@@ -20,7 +20,6 @@ import shutil
 import subprocess
 import tempfile
 import time
-import warnings
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -46,18 +45,6 @@ WINDOW = (1280, 2000)
 @pytest.fixture(scope="module")
 def circle():
     return qc.fly("circle")          # 20 s at 1 kHz: 20,001 logged instants
-
-
-@pytest.fixture(scope="module")
-def diverged():
-    # one rotor at full power, the opposite one off: the body rate leaves the bound
-    t = np.linspace(0, 10, 1001)
-    u = np.tile([1.0, 0.07, 0.0, 0.07], (t.size, 1))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        res = qc.replay(qc.DutySchedule(t=t, duties=u), limits=qc.Limits(max_rate=50.0))
-    assert not res.ok[0]
-    return res
 
 
 @pytest.fixture(scope="module")

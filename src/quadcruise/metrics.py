@@ -66,6 +66,16 @@ def _check_time(t) -> np.ndarray:
     return t
 
 
+def _step_time(t: np.ndarray, signal: np.ndarray, t_step, what: str) -> float:
+    """Check the signal is finite and t_step (default t[0]) lies in [t[0], t[-1])."""
+    if not np.all(np.isfinite(signal)):
+        raise InputError(f"{what} contains NaN or inf")
+    t_step = float(t[0]) if t_step is None else float(t_step)
+    if not t[0] <= t_step < t[-1]:
+        raise InputError(f"t_step = {t_step:g} s is outside [{t[0]:g}, {t[-1]:g}) s")
+    return t_step
+
+
 def _first_crossing(t: np.ndarray, z: np.ndarray, level: float) -> float | None:
     """Time at which z first reaches ``level`` from below, interpolated (None if never)."""
     hits = np.flatnonzero(z >= level)
@@ -157,11 +167,7 @@ def step_info(t, y, *, y_initial=None, y_final=None, t_step=None,
     y = np.asarray(y, dtype=float)
     if y.shape != t.shape:
         raise InputError(f"response y has shape {y.shape}, time vector has {t.shape}")
-    if not np.all(np.isfinite(y)):
-        raise InputError("response y contains NaN or inf")
-    t_step = float(t[0]) if t_step is None else float(t_step)
-    if not t[0] <= t_step < t[-1]:
-        raise InputError(f"t_step = {t_step:g} s is outside [{t[0]:g}, {t[-1]:g}) s")
+    t_step = _step_time(t, y, t_step, "response y")
     levels = tuple(float(v) for v in rise)
     if len(levels) != 2 or not 0.0 <= levels[0] < levels[1] <= 1.0:
         raise InputError(f"rise levels must satisfy 0 <= low < high <= 1, got {rise}")
@@ -254,11 +260,7 @@ def transient_info(t, actual, reference, *, t_step=None, rise=(0.1, 0.9),
         raise InputError(f"actual and reference must be (L,) or (L, n_axes), got {e.shape}")
     if e.shape != t.shape:
         raise InputError(f"error signal has {e.shape[0]} samples, time vector has {t.size}")
-    if not np.all(np.isfinite(e)):
-        raise InputError("actual or reference contains NaN or inf")
-    t_step = float(t[0]) if t_step is None else float(t_step)
-    if not t[0] <= t_step < t[-1]:
-        raise InputError(f"t_step = {t_step:g} s is outside [{t[0]:g}, {t[-1]:g}) s")
+    t_step = _step_time(t, e, t_step, "actual or reference")
     e0 = float(np.interp(t_step, t, e))
     scale = max(np.abs(actual).max(), np.abs(reference).max())
     if e0 == 0.0 or abs(e0) <= 1e-9 * scale:
