@@ -1,6 +1,7 @@
 """The command line: fly, compare, analyze; outputs and one-line errors."""
 
 import json
+from pathlib import Path
 import subprocess
 import sys
 
@@ -116,3 +117,20 @@ def test_montecarlo_bad_input(tmp_path, args, words):
     assert res.exit_code == 2 and words in res.output, res.output
     assert res.output.count("error:") == 1
     assert not (tmp_path / "mc").exists()
+
+
+def test_montecarlo_and_reproduce_accept_a_scenario(tmp_path):
+    scen = Path(__file__).resolve().parents[1] / "examples" / "scenarios"
+    res = run("montecarlo", "--scenario", scen / "montecarlo_circle.toml", "-n", "5", "--duration", "2",
+              "--scheduler", "none", "--quiet", "--out", tmp_path / "mc")
+    assert res.exit_code == 0, res.output
+    assert "5 flights of nlpd on circle, seed 1" in res.output          # seed from [montecarlo]
+    meta = json.loads((tmp_path / "mc" / "quadcruise.json").read_text())
+    assert "0.1" in json.dumps(meta) and "turbulence" in json.dumps(meta)
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[montecarlo]\nmass_sprad = 0.1\n")
+    res = run("montecarlo", "--scenario", bad, "-n", "2", "--scheduler", "none")
+    assert res.exit_code == 2 and "[montecarlo] unknown key(s) mass_sprad" in res.output
+    res = run("reproduce", "--scenario", scen / "light_vehicle_square.toml", "--out", tmp_path / "r")
+    assert res.exit_code == 0, res.output
+    assert json.loads((tmp_path / "r" / "metrics.json").read_text())["config"]["vehicle"]["m"] == 1.4

@@ -217,8 +217,10 @@ def write_flight(result, metrics, out: str, fmt: str) -> None:
 @click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
 @click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html",
               help="Also write a self-contained HTML report (tables, figures, interactive 3-D view, configuration).")
+@click.option("--scenario", type=click.Path(dir_okay=False), metavar="FILE.toml",
+              help="Reproduce with a scenario's vehicle and control period (e.g. the 1.4 kg Qball-X4).")
 @_friendly
-def reproduce(out, fmt, force, report):
+def reproduce(out, fmt, force, report, scenario):
     """Reproduce the paper: both controllers on the circle, square and step, beside its numbers.
 
     Writes OUT/metrics.json, one figure per paper figure, the traces and OUT/report.md,
@@ -234,7 +236,13 @@ def reproduce(out, fmt, force, report):
     def flown(done, total, label):
         click.echo(f"[{done}/{total}] flew {label}", err=True)
 
-    rep = run_reproduce(progress=flown)
+    settings = {}
+    if scenario is not None:
+        from .scenario import load_scenario
+
+        sc = load_scenario(scenario)
+        settings = {"vehicle": sc.vehicle, "dt": sc.dt}
+    rep = run_reproduce(progress=flown, **settings)
     click.echo(results_table(rep))
     write_reproduction(rep, out, force=force, fmt=fmt, progress=lambda name: click.echo(f"drew {name}", err=True))
     if report is not None:
@@ -351,6 +359,8 @@ def analyze(controller, controller_params, position_poles, dt, out, force):
 @click.option("--case", type=int, help="Fly flight I alone (replays a worst case exactly).")
 @click.option("--worst", type=int, default=5, show_default=True, help="How many worst cases to list.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
+@click.option("--scenario", type=click.Path(dir_okay=False), metavar="FILE.toml",
+              help="Mission, controller, vehicle, disturbances and a [montecarlo] table from a scenario file.")
 @_friendly
 def montecarlo(**options):
     """Fly a population of perturbed vehicles and report the distribution of every metric.

@@ -604,6 +604,29 @@ def montecarlo(mission: Mission | str = "circle", controller: Controller | str =
 
 
 # --- command line -----------------------------------------------------------------------
+def _from_scenario(path: str, spreads: dict, n: int, seed: int):
+    """The scenario, with its [montecarlo] table merged into spreads (explicit CLI values,
+    those that differ from the defaults, win), and n and seed."""
+    import dataclasses
+
+    from .scenario import load_scenario
+
+    sc = load_scenario(path)
+    table = dict(sc.montecarlo)
+    known = {f.name for f in dataclasses.fields(Population)} - {"environment", "noise"}
+    unknown = set(table) - known - {"n", "seed"}
+    if unknown:
+        raise InputError(f"{path}: [montecarlo] unknown key(s) {', '.join(sorted(unknown))} "
+                         f"(known: n, seed, {', '.join(sorted(known))})")
+    defaults = {f.name: f.default for f in dataclasses.fields(Population)}
+    for key, value in table.items():
+        if key in spreads and spreads[key] == defaults.get(key):
+            spreads[key] = value
+    n = table.get("n", n) if n == 1000 else n
+    seed = table.get("seed", sc.simulation.get("seed", seed)) if seed == 0 else seed
+    return sc, n, seed
+
+
 def parse_noise(text: str | None):
     """``position=STD,velocity=STD,angle=STD,rate=STD,delay=S`` -> SensorNoise (None: none).
 
@@ -637,7 +660,7 @@ def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: 
                        model_error: bool = True, chunk_size: str | int = "auto", scheduler: str = "local",
                        workers: int | None = None, connect_timeout: float = 10.0, out: str | None = None,
                        force: bool = False, resume: bool = True, fmt: str = "csv", case: int | None = None,
-                       worst: int = 5, quiet: bool = False,
+                       worst: int = 5, quiet: bool = False, scenario: str | None = None,
                        echo: Callable[[str], None] = print) -> MonteCarloResult | Case:
     """What ``quadcruise montecarlo`` runs: build the population, fly it, print the summary
     and the worst cases, write ``out``.
@@ -647,7 +670,9 @@ def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: 
     the sweep (whose options must be the same), else into ``out``. Bad input raises
     InputError before anything is written; ``chunk_size`` may be a number or "auto";
     ``wind`` is a :func:`~quadcruise.disturbances.parse_wind` spec and ``noise`` a
-    :func:`parse_noise` one.
+    :func:`parse_noise` one. A ``scenario`` file supplies the mission, controller, nominal
+    vehicle, disturbances, sensor noise and simulation settings, and its ``[montecarlo]``
+    table any of n, seed and the Population fields; options given explicitly win.
     """
     import sys
 
@@ -660,12 +685,20 @@ def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: 
         except ValueError:
             raise InputError(f"--chunk-size must be a whole number or auto, got {chunk_size!r}") from None
     env = parse_wind(wind) if wind is not None else None
-    population = Population(mass_spread=mass_spread, inertia_spread=inertia_spread, thrust_spread=thrust_spread,
-                            bandwidth_spread=bandwidth_spread, yaw_arm_spread=yaw_arm_spread, offset=offset,
-                            wind_spread=wind_spread, distribution=distribution,
-                            environment=env if env is not None and env.parts else None,
-                            noise=parse_noise(noise), model_error=model_error)
-    options = dict(duration=duration, dt=dt)
+    spreads = dict(mass_spread=mass_spread, inertia_spread=inertia_spread, thrust_spread=thrust_spread,
+                   bandwidth_spread=bandwidth_spread, yaw_arm_spread=yaw_arm_spread, offset=offset,
+                   wind_spread=wind_spread, distribution=distribution, model_error=model_error)
+    sensor = parse_noise(noise)
+    options: dict = dict(duration=duration, dt=dt)
+    if scenario is not None:
+        sc, n, seed = _from_scenario(scenario, spreads, n, seed)
+        mission = sc.mission or mission
+        controller = sc.controller or controller
+        env = env if env is not None else sc.environment
+        sensor = sensor if sensor is not None else sc.sensor_noise
+        options.update(vehicle=sc.vehicle, duration=duration or sc.duration, dt=sc.simulation.get("dt", dt),
+                       full_dynamics=sc.simulation.get("full_dynamics", False))
+    population = Population(**spreads, environment=env if env is not None and env.parts else None, noise=sensor)
     if case is not None:
         from pathlib import Path
 
