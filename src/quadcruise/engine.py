@@ -18,7 +18,6 @@ serves every controller, a user's own included.
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 
@@ -141,17 +140,17 @@ _u8m = types.uint64[:, ::1]
 
 KERNEL_SIG = types.void(
     _f8v, _f8m, _f8m, _f8m, ControllerType, _f8m, _f8m, MissionType, _f8m,
-    types.boolean, DisturbanceType, _f8m, _f8m, _u8m, _f8m, types.int64, types.boolean,
+    DisturbanceType, _f8m, _f8m, _u8m, _f8m, types.int64, types.boolean,
     types.float64, types.int64, _f8v,
     _f8c, _f8c, _f8c, _f8m, _i8v, _f8v, _f8m,
 )
 
 
-def _kernel_body(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
-                 disturbed, disturbance, dp, dmem, rng, sensor_std, sensor_delay, full,
-                 max_step, log_every, limits,
-                 log_x, log_cmd, log_ref, x_final, status, t_stop, saturated):
-    """The engine: every vehicle, every period (compiled twice, see :func:`_kernel`)."""
+@njit(KERNEL_SIG, cache=True, parallel=True, error_model="numpy")
+def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
+            disturbance, dp, dmem, rng, sensor_std, sensor_delay, full,
+            max_step, log_every, limits,
+            log_x, log_cmd, log_ref, x_final, status, t_stop, saturated):
     n_vehicles = x0.shape[0]
     n_periods = t_grid.shape[0] - 1
     for i in prange(n_vehicles):
@@ -164,17 +163,13 @@ def _kernel_body(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
         cmd = np.zeros(CMD_SIZE)
         u = np.zeros(4)
         ext = np.zeros(EXT_SIZE)
-        for j in range(EXT_E1, EXT_E1 + 4):
-            ext[j] = 1.0                        # still air, healthy rotors unless disturbed
         k1 = np.empty(STATE_SIZE)
         k2 = np.empty(STATE_SIZE)
         k3 = np.empty(STATE_SIZE)
         k4 = np.empty(STATE_SIZE)
         xt = np.empty(STATE_SIZE)
-        # private copies of this vehicle's rows: views would share their parent's reference
-        # count with the other threads, and every call that counts references would contend
-        vpi, vci, gi, mi, mpi = vp[i].copy(), vp_ctrl[i].copy(), gains[i].copy(), mem[i].copy(), mp[i].copy()
-        dpi, dmi, rngi, stdi = dp[i].copy(), dmem[i].copy(), rng[i].copy(), sensor_std[i].copy()
+        vpi, vci, gi, mi, mpi = vp[i], vp_ctrl[i], gains[i], mem[i], mp[i]
+        dpi, dmi, rngi, stdi = dp[i], dmem[i], rng[i], sensor_std[i]
         noisy = False
         for j in range(STATE_SIZE):
             if stdi[j] != 0.0:
@@ -186,16 +181,12 @@ def _kernel_body(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
             mission(t, mpi, ref)
             # what the controller sees: the state sensor_delay periods ago, plus noise
-            if sensor_delay == 0:
-                for j in range(STATE_SIZE):
-                    seen[j] = x[j]
-            else:
-                slot = k % (sensor_delay + 1)
-                for j in range(STATE_SIZE):
-                    history[slot, j] = x[j]
-                old = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
-                for j in range(STATE_SIZE):
-                    seen[j] = history[old, j]
+            slot = k % (sensor_delay + 1)
+            for j in range(STATE_SIZE):
+                history[slot, j] = x[j]
+            old = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
+            for j in range(STATE_SIZE):
+                seen[j] = history[old, j]
             if noisy:
                 for j in range(STATE_SIZE):
                     if stdi[j] != 0.0:
@@ -219,8 +210,7 @@ def _kernel_body(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
                 saturated[i, 0] += dt
             if cmd[CMD_FLAGS] != 0.0:
                 saturated[i, 1] += dt
-            if disturbed:
-                disturbance(t, dt, x, dpi, dmi, rngi, ext)
+            disturbance(t, dt, x, dpi, dmi, rngi, ext)
             n_sub = max(1, int(math.ceil(dt / max_step - 1e-9)))
             h = dt / n_sub
             for _ in range(n_sub):
@@ -232,23 +222,8 @@ def _kernel_body(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
                     log_x[i, (k + 1) // log_every, :] = x
                 break
         x_final[i, :] = x
-        mem[i, :] = mi                          # the memories go back to the caller
-        dmem[i, :] = dmi
         status[i] = code
         t_stop[i] = t_end
-
-
-@functools.cache
-def _compiled(parallel: bool):
-    """The kernel compiled (or loaded from numba's cache) on first use, with or without
-    threads: one implementation, two builds."""
-    return njit(KERNEL_SIG, cache=True, parallel=parallel, error_model="numpy")(_kernel_body)
-
-
-def _kernel(*args) -> None:
-    """Run the kernel: threaded for a batch, serial for one vehicle, which has nothing to
-    share out and would only pay the thread pool's start-up (milliseconds on a busy machine)."""
-    _compiled(args[1].shape[0] > 1)(*args)
 
 
 def time_grid(duration: float, dt: float, t0: float = 0.0) -> np.ndarray:
@@ -370,8 +345,7 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
     t_stop = np.empty(n)
     saturated = np.zeros((n, 2))
     _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
-            disturbance is not None, disturbance or still_air, dp, dmem, rng, std, int(sensor_delay),
-            bool(full_dynamics),
+            disturbance or still_air, dp, dmem, rng, std, int(sensor_delay), bool(full_dynamics),
             float(max_step), int(log_every), limits.array(),
             log_x, log_cmd, log_ref, x_final, status, t_stop, saturated)
     return SimResult(

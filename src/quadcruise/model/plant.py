@@ -52,7 +52,7 @@ from ..layout import (
 from .actuators import mix
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def derivative(x, u, vp, ext, full, dx):
     """Write dx/dt of one vehicle into ``dx``.
 
