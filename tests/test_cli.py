@@ -134,3 +134,12 @@ def test_montecarlo_and_reproduce_accept_a_scenario(tmp_path):
     res = run("reproduce", "--scenario", scen / "light_vehicle_square.toml", "--out", tmp_path / "r")
     assert res.exit_code == 0, res.output
     assert json.loads((tmp_path / "r" / "metrics.json").read_text())["config"]["vehicle"]["m"] == 1.4
+
+
+def test_compare_on_the_same_population():
+    res = run("compare", "step", "--duration", "9", "--controllers", "nlpd,gonzalez", "--population", "5",
+              "--mass-spread", "0.05", "--seed", "2")
+    assert res.exit_code == 0, res.output
+    assert "the same 5 perturbed vehicles (seed 2" in res.output
+    table = res.output.split("perturbed vehicles")[1]
+    assert "nlpd" in table and "gonzalez" in table and "failure_rate" in table

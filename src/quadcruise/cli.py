@@ -267,18 +267,36 @@ def reproduce(out, fmt, force, report, scenario):
               help="Mission parameter (repeatable).")
 @click.option("--out", type=click.Path(file_okay=False), help="Folder for metrics.csv and comparison.png.")
 @click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
+@click.option("--population", type=int, metavar="N",
+              help="Also fly every controller on the same Monte Carlo population of N vehicles.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the population.")
+@click.option("--mass-spread", type=float, default=0.1, show_default=True, help="Relative std of the mass.")
+@click.option("--wind", metavar="SPEC", help="Wind of the population, e.g. dryden:moderate@10.")
 @click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html",
               help="Also write a self-contained HTML report (tables, figures, interactive 3-D view, configuration).")
 @_friendly
-def compare(mission, controllers, duration, dt, mission_params, out, force, report):
+def compare(mission, controllers, duration, dt, mission_params, out, force, population, seed, mass_spread, wind,
+            report):
     """Fly MISSION (a name or a waypoint CSV) with several controllers; one table, one figure."""
     from .compare import compare as run_compare
 
     if out is not None:
         check_output_dir(out, force)
-    cmp = run_compare(_mission(mission, mission_params, smooth=False), controllers.split(","),
-                      duration=duration, dt=dt)
+    cmp_mission = _mission(mission, mission_params, smooth=False)
+    cmp = run_compare(cmp_mission, controllers.split(","), duration=duration, dt=dt)
     click.echo(cmp.text())
+    if population is not None:
+        from .compare import compare_population
+        from .disturbances import parse_wind
+        from .montecarlo import Population
+
+        env = parse_wind(wind) if wind else None
+        pop = Population(mass_spread=mass_spread, environment=env if env is not None and env.parts else None)
+        table = compare_population(cmp_mission, controllers, pop, population, seed, duration=duration, dt=dt,
+                                   scheduler="none")
+        click.echo(f"\nthe same {population} perturbed vehicles (seed {seed}, mass spread {mass_spread:g}"
+                   + (f", wind {wind}" if wind else "") + "):")
+        click.echo(table.to_string(float_format=lambda v: f"{v:.4g}"))
     if out is not None:
         cmp.write(out, force=force)
         click.echo(f"wrote metrics.csv and comparison.png to {out}")
