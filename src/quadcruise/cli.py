@@ -15,6 +15,14 @@ from . import __version__
 from .errors import InputError
 from .io import check_output_dir
 
+# options several commands share
+FORMAT_OPTION = click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv",
+                             show_default=True, help="Format of the traces.")
+FORCE_OPTION = click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
+REPORT_OPTION = click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html",
+                             help="Also write a self-contained HTML report (tables, figures, interactive 3-D "
+                                  "view, configuration).")
+
 
 def _friendly(func):
     """Turn InputError into a one-line message with exit status 2; show warnings plainly."""
@@ -119,12 +127,10 @@ def _metrics_table(frame) -> str:
 @click.option("--poles", "position_poles", metavar="P1,P2",
               help="Closed-loop poles of the x/y loops [rad/s], e.g. -0.7,-4.3 (the paper's).")
 @click.option("--out", "out", type=click.Path(file_okay=False), help="Folder for traces, figure and metrics.")
-@click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv", show_default=True,
-              help="Format of the traces.")
-@click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
+@FORMAT_OPTION
+@FORCE_OPTION
 @click.option("--smooth", is_flag=True, help="Fly a waypoint file as a minimum-snap path instead of legs.")
-@click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html",
-              help="Also write a self-contained HTML report (tables, figures, interactive 3-D view, configuration).")
+@REPORT_OPTION
 @click.option("--animate", type=click.Path(dir_okay=False), metavar="PATH.gif",
               help="Also write an animation of the flight (.gif; .mp4 needs ffmpeg).")
 @_friendly
@@ -212,11 +218,9 @@ def write_flight(result, metrics, out: str, fmt: str) -> None:
 @main.command()
 @click.option("--out", "out", default="quadcruise-out", show_default=True, type=click.Path(file_okay=False),
               help="Folder for metrics.json, figures, traces and report.md.")
-@click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv", show_default=True,
-              help="Format of the traces.")
-@click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
-@click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html",
-              help="Also write a self-contained HTML report (tables, figures, interactive 3-D view, configuration).")
+@FORMAT_OPTION
+@FORCE_OPTION
+@REPORT_OPTION
 @click.option("--scenario", type=click.Path(dir_okay=False), metavar="FILE.toml",
               help="Reproduce with a scenario's vehicle and control period (e.g. the 1.4 kg Qball-X4).")
 @_friendly
@@ -266,14 +270,13 @@ def reproduce(out, fmt, force, report, scenario):
 @click.option("-m", "--mission-param", "mission_params", multiple=True, metavar="KEY=VALUE",
               help="Mission parameter (repeatable).")
 @click.option("--out", type=click.Path(file_okay=False), help="Folder for metrics.csv and comparison.png.")
-@click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
+@FORCE_OPTION
 @click.option("--population", type=int, metavar="N",
               help="Also fly every controller on the same Monte Carlo population of N vehicles.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the population.")
 @click.option("--mass-spread", type=float, default=0.1, show_default=True, help="Relative std of the mass.")
 @click.option("--wind", metavar="SPEC", help="Wind of the population, e.g. dryden:moderate@10.")
-@click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html",
-              help="Also write a self-contained HTML report (tables, figures, interactive 3-D view, configuration).")
+@REPORT_OPTION
 @_friendly
 def compare(mission, controllers, duration, dt, mission_params, out, force, population, seed, mass_spread, wind,
             report):
@@ -314,7 +317,7 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
 @click.option("--poles", "position_poles", metavar="P1,P2", help="Closed-loop poles of the x/y loops [rad/s].")
 @click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
 @click.option("--out", type=click.Path(file_okay=False), help="Folder for analysis.json and Bode plots.")
-@click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
+@FORCE_OPTION
 @_friendly
 def analyze(controller, controller_params, position_poles, dt, out, force):
     """Linearise the closed loop about hover: poles, damping, margins of each loop, Bode plots."""
