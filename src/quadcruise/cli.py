@@ -92,8 +92,10 @@ def _assignments(items: tuple[str, ...], option: str) -> dict:
 def _poles(text: str | None, option: str):
     if text is None:
         return None
+    from .control.design import parse_pole
+
     try:
-        return [complex(p.replace(" ", "").replace("i", "j")) for p in text.split(",")]
+        return [parse_pole(p) for p in text.split(",")]
     except ValueError:
         raise InputError(f"{option} {text!r}: expected comma-separated poles, e.g. -0.7,-4.3") from None
 

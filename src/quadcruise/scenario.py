@@ -64,7 +64,7 @@ from pathlib import Path
 from typing import Any
 
 from .control import CONTROLLERS, Controller
-from .control.design import PDGains, PIDGains, pd_from_poles, pid_from_poles
+from .control.design import PDGains, PIDGains, parse_pole, pd_from_poles, pid_from_poles
 from .errors import InputError
 from .missions import MISSIONS, Mission
 from .params import Vehicle
@@ -213,7 +213,7 @@ def _poles(where: _Where, key: str, value) -> list:
     out = []
     for p in value:
         try:
-            out.append(complex(p.replace(" ", "").replace("i", "j")) if isinstance(p, str) else complex(p))
+            out.append(parse_pole(p))
         except (TypeError, ValueError):
             raise where.error(f"'{key}': {p!r} is not a pole (a number, or a string like \"-1+2j\")") from None
     return out

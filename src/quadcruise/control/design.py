@@ -29,7 +29,7 @@ def _control():
 
     return control
 
-__all__ = ["PAPER_POSITION_POLES", "PDGains", "PIDGains", "pd_from_poles", "pid_from_poles",
+__all__ = ["PAPER_POSITION_POLES", "PDGains", "PIDGains", "parse_pole", "pd_from_poles", "pid_from_poles",
            "position_pd_design", "altitude_pd_design", "attitude_pid_design",
            "loop_transfer", "loop_margins", "check_with_control", "cascade_state_space"]
 
@@ -125,6 +125,16 @@ class PIDGains(_Gains):
     @property
     def _char(self) -> np.ndarray:
         return np.array([1.0, self.kd, self.kp, self.ki])
+
+
+def parse_pole(value) -> complex:
+    """A pole from a number or a string such as "-0.7" or "-1+2j" ("-1+2i" too).
+
+    Raises ValueError (TypeError for other types) if it is not one; callers name the source.
+    """
+    if isinstance(value, str):
+        return complex(value.replace(" ", "").replace("i", "j"))
+    return complex(value)
 
 
 def _fmt(z: complex) -> str:
