@@ -21,7 +21,7 @@ from . import __version__
 from .control import Controller, controller_from_name
 from .engine import Limits, simulate, time_grid
 from .errors import InputError
-from .layout import F1, PSI, REF_PSI, REF_Z, STATE_SIZE, Z
+from .layout import F1, P_G, P_M, PSI, REF_PSI, REF_Z, STATE_SIZE, Z
 from .missions import Circle, Mission, Square, Step, mission_from_name, stack_params
 from .params import Vehicle
 from .result import SimResult
@@ -50,7 +50,7 @@ def hover_state(vehicle: Vehicle, n: int, mission: Mission) -> np.ndarray:
     x0 = np.zeros((n, STATE_SIZE))
     x0[:, Z] = ref0[REF_Z]
     x0[:, PSI] = ref0[REF_PSI]
-    x0[:, F1:F1 + 4] = (vp[:, 0] * vp[:, 8] / 4.0)[:, None]
+    x0[:, F1:F1 + 4] = (vp[:, P_M] * vp[:, P_G] / 4.0)[:, None]
     return x0
 
 
