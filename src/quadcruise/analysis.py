@@ -38,7 +38,6 @@ from dataclasses import dataclass
 import control
 import numpy as np
 import scipy.linalg
-from matplotlib.figure import Figure
 from scipy.sparse.csgraph import connected_components
 
 from .errors import InputError
@@ -348,7 +347,7 @@ def loop_margins(lin: Linearization, loop: str = "x", at: str = "input") -> dict
             "open_loop_unstable_poles": int(np.sum(np.abs(np.linalg.eigvals(L.A)) > 1.0 + 1e-9))}
 
 
-def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "input") -> Figure:
+def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "input"):
     """Closed-loop x_r->x, y_r->y (dashed: the same as x for a symmetric vehicle), z_r->z,
     psi_r->psi magnitude and phase; with ``loops``, a second column of the loop transfers
     (broken ``at``), their gain crossovers marked and their phase read so that the phase
@@ -359,6 +358,8 @@ def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "inpu
     4
     """
     w = np.logspace(-2, math.log10(0.999 * math.pi / lin.dt), 800) if omega is None else np.asarray(omega, float)
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=(12 if loops else 7, 6.5), layout="constrained")
     axes = fig.subplots(2, 2 if loops else 1, sharex="col", squeeze=False)
     for (loop, (_, state)), color in zip(LOOPS.items(), ("C0", "C1", "C2", "C3")):

@@ -361,6 +361,23 @@ def plot_envelope(result, *, title: str | None = None, max_paths: int = 50) -> F
     return fig
 
 
+def plot_reference(result, *, vehicle: int = 0, title: str | None = None) -> Figure:
+    """The reference path of a flight in 3-D with the vehicle's start (the paper's Fig 4)."""
+    fig = Figure(figsize=(7, 6), layout="constrained")
+    ax = fig.add_subplot(projection="3d")
+    ref = result.references[vehicle]
+    start = result.states[vehicle, 0]
+    ax.plot(ref[:, 0], ref[:, 1], ref[:, 2], "k--", lw=1.5, label="reference")
+    ax.scatter([start[0]], [start[1]], [start[2]], color="tab:green", label="start (hover)")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    if title:
+        ax.set_title(title)
+    ax.legend(loc="upper left")
+    return fig
+
+
 def save_figure(fig: Figure, path: str | os.PathLike) -> None:
     """Write a figure as PNG (120 dpi), whole or not at all.
 

@@ -449,11 +449,9 @@ def reproduction_report(rep, figures: dict | None = None, *, title: str | None =
     table = pd.DataFrame(rows).astype({c: float for c in rows[0] if c.endswith(("_s", "_pct", "_m"))}) \
         if rows else pd.DataFrame()
     if figures is None:
-        from .plots import plot_paths
-
         light = {key: res.decimate(TRACE_EVERY) for key, res in rep.results.items()}
         figures = {cap: fig for name, cap in FIGURES.items()
-                   if (fig := _figure(name, cap, light, plot_paths)) is not None}
+                   if (fig := _figure(name, cap, light)) is not None}
     flights = {scen: {c: res for (s, c), res in rep.results.items() if s == scen} for scen in ("circle", "square")}
     intro = ("Our values beside the paper's. Transients are measured on x from hover; settling uses the "
              "2 % band (5 % beside it); RMSE is the 3-D position error over the whole flight, transient "

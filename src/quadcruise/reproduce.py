@@ -167,7 +167,7 @@ def _json_number(value) -> float | None:
 def write_reproduction(rep: Reproduction, out: str | Path, *, force: bool = False, fmt: str = "csv",
                        progress: Callable[[str], None] | None = None) -> Path:
     """Write metrics.json, the figures, the traces and report.md into ``out``, atomically."""
-    from .plots import plot_paths, save_figure
+    from .plots import save_figure
 
     out = check_output_dir(out, force)
     with atomic_dir(out) as tmp:
@@ -182,7 +182,7 @@ def write_reproduction(rep: Reproduction, out: str | Path, *, force: bool = Fals
             write_table(result.to_pandas(), traces / f"{scen}_{ctrl.replace('+', '_')}", fmt)
         written = []
         for name, caption in FIGURES.items():
-            fig = _figure(name, caption, light, plot_paths)
+            fig = _figure(name, caption, light)
             if fig is not None:
                 save_figure(fig, tmp / name)
                 written.append(name)
@@ -192,34 +192,20 @@ def write_reproduction(rep: Reproduction, out: str | Path, *, force: bool = Fals
     return out
 
 
-def _figure(name: str, caption: str, results: dict, plot_paths):
+def _figure(name: str, caption: str, results: dict):
+    """The figure ``name`` of FIGURES drawn from the flights, or None if they are missing."""
+    from .plots import plot_paths, plot_reference
+
     scen = "circle" if "circle" in name else "square"
     have = {c: r for (s, c), r in results.items() if s == scen}
     if name.startswith("fig4"):
         if not have:
             return None
-        return _reference_figure(next(iter(have.values())), caption)
+        return plot_reference(next(iter(have.values())), title=caption)
     if name.startswith("compare"):
         return plot_paths(have, title=caption) if len(have) > 1 else None
     ctrl = "nlpd" if name.endswith("_nlpd.png") else "gonzalez"
     return plot_paths({ctrl: have[ctrl]}, title=caption) if ctrl in have else None
-
-
-def _reference_figure(result: SimResult, caption: str):
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(7, 6), layout="constrained")
-    ax = fig.add_subplot(projection="3d")
-    ref = result.references[0]
-    ax.plot(ref[:, 0], ref[:, 1], ref[:, 2], "k--", lw=1.5, label="reference")
-    ax.scatter([result.states[0, 0, 0]], [result.states[0, 0, 1]], [result.states[0, 0, 2]],
-               color="tab:green", label="start (hover)")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_zlabel("z [m]")
-    ax.set_title(caption)
-    ax.legend(loc="upper left")
-    return fig
 
 
 def _cell(value, missing: str = "-") -> str:
