@@ -11,7 +11,6 @@ import contextlib
 import json
 import math
 import os
-import platform
 import resource
 import shutil
 import subprocess
@@ -26,6 +25,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 from reference_model import rhs as reference_rhs  # noqa: E402
+from machine import machine  # noqa: E402
 
 HZ = 1000.0          # control and integration rate of every benchmark [1/s]
 ROW_HZ = 100.0       # open-loop schedule: duties held for 10 ms per row
@@ -33,17 +33,6 @@ FULL = dict(single_s=60.0, batch_n=2000, batch_s=10.0, repeats=5, warm_repeats=3
             scipy_single_s=60.0, scipy_batch_n=2000, scipy_batch_s=10.0, scipy_budget_s=60.0)
 QUICK = dict(single_s=2.0, batch_n=100, batch_s=1.0, repeats=2, warm_repeats=1,
              scipy_single_s=0.5, scipy_batch_n=50, scipy_batch_s=0.1, scipy_budget_s=5.0)
-
-
-def machine() -> dict:
-    import scipy
-    import quadcruise
-    lines = Path("/proc/cpuinfo").read_text().splitlines() if Path("/proc/cpuinfo").exists() else []
-    cpu = next((ln.split(":", 1)[1].strip() for ln in lines if ln.startswith("model name")), platform.processor())
-    return {"cpu": cpu, "cores": os.cpu_count(), "numba_threads": numba.get_num_threads(),
-            "python": platform.python_version(), "numba": numba.__version__, "numpy": np.__version__,
-            "scipy": scipy.__version__, "quadcruise": quadcruise.__version__,
-            "load_avg_start": list(os.getloadavg())}
 
 
 @contextlib.contextmanager
@@ -292,7 +281,9 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     import quadcruise  # noqa: F401
     import_s = time.perf_counter() - t0
-    info = machine() | {"import_s": import_s}
+    import scipy
+
+    info = machine(scipy=scipy.__version__) | {"import_s": import_s}
     r: dict = {"call_overhead": bench_open_loop(10 / HZ, 1, 7)[0]}   # also starts numba's threads
     final: dict = {}
     info["threading_layer"] = numba.threading_layer()

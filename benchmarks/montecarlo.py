@@ -25,32 +25,17 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import resource
 import sys
 import time
 import warnings
 from pathlib import Path
 
-import numpy as np
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from machine import machine  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 TARGET = dict(n=10_000, duration=60.0, seconds=180.0)
-
-
-def machine() -> dict:
-    import dask
-    import distributed
-    import numba
-
-    import quadcruise
-
-    lines = Path("/proc/cpuinfo").read_text().splitlines() if Path("/proc/cpuinfo").exists() else []
-    cpu = next((ln.split(":", 1)[1].strip() for ln in lines if ln.startswith("model name")), platform.processor())
-    return {"cpu": cpu, "cores": os.cpu_count(), "numba_threads": numba.get_num_threads(),
-            "python": platform.python_version(), "numba": numba.__version__, "numpy": np.__version__,
-            "dask": dask.__version__, "distributed": distributed.__version__,
-            "quadcruise": quadcruise.__version__, "load_avg_start": list(os.getloadavg())}
 
 
 def make_spec(duration: float):
@@ -108,7 +93,10 @@ def main(argv=None) -> int:
     from quadcruise.sweep import run_chunk
 
     sources = {p: p.stat().st_mtime for p in (ROOT / "src" / "quadcruise").rglob("*.py")}
-    info = machine()
+    import dask
+    import distributed
+
+    info = machine(dask=dask.__version__, distributed=distributed.__version__)
     print(f"machine: {info['cpu']}, {info['cores']} cores, numba {info['numba']} ({info['numba_threads']} threads), "
           f"dask {info['distributed']}; load average {', '.join(f'{v:.2f}' for v in info['load_avg_start'])}")
     spec = make_spec(duration)
