@@ -77,26 +77,37 @@ def check_output_dir(path: str | os.PathLike, force: bool = False) -> Path:
     return path
 
 
-def write_table(frame, path: Path, fmt: str) -> Path:
-    """Write a numeric DataFrame as CSV or Parquet; returns the file written."""
+def check_table_format(fmt: str) -> None:
+    """Refuse an unknown table format, or Parquet without pyarrow, before any work is done."""
     from .errors import InputError
 
-    if fmt == "csv":
-        import numpy as np
-
-        out = path.with_suffix(".csv")
-        # numpy formats numeric tables about twice as fast as pandas' to_csv
-        np.savetxt(out, frame.to_numpy(dtype=float), delimiter=",", fmt="%.10g",
-                   header=",".join(map(str, frame.columns)), comments="")
-    elif fmt == "parquet":
+    if fmt not in ("csv", "parquet"):
+        raise InputError(f"unknown table format {fmt!r}; choose csv or parquet")
+    if fmt == "parquet":
         try:
             import pyarrow  # noqa: F401  (pandas needs it for Parquet)
         except ImportError:
             raise InputError("writing Parquet needs pyarrow: pip install 'quadcruise[parquet]'") from None
-        out = path.with_suffix(".parquet")
-        frame.to_parquet(out, index=False)
-    else:
-        raise InputError(f"unknown table format {fmt!r}; choose csv or parquet")
+
+
+def write_table(frame, path: Path, fmt: str) -> Path:
+    """Write a DataFrame as CSV or Parquet at ``path`` with the format's suffix, atomically;
+    returns the file written."""
+    import pandas as pd
+
+    check_table_format(fmt)
+    out = Path(path).with_suffix("." + fmt)
+    with atomic_path(out) as tmp:
+        if fmt == "parquet":
+            frame.to_parquet(tmp, index=False)
+        elif all(pd.api.types.is_numeric_dtype(d) for d in frame.dtypes):
+            import numpy as np
+
+            # numpy formats numeric tables about twice as fast as pandas' to_csv
+            np.savetxt(tmp, frame.to_numpy(dtype=float), delimiter=",", fmt="%.10g",
+                       header=",".join(map(str, frame.columns)), comments="")
+        else:
+            frame.to_csv(tmp, index=False, float_format="%.10g")
     return out
 
 

@@ -51,8 +51,9 @@ import numpy as np
 
 from . import __version__
 from .errors import InputError, SimulationError
-from .io import MARKER, atomic_path, check_output_dir
+from .io import MARKER, atomic_path, check_output_dir, check_table_format, write_table
 from .layout import CMD_U1, REF_X, X
+from .metrics import control_effort, tracking_errors
 from .montecarlo import COLUMNS, FAILURES, METRICS, Draw, MonteCarloResult, MonteCarloSpec, Traces, _plain
 
 __all__ = ["run_chunk", "fly_chunk", "reduce_chunk", "sweep_metrics", "run_sweep", "auto_chunk_size",
@@ -230,16 +231,11 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
     if live.size:
         pos = result.states[live, :, X:X + 3]
         ref = refs[live]
-        d2 = np.ascontiguousarray((pos - ref).transpose(0, 2, 1)) ** 2      # (k, 3, L)
-        w = np.diff(t)
-        ms = (0.5 * (d2[..., 1:] + d2[..., :-1]) * w).sum(axis=-1) / (t[-1] - t[0])
-        out["rmse_m"][live] = np.sqrt(ms[:, 0] + ms[:, 1] + ms[:, 2])
-        e2 = d2[:, 0] + d2[:, 1] + d2[:, 2]
-        out["max_error_m"][live] = np.sqrt(e2).max(axis=1)
-        out["final_error_m"][live] = np.sqrt(e2[:, -1])
-        u = np.ascontiguousarray(result.commands[live, :, CMD_U1:CMD_U1 + 4].transpose(0, 2, 1))
-        u2 = u[:, 0] ** 2 + u[:, 1] ** 2 + u[:, 2] ** 2 + u[:, 3] ** 2
-        out["effort"][live] = (0.5 * (u2[:, 1:] + u2[:, :-1]) * w).sum(axis=-1)
+        err = tracking_errors(t, pos, ref)                              # batched over vehicles
+        out["rmse_m"][live] = err["rmse"]
+        out["max_error_m"][live] = err["max_error"]
+        out["final_error_m"][live] = np.linalg.norm(pos[:, -1] - ref[:, -1], axis=1)
+        out["effort"][live] = control_effort(t, result.commands[live, :, CMD_U1:CMD_U1 + 4])["integral"]
         keep = slice(None) if spec.transient_until is None else t <= spec.transient_until
         mission = result.meta.get("mission") if isinstance(result.meta.get("mission"), dict) else {}
         tk = t[keep]
@@ -572,13 +568,7 @@ def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", s
         raise InputError(f"chunk size must be a whole number >= 1 or 'auto', got {chunk_size!r}")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1):
         raise InputError(f"workers must be a whole number >= 1, got {workers!r}")
-    if fmt not in ("csv", "parquet"):
-        raise InputError(f"unknown table format {fmt!r}; choose csv or parquet")
-    if fmt == "parquet":
-        try:
-            import pyarrow  # noqa: F401
-        except ImportError:
-            raise InputError("writing Parquet needs pyarrow: pip install 'quadcruise[parquet]'") from None
+    check_table_format(fmt)
     mode = _scheduler(scheduler)
     folder = _Folder(out, spec, force=force, resume=resume) if out is not None else None
     collector = _Collector(spec, n)
@@ -637,17 +627,7 @@ def write_outputs(result: MonteCarloResult, out, *, fmt: str = "csv", force: boo
         if path.is_dir() and any(path.iterdir()):
             shutil.rmtree(path)
     path.mkdir(parents=True, exist_ok=True)
-    table = result.table
-    if fmt == "csv":
-        name = "flights.csv"
-        with atomic_path(path / name) as tmp:
-            table.to_csv(tmp, index=False, float_format="%.10g")
-    elif fmt == "parquet":
-        name = "flights.parquet"
-        with atomic_path(path / name) as tmp:
-            table.to_parquet(tmp, index=False)
-    else:
-        raise InputError(f"unknown table format {fmt!r}; choose csv or parquet")
+    name = write_table(result.table, path / "flights", fmt).name
     summary = result.summary()
     with atomic_path(path / "summary.json") as tmp:
         tmp.write_text(json.dumps({**summary, "info": result.info}, indent=2, default=_plain) + "\n")
