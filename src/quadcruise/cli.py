@@ -148,21 +148,20 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
     """
     from .missions import mission_from_name
 
+    overrides = {k: v for k, v in (("duration", duration), ("dt", dt), ("max_step", max_step)) if v is not None}
     if mission.lower().endswith(".toml"):
         from .scenario import load_scenario
 
         scenario = load_scenario(mission)
-        kwargs = scenario.fly_kwargs()
-        kwargs.update({k: v for k, v in (("duration", duration), ("dt", dt), ("max_step", max_step)) if v is not None})
         the_mission, the_controller = scenario.mission or mission_from_name("circle"), scenario.controller
         if the_controller is None or controller_params or position_poles or controller != "nlpd":
             the_controller = _controller_from_options(controller, controller_params, position_poles)
-        _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate)
-        return
-    the_mission = _mission(mission, mission_params, smooth)
-    the_controller = _controller_from_options(controller, controller_params, position_poles)
-    _fly_and_report(the_mission, the_controller, {"duration": duration, "dt": dt or 1e-3, "max_step": max_step},
-                    out, fmt, force, report, animate)
+        kwargs = {**scenario.fly_kwargs(), **overrides}
+    else:
+        the_mission = _mission(mission, mission_params, smooth)
+        the_controller = _controller_from_options(controller, controller_params, position_poles)
+        kwargs = overrides
+    _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate)
 
 
 def _controller_from_options(name: str, params: tuple[str, ...], poles_text: str | None):
@@ -177,7 +176,7 @@ def _controller_from_options(name: str, params: tuple[str, ...], poles_text: str
 
 
 def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=None, animate=None) -> None:
-    from .flight import fly as run_fly
+    from .flight import fly as run_fly, write_flight
 
     if animate is not None and not animate.lower().endswith((".gif", ".mp4")):
         raise InputError(f"--animate {animate}: the animation must be a .gif (or .mp4, with ffmpeg)")
@@ -185,10 +184,10 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
         check_output_dir(out, force)
     result = run_fly(mission, controller, **kwargs)
     metrics = result.metrics()
-    click.echo(f"{controller.name} on {mission.name}: {result.t[-1]:g} s at dt = {kwargs.get('dt') or 1e-3:g} s")
+    click.echo(f"{controller.name} on {mission.name}: {result.t[-1]:g} s at dt = {result.meta['dt_s']:g} s")
     click.echo(_metrics_table(metrics))
     if out is not None:
-        write_flight(result, metrics, out, fmt)
+        write_flight(result, out, fmt, metrics=metrics)
         click.echo(f"wrote traces, figure and metrics to {out}")
     if report is not None:
         from .report import flight_report, write_html_report
@@ -200,21 +199,6 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
 
         animate_flight(result, animate)
         click.echo(f"wrote animation {animate}")
-
-
-def write_flight(result, metrics, out: str, fmt: str) -> None:
-    """The --out folder of ``fly``: traces, metrics, figure, configuration."""
-    from pathlib import Path
-
-    from .io import MARKER, atomic_dir, write_table
-    from .plots import plot_flight, save_figure
-
-    with atomic_dir(out) as tmp:
-        tmp = Path(tmp)
-        write_table(result.to_pandas(), tmp / "traces", fmt)
-        metrics.to_csv(tmp / "metrics.csv", index=False)
-        save_figure(plot_flight(result), tmp / "flight.png")
-        (tmp / MARKER).write_text(result.meta_json() + "\n")
 
 
 @main.command()

@@ -142,6 +142,24 @@ def fly(mission: Mission | str = "circle", controller: Controller | str = "nlpd"
     return result
 
 
+def write_flight(result: SimResult, out, fmt: str = "csv", metrics=None) -> None:
+    """A flight's folder, written whole or not at all: the traces (CSV or Parquet), the
+    metrics, a figure and the configuration (``quadcruise.json``). ``metrics``, if already
+    computed, saves computing them again."""
+    from pathlib import Path
+
+    from .io import MARKER, atomic_dir, write_table
+    from .plots import plot_flight, save_figure
+
+    metrics = result.metrics() if metrics is None else metrics
+    with atomic_dir(out) as tmp:
+        tmp = Path(tmp)
+        write_table(result.to_pandas(), tmp / "traces", fmt)
+        metrics.to_csv(tmp / "metrics.csv", index=False)
+        save_figure(plot_flight(result), tmp / "flight.png")
+        (tmp / MARKER).write_text(result.meta_json() + "\n")
+
+
 def _warn_about(result: SimResult) -> None:
     bad = np.flatnonzero(~result.ok)
     if bad.size:
@@ -154,4 +172,4 @@ def _warn_about(result: SimResult) -> None:
                       f"({np.count_nonzero(clipped)} of {result.n} vehicles)", stacklevel=3)
 
 
-__all__ = ["fly", "default_duration", "hover_state"]
+__all__ = ["fly", "default_duration", "hover_state", "write_flight"]
