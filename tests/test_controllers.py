@@ -182,3 +182,31 @@ def test_diverging_flight_warns_and_stops():
                      limits=qc.Limits(max_position=100.0))
     assert not res.ok[0] and res.t_stop[0] < 20.0
     assert res.metrics().iloc[0].status.startswith("diverged")
+
+
+@pytest.mark.parametrize("name", ["nlpd", "gonzalez"])
+def test_compiled_controller_makes_no_reference_count_calls(name):
+    """The engine runs vehicles in parallel threads that share the batch arrays; each
+    NRT_incref/decref on them is an atomic write to one shared counter. The paper's
+    controllers read their arrays into scalars first and write last, so their compiled body
+    has none (only numba's Python-facing wrapper does). A fresh, uncached compile of the same
+    Python function shows what the engine runs."""
+    import re
+
+    from numba import njit
+
+    from quadcruise.layout import CONTROLLER_SIG
+
+    fn = controller_from_name(name).function
+    fresh = njit(CONTROLLER_SIG, error_model="numpy")(fn.py_func)
+    ir = "".join(fresh.inspect_llvm().values())
+    calls = []
+    body = None
+    for line in ir.splitlines():
+        start = re.match(r'define [^@]*@"?([^"(]+)', line)
+        if start:
+            body = start.group(1)
+        elif "@NRT_incref" in line or "@NRT_decref" in line:
+            if "call " in line and not body.startswith("_ZN7cpython"):
+                calls.append(body)
+    assert calls == []

@@ -41,34 +41,63 @@ def wrap_angle(a):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _axis_pid(j, e, rate, kp, ki, kd, i_limit, dt, mem):
-    """PID on one angle j (0 roll, 1 pitch, 2 yaw); returns (U*, integrator held?)."""
+def pid_axis(e, rate, integral, kp, ki, kd, i_limit, dt):
+    """PID on one angle error e [rad] with measured rate [rad/s] and the integral of e so far
+    [rad s]; returns (U* [rad/s^2], the new integral, whether anti-windup held it)."""
     held = False
     if ki > 0.0:
-        integral = mem[j] + e * dt
+        integral = integral + e * dt
         bound = i_limit / ki
         if integral > bound:
             integral, held = bound, True
         elif integral < -bound:
             integral, held = -bound, True
-        mem[j] = integral
-    return kp * e + ki * mem[j] - kd * rate, held
+    return kp * e + ki * integral - kd * rate, integral, held
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def attitude_law(phi_d, theta_d, psi_d, phi, theta, psi, p, q, r, k, g, integrals, dt):
+    """Eqs (13)-(15) with PID, on scalars: returns ((U2, U3, U4), new integrals, flags).
+
+    ``k`` is (k1, ..., k6), ``g`` the attitude gains (ATT_GAINS entries, layout ATT_*),
+    ``integrals`` the roll, pitch and yaw error integrals [rad s]. Scalars in, scalars out:
+    the controllers read their arrays once, call this, and write once.
+    """
+    k1, k2, k3, k4, k5, k6 = k
+    i_phi, i_theta, i_psi = integrals
+    lim = g[ATT_I_LIMIT]
+    u2s, i_phi, h1 = pid_axis(phi_d - phi, p, i_phi, g[ATT_KP], g[ATT_KI], g[ATT_KD], lim, dt)
+    u3s, i_theta, h2 = pid_axis(theta_d - theta, q, i_theta, g[ATT_KP], g[ATT_KI], g[ATT_KD], lim, dt)
+    u4s, i_psi, h3 = pid_axis(wrap_angle(psi_d - psi), r, i_psi, g[YAW_KP], g[YAW_KI], g[YAW_KD], lim, dt)
+    U2 = (u2s - k1 * q * r) / k2                                             # (13)
+    U3 = (u3s - k3 * p * r) / k4                                             # (13)
+    U4 = (u4s - k5 * p * q) / k6                                             # (13)
+    flags = FLAG_INTEGRATOR_HOLD if (h1 or h2 or h3) else 0
+    return (U2, U3, U4), (i_phi, i_theta, i_psi), flags
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def decoupling_constants(vp):
+    """(k1, ..., k6) of a vehicle parameter row."""
+    return vp[P_K1], vp[P_K2], vp[P_K3], vp[P_K4], vp[P_K5], vp[P_K6]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def attitude_gains(gains):
+    """The attitude block (the first ATT_GAINS entries) of a gains vector, as a tuple."""
+    return (gains[ATT_KP], gains[ATT_KI], gains[ATT_KD], gains[YAW_KP], gains[YAW_KI],
+            gains[YAW_KD], gains[ATT_I_LIMIT])
 
 
 @njit(cache=True, error_model="numpy")
 def decoupled_attitude(x, phi_d, theta_d, psi_d, vp, g, mem, dt):
-    """Eqs (13)-(15) with PID: the roll, pitch and yaw inputs (U2, U3, U4) and a flag word.
+    """Eqs (13)-(15) with PID from arrays: the roll, pitch and yaw inputs (U2, U3, U4) and a
+    flag word; updates the integrals in ``mem[:ATT_MEMORY]``.
 
-    ``g`` and ``mem`` are the controller's gains and memory, whose first ATT_GAINS and
-    ATT_MEMORY entries belong to the attitude loop (layout ATT_* above).
+    The array form of :func:`attitude_law`, for use outside the engine's hot loop.
     """
-    p, q, r = x[P], x[Q], x[R]
-    lim = g[ATT_I_LIMIT]
-    u2s, h1 = _axis_pid(0, phi_d - x[PHI], p, g[ATT_KP], g[ATT_KI], g[ATT_KD], lim, dt, mem)
-    u3s, h2 = _axis_pid(1, theta_d - x[THETA], q, g[ATT_KP], g[ATT_KI], g[ATT_KD], lim, dt, mem)
-    u4s, h3 = _axis_pid(2, wrap_angle(psi_d - x[PSI]), r, g[YAW_KP], g[YAW_KI], g[YAW_KD], lim, dt, mem)
-    U2 = (u2s - vp[P_K1] * q * r) / vp[P_K2]                                 # (13)
-    U3 = (u3s - vp[P_K3] * p * r) / vp[P_K4]                                 # (13)
-    U4 = (u4s - vp[P_K5] * p * q) / vp[P_K6]                                 # (13)
-    flags = FLAG_INTEGRATOR_HOLD if (h1 or h2 or h3) else 0
-    return U2, U3, U4, flags
+    U, integrals, flags = attitude_law(
+        phi_d, theta_d, psi_d, x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R],
+        decoupling_constants(vp), attitude_gains(g), (mem[0], mem[1], mem[2]), dt)
+    mem[0], mem[1], mem[2] = integrals
+    return U[0], U[1], U[2], flags

@@ -58,12 +58,12 @@ from numba import njit
 
 from ..errors import InputError
 from ..layout import (
-    CONTROLLER_SIG, P_G, REF_PSI, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y, REF_Z, VX, VY, VZ, X, Y, Z,
+    CONTROLLER_SIG, P_G, P_K, P_M, PHI, REF_PSI, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y, REF_Z, THETA, VX, VY, VZ, X, Y, Z,
 )
 from .attitude import ATT_GAINS, ATT_MEMORY
 from .base import Controller
 from .design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
-from .position import attitude_block, check_positive, collective_thrust, finish, tilt_setpoint
+from .position import attitude_block, check_positive, finish, thrust_for_tilt, tilt_setpoint
 
 # gains layout after the attitude block
 KP_XY, KD_XY, SAT_P, SAT_D, KP_Z, KD_Z, MAX_TILT = range(ATT_GAINS, ATT_GAINS + 7)
@@ -89,9 +89,10 @@ def gonzalez(t, dt, x, ref, vp, gains, mem, cmd):
     ux = saturated_pd(ref[REF_X] - x[X], ref[REF_VX] - x[VX], kp, kd, ap, ad)
     uy = saturated_pd(ref[REF_Y] - x[Y], ref[REF_VY] - x[VY], kp, kd, ap, ad)
     uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ])
-    U1, flags = collective_thrust(uz, x, vp, tilt)
-    theta_d, flags = tilt_setpoint(ux / vp[P_G], False, tilt, flags)     # eq (5), small angle
-    phi_d, flags = tilt_setpoint(-uy / vp[P_G], False, tilt, flags)      # eq (6), small angle
+    g = vp[P_G]
+    U1, flags = thrust_for_tilt(uz, math.cos(x[PHI]) * math.cos(x[THETA]), vp[P_M], g, vp[P_K], tilt)
+    theta_d, flags = tilt_setpoint(ux / g, False, tilt, flags)           # eq (5), small angle
+    phi_d, flags = tilt_setpoint(-uy / g, False, tilt, flags)            # eq (6), small angle
     finish(U1, phi_d, theta_d, ref[REF_PSI], flags, dt, x, vp, gains, mem, cmd)
 
 

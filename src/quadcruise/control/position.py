@@ -39,14 +39,14 @@ from numba import njit
 from ..errors import InputError
 from ..layout import (
     CMD_FLAGS, CMD_PHI_D, CMD_PSI_D, CMD_TAU_PHI, CMD_TAU_PSI, CMD_TAU_THETA, CMD_THETA_D,
-    CMD_THRUST, CONTROLLER_SIG, FLAG_ASIN_CLIP, FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT, P_G, P_K,
-    P_M, PHI, PSI, REF_AX, REF_AY, REF_AZ, REF_PSI, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y,
+    CMD_THRUST, CONTROLLER_SIG, FLAG_ASIN_CLIP, FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT, P, P_D, P_G,
+    P_K, P_M, PHI, PSI, Q, R, REF_AX, REF_AY, REF_AZ, REF_PSI, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y,
     REF_Z, THETA, VX, VY, VZ, X, Y, Z,
 )
-from ..model.actuators import duties_from_inputs
+from ..model.actuators import unmix
 from .attitude import (
-    ATT_GAINS, ATT_I_LIMIT, ATT_KD, ATT_KI, ATT_KP, ATT_MEMORY, YAW_KD,
-    YAW_KI, YAW_KP, decoupled_attitude,
+    ATT_GAINS, ATT_I_LIMIT, ATT_KD, ATT_KI, ATT_KP, ATT_MEMORY, YAW_KD, YAW_KI, YAW_KP,
+    attitude_gains, attitude_law, decoupling_constants,
 )
 from .base import Controller
 from .design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
@@ -117,38 +117,17 @@ def phi_from_eq6(uy, theta, psi, a):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def collective_thrust(uz, x, vp, max_tilt):
-    """Altitude law: U1 = m (g + u_z) / (cos phi cos theta), limited to [0, 4 K] [N]."""
-    return thrust_for_tilt(uz, math.cos(x[PHI]) * math.cos(x[THETA]), vp, max_tilt)
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def thrust_for_tilt(uz, cos_tilt, vp, max_tilt):
-    """The altitude law given cos phi cos theta. The tilt compensation uses at most
-    1/cos(max_tilt) so that it cannot blow up."""
+def thrust_for_tilt(uz, cos_tilt, m, g, K, max_tilt):
+    """Altitude law: U1 = m (g + u_z) / (cos phi cos theta), limited to [0, 4 K] [N], and its
+    flag. ``cos_tilt`` is cos phi cos theta; the compensation uses at most 1/cos(max_tilt) so
+    that it cannot blow up."""
     c = max(cos_tilt, math.cos(max_tilt))
-    U1 = vp[P_M] * (vp[P_G] + uz) / c
+    U1 = m * (g + uz) / c
     if U1 < 0.0:
         return 0.0, FLAG_THRUST_LIMIT
-    if U1 > 4.0 * vp[P_K]:
-        return 4.0 * vp[P_K], FLAG_THRUST_LIMIT
+    if U1 > 4.0 * K:
+        return 4.0 * K, FLAG_THRUST_LIMIT
     return U1, 0
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd):
-    """Shared tail of the position controllers: the decoupled attitude PID, the mixer
-    inverse to duties, and the logged command."""
-    U2, U3, U4, att_flags = decoupled_attitude(x, phi_d, theta_d, psi_d, vp, gains, mem, dt)
-    duties_from_inputs(U1, U2, U3, U4, vp, cmd)
-    cmd[CMD_THRUST] = U1
-    cmd[CMD_TAU_PHI] = U2
-    cmd[CMD_TAU_THETA] = U3
-    cmd[CMD_TAU_PSI] = U4
-    cmd[CMD_PHI_D] = phi_d
-    cmd[CMD_THETA_D] = theta_d
-    cmd[CMD_PSI_D] = psi_d
-    cmd[CMD_FLAGS] = flags | att_flags
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -162,22 +141,58 @@ def tilt_setpoint(angle, clipped, max_tilt, flags):
     return angle, flags
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd):
+    """Shared tail of the position controllers: the decoupled attitude PID (eqs 13-15), the
+    mixer inverse to duties, and the logged command.
+
+    It reads every array entry it needs into scalars before it computes and writes only at
+    the end. Kept that way, the compiled controllers make no reference-count calls at all,
+    which in a parallel batch would contend for the shared arrays' counters.
+    """
+    phi, theta, psi, p, q, r = x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R]
+    k = decoupling_constants(vp)
+    d, K = vp[P_D], vp[P_K]
+    g = attitude_gains(gains)
+    integrals = (mem[0], mem[1], mem[2])
+    U, integrals, att_flags = attitude_law(phi_d, theta_d, psi_d, phi, theta, psi, p, q, r,
+                                           k, g, integrals, dt)
+    U2, U3, U4 = U
+    F1, F2, F3, F4 = unmix(U1, U2, U3, U4, d)
+    mem[0], mem[1], mem[2] = integrals
+    inv_k = 1.0 / K                       # duties F_i / K, clipped (and counted) by the engine
+    cmd[0] = F1 * inv_k
+    cmd[1] = F2 * inv_k
+    cmd[2] = F3 * inv_k
+    cmd[3] = F4 * inv_k
+    cmd[CMD_THRUST] = U1
+    cmd[CMD_TAU_PHI] = U2
+    cmd[CMD_TAU_THETA] = U3
+    cmd[CMD_TAU_PSI] = U4
+    cmd[CMD_PHI_D] = phi_d
+    cmd[CMD_THETA_D] = theta_d
+    cmd[CMD_PSI_D] = psi_d
+    cmd[CMD_FLAGS] = flags | att_flags
+
+
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
     """The paper's inverse-model nonlinear PD (eqs 16, 19) over decoupled attitude PID."""
-    ff = gains[ACCEL_FF]
+    ff, tilt = gains[ACCEL_FF], gains[MAX_TILT]
     ux = gains[KP_XY] * (ref[REF_X] - x[X]) + gains[KD_XY] * (ref[REF_VX] - x[VX]) + ff * ref[REF_AX]
     uy = gains[KP_XY] * (ref[REF_Y] - x[Y]) + gains[KD_XY] * (ref[REF_VY] - x[VY]) + ff * ref[REF_AY]
     uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ]) + ff * ref[REF_AZ]
-    sphi, cphi = math.sin(x[PHI]), math.cos(x[PHI])          # each computed once, shared
-    spsi, cpsi = math.sin(x[PSI]), math.cos(x[PSI])
-    U1, flags = thrust_for_tilt(uz, cphi * math.cos(x[THETA]), vp, gains[MAX_TILT])
-    a = U1 / vp[P_M]
+    phi, theta, psi, psi_d = x[PHI], x[THETA], x[PSI], ref[REF_PSI]
+    m, g, K = vp[P_M], vp[P_G], vp[P_K]
+    sphi, cphi = math.sin(phi), math.cos(phi)          # each computed once, shared
+    spsi, cpsi = math.sin(psi), math.cos(psi)
+    U1, flags = thrust_for_tilt(uz, cphi * math.cos(theta), m, g, K, tilt)
+    a = U1 / m
     theta_d, clipped = pitch_eq16(ux, sphi, cphi, spsi, cpsi, a)              # (16)
-    theta_d, flags = tilt_setpoint(theta_d, clipped, gains[MAX_TILT], flags)
+    theta_d, flags = tilt_setpoint(theta_d, clipped, tilt, flags)
     phi_d, clipped = roll_eq19(uy, math.sin(theta_d), spsi, cpsi, a)          # (19), sign kept
-    phi_d, flags = tilt_setpoint(phi_d, clipped, gains[MAX_TILT], flags)
-    finish(U1, phi_d, theta_d, ref[REF_PSI], flags, dt, x, vp, gains, mem, cmd)
+    phi_d, flags = tilt_setpoint(phi_d, clipped, tilt, flags)
+    finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd)
 
 
 def attitude_block(attitude: PIDGains, yaw: PIDGains, i_limit: float) -> list[float]:
