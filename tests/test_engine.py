@@ -110,6 +110,26 @@ def test_divergence_stops_the_vehicle_and_says_why_and_when():
     assert np.all(np.isfinite(res.states[0, :stop + 1]))
 
 
+@pytest.mark.parametrize("log_every", [1, 3])
+def test_rows_after_a_stop_are_nan_and_the_rest_of_the_batch_flies_on(log_every):
+    t = np.linspace(0, 10, 1001)
+    spin = np.tile([1.0, 0.07, 0.0, 0.07], (t.size, 1))
+    hover = np.tile(V.hover_duty * np.ones(4), (t.size, 1))
+    grid = np.linspace(0, 10, 1001)
+    mission = qc.missions.Hover()
+    x0 = qc.flight.hover_state(V, 2, mission)
+    gains = np.stack([pack_schedule(t, spin), pack_schedule(t, hover)])
+    res = qc.simulate(grid, x0, V.rows(2), duty_schedule, gains, mission.function, mission.params(),
+                      memory=np.zeros(1), log_every=log_every, limits=qc.Limits(max_rate=50.0))
+    assert list(res.ok) == [False, True]
+    last = int(np.searchsorted(res.t, res.t_stop[0], side="right"))   # rows up to the stop
+    for log in (res.states, res.commands[..., :4], res.references):
+        assert np.all(np.isnan(log[0, last:]))
+        assert np.all(np.isfinite(log[1]))
+    assert np.all(np.isfinite(res.commands[0, :last - 1, :4]))
+    assert np.all(np.isfinite(res.states[0, :last - 1]))
+
+
 def test_nonfinite_controller_command_stops_cleanly():
     from numba import njit
 

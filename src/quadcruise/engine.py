@@ -132,6 +132,23 @@ def hold_duties(cmd, u):
     return clipped, True
 
 
+@njit(cache=True, inline="always")
+def log_row(log, i, row, v):
+    """log[i, row, :] = v, element by element (a slice would take a reference on the shared
+    log array at every logged period)."""
+    for j in range(v.shape[0]):
+        log[i, row, j] = v[j]
+
+
+@njit(cache=True, inline="always")
+def blank_rows(log, i, first):
+    """NaN in the rows of vehicle i from ``first`` on: the log is allocated empty, and a
+    vehicle that stopped early leaves its last rows unwritten."""
+    for row in range(first, log.shape[1]):
+        for j in range(log.shape[2]):
+            log[i, row, j] = np.nan
+
+
 _f8v = types.float64[::1]
 _f8m = types.float64[:, ::1]
 _f8c = types.float64[:, :, ::1]
@@ -176,6 +193,7 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
                 noisy = True
         code = FINISHED
         t_end = t_grid[n_periods]
+        rows_x = rows = 0
         for k in range(n_periods + 1):
             t = t_grid[k]
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
@@ -196,9 +214,10 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
             if k % log_every == 0:
                 row = k // log_every
-                log_x[i, row, :] = x
-                log_cmd[i, row, :] = cmd
-                log_ref[i, row, :] = ref
+                log_row(log_x, i, row, x)
+                log_row(log_cmd, i, row, cmd)
+                log_row(log_ref, i, row, ref)
+                rows_x = rows = row + 1
             if k == n_periods:
                 break
             clipped, finite = hold_duties(cmd, u)
@@ -219,8 +238,12 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
             if code != FINISHED:
                 t_end = t_grid[k + 1]
                 if (k + 1) % log_every == 0:   # keep the state that broke the bound
-                    log_x[i, (k + 1) // log_every, :] = x
+                    log_row(log_x, i, (k + 1) // log_every, x)
+                    rows_x += 1
                 break
+        blank_rows(log_x, i, rows_x)               # rows after a stop: NaN
+        blank_rows(log_cmd, i, rows)
+        blank_rows(log_ref, i, rows)
         x_final[i, :] = x
         status[i] = code
         t_stop[i] = t_end
@@ -337,9 +360,9 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
 
     n_periods = t_grid.shape[0] - 1
     n_log = n_periods // log_every + 1
-    log_x = np.full((n, n_log, STATE_SIZE), np.nan)
-    log_cmd = np.full((n, n_log, CMD_SIZE), np.nan)
-    log_ref = np.full((n, n_log, REF_SIZE), np.nan)
+    log_x = np.empty((n, n_log, STATE_SIZE))      # every row is written by the kernel:
+    log_cmd = np.empty((n, n_log, CMD_SIZE))      # logged, or NaN after a stop
+    log_ref = np.empty((n, n_log, REF_SIZE))
     x_final = np.empty((n, STATE_SIZE))
     status = np.zeros(n, dtype=np.int64)
     t_stop = np.empty(n)
