@@ -2,7 +2,8 @@
 
 Pure numpy; times in seconds, positions in metres. Everything reads sampled signals on a
 time grid ``t`` that must be strictly increasing but need not be uniform: crossings are
-interpolated linearly between samples and integrals use the trapezoid rule.
+interpolated linearly between samples and integrals use the trapezoid rule. The same
+metrics for every vehicle of a batch at once, vectorised: :mod:`quadcruise.metrics_batch`.
 
 Examples
 --------

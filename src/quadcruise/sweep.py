@@ -1,5 +1,5 @@
 """The machinery of a Monte Carlo sweep: chunks flown and reduced to metrics, in this
-process or on Dask, streamed to disk, resumed; the figures and the report.
+process or on Dask, streamed to disk (:mod:`quadcruise.sweep_store`), resumed.
 
 **Chunks.** The population is cut into chunks of consecutive vehicles. A chunk is a pure
 function of ``(spec, first, count)`` (:func:`run_chunk`): it draws its vehicles, flies
@@ -14,19 +14,6 @@ A worker that dies loses its tasks, the scheduler runs them again elsewhere, and
 chunk is keyed by its first vehicle and written whole, every flight is counted once. Each
 worker process loads the compiled engine from numba's cache once.
 
-**On disk** (``out``)::
-
-    quadcruise.json            the spec, its hash, n, and whether the sweep is complete
-    chunks/chunk-000000120.npz one per chunk (vehicles 120 ..), written whole or not at all
-    flights.csv                one row per flight (or flights.parquet)
-    summary.json, worst.csv    quantiles, failure rate by reason, the worst flights
-    histograms.png, envelope.png, report.md
-
-quadcruise.json is written before the first chunk and chunks as they finish, so an
-interrupted sweep leaves a folder that the same command resumes: chunks already there
-(of the same spec hash) are loaded, not flown. A folder holding another sweep, or
-anything else, is refused unless ``force``. The results are written at the end.
-
 **Memory.** One row per flight is kept; paths only for the first ``max_traces`` vehicles
 and the first ``max_failure_traces`` failed ones; a chunk's log is held only while it is
 reduced (about 64 MB with ``chunk_size="auto"``).
@@ -35,33 +22,32 @@ reduced (about 64 MB with ``chunk_size="auto"``).
 from __future__ import annotations
 
 import contextlib
-import json
 import logging
 import math
 import os
-import shutil
-import sys
 import time
 import uuid
 import warnings
-from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Callable
 
 import numpy as np
 
-from . import __version__
 from .errors import InputError, SimulationError
-from .io import MARKER, atomic_path, check_output_dir, check_table_format, write_table
+from .io import check_table_format
 from .layout import CMD_U1, REF_X, X
-from .metrics import control_effort, tracking_errors
-from .montecarlo import COLUMNS, FAILURES, METRICS, Draw, MonteCarloResult, MonteCarloSpec, Traces, _plain
+from .mcspec import MonteCarloSpec
+from .metrics_batch import flight_metrics_batch
+from .montecarlo_output import write_outputs
+from .montecarlo_result import COLUMNS, FAILURES, METRICS, MonteCarloResult, Traces
+from .population import Draw
+from .progress import ProgressBar
+from .sweep_store import _Folder
 
 __all__ = ["run_chunk", "fly_chunk", "reduce_chunk", "sweep_metrics", "run_sweep", "auto_chunk_size",
-           "ProgressBar", "plot_histograms", "plot_envelope", "write_outputs", "CHUNK_BUDGET"]
+           "ProgressBar", "CHUNK_BUDGET"]
 
 CHUNK_BUDGET = 64 * 2**20
 """Bytes of engine log per chunk that ``chunk_size="auto"`` aims at."""
-CHUNKS = "chunks"
 
 
 # --- one chunk --------------------------------------------------------------------------
@@ -88,12 +74,12 @@ def fly_chunk(spec: MonteCarloSpec, first: int, count: int, log_every: int | Non
 def run_chunk(spec: MonteCarloSpec, first: int, count: int, threads: int | None = None) -> dict:
     """Vehicles first .. first + count - 1, flown and reduced to a chunk (dict of arrays).
 
-    Keys: ``first``, ``count``, ``hash``, one array per column of :data:`COLUMNS`, and the
-    kept paths: ``trace_vehicle`` (k,), ``trace_t`` (L,), ``trace_pos`` and ``trace_ref``
-    (k, L, 3), ``trace_sample`` (k,) (True: one of the first ``max_traces`` vehicles; else
-    kept as one of the first ``max_failure_traces`` failures). A pure function of its
-    arguments: this is the Dask task. ``threads`` sets numba's threads for this call (1 on a
-    Dask worker).
+    Keys: ``first``, ``count``, ``hash``, one array per column of
+    :data:`~quadcruise.montecarlo_result.COLUMNS`, and the kept paths: ``trace_vehicle``
+    (k,), ``trace_t`` (L,), ``trace_pos`` and ``trace_ref`` (k, L, 3), ``trace_sample`` (k,)
+    (True: one of the first ``max_traces`` vehicles; else kept as one of the first
+    ``max_failure_traces`` failures). A pure function of its arguments: this is the Dask
+    task. ``threads`` sets numba's threads for this call (1 on a Dask worker).
     """
     if threads is not None:
         import numba
@@ -124,97 +110,19 @@ def reduce_chunk(spec: MonteCarloSpec, first: int, res, draw: Draw) -> dict:
     return out
 
 
-# --- vectorised metrics -----------------------------------------------------------------
-def _first_crossing(t, z, level):
-    """Per row of z (N, L): time z first reaches level, interpolated (NaN if never)."""
-    rows = np.arange(z.shape[0])
-    hit = z >= level
-    k = hit.argmax(axis=1)
-    km = np.maximum(k - 1, 0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        frac = (level - z[rows, km]) / (z[rows, k] - z[rows, km])
-        out = t[km] + frac * (t[k] - t[km])
-    out[k == 0] = t[0]
-    out[~hit[rows, k]] = np.nan
-    return out
-
-
-def _settling(t, z, band):
-    """Per row: time from t[0] after which |z - 1| <= band for good (NaN: outside at the end)."""
-    rows = np.arange(z.shape[0])
-    outside = np.abs(z - 1.0) > band
-    last = z.shape[1] - 1 - outside[:, ::-1].argmax(axis=1)
-    any_out = outside[rows, last]
-    k = np.minimum(last, z.shape[1] - 2)
-    zk, zk1 = z[rows, k], z[rows, k + 1]
-    edge = np.where(zk > 1.0, 1.0 + band, 1.0 - band)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        out = t[k] + (edge - zk) / (zk1 - zk) * (t[k + 1] - t[k]) - t[0]
-    out[~any_out] = 0.0
-    out[outside[:, -1]] = np.nan
-    return out
-
-
-def _transients(t, pos, ref, mission: dict, bands):
-    """Transient of each vehicle as :func:`quadcruise.metrics.flight_metrics` measures it:
-    (axis (N,), rise, settling per band..., overshoot), on pos/ref (N, L, 3)."""
-    from .metrics import TRANSIENT_MIN_ERROR
-
-    n = pos.shape[0]
-    axis = np.full(n, -1, dtype=np.int64)
-    nan = np.full(n, np.nan)
-    if mission.get("kind") == "step" and mission.get("axis") in ("x", "y", "z"):
-        j = "xyz".index(mission["axis"])
-        t_step = float(mission["time"])
-        if not t[0] <= t_step < t[-1]:
-            return axis, nan, [nan] * len(bands), nan
-        y0 = float(mission[mission["axis"]])
-        step = float(mission["size"])
-        after = t > t_step
-        ts = np.concatenate(([t_step], t[after]))
-        ys = np.empty((n, ts.size))
-        ys[:, 1:] = pos[:, after, j]
-        ys[:, 0] = [np.interp(t_step, t, pos[i, :, j]) for i in range(n)]
-        z = (ys - y0) / step
-        axis[:] = j
-    else:
-        e0 = np.abs(ref[:, 0] - pos[:, 0])
-        j = e0.argmax(axis=1)
-        rows = np.arange(n)
-        measured = e0[rows, j] >= TRANSIENT_MIN_ERROR
-        axis[measured] = j[measured]
-        if not measured.any():
-            return axis, nan, [nan] * len(bands), nan
-        rows = rows[measured]
-        e = ref[rows, :, j[measured]] - pos[rows, :, j[measured]]
-        z = 1.0 - e / e[:, :1]
-        ts = t
-    t_lo, t_hi = _first_crossing(ts, z, 0.1), _first_crossing(ts, z, 0.9)
-    rise = t_hi - t_lo
-    settle = [_settling(ts, z, b) for b in bands]
-    over = np.maximum(0.0, 100.0 * (z.max(axis=1) - 1.0))
-    if z.shape[0] == n:
-        return axis, rise, settle, over
-    sel = axis >= 0
-
-    def put(v):
-        full = np.full(n, np.nan)
-        full[sel] = v
-        return full
-    return axis, put(rise), [put(s) for s in settle], put(over)
-
-
+# --- metrics of a chunk -----------------------------------------------------------------
 def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
-    """Per-vehicle metrics of a batch, vectorised: the columns of :data:`COLUMNS` but the
-    vehicle index and the drawn values.
+    """Per-vehicle metrics of a batch, vectorised: the columns of
+    :data:`~quadcruise.montecarlo_result.COLUMNS` but the vehicle index and the drawn values.
 
     ``rmse_m``, ``max_error_m``, ``rise_time_s``, ``settling_time_s`` (2 %),
     ``settling_time_5pct_s``, ``overshoot_pct``, ``effort``, ``duty_clipped_s`` and
     ``controller_limited_s`` equal :func:`quadcruise.metrics.flight_metrics` on the same
-    result (to rounding; the transient is measured on the same axis with the same rules);
-    ``final_error_m`` is the position error at the end. Every metric of a vehicle that
-    stopped early is NaN. Each vehicle's numbers depend on its own rows only, so they do
-    not change with the batch a vehicle is flown in.
+    result (to rounding; the transient is measured on the same axis with the same rules,
+    by :func:`quadcruise.metrics_batch.flight_metrics_batch`); ``final_error_m`` is the
+    position error at the end. Every metric of a vehicle that stopped early is NaN. Each
+    vehicle's numbers depend on its own rows only, so they do not change with the batch a
+    vehicle is flown in. The failure of each vehicle follows the spec's rules.
     """
     t = result.t
     n = result.n
@@ -229,162 +137,20 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
     live = np.flatnonzero((status == 0) & np.isfinite(refs).all(axis=(1, 2)))
     not_settled = np.zeros(n, dtype=bool)
     if live.size:
-        pos = result.states[live, :, X:X + 3]
-        ref = refs[live]
-        err = tracking_errors(t, pos, ref)                              # batched over vehicles
-        out["rmse_m"][live] = err["rmse"]
-        out["max_error_m"][live] = err["max_error"]
-        out["final_error_m"][live] = np.linalg.norm(pos[:, -1] - ref[:, -1], axis=1)
-        out["effort"][live] = control_effort(t, result.commands[live, :, CMD_U1:CMD_U1 + 4])["integral"]
-        keep = slice(None) if spec.transient_until is None else t <= spec.transient_until
         mission = result.meta.get("mission") if isinstance(result.meta.get("mission"), dict) else {}
-        tk = t[keep]
-        if tk.size >= 2:
-            bands = (0.02, 0.05, spec.settle_band)
-            axis, rise, settle, over = _transients(tk, pos[:, keep], ref[:, keep], mission, bands)
-            out["transient_axis"][live] = axis
-            out["rise_time_s"][live] = rise
-            out["settling_time_s"][live] = settle[0]
-            out["settling_time_5pct_s"][live] = settle[1]
-            out["overshoot_pct"][live] = over
-            not_settled[live] = (axis >= 0) & np.isnan(settle[2])
+        got = flight_metrics_batch(t, result.states[live, :, X:X + 3], refs[live],
+                                   result.commands[live, :, CMD_U1:CMD_U1 + 4], mission=mission,
+                                   bands=(0.02, 0.05, spec.settle_band), transient_until=spec.transient_until)
+        for key in ("rmse_m", "max_error_m", "final_error_m", "effort", "transient_axis", "rise_time_s",
+                    "overshoot_pct"):
+            out[key][live] = got[key]
+        out["settling_time_s"][live], out["settling_time_5pct_s"][live] = got["settling_s"][:2]
+        not_settled[live] = (got["transient_axis"] >= 0) & np.isnan(got["settling_s"][2])
     diverged = status != 0
     saturated = out["duty_clipped_s"] > spec.max_clipped_s
     out.update(diverged=diverged, saturated=saturated, not_settled=not_settled)
     out["failure"] = np.select([diverged, saturated, not_settled], [1, 2, 3], 0).astype(np.int64)
     return out
-
-
-# --- progress ---------------------------------------------------------------------------
-class ProgressBar:
-    """``progress(done, total)`` that prints flights done, the rate and the time left.
-
-    On a terminal it rewrites one line; otherwise it prints a line at most every
-    ``log_interval`` seconds (and the last one). The rate counts the flights flown since
-    the first call (flights resumed from disk are done but not flown).
-
-    >>> import io
-    >>> buf = io.StringIO()
-    >>> bar = ProgressBar(buf)
-    >>> bar(0, 10); bar(10, 10); bar.close()
-    >>> buf.getvalue().splitlines()[-1].split(",")[0]
-    '10/10 flights (100.0 %)'
-    """
-
-    def __init__(self, stream=None, *, label: str = "flights", min_interval: float = 0.25,
-                 log_interval: float = 10.0) -> None:
-        self.stream = sys.stderr if stream is None else stream
-        self.label = label
-        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
-        self.interval = min_interval if self.tty else log_interval
-        self.t0: float | None = None
-        self.done0 = 0
-        self.last = -math.inf
-        self.width = 0
-
-    def __call__(self, done: int, total: int) -> None:
-        now = time.monotonic()
-        if self.t0 is None:
-            self.t0, self.done0 = now, done
-        final = done >= total
-        if not final and now - self.last < self.interval:
-            return
-        self.last = now
-        elapsed = now - self.t0
-        rate = (done - self.done0) / elapsed if elapsed > 0 and done > self.done0 else 0.0
-        eta = "-" if not rate else _clock((total - done) / rate)
-        text = (f"{done:,}/{total:,} {self.label} ({100.0 * done / max(total, 1):.1f} %), "
-                f"{rate:,.0f} {self.label}/s, ETA {eta}")
-        if self.tty:
-            self.stream.write("\r" + text.ljust(self.width))
-            self.width = len(text)
-        else:
-            self.stream.write(text + "\n")
-        self.stream.flush()
-
-    def close(self) -> None:
-        """End the line (on a terminal)."""
-        if self.tty and self.width:
-            self.stream.write("\n")
-            self.stream.flush()
-            self.width = 0
-
-
-def _clock(seconds: float) -> str:
-    seconds = int(round(seconds))
-    h, rest = divmod(seconds, 3600)
-    return f"{h}:{rest // 60:02d}:{rest % 60:02d}" if h else f"{rest // 60}:{rest % 60:02d}"
-
-
-# --- chunks on disk ---------------------------------------------------------------------
-def _chunk_path(folder: Path, first: int) -> Path:
-    return folder / CHUNKS / f"chunk-{first:09d}.npz"
-
-
-def _write_chunk(folder: Path, chunk: dict) -> None:
-    with atomic_path(_chunk_path(folder, int(chunk["first"]))) as tmp:
-        with open(tmp, "wb") as f:
-            np.savez(f, **chunk)
-
-
-def _read_chunks(folder: Path, spec_hash: str) -> Iterator[dict]:
-    """The complete chunks of this spec in ``folder``; others are skipped with a warning."""
-    for path in sorted((folder / CHUNKS).glob("chunk-*.npz")):
-        try:
-            with np.load(path, allow_pickle=False) as data:
-                chunk = {k: data[k] for k in data.files}
-        except Exception as exc:              # a foreign or damaged file: fly it again
-            warnings.warn(f"{path}: unreadable ({exc}); its flights are flown again", stacklevel=3)
-            continue
-        if str(chunk.get("hash")) != spec_hash or int(chunk["first"]) != int(path.stem.split("-")[1]):
-            warnings.warn(f"{path}: belongs to another sweep; its flights are flown again", stacklevel=3)
-            continue
-        yield chunk
-
-
-def _marker(path: Path) -> dict | None:
-    try:
-        return json.loads((path / MARKER).read_text())
-    except (OSError, ValueError):
-        return None
-
-
-class _Folder:
-    """The output folder of a sweep: checked at construction (nothing is written), then
-    :meth:`prepare` (marker), :meth:`write_chunk`."""
-
-    def __init__(self, out, spec: MonteCarloSpec, *, force: bool, resume: bool) -> None:
-        self.path = check_output_dir(out, force)
-        self.hash = spec.hash()
-        self.spec = spec
-        meta = _marker(self.path) if self.path.is_dir() else None
-        same = bool(meta) and meta.get("workflow") == "montecarlo" and meta.get("spec_hash") == self.hash
-        if meta is not None and not same and not force:
-            what = (f"a different sweep (spec {meta.get('spec_hash')})" if meta.get("workflow") == "montecarlo"
-                    else f"a quadcruise {meta.get('workflow', 'result')} result")
-            raise InputError(f"{self.path}: holds {what}; use --force to replace it or choose another --out")
-        self.resume = same and resume
-        self.clear = self.path.is_dir() and any(self.path.iterdir()) and not self.resume
-
-    def existing(self) -> Iterator[dict]:
-        return _read_chunks(self.path, self.hash) if self.resume else iter(())
-
-    def prepare(self, n: int, chunk_size: int) -> None:
-        if self.clear:
-            shutil.rmtree(self.path)
-        (self.path / CHUNKS).mkdir(parents=True, exist_ok=True)
-        write_marker(self.path, self.spec, n, chunk_size=chunk_size, complete=False)
-
-    def write_chunk(self, chunk: dict) -> None:
-        _write_chunk(self.path, chunk)
-
-
-def write_marker(path: Path, spec: MonteCarloSpec, n: int, **extra: Any) -> None:
-    """quadcruise.json of a sweep folder, whole or not at all."""
-    doc = {"workflow": "montecarlo", "version": __version__, "spec_hash": spec.hash(), "n": n,
-           "seed": spec.seed, **extra, "spec": spec.to_dict()}
-    with atomic_path(path / MARKER) as tmp:
-        tmp.write_text(json.dumps(doc, indent=2, default=_plain) + "\n")
 
 
 # --- collecting chunks ------------------------------------------------------------------
@@ -609,182 +375,3 @@ def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", s
     if folder is not None:
         write_outputs(result, folder.path, fmt=fmt)
     return result
-
-
-# --- results on disk --------------------------------------------------------------------
-def write_outputs(result: MonteCarloResult, out, *, fmt: str = "csv", force: bool = False) -> Path:
-    """The results of a sweep into ``out`` (see the module), each file whole or not at all;
-    quadcruise.json last, marked complete."""
-    from .plots import save_figure
-
-    path = Path(out)
-    meta = _marker(path) if path.is_dir() else None
-    ours = bool(meta) and meta.get("workflow") == "montecarlo" and meta.get("spec_hash") == result.spec.hash()
-    if not ours:
-        check_output_dir(path, force)
-        if meta is not None and not force:
-            raise InputError(f"{path}: holds another quadcruise result; use --force to replace it")
-        if path.is_dir() and any(path.iterdir()):
-            shutil.rmtree(path)
-    path.mkdir(parents=True, exist_ok=True)
-    name = write_table(result.table, path / "flights", fmt).name
-    summary = result.summary()
-    with atomic_path(path / "summary.json") as tmp:
-        tmp.write_text(json.dumps({**summary, "info": result.info}, indent=2, default=_plain) + "\n")
-    worst = result.worst(20)
-    with atomic_path(path / "worst.csv") as tmp:
-        worst.to_csv(tmp, index=False, float_format="%.10g")
-    figures = {"histograms.png": result.plot_histograms(), "envelope.png": result.plot_envelope()}
-    for fig_name, fig in figures.items():
-        save_figure(fig, path / fig_name)
-    with atomic_path(path / "report.md") as tmp:
-        tmp.write_text(report_markdown(result, summary, worst, name))
-    write_marker(path, result.spec, result.n, complete=True, table=name,
-                 chunk_size=result.info.get("chunk_size"))
-    return path
-
-
-def write_case(case, out, *, fmt: str = "csv", force: bool = False) -> Path:
-    """One re-flown vehicle into ``out``, whole or not at all: its traces, its row
-    (case.json), a figure of the flight and quadcruise.json."""
-    from .io import atomic_dir, write_table
-    from .plots import plot_flight, save_figure
-
-    path = check_output_dir(out, force)
-    with atomic_dir(path) as tmp:
-        tmp = Path(tmp)
-        write_table(case.result.to_pandas(), tmp / "traces", fmt)
-        (tmp / "case.json").write_text(json.dumps(case.row, indent=2, default=_plain) + "\n")
-        save_figure(plot_flight(case.result), tmp / "flight.png")
-        (tmp / MARKER).write_text(json.dumps({"workflow": "montecarlo-case", "vehicle": case.vehicle,
-                                              **case.result.meta}, indent=2, default=_plain) + "\n")
-    return path
-
-
-def report_markdown(result: MonteCarloResult, summary: dict, worst, table_name: str) -> str:
-    """report.md: what was flown, the failures, the quantiles, the worst flights, figures."""
-    spec = result.spec
-    pop = {k: v for k, v in spec.population.to_dict().items() if v not in (0.0, None)}
-    f = summary["failures"]
-    lines = [f"# Monte Carlo: {spec.controller.name} on {spec.mission.name}, {summary['flights']:,} flights\n",
-             f"quadcruise {__version__}, seed {spec.seed}, {spec.duration:g} s at dt = {spec.dt:g} s, "
-             f"metrics on a {spec.dt * spec.log_every:g} s log; spec hash `{spec.hash()}`.\n",
-             "Population: " + (", ".join(f"{k} = {v}" for k, v in pop.items()) or "nominal") + ".\n",
-             f"## Failures: {f['count']:,} of {summary['flights']:,} ({100 * f['rate']:.2f} %)\n",
-             "Each flight counts once, under the first that applies: diverged (the engine stopped it), "
-             f"saturated (rotor duties clipped for more than {spec.max_clipped_s:g} s), did not settle "
-             f"(the transient still outside the {100 * spec.settle_band:g} % band at the end).\n",
-             "| reason | flights | rate |", "|---|---|---|"]
-    for reason, v in f["by_reason"].items():
-        lines.append(f"| {reason} | {v['count']:,} | {100 * v['rate']:.2f} % |")
-    if summary["stopped"]:
-        lines.append("\nWhy the engine stopped flights: " + "; ".join(f"{k}: {v:,}" for k, v in summary["stopped"].items()) + ".")
-    lines += ["\n## Metrics\n", "| metric | flights | p5 | p50 | p95 | max |", "|---|---|---|---|---|---|"]
-    for name, m in summary["metrics"].items():
-        cells = " | ".join("-" if m[k] is None else f"{m[k]:.4g}" for k in ("p5", "p50", "p95", "max"))
-        lines.append(f"| {name} | {m['count']:,} | {cells} |")
-    lines += ["\n## Worst flights\n",
-              "Fly one alone again: `quadcruise montecarlo <the same options> --case VEHICLE`, or in Python "
-              "`quadcruise.montecarlo.montecarlo_case(spec, VEHICLE)`; it gives the same row.\n",
-              "| vehicle | reason | rmse [m] | max error [m] | settling 5 % [s] | stop [s] | m [kg] |",
-              "|---|---|---|---|---|---|---|"]
-    for _, r in worst.head(10).iterrows():
-        cells = " | ".join("-" if not np.isfinite(r[k]) else f"{r[k]:.4g}"
-                           for k in ("rmse_m", "max_error_m", "settling_time_5pct_s", "stop_time_s", "m"))
-        lines.append(f"| {int(r['vehicle'])} | {r['reason']} | {cells} |")
-    info = result.info
-    lines += ["\n## Figures\n", "![histograms](histograms.png)\n", "![envelope](envelope.png)\n",
-              "\n## How it ran\n",
-              f"{info.get('flown', 0):,} flights flown and {info.get('resumed', 0):,} resumed from disk on "
-              f"{info.get('scheduler')}, chunks of {info.get('chunk_size')} vehicles, "
-              f"{info.get('wall_s', 0):.1f} s. One row per flight: `{table_name}`; the chunks: `chunks/`.\n"]
-    return "\n".join(lines)
-
-
-# --- figures ----------------------------------------------------------------------------
-def plot_histograms(result, metrics=("rmse_m", "max_error_m", "final_error_m", "rise_time_s",
-                                   "settling_time_5pct_s", "overshoot_pct", "effort", "duty_clipped_s")):
-    """Figure of :meth:`MonteCarloResult.plot_histograms`."""
-    from matplotlib.figure import Figure
-
-    panels = list(metrics) + ["failures"]
-    cols = 3
-    rows = math.ceil(len(panels) / cols)
-    fig = Figure(figsize=(4.3 * cols, 3.2 * rows), layout="constrained")
-    axes = fig.subplots(rows, cols, squeeze=False).ravel()
-    for ax, name in zip(axes, panels):
-        if name == "failures":
-            counts = [int(np.count_nonzero(result.table["failure"] == c)) for c in range(4)]
-            ax.bar(range(4), counts, color=["tab:green", "tab:red", "tab:orange", "tab:purple"])
-            ax.set_xticks(range(4), FAILURES, fontsize="small")
-            for x, c in enumerate(counts):
-                ax.annotate(f"{c:,}", (x, c), ha="center", va="bottom", fontsize="small")
-            ax.set_title(f"outcome of {result.n:,} flights", fontsize="medium")
-            ax.set_ylabel("flights")
-            continue
-        v = result.table[name].to_numpy(dtype=float)
-        v = v[np.isfinite(v)]
-        if v.size:
-            ax.hist(v, bins=40, color="tab:blue", alpha=0.8)
-            for q, style in zip(np.percentile(v, [5, 50, 95]), (":", "-", ":")):
-                ax.axvline(q, color="k", ls=style, lw=1.0)
-        else:
-            ax.text(0.5, 0.5, "not measured", ha="center", va="center", transform=ax.transAxes, color="0.4")
-        missing = result.n - v.size
-        ax.set_title(f"{name}  (n = {v.size:,}" + (f", {missing:,} n/a)" if missing else ")"), fontsize="medium")
-        ax.grid(True, alpha=0.3)
-    for ax in axes[len(panels):]:
-        ax.set_visible(False)
-    fig.suptitle(f"{result.spec.controller.name} on {result.spec.mission.name}: {result.n:,} flights, seed "
-                 f"{result.spec.seed} (lines: 5 %, median, 95 %)")
-    return fig
-
-def plot_envelope(result):
-    """Top view of the kept paths (the first vehicles; failures in orange, diverged in
-    red) and the median and 5-95 % band of the position error of the sampled flights."""
-    from matplotlib.figure import Figure
-
-    tr = result.traces
-    fig = Figure(figsize=(13, 5.5), layout="constrained")
-    top, ax_e = fig.subplots(1, 2, width_ratios=(1, 1.4))
-    lookup = result.table.set_index("vehicle")["failure"]
-    fail = lookup.reindex(tr.vehicle).to_numpy() if len(tr.vehicle) else np.zeros(0, int)
-    n_sample = int(np.count_nonzero(tr.sample))
-    alpha = float(np.clip(6.0 / max(n_sample, 1), 0.08, 0.8))
-    for k in range(len(tr.vehicle)):
-        x, y = tr.pos[k, :, 0], tr.pos[k, :, 1]
-        color = {0: "tab:blue", 1: "tab:red"}.get(int(fail[k]), "tab:orange")
-        top.plot(x, y, color=color, lw=0.7 if fail[k] == 0 else 0.9, alpha=alpha if fail[k] == 0 else 0.7)
-        live = np.flatnonzero(np.isfinite(x) & np.isfinite(y))
-        if fail[k] == 1 and live.size:
-            top.plot(x[live[-1]], y[live[-1]], "x", color="tab:red", ms=6)
-    total = result.table["failure"].value_counts()
-    for code, color, what in ((0, "tab:blue", "ok"), (1, "tab:red", "diverged"), (2, "tab:orange", "failed otherwise")):
-        drawn = int(np.count_nonzero(fail == code)) if code < 2 else int(np.count_nonzero(fail >= 2))
-        all_ = int(total.get(code, 0)) if code < 2 else int(total.get(2, 0) + total.get(3, 0))
-        if all_:
-            top.plot([], [], color=color, lw=1, label=f"{what} ({drawn:,} drawn of {all_:,})")
-    ref = next((tr.ref[k] for k in range(len(tr.vehicle)) if np.all(np.isfinite(tr.ref[k, :, :2]))), None)
-    if ref is not None:
-        top.plot(ref[:, 0], ref[:, 1], color="k", ls="--", lw=1.0, label="reference")
-    top.set_aspect("equal", adjustable="datalim")
-    top.set(xlabel="x [m]", ylabel="y [m]", title="top view")
-    top.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.12), ncols=2)
-    err = np.linalg.norm(tr.pos[tr.sample] - tr.ref[tr.sample], axis=2)
-    if err.size and np.any(np.isfinite(err)):
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            p5, p50, p95 = np.nanpercentile(err, [5, 50, 95], axis=0)
-        ax_e.fill_between(tr.t, p5, p95, color="tab:blue", alpha=0.25, lw=0, label="5-95 %")
-        ax_e.plot(tr.t, p50, color="tab:blue", lw=1.5, label="median")
-        ax_e.set_ylim(bottom=0)
-        ax_e.legend(fontsize="small", loc="best")
-    ax_e.set(xlabel="time [s]", ylabel="position error |p - p_ref| [m]",
-             title=f"position error of the first {n_sample:,} flights")
-    if tr.t.size > 1:
-        ax_e.set_xlim(tr.t[0], tr.t[-1])
-    for ax in (top, ax_e):
-        ax.grid(True, alpha=0.3)
-    fig.suptitle(f"{result.spec.controller.name} on {result.spec.mission.name}: {result.n:,} flights, seed {result.spec.seed}")
-    return fig
-
