@@ -127,6 +127,14 @@ def test_montecarlo_and_reproduce_accept_a_scenario(tmp_path):
     assert "5 flights of nlpd on circle, seed 1" in res.output          # seed from [montecarlo]
     meta = json.loads((tmp_path / "mc" / "quadcruise.json").read_text())
     assert "0.1" in json.dumps(meta) and "turbulence" in json.dumps(meta)
+    # an option given explicitly wins over the scenario, even when it equals the default
+    res = run("montecarlo", "--scenario", scen / "montecarlo_circle.toml", "-n", "3", "--duration", "2",
+              "--seed", "0", "--mass-spread", "0", "--scheduler", "none", "--quiet", "--worst", "0",
+              "--out", tmp_path / "mc0")
+    assert res.exit_code == 0, res.output
+    assert "3 flights of nlpd on circle, seed 0" in res.output
+    meta = json.dumps(json.loads((tmp_path / "mc0" / "quadcruise.json").read_text()))
+    assert '"mass_spread": 0.0' in meta and '"inertia_spread": 0.05' in meta
     bad = tmp_path / "bad.toml"
     bad.write_text("[montecarlo]\nmass_sprad = 0.1\n")
     res = run("montecarlo", "--scenario", bad, "-n", "2", "--scheduler", "none")

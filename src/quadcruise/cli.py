@@ -334,25 +334,25 @@ def analyze(controller, controller_params, position_poles, dt, out, force):
 @main.command()
 @click.option("--mission", default="circle", show_default=True, help="Mission name.")
 @click.option("--controller", default="nlpd", show_default=True, help="Controller name.")
-@click.option("-n", "--n", "n", type=int, default=1000, show_default=True, help="Number of flights.")
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of every random draw.")
+@click.option("-n", "--n", "n", type=int, show_default="1000", help="Number of flights.")
+@click.option("--seed", type=int, show_default="0", help="Seed of every random draw.")
 @click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
 @click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
 @click.option("--wind", metavar="SPEC", help="Wind: constant:WX,WY,WZ | gust:AX,AY,AZ@START+DURATION | "
               "dryden:light|moderate|severe@ALTITUDE (comma-separable).")
-@click.option("--wind-spread", type=float, default=0.0, show_default=True,
+@click.option("--wind-spread", type=float, show_default="0",
               help="Std of a random steady horizontal wind per flight [m/s].")
-@click.option("--mass-spread", type=float, default=0.0, show_default=True, help="Relative std of the mass.")
-@click.option("--inertia-spread", type=float, default=0.0, show_default=True, help="Relative std of each inertia.")
-@click.option("--thrust-spread", type=float, default=0.0, show_default=True, help="Relative std of K.")
-@click.option("--bandwidth-spread", type=float, default=0.0, show_default=True,
+@click.option("--mass-spread", type=float, show_default="0", help="Relative std of the mass.")
+@click.option("--inertia-spread", type=float, show_default="0", help="Relative std of each inertia.")
+@click.option("--thrust-spread", type=float, show_default="0", help="Relative std of K.")
+@click.option("--bandwidth-spread", type=float, show_default="0",
               help="Relative std of the actuator bandwidth.")
-@click.option("--yaw-arm-spread", type=float, default=0.0, show_default=True, help="Relative std of d.")
-@click.option("--distribution", type=click.Choice(["normal", "uniform"]), default="normal", show_default=True)
-@click.option("--offset", type=float, default=0.0, show_default=True, help="Std of the start position [m].")
+@click.option("--yaw-arm-spread", type=float, show_default="0", help="Relative std of d.")
+@click.option("--distribution", type=click.Choice(["normal", "uniform"]), show_default="normal")
+@click.option("--offset", type=float, show_default="0", help="Std of the start position [m].")
 @click.option("--noise", metavar="position=STD,velocity=STD,angle=STD,rate=STD,delay=S",
               help="Sensor noise and delay.")
-@click.option("--model-error/--no-model-error", default=True, show_default=True,
+@click.option("--model-error/--no-model-error", default=None, show_default="model-error",
               help="The controller flies with the nominal model, not each vehicle's own.")
 @click.option("--chunk-size", default="auto", show_default=True, help="Flights per task.")
 @click.option("--scheduler", default="local", show_default=True,

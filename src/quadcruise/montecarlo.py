@@ -147,9 +147,9 @@ def montecarlo(mission: Mission | str = "circle", controller: Controller | str =
 
 
 # --- command line -----------------------------------------------------------------------
-def _from_scenario(path: str, spreads: dict, n: int, seed: int):
-    """The scenario, with its [montecarlo] table merged into spreads (explicit CLI values,
-    those that differ from the defaults, win), and n and seed."""
+def _from_scenario(path: str, given: dict):
+    """The scenario, and the options ``given`` explicitly (Population fields, n, seed) with
+    its [montecarlo] table (and [simulation] seed) filling the ones not given."""
     import dataclasses
 
     from .scenario import load_scenario
@@ -161,13 +161,9 @@ def _from_scenario(path: str, spreads: dict, n: int, seed: int):
     if unknown:
         raise InputError(f"{path}: [montecarlo] unknown key(s) {', '.join(sorted(unknown))} "
                          f"(known: n, seed, {', '.join(sorted(known))})")
-    defaults = {f.name: f.default for f in dataclasses.fields(Population)}
-    for key, value in table.items():
-        if key in spreads and spreads[key] == defaults.get(key):
-            spreads[key] = value
-    n = table.get("n", n) if n == 1000 else n
-    seed = table.get("seed", sc.simulation.get("seed", seed)) if seed == 0 else seed
-    return sc, n, seed
+    if "seed" in sc.simulation:
+        table.setdefault("seed", sc.simulation["seed"])
+    return sc, {**table, **given}
 
 
 def parse_noise(text: str | None):
@@ -195,12 +191,14 @@ def parse_noise(text: str | None):
     return SensorNoise(**kw)
 
 
-def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: int = 1000, seed: int = 0,
-                       duration: float | None = None, dt: float = 1e-3, wind: str | None = None,
-                       wind_spread: float = 0.0, mass_spread: float = 0.0, inertia_spread: float = 0.0,
-                       thrust_spread: float = 0.0, bandwidth_spread: float = 0.0, yaw_arm_spread: float = 0.0,
-                       distribution: str = "normal", offset: float = 0.0, noise: str | None = None,
-                       model_error: bool = True, chunk_size: str | int = "auto", scheduler: str = "local",
+def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: int | None = None,
+                       seed: int | None = None, duration: float | None = None, dt: float = 1e-3,
+                       wind: str | None = None, wind_spread: float | None = None,
+                       mass_spread: float | None = None, inertia_spread: float | None = None,
+                       thrust_spread: float | None = None, bandwidth_spread: float | None = None,
+                       yaw_arm_spread: float | None = None, distribution: str | None = None,
+                       offset: float | None = None, noise: str | None = None,
+                       model_error: bool | None = None, chunk_size: str | int = "auto", scheduler: str = "local",
                        workers: int | None = None, connect_timeout: float = 10.0, out: str | None = None,
                        force: bool = False, resume: bool = True, fmt: str = "csv", case: int | None = None,
                        worst: int = 5, quiet: bool = False, scenario: str | None = None,
@@ -215,7 +213,9 @@ def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: 
     ``wind`` is a :func:`~quadcruise.disturbances.parse_wind` spec and ``noise`` a
     :func:`parse_noise` one. A ``scenario`` file supplies the mission, controller, nominal
     vehicle, disturbances, sensor noise and simulation settings, and its ``[montecarlo]``
-    table any of n, seed and the Population fields; options given explicitly win.
+    table any of n, seed and the Population fields; options given explicitly win. None
+    means "not given": n 1000, seed 0 and the Population's defaults, unless the scenario
+    sets them.
     """
     import sys
 
@@ -227,13 +227,18 @@ def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: 
         except ValueError:
             raise InputError(f"--chunk-size must be a whole number or auto, got {chunk_size!r}") from None
     env = parse_wind(wind) if wind is not None else None
-    spreads = dict(mass_spread=mass_spread, inertia_spread=inertia_spread, thrust_spread=thrust_spread,
-                   bandwidth_spread=bandwidth_spread, yaw_arm_spread=yaw_arm_spread, offset=offset,
-                   wind_spread=wind_spread, distribution=distribution, model_error=model_error)
+    given = dict(mass_spread=mass_spread, inertia_spread=inertia_spread, thrust_spread=thrust_spread,
+                 bandwidth_spread=bandwidth_spread, yaw_arm_spread=yaw_arm_spread, offset=offset,
+                 wind_spread=wind_spread, distribution=distribution, model_error=model_error, n=n, seed=seed)
+    given = {key: value for key, value in given.items() if value is not None}
     sensor = parse_noise(noise)
     options: dict = dict(duration=duration, dt=dt)
+    sc = None
     if scenario is not None:
-        sc, n, seed = _from_scenario(scenario, spreads, n, seed)
+        sc, given = _from_scenario(scenario, given)
+    n, seed = given.pop("n", 1000), given.pop("seed", 0)
+    spreads = given
+    if sc is not None:
         mission = sc.mission or mission
         controller = sc.controller or controller
         env = env if env is not None else sc.environment
