@@ -184,11 +184,11 @@ def test_diverging_flight_warns_and_stops():
     assert res.metrics().iloc[0].status.startswith("diverged")
 
 
-@pytest.mark.parametrize("name", ["nlpd", "gonzalez"])
+@pytest.mark.parametrize("name", ["nlpd", "gonzalez", "se3"])
 def test_compiled_controller_makes_no_reference_count_calls(name):
     """The engine runs vehicles in parallel threads that share the batch arrays; each
-    NRT_incref/decref on them is an atomic write to one shared counter. The paper's
-    controllers read their arrays into scalars first and write last, so their compiled body
+    NRT_incref/decref on them is an atomic write to one shared counter. These controllers
+    read their arrays into scalars first and write last, so their compiled body
     has none (only numba's Python-facing wrapper does). A fresh, uncached compile of the same
     Python function shows what the engine runs."""
     import re

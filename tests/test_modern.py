@@ -58,26 +58,25 @@ def command(ctrl, dx=0.0, dy=0.0, dz=0.0, dpsi=0.0, vp=VP, state=None):
 # --- rotations ---------------------------------------------------------------------------
 def test_rotation_is_the_models_zyx_convention():
     rng = np.random.default_rng(3)
-    Rm = np.empty((3, 3))
     for _ in range(100):
         phi, theta, psi = rng.uniform(-1.2, 1.2, 3)
-        rotation_zyx(phi, theta, psi, Rm)
+        R = rotation_zyx(phi, theta, psi)
+        Rm = np.array(R)
         np.testing.assert_allclose(Rm[:, 2], b3_of_eqs_5_to_7(phi, theta, psi), atol=1e-14)
         np.testing.assert_allclose(Rm.T @ Rm, np.eye(3), atol=1e-14)
         assert np.linalg.det(Rm) == pytest.approx(1.0)
-        assert euler_zyx(Rm) == pytest.approx((phi, theta, psi), abs=1e-12)
+        assert euler_zyx(R) == pytest.approx((phi, theta, psi), abs=1e-12)
 
 
 @pytest.mark.parametrize("build", [attitude_lee, attitude_px4])
 def test_desired_attitude_has_the_thrust_axis_and_the_heading(build):
     rng = np.random.default_rng(4)
-    Rd = np.empty((3, 3))
     for _ in range(100):
         b3 = rng.normal(size=3)
         b3[2] = abs(b3[2]) + 0.5
         b3 /= np.linalg.norm(b3)
         psi = rng.uniform(-3, 3)
-        build(*b3, psi, Rd)
+        Rd = np.array(build(*b3, psi))
         np.testing.assert_allclose(Rd[:, 2], b3, atol=1e-14)
         np.testing.assert_allclose(Rd.T @ Rd, np.eye(3), atol=1e-14)
         assert np.linalg.det(Rd) == pytest.approx(1.0)
@@ -91,18 +90,17 @@ def test_desired_attitude_has_the_thrust_axis_and_the_heading(build):
 
 
 def test_attitude_errors_are_the_angle_differences_to_first_order():
-    Rm, Rd = np.empty((3, 3)), np.empty((3, 3))
     for axis in range(3):
         d = np.zeros(3)
         d[axis] = 1e-4
-        rotation_zyx(*(0.02 + d), Rm)
-        rotation_zyx(0.02, 0.02, 0.02, Rd)
+        Rm = rotation_zyx(*(0.02 + d))
+        Rd = rotation_zyx(0.02, 0.02, 0.02)
         assert np.array(error_lee(Rm, Rd)) == pytest.approx(d, abs=2e-6)          # current - desired
         assert np.array(error_quaternion(Rm, Rd)) == pytest.approx(-d, abs=2e-6)  # desired - current
     # large errors: Lee's is sin(angle) on the axis, PX4's 2 sin(angle / 2), also near 180 deg
     for angle in (0.5, 2.0, math.pi - 1e-9):
-        rotation_zyx(0.0, 0.0, angle, Rm)
-        rotation_zyx(0.0, 0.0, 0.0, Rd)
+        Rm = rotation_zyx(0.0, 0.0, angle)
+        Rd = rotation_zyx(0.0, 0.0, 0.0)
         assert error_lee(Rm, Rd) == pytest.approx((0, 0, math.sin(angle)), abs=1e-12)
         assert error_quaternion(Rm, Rd) == pytest.approx((0, 0, -2 * math.sin(angle / 2)), abs=1e-7)
 

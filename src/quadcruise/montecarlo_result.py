@@ -136,10 +136,10 @@ class MonteCarloResult:
 
         return replay_case(self, i, **kw)
 
-    def plot_histograms(self, metrics=("rmse_m", "max_error_m", "final_error_m", "rise_time_s",
-                                       "settling_time_5pct_s", "overshoot_pct", "effort", "duty_clipped_s")):
+    def plot_histograms(self, metrics=None):
         """Histograms of the metrics (finite values; lines at 5 %, median, 95 %) and a bar
-        chart of the outcomes: a matplotlib Figure."""
+        chart of the outcomes: a matplotlib Figure. ``metrics``: column names (by default
+        :data:`quadcruise.plots_montecarlo.HISTOGRAM_METRICS`)."""
         from .plots_montecarlo import plot_histograms
 
         return plot_histograms(self, metrics)

@@ -18,10 +18,15 @@ from .montecarlo_result import FAILURES
 __all__ = ["plot_histograms", "plot_envelope"]
 
 
-def plot_histograms(result, metrics=("rmse_m", "max_error_m", "final_error_m", "rise_time_s",
-                                   "settling_time_5pct_s", "overshoot_pct", "effort", "duty_clipped_s")):
-    """Figure of :meth:`~quadcruise.montecarlo_result.MonteCarloResult.plot_histograms`."""
-    panels = list(metrics) + ["failures"]
+HISTOGRAM_METRICS = ("rmse_m", "max_error_m", "final_error_m", "rise_time_s", "settling_time_5pct_s",
+                     "overshoot_pct", "effort", "duty_clipped_s")
+"""The metrics :func:`plot_histograms` draws by default."""
+
+
+def plot_histograms(result, metrics=None):
+    """Figure of :meth:`~quadcruise.montecarlo_result.MonteCarloResult.plot_histograms`
+    (``metrics``: column names; :data:`HISTOGRAM_METRICS` by default)."""
+    panels = list(HISTOGRAM_METRICS if metrics is None else metrics) + ["failures"]
     cols = 3
     rows = math.ceil(len(panels) / cols)
     fig = Figure(figsize=(4.3 * cols, 3.2 * rows), layout="constrained")

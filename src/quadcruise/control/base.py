@@ -12,6 +12,12 @@ import dataclasses
 from typing import Any, ClassVar
 
 import numpy as np
+from numba import njit
+
+from ..layout import (
+    CMD_FLAGS, CMD_PHI_D, CMD_PSI_D, CMD_TAU_PHI, CMD_TAU_PSI, CMD_TAU_THETA, CMD_THETA_D, CMD_THRUST,
+)
+from ..model.actuators import duties
 
 
 @dataclasses.dataclass(frozen=True)
@@ -41,3 +47,16 @@ class Controller:
             value = getattr(self, f.name)
             out[f.name] = dataclasses.asdict(value) if dataclasses.is_dataclass(value) else value
         return out
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags, d, K):
+    """Fill a controller's output ``cmd``: the duties for (U1..U4) (yaw arm d [m], PWM gain
+    K [N]; see :func:`quadcruise.model.actuators.duties`), the desired inputs, the attitude
+    setpoints and the flag word. Straight-line code on scalars, so a controller that reads
+    its arrays first and calls this last makes no reference-count calls."""
+    u1, u2, u3, u4 = duties(U1, U2, U3, U4, d, K)
+    cmd[0], cmd[1], cmd[2], cmd[3] = u1, u2, u3, u4
+    cmd[CMD_THRUST], cmd[CMD_TAU_PHI], cmd[CMD_TAU_THETA], cmd[CMD_TAU_PSI] = U1, U2, U3, U4
+    cmd[CMD_PHI_D], cmd[CMD_THETA_D], cmd[CMD_PSI_D] = phi_d, theta_d, psi_d
+    cmd[CMD_FLAGS] = flags

@@ -50,7 +50,7 @@ from numba import njit
 
 from ..errors import InputError
 from ..layout import (
-    CONTROLLER_SIG, FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT, P, P_G, P_JXX, P_JYY, P_JZZ, P_K, P_L,
+    CONTROLLER_SIG, FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT, P, P_D, P_G, P_JXX, P_JYY, P_JZZ, P_K, P_L,
     P_M, PHI, PSI, Q, R, REF_AX, REF_AY, REF_AZ, REF_PSI, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y,
     REF_Z, THETA, VX, VY, VZ, X, Y, Z,
 )
@@ -76,31 +76,32 @@ KX, KV, KX_Z, KV_Z, K_R, K_W, SE3_MAX_TILT = range(7)
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def se3(t, dt, x, ref, vp, gains, mem, cmd):
     """Geometric tracking control on SE(3) (Lee et al. 2010), moments per unit inertia."""
-    m = vp[P_M]
-    fx = m * (gains[KX] * (ref[REF_X] - x[X]) + gains[KV] * (ref[REF_VX] - x[VX]) + ref[REF_AX])
-    fy = m * (gains[KX] * (ref[REF_Y] - x[Y]) + gains[KV] * (ref[REF_VY] - x[VY]) + ref[REF_AY])
-    fz = m * (gains[KX_Z] * (ref[REF_Z] - x[Z]) + gains[KV_Z] * (ref[REF_VZ] - x[VZ])
-              + ref[REF_AZ] + vp[P_G])
-    fx, fy, tilted = limit_tilt(fx, fy, fz, gains[SE3_MAX_TILT])
+    # every array entry is read first and the command written last: no reference counting
+    phi, theta, psi, p, q, r = x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R]
+    m, g, K, l, d = vp[P_M], vp[P_G], vp[P_K], vp[P_L], vp[P_D]
+    jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
+    kx, kv, kx_z, kv_z = gains[KX], gains[KV], gains[KX_Z], gains[KV_Z]
+    kr, kw, max_tilt = gains[K_R], gains[K_W], gains[SE3_MAX_TILT]
+    psi_d = ref[REF_PSI]
+    fx = m * (kx * (ref[REF_X] - x[X]) + kv * (ref[REF_VX] - x[VX]) + ref[REF_AX])
+    fy = m * (kx * (ref[REF_Y] - x[Y]) + kv * (ref[REF_VY] - x[VY]) + ref[REF_AY])
+    fz = m * (kx_z * (ref[REF_Z] - x[Z]) + kv_z * (ref[REF_VZ] - x[VZ]) + ref[REF_AZ] + g)
+    fx, fy, tilted = limit_tilt(fx, fy, fz, max_tilt)
     flags = FLAG_TILT_LIMIT if tilted else 0
-    Rm, Rd = np.empty((3, 3)), np.empty((3, 3))
-    rotation_zyx(x[PHI], x[THETA], x[PSI], Rm)
+    Rm = rotation_zyx(phi, theta, psi)
     n = math.sqrt(fx * fx + fy * fy + fz * fz) if fz > 0.0 else 0.0
     if n > 0.0:
-        attitude_lee(fx / n, fy / n, fz / n, ref[REF_PSI], Rd)
+        Rd = attitude_lee(fx / n, fy / n, fz / n, psi_d)
     else:                                                  # F points down: b3_d = e3, U1 -> 0
-        attitude_lee(0.0, 0.0, 1.0, ref[REF_PSI], Rd)
-    U1, limited = clamp(fx * Rm[0, 2] + fy * Rm[1, 2] + fz * Rm[2, 2], 0.0, 4.0 * vp[P_K])
+        Rd = attitude_lee(0.0, 0.0, 1.0, psi_d)
+    U1, limited = clamp(fx * Rm[0][2] + fy * Rm[1][2] + fz * Rm[2][2], 0.0, 4.0 * K)
     if limited:
         flags |= FLAG_THRUST_LIMIT
     ex, ey, ez = error_lee(Rm, Rd)
-    p, q, r = x[P], x[Q], x[R]
-    jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
-    kr, kw = gains[K_R], gains[K_W]
     mx = -jx * (kr * ex + kw * p) + (jz - jy) * q * r          # + (w x J w)_x
     my = -jy * (kr * ey + kw * q) + (jx - jz) * p * r
     mz = -jz * (kr * ez + kw * r) + (jy - jx) * p * q
-    command_from_rotation(U1, mx / vp[P_L], my / vp[P_L], mz, Rd, flags, vp, cmd)
+    command_from_rotation(U1, mx / l, my / l, mz, Rd, flags, d, K, cmd)
 
 
 def se3_attitude_design(actuator_bandwidth: float = 15.0) -> PDGains:

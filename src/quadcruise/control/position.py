@@ -38,17 +38,15 @@ from numba import njit
 
 from ..errors import InputError
 from ..layout import (
-    CMD_FLAGS, CMD_PHI_D, CMD_PSI_D, CMD_TAU_PHI, CMD_TAU_PSI, CMD_TAU_THETA, CMD_THETA_D,
-    CMD_THRUST, CONTROLLER_SIG, FLAG_ASIN_CLIP, FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT, P, P_D, P_G,
+    CONTROLLER_SIG, FLAG_ASIN_CLIP, FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT, P, P_D, P_G,
     P_K, P_M, PHI, PSI, Q, R, REF_AX, REF_AY, REF_AZ, REF_PSI, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y,
     REF_Z, THETA, VX, VY, VZ, X, Y, Z,
 )
-from ..model.actuators import unmix
 from .attitude import (
     ATT_GAINS, ATT_I_LIMIT, ATT_KD, ATT_KI, ATT_KP, ATT_MEMORY, YAW_KD, YAW_KI, YAW_KP,
     attitude_gains, attitude_law, decoupling_constants,
 )
-from .base import Controller
+from .base import Controller, write_command
 from .design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
 
 # gains layout after the attitude block
@@ -157,22 +155,8 @@ def finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd):
     integrals = (mem[0], mem[1], mem[2])
     U, integrals, att_flags = attitude_law(phi_d, theta_d, psi_d, phi, theta, psi, p, q, r,
                                            k, g, integrals, dt)
-    U2, U3, U4 = U
-    F1, F2, F3, F4 = unmix(U1, U2, U3, U4, d)
     mem[0], mem[1], mem[2] = integrals
-    inv_k = 1.0 / K                       # duties F_i / K, clipped (and counted) by the engine
-    cmd[0] = F1 * inv_k
-    cmd[1] = F2 * inv_k
-    cmd[2] = F3 * inv_k
-    cmd[3] = F4 * inv_k
-    cmd[CMD_THRUST] = U1
-    cmd[CMD_TAU_PHI] = U2
-    cmd[CMD_TAU_THETA] = U3
-    cmd[CMD_TAU_PSI] = U4
-    cmd[CMD_PHI_D] = phi_d
-    cmd[CMD_THETA_D] = theta_d
-    cmd[CMD_PSI_D] = psi_d
-    cmd[CMD_FLAGS] = flags | att_flags
+    write_command(cmd, U1, U[0], U[1], U[2], phi_d, theta_d, psi_d, flags | att_flags, d, K)
 
 
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")

@@ -42,7 +42,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
 from numba import njit
 
 from ..layout import (
@@ -69,13 +68,12 @@ I_FACTOR_RATE = math.radians(400.0)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _derivative(mem, j, value, dt, alpha, first):
-    """Low-passed backward difference of ``value``; its last sample is mem[j], the filter
-    state mem[j + 6]. Zero in the first period."""
-    if not first:
-        mem[j + 6] += alpha * ((value - mem[j]) / dt - mem[j + 6])
-    mem[j] = value
-    return mem[j + 6]
+def _derivative(value, last, state, dt, alpha, first):
+    """Low-passed backward difference of ``value`` (its last sample ``last``, the filter's
+    state ``state``): the new state, which is the output. Zero in the first period."""
+    if first:
+        return state
+    return state + alpha * ((value - last) / dt - state)
 
 
 @njit(cache=True, error_model="numpy")
@@ -101,40 +99,61 @@ def constrain_xy(v0x, v0y, v1x, v1y, vmax):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _rate_axis(mem, j, setpoint, rate, dt, alpha, first, kp, ki, kd, i_limit):
-    """PX4 rate PID on axis j, per unit inertia [rad/s^2]; the integral updates after use."""
+def _rate_axis(setpoint, rate, integral, last, state, dt, alpha, first, kp, ki, kd, i_limit):
+    """PX4 rate PID on one axis, per unit inertia [rad/s^2]; the integral updates after use.
+    Returns (output, new integral, new derivative state, integrator held?)."""
     e = setpoint - rate
-    out = kp * e + mem[M_RI + j] - kd * _derivative(mem, M_W + j, rate, dt, alpha, first)
+    d = _derivative(rate, last, state, dt, alpha, first)
+    out = kp * e + integral - kd * d
     i_factor = max(0.0, 1.0 - (e / I_FACTOR_RATE) ** 2)
-    mem[M_RI + j], held = clamp(mem[M_RI + j] + i_factor * ki * e * dt, -i_limit, i_limit)
-    return out, held
+    integral, held = clamp(integral + i_factor * ki * e * dt, -i_limit, i_limit)
+    return out, integral, d, held
 
 
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
-def cascade(t, dt, x, ref, vp, gains, mem, cmd):
-    """PX4-style cascade: P position, PID velocity, P attitude, PID body rate."""
-    m, g, G = vp[P_M], vp[P_G], gains
+def cascade(t, dt, x, ref, vp, G, mem, cmd):
+    """PX4-style cascade: P position, PID velocity, P attitude, PID body rate (G: the gains)."""
+    # every array entry is read first and mem and cmd written last: no reference counting
+    m, g, K, l, d = vp[P_M], vp[P_G], vp[P_K], vp[P_L], vp[P_D]
+    jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
+    vx, vy, vz, p, q, r = x[VX], x[VY], x[VZ], x[P], x[Q], x[R]
+    phi, theta, psi = x[PHI], x[THETA], x[PSI]
+    vi_x, vi_y, vi_z = mem[M_VI], mem[M_VI + 1], mem[M_VI + 2]
+    ri_1, ri_2, ri_3 = mem[M_RI], mem[M_RI + 1], mem[M_RI + 2]
+    lv_x, lv_y, lv_z = mem[M_V], mem[M_V + 1], mem[M_V + 2]
+    lw_1, lw_2, lw_3 = mem[M_W], mem[M_W + 1], mem[M_W + 2]
+    dv_x, dv_y, dv_z = mem[M_VD], mem[M_VD + 1], mem[M_VD + 2]
+    dw_1, dw_2, dw_3 = mem[M_WD], mem[M_WD + 1], mem[M_WD + 2]
     first = mem[M_INIT] == 0.0
-    mem[M_INIT] = 1.0
-    av = dt / (dt + 1.0 / (2.0 * math.pi * G[C_VEL_D_LP]))
-    aw = dt / (dt + 1.0 / (2.0 * math.pi * G[C_RATE_D_LP]))
+    k_pos_xy, k_pos_z = G[C_POS_XY], G[C_POS_Z]
+    kv_p_xy, kv_i_xy, kv_d_xy, kv_p_z, kv_i_z, kv_d_z = G[C_VEL_P_XY], G[C_VEL_I_XY], G[C_VEL_D_XY], G[C_VEL_P_Z], G[C_VEL_I_Z], G[C_VEL_D_Z]
+    vmax_xy, vmax_up, vmax_down = G[C_VMAX_XY], G[C_VMAX_UP], G[C_VMAX_DOWN]
+    max_tilt, thr_min, thr_max = G[C_MAX_TILT], G[C_THR_MIN], G[C_THR_MAX]
+    k_att_rp, k_att_yaw, rmax_rp, rmax_yaw = G[C_ATT_RP], G[C_ATT_YAW], G[C_RMAX_RP], G[C_RMAX_YAW]
+    kr_p, kr_i, kr_d, ky_p, ky_i, ky_d, rate_i_lim = G[C_RATE_P], G[C_RATE_I], G[C_RATE_D], G[C_YRATE_P], G[C_YRATE_I], G[C_YRATE_D], G[C_RATE_I_LIM]
+    vel_d_lp, rate_d_lp = G[C_VEL_D_LP], G[C_RATE_D_LP]
+    psi_d, yr = ref[REF_PSI], ref[REF_PSI_DOT]
+    av = dt / (dt + 1.0 / (2.0 * math.pi * vel_d_lp))
+    aw = dt / (dt + 1.0 / (2.0 * math.pi * rate_d_lp))
     flags = 0
     # 1. position P -> velocity setpoint
-    vsx, vsy = constrain_xy(G[C_POS_XY] * (ref[REF_X] - x[X]), G[C_POS_XY] * (ref[REF_Y] - x[Y]),
-                            ref[REF_VX], ref[REF_VY], G[C_VMAX_XY])
-    vsz, _ = clamp(G[C_POS_Z] * (ref[REF_Z] - x[Z]) + ref[REF_VZ], -G[C_VMAX_DOWN], G[C_VMAX_UP])
+    vsx, vsy = constrain_xy(k_pos_xy * (ref[REF_X] - x[X]), k_pos_xy * (ref[REF_Y] - x[Y]),
+                            ref[REF_VX], ref[REF_VY], vmax_xy)
+    vsz, _ = clamp(k_pos_z * (ref[REF_Z] - x[Z]) + ref[REF_VZ], -vmax_down, vmax_up)
     # 2. velocity PID -> acceleration -> thrust vector
-    ex, ey, ez = vsx - x[VX], vsy - x[VY], vsz - x[VZ]
-    ax = G[C_VEL_P_XY] * ex + mem[M_VI] - G[C_VEL_D_XY] * _derivative(mem, M_V, x[VX], dt, av, first)
-    ay = G[C_VEL_P_XY] * ey + mem[M_VI + 1] - G[C_VEL_D_XY] * _derivative(mem, M_V + 1, x[VY], dt, av, first)
-    az = G[C_VEL_P_Z] * ez + mem[M_VI + 2] - G[C_VEL_D_Z] * _derivative(mem, M_V + 2, x[VZ], dt, av, first)
-    ax, ay, az = ax + ref[REF_AX], ay + ref[REF_AY], az + ref[REF_AZ]
-    hx, hy, tilted = limit_tilt(ax, ay, g, G[C_MAX_TILT])
+    ex, ey, ez = vsx - vx, vsy - vy, vsz - vz
+    dv_x = _derivative(vx, lv_x, dv_x, dt, av, first)
+    dv_y = _derivative(vy, lv_y, dv_y, dt, av, first)
+    dv_z = _derivative(vz, lv_z, dv_z, dt, av, first)
+    ax = kv_p_xy * ex + vi_x - kv_d_xy * dv_x + ref[REF_AX]
+    ay = kv_p_xy * ey + vi_y - kv_d_xy * dv_y + ref[REF_AY]
+    az = kv_p_z * ez + vi_z - kv_d_z * dv_z + ref[REF_AZ]
+    hx, hy, tilted = limit_tilt(ax, ay, g, max_tilt)
     if tilted:
         flags |= FLAG_TILT_LIMIT
     n = math.sqrt(hx * hx + hy * hy + g * g)
     b3x, b3y, b3z = hx / n, hy / n, g / n
-    u_min, u_max = G[C_THR_MIN] * m * g, G[C_THR_MAX] * 4.0 * vp[P_K]
+    u_min, u_max = thr_min * m * g, thr_max * 4.0 * K
     U1, limited = clamp(m * (g + az) / b3z, u_min, u_max)
     if limited:
         flags |= FLAG_THRUST_LIMIT
@@ -143,32 +162,36 @@ def cascade(t, dt, x, ref, vp, gains, mem, cmd):
             flags |= FLAG_INTEGRATOR_HOLD
     px, py = U1 * b3x / m, U1 * b3y / m                   # horizontal acceleration produced
     if ax * ax + ay * ay > px * px + py * py:             # tracking anti-windup
-        ex -= 2.0 / G[C_VEL_P_XY] * (ax - px)
-        ey -= 2.0 / G[C_VEL_P_XY] * (ay - py)
-    mem[M_VI] += G[C_VEL_I_XY] * ex * dt
-    mem[M_VI + 1] += G[C_VEL_I_XY] * ey * dt
-    mem[M_VI + 2], _ = clamp(mem[M_VI + 2] + G[C_VEL_I_Z] * ez * dt, -g, g)
+        ex -= 2.0 / kv_p_xy * (ax - px)
+        ey -= 2.0 / kv_p_xy * (ay - py)
+    vi_x += kv_i_xy * ex * dt
+    vi_y += kv_i_xy * ey * dt
+    vi_z, _ = clamp(vi_z + kv_i_z * ez * dt, -g, g)
     # 3. attitude P -> body-rate setpoints (+ the yaw rate reference in the body frame)
-    Rm, Rd = np.empty((3, 3)), np.empty((3, 3))
-    rotation_zyx(x[PHI], x[THETA], x[PSI], Rm)
-    attitude_px4(b3x, b3y, b3z, ref[REF_PSI], Rd)
+    Rm = rotation_zyx(phi, theta, psi)
+    Rd = attitude_px4(b3x, b3y, b3z, psi_d)
     e1, e2, e3 = error_quaternion(Rm, Rd)
-    yr = ref[REF_PSI_DOT]
-    sp1, _ = limit(G[C_ATT_RP] * e1 + Rm[2, 0] * yr, G[C_RMAX_RP])
-    sp2, _ = limit(G[C_ATT_RP] * e2 + Rm[2, 1] * yr, G[C_RMAX_RP])
-    sp3, _ = limit(G[C_ATT_YAW] * e3 + Rm[2, 2] * yr, G[C_RMAX_YAW])
+    sp1, _ = limit(k_att_rp * e1 + Rm[2][0] * yr, rmax_rp)
+    sp2, _ = limit(k_att_rp * e2 + Rm[2][1] * yr, rmax_rp)
+    sp3, _ = limit(k_att_yaw * e3 + Rm[2][2] * yr, rmax_yaw)
     # 4. rate PID -> torques
-    full = vp[P_L] * vp[P_K]                              # full roll/pitch torque [N m]
-    a1, h1 = _rate_axis(mem, 0, sp1, x[P], dt, aw, first, G[C_RATE_P], G[C_RATE_I], G[C_RATE_D],
-                        G[C_RATE_I_LIM] * full / vp[P_JXX])
-    a2, h2 = _rate_axis(mem, 1, sp2, x[Q], dt, aw, first, G[C_RATE_P], G[C_RATE_I], G[C_RATE_D],
-                        G[C_RATE_I_LIM] * full / vp[P_JYY])
-    a3, h3 = _rate_axis(mem, 2, sp3, x[R], dt, aw, first, G[C_YRATE_P], G[C_YRATE_I], G[C_YRATE_D],
-                        G[C_RATE_I_LIM] * 2.0 * vp[P_D] * vp[P_K] / vp[P_JZZ])
+    full = l * K                                          # full roll/pitch torque [N m]
+    a1, ri_1, dw_1, h1 = _rate_axis(sp1, p, ri_1, lw_1, dw_1, dt, aw, first, kr_p, kr_i,
+                                    kr_d, rate_i_lim * full / jx)
+    a2, ri_2, dw_2, h2 = _rate_axis(sp2, q, ri_2, lw_2, dw_2, dt, aw, first, kr_p, kr_i,
+                                    kr_d, rate_i_lim * full / jy)
+    a3, ri_3, dw_3, h3 = _rate_axis(sp3, r, ri_3, lw_3, dw_3, dt, aw, first, ky_p, ky_i,
+                                    ky_d, rate_i_lim * 2.0 * d * K / jz)
     if h1 or h2 or h3:
         flags |= FLAG_INTEGRATOR_HOLD
-    command_from_rotation(U1, vp[P_JXX] * a1 / vp[P_L], vp[P_JYY] * a2 / vp[P_L], vp[P_JZZ] * a3,
-                          Rd, flags, vp, cmd)
+    mem[M_VI], mem[M_VI + 1], mem[M_VI + 2] = vi_x, vi_y, vi_z
+    mem[M_RI], mem[M_RI + 1], mem[M_RI + 2] = ri_1, ri_2, ri_3
+    mem[M_V], mem[M_V + 1], mem[M_V + 2] = vx, vy, vz
+    mem[M_W], mem[M_W + 1], mem[M_W + 2] = p, q, r
+    mem[M_VD], mem[M_VD + 1], mem[M_VD + 2] = dv_x, dv_y, dv_z
+    mem[M_WD], mem[M_WD + 1], mem[M_WD + 2] = dw_1, dw_2, dw_3
+    mem[M_INIT] = 1.0
+    command_from_rotation(U1, jx * a1 / l, jy * a2 / l, jz * a3, Rd, flags, d, K, cmd)
 
 
 @dataclass(frozen=True)

@@ -9,14 +9,15 @@ body to earth coordinates, z up; its third column b3 = R e3 is the thrust direct
 exactly the factors of U1/m in eqs (5)-(7). Roll torque l U2 acts about body x, pitch l U3
 about body y and yaw U4 about body z (eq 11), so (p, q, r) is the body angular velocity.
 
-Compiled scalar code; a matrix is a (3, 3) float64 array filled in place (``out``). Also
-here: :func:`command_from_rotation`, the shared tail of these controllers (duties, logged
-inputs and setpoints), and :func:`clamp`.
+Compiled scalar code. A matrix is a tuple of its three rows, each a tuple of three floats
+(``R[i][j]``): a value, not an array, so the controllers allocate nothing per control period
+and take no references on shared memory. Also here: :func:`command_from_rotation`, the
+shared tail of these controllers (duties, logged inputs and setpoints), and :func:`clamp`.
 
 >>> import numpy as np
->>> R = np.empty((3, 3))
->>> rotation_zyx(0.1, -0.2, 0.3, R)
->>> bool(np.allclose(R.T @ R, np.eye(3))), [round(float(a), 12) for a in euler_zyx(R)]
+>>> R = rotation_zyx(0.1, -0.2, 0.3)
+>>> M = np.array(R)
+>>> bool(np.allclose(M.T @ M, np.eye(3))), [round(float(a), 12) for a in euler_zyx(R)]
 (True, [0.1, -0.2, 0.3])
 """
 
@@ -26,28 +27,25 @@ import math
 
 from numba import njit
 
-from ..layout import (
-    CMD_FLAGS, CMD_PHI_D, CMD_PSI_D, CMD_TAU_PHI, CMD_TAU_PSI, CMD_TAU_THETA, CMD_THETA_D, CMD_THRUST,
-)
-from ..model.actuators import duties_from_inputs
+from .base import write_command
 
 
 @njit(cache=True, error_model="numpy")
-def rotation_zyx(phi, theta, psi, out):
-    """out = Rz(psi) Ry(theta) Rx(phi): the body-to-earth rotation of the paper's angles."""
+def rotation_zyx(phi, theta, psi):
+    """Rz(psi) Ry(theta) Rx(phi): the body-to-earth rotation of the paper's angles."""
     sf, cf = math.sin(phi), math.cos(phi)
     st, ct = math.sin(theta), math.cos(theta)
     sp, cp = math.sin(psi), math.cos(psi)
-    out[0, 0], out[0, 1], out[0, 2] = cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf
-    out[1, 0], out[1, 1], out[1, 2] = sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf
-    out[2, 0], out[2, 1], out[2, 2] = -st, ct * sf, ct * cf
+    return ((cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf),
+            (sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf),
+            (-st, ct * sf, ct * cf))
 
 
 @njit(cache=True, error_model="numpy")
 def euler_zyx(Rm):
     """(phi, theta, psi) of a rotation R = Rz(psi) Ry(theta) Rx(phi), |theta| <= pi/2."""
-    s = min(1.0, max(-1.0, -Rm[2, 0]))
-    return math.atan2(Rm[2, 1], Rm[2, 2]), math.asin(s), math.atan2(Rm[1, 0], Rm[0, 0])
+    s = min(1.0, max(-1.0, -Rm[2][0]))
+    return math.atan2(Rm[2][1], Rm[2][2]), math.asin(s), math.atan2(Rm[1][0], Rm[0][0])
 
 
 @njit(cache=True, error_model="numpy")
@@ -69,7 +67,7 @@ def limit_tilt(hx, hy, vz, max_tilt):
 
 
 @njit(cache=True, error_model="numpy")
-def attitude_lee(b3x, b3y, b3z, psi, out):
+def attitude_lee(b3x, b3y, b3z, psi):
     """Desired rotation of Lee et al. (2010): b3 given (unit), b1 the projection of the
     heading c1 = (cos psi, sin psi, 0) on the plane normal to b3: b2 = b3 x c1 / |b3 x c1|,
     b1 = b2 x b3. Needs b3 away from the horizontal heading (true for any tilt < 90 deg)."""
@@ -77,12 +75,12 @@ def attitude_lee(b3x, b3y, b3z, psi, out):
     b2x, b2y, b2z = -b3z * cy, b3z * cx, b3x * cy - b3y * cx        # b3 x c1, c1z = 0
     n = math.sqrt(b2x * b2x + b2y * b2y + b2z * b2z)
     b2x, b2y, b2z = b2x / n, b2y / n, b2z / n
-    _columns(b2y * b3z - b2z * b3y, b2z * b3x - b2x * b3z, b2x * b3y - b2y * b3x,
-             b2x, b2y, b2z, b3x, b3y, b3z, out)
+    return _columns(b2y * b3z - b2z * b3y, b2z * b3x - b2x * b3z, b2x * b3y - b2y * b3x,
+                    b2x, b2y, b2z, b3x, b3y, b3z)
 
 
 @njit(cache=True, error_model="numpy")
-def attitude_px4(b3x, b3y, b3z, psi, out):
+def attitude_px4(b3x, b3y, b3z, psi):
     """Desired rotation as PX4's ``bodyzToAttitude``: b3 given (unit), b1 normal to the
     yaw frame's y axis c2 = (-sin psi, cos psi, 0): b1 = c2 x b3 / |c2 x b3|, b2 = b3 x b1.
     Its ZYX yaw is exactly psi (b1 stays in the vertical plane of the heading)."""
@@ -90,21 +88,20 @@ def attitude_px4(b3x, b3y, b3z, psi, out):
     b1x, b1y, b1z = cy * b3z, -cx * b3z, cx * b3y - cy * b3x        # c2 x b3, c2z = 0
     n = math.sqrt(b1x * b1x + b1y * b1y + b1z * b1z)
     b1x, b1y, b1z = b1x / n, b1y / n, b1z / n
-    _columns(b1x, b1y, b1z, b3y * b1z - b3z * b1y, b3z * b1x - b3x * b1z, b3x * b1y - b3y * b1x,
-             b3x, b3y, b3z, out)
+    return _columns(b1x, b1y, b1z, b3y * b1z - b3z * b1y, b3z * b1x - b3x * b1z, b3x * b1y - b3y * b1x,
+                    b3x, b3y, b3z)
 
 
 @njit(cache=True, inline="always")
-def _columns(ax, ay, az, bx, by, bz, cx, cy, cz, out):
-    out[0, 0], out[1, 0], out[2, 0] = ax, ay, az
-    out[0, 1], out[1, 1], out[2, 1] = bx, by, bz
-    out[0, 2], out[1, 2], out[2, 2] = cx, cy, cz
+def _columns(ax, ay, az, bx, by, bz, cx, cy, cz):
+    """The matrix whose columns are a, b and c."""
+    return (ax, bx, cx), (ay, by, cy), (az, bz, cz)
 
 
 @njit(cache=True, inline="always")
 def _tn(A, B, i, j):
     """(A^T B)[i, j]."""
-    return A[0, i] * B[0, j] + A[1, i] * B[1, j] + A[2, i] * B[2, j]
+    return A[0][i] * B[0][j] + A[1][i] * B[1][j] + A[2][i] * B[2][j]
 
 
 @njit(cache=True, error_model="numpy")
@@ -143,14 +140,12 @@ def error_quaternion(Rm, Rd):
     return k * x, k * y, k * z
 
 
-@njit(cache=True, error_model="numpy")
-def command_from_rotation(U1, U2, U3, U4, Rd, flags, vp, cmd):
-    """Write the command: the duties for (U1..U4) (:func:`duties_from_inputs`), the desired
-    inputs, the ZYX angles of the desired rotation Rd as (phi_d, theta_d, psi_d), the flags."""
-    duties_from_inputs(U1, U2, U3, U4, vp, cmd)
-    cmd[CMD_THRUST], cmd[CMD_TAU_PHI], cmd[CMD_TAU_THETA], cmd[CMD_TAU_PSI] = U1, U2, U3, U4
-    cmd[CMD_PHI_D], cmd[CMD_THETA_D], cmd[CMD_PSI_D] = euler_zyx(Rd)
-    cmd[CMD_FLAGS] = flags
+@njit(cache=True, inline="always", error_model="numpy")
+def command_from_rotation(U1, U2, U3, U4, Rd, flags, d, K, cmd):
+    """Write the command (:func:`~quadcruise.control.base.write_command`) with the ZYX angles
+    of the desired rotation Rd as the attitude setpoints (phi_d, theta_d, psi_d)."""
+    phi_d, theta_d, psi_d = euler_zyx(Rd)
+    write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags, d, K)
 
 
 @njit(cache=True, inline="always", error_model="numpy")

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 from numba import njit
 
-from ..layout import P_D, P_K
 
 
 @njit(cache=True, inline="always")
@@ -30,23 +29,21 @@ def unmix(U1, U2, U3, U4, d):
     """Inverse of eqs (1)-(4): (U1, U2, U3, U4) to rotor thrusts (F1, F2, F3, F4) [N].
 
     The solution is exact and unique for d > 0; it may ask for a negative thrust, which
-    :func:`duties_from_inputs` then clips (and reports).
+    :func:`duties` passes on and the engine clips (and reports).
     """
     s13 = 0.25 * (U1 + U4 / d)   # (F1 + F3) / 2
     s24 = 0.25 * (U1 - U4 / d)   # (F2 + F4) / 2
     return s13 + 0.5 * U3, s24 + 0.5 * U2, s13 - 0.5 * U3, s24 - 0.5 * U2
 
 
-@njit(cache=True)
-def duties_from_inputs(U1, U2, U3, U4, vp, cmd):
-    """Write the PWM duties that give (U1..U4) in steady state into cmd[0:4].
+@njit(cache=True, inline="always")
+def duties(U1, U2, U3, U4, d, K):
+    """The PWM duties (u1, u2, u3, u4) that give (U1..U4) in steady state: F_i / K, with
+    yaw arm d [m] and PWM gain K [N].
 
-    The duties are F_i / K, *not* clipped here: the engine clips them to [0, 1] and
-    counts the periods in which it had to, so saturation is always reported.
+    They are *not* clipped here: the engine clips them to [0, 1] and counts the periods in
+    which it had to, so saturation is always reported.
     """
-    F1, F2, F3, F4 = unmix(U1, U2, U3, U4, vp[P_D])
-    inv_k = 1.0 / vp[P_K]
-    cmd[0] = F1 * inv_k
-    cmd[1] = F2 * inv_k
-    cmd[2] = F3 * inv_k
-    cmd[3] = F4 * inv_k
+    F1, F2, F3, F4 = unmix(U1, U2, U3, U4, d)
+    inv_k = 1.0 / K
+    return F1 * inv_k, F2 * inv_k, F3 * inv_k, F4 * inv_k
