@@ -1,4 +1,10 @@
-"""What every benchmark prints about the machine it ran on."""
+"""What every benchmark prints about the machine it ran on.
+
+Shared virtual machines change speed from minute to minute. So besides the load average,
+each benchmark prints a speed probe at its start and its end: the time of one RK4 step of
+the plant (one vehicle, one thread, a compiled loop). Figures from runs whose probes differ
+are not comparable; divide by the probe's ratio to compare them roughly.
+"""
 
 from __future__ import annotations
 
@@ -6,12 +12,14 @@ import os
 import platform
 from pathlib import Path
 
+import numpy as np
+from numba import njit
+
 
 def machine(**versions: str) -> dict:
     """CPU, cores, numba threads, the versions of Python, numba, numpy and quadcruise (plus
     any ``versions`` given), and the load average at the start."""
     import numba
-    import numpy as np
 
     import quadcruise
 
@@ -19,4 +27,48 @@ def machine(**versions: str) -> dict:
     cpu = next((ln.split(":", 1)[1].strip() for ln in lines if ln.startswith("model name")), platform.processor())
     return {"cpu": cpu, "cores": os.cpu_count(), "numba_threads": numba.get_num_threads(),
             "python": platform.python_version(), "numba": numba.__version__, "numpy": np.__version__,
-            **versions, "quadcruise": quadcruise.__version__, "load_avg_start": list(os.getloadavg())}
+            **versions, "quadcruise": quadcruise.__version__, "load_avg_start": list(os.getloadavg()),
+            "probe_ns_start": probe()}
+
+
+def probe(steps: int = 200_000, repeats: int = 3) -> float:
+    """Nanoseconds of one RK4 step of the Table I plant (hovering slightly tilted, one
+    thread): best of ``repeats`` loops of ``steps``."""
+    import time
+
+    import quadcruise as qc
+    from quadcruise.layout import EXT_E1, EXT_SIZE, F1, PHI, PSI, THETA, Z
+
+    vp = qc.Vehicle.paper().rows(1)[0]
+    x = np.zeros(16)
+    x[Z], x[PHI], x[THETA], x[PSI] = 1.0, 0.02, -0.01, 0.3
+    x[F1:F1 + 4] = vp[qc.layout.P_M] * vp[qc.layout.P_G] / 4.0
+    u = np.full(4, qc.Vehicle.paper().hover_duty)
+    ext = np.zeros(EXT_SIZE)
+    ext[EXT_E1:EXT_E1 + 4] = 1.0
+    _rk4_loop(x.copy(), u, vp, ext, 10)
+    best = float("inf")
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        _rk4_loop(x.copy(), u, vp, ext, steps)
+        best = min(best, time.perf_counter() - t0)
+    return 1e9 * best / steps
+
+
+_LOOP: list = []
+
+
+def _rk4_loop(x, u, vp, ext, steps):
+    """``steps`` RK4 steps of the plant in a compiled loop (compiled on first use, after
+    quadcruise is imported, so that importing this module does not import it)."""
+    if not _LOOP:
+        from quadcruise.engine import rk4_step
+
+        def loop(x, u, vp, ext, steps):
+            k1, k2, k3, k4, xt = np.empty(16), np.empty(16), np.empty(16), np.empty(16), np.empty(16)
+            for _ in range(steps):
+                rk4_step(x, u, vp, ext, False, 1e-3, k1, k2, k3, k4, xt)
+            return x[0]
+
+        _LOOP.append(njit(loop))
+    return _LOOP[0](x, u, vp, ext, steps)

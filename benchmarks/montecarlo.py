@@ -32,7 +32,7 @@ import warnings
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from machine import machine  # noqa: E402
+from machine import machine, probe as speed_probe  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 TARGET = dict(n=10_000, duration=60.0, seconds=180.0)
@@ -98,7 +98,8 @@ def main(argv=None) -> int:
 
     info = machine(dask=dask.__version__, distributed=distributed.__version__)
     print(f"machine: {info['cpu']}, {info['cores']} cores, numba {info['numba']} ({info['numba_threads']} threads), "
-          f"dask {info['distributed']}; load average {', '.join(f'{v:.2f}' for v in info['load_avg_start'])}")
+          f"dask {info['distributed']}; load average {', '.join(f'{v:.2f}' for v in info['load_avg_start'])}; "
+          f"speed probe {info['probe_ns_start']:.0f} ns per plant RK4 step")
     spec = make_spec(duration)
     work = n * spec.periods
     print(f"{n:,} flights of {duration:g} s at 1 kHz with moderate Dryden turbulence = {work / 1e6:,.0f} M vehicle-steps")
@@ -153,7 +154,9 @@ def main(argv=None) -> int:
         print(f"target (10,000 x 60 s under {TARGET['seconds']:.0f} s on Dask): {'met' if ok else 'NOT met'} ({d:.0f} s)")
         results["target_met"] = ok
     info["load_avg_end"] = list(os.getloadavg())
-    print(f"load average at the end: {', '.join(f'{v:.2f}' for v in info['load_avg_end'])}")
+    info["probe_ns_end"] = speed_probe()
+    print(f"load average at the end: {', '.join(f'{v:.2f}' for v in info['load_avg_end'])}; speed probe "
+          f"{info['probe_ns_end']:.0f} ns (at the start {info['probe_ns_start']:.0f} ns)")
     if args.json:
         args.json.write_text(json.dumps({"machine": info, "quick": args.quick, "n": n, "duration_s": duration,
                                          "workers": args.workers, "results": results}, indent=2) + "\n")
