@@ -194,17 +194,23 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
         code = FINISHED
         t_end = t_grid[n_periods]
         rows_x = rows = 0
+        slot = 0                       # = k % (sensor_delay + 1), kept as a counter: the
+        next_log = 0                   # step has no integer division in it
         for k in range(n_periods + 1):
             t = t_grid[k]
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
             mission(t, mpi, ref)
             # what the controller sees: the state sensor_delay periods ago, plus noise
-            slot = k % (sensor_delay + 1)
-            for j in range(STATE_SIZE):
-                history[slot, j] = x[j]
-            old = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
-            for j in range(STATE_SIZE):
-                seen[j] = history[old, j]
+            if sensor_delay == 0:
+                for j in range(STATE_SIZE):
+                    seen[j] = x[j]
+            else:
+                for j in range(STATE_SIZE):
+                    history[slot, j] = x[j]
+                slot = slot + 1 if slot < sensor_delay else 0
+                old = slot if k >= sensor_delay else 0     # the oldest state kept
+                for j in range(STATE_SIZE):
+                    seen[j] = history[old, j]
             if noisy:
                 for j in range(STATE_SIZE):
                     if stdi[j] != 0.0:
@@ -212,12 +218,13 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
             for j in range(CMD_SIZE):
                 cmd[j] = 0.0
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
-            if k % log_every == 0:
-                row = k // log_every
-                log_row(log_x, i, row, x)
-                log_row(log_cmd, i, row, cmd)
-                log_row(log_ref, i, row, ref)
-                rows_x = rows = row + 1
+            if k == next_log:
+                log_row(log_x, i, rows, x)
+                log_row(log_cmd, i, rows, cmd)
+                log_row(log_ref, i, rows, ref)
+                rows += 1
+                rows_x = rows
+                next_log += log_every
             if k == n_periods:
                 break
             clipped, finite = hold_duties(cmd, u)
@@ -237,8 +244,8 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
             code = check_state(x, limits)
             if code != FINISHED:
                 t_end = t_grid[k + 1]
-                if (k + 1) % log_every == 0:   # keep the state that broke the bound
-                    log_row(log_x, i, (k + 1) // log_every, x)
+                if k + 1 == next_log:           # keep the state that broke the bound
+                    log_row(log_x, i, rows, x)
                     rows_x += 1
                 break
         blank_rows(log_x, i, rows_x)               # rows after a stop: NaN
