@@ -89,12 +89,13 @@ def attitude_gains(gains):
             gains[YAW_KD], gains[ATT_I_LIMIT])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def decoupled_attitude(x, phi_d, theta_d, psi_d, vp, g, mem, dt):
     """Eqs (13)-(15) with PID from arrays: the roll, pitch and yaw inputs (U2, U3, U4) and a
     flag word; updates the integrals in ``mem[:ATT_MEMORY]``.
 
-    The array form of :func:`attitude_law`, for use outside the engine's hot loop.
+    The array form of :func:`attitude_law`: it reads every entry it needs first and writes
+    ``mem`` last, so the controllers that inline it make no reference-count calls.
     """
     U, integrals, flags = attitude_law(
         phi_d, theta_d, psi_d, x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R],

@@ -38,13 +38,13 @@ from numba import njit
 
 from ..errors import InputError
 from ..layout import (
-    CONTROLLER_SIG, FLAG_ASIN_CLIP, FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT, P, P_D, P_G,
-    P_K, P_M, PHI, PSI, Q, R, REF_AX, REF_AY, REF_AZ, REF_PSI, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y,
+    CONTROLLER_SIG, FLAG_ASIN_CLIP, FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT, P_D, P_G,
+    P_K, P_M, PHI, PSI, REF_AX, REF_AY, REF_AZ, REF_PSI, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y,
     REF_Z, THETA, VX, VY, VZ, X, Y, Z,
 )
 from .attitude import (
     ATT_GAINS, ATT_I_LIMIT, ATT_KD, ATT_KI, ATT_KP, ATT_MEMORY, YAW_KD, YAW_KI, YAW_KP,
-    attitude_gains, attitude_law, decoupling_constants,
+    decoupled_attitude,
 )
 from .base import Controller, write_command
 from .design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
@@ -144,19 +144,12 @@ def finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd):
     """Shared tail of the position controllers: the decoupled attitude PID (eqs 13-15), the
     mixer inverse to duties, and the logged command.
 
-    It reads every array entry it needs into scalars before it computes and writes only at
-    the end. Kept that way, the compiled controllers make no reference-count calls at all,
-    which in a parallel batch would contend for the shared arrays' counters.
+    Like :func:`~quadcruise.control.attitude.decoupled_attitude`, it reads before it writes
+    and writes last. Kept that way, the compiled controllers make no reference-count calls
+    at all, which in a parallel batch would contend for the shared arrays' counters.
     """
-    phi, theta, psi, p, q, r = x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R]
-    k = decoupling_constants(vp)
-    d, K = vp[P_D], vp[P_K]
-    g = attitude_gains(gains)
-    integrals = (mem[0], mem[1], mem[2])
-    U, integrals, att_flags = attitude_law(phi_d, theta_d, psi_d, phi, theta, psi, p, q, r,
-                                           k, g, integrals, dt)
-    mem[0], mem[1], mem[2] = integrals
-    write_command(cmd, U1, U[0], U[1], U[2], phi_d, theta_d, psi_d, flags | att_flags, d, K)
+    U2, U3, U4, att_flags = decoupled_attitude(x, phi_d, theta_d, psi_d, vp, gains, mem, dt)
+    write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags | att_flags, vp[P_D], vp[P_K])
 
 
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")

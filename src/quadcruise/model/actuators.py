@@ -17,7 +17,6 @@ from __future__ import annotations
 from numba import njit
 
 
-
 @njit(cache=True, inline="always")
 def mix(F1, F2, F3, F4, d):
     """Eqs (1)-(4): rotor thrusts [N] to (U1, U2, U3, U4)."""
