@@ -52,8 +52,6 @@ from functools import cached_property
 from typing import Any, ClassVar
 
 import numpy as np
-import scipy.sparse
-import scipy.sparse.linalg
 from numba import njit
 
 from .errors import InputError
@@ -329,6 +327,9 @@ def minimum_snap_coefficients(values: Any, times: Any, stops: Any = None) -> np.
     >>> c[0, :, 0].round(9) + 0.0
     array([  0.,   0.,   0.,   0.,  35., -84.,  70., -20.])
     """
+    import scipy.sparse                  # here, not at the top: importing quadcruise stays
+    import scipy.sparse.linalg           # free of scipy
+
     w = np.asarray(values, dtype=float).reshape(len(times), -1)
     dur = np.diff(np.asarray(times, dtype=float))
     n, m, axes = w.shape[0], w.shape[0] - 1, w.shape[1]
