@@ -153,12 +153,13 @@ def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optiona
     if extra:
         warnings.warn(f"{path}: ignoring column(s) {', '.join(extra)}", stacklevel=3)
     used = [c for c in required + optional if c in header]
+    position = [header.index(name) for name in used]
     data = np.empty((len(rows) - 1, len(used)))
     for k, (line, row) in enumerate(rows[1:]):
         if len(row) != len(header):
             raise InputError(f"{path}, line {line}: has {len(row)} cells, the header has {len(header)}")
         for j, name in enumerate(used):
-            cell = row[header.index(name)].strip()
+            cell = row[position[j]].strip()
             if not cell and blank_ok is not None and blank_ok(name, k):
                 data[k, j] = math.nan
                 continue
