@@ -58,12 +58,13 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numba import njit, uint64
+from numba import njit
 
 from .errors import InputError
 from .layout import DISTURBANCE_SIG, EXT_E1, EXT_FX, EXT_WX, PHI, P, STATE_SIZE, VX, X
+from .missions import _f  # a field with unit, doc and check (here: real, nonneg, pos, frac, rotor, vec)
 from .params import Vehicle
-from .rng import _GOLDEN, _MIX1, _MIX2
+from .rng import next_unit
 
 __all__ = ["ConstantWind", "Gust", "Turbulence", "RotorLoss", "ExternalForce", "Environment",
            "SensorNoise", "DEFAULT_DRAG", "with_drag", "wind_from_name", "parse_wind",
@@ -125,20 +126,13 @@ def _normal_pair(s):
     """Two standard normals from the vehicle's SplitMix64 state s (:mod:`quadcruise.rng`'s
     generator, on the scalar state) by Marsaglia's polar method: (n1, n2, new state)."""
     while True:
-        a, s = 2.0 * _unit(s + _GOLDEN) - 1.0, s + _GOLDEN
-        b, s = 2.0 * _unit(s + _GOLDEN) - 1.0, s + _GOLDEN
+        a, s = next_unit(s)
+        b, s = next_unit(s)
+        a, b = 2.0 * a - 1.0, 2.0 * b - 1.0
         q = a * a + b * b
         if 0.0 < q < 1.0:
             f = math.sqrt(-2.0 * math.log(q) / q)
             return a * f, b * f, s
-
-
-@njit(cache=True)
-def _unit(z):
-    """SplitMix64's output for the advanced state z, as a float in [0, 1)."""
-    z = (z ^ (z >> uint64(30))) * _MIX1
-    z = (z ^ (z >> uint64(27))) * _MIX2
-    return float((z ^ (z >> uint64(31))) >> uint64(11)) * (1.0 / 9007199254740992.0)
 
 
 @njit(DISTURBANCE_SIG, cache=True, error_model="numpy")
@@ -188,11 +182,6 @@ def environment_disturbance(t, dt, x, dp, dmem, rng, ext):
 
 
 # --- Python side -------------------------------------------------------------------------
-def _f(default: Any, unit: str, doc: str, check: str = "real"):
-    """A field: check is real, nonneg, pos, frac (0..1), rotor (1..4) or vec (x, y, z)."""
-    return field(default=default, metadata={"unit": unit, "doc": doc, "check": check})
-
-
 _CHECKS = {"nonneg": (lambda a: a < 0, ">= 0"), "pos": (lambda a: a <= 0, "> 0"),
            "frac": (lambda a: (a < 0) | (a > 1), "in [0, 1]"),
            "rotor": (lambda a: (a != np.round(a)) | (a < 1) | (a > 4), "1, 2, 3 or 4")}

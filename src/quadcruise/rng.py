@@ -30,21 +30,36 @@ _MIX1 = uint64(0xBF58476D1CE4E5B9)
 _MIX2 = uint64(0x94D049BB133111EB)
 
 
-@njit(cache=True)
-def next_u64(state):
-    """Advance ``state`` (uint64 array, entry 0) and return the next 64 random bits."""
-    s = state[0] + _GOLDEN
-    state[0] = s
-    z = s
+@njit(cache=True, inline="always")
+def _mix(z):
+    """SplitMix64's output function: 64 random bits from the advanced state z."""
     z = (z ^ (z >> uint64(30))) * _MIX1
     z = (z ^ (z >> uint64(27))) * _MIX2
     return z ^ (z >> uint64(31))
 
 
+@njit(cache=True, inline="always")
+def next_unit(s):
+    """On a scalar state s: (a float in [0, 1) with 53 random bits, the advanced state).
+
+    For compiled code that keeps the state in a local variable and stores it once."""
+    s = s + _GOLDEN
+    return float(_mix(s) >> uint64(11)) * (1.0 / 9007199254740992.0), s
+
+
+@njit(cache=True)
+def next_u64(state):
+    """Advance ``state`` (uint64 array, entry 0) and return the next 64 random bits."""
+    s = state[0] + _GOLDEN
+    state[0] = s
+    return _mix(s)
+
+
 @njit(cache=True)
 def uniform(state):
     """A float in [0, 1) with 53 random bits."""
-    return float(next_u64(state) >> uint64(11)) * (1.0 / 9007199254740992.0)
+    u, state[0] = next_unit(state[0])
+    return u
 
 
 @njit(cache=True)
