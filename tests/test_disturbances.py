@@ -346,15 +346,17 @@ def test_bad_inputs_name_the_field():
 
 def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
     """The polar-method normals use quadcruise.rng's generator on the scalar state."""
-    from quadcruise.disturbances import _normal_pair, _unit
-    from quadcruise.rng import _GOLDEN, uniform
+    from quadcruise.disturbances import _normal_pair
+    from quadcruise.rng import _GOLDEN, next_unit, uniform
     state = vehicle_states(4, 1)[0]
     s0 = int(state[0])
     expected = [uniform(state) for _ in range(3)]
-    got, s = [], s0
+    got, s = [], np.uint64(s0)
     for _ in range(3):
-        s = (s + int(_GOLDEN)) % 2 ** 64
-        got.append(_unit(np.uint64(s)))
+        u, s_next = next_unit(s)
+        assert int(s_next) == (int(s) + int(_GOLDEN)) % 2 ** 64
+        got.append(u)
+        s = np.uint64(s_next)
     assert got == expected
     n1, n2, s_after = _normal_pair(np.uint64(s0))
     assert math.isfinite(n1) and math.isfinite(n2) and s_after != s0
