@@ -28,6 +28,7 @@ import numpy as np
 from . import __version__
 from .control import Controller, controller_from_name
 from .errors import InputError
+from .layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from .missions import Mission, mission_from_name
 from .params import Vehicle
 from .population import Population
@@ -156,7 +157,7 @@ class MonteCarloSpec:
 
     def log_bytes(self) -> int:
         """Bytes the engine's log takes per vehicle (states, commands, references)."""
-        return (self.periods // self.log_every + 1) * (16 + 12 + 11) * 8
+        return (self.periods // self.log_every + 1) * (STATE_SIZE + CMD_SIZE + REF_SIZE) * 8
 
     def to_dict(self) -> dict:
         """Plain values (for quadcruise.json and the hash)."""

@@ -130,7 +130,8 @@ class Population:
         for k in range(count):
             g = np.random.default_rng(np.random.SeedSequence([seed, first + k], spawn_key=(DRAW_KEY,)))
             out[k] = g.standard_normal(N_DRAWS) if normal else g.random(N_DRAWS)
-        return np.clip(out, -3.0, 3.0) if normal else math.sqrt(3.0) * (2.0 * out - 1.0)
+        clip = CLIP[self.distribution]
+        return np.clip(out, -clip, clip) if normal else clip * (2.0 * out - 1.0)
 
     def draw(self, seed: int, first: int, count: int, nominal: Vehicle, dt: float = 1e-3) -> "Draw":
         """The vehicles first .. first + count - 1: parameters, offsets and environment."""
@@ -158,7 +159,7 @@ class Population:
             kwargs.update(env.kwargs(count))
         if self.noise is not None:
             kwargs.update(self.noise.kwargs(dt))
-        vehicle = nominal.replace(**{k: cols[k] for k in ("m", "Jxx", "Jyy", "Jzz", "K", "omega", "d")})
+        vehicle = nominal.replace(**{k: cols[k] for names in SPREADS.values() for k in names})
         return Draw(vehicle=vehicle, offsets=offsets, environment=kwargs, columns=cols)
 
     def to_dict(self) -> dict:

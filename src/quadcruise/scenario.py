@@ -174,9 +174,7 @@ class _Where:
         """Call func; re-raise its InputError (or TypeError) with the file and table in front."""
         try:
             return func(*args, **kwargs)
-        except InputError as exc:
-            raise self.error(str(exc)) from None
-        except TypeError as exc:
+        except (InputError, TypeError) as exc:
             raise self.error(str(exc)) from None
 
 
