@@ -25,7 +25,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 from reference_model import rhs as reference_rhs  # noqa: E402
-from machine import machine, probe as speed_probe  # noqa: E402
+from machine import end_of_run, machine  # noqa: E402
 
 HZ = 1000.0          # control and integration rate of every benchmark [1/s]
 ROW_HZ = 100.0       # open-loop schedule: duties held for 10 ms per row
@@ -297,10 +297,7 @@ def main(argv=None) -> int:
     if not args.skip_scipy:
         scipy_section(size, r, final)
     startup_section(size, args.quick, args.cold, r)
-    info["load_avg_end"] = list(os.getloadavg())
-    info["probe_ns_end"] = speed_probe()
-    print(f"\nload average {info['load_avg_end'][0]:.2f} at end; speed probe {info['probe_ns_end']:.0f} ns "
-          f"(at the start {info['probe_ns_start']:.0f} ns)")
+    print("\n" + end_of_run(info))
     if args.json:
         Path(args.json).write_text(json.dumps({"machine": info, "quick": args.quick, "sizes": size,
                                                "results": r}, indent=2))

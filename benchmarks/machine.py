@@ -8,6 +8,7 @@ are not comparable; divide by the probe's ratio to compare them roughly.
 
 from __future__ import annotations
 
+import functools
 import os
 import platform
 from pathlib import Path
@@ -37,38 +38,47 @@ def probe(steps: int = 200_000, repeats: int = 3) -> float:
     import time
 
     import quadcruise as qc
-    from quadcruise.layout import EXT_E1, EXT_SIZE, F1, PHI, PSI, THETA, Z
+    from quadcruise.layout import EXT_E1, EXT_SIZE, F1, P_G, P_M, PHI, PSI, STATE_SIZE, THETA, Z
 
     vp = qc.Vehicle.paper().rows(1)[0]
-    x = np.zeros(16)
+    x = np.zeros(STATE_SIZE)
     x[Z], x[PHI], x[THETA], x[PSI] = 1.0, 0.02, -0.01, 0.3
-    x[F1:F1 + 4] = vp[qc.layout.P_M] * vp[qc.layout.P_G] / 4.0
+    x[F1:F1 + 4] = vp[P_M] * vp[P_G] / 4.0
     u = np.full(4, qc.Vehicle.paper().hover_duty)
     ext = np.zeros(EXT_SIZE)
     ext[EXT_E1:EXT_E1 + 4] = 1.0
-    _rk4_loop(x.copy(), u, vp, ext, 10)
+    loop = _rk4_loop()
+    loop(x.copy(), u, vp, ext, 10)
     best = float("inf")
     for _ in range(repeats):
         t0 = time.perf_counter()
-        _rk4_loop(x.copy(), u, vp, ext, steps)
+        loop(x.copy(), u, vp, ext, steps)
         best = min(best, time.perf_counter() - t0)
     return 1e9 * best / steps
 
 
-_LOOP: list = []
+def end_of_run(info: dict) -> str:
+    """Record the load average and the speed probe at the end of a run in ``info``; the line
+    that reports them."""
+    info["load_avg_end"] = list(os.getloadavg())
+    info["probe_ns_end"] = probe()
+    return (f"load average at the end: {', '.join(f'{v:.2f}' for v in info['load_avg_end'])}; speed probe "
+            f"{info['probe_ns_end']:.0f} ns (at the start {info['probe_ns_start']:.0f} ns)")
 
 
-def _rk4_loop(x, u, vp, ext, steps):
-    """``steps`` RK4 steps of the plant in a compiled loop (compiled on first use, after
-    quadcruise is imported, so that importing this module does not import it)."""
-    if not _LOOP:
-        from quadcruise.engine import rk4_step
+@functools.cache
+def _rk4_loop():
+    """A compiled loop of RK4 steps of the plant, built on first use (after quadcruise is
+    imported, so that importing this module does not import it)."""
+    from quadcruise.engine import rk4_step
+    from quadcruise.layout import STATE_SIZE
 
-        def loop(x, u, vp, ext, steps):
-            k1, k2, k3, k4, xt = np.empty(16), np.empty(16), np.empty(16), np.empty(16), np.empty(16)
-            for _ in range(steps):
-                rk4_step(x, u, vp, ext, False, 1e-3, k1, k2, k3, k4, xt)
-            return x[0]
+    @njit
+    def loop(x, u, vp, ext, steps):
+        k1, k2, k3 = np.empty(STATE_SIZE), np.empty(STATE_SIZE), np.empty(STATE_SIZE)
+        k4, xt = np.empty(STATE_SIZE), np.empty(STATE_SIZE)
+        for _ in range(steps):
+            rk4_step(x, u, vp, ext, False, 1e-3, k1, k2, k3, k4, xt)
+        return x[0]
 
-        _LOOP.append(njit(loop))
-    return _LOOP[0](x, u, vp, ext, steps)
+    return loop

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import resource
 import sys
 import time
@@ -32,7 +31,7 @@ import warnings
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from machine import machine, probe as speed_probe  # noqa: E402
+from machine import end_of_run, machine  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 TARGET = dict(n=10_000, duration=60.0, seconds=180.0)
@@ -153,10 +152,7 @@ def main(argv=None) -> int:
         ok = d < TARGET["seconds"]
         print(f"target (10,000 x 60 s under {TARGET['seconds']:.0f} s on Dask): {'met' if ok else 'NOT met'} ({d:.0f} s)")
         results["target_met"] = ok
-    info["load_avg_end"] = list(os.getloadavg())
-    info["probe_ns_end"] = speed_probe()
-    print(f"load average at the end: {', '.join(f'{v:.2f}' for v in info['load_avg_end'])}; speed probe "
-          f"{info['probe_ns_end']:.0f} ns (at the start {info['probe_ns_start']:.0f} ns)")
+    print(end_of_run(info))
     if args.json:
         args.json.write_text(json.dumps({"machine": info, "quick": args.quick, "n": n, "duration_s": duration,
                                          "workers": args.workers, "results": results}, indent=2) + "\n")
