@@ -192,7 +192,7 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
     if report is not None:
         from .report import flight_report, write_html_report
 
-        write_html_report(report, **flight_report(result))
+        write_html_report(report, **flight_report(result, metrics=metrics))
         click.echo(f"wrote report {report}")
     if animate is not None:
         from .animate import animate_flight

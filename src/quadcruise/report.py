@@ -386,9 +386,10 @@ def _metrics_table(frame):
     return shown
 
 
-def flight_report(result, *, title: str | None = None) -> dict:
+def flight_report(result, *, title: str | None = None, metrics=None) -> dict:
     """Keywords of :func:`html_report` for one flight (one ``fly``): its metrics, the run,
-    the flight figure (and the envelope of a batch), the 3-D view and ``result.meta``."""
+    the flight figure (and the envelope of a batch), the 3-D view and ``result.meta``.
+    ``metrics``, if already computed (``result.metrics()``), saves computing them again."""
     import pandas as pd
 
     from .plots import _describe, plot_envelope, plot_flight
@@ -407,7 +408,8 @@ def flight_report(result, *, title: str | None = None) -> dict:
     if result.n > 1:
         figures[f"All {result.n} vehicles"] = plot_envelope(result)
     return {"title": title or f"quadcruise: {label}",
-            "tables": {"Flight metrics": _metrics_table(result.metrics()), "Run": run_table},
+            "tables": {"Flight metrics": _metrics_table(result.metrics() if metrics is None else metrics),
+                       "Run": run_table},
             "figures": figures, "flights": {label: result}, "config": meta}
 
 
