@@ -135,6 +135,14 @@ def test_montecarlo_and_reproduce_accept_a_scenario(tmp_path):
     assert "3 flights of nlpd on circle, seed 0" in res.output
     meta = json.dumps(json.loads((tmp_path / "mc0" / "quadcruise.json").read_text()))
     assert '"mass_spread": 0.0' in meta and '"inertia_spread": 0.05' in meta
+    # the control period too: the scenario's unless --dt is given
+    coarse = tmp_path / "coarse.toml"
+    coarse.write_text((scen / "montecarlo_circle.toml").read_text().replace("duration = 20.0", "duration = 1.0\ndt = 0.002"))
+    for extra, dt in (((), 0.002), (("--dt", "0.001"), 0.001)):
+        res = run("montecarlo", "--scenario", coarse, "-n", "2", *extra, "--scheduler", "none", "--quiet",
+                  "--worst", "0", "--out", tmp_path / f"dt{dt}")
+        assert res.exit_code == 0, res.output
+        assert json.loads((tmp_path / f"dt{dt}" / "quadcruise.json").read_text())["spec"]["dt"] == dt
     bad = tmp_path / "bad.toml"
     bad.write_text("[montecarlo]\nmass_sprad = 0.1\n")
     res = run("montecarlo", "--scenario", bad, "-n", "2", "--scheduler", "none")
@@ -145,9 +153,11 @@ def test_montecarlo_and_reproduce_accept_a_scenario(tmp_path):
 
 
 def test_compare_on_the_same_population():
-    res = run("compare", "step", "--duration", "9", "--controllers", "nlpd,gonzalez", "--population", "5",
+    res = run("compare", "step", "--duration", "9", "--controllers", "nlpd, gonzalez", "--population", "5",
               "--mass-spread", "0.05", "--seed", "2")
     assert res.exit_code == 0, res.output
     assert "the same 5 perturbed vehicles (seed 2" in res.output
     table = res.output.split("perturbed vehicles")[1]
     assert "nlpd" in table and "gonzalez" in table and "failure_rate" in table
+    # the list is read the same way for both tables: a space after the comma is fine
+    assert table.count("nlpd") == 1 and table.count("gonzalez") == 1

@@ -272,7 +272,7 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
     if out is not None:
         check_output_dir(out, force)
     cmp_mission = _mission(mission, mission_params, smooth=False)
-    cmp = run_compare(cmp_mission, controllers.split(","), duration=duration, dt=dt)
+    cmp = run_compare(cmp_mission, controllers, duration=duration, dt=dt)
     click.echo(cmp.text())
     if population is not None:
         from .compare import compare_population
@@ -337,7 +337,7 @@ def analyze(controller, controller_params, position_poles, dt, out, force):
 @click.option("-n", "--n", "n", type=int, show_default="1000", help="Number of flights.")
 @click.option("--seed", type=int, show_default="0", help="Seed of every random draw.")
 @click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
-@click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
+@click.option("--dt", type=float, help="Control period [s] (default 0.001, or the scenario's).")
 @click.option("--wind", metavar="SPEC", help="Wind: constant:WX,WY,WZ | gust:AX,AY,AZ@START+DURATION | "
               "dryden:light|moderate|severe@ALTITUDE (comma-separable).")
 @click.option("--wind-spread", type=float, show_default="0",

@@ -257,12 +257,12 @@ def compare_population(mission, controllers, population, n: int, seed: int, **mo
     from .montecarlo import montecarlo
 
     rows = {}
-    for name in ([c.strip() for c in controllers.split(",")] if isinstance(controllers, str) else controllers):
-        res = montecarlo(mission, name, population, n, seed, **montecarlo_kw)
+    for label, ctrl in _labelled(controllers).items():
+        res = montecarlo(mission, ctrl, population, n, seed, **montecarlo_kw)
         s = res.summary()
         row = {"flights": s["flights"], "failure_rate": s["failures"]["rate"]}
         for metric in ("rmse_m", "max_error_m", "settling_time_5pct_s"):
             row[f"{metric} p50"] = s["metrics"][metric]["p50"]
             row[f"{metric} p95"] = s["metrics"][metric]["p95"]
-        rows[getattr(name, "name", name)] = row
+        rows[label] = row
     return pd.DataFrame.from_dict(rows, orient="index")

@@ -192,7 +192,7 @@ def parse_noise(text: str | None):
 
 
 def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: int | None = None,
-                       seed: int | None = None, duration: float | None = None, dt: float = 1e-3,
+                       seed: int | None = None, duration: float | None = None, dt: float | None = None,
                        wind: str | None = None, wind_spread: float | None = None,
                        mass_spread: float | None = None, inertia_spread: float | None = None,
                        thrust_spread: float | None = None, bandwidth_spread: float | None = None,
@@ -214,8 +214,8 @@ def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: 
     :func:`parse_noise` one. A ``scenario`` file supplies the mission, controller, nominal
     vehicle, disturbances, sensor noise and simulation settings, and its ``[montecarlo]``
     table any of n, seed and the Population fields; options given explicitly win. None
-    means "not given": n 1000, seed 0 and the Population's defaults, unless the scenario
-    sets them.
+    means "not given": n 1000, seed 0, dt 1 ms and the Population's defaults, unless the
+    scenario sets them.
     """
     import sys
 
@@ -232,7 +232,7 @@ def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: 
                  wind_spread=wind_spread, distribution=distribution, model_error=model_error, n=n, seed=seed)
     given = {key: value for key, value in given.items() if value is not None}
     sensor = parse_noise(noise)
-    options: dict = dict(duration=duration, dt=dt)
+    options: dict = dict(duration=duration, dt=1e-3 if dt is None else dt)
     sc = None
     if scenario is not None:
         sc, given = _from_scenario(scenario, given)
@@ -243,7 +243,8 @@ def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: 
         controller = sc.controller or controller
         env = env if env is not None else sc.environment
         sensor = sensor if sensor is not None else sc.sensor_noise
-        options.update(vehicle=sc.vehicle, duration=duration or sc.duration, dt=sc.simulation.get("dt", dt),
+        options.update(vehicle=sc.vehicle, duration=duration or sc.duration,
+                       dt=sc.dt if dt is None else dt, max_step=sc.simulation.get("max_step"),
                        full_dynamics=sc.simulation.get("full_dynamics", False))
     population = Population(**spreads, environment=env if env is not None and env.parts else None, noise=sensor)
     if case is not None:
