@@ -14,6 +14,10 @@ try:
 except _metadata.PackageNotFoundError:  # running from a source tree
     __version__ = "0.0.0+unknown"
 
+from ._cache import drop_stale_cache as _drop_stale_cache  # noqa: E402
+
+_drop_stale_cache()                      # before anything compiles: see quadcruise._cache
+
 from .engine import Limits, simulate, time_grid  # noqa: E402
 from .errors import InputError  # noqa: E402
 from .flight import fly  # noqa: E402

@@ -1,0 +1,52 @@
+"""Keep numba's on-disk cache in step with the package's sources.
+
+numba keys each cached function on the file that defines it, not on the files of the
+functions it calls and inlines: the engine's kernel inlines the plant's derivative, so an
+edit to ``model/plant.py`` alone would leave a stale kernel in the cache (a checkout of
+another commit, an edited source tree). At import, before anything compiles, we stamp the
+package's sources (path, size and modification time of every ``.py`` file) and, when the
+stamp differs from the one stored beside the cache, remove the package's cached machine
+code, which numba then compiles afresh. A read-only install is left alone (numba caches
+such a package elsewhere, and an upgrade replaces every file there anyway).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import os
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parent
+STAMP = PACKAGE / "__pycache__" / "quadcruise-sources.stamp"
+
+
+def sources_stamp(package: Path = PACKAGE) -> str:
+    """A hash of the path, size and modification time of every source file of the package."""
+    h = hashlib.sha256()
+    for path in sorted(package.rglob("*.py")):
+        st = path.stat()
+        h.update(f"{path.relative_to(package).as_posix()}:{st.st_size}:{st.st_mtime_ns};".encode())
+    return h.hexdigest()
+
+
+def drop_stale_cache(package: Path = PACKAGE, stamp_file: Path | None = None) -> bool:
+    """Remove the package's numba cache files if the sources changed since the last stamp;
+    True if it did. Errors (a read-only tree, a file another process removed) are ignored."""
+    stamp_file = stamp_file or package / "__pycache__" / STAMP.name
+    stamp = sources_stamp(package)
+    with contextlib.suppress(OSError):
+        if stamp_file.read_text() == stamp:
+            return False
+    try:
+        for pattern in ("*.nbi", "*.nbc"):
+            for path in package.rglob(pattern):
+                with contextlib.suppress(FileNotFoundError):
+                    path.unlink()
+        stamp_file.parent.mkdir(exist_ok=True)
+        tmp = stamp_file.with_name(f"{stamp_file.name}.{os.getpid()}.tmp")
+        tmp.write_text(stamp)
+        tmp.replace(stamp_file)
+    except OSError:
+        return False
+    return True

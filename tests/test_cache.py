@@ -1,0 +1,30 @@
+"""numba's cache is dropped when any of the package's sources changes (quadcruise._cache)."""
+
+import os
+
+from quadcruise._cache import drop_stale_cache, sources_stamp
+
+
+def test_cache_files_go_when_any_source_changes(tmp_path):
+    pkg = tmp_path / "pkg"
+    (pkg / "model" / "__pycache__").mkdir(parents=True)
+    (pkg / "engine.py").write_text("x = 1\n")
+    (pkg / "model" / "plant.py").write_text("y = 2\n")
+    cached = [pkg / "model" / "__pycache__" / "plant.derivative-1.py311.nbi",
+              pkg / "model" / "__pycache__" / "plant.derivative-1.py311.1.nbc"]
+    for path in cached:
+        path.write_bytes(b"machine code")
+    assert drop_stale_cache(pkg)                       # no stamp yet: dropped
+    assert not any(p.exists() for p in cached)
+    for path in cached:
+        path.write_bytes(b"machine code")
+    assert not drop_stale_cache(pkg)                   # unchanged sources: kept
+    assert all(p.exists() for p in cached)
+    before = sources_stamp(pkg)
+    plant = pkg / "model" / "plant.py"
+    st = plant.stat()
+    os.utime(plant, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000))   # edit a callee's file only
+    assert sources_stamp(pkg) != before
+    assert drop_stale_cache(pkg) and not any(p.exists() for p in cached)
+    (pkg / "new.py").write_text("")                    # a new module changes the stamp too
+    assert drop_stale_cache(pkg) and not drop_stale_cache(pkg)
