@@ -345,9 +345,9 @@ def test_bad_inputs_name_the_field():
 
 
 def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
-    """The polar-method normals use quadcruise.rng's generator on the scalar state."""
-    from quadcruise.disturbances import _normal_pair
-    from quadcruise.rng import _GOLDEN, next_unit, uniform
+    """The turbulence's normals are rng.next_normal's on the vehicle's scalar SplitMix64 state."""
+    from quadcruise.disturbances import _five_normals
+    from quadcruise.rng import _GOLDEN, next_normal, next_unit, uniform
     state = vehicle_states(4, 1)[0]
     s0 = int(state[0])
     expected = [uniform(state) for _ in range(3)]
@@ -358,5 +358,10 @@ def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
         got.append(u)
         s = np.uint64(s_next)
     assert got == expected
-    n1, n2, s_after = _normal_pair(np.uint64(s0))
-    assert math.isfinite(n1) and math.isfinite(n2) and s_after != s0
+    *five, s_after = _five_normals(np.uint64(s0))
+    one_by_one, s = [], np.uint64(s0)
+    for _ in range(5):
+        x, s = next_normal(s)
+        s = np.uint64(s)                 # back from Python: keep the state unsigned
+        one_by_one.append(x)
+    assert five == one_by_one and s_after == s != s0

@@ -64,7 +64,7 @@ from .errors import InputError
 from .layout import DISTURBANCE_SIG, EXT_E1, EXT_FX, EXT_WX, PHI, P, STATE_SIZE, VX, X
 from .missions import _f  # a field with unit, doc and check (here: real, nonneg, pos, frac, rotor, vec)
 from .params import Vehicle
-from .rng import next_unit
+from .rng import next_normal
 
 __all__ = ["ConstantWind", "Gust", "Turbulence", "RotorLoss", "ExternalForce", "Environment",
            "SensorNoise", "DEFAULT_DRAG", "with_drag", "wind_from_name", "parse_wind",
@@ -121,18 +121,16 @@ def _lateral_coefficients(a):
     return math.exp(-a), a, l11, l21, math.sqrt(max(i2 - l21 * l21, 0.0))
 
 
-@njit(cache=True, error_model="numpy")
-def _normal_pair(s):
-    """Two standard normals from the vehicle's SplitMix64 state s (:mod:`quadcruise.rng`'s
-    generator, on the scalar state) by Marsaglia's polar method: (n1, n2, new state)."""
-    while True:
-        a, s = next_unit(s)
-        b, s = next_unit(s)
-        a, b = 2.0 * a - 1.0, 2.0 * b - 1.0
-        q = a * a + b * b
-        if 0.0 < q < 1.0:
-            f = math.sqrt(-2.0 * math.log(q) / q)
-            return a * f, b * f, s
+@njit(cache=True, inline="always")
+def _five_normals(s):
+    """Five standard normals from the vehicle's SplitMix64 state s (:mod:`quadcruise.rng`'s
+    ziggurat on the scalar state), and the new state."""
+    n0, s = next_normal(s)
+    n1, s = next_normal(s)
+    n2, s = next_normal(s)
+    n3, s = next_normal(s)
+    n4, s = next_normal(s)
+    return n0, n1, n2, n3, n4, s
 
 
 @njit(DISTURBANCE_SIG, cache=True, error_model="numpy")
@@ -151,15 +149,11 @@ def environment_disturbance(t, dt, x, dp, dmem, rng, ext):
                 ext[EXT_WX + j] += k * dp[_GUST + 1 + j]
     if dp[_TURB] != 0.0:              # Dryden: output at t, then advance the filters to t + dt
         if started == 0.0:            # first period: draw the stationary start
-            n0, _, state = _normal_pair(state)
-            n1, n2, state = _normal_pair(state)
-            n3, n4, state = _normal_pair(state)
+            n0, n1, n2, n3, n4, state = _five_normals(state)
             started, dmem[1] = 1.0, n0
             dmem[2], dmem[3] = n1 / math.sqrt(2.0), math.sqrt(2.0) / 4.0 * n1 + n2 / math.sqrt(8.0)
             dmem[4], dmem[5] = n3 / math.sqrt(2.0), math.sqrt(2.0) / 4.0 * n3 + n4 / math.sqrt(8.0)
-        n0, _, state = _normal_pair(state)
-        n1, n2, state = _normal_pair(state)
-        n3, n4, state = _normal_pair(state)
+        n0, n1, n2, n3, n4, state = _five_normals(state)
         if dmem[_MDT] != dt:          # coefficients, cached per dt
             a = dt / dp[_TURB + 4]
             dmem[_MDT], dmem[_CU], dmem[_CU + 1] = dt, math.exp(-a), math.sqrt(-math.expm1(-2.0 * a))
