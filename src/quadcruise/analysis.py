@@ -30,7 +30,6 @@ velocity and attitude feedback closed: the outer loop's own margins.
 
 from __future__ import annotations
 
-import json
 import math
 import warnings
 from dataclasses import dataclass
@@ -44,7 +43,6 @@ from .errors import InputError
 from .layout import (
     CMD_FLAGS, CMD_SIZE, EXT_E1, EXT_SIZE, F1, P_D, P_G, P_K, P_M, REF_NAMES, REF_Z, STATE_NAMES, STATE_SIZE, Z,
 )
-from .model import plant
 from .model.actuators import mix
 from .params import Vehicle
 
@@ -60,23 +58,18 @@ class HoverError(InputError):
     """The controller does not hold hover: there is no equilibrium to linearise about."""
 
 
-def _plant_derivative():
-    """``f(x, u, vp, dx)``: the plant in still air (healthy rotors) with the paper's kinematics
-    (the exact ones agree to first order at hover)."""
+def _period(x, u, vp, dt, n_sub):
+    """One control period as the engine integrates it (:func:`quadcruise.engine.rk4_step`,
+    n_sub substeps, duties held) in still air with healthy rotors and the paper's
+    kinematics (the exact ones agree to first order at hover): the next state."""
+    from .engine import rk4_step
+
     ext = np.zeros(EXT_SIZE)
     ext[EXT_E1:EXT_E1 + 4] = 1.0
-    return lambda x, u, vp, dx: plant.derivative(x, u, vp, ext, False, dx)
-
-
-def _rk4(f, x, u, vp, dt, n_sub):
-    """The engine's integration of one period: n_sub classical RK4 steps, duties held."""
-    h, k = dt / n_sub, [np.empty(STATE_SIZE) for _ in range(4)]
+    x, u = np.array(x, dtype=float), np.ascontiguousarray(u, dtype=float)
+    work = [np.empty(STATE_SIZE) for _ in range(5)]
     for _ in range(n_sub):
-        f(x, u, vp, k[0])
-        f(x + 0.5 * h * k[0], u, vp, k[1])
-        f(x + 0.5 * h * k[1], u, vp, k[2])
-        f(x + h * k[2], u, vp, k[3])
-        x = x + h / 6.0 * (k[0] + 2.0 * (k[1] + k[2]) + k[3])
+        rk4_step(x, u, vp, ext, False, dt / n_sub, *work)
     return x
 
 
@@ -227,7 +220,6 @@ def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 
     mem0 = np.array(controller.memory() if memory is None else memory, dtype=float).ravel()
     n, C = STATE_SIZE + mem0.size, mem0.size
     n_sub = max(1, math.ceil(dt / (max_step or dt) - 1e-9))
-    f = _plant_derivative()
     x0, ref0 = np.zeros(STATE_SIZE), np.zeros(len(REF_NAMES))
     x0[Z], x0[F1:F1 + 4], ref0[REF_Z] = hover_z, vp[P_M] * vp[P_G] / 4.0, hover_z
     cols = [REF_NAMES.index(name) for name in INPUTS]
@@ -243,7 +235,7 @@ def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 
     v0 = np.concatenate([x0, mem0, ref0[cols]])
     out0 = ctrl(v0)
     u0 = out0[:4]
-    drift = np.concatenate([_rk4(f, x0, np.clip(u0, 0.0, 1.0), vp, dt, n_sub) - x0, out0[4:4 + C] - mem0]) / dt
+    drift = np.concatenate([_period(x0, np.clip(u0, 0.0, 1.0), vp, dt, n_sub) - x0, out0[4:4 + C] - mem0]) / dt
     names = list(STATE_NAMES) + [f"mem{i}" for i in range(C)]
     if not np.all(np.abs(drift) <= tol):
         i = int(np.argmax(np.where(np.isfinite(drift), np.abs(drift), np.inf)))
@@ -258,7 +250,7 @@ def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 
 
     # the period map's Jacobian by the chain rule: controller, then plant (a duty clip is inactive)
     G = _jacobian(lambda v: ctrl(v)[:4 + C], v0, eps)
-    P = _jacobian(lambda v: _rk4(f, v[:STATE_SIZE], v[STATE_SIZE:], vp, dt, n_sub), np.r_[x0, u0], eps)
+    P = _jacobian(lambda v: _period(v[:STATE_SIZE], v[STATE_SIZE:], vp, dt, n_sub), np.r_[x0, u0], eps)
     Ap, Bp = P[:, :STATE_SIZE], P[:, STATE_SIZE:]
     (Kx, Km, Kr), (Hx, Hm, Hr) = np.split(G[:4], [STATE_SIZE, n], axis=1), np.split(G[4:], [STATE_SIZE, n], axis=1)
     A = np.block([[Ap + Bp @ Kx, Bp @ Km], [Hx, Hm]])
@@ -462,11 +454,9 @@ def summary(rep: dict) -> str:
 
 def to_json(rep: dict) -> str:
     """:func:`report` as strict JSON: an infinite or undefined number becomes null."""
-    def clean(v):
-        if isinstance(v, (dict, list)):
-            return {k: clean(x) for k, x in v.items()} if isinstance(v, dict) else [clean(x) for x in v]
-        return None if isinstance(v, float) and not math.isfinite(v) else v
-    return json.dumps(clean(rep), indent=2, allow_nan=False)
+    from .plainjson import dumps
+
+    return dumps(rep, indent=2)
 
 
 __all__ = ["HoverError", "Linearization", "linearize", "loop_transfer", "loop_margins", "bode", "report",

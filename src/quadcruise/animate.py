@@ -29,6 +29,7 @@ import numpy as np
 
 from .errors import InputError, SimulationError
 from .io import atomic_path
+from .result import thinned
 
 __all__ = ["animate_flight"]
 
@@ -61,8 +62,7 @@ def _frame_indices(t: np.ndarray, end: int, fps: float, duration_s, every) -> np
 
 def _thin(i0: int, i1: int) -> np.ndarray:
     """At most MAX_LINE_POINTS indices from i0 to i1, both included."""
-    step = max(1, (i1 - i0) // MAX_LINE_POINTS + 1)
-    return np.unique(np.r_[np.arange(i0, i1 + 1, step), i1])
+    return thinned(i0, i1, (i1 - i0) // MAX_LINE_POINTS + 1)
 
 
 def animate_flight(result, path, *, vehicle: int = 0, fps: float = 15, duration_s: float | None = None,

@@ -101,19 +101,10 @@ def _poles(text: str | None, option: str):
 
 
 def _metrics_table(frame) -> str:
-    """The metrics of each vehicle as aligned text; a missing settling time of a measured
-    transient reads "did not settle", any other missing value "-"."""
-    shown = frame.drop(columns=["vehicle"]).astype(object)
-    for col in shown.columns:
-        for i, value in shown[col].items():
-            if isinstance(value, float):
-                missing = "did not settle" if col.startswith("settling") and frame.at[i, "axis"] else "-"
-                shown.at[i, col] = missing if value != value else f"{value:.4g}"
-            elif value is None:
-                shown.at[i, col] = "-"
-    shown = shown.T
-    shown.columns = [f"vehicle {c}" for c in frame["vehicle"]]
-    return shown.to_string()
+    """The metrics of each vehicle as aligned text (see :mod:`quadcruise.tables`)."""
+    from .tables import metrics_text
+
+    return metrics_text(frame.drop(columns=["vehicle"]), [f"vehicle {c}" for c in frame["vehicle"]])
 
 
 @main.command()
@@ -307,11 +298,11 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
 @_friendly
 def analyze(controller, controller_params, position_poles, dt, out, force):
     """Linearise the closed loop about hover: poles, damping, margins of each loop, Bode plots."""
-    import json
     from pathlib import Path
 
     from .analysis import bode, linearize, report, summary, to_json
     from .io import MARKER, atomic_dir
+    from .plainjson import dumps
     from .plots import save_figure
 
     the_controller = _controller_from_options(controller, controller_params, position_poles)
@@ -326,8 +317,8 @@ def analyze(controller, controller_params, position_poles, dt, out, force):
             (tmp / "analysis.json").write_text(to_json(rep) + "\n")
             save_figure(bode(lin, loops=True), tmp / "bode.png")
             save_figure(bode(lin, loops=True, at="output"), tmp / "bode_output.png")
-            (tmp / MARKER).write_text(json.dumps({"workflow": "analyze", "controller": the_controller.to_dict(),
-                                                  "dt_s": dt, "version": __version__}, default=str) + "\n")
+            (tmp / MARKER).write_text(dumps({"workflow": "analyze", "controller": the_controller,
+                                             "dt_s": dt, "version": __version__}) + "\n")
         click.echo(f"wrote analysis.json and Bode plots to {out}")
 
 

@@ -15,10 +15,9 @@ Examples
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -27,6 +26,7 @@ import numpy as np
 from .control import Controller, controller_from_name
 from .errors import InputError
 from .missions import Mission, mission_from_name
+from .plainjson import dumps, plain
 from .result import SimResult
 
 __all__ = ["compare", "Comparison", "DEFAULT_CONTROLLERS"]
@@ -51,10 +51,18 @@ class Comparison:
     mission: Mission
     controllers: dict
     results: dict
+    _tables: dict = field(default_factory=dict, init=False, repr=False)   # table() per keywords
 
     def table(self, **metric_kw: Any):
         """One row per controller (per controller and vehicle for a batch): every column of
-        :func:`quadcruise.metrics.flight_metrics` (keywords go to it), indexed by controller."""
+        :func:`quadcruise.metrics.flight_metrics` (keywords go to it), indexed by controller.
+        Computed once per set of keywords (the text, the files and a report share it)."""
+        key = repr(sorted(metric_kw.items()))
+        if key not in self._tables:
+            self._tables[key] = self._table(metric_kw)
+        return self._tables[key].copy()
+
+    def _table(self, metric_kw: dict):
         import pandas as pd
 
         frames = []
@@ -70,14 +78,10 @@ class Comparison:
     def text(self, **metric_kw: Any) -> str:
         """The table as aligned text, metrics down and controllers across (for a terminal);
         a missing settling time of a measured transient reads "did not settle"."""
+        from .tables import metrics_text
+
         table = self.table(**metric_kw)
-        shown = table.astype(object)
-        for col in shown.columns:
-            shown[col] = ["did not settle" if col.startswith("settling") and _plain(v) is None and axis
-                          else _show(v) for v, axis in zip(table[col], table["axis"])]
-        shown = shown.T
-        shown.columns = [" ".join(map(str, c)) if isinstance(c, tuple) else c for c in shown.columns]
-        return shown.to_string()
+        return metrics_text(table, [" ".join(map(str, c)) if isinstance(c, tuple) else c for c in table.index])
 
     def plot(self, vehicle: int = 0, *, title: str | None = None):
         """Overlay of the flights: top view, and x, y, z against time, each reference once.
@@ -98,7 +102,7 @@ class Comparison:
         rows: dict = {}
         for rec in metrics.to_dict(orient="records"):
             label = rec.pop("controller") if len(key) == 1 else f"{rec.pop('controller')}/{rec['vehicle']}"
-            rows[label] = {k: _plain(v) for k, v in rec.items()}
+            rows[label] = {k: plain(v) for k, v in rec.items()}
         return {
             "workflow": "compare",
             "mission": self.mission.to_dict(),
@@ -116,8 +120,6 @@ class Comparison:
 
         A non-empty folder that quadcruise did not write is refused unless ``force``.
         """
-        import json
-
         from .io import MARKER, atomic_dir, check_output_dir
         from .plots import save_figure
 
@@ -126,7 +128,7 @@ class Comparison:
             tmp = Path(tmp)
             self.table().reset_index().to_csv(tmp / "metrics.csv", index=False)
             save_figure(self.plot(), tmp / "comparison.png")
-            (tmp / MARKER).write_text(json.dumps(self.to_dict(), indent=2, sort_keys=True, default=_plain) + "\n")
+            (tmp / MARKER).write_text(dumps(self.to_dict(), indent=2, sort_keys=True) + "\n")
         return out
 
 
@@ -219,23 +221,6 @@ def _labelled(controllers) -> dict:
             unique = f"{name}#{k}"
         out[unique] = ctrl
     return out
-
-
-def _plain(v):
-    if isinstance(v, np.generic):
-        v = v.item()
-    if isinstance(v, float) and not math.isfinite(v):
-        return None
-    if isinstance(v, np.ndarray):
-        return v.tolist()
-    return v
-
-
-def _show(v) -> str:
-    v = _plain(v)
-    if v is None:
-        return "-"
-    return f"{v:.4g}" if isinstance(v, float) else str(v)
 
 
 def compare_population(mission, controllers, population, n: int, seed: int, **montecarlo_kw):

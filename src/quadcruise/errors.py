@@ -13,3 +13,13 @@ class InputError(ValueError):
 
 class SimulationError(RuntimeError):
     """A simulation could not be carried out as asked (not bad input, not divergence)."""
+
+
+def whole_number(value, what: str, minimum: int = 0) -> int:
+    """``value`` as an int if it is a whole number >= ``minimum`` (not a bool, not a float);
+    else InputError "<what> must be a whole number >= <minimum>, got <value>"."""
+    import numbers
+
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
+        raise InputError(f"{what} must be a whole number >= {minimum}, got {value!r}")
+    return int(value)

@@ -18,19 +18,17 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import json
 import math
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
 from . import __version__
 from .control import Controller, controller_from_name
-from .errors import InputError
+from .errors import InputError, whole_number
 from .layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from .missions import Mission, mission_from_name
 from .params import Vehicle
+from .plainjson import dumps
 from .population import Population
 
 __all__ = ["MonteCarloSpec"]
@@ -115,9 +113,7 @@ class MonteCarloSpec:
             raise InputError("population must be a Population")
         if not isinstance(self.vehicle, Vehicle) or self.vehicle.batch_size is not None:
             raise InputError("the nominal vehicle must be one (unbatched) Vehicle")
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
-            raise InputError(f"seed must be an integer >= 0, got {self.seed!r}")
-        object.__setattr__(self, "seed", int(self.seed))
+        object.__setattr__(self, "seed", whole_number(self.seed, "seed"))
         duration = default_duration(self.mission) if self.duration is None else self.duration
         time_grid(float(duration), float(self.dt))          # validates duration and dt
         object.__setattr__(self, "duration", float(duration))
@@ -171,16 +167,7 @@ class MonteCarloSpec:
 
     def hash(self) -> str:
         """A short hash of :meth:`to_dict` and the version: equal specs fly equal flights."""
-        text = json.dumps({"spec": self.to_dict(), "version": __version__}, sort_keys=True, default=_plain)
+        text = dumps({"spec": self.to_dict(), "version": __version__}, sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def _plain(obj):
-    """JSON ``default`` for what a spec or a result holds: numpy values and dataclasses."""
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if dataclasses.is_dataclass(obj):
-        return dataclasses.asdict(obj)
-    raise TypeError(f"cannot record {type(obj).__name__}")

@@ -43,7 +43,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .control import Controller
-from .errors import InputError
+from .errors import InputError, whole_number
 from .io import check_output_dir
 from .mcspec import MonteCarloSpec
 from .missions import Mission
@@ -52,7 +52,7 @@ from .montecarlo_result import COLUMNS, FAILURES, METRICS, MonteCarloResult, Tra
 from .population import Population
 from .progress import ProgressBar
 from .sweep import fly_chunk, reduce_chunk, run_sweep
-from .sweep_store import _marker
+from .sweep_store import holds_sweep
 
 __all__ = ["Population", "MonteCarloSpec", "MonteCarloResult", "Traces", "Case", "montecarlo",
            "montecarlo_case", "replay_case", "montecarlo_command", "parse_noise", "FAILURES",
@@ -80,9 +80,8 @@ def montecarlo_case(spec: MonteCarloSpec, i: int, *, log_every: int | None = Non
     >>> case.row["vehicle"], case.result.n, case.row["dx0"] == float(case.result.states[0, 0, 0])
     (7, 1, True)
     """
-    if isinstance(i, bool) or not isinstance(i, (int, np.integer)) or i < 0:
-        raise InputError(f"vehicle index must be an integer >= 0, got {i!r}")
-    res, draw = fly_chunk(spec, int(i), 1)
+    i = whole_number(i, "the vehicle index")
+    res, draw = fly_chunk(spec, i, 1)
     chunk = reduce_chunk(spec, int(i), res, draw)
     row = {k: chunk[k][0].item() for k in COLUMNS}
     row["reason"] = FAILURES[row["failure"]]
@@ -252,9 +251,9 @@ def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: 
         if isinstance(case, bool) or not isinstance(case, (int, np.integer)) or not 0 <= case < n:
             raise InputError(f"--case {case} is not one of the {n} flights")
         target = None if out is None else Path(out)
-        meta = _marker(target) if target is not None and target.is_dir() else None
+        meta, same = holds_sweep(target, spec) if target is not None else (None, False)
         if meta and meta.get("workflow") == "montecarlo":      # a sweep's folder: the case goes inside
-            if meta.get("spec_hash") != spec.hash():
+            if not same:
                 raise InputError(f"{out}: holds a sweep flown with other options (spec {meta.get('spec_hash')}, "
                                  f"these give {spec.hash()}); give the sweep's options to replay its flight")
             target = target / f"case-{case:06d}"

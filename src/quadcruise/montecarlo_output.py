@@ -6,7 +6,6 @@ The folder's layout and its marker are those of :mod:`quadcruise.sweep_store`.
 
 from __future__ import annotations
 
-import json
 import shutil
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -16,8 +15,8 @@ import numpy as np
 from . import __version__
 from .errors import InputError
 from .io import MARKER, atomic_dir, atomic_path, check_output_dir, write_table
-from .mcspec import _plain
-from .sweep_store import _marker, write_marker
+from .plainjson import dumps
+from .sweep_store import holds_sweep, write_marker
 
 if TYPE_CHECKING:
     from .montecarlo_result import MonteCarloResult
@@ -31,8 +30,7 @@ def write_outputs(result: MonteCarloResult, out, *, fmt: str = "csv", force: boo
     from .plots import save_figure
 
     path = Path(out)
-    meta = _marker(path) if path.is_dir() else None
-    ours = bool(meta) and meta.get("workflow") == "montecarlo" and meta.get("spec_hash") == result.spec.hash()
+    meta, ours = holds_sweep(path, result.spec)
     if not ours:
         check_output_dir(path, force)
         if meta is not None and not force:
@@ -43,7 +41,7 @@ def write_outputs(result: MonteCarloResult, out, *, fmt: str = "csv", force: boo
     name = write_table(result.table, path / "flights", fmt).name
     summary = result.summary()
     with atomic_path(path / "summary.json") as tmp:
-        tmp.write_text(json.dumps({**summary, "info": result.info}, indent=2, default=_plain) + "\n")
+        tmp.write_text(dumps({**summary, "info": result.info}, indent=2) + "\n")
     worst = result.worst(20)
     with atomic_path(path / "worst.csv") as tmp:
         worst.to_csv(tmp, index=False, float_format="%.10g")
@@ -66,10 +64,10 @@ def write_case(case, out, *, fmt: str = "csv", force: bool = False) -> Path:
     with atomic_dir(path) as tmp:
         tmp = Path(tmp)
         write_table(case.result.to_pandas(), tmp / "traces", fmt)
-        (tmp / "case.json").write_text(json.dumps(case.row, indent=2, default=_plain) + "\n")
+        (tmp / "case.json").write_text(dumps(case.row, indent=2) + "\n")
         save_figure(plot_flight(case.result), tmp / "flight.png")
-        (tmp / MARKER).write_text(json.dumps({"workflow": "montecarlo-case", "vehicle": case.vehicle,
-                                              **case.result.meta}, indent=2, default=_plain) + "\n")
+        (tmp / MARKER).write_text(dumps({"workflow": "montecarlo-case", "vehicle": case.vehicle,
+                                          **case.result.meta}, indent=2) + "\n")
     return path
 
 

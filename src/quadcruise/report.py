@@ -34,6 +34,9 @@ import numpy as np
 
 from .errors import InputError
 from .io import atomic_path
+from .plainjson import dumps
+from .result import thinned
+from .tables import DID_NOT_SETTLE, metric_cell
 
 __all__ = ["html_report", "write_html_report", "flight_report", "comparison_report",
            "reproduction_report", "markdown_html", "table_html"]
@@ -62,32 +65,6 @@ def _label(name) -> str:
     return name.replace("_", " ")
 
 
-def _cell(value) -> tuple[str, bool]:
-    """(text, is_number) of one table cell."""
-    if value is None or (isinstance(value, float | np.floating) and math.isnan(value)):
-        return MISSING, False
-    if isinstance(value, bool | np.bool_):
-        return ("yes" if value else "no"), False
-    if isinstance(value, int | np.integer):
-        return str(int(value)), True
-    if isinstance(value, float | np.floating):
-        a = abs(float(value))
-        if a == 0.0:
-            return "0", True
-        if math.isinf(a) or a >= 1e7 or a < 1e-3:
-            return f"{value:.3e}", True
-        return (f"{value:,.0f}" if a >= 1e4 else f"{value:.4g}"), True
-    return str(value), False
-
-
-def _is_settling(name) -> bool:
-    return isinstance(name, str) and name.startswith("settling")
-
-
-def _named(axis) -> bool:
-    return isinstance(axis, str) and bool(axis.strip())
-
-
 def table_html(frame) -> str:
     """A DataFrame as an HTML table: numbers to 4 significant digits, NaN as "—", and a
     NaN settling time of a measured transient (a non-empty ``axis``, as a column or, in a
@@ -107,14 +84,13 @@ def table_html(frame) -> str:
         keys = key if isinstance(key, tuple) else (key,)
         cells = [f'<th scope="row">{html.escape(_label(k))}</th>' for k in keys] if shown_index else []
         for c, (col, value) in enumerate(row.items()):
-            text, num = _cell(value)
-            if text == MISSING:
-                if rows_axis is not None and _is_settling(col) and _named(rows_axis.iloc[r]):
-                    text = "did not settle"
-                elif cols_axis is not None and _is_settling(key) and _named(cols_axis.iloc[c]):
-                    text = "did not settle"
+            axis = rows_axis.iloc[r] if rows_axis is not None else None
+            metric = col
+            if cols_axis is not None:                    # a transposed table: metrics down
+                axis, metric = cols_axis.iloc[c], key
+            text, num = metric_cell(value, metric, axis, MISSING)
             cls = ["num"] if num else []
-            if text in (MISSING, "did not settle"):
+            if text in (MISSING, DID_NOT_SETTLE):
                 cls.append("missing")
             if (col == "status" or key == "status") and isinstance(value, str):
                 cls.append("ok" if value == "finished" else "bad")
@@ -143,25 +119,6 @@ def _png_b64(fig) -> str:
     return base64.b64encode(data).decode("ascii")
 
 
-def _plain(obj):
-    """A configuration as plain JSON values: numpy to lists and numbers, NaN to null."""
-    if isinstance(obj, dict):
-        return {str(k): _plain(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_plain(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _plain(obj.tolist())
-    if isinstance(obj, np.generic):
-        obj = obj.item()
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if obj is None or isinstance(obj, str | int | float | bool):
-        return obj
-    if hasattr(obj, "to_dict"):
-        return _plain(obj.to_dict())
-    return str(obj)
-
-
 def _series(t, pos, keep) -> dict:
     out = {"t": np.round(t[keep], 4).tolist()}
     for k, name in enumerate("xyz"):
@@ -183,12 +140,12 @@ def _view_data(flights: dict) -> dict:
             live = np.flatnonzero(np.all(np.isfinite(pos), axis=1))
             end = int(live[-1]) + 1 if live.size else 1
             step = max(1, math.ceil(end / MAX_POINTS))
-            keep = np.unique(np.concatenate([np.arange(0, end, step), [end - 1]]))
+            keep = thinned(0, end - 1, step)
             entry = {"label": label if res.n == 1 else f"{label} · vehicle {v}",
                      "color": COLORS[len(entries) % len(COLORS)], "ok": bool(res.ok[v]),
                      "status": res.status_text(v), "ref": None, **_series(res.t, pos, keep)}
             if np.any(np.all(np.isfinite(ref), axis=1)):
-                rkeep = np.unique(np.concatenate([np.arange(0, ref.shape[0], step), [ref.shape[0] - 1]]))
+                rkeep = thinned(0, ref.shape[0] - 1, step)
                 rdata = _series(res.t, ref, rkeep)
                 entry["ref"] = next((i for i, r in enumerate(refs) if r == rdata), len(refs))
                 if entry["ref"] == len(refs):
@@ -349,7 +306,7 @@ def html_report(*, title: str, tables: dict | None = None, figures: dict | None 
         sections.append(("figures", "Figures", body))
     if notes:
         sections.append(("notes", "Notes", f'<div class="qc-notes">{notes}</div>'))
-    text = json.dumps(_plain(config), indent=2)
+    text = dumps(config, indent=2)
     link = base64.b64encode(text.encode()).decode("ascii")
     sections.append(("config", "Scenario", f'<details open><summary>configuration that produced this report '
                      f'(JSON)</summary><pre class="qc-config">{html.escape(text)}</pre></details><p>'

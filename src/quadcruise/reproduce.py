@@ -27,7 +27,6 @@ Examples
 
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,6 +41,7 @@ from .flight import fly
 from .io import MARKER, atomic_dir, check_output_dir, write_table
 from .missions import Circle, Mission, Square, Step
 from .params import Vehicle
+from .plainjson import dumps
 from .result import SimResult
 
 PAPER = {
@@ -172,9 +172,8 @@ def write_reproduction(rep: Reproduction, out: str | Path, *, force: bool = Fals
     out = check_output_dir(out, force)
     with atomic_dir(out) as tmp:
         tmp = Path(tmp)
-        (tmp / "metrics.json").write_text(json.dumps(rep.to_json(), indent=2) + "\n")
-        (tmp / MARKER).write_text(json.dumps({"workflow": "reproduce", **rep.config,
-                                              "version": __version__}, indent=2, default=str) + "\n")
+        (tmp / "metrics.json").write_text(dumps(rep.to_json(), indent=2) + "\n")
+        (tmp / MARKER).write_text(dumps({"workflow": "reproduce", **rep.config, "version": __version__}, indent=2) + "\n")
         traces = tmp / "traces"
         traces.mkdir()
         light = {key: result.decimate(TRACE_EVERY) for key, result in rep.results.items()}

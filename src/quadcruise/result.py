@@ -16,7 +16,6 @@ Examples
 from __future__ import annotations
 
 import dataclasses
-import json
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -33,6 +32,12 @@ STATUS_REASONS = (
     "diverged: tilt left the bound",
     "stopped: the controller returned a non-finite command",
 )
+
+
+def thinned(first: int, last: int, step: int) -> np.ndarray:
+    """Log indices first, first + step, ... up to ``last``, and ``last`` itself (a path
+    thinned for drawing keeps its end)."""
+    return np.unique(np.r_[np.arange(first, last + 1, max(1, int(step))), last])
 
 
 @dataclass(frozen=True, eq=False)
@@ -152,12 +157,8 @@ class SimResult:
 
     def meta_json(self) -> str:
         """The recorded configuration as JSON."""
-        return json.dumps(self.meta, indent=2, sort_keys=True, default=_jsonable)
+        from .plainjson import dumps
+
+        return dumps(self.meta, indent=2, sort_keys=True)
 
 
-def _jsonable(obj):
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if isinstance(obj, np.generic):
-        return obj.item()
-    raise TypeError(f"cannot record {type(obj).__name__} in a result bundle")

@@ -32,7 +32,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .errors import InputError, SimulationError
+from .errors import InputError, SimulationError, whole_number
 from .io import check_table_format
 from .layout import CMD_U1, REF_X, X
 from .mcspec import MonteCarloSpec
@@ -326,14 +326,11 @@ def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", s
     after each chunk; an exception from it (or Ctrl-C) stops the sweep, leaving the chunks
     already written for a resume.
     """
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-        raise InputError(f"the number of flights must be a whole number >= 1, got {n!r}")
-    n = int(n)
+    n = whole_number(n, "the number of flights", 1)
     if chunk_size != "auto" and (isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer))
                                  or chunk_size < 1):
         raise InputError(f"chunk size must be a whole number >= 1 or 'auto', got {chunk_size!r}")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1):
-        raise InputError(f"workers must be a whole number >= 1, got {workers!r}")
+    workers = None if workers is None else whole_number(workers, "workers", 1)
     check_table_format(fmt)
     mode = _scheduler(scheduler)
     folder = _Folder(out, spec, force=force, resume=resume) if out is not None else None

@@ -29,9 +29,10 @@ import numpy as np
 from . import __version__
 from .errors import InputError
 from .io import MARKER, atomic_path, check_output_dir
-from .mcspec import MonteCarloSpec, _plain
+from .mcspec import MonteCarloSpec
+from .plainjson import dumps
 
-__all__ = ["CHUNKS", "write_marker"]
+__all__ = ["CHUNKS", "write_marker", "holds_sweep"]
 
 CHUNKS = "chunks"
 
@@ -68,6 +69,13 @@ def _marker(path: Path) -> dict | None:
         return None
 
 
+def holds_sweep(path: Path, spec: MonteCarloSpec) -> tuple[dict | None, bool]:
+    """(the quadcruise.json of folder ``path``, or None; whether it is this very sweep:
+    a Monte Carlo folder of the same spec hash)."""
+    meta = _marker(path) if path.is_dir() else None
+    return meta, bool(meta) and meta.get("workflow") == "montecarlo" and meta.get("spec_hash") == spec.hash()
+
+
 class _Folder:
     """The output folder of a sweep: checked at construction (nothing is written), then
     :meth:`prepare` (marker), :meth:`write_chunk`."""
@@ -76,8 +84,7 @@ class _Folder:
         self.path = check_output_dir(out, force)
         self.hash = spec.hash()
         self.spec = spec
-        meta = _marker(self.path) if self.path.is_dir() else None
-        same = bool(meta) and meta.get("workflow") == "montecarlo" and meta.get("spec_hash") == self.hash
+        meta, same = holds_sweep(self.path, spec)
         if meta is not None and not same and not force:
             what = (f"a different sweep (spec {meta.get('spec_hash')})" if meta.get("workflow") == "montecarlo"
                     else f"a quadcruise {meta.get('workflow', 'result')} result")
@@ -103,4 +110,4 @@ def write_marker(path: Path, spec: MonteCarloSpec, n: int, **extra: Any) -> None
     doc = {"workflow": "montecarlo", "version": __version__, "spec_hash": spec.hash(), "n": n,
            "seed": spec.seed, **extra, "spec": spec.to_dict()}
     with atomic_path(path / MARKER) as tmp:
-        tmp.write_text(json.dumps(doc, indent=2, default=_plain) + "\n")
+        tmp.write_text(dumps(doc, indent=2) + "\n")

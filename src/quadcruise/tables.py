@@ -1,0 +1,67 @@
+"""How a metric reads in a table: one rule for the terminal (``fly``, ``compare``) and the
+HTML report.
+
+Numbers show 4 significant digits (scientific notation when very large or small), a
+missing value a dash, and a missing settling time of a response that did have a transient
+(its ``axis`` is named) reads "did not settle": the response never stayed in the band,
+which is not the same as "no step to measure".
+
+>>> import pandas as pd
+>>> frame = pd.DataFrame({"axis": ["x", ""], "settling_time_s": [float("nan")] * 2, "rmse_m": [0.01234, 2e-5]})
+>>> print(metrics_text(frame, ["vehicle 0", "vehicle 1"]))
+                      vehicle 0  vehicle 1
+axis                          x
+settling_time_s  did not settle          -
+rmse_m                  0.01234  2.000e-05
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+__all__ = ["cell", "metric_cell", "metrics_text", "DID_NOT_SETTLE"]
+
+DID_NOT_SETTLE = "did not settle"
+
+
+def cell(value: Any, missing: str = "-") -> tuple[str, bool]:
+    """(text, is_number) of one value."""
+    if value is None or (isinstance(value, float | np.floating) and math.isnan(value)):
+        return missing, False
+    if isinstance(value, bool | np.bool_):
+        return ("yes" if value else "no"), False
+    if isinstance(value, int | np.integer):
+        return str(int(value)), True
+    if isinstance(value, float | np.floating):
+        a = abs(float(value))
+        if a == 0.0:
+            return "0", True
+        if math.isinf(a) or a >= 1e7 or a < 1e-3:
+            return f"{value:.3e}", True
+        return (f"{value:,.0f}" if a >= 1e4 else f"{value:.4g}"), True
+    return str(value), False
+
+
+def metric_cell(value: Any, metric: Any, axis: Any, missing: str = "-") -> tuple[str, bool]:
+    """:func:`cell` of ``metric``'s value for a flight whose transient axis is ``axis``:
+    a missing settling time of a measured transient reads :data:`DID_NOT_SETTLE`."""
+    text, number = cell(value, missing)
+    measured = isinstance(axis, str) and bool(axis.strip())
+    if text == missing and isinstance(metric, str) and metric.startswith("settling") and measured:
+        return DID_NOT_SETTLE, False
+    return text, number
+
+
+def metrics_text(frame, labels) -> str:
+    """A table of metrics, one row per flight (with an ``axis`` column), as aligned text
+    with the metrics down and the flights across, headed by ``labels``."""
+    import pandas as pd
+
+    axes = frame["axis"].tolist() if "axis" in frame.columns else [None] * len(frame)
+    shown = pd.DataFrame({label: [metric_cell(v, col, axis)[0] for col, v in row.items()]
+                          for label, axis, (_, row) in zip(labels, axes, frame.iterrows())},
+                         index=list(frame.columns))
+    return shown.to_string()
