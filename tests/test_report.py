@@ -30,6 +30,7 @@ from PIL import Image
 import quadcruise as qc
 from quadcruise import animate, report
 from quadcruise.compare import compare
+from quadcruise.plainjson import dumps
 from quadcruise.report import (comparison_report, flight_report, html_report, markdown_html,
                                reproduction_report, table_html, write_html_report)
 from quadcruise.reproduce import reproduce
@@ -109,7 +110,7 @@ def test_page_is_self_contained(flight_page, circle):
     assert len(dom.find("canvas")) == 1
     # the configuration, as JSON that reads back
     shown = json.loads(html.unescape(dom.text["qc-config"]))
-    assert shown == json.loads(json.dumps(report._plain(circle.meta)))
+    assert shown == json.loads(dumps(circle.meta))
     assert shown["mission"]["kind"] == "circle"
 
 
