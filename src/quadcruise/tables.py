@@ -7,10 +7,10 @@ missing value a dash, and a missing settling time of a response that did have a 
 which is not the same as "no step to measure".
 
 >>> import pandas as pd
->>> frame = pd.DataFrame({"axis": ["x", ""], "settling_time_s": [float("nan")] * 2, "rmse_m": [0.01234, 2e-5]})
+>>> frame = pd.DataFrame({"axis": ["x", None], "settling_time_s": [float("nan")] * 2, "rmse_m": [0.01234, 2e-5]})
 >>> print(metrics_text(frame, ["vehicle 0", "vehicle 1"]))
                       vehicle 0  vehicle 1
-axis                          x
+axis                          x          -
 settling_time_s  did not settle          -
 rmse_m                  0.01234  2.000e-05
 """
