@@ -8,8 +8,9 @@ Since vehicle i depends on (seed, i) only, the table does not depend on the chun
 on where a chunk ran.
 
 **Dask.** ``scheduler="local"`` starts a ``distributed.LocalCluster`` of worker processes
-with one thread each (numba runs one thread per task there); an address connects to an
-existing cluster. One task per chunk, a bounded number in flight, gathered as they finish.
+with one thread each (numba runs one thread per task there) and without Dask's profiler
+(:data:`QUIET_WORKERS`); an address connects to an existing cluster. One task per chunk,
+a bounded number in flight, gathered as they finish.
 A worker that dies loses its tasks, the scheduler runs them again elsewhere, and since a
 chunk is keyed by its first vehicle and written whole, every flight is counted once. Each
 worker process loads the compiled engine from numba's cache once.
@@ -48,6 +49,12 @@ __all__ = ["run_chunk", "fly_chunk", "reduce_chunk", "sweep_metrics", "run_sweep
 
 CHUNK_BUDGET = 64 * 2**20
 """Bytes of engine log per chunk that ``chunk_size="auto"`` aims at."""
+
+QUIET_WORKERS = {"distributed.worker.profile.enabled": False,
+                 "distributed.admin.system-monitor.gil.enabled": False}
+"""Dask settings of the local cluster's workers: no statistical profiler (it samples every
+task thread's stack every 10 ms: 2-3 % of a worker's CPU in a sweep here) and no GIL
+monitor; a cluster of the user's (``scheduler=ADDRESS``) keeps its own settings."""
 
 
 # --- one chunk --------------------------------------------------------------------------
@@ -242,10 +249,13 @@ class _Dask:
 
         self.cluster = None
         if scheduler == "local":
+            import dask
+
             n_workers = workers or os.cpu_count() or 1
-            self.cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                                        dashboard_address=":0", silence_logs=logging.ERROR,
-                                        env={"NUMBA_NUM_THREADS": "1"})
+            with dask.config.set(QUIET_WORKERS):
+                self.cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                                            dashboard_address=":0", silence_logs=logging.ERROR,
+                                            env={"NUMBA_NUM_THREADS": "1"})
             self.client = Client(self.cluster, set_as_default=False)
             self.name = f"a local Dask cluster of {n_workers} processes"
         else:
