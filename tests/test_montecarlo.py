@@ -178,15 +178,16 @@ def test_local_cluster_equals_in_process(reference, tmp_path):
     same_outputs(tmp_path / "dask", ref_out)
 
 
-def test_the_local_clusters_workers_run_without_dasks_profiler():
-    from quadcruise.sweep import QUIET_WORKERS, _Dask
+def test_the_local_cluster_runs_with_its_quiet_settings():
+    from quadcruise.sweep import LOCAL_CLUSTER_SETTINGS, _Dask
 
     runner = _Dask("local", 1, 10.0)
     try:
-        got = runner.client.run(lambda: {k: __import__("dask").config.get(k) for k in QUIET_WORKERS})
+        got = runner.client.run(lambda: {k: __import__("dask").config.get(k) for k in LOCAL_CLUSTER_SETTINGS})
+        stealing = runner.client.run_on_scheduler(lambda dask_scheduler: "stealing" in dask_scheduler.extensions)
     finally:
         runner.close()
-    assert list(got.values()) == [QUIET_WORKERS]
+    assert list(got.values()) == [LOCAL_CLUSTER_SETTINGS] and stealing is False
 
 
 def test_a_worker_killed_mid_run_costs_nothing(reference, cluster, tmp_path):
