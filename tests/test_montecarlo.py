@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 
 from quadcruise.disturbances import ConstantWind, Environment, SensorNoise, Turbulence, with_drag
-from quadcruise.errors import InputError
+from quadcruise.errors import InputError, SimulationError
 from quadcruise.metrics import flight_metrics
 from quadcruise.montecarlo import (
     COLUMNS, MonteCarloSpec, Population, montecarlo, montecarlo_case, montecarlo_command, replay_case,
@@ -253,6 +253,23 @@ def test_a_folder_of_another_sweep_is_refused_unless_forced(reference, tmp_path)
     with pytest.raises(InputError, match="not empty"):
         sweep(n=7, out=tmp_path / "mine")
     assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"
+
+
+def test_other_code_makes_another_sweep(reference, tmp_path, monkeypatch):
+    """The spec hash covers the code: a folder flown by other code is not resumed, and a
+    chunk from a worker running other code is refused, not mixed in."""
+    import quadcruise.mcspec as mcspec
+    from quadcruise.sweep import _Collector, run_chunk
+
+    ref, ref_out = reference
+    spec = ref.spec
+    chunk = run_chunk(spec, 0, 2)
+    monkeypatch.setattr(mcspec, "code_digest", lambda: "edited source tree")
+    assert spec.hash() != str(chunk["hash"])
+    with pytest.raises(SimulationError, match="other quadcruise code"):
+        _Collector(spec, 2).add(chunk)
+    with pytest.raises(InputError, match="different sweep"):
+        sweep(out=ref_out)
 
 
 # --- bad input ------------------------------------------------------------------------------

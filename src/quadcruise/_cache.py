@@ -1,4 +1,5 @@
-"""Keep numba's on-disk cache in step with the package's sources.
+"""Fingerprints of the package's sources: numba's on-disk cache kept in step with them,
+and the code a Monte Carlo sweep was flown with (:func:`code_digest`).
 
 numba keys each cached function on the file that defines it, not on the files of the
 functions it calls and inlines: the engine's kernel inlines the plant's derivative, so an
@@ -13,6 +14,7 @@ such a package elsewhere, and an upgrade replaces every file there anyway).
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import os
 from pathlib import Path
@@ -21,14 +23,27 @@ PACKAGE = Path(__file__).resolve().parent
 STAMP = PACKAGE / "__pycache__" / "quadcruise-sources.stamp"
 
 
-def sources_stamp(package: Path = PACKAGE) -> str:
-    """A hash of the contents of every source file of the package that uses numba."""
+def _digest(package: Path, compiled_only: bool) -> str:
     h = hashlib.sha256()
     for path in sorted(package.rglob("*.py")):
         text = path.read_bytes()
-        if b"numba" in text:
+        if not compiled_only or b"numba" in text:
             h.update(path.relative_to(package).as_posix().encode() + b"\0" + text + b"\0")
     return h.hexdigest()
+
+
+def sources_stamp(package: Path = PACKAGE) -> str:
+    """A hash of the contents of every source file of the package that uses numba."""
+    return _digest(package, True)
+
+
+@functools.cache
+def code_digest() -> str:
+    """A hash of the contents of every source file of the package, as this process found
+    them when first asked: a Monte Carlo spec's hash includes it, so a sweep resumes, or
+    takes a worker's chunk, only from the same code (a version number alone does not change
+    when a source tree is edited)."""
+    return _digest(PACKAGE, False)
 
 
 def drop_stale_cache(package: Path = PACKAGE, stamp_file: Path | None = None) -> bool:

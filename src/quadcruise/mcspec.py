@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from . import __version__
+from ._cache import code_digest
 from .control import Controller, controller_from_name
 from .errors import InputError, whole_number
 from .layout import CMD_SIZE, REF_SIZE, STATE_SIZE
@@ -166,8 +167,9 @@ class MonteCarloSpec:
         return out
 
     def hash(self) -> str:
-        """A short hash of :meth:`to_dict` and the version: equal specs fly equal flights."""
-        text = dumps({"spec": self.to_dict(), "version": __version__}, sort_keys=True)
+        """A short hash of :meth:`to_dict`, the version and the code
+        (:func:`quadcruise._cache.code_digest`): equal hashes fly equal flights."""
+        text = dumps({"spec": self.to_dict(), "version": __version__, "code": code_digest()}, sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 

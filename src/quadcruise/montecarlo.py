@@ -254,7 +254,7 @@ def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: 
         meta, same = holds_sweep(target, spec) if target is not None else (None, False)
         if meta and meta.get("workflow") == "montecarlo":      # a sweep's folder: the case goes inside
             if not same:
-                raise InputError(f"{out}: holds a sweep flown with other options (spec {meta.get('spec_hash')}, "
+                raise InputError(f"{out}: holds a sweep flown with other options or code (spec {meta.get('spec_hash')}, "
                                  f"these give {spec.hash()}); give the sweep's options to replay its flight")
             target = target / f"case-{case:06d}"
         if target is not None:

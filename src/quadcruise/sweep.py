@@ -174,7 +174,7 @@ class _Collector:
     """Rows of every flight, paths of a few; each vehicle at most once."""
 
     def __init__(self, spec: MonteCarloSpec, n: int) -> None:
-        self.spec, self.n = spec, n
+        self.spec, self.n, self.hash = spec, n, spec.hash()
         self.parts: dict[int, dict] = {}
         self.covered: list[tuple[int, int]] = []
         self.trace_t: np.ndarray | None = None
@@ -184,6 +184,10 @@ class _Collector:
     def add(self, chunk: dict) -> int:
         """Take a chunk (cut at n; a chunk overlapping one already taken is an error)."""
         first = int(chunk["first"])
+        if str(chunk["hash"]) != self.hash:
+            raise SimulationError(f"the chunk of vehicles from {first} was flown with other options or other "
+                                  f"quadcruise code (spec {chunk['hash']}, this sweep's {self.hash}): "
+                                  "every worker must run the same version")
         count = min(int(chunk["count"]), self.n - first)
         if count <= 0:
             return 0

@@ -3,7 +3,8 @@ and the resume of an interrupted sweep.
 
 On disk::
 
-    quadcruise.json            the spec, its hash, n, and whether the sweep is complete
+    quadcruise.json            the spec, its hash (of the options, version and code), n,
+                               and whether the sweep is complete
     chunks/chunk-000000120.npz one per chunk (vehicles 120 ..), written whole or not at all
     flights.csv                one row per flight (or flights.parquet)
     summary.json, worst.csv    quantiles, failure rate by reason, the worst flights
@@ -27,6 +28,7 @@ from typing import Any, Iterator
 import numpy as np
 
 from . import __version__
+from ._cache import code_digest
 from .errors import InputError
 from .io import MARKER, atomic_path, check_output_dir
 from .mcspec import MonteCarloSpec
@@ -107,7 +109,7 @@ class _Folder:
 
 def write_marker(path: Path, spec: MonteCarloSpec, n: int, **extra: Any) -> None:
     """quadcruise.json of a sweep folder, whole or not at all."""
-    doc = {"workflow": "montecarlo", "version": __version__, "spec_hash": spec.hash(), "n": n,
-           "seed": spec.seed, **extra, "spec": spec.to_dict()}
+    doc = {"workflow": "montecarlo", "version": __version__, "code": code_digest()[:16], "spec_hash": spec.hash(),
+           "n": n, "seed": spec.seed, **extra, "spec": spec.to_dict()}
     with atomic_path(path / MARKER) as tmp:
         tmp.write_text(dumps(doc, indent=2) + "\n")
