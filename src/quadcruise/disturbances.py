@@ -232,6 +232,13 @@ class _Part:
         vals = [getattr(self, f.name) for f in dataclasses.fields(self)]
         return {u.shape[0] for v in vals for u in (v if isinstance(v, tuple) else (v,)) if isinstance(u, np.ndarray)}
 
+    @staticmethod
+    def one_size(sizes: set, what: str) -> int | None:
+        """The one batch length among ``sizes`` (None if empty); InputError if they differ."""
+        if len(sizes) > 1:
+            raise InputError(f"{what} fields have different batch lengths {sorted(sizes)}")
+        return next(iter(sizes), None)
+
     def to_dict(self) -> dict:
         def plain(v):
             return [plain(u) for u in v] if isinstance(v, tuple) else v.tolist() if isinstance(v, np.ndarray) else v
@@ -372,10 +379,7 @@ class Environment:
     @property
     def batch_size(self) -> int | None:
         """N if a field is per-vehicle, else None."""
-        sizes = set().union(*(p.sizes() for p in self.parts.values()))
-        if len(sizes) > 1:
-            raise InputError(f"disturbance fields have different batch lengths {sorted(sizes)}")
-        return sizes.pop() if sizes else None
+        return _Part.one_size(set().union(*(p.sizes() for p in self.parts.values())), "disturbance")
 
     def params(self, n: int | None = None) -> np.ndarray:
         """(N, PARAMS_SIZE) float64 parameter rows; per-vehicle arrays must have N values."""
@@ -424,13 +428,11 @@ class SensorNoise(_Part):
 
     def std_vector(self) -> np.ndarray:
         """(16,) standard deviations per state ((N, 16) if a field is per-vehicle); rotors 0."""
-        sizes = self.sizes()
-        if len(sizes) > 1:
-            raise InputError(f"sensor fields have different batch lengths {sorted(sizes)}")
-        out = np.zeros((max(sizes, default=1), STATE_SIZE))
+        size = self.one_size(self.sizes(), "sensor")
+        out = np.zeros((size or 1, STATE_SIZE))
         for name, j in (("position_std", X), ("velocity_std", VX), ("angle_std", PHI), ("rate_std", P)):
             out[:, j:j + 3] = np.asarray(getattr(self, name))[..., None]
-        return out if sizes else out[0]
+        return out if size else out[0]
 
     def delay_periods(self, dt: float) -> int:
         """The delay in control periods; it must be a whole number of dt (to 1e-9 s)."""

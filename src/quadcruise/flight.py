@@ -22,24 +22,15 @@ from .control import Controller, controller_from_name
 from .engine import Limits, simulate, time_grid
 from .errors import InputError
 from .layout import F1, P_G, P_M, PSI, REF_PSI, REF_Z, STATE_SIZE, Z
-from .missions import Circle, Mission, Square, Step, mission_from_name, stack_params
+from .missions import Mission, mission_from_name, stack_params
 from .params import Vehicle
 from .result import SimResult
 
 
 def default_duration(mission: Mission) -> float:
-    """The mission's own ``duration`` if it has one (waypoint kinds), one lap of a circle or
-    square, 10 s after a step, 5 s of hover [s]."""
-    own = getattr(mission, "duration", None)
-    if own is not None:
-        return float(own)
-    if isinstance(mission, Circle):
-        return mission.period
-    if isinstance(mission, Square):
-        return mission.lap_time
-    if isinstance(mission, Step):
-        return mission.time + 10.0
-    return 5.0
+    """The mission's default flight time (:attr:`Mission.duration`): one lap of a circle or
+    square, 10 s after a step, the last waypoint and a settling time, 5 s of hover [s]."""
+    return float(mission.duration)
 
 
 def hover_state(vehicle: Vehicle, n: int, mission: Mission) -> np.ndarray:

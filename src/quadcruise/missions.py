@@ -152,9 +152,10 @@ def _evaluate(fn, ts, mp, out):
 
 
 # --- Python side -----------------------------------------------------------------------
-def _f(default: Any, unit: str, doc: str, check: str = "real"):
-    """A field with its unit and check: real, pos (> 0), nonneg (>= 0), sign, pair, axis."""
-    return field(default=default, metadata={"unit": unit, "doc": doc, "check": check})
+def _f(default: Any, unit: str, doc: str, check: str = "real", choices: tuple = ()):
+    """A field with its unit and check: real, pos (> 0), nonneg (>= 0), sign, pair, choice
+    (one of ``choices``) or custom (the subclass checks it)."""
+    return field(default=default, metadata={"unit": unit, "doc": doc, "check": check, "choices": choices})
 
 
 def _number(label: str, value: Any) -> float:
@@ -180,9 +181,11 @@ class Mission:
         for f in dataclasses.fields(self):
             value, check = getattr(self, f.name), f.metadata["check"]
             label = f"{self.name} field '{f.name}' ({f.metadata['doc']}, {f.metadata['unit']})"
-            if check == "axis":
-                if value not in _AXES:
-                    raise InputError(f"{label} must be one of {', '.join(_AXES)}, got {value!r}")
+            if check == "custom":
+                continue
+            if check == "choice":
+                if value not in f.metadata["choices"]:
+                    raise InputError(f"{label} must be one of {', '.join(f.metadata['choices'])}, got {value!r}")
                 continue
             if check == "pair":
                 if isinstance(value, (str, bytes)) or np.ndim(value) != 1 or len(value) != 2:
@@ -198,6 +201,12 @@ class Mission:
 
     def _row(self) -> tuple:
         raise NotImplementedError
+
+    @property
+    def duration(self) -> float:
+        """The default flight time [s]: 5 s here; one lap, the step and 10 s after it, or
+        the last waypoint and a settling time in the kinds that know better."""
+        return 5.0
 
     def params(self) -> np.ndarray:
         """The mission's parameter vector mp (float64, C-contiguous), laid out as ``columns``."""
@@ -260,7 +269,7 @@ class Step(Mission):
     array([1. , 1.5])
     """
 
-    axis: str = _f("x", "-", "stepped axis", "axis")
+    axis: str = _f("x", "-", "stepped axis", "choice", tuple(_AXES))
     size: float = _f(1.0, "m or rad", "step size")
     time: float = _f(1.0, "s", "step time", "nonneg")
     x: float = _f(0.0, "m", "base x")
@@ -271,6 +280,11 @@ class Step(Mission):
     name: ClassVar[str] = "step"
     columns: ClassVar[tuple] = ("x", "y", "z", "yaw", "column", "size", "time")
     function = staticmethod(step_ref)
+
+    @property
+    def duration(self) -> float:
+        """The step's time and 10 s to settle [s]."""
+        return self.time + 10.0
 
     def _row(self) -> tuple:
         return (self.x, self.y, self.z, self.yaw, _AXES[self.axis], self.size, self.time)
@@ -303,6 +317,11 @@ class Circle(Mission):
     def speed(self) -> float:
         """Cruise speed 2 pi R / period [m/s]."""
         return 2.0 * math.pi * self.radius / self.period
+
+    @property
+    def duration(self) -> float:
+        """One lap [s]."""
+        return self.period
 
     def _row(self) -> tuple:
         return (self.radius, self.direction * 2.0 * math.pi / self.period, self.altitude,
@@ -339,6 +358,11 @@ class Square(Mission):
     def lap_time(self) -> float:
         """Time per lap, 4 (dwell + side / speed) [s]."""
         return 4.0 * (self.dwell + self.side / self.speed)
+
+    @property
+    def duration(self) -> float:
+        """One lap [s]."""
+        return self.lap_time
 
     def _row(self) -> tuple:
         return (self.side, self.speed, self.altitude, *self.corner, self.direction,

@@ -57,7 +57,7 @@ from numba import njit
 from .errors import InputError
 from .io import read_numeric_csv
 from .layout import MISSION_SIG, REF_AX, REF_PSI, REF_PSI_DOT, REF_SIZE, REF_VX, REF_X
-from .missions import Mission, _number
+from .missions import Mission, _f
 
 __all__ = ["WaypointTable", "read_waypoints_csv", "Waypoints", "MinimumSnap",
            "minimum_snap_coefficients", "SETTLE_S", "DEFAULT_SPEED"]
@@ -380,25 +380,17 @@ def _as_table(value: Any) -> WaypointTable:
     raise InputError(f"a waypoint table must be a WaypointTable, a CSV path or a dict, got {type(value).__name__}")
 
 
-def _meta(unit: str, doc: str) -> dict:
-    return {"unit": unit, "doc": doc, "check": "custom"}
-
-
 @dataclass(frozen=True)
 class _WaypointMission(Mission):
     """Shared parts: the table (a WaypointTable, CSV path or dict), the default speed,
     ``duration``, ``stack`` and ``to_dict``."""
 
-    table: Any = field(default=None, metadata=_meta("-", "waypoint table or CSV path"))
-    speed: float = field(default=DEFAULT_SPEED, metadata=_meta("m/s", "leg speed where the table gives no timing"))
+    table: Any = _f(None, "-", "waypoint table or CSV path", "custom")
+    speed: float = _f(DEFAULT_SPEED, "m/s", "leg speed where the table gives no timing", "pos")
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "table", _as_table(self.table))
-        label = f"{self.name} field 'speed' (leg speed where the table gives no timing, m/s)"
-        speed = _number(label, self.speed)
-        if speed <= 0:
-            raise InputError(f"{label} must be > 0, got {speed!r}")
-        object.__setattr__(self, "speed", speed)
+        super().__post_init__()
 
     @property
     def times(self) -> np.ndarray:
@@ -427,8 +419,8 @@ class Waypoints(_WaypointMission):
     array([2., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 2.])
     """
 
-    style: str = field(default="legs", metadata=_meta("-", "'legs'"))
-    yaw_mode: str = field(default="linear", metadata=_meta("-", "'linear' or 'hold'"))
+    style: str = _f("legs", "-", "'legs'", "custom")
+    yaw_mode: str = _f("linear", "-", "yaw over a leg", "choice", ("linear", "hold"))
 
     name: ClassVar[str] = "waypoints"
     columns: ClassVar[tuple] = ("n", "hold_yaw", "x[k]", "y[k]", "z[k]", "yaw[k]", "t[k]")
@@ -439,8 +431,6 @@ class Waypoints(_WaypointMission):
         if self.style != "legs":
             raise InputError(f"waypoints field 'style' must be 'legs' (the smooth path is the "
                              f"mission 'minsnap'), got {self.style!r}")
-        if self.yaw_mode not in ("linear", "hold"):
-            raise InputError(f"waypoints field 'yaw_mode' must be 'linear' or 'hold', got {self.yaw_mode!r}")
 
     def _row(self) -> tuple:
         per_point = np.column_stack([self.table.points, self.table.yaws(), self.times])
