@@ -255,6 +255,19 @@ def test_a_folder_of_another_sweep_is_refused_unless_forced(reference, tmp_path)
     assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"
 
 
+def test_auto_chunks_fit_the_memory_budget_and_split_evenly_over_threads():
+    from quadcruise.sweep import CHUNK_BUDGET, auto_chunk_size
+
+    spec = MonteCarloSpec("circle", "nlpd", Population(), seed=1, duration=60.0, dt=1e-3)
+    alone = auto_chunk_size(spec, 10_000)
+    assert alone * spec.log_bytes() <= CHUNK_BUDGET < (alone + 1) * spec.log_bytes()
+    for threads in (2, 3, 4):
+        size = auto_chunk_size(spec, 10_000, threads=threads)
+        assert size % threads == 0 and alone - threads < size <= alone
+    assert auto_chunk_size(spec, 8, parallel=2) == 1                  # 4 chunks per worker
+    assert auto_chunk_size(spec, 8, parallel=2, threads=2) == 1       # fewer vehicles than threads
+
+
 def test_other_code_makes_another_sweep(reference, tmp_path, monkeypatch):
     """The spec hash covers the code: a folder flown by other code is not resumed, and a
     chunk from a worker running other code is refused, not mixed in."""

@@ -246,6 +246,12 @@ class _InProcess:
     name = "this process"
     parallel = 1
 
+    @property
+    def threads(self) -> int:
+        import numba
+
+        return numba.get_num_threads()
+
     def run(self, spec, ranges):
         for first, count in ranges:
             yield run_chunk(spec, first, count)
@@ -279,6 +285,7 @@ class _Dask:
                 raise InputError(f"cannot reach the Dask scheduler at {scheduler}: {reason}") from None
             self.name = f"the Dask cluster at {scheduler}"
         self.parallel = max(1, sum(self.client.nthreads().values()))
+        self.threads = 1                    # each task runs numba on one thread
 
     def run(self, spec, ranges):
         from distributed import as_completed
@@ -332,11 +339,14 @@ def _scheduler(scheduler: str | None) -> str:
     return text
 
 
-def auto_chunk_size(spec: MonteCarloSpec, n: int, parallel: int = 1) -> int:
-    """Vehicles per chunk: a log of about CHUNK_BUDGET bytes, at least 4 chunks per worker."""
+def auto_chunk_size(spec: MonteCarloSpec, n: int, parallel: int = 1, threads: int = 1) -> int:
+    """Vehicles per chunk: a log of about CHUNK_BUDGET bytes, at least 4 chunks per worker,
+    and a multiple of the ``threads`` that share each chunk (when a chunk has that many), so
+    that none of them waits for the others at the chunk's end."""
     by_memory = max(1, CHUNK_BUDGET // spec.log_bytes())
     by_balance = max(1, math.ceil(n / (4 * max(1, parallel))))
-    return int(min(by_memory, by_balance, 1024))
+    size = int(min(by_memory, by_balance, 1024))
+    return size - size % threads if size >= threads > 1 else size
 
 
 def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", scheduler: str | None = "local",
@@ -362,7 +372,7 @@ def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", s
     runner = _InProcess() if mode == "none" else _Dask(mode, workers, connect_timeout)
     flown = 0
     try:
-        size = auto_chunk_size(spec, n, runner.parallel) if chunk_size == "auto" else int(chunk_size)
+        size = auto_chunk_size(spec, n, runner.parallel, runner.threads) if chunk_size == "auto" else int(chunk_size)
         if folder is not None:
             folder.prepare(n, size)
             for chunk in folder.existing():
