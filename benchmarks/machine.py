@@ -73,7 +73,7 @@ def _rk4_loop():
     from quadcruise.engine import rk4_step
     from quadcruise.layout import STATE_SIZE
 
-    @njit
+    @njit(error_model="numpy")
     def loop(x, u, vp, ext, steps):
         k1, k2, k3 = np.empty(STATE_SIZE), np.empty(STATE_SIZE), np.empty(STATE_SIZE)
         k4, xt = np.empty(STATE_SIZE), np.empty(STATE_SIZE)

@@ -57,6 +57,49 @@ def test_rk4_error_falls_sixteen_fold_when_step_halves():
     assert 14.0 < ratio < 18.0, ratio
 
 
+def test_turned_angles_equal_the_library_sine_and_cosine():
+    import math
+
+    from quadcruise.engine import SMALL_TURN, turned
+
+    rng = np.random.default_rng(3)
+    worst = 0.0
+    for a, d in zip(rng.uniform(-4.0, 4.0, 2000), rng.uniform(-SMALL_TURN, SMALL_TURN, 2000) ** 3 / SMALL_TURN ** 2):
+        s, c = turned(a + d, math.sin(a), math.cos(a), d)
+        worst = max(worst, abs(s - math.sin(a + d)), abs(c - math.cos(a + d)))
+    assert worst < 5e-16, worst
+    for d in (SMALL_TURN, -SMALL_TURN):              # the series' edge, where truncation is largest
+        s, c = turned(1.0 + d, math.sin(1.0), math.cos(1.0), d)
+        assert abs(s - math.sin(1.0 + d)) < 5e-16 and abs(c - math.cos(1.0 + d)) < 5e-16
+    # a larger turn than the series covers: the library's values exactly
+    assert turned(2.5, 0.0, 1.0, 0.5) == (math.sin(2.5), math.cos(2.5))
+
+
+def test_rk4_step_equals_four_plain_derivative_calls():
+    """The step that carries sines and cosines between stages is the classical RK4 of the
+    plant's derivative, to rounding, on a tumbling vehicle (fast rates use the library)."""
+    from quadcruise.engine import rk4_step
+    from quadcruise.layout import EXT_E1, EXT_SIZE, P, PHI
+    from quadcruise.model.plant import derivative
+
+    vp = V.rows(1)[0]
+    ext = np.zeros(EXT_SIZE)
+    ext[EXT_E1:EXT_E1 + 4] = 1.0
+    u = np.array([0.9, 0.1, 0.6, 0.3])
+    for rates in ((0.3, -0.2, 0.1), (40.0, -25.0, 3.0)):          # slow turns, and a tumble
+        x = np.zeros(STATE_SIZE)
+        x[PHI:PHI + 3], x[P:P + 3], x[F1:] = (0.2, -0.4, 2.0), rates, 5.0
+        y, h, k = x.copy(), 2e-3, [np.empty(STATE_SIZE) for _ in range(5)]
+        for _ in range(200):
+            rk4_step(x, u, vp, ext, True, h, *k)
+            derivative(y, u, vp, ext, True, k[0])
+            derivative(y + 0.5 * h * k[0], u, vp, ext, True, k[1])
+            derivative(y + 0.5 * h * k[1], u, vp, ext, True, k[2])
+            derivative(y + h * k[2], u, vp, ext, True, k[3])
+            y = y + h / 6.0 * (k[0] + 2.0 * (k[1] + k[2]) + k[3])
+        np.testing.assert_allclose(x, y, rtol=1e-11, atol=1e-11)
+
+
 def test_batch_equals_one_by_one():
     masses = np.array([3.0, 3.499, 3.8, 4.2, 2.5])
     jzz = np.array([0.04, 0.05, 0.035, 0.04, 0.045])

@@ -63,14 +63,17 @@ def derivative(x, u, vp, ext, full, dx):
     full : bool, exact Euler-angle kinematics instead of the paper's simplification;
     dx : (16,) output.
     """
+    derivative_at(x, math.sin(x[PHI]), math.cos(x[PHI]), math.sin(x[THETA]), math.cos(x[THETA]),
+                  math.sin(x[PSI]), math.cos(x[PSI]), u, vp, ext, full, dx)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def derivative_at(x, sphi, cphi, sth, cth, spsi, cpsi, u, vp, ext, full, dx):
+    """:func:`derivative` given the sines and cosines of the state's phi, theta and psi (the
+    integrator carries them from one RK4 stage to the next: :func:`quadcruise.engine.rk4_step`)."""
     m = vp[P_M]
-    phi, theta, psi = x[PHI], x[THETA], x[PSI]
     p, q, r = x[P], x[Q], x[R]
     U1, U2, U3, U4 = mix(x[F1], x[F2], x[F3], x[F4], vp[P_D])             # (1)-(4)
-
-    sphi, cphi = math.sin(phi), math.cos(phi)
-    sth, cth = math.sin(theta), math.cos(theta)
-    spsi, cpsi = math.sin(psi), math.cos(psi)
     a = U1 / m
 
     fx, fy, fz = ext[EXT_FX], ext[EXT_FY], ext[EXT_FZ]
