@@ -2,6 +2,8 @@
 
 import os
 
+import hashlib
+
 from quadcruise._cache import drop_stale_cache, sources_stamp
 
 
@@ -15,21 +17,38 @@ def test_cache_files_go_when_any_source_changes(tmp_path):
               pkg / "model" / "__pycache__" / "plant.derivative-1.py311.1.nbc"]
     for path in cached:
         path.write_bytes(b"machine code")
-    assert drop_stale_cache(pkg)                       # no stamp yet: dropped
+    assert drop_stale_cache(pkg, "")                       # no stamp yet: dropped
     assert not any(p.exists() for p in cached)
     for path in cached:
         path.write_bytes(b"machine code")
-    assert not drop_stale_cache(pkg)                   # unchanged sources: kept
+    assert not drop_stale_cache(pkg, "")                   # unchanged sources: kept
     assert all(p.exists() for p in cached)
     before = sources_stamp(pkg)
     (pkg / "tables.py").write_text("z = 4\n")         # no compiled code in it: the cache stays
-    assert sources_stamp(pkg) == before and not drop_stale_cache(pkg)
+    assert sources_stamp(pkg) == before and not drop_stale_cache(pkg, "")
     plant = pkg / "model" / "plant.py"
     st = plant.stat()
     os.utime(plant, ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))   # touched, not changed: stays
     assert sources_stamp(pkg) == before
     plant.write_text("from numba import njit\ny = 3\n")          # an edit to a callee's file only
     assert sources_stamp(pkg) != before
-    assert drop_stale_cache(pkg) and not any(p.exists() for p in cached)
+    assert drop_stale_cache(pkg, "") and not any(p.exists() for p in cached)
     (pkg / "new.py").write_text("import numba\n")    # a new compiled module changes the stamp too
-    assert drop_stale_cache(pkg) and not drop_stale_cache(pkg)
+    assert drop_stale_cache(pkg, "") and not drop_stale_cache(pkg, "")
+
+
+def test_a_numba_cache_dir_is_cleaned_too(tmp_path):
+    """With NUMBA_CACHE_DIR set, numba keeps a source folder's code in
+    <dir>/<folder name>_<sha1 of the folder's path>; that is where stale files go from."""
+    pkg = tmp_path / "pkg"
+    pkg.mkdir()
+    (pkg / "engine.py").write_text("import numba\n")
+    where = tmp_path / "nc" / f"pkg_{hashlib.sha1(str(pkg).encode()).hexdigest()}"
+    where.mkdir(parents=True)
+    stale = where / "engine._kernel-1.py311.nbi"
+    stale.write_bytes(b"machine code")
+    assert drop_stale_cache(pkg, str(tmp_path / "nc")) and not stale.exists()
+    stale.write_bytes(b"machine code")
+    assert not drop_stale_cache(pkg, str(tmp_path / "nc")) and stale.exists()
+    (pkg / "engine.py").write_text("import numba\nx = 1\n")
+    assert drop_stale_cache(pkg, str(tmp_path / "nc")) and not stale.exists()

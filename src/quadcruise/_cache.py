@@ -7,7 +7,8 @@ edit to ``model/plant.py`` alone would leave a stale kernel in the cache (a chec
 another commit, an edited source tree). At import, before anything compiles, we stamp the
 package's compiled sources (the contents of every ``.py`` file that uses numba: about a
 millisecond) and, when the stamp differs from the one stored beside the cache, remove the
-package's cached machine code, which numba then compiles afresh. A read-only install is left alone (numba caches
+package's cached machine code (in the ``__pycache__`` folders, or under ``NUMBA_CACHE_DIR``
+when it is set), which numba then compiles afresh. A read-only install is left alone (numba caches
 such a package elsewhere, and an upgrade replaces every file there anyway).
 """
 
@@ -19,8 +20,8 @@ import hashlib
 import os
 from pathlib import Path
 
-PACKAGE = Path(__file__).resolve().parent
-STAMP = PACKAGE / "__pycache__" / "quadcruise-sources.stamp"
+PACKAGE = Path(os.path.abspath(__file__)).parent     # as numba names the source files
+STAMP = "quadcruise-sources.stamp"
 
 
 def _digest(package: Path, compiled_only: bool) -> str:
@@ -46,20 +47,37 @@ def code_digest() -> str:
     return _digest(PACKAGE, False)
 
 
-def drop_stale_cache(package: Path = PACKAGE, stamp_file: Path | None = None) -> bool:
-    """Remove the package's numba cache files if the sources changed since the last stamp;
-    True if it did. Errors (a read-only tree, a file another process removed) are ignored."""
-    stamp_file = stamp_file or package / "__pycache__" / STAMP.name
+def cache_dirs(package: Path = PACKAGE, numba_cache_dir: str | None = None) -> list[Path]:
+    """Where numba keeps the package's compiled code: each source folder's ``__pycache__``,
+    or, when ``NUMBA_CACHE_DIR`` is set, its folder there (``<name>_<sha1 of the path>``, as
+    numba's ``UserProvidedCacheLocator`` names it)."""
+    folders = sorted({path.parent for path in package.rglob("*.py")})
+    if numba_cache_dir is None:
+        from numba.core import config
+
+        numba_cache_dir = config.CACHE_DIR
+    if numba_cache_dir:
+        return [Path(numba_cache_dir) / f"{d.name}_{hashlib.sha1(str(d).encode()).hexdigest()}" for d in folders]
+    return [d / "__pycache__" for d in folders]
+
+
+def drop_stale_cache(package: Path = PACKAGE, numba_cache_dir: str | None = None) -> bool:
+    """Remove the package's numba cache files if the sources changed since the last stamp
+    (kept beside them); True if it did. Errors (a read-only tree, a file another process
+    removed) are ignored."""
+    dirs = cache_dirs(package, numba_cache_dir)
+    stamp_file = dirs[0] / STAMP
     stamp = sources_stamp(package)
     with contextlib.suppress(OSError):
         if stamp_file.read_text() == stamp:
             return False
     try:
-        for pattern in ("*.nbi", "*.nbc"):
-            for path in package.rglob(pattern):
-                with contextlib.suppress(FileNotFoundError):
-                    path.unlink()
-        stamp_file.parent.mkdir(exist_ok=True)
+        for folder in dirs:
+            for pattern in ("*.nbi", "*.nbc"):
+                for path in folder.glob(pattern):
+                    with contextlib.suppress(FileNotFoundError):
+                        path.unlink()
+        stamp_file.parent.mkdir(parents=True, exist_ok=True)
         tmp = stamp_file.with_name(f"{stamp_file.name}.{os.getpid()}.tmp")
         tmp.write_text(stamp)
         tmp.replace(stamp_file)
