@@ -8,8 +8,8 @@ another commit, an edited source tree). At import, before anything compiles, we 
 package's compiled sources (the contents of every ``.py`` file that uses numba: about a
 millisecond) and, when the stamp differs from the one stored beside the cache, remove the
 package's cached machine code (in the ``__pycache__`` folders, or under ``NUMBA_CACHE_DIR``
-when it is set), which numba then compiles afresh. A read-only install is left alone (numba caches
-such a package elsewhere, and an upgrade replaces every file there anyway).
+when it is set), which numba then compiles afresh. A read-only install is left alone
+(numba caches such a package elsewhere, and an upgrade replaces every file there anyway).
 """
 
 from __future__ import annotations

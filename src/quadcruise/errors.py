@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import numbers
+
 
 class InputError(ValueError):
     """Bad input from a user: a parameter, option or file that cannot be used.
@@ -18,8 +20,6 @@ class SimulationError(RuntimeError):
 def whole_number(value, what: str, minimum: int = 0) -> int:
     """``value`` as an int if it is a whole number >= ``minimum`` (not a bool, not a float);
     else InputError "<what> must be a whole number >= <minimum>, got <value>"."""
-    import numbers
-
     if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
         raise InputError(f"{what} must be a whole number >= {minimum}, got {value!r}")
     return int(value)
