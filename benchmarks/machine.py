@@ -70,15 +70,14 @@ def end_of_run(info: dict) -> str:
 def _rk4_loop():
     """A compiled loop of RK4 steps of the plant, built on first use (after quadcruise is
     imported, so that importing this module does not import it)."""
-    from quadcruise.engine import rk4_step
+    from quadcruise.engine import TRIG_REFRESH, WORK_ROWS, rk4_step
     from quadcruise.layout import STATE_SIZE
 
     @njit(error_model="numpy")
     def loop(x, u, vp, ext, steps):
-        k1, k2, k3 = np.empty(STATE_SIZE), np.empty(STATE_SIZE), np.empty(STATE_SIZE)
-        k4, xt = np.empty(STATE_SIZE), np.empty(STATE_SIZE)
-        for _ in range(steps):
-            rk4_step(x, u, vp, ext, False, 1e-3, k1, k2, k3, k4, xt)
+        work = np.empty((WORK_ROWS, STATE_SIZE))
+        for i in range(steps):
+            rk4_step(x, u, vp, ext, False, 1e-3, work, i % TRIG_REFRESH == 0)
         return x[0]
 
     return loop

@@ -76,10 +76,13 @@ def test_turned_angles_equal_the_library_sine_and_cosine():
 
 
 def test_rk4_step_equals_four_plain_derivative_calls():
-    """The step that carries sines and cosines between stages is the classical RK4 of the
-    plant's derivative, to rounding, on a tumbling vehicle (fast rates use the library)."""
-    from quadcruise.engine import rk4_step
-    from quadcruise.layout import EXT_E1, EXT_SIZE, P, PHI
+    """The step that carries sines and cosines between stages, and from one step to the
+    next, is the classical RK4 of the plant's derivative, to rounding, on a tumbling vehicle
+    (fast rates use the library) as well as on slow turns."""
+    import math
+
+    from quadcruise.engine import TRIG, WORK_ROWS, rk4_step
+    from quadcruise.layout import EXT_E1, EXT_SIZE, P, PHI, PSI, THETA
     from quadcruise.model.plant import derivative
 
     vp = V.rows(1)[0]
@@ -89,15 +92,19 @@ def test_rk4_step_equals_four_plain_derivative_calls():
     for rates in ((0.3, -0.2, 0.1), (40.0, -25.0, 3.0)):          # slow turns, and a tumble
         x = np.zeros(STATE_SIZE)
         x[PHI:PHI + 3], x[P:P + 3], x[F1:] = (0.2, -0.4, 2.0), rates, 5.0
-        y, h, k = x.copy(), 2e-3, [np.empty(STATE_SIZE) for _ in range(5)]
-        for _ in range(200):
-            rk4_step(x, u, vp, ext, True, h, *k)
+        y, h, k = x.copy(), 2e-3, [np.empty(STATE_SIZE) for _ in range(4)]
+        work = np.empty((WORK_ROWS, STATE_SIZE))
+        for i in range(200):
+            rk4_step(x, u, vp, ext, True, h, work, i == 0)        # trig computed afresh once
             derivative(y, u, vp, ext, True, k[0])
             derivative(y + 0.5 * h * k[0], u, vp, ext, True, k[1])
             derivative(y + 0.5 * h * k[1], u, vp, ext, True, k[2])
             derivative(y + h * k[2], u, vp, ext, True, k[3])
             y = y + h / 6.0 * (k[0] + 2.0 * (k[1] + k[2]) + k[3])
         np.testing.assert_allclose(x, y, rtol=1e-11, atol=1e-11)
+        # the carried sines and cosines are those of the final angles
+        exact = [f(x[j]) for j in (PHI, THETA, PSI) for f in (math.sin, math.cos)]
+        np.testing.assert_allclose(work[TRIG, :6], exact, rtol=0, atol=1e-14)
 
 
 def test_batch_equals_one_by_one():

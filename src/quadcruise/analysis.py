@@ -62,14 +62,14 @@ def _period(x, u, vp, dt, n_sub):
     """One control period as the engine integrates it (:func:`quadcruise.engine.rk4_step`,
     n_sub substeps, duties held) in still air with healthy rotors and the paper's
     kinematics (the exact ones agree to first order at hover): the next state."""
-    from .engine import rk4_step
+    from .engine import WORK_ROWS, rk4_step
 
     ext = np.zeros(EXT_SIZE)
     ext[EXT_E1:EXT_E1 + 4] = 1.0
     x, u = np.array(x, dtype=float), np.ascontiguousarray(u, dtype=float)
-    work = [np.empty(STATE_SIZE) for _ in range(5)]
+    work = np.empty((WORK_ROWS, STATE_SIZE))
     for _ in range(n_sub):
-        rk4_step(x, u, vp, ext, False, dt / n_sub, *work)
+        rk4_step(x, u, vp, ext, False, dt / n_sub, work, True)
     return x
 
 

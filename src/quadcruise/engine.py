@@ -90,48 +90,56 @@ def turned(angle, s, c, d):
     return s + (s * cm1 + c * sd), c + (c * cm1 - s * sd)
 
 
-@njit(cache=True, error_model="numpy")
-def _first_stage(x, u, vp, ext, full, k1):
-    """The plant's derivative at x into k1; returns the sines and cosines of x's phi, theta
-    and psi (sin phi, cos phi, sin theta, cos theta, sin psi, cos psi)."""
-    sa, ca = math.sin(x[PHI]), math.cos(x[PHI])
-    sb, cb = math.sin(x[THETA]), math.cos(x[THETA])
-    sc, cc = math.sin(x[PSI]), math.cos(x[PSI])
-    derivative_at(x, sa, ca, sb, cb, sc, cc, u, vp, ext, full, k1)
-    return sa, ca, sb, cb, sc, cc
+# rows of the RK4 workspace: the four stage derivatives, the stage state, and the sines
+# and cosines of the state's phi, theta and psi carried from one step to the next
+K1, K2, K3, K4, XT, TRIG = range(6)
+WORK_ROWS = 6
+TRIG_REFRESH = 256
+"""The engine computes the angles' sines and cosines afresh every this many RK4 steps and
+carries them by :func:`turned` in between (each turn adds a rounding, ~1e-16)."""
 
 
 @njit(cache=True, error_model="numpy")
-def _stage(x, w, k_in, sa, ca, sb, cb, sc, cc, u, vp, ext, full, xt, k_out):
-    """An RK4 stage: xt = x + w k_in, and the plant's derivative there into k_out, the
-    stage's sines and cosines turned from x's (sa, ca: phi; sb, cb: theta; sc, cc: psi).
-
-    (The plant's derivative is inlined here, and this function and :func:`_first_stage`
-    are called, not inlined into the kernel: copies of the plant in the kernel took its
-    first compile from 14 s to 35 s.)"""
-    for j in range(x.shape[0]):
-        xt[j] = x[j] + w * k_in[j]
-    s1, c1 = turned(xt[PHI], sa, ca, w * k_in[PHI])
-    s2, c2 = turned(xt[THETA], sb, cb, w * k_in[THETA])
-    s3, c3 = turned(xt[PSI], sc, cc, w * k_in[PSI])
-    derivative_at(xt, s1, c1, s2, c2, s3, c3, u, vp, ext, full, k_out)
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def rk4_step(x, u, vp, ext, full, h, k1, k2, k3, k4, xt):
+def rk4_step(x, u, vp, ext, full, h, work, fresh):
     """One classical Runge-Kutta step of length h [s], in place on x.
 
-    The plant needs the sines and cosines of phi, theta and psi at every stage. They are
-    computed once, at x; a stage's angles differ from x's by w k[angle] (w = h/2, h/2, h),
-    so their sines and cosines follow by :func:`turned`.
+    ``work`` is a (WORK_ROWS, STATE_SIZE) scratch array: the stage derivatives k1..k4, the
+    stage state and, in row TRIG, sin and cos of x's phi, theta and psi.
+
+    The plant needs those sines and cosines at every stage. With ``fresh`` they are
+    computed from x; otherwise they are the ones the previous step left in row TRIG. A
+    stage's angles differ from x's by w k[angle] (w = 0, h/2, h/2, h), and the next step's
+    by the step's increment, so their sines and cosines follow by :func:`turned`. The four
+    stages run through one loop, so the step holds one copy of the plant: it compiles once,
+    and the engine calls it as one function with few arguments.
     """
-    sa, ca, sb, cb, sc, cc = _first_stage(x, u, vp, ext, full, k1)
-    _stage(x, 0.5 * h, k1, sa, ca, sb, cb, sc, cc, u, vp, ext, full, xt, k2)
-    _stage(x, 0.5 * h, k2, sa, ca, sb, cb, sc, cc, u, vp, ext, full, xt, k3)
-    _stage(x, h, k3, sa, ca, sb, cb, sc, cc, u, vp, ext, full, xt, k4)
+    xt, trig = work[XT], work[TRIG]
+    if fresh:
+        trig[0], trig[1] = math.sin(x[PHI]), math.cos(x[PHI])
+        trig[2], trig[3] = math.sin(x[THETA]), math.cos(x[THETA])
+        trig[4], trig[5] = math.sin(x[PSI]), math.cos(x[PSI])
+    sa, ca, sb, cb, sc, cc = trig[0], trig[1], trig[2], trig[3], trig[4], trig[5]
+    for stage in range(4):
+        s1, c1, s2, c2, s3, c3 = sa, ca, sb, cb, sc, cc
+        if stage == 0:
+            for j in range(STATE_SIZE):
+                xt[j] = x[j]
+        else:
+            w = h if stage == 3 else 0.5 * h
+            k_in = work[stage - 1]
+            for j in range(STATE_SIZE):
+                xt[j] = x[j] + w * k_in[j]
+            s1, c1 = turned(xt[PHI], sa, ca, w * k_in[PHI])
+            s2, c2 = turned(xt[THETA], sb, cb, w * k_in[THETA])
+            s3, c3 = turned(xt[PSI], sc, cc, w * k_in[PSI])
+        derivative_at(xt, s1, c1, s2, c2, s3, c3, u, vp, ext, full, work[stage])
     c = h / 6.0
-    for j in range(x.shape[0]):
-        x[j] += c * (k1[j] + 2.0 * (k2[j] + k3[j]) + k4[j])
+    for j in range(STATE_SIZE):
+        xt[j] = c * (work[K1, j] + 2.0 * (work[K2, j] + work[K3, j]) + work[K4, j])   # the increment
+        x[j] += xt[j]
+    trig[0], trig[1] = turned(x[PHI], sa, ca, xt[PHI])
+    trig[2], trig[3] = turned(x[THETA], sb, cb, xt[THETA])
+    trig[4], trig[5] = turned(x[PSI], sc, cc, xt[PSI])
 
 
 @njit(DISTURBANCE_SIG, cache=True)
@@ -226,11 +234,7 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
         cmd = np.zeros(CMD_SIZE)
         u = np.zeros(4)
         ext = np.zeros(EXT_SIZE)
-        k1 = np.empty(STATE_SIZE)
-        k2 = np.empty(STATE_SIZE)
-        k3 = np.empty(STATE_SIZE)
-        k4 = np.empty(STATE_SIZE)
-        xt = np.empty(STATE_SIZE)
+        work = np.empty((WORK_ROWS, STATE_SIZE))
         vpi, vci, gi, mi, mpi = vp[i], vp_ctrl[i], gains[i], mem[i], mp[i]
         dpi, dmi, rngi, stdi = dp[i], dmem[i], rng[i], sensor_std[i]
         noisy = False
@@ -242,6 +246,7 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
         rows_x = rows = 0
         slot = 0                       # = k % (sensor_delay + 1), kept as a counter: the
         next_log = 0                   # step has no integer division in it
+        steps = 0                      # RK4 steps since the angles' trig was computed afresh
         for k in range(n_periods + 1):
             t = t_grid[k]
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
@@ -286,7 +291,8 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
             n_sub = max(1, int(math.ceil(dt / max_step - 1e-9)))
             h = dt / n_sub
             for _ in range(n_sub):
-                rk4_step(x, u, vpi, ext, full, h, k1, k2, k3, k4, xt)
+                rk4_step(x, u, vpi, ext, full, h, work, steps == 0)
+                steps = steps + 1 if steps < TRIG_REFRESH - 1 else 0
             code = check_state(x, limits)
             if code != FINISHED:
                 t_end = t_grid[k + 1]
