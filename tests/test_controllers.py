@@ -13,8 +13,8 @@ from quadcruise.control.attitude import ATT_MEMORY, decoupled_attitude
 from quadcruise.control.design import PIDGains, attitude_pid_design, cascade_state_space, pd_from_poles
 from quadcruise.control.position import nlpd, phi_from_eq6, theta_from_eq5
 from quadcruise.layout import (
-    CMD_FLAGS, CMD_PHI_D, CMD_SIZE, CMD_THETA_D, FLAG_TILT_LIMIT, P, PHI, PSI, Q, R, REF_SIZE,
-    REF_X, STATE_SIZE, THETA,
+    CMD_FLAGS, CMD_PHI_D, CMD_SIZE, CMD_THETA_D, CMD_THRUST, FLAG_TILT_LIMIT, P, PHI, PSI, Q, R,
+    REF_SIZE, REF_X, REF_Y, STATE_SIZE, THETA,
 )
 from quadcruise.missions import Circle, Hover, Step
 from quadcruise.model.plant import derivative
@@ -43,6 +43,40 @@ def test_inverse_model_solves_eqs_5_and_6_exactly():
         assert eq5(theta_d, phi, psi, a) == pytest.approx(ux, abs=1e-10)
         assert eq6(phi_d, theta_d, psi, a) == pytest.approx(uy, abs=1e-10)
         assert abs(phi_d) < math.pi / 2
+
+
+def test_eq19_root_is_the_one_nearest_level_at_any_yaw():
+    """Beyond |psi| = pi/2 (cos psi <= 0) the roll still solves eq (6) exactly, and of the
+    two roots in (-pi, pi] it is the one with the smaller |phi| (checked by bisection)."""
+    rng = np.random.default_rng(7)
+    for psi in list(rng.uniform(-3.1, 3.1, 300)) + [math.pi / 2, -math.pi / 2, math.pi]:
+        theta, a, uy = rng.uniform(-0.6, 0.6), rng.uniform(8, 15), rng.uniform(-3, 3)
+        phi_d, clipped = phi_from_eq6(uy, theta, psi, a)
+        if clipped:
+            continue
+        assert eq6(phi_d, theta, psi, a) == pytest.approx(uy, abs=1e-9)
+        grid = np.linspace(-math.pi, math.pi, 20001)
+        f = np.array([eq6(p, theta, psi, a) - uy for p in grid])
+        roots = grid[:-1][np.sign(f[:-1]) != np.sign(f[1:])]
+        assert abs(phi_d) <= np.min(np.abs(roots)) + 1e-3, (psi, phi_d, roots)
+
+
+def test_roll_of_a_tilt_limited_pitch_uses_the_limited_pitch():
+    """When the pitch setpoint is limited, eq (19) is solved with the limited pitch's sine."""
+    c = NLPD(max_tilt=math.radians(20))
+    x = np.zeros(STATE_SIZE)
+    x[12:] = V.m * V.g / 4
+    x[PSI] = 0.4
+    ref = np.zeros(REF_SIZE)
+    ref[REF_X], ref[REF_Y] = 100.0, 0.5
+    cmd = np.zeros(CMD_SIZE)
+    nlpd(0.0, 1e-3, x, ref, V.rows()[0], c.gains(), c.memory(), cmd)
+    assert cmd[CMD_THETA_D] == pytest.approx(math.radians(20)) and int(cmd[CMD_FLAGS]) & FLAG_TILT_LIMIT
+    uy = c.position.kp * 0.5
+    a = cmd[CMD_THRUST] / V.m
+    phi_d, _ = phi_from_eq6(uy, cmd[CMD_THETA_D], 0.4, a)
+    assert cmd[CMD_PHI_D] == pytest.approx(phi_d, abs=1e-14)
+    assert eq6(cmd[CMD_PHI_D], cmd[CMD_THETA_D], 0.4, a) == pytest.approx(uy, abs=1e-12)
 
 
 def test_eq19_keeps_the_sign_the_paper_squares_away():

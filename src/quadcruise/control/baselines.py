@@ -66,8 +66,8 @@ from .design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, 
 from .position import attitude_block, check_positive, finish, thrust_for_tilt, tilt_setpoint
 
 # gains layout after the attitude block
-KP_XY, KD_XY, SAT_P, SAT_D, KP_Z, KD_Z, MAX_TILT = range(ATT_GAINS, ATT_GAINS + 7)
-GONZALEZ_GAINS = ATT_GAINS + 7
+KP_XY, KD_XY, SAT_P, SAT_D, KP_Z, KD_Z, MAX_TILT, COS_MAX_TILT = range(ATT_GAINS, ATT_GAINS + 8)
+GONZALEZ_GAINS = ATT_GAINS + 8
 G0 = 9.81
 """Gravity [m/s^2] of the tilt-budget rule a_p = a_d = G0 max_tilt / 2 (not the default)."""
 UNIT_ERROR = 1.0
@@ -90,7 +90,7 @@ def gonzalez(t, dt, x, ref, vp, gains, mem, cmd):
     uy = saturated_pd(ref[REF_Y] - x[Y], ref[REF_VY] - x[VY], kp, kd, ap, ad)
     uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ])
     g = vp[P_G]
-    U1, flags = thrust_for_tilt(uz, math.cos(x[PHI]) * math.cos(x[THETA]), vp[P_M], g, vp[P_K], tilt)
+    U1, flags = thrust_for_tilt(uz, math.cos(x[PHI]) * math.cos(x[THETA]), vp[P_M], g, vp[P_K], gains[COS_MAX_TILT])
     theta_d, flags = tilt_setpoint(ux / g, False, tilt, flags)           # eq (5), small angle
     phi_d, flags = tilt_setpoint(-uy / g, False, tilt, flags)            # eq (6), small angle
     finish(U1, phi_d, theta_d, ref[REF_PSI], flags, dt, x, vp, gains, mem, cmd)
@@ -124,7 +124,7 @@ class Gonzalez(Controller):
     >>> round(c.position.kp, 2), round(c.position.kd, 2), round(c.accel_p, 3), round(c.accel_d, 3)
     (3.01, 5.0, 3.01, 5.0)
     >>> c.gains().shape, c.memory().shape
-    ((14,), (3,))
+    ((15,), (3,))
     >>> Gonzalez(accel_d=-1.0)
     Traceback (most recent call last):
         ...
@@ -165,5 +165,5 @@ class Gonzalez(Controller):
 
     def gains(self) -> np.ndarray:
         tail = [self.position.kp, self.position.kd, self.accel_p, self.accel_d,
-                self.altitude.kp, self.altitude.kd, self.max_tilt]
+                self.altitude.kp, self.altitude.kd, self.max_tilt, math.cos(self.max_tilt)]
         return np.array(attitude_block(self.attitude, self.yaw, self.i_limit) + tail)

@@ -18,8 +18,10 @@ Per control period, with a = U1 / m:
    eq (19) squares the equation and takes a square root, which loses the sign of phi;
    with A = cos psi, B = sin theta_d sin psi, eq (6) reads A sin phi - B cos phi = -u_y/a,
    i.e. sin(phi - gamma) = -u_y / (a R), R = hypot(A, B), gamma = atan2(B, A); of the two
-   roots we take the one nearest level. At psi = 0 this is phi_d = -asin(u_y / a): the
-   paper's form with its sign restored.
+   roots we take the one nearest level, which for cos psi > 0 is gamma - asin(u_y / (a R))
+   with gamma = atan(B / A). At psi = 0 this is phi_d = -asin(u_y / a): the paper's form
+   with its sign restored. sin theta_d is the asin argument of step 3 (or sin max_tilt when
+   the pitch was limited), not a new sine.
 5. Yaw setpoint: the mission's yaw (a hold at 0 by default).
 
 Every asin argument outside [-1, 1] is clipped and flagged (FLAG_ASIN_CLIP), and roll and
@@ -50,8 +52,9 @@ from .base import Controller, write_command
 from .design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
 
 # gains layout after the attitude block
-KP_XY, KD_XY, KP_Z, KD_Z, MAX_TILT, ACCEL_FF = range(ATT_GAINS, ATT_GAINS + 6)
-NLPD_GAINS = ATT_GAINS + 6
+# (COS_MAX_TILT and SIN_MAX_TILT are cos and sin of MAX_TILT, so the step calls neither)
+KP_XY, KD_XY, KP_Z, KD_Z, MAX_TILT, ACCEL_FF, COS_MAX_TILT, SIN_MAX_TILT = range(ATT_GAINS, ATT_GAINS + 8)
+NLPD_GAINS = ATT_GAINS + 8
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -76,12 +79,13 @@ def limit(value, bound):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def pitch_eq16(ux, sphi, cphi, spsi, cpsi, a):
-    """Eq (16) from the sines and cosines of roll and yaw (see :func:`theta_from_eq5`)."""
+    """Eq (16) from the sines and cosines of roll and yaw (see :func:`theta_from_eq5`):
+    (theta, sin theta, clipped?)."""
     den = cphi * cpsi * a
     if abs(den) < 1e-9:
-        return 0.0, True
+        return 0.0, 0.0, True
     s, clipped = clip_unit((ux - sphi * spsi * a) / den)
-    return math.asin(s), clipped
+    return math.asin(s), s, clipped
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -89,12 +93,16 @@ def roll_eq19(uy, stheta, spsi, cpsi, a):
     """Eq (19), sign kept, from sin(theta) and the yaw's sine and cosine (see :func:`phi_from_eq6`)."""
     A = cpsi
     B = stheta * spsi
-    R = math.hypot(A, B)
+    R = math.sqrt(A * A + B * B)         # |A|, |B| <= 1: no overflow to guard against
     if R * a < 1e-9:
         return 0.0, True
     s, clipped = clip_unit(uy / (a * R))
-    gamma = math.atan2(B, A)
     r1 = math.asin(s)
+    if A > 0.0:
+        # |gamma| < pi/2 and |r1| <= pi/2: gamma - r1 lies in (-pi, pi) and, cos phi1 -
+        # cos phi2 = 2 A sqrt(1 - s^2) / R >= 0, it is the root nearest level
+        return math.atan(B / A) - r1, clipped
+    gamma = math.atan2(B, A)
     phi1 = gamma - r1
     phi2 = gamma + math.pi + r1
     phi1 -= 2.0 * math.pi * math.floor((phi1 + math.pi) / (2.0 * math.pi))
@@ -105,7 +113,8 @@ def roll_eq19(uy, stheta, spsi, cpsi, a):
 @njit(cache=True, error_model="numpy")
 def theta_from_eq5(ux, phi, psi, a):
     """Eq (16): the pitch that gives x'' = ux at roll phi, yaw psi and a = U1/m [m/s^2]."""
-    return pitch_eq16(ux, math.sin(phi), math.cos(phi), math.sin(psi), math.cos(psi), a)
+    theta, _, clipped = pitch_eq16(ux, math.sin(phi), math.cos(phi), math.sin(psi), math.cos(psi), a)
+    return theta, clipped
 
 
 @njit(cache=True, error_model="numpy")
@@ -115,11 +124,11 @@ def phi_from_eq6(uy, theta, psi, a):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def thrust_for_tilt(uz, cos_tilt, m, g, K, max_tilt):
+def thrust_for_tilt(uz, cos_tilt, m, g, K, cos_max_tilt):
     """Altitude law: U1 = m (g + u_z) / (cos phi cos theta), limited to [0, 4 K] [N], and its
     flag. ``cos_tilt`` is cos phi cos theta; the compensation uses at most 1/cos(max_tilt) so
     that it cannot blow up."""
-    c = max(cos_tilt, math.cos(max_tilt))
+    c = max(cos_tilt, cos_max_tilt)
     U1 = m * (g + uz) / c
     if U1 < 0.0:
         return 0.0, FLAG_THRUST_LIMIT
@@ -163,11 +172,13 @@ def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
     m, g, K = vp[P_M], vp[P_G], vp[P_K]
     sphi, cphi = math.sin(phi), math.cos(phi)          # each computed once, shared
     spsi, cpsi = math.sin(psi), math.cos(psi)
-    U1, flags = thrust_for_tilt(uz, cphi * math.cos(theta), m, g, K, tilt)
+    U1, flags = thrust_for_tilt(uz, cphi * math.cos(theta), m, g, K, gains[COS_MAX_TILT])
     a = U1 / m
-    theta_d, clipped = pitch_eq16(ux, sphi, cphi, spsi, cpsi, a)              # (16)
-    theta_d, flags = tilt_setpoint(theta_d, clipped, tilt, flags)
-    phi_d, clipped = roll_eq19(uy, math.sin(theta_d), spsi, cpsi, a)          # (19), sign kept
+    pitch, stheta_d, clipped = pitch_eq16(ux, sphi, cphi, spsi, cpsi, a)      # (16)
+    theta_d, flags = tilt_setpoint(pitch, clipped, tilt, flags)
+    if theta_d != pitch:                  # limited: sin theta_d is no longer asin's argument
+        stheta_d = math.copysign(gains[SIN_MAX_TILT], theta_d)
+    phi_d, clipped = roll_eq19(uy, stheta_d, spsi, cpsi, a)                    # (19), sign kept
     phi_d, flags = tilt_setpoint(phi_d, clipped, tilt, flags)
     finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd)
 
@@ -216,7 +227,7 @@ class NLPD(Controller):
     >>> round(c.position.kp, 2), round(c.position.kd, 2)
     (3.01, 5.0)
     >>> c.gains().shape, c.memory().shape
-    ((13,), (3,))
+    ((15,), (3,))
     """
 
     name = "nlpd"
@@ -241,5 +252,6 @@ class NLPD(Controller):
 
     def gains(self) -> np.ndarray:
         tail = [self.position.kp, self.position.kd, self.altitude.kp, self.altitude.kd,
-                self.max_tilt, 1.0 if self.accel_feedforward else 0.0]
+                self.max_tilt, 1.0 if self.accel_feedforward else 0.0,
+                math.cos(self.max_tilt), math.sin(self.max_tilt)]
         return np.array(attitude_block(self.attitude, self.yaw, self.i_limit) + tail)
