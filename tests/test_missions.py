@@ -174,9 +174,13 @@ def test_per_vehicle_rows():
 
 
 def test_cache_hits_in_a_new_process():
+    """The references compile on first use, not at import, and then load from the cache."""
     code = ("import quadcruise.missions as m; "
-            "print(all(sum(f.stats.cache_hits.values()) > 0 "
-            "for f in (m.hover_ref, m.step_ref, m.circle_ref, m.square_ref)))")
+            "fs = (m.hover_ref, m.step_ref, m.circle_ref, m.square_ref); "
+            "lazy = all(not f.signatures for f in fs); "
+            "[M().reference(1.0) for M in (m.Hover, m.Step, m.Circle, m.Square)]; "
+            "print(lazy and all(sum(f.stats.cache_hits.values()) > 0 and not f.stats.cache_misses "
+            "for f in fs))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "True"
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from quadcruise import InputError, Vehicle
-from quadcruise.layout import P_K1, P_K2, P_K5, P_K6, PARAM_SIZE
+from quadcruise.layout import P_INV_JXX, P_INV_JYY, P_INV_JZZ, P_INV_M, P_K1, P_K2, P_K5, P_K6, PARAM_SIZE
 
 
 def test_paper_preset_is_table_one():
@@ -25,6 +25,7 @@ def test_rows_carry_k_coefficients_of_section_three():
     assert row[P_K2] == pytest.approx(0.2 / 0.02)
     assert row[P_K5] == pytest.approx((0.02 - 0.03) / 0.045)
     assert row[P_K6] == pytest.approx(1 / 0.045)
+    assert (row[P_INV_M], row[P_INV_JXX], row[P_INV_JYY], row[P_INV_JZZ]) == (1 / v.m, 1 / 0.02, 1 / 0.03, 1 / 0.045)
 
 
 def test_frozen():

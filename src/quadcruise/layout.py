@@ -66,12 +66,14 @@ FLAG_ASIN_CLIP = 2       # an inverse-model asin argument left [-1, 1] and was c
 FLAG_THRUST_LIMIT = 4    # the collective thrust was limited
 FLAG_INTEGRATOR_HOLD = 8  # anti-windup held an integrator
 
-# --- vehicle parameter row: 17 columns -------------------------------------------------
+# --- vehicle parameter row: 21 columns -------------------------------------------------
 # The physical parameters; k1..k6 (Section III of the paper) are derived from them when the
-# row is built, so the compiled step never divides; then the drag coefficients.
+# row is built, and so are 1/m and 1/J, so the compiled step never divides; then the drag
+# coefficients.
 (P_M, P_JXX, P_JYY, P_JZZ, P_L, P_K, P_OMEGA, P_D, P_G,
- P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, P_CD1, P_CD2) = range(17)
-PARAM_SIZE = 17
+ P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, P_CD1, P_CD2,
+ P_INV_M, P_INV_JXX, P_INV_JYY, P_INV_JZZ) = range(21)
+PARAM_SIZE = 21
 
 # --- compiled signatures ---------------------------------------------------------------
 _f8 = types.float64

@@ -57,7 +57,7 @@ from numba import njit, types
 
 from .errors import InputError
 from .layout import (
-    MISSION_SIG, MissionType, REF_PSI, REF_SIZE, REF_VX, REF_VY, REF_X, REF_Y, REF_Z,
+    MissionType, REF_PSI, REF_SIZE, REF_VX, REF_VY, REF_X, REF_Y, REF_Z,
     REF_AX, REF_AY,
 )
 
@@ -68,21 +68,24 @@ _AXES = {"x": REF_X, "y": REF_Y, "z": REF_Z, "yaw": REF_PSI}
 
 
 # --- compiled references (scalar code, no allocation; error_model="numpy" drops the
-# zero-division checks, the dataclasses having ruled zero divisors out) -------------
+# zero-division checks, the dataclasses having ruled zero divisors out). Each compiles
+# (or loads from numba's cache) the first time a flight passes it to the engine, as a
+# function with MISSION_SIG; a signature in the decorator would compile every mission
+# when the package is imported (about 2 s of a cold start for missions not flown). -----
 @njit(cache=True)
 def _clear(ref):
     for i in range(REF_SIZE):
         ref[i] = 0.0
 
 
-@njit(MISSION_SIG, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def hover_ref(t, mp, ref):
     """mp = (x, y, z, yaw): a constant point."""
     _clear(ref)
     ref[REF_X], ref[REF_Y], ref[REF_Z], ref[REF_PSI] = mp[0], mp[1], mp[2], mp[3]
 
 
-@njit(MISSION_SIG, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def step_ref(t, mp, ref):
     """mp = (x, y, z, yaw, column, size, time): ref[column] += size from t >= time."""
     _clear(ref)
@@ -91,7 +94,7 @@ def step_ref(t, mp, ref):
         ref[int(mp[4])] += mp[5]
 
 
-@njit(MISSION_SIG, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def circle_ref(t, mp, ref):
     """mp = (radius, omega, altitude, start_angle, cx, cy, yaw, ramp_time)."""
     radius, omega, ramp = mp[0], mp[1], mp[7]
@@ -120,7 +123,7 @@ def circle_ref(t, mp, ref):
     ref[REF_PSI] = mp[6]
 
 
-@njit(MISSION_SIG, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def square_ref(t, mp, ref):
     """mp = (side, speed, altitude, x0, y0, direction, dwell, yaw)."""
     side, speed, sgn, dwell = mp[0], mp[1], mp[5], mp[6]

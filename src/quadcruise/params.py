@@ -21,7 +21,7 @@ Examples
 >>> import numpy as np
 >>> batch = v.replace(m=np.array([3.0, 3.5, 4.0]))
 >>> batch.batch_size, batch.rows().shape
-(3, (3, 17))
+(3, (3, 21))
 >>> Vehicle.paper().replace(m=0.0)
 Traceback (most recent call last):
     ...
@@ -38,8 +38,8 @@ import numpy as np
 
 from .errors import InputError
 from .layout import (
-    P_CD1, P_CD2, P_D, P_G, P_JXX, P_JYY, P_JZZ, P_K, P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, P_L,
-    P_M, P_OMEGA, PARAM_SIZE,
+    P_CD1, P_CD2, P_D, P_G, P_INV_JXX, P_INV_JYY, P_INV_JZZ, P_INV_M, P_JXX, P_JYY, P_JZZ, P_K,
+    P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, P_L, P_M, P_OMEGA, PARAM_SIZE,
 )
 
 
@@ -155,6 +155,8 @@ class Vehicle:
             out[:, col] = value
         out[:, P_CD1] = self.drag_linear
         out[:, P_CD2] = self.drag_quadratic
+        for col, src in ((P_INV_M, P_M), (P_INV_JXX, P_JXX), (P_INV_JYY, P_JYY), (P_INV_JZZ, P_JZZ)):
+            out[:, col] = 1.0 / out[:, src]
         return out
 
     def to_dict(self) -> dict:

@@ -29,7 +29,7 @@ from .control.openloop import duty_schedule, pack_schedule
 from .engine import Limits, simulate
 from .errors import InputError
 from .io import atomic_path, read_numeric_csv
-from .layout import F1, MISSION_SIG, P_K, STATE_NAMES, STATE_SIZE
+from .layout import F1, P_K, STATE_NAMES, STATE_SIZE
 from .params import Vehicle
 from .result import SimResult
 
@@ -37,7 +37,7 @@ INPUT_COLUMNS = ("t", "u1", "u2", "u3", "u4")
 OUTPUT_COLUMNS = ("t",) + STATE_NAMES
 
 
-@njit(MISSION_SIG, cache=True)
+@njit(cache=True)     # compiled (as MISSION_SIG) on first use, not at import
 def no_reference(t, mp, ref):
     """An open-loop flight has no reference: NaN throughout."""
     for j in range(ref.shape[0]):

@@ -56,7 +56,7 @@ from numba import njit
 
 from .errors import InputError
 from .io import read_numeric_csv
-from .layout import MISSION_SIG, REF_AX, REF_PSI, REF_PSI_DOT, REF_SIZE, REF_VX, REF_X
+from .layout import REF_AX, REF_PSI, REF_PSI_DOT, REF_SIZE, REF_VX, REF_X
 from .missions import Mission, _f
 
 __all__ = ["WaypointTable", "read_waypoints_csv", "Waypoints", "MinimumSnap",
@@ -238,7 +238,7 @@ def _last_start(t, mp, first, stride, count):
     return lo
 
 
-@njit(MISSION_SIG, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def waypoints_ref(t, mp, ref):
     """mp = [n, hold_yaw, (x, y, z, yaw, t) per point]: straight legs, C0 at the points."""
     for i in range(REF_SIZE):
@@ -265,7 +265,7 @@ def waypoints_ref(t, mp, ref):
         ref[REF_PSI_DOT] = (mp[b + 3] - mp[a + 3]) / dur
 
 
-@njit(MISSION_SIG, cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def minsnap_ref(t, mp, ref):
     """mp = [m, x, y, z, yaw and t at the end, (t_i, T_i, 4 x 8 coefficients in s) per segment]."""
     for i in range(REF_SIZE):

@@ -10,10 +10,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..layout import CMD_FLAGS, CONTROLLER_SIG
+from ..layout import CMD_FLAGS
 
 
-@njit(CONTROLLER_SIG, cache=True)
+@njit(cache=True)     # compiled (as CONTROLLER_SIG) on first use, not at import
 def duty_schedule(t, dt, x, ref, vp, gains, mem, cmd):
     """Hold the duties of the last schedule row whose time is <= t."""
     n = int(gains[0])
