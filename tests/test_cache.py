@@ -1,8 +1,7 @@
 """numba's cache is dropped when any of the package's sources changes (quadcruise._cache)."""
 
-import os
-
 import hashlib
+import os
 
 from quadcruise._cache import drop_stale_cache, sources_stamp
 
