@@ -19,7 +19,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import numba
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -37,19 +36,20 @@ QUICK = dict(single_s=2.0, batch_n=100, batch_s=1.0, repeats=2, warm_repeats=1,
 
 @contextlib.contextmanager
 def kernel_clock():
-    """Time each call of the compiled kernel inside simulate()/fly() (list of seconds)."""
+    """Time each run of the compiled kernel (over all its threads) inside simulate()/fly()
+    (list of seconds)."""
     from quadcruise import engine
-    real, spent = engine._kernel, []
+    real, spent = engine.fly_vehicles, []
 
     def timed(*args):
         t0 = time.perf_counter()
         real(*args)
         spent.append(time.perf_counter() - t0)
-    engine._kernel = timed
+    engine.fly_vehicles = timed
     try:
         yield spent
     finally:
-        engine._kernel = real
+        engine.fly_vehicles = real
 
 
 def measure(prepare, n: int, duration: float, repeats: int) -> tuple[dict, object]:
@@ -284,12 +284,11 @@ def main(argv=None) -> int:
     import scipy
 
     info = machine(scipy=scipy.__version__) | {"import_s": import_s}
-    r: dict = {"call_overhead": bench_open_loop(10 / HZ, 1, 7)[0]}   # also starts numba's threads
+    r: dict = {"call_overhead": bench_open_loop(10 / HZ, 1, 7)[0]}
     final: dict = {}
-    info["threading_layer"] = numba.threading_layer()
     print(f"quadcruise {info['quadcruise']} engine benchmark{' --quick' if args.quick else ''}\n"
-          f"  {info['cpu']}, {info['cores']} cores, numba threads {info['numba_threads']} "
-          f"({info['threading_layer']}); python {info['python']}, numba {info['numba']}, "
+          f"  {info['cpu']}, {info['cores']} cores, {info['numba_threads']} threads (numba's number); "
+          f"python {info['python']}, numba {info['numba']}, "
           f"numpy {info['numpy']}, scipy {info['scipy']}\n"
           f"  load average {info['load_avg_start'][0]:.2f} at start; import quadcruise {info['import_s']:.2f} s; "
           f"speed probe {info['probe_ns_start']:.0f} ns per plant RK4 step")

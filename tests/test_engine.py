@@ -180,6 +180,61 @@ def test_rows_after_a_stop_are_nan_and_the_rest_of_the_batch_flies_on(log_every)
     assert np.all(np.isfinite(res.states[0, :last - 1]))
 
 
+@pytest.mark.parametrize("limit, status", [
+    (dict(max_position=0.5), 2), (dict(max_speed=0.3), 3), (dict(max_rate=0.05), 4),
+    (dict(max_tilt=0.01), 5),
+])
+def test_each_bound_stops_the_flight_with_its_own_status(limit, status):
+    with pytest.warns(UserWarning, match="diverged"):
+        res = qc.fly("step", duration=5.0, limits=qc.Limits(**limit))
+    assert res.status[0] == status, res.status_text(0)
+    assert 0 < res.t_stop[0] < 5.0
+
+
+def test_a_nonfinite_state_stops_the_flight():
+    from numba import njit
+
+    from quadcruise.layout import DISTURBANCE_SIG, EXT_E1, EXT_FX, EXT_SIZE
+
+    @njit(DISTURBANCE_SIG)
+    def poisoned(t, dt, x, dp, dmem, rng, ext):
+        for j in range(EXT_SIZE):
+            ext[j] = 1.0 if j >= EXT_E1 else 0.0
+        if t >= 0.25:
+            ext[EXT_FX] = np.inf
+
+    with pytest.warns(UserWarning, match="non-finite"):
+        res = qc.fly("hover", duration=1.0, disturbance=poisoned)
+    assert res.status[0] == 1 and res.t_stop[0] == pytest.approx(0.251)
+    assert "non-finite" in res.status_text(0)
+
+
+def test_threads_and_pieces_do_not_change_a_batch():
+    """The kernel flies a batch in pieces on numba's threads; any split gives the same
+    flights, noisy ones included (each vehicle draws from its own stream)."""
+    import numba
+
+    from quadcruise import engine
+
+    masses = np.linspace(3.0, 4.0, 37)
+    kw = dict(vehicle=qc.Vehicle(m=masses), duration=1.0, sensor_std=np.full(STATE_SIZE, 1e-3), seed=4)
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = qc.fly("circle", **kw)
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+        pieces, engine.PIECES_PER_THREAD = engine.PIECES_PER_THREAD, 5
+        many = qc.fly("circle", **kw)
+    finally:
+        numba.set_num_threads(threads)
+        engine.PIECES_PER_THREAD = pieces
+    np.testing.assert_array_equal(one.states, many.states)
+    np.testing.assert_array_equal(one.commands, many.commands)
+    single = qc.fly("circle", **(kw | dict(vehicle=qc.Vehicle(m=masses[20]), first_vehicle=20)))
+    np.testing.assert_array_equal(single.states[0], many.states[20])
+    assert np.ptp(many.final_state[:, Z]) > 0.0
+
+
 def test_nonfinite_controller_command_stops_cleanly():
     from numba import njit
 

@@ -7,9 +7,13 @@ substeps no longer than ``max_step``. After every period it checks the state; a 
 whose state turns non-finite or leaves the bounds in :class:`Limits` stops there, with its
 status, time and reason recorded, while the rest of the batch flies on.
 
-The single-vehicle flight is the N = 1 case of the same kernel. Vehicles are independent,
-so the kernel runs them in parallel (numba ``prange``); each vehicle's arithmetic does not
-depend on the batch it is in, so a batch reproduces single flights bit for bit.
+The single-vehicle flight is the N = 1 case of the same kernel. The kernel flies the
+vehicles of one range of the batch, one after another, without the GIL; vehicles are
+independent, so :func:`simulate` splits a batch into pieces that numba's number of threads
+(``numba.set_num_threads``) fly at once. Each vehicle's arithmetic does not depend on the
+batch it is in or the piece it falls in, so a batch reproduces single flights bit for bit.
+(A ``prange`` kernel would do the same, but numba's parallel passes on a body this size
+add about 6 s to the cold compile, and with one vehicle the idle OpenMP thread spins.)
 
 Controllers and missions are compiled functions with the signatures in
 :mod:`quadcruise.layout`, passed as first-class function values: one cached kernel
@@ -18,11 +22,13 @@ serves every controller, a user's own included.
 
 from __future__ import annotations
 
+import itertools
 import math
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit, prange, types
+from numba import config, get_num_threads, njit, types
 
 from .errors import InputError
 from .layout import (
@@ -30,7 +36,7 @@ from .layout import (
     MissionType, P, PHI, PSI, Q, R, REF_SIZE, STATE_SIZE, THETA, VX, VY, VZ, X, Y, Z,
 )
 from .model.plant import derivative_at
-from .rng import gauss, vehicle_states
+from .rng import next_normal, vehicle_states
 from .result import STATUS_REASONS, SimResult
 
 # exit status of each vehicle (the reasons live in result.STATUS_REASONS)
@@ -151,39 +157,26 @@ def still_air(t, dt, x, dp, dmem, rng, ext):
         ext[j] = 1.0
 
 
+# The per-period helpers below take scalars, not arrays: numba inlining a helper with
+# array arguments into the kernel (or calling it) keeps a reference-count increment and
+# decrement of each array, two atomic operations, in every control period.
+
 @njit(cache=True, inline="always")
-def check_state(x, limits):
-    """0 if the state is sound, else the divergence status code."""
-    for j in range(x.shape[0]):
-        if not math.isfinite(x[j]):
-            return NONFINITE
-    if abs(x[X]) > limits[0] or abs(x[Y]) > limits[0] or abs(x[Z]) > limits[0]:
-        return POSITION_BOUND
-    if abs(x[VX]) > limits[1] or abs(x[VY]) > limits[1] or abs(x[VZ]) > limits[1]:
-        return SPEED_BOUND
-    if abs(x[P]) > limits[2] or abs(x[Q]) > limits[2] or abs(x[R]) > limits[2]:
-        return RATE_BOUND
-    if abs(x[PHI]) > limits[3] or abs(x[THETA]) > limits[3]:
-        return TILT_BOUND
-    return FINISHED
+def beyond(a, b, c, bound):
+    """Whether |a|, |b| or |c| exceeds bound."""
+    return abs(a) > bound or abs(b) > bound or abs(c) > bound
 
 
 @njit(cache=True, inline="always")
-def hold_duties(cmd, u):
-    """Clip the commanded duties into u (in [0, 1]); return (clipped?, finite?)."""
-    clipped = False
-    for j in range(4):
-        v = cmd[j]
-        if not math.isfinite(v):
-            return clipped, False
-        if v < 0.0:
-            v = 0.0
-            clipped = True
-        elif v > 1.0:
-            v = 1.0
-            clipped = True
-        u[j] = v
-    return clipped, True
+def clip_duty(v):
+    """A commanded duty held in [0, 1]: (duty, clipped?, finite?)."""
+    if not math.isfinite(v):
+        return 0.0, False, False
+    if v < 0.0:
+        return 0.0, True, True
+    if v > 1.0:
+        return 1.0, True, True
+    return v, False, True
 
 
 @njit(cache=True, inline="always")
@@ -192,6 +185,14 @@ def log_row(log, i, row, v):
     log array at every logged period)."""
     for j in range(v.shape[0]):
         log[i, row, j] = v[j]
+
+
+@njit(cache=True, inline="always")
+def put_row(a, i, v):
+    """a[i, :] = v, element by element: numba compiles a slice assignment with a shape
+    check of its own, which costs seconds of compile time."""
+    for j in range(v.shape[0]):
+        a[i, j] = v[j]
 
 
 @njit(cache=True, inline="always")
@@ -210,26 +211,26 @@ _i8v = types.int64[::1]
 _u8m = types.uint64[:, ::1]
 
 KERNEL_SIG = types.void(
-    _f8v, _f8m, _f8m, _f8m, ControllerType, _f8m, _f8m, MissionType, _f8m,
-    DisturbanceType, _f8m, _f8m, _u8m, _f8m, types.int64, types.boolean,
+    types.int64, types.int64, _f8v, _f8m, _f8m, _f8m, ControllerType, _f8m, _f8m, MissionType, _f8m,
+    DisturbanceType, types.boolean, _f8m, _f8m, _u8m, _f8m, types.int64, types.boolean,
     types.float64, types.int64, _f8v,
     _f8c, _f8c, _f8c, _f8m, _i8v, _f8v, _f8m,
 )
 
 
-@njit(KERNEL_SIG, cache=True, parallel=True, error_model="numpy")
-def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
-            disturbance, dp, dmem, rng, sensor_std, sensor_delay, full,
+@njit(KERNEL_SIG, cache=True, nogil=True, error_model="numpy")
+def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
+            disturbance, disturbed, dp, dmem, rng, sensor_std, sensor_delay, full,
             max_step, log_every, limits,
             log_x, log_cmd, log_ref, x_final, status, t_stop, saturated):
-    n_vehicles = x0.shape[0]
     n_periods = t_grid.shape[0] - 1
-    for i in prange(n_vehicles):
+    steps_per_s = 1.0 / max_step
+    for i in range(first, stop):
         x = x0[i].copy()
         seen = np.empty(STATE_SIZE)
         history = np.empty((sensor_delay + 1, STATE_SIZE))   # ring buffer of past states
         for d in range(sensor_delay + 1):
-            history[d, :] = x
+            put_row(history, d, x)
         ref = np.zeros(REF_SIZE)
         cmd = np.zeros(CMD_SIZE)
         u = np.zeros(4)
@@ -237,6 +238,7 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
         work = np.empty((WORK_ROWS, STATE_SIZE))
         vpi, vci, gi, mi, mpi = vp[i], vp_ctrl[i], gains[i], mem[i], mp[i]
         dpi, dmi, rngi, stdi = dp[i], dmem[i], rng[i], sensor_std[i]
+        max_position, max_speed, max_rate, max_tilt = limits[0], limits[1], limits[2], limits[3]
         noisy = False
         for j in range(STATE_SIZE):
             if stdi[j] != 0.0:
@@ -247,6 +249,8 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
         slot = 0                       # = k % (sensor_delay + 1), kept as a counter: the
         next_log = 0                   # step has no integer division in it
         steps = 0                      # RK4 steps since the angles' trig was computed afresh
+        if not disturbed:
+            still_air(0.0, 0.0, x, dpi, dmi, rngi, ext)      # and it stays so
         for k in range(n_periods + 1):
             t = t_grid[k]
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
@@ -262,10 +266,13 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
                 old = slot if k >= sensor_delay else 0     # the oldest state kept
                 for j in range(STATE_SIZE):
                     seen[j] = history[old, j]
-            if noisy:
+            if noisy:                  # the generator's state as a scalar: no array helper
+                state = rngi[0]
                 for j in range(STATE_SIZE):
                     if stdi[j] != 0.0:
-                        seen[j] += stdi[j] * gauss(rngi)
+                        draw, state = next_normal(state)
+                        seen[j] += stdi[j] * draw
+                rngi[0] = state
             for j in range(CMD_SIZE):
                 cmd[j] = 0.0
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
@@ -278,7 +285,10 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
                 next_log += log_every
             if k == n_periods:
                 break
-            clipped, finite = hold_duties(cmd, u)
+            clipped, finite = False, True
+            for j in range(4):
+                u[j], c, f = clip_duty(cmd[j])
+                clipped, finite = clipped or c, finite and f
             if not finite:
                 code = BAD_COMMAND
                 t_end = t
@@ -287,13 +297,26 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
                 saturated[i, 0] += dt
             if cmd[CMD_FLAGS] != 0.0:
                 saturated[i, 1] += dt
-            disturbance(t, dt, x, dpi, dmi, rngi, ext)
-            n_sub = max(1, int(math.ceil(dt / max_step - 1e-9)))
-            h = dt / n_sub
+            if disturbed:
+                disturbance(t, dt, x, dpi, dmi, rngi, ext)
+            n_sub = max(1, int(math.ceil(dt * steps_per_s - 1e-9)))
+            h = dt if n_sub == 1 else dt / n_sub
             for _ in range(n_sub):
                 rk4_step(x, u, vpi, ext, full, h, work, steps == 0)
                 steps = steps + 1 if steps < TRIG_REFRESH - 1 else 0
-            code = check_state(x, limits)
+            nonfinite = 0.0
+            for j in range(STATE_SIZE):
+                nonfinite += x[j] * 0.0               # 0 while every entry is finite, else NaN
+            if nonfinite != 0.0:
+                code = NONFINITE
+            elif beyond(x[X], x[Y], x[Z], max_position):
+                code = POSITION_BOUND
+            elif beyond(x[VX], x[VY], x[VZ], max_speed):
+                code = SPEED_BOUND
+            elif beyond(x[P], x[Q], x[R], max_rate):
+                code = RATE_BOUND
+            elif beyond(x[PHI], x[THETA], 0.0, max_tilt):
+                code = TILT_BOUND
             if code != FINISHED:
                 t_end = t_grid[k + 1]
                 if k + 1 == next_log:           # keep the state that broke the bound
@@ -303,9 +326,41 @@ def _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
         blank_rows(log_x, i, rows_x)               # rows after a stop: NaN
         blank_rows(log_cmd, i, rows)
         blank_rows(log_ref, i, rows)
-        x_final[i, :] = x
+        put_row(x_final, i, x)
         status[i] = code
         t_stop[i] = t_end
+
+
+PIECES_PER_THREAD = 8
+"""A batch is cut into this many pieces per thread, taken in turn by whichever thread is
+free, so a thread whose vehicles stopped early (or ran slower) does not leave the others
+waiting at the end."""
+
+_pool: ThreadPoolExecutor | None = None
+
+
+def fly_vehicles(n: int, args: tuple) -> None:
+    """Run the kernel over vehicles 0..n-1 of the batch arrays in ``args``, on numba's
+    number of threads (``numba.get_num_threads()``): one range on this thread when that is
+    1 or n is 1, else ``PIECES_PER_THREAD`` ranges per thread, handed out in turn."""
+    global _pool
+    threads = min(n, get_num_threads())
+    if threads <= 1:
+        _kernel(0, n, *args)
+        return
+    bounds = np.linspace(0, n, min(n, PIECES_PER_THREAD * threads) + 1).round().astype(np.int64)
+    pieces = itertools.count()                  # next() on it is atomic under the GIL
+
+    def work() -> None:
+        while (k := next(pieces)) < bounds.shape[0] - 1:
+            _kernel(int(bounds[k]), int(bounds[k + 1]), *args)
+    if _pool is None:                            # numba's threads can never exceed this
+        _pool = ThreadPoolExecutor(max_workers=max(1, config.NUMBA_NUM_THREADS - 1),
+                                   thread_name_prefix="quadcruise")
+    helpers = [_pool.submit(work) for _ in range(threads - 1)]
+    work()
+    for h in helpers:
+        h.result()
 
 
 def time_grid(duration: float, dt: float, t0: float = 0.0) -> np.ndarray:
@@ -426,10 +481,10 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
     status = np.zeros(n, dtype=np.int64)
     t_stop = np.empty(n)
     saturated = np.zeros((n, 2))
-    _kernel(t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
-            disturbance or still_air, dp, dmem, rng, std, int(sensor_delay), bool(full_dynamics),
-            float(max_step), int(log_every), limits.array(),
-            log_x, log_cmd, log_ref, x_final, status, t_stop, saturated)
+    fly_vehicles(n, (t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
+                     disturbance or still_air, disturbance is not None, dp, dmem, rng, std, int(sensor_delay), bool(full_dynamics),
+                     float(max_step), int(log_every), limits.array(),
+                     log_x, log_cmd, log_ref, x_final, status, t_stop, saturated))
     return SimResult(
         t=t_grid[::log_every][:n_log].copy(), states=log_x, commands=log_cmd, references=log_ref,
         final_state=x_final, status=status, t_stop=t_stop, memory=mem, disturbance_memory=dmem,
