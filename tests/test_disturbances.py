@@ -365,3 +365,22 @@ def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
         s = np.uint64(s)                 # back from Python: keep the state unsigned
         one_by_one.append(x)
     assert five == one_by_one and s_after == s != s0
+
+
+def test_dryden_coefficients_follow_the_period_but_not_its_rounding():
+    """Cached per period: a grid's rounding (1e-12 relative) keeps them, a new period
+    (2 ms after 1 ms) recomputes them, as the exact discretisation of the new a = dt / T."""
+    from quadcruise.disturbances import DT_TOLERANCE, _CU, _CV, _MDT
+    tb = Turbulence(intensity="moderate", altitude=10.0, airspeed=5.0)
+    env = Environment(turbulence=tb)
+    dp, dm, rng = env.params(1)[0], env.memory(1)[0], vehicle_states(1, 1)[0]
+    x, ext = np.zeros(STATE_SIZE), np.zeros(EXT_SIZE)
+    env.function(0.0, 1e-3, x, dp, dm, rng, ext)
+    first = dm.copy()
+    env.function(1e-3, 1e-3 * (1 + 1e-12), x, dp, dm, rng, ext)
+    assert dm[_MDT] == 1e-3 and np.array_equal(dm[_CU:], first[_CU:])
+    env.function(2e-3, 2e-3, x, dp, dm, rng, ext)
+    T_u, T_v = tb.time_constants()[:2]
+    assert dm[_MDT] == 2e-3 and dm[_CU] == pytest.approx(math.exp(-2e-3 / T_u), rel=1e-15)
+    np.testing.assert_allclose(dm[_CV:_CV + 5], _lateral_coefficients(2e-3 / T_v), rtol=1e-15)
+    assert 1e-11 < DT_TOLERANCE < 1e-3
