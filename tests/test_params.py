@@ -69,3 +69,20 @@ def test_stack():
     a, b = Vehicle(m=3.0), Vehicle(m=np.array([4.0, 5.0]))
     s = Vehicle.stack([a, b])
     assert s.batch_size == 3 and s.m.tolist() == [3.0, 4.0, 5.0]
+
+
+def test_default_objects_are_built_once_shared_and_frozen():
+    """fly() with names and no parameters reuses one validated, frozen default of each."""
+    import dataclasses
+
+    from quadcruise.control import controller_from_name
+    from quadcruise.missions import mission_from_name
+
+    assert Vehicle.paper() is Vehicle.paper() and Vehicle.paper() == Vehicle()
+    assert controller_from_name("nlpd") is controller_from_name("nlpd")
+    assert controller_from_name("nlpd", max_tilt=0.5) is not controller_from_name("nlpd")
+    assert controller_from_name("nlpd", max_tilt=0.5).max_tilt == 0.5
+    assert mission_from_name("circle") is mission_from_name("circle")
+    assert mission_from_name("circle", radius=3.0).radius == 3.0
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        Vehicle.paper().m = 1.0

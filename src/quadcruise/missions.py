@@ -60,6 +60,7 @@ from .layout import (
     MissionType, REF_PSI, REF_SIZE, REF_VX, REF_VY, REF_X, REF_Y, REF_Z,
     REF_AX, REF_AY,
 )
+from .params import shared_default
 
 __all__ = ["Mission", "Hover", "Step", "Circle", "Square", "mission_from_name",
            "mission_from_dict", "stack_params", "MISSIONS"]
@@ -391,7 +392,7 @@ def mission_from_name(name: str, **kw: Any) -> Mission:
     if cls is None:
         raise InputError(f"unknown mission {name!r}; valid missions: {', '.join(MISSIONS)}")
     _check_names(cls, kw)
-    return cls(**kw)
+    return cls(**kw) if kw else shared_default(cls)
 
 
 def mission_from_dict(d: dict) -> Mission:

@@ -31,6 +31,7 @@ quadcruise.errors.InputError: vehicle field 'm' (mass, kg) must be > 0, got 0.0
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -94,8 +95,8 @@ class Vehicle:
     # --- constructors -------------------------------------------------------------------
     @classmethod
     def paper(cls) -> "Vehicle":
-        """The paper's Table I (Qball-X4) with d = 4/120 m."""
-        return cls()
+        """The paper's Table I (Qball-X4) with d = 4/120 m (one shared, frozen instance)."""
+        return shared_default(cls)
 
     def replace(self, **changes: Any) -> "Vehicle":
         """A copy with some fields changed (validated again)."""
@@ -168,6 +169,13 @@ class Vehicle:
     def units(cls) -> dict:
         """Each field's unit."""
         return {f.name: f.metadata["unit"] for f in dataclasses.fields(cls)}
+
+
+@functools.cache
+def shared_default(cls: type) -> Any:
+    """``cls()`` of a frozen dataclass, built and validated once and shared by every caller
+    (the default vehicle, mission or controller of each ``fly``)."""
+    return cls()
 
 
 def _show(value: np.ndarray) -> str:

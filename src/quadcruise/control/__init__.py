@@ -22,6 +22,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from ..errors import InputError
+from ..params import shared_default
 from .base import Controller
 from .position import NLPD
 
@@ -50,7 +51,7 @@ def controller_from_name(name: str, **params: Any) -> Controller:
     """A built-in controller by name, with optional parameters."""
     if name not in CONTROLLERS:
         raise InputError(f"unknown controller {name!r}; choose one of {', '.join(CONTROLLERS)}")
-    return CONTROLLERS[name](**params)
+    return CONTROLLERS[name](**params) if params else shared_default(CONTROLLERS[name])
 
 
 def __getattr__(name: str):
