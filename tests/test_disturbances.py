@@ -384,3 +384,24 @@ def test_dryden_coefficients_follow_the_period_but_not_its_rounding():
     assert dm[_MDT] == 2e-3 and dm[_CU] == pytest.approx(math.exp(-2e-3 / T_u), rel=1e-15)
     np.testing.assert_allclose(dm[_CV:_CV + 5], _lateral_coefficients(2e-3 / T_v), rtol=1e-15)
     assert 1e-11 < DT_TOLERANCE < 1e-3
+
+
+def test_compiled_disturbance_makes_no_reference_count_calls():
+    """The disturbance runs every period on every thread, on rows of arrays the batch
+    shares: an NRT_incref/decref there is an atomic write to a shared counter. A fresh,
+    uncached compile shows what the engine runs (only the Python-facing wrapper counts)."""
+    import re
+
+    from quadcruise.disturbances import environment_disturbance
+    from quadcruise.layout import DISTURBANCE_SIG
+
+    fresh = njit(DISTURBANCE_SIG, error_model="numpy")(environment_disturbance.py_func)
+    body, calls = "", []
+    for line in "".join(fresh.inspect_llvm().values()).splitlines():
+        start = re.match(r'define [^@]*@"?([^"(]+)', line)
+        if start:
+            body = start.group(1)
+        elif ("@NRT_incref" in line or "@NRT_decref" in line) and "call " in line \
+                and not body.startswith("_ZN7cpython"):
+            calls.append(body)
+    assert calls == []

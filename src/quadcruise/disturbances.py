@@ -64,7 +64,7 @@ from .errors import InputError
 from .layout import DISTURBANCE_SIG, EXT_E1, EXT_FX, EXT_WX, PHI, P, STATE_SIZE, VX, X
 from .missions import _f  # a field with unit, doc and check (here: real, nonneg, pos, frac, rotor, vec)
 from .params import Vehicle
-from .rng import next_normal
+from .rng import ziggurat
 
 __all__ = ["ConstantWind", "Gust", "Turbulence", "RotorLoss", "ExternalForce", "Environment",
            "SensorNoise", "DEFAULT_DRAG", "with_drag", "wind_from_name", "parse_wind",
@@ -100,8 +100,10 @@ exponentials, a series, three square roots) in two periods of three."""
 # Note on speed: numba drops the reference counting of the array arguments (an atomic
 # NRT_incref/decref pair each on the batch's shared arrays: ~50 ns a call, contended between
 # threads) only when the function's CFG lets it prove the pairs redundant; arrays used only
-# in a branch, or a function ending in a branch, defeat it (numba 0.68). Hence scalar
-# helpers, rng[0] and dmem[0] loaded first and stored last, and no trailing if.
+# in a branch, a function ending in a branch, or a call of another compiled function (its
+# error path) defeat it (numba 0.68). Hence scalar helpers, rng[0] and dmem[0] loaded
+# first and stored last, no trailing if, and the ziggurat inlined once (_five_normals).
+# tests/test_disturbances.py checks the compiled body for reference counting.
 @njit(cache=True, error_model="numpy")
 def _lateral_coefficients(a):
     """Exact discretisation of (1 + sqrt3 T s)/(1 + T s)^2 over a = dt/T, states scaled to the
@@ -129,12 +131,25 @@ def _lateral_coefficients(a):
 @njit(cache=True, inline="always")
 def _five_normals(s):
     """Five standard normals from the vehicle's SplitMix64 state s (:mod:`quadcruise.rng`'s
-    ziggurat on the scalar state), and the new state."""
-    n0, s = next_normal(s)
-    n1, s = next_normal(s)
-    n2, s = next_normal(s)
-    n3, s = next_normal(s)
-    n4, s = next_normal(s)
+    ziggurat on the scalar state), and the new state.
+
+    One inlined copy of the ziggurat in a loop, not five calls of ``next_normal``: a call
+    of a compiled function may fail, and its error path keeps numba from dropping the
+    reference counting of :func:`environment_disturbance`'s four array arguments (eight
+    atomic operations a period, on counters the batch's threads share)."""
+    n0 = n1 = n2 = n3 = n4 = 0.0
+    for k in range(5):
+        v, s = ziggurat(s)
+        if k == 0:
+            n0 = v
+        elif k == 1:
+            n1 = v
+        elif k == 2:
+            n2 = v
+        elif k == 3:
+            n3 = v
+        else:
+            n4 = v
     return n0, n1, n2, n3, n4, s
 
 
