@@ -470,7 +470,8 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
     if int(sensor_delay) != sensor_delay or sensor_delay < 0:
         raise InputError(f"sensor delay must be a whole number of periods >= 0, got {sensor_delay!r}")
     # the random streams, when anything draws from them (SeedSequence: ~25 us a vehicle)
-    drawn = disturbance is not None or bool(np.any(std))
+    disturbed = disturbance is not None
+    drawn = disturbed or bool(np.any(std))
     rng = vehicle_states(seed, n, first_vehicle) if drawn else np.zeros((n, 1), dtype=np.uint64)
     limits = limits or Limits()
 
@@ -484,8 +485,8 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
     t_stop = np.empty(n)
     saturated = np.zeros((n, 2))
     fly_vehicles(n, (t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
-                     disturbance or still_air, disturbance is not None, dp, dmem, rng, std, int(sensor_delay), bool(full_dynamics),
-                     float(max_step), int(log_every), limits.array(),
+                     disturbance or still_air, disturbed, dp, dmem, rng, std, int(sensor_delay),
+                     bool(full_dynamics), float(max_step), int(log_every), limits.array(),
                      log_x, log_cmd, log_ref, x_final, status, t_stop, saturated))
     return SimResult(
         t=t_grid[::log_every][:n_log].copy(), states=log_x, commands=log_cmd, references=log_ref,
