@@ -236,8 +236,12 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
         u = np.zeros(4)
         ext = np.zeros(EXT_SIZE)
         work = np.empty((WORK_ROWS, STATE_SIZE))
-        vpi, vci, gi, mi, mpi = vp[i], vp_ctrl[i], gains[i], mem[i], mp[i]
-        dpi, dmi, rngi, stdi = dp[i], dmem[i], rng[i], sensor_std[i]
+        vpi, vci, gi, mpi, dpi, stdi = vp[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
+        # what changes every period is this vehicle's own copy, written back at the end:
+        # rows of neighbouring vehicles share cache lines, and threads flying neighbours
+        # would otherwise write to the same lines each period (false sharing)
+        mi, dmi, rngi = mem[i].copy(), dmem[i].copy(), rng[i].copy()
+        clipped_s = limited_s = 0.0
         max_position, max_speed, max_rate, max_tilt = limits[0], limits[1], limits[2], limits[3]
         noisy = False
         for j in range(STATE_SIZE):
@@ -294,9 +298,9 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
                 t_end = t
                 break
             if clipped:
-                saturated[i, 0] += dt
+                clipped_s += dt
             if cmd[CMD_FLAGS] != 0.0:
-                saturated[i, 1] += dt
+                limited_s += dt
             if disturbed:
                 disturbance(t, dt, x, dpi, dmi, rngi, ext)
             n_sub = max(1, int(math.ceil(dt * steps_per_s - 1e-9)))
@@ -327,6 +331,10 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
         blank_rows(log_cmd, i, rows)
         blank_rows(log_ref, i, rows)
         put_row(x_final, i, x)
+        put_row(mem, i, mi)
+        put_row(dmem, i, dmi)
+        put_row(rng, i, rngi)
+        saturated[i, 0], saturated[i, 1] = clipped_s, limited_s
         status[i] = code
         t_stop[i] = t_end
 
