@@ -60,7 +60,7 @@ def test_rk4_error_falls_sixteen_fold_when_step_halves():
 def test_turned_angles_equal_the_library_sine_and_cosine():
     import math
 
-    from quadcruise.engine import SMALL_TURN, turned
+    from quadcruise.engine import SHORT_TURN, SMALL_TURN, turned
 
     rng = np.random.default_rng(3)
     worst = 0.0
@@ -68,8 +68,8 @@ def test_turned_angles_equal_the_library_sine_and_cosine():
         s, c = turned(a + d, math.sin(a), math.cos(a), d)
         worst = max(worst, abs(s - math.sin(a + d)), abs(c - math.cos(a + d)))
     assert worst < 5e-16, worst
-    for d in (SMALL_TURN, -SMALL_TURN):              # the series' edge, where truncation is largest
-        s, c = turned(1.0 + d, math.sin(1.0), math.cos(1.0), d)
+    for d in (SMALL_TURN, -SMALL_TURN, SHORT_TURN, -SHORT_TURN):   # each series' edge: its
+        s, c = turned(1.0 + d, math.sin(1.0), math.cos(1.0), d)   # largest truncation
         assert abs(s - math.sin(1.0 + d)) < 5e-16 and abs(c - math.cos(1.0 + d)) < 5e-16
     # a larger turn than the series covers: the library's values exactly
     assert turned(2.5, 0.0, 1.0, 0.5) == (math.sin(2.5), math.cos(2.5))
