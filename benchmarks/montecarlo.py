@@ -3,21 +3,24 @@
 The issue's target: 10,000 flights of 60 s at 1 kHz with turbulence, on a 2-core machine,
 in under 3 minutes. Three runs of the same population (the circle flown by nlpd for 60 s,
 3 laps; mass, inertia and thrust-gain spreads, 10 cm initial offsets, moderate Dryden
-turbulence at 10 m, default drag):
+turbulence at 10 m, default drag), in this order:
 
+- ``dask``: ``montecarlo(scheduler="local", workers=W)``: chunks of vehicles on a new
+  ``distributed.LocalCluster`` of W processes, one numba thread each, metrics on a 10 ms
+  log. Its time includes starting and stopping the cluster and each worker loading the
+  compiled engine. It is the target's run, and it goes first, as a user's command starts
+  on a machine that has not been busy for minutes;
+- ``in process``: ``montecarlo(scheduler="none")``: the same chunks one after the other in
+  this process (numba on all cores inside a chunk);
 - ``plain``: every vehicle in ONE batched ``fly`` call logging only the start and the end:
-  the engine alone, no chunks, no metrics;
-- ``in process``: ``montecarlo(scheduler="none")``: chunks flown one after the other in this
-  process (numba on all cores inside a chunk), metrics on a 10 ms log;
-- ``dask``: ``montecarlo(scheduler="local", workers=W)``: the same on a new
-  ``distributed.LocalCluster`` of W processes, one numba thread each. Its time includes
-  starting and stopping the cluster and each worker loading the compiled engine.
+  the engine alone, no chunks, no metrics.
 
 The Dask overhead is reported against both, in wall time and in CPU time (this process
 and its children: the Dask workers; less sensitive to other load on the machine). The
 in-process and Dask tables are checked equal. Options: --quick (200 flights of 5 s, a smoke test), --n, --duration, --workers,
---skip-plain, --json PATH. The load average is printed at the start and the end: other
-processes on the machine slow every figure.
+--skip-plain, --json PATH. The load average is printed at the start and the end, and the
+speed probe before each run: the host's speed moves (by up to 2x within minutes here), and
+other processes on the machine slow every figure.
 """
 
 from __future__ import annotations
@@ -31,7 +34,7 @@ import warnings
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from machine import end_of_run, machine  # noqa: E402
+from machine import end_of_run, machine, probe  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 TARGET = dict(n=10_000, duration=60.0, seconds=180.0)
@@ -106,20 +109,24 @@ def main(argv=None) -> int:
     run_chunk(make_spec(0.01), 0, 2)            # load the compiled engine in this process
     results = {"warm_up_s": time.perf_counter() - t0}
 
-    def report(name, wall, cpu, extra=""):
+    def run(name, call, extra=lambda value: ""):
+        before = probe()
+        wall, cpu, value = timed(call)
         rate = work / wall
         results[name] = {"wall_s": wall, "cpu_s": cpu, "vehicle_steps_per_s": rate, "flights_per_s": n / wall,
-                         "vehicle_steps_per_cpu_s": work / cpu}
+                         "vehicle_steps_per_cpu_s": work / cpu, "probe_ns_before": before}
         print(f"  {name:<11} {wall:8.1f} s  {rate / 1e6:6.2f} M vehicle-steps/s  {n / wall:8.1f} flights/s"
-              f"  {cpu:8.1f} CPU s ({work / cpu / 1e6:.2f} M per CPU s){extra}", flush=True)
+              f"  {cpu:8.1f} CPU s ({work / cpu / 1e6:.2f} M per CPU s)  probe {before:.0f} ns{extra(value)}",
+              flush=True)
+        return value
 
+    # the target's run first, as a user's command starts on a machine not already busy
+    # for minutes; the host may slow under sustained load (see each run's probe)
+    dist = run("dask", lambda: sweep(spec, n, "local", args.workers),
+               lambda r: f"  ({args.workers} workers, chunks of {r.info['chunk_size']})")
+    local = run("in process", lambda: sweep(spec, n, "none", None), lambda r: f"  (chunks of {r.info['chunk_size']})")
     if not args.skip_plain:
-        wall, cpu, _ = timed(lambda: plain(spec, n))
-        report("plain", wall, cpu)
-    wall, cpu, local = timed(lambda: sweep(spec, n, "none", None))
-    report("in process", wall, cpu, f"  (chunks of {local.info['chunk_size']})")
-    wall, cpu, dist = timed(lambda: sweep(spec, n, "local", args.workers))
-    report("dask", wall, cpu, f"  ({args.workers} workers, chunks of {dist.info['chunk_size']})")
+        run("plain", lambda: plain(spec, n))
     import pandas as pd
 
     changed = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "src" / "quadcruise").rglob("*.py")
