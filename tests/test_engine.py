@@ -211,11 +211,10 @@ def test_a_nonfinite_state_stops_the_flight():
 
 def test_threads_and_pieces_do_not_change_a_batch():
     """The kernel flies a batch in pieces on numba's threads; any split gives the same
-    flights, noisy ones included (each vehicle draws from its own stream)."""
+    flights, noisy and turbulent ones included (each vehicle draws from its own stream)."""
     import numba
 
     from quadcruise import engine
-
     from quadcruise.disturbances import Environment, Turbulence
 
     masses = np.linspace(3.0, 4.0, 37)
@@ -234,7 +233,7 @@ def test_threads_and_pieces_do_not_change_a_batch():
         numba.set_num_threads(threads)
         engine.PIECES_PER_THREAD = pieces
     # what each vehicle carries through the flight (its controller's integrators, its
-    # turbulence filters, its generator, its time in saturation) is its own, in any split
+    # turbulence filters, its time in saturation) is its own, in any split
     ends = ("states", "commands", "memory", "disturbance_memory", "duty_clipped_s", "controller_limited_s")
     for name in ends:
         np.testing.assert_array_equal(getattr(one, name), getattr(many, name), err_msg=name)

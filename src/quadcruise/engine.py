@@ -9,8 +9,8 @@ status, time and reason recorded, while the rest of the batch flies on.
 
 The single-vehicle flight is the N = 1 case of the same kernel. The kernel flies the
 vehicles of one range of the batch, one after another, without the GIL; vehicles are
-independent, so :func:`simulate` splits a batch into pieces that numba's number of threads
-(``numba.set_num_threads``) fly at once. Each vehicle's arithmetic does not depend on the
+independent, so :func:`fly_vehicles` splits a batch into pieces that numba's number of
+threads (``numba.set_num_threads``) fly at once. Each vehicle's arithmetic does not depend on the
 batch it is in or the piece it falls in, so a batch reproduces single flights bit for bit.
 (A ``prange`` kernel would do the same, but numba's parallel passes on a body this size
 add about 6 s to the cold compile, and with one vehicle the idle OpenMP thread spins.)
@@ -247,9 +247,10 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
         ext = np.zeros(EXT_SIZE)
         work = np.empty((WORK_ROWS, STATE_SIZE))
         vpi, vci, gi, mpi, dpi, stdi = vp[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
-        # what changes every period is this vehicle's own copy, written back at the end:
-        # rows of neighbouring vehicles share cache lines, and threads flying neighbours
-        # would otherwise write to the same lines each period (false sharing)
+        # what changes every period is this vehicle's own copy (memories written back at the
+        # end; the generator's state is not returned): rows of neighbouring vehicles share
+        # cache lines, and threads flying neighbours would otherwise write to the same lines
+        # each period (false sharing)
         mi, dmi, rngi = mem[i].copy(), dmem[i].copy(), rng[i].copy()
         clipped_s = limited_s = 0.0
         max_position, max_speed, max_rate, max_tilt = limits[0], limits[1], limits[2], limits[3]
@@ -343,7 +344,6 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
         put_row(x_final, i, x)
         put_row(mem, i, mi)
         put_row(dmem, i, dmi)
-        put_row(rng, i, rngi)
         saturated[i, 0], saturated[i, 1] = clipped_s, limited_s
         status[i] = code
         t_stop[i] = t_end
