@@ -118,6 +118,24 @@ def test_early_stop_is_marked_and_explained(diverged):
     assert t_stop < time_axes[0].get_xlim()[1] < diverged.t[-1]
 
 
+@pytest.mark.parametrize("which", ["circle", "step", "diverged"])
+def test_plot_flight_panels_stay_inside_and_apart(which, request):
+    """The flight figure's grid is fixed, not found by a layout engine: each panel with its
+    tick labels, axis labels and legends stays inside the figure and clear of the others and
+    of the title (two lines when the flight stopped)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig = plot_flight(request.getfixturevalue(which))
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    fig.draw(renderer)
+    boxes = [ax.get_tightbbox(renderer) for ax in fig.axes] + [fig._suptitle.get_window_extent(renderer)]
+    frame = fig.bbox
+    for i, a in enumerate(boxes):
+        assert frame.x0 <= a.x0 and a.x1 <= frame.x1 and frame.y0 <= a.y0 and a.y1 <= frame.y1, (i, a, frame)
+        for j, b in enumerate(boxes[:i]):
+            assert not a.overlaps(b), (j, i, b, a)
+
+
 def test_nan_references_are_skipped(diverged):
     assert np.all(np.isnan(diverged.references))
     fig = plot_flight(diverged)

@@ -27,6 +27,11 @@ REF_STYLE = dict(color="k", ls="--", lw=1.0, label="reference")
 STOP_STYLE = dict(color="tab:red", ls=":", lw=1.5)
 
 
+FLIGHT_MARGINS = dict(left=0.05, right=0.86, bottom=0.055, top=0.92, wspace=0.32, hspace=0.14)
+"""The flight figure's grid in fractions of the figure, fixed rather than found by a
+layout engine: constrained layout draws the whole figure once more to measure it, which
+doubles the time to save it."""
+
 MAX_DRAWN = 3000
 """Figures draw at most this many instants of a flight (a 60 s flight at 1 kHz has 60,001):
 more are invisible at screen resolution and only slow the drawing down."""
@@ -149,12 +154,15 @@ def plot_flight(result, vehicle: int = 0, *, title: str | None = None) -> Figure
     """
     result = drawable(result)
     t = result.t
-    fig = Figure(figsize=(16, 10), layout="constrained")
-    gs = fig.add_gridspec(4, 3, width_ratios=(1.3, 1, 1), height_ratios=(1, 1, 1, 1.1))
+    fig = Figure(figsize=(16, 10))
+    # row 3 and column 1 are gaps: for the time axes' labels above the duties, and between
+    # the 3-D path's labels and the position panels' own
+    gs = fig.add_gridspec(5, 4, width_ratios=(1.3, 0.02, 1, 1), height_ratios=(1, 1, 1, 0.12, 1.1),
+                          **FLIGHT_MARGINS)
     _path3d(fig.add_subplot(gs[0:3, 0], projection="3d"), result, vehicle)
-    pos_axes = [fig.add_subplot(gs[0, 1])]
-    pos_axes += [fig.add_subplot(gs[i, 1], sharex=pos_axes[0]) for i in (1, 2)]
-    att_axes = [fig.add_subplot(gs[i, 2], sharex=pos_axes[0]) for i in range(3)]
+    pos_axes = [fig.add_subplot(gs[0, 2])]
+    pos_axes += [fig.add_subplot(gs[i, 2], sharex=pos_axes[0]) for i in (1, 2)]
+    att_axes = [fig.add_subplot(gs[i, 3], sharex=pos_axes[0]) for i in range(3)]
     closed_loop = any(_has(result.state(f"{n}_ref")[vehicle]) for n in "xyz")
     for ax, name, c in zip(pos_axes, "xyz", ("tab:blue", "tab:orange", "tab:green")):
         _time_panel(ax, t, result.state(name)[vehicle], result.state(f"{name}_ref")[vehicle],
@@ -164,7 +172,7 @@ def plot_flight(result, vehicle: int = 0, *, title: str | None = None) -> Figure
         sp = np.degrees(result.state(f"{name}_d")[vehicle]) if closed_loop else None
         _time_panel(ax, t, np.degrees(result.state(name)[vehicle]), sp, f"{label} [deg]", c,
                     label, min_span=2.0, ref_label="setpoint")
-    ax_u = fig.add_subplot(gs[3, :], sharex=pos_axes[0])
+    ax_u = fig.add_subplot(gs[4, :], sharex=pos_axes[0])
     _duties(ax_u, result, vehicle)
     stopped = int(result.status[vehicle]) != 0
     t_end = t[-1]
