@@ -6,6 +6,7 @@ Bad input prints one line, ``error: ...``, and exits with status 2.
 from __future__ import annotations
 
 import functools
+import gc
 import sys
 import warnings
 
@@ -384,7 +385,12 @@ def _mission(text: str, params: tuple[str, ...], smooth: bool):
 
 
 def run() -> None:
-    """Entry point: click's own usage errors become one line with exit status 2 too."""
+    """Entry point: click's own usage errors become one line with exit status 2 too.
+
+    The process ends here, so what it made is first moved out of the garbage collector's
+    sight (``gc.freeze``): the interpreter's last collection at exit would otherwise walk
+    every object that numba, pandas and matplotlib left, about 0.2 s.
+    """
     try:
         code = main(standalone_mode=False)
     except click.exceptions.UsageError as exc:
@@ -393,6 +399,8 @@ def run() -> None:
     except (click.exceptions.Abort, KeyboardInterrupt):
         click.echo("error: interrupted (a montecarlo sweep with --out resumes if run again)", err=True)
         sys.exit(130)
+    finally:
+        gc.freeze()
     sys.exit(code if isinstance(code, int) else 0)
 
 
