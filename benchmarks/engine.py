@@ -28,9 +28,9 @@ from machine import end_of_run, machine  # noqa: E402
 
 HZ = 1000.0          # control and integration rate of every benchmark [1/s]
 ROW_HZ = 100.0       # open-loop schedule: duties held for 10 ms per row
-FULL = dict(single_s=60.0, batch_n=2000, batch_s=10.0, repeats=5, min_s=2.0, warm_repeats=3,
+FULL = dict(single_s=60.0, batch_n=2000, batch_s=10.0, repeats=5, min_s=3.0, rounds=5, warm_repeats=3,
             scipy_single_s=60.0, scipy_batch_n=2000, scipy_batch_s=10.0, scipy_budget_s=60.0)
-QUICK = dict(single_s=2.0, batch_n=100, batch_s=1.0, repeats=2, min_s=0.0, warm_repeats=1,
+QUICK = dict(single_s=2.0, batch_n=100, batch_s=1.0, repeats=2, min_s=0.0, rounds=2, warm_repeats=1,
              scipy_single_s=0.5, scipy_batch_n=50, scipy_batch_s=0.1, scipy_budget_s=5.0)
 MAX_CALLS = 200      # a cap on the calls of one figure (a 60 s single flight takes ~20 ms)
 
@@ -53,27 +53,57 @@ def kernel_clock():
         engine.fly_vehicles = real
 
 
-def measure(prepare, n: int, duration: float, repeats: int, min_s: float = 0.0) -> tuple[dict, object]:
-    """``prepare(duration)`` gives a zero-argument call that flies n vehicles. Time a first
-    call of 10 steps (compilation or cache loading, plus the fixed cost), then full calls:
-    at least ``repeats``, and more until they have taken ``min_s`` seconds (at most
-    MAX_CALLS). The best call and the median, whole and compiled kernel alone (rates in
-    vehicle-steps/s)."""
-    with kernel_clock() as kern:
-        small, call = prepare(10 / HZ), prepare(duration)
-        t0 = time.perf_counter()
-        small()
-        first, skip, walls = time.perf_counter() - t0, len(kern), []
-        while len(walls) < repeats or (sum(walls) < min_s and len(walls) < MAX_CALLS):
-            t0 = time.perf_counter()
-            res = call()
-            walls.append(time.perf_counter() - t0)
-    if not res.ok.all():
-        raise RuntimeError(f"a benchmark flight stopped early: {res.status_text(int(np.argmin(res.ok)))}")
-    work, best, kbest = n * round(duration * HZ), min(walls), min(kern[skip:])
-    return {"vehicle_steps": work, "first_call_s": first, "best_s": best, "runs_s": walls,
-            "calls": len(walls), "rate": work / best, "median_rate": work / float(np.median(walls)),
-            "kernel_s": kbest, "kernel_rate": work / kbest}, res
+class Figure:
+    """The calls of one figure: ``prepare(duration)`` gives a zero-argument call that flies
+    n vehicles. A first call of 10 steps (compilation or cache loading, plus the fixed
+    cost) is timed apart; then full calls, taken in rounds by :meth:`round`."""
+
+    def __init__(self, prepare, n: int, duration: float):
+        self.small, self.call = prepare(10 / HZ), prepare(duration)
+        self.work = n * round(duration * HZ)
+        self.first, self.walls, self.kernel, self.result = None, [], [], None
+
+    def round(self, calls: int, seconds: float, cap: int) -> None:
+        """At least ``calls`` full calls, and more until they have taken ``seconds`` (at
+        most ``cap`` in this round)."""
+        with kernel_clock() as kern:
+            if self.first is None:
+                t0 = time.perf_counter()
+                self.small()
+                self.first = time.perf_counter() - t0
+                kern.clear()
+            spent = done = 0
+            while done < calls or (spent < seconds and done < cap):
+                t0 = time.perf_counter()
+                self.result = self.call()
+                self.walls.append(time.perf_counter() - t0)
+                spent, done = spent + self.walls[-1], done + 1
+        self.kernel += kern
+
+    def summary(self) -> dict:
+        """The best call and the median, whole and compiled kernel alone (rates in
+        vehicle-steps/s)."""
+        res = self.result
+        if not res.ok.all():
+            raise RuntimeError(f"a benchmark flight stopped early: {res.status_text(int(np.argmin(res.ok)))}")
+        best, kbest = min(self.walls), min(self.kernel)
+        return {"vehicle_steps": self.work, "first_call_s": self.first, "best_s": best, "runs_s": self.walls,
+                "calls": len(self.walls), "rate": self.work / best,
+                "median_rate": self.work / float(np.median(self.walls)), "kernel_s": kbest,
+                "kernel_rate": self.work / kbest}
+
+
+def measure(figures: dict, repeats: int, min_s: float = 0.0, rounds: int = 1) -> dict:
+    """Time ``figures`` (name -> Figure) in ``rounds`` rounds, each figure in turn within a
+    round: every figure makes at least ``repeats`` calls in all, and more until they have
+    taken ``min_s`` seconds (at most MAX_CALLS). Rounds spread each figure's calls over the
+    whole run, so that a slow spell of the host, which can last tens of seconds, meets
+    every figure's calls alike instead of deciding one figure. Returns name -> summary."""
+    calls, seconds, cap = -(-repeats // rounds), min_s / rounds, -(-MAX_CALLS // rounds)
+    for _ in range(rounds):
+        for fig in figures.values():
+            fig.round(calls, seconds, cap)
+    return {name: fig.summary() for name, fig in figures.items()}
 
 
 def masses(n: int) -> np.ndarray:
@@ -96,7 +126,7 @@ def open_loop_setup(duration: float, m: np.ndarray):
     return vp, x0, t_rows, u
 
 
-def bench_open_loop(duration: float, n: int, repeats: int, min_s: float = 0.0):
+def open_loop(n: int, duration: float) -> Figure:
     from quadcruise import simulate, time_grid
     from quadcruise.control.openloop import duty_schedule, pack_schedule
     from quadcruise.replay import no_reference
@@ -106,17 +136,15 @@ def bench_open_loop(duration: float, n: int, repeats: int, min_s: float = 0.0):
         grid, gains = time_grid(dur, 1.0 / HZ), pack_schedule(t_rows, u)
         return lambda: simulate(grid, x0, vp, duty_schedule, gains, no_reference, np.zeros(1),
                                 memory=np.zeros(1), max_step=1.0 / HZ, log_every=1000)
-    out, res = measure(prepare, n, duration, repeats, min_s)
-    return out, res.final_state
+    return Figure(prepare, n, duration)
 
 
-def bench_closed_loop(duration: float, n: int, repeats: int, min_s: float = 0.0):
+def closed_loop(n: int, duration: float) -> Figure:
     """The paper's controller on the default circle (R 2 m, 20 s a lap: 60 s is 3 laps)."""
     import quadcruise as qc
     vehicle = qc.Vehicle(m=masses(n)) if n > 1 else None
-    out, res = measure(lambda dur: lambda: qc.fly("circle", "nlpd", vehicle=vehicle, duration=dur,
-                                                  dt=1.0 / HZ, log_every=1000), n, duration, repeats, min_s)
-    return out, res.final_state
+    return Figure(lambda dur: lambda: qc.fly("circle", "nlpd", vehicle=vehicle, duration=dur,
+                                             dt=1.0 / HZ, log_every=1000), n, duration)
 
 
 def rhs_batch(x: np.ndarray, u: np.ndarray, m: np.ndarray, Jxx=0.03, Jyy=0.03, Jzz=0.04, l=0.2,
@@ -220,17 +248,17 @@ def row(label: str, value, unit: str, target=None, quick=False, note="") -> str:
 
 def engine_section(size: dict, quick: bool, r: dict, final: dict) -> None:
     print(f"\nquadcruise, RK4 at {HZ:g} Hz: vehicle-steps/s, best whole call of at least {size['repeats']}, "
-          f"repeated for {size['min_s']:g} s [compiled kernel alone] (median; calls);\n"
-          f"  first call = 10 steps, compile or cache load included")
+          f"repeated for {size['min_s']:g} s, in {size['rounds']} rounds taken in turn\n"
+          f"  [compiled kernel alone] (median; calls); first call = 10 steps, compile or cache load included")
     one, bn, bs = f"1 vehicle, {size['single_s']:g} s", f"{size['batch_n']} vehicles", f"{size['batch_s']:g} s"
-    for key, label, bench, n, dur, target in (
-            ("openloop_single", f"open loop, {one}", bench_open_loop, 1, size["single_s"], 3e6),
-            ("openloop_batch", f"open loop, {bn}, {bs}", bench_open_loop, size["batch_n"], size["batch_s"], 5e6),
-            ("closedloop_single", f"nlpd circle, {one}", bench_closed_loop, 1, size["single_s"], 2.5e6),
-            ("closedloop_batch", f"nlpd circle, {bn}, {bs}", bench_closed_loop, size["batch_n"], size["batch_s"],
-             5e6)):
-        d, final[key] = bench(dur, n, size["repeats"], size["min_s"])
-        r[key] = d
+    rows = (("openloop_single", f"open loop, {one}", open_loop, 1, size["single_s"], 3e6),
+            ("openloop_batch", f"open loop, {bn}, {bs}", open_loop, size["batch_n"], size["batch_s"], 5e6),
+            ("closedloop_single", f"nlpd circle, {one}", closed_loop, 1, size["single_s"], 2.5e6),
+            ("closedloop_batch", f"nlpd circle, {bn}, {bs}", closed_loop, size["batch_n"], size["batch_s"], 5e6))
+    figures = {key: make(n, dur) for key, _, make, n, dur, _ in rows}
+    r |= measure(figures, size["repeats"], size["min_s"], size["rounds"])
+    for key, label, *_, target in rows:
+        d, final[key] = r[key], figures[key].result.final_state
         print(row(label, d["rate"], "/s", target, quick,
                   f"  [{d['kernel_rate'] / 1e6:.2f} M]  ({d['median_rate'] / 1e6:.2f} M; {d['calls']})"
                   f"  first {d['first_call_s'] * 1e3:.1f} ms"))
@@ -290,7 +318,7 @@ def main(argv=None) -> int:
     import scipy
 
     info = machine(scipy=scipy.__version__) | {"import_s": import_s}
-    r: dict = {"call_overhead": bench_open_loop(10 / HZ, 1, 7)[0]}
+    r: dict = measure({"call_overhead": open_loop(1, 10 / HZ)}, 7)
     final: dict = {}
     print(f"quadcruise {info['quadcruise']} engine benchmark{' --quick' if args.quick else ''}\n"
           f"  {info['cpu']}, {info['cores']} cores, {info['numba_threads']} threads (numba's number); "
