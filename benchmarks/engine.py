@@ -53,7 +53,7 @@ def kernel_clock():
         engine.fly_vehicles = real
 
 
-class Figure:
+class Timing:
     """The calls of one figure: ``prepare(duration)`` gives a zero-argument call that flies
     n vehicles. A first call of 10 steps (compilation or cache loading, plus the fixed
     cost) is timed apart; then full calls, taken in rounds by :meth:`round`."""
@@ -94,7 +94,7 @@ class Figure:
 
 
 def measure(figures: dict, repeats: int, min_s: float = 0.0, rounds: int = 1) -> dict:
-    """Time ``figures`` (name -> Figure) in ``rounds`` rounds, each figure in turn within a
+    """Time ``figures`` (name -> Timing) in ``rounds`` rounds, each figure in turn within a
     round: every figure makes at least ``repeats`` calls in all, and more until they have
     taken ``min_s`` seconds (at most MAX_CALLS). Rounds spread each figure's calls over the
     whole run, so that a slow spell of the host, which can last tens of seconds, meets
@@ -126,7 +126,7 @@ def open_loop_setup(duration: float, m: np.ndarray):
     return vp, x0, t_rows, u
 
 
-def open_loop(n: int, duration: float) -> Figure:
+def open_loop(n: int, duration: float) -> Timing:
     from quadcruise import simulate, time_grid
     from quadcruise.control.openloop import duty_schedule, pack_schedule
     from quadcruise.replay import no_reference
@@ -136,14 +136,14 @@ def open_loop(n: int, duration: float) -> Figure:
         grid, gains = time_grid(dur, 1.0 / HZ), pack_schedule(t_rows, u)
         return lambda: simulate(grid, x0, vp, duty_schedule, gains, no_reference, np.zeros(1),
                                 memory=np.zeros(1), max_step=1.0 / HZ, log_every=1000)
-    return Figure(prepare, n, duration)
+    return Timing(prepare, n, duration)
 
 
-def closed_loop(n: int, duration: float) -> Figure:
+def closed_loop(n: int, duration: float) -> Timing:
     """The paper's controller on the default circle (R 2 m, 20 s a lap: 60 s is 3 laps)."""
     import quadcruise as qc
     vehicle = qc.Vehicle(m=masses(n)) if n > 1 else None
-    return Figure(lambda dur: lambda: qc.fly("circle", "nlpd", vehicle=vehicle, duration=dur,
+    return Timing(lambda dur: lambda: qc.fly("circle", "nlpd", vehicle=vehicle, duration=dur,
                                              dt=1.0 / HZ, log_every=1000), n, duration)
 
 
