@@ -225,24 +225,11 @@ def test_compiled_controller_makes_no_reference_count_calls(name):
     read their arrays into scalars first and write last, so their compiled body
     has none (only numba's Python-facing wrapper does). A fresh, uncached compile of the same
     Python function shows what the engine runs."""
-    import re
-
-    from numba import njit
+    from compiled_code import reference_count_calls
 
     from quadcruise.layout import CONTROLLER_SIG
 
-    fn = controller_from_name(name).function
-    fresh = njit(CONTROLLER_SIG, error_model="numpy")(fn.py_func)
-    ir = "".join(fresh.inspect_llvm().values())
-    calls = []
-    body = None
-    for line in ir.splitlines():
-        start = re.match(r'define [^@]*@"?([^"(]+)', line)
-        if start:
-            body = start.group(1)
-        elif "@NRT_incref" in line or "@NRT_decref" in line:
-            if "call " in line and not body.startswith("_ZN7cpython"):
-                calls.append(body)
+    calls = reference_count_calls(controller_from_name(name).function.py_func, CONTROLLER_SIG)
     assert calls == []
 
 

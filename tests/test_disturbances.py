@@ -390,18 +390,10 @@ def test_compiled_disturbance_makes_no_reference_count_calls():
     """The disturbance runs every period on every thread, on rows of arrays the batch
     shares: an NRT_incref/decref there is an atomic write to a shared counter. A fresh,
     uncached compile shows what the engine runs (only the Python-facing wrapper counts)."""
-    import re
+    from compiled_code import reference_count_calls
 
     from quadcruise.disturbances import environment_disturbance
     from quadcruise.layout import DISTURBANCE_SIG
 
-    fresh = njit(DISTURBANCE_SIG, error_model="numpy")(environment_disturbance.py_func)
-    body, calls = "", []
-    for line in "".join(fresh.inspect_llvm().values()).splitlines():
-        start = re.match(r'define [^@]*@"?([^"(]+)', line)
-        if start:
-            body = start.group(1)
-        elif ("@NRT_incref" in line or "@NRT_decref" in line) and "call " in line \
-                and not body.startswith("_ZN7cpython"):
-            calls.append(body)
+    calls = reference_count_calls(environment_disturbance.py_func, DISTURBANCE_SIG)
     assert calls == []
