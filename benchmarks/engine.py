@@ -23,8 +23,9 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
-from reference_model import rhs as reference_rhs  # noqa: E402
 from machine import end_of_run, machine  # noqa: E402
+
+from reference_model import rhs as reference_rhs  # noqa: E402
 
 HZ = 1000.0          # control and integration rate of every benchmark [1/s]
 ROW_HZ = 100.0       # open-loop schedule: duties held for 10 ms per row
@@ -39,7 +40,7 @@ MAX_CALLS = 200      # a cap on the calls of one figure (a 60 s single flight ta
 def kernel_clock():
     """Time each run of the compiled kernel (over all its threads) inside simulate()/fly()
     (list of seconds)."""
-    from quadcruise import engine
+    from quadcruise.sim import engine
     real, spent = engine.fly_vehicles, []
 
     def timed(*args):
@@ -129,7 +130,7 @@ def open_loop_setup(duration: float, m: np.ndarray):
 def open_loop(n: int, duration: float) -> Timing:
     from quadcruise import simulate, time_grid
     from quadcruise.control.openloop import duty_schedule, pack_schedule
-    from quadcruise.replay import no_reference
+    from quadcruise.workflows.replay import no_reference
 
     def prepare(dur):
         vp, x0, t_rows, u = open_loop_setup(dur, masses(n))

@@ -70,8 +70,8 @@ def end_of_run(info: dict) -> str:
 def _rk4_loop():
     """A compiled loop of RK4 steps of the plant, built on first use (after quadcruise is
     imported, so that importing this module does not import it)."""
-    from quadcruise.engine import TRIG_REFRESH, WORK_ROWS, rk4_step
     from quadcruise.layout import STATE_SIZE
+    from quadcruise.sim.engine import TRIG_REFRESH, WORK_ROWS, rk4_step
 
     @njit(error_model="numpy")
     def loop(x, u, vp, ext, steps):

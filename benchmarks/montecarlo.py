@@ -42,8 +42,8 @@ TARGET = dict(n=10_000, duration=60.0, seconds=180.0)
 
 def make_spec(duration: float):
     from quadcruise.disturbances import Environment, Turbulence, with_drag
+    from quadcruise.model.vehicle import Vehicle
     from quadcruise.montecarlo import MonteCarloSpec, Population
-    from quadcruise.params import Vehicle
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -69,13 +69,13 @@ def timed(call):
 
 def plain(spec, n: int):
     """All n vehicles in one batched fly call, logging the start and the end only."""
-    from quadcruise.sweep import fly_chunk
+    from quadcruise.montecarlo.sweep import fly_chunk
 
     return fly_chunk(spec, 0, n, log_every=spec.periods)[0]
 
 
 def sweep(spec, n: int, scheduler: str, workers: int | None):
-    from quadcruise.sweep import run_sweep
+    from quadcruise.montecarlo.sweep import run_sweep
 
     return run_sweep(spec, n, scheduler=scheduler, workers=workers)
 
@@ -92,7 +92,7 @@ def main(argv=None) -> int:
     n = args.n or (200 if args.quick else TARGET["n"])
     duration = args.duration or (5.0 if args.quick else TARGET["duration"])
 
-    from quadcruise.sweep import run_chunk
+    from quadcruise.montecarlo.sweep import run_chunk
 
     sources = {p: p.stat().st_mtime for p in (ROOT / "src" / "quadcruise").rglob("*.py")}
     import dask

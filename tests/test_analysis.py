@@ -13,17 +13,25 @@ from matplotlib.figure import Figure
 from numba import njit
 
 import quadcruise as qc
-from quadcruise.analysis import (
-    LOOPS, HoverError, bode, linearize, loop_margins, loop_transfer, report, summary, to_json,
-)
 from quadcruise.control.baselines import Gonzalez
-from quadcruise.control.design import (
-    cascade_state_space, loop_margins as design_margins, loop_transfer as design_loop, pd_from_poles,
-)
+from quadcruise.control.design import cascade_state_space, pd_from_poles
+from quadcruise.control.design import loop_margins as design_margins
+from quadcruise.control.design import loop_transfer as design_loop
 from quadcruise.control.position import NLPD
 from quadcruise.errors import InputError
 from quadcruise.layout import CONTROLLER_SIG
 from quadcruise.missions import Step
+from quadcruise.workflows.analysis import (
+    LOOPS,
+    HoverError,
+    bode,
+    linearize,
+    loop_margins,
+    loop_transfer,
+    report,
+    summary,
+    to_json,
+)
 
 
 @pytest.fixture(scope="module")

@@ -15,9 +15,24 @@ from quadcruise.control.baselines import COS_MAX_TILT, GONZALEZ_GAINS, MAX_TILT,
 from quadcruise.control.position import NLPD, nlpd
 from quadcruise.errors import InputError
 from quadcruise.layout import (
-    CMD_FLAGS, CMD_PHI_D, CMD_SIZE, CMD_THETA_D, F1, FLAG_TILT_LIMIT, P_G, P_M, REF_SIZE, REF_X, REF_Y, REF_Z, STATE_SIZE, VX, VY, Z,
+    CMD_FLAGS,
+    CMD_PHI_D,
+    CMD_SIZE,
+    CMD_THETA_D,
+    F1,
+    FLAG_TILT_LIMIT,
+    P_G,
+    P_M,
+    REF_SIZE,
+    REF_X,
+    REF_Y,
+    REF_Z,
+    STATE_SIZE,
+    VX,
+    VY,
+    Z,
 )
-from quadcruise.params import Vehicle
+from quadcruise.model.vehicle import Vehicle
 
 VP = Vehicle.paper().rows(1)[0].copy()
 

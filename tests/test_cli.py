@@ -1,9 +1,9 @@
 """The command line: fly, compare, analyze; outputs and one-line errors."""
 
 import json
-from pathlib import Path
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pandas as pd

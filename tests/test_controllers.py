@@ -13,8 +13,22 @@ from quadcruise.control.attitude import ATT_MEMORY, decoupled_attitude
 from quadcruise.control.design import PIDGains, attitude_pid_design, cascade_state_space, pd_from_poles
 from quadcruise.control.position import nlpd, phi_from_eq6, theta_from_eq5
 from quadcruise.layout import (
-    CMD_FLAGS, CMD_PHI_D, CMD_SIZE, CMD_THETA_D, CMD_THRUST, FLAG_TILT_LIMIT, P, PHI, PSI, Q, R,
-    REF_SIZE, REF_X, REF_Y, STATE_SIZE, THETA,
+    CMD_FLAGS,
+    CMD_PHI_D,
+    CMD_SIZE,
+    CMD_THETA_D,
+    CMD_THRUST,
+    FLAG_TILT_LIMIT,
+    PHI,
+    PSI,
+    REF_SIZE,
+    REF_X,
+    REF_Y,
+    STATE_SIZE,
+    THETA,
+    P,
+    Q,
+    R,
 )
 from quadcruise.missions import Circle, Hover, Step
 from quadcruise.model.plant import derivative
@@ -226,7 +240,6 @@ def test_compiled_controller_makes_no_reference_count_calls(name):
     has none (only numba's Python-facing wrapper does). A fresh, uncached compile of the same
     Python function shows what the engine runs."""
     from compiled_code import reference_count_calls
-
     from quadcruise.layout import CONTROLLER_SIG
 
     calls = reference_count_calls(controller_from_name(name).function.py_func, CONTROLLER_SIG)
@@ -240,7 +253,7 @@ def test_controller_sine_and_cosine_are_the_librarys_to_an_ulp():
 
     from numba import njit
 
-    from quadcruise.control.trig import QUARTER_PI, sin_cos
+    from quadcruise.sim.fastmath import QUARTER_PI, sin_cos
 
     @njit
     def both(a):

@@ -10,9 +10,18 @@ import pytest
 import scipy.signal
 
 from quadcruise.control.design import (
-    PAPER_POSITION_POLES, PDGains, PIDGains, altitude_pd_design, attitude_pid_design,
-    cascade_state_space, check_with_control, loop_margins, loop_transfer, pd_from_poles,
-    pid_from_poles, position_pd_design,
+    PAPER_POSITION_POLES,
+    PDGains,
+    PIDGains,
+    altitude_pd_design,
+    attitude_pid_design,
+    cascade_state_space,
+    check_with_control,
+    loop_margins,
+    loop_transfer,
+    pd_from_poles,
+    pid_from_poles,
+    position_pd_design,
 )
 from quadcruise.errors import InputError
 

@@ -12,17 +12,26 @@ from scipy.integrate import quad
 
 import quadcruise as qc
 from quadcruise.control.openloop import duty_schedule, pack_schedule
-from quadcruise.disturbances import (
-    DEFAULT_DRAG, MEMORY_SIZE, PARAMS_SIZE, ConstantWind, Environment, ExternalForce, Gust,
-    RotorLoss, SensorNoise, Turbulence, _lateral_coefficients, parse_wind, wind_from_name,
+from quadcruise.disturbances.environment import (
+    DEFAULT_DRAG,
+    MEMORY_SIZE,
+    PARAMS_SIZE,
+    ConstantWind,
+    Environment,
+    ExternalForce,
+    Gust,
+    RotorLoss,
+    SensorNoise,
+    Turbulence,
+    _lateral_coefficients,
+    parse_wind,
+    wind_from_name,
     with_drag,
 )
-from quadcruise.layout import (
-    EXT_E1, EXT_FX, EXT_SIZE, EXT_TX, EXT_WX, F1, PHI, PSI, STATE_SIZE, THETA, VX, VY, X, Y, Z,
-)
+from quadcruise.layout import EXT_E1, EXT_FX, EXT_SIZE, EXT_TX, EXT_WX, F1, PHI, PSI, STATE_SIZE, THETA, VX, VY, X, Y, Z
 from quadcruise.missions import Circle, Hover
-from quadcruise.replay import no_reference
-from quadcruise.rng import vehicle_states
+from quadcruise.sim.rng import vehicle_states
+from quadcruise.workflows.replay import no_reference
 
 V = qc.Vehicle.paper()
 
@@ -91,7 +100,7 @@ def test_per_vehicle_wind_speeds_give_different_flights_in_one_batch():
 
 def test_empty_environment_is_still_air_bit_for_bit():
     a = qc.fly("step", n=2, duration=3.0)
-    b = qc.fly("step", n=2, duration=3.0, **Environment().kwargs(2))
+    b = qc.fly("step", n=2, duration=3.0, environment=Environment())
     np.testing.assert_array_equal(a.states, b.states)
 
 
@@ -184,7 +193,7 @@ def test_turbulence_is_seeded_per_vehicle_and_independent_of_the_batching():
     env = Environment(turbulence=Turbulence(intensity="severe", altitude=2.0, airspeed=2.0))
 
     def flight(n=4, **kw):
-        return qc.fly("hover", vehicle=vehicle, n=n, duration=3.0, **env.kwargs(n), **kw)
+        return qc.fly("hover", vehicle=vehicle, n=n, duration=3.0, environment=env, **kw)
 
     a = flight(seed=5)
     np.testing.assert_array_equal(flight(seed=5).states, a.states)
@@ -202,7 +211,7 @@ def test_turbulence_is_seeded_per_vehicle_and_independent_of_the_batching():
 def test_nlpd_survives_moderate_turbulence_on_the_circle():
     n, vehicle = 8, quiet_drag()
     env = Environment(turbulence=Turbulence(intensity="moderate", altitude=1.0, airspeed=Circle().speed))
-    res = qc.fly("circle", "nlpd", vehicle=vehicle, n=n, seed=1, duration=40.0, **env.kwargs(n))
+    res = qc.fly("circle", "nlpd", vehicle=vehicle, n=n, seed=1, duration=40.0, environment=env)
     calm = qc.fly("circle", "nlpd", vehicle=vehicle, duration=40.0)
     assert res.ok.all() and res.duty_clipped_s.max() == 0
 
@@ -239,7 +248,7 @@ def test_nlpd_hover_after_losing_30_percent_of_rotor_1():
     which needs a steady x offset (~0.79 m); and the altitude PD, which believes the lost
     thrust is there, sags ~0.35 m. A larger i_limit removes the x offset, not the sag."""
     env = Environment(rotor_loss=RotorLoss(rotor=1, fraction=0.3, time=5.0))
-    res = qc.fly(Hover(), "nlpd", duration=30.0, **env.kwargs(1))
+    res = qc.fly(Hover(), "nlpd", duration=30.0, environment=env)
     s, t = res.states[0], res.t
     assert res.ok.all() and res.duty_clipped_s[0] == 0
     np.testing.assert_array_equal(s[t <= 5.0, :3], [[0.0, 0.0, 1.0]] * np.count_nonzero(t <= 5.0))
@@ -249,7 +258,7 @@ def test_nlpd_hover_after_losing_30_percent_of_rotor_1():
     assert s[-1, X] == pytest.approx(-0.79, abs=0.02) and abs(s[-1, Y]) < 1e-3
     assert 1.0 - s[-1, Z] == pytest.approx(0.35, abs=0.02)
     assert res.controller_limited_s[0] > 20                             # integrator held
-    wide = qc.fly(Hover(), qc.control.NLPD(i_limit=30.0), duration=30.0, **env.kwargs(1))
+    wide = qc.fly(Hover(), qc.control.NLPD(i_limit=30.0), duration=30.0, environment=env)
     assert abs(wide.final_state[0, X]) < 1e-3 and 1.0 - wide.final_state[0, Z] == pytest.approx(0.35, abs=0.02)
 
 
@@ -262,8 +271,13 @@ def test_sensor_noise_vector_and_delay():
     assert sn.kwargs(1e-3)["sensor_delay"] == 5
     batch = SensorNoise(position_std=np.array([0.0, 0.1, 0.2])).std_vector()
     assert batch.shape == (3, STATE_SIZE) and batch[2, Z] == 0.2
-    res = qc.fly("hover", n=3, duration=1.0, seed=2, sensor_std=batch, sensor_delay=5)
+    res = qc.fly("hover", n=3, duration=1.0, seed=2,
+                 sensors=SensorNoise(position_std=np.array([0.0, 0.1, 0.2]), delay=0.005))
     assert res.ok.all()
+    # a delay is a time: 4 ms is 2 periods at dt = 2 ms
+    assert SensorNoise(delay=0.004).kwargs(2e-3)["sensor_delay"] == 2
+    with pytest.raises(qc.InputError, match="sede"):
+        qc.fly("hover", sede=1)
     with pytest.raises(qc.InputError, match="delay"):
         SensorNoise(delay=0.0015).delay_periods(1e-3)
 
@@ -298,7 +312,7 @@ def test_parse_wind_grammar_and_round_trip():
     # without n, an unbatched environment gives one row that the engine hands every vehicle
     one = parse_wind("dryden:severe@2/1").kwargs()
     assert one["disturbance_params"].shape == (PARAMS_SIZE,) and one["disturbance_memory"].shape == (MEMORY_SIZE,)
-    res = qc.fly("hover", vehicle=quiet_drag(), n=2, duration=1.0, **one)
+    res = qc.fly("hover", vehicle=quiet_drag(), n=2, duration=1.0, environment=parse_wind("dryden:severe@2/1"))
     assert not np.allclose(res.states[0, :, X], res.states[1, :, X])
 
 
@@ -346,8 +360,8 @@ def test_bad_inputs_name_the_field():
 
 def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
     """The turbulence's normals are rng.next_normal's on the vehicle's scalar SplitMix64 state."""
-    from quadcruise.disturbances import _five_normals
-    from quadcruise.rng import _GOLDEN, next_normal, next_unit, uniform
+    from quadcruise.disturbances.environment import _five_normals
+    from quadcruise.sim.rng import _GOLDEN, next_normal, next_unit, uniform
     state = vehicle_states(4, 1)[0]
     s0 = int(state[0])
     expected = [uniform(state) for _ in range(3)]
@@ -370,7 +384,7 @@ def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
 def test_dryden_coefficients_follow_the_period_but_not_its_rounding():
     """Cached per period: a grid's rounding (1e-12 relative) keeps them, a new period
     (2 ms after 1 ms) recomputes them, as the exact discretisation of the new a = dt / T."""
-    from quadcruise.disturbances import DT_TOLERANCE, _CU, _CV, _MDT
+    from quadcruise.disturbances.environment import _CU, _CV, _MDT, DT_TOLERANCE
     tb = Turbulence(intensity="moderate", altitude=10.0, airspeed=5.0)
     env = Environment(turbulence=tb)
     dp, dm, rng = env.params(1)[0], env.memory(1)[0], vehicle_states(1, 1)[0]
@@ -391,7 +405,6 @@ def test_compiled_disturbance_makes_no_reference_count_calls():
     shares: an NRT_incref/decref there is an atomic write to a shared counter. A fresh,
     uncached compile shows what the engine runs (only the Python-facing wrapper counts)."""
     from compiled_code import reference_count_calls
-
     from quadcruise.disturbances import environment_disturbance
     from quadcruise.layout import DISTURBANCE_SIG
 

@@ -6,8 +6,9 @@ from scipy.integrate import solve_ivp
 
 import quadcruise as qc
 from quadcruise.control.openloop import duty_schedule, pack_schedule
+from quadcruise.disturbances import CustomDisturbance, SensorNoise
 from quadcruise.layout import F1, STATE_SIZE, X, Z
-from quadcruise.replay import no_reference
+from quadcruise.workflows.replay import no_reference
 from reference_model import rhs
 
 V = qc.Vehicle.paper()
@@ -60,7 +61,7 @@ def test_rk4_error_falls_sixteen_fold_when_step_halves():
 def test_turned_angles_equal_the_library_sine_and_cosine():
     import math
 
-    from quadcruise.engine import SHORT_TURN, SMALL_TURN, turned
+    from quadcruise.sim.engine import SHORT_TURN, SMALL_TURN, turned
 
     rng = np.random.default_rng(3)
     worst = 0.0
@@ -81,9 +82,9 @@ def test_rk4_step_equals_four_plain_derivative_calls():
     (fast rates use the library) as well as on slow turns."""
     import math
 
-    from quadcruise.engine import TRIG, WORK_ROWS, rk4_step
-    from quadcruise.layout import EXT_E1, EXT_SIZE, P, PHI, PSI, THETA
+    from quadcruise.layout import EXT_E1, EXT_SIZE, PHI, PSI, THETA, P
     from quadcruise.model.plant import derivative
+    from quadcruise.sim.engine import TRIG, WORK_ROWS, rk4_step
 
     vp = V.rows(1)[0]
     ext = np.zeros(EXT_SIZE)
@@ -167,7 +168,7 @@ def test_rows_after_a_stop_are_nan_and_the_rest_of_the_batch_flies_on(log_every)
     hover = np.tile(V.hover_duty * np.ones(4), (t.size, 1))
     grid = np.linspace(0, 10, 1001)
     mission = qc.missions.Hover()
-    x0 = qc.flight.hover_state(V, 2, mission)
+    x0 = qc.workflows.fly.hover_state(V, 2, mission)
     gains = np.stack([pack_schedule(t, spin), pack_schedule(t, hover)])
     res = qc.simulate(grid, x0, V.rows(2), duty_schedule, gains, mission.function, mission.params(),
                       memory=np.zeros(1), log_every=log_every, limits=qc.Limits(max_rate=50.0))
@@ -204,7 +205,7 @@ def test_a_nonfinite_state_stops_the_flight():
             ext[EXT_FX] = np.inf
 
     with pytest.warns(UserWarning, match="non-finite"):
-        res = qc.fly("hover", duration=1.0, disturbance=poisoned)
+        res = qc.fly("hover", duration=1.0, environment=CustomDisturbance(poisoned))
     assert res.status[0] == 1 and res.t_stop[0] == pytest.approx(0.251)
     assert "non-finite" in res.status_text(0)
 
@@ -214,14 +215,15 @@ def test_threads_and_pieces_do_not_change_a_batch():
     flights, noisy and turbulent ones included (each vehicle draws from its own stream)."""
     import numba
 
-    from quadcruise import engine
     from quadcruise.disturbances import Environment, Turbulence
+    from quadcruise.sim import engine
 
     masses = np.linspace(3.0, 4.0, 37)
     drag = dict(drag_linear=0.1, drag_quadratic=0.05)         # so that the turbulence acts
     vehicle = qc.Vehicle(m=masses, **drag)
     env = Environment(turbulence=Turbulence(intensity="severe", altitude=10.0))
-    kw = dict(vehicle=vehicle, duration=1.0, sensor_std=np.full(STATE_SIZE, 1e-3), seed=4, **env.kwargs(37))
+    noise = SensorNoise(position_std=1e-3, velocity_std=1e-3, angle_std=1e-3, rate_std=1e-3)
+    kw = dict(vehicle=vehicle, duration=1.0, sensors=noise, seed=4, environment=env)
     threads = numba.get_num_threads()
     try:
         numba.set_num_threads(1)
@@ -237,7 +239,7 @@ def test_threads_and_pieces_do_not_change_a_batch():
     ends = ("states", "commands", "memory", "disturbance_memory", "duty_clipped_s", "controller_limited_s")
     for name in ends:
         np.testing.assert_array_equal(getattr(one, name), getattr(many, name), err_msg=name)
-    single = qc.fly("circle", **(kw | dict(vehicle=qc.Vehicle(m=masses[20], **drag), first_vehicle=20, **env.kwargs(1))))
+    single = qc.fly("circle", **(kw | dict(vehicle=qc.Vehicle(m=masses[20], **drag), first_vehicle=20)))
     for name in ends:
         np.testing.assert_array_equal(getattr(single, name)[0], getattr(many, name)[20], err_msg=name)
     assert np.ptp(many.final_state[:, Z]) > 0.0

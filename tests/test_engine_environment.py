@@ -11,11 +11,25 @@ from scipy.spatial.transform import Rotation
 import quadcruise as qc
 from quadcruise.control.openloop import duty_schedule, pack_schedule
 from quadcruise.layout import (
-    CMD_PHI_D, CMD_THETA_D, CONTROLLER_SIG, DISTURBANCE_SIG, EXT_E1, EXT_SIZE, EXT_WX, F1, P,
-    PHI, PSI, R, STATE_SIZE, VX, X, Z,
+    CMD_PHI_D,
+    CMD_THETA_D,
+    CONTROLLER_SIG,
+    DISTURBANCE_SIG,
+    EXT_E1,
+    EXT_SIZE,
+    EXT_WX,
+    F1,
+    PHI,
+    PSI,
+    STATE_SIZE,
+    VX,
+    P,
+    R,
+    X,
+    Z,
 )
 from quadcruise.missions import Hover
-from quadcruise.replay import no_reference
+from quadcruise.workflows.replay import no_reference
 
 V = qc.Vehicle.paper()
 

@@ -10,12 +10,17 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from quadcruise import metrics
 from quadcruise.errors import InputError
 from quadcruise.metrics import (
-    StepInfo, control_effort, step_info, step_info_batch, time_in_saturation,
-    tracking_errors, transient_info,
+    StepInfo,
+    control_effort,
+    step_info,
+    step_info_batch,
+    time_in_saturation,
+    tracking_errors,
+    transient_info,
 )
+from quadcruise.metrics import flight as metrics
 
 # The linear design loop G = (5 s + 3.01) / (s^2 + 5 s + 3.01), poles -4.3 and -0.7.
 G = control.tf([5.0, 3.01], [1.0, 5.0, 3.01])

@@ -10,12 +10,21 @@ from numba import njit, types
 
 from quadcruise.errors import InputError
 from quadcruise.layout import (
-    MissionType, REF_AX, REF_AY, REF_AZ, REF_PSI, REF_PSI_DOT, REF_SIZE, REF_VX, REF_VY,
-    REF_VZ, REF_X, REF_Y, REF_Z,
+    REF_AX,
+    REF_AY,
+    REF_AZ,
+    REF_PSI,
+    REF_PSI_DOT,
+    REF_SIZE,
+    REF_VX,
+    REF_VY,
+    REF_VZ,
+    REF_X,
+    REF_Y,
+    REF_Z,
+    MissionType,
 )
-from quadcruise.missions import (
-    Circle, Hover, Square, Step, mission_from_dict, mission_from_name, stack_params,
-)
+from quadcruise.missions import Circle, Hover, Square, Step, mission_from_dict, mission_from_name, stack_params
 
 POS = [REF_X, REF_Y, REF_Z]
 VEL = [REF_VX, REF_VY, REF_VZ]

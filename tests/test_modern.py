@@ -13,22 +13,64 @@ import numpy as np
 import pytest
 
 import quadcruise as qc
-from quadcruise.compare import Comparison, compare
 from quadcruise.control import CONTROLLERS, controller_from_name
+from quadcruise.control.cascade import (
+    CASCADE_GAINS,
+    Cascade,
+    RateGains,
+    cascade,
+    constrain_xy,
+    rate_loops,
+    rate_pid_design,
+)
 from quadcruise.control.design import PDGains, PIDGains, cascade_state_space, loop_margins
-from quadcruise.control.modern import SE3, Cascade, RateGains, cascade, rate_loops, se3
-from quadcruise.control.px4 import CASCADE_GAINS, constrain_xy, rate_pid_design
+from quadcruise.control.se3 import SE3, se3
 from quadcruise.control.so3 import (
-    attitude_lee, attitude_px4, error_lee, error_quaternion, euler_zyx, limit_tilt, rotation_zyx,
+    attitude_lee,
+    attitude_px4,
+    error_lee,
+    error_quaternion,
+    euler_zyx,
+    limit_tilt,
+    rotation_zyx,
 )
 from quadcruise.layout import (
-    CMD_FLAGS, CMD_PHI_D, CMD_PSI_D, CMD_SIZE, CMD_TAU_PHI, CMD_TAU_PSI, CMD_TAU_THETA, CMD_THETA_D,
-    CMD_THRUST, F1, FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT, P, P_G, P_K1, P_K2, P_K3, P_K4, P_K5,
-    P_K6, P_M, PSI, Q, R, REF_PSI, REF_SIZE, REF_X, REF_Y, REF_Z, STATE_SIZE, Z,
+    CMD_FLAGS,
+    CMD_PHI_D,
+    CMD_PSI_D,
+    CMD_SIZE,
+    CMD_TAU_PHI,
+    CMD_TAU_PSI,
+    CMD_TAU_THETA,
+    CMD_THETA_D,
+    CMD_THRUST,
+    F1,
+    FLAG_THRUST_LIMIT,
+    FLAG_TILT_LIMIT,
+    P_G,
+    P_K1,
+    P_K2,
+    P_K3,
+    P_K4,
+    P_K5,
+    P_K6,
+    P_M,
+    PSI,
+    REF_PSI,
+    REF_SIZE,
+    REF_X,
+    REF_Y,
+    REF_Z,
+    STATE_SIZE,
+    P,
+    Q,
+    R,
+    Z,
 )
 from quadcruise.metrics import tracking_errors
 from quadcruise.missions import Circle, Hover, Step
 from quadcruise.model.actuators import mix
+from quadcruise.workflows.compare import Comparison, compare
 
 V = qc.Vehicle.paper()
 VP = V.rows(1)[0].copy()

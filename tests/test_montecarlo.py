@@ -13,14 +13,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from quadcruise.cli.montecarlo import montecarlo_command
 from quadcruise.disturbances import ConstantWind, Environment, SensorNoise, Turbulence, with_drag
 from quadcruise.errors import InputError, SimulationError
 from quadcruise.metrics import flight_metrics
-from quadcruise.montecarlo import (
-    COLUMNS, MonteCarloSpec, Population, montecarlo, montecarlo_case, montecarlo_command, replay_case,
-)
-from quadcruise.sweep import ProgressBar, fly_chunk, sweep_metrics
-from quadcruise.params import Vehicle
+from quadcruise.model.vehicle import Vehicle
+from quadcruise.montecarlo import MonteCarloSpec, Population, montecarlo, montecarlo_case, replay_case
+from quadcruise.montecarlo.chunk import fly_chunk, sweep_metrics
+from quadcruise.montecarlo.progress import ProgressBar
+from quadcruise.montecarlo.schema import COLUMNS
 
 POP = Population(mass_spread=0.15, inertia_spread=0.1, thrust_spread=0.1, bandwidth_spread=0.1,
                  yaw_arm_spread=0.1, offset=0.2)
@@ -179,7 +180,7 @@ def test_local_cluster_equals_in_process(reference, tmp_path):
 
 
 def test_the_local_cluster_runs_with_its_quiet_settings():
-    from quadcruise.sweep import LOCAL_CLUSTER_SETTINGS, _Dask
+    from quadcruise.montecarlo.sweep import LOCAL_CLUSTER_SETTINGS, _Dask
 
     runner = _Dask("local", 1, 10.0)
     try:
@@ -256,7 +257,7 @@ def test_a_folder_of_another_sweep_is_refused_unless_forced(reference, tmp_path)
 
 
 def test_auto_chunks_fit_the_memory_budget_and_split_evenly_over_threads():
-    from quadcruise.sweep import CHUNK_BUDGET, auto_chunk_size
+    from quadcruise.montecarlo.sweep import CHUNK_BUDGET, auto_chunk_size
 
     spec = MonteCarloSpec("circle", "nlpd", Population(), seed=1, duration=60.0, dt=1e-3)
     alone = auto_chunk_size(spec, 10_000)
@@ -271,8 +272,8 @@ def test_auto_chunks_fit_the_memory_budget_and_split_evenly_over_threads():
 def test_other_code_makes_another_sweep(reference, tmp_path, monkeypatch):
     """The spec hash covers the code: a folder flown by other code is not resumed, and a
     chunk from a worker running other code is refused, not mixed in."""
-    import quadcruise.mcspec as mcspec
-    from quadcruise.sweep import _Collector, run_chunk
+    import quadcruise.montecarlo.spec as mcspec
+    from quadcruise.montecarlo.sweep import _Collector, run_chunk
 
     ref, ref_out = reference
     spec = ref.spec

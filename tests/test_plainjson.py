@@ -1,4 +1,4 @@
-"""Every JSON document quadcruise writes is strict JSON (quadcruise.plainjson)."""
+"""Every JSON document quadcruise writes is strict JSON (quadcruise.io.plainjson)."""
 
 import json
 import math
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import quadcruise as qc
-from quadcruise.plainjson import dumps, plain
+from quadcruise.io.plainjson import dumps, plain
 
 
 def _strict(text):

@@ -14,11 +14,11 @@ import pytest
 from matplotlib.figure import Figure
 
 import quadcruise as qc
-from quadcruise import plots
-from quadcruise.flight import hover_state
 from quadcruise.layout import CMD_FLAGS
 from quadcruise.missions import Step
+from quadcruise.plots import flight as plots
 from quadcruise.plots import plot_envelope, plot_flight, plot_paths, save_figure
+from quadcruise.workflows.fly import hover_state
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

@@ -6,10 +6,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from click.testing import CliRunner
 
 import quadcruise as qc
 from quadcruise.cli import main
-from click.testing import CliRunner
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "pwm_step.csv"
 

@@ -1,4 +1,4 @@
-"""Tests of quadcruise.report (the self-contained HTML page) and quadcruise.animate.
+"""Tests of quadcruise.report (the self-contained HTML page) and quadcruise.plots.animate.
 
 The page is checked as text (no network reference, tables, images, 3-D views, the
 configuration) and in a real headless Chromium: its DOM after the scripts ran (no error
@@ -28,12 +28,20 @@ import pytest
 from PIL import Image
 
 import quadcruise as qc
-from quadcruise import animate, report
-from quadcruise.compare import compare
-from quadcruise.plainjson import dumps
-from quadcruise.report import (comparison_report, flight_report, html_report, markdown_html,
-                               reproduction_report, table_html, write_html_report)
-from quadcruise.reproduce import reproduce
+from quadcruise.io.plainjson import dumps
+from quadcruise.plots import animate
+from quadcruise.report import html as report
+from quadcruise.report.html import (
+    comparison_report,
+    flight_report,
+    html_report,
+    markdown_html,
+    reproduction_report,
+    table_html,
+    write_html_report,
+)
+from quadcruise.workflows.compare import compare
+from quadcruise.workflows.reproduce import reproduce
 
 CHROMIUM = os.environ.get("QUADCRUISE_CHROMIUM", "/usr/bin/chromium")
 FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",

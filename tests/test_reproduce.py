@@ -7,7 +7,7 @@ from click.testing import CliRunner
 
 from quadcruise import __version__
 from quadcruise.cli import main
-from quadcruise.reproduce import FIGURES, PAPER, SCENARIOS
+from quadcruise.workflows.reproduce import FIGURES, PAPER, SCENARIOS
 
 
 @pytest.fixture(scope="module")

@@ -6,10 +6,10 @@ import numpy as np
 from numba import njit
 from scipy import stats
 
-from quadcruise.rng import ZIGGURAT_R, ZIGGURAT_V, gauss, next_normal, vehicle_states, ziggurat_tables
+from quadcruise.sim.rng import ZIGGURAT_R, ZIGGURAT_V, gauss, next_normal, vehicle_states, ziggurat_tables
 
 
-@njit   # not cached: numba would not see a change in quadcruise.rng
+@njit   # not cached: numba would not see a change in quadcruise.sim.rng
 def _draws(n, s):
     out = np.empty(n)
     for k in range(n):

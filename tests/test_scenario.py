@@ -9,7 +9,7 @@ from click.testing import CliRunner
 
 import quadcruise as qc
 from quadcruise.cli import main
-from quadcruise.scenario import load_scenario
+from quadcruise.workflows.scenario import load_scenario
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -120,7 +120,7 @@ def test_disturbances_reach_the_flight_and_the_seed_makes_it_repeatable(tmp_path
     sc = load_scenario(EXAMPLES / "scenarios" / "circle_turbulence.toml")
     assert sc.environment.needs_drag and sc.sensor_noise is not None
     kw = sc.fly_kwargs()
-    assert kw["sensor_delay"] == 4 and kw["seed"] == 7 and "disturbance" in kw
+    assert kw["sensors"].delay == 0.004 and kw["seed"] == 7 and kw["environment"] is sc.environment
     a, b = sc.fly(), sc.fly()
     np.testing.assert_array_equal(a.states, b.states)
     calm = load_scenario(EXAMPLES / "scenarios" / "circle_paper.toml").fly()

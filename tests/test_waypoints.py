@@ -12,12 +12,15 @@ from scipy.linalg import null_space
 
 import quadcruise as qc
 from quadcruise.errors import InputError
-from quadcruise.layout import (
-    REF_AX, REF_AY, REF_AZ, REF_PSI, REF_PSI_DOT, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y, REF_Z,
-)
+from quadcruise.layout import REF_AX, REF_AY, REF_AZ, REF_PSI, REF_PSI_DOT, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y, REF_Z
 from quadcruise.missions import MISSIONS, mission_from_dict, mission_from_name, stack_params
-from quadcruise.waypoints import (
-    SETTLE_S, MinimumSnap, WaypointTable, Waypoints, minimum_snap_coefficients, read_waypoints_csv,
+from quadcruise.missions.waypoints import (
+    SETTLE_S,
+    MinimumSnap,
+    Waypoints,
+    WaypointTable,
+    minimum_snap_coefficients,
+    read_waypoints_csv,
 )
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "waypoints.csv"
@@ -271,7 +274,7 @@ def test_minsnap_has_less_snap_than_the_alternatives():
     naive = minimum_snap_coefficients(pts, tk, stops=np.ones(len(tk), bool))
     assert best < 0.5 * snap_integral(naive, tk)
     # 2. any feasible change of the coefficients (same points, C3, rest at the ends) adds snap
-    from quadcruise.waypoints import _derivative_row
+    from quadcruise.missions.waypoints import _derivative_row
     m_seg = len(tk) - 1
     rows = []
     for j in range(len(tk)):
@@ -332,7 +335,7 @@ def test_stack_pads_tables_of_different_lengths(cls):
     t = np.linspace(-1, 50, 301)
     for row, mission in zip(rows, (long, short)):
         out = np.empty((t.size, 11))
-        from quadcruise.missions import _evaluate
+        from quadcruise.missions.base import _evaluate
         _evaluate(cls.function, t, np.ascontiguousarray(row), out)
         np.testing.assert_array_equal(out, mission.reference(t))
     assert stack_params([short], n=3).shape == (3, short.params().size)

@@ -1,5 +1,5 @@
 """``python -m quadcruise`` runs the command line."""
 
-from .cli import run
+from quadcruise.cli.main import run
 
 run()

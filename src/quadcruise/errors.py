@@ -23,3 +23,32 @@ def whole_number(value, what: str, minimum: int = 0) -> int:
     if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
         raise InputError(f"{what} must be a whole number >= {minimum}, got {value!r}")
     return int(value)
+
+
+def reject_unknown(where: str, given: dict, known) -> None:
+    """InputError naming the first keyword of ``given`` (a ``**kwargs`` dict) and the choices.
+
+    Parameters
+    ----------
+    where : str
+        The function or table, e.g. ``"fly()"``.
+    given : dict
+        The keywords that no parameter took.
+    known : iterable of str
+        The keywords that are accepted.
+
+    Examples
+    --------
+    >>> reject_unknown("fly()", {"sede": 1}, ["seed", "dt"])
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: fly() has no option 'sede' (did you mean 'seed'?); options: dt, seed
+    """
+    if not given:
+        return
+    import difflib
+
+    name = sorted(given)[0]
+    close = difflib.get_close_matches(name, list(known), n=1)
+    hint = f" (did you mean '{close[0]}'?)" if close else ""
+    raise InputError(f"{where} has no option '{name}'{hint}; options: {', '.join(sorted(known))}")

@@ -104,6 +104,6 @@ EXT_SIZE = 13
 #: ``disturbance(t, dt, x, dp, dmem, rng, ext) -> None``: writes the external inputs held
 #: over [t, t + dt] into ext (EXT_SIZE). dp: its parameters; dmem: its state (e.g. the
 #: turbulence filters), kept between periods; rng: the vehicle's random generator state
-#: (see :mod:`quadcruise.rng`); x: the true state.
+#: (see :mod:`quadcruise.sim.rng`); x: the true state.
 DISTURBANCE_SIG = types.void(_f8, _f8, _vec, _vec, _vec, types.uint64[::1], _vec)
 DisturbanceType = types.FunctionType(DISTURBANCE_SIG)

@@ -21,21 +21,21 @@ import importlib
 from collections.abc import Mapping
 from typing import Any
 
-from ..errors import InputError
-from ..params import shared_default
-from .base import Controller
-from .position import NLPD
+from quadcruise.control.base import Controller
+from quadcruise.control.position import NLPD
+from quadcruise.errors import InputError
+from quadcruise.model.vehicle import shared_default
 
 
 class _Registry(Mapping):
     """Controller name -> class, importing each module on first use."""
 
-    _where = {"nlpd": (".position", "NLPD"), "gonzalez": (".baselines", "Gonzalez"),
-              "se3": (".modern", "SE3"), "cascade": (".modern", "Cascade")}
+    _where = {"nlpd": ("quadcruise.control.position", "NLPD"), "gonzalez": ("quadcruise.control.baselines", "Gonzalez"),
+              "se3": ("quadcruise.control.se3", "SE3"), "cascade": ("quadcruise.control.cascade", "Cascade")}
 
     def __getitem__(self, name: str) -> type[Controller]:
         module, attr = self._where[name]
-        return getattr(importlib.import_module(module, __name__), attr)
+        return getattr(importlib.import_module(module), attr)
 
     def __iter__(self):
         return iter(self._where)

@@ -25,7 +25,7 @@ import math
 
 from numba import njit
 
-from ..layout import FLAG_INTEGRATOR_HOLD, P, P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, PHI, PSI, Q, R, THETA
+from quadcruise.layout import FLAG_INTEGRATOR_HOLD, P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, PHI, PSI, THETA, P, Q, R
 
 # gains layout shared by every controller built on this loop (offsets into ``gains``)
 ATT_KP, ATT_KI, ATT_KD, YAW_KP, YAW_KI, YAW_KD, ATT_I_LIMIT = range(7)

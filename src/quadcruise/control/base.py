@@ -9,15 +9,24 @@ a function compiled with ``layout.CONTROLLER_SIG`` and these three members.
 from __future__ import annotations
 
 import dataclasses
+import math
 from typing import Any, ClassVar
 
 import numpy as np
 from numba import njit
 
-from ..layout import (
-    CMD_FLAGS, CMD_PHI_D, CMD_PSI_D, CMD_TAU_PHI, CMD_TAU_PSI, CMD_TAU_THETA, CMD_THETA_D, CMD_THRUST,
+from quadcruise.errors import InputError
+from quadcruise.layout import (
+    CMD_FLAGS,
+    CMD_PHI_D,
+    CMD_PSI_D,
+    CMD_TAU_PHI,
+    CMD_TAU_PSI,
+    CMD_TAU_THETA,
+    CMD_THETA_D,
+    CMD_THRUST,
 )
-from ..model.actuators import duties
+from quadcruise.model.actuators import duties
 
 
 @dataclasses.dataclass(frozen=True)
@@ -47,6 +56,27 @@ class Controller:
             value = getattr(self, f.name)
             out[f.name] = dataclasses.asdict(value) if dataclasses.is_dataclass(value) else value
         return out
+
+
+def check_positive(owner: str, **values: float) -> None:
+    """InputError naming the first of ``values`` that is not a finite number > 0."""
+    for name, value in values.items():
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise InputError(f"{owner} parameter '{name}' must be a positive number, got {value!r}")
+
+
+def check_type(owner: str, obj, names, cls) -> None:
+    """InputError unless each field ``names`` of ``obj`` is a ``cls``."""
+    for name in names:
+        if not isinstance(getattr(obj, name), cls):
+            raise InputError(f"{owner} parameter '{name}' must be {cls.__name__}, got {getattr(obj, name)!r}")
+
+
+def check_tilt(owner: str, max_tilt) -> None:
+    """InputError unless 0 < ``max_tilt`` < pi/2 [rad]."""
+    check_positive(owner, max_tilt=max_tilt)
+    if max_tilt >= math.pi / 2:
+        raise InputError(f"{owner} parameter 'max_tilt' must be below pi/2 rad, got {max_tilt!r}")
 
 
 @njit(cache=True, inline="always", error_model="numpy")

@@ -56,15 +56,33 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from ..errors import InputError
-from ..layout import (
-    CONTROLLER_SIG, P_G, P_K, P_M, PHI, REF_PSI, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y, REF_Z, THETA, VX, VY, VZ, X, Y, Z,
+from quadcruise.control.attitude import ATT_GAINS, ATT_MEMORY
+from quadcruise.control.base import Controller, check_positive
+from quadcruise.control.design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
+from quadcruise.control.position import attitude_block, finish, thrust_for_tilt, tilt_setpoint
+from quadcruise.errors import InputError
+from quadcruise.layout import (
+    CONTROLLER_SIG,
+    P_G,
+    P_K,
+    P_M,
+    PHI,
+    REF_PSI,
+    REF_VX,
+    REF_VY,
+    REF_VZ,
+    REF_X,
+    REF_Y,
+    REF_Z,
+    THETA,
+    VX,
+    VY,
+    VZ,
+    X,
+    Y,
+    Z,
 )
-from .attitude import ATT_GAINS, ATT_MEMORY
-from .base import Controller
-from .design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
-from .position import attitude_block, check_positive, finish, thrust_for_tilt, tilt_setpoint
-from .trig import sin_cos
+from quadcruise.sim.fastmath import sin_cos
 
 # gains layout after the attitude block
 KP_XY, KD_XY, SAT_P, SAT_D, KP_Z, KD_Z, MAX_TILT, COS_MAX_TILT = range(ATT_GAINS, ATT_GAINS + 8)

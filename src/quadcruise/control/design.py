@@ -20,10 +20,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
+from quadcruise.errors import InputError
 
 
-def _control():
+def python_control():
     """python-control, imported on first use (it costs about a second at start-up)."""
     import control
 
@@ -51,14 +51,14 @@ class _Gains:
 
     def controller(self):
         """C(s) from error to u: ``Kd s + Kp`` (PD) or ``(Kd s^2 + Kp s + Ki) / s`` (PID)."""
-        return _control().tf(self._char[1:], [1.0] + [0.0] * (len(self._char) - 3))
+        return python_control().tf(self._char[1:], [1.0] + [0.0] * (len(self._char) - 3))
 
     def closed_loop(self):
         """y/r with the law acting on the error, e.g. ``(Kd s + Kp) / (s^2 + Kd s + Kp)``."""
-        return _control().tf(self._char[1:], self._char)
+        return python_control().tf(self._char[1:], self._char)
 
 
-def _check_gains(obj, names) -> None:
+def check_gains(obj, names) -> None:
     for name in names:
         try:
             v = float(getattr(obj, name))
@@ -84,7 +84,7 @@ class PDGains(_Gains):
     kd: float
 
     def __post_init__(self):
-        _check_gains(self, ("kp", "kd"))
+        check_gains(self, ("kp", "kd"))
 
     @property
     def _char(self) -> np.ndarray:
@@ -120,7 +120,7 @@ class PIDGains(_Gains):
     kd: float
 
     def __post_init__(self):
-        _check_gains(self, ("kp", "ki", "kd"))
+        check_gains(self, ("kp", "ki", "kd"))
 
     @property
     def _char(self) -> np.ndarray:
@@ -295,12 +295,12 @@ def cascade_state_space(position: PDGains, attitude: PIDGains, actuator_bandwidt
     B = np.zeros((6, 1))
     B[4, 0] = w * kpa * kp / g
     B[5, 0] = kp / g
-    return _control().ss(A, B, e[:1], 0.0)
+    return python_control().ss(A, B, e[:1], 0.0)
 
 
 def loop_transfer(gains: PDGains | PIDGains, actuator_bandwidth: float | None = None):
     """Open loop L(s) = C(s) w/(s+w) / s^2 (without the lag factor when the bandwidth is None)."""
-    s = _control().tf("s")
+    s = python_control().tf("s")
     lag = 1 if actuator_bandwidth is None else actuator_bandwidth / (s + actuator_bandwidth)
     return gains.controller() * lag / s**2
 
@@ -317,8 +317,8 @@ def loop_margins(gains: PDGains | PIDGains, actuator_bandwidth: float | None = 1
     (83.2, inf, True)
     """
     L = loop_transfer(gains, actuator_bandwidth)
-    gm, pm, _, wpc, wgc, _ = _control().stability_margins(L)
-    stable = bool(np.all(_control().feedback(L, 1).poles().real < 0))
+    gm, pm, _, wpc, wgc, _ = python_control().stability_margins(L)
+    stable = bool(np.all(python_control().feedback(L, 1).poles().real < 0))
     return {"gain_margin": float(gm), "phase_margin": float(pm), "phase_crossover": float(wpc),
             "gain_crossover": float(wgc), "stable": stable}
 
@@ -340,15 +340,15 @@ def check_with_control(gains: PDGains | PIDGains) -> dict:
     """
     n = len(gains._char) - 1
     A, B = np.eye(n, k=1), np.eye(n)[:, -1:]
-    sys = _control().ss(A, B, np.eye(n)[-2:-1], 0)
+    sys = python_control().ss(A, B, np.eye(n)[-2:-1], 0)
     poles = gains.poles
     try:
-        K = np.asarray(_control().place(sys.A, sys.B, poles)).ravel()
+        K = np.asarray(python_control().place(sys.A, sys.B, poles)).ravel()
     except ValueError:
-        K = np.asarray(_control().acker(sys.A, sys.B, poles)).ravel()
+        K = np.asarray(python_control().acker(sys.A, sys.B, poles)).ravel()
     want = gains._char[:0:-1]
     cl = np.linalg.eigvals(sys.A - sys.B @ K[None, :])
     dist = np.abs(cl[:, None] - poles[None, :])
     return {"place_gain": K, "gain_error": float(np.max(np.abs(K - want)) / np.max(np.abs(want))),
             "closed_loop_poles": cl, "pole_error": float(max(dist.min(0).max(), dist.min(1).max())),
-            "step_info": _control().step_info(gains.closed_loop())}
+            "step_info": python_control().step_info(gains.closed_loop())}

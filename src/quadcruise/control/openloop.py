@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..layout import CMD_FLAGS
+from quadcruise.layout import CMD_FLAGS
 
 
 @njit(cache=True)     # compiled (as CONTROLLER_SIG) on first use, not at import

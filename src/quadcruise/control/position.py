@@ -38,19 +38,51 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
-from ..errors import InputError
-from ..layout import (
-    CONTROLLER_SIG, FLAG_ASIN_CLIP, FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT, P_D, P_G,
-    P_K, P_M, PHI, PSI, REF_AX, REF_AY, REF_AZ, REF_PSI, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y,
-    REF_Z, THETA, VX, VY, VZ, X, Y, Z,
-)
-from .attitude import (
-    ATT_GAINS, ATT_I_LIMIT, ATT_KD, ATT_KI, ATT_KP, ATT_MEMORY, YAW_KD, YAW_KI, YAW_KP,
+from quadcruise.control.attitude import (
+    ATT_GAINS,
+    ATT_I_LIMIT,
+    ATT_KD,
+    ATT_KI,
+    ATT_KP,
+    ATT_MEMORY,
+    YAW_KD,
+    YAW_KI,
+    YAW_KP,
     decoupled_attitude,
 )
-from .base import Controller, write_command
-from .design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
-from .trig import sin_cos
+from quadcruise.control.base import Controller, check_positive, write_command
+from quadcruise.control.design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
+from quadcruise.errors import InputError
+from quadcruise.layout import (
+    CONTROLLER_SIG,
+    FLAG_ASIN_CLIP,
+    FLAG_THRUST_LIMIT,
+    FLAG_TILT_LIMIT,
+    P_D,
+    P_G,
+    P_K,
+    P_M,
+    PHI,
+    PSI,
+    REF_AX,
+    REF_AY,
+    REF_AZ,
+    REF_PSI,
+    REF_VX,
+    REF_VY,
+    REF_VZ,
+    REF_X,
+    REF_Y,
+    REF_Z,
+    THETA,
+    VX,
+    VY,
+    VZ,
+    X,
+    Y,
+    Z,
+)
+from quadcruise.sim.fastmath import sin_cos
 
 # gains layout after the attitude block
 # (COS_MAX_TILT and SIN_MAX_TILT are cos and sin of MAX_TILT, so the step calls neither)
@@ -191,12 +223,6 @@ def attitude_block(attitude: PIDGains, yaw: PIDGains, i_limit: float) -> list[fl
     block[YAW_KP], block[YAW_KI], block[YAW_KD] = yaw.kp, yaw.ki, yaw.kd
     block[ATT_I_LIMIT] = i_limit
     return block
-
-
-def check_positive(owner: str, **values: float) -> None:
-    for name, value in values.items():
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            raise InputError(f"{owner} parameter '{name}' must be a positive number, got {value!r}")
 
 
 @dataclass(frozen=True)

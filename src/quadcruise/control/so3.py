@@ -27,7 +27,7 @@ import math
 
 from numba import njit
 
-from .base import write_command
+from quadcruise.control.base import write_command
 
 
 @njit(cache=True, error_model="numpy")

@@ -43,14 +43,54 @@ import math
 
 from numba import njit
 
-from ..layout import (
-    EXT_E1, EXT_E2, EXT_E3, EXT_E4, EXT_FX, EXT_FY, EXT_FZ, EXT_TX, EXT_TY, EXT_TZ, EXT_WX,
-    EXT_WY, EXT_WZ, P_CD1, P_CD2,
-    F1, F2, F3, F4, P, PHI, PSI, Q, R, THETA, VX, VY, VZ, X, Y, Z,
-    P_D, P_G, P_INV_JXX, P_INV_JYY, P_INV_JZZ, P_INV_M, P_K, P_K1, P_K2, P_K3, P_K4, P_K5, P_K6,
+from quadcruise.layout import (
+    EXT_E1,
+    EXT_E2,
+    EXT_E3,
+    EXT_E4,
+    EXT_FX,
+    EXT_FY,
+    EXT_FZ,
+    EXT_TX,
+    EXT_TY,
+    EXT_TZ,
+    EXT_WX,
+    EXT_WY,
+    EXT_WZ,
+    F1,
+    F2,
+    F3,
+    F4,
+    P_CD1,
+    P_CD2,
+    P_D,
+    P_G,
+    P_INV_JXX,
+    P_INV_JYY,
+    P_INV_JZZ,
+    P_INV_M,
+    P_K,
+    P_K1,
+    P_K2,
+    P_K3,
+    P_K4,
+    P_K5,
+    P_K6,
     P_OMEGA,
+    PHI,
+    PSI,
+    THETA,
+    VX,
+    VY,
+    VZ,
+    P,
+    Q,
+    R,
+    X,
+    Y,
+    Z,
 )
-from .actuators import mix
+from quadcruise.model.actuators import mix
 
 
 @njit(cache=True, error_model="numpy")
@@ -71,7 +111,7 @@ def derivative(x, u, vp, ext, full, dx):
 @njit(cache=True, inline="always", error_model="numpy")
 def derivative_at(x, sphi, cphi, sth, cth, spsi, cpsi, u, vp, ext, full, dx):
     """:func:`derivative` given the sines and cosines of the state's phi, theta and psi (the
-    integrator carries them from one RK4 stage to the next: :func:`quadcruise.engine.rk4_step`)."""
+    integrator carries them from one RK4 stage to the next: :func:`quadcruise.sim.engine.rk4_step`)."""
     inv_m = vp[P_INV_M]                          # 1/m and 1/J come with the row: no division
     p, q, r = x[P], x[Q], x[R]
     U1, U2, U3, U4 = mix(x[F1], x[F2], x[F3], x[F4], vp[P_D])             # (1)-(4)

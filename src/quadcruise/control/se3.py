@@ -1,0 +1,186 @@
+"""State-of-the-art controllers on the paper's plant: geometric control on SE(3) and a
+PX4-style cascade, both flying the same model, missions and engine as ``nlpd``.
+
+``se3`` (:class:`SE3`): Lee, Leok and McClamroch, "Geometric tracking control of a quadrotor
+UAV on SE(3)", CDC 2010, in the form RotorPy and crazyflow fly it. With e = ref - actual::
+
+    F = m (kx e_x + kv e_v + a_ref + g e3)           desired force, earth frame [N]
+    b3_d = F / |F|,  b1_d from the yaw reference,    R_d = [b1_d, b2_d, b3_d]
+    U1 = F . R e3                                    thrust along the current b3 [N]
+    e_R = vee(R_d^T R - R^T R_d) / 2,  e_w = w - R^T R_d w_d,  w_d = 0
+    M = J (-kR e_R - kw e_w) + w x J w               moments, body frame [N m]
+    U2 = M_x / l,  U3 = M_y / l,  U4 = M_z
+
+R = Rz(psi) Ry(theta) Rx(phi) from the state's angles (so R e3 is eqs 5-7's thrust
+direction), w = (p, q, r) the state's body rates. w_d = 0: the missions' yaw references are
+holds and steps (no yaw rate) and the rate of a tilting R_d is left out, as RotorPy does by
+default. kR and kw multiply the inertia (RotorPy's form), i.e. they are per unit inertia; the
+w x J w term cancels the gyroscopic terms of eq (11) exactly, so J w' = J (-kR e_R - kw w).
+Added to Lee's law: the horizontal part of F is scaled down to keep b3_d within ``max_tilt``
+(FLAG_TILT_LIMIT) and U1 is limited to [0, 4 K] (FLAG_THRUST_LIMIT); neither acts in the
+default missions.
+
+Gain rule, for a fair comparison with ``nlpd``: kx, kv place the paper's position poles
+(-0.7, -4.3: kx = 3.01 1/s^2, kv = 5.0 1/s), and so do the altitude gains; kR, kw put each
+attitude axis (a double integrator per unit inertia behind the 15 rad/s rotor lag) at the
+attitude design's pair wn = 0.6 w = 9 rad/s, zeta = 0.8: kR = 81 1/s^2, kw = 14.4 1/s
+(:func:`se3_attitude_design`; ``nlpd``'s attitude PID without its slow integrator). With
+the rotor lag each attitude axis keeps a 26 deg phase margin at a 12.3 rad/s crossover.
+
+``cascade`` (:class:`Cascade`): PX4's multicopter cascade, P position -> PID velocity -> P
+attitude -> PID body rate; the law is in :mod:`quadcruise.control.cascade`. Its gains are
+PX4's defaults where they are in SI units; the rate gains, which PX4 gives in normalized
+torque, are designed for this vehicle's rotor lag (:func:`rate_pid_design`).
+
+Examples
+--------
+>>> import quadcruise as qc
+>>> from quadcruise.control.cascade import Cascade
+>>> res = qc.fly("step", Cascade(), duration=12.0)
+>>> bool(abs(res.final_state[0, 0] - 1.0) < 0.02)
+True
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numba import njit
+
+from quadcruise.control.base import Controller, check_positive, check_tilt, check_type
+from quadcruise.control.design import ATTITUDE_WN_RATIO, ATTITUDE_ZETA, PDGains, altitude_pd_design, position_pd_design
+from quadcruise.control.so3 import attitude_lee, clamp, command_from_rotation, error_lee, limit_tilt, rotation_zyx
+from quadcruise.layout import (
+    CONTROLLER_SIG,
+    FLAG_THRUST_LIMIT,
+    FLAG_TILT_LIMIT,
+    P_D,
+    P_G,
+    P_JXX,
+    P_JYY,
+    P_JZZ,
+    P_K,
+    P_L,
+    P_M,
+    PHI,
+    PSI,
+    REF_AX,
+    REF_AY,
+    REF_AZ,
+    REF_PSI,
+    REF_VX,
+    REF_VY,
+    REF_VZ,
+    REF_X,
+    REF_Y,
+    REF_Z,
+    THETA,
+    VX,
+    VY,
+    VZ,
+    P,
+    Q,
+    R,
+    X,
+    Y,
+    Z,
+)
+
+__all__ = ["SE3", "se3", "se3_attitude_design"]
+
+# gains layout of se3
+KX, KV, KX_Z, KV_Z, K_R, K_W, SE3_MAX_TILT = range(7)
+
+
+@njit(CONTROLLER_SIG, cache=True, error_model="numpy")
+def se3(t, dt, x, ref, vp, gains, mem, cmd):
+    """Geometric tracking control on SE(3) (Lee et al. 2010), moments per unit inertia."""
+    # every array entry is read first and the command written last: no reference counting
+    phi, theta, psi, p, q, r = x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R]
+    m, g, K, l, d = vp[P_M], vp[P_G], vp[P_K], vp[P_L], vp[P_D]
+    jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
+    kx, kv, kx_z, kv_z = gains[KX], gains[KV], gains[KX_Z], gains[KV_Z]
+    kr, kw, max_tilt = gains[K_R], gains[K_W], gains[SE3_MAX_TILT]
+    psi_d = ref[REF_PSI]
+    fx = m * (kx * (ref[REF_X] - x[X]) + kv * (ref[REF_VX] - x[VX]) + ref[REF_AX])
+    fy = m * (kx * (ref[REF_Y] - x[Y]) + kv * (ref[REF_VY] - x[VY]) + ref[REF_AY])
+    fz = m * (kx_z * (ref[REF_Z] - x[Z]) + kv_z * (ref[REF_VZ] - x[VZ]) + ref[REF_AZ] + g)
+    fx, fy, tilted = limit_tilt(fx, fy, fz, max_tilt)
+    flags = FLAG_TILT_LIMIT if tilted else 0
+    Rm = rotation_zyx(phi, theta, psi)
+    n = math.sqrt(fx * fx + fy * fy + fz * fz) if fz > 0.0 else 0.0
+    if n > 0.0:
+        Rd = attitude_lee(fx / n, fy / n, fz / n, psi_d)
+    else:                                                  # F points down: b3_d = e3, U1 -> 0
+        Rd = attitude_lee(0.0, 0.0, 1.0, psi_d)
+    U1, limited = clamp(fx * Rm[0][2] + fy * Rm[1][2] + fz * Rm[2][2], 0.0, 4.0 * K)
+    if limited:
+        flags |= FLAG_THRUST_LIMIT
+    ex, ey, ez = error_lee(Rm, Rd)
+    mx = -jx * (kr * ex + kw * p) + (jz - jy) * q * r          # + (w x J w)_x
+    my = -jy * (kr * ey + kw * q) + (jx - jz) * p * r
+    mz = -jz * (kr * ez + kw * r) + (jy - jx) * p * q
+    command_from_rotation(U1, mx / l, my / l, mz, Rd, flags, d, K, cmd)
+
+
+def se3_attitude_design(actuator_bandwidth: float = 15.0) -> PDGains:
+    """kR = wn^2 [1/s^2], kw = 2 zeta wn [1/s] per unit inertia at the attitude design's
+    wn = 0.6 w, zeta = 0.8 (see :func:`quadcruise.control.design.attitude_pid_design`).
+
+    >>> from quadcruise.control.design import loop_margins
+    >>> g = se3_attitude_design()
+    >>> round(g.kp, 6), round(g.kd, 6), round(loop_margins(g, 15.0)["phase_margin"], 1)
+    (81.0, 14.4, 26.1)
+    """
+    check_positive("se3_attitude_design", actuator_bandwidth=actuator_bandwidth)
+    wn = ATTITUDE_WN_RATIO * actuator_bandwidth
+    return PDGains(kp=wn * wn, kd=2.0 * ATTITUDE_ZETA * wn)
+
+
+@dataclass(frozen=True)
+class SE3(Controller):
+    """Geometric tracking control on SE(3) (Lee, Leok, McClamroch 2010).
+
+    Parameters
+    ----------
+    position : PDGains
+        kx (kp) [1/s^2] and kv (kd) [1/s] of x and y, per unit mass; the paper's poles.
+    altitude : PDGains
+        the same for z; the paper's poles.
+    attitude : PDGains
+        kR (kp) [1/s^2] and kw (kd) [1/s] per unit inertia, all three axes; 81 and 14.4.
+    max_tilt : float
+        largest angle of b3_d from the vertical [rad]; 45 degrees.
+
+    Examples
+    --------
+    >>> c = SE3()
+    >>> c.gains().round(3).tolist()
+    [3.01, 5.0, 3.01, 5.0, 81.0, 14.4, 0.785]
+    >>> SE3(max_tilt=-1.0)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: se3 parameter 'max_tilt' must be a positive number, got -1.0
+    """
+
+    name = "se3"
+    memory_size = 0
+
+    position: PDGains = field(default_factory=position_pd_design)
+    altitude: PDGains = field(default_factory=altitude_pd_design)
+    attitude: PDGains = field(default_factory=se3_attitude_design)
+    max_tilt: float = math.radians(45.0)
+
+    def __post_init__(self) -> None:
+        check_type(self.name, self, ("position", "altitude", "attitude"), PDGains)
+        check_tilt(self.name, self.max_tilt)
+
+    @property
+    def function(self):
+        return se3
+
+    def gains(self) -> np.ndarray:
+        return np.array([self.position.kp, self.position.kd, self.altitude.kp, self.altitude.kd,
+                         self.attitude.kp, self.attitude.kd, self.max_tilt])

@@ -1,0 +1,561 @@
+"""Disturbances: wind (constant, 1 - cosine gust, Dryden turbulence), rotor loss, external
+force and torque, sensor noise; batched (any numeric field may hold one value per vehicle)
+and seeded through the engine's per-vehicle generator.
+
+:class:`Environment` hands the engine ONE compiled disturbance with a flat parameter row per
+vehicle (absent parts are off by a 0/1 column). Each period [t, t + dt] it writes into ext:
+the force (earth frame) and torque (body frame) of :class:`ExternalForce`; the wind (earth
+frame) = :class:`ConstantWind` + :class:`Gust` + :class:`Turbulence`, which acts only through
+the vehicle's drag -(c1 + c2 |v - w|)(v - w) (the paper's vehicle has none: :func:`with_drag`);
+and the rotor effectiveness (:class:`RotorLoss`). t is the period's start; ext is held over it.
+
+- Gust: w = (A/2)(1 - cos(2 pi (t - start)/duration)) for start <= t <= start + duration, else
+  0: MIL-F-8785C's 1 - cosine rise (A/2)(1 - cos(pi x/d_m)) with the gust length d_m covered in
+  duration/2 (peak A at start + duration/2), then mirrored back to 0 (the full 1 - cosine gust).
+- Turbulence: Dryden, MIL-F-8785C low altitude (h in ft, < 1000 ft; below 10 ft taken as 10 ft,
+  as MATLAB's Dryden block does; w20 = 15/30/45 kt for light/moderate/severe):
+  L_w = h, L_u = L_v = h/(0.177 + 0.000823 h)^1.2, sigma_w = 0.1 w20,
+  sigma_u = sigma_v = sigma_w/(0.177 + 0.000823 h)^0.4; forming filters
+  H_u = sigma_u sqrt(2 L_u/(pi V))/(1 + T_u s), H_v,w = sigma sqrt(L/(pi V))(1 + sqrt3 T s)/(1 + T s)^2,
+  T = L/V, V = max(airspeed, 0.5 m/s) (the transport speed of the frozen field, meaningless at
+  V -> 0, hence the floor). Axes u, v, w = earth x, y, z (fine for hover and slow cruise).
+  Discretised EXACTLY per period: the filter states advance by exp(A dt) plus Gaussian noise
+  with the covariance the continuous white noise builds up over dt, so the samples have the
+  variance sigma^2 and the correlations sigma_u^2 exp(-V tau/L_u), sigma^2 (1 - V tau/(2L))
+  exp(-V tau/L) of the continuous process, at any dt. The states, in the disturbance memory,
+  start from the stationary distribution (drawn on the first period): no warm-up.
+- Rotor loss: e_rotor = 1 - fraction from the first period that starts at t >= time.
+
+Examples
+--------
+>>> import quadcruise as qc
+>>> from quadcruise.disturbances import DEFAULT_DRAG, Environment, Gust, Turbulence, parse_wind
+>>> env = parse_wind("constant:2,0,0,dryden:light@5/1")
+>>> sorted(env.kwargs(3)), env.params(3).shape, env.needs_drag
+(['disturbance', 'disturbance_memory', 'disturbance_params'], (3, 25), True)
+>>> [round(s, 3) for s in Turbulence(intensity="moderate", altitude=10.0).sigmas()]
+[2.915, 2.915, 1.543]
+>>> vehicle = qc.Vehicle.paper().replace(**DEFAULT_DRAG)     # wind needs drag to act
+>>> res = qc.fly("hover", vehicle=vehicle, n=3, duration=2.0, seed=1, environment=env)
+>>> res.ok.tolist(), bool(res.states[0, -1, 0] != res.states[1, -1, 0])
+([True, True, True], True)
+>>> three = Environment(gust=Gust(amplitude=([1.0, 2.0, 3.0], 0.0, 0.0), start=1.0, duration=2.0))
+>>> three.batch_size, three.params()[:, 10].tolist()    # one gust peak per vehicle
+(3, [1.0, 2.0, 3.0])
+>>> parse_wind("gust:2,0@5+2")
+Traceback (most recent call last):
+    ...
+quadcruise.errors.InputError: wind spec 'gust:2,0@5+2': needs 3 values AX,AY,AZ, got '2,0'
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+import warnings
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from quadcruise.errors import InputError
+from quadcruise.fields import (
+    unit_field as _f,  # a field with unit, doc and check (here: real, nonneg, pos, frac, rotor, vec)
+)
+from quadcruise.layout import DISTURBANCE_SIG, EXT_E1, EXT_FX, EXT_WX, PHI, STATE_SIZE, VX, P, X
+from quadcruise.model.vehicle import Vehicle
+from quadcruise.sim.rng import ziggurat
+
+__all__ = ["ConstantWind", "Gust", "Turbulence", "RotorLoss", "ExternalForce", "Environment",
+           "SensorNoise", "DEFAULT_DRAG", "with_drag", "wind_from_name", "parse_wind",
+           "environment_disturbance", "PARAMS_SIZE", "MEMORY_SIZE"]
+
+KNOT = 0.514444                      # m/s
+FOOT = 0.3048                        # m
+INTENSITIES = {"light": 15.0 * KNOT, "moderate": 30.0 * KNOT, "severe": 45.0 * KNOT}
+AIRSPEED_FLOOR = 0.5                 # m/s
+
+#: Drag estimates for a Qball-X4-sized vehicle (assumptions, not measurements): quadratic
+#: 0.5 rho Cd A with rho = 1.225 kg/m^3, Cd ~ 1 (bluff frame and cage), A ~ 0.1 m^2 frontal
+#: area -> 0.06 N s^2/m^2; linear rotor drag (the induced drag of the rotors, linear in the
+#: air-relative velocity: Martin and Salaun, ICRA 2010) ~ 0.3 N s/m, i.e. c1/m ~ 0.09 1/s;
+#: an order-of-magnitude guess, not measured on the Qball-X4.
+DEFAULT_DRAG = {"drag_linear": 0.3, "drag_quadratic": 0.5 * 1.225 * 1.0 * 0.1}
+
+# parameter row: force 0-2, torque 3-5, constant wind 6-8, gust (on, A xyz, start, duration)
+# 9-14, turbulence (on, sigma u v w, T_u, T_w) 15-20, rotor loss (on, rotor 0-3, e, time) 21-24
+_GUST, _TURB, _LOSS, PARAMS_SIZE = 9, 15, 21, 25
+# memory: started 0, states u 1, v 2-3, w 4-5, cached dt 6, coefficients (e_u, g_u) 7-8,
+# v (e, a, l11, l21, l22) 9-13, w 14-18
+_MDT, _CU, _CV, _CW, MEMORY_SIZE = 6, 7, 9, 14, 19
+_S3 = math.sqrt(3.0)
+DT_TOLERANCE = 1e-6
+"""The Dryden filters' coefficients are recomputed when the period changes by more than
+this fraction. A uniform grid's periods t[k+1] - t[k] differ in their last bits (at 1 kHz
+and t = 60 s, by up to 1e-11 relative): an exact comparison recomputed them (two
+exponentials, a series, three square roots) in two periods of three."""
+
+
+# --- compiled ---------------------------------------------------------------------------
+# Note on speed: numba drops the reference counting of the array arguments (an atomic
+# NRT_incref/decref pair each on the batch's shared arrays: ~50 ns a call, contended between
+# threads) only when the function's CFG lets it prove the pairs redundant; arrays used only
+# in a branch, a function ending in a branch, or a call of another compiled function (its
+# error path) defeat it (numba 0.68). Hence scalar helpers, rng[0] and dmem[0] loaded
+# first and stored last, no trailing if, and the ziggurat inlined once (_five_normals).
+# tests/test_disturbances.py checks the compiled body for reference counting.
+@njit(cache=True, error_model="numpy")
+def _lateral_coefficients(a):
+    """Exact discretisation of (1 + sqrt3 T s)/(1 + T s)^2 over a = dt/T, states scaled to the
+    stationary covariance [[1/2, 1/4], [1/4, 1/4]]: Phi = e^-a [[1, 0], [a, 1]] and noise of
+    covariance Q = int_0^a e^-2u [[1, u], [u, u^2]] du. Returns (e^-a, a, Cholesky of Q)."""
+    if a < 1.0:                       # series: no cancellation for small a
+        i0 = i1 = i2 = 0.0
+        term = 1.0                    # (-2a)^n / n!
+        for n in range(60):
+            i0 += term * a / (n + 1)
+            i1 += term * a * a / (n + 2)
+            i2 += term * a * a * a / (n + 3)
+            term *= -2.0 * a / (n + 1)
+            if abs(term) < 1e-18:
+                break
+    else:
+        e2 = math.exp(-2.0 * a)
+        i0, i1 = 0.5 * (1.0 - e2), 0.25 * (1.0 - e2 * (1.0 + 2.0 * a))
+        i2 = 0.25 * (1.0 - e2 * (1.0 + 2.0 * a + 2.0 * a * a))
+    l11 = math.sqrt(i0)
+    l21 = i1 / l11
+    return math.exp(-a), a, l11, l21, math.sqrt(max(i2 - l21 * l21, 0.0))
+
+
+@njit(cache=True, inline="always")
+def _five_normals(s):
+    """Five standard normals from the vehicle's SplitMix64 state s (:mod:`quadcruise.sim.rng`'s
+    ziggurat on the scalar state), and the new state.
+
+    One inlined copy of the ziggurat in a loop, not five calls of ``next_normal``: a call
+    of a compiled function may fail, and its error path keeps numba from dropping the
+    reference counting of :func:`environment_disturbance`'s four array arguments (eight
+    atomic operations a period, on counters the batch's threads share)."""
+    n0 = n1 = n2 = n3 = n4 = 0.0
+    for k in range(5):
+        v, s = ziggurat(s)
+        if k == 0:
+            n0 = v
+        elif k == 1:
+            n1 = v
+        elif k == 2:
+            n2 = v
+        elif k == 3:
+            n3 = v
+        else:
+            n4 = v
+    return n0, n1, n2, n3, n4, s
+
+
+@njit(DISTURBANCE_SIG, cache=True, error_model="numpy")
+def environment_disturbance(t, dt, x, dp, dmem, rng, ext):
+    """The composite disturbance of :class:`Environment` (see the module's formulas)."""
+    state, started = rng[0], dmem[0]  # loaded first, stored last (see the note above)
+    for j in range(6):
+        ext[EXT_FX + j] = dp[j]
+    for j in range(3):
+        ext[EXT_WX + j] = dp[6 + j]
+    if dp[_GUST] != 0.0:
+        s = t - dp[_GUST + 4]
+        if 0.0 <= s <= dp[_GUST + 5]:
+            k = 0.5 * (1.0 - math.cos(2.0 * math.pi * s / dp[_GUST + 5]))
+            for j in range(3):
+                ext[EXT_WX + j] += k * dp[_GUST + 1 + j]
+    if dp[_TURB] != 0.0:              # Dryden: output at t, then advance the filters to t + dt
+        if started == 0.0:            # first period: draw the stationary start
+            n0, n1, n2, n3, n4, state = _five_normals(state)
+            started, dmem[1] = 1.0, n0
+            dmem[2], dmem[3] = n1 / math.sqrt(2.0), math.sqrt(2.0) / 4.0 * n1 + n2 / math.sqrt(8.0)
+            dmem[4], dmem[5] = n3 / math.sqrt(2.0), math.sqrt(2.0) / 4.0 * n3 + n4 / math.sqrt(8.0)
+        n0, n1, n2, n3, n4, state = _five_normals(state)
+        if abs(dmem[_MDT] - dt) > DT_TOLERANCE * dt:    # coefficients, cached per dt
+            a = dt / dp[_TURB + 4]
+            dmem[_MDT], dmem[_CU], dmem[_CU + 1] = dt, math.exp(-a), math.sqrt(-math.expm1(-2.0 * a))
+            dmem[_CV], dmem[_CV + 1], dmem[_CV + 2], dmem[_CV + 3], dmem[_CV + 4] = _lateral_coefficients(a)
+            a = dt / dp[_TURB + 5]
+            dmem[_CW], dmem[_CW + 1], dmem[_CW + 2], dmem[_CW + 3], dmem[_CW + 4] = _lateral_coefficients(a)
+        ext[EXT_WX] += dp[_TURB + 1] * dmem[1]
+        dmem[1] = dmem[_CU] * dmem[1] + dmem[_CU + 1] * n0
+        for k in range(2):            # v (states 2, 3), w (4, 5)
+            j, c = 2 + 2 * k, _CV + 5 * k
+            na, nb = (n1, n2) if k == 0 else (n3, n4)
+            s1, s2, e = dmem[j], dmem[j + 1], dmem[c]
+            ext[EXT_WX + 1 + k] += dp[_TURB + 2 + k] * (_S3 * s1 + (1.0 - _S3) * s2)
+            dmem[j] = e * s1 + dmem[c + 2] * na
+            dmem[j + 1] = e * (dmem[c + 1] * s1 + s2) + dmem[c + 3] * na + dmem[c + 4] * nb
+    lost = dp[_LOSS] != 0.0 and t >= dp[_LOSS + 3] - 1e-9 * (1.0 + abs(dp[_LOSS + 3]))
+    for j in range(4):
+        ext[EXT_E1 + j] = dp[_LOSS + 2] if lost and dp[_LOSS + 1] == j else 1.0
+    rng[0], dmem[0] = state, started
+
+
+# --- Python side -------------------------------------------------------------------------
+_CHECKS = {"nonneg": (lambda a: a < 0, ">= 0"), "pos": (lambda a: a <= 0, "> 0"),
+           "frac": (lambda a: (a < 0) | (a > 1), "in [0, 1]"),
+           "rotor": (lambda a: (a != np.round(a)) | (a < 1) | (a > 4), "1, 2, 3 or 4")}
+
+
+def _number(label: str, value: Any, check: str) -> Any:
+    """A finite float, or a read-only 1-D float array (one value per vehicle)."""
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        arr = np.zeros((0, 0))
+    if arr.ndim > 1 or arr.size == 0:
+        raise InputError(f"{label} must be a number or a 1-D array of numbers, got {value!r}")
+    bad, want = _CHECKS.get(check, (lambda a: ~np.isfinite(a), "finite"))
+    bad = np.atleast_1d(~np.isfinite(arr) | bad(arr))
+    if bad.any():
+        raise InputError(f"{label} must be finite and {want}, got {np.atleast_1d(arr)[bad][0]!r}")
+    if arr.ndim == 0:
+        return float(arr)
+    arr.flags.writeable = False
+    return arr
+
+
+def _vector(label: str, value: Any) -> tuple:
+    """(x, y, z): a sequence of 3 numbers or length-N arrays, or an (N, 3) numpy array."""
+    if isinstance(value, np.ndarray) and value.ndim == 2 and value.shape[1] == 3:
+        value = tuple(value.T)
+    if isinstance(value, (str, bytes, np.ndarray)) and np.ndim(value) != 1 or not hasattr(value, "__len__") \
+            or len(value) != 3:
+        raise InputError(f"{label} must be 3 values (x, y, z), each a number or a 1-D array, "
+                         f"or an (N, 3) array, got {value!r}")
+    return tuple(_number(label, v, "real") for v in value)
+
+
+@dataclass(frozen=True)
+class _Part:
+    """Validation, batch size and ``to_dict`` shared by the models. Each numeric field is a
+    number or a 1-D array with one value per vehicle; a vector field is (x, y, z) of such, or
+    an (N, 3) numpy array."""
+
+    name = "part"
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            value, check = getattr(self, f.name), f.metadata.get("check")
+            if check is None or (value is None and f.default is None):
+                continue
+            label = f"{self.name} field '{f.name}' ({f.metadata['doc']}, {f.metadata['unit']})"
+            value = _vector(label, value) if check == "vec" else _number(label, value, check)
+            object.__setattr__(self, f.name, value)
+
+    def sizes(self) -> set:
+        """Lengths of the per-vehicle arrays among the fields."""
+        vals = [getattr(self, f.name) for f in dataclasses.fields(self)]
+        return {u.shape[0] for v in vals for u in (v if isinstance(v, tuple) else (v,)) if isinstance(u, np.ndarray)}
+
+    @staticmethod
+    def one_size(sizes: set, what: str) -> int | None:
+        """The one batch length among ``sizes`` (None if empty); InputError if they differ."""
+        if len(sizes) > 1:
+            raise InputError(f"{what} fields have different batch lengths {sorted(sizes)}")
+        return next(iter(sizes), None)
+
+    def to_dict(self) -> dict:
+        def plain(v):
+            return [plain(u) for u in v] if isinstance(v, tuple) else v.tolist() if isinstance(v, np.ndarray) else v
+        return {"model": self.name, **{f.name: plain(getattr(self, f.name)) for f in dataclasses.fields(self)}}
+
+
+@dataclass(frozen=True)
+class ConstantWind(_Part):
+    """A steady wind (earth frame)."""
+
+    velocity: Any = _f((0.0, 0.0, 0.0), "m/s", "wind velocity (x, y, z)", "vec")
+    name = "constant"
+
+
+@dataclass(frozen=True)
+class Gust(_Part):
+    """A full "1 - cosine" gust: (A/2)(1 - cos(2 pi (t - start)/duration)) over the duration."""
+
+    amplitude: Any = _f((1.0, 0.0, 0.0), "m/s", "gust peak (x, y, z)", "vec")
+    start: Any = _f(1.0, "s", "gust start", "nonneg")
+    duration: Any = _f(1.0, "s", "gust duration", "pos")
+    name = "gust"
+
+
+@dataclass(frozen=True)
+class Turbulence(_Part):
+    """Dryden turbulence, MIL-F-8785C low altitude; ``w20``, if given, overrides ``intensity``."""
+
+    intensity: str = field(default="moderate", metadata={"doc": "light, moderate or severe"})
+    w20: Any = _f(None, "m/s", "wind speed at 20 ft", "pos")
+    altitude: Any = _f(10.0, "m", "height above ground, < 304.8 m", "pos")
+    airspeed: Any = _f(1.0, "m/s", "speed through the air, floor 0.5 m/s", "nonneg")
+    name = "dryden"
+
+    def __post_init__(self) -> None:
+        if self.intensity not in INTENSITIES:
+            raise InputError(f"dryden field 'intensity' must be one of {', '.join(INTENSITIES)}, got {self.intensity!r}")
+        super().__post_init__()
+        if np.any(np.asarray(self.altitude) >= 1000 * FOOT):
+            raise InputError(f"dryden field 'altitude' must be < 304.8 m (low-altitude model), got {self.altitude!r}")
+
+    def _h(self) -> Any:
+        return np.maximum(self.altitude, 10 * FOOT) / FOOT          # ft, 10 ft floor
+
+    def scales(self) -> tuple:
+        """(L_u, L_v, L_w) [m]."""
+        h = self._h()
+        lu = h / (0.177 + 0.000823 * h) ** 1.2 * FOOT
+        return lu, lu, h * FOOT
+
+    def sigmas(self) -> tuple:
+        """(sigma_u, sigma_v, sigma_w) [m/s]."""
+        sw = 0.1 * np.asarray(INTENSITIES[self.intensity] if self.w20 is None else self.w20, dtype=float)
+        su = sw / (0.177 + 0.000823 * self._h()) ** 0.4
+        return (su, su, sw) if np.ndim(su) else (float(su), float(su), float(sw))
+
+    def time_constants(self) -> tuple:
+        """(T_u, T_v, T_w) = L / max(airspeed, 0.5 m/s) [s]."""
+        return tuple(L / np.maximum(self.airspeed, AIRSPEED_FLOOR) for L in self.scales())
+
+
+@dataclass(frozen=True)
+class RotorLoss(_Part):
+    """From ``time`` on, rotor ``rotor`` gives 1 - ``fraction`` of its thrust."""
+
+    rotor: Any = _f(1, "-", "rotor number", "rotor")
+    fraction: Any = _f(0.3, "-", "fraction of thrust lost", "frac")
+    time: Any = _f(5.0, "s", "time of the loss", "nonneg")
+    name = "loss"
+
+
+@dataclass(frozen=True)
+class ExternalForce(_Part):
+    """A constant force (earth frame) and torque (body frame)."""
+
+    force: Any = _f((0.0, 0.0, 0.0), "N", "force (x, y, z)", "vec")
+    torque: Any = _f((0.0, 0.0, 0.0), "N m", "torque (x, y, z)", "vec")
+    name = "force"
+
+
+_SLOTS = {"wind": ConstantWind, "gust": Gust, "turbulence": Turbulence, "rotor_loss": RotorLoss,
+          "force": ExternalForce}
+
+
+def _columns(n: int, *values: Any) -> np.ndarray:
+    return np.column_stack(np.broadcast_arrays(*values, np.zeros(n))[:-1])
+
+
+@dataclass(frozen=True)
+class Environment:
+    """The disturbances a flight meets, each part optional: ``fly(..., environment=env)``."""
+
+    wind: ConstantWind | None = None
+    gust: Gust | None = None
+    turbulence: Turbulence | None = None
+    rotor_loss: RotorLoss | None = None
+    force: ExternalForce | None = None
+
+    def __post_init__(self) -> None:
+        for slot, cls in _SLOTS.items():
+            if getattr(self, slot) is not None and not isinstance(getattr(self, slot), cls):
+                raise InputError(f"environment field '{slot}' must be a {cls.__name__} or None")
+
+    @classmethod
+    def from_parts(cls, *parts: _Part) -> "Environment":
+        """Each part into its slot (one of each kind)."""
+        slots: dict = {}
+        for part in parts:
+            slot = next((s for s, c in _SLOTS.items() if isinstance(part, c)), None)
+            if slot is None or slot in slots:
+                raise InputError(f"{'unknown' if slot is None else 'a second'} disturbance part {part!r}")
+            slots[slot] = part
+        return cls(**slots)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Environment":
+        """Inverse of :meth:`to_dict`."""
+        return cls(**{k: v and _SLOTS[k](**{a: b for a, b in v.items() if a != "model"}) for k, v in d.items()})
+
+    def to_dict(self) -> dict:
+        return {s: getattr(self, s) and getattr(self, s).to_dict() for s in _SLOTS}
+
+    @property
+    def parts(self) -> dict:
+        """The parts present, by slot (empty: still air)."""
+        return {s: getattr(self, s) for s in _SLOTS if getattr(self, s) is not None}
+
+    @property
+    def function(self):
+        """The compiled composite disturbance (``DISTURBANCE_SIG``)."""
+        return environment_disturbance
+
+    @property
+    def needs_drag(self) -> bool:
+        """True if there is wind: it acts only through the vehicle's drag."""
+        return any(getattr(self, s) is not None for s in ("wind", "gust", "turbulence"))
+
+    @property
+    def batch_size(self) -> int | None:
+        """N if a field is per-vehicle, else None."""
+        return _Part.one_size(set().union(*(p.sizes() for p in self.parts.values())), "disturbance")
+
+    def params(self, n: int | None = None) -> np.ndarray:
+        """(N, PARAMS_SIZE) float64 parameter rows; per-vehicle arrays must have N values."""
+        size = self.batch_size
+        n = (size or 1) if n is None else int(n)
+        if size is not None and size != n:
+            raise InputError(f"disturbance fields have {size} values but {n} vehicles were asked for")
+        out = np.zeros((n, PARAMS_SIZE))
+        if self.force is not None:
+            out[:, 0:6] = _columns(n, *self.force.force, *self.force.torque)
+        if self.wind is not None:
+            out[:, 6:9] = _columns(n, *self.wind.velocity)
+        if (g := self.gust) is not None:
+            out[:, _GUST:_GUST + 6] = _columns(n, 1.0, *g.amplitude, g.start, g.duration)
+        if (tb := self.turbulence) is not None:
+            tu, _, tw = tb.time_constants()
+            out[:, _TURB:_TURB + 6] = _columns(n, 1.0, *tb.sigmas(), tu, tw)
+        if (r := self.rotor_loss) is not None:
+            out[:, _LOSS:_LOSS + 4] = _columns(n, 1.0, np.subtract(r.rotor, 1), np.subtract(1, r.fraction), r.time)
+        return out
+
+    def memory(self, n: int | None = None) -> np.ndarray:
+        """(N, MEMORY_SIZE) zeros: the turbulence filters start on the first period."""
+        return np.zeros(((self.batch_size or 1) if n is None else int(n), MEMORY_SIZE))
+
+    def kwargs(self, n: int | None = None) -> dict:
+        """``disturbance``, ``disturbance_params`` and ``disturbance_memory`` for simulate/fly
+        ((N, ...) rows; one row each, which the engine gives every vehicle, if n is None and
+        no field is per-vehicle)."""
+        one = n is None and self.batch_size is None
+        dp, dm = self.params(n), self.memory(n)
+        return {"disturbance": self.function, "disturbance_params": dp[0] if one else dp,
+                "disturbance_memory": dm[0] if one else dm}
+
+
+@dataclass(frozen=True)
+class SensorNoise(_Part):
+    """White noise on what the controller sees, and a delay (a whole number of periods)."""
+
+    position_std: Any = _f(0.0, "m", "position noise std", "nonneg")
+    velocity_std: Any = _f(0.0, "m/s", "velocity noise std", "nonneg")
+    angle_std: Any = _f(0.0, "rad", "angle noise std", "nonneg")
+    rate_std: Any = _f(0.0, "rad/s", "body rate noise std", "nonneg")
+    delay: Any = _f(0.0, "s", "sensor delay", "nonneg")
+    name = "sensor"
+
+    def std_vector(self) -> np.ndarray:
+        """(16,) standard deviations per state ((N, 16) if a field is per-vehicle); rotors 0."""
+        size = self.one_size(self.sizes(), "sensor")
+        out = np.zeros((size or 1, STATE_SIZE))
+        for name, j in (("position_std", X), ("velocity_std", VX), ("angle_std", PHI), ("rate_std", P)):
+            out[:, j:j + 3] = np.asarray(getattr(self, name))[..., None]
+        return out if size else out[0]
+
+    def delay_periods(self, dt: float) -> int:
+        """The delay in control periods; it must be a whole number of dt (to 1e-9 s)."""
+        if np.ndim(self.delay):
+            raise InputError("sensor field 'delay' must be one number for the whole batch")
+        k = round(self.delay / dt)
+        if abs(k * dt - self.delay) > 1e-9:
+            raise InputError(f"sensor field 'delay' ({self.delay:g} s) is not a whole number of dt ({dt:g} s) periods")
+        return int(k)
+
+    def kwargs(self, dt: float) -> dict:
+        """``sensor_std`` and ``sensor_delay`` for simulate/fly."""
+        return {"sensor_std": self.std_vector(), "sensor_delay": self.delay_periods(dt)}
+
+
+def with_drag(vehicle: Vehicle) -> Vehicle:
+    """The vehicle with :data:`DEFAULT_DRAG` where both its drag coefficients are zero (warns)."""
+    c1, c2 = np.asarray(vehicle.drag_linear), np.asarray(vehicle.drag_quadratic)
+    bare = (c1 == 0) & (c2 == 0)
+    if not np.any(bare):
+        return vehicle
+    warnings.warn(f"the vehicle has no drag, so wind could not act on it: using DEFAULT_DRAG "
+                  f"{DEFAULT_DRAG} for {int(np.count_nonzero(bare))} vehicle(s)", stacklevel=2)
+    new = {k: np.where(bare, v, c) for (k, v), c in zip(DEFAULT_DRAG.items(), (c1, c2))}
+    return vehicle.replace(**{k: float(v) if v.ndim == 0 else v for k, v in new.items()})
+
+
+_NAMES = {"constant": ConstantWind, "wind": ConstantWind, "gust": Gust, "dryden": Turbulence,
+          "turbulence": Turbulence, "loss": RotorLoss, "rotor_loss": RotorLoss, "force": ExternalForce}
+
+
+def wind_from_name(name: str, **kw: Any) -> _Part:
+    """A part by name (``constant``/``wind``, ``gust``, ``dryden``/``turbulence``,
+    ``loss``/``rotor_loss``, ``force``) with its fields as keywords."""
+    cls = _NAMES.get(str(name).lower())
+    if cls is None:
+        raise InputError(f"unknown disturbance {name!r}; choose one of {', '.join(_NAMES)}")
+    try:
+        return cls(**kw)
+    except TypeError as e:
+        raise InputError(f"{name}: {e}") from None
+
+
+def _floats(text: str, k: int, what: str) -> list:
+    vals = text.split(",")
+    if len(vals) != k:
+        raise InputError(f"needs {k} value{'s' * (k > 1)} {what}, got {text!r}")
+    try:
+        return [float(v) for v in vals]
+    except ValueError:
+        raise InputError(f"{what} must be numbers, got {text!r}") from None
+
+
+def _part(text: str) -> _Part:
+    name, _, body = text.partition(":")
+    cls, body = _NAMES.get(name.strip().lower()), re.sub(r"\s+", "", body)
+    first, at, rest = body.partition("@")
+    if cls is None:
+        raise InputError(f"unknown model {name.strip()!r}; choose one of {', '.join(_NAMES)}")
+    if cls is ConstantWind:
+        return ConstantWind(velocity=_floats(body, 3, "WX,WY,WZ"))
+    if cls is Gust:
+        start, plus, dur = rest.partition("+")
+        if not plus:
+            raise InputError("expected gust:AX,AY,AZ@START+DURATION")
+        return Gust(_floats(first, 3, "AX,AY,AZ"), _floats(start, 1, "START")[0], _floats(dur, 1, "DURATION")[0])
+    if cls is Turbulence:
+        alt, _, speed = rest.partition("/")
+        kw: dict = {"intensity": first.lower()} if first.lower() in INTENSITIES else {
+            "w20": _floats(first, 1, "LEVEL (light, moderate, severe or w20 m/s)")[0]}
+        return Turbulence(**kw, **{k: _floats(v, 1, k)[0] for k, v in (("altitude", alt), ("airspeed", speed)) if v})
+    if cls is RotorLoss:
+        if not at:
+            raise InputError("expected loss:ROTOR,FRACTION@TIME")
+        return RotorLoss(*_floats(first, 2, "ROTOR,FRACTION"), _floats(rest, 1, "TIME")[0])
+    force, _, torque = body.partition("/")
+    return ExternalForce(_floats(force, 3, "FX,FY,FZ"), _floats(torque, 3, "TX,TY,TZ") if torque else (0.0, 0.0, 0.0))
+
+
+def parse_wind(text: str) -> Environment:
+    """An :class:`Environment` from a command-line spec: parts separated by ``,`` ``;`` or spaces.
+
+    Grammar (SI units; each kind at most once; ``none`` or ``calm``: still air)::
+
+        constant:WX,WY,WZ                  steady wind [m/s]                   (or wind:)
+        gust:AX,AY,AZ@START+DURATION       1 - cosine gust [m/s, s, s]
+        dryden:LEVEL[@ALTITUDE[/AIRSPEED]] LEVEL light|moderate|severe or w20 [m/s];
+                                           altitude [m] (10), airspeed [m/s] (1)  (or turbulence:)
+        loss:ROTOR,FRACTION@TIME           rotor 1-4 loses FRACTION of its thrust at TIME [s]
+        force:FX,FY,FZ[/TX,TY,TZ]          force [N] (earth frame), torque [N m] (body frame)
+
+    e.g. ``constant:3,0,0,gust:2,0,0@5+2,dryden:moderate@10``. Bad input raises a one-line
+    :class:`InputError` quoting the part.
+    """
+    text = str(text).strip()
+    if text.lower() in ("", "none", "calm"):
+        return Environment()
+    parts = []
+    for piece in filter(None, re.split(r"[,;\s]+(?=[A-Za-z_]+\s*:)", text)):
+        try:
+            parts.append(_part(piece))
+        except InputError as e:
+            raise InputError(f"wind spec {piece!r}: {e}") from None
+    return Environment.from_parts(*parts)

@@ -1,0 +1,446 @@
+"""Response metrics: step and transient characteristics, tracking error, effort, saturation.
+
+Pure numpy; times in seconds, positions in metres. Everything reads sampled signals on a
+time grid ``t`` that must be strictly increasing but need not be uniform: crossings are
+interpolated linearly between samples and integrals use the trapezoid rule. The same
+metrics for every vehicle of a batch at once, vectorised: :mod:`quadcruise.metrics.batch`.
+
+Examples
+--------
+>>> import numpy as np
+>>> t = np.linspace(0.0, 10.0, 10001)
+>>> info = step_info(t, 1.0 - np.exp(-t), y_final=1.0)   # first order, tau = 1 s
+>>> round(info.rise_time, 4), round(float(np.log(9.0)), 4)    # 10-90 % rise is ln 9
+(2.1972, 2.1972)
+>>> round(info.settling_time, 4), round(float(np.log(50.0)), 4)  # 2 % settling: ln 50
+(3.912, 3.912)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from quadcruise.errors import InputError
+
+__all__ = ["StepInfo", "step_info", "step_info_batch", "transient_info",
+           "tracking_errors", "control_effort", "time_in_saturation", "flight_metrics"]
+
+
+@dataclass(frozen=True)
+class StepInfo:
+    """Step-response characteristics; times in seconds measured from the step.
+
+    ``rise_time`` is None if the response never reaches the upper rise level; a settling
+    time is None if the response is outside its band at the last sample ("did not
+    settle"). ``settling_time`` belongs to ``settle_bands[0]`` (2 % by default),
+    ``settling_time_5pct`` to ``settle_bands[1]`` and ``settled`` to the first band.
+    Percentages are of the step size ``|y_final - y_initial|``.
+    """
+
+    rise_time: float | None
+    settling_time: float | None
+    settling_time_5pct: float | None
+    overshoot_pct: float
+    undershoot_pct: float
+    peak: float
+    peak_time: float
+    y_initial: float
+    y_final: float
+    settled: bool
+
+    def to_dict(self) -> dict:
+        """The fields as a plain dict (None stays None)."""
+        return dataclasses.asdict(self)
+
+
+def _check_time(t) -> np.ndarray:
+    t = np.asarray(t, dtype=float)
+    if t.ndim != 1 or t.size < 2:
+        raise InputError(f"time vector must be 1-D with at least 2 samples, got shape {t.shape}")
+    if not np.all(np.isfinite(t)):
+        raise InputError("time vector contains NaN or inf")
+    if not np.all(np.diff(t) > 0):
+        raise InputError("time vector must be strictly increasing")
+    return t
+
+
+def _step_time(t: np.ndarray, signal: np.ndarray, t_step, what: str) -> float:
+    """Check the signal is finite and t_step (default t[0]) lies in [t[0], t[-1])."""
+    if not np.all(np.isfinite(signal)):
+        raise InputError(f"{what} contains NaN or inf")
+    t_step = float(t[0]) if t_step is None else float(t_step)
+    if not t[0] <= t_step < t[-1]:
+        raise InputError(f"t_step = {t_step:g} s is outside [{t[0]:g}, {t[-1]:g}) s")
+    return t_step
+
+
+def _first_crossing(t: np.ndarray, z: np.ndarray, level: float) -> float | None:
+    """Time at which z first reaches ``level`` from below, interpolated (None if never)."""
+    hits = np.flatnonzero(z >= level)
+    if hits.size == 0:
+        return None
+    k = hits[0]
+    if k == 0:
+        return float(t[0])
+    frac = (level - z[k - 1]) / (z[k] - z[k - 1])
+    return float(t[k - 1] + frac * (t[k] - t[k - 1]))
+
+
+def _settling_time(t: np.ndarray, z: np.ndarray, band: float) -> float | None:
+    """Time (from t[0]) after which |z - 1| <= band for good, interpolated at the last exit."""
+    outside = np.abs(z - 1.0) > band
+    if outside[-1]:
+        return None
+    if not outside.any():
+        return 0.0
+    k = np.flatnonzero(outside)[-1]              # z[k] outside, z[k + 1] inside
+    edge = 1.0 + band if z[k] > 1.0 else 1.0 - band
+    frac = (edge - z[k]) / (z[k + 1] - z[k])
+    return float(t[k] + frac * (t[k + 1] - t[k]) - t[0])
+
+
+def step_info(t, y, *, y_initial=None, y_final=None, t_step=None,
+              rise=(0.1, 0.9), settle_bands=(0.02, 0.05)) -> StepInfo:
+    """Rise time, settling times, overshoot, undershoot and peak of one step response.
+
+    Parameters
+    ----------
+    t : array_like, shape (L,)
+        Sample times [s], strictly increasing, not necessarily uniform.
+    y : array_like, shape (L,)
+        The response.
+    y_initial : float, optional
+        Value before the step; default: ``y`` at ``t_step`` (interpolated).
+    y_final : float, optional
+        Value the response should settle to; default: the **last sample** ``y[-1]``.
+        With the default the response is, by construction, inside every band at the end,
+        so pass ``y_final`` (e.g. the commanded value) to detect a response that did not
+        settle or settles somewhere else.
+    t_step : float, optional
+        Time of the step, ``t[0] <= t_step < t[-1]``; default ``t[0]``. Samples before it
+        are ignored and all reported times are measured from it.
+    rise : (float, float)
+        Rise-time levels as fractions of the step (10 % and 90 %).
+    settle_bands : (float, float)
+        Settling bands as fractions of ``|step|`` (2 % and 5 %).
+
+    Returns
+    -------
+    StepInfo
+
+    Notes
+    -----
+    The response is normalised as ``z = (y - y_initial) / (y_final - y_initial)``, so a
+    downward step is the mirror image of an upward one.
+
+    * rise time: from the first time z reaches ``rise[0]`` to the first time it reaches
+      ``rise[1]``, each crossing interpolated linearly between samples;
+    * settling time: ``t - t_step`` at the last exit from ``|z - 1| <= band``,
+      interpolated; None if the last sample is outside the band. Only the record is
+      seen: a settling time near the end of it means little;
+    * overshoot: ``100 * (max z - 1)`` if positive, else 0; undershoot: ``-100 * min z``
+      (excursion against the step direction) if positive, else 0;
+    * peak: the value of ``y`` at the largest excursion in the step direction (the
+      sample maximum of z), peak_time its first time.
+
+    Against ``control.step_info`` (python-control 0.10): its crossings and settling time
+    are the first samples past each threshold (not interpolated: they differ from ours
+    by less than one sample interval); its levels, bands and percentages are fractions
+    of the final value measured from 0 (ours: of the step, measured from
+    ``y_initial``; the same when ``y_initial == 0``); its times are absolute (ours: from
+    ``t_step``); its ``Peak`` is ``max |y|`` (ours: signed ``y`` at the peak).
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, 2.0, 5)
+    >>> info = step_info(t, [4.0, 3.0, 2.0, 1.8, 2.0])     # downward step from 4 to 2
+    >>> round(info.rise_time, 9), round(info.overshoot_pct, 9), info.peak, info.peak_time
+    (0.8, 10.0, 1.8, 1.5)
+    >>> step_info(t, [1.0, 1.0, 1.0, 1.0, 1.0])
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: step size y_final - y_initial is zero (y_initial = y_final = 1)
+    """
+    t = _check_time(t)
+    y = np.asarray(y, dtype=float)
+    if y.shape != t.shape:
+        raise InputError(f"response y has shape {y.shape}, time vector has {t.shape}")
+    t_step = _step_time(t, y, t_step, "response y")
+    levels = tuple(float(v) for v in rise)
+    if len(levels) != 2 or not 0.0 <= levels[0] < levels[1] <= 1.0:
+        raise InputError(f"rise levels must satisfy 0 <= low < high <= 1, got {rise}")
+    lo, hi = levels
+    bands = tuple(float(b) for b in settle_bands)
+    if len(bands) != 2 or not all(0.0 < b < 1.0 for b in bands):
+        raise InputError(f"settle_bands must be two fractions in (0, 1), got {settle_bands}")
+
+    after = t > t_step                           # the record from the step on
+    ts = np.concatenate(([t_step], t[after]))
+    ys = np.concatenate(([np.interp(t_step, t, y)], y[after]))
+    y0 = float(ys[0]) if y_initial is None else float(y_initial)
+    y1 = float(y[-1]) if y_final is None else float(y_final)
+    if not (np.isfinite(y0) and np.isfinite(y1)):
+        raise InputError(f"y_initial and y_final must be finite, got {y0}, {y1}")
+    step = y1 - y0
+    if abs(step) <= 16 * np.finfo(float).eps * max(abs(y0), abs(y1)) or step == 0.0:
+        raise InputError(f"step size y_final - y_initial is zero (y_initial = y_final = {y0:g})")
+    z = (ys - y0) / step
+
+    t_lo, t_hi = _first_crossing(ts, z, lo), _first_crossing(ts, z, hi)
+    settle = [_settling_time(ts, z, b) for b in bands]
+    k_peak = int(np.argmax(z))
+    return StepInfo(
+        rise_time=None if t_hi is None else t_hi - t_lo,
+        settling_time=settle[0],
+        settling_time_5pct=settle[1],
+        overshoot_pct=max(0.0, 100.0 * (float(z.max()) - 1.0)),
+        undershoot_pct=max(0.0, -100.0 * float(z.min())),
+        peak=float(ys[k_peak]),
+        peak_time=float(ts[k_peak] - t_step),
+        y_initial=y0,
+        y_final=y1,
+        settled=settle[0] is not None,
+    )
+
+
+def step_info_batch(t, y, *, y_initial=None, y_final=None, **kw) -> dict[str, np.ndarray]:
+    """:func:`step_info` for each row of ``y`` (shape (N, L)): a dict of arrays of shape (N,).
+
+    ``y_initial``/``y_final`` may be scalars or arrays of shape (N,); other keywords go to
+    :func:`step_info`. A None (did not settle, never rose) becomes NaN; ``settled`` is bool.
+
+    >>> t = np.linspace(0.0, 1.0, 3)
+    >>> out = step_info_batch(t, [[0.0, 0.5, 1.0], [0.0, 0.2, 0.4]], y_final=1.0)
+    >>> out["settling_time"], out["settled"]
+    (array([0.98,  nan]), array([ True, False]))
+    """
+    y = np.asarray(y, dtype=float)
+    if y.ndim != 2:
+        raise InputError(f"batch response y must have shape (N, L), got {y.shape}")
+    n = y.shape[0]
+    y0 = [None] * n if y_initial is None else np.broadcast_to(np.asarray(y_initial, float), (n,))
+    y1 = [None] * n if y_final is None else np.broadcast_to(np.asarray(y_final, float), (n,))
+    rows = [step_info(t, y[i], y_initial=y0[i], y_final=y1[i], **kw).to_dict() for i in range(n)]
+    out = {}
+    for f in dataclasses.fields(StepInfo):
+        vals = [r[f.name] for r in rows]
+        out[f.name] = (np.array(vals, dtype=bool) if f.name == "settled" else
+                       np.array([np.nan if v is None else v for v in vals], dtype=float))
+    return out
+
+
+def transient_info(t, actual, reference, *, t_step=None, rise=(0.1, 0.9),
+                   settle_bands=(0.02, 0.05)) -> StepInfo:
+    """Step metrics of a tracking transient in which the reference itself moves.
+
+    The progress ``y(t) = 1 - e(t) / e(t_step)`` with ``e = reference - actual`` goes
+    from 0 to 1 as the error dies out; :func:`step_info` is applied to it with
+    ``y_initial=0, y_final=1``. For a constant reference this is exactly the ordinary
+    step response scaled to the step, so times and percentages are the ordinary ones;
+    ``peak``, ``y_initial`` and ``y_final`` are in progress units.
+
+    ``actual`` and ``reference`` are (L,) or (L, n_axes) (broadcast against each other).
+    With several axes the error is its Euclidean norm, ``y = 1 - |e(t)| / |e(t_step)|``:
+    rise and settling are then about the error size in any direction and the overshoot
+    is always 0 (an error that grows beyond the initial one shows as undershoot).
+
+    >>> t = np.linspace(0.0, 10.0, 10001)
+    >>> ref = np.c_[2.0 * np.cos(t), 2.0 * np.sin(t)]        # circle, starts 2 m away
+    >>> act = ref * (1.0 - np.exp(-t))[:, None]                # error 2 exp(-t) m
+    >>> round(transient_info(t, act, ref).settling_time, 4)    # ln 50
+    3.912
+    """
+    t = _check_time(t)
+    e = _difference(reference, actual)
+    if e.ndim == 2:
+        e = np.linalg.norm(e, axis=1)
+    elif e.ndim != 1:
+        raise InputError(f"actual and reference must be (L,) or (L, n_axes), got {e.shape}")
+    if e.shape != t.shape:
+        raise InputError(f"error signal has {e.shape[0]} samples, time vector has {t.size}")
+    t_step = _step_time(t, e, t_step, "actual or reference")
+    e0 = float(np.interp(t_step, t, e))
+    scale = max(np.abs(actual).max(), np.abs(reference).max())
+    if e0 == 0.0 or abs(e0) <= 1e-9 * scale:
+        raise InputError(f"tracking error at t = {t_step:g} s is ~0: no transient to measure")
+    return step_info(t, 1.0 - e / e0, y_initial=0.0, y_final=1.0, t_step=t_step,
+                     rise=rise, settle_bands=settle_bands)
+
+
+def _trapezoid(t: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """Integral of f over t along the last axis (trapezoid rule), vectorised."""
+    return np.sum(0.5 * (f[..., 1:] + f[..., :-1]) * np.diff(t), axis=-1)
+
+
+def _difference(a, b) -> np.ndarray:
+    """a - b as float arrays; shapes that do not broadcast are an InputError."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    try:
+        return a - b
+    except ValueError:
+        raise InputError(f"shapes {a.shape} and {b.shape} do not match") from None
+
+
+def _time_major(name: str, a, n_t: int) -> np.ndarray:
+    """(L,) -> (L, 1); (..., L, n) kept; checks the time axis (second-last) has n_t samples.
+
+    A scalar is kept as it is (a constant, broadcast against the other operand)."""
+    a = np.asarray(a, dtype=float)
+    a = a[:, None] if a.ndim == 1 else a
+    if a.ndim == 1 or (a.ndim >= 2 and a.shape[-2] != n_t):
+        raise InputError(f"{name} must be (L,) or (..., L, n_axes) with L = {n_t}, got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise InputError(f"{name} contains NaN or inf")
+    return a
+
+
+def tracking_errors(t, actual, reference, *, t_from=None) -> dict[str, np.ndarray]:
+    """RMS and maximum tracking error over time, trapezoid-weighted in time.
+
+    ``actual`` and ``reference`` are (L,) or (..., L, n_axes), broadcast against each
+    other (e.g. (N, L, 3) positions of N vehicles and one (L, 3) reference; a scalar
+    reference is a constant); the time
+    axis is the second-last and ``t`` (L,) is shared. The error at each time is the
+    Euclidean norm over the axes. ``t_from`` skips the transient: the window is
+    ``[t_from, t[-1]]`` with the error interpolated at ``t_from``.
+
+    Returns ``rmse`` = sqrt(integral |e|^2 dt / duration) and ``max_error`` of shape
+    (...), and ``rmse_axes`` (per axis) of shape (..., n_axes).
+
+    >>> t = np.array([0.0, 1.0, 3.0])                 # non-uniform grid
+    >>> out = tracking_errors(t, np.c_[[1.0, 1.0, 1.0], [0.0, 0.0, 0.0]], np.zeros((3, 2)))
+    >>> float(out["rmse"]), float(out["max_error"]), out["rmse_axes"]
+    (1.0, 1.0, array([1., 0.]))
+    """
+    t = _check_time(t)
+    d = _difference(_time_major("actual", actual, t.size),
+                    _time_major("reference", reference, t.size))
+    d = np.moveaxis(d, -2, -1)                        # (..., n_axes, L)
+    if t_from is not None:
+        if not t[0] <= t_from < t[-1]:
+            raise InputError(f"t_from = {t_from:g} s is outside [{t[0]:g}, {t[-1]:g}) s")
+        k = int(np.searchsorted(t, t_from, side="right"))  # t[k - 1] <= t_from < t[k]
+        w = (t_from - t[k - 1]) / (t[k] - t[k - 1])
+        d_from = d[..., k - 1] + w * (d[..., k] - d[..., k - 1])
+        d = np.concatenate((d_from[..., None], d[..., k:]), axis=-1)
+        t = np.concatenate(([t_from], t[k:]))
+    duration = t[-1] - t[0]
+    ms_axes = _trapezoid(t, d**2) / duration
+    return {"rmse": np.sqrt(ms_axes.sum(axis=-1)),
+            "max_error": np.sqrt((d**2).sum(axis=-2)).max(axis=-1),
+            "rmse_axes": np.sqrt(ms_axes)}
+
+
+def control_effort(t, u) -> dict[str, np.ndarray]:
+    """Integral over time of the sum of squared inputs (trapezoid) and its time mean.
+
+    ``u`` is (L,) or (..., L, m) with the time axis second-last; subtract a trim (e.g.
+    the hover duty) first to measure effort about it. Returns ``integral`` [unit^2 s]
+    and ``mean`` [unit^2] of shape (...).
+
+    >>> out = control_effort([0.0, 1.0, 2.0], np.c_[[1.0, 1.0, 1.0], [0.0, 1.0, 0.0]])
+    >>> float(out["integral"]), float(out["mean"])
+    (3.0, 1.5)
+    """
+    t = _check_time(t)
+    u = np.moveaxis(_time_major("u", u, t.size), -2, -1)
+    integral = _trapezoid(t, (u**2).sum(axis=-2))
+    return {"integral": integral, "mean": integral / (t[-1] - t[0])}
+
+
+def time_in_saturation(t, flags) -> dict[str, np.ndarray]:
+    """Seconds and fraction of the record during which ``flags`` is set (nonzero).
+
+    Sample-and-hold: sample k holds from t[k] to t[k + 1], so the last sample adds no
+    time. ``flags`` is (L,) or (..., L) with time on the last axis (e.g. (N, L) for a
+    batch). Returns ``seconds`` and ``fraction`` (of ``t[-1] - t[0]``) of shape (...).
+
+    >>> out = time_in_saturation([0.0, 1.0, 3.0, 4.0], [0, 1, 0, 1])
+    >>> float(out["seconds"]), float(out["fraction"])
+    (2.0, 0.5)
+    """
+    t = _check_time(t)
+    f = np.asarray(flags)
+    if f.ndim < 1 or f.shape[-1] != t.size:
+        raise InputError(f"flags must have time on the last axis with L = {t.size}, got {f.shape}")
+    if f.dtype.kind == "f" and not np.all(np.isfinite(f)):
+        raise InputError("flags contain NaN or inf")
+    seconds = ((f[..., :-1] != 0) * np.diff(t)).sum(axis=-1)
+    return {"seconds": seconds, "fraction": seconds / (t[-1] - t[0])}
+
+
+# --- a whole flight --------------------------------------------------------------------
+_AXIS_NAMES = ("x", "y", "z")
+TRANSIENT_MIN_ERROR = 0.01
+"""An axis whose initial tracking error is below this [m] has no transient to measure."""
+
+
+def flight_metrics(result, *, transient_axis: str | None = None, transient_until: float | None = None):
+    """Per-vehicle metrics of a :class:`~quadcruise.sim.result.SimResult`, as a DataFrame.
+
+    Columns: ``vehicle``, ``status``, ``rmse_m`` and ``max_error_m`` (3-D position error
+    over the whole flight), the transient of one axis (``axis``, ``rise_time_s``,
+    ``settling_time_s`` (2 %), ``settling_time_5pct_s``, ``overshoot_pct``), ``effort``
+    (integral of the sum of squared duties [s]), ``duty_clipped_s`` and
+    ``controller_limited_s``.
+
+    The transient is measured on ``transient_axis``, or else on the stepped axis of a
+    step mission (as a step response from the reference before the step to the one
+    after, so a response that never arrives reads "did not settle"), or else on the
+    axis with the largest initial tracking error (the circle's start offset, say), if it
+    exceeds TRANSIENT_MIN_ERROR; otherwise those columns are empty. A settling time that
+    does not exist (still outside the band at the end) is NaN, and so is every metric of
+    a vehicle that stopped early. ``transient_until`` [s] ends the window in which the
+    transient is measured (e.g. the first corner of a square, after which the reference
+    turns and the error grows again).
+    """
+    import pandas as pd
+
+    from quadcruise.layout import CMD_U1, REF_X, X
+
+    t = result.t
+    mission = result.meta.get("mission") if isinstance(result.meta.get("mission"), dict) else {}
+    rows = []
+    for i in range(result.n):
+        row = {"vehicle": i, "status": result.status_text(i), "rmse_m": np.nan, "max_error_m": np.nan,
+               "axis": None, "rise_time_s": np.nan, "settling_time_s": np.nan,
+               "settling_time_5pct_s": np.nan, "overshoot_pct": np.nan, "effort": np.nan,
+               "duty_clipped_s": float(result.duty_clipped_s[i]),
+               "controller_limited_s": float(result.controller_limited_s[i])}
+        rows.append(row)
+        if result.status[i] != 0:
+            continue
+        pos, ref = result.states[i, :, X:X + 3], result.references[i, :, REF_X:REF_X + 3]
+        if np.all(np.isfinite(ref)):
+            err = tracking_errors(t, pos, ref)
+            row["rmse_m"], row["max_error_m"] = float(err["rmse"]), float(err["max_error"])
+            keep = slice(None) if transient_until is None else t <= transient_until
+            info, axis = _flight_transient(t[keep], pos[keep], ref[keep], mission, transient_axis)
+            if info is not None:
+                row.update(axis=axis, rise_time_s=_nan(info.rise_time), settling_time_s=_nan(info.settling_time),
+                           settling_time_5pct_s=_nan(info.settling_time_5pct), overshoot_pct=info.overshoot_pct)
+        row["effort"] = float(control_effort(t, result.commands[i, :, CMD_U1:CMD_U1 + 4])["integral"])
+    return pd.DataFrame(rows)
+
+
+def _flight_transient(t, pos, ref, mission: dict, axis: str | None):
+    if axis is None and mission.get("kind") == "step" and mission.get("axis") in _AXIS_NAMES:
+        j = _AXIS_NAMES.index(mission["axis"])
+        t_step = float(mission["time"])
+        if t[0] <= t_step < t[-1]:
+            before = float(mission[mission["axis"]])   # the hover point the step leaves
+            return step_info(t, pos[:, j], y_initial=before, y_final=before + float(mission["size"]),
+                             t_step=t_step), mission["axis"]
+        return None, None
+    e0 = np.abs(ref[0] - pos[0])
+    j = _AXIS_NAMES.index(axis) if axis is not None else int(np.argmax(e0))
+    if e0[j] < TRANSIENT_MIN_ERROR:
+        return None, None
+    return transient_info(t, pos[:, j], ref[:, j]), _AXIS_NAMES[j]
+
+
+def _nan(value):
+    return np.nan if value is None else float(value)

@@ -1,0 +1,140 @@
+"""What every mission kind shares: validation of its fields, its parameter vector ``mp``, its
+reference at given times, and the stacking of a batch's parameter rows.
+
+A kind sets ``name``, ``columns`` (names of the mp entries), ``function`` (the compiled
+reference with ``MISSION_SIG``, as a staticmethod) and ``_row()`` (the mp entries in order).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any, ClassVar, Sequence
+
+import numpy as np
+from numba import njit, types
+
+from quadcruise.errors import InputError
+from quadcruise.fields import check_number
+from quadcruise.layout import REF_SIZE, MissionType
+
+__all__ = ["Mission", "check_names", "stack_params"]
+
+
+@njit(types.void(MissionType, types.float64[::1], types.float64[::1], types.float64[:, ::1]),
+      cache=True)
+def _evaluate(fn, ts, mp, out):
+    for i in range(ts.shape[0]):
+        fn(ts[i], mp, out[i])
+
+
+
+@dataclass(frozen=True)
+class Mission:
+    """Shared code of every mission kind: validation, ``params``, ``reference``, ``to_dict``.
+
+    A subclass sets ``name``, ``columns`` (names of the mp entries), ``function`` (the
+    compiled reference, as a staticmethod) and ``_row()`` (the mp entries in order).
+    """
+
+    name: ClassVar[str] = ""
+    columns: ClassVar[tuple] = ()
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            value, check = getattr(self, f.name), f.metadata["check"]
+            label = f"{self.name} field '{f.name}' ({f.metadata['doc']}, {f.metadata['unit']})"
+            if check == "custom":
+                continue
+            if check == "choice":
+                if value not in f.metadata["choices"]:
+                    raise InputError(f"{label} must be one of {', '.join(f.metadata['choices'])}, got {value!r}")
+                continue
+            if check == "pair":
+                if isinstance(value, (str, bytes)) or np.ndim(value) != 1 or len(value) != 2:
+                    raise InputError(f"{label} must be a pair of numbers, got {value!r}")
+                object.__setattr__(self, f.name, tuple(check_number(label, v) for v in value))
+                continue
+            num = check_number(label, value)
+            if (check == "pos" and num <= 0) or (check == "nonneg" and num < 0):
+                raise InputError(f"{label} must be {'>' if check == 'pos' else '>='} 0, got {num!r}")
+            if check == "sign" and num not in (1.0, -1.0):
+                raise InputError(f"{label} must be +1 or -1, got {value!r}")
+            object.__setattr__(self, f.name, int(num) if check == "sign" else num)
+
+    def _row(self) -> tuple:
+        raise NotImplementedError
+
+    @property
+    def duration(self) -> float:
+        """The default flight time [s]: 5 s here; one lap, the step and 10 s after it, or
+        the last waypoint and a settling time in the kinds that know better."""
+        return 5.0
+
+    def params(self) -> np.ndarray:
+        """The mission's parameter vector mp (float64, C-contiguous), laid out as ``columns``."""
+        return np.ascontiguousarray(self._row(), dtype=np.float64)
+
+    def reference(self, t: Any) -> np.ndarray:
+        """The reference at times ``t`` [s], shape (len(t), REF_SIZE), from the compiled function."""
+        ts = np.array(np.atleast_1d(t), dtype=np.float64)    # a writable C-ordered copy
+        if ts.ndim != 1 or not np.all(np.isfinite(ts)):
+            raise InputError("mission reference times must be a 1-D array of finite numbers")
+        out = np.empty((ts.shape[0], REF_SIZE))
+        _evaluate(self.function, ts, self.params(), out)
+        return out
+
+    def replace(self, **changes: Any) -> "Mission":
+        """A copy with some fields changed (validated again)."""
+        check_names(type(self), changes)
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self) -> dict:
+        """``{'kind': name, field: value, ...}`` with plain values, for result bundles."""
+        values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        return {"kind": self.name, **{k: list(v) if isinstance(v, tuple) else v for k, v in values.items()}}
+
+    @classmethod
+    def units(cls) -> dict:
+        """Each field's unit."""
+        return {f.name: f.metadata["unit"] for f in dataclasses.fields(cls)}
+
+
+
+def check_names(cls: type, kw: dict) -> None:
+    """InputError naming any key of ``kw`` that is not a field of the mission kind ``cls``."""
+    unknown = set(kw) - {f.name for f in dataclasses.fields(cls)}
+    if unknown:
+        raise InputError(f"unknown {cls.name} field(s): {', '.join(sorted(unknown))}")
+
+
+
+def stack_params(missions: Mission | Sequence[Mission], n: int | None = None) -> np.ndarray:
+    """The (N, M) mp array of a batch: one row per mission, all of the same kind.
+
+    A single mission (or a list of one) is broadcast to ``n`` rows when ``n`` is given.
+    Rows of different lengths (waypoint tables of different sizes) are padded with zeros.
+
+    >>> from quadcruise.missions import Circle, Hover
+    >>> stack_params([Circle(radius=1.0), Circle(radius=2.0)])[:, 0]
+    array([1., 2.])
+    >>> stack_params(Hover(), n=3).shape
+    (3, 4)
+    """
+    missions = [missions] if isinstance(missions, Mission) else list(missions)
+    if not missions or not all(isinstance(m, Mission) for m in missions):
+        raise InputError("stack_params needs a non-empty list of missions")
+    kinds = sorted({type(m).name for m in missions})
+    if len(kinds) > 1:
+        raise InputError(f"a batch flies one mission kind, got {', '.join(kinds)}")
+    params = [m.params() for m in missions]
+    width = max(p.shape[0] for p in params)      # tables of waypoints differ in length:
+    rows = np.zeros((len(params), width))        # pad; each function reads its own count
+    for i, p in enumerate(params):
+        rows[i, :p.shape[0]] = p
+    if n is not None:
+        if len(missions) == 1:
+            rows = np.repeat(rows, n, axis=0)
+        elif len(missions) != n:
+            raise InputError(f"{len(missions)} missions given but {n} vehicles were asked for")
+    return np.ascontiguousarray(rows)

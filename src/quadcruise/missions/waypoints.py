@@ -1,0 +1,473 @@
+"""Waypoint missions: a table of points flown as straight legs or as one minimum-snap path.
+
+A :class:`WaypointTable` holds points (x, y, z [m]), optionally a yaw at each [rad], and the
+timing: EITHER arrival times ``t`` [s] (first 0, strictly increasing; a point repeated then
+means a dwell there) OR ``speed`` [m/s], the cruise speed on the leg that ENDS at each point
+(the first row's is unused and may be left empty), or neither: the mission's ``speed``
+(0.5 m/s by default) on every leg. :func:`read_waypoints_csv` reads ``x,y,z[,yaw][,t|speed]``.
+
+Kinds (both hold the last point after the end, and the first before t = 0):
+
+- :class:`Waypoints` ('waypoints'): constant-speed straight legs with explicit corners, like the
+  paper's square: C0 at the points (the velocity jumps, each leg being [departure, arrival)),
+  zero acceleration on the legs, yaw linear per leg (or held).
+  mp = [n, hold_yaw, then per point: x, y, z, yaw, t], length 2 + 5 n.
+- :class:`MinimumSnap` ('minsnap'): Mellinger & Kumar's (2011) minimum-snap path, one
+  7th-order polynomial per segment and axis (x, y, z, yaw) through every point at its time,
+  at rest (zero velocity, acceleration, jerk) at both ends and at every dwell, C3 by
+  constraint and C6 elsewhere by optimality: the equality-constrained QP
+  min sum_i int |p_i''''|^2 dt, solved through its KKT system in each segment's local time
+  s = (t - t_i) / T_i. mp = [m, x, y, z, yaw and t of the end, then per segment: t_i, T_i,
+  8 coefficients of s^0..s^7 for each of x, y, z, yaw], length 6 + 34 m, m = n - 1.
+
+A batch flies one kind but its tables may differ in length: ``stack`` pads shorter rows with
+zeros, which the compiled functions never read (the count is mp[0]). ``duration`` is the last
+arrival + ``SETTLE_S``, rounded up to a whole second (so any usual dt divides it).
+
+Examples
+--------
+>>> from quadcruise.missions.waypoints import MinimumSnap, WaypointTable, Waypoints
+>>> table = WaypointTable([[0, 0, 1], [2, 0, 1], [2, 1, 1]], speed=[0, 0.5, 0.25])
+>>> table.times()
+array([0., 4., 8.])
+>>> legs = Waypoints(table)
+>>> legs.reference([2.0, 6.0])[:, :5]            # x, y, z, vx, vy half-way along each leg
+array([[1.  , 0.  , 1.  , 0.5 , 0.  ],
+       [2.  , 0.5 , 1.  , 0.  , 0.25]])
+>>> legs.duration
+13.0
+>>> smooth = MinimumSnap(table)
+>>> smooth.reference([0.0, 4.0, 8.0])[:, :3].round(12) + 0.0
+array([[0., 0., 1.],
+       [2., 0., 1.],
+       [2., 1., 1.]])
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any, ClassVar
+
+import numpy as np
+from numba import njit
+
+from quadcruise.errors import InputError
+from quadcruise.fields import unit_field as _f
+from quadcruise.io.files import read_numeric_csv
+from quadcruise.layout import REF_AX, REF_PSI, REF_PSI_DOT, REF_SIZE, REF_VX, REF_X
+from quadcruise.missions.base import Mission
+
+__all__ = ["WaypointTable", "read_waypoints_csv", "Waypoints", "MinimumSnap",
+           "minimum_snap_coefficients", "SETTLE_S", "DEFAULT_SPEED"]
+
+COLUMNS = ("x", "y", "z", "yaw", "t", "speed")
+DEFAULT_SPEED = 0.5   # m/s, the paper's square speed, for tables that give no timing
+SETTLE_S = 5.0        # s flown after the last point by default
+_ORDER = 7            # polynomial degree of the minimum-snap segments
+_NC = _ORDER + 1
+
+
+# --- the table -----------------------------------------------------------------------------
+@dataclass(frozen=True, eq=False)
+class WaypointTable:
+    """Waypoints and their timing, checked on construction.
+
+    Parameters
+    ----------
+    points : (n, 3) positions x, y, z [m], n >= 2
+    yaw : (n,) yaw at each point [rad], optional (0 throughout if left out)
+    t : (n,) arrival times [s], strictly increasing from 0; optional
+    speed : (n,) cruise speed on the leg ending at each point [m/s], > 0; the first entry is
+        unused (NaN allowed); optional, and not together with ``t``
+    source : name used in error messages (the file name)
+
+    >>> WaypointTable([[0, 0, 1], [1, 0, 1]], t=[0.0, 0.0])
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: waypoints, row 2, column 't': time 0 is not after the previous point's 0
+    """
+
+    points: Any
+    yaw: Any = None
+    t: Any = None
+    speed: Any = None
+    source: str = "waypoints"
+    lines: Any = field(default=None, repr=False)   # file line of each point, for messages
+
+    def __post_init__(self) -> None:
+        src, lines = str(self.source), self.lines
+
+        def where(k: int, col: str) -> str:
+            return f"{src}, {'line ' + str(lines[k]) if lines else 'row ' + str(k + 1)}, column '{col}'"
+
+        pts = _array(self.points, src, "points")
+        if pts.ndim != 2 or pts.shape[1] != 3:
+            raise InputError(f"{src}: points have shape {pts.shape}, expected (n, 3) (x, y, z)")
+        n = pts.shape[0]
+        if n < 2:
+            raise InputError(f"{src}: needs at least two waypoints, found {n}")
+        cols = {"yaw": self.yaw, "t": self.t, "speed": self.speed}
+        if self.t is not None and self.speed is not None:
+            raise InputError(f"{src}, columns 't' and 'speed': give arrival times or leg speeds, not both")
+        for name, value in cols.items():
+            if value is not None:
+                cols[name] = _array(value, src, name)
+                if cols[name].shape != (n,):
+                    raise InputError(f"{src}: {name} has shape {cols[name].shape}, expected ({n},)")
+        t, v = cols["t"], cols["speed"]
+        named = [("x", pts[:, 0]), ("y", pts[:, 1]), ("z", pts[:, 2])]
+        named += [(c, cols[c]) for c in ("yaw", "t") if cols[c] is not None]
+        bad = np.argwhere(~np.isfinite(np.column_stack([c for _, c in named])))
+        if bad.size:                                   # the first bad cell, row by row
+            k, j = bad[0]
+            raise InputError(f"{where(k, named[j][0])}: value is not finite ({named[j][1][k]!r})")
+        if t is not None and t[0] != 0.0:
+            raise InputError(f"{where(0, 't')}: the first arrival time must be 0, got {t[0]:g}")
+        k = None if t is None else _after_first(np.diff(t) <= 0)
+        if k is not None:
+            raise InputError(f"{where(k, 't')}: time {t[k]:g} is not after the previous point's {t[k - 1]:g}")
+        if v is not None and v[0] < 0:
+            raise InputError(f"{where(0, 'speed')}: speed {v[0]:g} is negative (the first row's is unused)")
+        k = None if v is None else _after_first(~(np.isfinite(v[1:]) & (v[1:] > 0)))
+        if k is not None:
+            raise InputError(f"{where(k, 'speed')}: the leg speed must be a positive number, got {v[k]:g}")
+        k = None if t is not None else _after_first(np.all(pts[1:] == pts[:-1], axis=1))
+        if k is not None:
+            raise InputError(f"{where(k, 'x')} (and 'y', 'z'): the same point as the one before, "
+                             "a zero-length leg with no dwell time (give arrival times 't')")
+        for name, arr in (("points", pts), *cols.items()):
+            if arr is not None:
+                arr.setflags(write=False)
+                object.__setattr__(self, name, arr)
+        object.__setattr__(self, "source", src)
+
+    def __len__(self) -> int:
+        return self.points.shape[0]
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, WaypointTable):
+            return NotImplemented
+        return all(_same(getattr(self, n), getattr(other, n)) for n in ("points", "yaw", "t", "speed"))
+
+    def __hash__(self) -> int:
+        return hash(tuple(None if a is None else a.tobytes() for a in
+                          (self.points, self.yaw, self.t, self.speed)))
+
+    def times(self, speed: float = DEFAULT_SPEED) -> np.ndarray:
+        """Arrival times [s]: ``t``, or cumulated leg length / leg speed (``speed`` on every
+        leg when the table gives no timing)."""
+        if self.t is not None:
+            return np.array(self.t)
+        v = self.speed[1:] if self.speed is not None else np.full(len(self) - 1, float(speed))
+        legs = np.linalg.norm(np.diff(self.points, axis=0), axis=1)
+        return np.concatenate([[0.0], np.cumsum(legs / v)])
+
+    def yaws(self) -> np.ndarray:
+        """Yaw at each point [rad] (zeros if the table has none)."""
+        return np.zeros(len(self)) if self.yaw is None else np.array(self.yaw)
+
+    def to_dict(self) -> dict:
+        """Plain lists (None for absent columns and the unused first speed), for JSON."""
+        out: dict = {name: self.points[:, j].tolist() for j, name in enumerate("xyz")}
+        for name in ("yaw", "t", "speed"):
+            arr = getattr(self, name)
+            out[name] = None if arr is None else [v if math.isfinite(v) else None for v in arr.tolist()]
+        return {**out, "source": self.source}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "WaypointTable":
+        """Inverse of :meth:`to_dict`."""
+        try:
+            pts = np.column_stack([np.asarray(d[c], dtype=float) for c in "xyz"])
+            opt = {c: None if d.get(c) is None else np.array([np.nan if v is None else v for v in d[c]], dtype=float)
+                   for c in ("yaw", "t", "speed")}
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(f"waypoint table: bad dict ({exc.__class__.__name__}: {exc})") from None
+        return cls(pts, **opt, source=str(d.get("source", "waypoints")))
+
+
+def _array(value: Any, src: str, name: str) -> np.ndarray:
+    try:
+        return np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{src}: {name} must be numbers, got {value!r}") from None
+
+
+def _after_first(mask: np.ndarray) -> int | None:
+    """1 + the index of the first True of a mask over legs (the row that ends that leg)."""
+    idx = np.flatnonzero(mask)
+    return int(idx[0]) + 1 if idx.size else None
+
+
+def _same(a, b) -> bool:
+    return (a is None) == (b is None) and (a is None or np.array_equal(a, b, equal_nan=True))
+
+
+def read_waypoints_csv(path: str | os.PathLike) -> WaypointTable:
+    """Read a waypoint CSV (header ``x,y,z`` and optionally ``yaw`` and ``t`` or ``speed``).
+
+    Errors are one line naming the file, line and column; unknown columns are ignored with a
+    warning. The first row's ``speed`` cell may be empty.
+    """
+    head_line, used, data, lines = read_numeric_csv(
+        path, ("x", "y", "z"), tuple(c for c in COLUMNS if c not in "xyz"),
+        blank_ok=lambda name, k: name == "speed" and k == 0)       # the first point ends no leg
+    if "t" in used and "speed" in used:
+        raise InputError(f"{path}, line {head_line}, columns 't' and 'speed': give arrival times or leg speeds, not both")
+    if data.shape[0] < 2:
+        raise InputError(f"{path}, line {lines[-1] if lines else head_line}: needs at least two waypoints, found {data.shape[0]}")
+    col = {name: data[:, j] for j, name in enumerate(used)}
+    return WaypointTable(np.column_stack([col["x"], col["y"], col["z"]]), yaw=col.get("yaw"),
+                         t=col.get("t"), speed=col.get("speed"), source=str(path),
+                         lines=tuple(lines))
+
+
+# --- compiled references ---------------------------------------------------------------------
+@njit(cache=True)
+def _last_start(t, mp, first, stride, count):
+    """Largest k < count with mp[first + stride k] <= t (0 when t is before them all)."""
+    lo, hi = 0, count - 1
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if mp[first + stride * mid] <= t:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
+
+
+@njit(cache=True, error_model="numpy")
+def waypoints_ref(t, mp, ref):
+    """mp = [n, hold_yaw, (x, y, z, yaw, t) per point]: straight legs, C0 at the points."""
+    for i in range(REF_SIZE):
+        ref[i] = 0.0
+    n = int(mp[0])
+    last = 2 + 5 * (n - 1)
+    if t >= mp[last + 4] or t < 0.0:               # hold the last (first) point
+        at = last if t >= 0.0 else 2
+        for j in range(3):
+            ref[REF_X + j] = mp[at + j]
+        ref[REF_PSI] = mp[at + 3]
+        return
+    a = 2 + 5 * _last_start(t, mp, 6, 5, n - 1)    # leg [t_k, t_k+1): departure point a
+    b = a + 5
+    dur = mp[b + 4] - mp[a + 4]
+    s = (t - mp[a + 4]) / dur
+    for j in range(3):                             # REF_X.. and REF_VX.. are x, y, z in order
+        ref[REF_X + j] = mp[a + j] + s * (mp[b + j] - mp[a + j])
+        ref[REF_VX + j] = (mp[b + j] - mp[a + j]) / dur
+    if mp[1] != 0.0:
+        ref[REF_PSI] = mp[a + 3]
+    else:
+        ref[REF_PSI] = mp[a + 3] + s * (mp[b + 3] - mp[a + 3])
+        ref[REF_PSI_DOT] = (mp[b + 3] - mp[a + 3]) / dur
+
+
+@njit(cache=True, error_model="numpy")
+def minsnap_ref(t, mp, ref):
+    """mp = [m, x, y, z, yaw and t at the end, (t_i, T_i, 4 x 8 coefficients in s) per segment]."""
+    for i in range(REF_SIZE):
+        ref[i] = 0.0
+    if t >= mp[5]:
+        for j in range(3):
+            ref[REF_X + j] = mp[1 + j]
+        ref[REF_PSI] = mp[4]
+        return
+    off = 6 + 34 * _last_start(t, mp, 6, 34, int(mp[0]))
+    dur = mp[off + 1]
+    s = max(t - mp[off], 0.0) / dur               # before t = 0: the first point, at rest
+    for j in range(4):                            # Horner for p, p' and p'' / 2 (in s)
+        c = off + 2 + 8 * j
+        p, dp, ddp = mp[c + 7], 0.0, 0.0
+        for k in range(6, -1, -1):
+            ddp = ddp * s + dp
+            dp = dp * s + p
+            p = p * s + mp[c + k]
+        if j < 3:
+            ref[REF_X + j] = p
+            ref[REF_VX + j] = dp / dur
+            ref[REF_AX + j] = 2.0 * ddp / (dur * dur)
+        else:
+            ref[REF_PSI] = p
+            ref[REF_PSI_DOT] = dp / dur
+
+
+# --- minimum snap: the KKT system ------------------------------------------------------------
+def _derivative_row(r: int, s: float) -> np.ndarray:
+    """d^r/ds^r of (1, s, ..., s^7) at s."""
+    return np.array([math.perm(k, r) * s ** max(k - r, 0) for k in range(_NC)], dtype=float)
+
+
+def _snap_hessian() -> np.ndarray:
+    """H with int_0^1 (d^4 p / ds^4)^2 ds = a^T H a for p = sum a_k s^k."""
+    k = np.arange(4, _NC)
+    fall = np.array([math.perm(i, 4) for i in k], dtype=float)
+    h = np.zeros((_NC, _NC))
+    h[4:, 4:] = np.outer(fall, fall) / (k[:, None] + k[None, :] - 7)
+    return h
+
+
+def minimum_snap_coefficients(values: Any, times: Any, stops: Any = None) -> np.ndarray:
+    """Minimum-snap 7th-order segments through ``values`` at ``times``.
+
+    Parameters
+    ----------
+    values : (n,) or (n, A) knot values (A axes solved together)
+    times : (n,) strictly increasing knot times [s]
+    stops : (n,) bool, optional; True where the path comes to rest (zero velocity,
+        acceleration and jerk). The two ends always do.
+
+    Returns
+    -------
+    (m, 8, A) array: coefficients of s^0..s^7, s = (t - times[i]) / (times[i+1] - times[i]).
+
+    >>> c = minimum_snap_coefficients([0.0, 1.0], [0.0, 2.0])   # rest to rest: 35s^4 - 84s^5 ...
+    >>> c[0, :, 0].round(9) + 0.0
+    array([  0.,   0.,   0.,   0.,  35., -84.,  70., -20.])
+    """
+    import scipy.sparse  # here, not at the top: importing quadcruise stays
+    import scipy.sparse.linalg  # free of scipy
+
+    w = np.asarray(values, dtype=float).reshape(len(times), -1)
+    dur = np.diff(np.asarray(times, dtype=float))
+    n, m, axes = w.shape[0], w.shape[0] - 1, w.shape[1]
+    stop = np.zeros(n, bool) if stops is None else np.asarray(stops, bool).copy()
+    stop[[0, -1]] = True
+    # cost int |d^4p/dt^4|^2 dt = sum_i T_i^-7 a_i^T H a_i; with a_i = g_i b_i, g_i = (T_i/T_0)^3.5,
+    # every block weighs H alone, and rows scaled to a largest entry of 1 keep the KKT balanced
+    g = (dur / dur[0]) ** 3.5
+    ii, jj, vv, rhs = [], [], [], []
+
+    def constrain(value, *terms) -> None:          # sum of d^r p_seg / dt^r terms = value
+        scale = max(np.abs(row).max() * g[seg] for seg, row in terms)
+        for seg, row in terms:
+            ii.extend([len(rhs)] * _NC)
+            jj.extend(range(_NC * seg, _NC * seg + _NC))
+            vv.extend(row * g[seg] / scale)
+        rhs.append(np.broadcast_to(value, (axes,)) / scale)
+
+    for j in range(n):
+        if j > 0:
+            constrain(w[j], (j - 1, _derivative_row(0, 1.0)))
+        if j < m:
+            constrain(w[j], (j, _derivative_row(0, 0.0)))
+        for r in range(1, 4):
+            if stop[j]:                            # at rest on both sides
+                if j > 0:
+                    constrain(0.0, (j - 1, _derivative_row(r, 1.0)))
+                if j < m:
+                    constrain(0.0, (j, _derivative_row(r, 0.0)))
+            else:                                  # d^r/dt^r continuous
+                constrain(0.0, (j - 1, _derivative_row(r, 1.0) / dur[j - 1] ** r),
+                          (j, -_derivative_row(r, 0.0) / dur[j] ** r))
+    a_eq = scipy.sparse.csr_matrix((vv, (ii, jj)), shape=(len(rhs), _NC * m))
+    kkt = scipy.sparse.bmat([[scipy.sparse.block_diag([_snap_hessian()] * m), a_eq.T], [a_eq, None]])
+    sol = scipy.sparse.linalg.spsolve(kkt.tocsc(), np.vstack([np.zeros((_NC * m, axes)), *rhs]))
+    b = np.asarray(sol).reshape(-1, axes)[:_NC * m].reshape(m, _NC, axes)
+    return g[:, None, None] * b
+
+
+# --- the mission kinds -----------------------------------------------------------------------
+def _as_table(value: Any) -> WaypointTable:
+    if isinstance(value, WaypointTable):
+        return value
+    if isinstance(value, (str, os.PathLike)):
+        return read_waypoints_csv(value)
+    if isinstance(value, dict):
+        return WaypointTable.from_dict(value)
+    raise InputError(f"a waypoint table must be a WaypointTable, a CSV path or a dict, got {type(value).__name__}")
+
+
+@dataclass(frozen=True)
+class _WaypointMission(Mission):
+    """Shared parts: the table (a WaypointTable, CSV path or dict), the default speed,
+    ``duration``, ``stack`` and ``to_dict``."""
+
+    table: Any = _f(None, "-", "waypoint table or CSV path", "custom")
+    speed: float = _f(DEFAULT_SPEED, "m/s", "leg speed where the table gives no timing", "pos")
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "table", _as_table(self.table))
+        super().__post_init__()
+
+    @property
+    def times(self) -> np.ndarray:
+        """Arrival time at each point [s]."""
+        return self.table.times(self.speed)
+
+    @property
+    def duration(self) -> float:
+        """Default flight time: the last arrival + SETTLE_S, rounded up to a whole second."""
+        return float(math.ceil(self.times[-1] + SETTLE_S - 1e-9))
+
+    def to_dict(self) -> dict:
+        d = super().to_dict()
+        return {**d, "table": self.table.to_dict()}
+
+
+@dataclass(frozen=True)
+class Waypoints(_WaypointMission):
+    """Straight constant-speed legs between the points, explicit corners (C0), like the square.
+
+    ``style`` is 'legs' (the smooth style is the kind :class:`MinimumSnap`); ``yaw_mode``
+    'linear' turns at a constant rate over each leg, 'hold' keeps the departure point's yaw
+    until the arrival. mp = [n, hold_yaw, (x, y, z, yaw, t) per point].
+
+    >>> Waypoints(WaypointTable([[0, 0, 1], [0, 0, 1]], t=[0, 2])).params()
+    array([2., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 2.])
+    """
+
+    style: str = _f("legs", "-", "'legs'", "custom")
+    yaw_mode: str = _f("linear", "-", "yaw over a leg", "choice", ("linear", "hold"))
+
+    name: ClassVar[str] = "waypoints"
+    columns: ClassVar[tuple] = ("n", "hold_yaw", "x[k]", "y[k]", "z[k]", "yaw[k]", "t[k]")
+    function = staticmethod(waypoints_ref)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.style != "legs":
+            raise InputError(f"waypoints field 'style' must be 'legs' (the smooth path is the "
+                             f"mission 'minsnap'), got {self.style!r}")
+
+    def _row(self) -> tuple:
+        per_point = np.column_stack([self.table.points, self.table.yaws(), self.times])
+        return (len(self.table), float(self.yaw_mode == "hold"), *per_point.ravel())
+
+
+@dataclass(frozen=True)
+class MinimumSnap(_WaypointMission):
+    """The minimum-snap path through the points (Mellinger & Kumar 2011), yaw included.
+
+    At rest at both ends and wherever the table dwells (two equal points in a row);
+    C6 elsewhere. mp = [m, x, y, z, yaw, t at the end, (t_i, T_i, 32 coefficients) per segment].
+
+    >>> ms = MinimumSnap(WaypointTable([[0, 0, 1], [1, 1, 1], [2, 0, 1]], t=[0, 3, 6]))
+    >>> ms.params().shape, ms.reference(3.0)[0, :2] .round(12) + 0.0
+    ((74,), array([1., 1.]))
+    """
+
+    name: ClassVar[str] = "minsnap"
+    columns: ClassVar[tuple] = ("m", "x_end", "y_end", "z_end", "yaw_end", "t_end", "t[i]", "T[i]",
+                                "x[i, 0..7]", "y[i, 0..7]", "z[i, 0..7]", "yaw[i, 0..7]")
+    function = staticmethod(minsnap_ref)
+
+    @cached_property
+    def coefficients(self) -> np.ndarray:
+        """(m, 8, 4) coefficients of s^0..s^7 per segment, for x, y, z, yaw."""
+        pts = self.table.points
+        still = np.all(pts[1:] == pts[:-1], axis=1)             # dwells: rest at both ends
+        stops = np.zeros(len(pts), bool)
+        stops[:-1] |= still
+        stops[1:] |= still
+        coef = minimum_snap_coefficients(np.column_stack([pts, self.table.yaws()]), self.times, stops)
+        coef.setflags(write=False)
+        return coef
+
+    def _row(self) -> tuple:
+        tk, end = self.times, np.append(self.table.points[-1], self.table.yaws()[-1])
+        segs = np.column_stack([tk[:-1], np.diff(tk), self.coefficients.transpose(0, 2, 1).reshape(len(tk) - 1, -1)])
+        return (len(tk) - 1, *end, tk[-1], *segs.ravel())

@@ -1,0 +1,203 @@
+"""Vehicle parameters: frozen, validated, with units, and able to carry a batch axis.
+
+The default is the paper's Table I (the Quanser Qball-X4 of its reference [8]), with the
+yaw moment arm ``d`` the paper leaves out derived from the Qball-X4's documented yaw
+torque gain (4 N m per unit duty) divided by the thrust gain K: d = 4/120 m. The paper's
+model has no aerodynamic drag, so both drag coefficients default to zero; wind acts on the
+vehicle only through them (see :mod:`quadcruise.disturbances`).
+
+A field may be a scalar (every vehicle alike) or a 1-D array of length N (each vehicle its
+own value). :meth:`Vehicle.rows` turns either into the ``(N, PARAM_SIZE)`` array the
+compiled engine reads.
+
+Examples
+--------
+>>> from quadcruise import Vehicle
+>>> v = Vehicle.paper()
+>>> round(v.hover_duty, 4)
+0.0715
+>>> v.replace(m=1.4).m
+1.4
+>>> import numpy as np
+>>> batch = v.replace(m=np.array([3.0, 3.5, 4.0]))
+>>> batch.batch_size, batch.rows().shape
+(3, (3, 21))
+>>> Vehicle.paper().replace(m=0.0)
+Traceback (most recent call last):
+    ...
+quadcruise.errors.InputError: vehicle field 'm' (mass, kg) must be > 0, got 0.0
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from quadcruise.errors import InputError
+from quadcruise.layout import (
+    P_CD1,
+    P_CD2,
+    P_D,
+    P_G,
+    P_INV_JXX,
+    P_INV_JYY,
+    P_INV_JZZ,
+    P_INV_M,
+    P_JXX,
+    P_JYY,
+    P_JZZ,
+    P_K,
+    P_K1,
+    P_K2,
+    P_K3,
+    P_K4,
+    P_K5,
+    P_K6,
+    P_L,
+    P_M,
+    P_OMEGA,
+    PARAM_SIZE,
+)
+
+
+def _field(default: float, unit: str, doc: str, minimum: float = 0.0, strict: bool = True):
+    return field(default=default, metadata={"unit": unit, "doc": doc, "min": minimum, "strict": strict})
+
+
+@dataclass(frozen=True)
+class Vehicle:
+    """Physical parameters of a quadrotor (the paper's Table I by default).
+
+    Each field is a float, or a 1-D array giving one value per vehicle of a batch.
+    """
+
+    m: Any = _field(3.499, "kg", "mass")
+    Jxx: Any = _field(0.03, "kg m^2", "moment of inertia about body x")
+    Jyy: Any = _field(0.03, "kg m^2", "moment of inertia about body y")
+    Jzz: Any = _field(0.04, "kg m^2", "moment of inertia about body z")
+    l: Any = _field(0.2, "m", "arm length, rotor to centre (Table I's L)")
+    K: Any = _field(120.0, "N", "thrust per unit PWM duty (Table I's K)")
+    omega: Any = _field(15.0, "rad/s", "actuator bandwidth (first-order rotor lag)")
+    d: Any = _field(4.0 / 120.0, "m", "yaw moment per unit thrust, eq (4)")
+    g: Any = _field(9.81, "m/s^2", "gravitational acceleration", strict=False)
+    drag_linear: Any = _field(0.0, "N s/m", "linear drag coefficient (air-relative velocity)", strict=False)
+    drag_quadratic: Any = _field(0.0, "N s^2/m^2", "quadratic drag coefficient", strict=False)
+
+    def __post_init__(self) -> None:
+        sizes = set()
+        for f in dataclasses.fields(self):
+            value = np.asarray(getattr(self, f.name), dtype=float) if not isinstance(
+                getattr(self, f.name), str) else None
+            label = f"vehicle field '{f.name}' ({f.metadata['doc']}, {f.metadata['unit']})"
+            if value is None or value.ndim > 1:
+                raise InputError(f"{label} must be a number or a 1-D array of numbers")
+            if not np.all(np.isfinite(value)):
+                raise InputError(f"{label} must be finite, got {_show(value)}")
+            low, strict = f.metadata["min"], f.metadata["strict"]
+            bad = value <= low if strict else value < low
+            if np.any(bad):
+                op = ">" if strict else ">="
+                raise InputError(f"{label} must be {op} {low:g}, got {_show(value[bad] if value.ndim else value)}")
+            if value.ndim == 1:
+                sizes.add(value.shape[0])
+                value = value.copy()
+                value.flags.writeable = False
+                object.__setattr__(self, f.name, value)
+            else:
+                object.__setattr__(self, f.name, float(value))
+        if len(sizes) > 1:
+            raise InputError(f"vehicle fields have different batch lengths {sorted(sizes)}")
+
+    # --- constructors -------------------------------------------------------------------
+    @classmethod
+    def paper(cls) -> "Vehicle":
+        """The paper's Table I (Qball-X4) with d = 4/120 m (one shared, frozen instance)."""
+        return shared_default(cls)
+
+    def replace(self, **changes: Any) -> "Vehicle":
+        """A copy with some fields changed (validated again)."""
+        unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
+        if unknown:
+            raise InputError(f"unknown vehicle field(s): {', '.join(sorted(unknown))}")
+        return dataclasses.replace(self, **changes)
+
+    @classmethod
+    def stack(cls, vehicles: "list[Vehicle]") -> "Vehicle":
+        """One batched Vehicle from a list of single vehicles."""
+        if not vehicles:
+            raise InputError("cannot stack an empty list of vehicles")
+        cols = {f.name: np.concatenate([np.atleast_1d(getattr(v, f.name)) * np.ones(v.batch_size or 1)
+                                        for v in vehicles]) for f in dataclasses.fields(cls)}
+        return cls(**cols)
+
+    # --- views --------------------------------------------------------------------------
+    @property
+    def batch_size(self) -> int | None:
+        """N if any field carries a batch axis, else None."""
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, np.ndarray):
+                return value.shape[0]
+        return None
+
+    @property
+    def hover_duty(self) -> Any:
+        """PWM duty per rotor that holds hover: m g / (4 K)."""
+        return self.m * self.g / (4.0 * self.K)
+
+    @property
+    def k(self) -> tuple:
+        """(k1, ..., k6) of the paper's Section III, eq (11)."""
+        return (
+            (self.Jyy - self.Jzz) / self.Jxx, self.l / self.Jxx,
+            (self.Jzz - self.Jxx) / self.Jyy, self.l / self.Jyy,
+            (self.Jxx - self.Jyy) / self.Jzz, 1.0 / self.Jzz,
+        )
+
+    def rows(self, n: int | None = None) -> np.ndarray:
+        """The ``(N, PARAM_SIZE)`` parameter array for the compiled engine.
+
+        ``n`` broadcasts an unbatched vehicle to N rows; a batched one must match it.
+        """
+        size = self.batch_size
+        if n is None:
+            n = size or 1
+        if size is not None and size != n:
+            raise InputError(f"vehicle batch has {size} entries but {n} vehicles were asked for")
+        out = np.empty((n, PARAM_SIZE))
+        for col, name in ((P_M, "m"), (P_JXX, "Jxx"), (P_JYY, "Jyy"), (P_JZZ, "Jzz"),
+                          (P_L, "l"), (P_K, "K"), (P_OMEGA, "omega"), (P_D, "d"), (P_G, "g")):
+            out[:, col] = getattr(self, name)
+        for col, value in zip((P_K1, P_K2, P_K3, P_K4, P_K5, P_K6), self.k):
+            out[:, col] = value
+        out[:, P_CD1] = self.drag_linear
+        out[:, P_CD2] = self.drag_quadratic
+        for col, src in ((P_INV_M, P_M), (P_INV_JXX, P_JXX), (P_INV_JYY, P_JYY), (P_INV_JZZ, P_JZZ)):
+            out[:, col] = 1.0 / out[:, src]
+        return out
+
+    def to_dict(self) -> dict:
+        """Plain values (lists for batched fields), for result bundles."""
+        return {f.name: (getattr(self, f.name).tolist() if isinstance(getattr(self, f.name), np.ndarray)
+                         else getattr(self, f.name)) for f in dataclasses.fields(self)}
+
+    @classmethod
+    def units(cls) -> dict:
+        """Each field's unit."""
+        return {f.name: f.metadata["unit"] for f in dataclasses.fields(cls)}
+
+
+@functools.cache
+def shared_default(cls: type) -> Any:
+    """``cls()`` of a frozen dataclass, built and validated once and shared by every caller
+    (the default vehicle, mission or controller of each ``fly``)."""
+    return cls()
+
+
+def _show(value: np.ndarray) -> str:
+    flat = np.atleast_1d(value)
+    return repr(float(flat[0])) if flat.size == 1 else np.array2string(flat[:4], separator=", ")

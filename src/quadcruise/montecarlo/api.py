@@ -1,0 +1,101 @@
+"""Monte Carlo sweeps: a population of perturbed vehicles flown through the batched engine,
+with the distribution of every metric, the failure rate and its reasons, the worst cases
+(each replayable alone), histograms and an envelope of the paths.
+
+This module holds the entry points; the pieces, from the bottom up:
+
+- :class:`~quadcruise.montecarlo.population.Population` (:mod:`quadcruise.montecarlo.population`): relative
+  spreads of the vehicle's parameters, an initial position offset, a random steady wind,
+  an :class:`~quadcruise.disturbances.Environment` and
+  :class:`~quadcruise.disturbances.SensorNoise`; where each vehicle's randomness comes from;
+- :class:`~quadcruise.montecarlo.spec.MonteCarloSpec` (:mod:`quadcruise.montecarlo.spec`): the population
+  with the mission, controller, nominal vehicle, seed, flight time and step: everything
+  that fixes the flights (it has a :meth:`~quadcruise.montecarlo.spec.MonteCarloSpec.hash`);
+- :func:`quadcruise.montecarlo.sweep.run_chunk`: vehicles ``first .. first + count - 1`` flown as one batch, reduced to
+  one row of metrics each (:mod:`quadcruise.metrics.batch`) plus a few decimated paths. It
+  is a pure function of ``(spec, first, count)``, and vehicle i's flight depends on
+  ``(seed, i)`` only, so any split into chunks gives the same table;
+- :func:`montecarlo`: the whole population, in process or on Dask (:mod:`quadcruise.montecarlo.sweep`),
+  streamed to disk and resumable (:mod:`quadcruise.montecarlo.store`), returning a
+  :class:`~quadcruise.montecarlo.result.MonteCarloResult` (:mod:`quadcruise.montecarlo.result`;
+  its figures: :mod:`quadcruise.plots.montecarlo`; its folder:
+  :mod:`quadcruise.montecarlo.output`);
+- :func:`montecarlo_case` / :func:`replay_case`: one vehicle flown alone again;
+- ``quadcruise montecarlo`` runs :func:`quadcruise.cli.montecarlo.montecarlo_command`.
+
+Examples
+--------
+>>> from quadcruise.montecarlo import Population, montecarlo
+>>> res = montecarlo("hover", "nlpd", Population(mass_spread=0.05, offset=0.1), n=4, seed=1,
+...                  duration=0.5, scheduler="none")
+>>> len(res.table), res.table["vehicle"].tolist()
+(4, [0, 1, 2, 3])
+>>> res.summary()["failures"]["count"]             # 0.5 s is too short to settle
+4
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Callable
+
+from quadcruise.control import Controller
+from quadcruise.missions import Mission
+from quadcruise.montecarlo.chunk import Case, montecarlo_case, replay_case
+from quadcruise.montecarlo.population import Population
+from quadcruise.montecarlo.result import MonteCarloResult
+from quadcruise.montecarlo.spec import MonteCarloSpec
+from quadcruise.montecarlo.sweep import run_sweep
+
+__all__ = ["Case", "montecarlo", "montecarlo_case", "replay_case"]
+
+
+# --- the whole population ---------------------------------------------------------------
+def montecarlo(mission: Mission | str = "circle", controller: Controller | str = "nlpd",
+               population: Population | None = None, n: int = 100, seed: int = 0, *,
+               chunk_size: int | str = "auto", scheduler: str | None = "local", workers: int | None = None,
+               out: str | Path | None = None, resume: bool = True, force: bool = False, fmt: str = "csv",
+               progress: Callable[[int, int], None] | None = None, connect_timeout: float = 10.0,
+               **spec_options: Any) -> MonteCarloResult:
+    """Fly a population of n vehicles and collect one row of metrics per flight.
+
+    Parameters
+    ----------
+    mission, controller : names or objects
+    population : Population
+        The spreads; none (n identical vehicles) by default.
+    n : int
+        Number of flights (>= 1).
+    seed : int
+        Flight i depends on (seed, i) only.
+    chunk_size : int or "auto"
+        Vehicles per chunk (per task). "auto" keeps a chunk's log near 64 MB and gives each
+        worker several chunks. The result does not depend on it.
+    scheduler : "local", "none" or an address
+        "local" (default): a Dask LocalCluster of ``workers`` processes (the machine's
+        cores by default), one thread each; "none": in this process, numba using all cores;
+        "tcp://host:port": an existing Dask cluster (unreachable: InputError). Worker
+        processes are spawned, so a script using "local" needs the usual
+        ``if __name__ == "__main__":`` guard.
+    out : folder, optional
+        Stream each chunk to ``out/chunks`` as it finishes and write the results at the end
+        (see :mod:`quadcruise.montecarlo.store`). A folder holding part of the same sweep is resumed.
+    resume, force : bool
+        resume=False flies everything again; force replaces a folder holding something else.
+    fmt : "csv" or "parquet"
+        Format of the flights table.
+    progress : callable, optional
+        ``progress(done, total)`` after each chunk (flights done, resumed ones included);
+        :class:`quadcruise.progress.ProgressBar` prints a line on stderr.
+    connect_timeout : float
+        Seconds to wait for a scheduler given by address.
+    **spec_options
+        More :class:`MonteCarloSpec` fields: duration, dt, vehicle, log_dt, settle_band, ...
+    """
+    spec = MonteCarloSpec(mission=mission, controller=controller, population=population or Population(),
+                          seed=seed, **spec_options)
+    return run_sweep(spec, n, chunk_size=chunk_size, scheduler=scheduler, workers=workers, out=out,
+                     resume=resume, force=force, fmt=fmt, progress=progress, connect_timeout=connect_timeout)
+
+
+# --- command line -----------------------------------------------------------------------

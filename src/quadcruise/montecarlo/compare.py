@@ -1,0 +1,37 @@
+"""Several controllers on the same Monte Carlo population (same seed: the same draws, gusts
+and noise for each)."""
+
+from __future__ import annotations
+
+from quadcruise.montecarlo.api import montecarlo
+from quadcruise.workflows.compare import labelled
+
+__all__ = ["compare_population"]
+
+
+def compare_population(mission, controllers, population, n: int, seed: int, **montecarlo_kw):
+    """The controllers on the *same* Monte Carlo population: every controller flies the
+    same n perturbed vehicles (same seed, so the same draws, gusts and noise).
+
+    Returns a DataFrame, one row per controller: the failure rate and the median (p50) and
+    p95 of RMSE, maximum error and the 5 % settling time. ``montecarlo_kw`` goes to
+    :func:`quadcruise.montecarlo.montecarlo` (duration, dt, scheduler, ...).
+
+    >>> from quadcruise.montecarlo import Population
+    >>> t = compare_population("step", ["nlpd", "gonzalez"], Population(mass_spread=0.05), n=4, seed=1,
+    ...                        duration=3.0, scheduler="none")
+    >>> list(t.index), int(t.loc["nlpd", "flights"])
+    (['nlpd', 'gonzalez'], 4)
+    """
+    import pandas as pd
+
+    rows = {}
+    for label, ctrl in labelled(controllers).items():
+        res = montecarlo(mission, ctrl, population, n, seed, **montecarlo_kw)
+        s = res.summary()
+        row = {"flights": s["flights"], "failure_rate": s["failures"]["rate"]}
+        for metric in ("rmse_m", "max_error_m", "settling_time_5pct_s"):
+            row[f"{metric} p50"] = s["metrics"][metric]["p50"]
+            row[f"{metric} p95"] = s["metrics"][metric]["p95"]
+        rows[label] = row
+    return pd.DataFrame.from_dict(rows, orient="index")

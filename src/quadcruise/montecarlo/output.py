@@ -1,0 +1,107 @@
+"""The output folder of a Monte Carlo run: a finished sweep's table, summary, worst
+flights, figures and report (beside its chunks), or one re-flown vehicle.
+
+The folder's layout and its marker are those of :mod:`quadcruise.montecarlo.store`.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+from quadcruise._version import __version__
+from quadcruise.errors import InputError
+from quadcruise.io.files import MARKER, atomic_dir, atomic_path, check_output_dir, write_table
+from quadcruise.io.plainjson import dumps
+from quadcruise.montecarlo.store import holds_sweep, write_marker
+
+__all__ = ["write_outputs", "write_case", "report_markdown"]
+
+
+def write_outputs(result, out, *, fmt: str = "csv", force: bool = False) -> Path:
+    """The results of a sweep into ``out`` (see :mod:`quadcruise.montecarlo.store`), each file
+    whole or not at all; quadcruise.json last, marked complete."""
+    from quadcruise.plots.flight import save_figure
+
+    path = Path(out)
+    meta, ours = holds_sweep(path, result.spec)
+    if not ours:
+        check_output_dir(path, force)
+        if meta is not None and not force:
+            raise InputError(f"{path}: holds another quadcruise result; use --force to replace it")
+        if path.is_dir() and any(path.iterdir()):
+            shutil.rmtree(path)
+    path.mkdir(parents=True, exist_ok=True)
+    name = write_table(result.table, path / "flights", fmt).name
+    summary = result.summary()
+    with atomic_path(path / "summary.json") as tmp:
+        tmp.write_text(dumps({**summary, "info": result.info}, indent=2) + "\n")
+    worst = result.worst(20)
+    with atomic_path(path / "worst.csv") as tmp:
+        worst.to_csv(tmp, index=False, float_format="%.10g")
+    figures = {"histograms.png": result.plot_histograms(), "envelope.png": result.plot_envelope()}
+    for fig_name, fig in figures.items():
+        save_figure(fig, path / fig_name)
+    with atomic_path(path / "report.md") as tmp:
+        tmp.write_text(report_markdown(result, summary, worst, name))
+    write_marker(path, result.spec, result.n, complete=True, table=name,
+                 chunk_size=result.info.get("chunk_size"))
+    return path
+
+
+def write_case(case, out, *, fmt: str = "csv", force: bool = False) -> Path:
+    """One re-flown vehicle into ``out``, whole or not at all: its traces, its row
+    (case.json), a figure of the flight and quadcruise.json."""
+    from quadcruise.plots.flight import plot_flight, save_figure
+
+    path = check_output_dir(out, force)
+    with atomic_dir(path) as tmp:
+        tmp = Path(tmp)
+        write_table(case.result.to_pandas(), tmp / "traces", fmt)
+        (tmp / "case.json").write_text(dumps(case.row, indent=2) + "\n")
+        save_figure(plot_flight(case.result), tmp / "flight.png")
+        (tmp / MARKER).write_text(dumps({"workflow": "montecarlo-case", "vehicle": case.vehicle,
+                                          **case.result.meta}, indent=2) + "\n")
+    return path
+
+
+def report_markdown(result, summary: dict, worst, table_name: str) -> str:
+    """report.md: what was flown, the failures, the quantiles, the worst flights, figures."""
+    spec = result.spec
+    pop = {k: v for k, v in spec.population.to_dict().items() if v not in (0.0, None)}
+    f = summary["failures"]
+    lines = [f"# Monte Carlo: {spec.controller.name} on {spec.mission.name}, {summary['flights']:,} flights\n",
+             f"quadcruise {__version__}, seed {spec.seed}, {spec.duration:g} s at dt = {spec.dt:g} s, "
+             f"metrics on a {spec.dt * spec.log_every:g} s log; spec hash `{spec.hash()}`.\n",
+             "Population: " + (", ".join(f"{k} = {v}" for k, v in pop.items()) or "nominal") + ".\n",
+             f"## Failures: {f['count']:,} of {summary['flights']:,} ({100 * f['rate']:.2f} %)\n",
+             "Each flight counts once, under the first that applies: diverged (the engine stopped it), "
+             f"saturated (rotor duties clipped for more than {spec.max_clipped_s:g} s), did not settle "
+             f"(the transient still outside the {100 * spec.settle_band:g} % band at the end).\n",
+             "| reason | flights | rate |", "|---|---|---|"]
+    for reason, v in f["by_reason"].items():
+        lines.append(f"| {reason} | {v['count']:,} | {100 * v['rate']:.2f} % |")
+    if summary["stopped"]:
+        lines.append("\nWhy the engine stopped flights: " + "; ".join(f"{k}: {v:,}" for k, v in summary["stopped"].items()) + ".")
+    lines += ["\n## Metrics\n", "| metric | flights | p5 | p50 | p95 | max |", "|---|---|---|---|---|---|"]
+    for name, m in summary["metrics"].items():
+        cells = " | ".join("-" if m[k] is None else f"{m[k]:.4g}" for k in ("p5", "p50", "p95", "max"))
+        lines.append(f"| {name} | {m['count']:,} | {cells} |")
+    lines += ["\n## Worst flights\n",
+              "Fly one alone again: `quadcruise montecarlo <the same options> --case VEHICLE`, or in Python "
+              "`quadcruise.montecarlo.montecarlo_case(spec, VEHICLE)`; it gives the same row.\n",
+              "| vehicle | reason | rmse [m] | max error [m] | settling 5 % [s] | stop [s] | m [kg] |",
+              "|---|---|---|---|---|---|---|"]
+    for _, r in worst.head(10).iterrows():
+        cells = " | ".join("-" if not np.isfinite(r[k]) else f"{r[k]:.4g}"
+                           for k in ("rmse_m", "max_error_m", "settling_time_5pct_s", "stop_time_s", "m"))
+        lines.append(f"| {int(r['vehicle'])} | {r['reason']} | {cells} |")
+    info = result.info
+    lines += ["\n## Figures\n", "![histograms](histograms.png)\n", "![envelope](envelope.png)\n",
+              "\n## How it ran\n",
+              f"{info.get('flown', 0):,} flights flown and {info.get('resumed', 0):,} resumed from disk on "
+              f"{info.get('scheduler')}, chunks of {info.get('chunk_size')} vehicles, "
+              f"{info.get('wall_s', 0):.1f} s. One row per flight: `{table_name}`; the chunks: `chunks/`.\n"]
+    return "\n".join(lines)

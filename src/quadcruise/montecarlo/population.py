@@ -1,0 +1,180 @@
+"""The population of a Monte Carlo sweep: how each vehicle differs from the nominal one.
+
+:class:`Population` holds relative spreads of the vehicle's parameters, an initial position
+offset, a random steady wind, an :class:`~quadcruise.disturbances.Environment` and
+:class:`~quadcruise.disturbances.SensorNoise`; :meth:`Population.draw` turns them into a
+:class:`Draw`: the batched vehicles of one chunk.
+
+Randomness. Vehicle i's drawn parameters come only from
+``numpy.random.SeedSequence([seed, i], spawn_key=(1,))`` (16 unit draws, always all of
+them, in a fixed order, so changing one spread never moves another's draws); its sensor
+noise and turbulence come from the engine's stream of ``(seed, i)``
+(:mod:`quadcruise.sim.rng`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from quadcruise.errors import InputError
+from quadcruise.model.vehicle import Vehicle
+
+__all__ = ["Population", "Draw", "DRAW_KEY", "N_DRAWS", "SLOTS", "SPREADS", "CLIP"]
+
+DRAW_KEY = 1
+"""spawn_key of the population's draws (the engine's own streams have none)."""
+N_DRAWS = 16
+SLOTS = {"m": 0, "Jxx": 1, "Jyy": 2, "Jzz": 3, "K": 4, "omega": 5, "d": 6,
+         "dx0": 7, "dy0": 8, "dz0": 9, "wind_x": 10, "wind_y": 11}
+"""Which of the 16 unit draws of a vehicle feeds which quantity (12..15 are spare)."""
+SPREADS = {"mass_spread": ("m",), "inertia_spread": ("Jxx", "Jyy", "Jzz"), "thrust_spread": ("K",),
+           "bandwidth_spread": ("omega",), "yaw_arm_spread": ("d",)}
+CLIP = {"normal": 3.0, "uniform": math.sqrt(3.0)}
+"""Largest |unit draw|: normal draws are clipped at 3 sigma, uniform ones span +-sqrt(3)
+(unit standard deviation)."""
+
+
+@dataclass(frozen=True)
+class Population:
+    """How the vehicles of a sweep differ from the nominal one.
+
+    Attributes
+    ----------
+    mass_spread, inertia_spread, thrust_spread, bandwidth_spread, yaw_arm_spread : float
+        Relative standard deviations of m; of Jxx, Jyy, Jzz (each drawn on its own); of the
+        thrust gain K; of the rotor bandwidth omega; of the yaw moment arm d. A value is
+        ``nominal * (1 + spread * z)`` with z a unit draw: normal clipped to [-3, 3], or
+        uniform on [-sqrt 3, sqrt 3]. So that every value stays positive a spread must be
+        < 1/3 (normal) or < 1/sqrt 3 (uniform).
+    offset : float
+        Standard deviation [m] of the initial position offset on each axis (same clipping).
+    wind_spread : float
+        Standard deviation [m/s] of a steady horizontal wind on x and on y, drawn per vehicle
+        and added to the environment's steady wind.
+    distribution : {"normal", "uniform"}
+    environment : Environment, optional
+        Wind, gust, turbulence, rotor loss, the same for every vehicle (turbulence differs by
+        vehicle through its random stream). Wind acts through drag: a vehicle without drag
+        gets :data:`~quadcruise.disturbances.DEFAULT_DRAG` (with a warning).
+    noise : SensorNoise, optional
+    model_error : bool
+        The controller computes with the nominal vehicle (True) or knows each vehicle's
+        drawn parameters (False).
+
+    Examples
+    --------
+    >>> p = Population(mass_spread=0.1)
+    >>> d = p.draw(seed=1, first=0, count=5, nominal=Vehicle.paper())
+    >>> d.vehicle.batch_size, bool(np.all(p.draw(1, 3, 2, Vehicle.paper()).vehicle.m == d.vehicle.m[3:]))
+    (5, True)
+    >>> Population(mass_spread=-0.1)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: population field 'mass_spread' must be a number >= 0, got -0.1
+    """
+
+    mass_spread: float = 0.0
+    inertia_spread: float = 0.0
+    thrust_spread: float = 0.0
+    bandwidth_spread: float = 0.0
+    yaw_arm_spread: float = 0.0
+    offset: float = 0.0
+    wind_spread: float = 0.0
+    distribution: str = "normal"
+    environment: Any = None
+    noise: Any = None
+    model_error: bool = True
+
+    def __post_init__(self) -> None:
+        if self.distribution not in CLIP:
+            raise InputError(f"population field 'distribution' must be normal or uniform, got {self.distribution!r}")
+        for name in (*SPREADS, "offset", "wind_spread"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                    or not math.isfinite(value) or value < 0:
+                raise InputError(f"population field '{name}' must be a number >= 0, got {value!r}")
+            object.__setattr__(self, name, float(value))
+            limit = 1.0 / CLIP[self.distribution]
+            if name in SPREADS and value >= limit:
+                raise InputError(f"population field '{name}' = {value:g} is too large: with {self.distribution} "
+                                 f"draws it must be < {limit:.4f} so that every value stays positive")
+        from quadcruise.disturbances.environment import Environment, SensorNoise
+
+        if self.environment is not None:
+            if not isinstance(self.environment, Environment):
+                raise InputError("population field 'environment' must be an Environment or None")
+            if self.environment.batch_size is not None:
+                raise InputError("the population's environment must be the same for every vehicle "
+                                 "(per-vehicle values come from the spreads)")
+        if self.noise is not None:
+            if not isinstance(self.noise, SensorNoise):
+                raise InputError("population field 'noise' must be a SensorNoise or None")
+            if np.ndim(self.noise.std_vector()) > 1:
+                raise InputError("the population's sensor noise must be the same for every vehicle")
+        object.__setattr__(self, "model_error", bool(self.model_error))
+
+    @property
+    def needs_drag(self) -> bool:
+        """True if the vehicles meet wind (which acts only through drag)."""
+        return self.wind_spread > 0 or (self.environment is not None and self.environment.needs_drag)
+
+    def unit_draws(self, seed: int, first: int, count: int) -> np.ndarray:
+        """(count, 16) unit draws of vehicles first .. first + count - 1 (see the module)."""
+        out = np.empty((count, N_DRAWS))
+        normal = self.distribution == "normal"
+        for k in range(count):
+            g = np.random.default_rng(np.random.SeedSequence([seed, first + k], spawn_key=(DRAW_KEY,)))
+            out[k] = g.standard_normal(N_DRAWS) if normal else g.random(N_DRAWS)
+        clip = CLIP[self.distribution]
+        return np.clip(out, -clip, clip) if normal else clip * (2.0 * out - 1.0)
+
+    def draw(self, seed: int, first: int, count: int, nominal: Vehicle, dt: float = 1e-3) -> "Draw":
+        """The vehicles first .. first + count - 1: parameters, offsets and environment."""
+        if nominal.batch_size is not None:
+            raise InputError("the nominal vehicle of a population must not be batched")
+        z = self.unit_draws(seed, first, count)
+        cols: dict[str, np.ndarray] = {}
+        for spread, names in SPREADS.items():
+            for name in names:
+                cols[name] = getattr(nominal, name) * (1.0 + getattr(self, spread) * z[:, SLOTS[name]])
+        offsets = self.offset * z[:, [SLOTS["dx0"], SLOTS["dy0"], SLOTS["dz0"]]]
+        cols.update(dx0=offsets[:, 0], dy0=offsets[:, 1], dz0=offsets[:, 2])
+        env = self.environment
+        base = (0.0, 0.0, 0.0) if env is None or env.wind is None else tuple(map(float, env.wind.velocity))
+        wind = np.column_stack([base[0] + self.wind_spread * z[:, SLOTS["wind_x"]],
+                                base[1] + self.wind_spread * z[:, SLOTS["wind_y"]],
+                                np.full(count, base[2])])
+        cols.update(wind_x=wind[:, 0], wind_y=wind[:, 1])
+        if self.wind_spread > 0:
+            from quadcruise.disturbances.environment import ConstantWind, Environment
+
+            env = dataclasses.replace(env or Environment(), wind=ConstantWind(velocity=wind))
+        if env is not None and not env.parts:
+            env = None
+        vehicle = nominal.replace(**{k: cols[k] for names in SPREADS.values() for k in names})
+        return Draw(vehicle=vehicle, offsets=offsets, environment=env, sensors=self.noise, columns=cols)
+
+    def to_dict(self) -> dict:
+        """Plain values, for the result folder."""
+        out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        for key in ("environment", "noise"):
+            out[key] = None if out[key] is None else out[key].to_dict()
+        return out
+
+
+@dataclass(frozen=True)
+class Draw:
+    """A chunk's drawn vehicles (batched), initial offsets [m], environment (per-vehicle
+    wind where drawn), sensor noise, and the drawn values as table columns."""
+
+    vehicle: Vehicle
+    offsets: np.ndarray
+    environment: Any
+    sensors: Any
+    columns: dict
+

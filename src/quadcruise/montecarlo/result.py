@@ -1,0 +1,151 @@
+"""The result of a Monte Carlo sweep: its table of one row per flight, the kept paths,
+the summary (quantiles, failure rate by reason) and the worst flights.
+
+:data:`COLUMNS` is the table's schema, :data:`FAILURES` its failure codes and
+:data:`METRICS` the metrics summarised by quantiles. The figures are drawn by
+:mod:`quadcruise.plots.montecarlo` and the output folder written by
+:mod:`quadcruise.montecarlo.output`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from quadcruise.errors import InputError
+from quadcruise.montecarlo.schema import COLUMNS, FAILURES, METRICS
+from quadcruise.montecarlo.spec import MonteCarloSpec
+
+__all__ = ["MonteCarloResult", "Traces", "FAILURES", "COLUMNS", "METRICS"]
+
+@dataclass
+class Traces:
+    """The kept paths: vehicle indices (k,), times (L,), positions and references (k, L, 3),
+    ``sample`` (k,): True for the random sample (the first vehicles), False for extra
+    failures."""
+
+    vehicle: np.ndarray
+    t: np.ndarray
+    pos: np.ndarray
+    ref: np.ndarray
+    sample: np.ndarray
+
+
+@dataclass
+class MonteCarloResult:
+    """A finished sweep: one table row per flight, the kept paths, and how it ran.
+
+    Attributes
+    ----------
+    spec : MonteCarloSpec
+    table : pandas.DataFrame
+        One row per flight, sorted by vehicle index (see :data:`COLUMNS`), plus ``reason``
+        (the failure as text).
+    traces : Traces
+    info : dict
+        Scheduler, workers, chunk size, chunks flown and resumed, wall time, output folder.
+    """
+
+    failure_names: ClassVar[tuple] = FAILURES
+
+    spec: MonteCarloSpec
+    table: Any
+    traces: Traces
+    info: dict = field(default_factory=dict)
+
+    @property
+    def n(self) -> int:
+        """Number of flights."""
+        return len(self.table)
+
+    def summary(self) -> dict:
+        """Failure rate by reason (each flight counted once, under the first of diverged,
+        saturated, did not settle), the engine's stop reasons, and p5/p50/p95/max/mean of
+        each metric over the flights where it is defined (``count`` of them)."""
+        from quadcruise.sim.status import STATUS_REASONS
+
+        tab = self.table
+        n = len(tab)
+        failure = tab["failure"].to_numpy()
+        counts = np.bincount(failure, minlength=len(FAILURES))
+        by_reason = {FAILURES[c]: {"count": int(counts[c]), "rate": float(counts[c] / n)} for c in (1, 2, 3)}
+        stops = {STATUS_REASONS[c]: int(k) for c, k in zip(*np.unique(tab["status"], return_counts=True)) if c}
+        metrics = {}
+        for name in METRICS:
+            v = tab[name].to_numpy(dtype=float)
+            v = v[np.isfinite(v)]
+            q = np.percentile(v, [5, 50, 95]) if v.size else [np.nan] * 3
+            metrics[name] = {"count": int(v.size), "p5": _num(q[0]), "p50": _num(q[1]), "p95": _num(q[2]),
+                             "max": _num(v.max() if v.size else np.nan), "mean": _num(v.mean() if v.size else np.nan)}
+        fails = int(np.count_nonzero(failure))
+        return {"flights": n, "seed": self.spec.seed,
+                "failures": {"count": fails, "rate": fails / n, "by_reason": by_reason},
+                "stopped": stops, "metrics": metrics}
+
+    def summary_text(self) -> str:
+        """The summary as aligned text (for the terminal)."""
+        s = self.summary()
+        f = s["failures"]
+        lines = [f"{s['flights']:,} flights of {self.spec.controller.name} on {self.spec.mission.name}, "
+                 f"seed {s['seed']}: {f['count']:,} failed ({100 * f['rate']:.2f} %)"]
+        for reason, v in f["by_reason"].items():
+            lines.append(f"  {reason:<16} {v['count']:>8,}  ({100 * v['rate']:.2f} %)")
+        lines.append(f"  {'metric':<22}{'count':>8}{'p5':>11}{'p50':>11}{'p95':>11}{'max':>11}")
+        for name, m in s["metrics"].items():
+            lines.append(f"  {name:<22}{m['count']:>8,}" + "".join(
+                f"{'-' if m[k] is None else format(m[k], '.4g'):>11}" for k in ("p5", "p50", "p95", "max")))
+        return "\n".join(lines)
+
+    def worst(self, k: int = 10, by: str = "rmse_m"):
+        """The k worst flights: failures first (diverged, earliest stop first; then saturated,
+        then did not settle), then by ``by``, largest first. Each row has the ``vehicle``
+        index and the ``seed``: :func:`~quadcruise.montecarlo.replay_case` flies it again alone."""
+        if by not in self.table.columns:
+            raise InputError(f"unknown metric {by!r}; choose one of {', '.join(METRICS)}")
+        tab = self.table
+        rank = np.array([0, 3, 2, 1])[tab["failure"].to_numpy()]          # diverged first
+        value = tab[by].to_numpy(dtype=float)
+        stop = np.where(tab["failure"].to_numpy() == 1, tab["stop_time_s"].to_numpy(), 0.0)
+        order = np.lexsort((tab["vehicle"].to_numpy(), np.nan_to_num(-value, nan=np.inf), stop, -rank))
+        out = tab.iloc[order[:k]].copy()
+        out.insert(1, "seed", self.spec.seed)
+        return out.reset_index(drop=True)
+
+    def case(self, i: int, **kw):
+        """:func:`~quadcruise.montecarlo.replay_case` of vehicle i."""
+        from quadcruise.montecarlo.chunk import replay_case
+
+        return replay_case(self, i, **kw)
+
+    def plot_histograms(self, metrics=None):
+        """Histograms of the metrics (finite values; lines at 5 %, median, 95 %) and a bar
+        chart of the outcomes: a matplotlib Figure. ``metrics``: column names (by default
+        :data:`quadcruise.plots.montecarlo.HISTOGRAM_METRICS`)."""
+        from quadcruise.plots.montecarlo import plot_histograms
+
+        return plot_histograms(self, metrics)
+
+    def plot_envelope(self):
+        """Top view of the kept paths (the first vehicles; failures in orange, diverged in
+        red, with their first extra failures) and the median and 5-95 % band of the
+        position error of the first vehicles against time: a matplotlib Figure."""
+        from quadcruise.plots.montecarlo import plot_envelope
+
+        return plot_envelope(self)
+
+    def write(self, out: str | Path, *, fmt: str = "csv", force: bool = False) -> Path:
+        """Write flights.csv (or .parquet), summary.json, worst.csv, histograms.png,
+        envelope.png, report.md and quadcruise.json into ``out``, each file whole or not at
+        all. A folder holding the chunks of this same sweep is completed in place."""
+        from quadcruise.montecarlo.output import write_outputs
+
+        return write_outputs(self, out, fmt=fmt, force=force)
+
+
+def _num(value) -> float | None:
+    value = float(value)
+    return value if math.isfinite(value) else None

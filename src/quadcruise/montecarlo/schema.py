@@ -1,0 +1,25 @@
+"""The Monte Carlo table's schema: its failure codes, summarised metrics and typed columns (a leaf)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from quadcruise.montecarlo.population import SLOTS
+
+__all__ = ["COLUMNS", "FAILURES", "METRICS"]
+
+FAILURES = ("ok", "diverged", "saturated", "did not settle")
+"""Failure codes 0..3 of the table's ``failure`` column, in order of precedence."""
+METRICS = ("rmse_m", "max_error_m", "final_error_m", "rise_time_s", "settling_time_s",
+           "settling_time_5pct_s", "overshoot_pct", "effort", "duty_clipped_s", "controller_limited_s")
+"""The metrics summarised by quantiles (NaN where not applicable is left out)."""
+COLUMNS = {
+    "vehicle": np.int64, "status": np.int64, "stop_time_s": float, "failure": np.int64,
+    "diverged": bool, "saturated": bool, "not_settled": bool, "transient_axis": np.int64,
+    **{m: float for m in METRICS},
+    **{k: float for k in SLOTS},
+}
+"""Columns of the per-flight table and their types: engine ``status`` (see
+:data:`quadcruise.sim.status.ExitStatus`), ``failure`` (see :data:`FAILURES`),
+``transient_axis`` (0, 1, 2 for x, y, z; -1 if none), the metrics and the drawn values
+(``dx0``..: initial offset [m]; ``wind_x``, ``wind_y``: steady wind [m/s])."""

@@ -1,0 +1,115 @@
+"""The folder of a Monte Carlo sweep (``out``): its marker, the chunks as they finish,
+and the resume of an interrupted sweep.
+
+On disk::
+
+    quadcruise.json            the spec, its hash (of the options, version and code), n,
+                               and whether the sweep is complete
+    chunks/chunk-000000120.npz one per chunk (vehicles 120 ..), written whole or not at all
+    flights.csv                one row per flight (or flights.parquet)
+    summary.json, worst.csv    quantiles, failure rate by reason, the worst flights
+    histograms.png, envelope.png, report.md
+
+quadcruise.json is written before the first chunk and chunks as they finish, so an
+interrupted sweep leaves a folder that the same command resumes: chunks already there
+(of the same spec hash) are loaded, not flown. A folder holding another sweep, or
+anything else, is refused unless ``force``. The results are written at the end
+(:mod:`quadcruise.montecarlo.output`).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import warnings
+from pathlib import Path
+from typing import Any, Iterator
+
+import numpy as np
+
+from quadcruise._cache import code_digest
+from quadcruise._version import __version__
+from quadcruise.errors import InputError
+from quadcruise.io.files import MARKER, atomic_path, check_output_dir
+from quadcruise.io.plainjson import dumps
+from quadcruise.montecarlo.spec import MonteCarloSpec
+
+__all__ = ["CHUNKS", "write_marker", "holds_sweep"]
+
+CHUNKS = "chunks"
+
+
+def _chunk_path(folder: Path, first: int) -> Path:
+    return folder / CHUNKS / f"chunk-{first:09d}.npz"
+
+
+def _write_chunk(folder: Path, chunk: dict) -> None:
+    with atomic_path(_chunk_path(folder, int(chunk["first"]))) as tmp:
+        with open(tmp, "wb") as f:
+            np.savez(f, **chunk)
+
+
+def _read_chunks(folder: Path, spec_hash: str) -> Iterator[dict]:
+    """The complete chunks of this spec in ``folder``; others are skipped with a warning."""
+    for path in sorted((folder / CHUNKS).glob("chunk-*.npz")):
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                chunk = {k: data[k] for k in data.files}
+        except Exception as exc:              # a foreign or damaged file: fly it again
+            warnings.warn(f"{path}: unreadable ({exc}); its flights are flown again", stacklevel=3)
+            continue
+        if str(chunk.get("hash")) != spec_hash or int(chunk["first"]) != int(path.stem.split("-")[1]):
+            warnings.warn(f"{path}: belongs to another sweep; its flights are flown again", stacklevel=3)
+            continue
+        yield chunk
+
+
+def _marker(path: Path) -> dict | None:
+    try:
+        return json.loads((path / MARKER).read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def holds_sweep(path: Path, spec: MonteCarloSpec) -> tuple[dict | None, bool]:
+    """(the quadcruise.json of folder ``path``, or None; whether it is this very sweep:
+    a Monte Carlo folder of the same spec hash)."""
+    meta = _marker(path) if path.is_dir() else None
+    return meta, bool(meta) and meta.get("workflow") == "montecarlo" and meta.get("spec_hash") == spec.hash()
+
+
+class SweepFolder:
+    """The output folder of a sweep: checked at construction (nothing is written), then
+    :meth:`prepare` (marker), :meth:`write_chunk`."""
+
+    def __init__(self, out, spec: MonteCarloSpec, *, force: bool, resume: bool) -> None:
+        self.path = check_output_dir(out, force)
+        self.hash = spec.hash()
+        self.spec = spec
+        meta, same = holds_sweep(self.path, spec)
+        if meta is not None and not same and not force:
+            what = (f"a different sweep (spec {meta.get('spec_hash')})" if meta.get("workflow") == "montecarlo"
+                    else f"a quadcruise {meta.get('workflow', 'result')} result")
+            raise InputError(f"{self.path}: holds {what}; use --force to replace it or choose another --out")
+        self.resume = same and resume
+        self.clear = self.path.is_dir() and any(self.path.iterdir()) and not self.resume
+
+    def existing(self) -> Iterator[dict]:
+        return _read_chunks(self.path, self.hash) if self.resume else iter(())
+
+    def prepare(self, n: int, chunk_size: int) -> None:
+        if self.clear:
+            shutil.rmtree(self.path)
+        (self.path / CHUNKS).mkdir(parents=True, exist_ok=True)
+        write_marker(self.path, self.spec, n, chunk_size=chunk_size, complete=False)
+
+    def write_chunk(self, chunk: dict) -> None:
+        _write_chunk(self.path, chunk)
+
+
+def write_marker(path: Path, spec: MonteCarloSpec, n: int, **extra: Any) -> None:
+    """quadcruise.json of a sweep folder, whole or not at all."""
+    doc = {"workflow": "montecarlo", "version": __version__, "code": code_digest()[:16], "spec_hash": spec.hash(),
+           "n": n, "seed": spec.seed, **extra, "spec": spec.to_dict()}
+    with atomic_path(path / MARKER) as tmp:
+        tmp.write_text(dumps(doc, indent=2) + "\n")

@@ -1,0 +1,396 @@
+"""Figures of logged flights, drawn with matplotlib's object-oriented API only.
+
+No pyplot global state is touched, so the functions work headless and in threads; a
+figure is shown in a notebook as is, or written with :func:`save_figure`.
+
+Examples
+--------
+>>> import quadcruise as qc
+>>> from quadcruise.plots import plot_flight
+>>> fig = plot_flight(qc.fly("step", duration=2.0, log_every=10))
+>>> len(fig.axes)
+8
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
+
+from quadcruise.io.files import atomic_path
+
+REF_STYLE = dict(color="k", ls="--", lw=1.0, label="reference")
+STOP_STYLE = dict(color="tab:red", ls=":", lw=1.5)
+
+
+FLIGHT_MARGINS = dict(left=0.05, right=0.86, bottom=0.055, top=0.92, wspace=0.32, hspace=0.14)
+"""The flight figure's grid in fractions of the figure, fixed rather than found by a
+layout engine: constrained layout draws the whole figure once more to measure it, which
+doubles the time to save it."""
+
+MAX_DRAWN = 3000
+"""Figures draw at most this many instants of a flight (a 60 s flight at 1 kHz has 60,001):
+more are invisible at screen resolution and only slow the drawing down."""
+
+
+def drawable(result):
+    """The result, decimated to at most MAX_DRAWN logged instants for drawing."""
+    every = -(-len(result.t) // MAX_DRAWN)
+    return result if every <= 1 else result.decimate(every)
+
+
+def _has(trace: np.ndarray) -> bool:
+    return bool(np.any(np.isfinite(trace)))
+
+
+def _names(result, vehicle: int = 0) -> tuple[str | None, str | None]:
+    """The controller's name and the mission's kind recorded in ``result.meta``."""
+    meta = result.meta or {}
+    mission = meta.get("mission")
+    if isinstance(mission, list):
+        mission = mission[min(vehicle, len(mission) - 1)] if mission else None
+    ctrl = meta.get("controller")
+    return (ctrl.get("name") if isinstance(ctrl, dict) else ctrl,
+            mission.get("kind") if isinstance(mission, dict) else None)
+
+
+def describe(result, vehicle: int = 0) -> str:
+    """'<controller> on <mission>', or what the workflow was."""
+    name, kind = _names(result, vehicle)
+    meta = result.meta or {}
+    if name and kind:
+        return f"{name} on {kind}"
+    if meta.get("workflow") == "replay":
+        source = meta.get("source")
+        return "open-loop replay" + (f" of {os.path.basename(str(source))}" if source else "")
+    return name or kind or meta.get("workflow") or "flight"
+
+
+def _mark_stop(ax, t_stop: float, label: bool = False) -> None:
+    ax.axvline(t_stop, **STOP_STYLE, label=f"stopped, t = {t_stop:.3f} s" if label else None)
+
+
+def _legend(ax, **kwargs) -> None:
+    ax.legend(**{"fontsize": "small", "framealpha": 0.85, **kwargs})
+
+
+def _path3d(ax, result, vehicle: int) -> None:
+    pos = np.stack([result.state(n)[vehicle] for n in ("x", "y", "z")], axis=1)
+    ref = np.stack([result.state(n)[vehicle] for n in ("x_ref", "y_ref", "z_ref")], axis=1)
+    ax.plot(*pos.T, color="tab:blue", lw=1.5, label="actual")
+    pts = [pos]
+    if _has(ref):
+        ax.plot(*ref.T, **REF_STYLE)
+        pts.append(ref)
+    live = pos[np.all(np.isfinite(pos), axis=1)]
+    if live.size:
+        ax.scatter(*live[0], facecolor="none", edgecolor="tab:green", s=90, lw=2, marker="o",
+                   label="start", depthshade=False)
+        ax.scatter(*live[-1], color="tab:red", s=45, marker="X", label="end", depthshade=False)
+    # one scale on all three axes (box aspect = spans), each span at least 3/4 of the
+    # largest, so a level flight is not drawn as a flat sliver
+    allp = np.concatenate(pts)
+    allp = allp[np.all(np.isfinite(allp), axis=1)]
+    lo, hi = (allp.min(0), allp.max(0)) if allp.size else (np.zeros(3), np.ones(3))
+    half = np.maximum((hi - lo) / 2 * 1.1, 0.25)
+    half = np.maximum(half, 0.75 * half.max())
+    mid = (lo + hi) / 2
+    for setter, m, h in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), mid, half):
+        setter(m - h, m + h)
+    ax.set_box_aspect(tuple(half), zoom=0.8)
+    # x ends and y starts at the front corner in the default view: prune both there
+    for axis, prune in ((ax.xaxis, "upper"), (ax.yaxis, "lower"), (ax.zaxis, None)):
+        axis.set_major_locator(MaxNLocator(4, prune=prune))
+    ax.set(xlabel="x [m]", ylabel="y [m]", zlabel="z [m]")
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.labelpad = 9
+    _legend(ax, loc="upper center", ncols=4, title="3-D path", bbox_to_anchor=(0.5, 0.98))
+
+
+def _time_panel(ax, t, y, ref, ylabel: str, color: str, label: str, min_span: float,
+                ref_label: str = "reference") -> None:
+    """A trace against time with its reference (dashed, where finite) on a y range at
+    least ``min_span`` tall, so numerical noise on a held value is not blown up."""
+    ax.plot(t, y, color=color, lw=1.3, label=label)
+    shown = [y]
+    if ref is not None and _has(ref):
+        ax.plot(t, ref, **{**REF_STYLE, "label": ref_label})
+        shown.append(ref)
+    vals = np.concatenate(shown)
+    vals = vals[np.isfinite(vals)]
+    if vals.size:
+        lo, hi = vals.min(), vals.max()
+        pad = max(0.08 * (hi - lo), (min_span - (hi - lo)) / 2, 0.0)
+        ax.set_ylim(lo - pad, hi + pad)
+    ax.ticklabel_format(axis="y", useOffset=False)
+    ax.set_ylabel(ylabel)
+    ax.grid(True, alpha=0.3)
+
+
+def plot_flight(result, vehicle: int = 0, *, title: str | None = None) -> Figure:
+    """One vehicle's flight on one figure: path, position, attitude and rotor duties.
+
+    Parameters
+    ----------
+    result : SimResult
+    vehicle : int
+        Which of the result's vehicles to draw.
+    title : str, optional
+        Figure title; by default the controller and mission from ``result.meta``, and
+        the reason if the vehicle stopped early.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Eight axes: the 3-D path, x, y, z [m], roll, pitch, yaw [deg] against time, and
+        the four rotor duties with their [0, 1] limits. References are drawn dashed where
+        finite, attitude setpoints only where there is a reference (an open-loop replay
+        has none); periods in which the controller flagged a limit are shaded on the duty
+        panel. An early stop is marked on every time panel, which then end shortly after it.
+    """
+    result = drawable(result)
+    t = result.t
+    fig = Figure(figsize=(16, 10))
+    # row 3 and column 1 are gaps: for the time axes' labels above the duties, and between
+    # the 3-D path's labels and the position panels' own
+    gs = fig.add_gridspec(5, 4, width_ratios=(1.3, 0.02, 1, 1), height_ratios=(1, 1, 1, 0.12, 1.1),
+                          **FLIGHT_MARGINS)
+    _path3d(fig.add_subplot(gs[0:3, 0], projection="3d"), result, vehicle)
+    pos_axes = [fig.add_subplot(gs[0, 2])]
+    pos_axes += [fig.add_subplot(gs[i, 2], sharex=pos_axes[0]) for i in (1, 2)]
+    att_axes = [fig.add_subplot(gs[i, 3], sharex=pos_axes[0]) for i in range(3)]
+    closed_loop = any(_has(result.state(f"{n}_ref")[vehicle]) for n in "xyz")
+    for ax, name, c in zip(pos_axes, "xyz", ("tab:blue", "tab:orange", "tab:green")):
+        _time_panel(ax, t, result.state(name)[vehicle], result.state(f"{name}_ref")[vehicle],
+                    f"{name} [m]", c, name, min_span=0.02)
+    for ax, name, label, c in zip(att_axes, ("phi", "theta", "psi"), ("roll φ", "pitch θ", "yaw ψ"),
+                                  ("tab:blue", "tab:orange", "tab:green")):
+        sp = np.degrees(result.state(f"{name}_d")[vehicle]) if closed_loop else None
+        _time_panel(ax, t, np.degrees(result.state(name)[vehicle]), sp, f"{label} [deg]", c,
+                    label, min_span=2.0, ref_label="setpoint")
+    ax_u = fig.add_subplot(gs[4, :], sharex=pos_axes[0])
+    _duties(ax_u, result, vehicle)
+    stopped = int(result.status[vehicle]) != 0
+    t_end = t[-1]
+    if stopped:
+        t_stop = float(result.t_stop[vehicle])
+        step = t[1] - t[0] if t.size > 1 else 0.0
+        t_end = min(t[-1], t_stop + max(0.1 * (t_stop - t[0]), 3 * step))
+        for ax in pos_axes + att_axes + [ax_u]:
+            _mark_stop(ax, t_stop, label=ax in (pos_axes[0], att_axes[0], ax_u))
+    for ax in pos_axes + att_axes:
+        _legend(ax, loc="best")
+    _legend(ax_u, loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0)
+    for ax in (pos_axes[2], att_axes[2], ax_u):
+        ax.set_xlabel("time [s]")
+    for ax in pos_axes[:2] + att_axes[:2]:
+        ax.tick_params(labelbottom=False)
+    ax_u.set_xlim(t[0], t_end if t_end > t[0] else t[0] + 1.0)
+    if title is None:
+        title = f"{describe(result, vehicle)} — vehicle {vehicle}"
+        if stopped:
+            title += f"\n{result.status_text(vehicle)}"
+    fig.suptitle(title, color="tab:red" if stopped else "k")
+    return fig
+
+
+def _duties(ax, result, vehicle: int) -> None:
+    t = result.t
+    duties = result.commands[vehicle, :, :4]
+    for j in range(4):
+        ax.plot(t, duties[:, j], color=("tab:blue", "tab:orange", "tab:green", "tab:purple")[j],
+                lw=1.0, label=f"u{j + 1}")
+    flags = result.state("flags")[vehicle]
+    flagged = np.isfinite(flags) & (flags != 0)
+    if flagged.any():
+        ax.fill_between(t, 0, 1, where=flagged, transform=ax.get_xaxis_transform(), step="post",
+                        color="tab:red", alpha=0.15, lw=0, label="controller limit flagged")
+    live = duties[np.isfinite(duties)]
+    lo, hi = (live.min(), live.max()) if live.size else (0.0, 1.0)
+    lo, hi = min(lo, 0.0), max(hi, 0.0)
+    pad = 0.08 * max(hi - lo, 1e-3)
+    ax.set_ylim(lo - pad, hi + pad)
+    # the view fits the duties; when the upper limit is off it, the legend says so
+    # rather than the duties being squashed to the bottom of a [0, 1] scale
+    off = " (1 off scale)" if hi + pad < 1.0 else ""
+    for limit in (0.0, 1.0):
+        ax.axhline(limit, color="0.3", lw=1.2, ls="-.", zorder=1.5,
+                   label=f"duty limits 0, 1{off}" if limit == 0.0 else None)
+    for a, b in ((lo - 10 * pad - 1.0, 0.0), (1.0, hi + 10 * pad + 1.0)):
+        ax.axhspan(a, b, color="0.5", alpha=0.12, lw=0, label="clipped by the engine" if a < 0 else None)
+    ax.set_ylabel("rotor duty [-]")
+    ax.grid(True, alpha=0.3)
+
+
+def _reference_xy(results):
+    for res, v in results:
+        xr, yr = res.state("x_ref")[v], res.state("y_ref")[v]
+        if _has(xr) and _has(yr):
+            return res.t, xr, yr
+    return None
+
+
+def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None) -> Figure:
+    """Overlay several flights: top view (x-y) and x(t), y(t), with the reference once.
+
+    Parameters
+    ----------
+    results : dict of str to SimResult
+        Label -> flight, e.g. ``{"NL-PD": res_a, "linear PD": res_b}``.
+    vehicle : int
+        Which vehicle of each result to draw.
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Three axes: the top view (equal scale), x [m] and y [m] against time [s]. The
+        reference is taken from the first flight that has a finite one; a flight that
+        stopped early ends with a red cross and its label says when.
+    """
+    if not results:
+        raise ValueError("plot_paths needs at least one result")
+    results = {label: drawable(r) for label, r in results.items()}
+    fig = Figure(figsize=(13, 6.5), layout="constrained")
+    gs = fig.add_gridspec(2, 2, width_ratios=(1, 1.3))
+    top = fig.add_subplot(gs[:, 0])
+    ax_x = fig.add_subplot(gs[0, 1])
+    ax_y = fig.add_subplot(gs[1, 1], sharex=ax_x)
+    ref = _reference_xy([(r, vehicle) for r in results.values()])
+    if ref is not None:
+        tr, xr, yr = ref
+        top.plot(xr, yr, **REF_STYLE)
+        ax_x.plot(tr, xr, **REF_STYLE)
+        ax_y.plot(tr, yr, **REF_STYLE)
+    for k, (label, res) in enumerate(results.items()):
+        c = f"C{k}"
+        x, y = res.state("x")[vehicle], res.state("y")[vehicle]
+        if int(res.status[vehicle]) != 0:
+            label = f"{label} (stopped at {res.t_stop[vehicle]:.2f} s)"
+        top.plot(x, y, color=c, lw=1.4, label=label)
+        ax_x.plot(res.t, x, color=c, lw=1.4, label=label)
+        ax_y.plot(res.t, y, color=c, lw=1.4, label=label)
+        live = np.isfinite(x) & np.isfinite(y)
+        if live.any() and int(res.status[vehicle]) != 0:
+            i = np.flatnonzero(live)[-1]
+            top.plot(x[i], y[i], "X", color="tab:red", ms=9)
+    top.set_aspect("equal", adjustable="datalim")
+    top.set(xlabel="x [m]", ylabel="y [m]", title="top view")
+    ax_x.set_ylabel("x [m]")
+    ax_y.set(xlabel="time [s]", ylabel="y [m]")
+    ax_x.tick_params(labelbottom=False)
+    for ax in (top, ax_x, ax_y):
+        ax.grid(True, alpha=0.3)
+    _legend(top, loc="best")
+    if title is None:
+        kind = _names(next(iter(results.values())), vehicle)[1]
+        title = " vs ".join(results) + (f" on {kind}" if kind else "")
+    fig.suptitle(title)
+    return fig
+
+
+def _pick_paths(ok: np.ndarray, max_paths: int) -> np.ndarray:
+    """Up to max_paths vehicle indices: every stopped one first (as many as fit), then
+    evenly spread finished ones."""
+    max_paths = max(1, max_paths)
+    bad, good = np.flatnonzero(~ok)[:max_paths], np.flatnonzero(ok)
+    room = min(max_paths - bad.size, good.size)
+    good = good[np.unique(np.linspace(0, good.size - 1, room).round().astype(int))] if room > 0 else good[:0]
+    return np.sort(np.concatenate([bad, good]))
+
+
+def plot_envelope(result, *, title: str | None = None, max_paths: int = 50) -> Figure:
+    """A batch of N vehicles: their paths from above and the spread of position error.
+
+    Parameters
+    ----------
+    result : SimResult
+        A batched flight.
+    title : str, optional
+    max_paths : int
+        At most this many paths are drawn in the top view: those of stopped vehicles
+        first, then evenly picked finished ones.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two axes: the top view (thin translucent paths, those of stopped vehicles in red,
+        vehicle 0's reference dashed) and the median and 5-95 % band over vehicles of the
+        position error norm ``|p - p_ref|`` [m] against time [s].
+    """
+    n = result.n
+    fig = Figure(figsize=(13, 5.5), layout="constrained")
+    top, ax_e = fig.subplots(1, 2, width_ratios=(1, 1.4))
+    picks = _pick_paths(result.ok, max_paths)
+    alpha = float(np.clip(6.0 / len(picks), 0.12, 0.8))
+    x, y = result.state("x"), result.state("y")
+    for i in picks:
+        if result.ok[i]:
+            top.plot(x[i], y[i], color="tab:blue", lw=0.7, alpha=alpha)
+        else:
+            top.plot(x[i], y[i], color="tab:red", lw=0.9, alpha=max(alpha, 0.6))
+            live = np.flatnonzero(np.isfinite(x[i]) & np.isfinite(y[i]))
+            if live.size:
+                top.plot(x[i, live[-1]], y[i, live[-1]], "x", color="tab:red", ms=6)
+    for ok, c, what in ((True, "tab:blue", "finished"), (False, "tab:red", "stopped early")):
+        total = int(np.count_nonzero(result.ok == ok))
+        if total:   # legend proxies: how many of each kind are drawn
+            drawn = int(np.count_nonzero(result.ok[picks] == ok))
+            top.plot([], [], color=c, lw=1, label=f"{what} ({drawn} drawn of {total})")
+    ref = _reference_xy([(result, 0)])
+    if ref is not None:
+        top.plot(ref[1], ref[2], **REF_STYLE)
+    top.set_aspect("equal", adjustable="datalim")
+    top.set(xlabel="x [m]", ylabel="y [m]", title="top view")
+    _legend(top, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncols=3)
+    pos = result.states[:, :, :3]
+    err = np.linalg.norm(pos - result.references[:, :, :3], axis=2)
+    if _has(err):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)   # all-NaN instants after stops
+            p5, p50, p95 = np.nanpercentile(err, [5, 50, 95], axis=0)
+        ax_e.fill_between(result.t, p5, p95, color="tab:blue", alpha=0.25, lw=0, label="5-95 %")
+        ax_e.plot(result.t, p50, color="tab:blue", lw=1.5, label="median")
+        ax_e.set_ylim(bottom=0)
+        _legend(ax_e, loc="best")
+    else:
+        ax_e.text(0.5, 0.5, "no reference: the position error is undefined", ha="center",
+                  va="center", transform=ax_e.transAxes, color="0.4")
+    ax_e.set(xlabel="time [s]", ylabel="position error |p - p_ref| [m]",
+             title=f"position error over {n} vehicles")
+    ax_e.set_xlim(result.t[0], result.t[-1])
+    for ax in (top, ax_e):
+        ax.grid(True, alpha=0.3)
+    fig.suptitle(title or f"{describe(result)} — {n} vehicles")
+    return fig
+
+
+def plot_reference(result, *, vehicle: int = 0, title: str | None = None) -> Figure:
+    """The reference path of a flight in 3-D with the vehicle's start (the paper's Fig 4)."""
+    fig = Figure(figsize=(7, 6), layout="constrained")
+    ax = fig.add_subplot(projection="3d")
+    ref = result.references[vehicle]
+    start = result.states[vehicle, 0]
+    ax.plot(ref[:, 0], ref[:, 1], ref[:, 2], "k--", lw=1.5, label="reference")
+    ax.scatter([start[0]], [start[1]], [start[2]], color="tab:green", label="start (hover)")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    if title:
+        ax.set_title(title)
+    ax.legend(loc="upper left")
+    return fig
+
+
+def save_figure(fig: Figure, path: str | os.PathLike) -> None:
+    """Write a figure as PNG (120 dpi), whole or not at all.
+
+    The temporary file that :func:`quadcruise.io.atomic_path` hands out ends in
+    ``.tmp``, so the format is given explicitly rather than taken from the suffix.
+    """
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=120)

@@ -1,0 +1,539 @@
+"""The simulation engine: fixed-step RK4 for one vehicle or N, in one compiled function.
+
+Time runs on a grid of control instants t_0 < t_1 < ... < t_M shared by the batch. At
+each t_k the engine asks the mission for the reference and the controller for a command,
+then holds the command over [t_k, t_{k+1}] while RK4 integrates the plant in equal
+substeps no longer than ``max_step``. After every period it checks the state; a vehicle
+whose state turns non-finite or leaves the bounds in :class:`Limits` stops there, with its
+status, time and reason recorded, while the rest of the batch flies on.
+
+The single-vehicle flight is the N = 1 case of the same kernel. The kernel flies the
+vehicles of one range of the batch, one after another, without the GIL; vehicles are
+independent, so :func:`fly_vehicles` splits a batch into pieces that numba's number of
+threads (``numba.set_num_threads``) fly at once. Each vehicle's arithmetic does not depend on the
+batch it is in or the piece it falls in, so a batch reproduces single flights bit for bit.
+(A ``prange`` kernel would do the same, but numba's parallel passes on a body this size
+add about 6 s to the cold compile, and with one vehicle the idle OpenMP thread spins.)
+
+Controllers and missions are compiled functions with the signatures in
+:mod:`quadcruise.layout`, passed as first-class function values: one cached kernel
+serves every controller, a user's own included.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+from numba import config, get_num_threads, njit, types
+
+from quadcruise.errors import InputError
+from quadcruise.layout import (
+    CMD_FLAGS,
+    CMD_SIZE,
+    DISTURBANCE_SIG,
+    EXT_E1,
+    EXT_SIZE,
+    PHI,
+    PSI,
+    REF_SIZE,
+    STATE_SIZE,
+    THETA,
+    VX,
+    VY,
+    VZ,
+    ControllerType,
+    DisturbanceType,
+    MissionType,
+    P,
+    Q,
+    R,
+    X,
+    Y,
+    Z,
+)
+from quadcruise.model.plant import derivative_at
+from quadcruise.sim.result import SimResult
+from quadcruise.sim.rng import next_normal, vehicle_states
+from quadcruise.sim.status import STATUS_REASONS, ExitStatus
+
+# exit status codes as plain ints, which the kernel compiles as constants (see sim/status.py)
+FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, TILT_BOUND, BAD_COMMAND = (
+    int(s) for s in ExitStatus)
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Bounds beyond which a flight counts as diverged (and stops).
+
+    Attributes
+    ----------
+    max_position : float
+        |x|, |y| or |z| above this [m] ends the flight.
+    max_speed : float
+        any velocity component above this [m/s].
+    max_rate : float
+        any body rate above this [rad/s].
+    max_tilt : float
+        |roll| or |pitch| above this [rad]; infinite by default, since the paper's
+        model has no singularity at 90 degrees.
+    """
+
+    max_position: float = 1.0e4
+    max_speed: float = 1.0e3
+    max_rate: float = 1.0e3
+    max_tilt: float = math.inf
+
+    def __post_init__(self) -> None:
+        for name in ("max_position", "max_speed", "max_rate", "max_tilt"):
+            value = getattr(self, name)
+            if not value > 0:
+                raise InputError(f"limit '{name}' must be > 0, got {value!r}")
+
+    def array(self) -> np.ndarray:
+        return np.array([self.max_position, self.max_speed, self.max_rate, self.max_tilt])
+
+
+SMALL_TURN = 0.03
+"""Largest change of an angle over an RK4 stage [rad] for which :func:`turned` uses the
+angle-addition series (beyond it, the library's sine and cosine)."""
+SHORT_TURN = 1.0e-3
+"""Largest change [rad] for which :func:`turned` uses the short series: the usual case, as a
+body rate of 1 rad/s turns an angle by 1 mrad in a 1 ms step."""
+
+
+@njit(cache=True, inline="always")
+def turned(angle, s, c, d):
+    """sin and cos of ``angle`` = a + d, given s = sin a and c = cos a.
+
+    For |d| <= SMALL_TURN by the angle-addition formulas with the series of sin d and
+    cos d - 1, at a fraction of the cost of a sine and a cosine; else from ``angle``
+    directly. Within SHORT_TURN the series stop at d^5 and d^6 (the next terms are below
+    2e-25 and 3e-29), and the sine's is summed as d + d^3 (...), a shorter chain of
+    dependent operations; beyond it they run to d^7 and d^8 (truncation below 1e-20). Either
+    way the result is the library's to a rounding.
+    """
+    d2 = d * d
+    if abs(d) <= SHORT_TURN:
+        sd = d + d2 * d * (-1.0 / 6.0 + d2 * (1.0 / 120.0))
+        cm1 = d2 * (-0.5 + d2 * (1.0 / 24.0 - d2 * (1.0 / 720.0)))
+    elif abs(d) <= SMALL_TURN:
+        sd = d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0) * (1.0 - d2 * (1.0 / 42.0))))
+        cm1 = -d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0) * (1.0 - d2 * (1.0 / 30.0) * (1.0 - d2 * (1.0 / 56.0))))
+    else:
+        return math.sin(angle), math.cos(angle)
+    return s + (s * cm1 + c * sd), c + (c * cm1 - s * sd)
+
+
+# rows of the RK4 workspace: the four stage derivatives, the stage state, and the sines
+# and cosines of the state's phi, theta and psi carried from one step to the next
+K1, K2, K3, K4, XT, TRIG = range(6)
+WORK_ROWS = 6
+TRIG_REFRESH = 256
+"""The engine computes the angles' sines and cosines afresh every this many RK4 steps and
+carries them by :func:`turned` in between (each turn adds a rounding, ~1e-16)."""
+
+
+@njit(cache=True, error_model="numpy")
+def rk4_step(x, u, vp, ext, full, h, work, fresh):
+    """One classical Runge-Kutta step of length h [s], in place on x.
+
+    ``work`` is a (WORK_ROWS, STATE_SIZE) scratch array: the stage derivatives k1..k4, the
+    stage state and, in row TRIG, sin and cos of x's phi, theta and psi.
+
+    The plant needs those sines and cosines at every stage. With ``fresh`` they are
+    computed from x; otherwise they are the ones the previous step left in row TRIG. A
+    stage's angles differ from x's by w k[angle] (w = 0, h/2, h/2, h), and the next step's
+    by the step's increment, so their sines and cosines follow by :func:`turned`. The four
+    stages run through one loop, so the step holds one copy of the plant: it compiles once,
+    and the engine calls it as one function with few arguments.
+    """
+    xt, trig = work[XT], work[TRIG]
+    if fresh:
+        trig[0], trig[1] = math.sin(x[PHI]), math.cos(x[PHI])
+        trig[2], trig[3] = math.sin(x[THETA]), math.cos(x[THETA])
+        trig[4], trig[5] = math.sin(x[PSI]), math.cos(x[PSI])
+    sa, ca, sb, cb, sc, cc = trig[0], trig[1], trig[2], trig[3], trig[4], trig[5]
+    for stage in range(4):
+        s1, c1, s2, c2, s3, c3 = sa, ca, sb, cb, sc, cc
+        if stage == 0:
+            for j in range(STATE_SIZE):
+                xt[j] = x[j]
+        else:
+            w = h if stage == 3 else 0.5 * h
+            k_in = work[stage - 1]
+            for j in range(STATE_SIZE):
+                xt[j] = x[j] + w * k_in[j]
+            s1, c1 = turned(xt[PHI], sa, ca, w * k_in[PHI])
+            s2, c2 = turned(xt[THETA], sb, cb, w * k_in[THETA])
+            s3, c3 = turned(xt[PSI], sc, cc, w * k_in[PSI])
+        derivative_at(xt, s1, c1, s2, c2, s3, c3, u, vp, ext, full, work[stage])
+    c = h / 6.0
+    for j in range(STATE_SIZE):
+        xt[j] = c * (work[K1, j] + 2.0 * (work[K2, j] + work[K3, j]) + work[K4, j])   # the increment
+        x[j] += xt[j]
+    trig[0], trig[1] = turned(x[PHI], sa, ca, xt[PHI])
+    trig[2], trig[3] = turned(x[THETA], sb, cb, xt[THETA])
+    trig[4], trig[5] = turned(x[PSI], sc, cc, xt[PSI])
+
+
+@njit(DISTURBANCE_SIG, cache=True)
+def still_air(t, dt, x, dp, dmem, rng, ext):
+    """No disturbance: no force, torque or wind; every rotor healthy."""
+    for j in range(EXT_SIZE):
+        ext[j] = 0.0
+    for j in range(EXT_E1, EXT_E1 + 4):
+        ext[j] = 1.0
+
+
+# The per-period helpers below take scalars, not arrays: numba inlining a helper with
+# array arguments into the kernel (or calling it) keeps a reference-count increment and
+# decrement of each array, two atomic operations, in every control period.
+
+@njit(cache=True, inline="always")
+def beyond(a, b, c, bound):
+    """Whether |a|, |b| or |c| exceeds bound."""
+    return abs(a) > bound or abs(b) > bound or abs(c) > bound
+
+
+@njit(cache=True, inline="always")
+def clip_duty(v):
+    """A commanded duty held in [0, 1]: (duty, clipped?, finite?)."""
+    if not math.isfinite(v):
+        return 0.0, False, False
+    if v < 0.0:
+        return 0.0, True, True
+    if v > 1.0:
+        return 1.0, True, True
+    return v, False, True
+
+
+@njit(cache=True, inline="always")
+def log_row(log, i, row, v):
+    """log[i, row, :] = v, element by element (a slice would take a reference on the shared
+    log array at every logged period)."""
+    for j in range(v.shape[0]):
+        log[i, row, j] = v[j]
+
+
+@njit(cache=True, inline="always")
+def put_row(a, i, v):
+    """a[i, :] = v, element by element: numba compiles a slice assignment with a shape
+    check of its own, which costs seconds of compile time."""
+    for j in range(v.shape[0]):
+        a[i, j] = v[j]
+
+
+@njit(cache=True, inline="always")
+def blank_rows(log, i, first):
+    """NaN in the rows of vehicle i from ``first`` on: the log is allocated empty, and a
+    vehicle that stopped early leaves its last rows unwritten."""
+    for row in range(first, log.shape[1]):
+        for j in range(log.shape[2]):
+            log[i, row, j] = np.nan
+
+
+_f8v = types.float64[::1]
+_f8m = types.float64[:, ::1]
+_f8c = types.float64[:, :, ::1]
+_i8v = types.int64[::1]
+_u8m = types.uint64[:, ::1]
+
+KERNEL_SIG = types.void(
+    types.int64, types.int64, _f8v, _f8m, _f8m, _f8m, ControllerType, _f8m, _f8m, MissionType, _f8m,
+    DisturbanceType, types.boolean, _f8m, _f8m, _u8m, _f8m, types.int64, types.boolean,
+    types.float64, types.int64, _f8v,
+    _f8c, _f8c, _f8c, _f8m, _i8v, _f8v, _f8m,
+)
+
+
+@njit(KERNEL_SIG, cache=True, nogil=True, error_model="numpy")
+def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
+            disturbance, disturbed, dp, dmem, rng, sensor_std, sensor_delay, full,
+            max_step, log_every, limits,
+            log_x, log_cmd, log_ref, x_final, status, t_stop, saturated):
+    n_periods = t_grid.shape[0] - 1
+    steps_per_s = 1.0 / max_step
+    for i in range(first, stop):
+        x = x0[i].copy()
+        seen = np.empty(STATE_SIZE)
+        history = np.empty((sensor_delay + 1, STATE_SIZE))   # ring buffer of past states
+        for d in range(sensor_delay + 1):
+            put_row(history, d, x)
+        ref = np.zeros(REF_SIZE)
+        cmd = np.zeros(CMD_SIZE)
+        u = np.zeros(4)
+        ext = np.zeros(EXT_SIZE)
+        work = np.empty((WORK_ROWS, STATE_SIZE))
+        vpi, vci, gi, mpi, dpi, stdi = vp[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
+        # what changes every period is this vehicle's own copy (memories written back at the
+        # end; the generator's state is not returned): rows of neighbouring vehicles share
+        # cache lines, and threads flying neighbours would otherwise write to the same lines
+        # each period (false sharing)
+        mi, dmi, rngi = mem[i].copy(), dmem[i].copy(), rng[i].copy()
+        clipped_s = limited_s = 0.0
+        max_position, max_speed, max_rate, max_tilt = limits[0], limits[1], limits[2], limits[3]
+        noisy = False
+        for j in range(STATE_SIZE):
+            if stdi[j] != 0.0:
+                noisy = True
+        code = FINISHED
+        t_end = t_grid[n_periods]
+        rows_x = rows = 0
+        slot = 0                       # = k % (sensor_delay + 1), kept as a counter: the
+        next_log = 0                   # step has no integer division in it
+        steps = 0                      # RK4 steps since the angles' trig was computed afresh
+        if not disturbed:
+            still_air(0.0, 0.0, x, dpi, dmi, rngi, ext)      # and it stays so
+        for k in range(n_periods + 1):
+            t = t_grid[k]
+            dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
+            mission(t, mpi, ref)
+            # what the controller sees: the state sensor_delay periods ago, plus noise
+            if sensor_delay == 0:
+                for j in range(STATE_SIZE):
+                    seen[j] = x[j]
+            else:
+                for j in range(STATE_SIZE):
+                    history[slot, j] = x[j]
+                slot = slot + 1 if slot < sensor_delay else 0
+                old = slot if k >= sensor_delay else 0     # the oldest state kept
+                for j in range(STATE_SIZE):
+                    seen[j] = history[old, j]
+            if noisy:                  # the generator's state as a scalar: no array helper
+                state = rngi[0]
+                for j in range(STATE_SIZE):
+                    if stdi[j] != 0.0:
+                        draw, state = next_normal(state)
+                        seen[j] += stdi[j] * draw
+                rngi[0] = state
+            for j in range(CMD_SIZE):
+                cmd[j] = 0.0
+            controller(t, dt, seen, ref, vci, gi, mi, cmd)
+            if k == next_log:
+                log_row(log_x, i, rows, x)
+                log_row(log_cmd, i, rows, cmd)
+                log_row(log_ref, i, rows, ref)
+                rows += 1
+                rows_x = rows
+                next_log += log_every
+            if k == n_periods:
+                break
+            clipped, finite = False, True
+            for j in range(4):
+                u[j], c, f = clip_duty(cmd[j])
+                clipped, finite = clipped or c, finite and f
+            if not finite:
+                code = BAD_COMMAND
+                t_end = t
+                break
+            if clipped:
+                clipped_s += dt
+            if cmd[CMD_FLAGS] != 0.0:
+                limited_s += dt
+            if disturbed:
+                disturbance(t, dt, x, dpi, dmi, rngi, ext)
+            n_sub = max(1, int(math.ceil(dt * steps_per_s - 1e-9)))
+            h = dt if n_sub == 1 else dt / n_sub
+            for _ in range(n_sub):
+                rk4_step(x, u, vpi, ext, full, h, work, steps == 0)
+                steps = steps + 1 if steps < TRIG_REFRESH - 1 else 0
+            nonfinite = 0.0
+            for j in range(STATE_SIZE):
+                nonfinite += x[j] * 0.0               # 0 while every entry is finite, else NaN
+            if nonfinite != 0.0:
+                code = NONFINITE
+            elif beyond(x[X], x[Y], x[Z], max_position):
+                code = POSITION_BOUND
+            elif beyond(x[VX], x[VY], x[VZ], max_speed):
+                code = SPEED_BOUND
+            elif beyond(x[P], x[Q], x[R], max_rate):
+                code = RATE_BOUND
+            elif beyond(x[PHI], x[THETA], 0.0, max_tilt):
+                code = TILT_BOUND
+            if code != FINISHED:
+                t_end = t_grid[k + 1]
+                if k + 1 == next_log:           # keep the state that broke the bound
+                    log_row(log_x, i, rows, x)
+                    rows_x += 1
+                break
+        blank_rows(log_x, i, rows_x)               # rows after a stop: NaN
+        blank_rows(log_cmd, i, rows)
+        blank_rows(log_ref, i, rows)
+        put_row(x_final, i, x)
+        put_row(mem, i, mi)
+        put_row(dmem, i, dmi)
+        saturated[i, 0], saturated[i, 1] = clipped_s, limited_s
+        status[i] = code
+        t_stop[i] = t_end
+
+
+PIECES_PER_THREAD = 8
+"""A batch is cut into this many pieces per thread, taken in turn by whichever thread is
+free, so a thread whose vehicles stopped early (or ran slower) does not leave the others
+waiting at the end."""
+
+_pool: ThreadPoolExecutor | None = None
+
+
+def fly_vehicles(n: int, args: tuple) -> None:
+    """Run the kernel over vehicles 0..n-1 of the batch arrays in ``args``, on numba's
+    number of threads (``numba.get_num_threads()``): one range on this thread when that is
+    1 or n is 1, else ``PIECES_PER_THREAD`` ranges per thread, handed out in turn."""
+    global _pool
+    threads = min(n, get_num_threads())
+    if threads <= 1:
+        _kernel(0, n, *args)
+        return
+    bounds = np.linspace(0, n, min(n, PIECES_PER_THREAD * threads) + 1).round().astype(np.int64)
+    pieces = itertools.count()                  # next() on it is atomic under the GIL
+
+    def work() -> None:
+        while (k := next(pieces)) < bounds.shape[0] - 1:
+            _kernel(int(bounds[k]), int(bounds[k + 1]), *args)
+    if _pool is None:                            # numba's threads can never exceed this
+        _pool = ThreadPoolExecutor(max_workers=max(1, config.NUMBA_NUM_THREADS - 1),
+                                   thread_name_prefix="quadcruise")
+    helpers = [_pool.submit(work) for _ in range(threads - 1)]
+    work()
+    for h in helpers:
+        h.result()
+
+
+def time_grid(duration: float, dt: float, t0: float = 0.0) -> np.ndarray:
+    """Uniform control instants t0, t0 + dt, ..., t0 + duration.
+
+    ``duration`` must be a whole number of periods (to 1e-9 relative) so the grid ends
+    exactly at t0 + duration.
+    """
+    if not (math.isfinite(duration) and duration > 0):
+        raise InputError(f"duration must be a positive number of seconds, got {duration!r}")
+    if not (math.isfinite(dt) and dt > 0):
+        raise InputError(f"dt must be a positive number of seconds, got {dt!r}")
+    if dt > duration:
+        raise InputError(f"dt ({dt:g} s) is larger than the duration ({duration:g} s)")
+    n = round(duration / dt)
+    if abs(n * dt - duration) > 1e-9 * max(1.0, duration):
+        raise InputError(f"duration ({duration:g} s) is not a whole number of dt ({dt:g} s) periods")
+    return t0 + dt * np.arange(n + 1, dtype=float)
+
+
+def _batch(name: str, a, n: int, width: int | None) -> np.ndarray:
+    """Broadcast a vector or (N, w) array to a C-contiguous (n, w) float64 array."""
+    arr = np.asarray(a, dtype=float)
+    if arr.ndim == 1:
+        arr = np.broadcast_to(arr, (n, arr.shape[0]))
+    if arr.ndim != 2 or arr.shape[0] != n or (width is not None and arr.shape[1] != width):
+        want = f"({n}, {width})" if width is not None else f"({n}, w)"
+        raise InputError(f"{name} has shape {np.shape(a)}, expected {want} or one row")
+    return np.array(arr, dtype=float, order="C")  # a writable copy, never a broadcast view
+
+
+def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
+             vp_ctrl=None, disturbance=None, disturbance_params=None, disturbance_memory=None,
+             seed: int = 0, first_vehicle: int = 0, sensor_std=None, sensor_delay: int = 0,
+             full_dynamics: bool = False,
+             max_step: float = 1e-3, log_every: int = 1, limits: Limits | None = None,
+             meta: dict | None = None) -> SimResult:
+    """Fly N vehicles over the control instants ``t_grid`` and return a :class:`SimResult`.
+
+    This is the array-level entry point that :func:`quadcruise.fly` and
+    :func:`quadcruise.workflows.replay` build on.
+
+    Parameters
+    ----------
+    t_grid : (M+1,) array
+        Strictly increasing control instants [s]; the command is held in between.
+    x0 : (16,) or (N, 16) array
+        Initial states (one row is shared by all vehicles).
+    vp : (N, PARAM_SIZE) array
+        Vehicle parameter rows, from :meth:`Vehicle.rows`.
+    controller : compiled function with ``CONTROLLER_SIG``
+    gains : (G,) or (N, G) array
+        The controller's parameters.
+    mission : compiled function with ``MISSION_SIG``
+    mp : (Mp,) or (N, Mp) array
+        The mission's parameters.
+    memory : (C,) or (N, C) array, optional
+        The controller's initial memory (integrators); zeros of width 0 by default.
+    vp_ctrl : (N, PARAM_SIZE) array, optional
+        The parameters the controller believes in (its model); ``vp`` by default. With
+        model error the plant flies ``vp`` while the controller computes with these.
+    disturbance : compiled function with ``DISTURBANCE_SIG``, optional
+        External force, torque, wind and rotor effectiveness; still air by default.
+    disturbance_params, disturbance_memory : (D,) / (N, D) arrays, optional
+        Its parameters and initial state.
+    seed, first_vehicle : int
+        Vehicle i's random stream is seeded from (seed, first_vehicle + i) only, so a
+        population split into chunks draws the same numbers (see :mod:`quadcruise.sim.rng`).
+    sensor_std : (16,) or (N, 16) array, optional
+        Standard deviation of white noise added to each state the controller sees.
+    sensor_delay : int
+        The controller sees the state this many control periods late.
+    full_dynamics : bool
+        Exact Euler-angle kinematics instead of the paper's phi' = p, theta' = q, psi' = r.
+    max_step : float
+        Longest RK4 substep [s]; each period is split into equal substeps.
+    log_every : int
+        Log every this many control periods (1: all). The first instant is always logged.
+    limits : Limits
+        Divergence bounds.
+    meta : dict
+        Recorded in the result (config, seed, version).
+    """
+    t_grid = np.ascontiguousarray(t_grid, dtype=float)
+    if t_grid.ndim != 1 or t_grid.shape[0] < 2:
+        raise InputError("the time grid needs at least two instants")
+    if not np.all(np.isfinite(t_grid)) or np.any(np.diff(t_grid) <= 0):
+        raise InputError("the time grid must be finite and strictly increasing")
+    if not (math.isfinite(max_step) and max_step > 0):
+        raise InputError(f"max_step must be a positive number of seconds, got {max_step!r}")
+    if int(log_every) != log_every or log_every < 1:
+        raise InputError(f"log_every must be a positive integer, got {log_every!r}")
+    vp = np.ascontiguousarray(vp, dtype=float)
+    n = vp.shape[0]
+    x0 = _batch("initial state", x0, n, STATE_SIZE)
+    if not np.all(np.isfinite(x0)):
+        raise InputError("the initial state must be finite")
+    gains = _batch("controller gains", gains, n, None)
+    mp = _batch("mission parameters", mp, n, None)
+    mem = _batch("controller memory", np.zeros(0) if memory is None else memory, n, None)
+    vp_ctrl = vp if vp_ctrl is None else _batch("controller parameters", vp_ctrl, n, vp.shape[1])
+    dp = _batch("disturbance parameters", np.zeros(0) if disturbance_params is None else disturbance_params, n, None)
+    dmem = _batch("disturbance memory", np.zeros(0) if disturbance_memory is None else disturbance_memory, n, None)
+    std = _batch("sensor noise", np.zeros(STATE_SIZE) if sensor_std is None else sensor_std, n, STATE_SIZE)
+    if not np.all(np.isfinite(std)) or np.any(std < 0):
+        raise InputError("sensor noise standard deviations must be finite and >= 0")
+    if int(sensor_delay) != sensor_delay or sensor_delay < 0:
+        raise InputError(f"sensor delay must be a whole number of periods >= 0, got {sensor_delay!r}")
+    # the random streams, when anything draws from them (SeedSequence: ~25 us a vehicle)
+    disturbed = disturbance is not None
+    drawn = disturbed or bool(np.any(std))
+    rng = vehicle_states(seed, n, first_vehicle) if drawn else np.zeros((n, 1), dtype=np.uint64)
+    limits = limits or Limits()
+
+    n_periods = t_grid.shape[0] - 1
+    n_log = n_periods // log_every + 1
+    log_x = np.empty((n, n_log, STATE_SIZE))      # every row is written by the kernel:
+    log_cmd = np.empty((n, n_log, CMD_SIZE))      # logged, or NaN after a stop
+    log_ref = np.empty((n, n_log, REF_SIZE))
+    x_final = np.empty((n, STATE_SIZE))
+    status = np.zeros(n, dtype=np.int64)
+    t_stop = np.empty(n)
+    saturated = np.zeros((n, 2))
+    fly_vehicles(n, (t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
+                     disturbance or still_air, disturbed, dp, dmem, rng, std, int(sensor_delay),
+                     bool(full_dynamics), float(max_step), int(log_every), limits.array(),
+                     log_x, log_cmd, log_ref, x_final, status, t_stop, saturated))
+    return SimResult(
+        t=t_grid[::log_every][:n_log].copy(), states=log_x, commands=log_cmd, references=log_ref,
+        final_state=x_final, status=status, t_stop=t_stop, memory=mem, disturbance_memory=dmem,
+        duty_clipped_s=saturated[:, 0].copy(), controller_limited_s=saturated[:, 1].copy(),
+        meta=dict(meta or {}),
+    )
+
+
+__all__ = ["Limits", "simulate", "time_grid", "rk4_step", "STATUS_REASONS"]

@@ -1,0 +1,163 @@
+"""What a simulation returns: named arrays for N vehicles, their exit status, and the
+configuration that produced them.
+
+Examples
+--------
+>>> import quadcruise as qc
+>>> res = qc.replay(qc.DutySchedule(t=[0.0, 0.5], duties=[[0.0] * 4] * 2))
+>>> res.n, res.ok.tolist(), res.status_text(0)
+(1, [True], 'finished')
+>>> round(float(res.state("z")[0, -1]), 4)   # free fall for 0.5 s: -g t^2 / 2
+-1.2262
+>>> list(res.to_pandas().columns[:4])
+['vehicle', 't', 'x', 'y']
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from quadcruise.errors import InputError
+from quadcruise.layout import CMD_NAMES, REF_NAMES, STATE_NAMES
+from quadcruise.sim.status import STATUS_REASONS, ExitStatus
+
+
+@dataclass(frozen=True, eq=False)
+class SimResult:
+    """Logged flight of N vehicles.
+
+    Attributes
+    ----------
+    t : (L,) logged instants [s]
+    states : (N, L, 16) state at each instant (NaN after a vehicle stopped)
+    commands : (N, L, 12) controller output computed at each instant
+    references : (N, L, 11) mission reference at each instant
+    final_state : (N, 16) state when each vehicle finished or stopped
+    status : (N,) exit status code, 0 = finished (see :data:`STATUS_REASONS`)
+    t_stop : (N,) time each vehicle finished or stopped [s]
+    memory : (N, C) the controllers' memory at the end
+    duty_clipped_s : (N,) time [s] during which a commanded duty was clipped to [0, 1]
+    controller_limited_s : (N,) time [s] during which the controller flagged a limit
+    meta : dict, the configuration, seed and version that produced the result
+    disturbance_memory : (N, D) the disturbance models' state at the end
+    """
+
+    t: np.ndarray
+    states: np.ndarray
+    commands: np.ndarray
+    references: np.ndarray
+    final_state: np.ndarray
+    status: np.ndarray
+    t_stop: np.ndarray
+    memory: np.ndarray
+    duty_clipped_s: np.ndarray
+    controller_limited_s: np.ndarray
+    meta: dict = field(default_factory=dict)
+    disturbance_memory: np.ndarray | None = None
+
+    @property
+    def n(self) -> int:
+        """Number of vehicles."""
+        return self.states.shape[0]
+
+    @property
+    def ok(self) -> np.ndarray:
+        """(N,) True where the vehicle flew to the end."""
+        return self.status == 0
+
+    def exit_status(self, i: int = 0) -> ExitStatus:
+        """Vehicle i's exit status.
+
+        Parameters
+        ----------
+        i : int
+            The vehicle's index.
+
+        Returns
+        -------
+        ExitStatus
+        """
+        return ExitStatus(int(self.status[i]))
+
+    def status_text(self, i: int = 0) -> str:
+        """Why vehicle i stopped, and when."""
+        code = int(self.status[i])
+        if code == 0:
+            return STATUS_REASONS[0]
+        return f"{STATUS_REASONS[code]} at t = {self.t_stop[i]:.4f} s"
+
+    def state(self, name: str) -> np.ndarray:
+        """(N, L) trace of one state, reference or command column, by name."""
+        for names, arr in ((STATE_NAMES, self.states), (REF_NAMES, self.references),
+                           (CMD_NAMES, self.commands)):
+            if name in names:
+                return arr[:, :, names.index(name)]
+        raise InputError(f"unknown trace name {name!r}; known: {', '.join(STATE_NAMES + REF_NAMES + CMD_NAMES)}")
+
+    def to_pandas(self, vehicle: int | None = None, *, references: bool = True, commands: bool = True):
+        """Long-form DataFrame: one row per vehicle and logged instant.
+
+        Columns: ``vehicle``, ``t``, the 16 state names, then (optionally) the reference
+        and command names. ``vehicle`` selects one vehicle.
+        """
+        import pandas as pd
+
+        picks = range(self.n) if vehicle is None else [vehicle]
+        blocks = [self.states]
+        names = list(STATE_NAMES)
+        if references:
+            blocks.append(self.references)
+            names += REF_NAMES
+        if commands:
+            blocks.append(self.commands)
+            names += CMD_NAMES
+        data = np.concatenate(blocks, axis=2)[list(picks)]
+        n_sel, n_log, _ = data.shape
+        frame = pd.DataFrame(data.reshape(n_sel * n_log, -1), columns=names)
+        frame.insert(0, "t", np.tile(self.t, n_sel))
+        frame.insert(0, "vehicle", np.repeat(np.asarray(list(picks)), n_log))
+        return frame
+
+    def decimate(self, every: int) -> "SimResult":
+        """A result holding every ``every``-th logged instant (the end state stays exact)."""
+        if int(every) != every or every < 1:
+            raise InputError(f"decimation step must be a positive integer, got {every!r}")
+        keep = slice(None, None, int(every))
+        return dataclasses.replace(self, t=self.t[keep], states=self.states[:, keep],
+                                   commands=self.commands[:, keep], references=self.references[:, keep])
+
+    def metrics(self, **kwargs):
+        """Per-vehicle metrics as a DataFrame: see :func:`quadcruise.metrics.flight_metrics`."""
+        from quadcruise.metrics.flight import flight_metrics
+
+        return flight_metrics(self, **kwargs)
+
+    def plot(self, vehicle: int = 0, **kwargs):
+        """Figure of one vehicle's flight: see :func:`quadcruise.plots.plot_flight`."""
+        from quadcruise.plots.flight import plot_flight
+
+        return plot_flight(self, vehicle=vehicle, **kwargs)
+
+    def summary(self) -> dict:
+        """Counts of vehicles by exit status, and the saturation times."""
+        reasons: dict[str, int] = {}
+        for code in self.status:
+            key = STATUS_REASONS[int(code)]
+            reasons[key] = reasons.get(key, 0) + 1
+        return {
+            "vehicles": self.n,
+            "status": reasons,
+            "duty_clipped_s": float(self.duty_clipped_s.max(initial=0.0)),
+            "controller_limited_s": float(self.controller_limited_s.max(initial=0.0)),
+        }
+
+    def meta_json(self) -> str:
+        """The recorded configuration as JSON."""
+        from quadcruise.io.plainjson import dumps
+
+        return dumps(self.meta, indent=2, sort_keys=True)
+
+

@@ -1,0 +1,58 @@
+"""How a flight ended: each vehicle's exit status, its code and its reason in one place.
+
+The compiled engine writes the integer codes; everything that reads them (results, Monte
+Carlo tables, the command line's exit code) names them through :class:`ExitStatus`.
+
+Examples
+--------
+>>> ExitStatus(2).reason
+'diverged: position left the bound'
+>>> ExitStatus.FINISHED.ok, ExitStatus.NONFINITE.ok
+(True, False)
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+__all__ = ["ExitStatus", "STATUS_REASONS"]
+
+
+class ExitStatus(IntEnum):
+    """A vehicle's exit status: the engine's integer code with its reason.
+
+    ``FINISHED`` flew the whole mission; every other status stopped the vehicle at the time
+    recorded in :attr:`quadcruise.SimResult.t_stop`.
+    """
+
+    FINISHED = 0
+    NONFINITE = 1
+    POSITION_BOUND = 2
+    SPEED_BOUND = 3
+    RATE_BOUND = 4
+    TILT_BOUND = 5
+    BAD_COMMAND = 6
+
+    @property
+    def reason(self) -> str:
+        """One line saying what happened."""
+        return _REASONS[self]
+
+    @property
+    def ok(self) -> bool:
+        """True for a vehicle that flew its whole mission."""
+        return self is ExitStatus.FINISHED
+
+
+_REASONS = {
+    ExitStatus.FINISHED: "finished",
+    ExitStatus.NONFINITE: "diverged: the state became non-finite (NaN or inf)",
+    ExitStatus.POSITION_BOUND: "diverged: position left the bound",
+    ExitStatus.SPEED_BOUND: "diverged: speed left the bound",
+    ExitStatus.RATE_BOUND: "diverged: body rate left the bound",
+    ExitStatus.TILT_BOUND: "diverged: tilt left the bound",
+    ExitStatus.BAD_COMMAND: "stopped: the controller returned a non-finite command",
+}
+
+STATUS_REASONS = tuple(status.reason for status in ExitStatus)
+"""The reasons by integer code (index = :class:`ExitStatus` value)."""

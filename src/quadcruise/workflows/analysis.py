@@ -1,0 +1,476 @@
+"""Linear analysis of any closed loop about hover: poles, loop margins, Bode plots.
+
+:func:`linearize` differentiates one control period of the engine (the controller called
+once, its duties clipped and held, the plant integrated by RK4 over ``dt``) by central
+differences and hands it to python-control as the discrete system ``control.ss(A, B, C, D,
+dt)``: the state is the plant's 16 states then the controller's memory, the inputs are the
+set-points x_r, y_r, z_r, psi_r (their rates stay zero, as in a step), the outputs x, y, z,
+phi, theta, psi. Any controller compiled with ``layout.CONTROLLER_SIG`` works: it is only
+called. Hover must be an equilibrium of that map, else :class:`HoverError` names the state
+that drifts. Poles in rad/s are s = log(z) / dt (:meth:`Linearization.poles_continuous`).
+
+**Loops and where they are broken.** At hover the closed loop splits into four loops: the
+connected components of A once the rotor thrusts are written as U1..U4 of eqs (1)-(4).
+For margins one loop is broken, the others closed, at the plant input (``at="input"``):
+on the generalized input that drives it, before the rotor lag: U3 for x (through pitch), U2
+for y (roll), U1 for z, U4 for yaw. There a thrust-gain, inertia or motor-lag error of the
+real vehicle enters; for z and yaw it is the break of :func:`.control.design.loop_margins`.
+The x and y input margins cover the attitude loop *and* the position loop around it.
+``at="output"`` breaks instead at the position (or yaw) measurement the controller sees,
+velocity and attitude feedback closed: the outer loop's own margins.
+
+>>> lin = linearize("nlpd")
+>>> lin.stable, sorted(lin.loops)
+(True, ['x', 'y', 'yaw', 'z'])
+>>> [round(float(p.real), 2) for p in lin.loop_poles("x") if p.imag == 0]
+[-0.47, -0.66]
+>>> round(loop_margins(lin, "z")["phase_margin"], 1)     # design.loop_margins: 65.1 (continuous)
+65.0
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import control
+import numpy as np
+import scipy.linalg
+from scipy.sparse.csgraph import connected_components
+
+from quadcruise.errors import InputError
+from quadcruise.layout import (
+    CMD_FLAGS,
+    CMD_SIZE,
+    EXT_E1,
+    EXT_SIZE,
+    F1,
+    P_D,
+    P_G,
+    P_K,
+    P_M,
+    REF_NAMES,
+    REF_Z,
+    STATE_NAMES,
+    STATE_SIZE,
+    Z,
+)
+from quadcruise.model.actuators import mix
+from quadcruise.model.vehicle import Vehicle
+
+INPUTS = ("x_ref", "y_ref", "z_ref", "psi_ref")
+OUTPUTS = ("x", "y", "z", "phi", "theta", "psi")
+LOOPS = {"x": (2, "x"), "y": (1, "y"), "z": (0, "z"), "yaw": (3, "psi")}
+"""Each loop's generalized input (0..3: U1..U4) and measured output (a state name)."""
+DESIGN = {"x": "position", "y": "position", "z": "altitude", "yaw": "yaw"}
+"""The controller attribute with each loop's design gains (``.poles``), where it has one."""
+
+
+class HoverError(InputError):
+    """The controller does not hold hover: there is no equilibrium to linearise about."""
+
+
+def _period(x, u, vp, dt, n_sub):
+    """One control period as the engine integrates it (:func:`quadcruise.sim.engine.rk4_step`,
+    n_sub substeps, duties held) in still air with healthy rotors and the paper's
+    kinematics (the exact ones agree to first order at hover): the next state."""
+    from quadcruise.sim.engine import WORK_ROWS, rk4_step
+
+    ext = np.zeros(EXT_SIZE)
+    ext[EXT_E1:EXT_E1 + 4] = 1.0
+    x, u = np.array(x, dtype=float), np.ascontiguousarray(u, dtype=float)
+    work = np.empty((WORK_ROWS, STATE_SIZE))
+    for _ in range(n_sub):
+        rk4_step(x, u, vp, ext, False, dt / n_sub, work, True)
+    return x
+
+
+def _jacobian(f, v0, eps):
+    """Central differences of f at v0, step eps * max(1, |v_i|)."""
+    steps = eps * np.maximum(1.0, np.abs(v0))
+    return np.array([(f(v0 + h * e) - f(v0 - h * e)) / (2.0 * h) for h, e in zip(steps, np.eye(v0.size))]).T
+
+
+def _s_plane(z, dt):
+    """s = log(z) / dt, real where the imaginary part is rounding (-inf for a pole at z = 0,
+    a mode that dies in one period), and the order slowest first."""
+    z = np.asarray(z, complex)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = np.where(np.abs(z) < 1e-300, -np.inf, np.log(np.where(np.abs(z) < 1e-300, 1.0, z)) / dt)
+    s = np.where(np.abs(s.imag) < 1e-9 * np.maximum(1.0, np.abs(s)), s.real, s)
+    return np.lexsort((s.imag, -s.real)), s
+
+
+@dataclass(frozen=True)
+class Linearization:
+    """The discrete closed loop about hover, ``sys``, and the pieces it is composed of:
+    ``plant_A``, ``plant_B`` (one period, x+ = A x + B u, u the duties), ``K_state``,
+    ``K_memory`` (duties), ``H_state``, ``H_memory`` (next memory) as derivatives in x and
+    memory; ``mixer`` (U1..U4 = mixer @ u); ``loops`` (each loop's state indices);
+    ``residual`` (the largest drift rate at hover)."""
+
+    sys: control.StateSpace
+    dt: float
+    controller: object
+    plant_A: np.ndarray
+    plant_B: np.ndarray
+    K_state: np.ndarray
+    K_memory: np.ndarray
+    H_state: np.ndarray
+    H_memory: np.ndarray
+    mixer: np.ndarray
+    loops: dict
+    residual: float
+
+    @property
+    def stable(self) -> bool:
+        """All discrete poles strictly inside the unit circle."""
+        return bool(np.max(np.abs(self.poles())) < 1.0)
+
+    def poles(self) -> np.ndarray:
+        """Discrete-time poles (z-plane)."""
+        return np.linalg.eigvals(self.sys.A)
+
+    def poles_continuous(self) -> np.ndarray:
+        """Poles in rad/s, s = log(z) / dt (exact for the sampled modes), slowest first."""
+        order, s = _s_plane(self.poles(), self.dt)
+        return s[order]
+
+    def loop_poles(self, loop: str) -> np.ndarray:
+        """Poles [rad/s] of one loop's block of A, slowest first."""
+        return self.loop_modes(loop)[0]
+
+    def loop_modes(self, loop: str) -> tuple[np.ndarray, np.ndarray]:
+        """One loop's poles [rad/s], slowest first, and each one's weight |a_i| / |Re s_i| in
+        the step response of the loop's set-point to its output (a_i: the mode's amplitude;
+        the weight is the integral of |a_i exp(s_i t)|; the largest marks the dominant pole)."""
+        idx, state = self.loops[_check_loop(loop)], LOOPS[loop][1]
+        S = _to_generalized(self.sys.nstates, self.mixer)
+        Si = np.linalg.inv(S)
+        z, V = np.linalg.eig((S @ self.sys.A @ Si)[np.ix_(idx, idx)])
+        b = (S @ self.sys.B)[idx, INPUTS.index(f"{state}_ref")]
+        c = (self.sys.C @ Si)[OUTPUTS.index(state), idx]
+        order, s = _s_plane(z, self.dt)
+        with np.errstate(divide="ignore", invalid="ignore"):      # inf for a marginal mode
+            weight = np.abs((c @ V) * np.linalg.solve(V, b) / (1.0 - z)) / np.abs(s.real)
+        return s[order], weight[order]
+
+    def continuous(self) -> control.StateSpace:
+        """The continuous system whose zero-order-hold sampling is ``sys``:
+        logm([[A, B], [0, I]]) / dt = [[Ac, Bc], [0, 0]]."""
+        n, m = self.sys.B.shape
+        z = self.poles()
+        if np.any((np.abs(z.imag) < 1e-12) & (z.real <= 1e-12)):
+            raise InputError("the loop has purely discrete modes (poles at z = 0 or on the negative real "
+                             "axis, e.g. a one-period memory): it has no continuous equivalent")
+        L = scipy.linalg.logm(np.block([[self.sys.A, self.sys.B], [np.zeros((m, n)), np.eye(m)]])).real / self.dt
+        return control.ss(L[:n, :n], L[:n, n:], self.sys.C, self.sys.D, inputs=INPUTS, outputs=OUTPUTS,
+                          states=list(self.sys.state_labels))
+
+
+def _check_loop(loop: str) -> str:
+    if loop not in LOOPS:
+        raise InputError(f"unknown loop {loop!r}; choose one of {', '.join(LOOPS)}")
+    return loop
+
+
+def _as_controller(controller):
+    if isinstance(controller, str):
+        from quadcruise.control import controller_from_name
+        return controller_from_name(controller)
+    missing = [m for m in ("function", "gains", "memory") if not hasattr(controller, m)]
+    if missing:
+        raise InputError(f"controller must be a name or have .function, .gains() and .memory(); "
+                         f"{type(controller).__name__} lacks {', '.join(missing)}")
+    return controller
+
+
+def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 1e-3, hover_z: float = 1.0,
+              eps: float = 1e-6, max_step: float | None = None, memory=None, settle: int = 1,
+              tol: float = 1e-6) -> Linearization:
+    """Linearise plant + controller over one control period ``dt`` about hover at ``hover_z``.
+
+    Parameters
+    ----------
+    controller : Controller or str
+        Anything with ``.function`` (compiled, ``CONTROLLER_SIG``), ``.gains()``, ``.memory()``.
+    vehicle : Vehicle, optional
+        One vehicle (Table I by default); the controller sees the same parameters.
+    dt, max_step, hover_z : float
+        Control period, longest RK4 substep (``dt`` by default) [s], as in ``fly``; hover
+        altitude [m] (x = y = yaw = 0, every rotor at m g / 4).
+    eps, tol : float
+        Relative central-difference step; largest drift rate [unit/s] of any state or memory
+        entry that still counts as hover.
+    memory : array, optional
+        The controller's memory to start from; ``controller.memory()`` by default.
+    settle : int
+        Periods the controller is first called at hover, its memory kept: a controller may
+        initialise memory in its first period (a first-call flag, a derivative's last sample).
+
+    Raises
+    ------
+    HoverError
+        Hover is not an equilibrium of the period map, or a duty sits on its clip.
+
+    Examples
+    --------
+    >>> lin = linearize("nlpd")
+    >>> lin.sys.nstates, lin.sys.ninputs, lin.sys.noutputs, lin.sys.dt
+    (19, 4, 6, 0.001)
+    >>> bool(lin.residual < 1e-9), lin.sys.state_labels[-3:]
+    (True, ['mem0', 'mem1', 'mem2'])
+    """
+    controller = _as_controller(controller)
+    vehicle = vehicle or Vehicle.paper()
+    if vehicle.batch_size not in (None, 1):
+        raise InputError(f"linearize takes one vehicle, got a batch of {vehicle.batch_size}")
+    if not (math.isfinite(dt) and dt > 0):
+        raise InputError(f"dt must be a positive number of seconds, got {dt!r}")
+    vp = np.ascontiguousarray(vehicle.rows()[0])
+    gains = np.ascontiguousarray(controller.gains(), dtype=float)
+    mem0 = np.array(controller.memory() if memory is None else memory, dtype=float).ravel()
+    n, C = STATE_SIZE + mem0.size, mem0.size
+    n_sub = max(1, math.ceil(dt / (max_step or dt) - 1e-9))
+    x0, ref0 = np.zeros(STATE_SIZE), np.zeros(len(REF_NAMES))
+    x0[Z], x0[F1:F1 + 4], ref0[REF_Z] = hover_z, vp[P_M] * vp[P_G] / 4.0, hover_z
+    cols = [REF_NAMES.index(name) for name in INPUTS]
+
+    def ctrl(v):                      # (x, memory, set-points) -> (duties, next memory, flags)
+        ref, mem, cmd = ref0.copy(), v[STATE_SIZE:n].copy(), np.zeros(CMD_SIZE)
+        ref[cols] = v[n:]
+        controller.function(0.0, dt, np.ascontiguousarray(v[:STATE_SIZE]), ref, vp, gains, mem, cmd)
+        return np.concatenate([cmd[:4], mem, cmd[CMD_FLAGS:CMD_FLAGS + 1]])
+
+    for _ in range(settle):
+        mem0 = ctrl(np.concatenate([x0, mem0, ref0[cols]]))[4:4 + C]
+    v0 = np.concatenate([x0, mem0, ref0[cols]])
+    out0 = ctrl(v0)
+    u0 = out0[:4]
+    drift = np.concatenate([_period(x0, np.clip(u0, 0.0, 1.0), vp, dt, n_sub) - x0, out0[4:4 + C] - mem0]) / dt
+    names = list(STATE_NAMES) + [f"mem{i}" for i in range(C)]
+    if not np.all(np.abs(drift) <= tol):
+        i = int(np.argmax(np.where(np.isfinite(drift), np.abs(drift), np.inf)))
+        who = getattr(controller, "name", "the controller")
+        raise HoverError(f"{who} does not hold hover at z = {hover_z:g} m: '{names[i]}' moves at {drift[i]:.3g} "
+                         f"per second (tolerance {tol:g}), so there is no equilibrium to linearise about")
+    if np.any(u0 <= 0.0) or np.any(u0 >= 1.0):
+        raise HoverError(f"a hover duty sits on its clip to [0, 1] ({np.round(u0, 4).tolist()}): "
+                         f"the loop is not differentiable there")
+    if out0[-1] != 0.0:
+        warnings.warn(f"the controller flags a limit at hover (flags {out0[-1]:g})", stacklevel=2)
+
+    # the period map's Jacobian by the chain rule: controller, then plant (a duty clip is inactive)
+    G = _jacobian(lambda v: ctrl(v)[:4 + C], v0, eps)
+    P = _jacobian(lambda v: _period(v[:STATE_SIZE], v[STATE_SIZE:], vp, dt, n_sub), np.r_[x0, u0], eps)
+    Ap, Bp = P[:, :STATE_SIZE], P[:, STATE_SIZE:]
+    (Kx, Km, Kr), (Hx, Hm, Hr) = np.split(G[:4], [STATE_SIZE, n], axis=1), np.split(G[4:], [STATE_SIZE, n], axis=1)
+    A = np.block([[Ap + Bp @ Kx, Bp @ Km], [Hx, Hm]])
+    Cy = np.eye(n)[[STATE_NAMES.index(name) for name in OUTPUTS]]
+    sys = control.ss(A, np.vstack([Bp @ Kr, Hr]), Cy, 0.0, dt, inputs=INPUTS, outputs=OUTPUTS, states=names)
+    mixer = vp[P_K] * np.array([mix(*row, vp[P_D]) for row in np.eye(4)]).T
+    return Linearization(sys, float(dt), controller, Ap, Bp, Kx, Km, Hx, Hm, mixer, _loops(A, mixer),
+                         float(np.max(np.abs(drift))))
+
+
+def _to_generalized(n, mixer):
+    """The change of state that replaces the rotor thrusts F1..F4 by U1..U4 (up to scale)."""
+    S = np.eye(n)
+    S[F1:F1 + 4, F1:F1 + 4] = mixer / mixer[0, 0]
+    return S
+
+
+def _loops(A, mixer):
+    """Each loop's state indices: the connected component of A (in U1..U4 coordinates, where
+    the loops decouple at hover) that holds the loop's measured output."""
+    S = _to_generalized(A.shape[0], mixer)
+    At = np.abs(S @ A @ np.linalg.inv(S) - np.eye(A.shape[0]))
+    _, label = connected_components(At > 1e-9 * At.max(), directed=False)
+    return {loop: np.flatnonzero(label == label[STATE_NAMES.index(state)]) for loop, (_, state) in LOOPS.items()}
+
+
+def loop_transfer(lin: Linearization, loop: str = "x", at: str = "input") -> control.StateSpace:
+    """The discrete loop transfer L(z) of one loop broken ``at`` 'input' or 'output', the
+    others closed, signed for negative feedback (the closed loop is L / (1 + L))."""
+    u_idx, state = LOOPS[_check_loop(loop)]
+    Ap, Bp, Kx, Km, Hx, Hm = lin.plant_A, lin.plant_B, lin.K_state, lin.K_memory, lin.H_state, lin.H_memory
+    C = Hm.shape[0]
+    if at == "input":                # w replaces the controller's U_j at the plant input
+        Bu, KU, KmU = Bp @ np.linalg.inv(lin.mixer), lin.mixer @ Kx, lin.mixer @ Km
+        e = np.eye(4)[:, [u_idx]]
+        keep = np.eye(4) - e @ e.T
+        A = np.block([[Ap + Bu @ keep @ KU, Bu @ keep @ KmU], [Hx, Hm]])
+        B, Cl = np.vstack([Bu @ e, np.zeros((C, 1))]), -np.hstack([KU[u_idx], KmU[u_idx]])[None, :]
+    elif at == "output":             # w replaces the measured output the controller sees
+        e = np.eye(STATE_SIZE)[:, [STATE_NAMES.index(state)]]
+        keep = np.eye(STATE_SIZE) - e @ e.T
+        A = np.block([[Ap + Bp @ Kx @ keep, Bp @ Km], [Hx @ keep, Hm]])
+        B, Cl = np.vstack([Bp @ Kx @ e, Hx @ e]), -np.hstack([e.T, np.zeros((1, C))])
+    else:
+        raise InputError(f"at must be 'input' or 'output', got {at!r}")
+    return control.ss(A, B, Cl, 0.0, lin.dt)
+
+
+def _omega(dt, n=2000):
+    return np.logspace(-3, math.log10(0.999 * math.pi / dt), n)
+
+
+def loop_margins(lin: Linearization, loop: str = "x", at: str = "input") -> dict:
+    """Margins of :func:`loop_transfer` by ``control.stability_margins``, on its frequency
+    response up to the Nyquist frequency (the polynomial method is ill-conditioned for a
+    19-state loop with poles crowded near z = 1).
+
+    Returns ``phase_margin`` [deg] at ``gain_crossover`` [rad/s]; ``gain_margin`` (the one
+    python-control picks, nearest 1) at ``phase_crossover``; ``gain_increase`` (the smallest
+    destabilising factor > 1, inf if none) and ``gain_decrease`` (the largest < 1, 0 if none;
+    a PID on a double integrator has one); ``stability_margin`` (least distance of L to -1)
+    and its frequency; ``open_loop_unstable_poles`` (of L; when not 0 the margins alone do
+    not tell stability).
+
+    >>> m = loop_margins(linearize("nlpd"), "yaw")          # design.loop_margins: 24.5 deg
+    >>> round(m["phase_margin"], 1), round(m["gain_crossover"], 1)
+    (24.1, 12.5)
+    """
+    w, L = _omega(lin.dt), loop_transfer(lin, loop, at)
+    r = control.frequency_response(L, w).complex.ravel()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        gms, pms, sms, wpcs, wgcs, wsms = (np.atleast_1d(a) for a in control.stability_margins(
+            (np.abs(r), np.degrees(np.unwrap(np.angle(r))), w), returnall=True))
+    with np.errstate(divide="ignore"):
+        g = int(np.argmin(np.abs(np.log(gms)))) if gms.size and not np.isinf(gms).all() else None
+    p, s = (int(np.argmin(np.abs(pms))) if pms.size else None), (int(np.argmin(sms)) if sms.size else None)
+    return {"phase_margin": math.inf if p is None else float(pms[p]),
+            "gain_crossover": math.nan if p is None else float(wgcs[p]),
+            "gain_margin": math.inf if g is None else float(gms[g]),
+            "phase_crossover": math.nan if g is None else float(wpcs[g]),
+            "gain_increase": float(min(gms[gms > 1], default=math.inf)),
+            "gain_decrease": float(max(gms[gms < 1], default=0.0)),
+            "stability_margin": math.nan if s is None else float(sms[s]),
+            "stability_margin_frequency": math.nan if s is None else float(wsms[s]),
+            "open_loop_unstable_poles": int(np.sum(np.abs(np.linalg.eigvals(L.A)) > 1.0 + 1e-9))}
+
+
+def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "input"):
+    """Closed-loop x_r->x, y_r->y (dashed: the same as x for a symmetric vehicle), z_r->z,
+    psi_r->psi magnitude and phase; with ``loops``, a second column of the loop transfers
+    (broken ``at``), their gain crossovers marked and their phase read so that the phase
+    margin is its distance above the -180 deg line there.
+
+    >>> fig = bode(linearize("nlpd"), loops=True)
+    >>> len(fig.axes)
+    4
+    """
+    w = np.logspace(-2, math.log10(0.999 * math.pi / lin.dt), 800) if omega is None else np.asarray(omega, float)
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(12 if loops else 7, 6.5), layout="constrained")
+    axes = fig.subplots(2, 2 if loops else 1, sharex="col", squeeze=False)
+    for (loop, (_, state)), color in zip(LOOPS.items(), ("C0", "C1", "C2", "C3")):
+        style = {"color": color, "ls": "--" if loop == "y" else "-"}
+        r = control.frequency_response(lin.sys[OUTPUTS.index(state), INPUTS.index(f"{state}_ref")], w).complex.ravel()
+        axes[0, 0].semilogx(w, 20 * np.log10(np.abs(r)), label=f"{state}_r -> {state}", **style)
+        axes[1, 0].semilogx(w, np.degrees(np.unwrap(np.angle(r))), **style)
+        if loops:
+            r = control.frequency_response(loop_transfer(lin, loop, at), w).complex.ravel()
+            phase, wgc = np.degrees(np.unwrap(np.angle(r))), loop_margins(lin, loop, at)["gain_crossover"]
+            if math.isfinite(wgc):                       # phase at the crossover in (-360, 0]
+                phase -= 360.0 * math.ceil(np.interp(math.log(wgc), np.log(w), phase) / 360.0)
+                axes[0, 1].plot([wgc], [0.0], "o", color=color, ms=4)
+            axes[0, 1].semilogx(w, 20 * np.log10(np.abs(r)), label=f"L {loop} (at the {at})", **style)
+            axes[1, 1].semilogx(w, phase, **style)
+    axes[0, 0].set_ylim(bottom=max(axes[0, 0].get_ylim()[0], -150.0))
+    for col, title in enumerate(["closed loop (discrete, dt = %g s)" % lin.dt, "loop transfers"][:axes.shape[1]]):
+        axes[0, col].set(ylabel="magnitude [dB]", title=title)
+        axes[1, col].set(ylabel="phase [deg]", xlabel="frequency [rad/s]")
+        axes[0, col].axhline(0.0, color="0.6", lw=0.6)
+        if col == 1:
+            axes[1, col].axhline(-180.0, color="0.6", lw=0.6)
+        axes[0, col].legend(fontsize=8)
+        for ax in axes[:, col]:
+            ax.grid(True, which="both", alpha=0.3)
+    fig.suptitle(f"{getattr(lin.controller, 'name', 'controller')}: linearised about hover")
+    return fig
+
+
+def report(controller="nlpd", lin: Linearization | None = None, **kwargs) -> dict:
+    """Poles, damping and margins of every loop beside the design's poles, as plain values.
+
+    Per loop: ``poles`` [rad/s] as [re, im] (one of each pair) with their
+    ``natural_frequency`` [rad/s], ``damping`` and ``step_weight``
+    (:meth:`Linearization.loop_modes`); the ``dominant`` pole (largest weight);
+    ``min_damping``; ``margins_input`` and ``margins_output`` (:func:`loop_margins`); and
+    where the controller has design gains for the loop (``position`` for x and y, ``altitude``,
+    ``yaw``), their ``design_poles``, the ``nearest`` full-loop pole to each and its
+    ``nearest_rel_distance``. ``kwargs`` go to :func:`linearize`; a given ``lin`` is used as is.
+
+    >>> r = report("nlpd")
+    >>> x = r["loops"]["x"]
+    >>> r["stable"], x["design_poles"], [round(v, 3) for v in x["dominant"]]
+    (True, [-0.7, -4.3], [-0.658, 0.0])
+    >>> [round(d, 2) for d in x["nearest_rel_distance"]]     # -0.7 survives, -4.3 does not
+    [0.06, 0.85]
+    """
+    lin = lin or linearize(controller, **kwargs)
+    controller = lin.controller
+    out = {"controller": getattr(controller, "name", "controller"), "dt_s": lin.dt, "stable": lin.stable,
+           "spectral_radius": float(np.max(np.abs(lin.poles()))), "hover_residual": lin.residual, "loops": {}}
+    for loop in LOOPS:
+        p, weight = lin.loop_modes(loop)
+        p, weight = p[p.imag >= 0], weight[p.imag >= 0]
+        wn = np.abs(p)
+        with np.errstate(invalid="ignore"):
+            zeta = np.where(np.isinf(wn), 1.0, -p.real / np.where(wn > 0, wn, 1.0))
+        dom = p[np.argmax(weight)]
+        entry = out["loops"][loop] = {
+            "poles": [[round(float(z.real), 6), round(float(z.imag), 6)] for z in p],
+            "natural_frequency": wn.tolist(), "damping": zeta.tolist(), "step_weight": weight.tolist(),
+            "dominant": [round(float(dom.real), 6), round(float(dom.imag), 6)], "min_damping": float(zeta.min()),
+            "margins_input": loop_margins(lin, loop, "input"), "margins_output": loop_margins(lin, loop, "output")}
+        design = getattr(getattr(controller, DESIGN[loop], None), "poles", None)
+        if design is not None:
+            d = np.atleast_1d(np.asarray(design, complex)).round(9)
+            d = d[d.imag >= 0]                                   # one of each pair, as the poles
+            near = [p[np.argmin(np.abs(p - z))] for z in d]
+            entry["design_poles"] = [float(z.real) if z.imag == 0 else [float(z.real), float(z.imag)] for z in d]
+            entry["nearest"] = [[float(q.real), float(q.imag)] for q in near]
+            entry["nearest_rel_distance"] = [float(abs(q - z) / abs(z)) for q, z in zip(near, d)]
+    return out
+
+
+def summary(rep: dict) -> str:
+    """:func:`report` as an aligned text table, one column per loop.
+
+    >>> print(summary(report("nlpd")).splitlines()[4].split())
+    ['min', 'damping', '0.363', '0.363', '0.884', '0.272']
+    """
+    def pole(p):
+        return f"{p[0]:.3g}" if p[1] == 0 else f"{p[0]:.3g}±{p[1]:.3g}j"
+
+    def design(e):
+        return ", ".join(f"{z if isinstance(z, float) else complex(*z)}:{d:.0%}" for z, d in
+                         zip(e.get("design_poles", []), e.get("nearest_rel_distance", []))) or "-"
+
+    rows = [("dominant pole [rad/s]", lambda e: pole(e["dominant"])),
+            ("slowest pole [rad/s]", lambda e: pole(e["poles"][0])),
+            ("min damping", lambda e: f"{e['min_damping']:.3f}"), ("design poles: nearest off by", design)]
+    for at in ("input", "output"):
+        rows += [(f"PM at the {at} [deg] @ [rad/s]", lambda e, m="margins_" + at: f"{e[m]['phase_margin']:.1f} @ "
+                  f"{e[m]['gain_crossover']:.3g}"), (f"GM at the {at} (down, up)", lambda e, m="margins_" + at:
+                  f"{e[m]['gain_decrease']:.3g}, {e[m]['gain_increase']:.3g}")]
+    table = [[""] + list(rep["loops"])] + [[name] + [cell(e) for e in rep["loops"].values()] for name, cell in rows]
+    w = [max(len(row[j]) for row in table) + 2 for j in range(len(table[0]))]
+    head = f"{rep['controller']} about hover, dt = {rep['dt_s']:g} s: " + ("stable" if rep["stable"] else "UNSTABLE")
+    return "\n".join([head] + [r[0].ljust(w[0]) + "".join(c.rjust(k) for c, k in zip(r[1:], w[1:])) for r in table])
+
+
+def to_json(rep: dict) -> str:
+    """:func:`report` as strict JSON: an infinite or undefined number becomes null."""
+    from quadcruise.io.plainjson import dumps
+
+    return dumps(rep, indent=2)
+
+
+__all__ = ["HoverError", "Linearization", "linearize", "loop_transfer", "loop_margins", "bode", "report",
+           "summary", "to_json", "INPUTS", "OUTPUTS", "LOOPS"]

@@ -1,0 +1,223 @@
+"""Controllers side by side: one mission, one vehicle, the same engine, their metrics and paths.
+
+Examples
+--------
+>>> from quadcruise.workflows.compare import compare
+>>> cmp = compare("step", ("nlpd", "se3", "cascade"), duration=4.0, log_every=10)
+>>> list(cmp.results)
+['nlpd', 'se3', 'cascade']
+>>> table = cmp.table()
+>>> table.index.tolist(), bool(table["status"].eq("finished").all())
+(['nlpd', 'se3', 'cascade'], True)
+>>> [ax.get_ylabel() for ax in cmp.plot().axes]
+['y [m]', 'x [m]', 'y [m]', 'z [m]']
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from quadcruise.control import Controller, controller_from_name
+from quadcruise.errors import InputError
+from quadcruise.io.plainjson import dumps, plain
+from quadcruise.missions import Mission, mission_from_name
+from quadcruise.sim.result import SimResult
+
+__all__ = ["compare", "Comparison", "DEFAULT_CONTROLLERS"]
+
+DEFAULT_CONTROLLERS = ("nlpd", "gonzalez", "se3", "cascade")
+"""The paper's controller, its reconstructed baseline, geometric SE(3) and the PX4 cascade."""
+
+
+@dataclass(frozen=True, eq=False)
+class Comparison:
+    """Flights of several controllers on the same mission and vehicle.
+
+    Attributes
+    ----------
+    mission : Mission
+    controllers : dict of str to Controller
+        Label -> controller, in the order flown.
+    results : dict of str to SimResult
+        Label -> flight.
+    """
+
+    mission: Mission
+    controllers: dict
+    results: dict
+    _tables: dict = field(default_factory=dict, init=False, repr=False)   # table() per keywords
+
+    def table(self, **metric_kw: Any):
+        """One row per controller (per controller and vehicle for a batch): every column of
+        :func:`quadcruise.metrics.flight_metrics` (keywords go to it), indexed by controller.
+        Computed once per set of keywords (the text, the files and a report share it)."""
+        key = repr(sorted(metric_kw.items()))
+        if key not in self._tables:
+            self._tables[key] = self._table(metric_kw)
+        return self._tables[key].copy()
+
+    def _table(self, metric_kw: dict):
+        import pandas as pd
+
+        frames = []
+        for label, res in self.results.items():
+            frame = res.metrics(**metric_kw)
+            frame.insert(0, "controller", label)
+            frames.append(frame)
+        table = pd.concat(frames, ignore_index=True)
+        if all(res.n == 1 for res in self.results.values()):
+            return table.drop(columns="vehicle").set_index("controller")
+        return table.set_index(["controller", "vehicle"])
+
+    def text(self, **metric_kw: Any) -> str:
+        """The table as aligned text, metrics down and controllers across (for a terminal);
+        a missing settling time of a measured transient reads "did not settle"."""
+        from quadcruise.metrics.tables import metrics_text
+
+        table = self.table(**metric_kw)
+        return metrics_text(table, [" ".join(map(str, c)) if isinstance(c, tuple) else c for c in table.index])
+
+    def plot(self, vehicle: int = 0, *, title: str | None = None):
+        """Overlay of the flights: top view, and x, y, z against time, each reference once.
+
+        :func:`quadcruise.plots.plot_paths` with a z panel added below its x and y panels.
+        """
+        from quadcruise.plots.flight import plot_paths
+
+        fig = plot_paths(self.results, vehicle=vehicle, title=title)
+        add_z_panel(fig, self.results, vehicle)
+        return fig
+
+    def to_dict(self) -> dict:
+        """Mission, vehicle, controllers and metrics as plain values (NaN as None), for JSON."""
+        first = next(iter(self.results.values()))
+        metrics = self.table().reset_index()
+        key = ["controller"] + (["vehicle"] if "vehicle" in metrics.columns else [])
+        rows: dict = {}
+        for rec in metrics.to_dict(orient="records"):
+            label = rec.pop("controller") if len(key) == 1 else f"{rec.pop('controller')}/{rec['vehicle']}"
+            rows[label] = {k: plain(v) for k, v in rec.items()}
+        return {
+            "workflow": "compare",
+            "mission": self.mission.to_dict(),
+            "vehicle": first.meta.get("vehicle"),
+            "duration_s": first.meta.get("duration_s"),
+            "dt_s": first.meta.get("dt_s"),
+            "version": first.meta.get("version"),
+            "controllers": {label: c.to_dict() for label, c in self.controllers.items()},
+            "metrics": rows,
+        }
+
+    def write(self, out: str | os.PathLike, *, force: bool = False) -> Path:
+        """Write ``metrics.csv``, ``comparison.png`` and ``quadcruise.json`` (``to_dict``)
+        into the folder ``out``, whole or not at all; returns it.
+
+        A non-empty folder that quadcruise did not write is refused unless ``force``.
+        """
+        from quadcruise.io.files import MARKER, atomic_dir, check_output_dir
+        from quadcruise.plots.flight import save_figure
+
+        out = check_output_dir(out, force)
+        with atomic_dir(out) as tmp:
+            tmp = Path(tmp)
+            self.table().reset_index().to_csv(tmp / "metrics.csv", index=False)
+            save_figure(self.plot(), tmp / "comparison.png")
+            (tmp / MARKER).write_text(dumps(self.to_dict(), indent=2, sort_keys=True) + "\n")
+        return out
+
+
+def add_z_panel(fig, results: Mapping[str, SimResult], vehicle: int = 0):
+    """Add z(t) under the x and y panels of a :func:`~quadcruise.plots.plot_paths` figure
+    (same colours, reference dashed once, early stops crossed); returns the new axes."""
+    from quadcruise.plots.flight import REF_STYLE
+
+    top, ax_x, ax_y = fig.axes[:3]
+    gs = fig.add_gridspec(3, 2, width_ratios=(1, 1.3))
+    top.set_subplotspec(gs[:, 0])
+    ax_x.set_subplotspec(gs[0, 1])
+    ax_y.set_subplotspec(gs[1, 1])
+    ax_z = fig.add_subplot(gs[2, 1], sharex=ax_x)
+    for res in results.values():
+        zr = res.state("z_ref")[vehicle]
+        if np.any(np.isfinite(zr)):
+            ax_z.plot(res.t, zr, **REF_STYLE)
+            break
+    for k, res in enumerate(results.values()):
+        z = res.state("z")[vehicle]
+        ax_z.plot(res.t, z, color=f"C{k}", lw=1.4)
+        live = np.flatnonzero(np.isfinite(z))
+        if live.size and int(res.status[vehicle]) != 0:
+            ax_z.plot(res.t[live[-1]], z[live[-1]], "X", color="tab:red", ms=9)
+    ax_y.set_xlabel("")
+    ax_y.tick_params(labelbottom=False)
+    ax_z.set(xlabel="time [s]", ylabel="z [m]")
+    ax_z.grid(True, alpha=0.3)
+    fig.set_size_inches(13, 8.5)
+    return ax_z
+
+
+def compare(mission: Mission | str = "circle",
+            controllers: Sequence[Controller | str] | Mapping[str, Controller | str] = DEFAULT_CONTROLLERS,
+            *, vehicle=None, duration: float | None = None, dt: float = 1e-3, **fly_kw: Any) -> Comparison:
+    """Fly ``mission`` with each controller on the same vehicle; see :class:`Comparison`.
+
+    Parameters
+    ----------
+    mission : Mission or str
+        A mission, or its name ('hover', 'step', 'circle', 'square') for the defaults.
+    controllers : sequence or mapping
+        Names or Controller objects, labelled by their name (a repeated name gets '#2',
+        '#3', ...), or a mapping label -> name or Controller.
+    vehicle : Vehicle, optional
+        Table I by default.
+    duration : float, optional
+        Flight time [s]; the mission's default (one lap, step time + 10 s, ...) otherwise.
+    dt : float
+        Control period [s].
+    **fly_kw
+        Any other keyword of :func:`quadcruise.fly` (``max_step``, ``log_every``, ``x0``, ...).
+
+    Returns
+    -------
+    Comparison
+        ``.results``, ``.table()``, ``.text()``, ``.plot()``, ``.to_dict()``, ``.write(out)``.
+    """
+    from quadcruise.workflows.fly import fly
+
+    for bad in ("missions", "controller", "mission"):
+        if bad in fly_kw:
+            raise InputError(f"compare() flies one mission with each controller; '{bad}' is not an option")
+    if isinstance(mission, str):
+        mission = mission_from_name(mission)
+    if not isinstance(mission, Mission):
+        raise InputError(f"mission must be a name or a Mission, got {type(mission).__name__}")
+    chosen = labelled(controllers)
+    results = {label: fly(mission, ctrl, vehicle=vehicle, duration=duration, dt=dt, **fly_kw)
+               for label, ctrl in chosen.items()}
+    return Comparison(mission=mission, controllers=chosen, results=results)
+
+
+def labelled(controllers) -> dict:
+    if isinstance(controllers, str):
+        controllers = [c.strip() for c in controllers.split(",") if c.strip()]
+    items = list(controllers.items()) if isinstance(controllers, Mapping) else [(None, c) for c in controllers]
+    if not items:
+        raise InputError("compare() needs at least one controller")
+    out: dict = {}
+    for label, c in items:
+        ctrl = controller_from_name(c) if isinstance(c, str) else c
+        if not isinstance(ctrl, Controller):
+            raise InputError(f"controllers must be names or Controller objects, got {type(c).__name__}")
+        name = str(label) if label is not None else ctrl.name
+        k, unique = 1, name
+        while unique in out:
+            k += 1
+            unique = f"{name}#{k}"
+        out[unique] = ctrl
+    return out

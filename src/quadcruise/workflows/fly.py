@@ -1,0 +1,214 @@
+"""``fly``: a mission flown by a controller on one vehicle or N, through the engine.
+
+Examples
+--------
+>>> import quadcruise as qc
+>>> res = qc.fly("step", duration=10.0)
+>>> res.ok.tolist()
+[True]
+>>> bool(abs(res.final_state[0, 0] - 1.0) < 0.02)      # the 1 m step in x is reached
+True
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+
+from quadcruise._version import __version__
+from quadcruise.control import Controller, controller_from_name
+from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
+from quadcruise.errors import InputError, reject_unknown
+from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_Z, STATE_SIZE, Z
+from quadcruise.missions import Mission, mission_from_name, stack_params
+from quadcruise.model.vehicle import Vehicle
+from quadcruise.sim.engine import Limits, simulate, time_grid
+from quadcruise.sim.result import SimResult
+
+
+def default_duration(mission: Mission) -> float:
+    """The mission's default flight time (:attr:`Mission.duration`): one lap of a circle or
+    square, 10 s after a step, the last waypoint and a settling time, 5 s of hover [s]."""
+    return float(mission.duration)
+
+
+def hover_state(vehicle: Vehicle, n: int, mission: Mission) -> np.ndarray:
+    """(N, 16): hovering level at the origin's x, y at the mission's start altitude and yaw,
+    each rotor at the hover thrust m g / 4."""
+    vp = vehicle.rows(n)
+    ref0 = mission.reference(0.0)[0]
+    x0 = np.zeros((n, STATE_SIZE))
+    x0[:, Z] = ref0[REF_Z]
+    x0[:, PSI] = ref0[REF_PSI]
+    x0[:, F1:F1 + 4] = (vp[:, P_M] * vp[:, P_G] / 4.0)[:, None]
+    return x0
+
+
+def fly(mission: Mission | str = "circle", controller: Controller | str = "nlpd", *,
+        vehicle: Vehicle | None = None, duration: float | None = None, dt: float = 1e-3,
+        max_step: float | None = None, n: int | None = None, x0: Any = None,
+        log_every: int = 1, limits: Limits | None = None, missions: list[Mission] | None = None,
+        controller_vehicle: Vehicle | None = None, full_dynamics: bool = False,
+        environment: Environment | None = None, sensors: SensorNoise | None = None,
+        seed: int = 0, first_vehicle: int = 0, **unknown: Any) -> SimResult:
+    """Fly a mission with a controller and return the logged flight.
+
+    Parameters
+    ----------
+    mission : Mission or str
+        A mission object, or a name ('hover', 'step', 'circle', 'square') for its defaults.
+    controller : Controller or str
+        A controller object, or a name ('nlpd', ...) for its defaults.
+    vehicle : Vehicle, optional
+        Table I by default; a batched Vehicle gives each of the N vehicles its own values.
+    duration : float, optional
+        Flight time [s]; one lap (circle, square), step time + 10 s, or 5 s by default.
+    dt : float
+        Control period [s] (1 kHz by default); the command is held in between.
+    max_step : float, optional
+        Longest RK4 substep [s]; ``dt`` by default.
+    n : int, optional
+        Number of vehicles; taken from ``vehicle``, ``x0`` or ``missions`` if they are batched.
+    x0 : (16,) or (N, 16) array, optional
+        Initial states; by default each vehicle hovers at x = y = 0 at the mission's
+        starting altitude and yaw.
+    log_every : int
+        Log every this many control periods.
+    limits : Limits, optional
+        Divergence bounds.
+    missions : list of Mission, optional
+        One mission of the same kind per vehicle (instead of ``mission``).
+    controller_vehicle : Vehicle, optional
+        The vehicle the controller believes it flies (its model); ``vehicle`` by default.
+        Give the nominal vehicle here and a perturbed one as ``vehicle`` to fly with model error.
+    full_dynamics : bool
+        Fly the higher-fidelity plant (exact Euler-angle kinematics) instead of the paper's.
+    environment : Environment or CustomDisturbance, optional
+        Wind, gusts, turbulence, rotor loss, external force (any field may hold one value per
+        vehicle). Wind acts through drag: give a vehicle with drag (:func:`~quadcruise.disturbances.with_drag`).
+    sensors : SensorNoise, optional
+        Noise on what the controller sees and its delay [s], turned into whole control periods
+        of this flight's ``dt``.
+    seed : int
+        Seed of every random draw (turbulence, sensor noise).
+    first_vehicle : int
+        Index of the first vehicle in a larger population: vehicle i's random stream comes from
+        (seed, first_vehicle + i) only, so a batch split in parts flies the same numbers.
+
+    Returns
+    -------
+    SimResult
+        With ``metrics()``, ``to_pandas()`` and ``plot()``. A vehicle that diverged stops
+        and its status says why and when (a warning says so too), as does any clipping
+        of the rotor duties.
+    """
+    reject_unknown("fly()", unknown, FLY_OPTIONS)
+    if isinstance(mission, str):
+        mission = mission_from_name(mission)
+    if isinstance(controller, str):
+        controller = controller_from_name(controller)
+    if not isinstance(controller, Controller):
+        raise InputError(f"controller must be a name or a Controller, got {type(controller).__name__}")
+    vehicle = vehicle or Vehicle.paper()
+    sizes = {s for s in (vehicle.batch_size, None if x0 is None or np.ndim(x0) < 2 else np.shape(x0)[0],
+                         None if missions is None else len(missions), n) if s is not None}
+    if len(sizes) > 1:
+        raise InputError(f"the number of vehicles is ambiguous: {sorted(sizes)}")
+    n = sizes.pop() if sizes else 1
+    if n < 1:
+        raise InputError(f"the number of vehicles must be at least 1, got {n}")
+    mp = stack_params(missions if missions is not None else mission, n=None if missions else n)
+    first = missions[0] if missions else mission
+    duration = default_duration(first) if duration is None else duration
+    grid = time_grid(float(duration), float(dt))
+    x0 = hover_state(vehicle, n, first) if x0 is None else x0
+    meta = {
+        "workflow": "fly",
+        "mission": [m.to_dict() for m in missions] if missions else mission.to_dict(),
+        "controller": controller.to_dict(),
+        "vehicle": vehicle.to_dict(),
+        "duration_s": float(duration), "dt_s": float(dt),
+        "max_step_s": float(max_step or dt), "n": n, "version": __version__,
+        "full_dynamics": bool(full_dynamics), "seed": seed,
+    }
+    if controller_vehicle is not None:
+        meta["controller_vehicle"] = controller_vehicle.to_dict()
+    vp_ctrl = None if controller_vehicle is None else controller_vehicle.rows(n)
+    result = simulate(grid, x0, vehicle.rows(n), controller.function, controller.gains(),
+                      first.function, mp, memory=controller.memory(), max_step=max_step or dt,
+                      log_every=log_every, limits=limits, meta=meta, vp_ctrl=vp_ctrl,
+                      full_dynamics=full_dynamics, seed=seed, first_vehicle=first_vehicle,
+                      **engine_inputs(environment, sensors, n, dt))
+    _warn_about(result)
+    return result
+
+
+FLY_OPTIONS = ("vehicle", "duration", "dt", "max_step", "n", "x0", "log_every", "limits", "missions",
+               "controller_vehicle", "full_dynamics", "environment", "sensors", "seed", "first_vehicle")
+"""The keywords :func:`fly` takes besides the mission and the controller."""
+
+
+def engine_inputs(environment: Environment | None, sensors: SensorNoise | None, n: int, dt: float) -> dict:
+    """The engine's disturbance and sensor arrays for ``n`` vehicles at control period ``dt`` [s].
+
+    Parameters
+    ----------
+    environment : Environment or None
+    sensors : SensorNoise or None
+    n : int
+        Number of vehicles.
+    dt : float
+        The flight's control period [s]: a sensor delay becomes a whole number of them.
+
+    Returns
+    -------
+    dict
+        Keywords of :func:`quadcruise.simulate` (none for a missing or empty part).
+    """
+    out: dict = {}
+    if environment is not None:
+        if not isinstance(environment, (Environment, CustomDisturbance)):
+            raise InputError(f"environment must be an Environment or a CustomDisturbance, "
+                             f"got {type(environment).__name__}")
+        if environment.parts:
+            out.update(environment.kwargs(n))
+    if sensors is not None:
+        if not isinstance(sensors, SensorNoise):
+            raise InputError(f"sensors must be a SensorNoise, got {type(sensors).__name__}")
+        out.update(sensors.kwargs(dt))
+    return out
+
+
+def write_flight(result: SimResult, out, fmt: str = "csv", metrics=None) -> None:
+    """A flight's folder, written whole or not at all: the traces (CSV or Parquet), the
+    metrics, a figure and the configuration (``quadcruise.json``). ``metrics``, if already
+    computed, saves computing them again."""
+    from pathlib import Path
+
+    from quadcruise.io.files import MARKER, atomic_dir, write_table
+    from quadcruise.plots.flight import plot_flight, save_figure
+
+    metrics = result.metrics() if metrics is None else metrics
+    with atomic_dir(out) as tmp:
+        tmp = Path(tmp)
+        write_table(result.to_pandas(), tmp / "traces", fmt)
+        metrics.to_csv(tmp / "metrics.csv", index=False)
+        save_figure(plot_flight(result), tmp / "flight.png")
+        (tmp / MARKER).write_text(result.meta_json() + "\n")
+
+
+def _warn_about(result: SimResult) -> None:
+    bad = np.flatnonzero(~result.ok)
+    if bad.size:
+        first = int(bad[0])
+        more = f" ({bad.size} of {result.n} vehicles)" if result.n > 1 else ""
+        warnings.warn(f"vehicle {first} {result.status_text(first)}{more}", stacklevel=3)
+    clipped = result.duty_clipped_s
+    if np.any(clipped > 0):
+        warnings.warn(f"rotor duties were clipped to [0, 1] for up to {clipped.max():.3f} s "
+                      f"({np.count_nonzero(clipped)} of {result.n} vehicles)", stacklevel=3)
+
+
+__all__ = ["fly", "default_duration", "hover_state", "write_flight"]

@@ -1,0 +1,133 @@
+"""Open-loop replay, the model-validation workflow: PWM duties in, states out.
+
+Input: a schedule of rows ``t, u1, u2, u3, u4``; each row's duties hold from its t until
+the next row's. The vehicle starts at rest at the origin, level, each rotor's thrust
+already at K * u_i of the first row, in free flight (no ground). Output: one state per
+input row, the first being the initial state; the last row only marks the end time.
+
+Examples
+--------
+>>> import quadcruise as qc
+>>> v = qc.Vehicle.paper()
+>>> hover = [[float(v.hover_duty)] * 4] * 3
+>>> res = qc.replay(qc.DutySchedule(t=[0.0, 1.0, 2.0], duties=hover), vehicle=v)
+>>> bool(abs(res.final_state[0, 2]) < 1e-9)    # hover stays put
+True
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from quadcruise._version import __version__
+from quadcruise.control.openloop import duty_schedule, pack_schedule
+from quadcruise.errors import InputError
+from quadcruise.io.files import atomic_path, read_numeric_csv
+from quadcruise.layout import F1, P_K, STATE_NAMES, STATE_SIZE
+from quadcruise.model.vehicle import Vehicle
+from quadcruise.sim.engine import Limits, simulate
+from quadcruise.sim.result import SimResult
+
+INPUT_COLUMNS = ("t", "u1", "u2", "u3", "u4")
+OUTPUT_COLUMNS = ("t",) + STATE_NAMES
+
+
+@njit(cache=True)     # compiled (as MISSION_SIG) on first use, not at import
+def no_reference(t, mp, ref):
+    """An open-loop flight has no reference: NaN throughout."""
+    for j in range(ref.shape[0]):
+        ref[j] = math.nan
+
+
+@dataclass(frozen=True, eq=False)
+class DutySchedule:
+    """Piecewise-constant PWM duties: row k holds from t[k] until t[k+1].
+
+    Parameters
+    ----------
+    t : (n,) strictly increasing times [s], n >= 2
+    duties : (n, 4) duties of rotors 1..4, each in [0, 1]
+    source : where the rows came from (a file name), used in error messages
+    """
+
+    t: np.ndarray
+    duties: np.ndarray
+    source: str = "schedule"
+
+    def __post_init__(self) -> None:
+        t, u = _validated(self.t, self.duties, self.source)
+        object.__setattr__(self, "t", t)
+        object.__setattr__(self, "duties", u)
+
+
+def _validated(t, duties, source: str, lines: list[int] | None = None):
+    """Check a schedule; errors name ``source`` and the row (or the file line)."""
+    t = np.asarray(t, dtype=float)
+    u = np.asarray(duties, dtype=float)
+    if t.ndim != 1 or t.shape[0] < 2:
+        raise InputError(f"{source}: needs at least two rows (a start and an end time)")
+    if u.shape != (t.shape[0], 4):
+        raise InputError(f"{source}: duties have shape {u.shape}, expected ({t.shape[0]}, 4)")
+    for k in range(t.shape[0]):
+        where = f"{source}, line {lines[k]}" if lines else f"{source}, row {k + 1}"
+        if not math.isfinite(t[k]):
+            raise InputError(f"{where}, column 't': time is not finite ({t[k]!r})")
+        if k and t[k] <= t[k - 1]:
+            raise InputError(f"{where}, column 't': time {t[k]:g} is not after the previous row's {t[k - 1]:g}")
+        for j in range(4):
+            if not math.isfinite(u[k, j]):
+                raise InputError(f"{where}, column 'u{j + 1}': duty is not finite ({u[k, j]!r})")
+            if not 0.0 <= u[k, j] <= 1.0:
+                raise InputError(f"{where}, column 'u{j + 1}': duty {u[k, j]:g} is outside [0, 1]")
+    return t, u
+
+
+def read_duty_csv(path: str | os.PathLike) -> DutySchedule:
+    """Read a ``t,u1,u2,u3,u4`` CSV; errors name the file, line and column."""
+    _, _, data, lines = read_numeric_csv(path, INPUT_COLUMNS)
+    if data.shape[0] < 2:
+        raise InputError(f"{path}: needs at least two data rows (a start and an end time), found {data.shape[0]}")
+    _validated(data[:, 0], data[:, 1:], str(path), lines)
+    return DutySchedule(t=data[:, 0], duties=data[:, 1:], source=str(path))
+
+
+def replay(schedule: DutySchedule, vehicle: Vehicle | None = None, *, max_step: float = 1e-3,
+           limits: Limits | None = None) -> SimResult:
+    """Fly the duty schedule open loop and log the state at every schedule row.
+
+    Parameters
+    ----------
+    schedule : DutySchedule
+    vehicle : Vehicle, optional
+        Table I by default. A batched vehicle replays the same schedule on each.
+    max_step : float
+        Longest RK4 substep [s]; each row interval is split into equal substeps.
+    limits : Limits, optional
+        Divergence bounds.
+    """
+    vehicle = vehicle or Vehicle.paper()
+    vp = vehicle.rows()
+    x0 = np.zeros((vp.shape[0], STATE_SIZE))
+    x0[:, F1:F1 + 4] = vp[:, [P_K]] * schedule.duties[0]   # thrust K * u of the first row
+    meta = {
+        "workflow": "replay",
+        "source": schedule.source,
+        "vehicle": vehicle.to_dict(),
+        "max_step_s": max_step,
+        "version": __version__,
+    }
+    return simulate(schedule.t, x0, vp, duty_schedule, pack_schedule(schedule.t, schedule.duties),
+                    no_reference, np.zeros(1), memory=np.zeros(1), max_step=max_step,
+                    limits=limits, meta=meta)
+
+
+def write_states_csv(result: SimResult, path: str | os.PathLike, vehicle: int = 0) -> None:
+    """Write one vehicle's states as ``t,x,...,F4`` (SI units, radians), atomically."""
+    table = np.column_stack([result.t, result.states[vehicle]])
+    with atomic_path(path) as tmp:
+        np.savetxt(tmp, table, delimiter=",", header=",".join(OUTPUT_COLUMNS), comments="", fmt="%.15g")

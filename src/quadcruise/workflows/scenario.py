@@ -1,0 +1,306 @@
+"""Scenario files: a whole run described in TOML, validated with messages that name the
+file, the key and what is wrong. Loading parses data only (``tomllib``); it never runs code.
+
+A scenario has up to six tables; every one is optional::
+
+    title = "Circle in moderate turbulence"
+
+    [vehicle]                 # the paper's Table I, with any field overridden
+    m = 1.4
+    drag_linear = 0.3
+
+    [controller]              # a built-in controller and its parameters
+    name = "nlpd"
+    position_poles = [-0.7, -4.3]     # any gain set from poles: <field>_poles
+    attitude = { kp = 88.2, ki = 40.5, kd = 14.9 }   # or the gains themselves
+    accel_feedforward = true
+
+    [mission]                 # a mission kind and its fields
+    kind = "circle"
+    radius = 2.0
+    period = 20.0             # a waypoint table: kind = "waypoints", table = "path.csv"
+
+    [disturbances]
+    wind = [3.0, 0.0, 0.0]                                  # constant wind [m/s]
+    gust = { amplitude = [2.0, 0.0, 0.0], start = 5.0, duration = 2.0 }
+    turbulence = { intensity = "moderate", altitude = 10.0 }
+    rotor_loss = { rotor = 1, fraction = 0.3, time = 5.0 }
+    sensor_noise = { position_std = 0.01, delay = 0.005 }
+
+    [simulation]
+    duration = 30.0
+    dt = 0.001
+    full_dynamics = false
+    seed = 1
+
+    [montecarlo]              # read by `quadcruise montecarlo`
+    n = 1000
+    mass_spread = 0.1
+
+Relative file names (a waypoint table) are taken relative to the scenario file.
+
+Examples
+--------
+>>> import pathlib, tempfile
+>>> path = pathlib.Path(tempfile.mkdtemp()) / "s.toml"
+>>> _ = path.write_text('[mission]\\nkind = "step"\\nsize = 0.5\\n[simulation]\\nduration = 8.0\\n')
+>>> sc = load_scenario(path)
+>>> sc.mission.name, sc.mission.size, sc.duration
+('step', 0.5, 8.0)
+>>> _ = path.write_text('[mission]\\nkind = "circle"\\nradiu = 2\\n')
+>>> load_scenario(path)
+Traceback (most recent call last):
+    ...
+quadcruise.errors.InputError: ...s.toml: [mission] unknown key 'radiu' (known: ...)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from quadcruise.control import CONTROLLERS, Controller
+from quadcruise.control.design import PDGains, PIDGains, parse_pole, pd_from_poles, pid_from_poles
+from quadcruise.errors import InputError
+from quadcruise.missions import MISSIONS, Mission
+from quadcruise.model.vehicle import Vehicle
+
+TABLES = ("vehicle", "controller", "mission", "disturbances", "simulation", "montecarlo")
+SIMULATION_KEYS = {"duration": float, "dt": float, "max_step": float, "full_dynamics": bool,
+                   "seed": int, "log_every": int, "n": int}
+DISTURBANCE_KEYS = ("wind", "gust", "turbulence", "rotor_loss", "sensor_noise")
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario: objects ready to fly, and the source it came from."""
+
+    vehicle: Vehicle = field(default_factory=Vehicle.paper)
+    controller: Controller | None = None
+    mission: Mission | None = None
+    environment: Any = None
+    sensor_noise: Any = None
+    simulation: dict = field(default_factory=dict)
+    montecarlo: dict = field(default_factory=dict)
+    title: str = ""
+    source: str = "scenario"
+
+    @property
+    def duration(self) -> float | None:
+        return self.simulation.get("duration")
+
+    @property
+    def dt(self) -> float:
+        return self.simulation.get("dt", 1e-3)
+
+    def fly_kwargs(self) -> dict:
+        """Keyword arguments of :func:`quadcruise.fly` for this scenario."""
+        sim = self.simulation
+        kw: dict[str, Any] = {"duration": sim.get("duration"), "dt": self.dt}
+        for key in ("max_step", "full_dynamics", "seed", "log_every", "n"):
+            if key in sim:
+                kw[key] = sim[key]
+        vehicle = self.vehicle
+        if self.environment is not None:
+            if self.environment.needs_drag:
+                from quadcruise.disturbances.environment import with_drag
+
+                vehicle = with_drag(vehicle)
+            kw["environment"] = self.environment
+        if self.sensor_noise is not None:
+            kw["sensors"] = self.sensor_noise
+        kw["vehicle"] = vehicle
+        return kw
+
+    def fly(self):
+        """Fly the scenario: :func:`quadcruise.fly` with everything it describes."""
+        from quadcruise.workflows.fly import fly
+
+        result = fly(self.mission or "circle", self.controller or "nlpd", **self.fly_kwargs())
+        result.meta["scenario"] = {"source": self.source, "title": self.title}
+        return result
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a TOML scenario; any problem is one InputError naming file and key."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: no such file")
+    try:
+        doc = tomllib.loads(path.read_text())
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: not valid TOML ({exc})") from None
+    return scenario_from_dict(doc, source=str(path), base=path.parent)
+
+
+def scenario_from_dict(doc: dict, *, source: str = "scenario", base: Path | None = None) -> Scenario:
+    """Build a Scenario from the parsed tables (see the module docstring)."""
+    where = _Where(source)
+    _known(where, "", doc, set(TABLES) | {"title"})
+    for name in TABLES:
+        if name in doc and not isinstance(doc[name], dict):
+            raise InputError(f"{source}: [{name}] must be a table, got {type(doc[name]).__name__}")
+    title = doc.get("title", "")
+    if not isinstance(title, str):
+        raise InputError(f"{source}: 'title' must be a string")
+    vehicle = _vehicle(where.at("vehicle"), doc.get("vehicle", {}))
+    controller = _controller(where.at("controller"), doc.get("controller")) if "controller" in doc else None
+    mission = _mission(where.at("mission"), doc.get("mission"), base) if "mission" in doc else None
+    environment, noise = _disturbances(where.at("disturbances"), doc.get("disturbances", {}))
+    simulation = _simulation(where.at("simulation"), doc.get("simulation", {}))
+    return Scenario(vehicle=vehicle, controller=controller, mission=mission, environment=environment,
+                    sensor_noise=noise, simulation=simulation, montecarlo=dict(doc.get("montecarlo", {})),
+                    title=title, source=source)
+
+
+class _Where:
+    """Prefixes messages with the file and table: ``file: [table] ...``."""
+
+    def __init__(self, source: str, table: str = "") -> None:
+        self.source, self.table = source, table
+
+    def at(self, table: str) -> "_Where":
+        return _Where(self.source, table)
+
+    def error(self, message: str) -> InputError:
+        return InputError(f"{self.source}: [{self.table}] {message}" if self.table else f"{self.source}: {message}")
+
+    def wrap(self, func, *args, **kwargs):
+        """Call func; re-raise its InputError (or TypeError) with the file and table in front."""
+        try:
+            return func(*args, **kwargs)
+        except (InputError, TypeError) as exc:
+            raise self.error(str(exc)) from None
+
+
+def _known(where: _Where, prefix: str, table: dict, known: set) -> None:
+    for key in table:
+        if key not in known:
+            raise where.error(f"unknown key '{prefix}{key}' (known: {', '.join(sorted(known))})")
+
+
+def _number(where: _Where, key: str, value, kind=float):
+    if kind is bool:
+        if not isinstance(value, bool):
+            raise where.error(f"'{key}' must be true or false, got {value!r}")
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or (kind is int and not isinstance(value, int)):
+        raise where.error(f"'{key}' must be {'an integer' if kind is int else 'a number'}, got {value!r}")
+    if not math.isfinite(value):
+        raise where.error(f"'{key}' must be finite, got {value!r}")
+    return kind(value)
+
+
+def _vehicle(where: _Where, table: dict) -> Vehicle:
+    fields = {f.name for f in dataclasses.fields(Vehicle)}
+    _known(where, "", table, fields | {"preset"})
+    if table.get("preset", "paper") != "paper":
+        raise where.error(f"unknown preset {table['preset']!r} (known: paper)")
+    values = {k: _number(where, k, v) for k, v in table.items() if k != "preset"}
+    return where.wrap(Vehicle.paper().replace, **values)
+
+
+def _poles(where: _Where, key: str, value) -> list:
+    if not isinstance(value, list) or not value:
+        raise where.error(f"'{key}' must be a list of poles, e.g. [-0.7, -4.3]")
+    out = []
+    for p in value:
+        try:
+            out.append(parse_pole(p))
+        except (TypeError, ValueError):
+            raise where.error(f"'{key}': {p!r} is not a pole (a number, or a string like \"-1+2j\")") from None
+    return out
+
+
+def _controller(where: _Where, table: dict) -> Controller:
+    name = table.get("name", "nlpd")
+    if name not in CONTROLLERS:
+        raise where.error(f"unknown controller name {name!r} (known: {', '.join(CONTROLLERS)})")
+    cls = CONTROLLERS[name]
+    defaults = cls()
+    fields = {f.name for f in dataclasses.fields(cls)}
+    gain_fields = {n for n in fields if isinstance(getattr(defaults, n), (PDGains, PIDGains))}
+    known = fields | {f"{n}_poles" for n in gain_fields} | {"name"}
+    _known(where, "", table, known)
+    params: dict[str, Any] = {}
+    for key, value in table.items():
+        if key == "name":
+            continue
+        if key.endswith("_poles"):
+            poles = _poles(where, key, value)
+            design = pd_from_poles if len(poles) == 2 else pid_from_poles
+            params[key[:-6]] = where.wrap(design, poles)
+        elif key in gain_fields:
+            if not isinstance(value, dict):
+                raise where.error(f"'{key}' must be a table of gains, e.g. {{ kp = 3.01, kd = 5.0 }}")
+            cls_gains = PIDGains if "ki" in value else PDGains
+            _known(where, f"{key}.", value, {"kp", "kd", "ki"})
+            params[key] = where.wrap(cls_gains, **{k: _number(where, f"{key}.{k}", v) for k, v in value.items()})
+        elif isinstance(value, bool) or isinstance(value, str):
+            params[key] = value
+        else:
+            params[key] = _number(where, key, value)
+    return where.wrap(cls, **params)
+
+
+def _mission(where: _Where, table: dict, base: Path | None) -> Mission:
+    kind = table.get("kind")
+    if kind not in MISSIONS:
+        raise where.error(f"'kind' must be one of {', '.join(MISSIONS)}, got {kind!r}")
+    cls = MISSIONS[kind]
+    fields = {f.name for f in dataclasses.fields(cls)}
+    _known(where, "", table, fields | {"kind"})
+    params = {k: v for k, v in table.items() if k != "kind"}
+    if "table" in params and isinstance(params["table"], str) and base is not None:
+        params["table"] = str((base / params["table"]).resolve()) if not Path(params["table"]).is_absolute() \
+            else params["table"]
+    for k, v in params.items():
+        if isinstance(v, list):
+            params[k] = tuple(v)
+    return where.wrap(cls, **params)
+
+
+def _disturbances(where: _Where, table: dict):
+    _known(where, "", table, set(DISTURBANCE_KEYS))
+    if not table:
+        return None, None
+    from quadcruise.disturbances import environment as d
+
+    parts: dict[str, Any] = {}
+    if "wind" in table:
+        wind = table["wind"]
+        parts["wind"] = where.wrap(d.ConstantWind, velocity=tuple(wind)) if isinstance(wind, list) \
+            else where.wrap(d.ConstantWind, **_table(where, "wind", wind))
+    for key, cls in (("gust", d.Gust), ("turbulence", d.Turbulence), ("rotor_loss", d.RotorLoss)):
+        if key in table:
+            values = {k: tuple(v) if isinstance(v, list) else v for k, v in _table(where, key, table[key]).items()}
+            parts[key] = where.wrap(cls, **values)
+    noise = None
+    if "sensor_noise" in table:
+        noise = where.wrap(d.SensorNoise, **_table(where, "sensor_noise", table["sensor_noise"]))
+    environment = where.wrap(d.Environment, **parts) if parts else None
+    return environment, noise
+
+
+def _table(where: _Where, key: str, value) -> dict:
+    if not isinstance(value, dict):
+        raise where.error(f"'{key}' must be a table, e.g. {key} = {{ ... }}")
+    return value
+
+
+def _simulation(where: _Where, table: dict) -> dict:
+    _known(where, "", table, set(SIMULATION_KEYS))
+    out = {k: _number(where, k, v, SIMULATION_KEYS[k]) for k, v in table.items()}
+    for key in ("duration", "dt", "max_step"):
+        if key in out and out[key] <= 0:
+            raise where.error(f"'{key}' must be > 0 seconds, got {out[key]!r}")
+    if out.get("seed", 0) < 0:
+        raise where.error(f"'seed' must be >= 0, got {out['seed']!r}")
+    for key in ("log_every", "n"):
+        if key in out and out[key] < 1:
+            raise where.error(f"'{key}' must be >= 1, got {out[key]!r}")
+    return out

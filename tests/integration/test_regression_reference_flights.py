@@ -1,0 +1,71 @@
+"""Regression test: reference flights against values recorded before the package was split into
+layers (``tests/support/reference_flights.npz``, recorded at commit ff599ce with the flat layout's
+API). The move and the API of objects change no number: traces and metrics agree to rounding.
+
+These are our own earlier numbers, so this test guards against *change*, not against error; the
+physics is checked against independent paths (solve_ivp, python-control, closed forms) elsewhere.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import quadcruise as qc
+from quadcruise.disturbances import ConstantWind, Environment, Gust, RotorLoss, SensorNoise, Turbulence, with_drag
+from quadcruise.montecarlo import Population, montecarlo
+
+REFERENCE = np.load(Path(__file__).parents[1] / "support" / "reference_flights.npz")
+TOL = dict(rtol=1e-9, atol=1e-9)
+
+
+def flights():
+    env = Environment(wind=ConstantWind(velocity=(1.0, 0.5, 0.0)), turbulence=Turbulence(intensity="moderate"),
+                      rotor_loss=RotorLoss(rotor=1, fraction=0.2, time=4.0))
+    return {
+        "circle_nlpd": lambda: qc.fly("circle", "nlpd", log_every=10),
+        "square_gonzalez": lambda: qc.fly("square", "gonzalez", duration=12.0, log_every=10),
+        "step_se3": lambda: qc.fly("step", "se3", log_every=10),
+        "step_cascade": lambda: qc.fly("step", "cascade", log_every=10),
+        "step_full": lambda: qc.fly("step", "nlpd", full_dynamics=True, log_every=10),
+        "circle_env": lambda: qc.fly(
+            "circle", "nlpd", duration=8.0, vehicle=with_drag(qc.Vehicle.paper().replace(m=3.8)),
+            controller_vehicle=qc.Vehicle.paper(), seed=7, log_every=10, environment=env,
+            sensors=SensorNoise(position_std=0.01, angle_std=0.002, delay=0.004)),
+        "batch_mass": lambda: qc.fly("circle", "nlpd", vehicle=qc.Vehicle(m=np.linspace(2.5, 4.5, 6)),
+                                     duration=5.0, log_every=50),
+        "gust_dt2": lambda: qc.fly(
+            "step", "nlpd", dt=2e-3, vehicle=with_drag(qc.Vehicle.paper()), duration=6.0, log_every=5,
+            environment=Environment(gust=Gust(amplitude=(2.0, 0.0, 0.0), start=1.0, duration=1.0))),
+    }
+
+
+@pytest.mark.parametrize("name", sorted(flights()))
+def test_flight_traces_and_metrics_are_unchanged(name):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = flights()[name]()
+    np.testing.assert_allclose(res.t, REFERENCE[f"{name}/t"], **TOL)
+    np.testing.assert_allclose(res.states, REFERENCE[f"{name}/states"], **TOL)
+    np.testing.assert_allclose(res.commands, REFERENCE[f"{name}/commands"], **TOL)
+    metrics = res.metrics()
+    for key in (k for k in REFERENCE.files if k.startswith(f"{name}/metric/")):
+        column = key.rsplit("/", 1)[1]
+        np.testing.assert_allclose(metrics[column].to_numpy(dtype=float), REFERENCE[key], err_msg=column, **TOL)
+
+
+def test_replay_is_unchanged():
+    states = qc.replay(qc.read_duty_csv(Path(__file__).parents[2] / "examples" / "pwm_step.csv"))
+    np.testing.assert_allclose(states.states, REFERENCE["replay/states"], **TOL)
+
+
+def test_montecarlo_table_is_unchanged():
+    population = Population(mass_spread=0.1, environment=Environment(turbulence=Turbulence(intensity="light")))
+    mc = montecarlo("circle", "nlpd", population, n=16, seed=3, duration=4.0, scheduler="none")
+    table = mc.to_pandas() if hasattr(mc, "to_pandas") else mc.table
+    for key in (k for k in REFERENCE.files if k.startswith("mc/")):
+        column = key.split("/", 1)[1]
+        np.testing.assert_allclose(table[column].to_numpy(dtype=float), REFERENCE[key], err_msg=column, **TOL)
