@@ -21,10 +21,13 @@ import importlib
 from collections.abc import Mapping
 from typing import Any
 
+import numpy as np
+
 from quadcruise.control.base import Controller
 from quadcruise.control.position import NLPD
 from quadcruise.errors import InputError
 from quadcruise.model.vehicle import shared_default
+from quadcruise.protocols import ControllerLike
 
 
 class _Registry(Mapping):
@@ -54,6 +57,58 @@ def controller_from_name(name: str, **params: Any) -> Controller:
     return CONTROLLERS[name](**params) if params else shared_default(CONTROLLERS[name])
 
 
+def as_controller(obj: Any) -> ControllerLike:
+    """A controller from a name or any object that offers what the engine needs.
+
+    Parameters
+    ----------
+    obj : str or ControllerLike
+        A built-in controller's name (see :data:`CONTROLLERS`), or an object with ``name``,
+        ``function`` (compiled with :data:`quadcruise.layout.CONTROLLER_SIG`), ``gains()`` and
+        ``memory()`` (see :class:`quadcruise.protocols.ControllerLike`); it need not subclass
+        :class:`Controller`.
+
+    Returns
+    -------
+    ControllerLike
+
+    Examples
+    --------
+    >>> as_controller("nlpd").name
+    'nlpd'
+    >>> as_controller(3.0)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: controller must be a name (nlpd, gonzalez, se3, cascade) or an object with name, function, gains() and memory() (quadcruise.protocols.ControllerLike), got float
+    """
+    if isinstance(obj, str):
+        return controller_from_name(obj)
+    if not isinstance(obj, ControllerLike) or not callable(getattr(obj, "function", None)):
+        raise InputError(f"controller must be a name ({', '.join(CONTROLLERS)}) or an object with name, function, "
+                         f"gains() and memory() (quadcruise.protocols.ControllerLike), got {type(obj).__name__}")
+    return obj
+
+
+def controller_record(controller: ControllerLike) -> dict:
+    """What a result records of a controller: its ``to_dict()`` if it has one, else its name,
+    gains and memory size.
+
+    Parameters
+    ----------
+    controller : ControllerLike
+
+    Returns
+    -------
+    dict
+        Plain values (JSON-ready).
+    """
+    to_dict = getattr(controller, "to_dict", None)
+    if callable(to_dict):
+        return to_dict()
+    return {"name": str(controller.name), "gains": [float(g) for g in np.asarray(controller.gains()).ravel()],
+            "memory_size": int(np.asarray(controller.memory()).size)}
+
+
 def __getattr__(name: str):
     """``from quadcruise.control import Gonzalez`` etc. without importing them eagerly."""
     for key, (_, attr) in _Registry._where.items():
@@ -62,4 +117,5 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-__all__ = ["CONTROLLERS", "NLPD", "Gonzalez", "SE3", "Cascade", "Controller", "controller_from_name"]
+__all__ = ["CONTROLLERS", "NLPD", "Gonzalez", "SE3", "Cascade", "Controller", "ControllerLike", "as_controller",
+           "controller_from_name", "controller_record"]

@@ -36,10 +36,13 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import Any, Callable
 
 from quadcruise.control import Controller
+from quadcruise.disturbances import Environment, SensorNoise
+from quadcruise.errors import InputError, reject_unknown
 from quadcruise.missions import Mission
 from quadcruise.montecarlo.chunk import Case, montecarlo_case, replay_case
 from quadcruise.montecarlo.population import Population
@@ -53,7 +56,8 @@ __all__ = ["Case", "montecarlo", "montecarlo_case", "replay_case"]
 # --- the whole population ---------------------------------------------------------------
 def montecarlo(mission: Mission | str = "circle", controller: Controller | str = "nlpd",
                population: Population | None = None, n: int = 100, seed: int = 0, *,
-               chunk_size: int | str = "auto", scheduler: str | None = "local", workers: int | None = None,
+               environment: Environment | None = None, sensors: SensorNoise | None = None,
+               chunk_size: int | str = "auto", scheduler: str | None = None, workers: int | None = None,
                out: str | Path | None = None, resume: bool = True, force: bool = False, fmt: str = "csv",
                progress: Callable[[int, int], None] | None = None, connect_timeout: float = 10.0,
                **spec_options: Any) -> MonteCarloResult:
@@ -71,12 +75,16 @@ def montecarlo(mission: Mission | str = "circle", controller: Controller | str =
     chunk_size : int or "auto"
         Vehicles per chunk (per task). "auto" keeps a chunk's log near 64 MB and gives each
         worker several chunks. The result does not depend on it.
-    scheduler : "local", "none" or an address
-        "local" (default): a Dask LocalCluster of ``workers`` processes (the machine's
-        cores by default), one thread each; "none": in this process, numba using all cores;
-        "tcp://host:port": an existing Dask cluster (unreachable: InputError). Worker
-        processes are spawned, so a script using "local" needs the usual
-        ``if __name__ == "__main__":`` guard.
+    environment : Environment, optional
+        The disturbances every vehicle meets (the population's ``environment``, if it has none).
+    sensors : SensorNoise, optional
+        Every vehicle's sensor noise and delay (the population's ``noise``, if it has none).
+    scheduler : None, "none", "local" or an address
+        None or "none" (default): in this process, numba using all cores, so a script needs
+        no ``if __name__ == "__main__":`` guard; "local": a Dask LocalCluster of ``workers``
+        processes (the machine's cores by default), one thread each — its worker processes
+        are spawned, so a script using it needs that guard; "tcp://host:port": an existing
+        Dask cluster (unreachable: InputError).
     out : folder, optional
         Stream each chunk to ``out/chunks`` as it finishes and write the results at the end
         (see :mod:`quadcruise.montecarlo.store`). A folder holding part of the same sweep is resumed.
@@ -92,7 +100,19 @@ def montecarlo(mission: Mission | str = "circle", controller: Controller | str =
     **spec_options
         More :class:`MonteCarloSpec` fields: duration, dt, vehicle, log_dt, settle_band, ...
     """
-    spec = MonteCarloSpec(mission=mission, controller=controller, population=population or Population(),
+    spec_fields = [f.name for f in dataclasses.fields(MonteCarloSpec) if f.init]
+    reject_unknown("montecarlo()", {k: v for k, v in spec_options.items() if k not in spec_fields},
+                   ["chunk_size", "environment", "force", "fmt", "out", "progress", "resume", "scheduler", "sensors",
+                    "workers", "connect_timeout", *(f for f in spec_fields if f not in ("mission", "controller"))])
+    population = population or Population()
+    if environment is not None or sensors is not None:
+        if (environment is not None and population.environment is not None) or \
+                (sensors is not None and population.noise is not None):
+            raise InputError("give the environment and sensors either to montecarlo() or to the Population, not both")
+        population = dataclasses.replace(
+            population, environment=population.environment if environment is None else environment,
+            noise=population.noise if sensors is None else sensors)
+    spec = MonteCarloSpec(mission=mission, controller=controller, population=population,
                           seed=seed, **spec_options)
     return run_sweep(spec, n, chunk_size=chunk_size, scheduler=scheduler, workers=workers, out=out,
                      resume=resume, force=force, fmt=fmt, progress=progress, connect_timeout=connect_timeout)

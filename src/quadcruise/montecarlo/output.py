@@ -35,7 +35,7 @@ def write_outputs(result, out, *, fmt: str = "csv", force: bool = False) -> Path
             shutil.rmtree(path)
     path.mkdir(parents=True, exist_ok=True)
     name = write_table(result.table, path / "flights", fmt).name
-    summary = result.summary()
+    summary = result.summary_data()
     with atomic_path(path / "summary.json") as tmp:
         tmp.write_text(dumps({**summary, "info": result.info}, indent=2) + "\n")
     worst = result.worst(20)

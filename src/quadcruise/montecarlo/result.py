@@ -17,6 +17,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from quadcruise.errors import InputError
+from quadcruise.metrics.summary import Summary
 from quadcruise.montecarlo.schema import COLUMNS, FAILURES, METRICS
 from quadcruise.montecarlo.spec import MonteCarloSpec
 
@@ -62,7 +63,47 @@ class MonteCarloResult:
         """Number of flights."""
         return len(self.table)
 
-    def summary(self) -> dict:
+    def to_pandas(self):
+        """The table: one row per flight (see :data:`quadcruise.montecarlo.schema.COLUMNS`).
+
+        Returns
+        -------
+        pandas.DataFrame
+            A copy, sorted by vehicle index.
+        """
+        return self.table.copy()
+
+    def plot(self, kind: str = "histograms", **kwargs):
+        """A figure of the sweep: ``"histograms"`` (:meth:`plot_histograms`) or ``"envelope"``
+        (:meth:`plot_envelope`).
+
+        Parameters
+        ----------
+        kind : {"histograms", "envelope"}
+        **kwargs
+            Passed to the chosen method.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        if kind == "histograms":
+            return self.plot_histograms(**kwargs)
+        if kind == "envelope":
+            return self.plot_envelope(**kwargs)
+        raise InputError(f"unknown plot kind {kind!r}; choose histograms or envelope")
+
+    def summary(self) -> Summary:
+        """The headline numbers; prints as :meth:`summary_text`.
+
+        Returns
+        -------
+        Summary
+            See :meth:`summary_data` for the keys.
+        """
+        return Summary(self.summary_data(), self.summary_text())
+
+    def summary_data(self) -> dict:
         """Failure rate by reason (each flight counted once, under the first of diverged,
         saturated, did not settle), the engine's stop reasons, and p5/p50/p95/max/mean of
         each metric over the flights where it is defined (``count`` of them)."""
@@ -88,7 +129,7 @@ class MonteCarloResult:
 
     def summary_text(self) -> str:
         """The summary as aligned text (for the terminal)."""
-        s = self.summary()
+        s = self.summary_data()
         f = s["failures"]
         lines = [f"{s['flights']:,} flights of {self.spec.controller.name} on {self.spec.mission.name}, "
                  f"seed {s['seed']}: {f['count']:,} failed ({100 * f['rate']:.2f} %)"]

@@ -24,7 +24,7 @@ from typing import Any
 
 from quadcruise._cache import code_digest
 from quadcruise._version import __version__
-from quadcruise.control import Controller, controller_from_name
+from quadcruise.control import as_controller, controller_record
 from quadcruise.errors import InputError, whole_number
 from quadcruise.io.plainjson import dumps
 from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
@@ -104,12 +104,9 @@ class MonteCarloSpec:
 
         if isinstance(self.mission, str):
             object.__setattr__(self, "mission", mission_from_name(self.mission))
-        if isinstance(self.controller, str):
-            object.__setattr__(self, "controller", controller_from_name(self.controller))
+        object.__setattr__(self, "controller", as_controller(self.controller))
         if not isinstance(self.mission, Mission):
             raise InputError(f"mission must be a name or a Mission, got {type(self.mission).__name__}")
-        if not isinstance(self.controller, Controller):
-            raise InputError(f"controller must be a name or a Controller, got {type(self.controller).__name__}")
         if not isinstance(self.population, Population):
             raise InputError("population must be a Population")
         if not isinstance(self.vehicle, Vehicle) or self.vehicle.batch_size is not None:
@@ -158,7 +155,7 @@ class MonteCarloSpec:
 
     def to_dict(self) -> dict:
         """Plain values (for quadcruise.json and the hash)."""
-        out = {"mission": self.mission.to_dict(), "controller": self.controller.to_dict(),
+        out = {"mission": self.mission.to_dict(), "controller": controller_record(self.controller),
                "population": self.population.to_dict(), "vehicle": self.vehicle.to_dict()}
         for f in dataclasses.fields(self):
             if f.name not in out:

@@ -249,7 +249,7 @@ class _Dask:
 
 
 def _scheduler(scheduler: str | None) -> str:
-    text = "local" if scheduler is None else str(scheduler).strip()
+    text = "none" if scheduler is None else str(scheduler).strip()
     if text.lower() in ("local", "none", "process", ""):
         return text.lower() if text.lower() in ("local", "none") else "none"
     if "://" not in text and ":" not in text:
@@ -267,7 +267,7 @@ def auto_chunk_size(spec: MonteCarloSpec, n: int, parallel: int = 1, threads: in
     return size - size % threads if size >= threads > 1 else size
 
 
-def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", scheduler: str | None = "local",
+def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", scheduler: str | None = None,
               workers: int | None = None, out=None, resume: bool = True, force: bool = False, fmt: str = "csv",
               progress: Callable[[int, int], None] | None = None, connect_timeout: float = 10.0) -> MonteCarloResult:
     """Fly vehicles 0 .. n-1 of ``spec``: see :func:`quadcruise.montecarlo.montecarlo`.

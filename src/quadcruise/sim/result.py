@@ -16,12 +16,15 @@ Examples
 from __future__ import annotations
 
 import dataclasses
+import os
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
 from quadcruise.errors import InputError
 from quadcruise.layout import CMD_NAMES, REF_NAMES, STATE_NAMES
+from quadcruise.metrics.summary import Summary
 from quadcruise.sim.status import STATUS_REASONS, ExitStatus
 
 
@@ -141,18 +144,72 @@ class SimResult:
 
         return plot_flight(self, vehicle=vehicle, **kwargs)
 
-    def summary(self) -> dict:
-        """Counts of vehicles by exit status, and the saturation times."""
+    def summary(self) -> Summary:
+        """The headline numbers: vehicles by exit status, and the longest saturation times.
+
+        Returns
+        -------
+        Summary
+            Keys ``vehicles``, ``status`` (reason -> count), ``duty_clipped_s`` and
+            ``controller_limited_s`` [s] (the most of any vehicle); prints as a few lines.
+
+        Examples
+        --------
+        >>> import quadcruise as qc
+        >>> s = qc.fly("hover", duration=0.5).summary()
+        >>> s["status"]
+        {'finished': 1}
+        """
         reasons: dict[str, int] = {}
         for code in self.status:
             key = STATUS_REASONS[int(code)]
             reasons[key] = reasons.get(key, 0) + 1
-        return {
+        data = {
             "vehicles": self.n,
             "status": reasons,
             "duty_clipped_s": float(self.duty_clipped_s.max(initial=0.0)),
             "controller_limited_s": float(self.controller_limited_s.max(initial=0.0)),
         }
+        lines = [f"{self.n:,} vehicle(s) over {float(self.t[-1]) if self.t.size else 0.0:g} s"]
+        lines += [f"  {count:>8,}  {reason}" for reason, count in reasons.items()]
+        lines.append(f"  rotor duties clipped for up to {data['duty_clipped_s']:.3f} s; "
+                     f"controller limits active for up to {data['controller_limited_s']:.3f} s")
+        return Summary(data, "\n".join(lines))
+
+    def write(self, out: str | os.PathLike, *, fmt: str = "csv", force: bool = False, metrics=None) -> Path:
+        """Write the flight's folder, whole or not at all: the traces (``traces.csv`` or
+        ``traces.parquet``), ``metrics.csv``, ``flight.png`` and the configuration
+        (``quadcruise.json``).
+
+        Parameters
+        ----------
+        out : str or path
+            The folder. A non-empty folder that quadcruise did not write is refused unless ``force``.
+        fmt : {"csv", "parquet"}
+            Format of the traces.
+        force : bool
+            Replace a folder holding something else.
+        metrics : pandas.DataFrame, optional
+            :meth:`metrics` if already computed (saves computing them again).
+
+        Returns
+        -------
+        pathlib.Path
+            The folder written.
+        """
+        from quadcruise.io.files import MARKER, atomic_dir, check_output_dir, check_table_format, write_table
+        from quadcruise.plots.flight import plot_flight, save_figure
+
+        check_table_format(fmt)
+        out = check_output_dir(out, force)
+        metrics = self.metrics() if metrics is None else metrics
+        with atomic_dir(out) as tmp:
+            tmp = Path(tmp)
+            write_table(self.to_pandas(), tmp / "traces", fmt)
+            metrics.to_csv(tmp / "metrics.csv", index=False)
+            save_figure(plot_flight(self), tmp / "flight.png")
+            (tmp / MARKER).write_text(self.meta_json() + "\n")
+        return out
 
     def meta_json(self) -> str:
         """The recorded configuration as JSON."""

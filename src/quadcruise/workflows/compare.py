@@ -23,11 +23,13 @@ from typing import Any
 
 import numpy as np
 
-from quadcruise.control import Controller, controller_from_name
-from quadcruise.errors import InputError
+from quadcruise.control import Controller, as_controller, controller_record
+from quadcruise.errors import InputError, reject_unknown
 from quadcruise.io.plainjson import dumps, plain
+from quadcruise.metrics.summary import Summary
 from quadcruise.missions import Mission, mission_from_name
 from quadcruise.sim.result import SimResult
+from quadcruise.workflows.fly import FLY_OPTIONS, fly
 
 __all__ = ["compare", "Comparison", "DEFAULT_CONTROLLERS"]
 
@@ -75,6 +77,39 @@ class Comparison:
             return table.drop(columns="vehicle").set_index("controller")
         return table.set_index(["controller", "vehicle"])
 
+    def to_pandas(self):
+        """Every flight's traces, long-form, with a ``controller`` column first.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``controller``, ``vehicle``, ``t``, the states, references and commands.
+        """
+        import pandas as pd
+
+        frames = []
+        for label, res in self.results.items():
+            frame = res.to_pandas()
+            frame.insert(0, "controller", label)
+            frames.append(frame)
+        return pd.concat(frames, ignore_index=True)
+
+    def summary(self, **metric_kw: Any) -> Summary:
+        """The metrics of each controller; prints as :meth:`text`.
+
+        Parameters
+        ----------
+        **metric_kw
+            Keywords of :func:`quadcruise.metrics.flight_metrics`.
+
+        Returns
+        -------
+        Summary
+            Controller label -> {metric: value} (NaN as None), as in :meth:`to_dict`'s ``metrics``.
+        """
+        return Summary(self.to_dict()["metrics"] if not metric_kw else self._rows(self.table(**metric_kw)),
+                       self.text(**metric_kw))
+
     def text(self, **metric_kw: Any) -> str:
         """The table as aligned text, metrics down and controllers across (for a terminal);
         a missing settling time of a measured transient reads "did not settle"."""
@@ -97,12 +132,7 @@ class Comparison:
     def to_dict(self) -> dict:
         """Mission, vehicle, controllers and metrics as plain values (NaN as None), for JSON."""
         first = next(iter(self.results.values()))
-        metrics = self.table().reset_index()
-        key = ["controller"] + (["vehicle"] if "vehicle" in metrics.columns else [])
-        rows: dict = {}
-        for rec in metrics.to_dict(orient="records"):
-            label = rec.pop("controller") if len(key) == 1 else f"{rec.pop('controller')}/{rec['vehicle']}"
-            rows[label] = {k: plain(v) for k, v in rec.items()}
+        rows = self._rows(self.table())
         return {
             "workflow": "compare",
             "mission": self.mission.to_dict(),
@@ -110,9 +140,19 @@ class Comparison:
             "duration_s": first.meta.get("duration_s"),
             "dt_s": first.meta.get("dt_s"),
             "version": first.meta.get("version"),
-            "controllers": {label: c.to_dict() for label, c in self.controllers.items()},
+            "controllers": {label: controller_record(c) for label, c in self.controllers.items()},
             "metrics": rows,
         }
+
+    @staticmethod
+    def _rows(table) -> dict:
+        metrics = table.reset_index()
+        by_vehicle = "vehicle" in metrics.columns
+        rows: dict = {}
+        for rec in metrics.to_dict(orient="records"):
+            label = f"{rec.pop('controller')}/{rec['vehicle']}" if by_vehicle else rec.pop("controller")
+            rows[label] = {k: plain(v) for k, v in rec.items()}
+        return rows
 
     def write(self, out: str | os.PathLike, *, force: bool = False) -> Path:
         """Write ``metrics.csv``, ``comparison.png`` and ``quadcruise.json`` (``to_dict``)
@@ -188,11 +228,11 @@ def compare(mission: Mission | str = "circle",
     Comparison
         ``.results``, ``.table()``, ``.text()``, ``.plot()``, ``.to_dict()``, ``.write(out)``.
     """
-    from quadcruise.workflows.fly import fly
-
     for bad in ("missions", "controller", "mission"):
         if bad in fly_kw:
             raise InputError(f"compare() flies one mission with each controller; '{bad}' is not an option")
+    reject_unknown("compare()", {k: v for k, v in fly_kw.items() if k not in FLY_OPTIONS},
+                   ["controllers", *(k for k in FLY_OPTIONS if k != "missions")])
     if isinstance(mission, str):
         mission = mission_from_name(mission)
     if not isinstance(mission, Mission):
@@ -211,9 +251,7 @@ def labelled(controllers) -> dict:
         raise InputError("compare() needs at least one controller")
     out: dict = {}
     for label, c in items:
-        ctrl = controller_from_name(c) if isinstance(c, str) else c
-        if not isinstance(ctrl, Controller):
-            raise InputError(f"controllers must be names or Controller objects, got {type(c).__name__}")
+        ctrl = as_controller(c)
         name = str(label) if label is not None else ctrl.name
         k, unique = 1, name
         while unique in out:

@@ -18,12 +18,13 @@ from typing import Any
 import numpy as np
 
 from quadcruise._version import __version__
-from quadcruise.control import Controller, controller_from_name
+from quadcruise.control import as_controller, controller_record
 from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import InputError, reject_unknown
 from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_Z, STATE_SIZE, Z
 from quadcruise.missions import Mission, mission_from_name, stack_params
 from quadcruise.model.vehicle import Vehicle
+from quadcruise.protocols import ControllerLike
 from quadcruise.sim.engine import Limits, simulate, time_grid
 from quadcruise.sim.result import SimResult
 
@@ -46,7 +47,7 @@ def hover_state(vehicle: Vehicle, n: int, mission: Mission) -> np.ndarray:
     return x0
 
 
-def fly(mission: Mission | str = "circle", controller: Controller | str = "nlpd", *,
+def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "nlpd", *,
         vehicle: Vehicle | None = None, duration: float | None = None, dt: float = 1e-3,
         max_step: float | None = None, n: int | None = None, x0: Any = None,
         log_every: int = 1, limits: Limits | None = None, missions: list[Mission] | None = None,
@@ -107,10 +108,7 @@ def fly(mission: Mission | str = "circle", controller: Controller | str = "nlpd"
     reject_unknown("fly()", unknown, FLY_OPTIONS)
     if isinstance(mission, str):
         mission = mission_from_name(mission)
-    if isinstance(controller, str):
-        controller = controller_from_name(controller)
-    if not isinstance(controller, Controller):
-        raise InputError(f"controller must be a name or a Controller, got {type(controller).__name__}")
+    controller = as_controller(controller)
     vehicle = vehicle or Vehicle.paper()
     sizes = {s for s in (vehicle.batch_size, None if x0 is None or np.ndim(x0) < 2 else np.shape(x0)[0],
                          None if missions is None else len(missions), n) if s is not None}
@@ -127,7 +125,7 @@ def fly(mission: Mission | str = "circle", controller: Controller | str = "nlpd"
     meta = {
         "workflow": "fly",
         "mission": [m.to_dict() for m in missions] if missions else mission.to_dict(),
-        "controller": controller.to_dict(),
+        "controller": controller_record(controller),
         "vehicle": vehicle.to_dict(),
         "duration_s": float(duration), "dt_s": float(dt),
         "max_step_s": float(max_step or dt), "n": n, "version": __version__,
@@ -182,21 +180,19 @@ def engine_inputs(environment: Environment | None, sensors: SensorNoise | None, 
 
 
 def write_flight(result: SimResult, out, fmt: str = "csv", metrics=None) -> None:
-    """A flight's folder, written whole or not at all: the traces (CSV or Parquet), the
-    metrics, a figure and the configuration (``quadcruise.json``). ``metrics``, if already
-    computed, saves computing them again."""
-    from pathlib import Path
+    """:meth:`SimResult.write` into a folder the caller has already checked (``force``).
 
-    from quadcruise.io.files import MARKER, atomic_dir, write_table
-    from quadcruise.plots.flight import plot_flight, save_figure
-
-    metrics = result.metrics() if metrics is None else metrics
-    with atomic_dir(out) as tmp:
-        tmp = Path(tmp)
-        write_table(result.to_pandas(), tmp / "traces", fmt)
-        metrics.to_csv(tmp / "metrics.csv", index=False)
-        save_figure(plot_flight(result), tmp / "flight.png")
-        (tmp / MARKER).write_text(result.meta_json() + "\n")
+    Parameters
+    ----------
+    result : SimResult
+    out : str or path
+        The folder.
+    fmt : {"csv", "parquet"}
+        Format of the traces.
+    metrics : pandas.DataFrame, optional
+        The flight's metrics, if already computed.
+    """
+    result.write(out, fmt=fmt, force=True, metrics=metrics)
 
 
 def _warn_about(result: SimResult) -> None:
