@@ -22,9 +22,8 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT / "tests" / "support"))
 from machine import end_of_run, machine  # noqa: E402
-
 from reference_model import rhs as reference_rhs  # noqa: E402
 
 HZ = 1000.0          # control and integration rate of every benchmark [1/s]

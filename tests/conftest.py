@@ -1,15 +1,11 @@
 """Fixtures shared by several test modules."""
 
-import sys
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))      # tests import reference_model directly
-
-import quadcruise as qc  # noqa: E402
+import quadcruise as qc
 
 
 @pytest.fixture(scope="module")

@@ -404,9 +404,9 @@ def test_compiled_disturbance_makes_no_reference_count_calls():
     """The disturbance runs every period on every thread, on rows of arrays the batch
     shares: an NRT_incref/decref there is an atomic write to a shared counter. A fresh,
     uncached compile shows what the engine runs (only the Python-facing wrapper counts)."""
-    from compiled_code import reference_count_calls
     from quadcruise.disturbances import environment_disturbance
     from quadcruise.layout import DISTURBANCE_SIG
+    from support.compiled_code import reference_count_calls
 
     calls = reference_count_calls(environment_disturbance.py_func, DISTURBANCE_SIG)
     assert calls == []

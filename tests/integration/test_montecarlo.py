@@ -170,6 +170,7 @@ def test_the_world_acts_and_drag_is_added_with_a_warning():
     pd.testing.assert_frame_equal(res.table, sweep(n=12, chunk_size=12).table, check_exact=True)
 
 
+@pytest.mark.dask
 # --- Dask ---------------------------------------------------------------------------------
 def test_local_cluster_equals_in_process(reference, tmp_path):
     ref, ref_out = reference
@@ -179,6 +180,7 @@ def test_local_cluster_equals_in_process(reference, tmp_path):
     same_outputs(tmp_path / "dask", ref_out)
 
 
+@pytest.mark.dask
 def test_the_local_cluster_runs_with_its_quiet_settings():
     from quadcruise.montecarlo.sweep import LOCAL_CLUSTER_SETTINGS, _Dask
 
@@ -191,6 +193,7 @@ def test_the_local_cluster_runs_with_its_quiet_settings():
     assert list(got.values()) == [LOCAL_CLUSTER_SETTINGS] and stealing is False
 
 
+@pytest.mark.dask
 def test_a_worker_killed_mid_run_costs_nothing(reference, cluster, tmp_path):
     from distributed import Client
 

@@ -32,7 +32,7 @@ from quadcruise.layout import (
 )
 from quadcruise.missions import Circle, Hover, Step
 from quadcruise.model.plant import derivative
-from reference_model import still_air_ext
+from support.reference_model import still_air_ext
 
 V = qc.Vehicle.paper()
 
@@ -239,8 +239,8 @@ def test_compiled_controller_makes_no_reference_count_calls(name):
     read their arrays into scalars first and write last, so their compiled body
     has none (only numba's Python-facing wrapper does). A fresh, uncached compile of the same
     Python function shows what the engine runs."""
-    from compiled_code import reference_count_calls
     from quadcruise.layout import CONTROLLER_SIG
+    from support.compiled_code import reference_count_calls
 
     calls = reference_count_calls(controller_from_name(name).function.py_func, CONTROLLER_SIG)
     assert calls == []

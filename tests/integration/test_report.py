@@ -228,6 +228,7 @@ def test_browser_skip_or_fail(monkeypatch):
         browser(missing)
 
 
+@pytest.mark.browser
 def test_browser_renders_flight_page(flight_page):
     dom = rendered_dom(flight_page)
     assert dom.text["qc-errors"] == "", dom.text["qc-errors"]
@@ -239,6 +240,7 @@ def test_browser_renders_flight_page(flight_page):
     assert len([a for a in dom.find("img") if a["src"].startswith("data:image/png;base64,")]) == 1
 
 
+@pytest.mark.browser
 def test_browser_renders_several_views(rep, diverged, tmp_path):
     kw = reproduction_report(rep, figures={})
     kw["flights"]["replay"] = {"stopped": diverged}          # no reference, stops early
@@ -250,6 +252,7 @@ def test_browser_renders_several_views(rep, diverged, tmp_path):
     assert len(dom.find("input", type="checkbox")) == 3 + 3 + 1
 
 
+@pytest.mark.browser
 @pytest.mark.parametrize("notes, expected", [
     ("<script>undefined_function()</script>", "undefined_function"),
     ("<script>console.error('bad thing')</script>", "bad thing"),
@@ -263,6 +266,7 @@ def test_browser_catches_a_broken_page(notes, expected, tmp_path, circle):
     assert dom.find("canvas")[0].get("data-rendered") == "1"   # the rest of the page still works
 
 
+@pytest.mark.browser
 def test_browser_screenshot(circle, tmp_path):
     # a test-only script reports where the canvas is, in page pixels
     where = ("<script>addEventListener('load', () => { const r = document.querySelector('canvas')"

@@ -11,7 +11,7 @@ import quadcruise as qc
 from quadcruise.cli import main
 from quadcruise.workflows.scenario import load_scenario
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
 def write(tmp_path, text, name="s.toml"):

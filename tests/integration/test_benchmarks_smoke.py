@@ -7,7 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "engine.py"
+SCRIPT = Path(__file__).resolve().parents[2] / "benchmarks" / "engine.py"
 TIMINGS = ("vehicle_steps", "first_call_s", "best_s", "rate", "kernel_s", "kernel_rate")
 
 

@@ -9,7 +9,7 @@ from quadcruise.control.openloop import duty_schedule, pack_schedule
 from quadcruise.disturbances import CustomDisturbance, SensorNoise
 from quadcruise.layout import F1, STATE_SIZE, X, Z
 from quadcruise.workflows.replay import no_reference
-from reference_model import rhs
+from support.reference_model import rhs
 
 V = qc.Vehicle.paper()
 

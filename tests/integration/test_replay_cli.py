@@ -11,7 +11,7 @@ from click.testing import CliRunner
 import quadcruise as qc
 from quadcruise.cli import main
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "pwm_step.csv"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "pwm_step.csv"
 
 
 def run(*args):

@@ -23,7 +23,7 @@ from quadcruise.missions.waypoints import (
     read_waypoints_csv,
 )
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "waypoints.csv"
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "waypoints.csv"
 POS, VEL, ACC = [REF_X, REF_Y, REF_Z], [REF_VX, REF_VY, REF_VZ], [REF_AX, REF_AY, REF_AZ]
 
 # an irregular 3-D table with yaw and explicit times (and one sharp turn back)

@@ -120,7 +120,7 @@ def test_montecarlo_bad_input(tmp_path, args, words):
 
 
 def test_montecarlo_and_reproduce_accept_a_scenario(tmp_path):
-    scen = Path(__file__).resolve().parents[1] / "examples" / "scenarios"
+    scen = Path(__file__).resolve().parents[2] / "examples" / "scenarios"
     res = run("montecarlo", "--scenario", scen / "montecarlo_circle.toml", "-n", "5", "--duration", "2",
               "--scheduler", "none", "--quiet", "--out", tmp_path / "mc")
     assert res.exit_code == 0, res.output

@@ -7,7 +7,7 @@ import quadcruise as qc
 from quadcruise.layout import F1, P_K1, P_K3, P_K5, STATE_SIZE, P, Q, R
 from quadcruise.model.actuators import mix, unmix
 from quadcruise.model.plant import derivative
-from reference_model import still_air_ext
+from support.reference_model import still_air_ext
 
 V = qc.Vehicle.paper()
 
@@ -77,7 +77,7 @@ def test_mixer_round_trip():
 
 
 def test_matches_independent_model_pointwise():
-    from reference_model import rhs
+    from support.reference_model import rhs
 
     rng = np.random.default_rng(7)
     vp = V.rows()[0]
