@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["cell", "metric_cell", "metrics_text", "DID_NOT_SETTLE"]
+__all__ = ["cell", "metric_cell", "metrics_text", "vehicle_metrics_text", "DID_NOT_SETTLE"]
 
 DID_NOT_SETTLE = "did not settle"
 
@@ -65,3 +65,29 @@ def metrics_text(frame, labels) -> str:
                           for label, axis, (_, row) in zip(labels, axes, frame.iterrows())},
                          index=list(frame.columns))
     return shown.to_string()
+
+
+def vehicle_metrics_text(frame) -> str:
+    """The metrics of a flight, one column per vehicle, as aligned text (for a terminal).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        One row per vehicle with a ``vehicle`` column, as
+        :meth:`quadcruise.sim.result.SimResult.metrics` returns.
+
+    Returns
+    -------
+    str
+        :func:`metrics_text` of the other columns, headed ``vehicle 0``, ``vehicle 1``, ...
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> frame = pd.DataFrame({"vehicle": [0], "axis": ["x"], "rmse_m": [0.5]})
+    >>> print(vehicle_metrics_text(frame))
+           vehicle 0
+    axis           x
+    rmse_m       0.5
+    """
+    return metrics_text(frame.drop(columns=["vehicle"]), [f"vehicle {c}" for c in frame["vehicle"]])

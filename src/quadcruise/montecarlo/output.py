@@ -17,7 +17,7 @@ from quadcruise.io.files import MARKER, atomic_dir, atomic_path, check_output_di
 from quadcruise.io.plainjson import dumps
 from quadcruise.montecarlo.store import holds_sweep, write_marker
 
-__all__ = ["write_outputs", "write_case", "report_markdown"]
+__all__ = ["write_outputs", "write_case", "case_folder", "report_markdown"]
 
 
 def write_outputs(result, out, *, fmt: str = "csv", force: bool = False) -> Path:
@@ -65,6 +65,46 @@ def write_case(case, out, *, fmt: str = "csv", force: bool = False) -> Path:
         (tmp / MARKER).write_text(dumps({"workflow": "montecarlo-case", "vehicle": case.vehicle,
                                           **case.result.meta}, indent=2) + "\n")
     return path
+
+
+def case_folder(out, spec, case: int, *, force: bool = False) -> Path | None:
+    """Where flight ``case`` of the sweep ``spec``, flown again alone, is written.
+
+    Parameters
+    ----------
+    out : str or path-like or None
+        The folder asked for.
+    spec : MonteCarloSpec
+        The sweep the flight belongs to.
+    case : int
+        The flight's vehicle index.
+    force : bool
+        Replace a non-empty folder that quadcruise did not write.
+
+    Returns
+    -------
+    pathlib.Path or None
+        ``out/case-00000I`` if ``out`` holds this very sweep (its results stay beside),
+        else ``out``, checked (:func:`~quadcruise.io.files.check_output_dir`) before
+        anything is flown; None without ``out``.
+
+    Raises
+    ------
+    InputError
+        ``out`` holds a sweep flown with other options or code, or something else (unless
+        ``force``).
+    """
+    if out is None:
+        return None
+    target = Path(out)
+    meta, same = holds_sweep(target, spec)
+    if meta and meta.get("workflow") == "montecarlo":      # a sweep's folder: the case goes inside
+        if not same:
+            raise InputError(f"{out}: holds a sweep flown with other options or code (spec {meta.get('spec_hash')}, "
+                             f"these give {spec.hash()}); give the sweep's options to replay its flight")
+        target = target / f"case-{case:06d}"
+    check_output_dir(target, force)
+    return target
 
 
 def report_markdown(result, summary: dict, worst, table_name: str) -> str:

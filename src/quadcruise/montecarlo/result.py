@@ -156,6 +156,25 @@ class MonteCarloResult:
         out.insert(1, "seed", self.spec.seed)
         return out.reset_index(drop=True)
 
+    def worst_text(self, k: int = 5, by: str = "rmse_m") -> str:
+        """The k worst flights (:meth:`worst`) as aligned text (for the terminal).
+
+        Parameters
+        ----------
+        k : int
+            How many flights.
+        by : str
+            The metric that ranks the flights that did not fail.
+
+        Returns
+        -------
+        str
+            One line per flight: vehicle, seed, reason, RMSE, maximum error, 5 % settling
+            time, stop time and mass, numbers to 4 significant digits.
+        """
+        cols = ["vehicle", "seed", "reason", "rmse_m", "max_error_m", "settling_time_5pct_s", "stop_time_s", "m"]
+        return self.worst(k, by)[cols].to_string(index=False, float_format=lambda v: f"{v:.4g}")
+
     def case(self, i: int, **kw):
         """:func:`~quadcruise.montecarlo.replay_case` of vehicle i."""
         from quadcruise.montecarlo.chunk import replay_case

@@ -472,5 +472,44 @@ def to_json(rep: dict) -> str:
     return dumps(rep, indent=2)
 
 
+def write_analysis(lin: Linearization, rep: dict, out, *, force: bool = False):
+    """An analysis's folder, written whole or not at all: ``analysis.json`` (:func:`to_json`),
+    the Bode plots ``bode.png`` (at the plant input) and ``bode_output.png`` (at the
+    measurement), and ``quadcruise.json`` (the controller, the control period, the version).
+
+    Parameters
+    ----------
+    lin : Linearization
+        The closed loop, from :func:`linearize`.
+    rep : dict
+        Its :func:`report`.
+    out : str or path-like
+        The folder; a non-empty one that quadcruise did not write is refused unless ``force``.
+    force : bool
+        Replace such a folder.
+
+    Returns
+    -------
+    pathlib.Path
+        The folder written.
+    """
+    from pathlib import Path
+
+    from quadcruise._version import __version__
+    from quadcruise.io.files import MARKER, atomic_dir, check_output_dir
+    from quadcruise.io.plainjson import dumps
+    from quadcruise.plots.flight import save_figure
+
+    out = check_output_dir(out, force)
+    with atomic_dir(out) as tmp:
+        tmp = Path(tmp)
+        (tmp / "analysis.json").write_text(to_json(rep) + "\n")
+        save_figure(bode(lin, loops=True), tmp / "bode.png")
+        save_figure(bode(lin, loops=True, at="output"), tmp / "bode_output.png")
+        (tmp / MARKER).write_text(dumps({"workflow": "analyze", "controller": lin.controller,
+                                         "dt_s": lin.dt, "version": __version__}) + "\n")
+    return out
+
+
 __all__ = ["HoverError", "Linearization", "linearize", "loop_transfer", "loop_margins", "bode", "report",
-           "summary", "to_json", "INPUTS", "OUTPUTS", "LOOPS"]
+           "summary", "to_json", "write_analysis", "INPUTS", "OUTPUTS", "LOOPS"]

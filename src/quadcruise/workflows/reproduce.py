@@ -191,6 +191,23 @@ def write_reproduction(rep: Reproduction, out: str | Path, *, force: bool = Fals
     return out
 
 
+def written_figures(out: str | Path) -> dict[str, Path]:
+    """The figures that :func:`write_reproduction` wrote into ``out``, by caption.
+
+    Parameters
+    ----------
+    out : str or path-like
+        The reproduction's folder.
+
+    Returns
+    -------
+    dict of str to pathlib.Path
+        Caption -> PNG file, in the order of :data:`FIGURES`, for those present (the
+        ``figures`` of :func:`quadcruise.report.html.reproduction_report`).
+    """
+    return {caption: Path(out) / name for name, caption in FIGURES.items() if (Path(out) / name).is_file()}
+
+
 def paper_figure(name: str, caption: str, results: dict):
     """The figure ``name`` of FIGURES drawn from the flights, or None if they are missing."""
     from quadcruise.plots.flight import plot_paths, plot_reference

@@ -1,0 +1,35 @@
+"""``quadcruise analyze``: the closed loop linearised about hover; its summary printed, its
+folder written on request."""
+
+from __future__ import annotations
+
+import click
+
+from quadcruise.cli.common import FORCE_OPTION, controller_from_options, friendly
+from quadcruise.io.files import check_output_dir
+
+__all__ = ["analyze"]
+
+
+@click.command("analyze")
+@click.option("--controller", default="nlpd", show_default=True, help="Controller name.")
+@click.option("-c", "--controller-param", "controller_params", multiple=True, metavar="KEY=VALUE",
+              help="Controller parameter (repeatable).")
+@click.option("--poles", "position_poles", metavar="P1,P2", help="Closed-loop poles of the x/y loops [rad/s].")
+@click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
+@click.option("--out", type=click.Path(file_okay=False), help="Folder for analysis.json and Bode plots.")
+@FORCE_OPTION
+@friendly
+def analyze(controller, controller_params, position_poles, dt, out, force):
+    """Linearise the closed loop about hover: poles, damping, margins of each loop, Bode plots."""
+    from quadcruise.workflows.analysis import linearize, report, summary, write_analysis
+
+    the_controller = controller_from_options(controller, controller_params, position_poles)
+    if out is not None:
+        check_output_dir(out, force)
+    lin = linearize(the_controller, dt=dt)
+    rep = report(the_controller, lin=lin)
+    click.echo(summary(rep))
+    if out is not None:
+        write_analysis(lin, rep, out, force=force)
+        click.echo(f"wrote analysis.json and Bode plots to {out}")

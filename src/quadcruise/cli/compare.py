@@ -1,0 +1,85 @@
+"""``quadcruise compare``: several controllers on one mission, and on request on the same Monte
+Carlo population; one table, one figure."""
+
+from __future__ import annotations
+
+import click
+
+from quadcruise.cli.common import FORCE_OPTION, REPORT_OPTION, friendly, mission_from_options
+from quadcruise.io.files import check_output_dir
+
+__all__ = ["compare"]
+
+
+@click.command("compare")
+@click.argument("mission", metavar="MISSION")
+@click.option("--controllers", default="nlpd,gonzalez,se3,cascade", show_default=True,
+              help="Comma-separated controller names.")
+@click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
+@click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
+@click.option("-m", "--mission-param", "mission_params", multiple=True, metavar="KEY=VALUE",
+              help="Mission parameter (repeatable).")
+@click.option("--out", type=click.Path(file_okay=False), help="Folder for metrics.csv and comparison.png.")
+@FORCE_OPTION
+@click.option("--population", type=int, metavar="N",
+              help="Also fly every controller on the same Monte Carlo population of N vehicles.")
+@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the population.")
+@click.option("--mass-spread", type=float, default=0.1, show_default=True, help="Relative std of the mass.")
+@click.option("--wind", metavar="SPEC", help="Wind of the population, e.g. dryden:moderate@10.")
+@REPORT_OPTION
+@friendly
+def compare(mission, controllers, duration, dt, mission_params, out, force, population, seed, mass_spread, wind,
+            report):
+    """Fly MISSION (a name or a waypoint CSV) with several controllers; one table, one figure."""
+    from quadcruise.workflows.compare import compare as run_compare
+
+    if out is not None:
+        check_output_dir(out, force)
+    cmp_mission = mission_from_options(mission, mission_params, smooth=False)
+    cmp = run_compare(cmp_mission, controllers, duration=duration, dt=dt)
+    click.echo(cmp.text())
+    if population is not None:
+        _compare_population(cmp_mission, controllers, population, seed, mass_spread, wind, duration, dt)
+    if out is not None:
+        cmp.write(out, force=force)
+        click.echo(f"wrote metrics.csv and comparison.png to {out}")
+    if report is not None:
+        from quadcruise.report.html import comparison_report, write_html_report
+
+        write_html_report(report, **comparison_report(cmp))
+        click.echo(f"wrote report {report}")
+
+
+def _compare_population(mission, controllers: str, n: int, seed: int, mass_spread: float, wind: str | None,
+                        duration: float | None, dt: float) -> None:
+    """Fly the controllers on the same population of perturbed vehicles, in this process,
+    and print one row per controller.
+
+    Parameters
+    ----------
+    mission : Mission
+    controllers : str
+        Comma-separated controller names.
+    n : int
+        Number of vehicles.
+    seed : int
+        Seed of the population.
+    mass_spread : float
+        Relative standard deviation of the mass.
+    wind : str or None
+        A :func:`~quadcruise.disturbances.environment.parse_wind` spec.
+    duration : float or None
+        Flight time [s]; None: the mission's.
+    dt : float
+        Control period [s].
+    """
+    from quadcruise.disturbances.environment import parse_wind
+    from quadcruise.montecarlo.api import Population
+    from quadcruise.montecarlo.compare import compare_population
+
+    env = parse_wind(wind) if wind else None
+    pop = Population(mass_spread=mass_spread, environment=env if env is not None and env.parts else None)
+    table = compare_population(mission, controllers, pop, n, seed, duration=duration, dt=dt, scheduler="none")
+    click.echo(f"\nthe same {n} perturbed vehicles (seed {seed}, mass spread {mass_spread:g}"
+               + (f", wind {wind}" if wind else "") + "):")
+    click.echo(table.to_string(float_format=lambda v: f"{v:.4g}"))

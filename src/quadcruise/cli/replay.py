@@ -1,0 +1,34 @@
+"""``quadcruise replay``: PWM duties replayed open loop, the states written to a CSV."""
+
+from __future__ import annotations
+
+import click
+
+from quadcruise.cli.common import friendly
+
+__all__ = ["replay"]
+
+
+@click.command("replay")
+@click.argument("pwm_csv", metavar="PWM.csv")
+@click.option("-o", "--out", "out", required=True, metavar="STATES.csv",
+              help="Where to write the states (t,x,y,z,vx,vy,vz,phi,theta,psi,p,q,r,F1..F4).")
+@click.option("--max-step", default=1e-3, show_default=True, type=float,
+              help="Longest RK4 substep [s].")
+@friendly
+def replay(pwm_csv: str, out: str, max_step: float) -> None:
+    """Replay PWM duties open loop (columns t,u1,u2,u3,u4) and write the states.
+
+    Each row's duties hold until the next row's time. The vehicle (the paper's Table I)
+    starts at rest at the origin with each rotor at the thrust of the first row.
+    """
+    from quadcruise.workflows.replay import read_duty_csv, write_states_csv
+    from quadcruise.workflows.replay import replay as run_replay
+
+    schedule = read_duty_csv(pwm_csv)
+    result = run_replay(schedule, max_step=max_step)
+    if not result.ok[0]:
+        click.echo(f"warning: the flight stopped early: {result.status_text(0)}", err=True)
+    write_states_csv(result, out)
+    click.echo(f"wrote {len(result.t)} states to {out} "
+               f"(t = {result.t[0]:g} .. {result.t[-1]:g} s, final z = {result.final_state[0, 2]:.4f} m)")

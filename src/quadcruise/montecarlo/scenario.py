@@ -1,0 +1,102 @@
+"""A sweep from options and a scenario file: its :class:`MonteCarloSpec` and its number of
+flights, the options given explicitly winning over the scenario's ``[montecarlo]`` table,
+``[simulation]`` and disturbances, which win over the defaults."""
+
+from __future__ import annotations
+
+import dataclasses
+
+from quadcruise.errors import InputError
+from quadcruise.montecarlo.population import Population
+from quadcruise.montecarlo.spec import MonteCarloSpec
+from quadcruise.workflows.scenario import Scenario, load_scenario
+
+__all__ = ["merge_scenario", "sweep_spec"]
+
+
+def merge_scenario(path, given: dict) -> tuple[Scenario, dict]:
+    """A scenario, and its ``[montecarlo]`` table (and ``[simulation]`` seed) under the
+    options given explicitly.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The TOML scenario file (:func:`~quadcruise.workflows.scenario.load_scenario`).
+    given : dict
+        Options given explicitly: ``n``, ``seed`` and :class:`Population` fields (not
+        ``environment`` nor ``noise``). They win over the scenario's.
+
+    Returns
+    -------
+    scenario : Scenario
+    options : dict
+        The scenario's table updated with ``given``.
+
+    Raises
+    ------
+    InputError
+        The table has a key that is none of ``n``, ``seed`` and the Population fields.
+    """
+    sc = load_scenario(path)
+    table = dict(sc.montecarlo)
+    known = {f.name for f in dataclasses.fields(Population)} - {"environment", "noise"}
+    unknown = set(table) - known - {"n", "seed"}
+    if unknown:
+        raise InputError(f"{path}: [montecarlo] unknown key(s) {', '.join(sorted(unknown))} "
+                         f"(known: n, seed, {', '.join(sorted(known))})")
+    if "seed" in sc.simulation:
+        table.setdefault("seed", sc.simulation["seed"])
+    return sc, {**table, **given}
+
+
+def sweep_spec(*, mission="circle", controller="nlpd", n: int | None = None, seed: int | None = None,
+               duration: float | None = None, dt: float | None = None, environment=None, noise=None,
+               scenario=None, **population) -> tuple[MonteCarloSpec, int]:
+    """The spec of a sweep and its number of flights; None means "not given".
+
+    Parameters
+    ----------
+    mission, controller : names or objects
+        Those of ``scenario`` if it has them.
+    n, seed : int, optional
+        Number of flights and seed: given, else the scenario's, else 1000 and 0.
+    duration : float, optional
+        Flight time [s]: given, else the scenario's, else the mission's.
+    dt : float, optional
+        Control period [s]: given, else the scenario's, else 1 ms.
+    environment : Environment, optional
+        Disturbances (an empty one: none): given, else the scenario's.
+    noise : SensorNoise, optional
+        Sensor noise: given, else the scenario's.
+    scenario : str or path-like, optional
+        A TOML scenario file: mission, controller, nominal vehicle, disturbances, sensor
+        noise, simulation settings, and a ``[montecarlo]`` table (:func:`merge_scenario`).
+    **population
+        :class:`Population` fields (spreads, offset, distribution, model_error): given, else
+        the scenario's, else the Population's defaults.
+
+    Returns
+    -------
+    spec : MonteCarloSpec
+    n : int
+
+    Raises
+    ------
+    InputError
+        An unknown or bad option, or a bad scenario.
+    """
+    given = {key: value for key, value in {**population, "n": n, "seed": seed}.items() if value is not None}
+    options: dict = dict(duration=duration, dt=1e-3 if dt is None else dt)
+    if scenario is not None:
+        sc, given = merge_scenario(scenario, given)
+        mission = sc.mission or mission
+        controller = sc.controller or controller
+        environment = environment if environment is not None else sc.environment
+        noise = noise if noise is not None else sc.sensor_noise
+        options.update(vehicle=sc.vehicle, duration=duration or sc.duration,
+                       dt=sc.dt if dt is None else dt, max_step=sc.simulation.get("max_step"),
+                       full_dynamics=sc.simulation.get("full_dynamics", False))
+    n, seed = given.pop("n", 1000), given.pop("seed", 0)
+    pop = Population(**given, environment=environment if environment is not None and environment.parts else None,
+                     noise=noise)
+    return MonteCarloSpec(mission=mission, controller=controller, population=pop, seed=seed, **options), n
