@@ -73,7 +73,6 @@ NOT_YET = {
     "quadcruise.montecarlo.spec",
     "quadcruise.montecarlo.store",
     "quadcruise.montecarlo.sweep",
-    "quadcruise.report.html",
     "quadcruise.sim.engine",
     "quadcruise.sim.fastmath",
     "quadcruise.sim.rng",
