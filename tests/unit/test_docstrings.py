@@ -76,11 +76,6 @@ NOT_YET = {
     "quadcruise.sim.engine",
     "quadcruise.sim.fastmath",
     "quadcruise.sim.rng",
-    "quadcruise.workflows.analysis",
-    "quadcruise.workflows.compare",
-    "quadcruise.workflows.fly",
-    "quadcruise.workflows.replay",
-    "quadcruise.workflows.reproduce",
     "quadcruise.workflows.scenario",
 }
 
