@@ -60,8 +60,6 @@ NOT_YET = {
     "quadcruise.missions.registry",
     "quadcruise.missions.shapes",
     "quadcruise.missions.waypoints",
-    "quadcruise.model.actuators",
-    "quadcruise.model.plant",
     "quadcruise.model.vehicle",
     "quadcruise.montecarlo.api",
     "quadcruise.montecarlo.chunk",
