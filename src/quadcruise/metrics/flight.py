@@ -157,6 +157,7 @@ def step_info(t, y, *, y_initial=None, y_final=None, t_step=None,
     Returns
     -------
     StepInfo
+        Times [s] from ``t_step``, percentages of the step, peak in the unit of ``y``.
 
     Notes
     -----
