@@ -14,7 +14,7 @@ connected components of A once the rotor thrusts are written as U1..U4 of eqs (1
 For margins one loop is broken, the others closed, at the plant input (``at="input"``):
 on the generalized input that drives it, before the rotor lag: U3 for x (through pitch), U2
 for y (roll), U1 for z, U4 for yaw. There a thrust-gain, inertia or motor-lag error of the
-real vehicle enters; for z and yaw it is the break of :func:`.control.design.loop_margins`.
+real vehicle enters; for z and yaw it is the break of :func:`quadcruise.control.design.loop_margins`.
 The x and y input margins cover the attitude loop *and* the position loop around it.
 ``at="output"`` breaks instead at the position (or yaw) measurement the controller sees,
 velocity and attitude feedback closed: the outer loop's own margins.
