@@ -78,7 +78,8 @@ def animate_flight(result, path, *, vehicle: int = 0, fps: float = 15, duration_
     vehicle : int
         Which of the result's vehicles.
     fps : float
-        Frames per second of the animation.
+        Frames per second of the animation [1/s] (a GIF shows each frame for at least
+        20 ms, so it plays at most 50 of them per second).
     duration_s : float, optional
         Length of the animation [s]; by default the flight's (real time, up to the end of
         the flight or the instant the vehicle stopped). It has ``round(fps * duration_s)``
