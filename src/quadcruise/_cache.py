@@ -5,8 +5,7 @@ numba keys each cached function on the file that defines it, not on the files of
 functions it calls and inlines: the engine's kernel inlines the plant's derivative, so an
 edit to ``model/plant.py`` alone would leave a stale kernel in the cache (a checkout of
 another commit, an edited source tree). At import, before anything compiles, we stamp the
-package's compiled sources (the contents of every ``.py`` file that uses numba: about a
-millisecond) and, when the stamp differs from the one stored beside the cache, remove the
+package's compiled sources (the contents of every ``.py`` file that uses numba) and, when the stamp differs from the one stored beside the cache, remove the
 package's cached machine code (in the ``__pycache__`` folders, or under ``NUMBA_CACHE_DIR``
 when it is set), which numba then compiles afresh. A read-only install is left alone
 (numba caches such a package elsewhere, and an upgrade replaces every file there anyway).
@@ -34,23 +33,56 @@ def _digest(package: Path, compiled_only: bool) -> str:
 
 
 def sources_stamp(package: Path = PACKAGE) -> str:
-    """A hash of the contents of every source file of the package that uses numba."""
+    """A hash of the contents of every source file of the package that uses numba.
+
+    Parameters
+    ----------
+    package : pathlib.Path
+        The package's folder.
+
+    Returns
+    -------
+    str
+        The SHA-256 hex digest of the relative paths and contents of the ``.py`` files
+        that mention ``numba``.
+    """
     return _digest(package, True)
 
 
 @functools.cache
 def code_digest() -> str:
     """A hash of the contents of every source file of the package, as this process found
-    them when first asked: a Monte Carlo spec's hash includes it, so a sweep resumes, or
-    takes a worker's chunk, only from the same code (a version number alone does not change
-    when a source tree is edited)."""
+    them when first asked.
+
+    A Monte Carlo spec's hash includes it, so a sweep resumes, or takes a worker's chunk,
+    only from the same code (a version number alone does not change when a source tree is
+    edited).
+
+    Returns
+    -------
+    str
+        The SHA-256 hex digest of the relative paths and contents of every ``.py`` file.
+    """
     return _digest(PACKAGE, False)
 
 
 def cache_dirs(package: Path = PACKAGE, numba_cache_dir: str | None = None) -> list[Path]:
-    """Where numba keeps the package's compiled code: each source folder's ``__pycache__``,
-    or, when ``NUMBA_CACHE_DIR`` is set, its folder there (``<name>_<sha1 of the path>``, as
-    numba's ``UserProvidedCacheLocator`` names it)."""
+    """Where numba keeps the package's compiled code.
+
+    Parameters
+    ----------
+    package : pathlib.Path
+        The package's folder.
+    numba_cache_dir : str, optional
+        numba's ``NUMBA_CACHE_DIR``; default: numba's configuration (the environment).
+
+    Returns
+    -------
+    list of pathlib.Path
+        One folder per source folder: its ``__pycache__``, or, when ``numba_cache_dir`` is
+        set (not empty), its folder there (``<name>_<sha1 of the path>``, as numba's
+        ``UserProvidedCacheLocator`` names it). The folders need not exist.
+    """
     folders = sorted({path.parent for path in package.rglob("*.py")})
     if numba_cache_dir is None:
         from numba.core import config
@@ -62,9 +94,24 @@ def cache_dirs(package: Path = PACKAGE, numba_cache_dir: str | None = None) -> l
 
 
 def drop_stale_cache(package: Path = PACKAGE, numba_cache_dir: str | None = None) -> bool:
-    """Remove the package's numba cache files if the sources changed since the last stamp
-    (kept beside them); True if it did. Errors (a read-only tree, a file another process
-    removed) are ignored."""
+    """Remove the package's numba cache files if the sources changed since the last stamp.
+
+    The stamp is kept beside the cache files, in the first of :func:`cache_dirs`. Errors
+    (a read-only tree, a file another process removed) are ignored.
+
+    Parameters
+    ----------
+    package : pathlib.Path
+        The package's folder.
+    numba_cache_dir : str, optional
+        numba's ``NUMBA_CACHE_DIR`` (see :func:`cache_dirs`).
+
+    Returns
+    -------
+    bool
+        True if it removed the cache (and wrote a new stamp); False if the stamp was
+        current or the cache could not be written.
+    """
     dirs = cache_dirs(package, numba_cache_dir)
     stamp_file = dirs[0] / STAMP
     stamp = sources_stamp(package)

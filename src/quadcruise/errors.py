@@ -18,8 +18,36 @@ class SimulationError(RuntimeError):
 
 
 def whole_number(value, what: str, minimum: int = 0) -> int:
-    """``value`` as an int if it is a whole number >= ``minimum`` (not a bool, not a float);
-    else InputError "<what> must be a whole number >= <minimum>, got <value>"."""
+    """``value`` as an int if it is a whole number >= ``minimum`` (not a bool, not a float).
+
+    Parameters
+    ----------
+    value : Any
+        The value to check.
+    what : str
+        How the error names it, e.g. ``"n"``.
+    minimum : int
+        The smallest value accepted.
+
+    Returns
+    -------
+    int
+        ``value``.
+
+    Raises
+    ------
+    InputError
+        "<what> must be a whole number >= <minimum>, got <value>".
+
+    Examples
+    --------
+    >>> whole_number(3, "n", 1)
+    3
+    >>> whole_number(2.0, "n", 1)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: n must be a whole number >= 1, got 2.0
+    """
     if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
         raise InputError(f"{what} must be a whole number >= {minimum}, got {value!r}")
     return int(value)
@@ -36,6 +64,11 @@ def reject_unknown(where: str, given: dict, known) -> None:
         The keywords that no parameter took.
     known : iterable of str
         The keywords that are accepted.
+
+    Raises
+    ------
+    InputError
+        If ``given`` is not empty.
 
     Examples
     --------

@@ -37,10 +37,22 @@ class ControllerLike(Protocol):
         """The compiled control law."""
 
     def gains(self) -> Any:
-        """The flat float64 vector the compiled function reads as ``gains``."""
+        """The parameters of the compiled function.
+
+        Returns
+        -------
+        numpy.ndarray
+            The flat float64 vector it reads as ``gains`` (or (N, G) rows, one per vehicle).
+        """
 
     def memory(self) -> Any:
-        """The initial memory the compiled function reads and writes as ``mem`` (float64)."""
+        """The controller's initial memory.
+
+        Returns
+        -------
+        numpy.ndarray
+            The float64 vector the compiled function reads and writes as ``mem``.
+        """
 
 
 @runtime_checkable
@@ -48,13 +60,40 @@ class ResultLike(Protocol):
     """The vocabulary of every result."""
 
     def to_pandas(self) -> Any:
-        """The result's data as a pandas DataFrame."""
+        """The result's data.
+
+        Returns
+        -------
+        pandas.DataFrame
+        """
 
     def summary(self) -> Any:
-        """The headline numbers: a mapping that prints as a readable table."""
+        """The headline numbers.
+
+        Returns
+        -------
+        quadcruise.metrics.summary.Summary
+            A mapping that prints as a readable table.
+        """
 
     def plot(self) -> Any:
-        """A matplotlib Figure of the result."""
+        """A figure of the result.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
 
     def write(self, out: Any) -> Any:
-        """Write the result into the folder ``out``, whole or not at all; return its path."""
+        """Write the result into a folder, whole or not at all.
+
+        Parameters
+        ----------
+        out : str or os.PathLike
+            The folder.
+
+        Returns
+        -------
+        pathlib.Path
+            The folder written.
+        """

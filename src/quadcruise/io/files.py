@@ -20,6 +20,25 @@ def atomic_path(path: str | os.PathLike):
     """Yield a temporary path beside ``path``; move it into place only on success.
 
     A failure (or an interrupt) leaves no file at ``path`` and no temporary behind.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file to write; its folder is created if missing.
+
+    Yields
+    ------
+    pathlib.Path
+        The temporary file (empty, already created) to write to.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     with atomic_path(Path(folder) / "out.txt") as tmp:
+    ...         _ = tmp.write_text("done")
+    ...     sorted(p.name for p in Path(folder).iterdir())
+    ['out.txt']
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -39,7 +58,18 @@ def atomic_path(path: str | os.PathLike):
 def atomic_dir(path: str | os.PathLike):
     """Yield a temporary folder beside ``path``; it becomes ``path`` only on success.
 
-    An existing ``path`` is replaced only after the new one is complete.
+    An existing ``path`` is replaced only after the new one is complete. A failure (or an
+    interrupt) leaves ``path`` as it was and removes the temporary folder.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The folder to write; its parent is created if missing.
+
+    Yields
+    ------
+    pathlib.Path
+        The temporary folder (empty) to fill.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -65,7 +95,25 @@ MARKER = "quadcruise.json"
 
 
 def check_output_dir(path: str | os.PathLike, force: bool = False) -> Path:
-    """Refuse a non-empty folder that quadcruise did not write, unless ``force``."""
+    """Refuse a non-empty folder that quadcruise did not write, unless ``force``.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The output folder; it need not exist.
+    force : bool
+        Accept a non-empty folder without a :data:`MARKER` file (it will be replaced).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    InputError
+        If ``path`` is a file, or a non-empty folder without :data:`MARKER` and not ``force``.
+    """
     from quadcruise.errors import InputError
 
     path = Path(path)
@@ -78,7 +126,26 @@ def check_output_dir(path: str | os.PathLike, force: bool = False) -> Path:
 
 
 def check_table_format(fmt: str) -> None:
-    """Refuse an unknown table format, or Parquet without pyarrow, before any work is done."""
+    """Refuse an unknown table format, or Parquet without pyarrow, before any work is done.
+
+    Parameters
+    ----------
+    fmt : str
+        ``"csv"`` or ``"parquet"``.
+
+    Raises
+    ------
+    InputError
+        For another format, or for ``"parquet"`` when pyarrow is not installed.
+
+    Examples
+    --------
+    >>> check_table_format("csv")
+    >>> check_table_format("xlsx")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: unknown table format 'xlsx'; choose csv or parquet
+    """
     from quadcruise.errors import InputError
 
     if fmt not in ("csv", "parquet"):
@@ -91,8 +158,24 @@ def check_table_format(fmt: str) -> None:
 
 
 def write_table(frame, path: Path, fmt: str) -> Path:
-    """Write a DataFrame as CSV or Parquet at ``path`` with the format's suffix, atomically;
-    returns the file written."""
+    """Write a DataFrame as CSV or Parquet at ``path`` with the format's suffix, atomically.
+
+    Numbers are written with 10 significant digits in a CSV, without the index.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The table.
+    path : pathlib.Path
+        Where to write; its suffix is replaced by the format's (``.csv``, ``.parquet``).
+    fmt : str
+        ``"csv"`` or ``"parquet"`` (see :func:`check_table_format`).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
     import pandas as pd
 
     check_table_format(fmt)
@@ -103,7 +186,7 @@ def write_table(frame, path: Path, fmt: str) -> Path:
         elif all(pd.api.types.is_numeric_dtype(d) for d in frame.dtypes):
             import numpy as np
 
-            # numpy formats numeric tables about twice as fast as pandas' to_csv
+            # numpy's savetxt formats an all-numeric table faster than pandas' to_csv
             np.savetxt(tmp, frame.to_numpy(dtype=float), delimiter=",", fmt="%.10g",
                        header=",".join(map(str, frame.columns)), comments="")
         else:
@@ -116,11 +199,40 @@ def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optiona
     """Read a CSV of numbers with a header; any problem is one InputError naming the file,
     the line and the column.
 
-    Returns ``(header_line, columns, data, lines)``: the columns used (required ones, then
-    the optional ones present, in that order), the (rows, columns) float array, and the file
-    line of each row. Blank lines are skipped but counted. Unknown columns are ignored with
-    a warning. A blank cell is an error unless ``blank_ok(column, row_index)`` says otherwise;
-    it then reads as NaN.
+    Blank lines are skipped but counted. Unknown columns are ignored with a warning.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The CSV file.
+    required : tuple of str
+        Columns the header must name.
+    optional : tuple of str
+        Columns the header may name.
+    blank_ok : callable, optional
+        ``blank_ok(column, row_index) -> bool``: whether a blank cell is allowed (it then
+        reads as NaN); without it every blank cell is an error.
+
+    Returns
+    -------
+    header_line : int
+        The file line of the header (1-based).
+    columns : list of str
+        The columns used: the required ones, then the optional ones present, in that order.
+    data : ndarray, shape (rows, columns)
+        The numbers, as floats.
+    lines : list of int
+        The file line of each row of ``data``.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = Path(folder) / "duties.csv"
+    ...     _ = path.write_text("t,u1\\n0,0.5\\n\\n1,0.6\\n")
+    ...     head, columns, data, lines = read_numeric_csv(path, ("t",), ("u1", "u2"))
+    >>> head, columns, data.tolist(), lines
+    (1, ['t', 'u1'], [[0.0, 0.5], [1.0, 0.6]], [2, 4])
     """
     import csv
     import math

@@ -26,7 +26,29 @@ __all__ = ["plain", "dumps"]
 
 
 def plain(obj: Any) -> Any:
-    """``obj`` as plain JSON values (see the module); TypeError for what has no JSON form."""
+    """``obj`` as plain JSON values (see the module).
+
+    Parameters
+    ----------
+    obj : Any
+        Dicts (keys become strings), lists, tuples, numpy arrays and scalars, numbers,
+        strings, None, paths, objects with a ``to_dict()`` and dataclass instances, nested.
+
+    Returns
+    -------
+    Any
+        Dicts, lists, str, int, float (finite), bool and None only.
+
+    Raises
+    ------
+    TypeError
+        For a value that has no JSON form.
+
+    Examples
+    --------
+    >>> plain({1: (np.float32(0.5), float("inf"))})
+    {'1': [0.5, None]}
+    """
     if isinstance(obj, dict):
         return {str(k): plain(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple):
@@ -49,5 +71,18 @@ def plain(obj: Any) -> Any:
 
 
 def dumps(obj: Any, **kw: Any) -> str:
-    """``json.dumps`` of :func:`plain` (strict: never NaN or Infinity)."""
+    """``json.dumps`` of :func:`plain` (strict: never NaN or Infinity).
+
+    Parameters
+    ----------
+    obj : Any
+        What to record (see :func:`plain`).
+    **kw : Any
+        Keywords of :func:`json.dumps` (``indent``, ``sort_keys``, ...).
+
+    Returns
+    -------
+    str
+        The JSON text.
+    """
     return json.dumps(plain(obj), allow_nan=False, **kw)

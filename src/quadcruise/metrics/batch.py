@@ -40,6 +40,7 @@ def first_crossing_batch(t: np.ndarray, z: np.ndarray, level: float) -> np.ndarr
     z : ndarray, shape (N, L)
         One response per row (normalised: 0 at the start of a step, 1 at its end).
     level : float
+        The level to reach, on the scale of ``z`` (0.1 and 0.9 for a 10-90 % rise).
 
     Returns
     -------
@@ -136,6 +137,8 @@ def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: di
     overshoot : ndarray, shape (N,)
         Overshoot [%] of the step (or of the initial error).
 
+    Notes
+    -----
     Every value of a vehicle without a measured transient is NaN, and so is every value
     of a step whose time lies outside ``[t[0], t[-1])``.
     """

@@ -33,11 +33,32 @@ __all__ = ["StepInfo", "step_info", "step_info_batch", "transient_info",
 class StepInfo:
     """Step-response characteristics; times in seconds measured from the step.
 
-    ``rise_time`` is None if the response never reaches the upper rise level; a settling
-    time is None if the response is outside its band at the last sample ("did not
-    settle"). ``settling_time`` belongs to ``settle_bands[0]`` (2 % by default),
-    ``settling_time_5pct`` to ``settle_bands[1]`` and ``settled`` to the first band.
-    Percentages are of the step size ``|y_final - y_initial|``.
+    :func:`step_info` builds it. Percentages are of the step size ``|y_final - y_initial|``.
+
+    Parameters
+    ----------
+    rise_time : float or None
+        10-90 % rise time [s] (between the two ``rise`` levels of :func:`step_info`);
+        None if the response never reaches the upper level.
+    settling_time : float or None
+        Settling time [s] into ``settle_bands[0]`` (2 % by default); None if the response
+        is outside the band at the last sample ("did not settle").
+    settling_time_5pct : float or None
+        Settling time [s] into ``settle_bands[1]`` (5 % by default); None likewise.
+    overshoot_pct : float
+        Overshoot beyond ``y_final`` [%], 0 if none.
+    undershoot_pct : float
+        Excursion against the step direction [%], 0 if none.
+    peak : float
+        The response at its largest excursion in the step direction [unit of ``y``].
+    peak_time : float
+        First time of the peak [s], from the step.
+    y_initial : float
+        The value before the step [unit of ``y``].
+    y_final : float
+        The value the response should settle to [unit of ``y``].
+    settled : bool
+        True if ``settling_time`` exists (the response ends inside the first band).
     """
 
     rise_time: float | None
@@ -52,7 +73,13 @@ class StepInfo:
     settled: bool
 
     def to_dict(self) -> dict:
-        """The fields as a plain dict (None stays None)."""
+        """The fields as a plain dict (None stays None).
+
+        Returns
+        -------
+        dict
+            Field name -> value.
+        """
         return dataclasses.asdict(self)
 
 
@@ -130,6 +157,7 @@ def step_info(t, y, *, y_initial=None, y_final=None, t_step=None,
     Returns
     -------
     StepInfo
+        Times [s] from ``t_step``, percentages of the step, peak in the unit of ``y``.
 
     Notes
     -----
@@ -207,11 +235,27 @@ def step_info(t, y, *, y_initial=None, y_final=None, t_step=None,
 
 
 def step_info_batch(t, y, *, y_initial=None, y_final=None, **kw) -> dict[str, np.ndarray]:
-    """:func:`step_info` for each row of ``y`` (shape (N, L)): a dict of arrays of shape (N,).
+    """:func:`step_info` for each row of ``y``.
 
-    ``y_initial``/``y_final`` may be scalars or arrays of shape (N,); other keywords go to
-    :func:`step_info`. A None (did not settle, never rose) becomes NaN; ``settled`` is bool.
+    Parameters
+    ----------
+    t : array_like, shape (L,)
+        Sample times [s], strictly increasing.
+    y : array_like, shape (N, L)
+        One response per row.
+    y_initial, y_final : float or array_like of shape (N,), optional
+        As for :func:`step_info`, one for all rows or one per row.
+    **kw
+        Other keywords of :func:`step_info` (``t_step``, ``rise``, ``settle_bands``).
 
+    Returns
+    -------
+    dict of ndarray, shape (N,)
+        The fields of :class:`StepInfo`, one array each; a None (did not settle, never
+        rose) becomes NaN, and ``settled`` is bool.
+
+    Examples
+    --------
     >>> t = np.linspace(0.0, 1.0, 3)
     >>> out = step_info_batch(t, [[0.0, 0.5, 1.0], [0.0, 0.2, 0.4]], y_final=1.0)
     >>> out["settling_time"], out["settled"]
@@ -242,11 +286,31 @@ def transient_info(t, actual, reference, *, t_step=None, rise=(0.1, 0.9),
     step response scaled to the step, so times and percentages are the ordinary ones;
     ``peak``, ``y_initial`` and ``y_final`` are in progress units.
 
-    ``actual`` and ``reference`` are (L,) or (L, n_axes) (broadcast against each other).
     With several axes the error is its Euclidean norm, ``y = 1 - |e(t)| / |e(t_step)|``:
     rise and settling are then about the error size in any direction and the overshoot
     is always 0 (an error that grows beyond the initial one shows as undershoot).
 
+    Parameters
+    ----------
+    t : array_like, shape (L,)
+        Sample times [s], strictly increasing.
+    actual, reference : array_like, shape (L,) or (L, n_axes)
+        The response and what it tracks [m, or any unit, the same for both], broadcast
+        against each other.
+    t_step : float, optional
+        Start of the transient [s]; default ``t[0]``. The error there must not be ~0.
+    rise : (float, float)
+        Rise-time levels as fractions of the initial error (10 % and 90 %).
+    settle_bands : (float, float)
+        Settling bands as fractions of the initial error (2 % and 5 %).
+
+    Returns
+    -------
+    StepInfo
+        Of the progress ``y``: times [s] from ``t_step``, percentages of the initial error.
+
+    Examples
+    --------
     >>> t = np.linspace(0.0, 10.0, 10001)
     >>> ref = np.c_[2.0 * np.cos(t), 2.0 * np.sin(t)]        # circle, starts 2 m away
     >>> act = ref * (1.0 - np.exp(-t))[:, None]                # error 2 exp(-t) m
@@ -300,16 +364,28 @@ def _time_major(name: str, a, n_t: int) -> np.ndarray:
 def tracking_errors(t, actual, reference, *, t_from=None) -> dict[str, np.ndarray]:
     """RMS and maximum tracking error over time, trapezoid-weighted in time.
 
-    ``actual`` and ``reference`` are (L,) or (..., L, n_axes), broadcast against each
-    other (e.g. (N, L, 3) positions of N vehicles and one (L, 3) reference; a scalar
-    reference is a constant); the time
-    axis is the second-last and ``t`` (L,) is shared. The error at each time is the
-    Euclidean norm over the axes. ``t_from`` skips the transient: the window is
-    ``[t_from, t[-1]]`` with the error interpolated at ``t_from``.
+    The error at each time is the Euclidean norm over the axes.
 
-    Returns ``rmse`` = sqrt(integral |e|^2 dt / duration) and ``max_error`` of shape
-    (...), and ``rmse_axes`` (per axis) of shape (..., n_axes).
+    Parameters
+    ----------
+    t : array_like, shape (L,)
+        Sample times [s], strictly increasing, shared by every row.
+    actual, reference : array_like, shape (L,) or (..., L, n_axes)
+        The response and what it tracks [m, or any unit, the same for both], with time
+        on the second-last axis, broadcast against each other (e.g. (N, L, 3) positions
+        of N vehicles and one (L, 3) reference; a scalar reference is a constant).
+    t_from : float, optional
+        Start of the window [s], to skip the transient: the window is ``[t_from, t[-1]]``
+        with the error interpolated at ``t_from``; default ``t[0]``.
 
+    Returns
+    -------
+    dict of ndarray
+        ``rmse`` = sqrt(integral |e|^2 dt / duration) and ``max_error``, of shape (...),
+        and ``rmse_axes`` (per axis) of shape (..., n_axes), in the unit of the inputs.
+
+    Examples
+    --------
     >>> t = np.array([0.0, 1.0, 3.0])                 # non-uniform grid
     >>> out = tracking_errors(t, np.c_[[1.0, 1.0, 1.0], [0.0, 0.0, 0.0]], np.zeros((3, 2)))
     >>> float(out["rmse"]), float(out["max_error"]), out["rmse_axes"]
@@ -337,10 +413,21 @@ def tracking_errors(t, actual, reference, *, t_from=None) -> dict[str, np.ndarra
 def control_effort(t, u) -> dict[str, np.ndarray]:
     """Integral over time of the sum of squared inputs (trapezoid) and its time mean.
 
-    ``u`` is (L,) or (..., L, m) with the time axis second-last; subtract a trim (e.g.
-    the hover duty) first to measure effort about it. Returns ``integral`` [unit^2 s]
-    and ``mean`` [unit^2] of shape (...).
+    Parameters
+    ----------
+    t : array_like, shape (L,)
+        Sample times [s], strictly increasing.
+    u : array_like, shape (L,) or (..., L, m)
+        The inputs (e.g. rotor duties [-]), with time on the second-last axis; subtract a
+        trim (e.g. the hover duty) first to measure effort about it.
 
+    Returns
+    -------
+    dict of ndarray, shape (...)
+        ``integral`` [unit^2 s] and ``mean`` (the integral over the duration) [unit^2].
+
+    Examples
+    --------
     >>> out = control_effort([0.0, 1.0, 2.0], np.c_[[1.0, 1.0, 1.0], [0.0, 1.0, 0.0]])
     >>> float(out["integral"]), float(out["mean"])
     (3.0, 1.5)
@@ -355,9 +442,23 @@ def time_in_saturation(t, flags) -> dict[str, np.ndarray]:
     """Seconds and fraction of the record during which ``flags`` is set (nonzero).
 
     Sample-and-hold: sample k holds from t[k] to t[k + 1], so the last sample adds no
-    time. ``flags`` is (L,) or (..., L) with time on the last axis (e.g. (N, L) for a
-    batch). Returns ``seconds`` and ``fraction`` (of ``t[-1] - t[0]``) of shape (...).
+    time.
 
+    Parameters
+    ----------
+    t : array_like, shape (L,)
+        Sample times [s], strictly increasing.
+    flags : array_like, shape (L,) or (..., L)
+        Saturation flags (any nonzero value is set), time on the last axis (e.g. (N, L)
+        for a batch).
+
+    Returns
+    -------
+    dict of ndarray, shape (...)
+        ``seconds`` [s] and ``fraction`` (of ``t[-1] - t[0]``) [-].
+
+    Examples
+    --------
     >>> out = time_in_saturation([0.0, 1.0, 3.0, 4.0], [0, 1, 0, 1])
     >>> float(out["seconds"]), float(out["fraction"])
     (2.0, 0.5)
@@ -381,21 +482,41 @@ TRANSIENT_MIN_ERROR = 0.01
 def flight_metrics(result, *, transient_axis: str | None = None, transient_until: float | None = None):
     """Per-vehicle metrics of a :class:`~quadcruise.sim.result.SimResult`, as a DataFrame.
 
-    Columns: ``vehicle``, ``status``, ``rmse_m`` and ``max_error_m`` (3-D position error
-    over the whole flight), the transient of one axis (``axis``, ``rise_time_s``,
-    ``settling_time_s`` (2 %), ``settling_time_5pct_s``, ``overshoot_pct``), ``effort``
-    (integral of the sum of squared duties [s]), ``duty_clipped_s`` and
-    ``controller_limited_s``.
-
     The transient is measured on ``transient_axis``, or else on the stepped axis of a
     step mission (as a step response from the reference before the step to the one
     after, so a response that never arrives reads "did not settle"), or else on the
     axis with the largest initial tracking error (the circle's start offset, say), if it
-    exceeds TRANSIENT_MIN_ERROR; otherwise those columns are empty. A settling time that
-    does not exist (still outside the band at the end) is NaN, and so is every metric of
-    a vehicle that stopped early. ``transient_until`` [s] ends the window in which the
-    transient is measured (e.g. the first corner of a square, after which the reference
-    turns and the error grows again).
+    reaches :data:`TRANSIENT_MIN_ERROR`; otherwise those columns are empty. A settling
+    time that does not exist (still outside the band at the end) is NaN, and so is every
+    metric of a vehicle that stopped early.
+
+    Parameters
+    ----------
+    result : SimResult
+        The flight (duck-typed: ``t``, ``states``, ``references``, ``commands``,
+        ``status``, ``meta`` and the saturation times are read).
+    transient_axis : {"x", "y", "z"}, optional
+        The axis whose transient is measured, instead of the one chosen as above.
+    transient_until : float, optional
+        End [s] of the window in which the transient is measured (e.g. the first corner
+        of a square, after which the reference turns and the error grows again).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per vehicle. Columns: ``vehicle``, ``status``, ``rmse_m`` and
+        ``max_error_m`` (3-D position error over the whole flight [m]), the transient of
+        one axis (``axis``, ``rise_time_s``, ``settling_time_s`` (2 %),
+        ``settling_time_5pct_s``, ``overshoot_pct``), ``effort`` (integral of the sum of
+        squared duties [s]), ``duty_clipped_s`` and ``controller_limited_s`` [s].
+
+    Examples
+    --------
+    >>> import quadcruise as qc
+    >>> res = qc.fly("step", duration=2.0)
+    >>> flight_metrics(res)[["vehicle", "status", "axis"]]
+       vehicle    status axis
+    0        0  finished    x
     """
     import pandas as pd
 

@@ -28,7 +28,28 @@ DID_NOT_SETTLE = "did not settle"
 
 
 def cell(value: Any, missing: str = "-") -> tuple[str, bool]:
-    """(text, is_number) of one value."""
+    """How one value reads in a table.
+
+    Parameters
+    ----------
+    value : Any
+        A number, bool, string or None; None and NaN are missing.
+    missing : str
+        The text of a missing value.
+
+    Returns
+    -------
+    text : str
+        4 significant digits (scientific notation below 1e-3 or from 1e7 on, thousands
+        separators from 1e4 on), ``yes``/``no`` for a bool, ``missing`` for None or NaN.
+    is_number : bool
+        True if ``text`` is a number (right-aligned in a table).
+
+    Examples
+    --------
+    >>> cell(3.14159), cell(12345.6), cell(None), cell(True)
+    (('3.142', True), ('12,346', True), ('-', False), ('yes', False))
+    """
     if value is None or (isinstance(value, float | np.floating) and math.isnan(value)):
         return missing, False
     if isinstance(value, bool | np.bool_):
@@ -46,8 +67,36 @@ def cell(value: Any, missing: str = "-") -> tuple[str, bool]:
 
 
 def metric_cell(value: Any, metric: Any, axis: Any, missing: str = "-") -> tuple[str, bool]:
-    """:func:`cell` of ``metric``'s value for a flight whose transient axis is ``axis``:
-    a missing settling time of a measured transient reads :data:`DID_NOT_SETTLE`."""
+    """:func:`cell` of ``metric``'s value for a flight whose transient axis is ``axis``.
+
+    A missing settling time of a measured transient reads :data:`DID_NOT_SETTLE`.
+
+    Parameters
+    ----------
+    value : Any
+        The metric's value.
+    metric : Any
+        The metric's name (a column of :func:`~quadcruise.metrics.flight_metrics`).
+    axis : Any
+        The flight's transient axis (``"x"``, ``"y"``, ``"z"``), None or empty if none
+        was measured.
+    missing : str
+        The text of a missing value.
+
+    Returns
+    -------
+    text : str
+        As :func:`cell` writes it, or :data:`DID_NOT_SETTLE`.
+    is_number : bool
+        True if ``text`` is a number.
+
+    Examples
+    --------
+    >>> metric_cell(float("nan"), "settling_time_s", "x")
+    ('did not settle', False)
+    >>> metric_cell(float("nan"), "settling_time_s", None)
+    ('-', False)
+    """
     text, number = cell(value, missing)
     measured = isinstance(axis, str) and bool(axis.strip())
     if text == missing and isinstance(metric, str) and metric.startswith("settling") and measured:
@@ -56,8 +105,21 @@ def metric_cell(value: Any, metric: Any, axis: Any, missing: str = "-") -> tuple
 
 
 def metrics_text(frame, labels) -> str:
-    """A table of metrics, one row per flight (with an ``axis`` column), as aligned text
-    with the metrics down and the flights across, headed by ``labels``."""
+    """A table of metrics as aligned text, with the metrics down and the flights across.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        One row per flight, one column per metric (with an ``axis`` column, if any
+        transient was measured).
+    labels : sequence of str
+        The flights' column headings, one per row of ``frame``.
+
+    Returns
+    -------
+    str
+        The table, each value as :func:`metric_cell` writes it (see the module's example).
+    """
     import pandas as pd
 
     axes = frame["axis"].tolist() if "axis" in frame.columns else [None] * len(frame)

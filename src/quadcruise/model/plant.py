@@ -99,10 +99,18 @@ def derivative(x, u, vp, ext, full, dx):
 
     Parameters
     ----------
-    x : (16,) state; u : (4,) PWM duties, already in [0, 1];
-    vp : (PARAM_SIZE,) vehicle parameter row; ext : (EXT_SIZE,) external inputs;
-    full : bool, exact Euler-angle kinematics instead of the paper's simplification;
-    dx : (16,) output.
+    x : ndarray, shape (16,)
+        The state, in the SI units of :data:`quadcruise.layout.STATE_UNITS`.
+    u : ndarray, shape (4,)
+        PWM duties [-], already in [0, 1].
+    vp : ndarray, shape (PARAM_SIZE,)
+        The vehicle parameter row (:mod:`quadcruise.layout`).
+    ext : ndarray, shape (EXT_SIZE,)
+        External inputs: force [N], torque [N m], wind [m/s], rotor effectiveness [-].
+    full : bool
+        Exact Euler-angle kinematics instead of the paper's simplification.
+    dx : ndarray, shape (16,)
+        Output: the state's time derivative [unit/s].
     """
     derivative_at(x, math.sin(x[PHI]), math.cos(x[PHI]), math.sin(x[THETA]), math.cos(x[THETA]),
                   math.sin(x[PSI]), math.cos(x[PSI]), u, vp, ext, full, dx)
@@ -110,8 +118,32 @@ def derivative(x, u, vp, ext, full, dx):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def derivative_at(x, sphi, cphi, sth, cth, spsi, cpsi, u, vp, ext, full, dx):
-    """:func:`derivative` given the sines and cosines of the state's phi, theta and psi (the
-    integrator carries them from one RK4 stage to the next: :func:`quadcruise.sim.engine.rk4_step`)."""
+    """:func:`derivative` given the sines and cosines of the state's phi, theta and psi.
+
+    The integrator carries them from one RK4 stage to the next
+    (:func:`quadcruise.sim.engine.rk4_step`).
+
+    Parameters
+    ----------
+    x : ndarray, shape (16,)
+        The state, in the SI units of :data:`quadcruise.layout.STATE_UNITS`.
+    sphi, cphi : float
+        sin and cos of ``x[PHI]`` [-].
+    sth, cth : float
+        sin and cos of ``x[THETA]`` [-].
+    spsi, cpsi : float
+        sin and cos of ``x[PSI]`` [-].
+    u : ndarray, shape (4,)
+        PWM duties [-], already in [0, 1].
+    vp : ndarray, shape (PARAM_SIZE,)
+        The vehicle parameter row.
+    ext : ndarray, shape (EXT_SIZE,)
+        External inputs: force [N], torque [N m], wind [m/s], rotor effectiveness [-].
+    full : bool
+        Exact Euler-angle kinematics instead of the paper's simplification.
+    dx : ndarray, shape (16,)
+        Output: the state's time derivative [unit/s].
+    """
     inv_m = vp[P_INV_M]                          # 1/m and 1/J come with the row: no division
     p, q, r = x[P], x[Q], x[R]
     U1, U2, U3, U4 = mix(x[F1], x[F2], x[F3], x[F4], vp[P_D])             # (1)-(4)

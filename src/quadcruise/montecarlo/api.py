@@ -65,7 +65,10 @@ def montecarlo(mission: Mission | str = "circle", controller: Controller | str =
 
     Parameters
     ----------
-    mission, controller : names or objects
+    mission : Mission or str
+        The mission, or its name for the defaults.
+    controller : Controller or str
+        The controller, or its name for the defaults.
     population : Population
         The spreads; none (n identical vehicles) by default.
     n : int
@@ -85,20 +88,30 @@ def montecarlo(mission: Mission | str = "circle", controller: Controller | str =
         processes (the machine's cores by default), one thread each — its worker processes
         are spawned, so a script using it needs that guard; "tcp://host:port": an existing
         Dask cluster (unreachable: InputError).
-    out : folder, optional
+    workers : int, optional
+        Worker processes of the "local" cluster; the machine's cores by default.
+    out : str or pathlib.Path, optional
         Stream each chunk to ``out/chunks`` as it finishes and write the results at the end
         (see :mod:`quadcruise.montecarlo.store`). A folder holding part of the same sweep is resumed.
-    resume, force : bool
-        resume=False flies everything again; force replaces a folder holding something else.
-    fmt : "csv" or "parquet"
+    resume : bool
+        Load the chunks of this same sweep found in ``out`` instead of flying them again.
+    force : bool
+        Replace a folder holding something else (else InputError).
+    fmt : {"csv", "parquet"}
         Format of the flights table.
     progress : callable, optional
         ``progress(done, total)`` after each chunk (flights done, resumed ones included);
-        :class:`quadcruise.progress.ProgressBar` prints a line on stderr.
+        :class:`quadcruise.montecarlo.progress.ProgressBar` prints a line on stderr.
     connect_timeout : float
-        Seconds to wait for a scheduler given by address.
+        Time to wait for a scheduler given by address [s].
     **spec_options
-        More :class:`MonteCarloSpec` fields: duration, dt, vehicle, log_dt, settle_band, ...
+        More :class:`MonteCarloSpec` fields: duration [s], dt [s], vehicle, log_dt [s],
+        settle_band, ...
+
+    Returns
+    -------
+    MonteCarloResult
+        One table row per flight, the kept paths, the summary and how it ran.
     """
     spec_fields = [f.name for f in dataclasses.fields(MonteCarloSpec) if f.init]
     reject_unknown("montecarlo()", {k: v for k, v in spec_options.items() if k not in spec_fields},

@@ -10,13 +10,35 @@ __all__ = ["compare_population"]
 
 
 def compare_population(mission, controllers, population, n: int, seed: int, **montecarlo_kw):
-    """The controllers on the *same* Monte Carlo population: every controller flies the
-    same n perturbed vehicles (same seed, so the same draws, gusts and noise).
+    """The controllers on the *same* Monte Carlo population.
 
-    Returns a DataFrame, one row per controller: the failure rate and the median (p50) and
-    p95 of RMSE, maximum error and the 5 % settling time. ``montecarlo_kw`` goes to
-    :func:`quadcruise.montecarlo.montecarlo` (duration, dt, scheduler, ...).
+    Every controller flies the same n perturbed vehicles (same seed, so the same draws,
+    gusts and noise).
 
+    Parameters
+    ----------
+    mission : Mission or str
+        The mission, or its name.
+    controllers : str, sequence or mapping
+        The controllers, labelled as :func:`quadcruise.workflows.compare.labelled` does.
+    population : Population or None
+        The spreads.
+    n : int
+        Number of flights per controller.
+    seed : int
+        The population's seed.
+    **montecarlo_kw
+        Keywords of :func:`quadcruise.montecarlo.montecarlo` (duration, dt, scheduler, ...).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per controller, indexed by label: ``flights``, ``failure_rate`` [-], and
+        the median (p50) and p95 of ``rmse_m``, ``max_error_m`` [m] and
+        ``settling_time_5pct_s`` [s].
+
+    Examples
+    --------
     >>> from quadcruise.montecarlo import Population
     >>> t = compare_population("step", ["nlpd", "gonzalez"], Population(mass_spread=0.05), n=4, seed=1,
     ...                        duration=3.0, scheduler="none")

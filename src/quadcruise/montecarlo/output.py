@@ -21,8 +21,27 @@ __all__ = ["write_outputs", "write_case", "case_folder", "report_markdown"]
 
 
 def write_outputs(result, out, *, fmt: str = "csv", force: bool = False) -> Path:
-    """The results of a sweep into ``out`` (see :mod:`quadcruise.montecarlo.store`), each file
-    whole or not at all; quadcruise.json last, marked complete."""
+    """The results of a sweep into ``out`` (see :mod:`quadcruise.montecarlo.store`).
+
+    Each file is written whole or not at all; quadcruise.json last, marked complete. A
+    folder holding this sweep's chunks is completed in place.
+
+    Parameters
+    ----------
+    result : MonteCarloResult
+        The sweep.
+    out : str or os.PathLike
+        The folder.
+    fmt : str
+        Format of the flights table: ``"csv"`` or ``"parquet"``.
+    force : bool
+        Replace a folder that holds something else (else InputError).
+
+    Returns
+    -------
+    pathlib.Path
+        The folder written.
+    """
     from quadcruise.plots.flight import save_figure
 
     path = Path(out)
@@ -52,8 +71,27 @@ def write_outputs(result, out, *, fmt: str = "csv", force: bool = False) -> Path
 
 
 def write_case(case, out, *, fmt: str = "csv", force: bool = False) -> Path:
-    """One re-flown vehicle into ``out``, whole or not at all: its traces, its row
-    (case.json), a figure of the flight and quadcruise.json."""
+    """One re-flown vehicle into ``out``, whole or not at all.
+
+    The folder holds its traces (``traces.csv`` or ``.parquet``), its row (case.json), a
+    figure of the flight (flight.png) and quadcruise.json.
+
+    Parameters
+    ----------
+    case : Case
+        The vehicle flown again (:func:`~quadcruise.montecarlo.montecarlo_case`).
+    out : str or os.PathLike
+        The folder.
+    fmt : str
+        Format of the traces: ``"csv"`` or ``"parquet"``.
+    force : bool
+        Replace a non-empty folder that quadcruise did not write (else InputError).
+
+    Returns
+    -------
+    pathlib.Path
+        The folder written.
+    """
     from quadcruise.plots.flight import plot_flight, save_figure
 
     path = check_output_dir(out, force)
@@ -108,7 +146,24 @@ def case_folder(out, spec, case: int, *, force: bool = False) -> Path | None:
 
 
 def report_markdown(result, summary: dict, worst, table_name: str) -> str:
-    """report.md: what was flown, the failures, the quantiles, the worst flights, figures."""
+    """report.md: what was flown, the failures, the quantiles, the worst flights, figures.
+
+    Parameters
+    ----------
+    result : MonteCarloResult
+        The sweep.
+    summary : dict
+        ``result.summary()``.
+    worst : pandas.DataFrame
+        ``result.worst(k)``; the first 10 rows are listed.
+    table_name : str
+        The flights table's file name.
+
+    Returns
+    -------
+    str
+        The Markdown text.
+    """
     spec = result.spec
     pop = {k: v for k, v in spec.population.to_dict().items() if v not in (0.0, None)}
     f = summary["failures"]

@@ -43,7 +43,7 @@ CLIP = {"normal": 3.0, "uniform": math.sqrt(3.0)}
 class Population:
     """How the vehicles of a sweep differ from the nominal one.
 
-    Attributes
+    Parameters
     ----------
     mass_spread, inertia_spread, thrust_spread, bandwidth_spread, yaw_arm_spread : float
         Relative standard deviations of m; of Jxx, Jyy, Jzz (each drawn on its own); of the
@@ -57,14 +57,23 @@ class Population:
         Standard deviation [m/s] of a steady horizontal wind on x and on y, drawn per vehicle
         and added to the environment's steady wind.
     distribution : {"normal", "uniform"}
+        The distribution of the unit draws.
     environment : Environment, optional
         Wind, gust, turbulence, rotor loss, the same for every vehicle (turbulence differs by
         vehicle through its random stream). Wind acts through drag: a vehicle without drag
         gets :data:`~quadcruise.disturbances.DEFAULT_DRAG` (with a warning).
     noise : SensorNoise, optional
+        Sensor noise and delay, the same for every vehicle (the noise itself differs by
+        vehicle through its random stream).
     model_error : bool
         The controller computes with the nominal vehicle (True) or knows each vehicle's
         drawn parameters (False).
+
+    Raises
+    ------
+    InputError
+        For a negative or too large spread, an unknown distribution, or an environment or
+        noise that is not the same for every vehicle.
 
     Examples
     --------
@@ -124,7 +133,23 @@ class Population:
         return self.wind_spread > 0 or (self.environment is not None and self.environment.needs_drag)
 
     def unit_draws(self, seed: int, first: int, count: int) -> np.ndarray:
-        """(count, 16) unit draws of vehicles first .. first + count - 1 (see the module)."""
+        """The unit draws of vehicles first .. first + count - 1 (see the module).
+
+        Parameters
+        ----------
+        seed : int
+            The sweep's seed.
+        first : int
+            Index of the first vehicle.
+        count : int
+            Number of vehicles.
+
+        Returns
+        -------
+        ndarray, shape (count, 16)
+            Unit draws [-]: standard normal clipped to [-3, 3], or uniform on
+            [-sqrt 3, sqrt 3]; column :data:`SLOTS` feeds each quantity.
+        """
         out = np.empty((count, N_DRAWS))
         normal = self.distribution == "normal"
         for k in range(count):
@@ -134,7 +159,26 @@ class Population:
         return np.clip(out, -clip, clip) if normal else clip * (2.0 * out - 1.0)
 
     def draw(self, seed: int, first: int, count: int, nominal: Vehicle, dt: float = 1e-3) -> "Draw":
-        """The vehicles first .. first + count - 1: parameters, offsets and environment."""
+        """The vehicles first .. first + count - 1: parameters, offsets and environment.
+
+        Parameters
+        ----------
+        seed : int
+            The sweep's seed.
+        first : int
+            Index of the first vehicle.
+        count : int
+            Number of vehicles.
+        nominal : Vehicle
+            The nominal vehicle (not batched).
+        dt : float
+            Control period [s] (unused: the draws do not depend on it).
+
+        Returns
+        -------
+        Draw
+            The batched vehicles and what was drawn for them.
+        """
         if nominal.batch_size is not None:
             raise InputError("the nominal vehicle of a population must not be batched")
         z = self.unit_draws(seed, first, count)
@@ -160,7 +204,13 @@ class Population:
         return Draw(vehicle=vehicle, offsets=offsets, environment=env, sensors=self.noise, columns=cols)
 
     def to_dict(self) -> dict:
-        """Plain values, for the result folder."""
+        """Plain values, for the result folder.
+
+        Returns
+        -------
+        dict
+            Field name -> value; the environment and the noise as their ``to_dict()``.
+        """
         out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         for key in ("environment", "noise"):
             out[key] = None if out[key] is None else out[key].to_dict()
@@ -169,8 +219,24 @@ class Population:
 
 @dataclass(frozen=True)
 class Draw:
-    """A chunk's drawn vehicles (batched), initial offsets [m], environment (per-vehicle
-    wind where drawn), sensor noise, and the drawn values as table columns."""
+    """A chunk's drawn vehicles and what was drawn for them (:meth:`Population.draw`).
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+        The vehicles, batched (one value per vehicle of each drawn parameter).
+    offsets : ndarray, shape (count, 3)
+        Initial position offsets [m] on x, y, z.
+    environment : Environment or None
+        The disturbances, with a per-vehicle steady wind [m/s] where one was drawn; None
+        if there are none.
+    sensors : SensorNoise or None
+        The sensor noise and delay.
+    columns : dict of str to ndarray
+        The drawn values as table columns: ``m`` [kg], ``Jxx``, ``Jyy``, ``Jzz``
+        [kg m^2], ``K`` [N], ``omega`` [rad/s], ``d`` [m], ``dx0``, ``dy0``, ``dz0`` [m],
+        ``wind_x``, ``wind_y`` [m/s].
+    """
 
     vehicle: Vehicle
     offsets: np.ndarray

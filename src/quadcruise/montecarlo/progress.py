@@ -20,6 +20,20 @@ class ProgressBar:
     ``log_interval`` seconds (and the last one). The rate counts the flights flown since
     the first call (flights resumed from disk are done but not flown).
 
+    Parameters
+    ----------
+    stream : file-like, optional
+        Where to write; ``sys.stderr`` by default. A stream whose ``isatty()`` is true is
+        a terminal.
+    label : str
+        What is counted, e.g. ``"flights"``.
+    min_interval : float
+        Shortest time between two updates on a terminal [s].
+    log_interval : float
+        Shortest time between two lines elsewhere [s].
+
+    Examples
+    --------
     >>> import io
     >>> buf = io.StringIO()
     >>> bar = ProgressBar(buf)

@@ -25,9 +25,21 @@ __all__ = ["MonteCarloResult", "Traces", "FAILURES", "COLUMNS", "METRICS"]
 
 @dataclass
 class Traces:
-    """The kept paths: vehicle indices (k,), times (L,), positions and references (k, L, 3),
-    ``sample`` (k,): True for the random sample (the first vehicles), False for extra
-    failures."""
+    """The kept paths of a sweep.
+
+    Parameters
+    ----------
+    vehicle : ndarray of int, shape (k,)
+        The vehicles' indices.
+    t : ndarray, shape (L,)
+        Sample times [s].
+    pos : ndarray, shape (k, L, 3)
+        Positions [m] (NaN after a vehicle stopped).
+    ref : ndarray, shape (k, L, 3)
+        References [m].
+    sample : ndarray of bool, shape (k,)
+        True for the random sample (the first vehicles), False for extra failures.
+    """
 
     vehicle: np.ndarray
     t: np.ndarray
@@ -40,15 +52,20 @@ class Traces:
 class MonteCarloResult:
     """A finished sweep: one table row per flight, the kept paths, and how it ran.
 
-    Attributes
+    :func:`quadcruise.montecarlo.montecarlo` builds it.
+
+    Parameters
     ----------
     spec : MonteCarloSpec
+        What was flown.
     table : pandas.DataFrame
         One row per flight, sorted by vehicle index (see :data:`COLUMNS`), plus ``reason``
         (the failure as text).
     traces : Traces
+        The kept paths.
     info : dict
-        Scheduler, workers, chunk size, chunks flown and resumed, wall time, output folder.
+        Scheduler, workers, chunk size, chunks flown and resumed, wall time [s], output
+        folder.
     """
 
     failure_names: ClassVar[tuple] = FAILURES
@@ -104,9 +121,18 @@ class MonteCarloResult:
         return Summary(self.summary_data(), self.summary_text())
 
     def summary_data(self) -> dict:
-        """Failure rate by reason (each flight counted once, under the first of diverged,
-        saturated, did not settle), the engine's stop reasons, and p5/p50/p95/max/mean of
-        each metric over the flights where it is defined (``count`` of them)."""
+        """Failure rate by reason, the engine's stop reasons, and quantiles of each metric.
+
+        Returns
+        -------
+        dict
+            ``flights``, ``seed``; ``failures``: ``count``, ``rate`` and ``by_reason``
+            (each flight counted once, under the first of diverged, saturated, did not
+            settle: ``count`` and ``rate`` each); ``stopped``: the engine's stop reason ->
+            count; ``metrics``: for each of :data:`METRICS`, ``count`` (flights where it is
+            defined), ``p5``, ``p50``, ``p95``, ``max`` and ``mean`` over them, in the
+            metric's unit (None when no flight defines it).
+        """
         from quadcruise.sim.status import STATUS_REASONS
 
         tab = self.table
@@ -128,7 +154,14 @@ class MonteCarloResult:
                 "stopped": stops, "metrics": metrics}
 
     def summary_text(self) -> str:
-        """The summary as aligned text (for the terminal)."""
+        """The summary as aligned text (for the terminal).
+
+        Returns
+        -------
+        str
+            A headline (flights, controller, mission, seed, failures), a line per failure
+            reason, and a line per metric with its count, p5, p50, p95 and max.
+        """
         s = self.summary_data()
         f = s["failures"]
         lines = [f"{s['flights']:,} flights of {self.spec.controller.name} on {self.spec.mission.name}, "
@@ -142,9 +175,30 @@ class MonteCarloResult:
         return "\n".join(lines)
 
     def worst(self, k: int = 10, by: str = "rmse_m"):
-        """The k worst flights: failures first (diverged, earliest stop first; then saturated,
-        then did not settle), then by ``by``, largest first. Each row has the ``vehicle``
-        index and the ``seed``: :func:`~quadcruise.montecarlo.replay_case` flies it again alone."""
+        """The k worst flights.
+
+        Failures come first (diverged, earliest stop first; then saturated, then did not
+        settle), then the flights by ``by``, largest first.
+
+        Parameters
+        ----------
+        k : int
+            How many.
+        by : str
+            The column that ranks the flights within each outcome (a metric of
+            :data:`METRICS`).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Rows of :attr:`table` with the ``seed`` inserted after ``vehicle``:
+            :func:`~quadcruise.montecarlo.replay_case` flies one again alone.
+
+        Raises
+        ------
+        InputError
+            If ``by`` is not a column of the table.
+        """
         if by not in self.table.columns:
             raise InputError(f"unknown metric {by!r}; choose one of {', '.join(METRICS)}")
         tab = self.table
@@ -176,31 +230,80 @@ class MonteCarloResult:
         return self.worst(k, by)[cols].to_string(index=False, float_format=lambda v: f"{v:.4g}")
 
     def case(self, i: int, **kw):
-        """:func:`~quadcruise.montecarlo.replay_case` of vehicle i."""
+        """Vehicle i flown again alone (:func:`~quadcruise.montecarlo.replay_case`).
+
+        Parameters
+        ----------
+        i : int
+            The vehicle's index.
+        **kw
+            Keywords of :func:`~quadcruise.montecarlo.montecarlo_case` (``log_every``).
+
+        Returns
+        -------
+        Case
+            The vehicle's index, its flight (logged at the spec's rate unless
+            ``log_every`` says otherwise) and its table row.
+        """
         from quadcruise.montecarlo.chunk import replay_case
 
         return replay_case(self, i, **kw)
 
     def plot_histograms(self, metrics=None):
         """Histograms of the metrics (finite values; lines at 5 %, median, 95 %) and a bar
-        chart of the outcomes: a matplotlib Figure. ``metrics``: column names (by default
-        :data:`quadcruise.plots.montecarlo.HISTOGRAM_METRICS`)."""
+        chart of the outcomes.
+
+        Parameters
+        ----------
+        metrics : sequence of str, optional
+            Columns to draw; by default
+            :data:`quadcruise.plots.montecarlo.HISTOGRAM_METRICS`.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            See :func:`quadcruise.plots.montecarlo.plot_histograms`.
+        """
         from quadcruise.plots.montecarlo import plot_histograms
 
         return plot_histograms(self, metrics)
 
     def plot_envelope(self):
-        """Top view of the kept paths (the first vehicles; failures in orange, diverged in
-        red, with their first extra failures) and the median and 5-95 % band of the
-        position error of the first vehicles against time: a matplotlib Figure."""
+        """Top view of the kept paths and the spread of the position error.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            The kept paths from above (the first vehicles and the first extra failures;
+            diverged in red, other failures in orange) and the median and 5-95 % band of
+            the position error [m] of the first vehicles against time [s]
+            (:func:`quadcruise.plots.montecarlo.plot_envelope`).
+        """
         from quadcruise.plots.montecarlo import plot_envelope
 
         return plot_envelope(self)
 
     def write(self, out: str | Path, *, fmt: str = "csv", force: bool = False) -> Path:
-        """Write flights.csv (or .parquet), summary.json, worst.csv, histograms.png,
-        envelope.png, report.md and quadcruise.json into ``out``, each file whole or not at
-        all. A folder holding the chunks of this same sweep is completed in place."""
+        """Write the sweep's folder, each file whole or not at all.
+
+        It holds flights.csv (or .parquet), summary.json, worst.csv, histograms.png,
+        envelope.png, report.md and quadcruise.json. A folder holding the chunks of this
+        same sweep is completed in place.
+
+        Parameters
+        ----------
+        out : str or pathlib.Path
+            The folder.
+        fmt : str
+            Format of the flights table: ``"csv"`` or ``"parquet"``.
+        force : bool
+            Replace a folder that holds something else (else InputError).
+
+        Returns
+        -------
+        pathlib.Path
+            The folder written.
+        """
         from quadcruise.montecarlo.output import write_outputs
 
         return write_outputs(self, out, fmt=fmt, force=force)

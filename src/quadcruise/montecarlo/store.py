@@ -72,15 +72,47 @@ def _marker(path: Path) -> dict | None:
 
 
 def holds_sweep(path: Path, spec: MonteCarloSpec) -> tuple[dict | None, bool]:
-    """(the quadcruise.json of folder ``path``, or None; whether it is this very sweep:
-    a Monte Carlo folder of the same spec hash)."""
+    """What folder ``path`` holds, and whether it is this very sweep.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The folder; it need not exist.
+    spec : MonteCarloSpec
+        The sweep.
+
+    Returns
+    -------
+    meta : dict or None
+        The folder's quadcruise.json, or None if it has none (or it is unreadable).
+    same : bool
+        True if it is a Monte Carlo folder of the same spec hash.
+    """
     meta = _marker(path) if path.is_dir() else None
     return meta, bool(meta) and meta.get("workflow") == "montecarlo" and meta.get("spec_hash") == spec.hash()
 
 
 class SweepFolder:
     """The output folder of a sweep: checked at construction (nothing is written), then
-    :meth:`prepare` (marker), :meth:`write_chunk`."""
+    :meth:`prepare` (marker), :meth:`write_chunk`.
+
+    Parameters
+    ----------
+    out : str or os.PathLike
+        The folder.
+    spec : MonteCarloSpec
+        The sweep.
+    force : bool
+        Replace a folder that holds something else.
+    resume : bool
+        Load the chunks of this same sweep found in the folder.
+
+    Raises
+    ------
+    InputError
+        If the folder holds another sweep or another result and not ``force``, or
+        something quadcruise did not write (see :func:`~quadcruise.io.check_output_dir`).
+    """
 
     def __init__(self, out, spec: MonteCarloSpec, *, force: bool, resume: bool) -> None:
         self.path = check_output_dir(out, force)
@@ -95,20 +127,56 @@ class SweepFolder:
         self.clear = self.path.is_dir() and any(self.path.iterdir()) and not self.resume
 
     def existing(self) -> Iterator[dict]:
+        """The chunks of this sweep already in the folder (none unless resuming).
+
+        Returns
+        -------
+        iterator of dict
+            Each chunk's arrays; unreadable or foreign chunk files are skipped with a
+            warning (their flights are flown again).
+        """
         return _read_chunks(self.path, self.hash) if self.resume else iter(())
 
     def prepare(self, n: int, chunk_size: int) -> None:
+        """Clear a folder that is not resumed, and write the marker (not complete).
+
+        Parameters
+        ----------
+        n : int
+            Number of flights of the sweep.
+        chunk_size : int
+            Vehicles per chunk.
+        """
         if self.clear:
             shutil.rmtree(self.path)
         (self.path / CHUNKS).mkdir(parents=True, exist_ok=True)
         write_marker(self.path, self.spec, n, chunk_size=chunk_size, complete=False)
 
     def write_chunk(self, chunk: dict) -> None:
+        """Write one chunk as ``chunks/chunk-<first>.npz``, whole or not at all.
+
+        Parameters
+        ----------
+        chunk : dict of str to ndarray
+            The chunk's arrays, with its ``first`` vehicle and the spec ``hash``.
+        """
         _write_chunk(self.path, chunk)
 
 
 def write_marker(path: Path, spec: MonteCarloSpec, n: int, **extra: Any) -> None:
-    """quadcruise.json of a sweep folder, whole or not at all."""
+    """quadcruise.json of a sweep folder, whole or not at all.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The folder.
+    spec : MonteCarloSpec
+        The sweep: its hash, seed and fields are recorded.
+    n : int
+        Number of flights.
+    **extra : Any
+        More entries, e.g. ``complete``, ``chunk_size``, ``table``.
+    """
     doc = {"workflow": "montecarlo", "version": __version__, "code": code_digest()[:16], "spec_hash": spec.hash(),
            "n": n, "seed": spec.seed, **extra, "spec": spec.to_dict()}
     with atomic_path(path / MARKER) as tmp:

@@ -1,8 +1,8 @@
 """An animation of one vehicle's flight: top view and altitude, a moving marker and a trail.
 
 Frames are drawn by blitting on matplotlib's Agg canvas: the static part (reference,
-whole path, axes) is drawn once and only the moving artists are drawn per frame, which is
-many times faster than redrawing the figure (as ``matplotlib.animation`` writers do). A GIF
+whole path, axes) is drawn once and only the moving artists are drawn per frame, instead
+of redrawing the whole figure for each frame (as ``matplotlib.animation`` writers do). A GIF
 is written with Pillow; an MP4 is piped to ffmpeg, which must be installed.
 
 Examples
@@ -72,16 +72,18 @@ def animate_flight(result, path, *, vehicle: int = 0, fps: float = 15, duration_
     Parameters
     ----------
     result : SimResult
+        The flight.
     path : str or Path
         ``.gif`` (Pillow), or ``.mp4`` if ffmpeg is installed.
     vehicle : int
         Which of the result's vehicles.
     fps : float
-        Frames per second of the animation.
+        Frames per second of the animation [1/s] (a GIF shows each frame for at least
+        20 ms, so it plays at most 50 of them per second).
     duration_s : float, optional
         Length of the animation [s]; by default the flight's (real time, up to the end of
         the flight or the instant the vehicle stopped). It has ``round(fps * duration_s)``
-        frames, evenly spread over the flight.
+        frames (at least 2), evenly spread over the flight.
     every : int, optional
         Instead, one frame per ``every`` logged instants.
     trail_s : float, optional

@@ -30,7 +30,7 @@ STOP_STYLE = dict(color="tab:red", ls=":", lw=1.5)
 FLIGHT_MARGINS = dict(left=0.05, right=0.86, bottom=0.055, top=0.92, wspace=0.32, hspace=0.14)
 """The flight figure's grid in fractions of the figure, fixed rather than found by a
 layout engine: constrained layout draws the whole figure once more to measure it, which
-doubles the time to save it."""
+slows saving it (see docs/performance.md)."""
 
 MAX_DRAWN = 3000
 """Figures draw at most this many instants of a flight (a 60 s flight at 1 kHz has 60,001):
@@ -38,7 +38,19 @@ more are invisible at screen resolution and only slow the drawing down."""
 
 
 def drawable(result):
-    """The result, decimated to at most MAX_DRAWN logged instants for drawing."""
+    """The result, decimated to at most :data:`MAX_DRAWN` logged instants for drawing.
+
+    Parameters
+    ----------
+    result : SimResult
+        A flight.
+
+    Returns
+    -------
+    SimResult
+        ``result`` itself if it is short enough, else ``result.decimate(k)`` with the
+        smallest step ``k`` that fits.
+    """
     every = -(-len(result.t) // MAX_DRAWN)
     return result if every <= 1 else result.decimate(every)
 
@@ -59,7 +71,27 @@ def _names(result, vehicle: int = 0) -> tuple[str | None, str | None]:
 
 
 def describe(result, vehicle: int = 0) -> str:
-    """'<controller> on <mission>', or what the workflow was."""
+    """What a flight was, in a few words, for a title.
+
+    Parameters
+    ----------
+    result : SimResult
+        A flight; its ``meta`` is read.
+    vehicle : int
+        The vehicle whose mission is named, when each vehicle flew its own.
+
+    Returns
+    -------
+    str
+        ``"<controller> on <mission>"``, ``"open-loop replay of <file>"``, or whichever of
+        the controller, the mission and the workflow is recorded (``"flight"`` if none).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> describe(SimpleNamespace(meta={"controller": {"name": "nlpd"}, "mission": {"kind": "step"}}))
+    'nlpd on step'
+    """
     name, kind = _names(result, vehicle)
     meta = result.meta or {}
     if name and kind:
@@ -137,6 +169,7 @@ def plot_flight(result, vehicle: int = 0, *, title: str | None = None) -> Figure
     Parameters
     ----------
     result : SimResult
+        The flight; more than :data:`MAX_DRAWN` logged instants are thinned for drawing.
     vehicle : int
         Which of the result's vehicles to draw.
     title : str, optional
@@ -244,6 +277,7 @@ def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None) -> 
     vehicle : int
         Which vehicle of each result to draw.
     title : str, optional
+        Figure title; by default the labels joined by " vs " and the mission's kind.
 
     Returns
     -------
@@ -251,6 +285,11 @@ def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None) -> 
         Three axes: the top view (equal scale), x [m] and y [m] against time [s]. The
         reference is taken from the first flight that has a finite one; a flight that
         stopped early ends with a red cross and its label says when.
+
+    Raises
+    ------
+    ValueError
+        If ``results`` is empty.
     """
     if not results:
         raise ValueError("plot_paths needs at least one result")
@@ -311,6 +350,7 @@ def plot_envelope(result, *, title: str | None = None, max_paths: int = 50) -> F
     result : SimResult
         A batched flight.
     title : str, optional
+        Figure title; by default what the flight was and the number of vehicles.
     max_paths : int
         At most this many paths are drawn in the top view: those of stopped vehicles
         first, then evenly picked finished ones.
@@ -370,7 +410,22 @@ def plot_envelope(result, *, title: str | None = None, max_paths: int = 50) -> F
 
 
 def plot_reference(result, *, vehicle: int = 0, title: str | None = None) -> Figure:
-    """The reference path of a flight in 3-D with the vehicle's start (the paper's Fig 4)."""
+    """The reference path of a flight in 3-D with the vehicle's start (the paper's Fig 4).
+
+    Parameters
+    ----------
+    result : SimResult
+        The flight.
+    vehicle : int
+        The vehicle whose reference and start are drawn.
+    title : str, optional
+        Axes title; none by default.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One 3-D axes, x, y, z [m]: the reference dashed, the start as a dot.
+    """
     fig = Figure(figsize=(7, 6), layout="constrained")
     ax = fig.add_subplot(projection="3d")
     ref = result.references[vehicle]
@@ -391,6 +446,13 @@ def save_figure(fig: Figure, path: str | os.PathLike) -> None:
 
     The temporary file that :func:`quadcruise.io.atomic_path` hands out ends in
     ``.tmp``, so the format is given explicitly rather than taken from the suffix.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : str or os.PathLike
+        The file to write (PNG whatever its suffix); its folder is created if missing.
     """
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=120)

@@ -22,8 +22,22 @@ HISTOGRAM_METRICS = ("rmse_m", "max_error_m", "final_error_m", "rise_time_s", "s
 
 
 def plot_histograms(result, metrics=None):
-    """Figure of :meth:`~quadcruise.montecarlo.result.MonteCarloResult.plot_histograms`
-    (``metrics``: column names; :data:`HISTOGRAM_METRICS` by default)."""
+    """Histograms of a sweep's metrics and a bar chart of its outcomes.
+
+    Parameters
+    ----------
+    result : MonteCarloResult
+        The sweep (its ``table``, ``spec``, ``n`` and ``failure_names`` are read).
+    metrics : sequence of str, optional
+        Columns of the table to draw; :data:`HISTOGRAM_METRICS` by default.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel per metric (40 bins of its finite values, in the column's unit, with
+        lines at 5 %, the median and 95 %; "not measured" if none is finite), then the
+        count of flights per outcome (:data:`~quadcruise.montecarlo.result.FAILURES`).
+    """
     panels = list(HISTOGRAM_METRICS if metrics is None else metrics) + ["failures"]
     cols = 3
     rows = math.ceil(len(panels) / cols)
@@ -59,8 +73,20 @@ def plot_histograms(result, metrics=None):
 
 
 def plot_envelope(result):
-    """Top view of the kept paths (the first vehicles; failures in orange, diverged in
-    red) and the median and 5-95 % band of the position error of the sampled flights."""
+    """The kept paths of a sweep from above, and the spread of their position error.
+
+    Parameters
+    ----------
+    result : MonteCarloResult
+        The sweep (its ``traces``, ``table`` and ``spec`` are read).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two axes: the top view [m] of the kept paths (the first vehicles, and the extra
+        failures kept; diverged in red, other failures in orange) and the median and 5-95 %
+        band of the position error norm [m] of the sampled flights against time [s].
+    """
     tr = result.traces
     fig = Figure(figsize=(13, 5.5), layout="constrained")
     top, ax_e = fig.subplots(1, 2, width_ratios=(1, 1.4))

@@ -66,10 +66,33 @@ def _label(name) -> str:
 
 
 def table_html(frame) -> str:
-    """A DataFrame as an HTML table: numbers to 4 significant digits, NaN as "—", and a
-    NaN settling time of a measured transient (a non-empty ``axis``, as a column or, in a
-    transposed table, as a row) as "did not settle"; a status other than "finished" is
-    shown in red. A meaningful index (not 0, 1, 2, ...) is shown as the first column."""
+    """A DataFrame as an HTML table.
+
+    Numbers show 4 significant digits, NaN "—", and a NaN settling time of a measured
+    transient (a non-empty ``axis``, as a column or, in a transposed table, as a row)
+    "did not settle"; a status other than "finished" is shown in red. Column names become
+    headings with their unit (``rise_time_s`` -> "rise time [s]").
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The table; a meaningful index (not 0, 1, 2, ...) is shown as the first column(s).
+
+    Returns
+    -------
+    str
+        The ``<table>`` element, every text escaped.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> print(table_html(pd.DataFrame({"max_error_m": [0.012345]})))
+    <table>
+    <thead><tr><th>max error [m]</th></tr></thead>
+    <tbody>
+    <tr><td class="num">0.01235</td></tr>
+    </tbody></table>
+    """
     import pandas as pd
 
     rows_axis = frame["axis"] if "axis" in frame.columns else None
@@ -263,14 +286,16 @@ def html_report(*, title: str, tables: dict | None = None, figures: dict | None 
     Parameters
     ----------
     title : str
-    tables : dict of str to pandas.DataFrame
+        The page's title and heading.
+    tables : dict of str to pandas.DataFrame, optional
         Heading -> table, formatted by :func:`table_html`.
-    figures : dict of str to Figure, PNG bytes or PNG file path
+    figures : dict of str to Figure, PNG bytes or PNG file path, optional
         Caption -> figure, embedded as base64 PNG (100 dpi).
-    flights : dict
+    flights : dict, optional
         ``{label: SimResult}`` for one interactive 3-D view, or ``{view title: {label:
-        SimResult}}`` for several; paths are decimated to at most :data:`MAX_POINTS`.
-    config : dict
+        SimResult}}`` for several; paths are decimated to at most :data:`MAX_POINTS`
+        logged instants, and at most :data:`MAX_VEHICLES` vehicles of a batch are shown.
+    config : dict, optional
         The scenario or configuration that produced the report, shown as JSON.
     notes : str
         An HTML fragment inserted as is (see :func:`markdown_html` for text).
@@ -326,7 +351,20 @@ def html_report(*, title: str, tables: dict | None = None, figures: dict | None 
 
 
 def write_html_report(path, **kwargs) -> Path:
-    """Write :func:`html_report` (same keywords) to ``path``, whole or not at all."""
+    """Write :func:`html_report` to ``path``, whole or not at all.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The HTML file; its folder is created if missing.
+    **kwargs
+        Keywords of :func:`html_report`.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
     page = html_report(**kwargs)
     path = Path(path)
     with atomic_path(path) as tmp:
@@ -344,9 +382,25 @@ def _metrics_table(frame):
 
 
 def flight_report(result, *, title: str | None = None, metrics=None) -> dict:
-    """Keywords of :func:`html_report` for one flight (one ``fly``): its metrics, the run,
-    the flight figure (and the envelope of a batch), the 3-D view and ``result.meta``.
-    ``metrics``, if already computed (``result.metrics()``), saves computing them again."""
+    """Keywords of :func:`html_report` for one flight (one ``fly``).
+
+    Parameters
+    ----------
+    result : SimResult
+        The flight, of one vehicle or a batch.
+    title : str, optional
+        The page's title; by default "quadcruise: " and what the flight was.
+    metrics : pandas.DataFrame, optional
+        ``result.metrics()``, if already computed (saves computing them again).
+
+    Returns
+    -------
+    dict
+        ``title``, ``tables`` (the metrics, vehicles across for up to 6 vehicles, and the
+        run: controller, mission, duration [s], dt [s], vehicles, seed, version),
+        ``figures`` (the flight of vehicle 0, and the envelope of a batch), ``flights``
+        (the 3-D view) and ``config`` (``result.meta``).
+    """
     import pandas as pd
 
     from quadcruise.plots.flight import describe, plot_envelope, plot_flight
@@ -371,7 +425,22 @@ def flight_report(result, *, title: str | None = None, metrics=None) -> dict:
 
 
 def comparison_report(cmp, *, title: str | None = None) -> dict:
-    """Keywords of :func:`html_report` for a :class:`~quadcruise.workflows.compare.Comparison`."""
+    """Keywords of :func:`html_report` for a :class:`~quadcruise.workflows.compare.Comparison`.
+
+    Parameters
+    ----------
+    cmp : Comparison
+        The flights of several controllers.
+    title : str, optional
+        The page's title; by default the controllers and the mission.
+
+    Returns
+    -------
+    dict
+        ``title``, ``tables`` (the metrics by controller, transposed when every flight
+        has one vehicle), ``figures`` (the paths), ``flights`` (one 3-D view of all) and
+        ``config`` (:meth:`Comparison.to_dict` without the metrics).
+    """
     table = cmp.table()
     if all(r.n == 1 for r in cmp.results.values()):
         table = table.T   # metrics down, controllers across
@@ -386,9 +455,23 @@ def comparison_report(cmp, *, title: str | None = None) -> dict:
 def reproduction_report(rep, figures: dict | None = None, *, title: str | None = None) -> dict:
     """Keywords of :func:`html_report` for a :class:`~quadcruise.workflows.reproduce.Reproduction`.
 
-    ``figures`` maps captions to Figures, PNG bytes or PNG files (e.g. those that
-    :func:`~quadcruise.workflows.reproduce.write_reproduction` wrote); ``None`` draws them here.
-    The 3-D views show the circle and the square, each with every controller.
+    Parameters
+    ----------
+    rep : Reproduction
+        The runs.
+    figures : dict, optional
+        Caption -> Figure, PNG bytes or PNG file (e.g. those that
+        :func:`~quadcruise.workflows.reproduce.write_reproduction` wrote); ``None`` draws
+        them here.
+    title : str, optional
+        The page's title; by default the version and "reproduction of the paper".
+
+    Returns
+    -------
+    dict
+        ``title``, ``tables`` (each run beside the paper's numbers), ``figures``,
+        ``flights`` (3-D views of the circle and the square, each with every controller),
+        ``config`` and ``notes`` (where the numbers differ from the paper's, and why).
     """
     import pandas as pd
 
@@ -440,6 +523,19 @@ def markdown_html(text: str) -> str:
     """A little markdown as HTML: paragraphs, ``#`` headings, ``-`` lists, ``**bold**``,
     ``*italic*`` and ```code```; everything else is escaped.
 
+    Parameters
+    ----------
+    text : str
+        The markdown. Blocks are separated by blank lines; a heading of k ``#`` becomes
+        ``<h{k+1}>`` (the page's sections are ``<h2>``).
+
+    Returns
+    -------
+    str
+        The HTML fragment, one element per line.
+
+    Examples
+    --------
     >>> markdown_html("## Why\\n\\nThe **pole** at <1.")
     '<h3>Why</h3>\\n<p>The <strong>pole</strong> at &lt;1.</p>'
     """

@@ -32,20 +32,37 @@ from quadcruise.sim.status import STATUS_REASONS, ExitStatus
 class SimResult:
     """Logged flight of N vehicles.
 
-    Attributes
+    The engine builds it (:func:`quadcruise.simulate`, :func:`quadcruise.fly`, ...); the
+    columns of the arrays are named in :mod:`quadcruise.layout`.
+
+    Parameters
     ----------
-    t : (L,) logged instants [s]
-    states : (N, L, 16) state at each instant (NaN after a vehicle stopped)
-    commands : (N, L, 12) controller output computed at each instant
-    references : (N, L, 11) mission reference at each instant
-    final_state : (N, 16) state when each vehicle finished or stopped
-    status : (N,) exit status code, 0 = finished (see :data:`STATUS_REASONS`)
-    t_stop : (N,) time each vehicle finished or stopped [s]
-    memory : (N, C) the controllers' memory at the end
-    duty_clipped_s : (N,) time [s] during which a commanded duty was clipped to [0, 1]
-    controller_limited_s : (N,) time [s] during which the controller flagged a limit
-    meta : dict, the configuration, seed and version that produced the result
-    disturbance_memory : (N, D) the disturbance models' state at the end
+    t : ndarray, shape (L,)
+        Logged instants [s].
+    states : ndarray, shape (N, L, 16)
+        State at each instant (SI units of :data:`~quadcruise.layout.STATE_UNITS`; NaN
+        after a vehicle stopped).
+    commands : ndarray, shape (N, L, 12)
+        Controller output computed at each instant (duties [-], U1..U3 [N], U4 [N m],
+        attitude setpoints [rad], flags).
+    references : ndarray, shape (N, L, 11)
+        Mission reference at each instant ([m], [m/s], [m/s^2], [rad], [rad/s]).
+    final_state : ndarray, shape (N, 16)
+        State when each vehicle finished or stopped.
+    status : ndarray of int, shape (N,)
+        Exit status code, 0 = finished (see :class:`~quadcruise.ExitStatus`).
+    t_stop : ndarray, shape (N,)
+        Time each vehicle finished or stopped [s].
+    memory : ndarray, shape (N, C)
+        The controllers' memory at the end.
+    duty_clipped_s : ndarray, shape (N,)
+        Time [s] during which a commanded duty was clipped to [0, 1].
+    controller_limited_s : ndarray, shape (N,)
+        Time [s] during which the controller flagged a limit.
+    meta : dict
+        The configuration, seed and version that produced the result.
+    disturbance_memory : ndarray, shape (N, D), optional
+        The disturbance models' state at the end.
     """
 
     t: np.ndarray
@@ -63,7 +80,7 @@ class SimResult:
 
     @property
     def n(self) -> int:
-        """Number of vehicles."""
+        """Number of vehicles, N."""
         return self.states.shape[0]
 
     @property
@@ -82,18 +99,43 @@ class SimResult:
         Returns
         -------
         ExitStatus
+            Its code and reason.
         """
         return ExitStatus(int(self.status[i]))
 
     def status_text(self, i: int = 0) -> str:
-        """Why vehicle i stopped, and when."""
+        """Why vehicle i stopped, and when.
+
+        Parameters
+        ----------
+        i : int
+            The vehicle's index.
+
+        Returns
+        -------
+        str
+            ``"finished"``, or the reason and the time, e.g. ``"diverged: body rate left
+            the bound at t = 0.3120 s"``.
+        """
         code = int(self.status[i])
         if code == 0:
             return STATUS_REASONS[0]
         return f"{STATUS_REASONS[code]} at t = {self.t_stop[i]:.4f} s"
 
     def state(self, name: str) -> np.ndarray:
-        """(N, L) trace of one state, reference or command column, by name."""
+        """The trace of one state, reference or command column, by name.
+
+        Parameters
+        ----------
+        name : str
+            A name of :data:`~quadcruise.layout.STATE_NAMES`, ``REF_NAMES`` or
+            ``CMD_NAMES`` (e.g. ``"z"``, ``"x_ref"``, ``"u1"``).
+
+        Returns
+        -------
+        ndarray, shape (N, L)
+            The column, in its SI unit (a view, not a copy).
+        """
         for names, arr in ((STATE_NAMES, self.states), (REF_NAMES, self.references),
                            (CMD_NAMES, self.commands)):
             if name in names:
@@ -103,8 +145,20 @@ class SimResult:
     def to_pandas(self, vehicle: int | None = None, *, references: bool = True, commands: bool = True):
         """Long-form DataFrame: one row per vehicle and logged instant.
 
-        Columns: ``vehicle``, ``t``, the 16 state names, then (optionally) the reference
-        and command names. ``vehicle`` selects one vehicle.
+        Parameters
+        ----------
+        vehicle : int, optional
+            One vehicle's index; default: every vehicle.
+        references : bool
+            Include the reference columns.
+        commands : bool
+            Include the command columns.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Columns ``vehicle``, ``t`` [s], the 16 state names, then (optionally) the
+            reference and the command names.
         """
         import pandas as pd
 
@@ -125,7 +179,18 @@ class SimResult:
         return frame
 
     def decimate(self, every: int) -> "SimResult":
-        """A result holding every ``every``-th logged instant (the end state stays exact)."""
+        """A result holding every ``every``-th logged instant (the end state stays exact).
+
+        Parameters
+        ----------
+        every : int
+            The step between the instants kept, >= 1.
+
+        Returns
+        -------
+        SimResult
+            With ``t``, ``states``, ``commands`` and ``references`` thinned; the rest shared.
+        """
         if int(every) != every or every < 1:
             raise InputError(f"decimation step must be a positive integer, got {every!r}")
         keep = slice(None, None, int(every))
@@ -133,13 +198,38 @@ class SimResult:
                                    commands=self.commands[:, keep], references=self.references[:, keep])
 
     def metrics(self, **kwargs):
-        """Per-vehicle metrics as a DataFrame: see :func:`quadcruise.metrics.flight_metrics`."""
+        """Per-vehicle metrics as a DataFrame.
+
+        Parameters
+        ----------
+        **kwargs
+            Keywords of :func:`quadcruise.metrics.flight_metrics` (``transient_axis``,
+            ``transient_until``).
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per vehicle (see :func:`quadcruise.metrics.flight_metrics`).
+        """
         from quadcruise.metrics.flight import flight_metrics
 
         return flight_metrics(self, **kwargs)
 
     def plot(self, vehicle: int = 0, **kwargs):
-        """Figure of one vehicle's flight: see :func:`quadcruise.plots.plot_flight`."""
+        """Figure of one vehicle's flight.
+
+        Parameters
+        ----------
+        vehicle : int
+            The vehicle's index.
+        **kwargs
+            Keywords of :func:`quadcruise.plots.plot_flight`.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            See :func:`quadcruise.plots.plot_flight`.
+        """
         from quadcruise.plots.flight import plot_flight
 
         return plot_flight(self, vehicle=vehicle, **kwargs)
@@ -212,7 +302,13 @@ class SimResult:
         return out
 
     def meta_json(self) -> str:
-        """The recorded configuration as JSON."""
+        """The recorded configuration as JSON.
+
+        Returns
+        -------
+        str
+            :attr:`meta` as strict JSON, indented, keys sorted.
+        """
         from quadcruise.io.plainjson import dumps
 
         return dumps(self.meta, indent=2, sort_keys=True)

@@ -14,7 +14,7 @@ connected components of A once the rotor thrusts are written as U1..U4 of eqs (1
 For margins one loop is broken, the others closed, at the plant input (``at="input"``):
 on the generalized input that drives it, before the rotor lag: U3 for x (through pitch), U2
 for y (roll), U1 for z, U4 for yaw. There a thrust-gain, inertia or motor-lag error of the
-real vehicle enters; for z and yaw it is the break of :func:`.control.design.loop_margins`.
+real vehicle enters; for z and yaw it is the break of :func:`quadcruise.control.design.loop_margins`.
 The x and y input margins cover the attitude loop *and* the position loop around it.
 ``at="output"`` breaks instead at the position (or yaw) measurement the controller sees,
 velocity and attitude feedback closed: the outer loop's own margins.
@@ -104,11 +104,40 @@ def _s_plane(z, dt):
 
 @dataclass(frozen=True)
 class Linearization:
-    """The discrete closed loop about hover, ``sys``, and the pieces it is composed of:
-    ``plant_A``, ``plant_B`` (one period, x+ = A x + B u, u the duties), ``K_state``,
-    ``K_memory`` (duties), ``H_state``, ``H_memory`` (next memory) as derivatives in x and
-    memory; ``mixer`` (U1..U4 = mixer @ u); ``loops`` (each loop's state indices);
-    ``residual`` (the largest drift rate at hover)."""
+    """The discrete closed loop about hover, ``sys``, and the pieces it is composed of.
+
+    :func:`linearize` builds it. With x the plant's 16 states, m the controller's memory
+    and u the four duties, over one control period: x+ = plant_A x + plant_B u,
+    u = K_state x + K_memory m, m+ = H_state x + H_memory m (plus the set-point terms).
+
+    Parameters
+    ----------
+    sys : control.StateSpace
+        The discrete closed loop: states x then m, inputs :data:`INPUTS` [m, rad],
+        outputs :data:`OUTPUTS` [m, rad], sampling time ``dt``.
+    dt : float
+        Control period [s].
+    controller : Controller
+        The controller linearised.
+    plant_A : ndarray, shape (16, 16)
+        d x+ / d x of the plant over one period, duties held.
+    plant_B : ndarray, shape (16, 4)
+        d x+ / d u [state unit per unit duty].
+    K_state : ndarray, shape (4, 16)
+        d u / d x of the controller.
+    K_memory : ndarray, shape (4, C)
+        d u / d m.
+    H_state : ndarray, shape (C, 16)
+        d m+ / d x.
+    H_memory : ndarray, shape (C, C)
+        d m+ / d m.
+    mixer : ndarray, shape (4, 4)
+        U1..U4 = mixer @ u ([N], [N], [N], [N m] per unit duty).
+    loops : dict of str to ndarray
+        Each loop's (``x``, ``y``, ``z``, ``yaw``) state indices.
+    residual : float
+        The largest drift rate at hover [state unit/s].
+    """
 
     sys: control.StateSpace
     dt: float
@@ -125,26 +154,64 @@ class Linearization:
 
     @property
     def stable(self) -> bool:
-        """All discrete poles strictly inside the unit circle."""
+        """True if all discrete poles lie strictly inside the unit circle."""
         return bool(np.max(np.abs(self.poles())) < 1.0)
 
     def poles(self) -> np.ndarray:
-        """Discrete-time poles (z-plane)."""
+        """Discrete-time poles (z-plane).
+
+        Returns
+        -------
+        ndarray of complex
+            The eigenvalues of ``sys.A`` [-].
+        """
         return np.linalg.eigvals(self.sys.A)
 
     def poles_continuous(self) -> np.ndarray:
-        """Poles in rad/s, s = log(z) / dt (exact for the sampled modes), slowest first."""
+        """Poles in rad/s, s = log(z) / dt (exact for the sampled modes), slowest first.
+
+        Returns
+        -------
+        ndarray of complex
+            s [rad/s]; real where the imaginary part is rounding, -inf for a pole at z = 0
+            (a mode that dies in one period).
+        """
         order, s = _s_plane(self.poles(), self.dt)
         return s[order]
 
     def loop_poles(self, loop: str) -> np.ndarray:
-        """Poles [rad/s] of one loop's block of A, slowest first."""
+        """Poles [rad/s] of one loop's block of A, slowest first.
+
+        Parameters
+        ----------
+        loop : str
+            ``"x"``, ``"y"``, ``"z"`` or ``"yaw"``.
+
+        Returns
+        -------
+        ndarray of complex
+            s [rad/s], as :meth:`poles_continuous`.
+        """
         return self.loop_modes(loop)[0]
 
     def loop_modes(self, loop: str) -> tuple[np.ndarray, np.ndarray]:
-        """One loop's poles [rad/s], slowest first, and each one's weight |a_i| / |Re s_i| in
-        the step response of the loop's set-point to its output (a_i: the mode's amplitude;
-        the weight is the integral of |a_i exp(s_i t)|; the largest marks the dominant pole)."""
+        """One loop's poles, slowest first, and each one's weight in the loop's step response.
+
+        Parameters
+        ----------
+        loop : str
+            ``"x"``, ``"y"``, ``"z"`` or ``"yaw"``.
+
+        Returns
+        -------
+        poles : ndarray of complex
+            s [rad/s], as :meth:`poles_continuous`.
+        weights : ndarray
+            Each pole's weight |a_i| / |Re s_i| in the step response of the loop's set-point
+            to its output (a_i: the mode's amplitude; the weight is the integral of
+            |a_i exp(s_i t)| [output unit s]; the largest marks the dominant pole; inf for a
+            marginal mode).
+        """
         idx, state = self.loops[_check_loop(loop)], LOOPS[loop][1]
         S = _to_generalized(self.sys.nstates, self.mixer)
         Si = np.linalg.inv(S)
@@ -157,8 +224,21 @@ class Linearization:
         return s[order], weight[order]
 
     def continuous(self) -> control.StateSpace:
-        """The continuous system whose zero-order-hold sampling is ``sys``:
-        logm([[A, B], [0, I]]) / dt = [[Ac, Bc], [0, 0]]."""
+        """The continuous system whose zero-order-hold sampling is ``sys``.
+
+        logm([[A, B], [0, I]]) / dt = [[Ac, Bc], [0, 0]].
+
+        Returns
+        -------
+        control.StateSpace
+            Continuous time, the same states, inputs and outputs as ``sys``.
+
+        Raises
+        ------
+        InputError
+            If the loop has purely discrete modes (poles at z = 0 or on the negative real
+            axis), which have no continuous equivalent.
+        """
         n, m = self.sys.B.shape
         z = self.poles()
         if np.any((np.abs(z.imag) < 1e-12) & (z.real <= 1e-12)):
@@ -194,20 +274,30 @@ def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 
     Parameters
     ----------
     controller : Controller or str
-        Anything with ``.function`` (compiled, ``CONTROLLER_SIG``), ``.gains()``, ``.memory()``.
+        A controller name, or anything with ``.function`` (compiled, ``CONTROLLER_SIG``),
+        ``.gains()``, ``.memory()``.
     vehicle : Vehicle, optional
         One vehicle (Table I by default); the controller sees the same parameters.
-    dt, max_step, hover_z : float
-        Control period, longest RK4 substep (``dt`` by default) [s], as in ``fly``; hover
-        altitude [m] (x = y = yaw = 0, every rotor at m g / 4).
-    eps, tol : float
-        Relative central-difference step; largest drift rate [unit/s] of any state or memory
-        entry that still counts as hover.
+    dt : float
+        Control period [s], as in ``fly``.
+    hover_z : float
+        Hover altitude [m] (x = y = yaw = 0, every rotor at m g / 4).
+    eps : float
+        Relative central-difference step [-].
+    max_step : float, optional
+        Longest RK4 substep [s]; ``dt`` by default.
     memory : array, optional
         The controller's memory to start from; ``controller.memory()`` by default.
     settle : int
         Periods the controller is first called at hover, its memory kept: a controller may
         initialise memory in its first period (a first-call flag, a derivative's last sample).
+    tol : float
+        Largest drift rate [unit/s] of any state or memory entry that still counts as hover.
+
+    Returns
+    -------
+    Linearization
+        The discrete closed loop and its pieces.
 
     Raises
     ------
@@ -291,8 +381,24 @@ def _loops(A, mixer):
 
 
 def loop_transfer(lin: Linearization, loop: str = "x", at: str = "input") -> control.StateSpace:
-    """The discrete loop transfer L(z) of one loop broken ``at`` 'input' or 'output', the
-    others closed, signed for negative feedback (the closed loop is L / (1 + L))."""
+    """The discrete loop transfer L(z) of one loop broken at the plant input or output.
+
+    Parameters
+    ----------
+    lin : Linearization
+        The closed loop.
+    loop : str
+        ``"x"``, ``"y"``, ``"z"`` or ``"yaw"``; the others stay closed.
+    at : str
+        ``"input"``: at the loop's generalized input U1..U4; ``"output"``: at the position
+        (or yaw) measurement the controller sees (see the module).
+
+    Returns
+    -------
+    control.StateSpace
+        L(z), one input and one output, sampling time ``lin.dt``, signed for negative
+        feedback (the closed loop is L / (1 + L)).
+    """
     u_idx, state = LOOPS[_check_loop(loop)]
     Ap, Bp, Kx, Km, Hx, Hm = lin.plant_A, lin.plant_B, lin.K_state, lin.K_memory, lin.H_state, lin.H_memory
     C = Hm.shape[0]
@@ -317,17 +423,33 @@ def _omega(dt, n=2000):
 
 
 def loop_margins(lin: Linearization, loop: str = "x", at: str = "input") -> dict:
-    """Margins of :func:`loop_transfer` by ``control.stability_margins``, on its frequency
-    response up to the Nyquist frequency (the polynomial method is ill-conditioned for a
-    19-state loop with poles crowded near z = 1).
+    """Margins of :func:`loop_transfer` by ``control.stability_margins``.
 
-    Returns ``phase_margin`` [deg] at ``gain_crossover`` [rad/s]; ``gain_margin`` (the one
-    python-control picks, nearest 1) at ``phase_crossover``; ``gain_increase`` (the smallest
-    destabilising factor > 1, inf if none) and ``gain_decrease`` (the largest < 1, 0 if none;
-    a PID on a double integrator has one); ``stability_margin`` (least distance of L to -1)
-    and its frequency; ``open_loop_unstable_poles`` (of L; when not 0 the margins alone do
-    not tell stability).
+    They are read from its frequency response up to the Nyquist frequency (the polynomial
+    method is ill-conditioned for a 19-state loop with poles crowded near z = 1).
 
+    Parameters
+    ----------
+    lin : Linearization
+        The closed loop.
+    loop : str
+        ``"x"``, ``"y"``, ``"z"`` or ``"yaw"``.
+    at : str
+        Where the loop is broken: ``"input"`` or ``"output"`` (see :func:`loop_transfer`).
+
+    Returns
+    -------
+    dict
+        ``phase_margin`` [deg] at ``gain_crossover`` [rad/s]; ``gain_margin`` [-] (the one
+        python-control picks, nearest 1) at ``phase_crossover`` [rad/s]; ``gain_increase``
+        (the smallest destabilising factor > 1, inf if none) and ``gain_decrease`` (the
+        largest < 1, 0 if none; a PID on a double integrator has one);
+        ``stability_margin`` (least distance of L to -1) and its frequency
+        ``stability_margin_frequency`` [rad/s]; ``open_loop_unstable_poles`` (of L; when
+        not 0 the margins alone do not tell stability).
+
+    Examples
+    --------
     >>> m = loop_margins(linearize("nlpd"), "yaw")          # design.loop_margins: 24.5 deg
     >>> round(m["phase_margin"], 1), round(m["gain_crossover"], 1)
     (24.1, 12.5)
@@ -353,11 +475,31 @@ def loop_margins(lin: Linearization, loop: str = "x", at: str = "input") -> dict
 
 
 def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "input"):
-    """Closed-loop x_r->x, y_r->y (dashed: the same as x for a symmetric vehicle), z_r->z,
-    psi_r->psi magnitude and phase; with ``loops``, a second column of the loop transfers
-    (broken ``at``), their gain crossovers marked and their phase read so that the phase
-    margin is its distance above the -180 deg line there.
+    """Bode plots of the closed loop and, optionally, of the loop transfers.
 
+    Parameters
+    ----------
+    lin : Linearization
+        The closed loop.
+    loops : bool
+        Add a second column of the loop transfers (broken ``at``), their gain crossovers
+        marked and their phase read so that the phase margin is its distance above the
+        -180 deg line there.
+    omega : array_like, optional
+        Frequencies [rad/s]; by default 800 from 0.01 rad/s to just below the Nyquist
+        frequency.
+    at : str
+        Where the loops are broken: ``"input"`` or ``"output"`` (see :func:`loop_transfer`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Magnitude [dB] above phase [deg] against frequency [rad/s] of the closed loop
+        x_r->x, y_r->y (dashed: the same as x for a symmetric vehicle), z_r->z,
+        psi_r->psi; 2 or 4 axes.
+
+    Examples
+    --------
     >>> fig = bode(linearize("nlpd"), loops=True)
     >>> len(fig.axes)
     4
@@ -397,14 +539,29 @@ def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "inpu
 def report(controller="nlpd", lin: Linearization | None = None, **kwargs) -> dict:
     """Poles, damping and margins of every loop beside the design's poles, as plain values.
 
-    Per loop: ``poles`` [rad/s] as [re, im] (one of each pair) with their
-    ``natural_frequency`` [rad/s], ``damping`` and ``step_weight``
-    (:meth:`Linearization.loop_modes`); the ``dominant`` pole (largest weight);
-    ``min_damping``; ``margins_input`` and ``margins_output`` (:func:`loop_margins`); and
-    where the controller has design gains for the loop (``position`` for x and y, ``altitude``,
-    ``yaw``), their ``design_poles``, the ``nearest`` full-loop pole to each and its
-    ``nearest_rel_distance``. ``kwargs`` go to :func:`linearize`; a given ``lin`` is used as is.
+    Parameters
+    ----------
+    controller : Controller or str
+        The controller, if ``lin`` is not given.
+    lin : Linearization, optional
+        A linearisation to use as is (``controller`` and ``kwargs`` are then ignored).
+    **kwargs
+        Keywords of :func:`linearize`.
 
+    Returns
+    -------
+    dict
+        ``controller`` (name), ``dt_s`` [s], ``stable``, ``spectral_radius``,
+        ``hover_residual`` and ``loops``: per loop, ``poles`` [rad/s] as [re, im] (one of
+        each pair) with their ``natural_frequency`` [rad/s], ``damping`` and
+        ``step_weight`` (:meth:`Linearization.loop_modes`); the ``dominant`` pole (largest
+        weight); ``min_damping``; ``margins_input`` and ``margins_output``
+        (:func:`loop_margins`); and where the controller has design gains for the loop
+        (``position`` for x and y, ``altitude``, ``yaw``), their ``design_poles``, the
+        ``nearest`` full-loop pole to each and its ``nearest_rel_distance``.
+
+    Examples
+    --------
     >>> r = report("nlpd")
     >>> x = r["loops"]["x"]
     >>> r["stable"], x["design_poles"], [round(v, 3) for v in x["dominant"]]
@@ -442,6 +599,20 @@ def report(controller="nlpd", lin: Linearization | None = None, **kwargs) -> dic
 def summary(rep: dict) -> str:
     """:func:`report` as an aligned text table, one column per loop.
 
+    Parameters
+    ----------
+    rep : dict
+        What :func:`report` returns.
+
+    Returns
+    -------
+    str
+        A heading line (controller, dt, stable or not), then one row per quantity: the
+        dominant and slowest poles [rad/s], the least damping, how far the design poles
+        moved, and the phase margins [deg] and gain margins at the input and the output.
+
+    Examples
+    --------
     >>> print(summary(report("nlpd")).splitlines()[4].split())
     ['min', 'damping', '0.363', '0.363', '0.884', '0.272']
     """
@@ -466,7 +637,18 @@ def summary(rep: dict) -> str:
 
 
 def to_json(rep: dict) -> str:
-    """:func:`report` as strict JSON: an infinite or undefined number becomes null."""
+    """:func:`report` as strict JSON: an infinite or undefined number becomes null.
+
+    Parameters
+    ----------
+    rep : dict
+        What :func:`report` returns.
+
+    Returns
+    -------
+    str
+        The JSON text, indented.
+    """
     from quadcruise.io.plainjson import dumps
 
     return dumps(rep, indent=2)

@@ -41,13 +41,16 @@ DEFAULT_CONTROLLERS = ("nlpd", "gonzalez", "se3", "cascade")
 class Comparison:
     """Flights of several controllers on the same mission and vehicle.
 
-    Attributes
+    :func:`compare` builds it.
+
+    Parameters
     ----------
     mission : Mission
+        The mission every controller flew.
     controllers : dict of str to Controller
         Label -> controller, in the order flown.
     results : dict of str to SimResult
-        Label -> flight.
+        Label -> flight, in the same order.
     """
 
     mission: Mission
@@ -56,9 +59,22 @@ class Comparison:
     _tables: dict = field(default_factory=dict, init=False, repr=False)   # table() per keywords
 
     def table(self, **metric_kw: Any):
-        """One row per controller (per controller and vehicle for a batch): every column of
-        :func:`quadcruise.metrics.flight_metrics` (keywords go to it), indexed by controller.
-        Computed once per set of keywords (the text, the files and a report share it)."""
+        """The metrics of every flight, one row per controller.
+
+        Computed once per set of keywords (the text, the files and a report share it).
+
+        Parameters
+        ----------
+        **metric_kw : Any
+            Keywords of :func:`quadcruise.metrics.flight_metrics` (``transient_axis``,
+            ``transient_until``).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Every column of :func:`quadcruise.metrics.flight_metrics`, indexed by
+            controller (by controller and vehicle for a batch); a copy.
+        """
         key = repr(sorted(metric_kw.items()))
         if key not in self._tables:
             self._tables[key] = self._table(metric_kw)
@@ -111,8 +127,20 @@ class Comparison:
                        self.text(**metric_kw))
 
     def text(self, **metric_kw: Any) -> str:
-        """The table as aligned text, metrics down and controllers across (for a terminal);
-        a missing settling time of a measured transient reads "did not settle"."""
+        """The table as aligned text, metrics down and controllers across (for a terminal).
+
+        A missing settling time of a measured transient reads "did not settle".
+
+        Parameters
+        ----------
+        **metric_kw : Any
+            Keywords of :meth:`table`.
+
+        Returns
+        -------
+        str
+            See :func:`quadcruise.metrics.tables.metrics_text`.
+        """
         from quadcruise.metrics.tables import metrics_text
 
         table = self.table(**metric_kw)
@@ -122,6 +150,18 @@ class Comparison:
         """Overlay of the flights: top view, and x, y, z against time, each reference once.
 
         :func:`quadcruise.plots.plot_paths` with a z panel added below its x and y panels.
+
+        Parameters
+        ----------
+        vehicle : int
+            Which vehicle of each flight to draw.
+        title : str, optional
+            Figure title; by default the labels joined by " vs " and the mission's kind.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            Four axes: the top view, x, y and z [m] against time [s].
         """
         from quadcruise.plots.flight import plot_paths
 
@@ -130,7 +170,16 @@ class Comparison:
         return fig
 
     def to_dict(self) -> dict:
-        """Mission, vehicle, controllers and metrics as plain values (NaN as None), for JSON."""
+        """Mission, vehicle, controllers and metrics as plain values (NaN as None), for JSON.
+
+        Returns
+        -------
+        dict
+            ``workflow`` (``"compare"``), ``mission``, ``vehicle``, ``duration_s``, ``dt_s``,
+            ``version`` (as the first flight recorded them), ``controllers`` (label ->
+            parameters) and ``metrics`` (label, or ``label/vehicle`` for a batch -> the row
+            of :meth:`table`).
+        """
         first = next(iter(self.results.values()))
         rows = self._rows(self.table())
         return {
@@ -156,9 +205,19 @@ class Comparison:
 
     def write(self, out: str | os.PathLike, *, force: bool = False) -> Path:
         """Write ``metrics.csv``, ``comparison.png`` and ``quadcruise.json`` (``to_dict``)
-        into the folder ``out``, whole or not at all; returns it.
+        into the folder ``out``, whole or not at all.
 
-        A non-empty folder that quadcruise did not write is refused unless ``force``.
+        Parameters
+        ----------
+        out : str or os.PathLike
+            The output folder.
+        force : bool
+            Replace a non-empty folder that quadcruise did not write (else InputError).
+
+        Returns
+        -------
+        pathlib.Path
+            The folder written.
         """
         from quadcruise.io.files import MARKER, atomic_dir, check_output_dir
         from quadcruise.plots.flight import save_figure
@@ -173,8 +232,25 @@ class Comparison:
 
 
 def add_z_panel(fig, results: Mapping[str, SimResult], vehicle: int = 0):
-    """Add z(t) under the x and y panels of a :func:`~quadcruise.plots.plot_paths` figure
-    (same colours, reference dashed once, early stops crossed); returns the new axes."""
+    """Add z(t) under the x and y panels of a :func:`~quadcruise.plots.plot_paths` figure.
+
+    Same colours, the reference dashed once, early stops crossed; the figure grows to
+    13 x 8.5 inches.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        A figure of :func:`~quadcruise.plots.plot_paths` of the same ``results``.
+    results : mapping of str to SimResult
+        Label -> flight, in the figure's order.
+    vehicle : int
+        Which vehicle of each flight to draw.
+
+    Returns
+    -------
+    matplotlib.axes.Axes
+        The new z [m] against time [s] axes.
+    """
     from quadcruise.plots.flight import REF_STYLE
 
     top, ax_x, ax_y = fig.axes[:3]
@@ -244,6 +320,30 @@ def compare(mission: Mission | str = "circle",
 
 
 def labelled(controllers) -> dict:
+    """Controllers by label, as :func:`compare` flies them.
+
+    Parameters
+    ----------
+    controllers : str, sequence or mapping
+        Comma-separated names; a sequence of names or Controller objects, each labelled by
+        its name (a repeated name gets '#2', '#3', ...); or a mapping label -> name or
+        Controller.
+
+    Returns
+    -------
+    dict of str to Controller
+        Label -> controller, in the order given.
+
+    Raises
+    ------
+    InputError
+        For no controller, or one that is neither a name nor a Controller.
+
+    Examples
+    --------
+    >>> list(labelled("nlpd, nlpd, se3"))
+    ['nlpd', 'nlpd#2', 'se3']
+    """
     if isinstance(controllers, str):
         controllers = [c.strip() for c in controllers.split(",") if c.strip()]
     items = list(controllers.items()) if isinstance(controllers, Mapping) else [(None, c) for c in controllers]

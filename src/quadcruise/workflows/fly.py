@@ -30,14 +30,46 @@ from quadcruise.sim.result import SimResult
 
 
 def default_duration(mission: Mission) -> float:
-    """The mission's default flight time (:attr:`Mission.duration`): one lap of a circle or
-    square, 10 s after a step, the last waypoint and a settling time, 5 s of hover [s]."""
+    """The mission's default flight time (:attr:`Mission.duration`).
+
+    Parameters
+    ----------
+    mission : Mission
+        The mission.
+
+    Returns
+    -------
+    float
+        Flight time [s]: one lap of a circle or square, 10 s after a step, the last
+        waypoint and a settling time, 5 s of hover.
+
+    Examples
+    --------
+    >>> from quadcruise.missions import Hover
+    >>> default_duration(Hover())
+    5.0
+    """
     return float(mission.duration)
 
 
 def hover_state(vehicle: Vehicle, n: int, mission: Mission) -> np.ndarray:
-    """(N, 16): hovering level at the origin's x, y at the mission's start altitude and yaw,
-    each rotor at the hover thrust m g / 4."""
+    """Initial states hovering level at the origin's x, y at the mission's start altitude and yaw.
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+        The vehicle (batched or not): its mass and gravity set the hover thrust.
+    n : int
+        Number of vehicles.
+    mission : Mission
+        Its reference at t = 0 gives the altitude [m] and yaw [rad].
+
+    Returns
+    -------
+    ndarray, shape (n, 16)
+        Zero velocities, angles and rates but the yaw; each rotor at the hover thrust
+        m g / 4 [N].
+    """
     vp = vehicle.rows(n)
     ref0 = mission.reference(0.0)[0]
     x0 = np.zeros((n, STATE_SIZE))
@@ -97,6 +129,9 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
     first_vehicle : int
         Index of the first vehicle in a larger population: vehicle i's random stream comes from
         (seed, first_vehicle + i) only, so a batch split in parts flies the same numbers.
+    **unknown : Any
+        Refused: any other keyword is an InputError naming the options (see
+        :data:`FLY_OPTIONS`), so a misspelt one is not silently ignored.
 
     Returns
     -------
@@ -153,8 +188,10 @@ def engine_inputs(environment: Environment | None, sensors: SensorNoise | None, 
 
     Parameters
     ----------
-    environment : Environment or None
+    environment : Environment or CustomDisturbance or None
+        The disturbances, if any.
     sensors : SensorNoise or None
+        The sensor noise and delay, if any.
     n : int
         Number of vehicles.
     dt : float
@@ -164,6 +201,11 @@ def engine_inputs(environment: Environment | None, sensors: SensorNoise | None, 
     -------
     dict
         Keywords of :func:`quadcruise.simulate` (none for a missing or empty part).
+
+    Raises
+    ------
+    InputError
+        If ``environment`` or ``sensors`` is of another type.
     """
     out: dict = {}
     if environment is not None:
@@ -185,7 +227,8 @@ def write_flight(result: SimResult, out, fmt: str = "csv", metrics=None) -> None
     Parameters
     ----------
     result : SimResult
-    out : str or path
+        The flight.
+    out : str or os.PathLike
         The folder.
     fmt : {"csv", "parquet"}
         Format of the traces.

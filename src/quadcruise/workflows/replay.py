@@ -39,7 +39,17 @@ OUTPUT_COLUMNS = ("t",) + STATE_NAMES
 
 @njit(cache=True)     # compiled (as MISSION_SIG) on first use, not at import
 def no_reference(t, mp, ref):
-    """An open-loop flight has no reference: NaN throughout."""
+    """An open-loop flight has no reference: NaN throughout (a mission, ``MISSION_SIG``).
+
+    Parameters
+    ----------
+    t : float
+        Time [s] (unused).
+    mp : ndarray
+        Mission parameters (unused).
+    ref : ndarray, shape (11,)
+        Output: the reference, set to NaN.
+    """
     for j in range(ref.shape[0]):
         ref[j] = math.nan
 
@@ -50,9 +60,17 @@ class DutySchedule:
 
     Parameters
     ----------
-    t : (n,) strictly increasing times [s], n >= 2
-    duties : (n, 4) duties of rotors 1..4, each in [0, 1]
-    source : where the rows came from (a file name), used in error messages
+    t : array_like, shape (n,)
+        Strictly increasing times [s], n >= 2.
+    duties : array_like, shape (n, 4)
+        Duties of rotors 1..4 [-], each in [0, 1].
+    source : str
+        Where the rows came from (a file name), used in error messages.
+
+    Raises
+    ------
+    InputError
+        For a schedule that breaks these rules, naming ``source`` and the row.
     """
 
     t: np.ndarray
@@ -88,7 +106,19 @@ def _validated(t, duties, source: str, lines: list[int] | None = None):
 
 
 def read_duty_csv(path: str | os.PathLike) -> DutySchedule:
-    """Read a ``t,u1,u2,u3,u4`` CSV; errors name the file, line and column."""
+    """Read a ``t,u1,u2,u3,u4`` CSV; errors name the file, line and column.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The CSV file: a header naming at least ``t, u1, u2, u3, u4`` (others are ignored
+        with a warning), then at least two rows of times [s] and duties [-].
+
+    Returns
+    -------
+    DutySchedule
+        With ``source`` the file name.
+    """
     _, _, data, lines = read_numeric_csv(path, INPUT_COLUMNS)
     if data.shape[0] < 2:
         raise InputError(f"{path}: needs at least two data rows (a start and an end time), found {data.shape[0]}")
@@ -103,12 +133,19 @@ def replay(schedule: DutySchedule, vehicle: Vehicle | None = None, *, max_step: 
     Parameters
     ----------
     schedule : DutySchedule
+        The duties and their times.
     vehicle : Vehicle, optional
         Table I by default. A batched vehicle replays the same schedule on each.
     max_step : float
         Longest RK4 substep [s]; each row interval is split into equal substeps.
     limits : Limits, optional
         Divergence bounds.
+
+    Returns
+    -------
+    SimResult
+        One logged instant per schedule row (the first is the initial state); the
+        references are NaN.
     """
     vehicle = vehicle or Vehicle.paper()
     vp = vehicle.rows()
@@ -127,7 +164,17 @@ def replay(schedule: DutySchedule, vehicle: Vehicle | None = None, *, max_step: 
 
 
 def write_states_csv(result: SimResult, path: str | os.PathLike, vehicle: int = 0) -> None:
-    """Write one vehicle's states as ``t,x,...,F4`` (SI units, radians), atomically."""
+    """Write one vehicle's states as ``t,x,...,F4`` (SI units, radians), atomically.
+
+    Parameters
+    ----------
+    result : SimResult
+        The flight.
+    path : str or os.PathLike
+        The CSV file to write.
+    vehicle : int
+        The vehicle's index.
+    """
     table = np.column_stack([result.t, result.states[vehicle]])
     with atomic_path(path) as tmp:
         np.savetxt(tmp, table, delimiter=",", header=",".join(OUTPUT_COLUMNS), comments="", fmt="%.15g")

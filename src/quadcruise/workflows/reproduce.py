@@ -88,7 +88,24 @@ METRIC_KEYS = ("rise_time_s", "settling_time_s", "settling_time_5pct_s", "oversh
 
 @dataclass
 class Reproduction:
-    """The runs of a reproduction: one dict of metrics per (scenario, controller)."""
+    """The runs of a reproduction: one dict of metrics per (scenario, controller).
+
+    :func:`reproduce` builds it.
+
+    Parameters
+    ----------
+    runs : list of dict
+        One per flight, in the order flown: ``scenario``, ``controller``, ``axis``,
+        ``status`` and the metrics of :data:`METRIC_KEYS` (times [s], overshoot [%],
+        errors [m]; None where not applicable or not settled).
+    results : dict of (str, str) to SimResult
+        (scenario, controller) -> the flight, logged at every control period.
+    config : dict
+        The vehicle, control period, scenarios and controllers, as ``metrics.json`` and
+        ``quadcruise.json`` record them.
+    timings : dict of str to float
+        ``"scenario/controller"`` -> wall time of the flight and its metrics [s].
+    """
 
     runs: list[dict]
     results: dict[tuple[str, str], SimResult]
@@ -96,17 +113,47 @@ class Reproduction:
     timings: dict = field(default_factory=dict)
 
     def to_json(self) -> dict:
-        """The ``metrics.json`` document."""
+        """The ``metrics.json`` document.
+
+        Returns
+        -------
+        dict
+            ``runs``, ``paper`` (:data:`PAPER`), ``config`` and ``version``.
+        """
         return {"runs": self.runs, "paper": PAPER, "config": self.config, "version": __version__}
 
     def to_pandas(self):
-        """The runs as a DataFrame."""
+        """The runs as a DataFrame.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per run, the keys of :attr:`runs` as columns.
+        """
         import pandas as pd
 
         return pd.DataFrame(self.runs)
 
     def run(self, scenario: str, controller: str) -> dict:
-        """The metrics of one run."""
+        """The metrics of one run.
+
+        Parameters
+        ----------
+        scenario : str
+            A name of :data:`SCENARIOS`.
+        controller : str
+            A label of :data:`CONTROLLERS`.
+
+        Returns
+        -------
+        dict
+            The run's entry of :attr:`runs`.
+
+        Raises
+        ------
+        KeyError
+            If that pair was not flown.
+        """
         for r in self.runs:
             if r["scenario"] == scenario and r["controller"] == controller:
                 return r
@@ -120,10 +167,26 @@ def reproduce(*, scenarios=tuple(SCENARIOS), controllers=tuple(CONTROLLERS), dt:
 
     Parameters
     ----------
-    scenarios, controllers : names from SCENARIOS and CONTROLLERS
-    dt : control period [s]
-    vehicle : Table I by default
-    progress : called as ``progress(done, total, label)`` after each flight
+    scenarios : sequence of str
+        Names of :data:`SCENARIOS`; all by default.
+    controllers : sequence of str
+        Labels of :data:`CONTROLLERS`; all by default.
+    dt : float
+        Control period [s].
+    vehicle : Vehicle, optional
+        Table I by default.
+    progress : callable, optional
+        Called as ``progress(done, total, label)`` after each flight.
+
+    Returns
+    -------
+    Reproduction
+        The runs in the order scenario by scenario, each with every controller.
+
+    Raises
+    ------
+    InputError
+        For an unknown scenario or controller name.
     """
     for name in scenarios:
         if name not in SCENARIOS:
@@ -166,7 +229,29 @@ def _json_number(value) -> float | None:
 
 def write_reproduction(rep: Reproduction, out: str | Path, *, force: bool = False, fmt: str = "csv",
                        progress: Callable[[str], None] | None = None) -> Path:
-    """Write metrics.json, the figures, the traces and report.md into ``out``, atomically."""
+    """Write metrics.json, the figures, the traces and report.md into ``out``, atomically.
+
+    The folder also holds ``quadcruise.json`` (the configuration); traces and figures are
+    at every :data:`TRACE_EVERY`-th logged instant.
+
+    Parameters
+    ----------
+    rep : Reproduction
+        The runs.
+    out : str or pathlib.Path
+        The output folder.
+    force : bool
+        Replace a non-empty folder that quadcruise did not write (else InputError).
+    fmt : str
+        Format of the traces: ``"csv"`` or ``"parquet"``.
+    progress : callable, optional
+        Called as ``progress(name)`` after each figure written.
+
+    Returns
+    -------
+    pathlib.Path
+        The folder written.
+    """
     from quadcruise.plots.flight import save_figure
 
     out = check_output_dir(out, force)
@@ -209,7 +294,22 @@ def written_figures(out: str | Path) -> dict[str, Path]:
 
 
 def paper_figure(name: str, caption: str, results: dict):
-    """The figure ``name`` of FIGURES drawn from the flights, or None if they are missing."""
+    """The figure ``name`` of :data:`FIGURES` drawn from the flights.
+
+    Parameters
+    ----------
+    name : str
+        A file name of :data:`FIGURES`.
+    caption : str
+        The figure's title.
+    results : dict of (str, str) to SimResult
+        (scenario, controller) -> flight, as :attr:`Reproduction.results`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure or None
+        None if the flights it needs are missing.
+    """
     from quadcruise.plots.flight import plot_paths, plot_reference
 
     scen = "circle" if "circle" in name else "square"
@@ -229,7 +329,19 @@ def _cell(value, missing: str = "-") -> str:
 
 
 def results_table(rep: Reproduction) -> str:
-    """Markdown table: each run's transient and tracking metrics beside the paper's."""
+    """Markdown table: each run's transient and tracking metrics beside the paper's.
+
+    Parameters
+    ----------
+    rep : Reproduction
+        The runs.
+
+    Returns
+    -------
+    str
+        One row per run; the paper's value in brackets after ours where it reports one
+        (not for the ``step`` scenario).
+    """
     lines = ["| scenario | controller | rise [s] (paper) | settling 2 % [s] (paper) | settling 5 % [s] "
              "| overshoot [%] (paper) | RMSE [m] | max error [m] |",
              "|---|---|---|---|---|---|---|---|"]
@@ -245,7 +357,20 @@ def results_table(rep: Reproduction) -> str:
 
 
 def report_markdown(rep: Reproduction, figures: list[str]) -> str:
-    """report.md: the table, the figures, and what differs from the paper and why."""
+    """report.md: the table, the figures, and what differs from the paper and why.
+
+    Parameters
+    ----------
+    rep : Reproduction
+        The runs.
+    figures : list of str
+        The file names of the figures written (keys of :data:`FIGURES`).
+
+    Returns
+    -------
+    str
+        The Markdown text.
+    """
     text = [f"# quadcruise {__version__}: reproduction of the paper\n",
             "Our value first, the paper's in brackets. Transients are measured on x from hover; "
             "settling uses the 2 % band (5 % beside it); RMSE is the 3-D position error over the "
@@ -258,7 +383,19 @@ def report_markdown(rep: Reproduction, figures: list[str]) -> str:
 
 
 def baseline_comparison(rep: Reproduction) -> str:
-    """A sentence, from the numbers, on how the baseline compares with nlpd here."""
+    """A sentence, from the numbers, on how the baseline compares with nlpd here.
+
+    Parameters
+    ----------
+    rep : Reproduction
+        The runs.
+
+    Returns
+    -------
+    str
+        One line per scenario flown by both ``gonzalez`` and ``nlpd`` where both settled:
+        the differences in 5 % settling time [s] and overshoot [points]; empty if none.
+    """
     pairs = []
     for r in rep.runs:
         if r["controller"] != "gonzalez":
