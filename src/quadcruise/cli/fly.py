@@ -3,7 +3,10 @@ report and animation written on request."""
 
 from __future__ import annotations
 
+import sys
+
 import click
+import numpy as np
 
 from quadcruise.cli.common import (
     FORCE_OPTION,
@@ -64,11 +67,13 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
         the_mission = mission_from_options(mission, mission_params, smooth)
         the_controller = controller_from_options(controller, controller_params, position_poles)
         kwargs = overrides
-    _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate)
+    result = _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate)
+    if not result.ok.all():
+        sys.exit(1)             # a vehicle did not fly its mission: diverged, lost track, out of bounds
 
 
 def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=None, animate=None) -> None:
-    """Fly, print the metrics, and write what was asked for.
+    """Fly, print the metrics and each unfinished vehicle's reason, and write what was asked for.
 
     Parameters
     ----------
@@ -86,6 +91,11 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
         Path of an HTML report.
     animate : str, optional
         Path of an animation (.gif, or .mp4 with ffmpeg).
+
+    Returns
+    -------
+    SimResult
+        The flight.
     """
     from quadcruise.metrics.tables import vehicle_metrics_text
     from quadcruise.workflows.fly import fly as run_fly
@@ -99,6 +109,8 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
     metrics = result.metrics()
     click.echo(f"{controller.name} on {mission.name}: {result.t[-1]:g} s at dt = {result.meta['dt_s']:g} s")
     click.echo(vehicle_metrics_text(metrics))
+    for i in np.flatnonzero(~result.ok):
+        click.echo(f"vehicle {i} did not fly its mission: {result.status_text(int(i))}")
     if out is not None:
         write_flight(result, out, fmt, metrics=metrics)
         click.echo(f"wrote traces, figure and metrics to {out}")
@@ -112,3 +124,4 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
 
         animate_flight(result, animate)
         click.echo(f"wrote animation {animate}")
+    return result

@@ -532,7 +532,7 @@ def flight_metrics(result, *, transient_axis: str | None = None, transient_until
                "duty_clipped_s": float(result.duty_clipped_s[i]),
                "controller_limited_s": float(result.controller_limited_s[i])}
         rows.append(row)
-        if result.status[i] != 0:
+        if result.stopped[i]:                    # the engine stopped it: its later rows are NaN
             continue
         pos, ref = result.states[i, :, X:X + 3], result.references[i, :, REF_X:REF_X + 3]
         if np.all(np.isfinite(ref)):

@@ -62,7 +62,8 @@ from quadcruise.sim.status import STATUS_REASONS, ExitStatus
 
 # exit status codes as plain ints, which the kernel compiles as constants (see sim/status.py)
 FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, TILT_BOUND, BAD_COMMAND = (
-    int(s) for s in ExitStatus)
+    int(ExitStatus[name]) for name in ("FINISHED", "NONFINITE", "POSITION_BOUND", "SPEED_BOUND", "RATE_BOUND",
+                                       "TILT_BOUND", "BAD_COMMAND"))
 
 
 @dataclass(frozen=True)

@@ -85,8 +85,18 @@ class SimResult:
 
     @property
     def ok(self) -> np.ndarray:
-        """(N,) True where the vehicle flew to the end."""
+        """(N,) True where the vehicle flew its whole mission within every bound (status finished)."""
         return self.status == 0
+
+    @property
+    def stopped(self) -> np.ndarray:
+        """(N,) True where the engine stopped the vehicle early (its later log rows are NaN).
+
+        Returns
+        -------
+        numpy.ndarray of bool
+        """
+        return np.array([ExitStatus(int(code)).stopped for code in self.status], dtype=bool)
 
     def exit_status(self, i: int = 0) -> ExitStatus:
         """Vehicle i's exit status.

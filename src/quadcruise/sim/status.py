@@ -7,8 +7,10 @@ Examples
 --------
 >>> ExitStatus(2).reason
 'diverged: position left the bound'
->>> ExitStatus.FINISHED.ok, ExitStatus.NONFINITE.ok
-(True, False)
+>>> ExitStatus.FINISHED.ok, ExitStatus.NONFINITE.ok, ExitStatus.LOST_TRACK.ok
+(True, False, False)
+>>> ExitStatus.LOST_TRACK.stopped, ExitStatus.TILT_BOUND.stopped
+(False, True)
 """
 
 from __future__ import annotations
@@ -21,8 +23,10 @@ __all__ = ["ExitStatus", "STATUS_REASONS"]
 class ExitStatus(IntEnum):
     """A vehicle's exit status: the engine's integer code with its reason.
 
-    ``FINISHED`` flew the whole mission; every other status stopped the vehicle at the time
-    recorded in :attr:`quadcruise.SimResult.t_stop`.
+    ``FINISHED`` flew the whole mission. ``LOST_TRACK`` flew it too, but its position error
+    left the tracking bound at the time recorded in :attr:`quadcruise.SimResult.t_stop` (see
+    :func:`quadcruise.fly`'s ``max_track_error``). Every other status is the engine's: it
+    stopped the vehicle at ``t_stop``, and its later log rows are NaN.
     """
 
     FINISHED = 0
@@ -32,6 +36,7 @@ class ExitStatus(IntEnum):
     RATE_BOUND = 4
     TILT_BOUND = 5
     BAD_COMMAND = 6
+    LOST_TRACK = 7
 
     @property
     def reason(self) -> str:
@@ -43,6 +48,11 @@ class ExitStatus(IntEnum):
         """True for a vehicle that flew its whole mission."""
         return self is ExitStatus.FINISHED
 
+    @property
+    def stopped(self) -> bool:
+        """True for a vehicle the engine stopped before the end (diverged or a bad command)."""
+        return self not in (ExitStatus.FINISHED, ExitStatus.LOST_TRACK)
+
 
 _REASONS = {
     ExitStatus.FINISHED: "finished",
@@ -52,6 +62,7 @@ _REASONS = {
     ExitStatus.RATE_BOUND: "diverged: body rate left the bound",
     ExitStatus.TILT_BOUND: "diverged: tilt left the bound",
     ExitStatus.BAD_COMMAND: "stopped: the controller returned a non-finite command",
+    ExitStatus.LOST_TRACK: "lost track: the position error left the tracking bound",
 }
 
 STATUS_REASONS = tuple(status.reason for status in ExitStatus)

@@ -12,6 +12,7 @@ True
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from typing import Any
 
@@ -21,12 +22,13 @@ from quadcruise._version import __version__
 from quadcruise.control import as_controller, controller_record
 from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import InputError, reject_unknown
-from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_Z, STATE_SIZE, Z
+from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, REF_Z, STATE_SIZE, X, Z
 from quadcruise.missions import Mission, mission_from_name, stack_params
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
 from quadcruise.sim.engine import Limits, simulate, time_grid
 from quadcruise.sim.result import SimResult
+from quadcruise.sim.status import ExitStatus
 
 
 def default_duration(mission: Mission) -> float:
@@ -85,7 +87,8 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
         log_every: int = 1, limits: Limits | None = None, missions: list[Mission] | None = None,
         controller_vehicle: Vehicle | None = None, full_dynamics: bool = False,
         environment: Environment | None = None, sensors: SensorNoise | None = None,
-        seed: int = 0, first_vehicle: int = 0, **unknown: Any) -> SimResult:
+        seed: int = 0, first_vehicle: int = 0, max_track_error: float | None = None,
+        **unknown: Any) -> SimResult:
     """Fly a mission with a controller and return the logged flight.
 
     Parameters
@@ -129,6 +132,12 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
     first_vehicle : int
         Index of the first vehicle in a larger population: vehicle i's random stream comes from
         (seed, first_vehicle + i) only, so a batch split in parts flies the same numbers.
+    max_track_error : float, optional
+        Tracking bound [m]: a vehicle whose position error (3-D, at the logged instants) exceeds
+        it gets the status ``lost track`` from the first such instant on (it flies on; the
+        result says so, and ``fly`` warns). By default 1 m plus the diagonal of the box its
+        reference path spans (a circle of radius 2 m: 6.66 m; a 1 m step: 2 m; hover: 1 m),
+        so that the start offset of a mission never counts; ``numpy.inf`` turns it off.
     **unknown : Any
         Refused: any other keyword is an InputError naming the options (see
         :data:`FLY_OPTIONS`), so a misspelt one is not silently ignored.
@@ -141,6 +150,8 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
         of the rotor duties.
     """
     reject_unknown("fly()", unknown, FLY_OPTIONS)
+    if max_track_error is not None and not (isinstance(max_track_error, (int, float)) and max_track_error > 0):
+        raise InputError(f"max_track_error must be a positive number [m], got {max_track_error!r}")
     if isinstance(mission, str):
         mission = mission_from_name(mission)
     controller = as_controller(controller)
@@ -156,6 +167,7 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
     first = missions[0] if missions else mission
     duration = default_duration(first) if duration is None else duration
     grid = time_grid(float(duration), float(dt))
+    check_can_hover(vehicle)
     x0 = hover_state(vehicle, n, first) if x0 is None else x0
     meta = {
         "workflow": "fly",
@@ -174,12 +186,101 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
                       log_every=log_every, limits=limits, meta=meta, vp_ctrl=vp_ctrl,
                       full_dynamics=full_dynamics, seed=seed, first_vehicle=first_vehicle,
                       **engine_inputs(environment, sensors, n, dt))
+    result = mark_lost_track(result, max_track_error)
     _warn_about(result)
     return result
 
 
 FLY_OPTIONS = ("vehicle", "duration", "dt", "max_step", "n", "x0", "log_every", "limits", "missions",
-               "controller_vehicle", "full_dynamics", "environment", "sensors", "seed", "first_vehicle")
+               "controller_vehicle", "full_dynamics", "environment", "sensors", "seed", "first_vehicle",
+               "max_track_error")
+
+HOVER_DUTY_WARNING = 0.7
+"""A hover duty above this leaves less than 30 % of the rotors' thrust for control: ``fly`` warns."""
+
+
+def check_can_hover(vehicle: Vehicle) -> None:
+    """Refuse a vehicle that cannot lift itself; warn when hovering leaves little for control.
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+        One vehicle or a batch.
+
+    Raises
+    ------
+    InputError
+        If the hover duty m g / (4 K) of any vehicle is above 1: its four rotors at full duty
+        cannot hold its weight. The message names the vehicle, its mass and the thrust available.
+
+    Examples
+    --------
+    >>> import quadcruise as qc
+    >>> check_can_hover(qc.Vehicle.paper().replace(m=60.0))
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: the vehicle of mass 60 kg cannot lift itself: hovering needs 588.6 N, its four rotors give at most 480 N (K = 120 N each)
+    """
+    duty = np.atleast_1d(np.asarray(vehicle.hover_duty, dtype=float))
+    m = np.broadcast_to(np.asarray(vehicle.m, dtype=float), duty.shape)
+    k = np.broadcast_to(np.asarray(vehicle.K, dtype=float), duty.shape)
+    g = np.broadcast_to(np.asarray(vehicle.g, dtype=float), duty.shape)
+    bad = np.flatnonzero(~(duty <= 1.0))
+    if bad.size:
+        i = int(bad[0])
+        which = f"vehicle {i} (mass {m[i]:g} kg)" if duty.size > 1 else f"the vehicle of mass {m[i]:g} kg"
+        raise InputError(f"{which} cannot lift itself: hovering needs {m[i] * g[i]:.4g} N, its four rotors "
+                         f"give at most {4 * k[i]:g} N (K = {k[i]:g} N each)")
+    close = np.flatnonzero(duty > HOVER_DUTY_WARNING)
+    if close.size:
+        i = int(close[0])
+        warnings.warn(f"the vehicle{'' if duty.size == 1 else f' {i}'} hovers at {100 * duty[i]:.0f} % duty, "
+                      f"leaving {100 * (1 - duty[i]):.0f} % of its thrust for control", stacklevel=3)
+
+
+def track_bound(result: SimResult) -> np.ndarray:
+    """The default tracking bound of each vehicle: 1 m plus the diagonal of its reference path's box.
+
+    Parameters
+    ----------
+    result : SimResult
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) bounds [m].
+    """
+    ref = result.references[:, :, REF_X:REF_X + 3]
+    span = np.nanmax(ref, axis=1) - np.nanmin(ref, axis=1)
+    return 1.0 + np.linalg.norm(np.nan_to_num(span), axis=1)
+
+
+def mark_lost_track(result: SimResult, max_track_error: float | None = None) -> SimResult:
+    """The result, with ``lost track`` as the status of each finished vehicle whose position
+    error left the bound, and the first logged instant it did as its ``t_stop``.
+
+    Parameters
+    ----------
+    result : SimResult
+    max_track_error : float, optional
+        The bound [m]; :func:`track_bound` by default.
+
+    Returns
+    -------
+    SimResult
+        The same object when no vehicle lost track.
+    """
+    bound = track_bound(result) if max_track_error is None else np.full(result.n, float(max_track_error))
+    err = np.linalg.norm(result.states[:, :, X:X + 3] - result.references[:, :, REF_X:REF_X + 3], axis=2)
+    beyond = (err > bound[:, None]) & (result.status == int(ExitStatus.FINISHED))[:, None]
+    lost = np.flatnonzero(beyond.any(axis=1))
+    result.meta["max_track_error_m"] = None if max_track_error is None else float(max_track_error)
+    if not lost.size:
+        return result
+    status, t_stop = result.status.copy(), result.t_stop.copy()
+    status[lost] = int(ExitStatus.LOST_TRACK)
+    t_stop[lost] = result.t[np.argmax(beyond[lost], axis=1)]
+    return dataclasses.replace(result, status=status, t_stop=t_stop)
 """The keywords :func:`fly` takes besides the mission and the controller."""
 
 

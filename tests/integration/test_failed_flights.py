@@ -1,0 +1,73 @@
+"""A flight that failed says so: in its status, the command line's exit code and its output;
+a vehicle that cannot fly is refused before anything flies."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+import quadcruise as qc
+from quadcruise.cli import main
+from quadcruise.control import NLPD
+from quadcruise.control.design import pd_from_poles
+from quadcruise.sim.status import ExitStatus
+
+RUNNER = CliRunner()
+
+
+def fly_quietly(*args, **kwargs):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return qc.fly(*args, **kwargs)
+
+
+def test_a_controller_that_loses_the_circle_is_not_finished():
+    res = fly_quietly("circle", NLPD(position=pd_from_poles([-1000.0, -2000.0])), duration=8.0)
+    assert res.exit_status(0) is ExitStatus.LOST_TRACK and not res.ok[0] and not res.stopped[0]
+    err = np.linalg.norm(res.states[0, :, :3] - res.references[0, :, :3], axis=1)
+    ref = res.references[0, :, :3]
+    bound = 1.0 + np.linalg.norm(ref.max(axis=0) - ref.min(axis=0))    # 1 m + the reference box's diagonal
+    i = int(np.searchsorted(res.t, res.t_stop[0]))
+    assert err[i] > bound >= err[:i].max()                               # the first instant beyond it
+    assert "lost track" in res.status_text(0) and f"{res.t_stop[0]:.4f}" in res.status_text(0)
+    assert np.isfinite(res.metrics()["rmse_m"][0])                      # it flew on: metrics still shown
+
+
+def test_the_tracking_bound_is_settable_and_the_default_ignores_the_start_offset():
+    assert fly_quietly("circle", duration=5.0).ok[0]                   # starts 2 m off its circle
+    tight = fly_quietly("circle", duration=5.0, max_track_error=0.5)
+    assert tight.exit_status(0) is ExitStatus.LOST_TRACK and tight.t_stop[0] == 0.0
+    assert fly_quietly("circle", NLPD(position=pd_from_poles([-1000.0, -2000.0])), duration=3.0,
+                       max_track_error=np.inf).ok[0]
+    with pytest.raises(qc.InputError, match="max_track_error"):
+        qc.fly("hover", max_track_error=-1.0)
+
+
+def test_the_command_line_exits_1_after_printing_the_reason():
+    bad = RUNNER.invoke(main, ["fly", "circle", "--poles=-1000,-2000", "--duration", "4"])
+    assert bad.exit_code == 1, bad.output
+    assert "rmse_m" in bad.output and "did not fly its mission: lost track" in bad.output
+    good = RUNNER.invoke(main, ["fly", "step", "--duration", "3"])
+    assert good.exit_code == 0, good.output
+
+
+@pytest.mark.parametrize("mass", [60.0, 1e300])
+def test_a_vehicle_that_cannot_lift_itself_is_refused_before_flying(mass, tmp_path):
+    with pytest.raises(qc.InputError, match="cannot lift itself"):
+        qc.fly("hover", vehicle=qc.Vehicle.paper().replace(m=mass))
+    scenario = tmp_path / "heavy.toml"
+    scenario.write_text(f'[vehicle]\nm = {mass!r}\n\n[mission]\nkind = "hover"\n')
+    out = tmp_path / "out"
+    run = RUNNER.invoke(main, ["fly", str(scenario), "--out", str(out)])
+    assert run.exit_code == 2 and "cannot lift itself" in run.output and "Traceback" not in run.output
+    assert not out.exists()                                              # refused before any work
+    with pytest.raises(qc.InputError, match=r"vehicle 1 \(mass 60 kg\)"):
+        qc.fly("hover", vehicle=qc.Vehicle(m=np.array([3.0, 60.0])))
+
+
+def test_hovering_near_full_duty_warns():
+    with pytest.warns(UserWarning, match="hovers at 82 % duty"):
+        qc.fly("hover", vehicle=qc.Vehicle.paper().replace(m=40.0), duration=0.5)
