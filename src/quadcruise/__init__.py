@@ -17,8 +17,8 @@ from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.engine import Limits, simulate, time_grid
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.status import STATUS_REASONS, ExitStatus
-from quadcruise.workflows.fly import fly
 from quadcruise.workflows.compare import Comparison, compare
+from quadcruise.workflows.fly import fly
 from quadcruise.workflows.replay import DutySchedule, read_duty_csv, replay, write_states_csv
 
 __all__ = [
