@@ -19,6 +19,7 @@ PACKAGE = Path(quadcruise.__file__).parent
 #: bottom (0) to top: a module may import only from a lower rank or from its own subpackage
 RANKS = {
     "quadcruise._version": 0, "quadcruise.errors": 0, "quadcruise.layout": 0, "quadcruise._cache": 0,
+    "quadcruise.numeric": 0,
     "quadcruise.fields": 1, "quadcruise.io": 1,
     "quadcruise.model": 2,
     "quadcruise.metrics": 3,

@@ -21,11 +21,10 @@ themselves engine controllers.
 
 from __future__ import annotations
 
-import math
-
 from numba import njit
 
 from quadcruise.layout import FLAG_INTEGRATOR_HOLD, P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, PHI, PSI, THETA, P, Q, R
+from quadcruise.numeric import clamp, wrap_angle
 
 # gains layout shared by every controller built on this loop (offsets into ``gains``)
 ATT_KP, ATT_KI, ATT_KD, YAW_KP, YAW_KI, YAW_KD, ATT_I_LIMIT = range(7)
@@ -35,23 +34,13 @@ ATT_MEMORY = 3
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def wrap_angle(a):
-    """Angle wrapped into (-pi, pi]."""
-    return a - 2.0 * math.pi * math.floor((a + math.pi) / (2.0 * math.pi))
-
-
-@njit(cache=True, inline="always", error_model="numpy")
 def pid_axis(e, rate, integral, kp, ki, kd, i_limit, dt):
     """PID on one angle error e [rad] with measured rate [rad/s] and the integral of e so far
     [rad s]; returns (U* [rad/s^2], the new integral, whether anti-windup held it)."""
     held = False
     if ki > 0.0:
-        integral = integral + e * dt
         bound = i_limit / ki
-        if integral > bound:
-            integral, held = bound, True
-        elif integral < -bound:
-            integral, held = -bound, True
+        integral, held = clamp(integral + e * dt, -bound, bound)
     return kp * e + ki * integral - kd * rate, integral, held
 
 

@@ -47,15 +47,7 @@ from numba import njit
 
 from quadcruise.control.base import Controller, check_positive, check_tilt, check_type
 from quadcruise.control.design import check_gains, python_control
-from quadcruise.control.position import limit
-from quadcruise.control.so3 import (
-    attitude_px4,
-    clamp,
-    command_from_rotation,
-    error_quaternion,
-    limit_tilt,
-    rotation_zyx,
-)
+from quadcruise.control.so3 import attitude_px4, command_from_rotation, error_quaternion, limit_tilt, rotation_zyx
 from quadcruise.errors import InputError
 from quadcruise.layout import (
     CONTROLLER_SIG,
@@ -94,6 +86,7 @@ from quadcruise.layout import (
     Y,
     Z,
 )
+from quadcruise.numeric import clamp
 
 # gains layout
 (C_POS_XY, C_POS_Z, C_VEL_P_XY, C_VEL_I_XY, C_VEL_D_XY, C_VEL_P_Z, C_VEL_I_Z, C_VEL_D_Z,
@@ -213,9 +206,9 @@ def cascade(t, dt, x, ref, vp, G, mem, cmd):
     Rm = rotation_zyx(phi, theta, psi)
     Rd = attitude_px4(b3x, b3y, b3z, psi_d)
     e1, e2, e3 = error_quaternion(Rm, Rd)
-    sp1, _ = limit(k_att_rp * e1 + Rm[2][0] * yr, rmax_rp)
-    sp2, _ = limit(k_att_rp * e2 + Rm[2][1] * yr, rmax_rp)
-    sp3, _ = limit(k_att_yaw * e3 + Rm[2][2] * yr, rmax_yaw)
+    sp1, _ = clamp(k_att_rp * e1 + Rm[2][0] * yr, -rmax_rp, rmax_rp)
+    sp2, _ = clamp(k_att_rp * e2 + Rm[2][1] * yr, -rmax_rp, rmax_rp)
+    sp3, _ = clamp(k_att_yaw * e3 + Rm[2][2] * yr, -rmax_yaw, rmax_yaw)
     # 4. rate PID -> torques
     full = l * K                                          # full roll/pitch torque [N m]
     a1, ri_1, dw_1, h1 = _rate_axis(sp1, p, ri_1, lw_1, dw_1, dt, aw, first, kr_p, kr_i,

@@ -82,6 +82,7 @@ from quadcruise.layout import (
     Y,
     Z,
 )
+from quadcruise.numeric import clamp, wrap_angle
 from quadcruise.sim.fastmath import sin_cos
 
 # gains layout after the attitude block
@@ -91,33 +92,13 @@ NLPD_GAINS = ATT_GAINS + 8
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def clip_unit(s):
-    """s clipped to [-1, 1], and whether it had to be."""
-    if s > 1.0:
-        return 1.0, True
-    if s < -1.0:
-        return -1.0, True
-    return s, False
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def limit(value, bound):
-    """value clipped to [-bound, bound], and whether it had to be."""
-    if value > bound:
-        return bound, True
-    if value < -bound:
-        return -bound, True
-    return value, False
-
-
-@njit(cache=True, inline="always", error_model="numpy")
 def pitch_eq16(ux, sphi, cphi, spsi, cpsi, a):
     """Eq (16) from the sines and cosines of roll and yaw (see :func:`theta_from_eq5`):
     (theta, sin theta, clipped?)."""
     den = cphi * cpsi * a
     if abs(den) < 1e-9:
         return 0.0, 0.0, True
-    s, clipped = clip_unit((ux - sphi * spsi * a) / den)
+    s, clipped = clamp((ux - sphi * spsi * a) / den, -1.0, 1.0)
     return math.asin(s), s, clipped
 
 
@@ -129,7 +110,7 @@ def roll_eq19(uy, stheta, spsi, cpsi, a):
     R = math.sqrt(A * A + B * B)         # |A|, |B| <= 1: no overflow to guard against
     if R * a < 1e-9:
         return 0.0, True
-    s, clipped = clip_unit(uy / (a * R))
+    s, clipped = clamp(uy / (a * R), -1.0, 1.0)
     r1 = math.asin(s)
     if A > 0.0:
         # |gamma| < pi/2 and |r1| <= pi/2: gamma - r1 lies in (-pi, pi) and, cos phi1 -
@@ -138,8 +119,7 @@ def roll_eq19(uy, stheta, spsi, cpsi, a):
     gamma = math.atan2(B, A)
     phi1 = gamma - r1
     phi2 = gamma + math.pi + r1
-    phi1 -= 2.0 * math.pi * math.floor((phi1 + math.pi) / (2.0 * math.pi))
-    phi2 -= 2.0 * math.pi * math.floor((phi2 + math.pi) / (2.0 * math.pi))
+    phi1, phi2 = wrap_angle(phi1), wrap_angle(phi2)
     return (phi1 if abs(phi1) <= abs(phi2) else phi2), clipped
 
 
@@ -162,12 +142,8 @@ def thrust_for_tilt(uz, cos_tilt, m, g, K, cos_max_tilt):
     flag. ``cos_tilt`` is cos phi cos theta; the compensation uses at most 1/cos(max_tilt) so
     that it cannot blow up."""
     c = max(cos_tilt, cos_max_tilt)
-    U1 = m * (g + uz) / c
-    if U1 < 0.0:
-        return 0.0, FLAG_THRUST_LIMIT
-    if U1 > 4.0 * K:
-        return 4.0 * K, FLAG_THRUST_LIMIT
-    return U1, 0
+    U1, limited = clamp(m * (g + uz) / c, 0.0, 4.0 * K)
+    return U1, FLAG_THRUST_LIMIT if limited else 0
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -175,7 +151,7 @@ def tilt_setpoint(angle, clipped, max_tilt, flags):
     """Limit a roll/pitch setpoint to max_tilt and add the flags that apply."""
     if clipped:
         flags |= FLAG_ASIN_CLIP
-    angle, limited = limit(angle, max_tilt)
+    angle, limited = clamp(angle, -max_tilt, max_tilt)
     if limited:
         flags |= FLAG_TILT_LIMIT
     return angle, flags

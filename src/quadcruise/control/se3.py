@@ -51,7 +51,7 @@ from numba import njit
 
 from quadcruise.control.base import Controller, check_positive, check_tilt, check_type
 from quadcruise.control.design import ATTITUDE_WN_RATIO, ATTITUDE_ZETA, PDGains, altitude_pd_design, position_pd_design
-from quadcruise.control.so3 import attitude_lee, clamp, command_from_rotation, error_lee, limit_tilt, rotation_zyx
+from quadcruise.control.so3 import attitude_lee, command_from_rotation, error_lee, limit_tilt, rotation_zyx
 from quadcruise.layout import (
     CONTROLLER_SIG,
     FLAG_THRUST_LIMIT,
@@ -87,6 +87,7 @@ from quadcruise.layout import (
     Y,
     Z,
 )
+from quadcruise.numeric import clamp
 
 __all__ = ["SE3", "se3", "se3_attitude_design"]
 
