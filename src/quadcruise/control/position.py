@@ -33,7 +33,7 @@ holding yaw near zero.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
@@ -50,9 +50,10 @@ from quadcruise.control.attitude import (
     YAW_KP,
     decoupled_attitude,
 )
-from quadcruise.control.base import Controller, check_positive, write_command
+from quadcruise.control.base import TILT, Controller, write_command
 from quadcruise.control.design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
-from quadcruise.errors import InputError
+from quadcruise.fields import instance_of
+from quadcruise.fields import unit_field as _f
 from quadcruise.layout import (
     CONTROLLER_SIG,
     FLAG_ASIN_CLIP,
@@ -236,18 +237,14 @@ class NLPD(Controller):
     name = "nlpd"
     memory_size = ATT_MEMORY
 
-    position: PDGains = field(default_factory=position_pd_design)
-    altitude: PDGains = field(default_factory=altitude_pd_design)
-    attitude: PIDGains = field(default_factory=attitude_pid_design)
-    yaw: PIDGains = field(default_factory=attitude_pid_design)
-    max_tilt: float = math.radians(45.0)
-    i_limit: float = 5.0
-    accel_feedforward: bool = False
-
-    def __post_init__(self) -> None:
-        check_positive(self.name, max_tilt=self.max_tilt, i_limit=self.i_limit)
-        if self.max_tilt >= math.pi / 2:
-            raise InputError(f"{self.name} parameter 'max_tilt' must be below pi/2 rad, got {self.max_tilt!r}")
+    position: PDGains = _f(unit="-", doc="x and y PD loops", check=instance_of(PDGains), factory=position_pd_design)
+    altitude: PDGains = _f(unit="-", doc="z PD loop", check=instance_of(PDGains), factory=altitude_pd_design)
+    attitude: PIDGains = _f(unit="-", doc="roll and pitch PID loops", check=instance_of(PIDGains),
+                            factory=attitude_pid_design)
+    yaw: PIDGains = _f(unit="-", doc="yaw PID loop", check=instance_of(PIDGains), factory=attitude_pid_design)
+    max_tilt: float = _f(math.radians(45.0), "rad", "roll and pitch setpoint limit", TILT)
+    i_limit: float = _f(5.0, "rad/s^2", "anti-windup bound on the attitude integral term", "pos")
+    accel_feedforward: bool = _f(False, "-", "reference acceleration fed forward", "flag")
 
     @property
     def function(self):
