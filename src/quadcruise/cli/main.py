@@ -76,19 +76,11 @@ def replay(pwm_csv: str, out: str, max_step: float) -> None:
 
 
 def _assignments(items: tuple[str, ...], option: str) -> dict:
-    """Parse KEY=VALUE pairs: numbers, comma-separated pairs of numbers, or words."""
-    out = {}
-    for item in items:
-        key, sep, raw = item.partition("=")
-        if not sep or not key.strip():
-            raise InputError(f"{option} {item!r}: expected KEY=VALUE")
-        parts = [p.strip() for p in raw.split(",")]
-        try:
-            values = [float(p) for p in parts]
-            out[key.strip()] = values[0] if len(values) == 1 else tuple(values)
-        except ValueError:
-            out[key.strip()] = raw.strip()
-    return out
+    """Parse KEY=VALUE pairs (:func:`quadcruise.fields.parse_assignments`): numbers,
+    comma-separated numbers, true/false, or words."""
+    from quadcruise.fields import parse_assignments
+
+    return parse_assignments(items, option)
 
 
 def _poles(text: str | None, option: str):

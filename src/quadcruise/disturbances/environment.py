@@ -61,7 +61,7 @@ import numpy as np
 from numba import njit
 
 from quadcruise.errors import InputError
-from quadcruise.fields import Validated, between, instance_of, unit_field
+from quadcruise.fields import Validated, between, instance_of, parse_numbers, unit_field
 from quadcruise.layout import DISTURBANCE_SIG, EXT_E1, EXT_FX, EXT_WX, PHI, STATE_SIZE, VX, P, X
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.rng import ziggurat
@@ -455,13 +455,7 @@ def wind_from_name(name: str, **kw: Any) -> _Part:
 
 
 def _floats(text: str, k: int, what: str) -> list:
-    vals = text.split(",")
-    if len(vals) != k:
-        raise InputError(f"needs {k} value{'s' * (k > 1)} {what}, got {text!r}")
-    try:
-        return [float(v) for v in vals]
-    except ValueError:
-        raise InputError(f"{what} must be numbers, got {text!r}") from None
+    return parse_numbers(text, what, k)
 
 
 def _part(text: str) -> _Part:
