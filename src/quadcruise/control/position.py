@@ -94,8 +94,30 @@ NLPD_GAINS = ATT_GAINS + 8
 
 @njit(cache=True, inline="always", error_model="numpy")
 def pitch_eq16(ux, sphi, cphi, spsi, cpsi, a):
-    """Eq (16) from the sines and cosines of roll and yaw (see :func:`theta_from_eq5`):
-    (theta, sin theta, clipped?)."""
+    """Eq (16) from the sines and cosines of roll and yaw (see :func:`theta_from_eq5`).
+
+    Parameters
+    ----------
+    ux : float
+        Wanted x acceleration [m/s^2].
+    sphi, cphi, spsi, cpsi : float
+        sin and cos of roll and yaw.
+    a : float
+        U1 / m [m/s^2].
+
+    Returns
+    -------
+    (float, float, bool)
+        theta_d [rad], its sine (asin's argument, clamped to [-1, 1]) and whether it was clamped.
+
+    Examples
+    --------
+    >>> theta, s, clipped = pitch_eq16(0.981, 0.0, 1.0, 0.0, 1.0, 9.81)
+    >>> round(theta, 6), round(s, 6), clipped
+    (0.100167, 0.1, False)
+    >>> pitch_eq16(20.0, 0.0, 1.0, 0.0, 1.0, 9.81)[1:]
+    (1.0, True)
+    """
     den = cphi * cpsi * a
     if abs(den) < 1e-9:
         return 0.0, 0.0, True
@@ -105,7 +127,31 @@ def pitch_eq16(ux, sphi, cphi, spsi, cpsi, a):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def roll_eq19(uy, stheta, spsi, cpsi, a):
-    """Eq (19), sign kept, from sin(theta) and the yaw's sine and cosine (see :func:`phi_from_eq6`)."""
+    """Eq (19), sign kept, from sin(theta) and the yaw's sine and cosine (see :func:`phi_from_eq6`).
+
+    Parameters
+    ----------
+    uy : float
+        Wanted y acceleration [m/s^2].
+    stheta : float
+        sin theta_d.
+    spsi, cpsi : float
+        sin and cos of yaw.
+    a : float
+        U1 / m [m/s^2].
+
+    Returns
+    -------
+    (float, bool)
+        phi_d [rad] (the root nearest level, wrapped by :func:`quadcruise.numeric.wrap_angle`
+        when cos psi <= 0) and whether asin's argument was clamped.
+
+    Examples
+    --------
+    >>> phi, clipped = roll_eq19(0.981, 0.0, 0.0, 1.0, 9.81)
+    >>> round(phi, 6), clipped
+    (-0.100167, False)
+    """
     A = cpsi
     B = stheta * spsi
     R = math.sqrt(A * A + B * B)         # |A|, |B| <= 1: no overflow to guard against
@@ -141,7 +187,32 @@ def phi_from_eq6(uy, theta, psi, a):
 def thrust_for_tilt(uz, cos_tilt, m, g, K, cos_max_tilt):
     """Altitude law: U1 = m (g + u_z) / (cos phi cos theta), limited to [0, 4 K] [N], and its
     flag. ``cos_tilt`` is cos phi cos theta; the compensation uses at most 1/cos(max_tilt) so
-    that it cannot blow up."""
+    that it cannot blow up.
+
+    Parameters
+    ----------
+    uz : float
+        Wanted z acceleration [m/s^2].
+    cos_tilt : float
+        cos phi cos theta.
+    m, g, K : float
+        Mass [kg], gravity [m/s^2], thrust per unit duty [N].
+    cos_max_tilt : float
+        cos of the tilt limit.
+
+    Returns
+    -------
+    (float, int)
+        U1 [N] and FLAG_THRUST_LIMIT if it was limited, else 0.
+
+    Examples
+    --------
+    >>> U1, flag = thrust_for_tilt(0.0, 1.0, 3.499, 9.81, 120.0, 0.7)
+    >>> round(U1, 6), flag
+    (34.32519, 0)
+    >>> thrust_for_tilt(-20.0, 1.0, 3.499, 9.81, 120.0, 0.7)
+    (0.0, 4)
+    """
     c = max(cos_tilt, cos_max_tilt)
     U1, limited = clamp(m * (g + uz) / c, 0.0, 4.0 * K)
     return U1, FLAG_THRUST_LIMIT if limited else 0
@@ -149,7 +220,30 @@ def thrust_for_tilt(uz, cos_tilt, m, g, K, cos_max_tilt):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def tilt_setpoint(angle, clipped, max_tilt, flags):
-    """Limit a roll/pitch setpoint to max_tilt and add the flags that apply."""
+    """Limit a roll/pitch setpoint to max_tilt and add the flags that apply.
+
+    Parameters
+    ----------
+    angle : float
+        The setpoint [rad].
+    clipped : bool
+        Whether its asin argument was clamped (adds FLAG_ASIN_CLIP).
+    max_tilt : float
+        The limit [rad] (adds FLAG_TILT_LIMIT when it acts).
+    flags : int
+        The flags so far.
+
+    Returns
+    -------
+    (float, int)
+
+    Examples
+    --------
+    >>> tilt_setpoint(1.0, False, 0.5, 0)
+    (0.5, 1)
+    >>> tilt_setpoint(-0.2, True, 0.5, 0)
+    (-0.2, 2)
+    """
     if clipped:
         flags |= FLAG_ASIN_CLIP
     angle, limited = clamp(angle, -max_tilt, max_tilt)

@@ -45,7 +45,23 @@ def rotation_zyx(phi, theta, psi):
 
 @njit(cache=True, error_model="numpy")
 def euler_zyx(Rm):
-    """(phi, theta, psi) of a rotation R = Rz(psi) Ry(theta) Rx(phi), |theta| <= pi/2."""
+    """(phi, theta, psi) of a rotation R = Rz(psi) Ry(theta) Rx(phi), |theta| <= pi/2.
+
+    Parameters
+    ----------
+    Rm : tuple of three 3-tuples
+        The rotation, by rows (``R[i][j]``).
+
+    Returns
+    -------
+    (float, float, float)
+        Roll, pitch, yaw [rad]; -R[2][0] is clamped to [-1, 1] before its asin (a NaN stays NaN).
+
+    Examples
+    --------
+    >>> [round(a, 12) for a in euler_zyx(rotation_zyx(0.1, -0.2, 0.3))]
+    [0.1, -0.2, 0.3]
+    """
     s, _ = clamp(-Rm[2][0], -1.0, 1.0)
     return math.atan2(Rm[2][1], Rm[2][2]), math.asin(s), math.atan2(Rm[1][0], Rm[0][0])
 
