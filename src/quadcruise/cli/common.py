@@ -57,7 +57,8 @@ def friendly(func: Callable) -> Callable:
 
 
 def _assignments(items: tuple[str, ...], option: str) -> dict:
-    """Parse KEY=VALUE pairs: numbers, comma-separated pairs of numbers, or words.
+    """Parse KEY=VALUE pairs with :func:`quadcruise.fields.parse_assignments`: numbers,
+    comma-separated numbers, true/false, or words.
 
     Parameters
     ----------
@@ -69,25 +70,16 @@ def _assignments(items: tuple[str, ...], option: str) -> dict:
     Returns
     -------
     dict
-        Key -> a float, a tuple of floats (``1,2``) or the text as given.
+        Key -> an int or float, a tuple of numbers (``1,2``), a bool, or the text as given.
 
     Raises
     ------
     InputError
         An item has no ``=`` or no key.
     """
-    out = {}
-    for item in items:
-        key, sep, raw = item.partition("=")
-        if not sep or not key.strip():
-            raise InputError(f"{option} {item!r}: expected KEY=VALUE")
-        parts = [p.strip() for p in raw.split(",")]
-        try:
-            values = [float(p) for p in parts]
-            out[key.strip()] = values[0] if len(values) == 1 else tuple(values)
-        except ValueError:
-            out[key.strip()] = raw.strip()
-    return out
+    from quadcruise.fields import parse_assignments
+
+    return parse_assignments(items, option)
 
 
 def _poles(text: str | None, option: str):

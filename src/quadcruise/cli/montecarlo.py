@@ -68,10 +68,14 @@ def montecarlo(**options):
 def parse_noise(text: str | None):
     """Parse a sensor noise spec, ``position=STD,velocity=STD,angle=STD,rate=STD,delay=S``.
 
+    Parsed by :func:`quadcruise.fields.parse_assignments`; the values are checked by
+    :class:`~quadcruise.disturbances.SensorNoise`.
+
     Parameters
     ----------
     text : str or None
-        The spec; None, "" or "none" for no noise.
+        The spec: std of position [m], velocity [m/s], angles [rad], body rates [rad/s] and
+        the delay [s]; any left out are 0. None, "" or "none": no sensor noise.
 
     Returns
     -------
@@ -86,24 +90,19 @@ def parse_noise(text: str | None):
     --------
     >>> parse_noise("position=0.01,delay=0.002").delay
     0.002
+    >>> parse_noise("jitter=1")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: noise spec 'jitter=1': unknown key 'jitter'; keys: position, velocity, angle, rate, delay
     """
     if text is None or str(text).strip().lower() in ("", "none"):
         return None
     from quadcruise.disturbances import SensorNoise
+    from quadcruise.fields import parse_assignments
 
     names = {"position": "position_std", "velocity": "velocity_std", "angle": "angle_std",
              "rate": "rate_std", "delay": "delay"}
-    kw = {}
-    for item in str(text).split(","):
-        key, sep, value = item.partition("=")
-        key = key.strip().lower()
-        if not sep or key not in names:
-            raise InputError(f"noise spec {text!r}: expected KEY=VALUE with KEY one of {', '.join(names)}")
-        try:
-            kw[names[key]] = float(value)
-        except ValueError:
-            raise InputError(f"noise spec {text!r}: {key} must be a number, got {value.strip()!r}") from None
-    return SensorNoise(**kw)
+    return SensorNoise(**parse_assignments(text, "noise spec", keys=names, numbers=True))
 
 
 def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: int | None = None,

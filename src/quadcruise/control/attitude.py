@@ -21,11 +21,10 @@ themselves engine controllers.
 
 from __future__ import annotations
 
-import math
-
 from numba import njit
 
 from quadcruise.layout import FLAG_INTEGRATOR_HOLD, P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, PHI, PSI, THETA, P, Q, R
+from quadcruise.numeric import clamp, wrap_angle
 
 # gains layout shared by every controller built on this loop (offsets into ``gains``)
 ATT_KP, ATT_KI, ATT_KD, YAW_KP, YAW_KI, YAW_KD, ATT_I_LIMIT = range(7)
@@ -35,23 +34,42 @@ ATT_MEMORY = 3
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def wrap_angle(a):
-    """Angle wrapped into (-pi, pi]."""
-    return a - 2.0 * math.pi * math.floor((a + math.pi) / (2.0 * math.pi))
-
-
-@njit(cache=True, inline="always", error_model="numpy")
 def pid_axis(e, rate, integral, kp, ki, kd, i_limit, dt):
-    """PID on one angle error e [rad] with measured rate [rad/s] and the integral of e so far
-    [rad s]; returns (U* [rad/s^2], the new integral, whether anti-windup held it)."""
+    """PID on one angle error with the derivative on the measured rate; anti-windup holds
+    ``ki * integral`` within +-``i_limit`` (:func:`quadcruise.numeric.clamp`).
+
+    Parameters
+    ----------
+    e : float
+        Angle error [rad].
+    rate : float
+        Measured body rate [rad/s].
+    integral : float
+        Integral of e so far [rad s].
+    kp, ki, kd : float
+        Gains [1/s^2], [1/s^3], [1/s].
+    i_limit : float
+        Bound on the integral term [rad/s^2].
+    dt : float
+        Control period [s].
+
+    Returns
+    -------
+    (float, float, bool)
+        U* [rad/s^2], the new integral, whether anti-windup held it.
+
+    Examples
+    --------
+    >>> u, integral, held = pid_axis(0.1, 0.0, 0.0, 88.2, 40.5, 14.9, 5.0, 0.001)
+    >>> round(u, 6), integral, held
+    (8.82405, 0.0001, False)
+    >>> pid_axis(1.0, 0.0, 0.12, 1.0, 50.0, 0.0, 5.0, 0.001)[1:]
+    (0.1, True)
+    """
     held = False
     if ki > 0.0:
-        integral = integral + e * dt
         bound = i_limit / ki
-        if integral > bound:
-            integral, held = bound, True
-        elif integral < -bound:
-            integral, held = -bound, True
+        integral, held = clamp(integral + e * dt, -bound, bound)
     return kp * e + ki * integral - kd * rate, integral, held
 
 

@@ -1,9 +1,11 @@
 """What every controller object offers the engine: a compiled function, its parameter
 vector for a vehicle, and the size of its memory.
 
-A controller is a frozen dataclass of gains with units; :meth:`Controller.gains` packs
-them into the flat vector the compiled function reads. A user's own controller only needs
-a function compiled with ``layout.CONTROLLER_SIG`` and these three members.
+A controller is a frozen dataclass of gains with units (its fields come from
+:func:`quadcruise.fields.unit_field` and are checked by :func:`quadcruise.fields.validate`);
+:meth:`Controller.gains` packs them into the flat vector the compiled function reads. A
+user's own controller only needs a function compiled with ``layout.CONTROLLER_SIG`` and
+these three members.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numba import njit
 
-from quadcruise.errors import InputError
+from quadcruise.fields import Validated, between
 from quadcruise.layout import (
     CMD_FLAGS,
     CMD_PHI_D,
@@ -28,12 +30,25 @@ from quadcruise.layout import (
 )
 from quadcruise.model.actuators import duties
 
+TILT = between(0.0, math.pi / 2, "()", text="(0, pi/2)")
+"""The check of a tilt limit [rad]: above 0 and below pi/2."""
+
 
 @dataclasses.dataclass(frozen=True)
-class Controller:
-    """Base class of the built-in controllers."""
+class Controller(Validated):
+    """Base class of the built-in controllers: validation and ``units()`` of the fields
+    (:class:`quadcruise.fields.Validated`; messages call them parameters), ``memory``,
+    ``to_dict``.
+
+    Examples
+    --------
+    >>> from quadcruise.control.se3 import SE3
+    >>> SE3.units()["attitude.kp"], SE3.units()["max_tilt"]
+    ('1/s^2', 'rad')
+    """
 
     name: ClassVar[str] = "controller"
+    field_noun: ClassVar[str] = "parameter"
     memory_size: ClassVar[int] = 0
 
     @property
@@ -56,27 +71,6 @@ class Controller:
             value = getattr(self, f.name)
             out[f.name] = dataclasses.asdict(value) if dataclasses.is_dataclass(value) else value
         return out
-
-
-def check_positive(owner: str, **values: float) -> None:
-    """InputError naming the first of ``values`` that is not a finite number > 0."""
-    for name, value in values.items():
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            raise InputError(f"{owner} parameter '{name}' must be a positive number, got {value!r}")
-
-
-def check_type(owner: str, obj, names, cls) -> None:
-    """InputError unless each field ``names`` of ``obj`` is a ``cls``."""
-    for name in names:
-        if not isinstance(getattr(obj, name), cls):
-            raise InputError(f"{owner} parameter '{name}' must be {cls.__name__}, got {getattr(obj, name)!r}")
-
-
-def check_tilt(owner: str, max_tilt) -> None:
-    """InputError unless 0 < ``max_tilt`` < pi/2 [rad]."""
-    check_positive(owner, max_tilt=max_tilt)
-    if max_tilt >= math.pi / 2:
-        raise InputError(f"{owner} parameter 'max_tilt' must be below pi/2 rad, got {max_tilt!r}")
 
 
 @njit(cache=True, inline="always", error_model="numpy")

@@ -51,16 +51,17 @@ approach a_p, a_d), where the saturated law accelerates less and brakes with a b
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
 from quadcruise.control.attitude import ATT_GAINS, ATT_MEMORY
-from quadcruise.control.base import Controller, check_positive
+from quadcruise.control.base import TILT, Controller
 from quadcruise.control.design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
 from quadcruise.control.position import attitude_block, finish, thrust_for_tilt, tilt_setpoint
-from quadcruise.errors import InputError
+from quadcruise.fields import instance_of
+from quadcruise.fields import unit_field as _f
 from quadcruise.layout import (
     CONTROLLER_SIG,
     P_G,
@@ -148,36 +149,29 @@ class Gonzalez(Controller):
     >>> Gonzalez(accel_d=-1.0)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: gonzalez parameter 'accel_d' must be a positive number, got -1.0
+    quadcruise.errors.InputError: gonzalez parameter 'accel_d' (saturation level of the D term (None: k_d x 1 m/s), m/s^2) must be > 0 or None, got -1.0
     """
 
     name = "gonzalez"
     memory_size = ATT_MEMORY
 
-    position: PDGains = field(default_factory=position_pd_design)
-    accel_p: float | None = None
-    accel_d: float | None = None
-    altitude: PDGains = field(default_factory=altitude_pd_design)
-    attitude: PIDGains = field(default_factory=attitude_pid_design)
-    yaw: PIDGains = field(default_factory=attitude_pid_design)
-    max_tilt: float = math.radians(45.0)
-    i_limit: float = 5.0
+    position: PDGains = _f(unit="-", doc="small-signal PD of x and y", check=instance_of(PDGains),
+                           factory=position_pd_design)
+    accel_p: float | None = _f(None, "m/s^2", "saturation level of the P term (None: k_p x 1 m)", "pos")
+    accel_d: float | None = _f(None, "m/s^2", "saturation level of the D term (None: k_d x 1 m/s)", "pos")
+    altitude: PDGains = _f(unit="-", doc="z PD loop", check=instance_of(PDGains), factory=altitude_pd_design)
+    attitude: PIDGains = _f(unit="-", doc="roll and pitch PID loops", check=instance_of(PIDGains),
+                            factory=attitude_pid_design)
+    yaw: PIDGains = _f(unit="-", doc="yaw PID loop", check=instance_of(PIDGains), factory=attitude_pid_design)
+    max_tilt: float = _f(math.radians(45.0), "rad", "roll and pitch setpoint limit", TILT)
+    i_limit: float = _f(5.0, "rad/s^2", "anti-windup bound on the attitude integral term", "pos")
 
     def __post_init__(self) -> None:
-        check_positive(self.name, max_tilt=self.max_tilt, i_limit=self.i_limit)
-        if self.max_tilt >= math.pi / 2:
-            raise InputError(f"{self.name} parameter 'max_tilt' must be below pi/2 rad, got {self.max_tilt!r}")
-        for name in ("position", "altitude"):
-            if not isinstance(getattr(self, name), PDGains):
-                raise InputError(f"{self.name} parameter '{name}' must be PDGains, got {getattr(self, name)!r}")
+        super().__post_init__()
         defaults = {"accel_p": self.position.kp * UNIT_ERROR, "accel_d": self.position.kd * UNIT_RATE}
         for name, default in defaults.items():
             if getattr(self, name) is None:
                 object.__setattr__(self, name, default)
-            check_positive(self.name, **{name: getattr(self, name)})
-        for name in ("attitude", "yaw"):
-            if not isinstance(getattr(self, name), PIDGains):
-                raise InputError(f"{self.name} parameter '{name}' must be PIDGains, got {getattr(self, name)!r}")
 
     @property
     def function(self):

@@ -40,23 +40,16 @@ So they are designed for the lag instead (:func:`rate_pid_design`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
-from quadcruise.control.base import Controller, check_positive, check_tilt, check_type
-from quadcruise.control.design import check_gains, python_control
-from quadcruise.control.position import limit
-from quadcruise.control.so3 import (
-    attitude_px4,
-    clamp,
-    command_from_rotation,
-    error_quaternion,
-    limit_tilt,
-    rotation_zyx,
-)
-from quadcruise.errors import InputError
+from quadcruise.control.base import TILT, Controller
+from quadcruise.control.design import python_control
+from quadcruise.control.so3 import attitude_px4, command_from_rotation, error_quaternion, limit_tilt, rotation_zyx
+from quadcruise.fields import Validated, between, check_value, instance_of
+from quadcruise.fields import unit_field as _f
 from quadcruise.layout import (
     CONTROLLER_SIG,
     FLAG_INTEGRATOR_HOLD,
@@ -94,6 +87,7 @@ from quadcruise.layout import (
     Y,
     Z,
 )
+from quadcruise.numeric import clamp
 
 # gains layout
 (C_POS_XY, C_POS_Z, C_VEL_P_XY, C_VEL_I_XY, C_VEL_D_XY, C_VEL_P_Z, C_VEL_I_Z, C_VEL_D_Z,
@@ -213,9 +207,9 @@ def cascade(t, dt, x, ref, vp, G, mem, cmd):
     Rm = rotation_zyx(phi, theta, psi)
     Rd = attitude_px4(b3x, b3y, b3z, psi_d)
     e1, e2, e3 = error_quaternion(Rm, Rd)
-    sp1, _ = limit(k_att_rp * e1 + Rm[2][0] * yr, rmax_rp)
-    sp2, _ = limit(k_att_rp * e2 + Rm[2][1] * yr, rmax_rp)
-    sp3, _ = limit(k_att_yaw * e3 + Rm[2][2] * yr, rmax_yaw)
+    sp1, _ = clamp(k_att_rp * e1 + Rm[2][0] * yr, -rmax_rp, rmax_rp)
+    sp2, _ = clamp(k_att_rp * e2 + Rm[2][1] * yr, -rmax_rp, rmax_rp)
+    sp3, _ = clamp(k_att_yaw * e3 + Rm[2][2] * yr, -rmax_yaw, rmax_yaw)
     # 4. rate PID -> torques
     full = l * K                                          # full roll/pitch torque [N m]
     a1, ri_1, dw_1, h1 = _rate_axis(sp1, p, ri_1, lw_1, dw_1, dt, aw, first, kr_p, kr_i,
@@ -237,18 +231,35 @@ def cascade(t, dt, x, ref, vp, G, mem, cmd):
 
 
 @dataclass(frozen=True)
-class RateGains:
+class RateGains(Validated):
     """Body-rate PID per unit inertia: alpha = kp e + ki int(e) - kd w' [rad/s^2], torque J alpha.
 
     kp [1/s], ki [1/s^2], kd [-]; the derivative acts on the measured rate.
+
+    Parameters
+    ----------
+    kp : float
+        Proportional gain [1/s], > 0.
+    ki : float
+        Integral gain [1/s^2], >= 0.
+    kd : float
+        Derivative gain [-], >= 0.
+
+    Examples
+    --------
+    >>> RateGains(kp=15.0, ki=20.0, kd=0.6).kd
+    0.6
+    >>> RateGains(kp=1.0, ki=0.0, kd=-1.0)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: rate gain 'kd' (derivative gain, on the measured rate, -) must be >= 0, got -1.0
     """
 
-    kp: float
-    ki: float
-    kd: float
-
-    def __post_init__(self):
-        check_gains(self, ("kp", "ki", "kd"))
+    kp: float = _f(unit="1/s", doc="proportional gain", check="pos")
+    ki: float = _f(unit="1/s^2", doc="integral gain", check="nonneg")
+    kd: float = _f(unit="-", doc="derivative gain, on the measured rate", check="nonneg")
+    name = "rate"
+    field_noun = "gain"
 
 
 RATE_ZETA = 0.8
@@ -276,6 +287,19 @@ def rate_pid_design(actuator_bandwidth: float = 15.0, yaw: bool = False) -> Rate
     with the position and velocity loops the whole linearised x loop has a worst damping
     ratio of 0.22 and a 1 m step overshoots 13 % (PX4's position P on a raw step).
 
+    Parameters
+    ----------
+    actuator_bandwidth : float
+        The rotor lag's bandwidth w [rad/s], > 0.
+    yaw : bool
+        The yaw rate loop (no D) instead of roll and pitch.
+
+    Returns
+    -------
+    RateGains
+
+    Examples
+    --------
     >>> g = rate_pid_design()
     >>> round(g.kp, 6), round(g.ki, 6), round(g.kd, 6)
     (15.0, 20.0, 0.6)
@@ -283,8 +307,8 @@ def rate_pid_design(actuator_bandwidth: float = 15.0, yaw: bool = False) -> Rate
     >>> round(g.kp, 3), round(g.ki, 3), g.kd
     (5.859, 2.93, 0.0)
     """
-    check_positive("rate_pid_design", actuator_bandwidth=actuator_bandwidth)
-    w = float(actuator_bandwidth)
+    w = check_value("rate_pid_design argument 'actuator_bandwidth' (rotor lag bandwidth, rad/s)",
+                    actuator_bandwidth, "pos")
     if yaw:
         kp = w / (4.0 * RATE_ZETA**2)
         return RateGains(kp=kp, ki=PX4_YAW_RATE_I_RATIO * kp, kd=0.0)
@@ -364,51 +388,36 @@ class Cascade(Controller):
     >>> Cascade(thrust_min=1.5)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: cascade parameter 'thrust_min' must be in [0, 1), got 1.5
+    quadcruise.errors.InputError: cascade parameter 'thrust_min' (least thrust over the weight m g, -) must be in [0, 1), got 1.5
     """
 
     name = "cascade"
     memory_size = CASCADE_MEMORY
 
-    xy_p: float = 0.95
-    z_p: float = 1.0
-    xy_vel_p: float = 1.8
-    xy_vel_i: float = 0.4
-    xy_vel_d: float = 0.2
-    z_vel_p: float = 4.0
-    z_vel_i: float = 2.0
-    z_vel_d: float = 0.0
-    max_speed_xy: float = 12.0
-    max_speed_up: float = 3.0
-    max_speed_down: float = 1.5
-    max_tilt: float = math.radians(45.0)
-    thrust_min: float = 0.24
-    thrust_max: float = 1.0
-    roll_p: float = 6.5
-    yaw_p: float = 2.8
-    max_rate_rp: float = math.radians(220.0)
-    max_rate_yaw: float = math.radians(200.0)
-    rate: RateGains = field(default_factory=rate_pid_design)
-    yaw_rate: RateGains = field(default_factory=lambda: rate_pid_design(yaw=True))
-    rate_i_limit: float = 0.3
-    vel_d_cutoff: float = 5.0
-    rate_d_cutoff: float = 30.0
-
-    def __post_init__(self) -> None:
-        check_positive(self.name, **{k: getattr(self, k) for k in (
-            "xy_p", "z_p", "xy_vel_p", "z_vel_p", "max_speed_xy", "max_speed_up", "max_speed_down",
-            "roll_p", "yaw_p", "max_rate_rp", "max_rate_yaw", "rate_i_limit", "vel_d_cutoff",
-            "rate_d_cutoff")})
-        for k in ("xy_vel_i", "xy_vel_d", "z_vel_i", "z_vel_d"):
-            v = getattr(self, k)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
-                raise InputError(f"{self.name} parameter '{k}' must be a number >= 0, got {v!r}")
-        check_tilt(self.name, self.max_tilt)
-        if not (isinstance(self.thrust_min, (int, float)) and 0 <= self.thrust_min < 1):
-            raise InputError(f"{self.name} parameter 'thrust_min' must be in [0, 1), got {self.thrust_min!r}")
-        if not (isinstance(self.thrust_max, (int, float)) and 0 < self.thrust_max <= 1):
-            raise InputError(f"{self.name} parameter 'thrust_max' must be in (0, 1], got {self.thrust_max!r}")
-        check_type(self.name, self, ("rate", "yaw_rate"), RateGains)
+    xy_p: float = _f(0.95, "1/s", "horizontal position P", "pos")
+    z_p: float = _f(1.0, "1/s", "vertical position P", "pos")
+    xy_vel_p: float = _f(1.8, "1/s", "horizontal velocity P", "pos")
+    xy_vel_i: float = _f(0.4, "1/s^2", "horizontal velocity I", "nonneg")
+    xy_vel_d: float = _f(0.2, "-", "horizontal velocity D", "nonneg")
+    z_vel_p: float = _f(4.0, "1/s", "vertical velocity P", "pos")
+    z_vel_i: float = _f(2.0, "1/s^2", "vertical velocity I", "nonneg")
+    z_vel_d: float = _f(0.0, "-", "vertical velocity D", "nonneg")
+    max_speed_xy: float = _f(12.0, "m/s", "horizontal speed limit", "pos")
+    max_speed_up: float = _f(3.0, "m/s", "climb speed limit", "pos")
+    max_speed_down: float = _f(1.5, "m/s", "descent speed limit", "pos")
+    max_tilt: float = _f(math.radians(45.0), "rad", "thrust tilt limit", TILT)
+    thrust_min: float = _f(0.24, "-", "least thrust over the weight m g", between(0.0, 1.0, "[)"))
+    thrust_max: float = _f(1.0, "-", "most thrust over the full thrust 4 K", between(0.0, 1.0, "(]"))
+    roll_p: float = _f(6.5, "1/s", "roll and pitch attitude P", "pos")
+    yaw_p: float = _f(2.8, "1/s", "yaw attitude P", "pos")
+    max_rate_rp: float = _f(math.radians(220.0), "rad/s", "roll and pitch rate limit", "pos")
+    max_rate_yaw: float = _f(math.radians(200.0), "rad/s", "yaw rate limit", "pos")
+    rate: RateGains = _f(unit="-", doc="roll and pitch rate PID", check=instance_of(RateGains), factory=rate_pid_design)
+    yaw_rate: RateGains = _f(unit="-", doc="yaw rate PID", check=instance_of(RateGains),
+                             factory=lambda: rate_pid_design(yaw=True))
+    rate_i_limit: float = _f(0.3, "-", "rate integral bound over the axis' full torque", "pos")
+    vel_d_cutoff: float = _f(5.0, "Hz", "low-pass cutoff of the differenced velocity", "pos")
+    rate_d_cutoff: float = _f(30.0, "Hz", "low-pass cutoff of the differenced rate", "pos")
 
     @property
     def function(self):

@@ -21,6 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from quadcruise.errors import InputError
+from quadcruise.fields import Validated, check_value
+from quadcruise.fields import unit_field as _f
 
 
 def python_control():
@@ -37,8 +39,12 @@ PAPER_POSITION_POLES = (-0.7, -4.3)
 """Closed-loop poles of the paper's x/y PD loops [rad/s] (section III.B, eq 18)."""
 
 
-class _Gains:
-    """Shared behaviour: everything follows from the characteristic polynomial ``_char``."""
+class _Gains(Validated):
+    """Shared behaviour: everything follows from the characteristic polynomial ``_char``.
+    Validation and ``units()`` come from :mod:`quadcruise.fields` (messages call the fields
+    gains: ``PD gain 'kp' (proportional gain, 1/s^2) must be > 0, got 0.0``)."""
+
+    field_noun = "gain"
 
     _char: np.ndarray
 
@@ -58,33 +64,33 @@ class _Gains:
         return python_control().tf(self._char[1:], self._char)
 
 
-def check_gains(obj, names) -> None:
-    for name in names:
-        try:
-            v = float(getattr(obj, name))
-        except (TypeError, ValueError):
-            raise InputError(f"gain {name} must be a number, got {getattr(obj, name)!r}") from None
-        if not np.isfinite(v) or v < 0 or (name == "kp" and v == 0):
-            raise InputError(f"gain {name} = {v:g} must be finite and {'> 0' if name == 'kp' else '>= 0'}")
-        object.__setattr__(obj, name, v)
-
-
 @dataclass(frozen=True)
 class PDGains(_Gains):
     """PD gains for y'' = u: u = kp (r - y) + kd (r' - y'); eq (17) with tau_d = kd / kp.
 
+    Parameters
+    ----------
+    kp : float
+        Proportional gain [1/s^2] (per unit of y), > 0.
+    kd : float
+        Derivative gain [1/s], >= 0.
+
+    Examples
+    --------
     >>> g = PDGains(kp=3.01, kd=5.0)
     >>> [round(float(p), 6) for p in g.poles]
     [-0.7, -4.3]
     >>> round(g.natural_frequency, 3), round(g.damping, 3)
     (1.735, 1.441)
+    >>> PDGains(kp=0.0, kd=1.0)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: PD gain 'kp' (proportional gain, 1/s^2) must be > 0, got 0.0
     """
 
-    kp: float
-    kd: float
-
-    def __post_init__(self):
-        check_gains(self, ("kp", "kd"))
+    kp: float = _f(unit="1/s^2", doc="proportional gain", check="pos")
+    kd: float = _f(unit="1/s", doc="derivative gain", check="nonneg")
+    name = "PD"
 
     @property
     def _char(self) -> np.ndarray:
@@ -110,17 +116,28 @@ class PDGains(_Gains):
 class PIDGains(_Gains):
     """PID gains for y'' = u: u = kp e + ki int(e) + kd e'; poles of s^3 + kd s^2 + kp s + ki.
 
+    Parameters
+    ----------
+    kp : float
+        Proportional gain [1/s^2], > 0.
+    ki : float
+        Integral gain [1/s^3], >= 0.
+    kd : float
+        Derivative gain [1/s], >= 0.
+
+    Examples
+    --------
+    >>> PIDGains.units()
+    {'kp': '1/s^2', 'ki': '1/s^3', 'kd': '1/s'}
     >>> g = PIDGains(kp=63.0, ki=49.0, kd=15.0)
     >>> [round(float(p), 3) for p in g.poles]
     [-1.0, -7.0, -7.0]
     """
 
-    kp: float
-    ki: float
-    kd: float
-
-    def __post_init__(self):
-        check_gains(self, ("kp", "ki", "kd"))
+    kp: float = _f(unit="1/s^2", doc="proportional gain", check="pos")
+    ki: float = _f(unit="1/s^3", doc="integral gain", check="nonneg")
+    kd: float = _f(unit="1/s", doc="derivative gain", check="nonneg")
+    name = "PID"
 
     @property
     def _char(self) -> np.ndarray:
@@ -251,18 +268,25 @@ def attitude_pid_design(actuator_bandwidth: float = 15.0) -> PIDGains:
 
     Scaling every pole with the bandwidth leaves the margins unchanged (time scaling).
 
+    Parameters
+    ----------
+    actuator_bandwidth : float
+        The rotor lag's bandwidth w [rad/s], > 0.
+
+    Returns
+    -------
+    PIDGains
+
+    Examples
+    --------
     >>> g = attitude_pid_design()
     >>> round(g.kp, 2), round(g.ki, 2), round(g.kd, 2)
     (88.2, 40.5, 14.9)
     >>> round(loop_margins(g, 15.0)["phase_margin"], 1)
     24.5
     """
-    try:
-        w = float(actuator_bandwidth)
-    except (TypeError, ValueError):
-        raise InputError(f"actuator_bandwidth must be a number, got {actuator_bandwidth!r}") from None
-    if not (np.isfinite(w) and w > 0):
-        raise InputError(f"actuator_bandwidth = {w:g} rad/s must be finite and > 0")
+    w = check_value("attitude_pid_design argument 'actuator_bandwidth' (rotor lag bandwidth, rad/s)",
+                    actuator_bandwidth, "pos")
     wn, zeta = ATTITUDE_WN_RATIO * w, ATTITUDE_ZETA
     pair = complex(-zeta * wn, wn * np.sqrt(1.0 - zeta**2))
     return pid_from_poles([pair, pair.conjugate(), -ATTITUDE_INTEGRATOR_RATIO * w])

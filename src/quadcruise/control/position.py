@@ -33,7 +33,7 @@ holding yaw near zero.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
@@ -50,9 +50,10 @@ from quadcruise.control.attitude import (
     YAW_KP,
     decoupled_attitude,
 )
-from quadcruise.control.base import Controller, check_positive, write_command
+from quadcruise.control.base import TILT, Controller, write_command
 from quadcruise.control.design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
-from quadcruise.errors import InputError
+from quadcruise.fields import instance_of
+from quadcruise.fields import unit_field as _f
 from quadcruise.layout import (
     CONTROLLER_SIG,
     FLAG_ASIN_CLIP,
@@ -82,6 +83,7 @@ from quadcruise.layout import (
     Y,
     Z,
 )
+from quadcruise.numeric import clamp, wrap_angle
 from quadcruise.sim.fastmath import sin_cos
 
 # gains layout after the attitude block
@@ -91,45 +93,71 @@ NLPD_GAINS = ATT_GAINS + 8
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def clip_unit(s):
-    """s clipped to [-1, 1], and whether it had to be."""
-    if s > 1.0:
-        return 1.0, True
-    if s < -1.0:
-        return -1.0, True
-    return s, False
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def limit(value, bound):
-    """value clipped to [-bound, bound], and whether it had to be."""
-    if value > bound:
-        return bound, True
-    if value < -bound:
-        return -bound, True
-    return value, False
-
-
-@njit(cache=True, inline="always", error_model="numpy")
 def pitch_eq16(ux, sphi, cphi, spsi, cpsi, a):
-    """Eq (16) from the sines and cosines of roll and yaw (see :func:`theta_from_eq5`):
-    (theta, sin theta, clipped?)."""
+    """Eq (16) from the sines and cosines of roll and yaw (see :func:`theta_from_eq5`).
+
+    Parameters
+    ----------
+    ux : float
+        Wanted x acceleration [m/s^2].
+    sphi, cphi, spsi, cpsi : float
+        sin and cos of roll and yaw.
+    a : float
+        U1 / m [m/s^2].
+
+    Returns
+    -------
+    (float, float, bool)
+        theta_d [rad], its sine (asin's argument, clamped to [-1, 1]) and whether it was clamped.
+
+    Examples
+    --------
+    >>> theta, s, clipped = pitch_eq16(0.981, 0.0, 1.0, 0.0, 1.0, 9.81)
+    >>> round(theta, 6), round(s, 6), clipped
+    (0.100167, 0.1, False)
+    >>> pitch_eq16(20.0, 0.0, 1.0, 0.0, 1.0, 9.81)[1:]
+    (1.0, True)
+    """
     den = cphi * cpsi * a
     if abs(den) < 1e-9:
         return 0.0, 0.0, True
-    s, clipped = clip_unit((ux - sphi * spsi * a) / den)
+    s, clipped = clamp((ux - sphi * spsi * a) / den, -1.0, 1.0)
     return math.asin(s), s, clipped
 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def roll_eq19(uy, stheta, spsi, cpsi, a):
-    """Eq (19), sign kept, from sin(theta) and the yaw's sine and cosine (see :func:`phi_from_eq6`)."""
+    """Eq (19), sign kept, from sin(theta) and the yaw's sine and cosine (see :func:`phi_from_eq6`).
+
+    Parameters
+    ----------
+    uy : float
+        Wanted y acceleration [m/s^2].
+    stheta : float
+        sin theta_d.
+    spsi, cpsi : float
+        sin and cos of yaw.
+    a : float
+        U1 / m [m/s^2].
+
+    Returns
+    -------
+    (float, bool)
+        phi_d [rad] (the root nearest level, wrapped by :func:`quadcruise.numeric.wrap_angle`
+        when cos psi <= 0) and whether asin's argument was clamped.
+
+    Examples
+    --------
+    >>> phi, clipped = roll_eq19(0.981, 0.0, 0.0, 1.0, 9.81)
+    >>> round(phi, 6), clipped
+    (-0.100167, False)
+    """
     A = cpsi
     B = stheta * spsi
     R = math.sqrt(A * A + B * B)         # |A|, |B| <= 1: no overflow to guard against
     if R * a < 1e-9:
         return 0.0, True
-    s, clipped = clip_unit(uy / (a * R))
+    s, clipped = clamp(uy / (a * R), -1.0, 1.0)
     r1 = math.asin(s)
     if A > 0.0:
         # |gamma| < pi/2 and |r1| <= pi/2: gamma - r1 lies in (-pi, pi) and, cos phi1 -
@@ -138,8 +166,7 @@ def roll_eq19(uy, stheta, spsi, cpsi, a):
     gamma = math.atan2(B, A)
     phi1 = gamma - r1
     phi2 = gamma + math.pi + r1
-    phi1 -= 2.0 * math.pi * math.floor((phi1 + math.pi) / (2.0 * math.pi))
-    phi2 -= 2.0 * math.pi * math.floor((phi2 + math.pi) / (2.0 * math.pi))
+    phi1, phi2 = wrap_angle(phi1), wrap_angle(phi2)
     return (phi1 if abs(phi1) <= abs(phi2) else phi2), clipped
 
 
@@ -160,22 +187,66 @@ def phi_from_eq6(uy, theta, psi, a):
 def thrust_for_tilt(uz, cos_tilt, m, g, K, cos_max_tilt):
     """Altitude law: U1 = m (g + u_z) / (cos phi cos theta), limited to [0, 4 K] [N], and its
     flag. ``cos_tilt`` is cos phi cos theta; the compensation uses at most 1/cos(max_tilt) so
-    that it cannot blow up."""
+    that it cannot blow up.
+
+    Parameters
+    ----------
+    uz : float
+        Wanted z acceleration [m/s^2].
+    cos_tilt : float
+        cos phi cos theta.
+    m, g, K : float
+        Mass [kg], gravity [m/s^2], thrust per unit duty [N].
+    cos_max_tilt : float
+        cos of the tilt limit.
+
+    Returns
+    -------
+    (float, int)
+        U1 [N] and FLAG_THRUST_LIMIT if it was limited, else 0.
+
+    Examples
+    --------
+    >>> U1, flag = thrust_for_tilt(0.0, 1.0, 3.499, 9.81, 120.0, 0.7)
+    >>> round(U1, 6), flag
+    (34.32519, 0)
+    >>> thrust_for_tilt(-20.0, 1.0, 3.499, 9.81, 120.0, 0.7)
+    (0.0, 4)
+    """
     c = max(cos_tilt, cos_max_tilt)
-    U1 = m * (g + uz) / c
-    if U1 < 0.0:
-        return 0.0, FLAG_THRUST_LIMIT
-    if U1 > 4.0 * K:
-        return 4.0 * K, FLAG_THRUST_LIMIT
-    return U1, 0
+    U1, limited = clamp(m * (g + uz) / c, 0.0, 4.0 * K)
+    return U1, FLAG_THRUST_LIMIT if limited else 0
 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def tilt_setpoint(angle, clipped, max_tilt, flags):
-    """Limit a roll/pitch setpoint to max_tilt and add the flags that apply."""
+    """Limit a roll/pitch setpoint to max_tilt and add the flags that apply.
+
+    Parameters
+    ----------
+    angle : float
+        The setpoint [rad].
+    clipped : bool
+        Whether its asin argument was clamped (adds FLAG_ASIN_CLIP).
+    max_tilt : float
+        The limit [rad] (adds FLAG_TILT_LIMIT when it acts).
+    flags : int
+        The flags so far.
+
+    Returns
+    -------
+    (float, int)
+
+    Examples
+    --------
+    >>> tilt_setpoint(1.0, False, 0.5, 0)
+    (0.5, 1)
+    >>> tilt_setpoint(-0.2, True, 0.5, 0)
+    (-0.2, 2)
+    """
     if clipped:
         flags |= FLAG_ASIN_CLIP
-    angle, limited = limit(angle, max_tilt)
+    angle, limited = clamp(angle, -max_tilt, max_tilt)
     if limited:
         flags |= FLAG_TILT_LIMIT
     return angle, flags
@@ -260,18 +331,14 @@ class NLPD(Controller):
     name = "nlpd"
     memory_size = ATT_MEMORY
 
-    position: PDGains = field(default_factory=position_pd_design)
-    altitude: PDGains = field(default_factory=altitude_pd_design)
-    attitude: PIDGains = field(default_factory=attitude_pid_design)
-    yaw: PIDGains = field(default_factory=attitude_pid_design)
-    max_tilt: float = math.radians(45.0)
-    i_limit: float = 5.0
-    accel_feedforward: bool = False
-
-    def __post_init__(self) -> None:
-        check_positive(self.name, max_tilt=self.max_tilt, i_limit=self.i_limit)
-        if self.max_tilt >= math.pi / 2:
-            raise InputError(f"{self.name} parameter 'max_tilt' must be below pi/2 rad, got {self.max_tilt!r}")
+    position: PDGains = _f(unit="-", doc="x and y PD loops", check=instance_of(PDGains), factory=position_pd_design)
+    altitude: PDGains = _f(unit="-", doc="z PD loop", check=instance_of(PDGains), factory=altitude_pd_design)
+    attitude: PIDGains = _f(unit="-", doc="roll and pitch PID loops", check=instance_of(PIDGains),
+                            factory=attitude_pid_design)
+    yaw: PIDGains = _f(unit="-", doc="yaw PID loop", check=instance_of(PIDGains), factory=attitude_pid_design)
+    max_tilt: float = _f(math.radians(45.0), "rad", "roll and pitch setpoint limit", TILT)
+    i_limit: float = _f(5.0, "rad/s^2", "anti-windup bound on the attitude integral term", "pos")
+    accel_feedforward: bool = _f(False, "-", "reference acceleration fed forward", "flag")
 
     @property
     def function(self):

@@ -44,14 +44,16 @@ True
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
-from quadcruise.control.base import Controller, check_positive, check_tilt, check_type
+from quadcruise.control.base import TILT, Controller
 from quadcruise.control.design import ATTITUDE_WN_RATIO, ATTITUDE_ZETA, PDGains, altitude_pd_design, position_pd_design
-from quadcruise.control.so3 import attitude_lee, clamp, command_from_rotation, error_lee, limit_tilt, rotation_zyx
+from quadcruise.control.so3 import attitude_lee, command_from_rotation, error_lee, limit_tilt, rotation_zyx
+from quadcruise.fields import check_value, instance_of
+from quadcruise.fields import unit_field as _f
 from quadcruise.layout import (
     CONTROLLER_SIG,
     FLAG_THRUST_LIMIT,
@@ -87,6 +89,7 @@ from quadcruise.layout import (
     Y,
     Z,
 )
+from quadcruise.numeric import clamp
 
 __all__ = ["SE3", "se3", "se3_attitude_design"]
 
@@ -129,12 +132,25 @@ def se3_attitude_design(actuator_bandwidth: float = 15.0) -> PDGains:
     """kR = wn^2 [1/s^2], kw = 2 zeta wn [1/s] per unit inertia at the attitude design's
     wn = 0.6 w, zeta = 0.8 (see :func:`quadcruise.control.design.attitude_pid_design`).
 
+    Parameters
+    ----------
+    actuator_bandwidth : float
+        The rotor lag's bandwidth w [rad/s], > 0.
+
+    Returns
+    -------
+    PDGains
+        kp = kR, kd = kw.
+
+    Examples
+    --------
     >>> from quadcruise.control.design import loop_margins
     >>> g = se3_attitude_design()
     >>> round(g.kp, 6), round(g.kd, 6), round(loop_margins(g, 15.0)["phase_margin"], 1)
     (81.0, 14.4, 26.1)
     """
-    check_positive("se3_attitude_design", actuator_bandwidth=actuator_bandwidth)
+    actuator_bandwidth = check_value(
+        "se3_attitude_design argument 'actuator_bandwidth' (rotor lag bandwidth, rad/s)", actuator_bandwidth, "pos")
     wn = ATTITUDE_WN_RATIO * actuator_bandwidth
     return PDGains(kp=wn * wn, kd=2.0 * ATTITUDE_ZETA * wn)
 
@@ -162,20 +178,19 @@ class SE3(Controller):
     >>> SE3(max_tilt=-1.0)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: se3 parameter 'max_tilt' must be a positive number, got -1.0
+    quadcruise.errors.InputError: se3 parameter 'max_tilt' (largest tilt of b3_d from the vertical, rad) must be in (0, pi/2), got -1.0
     """
 
     name = "se3"
     memory_size = 0
 
-    position: PDGains = field(default_factory=position_pd_design)
-    altitude: PDGains = field(default_factory=altitude_pd_design)
-    attitude: PDGains = field(default_factory=se3_attitude_design)
-    max_tilt: float = math.radians(45.0)
-
-    def __post_init__(self) -> None:
-        check_type(self.name, self, ("position", "altitude", "attitude"), PDGains)
-        check_tilt(self.name, self.max_tilt)
+    position: PDGains = _f(unit="-", doc="kx (kp) and kv (kd) of x and y, per unit mass", check=instance_of(PDGains),
+                           factory=position_pd_design)
+    altitude: PDGains = _f(unit="-", doc="kx and kv of z, per unit mass", check=instance_of(PDGains),
+                           factory=altitude_pd_design)
+    attitude: PDGains = _f(unit="-", doc="kR (kp) and kw (kd) per unit inertia", check=instance_of(PDGains),
+                           factory=se3_attitude_design)
+    max_tilt: float = _f(math.radians(45.0), "rad", "largest tilt of b3_d from the vertical", TILT)
 
     @property
     def function(self):

@@ -12,7 +12,8 @@ about body y and yaw U4 about body z (eq 11), so (p, q, r) is the body angular v
 Compiled scalar code. A matrix is a tuple of its three rows, each a tuple of three floats
 (``R[i][j]``): a value, not an array, so the controllers allocate nothing per control period
 and take no references on shared memory. Also here: :func:`command_from_rotation`, the
-shared tail of these controllers (duties, logged inputs and setpoints), and :func:`clamp`.
+shared tail of these controllers (duties, logged inputs and setpoints). Limits use
+:func:`quadcruise.numeric.clamp`.
 
 >>> import numpy as np
 >>> R = rotation_zyx(0.1, -0.2, 0.3)
@@ -28,6 +29,7 @@ import math
 from numba import njit
 
 from quadcruise.control.base import write_command
+from quadcruise.numeric import clamp
 
 
 @njit(cache=True, error_model="numpy")
@@ -43,8 +45,24 @@ def rotation_zyx(phi, theta, psi):
 
 @njit(cache=True, error_model="numpy")
 def euler_zyx(Rm):
-    """(phi, theta, psi) of a rotation R = Rz(psi) Ry(theta) Rx(phi), |theta| <= pi/2."""
-    s = min(1.0, max(-1.0, -Rm[2][0]))
+    """(phi, theta, psi) of a rotation R = Rz(psi) Ry(theta) Rx(phi), |theta| <= pi/2.
+
+    Parameters
+    ----------
+    Rm : tuple of three 3-tuples
+        The rotation, by rows (``R[i][j]``).
+
+    Returns
+    -------
+    (float, float, float)
+        Roll, pitch, yaw [rad]; -R[2][0] is clamped to [-1, 1] before its asin (a NaN stays NaN).
+
+    Examples
+    --------
+    >>> [round(a, 12) for a in euler_zyx(rotation_zyx(0.1, -0.2, 0.3))]
+    [0.1, -0.2, 0.3]
+    """
+    s, _ = clamp(-Rm[2][0], -1.0, 1.0)
     return math.atan2(Rm[2][1], Rm[2][2]), math.asin(s), math.atan2(Rm[1][0], Rm[0][0])
 
 
@@ -146,13 +164,3 @@ def command_from_rotation(U1, U2, U3, U4, Rd, flags, d, K, cmd):
     of the desired rotation Rd as the attitude setpoints (phi_d, theta_d, psi_d)."""
     phi_d, theta_d, psi_d = euler_zyx(Rd)
     write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags, d, K)
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def clamp(value, low, high):
-    """value within [low, high], and whether it had to be moved."""
-    if value < low:
-        return low, True
-    if value > high:
-        return high, True
-    return value, False

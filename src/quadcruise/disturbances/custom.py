@@ -8,13 +8,26 @@ from typing import Any
 
 import numpy as np
 
-from quadcruise.errors import InputError
+from quadcruise.fields import Check, Validated, unit_field
 
 __all__ = ["CustomDisturbance"]
 
 
+def _numbers(value: Any) -> bool:
+    """Whether ``value`` is a number, a row or (N, P) rows of numbers, not empty."""
+    try:
+        a = np.asarray(value)
+    except (TypeError, ValueError):
+        return False
+    return a.dtype.kind in "iuf" and a.ndim <= 2 and a.size > 0
+
+
+_COMPILED = Check("compiled", "a numba-compiled function with DISTURBANCE_SIG", lambda f: hasattr(f, "py_func"))
+_ROWS = Check("rows", "numbers: one row for every vehicle or (N, P) rows, not empty", _numbers)
+
+
 @dataclass(frozen=True)
-class CustomDisturbance:
+class CustomDisturbance(Validated):
     """A compiled disturbance of the user's.
 
     Parameters
@@ -39,15 +52,16 @@ class CustomDisturbance:
     >>> res = qc.fly("hover", duration=2.0, environment=CustomDisturbance(push, params=[1.0]))
     >>> bool(res.states[0, -1, 0] > 0.0)
     True
+    >>> CustomDisturbance(print)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: custom disturbance field 'function' (the compiled disturbance, -) must be a numba-compiled function with DISTURBANCE_SIG, got <built-in function print>
     """
 
-    function: Any
-    params: Any = (0.0,)
-    memory: Any = (0.0,)
-
-    def __post_init__(self) -> None:
-        if not hasattr(self.function, "py_func"):
-            raise InputError("CustomDisturbance needs a numba-compiled function with DISTURBANCE_SIG")
+    function: Any = unit_field(unit="-", doc="the compiled disturbance", check=_COMPILED)
+    params: Any = unit_field((0.0,), "-", "its parameter row dp", _ROWS)
+    memory: Any = unit_field((0.0,), "-", "its initial state dmem", _ROWS)
+    name = "custom disturbance"
 
     @property
     def parts(self) -> dict:

@@ -54,16 +54,14 @@ import dataclasses
 import math
 import re
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numba import njit
 
 from quadcruise.errors import InputError
-from quadcruise.fields import (
-    unit_field as _f,  # a field with unit, doc and check (here: real, nonneg, pos, frac, rotor, vec)
-)
+from quadcruise.fields import Validated, between, instance_of, parse_numbers, unit_field
 from quadcruise.layout import DISTURBANCE_SIG, EXT_E1, EXT_FX, EXT_WX, PHI, STATE_SIZE, VX, P, X
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.rng import ziggurat
@@ -198,56 +196,19 @@ def environment_disturbance(t, dt, x, dp, dmem, rng, ext):
 
 
 # --- Python side -------------------------------------------------------------------------
-_CHECKS = {"nonneg": (lambda a: a < 0, ">= 0"), "pos": (lambda a: a <= 0, "> 0"),
-           "frac": (lambda a: (a < 0) | (a > 1), "in [0, 1]"),
-           "rotor": (lambda a: (a != np.round(a)) | (a < 1) | (a > 4), "1, 2, 3 or 4")}
-
-
-def _number(label: str, value: Any, check: str) -> Any:
-    """A finite float, or a read-only 1-D float array (one value per vehicle)."""
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        arr = np.zeros((0, 0))
-    if arr.ndim > 1 or arr.size == 0:
-        raise InputError(f"{label} must be a number or a 1-D array of numbers, got {value!r}")
-    bad, want = _CHECKS.get(check, (lambda a: ~np.isfinite(a), "finite"))
-    bad = np.atleast_1d(~np.isfinite(arr) | bad(arr))
-    if bad.any():
-        raise InputError(f"{label} must be finite and {want}, got {np.atleast_1d(arr)[bad][0]!r}")
-    if arr.ndim == 0:
-        return float(arr)
-    arr.flags.writeable = False
-    return arr
-
-
-def _vector(label: str, value: Any) -> tuple:
-    """(x, y, z): a sequence of 3 numbers or length-N arrays, or an (N, 3) numpy array."""
-    if isinstance(value, np.ndarray) and value.ndim == 2 and value.shape[1] == 3:
-        value = tuple(value.T)
-    if isinstance(value, (str, bytes, np.ndarray)) and np.ndim(value) != 1 or not hasattr(value, "__len__") \
-            or len(value) != 3:
-        raise InputError(f"{label} must be 3 values (x, y, z), each a number or a 1-D array, "
-                         f"or an (N, 3) array, got {value!r}")
-    return tuple(_number(label, v, "real") for v in value)
+def _f(*args: Any, **kw: Any):
+    """A field with unit, doc and check (:func:`quadcruise.fields.unit_field`) that may hold one
+    value per vehicle."""
+    return unit_field(*args, batch=True, **kw)
 
 
 @dataclass(frozen=True)
-class _Part:
-    """Validation, batch size and ``to_dict`` shared by the models. Each numeric field is a
-    number or a 1-D array with one value per vehicle; a vector field is (x, y, z) of such, or
-    an (N, 3) numpy array."""
+class _Part(Validated):
+    """Batch size and ``to_dict`` shared by the models; validation and ``units()`` come from
+    :mod:`quadcruise.fields`. Each numeric field is a number or a 1-D array with one value per
+    vehicle; a vector field is (x, y, z) of such, or an (N, 3) numpy array."""
 
     name = "part"
-
-    def __post_init__(self) -> None:
-        for f in dataclasses.fields(self):
-            value, check = getattr(self, f.name), f.metadata.get("check")
-            if check is None or (value is None and f.default is None):
-                continue
-            label = f"{self.name} field '{f.name}' ({f.metadata['doc']}, {f.metadata['unit']})"
-            value = _vector(label, value) if check == "vec" else _number(label, value, check)
-            object.__setattr__(self, f.name, value)
 
     def sizes(self) -> set:
         """Lengths of the per-vehicle arrays among the fields."""
@@ -289,18 +250,11 @@ class Gust(_Part):
 class Turbulence(_Part):
     """Dryden turbulence, MIL-F-8785C low altitude; ``w20``, if given, overrides ``intensity``."""
 
-    intensity: str = field(default="moderate", metadata={"doc": "light, moderate or severe"})
+    intensity: str = _f("moderate", "-", "MIL-F-8785C level", "choice", tuple(INTENSITIES))
     w20: Any = _f(None, "m/s", "wind speed at 20 ft", "pos")
-    altitude: Any = _f(10.0, "m", "height above ground, < 304.8 m", "pos")
+    altitude: Any = _f(10.0, "m", "height above ground, low-altitude model", between(0.0, 1000 * FOOT, "()"))
     airspeed: Any = _f(1.0, "m/s", "speed through the air, floor 0.5 m/s", "nonneg")
     name = "dryden"
-
-    def __post_init__(self) -> None:
-        if self.intensity not in INTENSITIES:
-            raise InputError(f"dryden field 'intensity' must be one of {', '.join(INTENSITIES)}, got {self.intensity!r}")
-        super().__post_init__()
-        if np.any(np.asarray(self.altitude) >= 1000 * FOOT):
-            raise InputError(f"dryden field 'altitude' must be < 304.8 m (low-altitude model), got {self.altitude!r}")
 
     def _h(self) -> Any:
         return np.maximum(self.altitude, 10 * FOOT) / FOOT          # ft, 10 ft floor
@@ -326,7 +280,7 @@ class Turbulence(_Part):
 class RotorLoss(_Part):
     """From ``time`` on, rotor ``rotor`` gives 1 - ``fraction`` of its thrust."""
 
-    rotor: Any = _f(1, "-", "rotor number", "rotor")
+    rotor: Any = _f(1, "-", "rotor number", between(1, 4, whole=True))
     fraction: Any = _f(0.3, "-", "fraction of thrust lost", "frac")
     time: Any = _f(5.0, "s", "time of the loss", "nonneg")
     name = "loss"
@@ -350,19 +304,21 @@ def _columns(n: int, *values: Any) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class Environment:
-    """The disturbances a flight meets, each part optional: ``fly(..., environment=env)``."""
+class Environment(Validated):
+    """The disturbances a flight meets, each part optional: ``fly(..., environment=env)``.
 
-    wind: ConstantWind | None = None
-    gust: Gust | None = None
-    turbulence: Turbulence | None = None
-    rotor_loss: RotorLoss | None = None
-    force: ExternalForce | None = None
+    Examples
+    --------
+    >>> Environment(gust=Gust()).units()["gust.duration"]
+    's'
+    """
 
-    def __post_init__(self) -> None:
-        for slot, cls in _SLOTS.items():
-            if getattr(self, slot) is not None and not isinstance(getattr(self, slot), cls):
-                raise InputError(f"environment field '{slot}' must be a {cls.__name__} or None")
+    wind: ConstantWind | None = unit_field(None, "-", "steady wind", instance_of(ConstantWind))
+    gust: Gust | None = unit_field(None, "-", "1 - cosine gust", instance_of(Gust))
+    turbulence: Turbulence | None = unit_field(None, "-", "Dryden turbulence", instance_of(Turbulence))
+    rotor_loss: RotorLoss | None = unit_field(None, "-", "loss of a rotor's thrust", instance_of(RotorLoss))
+    force: ExternalForce | None = unit_field(None, "-", "external force and torque", instance_of(ExternalForce))
+    name = "environment"
 
     @classmethod
     def from_parts(cls, *parts: _Part) -> "Environment":
@@ -499,13 +455,7 @@ def wind_from_name(name: str, **kw: Any) -> _Part:
 
 
 def _floats(text: str, k: int, what: str) -> list:
-    vals = text.split(",")
-    if len(vals) != k:
-        raise InputError(f"needs {k} value{'s' * (k > 1)} {what}, got {text!r}")
-    try:
-        return [float(v) for v in vals]
-    except ValueError:
-        raise InputError(f"{what} must be numbers, got {text!r}") from None
+    return parse_numbers(text, what, k)
 
 
 def _part(text: str) -> _Part:

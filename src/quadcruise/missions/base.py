@@ -1,5 +1,5 @@
-"""What every mission kind shares: validation of its fields, its parameter vector ``mp``, its
-reference at given times, and the stacking of a batch's parameter rows.
+"""What every mission kind shares: validation of its fields (:mod:`quadcruise.fields`), its
+parameter vector ``mp``, its reference at given times, and the stacking of a batch's rows.
 
 A kind sets ``name``, ``columns`` (names of the mp entries), ``function`` (the compiled
 reference with ``MISSION_SIG``, as a staticmethod) and ``_row()`` (the mp entries in order).
@@ -15,7 +15,7 @@ import numpy as np
 from numba import njit, types
 
 from quadcruise.errors import InputError
-from quadcruise.fields import check_number
+from quadcruise.fields import Validated
 from quadcruise.layout import REF_SIZE, MissionType
 
 __all__ = ["Mission", "check_names", "stack_params"]
@@ -30,37 +30,27 @@ def _evaluate(fn, ts, mp, out):
 
 
 @dataclass(frozen=True)
-class Mission:
-    """Shared code of every mission kind: validation, ``params``, ``reference``, ``to_dict``.
+class Mission(Validated):
+    """Shared code of every mission kind: validation (its fields come from
+    :func:`quadcruise.fields.unit_field`, checked by :func:`quadcruise.fields.validate`),
+    ``units``, ``params``, ``reference``, ``to_dict``.
 
     A subclass sets ``name``, ``columns`` (names of the mp entries), ``function`` (the
     compiled reference, as a staticmethod) and ``_row()`` (the mp entries in order).
+
+    Examples
+    --------
+    >>> from quadcruise.missions import Step
+    >>> Step.units()["time"], Step(axis="yaw").axis
+    ('s', 'yaw')
+    >>> Step(axis="w")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: step field 'axis' (stepped axis, -) must be one of x, y, z, yaw, got 'w'
     """
 
     name: ClassVar[str] = ""
     columns: ClassVar[tuple] = ()
-
-    def __post_init__(self) -> None:
-        for f in dataclasses.fields(self):
-            value, check = getattr(self, f.name), f.metadata["check"]
-            label = f"{self.name} field '{f.name}' ({f.metadata['doc']}, {f.metadata['unit']})"
-            if check == "custom":
-                continue
-            if check == "choice":
-                if value not in f.metadata["choices"]:
-                    raise InputError(f"{label} must be one of {', '.join(f.metadata['choices'])}, got {value!r}")
-                continue
-            if check == "pair":
-                if isinstance(value, (str, bytes)) or np.ndim(value) != 1 or len(value) != 2:
-                    raise InputError(f"{label} must be a pair of numbers, got {value!r}")
-                object.__setattr__(self, f.name, tuple(check_number(label, v) for v in value))
-                continue
-            num = check_number(label, value)
-            if (check == "pos" and num <= 0) or (check == "nonneg" and num < 0):
-                raise InputError(f"{label} must be {'>' if check == 'pos' else '>='} 0, got {num!r}")
-            if check == "sign" and num not in (1.0, -1.0):
-                raise InputError(f"{label} must be +1 or -1, got {value!r}")
-            object.__setattr__(self, f.name, int(num) if check == "sign" else num)
 
     def _row(self) -> tuple:
         raise NotImplementedError
@@ -93,11 +83,6 @@ class Mission:
         """``{'kind': name, field: value, ...}`` with plain values, for result bundles."""
         values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         return {"kind": self.name, **{k: list(v) if isinstance(v, tuple) else v for k, v in values.items()}}
-
-    @classmethod
-    def units(cls) -> dict:
-        """Each field's unit."""
-        return {f.name: f.metadata["unit"] for f in dataclasses.fields(cls)}
 
 
 

@@ -55,6 +55,7 @@ import numpy as np
 from numba import njit
 
 from quadcruise.errors import InputError
+from quadcruise.fields import instance_of
 from quadcruise.fields import unit_field as _f
 from quadcruise.io.files import read_numeric_csv
 from quadcruise.layout import REF_AX, REF_PSI, REF_PSI_DOT, REF_SIZE, REF_VX, REF_X
@@ -386,7 +387,7 @@ class _WaypointMission(Mission):
     """Shared parts: the table (a WaypointTable, CSV path or dict), the default speed,
     ``duration``, ``stack`` and ``to_dict``."""
 
-    table: Any = _f(None, "-", "waypoint table or CSV path", "custom")
+    table: Any = _f(None, "-", "waypoint table or CSV path", instance_of(WaypointTable), optional=False)
     speed: float = _f(DEFAULT_SPEED, "m/s", "leg speed where the table gives no timing", "pos")
 
     def __post_init__(self) -> None:
@@ -420,18 +421,12 @@ class Waypoints(_WaypointMission):
     array([2., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 2.])
     """
 
-    style: str = _f("legs", "-", "'legs'", "custom")
+    style: str = _f("legs", "-", "path style; the smooth path is the mission 'minsnap'", "choice", ("legs",))
     yaw_mode: str = _f("linear", "-", "yaw over a leg", "choice", ("linear", "hold"))
 
     name: ClassVar[str] = "waypoints"
     columns: ClassVar[tuple] = ("n", "hold_yaw", "x[k]", "y[k]", "z[k]", "yaw[k]", "t[k]")
     function = staticmethod(waypoints_ref)
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if self.style != "legs":
-            raise InputError(f"waypoints field 'style' must be 'legs' (the smooth path is the "
-                             f"mission 'minsnap'), got {self.style!r}")
 
     def _row(self) -> tuple:
         per_point = np.column_stack([self.table.points, self.table.yaws(), self.times])

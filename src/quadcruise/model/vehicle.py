@@ -32,12 +32,14 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 
 from quadcruise.errors import InputError
+from quadcruise.fields import Validated
+from quadcruise.fields import unit_field as _f
 from quadcruise.layout import (
     P_CD1,
     P_CD2,
@@ -64,53 +66,55 @@ from quadcruise.layout import (
 )
 
 
-def _field(default: float, unit: str, doc: str, minimum: float = 0.0, strict: bool = True):
-    return field(default=default, metadata={"unit": unit, "doc": doc, "min": minimum, "strict": strict})
-
-
 @dataclass(frozen=True)
-class Vehicle:
+class Vehicle(Validated):
     """Physical parameters of a quadrotor (the paper's Table I by default).
 
-    Each field is a float, or a 1-D array giving one value per vehicle of a batch.
+    Each field is a float, or a 1-D array giving one value per vehicle of a batch; fields are
+    checked by :func:`quadcruise.fields.validate` and their units listed by :meth:`units`.
+
+    Parameters
+    ----------
+    m : float or array
+        Mass [kg], > 0.
+    Jxx, Jyy, Jzz : float or array
+        Moments of inertia about the body axes [kg m^2], > 0.
+    l : float or array
+        Arm length, rotor to centre [m], > 0.
+    K : float or array
+        Thrust per unit PWM duty [N], > 0.
+    omega : float or array
+        Actuator bandwidth [rad/s], > 0.
+    d : float or array
+        Yaw moment per unit thrust [m], > 0.
+    g : float or array
+        Gravitational acceleration [m/s^2], >= 0.
+    drag_linear, drag_quadratic : float or array
+        Drag coefficients [N s/m], [N s^2/m^2], >= 0.
+
+    Examples
+    --------
+    >>> Vehicle(m=1.4).m, Vehicle.units()["Jxx"]
+    (1.4, 'kg m^2')
+    >>> Vehicle(K=[120, -1])
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: vehicle field 'K' (thrust per unit PWM duty (Table I's K), N) must be > 0, got -1.0 (entry 1 of 2)
     """
 
-    m: Any = _field(3.499, "kg", "mass")
-    Jxx: Any = _field(0.03, "kg m^2", "moment of inertia about body x")
-    Jyy: Any = _field(0.03, "kg m^2", "moment of inertia about body y")
-    Jzz: Any = _field(0.04, "kg m^2", "moment of inertia about body z")
-    l: Any = _field(0.2, "m", "arm length, rotor to centre (Table I's L)")
-    K: Any = _field(120.0, "N", "thrust per unit PWM duty (Table I's K)")
-    omega: Any = _field(15.0, "rad/s", "actuator bandwidth (first-order rotor lag)")
-    d: Any = _field(4.0 / 120.0, "m", "yaw moment per unit thrust, eq (4)")
-    g: Any = _field(9.81, "m/s^2", "gravitational acceleration", strict=False)
-    drag_linear: Any = _field(0.0, "N s/m", "linear drag coefficient (air-relative velocity)", strict=False)
-    drag_quadratic: Any = _field(0.0, "N s^2/m^2", "quadratic drag coefficient", strict=False)
+    m: Any = _f(3.499, "kg", "mass", "pos", batch=True)
+    Jxx: Any = _f(0.03, "kg m^2", "moment of inertia about body x", "pos", batch=True)
+    Jyy: Any = _f(0.03, "kg m^2", "moment of inertia about body y", "pos", batch=True)
+    Jzz: Any = _f(0.04, "kg m^2", "moment of inertia about body z", "pos", batch=True)
+    l: Any = _f(0.2, "m", "arm length, rotor to centre (Table I's L)", "pos", batch=True)
+    K: Any = _f(120.0, "N", "thrust per unit PWM duty (Table I's K)", "pos", batch=True)
+    omega: Any = _f(15.0, "rad/s", "actuator bandwidth (first-order rotor lag)", "pos", batch=True)
+    d: Any = _f(4.0 / 120.0, "m", "yaw moment per unit thrust, eq (4)", "pos", batch=True)
+    g: Any = _f(9.81, "m/s^2", "gravitational acceleration", "nonneg", batch=True)
+    drag_linear: Any = _f(0.0, "N s/m", "linear drag coefficient (air-relative velocity)", "nonneg", batch=True)
+    drag_quadratic: Any = _f(0.0, "N s^2/m^2", "quadratic drag coefficient", "nonneg", batch=True)
 
-    def __post_init__(self) -> None:
-        sizes = set()
-        for f in dataclasses.fields(self):
-            value = np.asarray(getattr(self, f.name), dtype=float) if not isinstance(
-                getattr(self, f.name), str) else None
-            label = f"vehicle field '{f.name}' ({f.metadata['doc']}, {f.metadata['unit']})"
-            if value is None or value.ndim > 1:
-                raise InputError(f"{label} must be a number or a 1-D array of numbers")
-            if not np.all(np.isfinite(value)):
-                raise InputError(f"{label} must be finite, got {_show(value)}")
-            low, strict = f.metadata["min"], f.metadata["strict"]
-            bad = value <= low if strict else value < low
-            if np.any(bad):
-                op = ">" if strict else ">="
-                raise InputError(f"{label} must be {op} {low:g}, got {_show(value[bad] if value.ndim else value)}")
-            if value.ndim == 1:
-                sizes.add(value.shape[0])
-                value = value.copy()
-                value.flags.writeable = False
-                object.__setattr__(self, f.name, value)
-            else:
-                object.__setattr__(self, f.name, float(value))
-        if len(sizes) > 1:
-            raise InputError(f"vehicle fields have different batch lengths {sorted(sizes)}")
+    name: ClassVar[str] = "vehicle"
 
     # --- constructors -------------------------------------------------------------------
     @classmethod
@@ -185,10 +189,6 @@ class Vehicle:
         return {f.name: (getattr(self, f.name).tolist() if isinstance(getattr(self, f.name), np.ndarray)
                          else getattr(self, f.name)) for f in dataclasses.fields(self)}
 
-    @classmethod
-    def units(cls) -> dict:
-        """Each field's unit."""
-        return {f.name: f.metadata["unit"] for f in dataclasses.fields(cls)}
 
 
 @functools.cache
@@ -196,8 +196,3 @@ def shared_default(cls: type) -> Any:
     """``cls()`` of a frozen dataclass, built and validated once and shared by every caller
     (the default vehicle, mission or controller of each ``fly``)."""
     return cls()
-
-
-def _show(value: np.ndarray) -> str:
-    flat = np.atleast_1d(value)
-    return repr(float(flat[0])) if flat.size == 1 else np.array2string(flat[:4], separator=", ")
