@@ -7,21 +7,23 @@ likely source (S. Gonzalez-Vazquez, J. Moreno-Valenzuela, "A new nonlinear PI/PI
 for quadrotor posture regulation", IEEE CERMA 2010) builds its laws from saturating tanh
 terms. What is assumed (everything below): the form, the mapping and the gains.
 
-Control law, per axis (e = x_r - x, e_v = x_r' - x')::
+Control law, per axis of the yaw frame (e = x_r - x, e_v = x_r' - x', rotated by the yaw psi
+into forward f = (cos psi, sin psi) and left l = (-sin psi, cos psi))::
 
-    u_x = a_p tanh(k_p e_x / a_p) + a_d tanh(k_d e_vx / a_d)        [m/s^2], same for y
+    u_f = a_p tanh(k_p e_f / a_p) + a_d tanh(k_d e_vf / a_d)        [m/s^2], same for l
 
 Each term has slope k_p (k_d) at zero and level a_p (a_d): for small errors the law *is* the
 linear PD u = k_p e + k_d e_v, so pole placement keeps its meaning, and |u| < a_p + a_d
 always. (The CERMA-style k tanh(e) is the case a_p = k_p with a 1 m saturation width; the
 normalisation above separates the gain from the level.) The output is mapped to setpoints by
-the SMALL-ANGLE relation of eqs (5)-(6) at yaw ~ 0 and U1 ~ m g,
+the SMALL-ANGLE relation of eqs (5)-(6) in the yaw frame at U1 ~ m g,
 
-    theta_d = u_x / g,   phi_d = -u_y / g,
+    theta_d = u_f / g,   phi_d = -u_l / g,
 
 i.e. without the paper's inverse model (eqs 16, 19): at large tilt the vehicle gets
-g tan(u/g) > u, and at yaw away from 0 the axes mix (the mapping is for yaw holds near 0,
-like the paper's own design). Setpoints are limited to ``max_tilt`` (FLAG_TILT_LIMIT). Altitude
+g tan(u/g) > u. Working in the yaw frame makes the law the same at any held yaw (at yaw 0,
+f = x and l = y: theta_d = u_x / g, phi_d = -u_y / g); mapped in the earth frame instead, the
+axes would mix at yaw away from 0 (146 % overshoot on a 1 m step at 45 degrees). Setpoints are limited to ``max_tilt`` (FLAG_TILT_LIMIT). Altitude
 is the same linear PD with tilt-compensated thrust as ``nlpd``, yaw holds the mission's yaw,
 and the attitude loop is the same decoupled PID (eqs 13-15).
 
@@ -68,6 +70,7 @@ from quadcruise.layout import (
     P_K,
     P_M,
     PHI,
+    PSI,
     REF_PSI,
     REF_VX,
     REF_VY,
@@ -106,14 +109,16 @@ def saturated_pd(e, ev, kp, kd, ap, ad):
 def gonzalez(t, dt, x, ref, vp, gains, mem, cmd):
     """Reconstructed Gonzalez baseline: saturated PD, small-angle mapping, decoupled PID."""
     kp, kd, ap, ad, tilt = gains[KP_XY], gains[KD_XY], gains[SAT_P], gains[SAT_D], gains[MAX_TILT]
-    ux = saturated_pd(ref[REF_X] - x[X], ref[REF_VX] - x[VX], kp, kd, ap, ad)
-    uy = saturated_pd(ref[REF_Y] - x[Y], ref[REF_VY] - x[VY], kp, kd, ap, ad)
+    spsi, cpsi = sin_cos(x[PSI])
+    ex, ey, evx, evy = ref[REF_X] - x[X], ref[REF_Y] - x[Y], ref[REF_VX] - x[VX], ref[REF_VY] - x[VY]
+    uf = saturated_pd(cpsi * ex + spsi * ey, cpsi * evx + spsi * evy, kp, kd, ap, ad)       # forward
+    ul = saturated_pd(cpsi * ey - spsi * ex, cpsi * evy - spsi * evx, kp, kd, ap, ad)       # left
     uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ])
     g = vp[P_G]
     U1, flags = thrust_for_tilt(uz, sin_cos(x[PHI])[1] * sin_cos(x[THETA])[1], vp[P_M], g, vp[P_K],
                                 gains[COS_MAX_TILT])
-    theta_d, flags = tilt_setpoint(ux / g, False, tilt, flags)           # eq (5), small angle
-    phi_d, flags = tilt_setpoint(-uy / g, False, tilt, flags)            # eq (6), small angle
+    theta_d, flags = tilt_setpoint(uf / g, False, tilt, flags)           # eq (5), small angle, yaw frame
+    phi_d, flags = tilt_setpoint(-ul / g, False, tilt, flags)            # eq (6), small angle, yaw frame
     finish(U1, phi_d, theta_d, ref[REF_PSI], flags, dt, x, vp, gains, mem, cmd)
 
 

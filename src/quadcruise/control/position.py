@@ -10,11 +10,25 @@ Per control period, with a = U1 / m:
 
 2. Altitude (not in the paper): u_z the same PD on z, and the tilt-compensated thrust
    U1 = m (g + u_z) / (cos phi cos theta), limited to [0, 4 K].
-3. Pitch setpoint from eq (5) solved for theta with the current phi, psi (eq 16)::
+3. Roll and pitch setpoints: eqs (5) and (6) solved *together* (the default,
+   ``inversion="joint"``). Rotated into the yaw frame they read
+   x'' sin psi - y'' cos psi = a sin phi and x'' cos psi + y'' sin psi = a cos phi sin theta, so::
+
+       sin phi_d = (u_x sin psi - u_y cos psi) / a
+       sin theta_d = (u_x cos psi + u_y sin psi) / (a cos phi_d)
+
+   with phi_d limited to ``max_tilt`` before theta_d is computed. The pair satisfies eqs (5)
+   and (6) at once, at any yaw. At psi = 0 it is the paper's law with its sign fixed
+   (phi_d = -asin(u_y / a)), except that eq (16) divides by the cosine of the *new* roll
+   rather than the current one.
+
+   ``inversion="sequential"`` is the paper's literal reading, kept as an option:
+
+3'. Pitch setpoint from eq (5) solved for theta with the current phi, psi (eq 16)::
 
        sin theta_d = (u_x - sin phi sin psi a) / (cos phi cos psi a)
 
-4. Roll setpoint from eq (6) solved *exactly* for phi given theta_d and psi. The paper's
+4'. Roll setpoint from eq (6) solved *exactly* for phi given theta_d and psi. The paper's
    eq (19) squares the equation and takes a square root, which loses the sign of phi;
    with A = cos psi, B = sin theta_d sin psi, eq (6) reads A sin phi - B cos phi = -u_y/a,
    i.e. sin(phi - gamma) = -u_y / (a R), R = hypot(A, B), gamma = atan2(B, A); of the two
@@ -25,9 +39,13 @@ Per control period, with a = U1 / m:
 5. Yaw setpoint: the mission's yaw (a hold at 0 by default).
 
 Every asin argument outside [-1, 1] is clipped and flagged (FLAG_ASIN_CLIP), and roll and
-pitch setpoints are limited to ``max_tilt`` (FLAG_TILT_LIMIT). The sequential inversion
-(x first, then y) needs cos psi away from 0: it is the paper's design for a vehicle
-holding yaw near zero.
+pitch setpoints are limited to ``max_tilt`` (FLAG_TILT_LIMIT).
+
+The sequential inversion loses its damping at a held yaw beyond about 39 degrees: linearised
+about hover, solving eq (16) with the *current* roll and then eq (19) feeds the roll back
+into the roll setpoint with gain -tan^2(psi) through the attitude loop and the rotor lag
+(tests/integration/test_inversion_at_any_yaw.py measures the limit). The joint inversion has
+no such loop: it is the default.
 """
 
 from __future__ import annotations
@@ -88,8 +106,50 @@ from quadcruise.sim.fastmath import sin_cos
 
 # gains layout after the attitude block
 # (COS_MAX_TILT and SIN_MAX_TILT are cos and sin of MAX_TILT, so the step calls neither)
-KP_XY, KD_XY, KP_Z, KD_Z, MAX_TILT, ACCEL_FF, COS_MAX_TILT, SIN_MAX_TILT = range(ATT_GAINS, ATT_GAINS + 8)
-NLPD_GAINS = ATT_GAINS + 8
+# (INVERSION: 0 joint, 1 the paper's sequential eqs 16 then 19)
+KP_XY, KD_XY, KP_Z, KD_Z, MAX_TILT, ACCEL_FF, COS_MAX_TILT, SIN_MAX_TILT, INVERSION = range(ATT_GAINS, ATT_GAINS + 9)
+NLPD_GAINS = ATT_GAINS + 9
+INVERSIONS = ("joint", "sequential")
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def tilt_joint(ux, uy, spsi, cpsi, a, max_tilt, flags):
+    """Eqs (5) and (6) solved together for the roll and pitch setpoints, each limited to max_tilt.
+
+    Parameters
+    ----------
+    ux, uy : float
+        Wanted x and y accelerations [m/s^2].
+    spsi, cpsi : float
+        sin and cos of yaw.
+    a : float
+        U1 / m [m/s^2].
+    max_tilt : float
+        Roll and pitch setpoint limit [rad].
+    flags : int
+        The flags so far.
+
+    Returns
+    -------
+    (float, float, int)
+        phi_d [rad], theta_d [rad] and the flags (FLAG_ASIN_CLIP, FLAG_TILT_LIMIT added as they apply).
+
+    Examples
+    --------
+    >>> phi, theta, flags = tilt_joint(0.981, 0.0, 0.0, 1.0, 9.81, 0.7, 0)    # yaw 0: x'' from pitch alone
+    >>> round(phi, 6), round(theta, 6), flags
+    (0.0, 0.100167, 0)
+    >>> phi, theta, flags = tilt_joint(0.981, 0.0, 1.0, 0.0, 9.81, 0.7, 0)    # yaw 90 deg: from roll alone
+    >>> round(phi, 6), round(theta, 6) + 0.0, flags
+    (0.100167, 0.0, 0)
+    """
+    if a < 1e-9:                                     # no thrust: no tilt can help
+        return 0.0, 0.0, flags | FLAG_ASIN_CLIP
+    sphi, clipped = clamp((ux * spsi - uy * cpsi) / a, -1.0, 1.0)            # (6) in the yaw frame
+    phi_d, flags = tilt_setpoint(math.asin(sphi), clipped, max_tilt, flags)
+    stheta, clipped = clamp((ux * cpsi + uy * spsi) / (a * math.cos(phi_d)), -1.0, 1.0)   # (5), (16)
+    theta_d, flags = tilt_setpoint(math.asin(stheta), clipped, max_tilt, flags)
+    return phi_d, theta_d, flags
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -278,12 +338,15 @@ def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
     spsi, cpsi = sin_cos(psi)
     U1, flags = thrust_for_tilt(uz, cphi * sin_cos(theta)[1], m, g, K, gains[COS_MAX_TILT])
     a = U1 / m
-    pitch, stheta_d, clipped = pitch_eq16(ux, sphi, cphi, spsi, cpsi, a)      # (16)
-    theta_d, flags = tilt_setpoint(pitch, clipped, tilt, flags)
-    if theta_d != pitch:                  # limited: sin theta_d is no longer asin's argument
-        stheta_d = math.copysign(gains[SIN_MAX_TILT], theta_d)
-    phi_d, clipped = roll_eq19(uy, stheta_d, spsi, cpsi, a)                    # (19), sign kept
-    phi_d, flags = tilt_setpoint(phi_d, clipped, tilt, flags)
+    if gains[INVERSION] == 0.0:                      # (5) and (6) together, at any yaw
+        phi_d, theta_d, flags = tilt_joint(ux, uy, spsi, cpsi, a, tilt, flags)
+    else:                                            # the paper's: (16) with the current roll, then (19)
+        pitch, stheta_d, clipped = pitch_eq16(ux, sphi, cphi, spsi, cpsi, a)      # (16)
+        theta_d, flags = tilt_setpoint(pitch, clipped, tilt, flags)
+        if theta_d != pitch:              # limited: sin theta_d is no longer asin's argument
+            stheta_d = math.copysign(gains[SIN_MAX_TILT], theta_d)
+        phi_d, clipped = roll_eq19(uy, stheta_d, spsi, cpsi, a)                    # (19), sign kept
+        phi_d, flags = tilt_setpoint(phi_d, clipped, tilt, flags)
     finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd)
 
 
@@ -317,6 +380,10 @@ class NLPD(Controller):
         anti-windup bound on the integral term Ki int(e) [rad/s^2].
     accel_feedforward : bool
         add the reference acceleration to u_x, u_y, u_z (off: the paper's eq 16 has none).
+    inversion : {"joint", "sequential"}
+        how roll and pitch setpoints come from u_x, u_y: eqs (5) and (6) solved together (the
+        default, exact at any yaw), or the paper's literal eq (16) with the current roll then
+        eq (19), which loses its damping at a held yaw beyond about 39 degrees.
 
     Examples
     --------
@@ -325,7 +392,7 @@ class NLPD(Controller):
     >>> round(c.position.kp, 2), round(c.position.kd, 2)
     (3.01, 5.0)
     >>> c.gains().shape, c.memory().shape
-    ((15,), (3,))
+    ((16,), (3,))
     """
 
     name = "nlpd"
@@ -339,6 +406,7 @@ class NLPD(Controller):
     max_tilt: float = _f(math.radians(45.0), "rad", "roll and pitch setpoint limit", TILT)
     i_limit: float = _f(5.0, "rad/s^2", "anti-windup bound on the attitude integral term", "pos")
     accel_feedforward: bool = _f(False, "-", "reference acceleration fed forward", "flag")
+    inversion: str = _f("joint", "-", "how roll and pitch setpoints are solved from u_x, u_y", "choice", INVERSIONS)
 
     @property
     def function(self):
@@ -347,5 +415,5 @@ class NLPD(Controller):
     def gains(self) -> np.ndarray:
         tail = [self.position.kp, self.position.kd, self.altitude.kp, self.altitude.kd,
                 self.max_tilt, 1.0 if self.accel_feedforward else 0.0,
-                math.cos(self.max_tilt), math.sin(self.max_tilt)]
+                math.cos(self.max_tilt), math.sin(self.max_tilt), float(INVERSIONS.index(self.inversion))]
         return np.array(attitude_block(self.attitude, self.yaw, self.i_limit) + tail)
