@@ -28,8 +28,8 @@ def test_a_controller_that_loses_the_circle_is_not_finished():
     res = fly_quietly("circle", NLPD(position=pd_from_poles([-1000.0, -2000.0])), duration=8.0)
     assert res.exit_status(0) is ExitStatus.LOST_TRACK and not res.ok[0] and not res.stopped[0]
     err = np.linalg.norm(res.states[0, :, :3] - res.references[0, :, :3], axis=1)
-    ref = res.references[0, :, :3]
-    bound = 1.0 + np.linalg.norm(ref.max(axis=0) - ref.min(axis=0))    # 1 m + the reference box's diagonal
+    bound = 1.0 + 4.0 * np.sqrt(2.0) + 2.0     # 1 m + the circle's box diagonal + the 2 m start offset
+    assert res.meta["max_track_error_m"] == pytest.approx(bound)
     i = int(np.searchsorted(res.t, res.t_stop[0]))
     assert err[i] > bound >= err[:i].max()                               # the first instant beyond it
     assert "lost track" in res.status_text(0) and f"{res.t_stop[0]:.4f}" in res.status_text(0)
@@ -38,6 +38,10 @@ def test_a_controller_that_loses_the_circle_is_not_finished():
 
 def test_the_tracking_bound_is_settable_and_the_default_ignores_the_start_offset():
     assert fly_quietly("circle", duration=5.0).ok[0]                   # starts 2 m off its circle
+    assert fly_quietly("circle", duration=0.01, log_every=1000).ok[0]  # however short and sparse the log
+    far = np.zeros(16)
+    far[:3], far[12:] = (0.0, 30.0, 1.0), qc.Vehicle.paper().hover_duty * 120.0
+    assert fly_quietly("hover", x0=far, duration=3.0).ok[0]             # nor a start far away
     tight = fly_quietly("circle", duration=5.0, max_track_error=0.5)
     assert tight.exit_status(0) is ExitStatus.LOST_TRACK and tight.t_stop[0] == 0.0
     assert fly_quietly("circle", NLPD(position=pd_from_poles([-1000.0, -2000.0])), duration=3.0,

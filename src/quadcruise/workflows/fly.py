@@ -135,9 +135,10 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
     max_track_error : float, optional
         Tracking bound [m]: a vehicle whose position error (3-D, at the logged instants) exceeds
         it gets the status ``lost track`` from the first such instant on (it flies on; the
-        result says so, and ``fly`` warns). By default 1 m plus the diagonal of the box its
-        reference path spans (a circle of radius 2 m: 6.66 m; a 1 m step: 2 m; hover: 1 m),
-        so that the start offset of a mission never counts; ``numpy.inf`` turns it off.
+        result says so, and ``fly`` warns). By default :func:`track_bound`: 1 m, plus the
+        diagonal of the box the mission's reference path spans, plus the vehicle's initial
+        position error (the default circle of radius 2 m: 8.66 m; a 1 m step: 2 m; hover:
+        1 m); ``numpy.inf`` turns it off.
     **unknown : Any
         Refused: any other keyword is an InputError naming the options (see
         :data:`FLY_OPTIONS`), so a misspelt one is not silently ignored.
@@ -186,7 +187,10 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
                       log_every=log_every, limits=limits, meta=meta, vp_ctrl=vp_ctrl,
                       full_dynamics=full_dynamics, seed=seed, first_vehicle=first_vehicle,
                       **engine_inputs(environment, sensors, n, dt))
-    result = mark_lost_track(result, max_track_error)
+    bound = (track_bound(missions or [first], np.broadcast_to(x0, (n, STATE_SIZE)), n)
+             if max_track_error is None else np.full(n, float(max_track_error)))
+    result.meta["max_track_error_m"] = bound.tolist() if n > 1 else float(bound[0])
+    result = mark_lost_track(result, bound)
     _warn_about(result)
     return result
 
@@ -238,43 +242,62 @@ def check_can_hover(vehicle: Vehicle) -> None:
                       f"leaving {100 * (1 - duty[i]):.0f} % of its thrust for control", stacklevel=3)
 
 
-def track_bound(result: SimResult) -> np.ndarray:
-    """The default tracking bound of each vehicle: 1 m plus the diagonal of its reference path's box.
+def track_bound(missions: list[Mission], x0: np.ndarray, n: int) -> np.ndarray:
+    """The default tracking bound of each vehicle [m]: 1 m, plus the diagonal of the box its
+    mission's reference path spans over the mission's default duration, plus its initial
+    position error, so that neither the start offset nor the mission's own size counts.
 
     Parameters
     ----------
-    result : SimResult
+    missions : list of Mission
+        One mission for every vehicle, or one for all.
+    x0 : numpy.ndarray
+        (N, 16) initial states.
+    n : int
+        Number of vehicles.
 
     Returns
     -------
     numpy.ndarray
         (N,) bounds [m].
+
+    Examples
+    --------
+    >>> from quadcruise.missions import Circle
+    >>> x0 = np.zeros((1, 16)); x0[0, 2] = 1.0
+    >>> track_bound([Circle()], x0, 1).round(3)          # 1 + 4 sqrt(2) + the 2 m start offset
+    array([8.657])
     """
-    ref = result.references[:, :, REF_X:REF_X + 3]
-    span = np.nanmax(ref, axis=1) - np.nanmin(ref, axis=1)
-    return 1.0 + np.linalg.norm(np.nan_to_num(span), axis=1)
+    sizes, starts = [], []
+    for mission in missions:
+        ref = mission.reference(np.linspace(0.0, float(mission.duration), 1001))
+        path = ref[:, REF_X:REF_X + 3]
+        sizes.append(float(np.linalg.norm(path.max(axis=0) - path.min(axis=0))))
+        starts.append(path[0])
+    size = np.broadcast_to(np.asarray(sizes), (n,))
+    start = np.broadcast_to(np.asarray(starts), (n, 3))
+    offset = np.linalg.norm(np.asarray(x0, dtype=float).reshape(n, -1)[:, X:X + 3] - start, axis=1)
+    return 1.0 + size + offset
 
 
-def mark_lost_track(result: SimResult, max_track_error: float | None = None) -> SimResult:
+def mark_lost_track(result: SimResult, bound: np.ndarray) -> SimResult:
     """The result, with ``lost track`` as the status of each finished vehicle whose position
     error left the bound, and the first logged instant it did as its ``t_stop``.
 
     Parameters
     ----------
     result : SimResult
-    max_track_error : float, optional
-        The bound [m]; :func:`track_bound` by default.
+    bound : numpy.ndarray
+        (N,) bounds [m].
 
     Returns
     -------
     SimResult
         The same object when no vehicle lost track.
     """
-    bound = track_bound(result) if max_track_error is None else np.full(result.n, float(max_track_error))
     err = np.linalg.norm(result.states[:, :, X:X + 3] - result.references[:, :, REF_X:REF_X + 3], axis=2)
     beyond = (err > bound[:, None]) & (result.status == int(ExitStatus.FINISHED))[:, None]
     lost = np.flatnonzero(beyond.any(axis=1))
-    result.meta["max_track_error_m"] = None if max_track_error is None else float(max_track_error)
     if not lost.size:
         return result
     status, t_stop = result.status.copy(), result.t_stop.copy()
