@@ -77,7 +77,7 @@ def test_eq19_root_is_the_one_nearest_level_at_any_yaw():
 
 def test_roll_of_a_tilt_limited_pitch_uses_the_limited_pitch():
     """When the pitch setpoint is limited, eq (19) is solved with the limited pitch's sine."""
-    c = NLPD(max_tilt=math.radians(20))
+    c = NLPD(max_tilt=math.radians(20), inversion="sequential")
     x = np.zeros(STATE_SIZE)
     x[12:] = V.m * V.g / 4
     x[PSI] = 0.4

@@ -155,8 +155,10 @@ def test_metrics_on_the_decimated_log_are_close_to_full_rate():
     spec = MonteCarloSpec("circle", population=POP, seed=2, duration=8.0)
     fast = sweep_metrics(fly_chunk(spec, 0, 5)[0], spec)              # 10 ms log
     full = flight_metrics(fly_chunk(spec, 0, 5, log_every=1)[0])      # every 1 ms period
-    for k, tol in (("rmse_m", 1e-5), ("max_error_m", 1e-4), ("rise_time_s", 1e-4), ("settling_time_5pct_s", 1e-4)):
+    for k, tol in (("rmse_m", 1e-5), ("max_error_m", 1e-4)):
         np.testing.assert_allclose(fast[k], full[k].to_numpy(dtype=float), rtol=tol, err_msg=k)
+    for k in ("rise_time_s", "settling_time_5pct_s"):         # crossings interpolated on the 10 ms log:
+        np.testing.assert_allclose(fast[k], full[k].to_numpy(dtype=float), atol=1e-3, err_msg=k)   # 1/10 of it
 
 
 def test_the_world_acts_and_drag_is_added_with_a_warning():

