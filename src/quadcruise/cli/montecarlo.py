@@ -57,5 +57,73 @@ def montecarlo(**options):
     Runs on Dask (a local cluster of processes by default); results stream to --out as
     chunks finish, so an interrupted sweep resumes where it stopped. Every draw comes from
     --seed, whatever the chunking or the machine.
+
+    \f
+    Parameters
+    ----------
+    **options
+        The options by parameter name, passed on to :func:`montecarlo_command`. An option
+        without a default is None when not given: the ``scenario`` file's value, else the
+        default that ``--help`` shows.
+
+        mission, controller : str
+            ``--mission``, ``--controller``: the mission's and the controller's names.
+        n : int or None
+            ``-n``/``--n``: number of flights.
+        seed : int or None
+            ``--seed``: seed of every random draw.
+        duration : float or None
+            ``--duration``: flight time [s]; None: the scenario's, else the mission's.
+        dt : float or None
+            ``--dt``: control period [s]; None: the scenario's, else 0.001 s.
+        wind : str or None
+            ``--wind``: wind, gust and turbulence of every flight, a
+            :func:`~quadcruise.disturbances.parse_wind` spec; None: the scenario's, else none.
+        wind_spread : float or None
+            ``--wind-spread``: standard deviation of a random steady horizontal wind drawn per
+            flight [m/s].
+        mass_spread, inertia_spread, thrust_spread, bandwidth_spread, yaw_arm_spread : float or None
+            ``--mass-spread`` .. ``--yaw-arm-spread``: relative standard deviations of the
+            mass m, of each inertia, of the thrust gain K, of the actuator bandwidth and of the
+            yaw moment arm d.
+        distribution : {"normal", "uniform"} or None
+            ``--distribution``: distribution of the random draws.
+        offset : float or None
+            ``--offset``: standard deviation of the start position on each axis [m].
+        noise : str or None
+            ``--noise``: sensor noise and delay, a :func:`parse_noise` spec; None: the
+            scenario's, else none.
+        model_error : bool or None
+            ``--model-error``/``--no-model-error``: the controller computes with the nominal
+            vehicle (True) or knows each vehicle's own parameters (False).
+        chunk_size : str
+            ``--chunk-size``: flights per task, a whole number or "auto".
+        scheduler : str
+            ``--scheduler``: "local" (a Dask cluster of processes here), "none" (in this
+            process) or the address of a Dask scheduler.
+        workers : int or None
+            ``--workers``: worker processes of the local cluster; None: the machine's cores.
+        connect_timeout : float
+            ``--connect-timeout``: time to wait for a scheduler given by address [s].
+        out : str or None
+            ``--out``: folder that the chunks stream to as they finish and the results go to at
+            the end; None: print only.
+        force : bool
+            ``--force``: replace an ``out`` folder holding something else.
+        resume : bool
+            ``--resume``/``--no-resume``: load the chunks of this same sweep found in ``out``
+            instead of flying them again.
+        fmt : {"csv", "parquet"}
+            ``--format``: format of the flights table.
+        case : int or None
+            ``--case``: fly this flight (its number in the sweep) alone and, with ``out``,
+            write it there; None: the whole sweep.
+        worst : int
+            ``--worst``: how many of the worst flights to list.
+        quiet : bool
+            ``--quiet``: no progress bar.
+        scenario : str or None
+            ``--scenario``: path of a TOML scenario file: mission, controller, vehicle,
+            disturbances and a ``[montecarlo]`` table.
     """
     montecarlo_command(**options, echo=click.echo)
