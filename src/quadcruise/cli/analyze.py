@@ -21,7 +21,25 @@ __all__ = ["analyze"]
 @FORCE_OPTION
 @friendly
 def analyze(controller, controller_params, position_poles, dt, out, force):
-    """Linearise the closed loop about hover: poles, damping, margins of each loop, Bode plots."""
+    """Linearise the closed loop about hover: poles, damping, margins of each loop, Bode plots.
+
+    \f
+    Parameters
+    ----------
+    controller : str
+        ``--controller``: the controller's name (:func:`quadcruise.control.controller_from_name`).
+    controller_params : tuple of str
+        ``-c``/``--controller-param``: the controller's parameters, each ``KEY=VALUE``.
+    position_poles : str or None
+        ``--poles``: comma-separated closed-loop poles of the x/y loops [rad/s], e.g.
+        ``-0.7,-4.3``; their PD gains replace the controller's position gains. None: not given.
+    dt : float
+        ``--dt``: control period [s].
+    out : str or None
+        ``--out``: folder to write ``analysis.json`` and the Bode plots to; None: print only.
+    force : bool
+        ``--force``: replace a non-empty ``out`` folder that quadcruise did not write.
+    """
     from quadcruise.workflows.analysis import linearize, report, summary, write_analysis
 
     the_controller = controller_from_options(controller, controller_params, position_poles)

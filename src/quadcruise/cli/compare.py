@@ -30,7 +30,39 @@ __all__ = ["compare"]
 @friendly
 def compare(mission, controllers, duration, dt, mission_params, out, force, population, seed, mass_spread, wind,
             report):
-    """Fly MISSION (a name or a waypoint CSV) with several controllers; one table, one figure."""
+    """Fly MISSION (a name or a waypoint CSV) with several controllers; one table, one figure.
+
+    \f
+    Parameters
+    ----------
+    mission : str
+        ``MISSION``: a mission name (:func:`quadcruise.missions.mission_from_name`) or the path
+        of a waypoint CSV, flown as constant-speed legs.
+    controllers : str
+        ``--controllers``: comma-separated controller names.
+    duration : float or None
+        ``--duration``: flight time [s]; None: the mission's.
+    dt : float
+        ``--dt``: control period [s].
+    mission_params : tuple of str
+        ``-m``/``--mission-param``: the mission's parameters, each ``KEY=VALUE``.
+    out : str or None
+        ``--out``: folder to write ``metrics.csv`` and ``comparison.png`` to; None: print only.
+    force : bool
+        ``--force``: replace a non-empty ``out`` folder that quadcruise did not write.
+    population : int or None
+        ``--population``: also fly every controller on the same Monte Carlo population of this
+        many perturbed vehicles; None: the nominal vehicle only.
+    seed : int
+        ``--seed``: seed of the population.
+    mass_spread : float
+        ``--mass-spread``: relative standard deviation of the population's mass.
+    wind : str or None
+        ``--wind``: wind of the population, a :func:`~quadcruise.disturbances.environment.parse_wind`
+        spec such as ``dryden:moderate@10``; None: no wind.
+    report : str or None
+        ``--report``: path of a self-contained HTML report to write as well; None: no report.
+    """
     from quadcruise.workflows.compare import compare as run_compare
 
     if out is not None:

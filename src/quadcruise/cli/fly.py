@@ -51,6 +51,46 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
     a TOML scenario file describing the whole run (options given here override it).
     With --out, also write the traces, a figure of the flight, the metrics and the
     configuration (quadcruise.json) to that folder, atomically.
+
+    \f
+    Parameters
+    ----------
+    mission : str
+        ``MISSION``: a mission name (:func:`quadcruise.missions.mission_from_name`), the path of
+        a waypoint CSV, or the path of a TOML scenario file (ending in ``.toml``).
+    controller : str
+        ``--controller``: the controller's name (:func:`quadcruise.control.controller_from_name`).
+        With a scenario that names a controller, that one flies unless this name is not
+        ``nlpd`` or ``controller_params`` or ``position_poles`` are given.
+    duration : float or None
+        ``--duration``: flight time [s]; None: the scenario's, else the mission's (one lap, or
+        10 s after a step).
+    dt : float or None
+        ``--dt``: control period [s]; None: the scenario's, else 0.001 s.
+    max_step : float or None
+        ``--max-step``: longest RK4 substep [s]; None: the scenario's, else ``dt``.
+    mission_params : tuple of str
+        ``-m``/``--mission-param``: the mission's parameters, each ``KEY=VALUE`` (not used with a
+        scenario).
+    controller_params : tuple of str
+        ``-c``/``--controller-param``: the controller's parameters, each ``KEY=VALUE``.
+    position_poles : str or None
+        ``--poles``: comma-separated closed-loop poles of the x/y loops [rad/s], e.g.
+        ``-0.7,-4.3``; their PD gains replace the controller's position gains. None: not given.
+    out : str or None
+        ``--out``: folder to write the traces, the figure, the metrics and ``quadcruise.json``
+        to; None: print only.
+    fmt : {"csv", "parquet"}
+        ``--format``: format of the traces.
+    force : bool
+        ``--force``: replace a non-empty ``out`` folder that quadcruise did not write.
+    smooth : bool
+        ``--smooth``: fly a waypoint CSV as a minimum-snap path instead of constant-speed legs.
+    report : str or None
+        ``--report``: path of a self-contained HTML report to write as well; None: no report.
+    animate : str or None
+        ``--animate``: path of an animation of the flight to write as well (``.gif``, or
+        ``.mp4`` with ffmpeg); None: no animation.
     """
     from quadcruise.missions import mission_from_name
 

@@ -21,6 +21,18 @@ def replay(pwm_csv: str, out: str, max_step: float) -> None:
 
     Each row's duties hold until the next row's time. The vehicle (the paper's Table I)
     starts at rest at the origin with each rotor at the thrust of the first row.
+
+    \f
+    Parameters
+    ----------
+    pwm_csv : str
+        ``PWM.csv``: path of the duty table, columns ``t`` [s] and ``u1`` .. ``u4`` (the four
+        rotors' PWM duties).
+    out : str
+        ``-o``/``--out``: path of the states CSV to write (t, position [m], velocity [m/s],
+        angles [rad], body rates [rad/s], rotor thrusts F1..F4 [N]).
+    max_step : float
+        ``--max-step``: longest RK4 substep [s].
     """
     from quadcruise.workflows.replay import read_duty_csv, write_states_csv
     from quadcruise.workflows.replay import replay as run_replay

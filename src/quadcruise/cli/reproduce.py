@@ -24,6 +24,21 @@ def reproduce(out, fmt, force, report, scenario):
 
     Writes OUT/metrics.json, one figure per paper figure, the traces and OUT/report.md,
     which explains every difference from the paper. Nothing is left half-written.
+
+    \f
+    Parameters
+    ----------
+    out : str
+        ``--out``: folder to write ``metrics.json``, the figures, the traces and ``report.md`` to.
+    fmt : {"csv", "parquet"}
+        ``--format``: format of the traces.
+    force : bool
+        ``--force``: replace a non-empty ``out`` folder that quadcruise did not write.
+    report : str or None
+        ``--report``: path of a self-contained HTML report to write as well; None: no report.
+    scenario : str or None
+        ``--scenario``: path of a TOML scenario file whose vehicle and control period the
+        flights use; None: the paper's vehicle and period.
     """
     import time
 

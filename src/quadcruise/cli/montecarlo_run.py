@@ -1,0 +1,152 @@
+"""What ``quadcruise montecarlo`` runs once its options are parsed: the population built from
+them, the sweep or one case flown, the summary printed. The library does the work
+(:func:`quadcruise.montecarlo.montecarlo`); the command itself, its options and its help are
+in :mod:`quadcruise.cli.montecarlo`, which re-exports these."""
+
+from __future__ import annotations
+
+import sys
+from typing import TYPE_CHECKING, Callable
+
+import click
+
+from quadcruise.errors import InputError
+
+if TYPE_CHECKING:
+    from quadcruise.montecarlo import Case, MonteCarloResult
+
+__all__ = ["montecarlo_command", "parse_noise"]
+
+
+def parse_noise(text: str | None):
+    """Parse a sensor noise spec, ``position=STD,velocity=STD,angle=STD,rate=STD,delay=S``.
+
+    Parsed by :func:`quadcruise.fields.parse_assignments`; the values are checked by
+    :class:`~quadcruise.disturbances.SensorNoise`.
+
+    Parameters
+    ----------
+    text : str or None
+        The spec: std of position [m], velocity [m/s], angles [rad], body rates [rad/s] and
+        the delay [s]; any left out are 0. None, "" or "none": no sensor noise.
+
+    Returns
+    -------
+    SensorNoise or None
+
+    Raises
+    ------
+    InputError
+        An unknown key, an item without ``=``, or a value that is not a number.
+
+    Examples
+    --------
+    >>> parse_noise("position=0.01,delay=0.002").delay
+    0.002
+    >>> parse_noise("jitter=1")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: noise spec 'jitter=1': unknown key 'jitter'; keys: position, velocity, angle, rate, delay
+    """
+    if text is None or str(text).strip().lower() in ("", "none"):
+        return None
+    from quadcruise.disturbances import SensorNoise
+    from quadcruise.fields import parse_assignments
+
+    names = {"position": "position_std", "velocity": "velocity_std", "angle": "angle_std",
+             "rate": "rate_std", "delay": "delay"}
+    return SensorNoise(**parse_assignments(text, "noise spec", keys=names, numbers=True))
+
+
+def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: int | None = None,
+                       seed: int | None = None, duration: float | None = None, dt: float | None = None,
+                       wind: str | None = None, wind_spread: float | None = None,
+                       mass_spread: float | None = None, inertia_spread: float | None = None,
+                       thrust_spread: float | None = None, bandwidth_spread: float | None = None,
+                       yaw_arm_spread: float | None = None, distribution: str | None = None,
+                       offset: float | None = None, noise: str | None = None,
+                       model_error: bool | None = None, chunk_size: str | int = "auto", scheduler: str = "local",
+                       workers: int | None = None, connect_timeout: float = 10.0, out: str | None = None,
+                       force: bool = False, resume: bool = True, fmt: str = "csv", case: int | None = None,
+                       worst: int = 5, quiet: bool = False, scenario: str | None = None,
+                       echo: Callable[[str], None] = click.echo) -> MonteCarloResult | Case:
+    """What ``quadcruise montecarlo`` runs: build the population, fly it (or one case), print
+    the summary and the worst flights, write ``out``.
+
+    Parameters
+    ----------
+    mission, controller, n, seed, duration, dt, scenario
+        As :func:`quadcruise.montecarlo.scenario.sweep_spec`: None means "not given" (a
+        ``scenario`` file's value, else the default).
+    wind, noise : str, optional
+        A :func:`~quadcruise.disturbances.parse_wind` spec and a :func:`parse_noise` one.
+    mass_spread, inertia_spread, thrust_spread, bandwidth_spread, yaw_arm_spread, wind_spread, \
+offset, distribution, model_error : optional
+        :class:`~quadcruise.montecarlo.Population` fields.
+    chunk_size : int or str
+        Flights per task: a number (also as text) or "auto".
+    scheduler, workers, connect_timeout, out, resume, force, fmt
+        As :func:`quadcruise.montecarlo.montecarlo`.
+    case : int, optional
+        Fly flight ``case`` alone; with ``out``, write it there (into ``out/case-00000I`` beside its sweep).
+    worst, quiet : int, bool
+        How many worst flights to print; no progress bar.
+    echo : callable
+        Prints one text.
+
+    Returns
+    -------
+    MonteCarloResult or Case
+        The sweep, or the one flight.
+
+    Raises
+    ------
+    InputError
+        Bad input, before anything is written.
+    """
+    import numpy as np
+
+    from quadcruise.disturbances import parse_wind
+    from quadcruise.montecarlo import montecarlo_case
+    from quadcruise.montecarlo.output import case_folder, write_case
+    from quadcruise.montecarlo.progress import ProgressBar
+    from quadcruise.montecarlo.scenario import sweep_spec
+    from quadcruise.montecarlo.sweep import run_sweep
+
+    if isinstance(chunk_size, str) and chunk_size != "auto":
+        try:
+            chunk_size = int(chunk_size)
+        except ValueError:
+            raise InputError(f"--chunk-size must be a whole number or auto, got {chunk_size!r}") from None
+    spec, n = sweep_spec(mission=mission, controller=controller, n=n, seed=seed, duration=duration, dt=dt,
+                         environment=parse_wind(wind) if wind is not None else None, noise=parse_noise(noise),
+                         scenario=scenario, mass_spread=mass_spread, inertia_spread=inertia_spread,
+                         thrust_spread=thrust_spread, bandwidth_spread=bandwidth_spread,
+                         yaw_arm_spread=yaw_arm_spread, offset=offset, wind_spread=wind_spread,
+                         distribution=distribution, model_error=model_error)
+    if case is not None:
+        if isinstance(case, bool) or not isinstance(case, (int, np.integer)) or not 0 <= case < n:
+            raise InputError(f"--case {case} is not one of the {n} flights")
+        target = case_folder(out, spec, case, force=force)
+        found = montecarlo_case(spec, case)
+        echo(f"flight {case} of seed {spec.seed}: {found.row['reason']}, " + ", ".join(
+            f"{k} = {found.row[k]:.4g}" for k in ("rmse_m", "max_error_m", "settling_time_5pct_s", "m")))
+        if target is not None:
+            write_case(found, target, fmt=fmt, force=True)
+            echo(f"wrote the flight to {target}")
+        return found
+    bar = None if quiet else ProgressBar(sys.stderr)
+    try:
+        res = run_sweep(spec, n, chunk_size=chunk_size, scheduler=scheduler, workers=workers, out=out,
+                        resume=resume, force=force, fmt=fmt, progress=bar, connect_timeout=connect_timeout)
+    finally:
+        if bar is not None:
+            bar.close()
+    echo(res.summary_text())
+    if worst:
+        echo(f"worst {worst} (fly one alone again with --case VEHICLE):")
+        echo(res.worst_text(worst))
+    info = res.info
+    echo(f"{info.get('flown', 0):,} flights flown ({info.get('resumed', 0):,} resumed) in {info.get('wall_s', 0):.1f} s "
+         f"on {info.get('scheduler')}" + (f"; wrote {out}" if out is not None else ""))
+    return res
