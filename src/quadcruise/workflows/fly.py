@@ -179,6 +179,11 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
         "max_step_s": float(max_step or dt), "n": n, "version": __version__,
         "full_dynamics": bool(full_dynamics), "seed": seed,
     }
+    if environment is not None:
+        meta["environment"] = (environment.to_dict() if isinstance(environment, Environment)
+                               else {"custom": getattr(environment.function, "__name__", "disturbance")})
+    if sensors is not None:
+        meta["sensors"] = sensors.to_dict()
     if controller_vehicle is not None:
         meta["controller_vehicle"] = controller_vehicle.to_dict()
     vp_ctrl = None if controller_vehicle is None else controller_vehicle.rows(n)
