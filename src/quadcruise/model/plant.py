@@ -35,6 +35,11 @@ paper's phi' = p, theta' = q, psi' = r:
     phi'   = p + (q sin phi + r cos phi) tan theta
     theta' = q cos phi - r sin phi
     psi'   = (q sin phi + r cos phi) / cos theta
+
+which are singular at theta = +-90 degrees: near it, 1/cos theta magnifies every error. A
+flight of the full plant therefore stops when |theta| passes :data:`EULER_PITCH_LIMIT`, with
+its own exit status (``ExitStatus.PITCH_SINGULAR``), instead of going on with a silently
+inaccurate attitude. The paper's kinematics have no such singularity.
 """
 
 from __future__ import annotations
@@ -92,6 +97,9 @@ from quadcruise.layout import (
 )
 from quadcruise.model.actuators import mix
 
+EULER_PITCH_LIMIT = math.radians(85.0)
+"""|pitch| [rad] beyond which a flight of the full plant stops: there 1/cos theta = 11.5, and
+the ZYX Euler-angle rates go singular at 90 degrees."""
 
 @njit(cache=True, error_model="numpy")
 def derivative(x, u, vp, ext, full, dx):

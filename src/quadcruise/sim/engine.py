@@ -55,15 +55,15 @@ from quadcruise.layout import (
     Y,
     Z,
 )
-from quadcruise.model.plant import derivative_at
+from quadcruise.model.plant import EULER_PITCH_LIMIT, derivative_at
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rng import next_normal, vehicle_states
 from quadcruise.sim.status import STATUS_REASONS, ExitStatus
 
 # exit status codes as plain ints, which the kernel compiles as constants (see sim/status.py)
-FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, TILT_BOUND, BAD_COMMAND = (
+FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, TILT_BOUND, BAD_COMMAND, PITCH_SINGULAR = (
     int(ExitStatus[name]) for name in ("FINISHED", "NONFINITE", "POSITION_BOUND", "SPEED_BOUND", "RATE_BOUND",
-                                       "TILT_BOUND", "BAD_COMMAND"))
+                                       "TILT_BOUND", "BAD_COMMAND", "PITCH_SINGULAR"))
 
 
 @dataclass(frozen=True)
@@ -80,7 +80,9 @@ class Limits:
         any body rate above this [rad/s].
     max_tilt : float
         |roll| or |pitch| above this [rad]; infinite by default, since the paper's
-        model has no singularity at 90 degrees.
+        model has no singularity at 90 degrees. (The full plant, ``full_dynamics=True``,
+        stops anyway at |pitch| > :data:`quadcruise.model.plant.EULER_PITCH_LIMIT`, 85
+        degrees, with the status ``PITCH_SINGULAR``.)
     """
 
     max_position: float = 1.0e4
@@ -355,6 +357,8 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
                 code = RATE_BOUND
             elif beyond(x[PHI], x[THETA], 0.0, max_tilt):
                 code = TILT_BOUND
+            elif full and abs(x[THETA]) > EULER_PITCH_LIMIT:      # the full plant's 1/cos theta
+                code = PITCH_SINGULAR
             if code != FINISHED:
                 t_end = t_grid[k + 1]
                 if k + 1 == next_log:           # keep the state that broke the bound

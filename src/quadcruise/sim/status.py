@@ -37,6 +37,7 @@ class ExitStatus(IntEnum):
     TILT_BOUND = 5
     BAD_COMMAND = 6
     LOST_TRACK = 7
+    PITCH_SINGULAR = 8
 
     @property
     def reason(self) -> str:
@@ -63,6 +64,7 @@ _REASONS = {
     ExitStatus.TILT_BOUND: "diverged: tilt left the bound",
     ExitStatus.BAD_COMMAND: "stopped: the controller returned a non-finite command",
     ExitStatus.LOST_TRACK: "lost track: the position error left the tracking bound",
+    ExitStatus.PITCH_SINGULAR: "stopped: pitch beyond 85 degrees, near the full plant's Euler-angle singularity",
 }
 
 STATUS_REASONS = tuple(status.reason for status in ExitStatus)

@@ -127,7 +127,7 @@ def read_duty_csv(path: str | os.PathLike) -> DutySchedule:
 
 
 def replay(schedule: DutySchedule, vehicle: Vehicle | None = None, *, max_step: float = 1e-3,
-           limits: Limits | None = None) -> SimResult:
+           limits: Limits | None = None, full_dynamics: bool = False) -> SimResult:
     """Fly the duty schedule open loop and log the state at every schedule row.
 
     Parameters
@@ -140,6 +140,8 @@ def replay(schedule: DutySchedule, vehicle: Vehicle | None = None, *, max_step: 
         Longest RK4 substep [s]; each row interval is split into equal substeps.
     limits : Limits, optional
         Divergence bounds.
+    full_dynamics : bool
+        Fly the plant with the exact Euler-angle kinematics instead of the paper's.
 
     Returns
     -------
@@ -156,11 +158,12 @@ def replay(schedule: DutySchedule, vehicle: Vehicle | None = None, *, max_step: 
         "source": schedule.source,
         "vehicle": vehicle.to_dict(),
         "max_step_s": max_step,
+        "full_dynamics": bool(full_dynamics),
         "version": __version__,
     }
     return simulate(schedule.t, x0, vp, duty_schedule, pack_schedule(schedule.t, schedule.duties),
                     no_reference, np.zeros(1), memory=np.zeros(1), max_step=max_step,
-                    limits=limits, meta=meta)
+                    limits=limits, meta=meta, full_dynamics=full_dynamics)
 
 
 def write_states_csv(result: SimResult, path: str | os.PathLike, vehicle: int = 0) -> None:
