@@ -8,6 +8,17 @@ Per control period, with a = U1 / m:
 
        u_x = Kp (x_r - x) + Kd (x_r' - x')   [+ x_r'' if acceleration feedforward is on]
 
+   That is the default, ``derivative="measurement"``: the derivative acts on the measured
+   velocity, with the reference's velocity. ``derivative="error"`` is eq (17) as printed,
+   the derivative of the whole error e = x_r - x through a first-order filter N (Simulink's
+   PID block, N = 100 1/s by default) whose state starts at rest::
+
+       u_x = Kp e + Kd N s / (s + N) e
+
+   A jump of the error by E (a step of the reference) then kicks u_x by Kd N E at once,
+   decaying as exp(-N t); beyond a few centimetres the asin clip and the tilt limit cut the
+   kick down to the largest tilt, held for a few hundredths of a second.
+
 2. Altitude (not in the paper): u_z the same PD on z, and the tilt-compensated thrust
    U1 = m (g + u_z) / (cos phi cos theta), limited to [0, 4 K].
 3. Roll and pitch setpoints: eqs (5) and (6) solved *together* (the default,
@@ -107,9 +118,16 @@ from quadcruise.sim.fastmath import sin_cos
 # gains layout after the attitude block
 # (COS_MAX_TILT and SIN_MAX_TILT are cos and sin of MAX_TILT, so the step calls neither)
 # (INVERSION: 0 joint, 1 the paper's sequential eqs 16 then 19)
-KP_XY, KD_XY, KP_Z, KD_Z, MAX_TILT, ACCEL_FF, COS_MAX_TILT, SIN_MAX_TILT, INVERSION = range(ATT_GAINS, ATT_GAINS + 9)
-NLPD_GAINS = ATT_GAINS + 9
+# (DERIVATIVE: 0 on the measurement with the reference's velocity, 1 on the whole error through
+#  the filter N [1/s] of FILTER_N)
+KP_XY, KD_XY, KP_Z, KD_Z, MAX_TILT, ACCEL_FF, COS_MAX_TILT, SIN_MAX_TILT, INVERSION, DERIVATIVE, FILTER_N = \
+    range(ATT_GAINS, ATT_GAINS + 11)
+NLPD_GAINS = ATT_GAINS + 11
 INVERSIONS = ("joint", "sequential")
+DERIVATIVES = ("measurement", "error")
+FILTER_X, FILTER_Y = ATT_MEMORY, ATT_MEMORY + 1
+"""Memory slots of the derivative filter's states (the filtered x and y errors [m])."""
+NLPD_MEMORY = ATT_MEMORY + 2
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -325,12 +343,57 @@ def finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd):
     write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags | att_flags, vp[P_D], vp[P_K])
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def filtered_derivative(e, f, kd, n, decay):
+    """The derivative term Kd N s / (s + N) of an error, and its filter's next state.
+
+    The filter is f' = N (e - f); the term is Kd f' = Kd N (e - f). Its state f holds the
+    filtered error and is advanced over one control period with the error held (exact for
+    a held input): f+ = e + (f - e) exp(-N dt).
+
+    Parameters
+    ----------
+    e : float
+        The error now [m].
+    f : float
+        The filter's state [m].
+    kd : float
+        Derivative gain [1/s].
+    n : float
+        Filter bandwidth N [1/s].
+    decay : float
+        exp(-N dt) over one control period.
+
+    Returns
+    -------
+    (float, float)
+        The derivative term [m/s^2] and the filter's state for the next period [m].
+
+    Examples
+    --------
+    >>> import math
+    >>> d, f = filtered_derivative(0.01, 0.0, 5.0, 100.0, math.exp(-0.1))   # a 1 cm step from rest
+    >>> round(d, 6), round(f, 6)                          # the kick: Kd N per metre of step
+    (5.0, 0.000952)
+    """
+    return kd * n * (e - f), e + (f - e) * decay
+
+
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
     """The paper's inverse-model nonlinear PD (eqs 16, 19) over decoupled attitude PID."""
     ff, tilt = gains[ACCEL_FF], gains[MAX_TILT]
-    ux = gains[KP_XY] * (ref[REF_X] - x[X]) + gains[KD_XY] * (ref[REF_VX] - x[VX]) + ff * ref[REF_AX]
-    uy = gains[KP_XY] * (ref[REF_Y] - x[Y]) + gains[KD_XY] * (ref[REF_VY] - x[VY]) + ff * ref[REF_AY]
+    if gains[DERIVATIVE] == 0.0:                     # on the measurement, with the reference's velocity
+        ux = gains[KP_XY] * (ref[REF_X] - x[X]) + gains[KD_XY] * (ref[REF_VX] - x[VX]) + ff * ref[REF_AX]
+        uy = gains[KP_XY] * (ref[REF_Y] - x[Y]) + gains[KD_XY] * (ref[REF_VY] - x[VY]) + ff * ref[REF_AY]
+    else:                                            # eq (17): on the whole error, filtered by N
+        ex, ey, n = ref[REF_X] - x[X], ref[REF_Y] - x[Y], gains[FILTER_N]
+        decay = math.exp(-n * dt)
+        dx, fx = filtered_derivative(ex, mem[FILTER_X], gains[KD_XY], n, decay)
+        dy, fy = filtered_derivative(ey, mem[FILTER_Y], gains[KD_XY], n, decay)
+        ux = gains[KP_XY] * ex + dx + ff * ref[REF_AX]
+        uy = gains[KP_XY] * ey + dy + ff * ref[REF_AY]
+        mem[FILTER_X], mem[FILTER_Y] = fx, fy
     uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ]) + ff * ref[REF_AZ]
     phi, theta, psi, psi_d = x[PHI], x[THETA], x[PSI], ref[REF_PSI]
     m, g, K = vp[P_M], vp[P_G], vp[P_K]
@@ -384,6 +447,17 @@ class NLPD(Controller):
         how roll and pitch setpoints come from u_x, u_y: eqs (5) and (6) solved together (the
         default, exact at any yaw), or the paper's literal eq (16) with the current roll then
         eq (19), which loses its damping at a held yaw beyond about 39 degrees.
+    derivative : {"measurement", "error"}
+        where the x and y derivative acts: on the measured velocity, with the reference's
+        velocity (u = Kp e + Kd (x_r' - x'), the default), or on the whole error as eq (17)
+        writes it, Kd N s / (s + N) e, through a first-order filter of bandwidth
+        ``derivative_filter`` whose state starts at rest (the filtered error is 0). A jump
+        of the error (a step, the circle's start offset) then gives a kick of Kd N per
+        metre of jump, decaying as exp(-N t); the asin clip and the tilt limit absorb it
+        beyond a few centimetres (see docs/paper.md).
+    derivative_filter : float
+        the filter's bandwidth N [1/s] of the ``"error"`` form (Simulink's PID default,
+        100); unused by the ``"measurement"`` form.
 
     Examples
     --------
@@ -392,11 +466,11 @@ class NLPD(Controller):
     >>> round(c.position.kp, 2), round(c.position.kd, 2)
     (3.01, 5.0)
     >>> c.gains().shape, c.memory().shape
-    ((16,), (3,))
+    ((18,), (5,))
     """
 
     name = "nlpd"
-    memory_size = ATT_MEMORY
+    memory_size = NLPD_MEMORY
 
     position: PDGains = _f(unit="-", doc="x and y PD loops", check=instance_of(PDGains), factory=position_pd_design)
     altitude: PDGains = _f(unit="-", doc="z PD loop", check=instance_of(PDGains), factory=altitude_pd_design)
@@ -407,6 +481,8 @@ class NLPD(Controller):
     i_limit: float = _f(5.0, "rad/s^2", "anti-windup bound on the attitude integral term", "pos")
     accel_feedforward: bool = _f(False, "-", "reference acceleration fed forward", "flag")
     inversion: str = _f("joint", "-", "how roll and pitch setpoints are solved from u_x, u_y", "choice", INVERSIONS)
+    derivative: str = _f("measurement", "-", "what the x and y derivative acts on", "choice", DERIVATIVES)
+    derivative_filter: float = _f(100.0, "1/s", "bandwidth N of the derivative filter on the error", "pos")
 
     @property
     def function(self):
@@ -415,5 +491,6 @@ class NLPD(Controller):
     def gains(self) -> np.ndarray:
         tail = [self.position.kp, self.position.kd, self.altitude.kp, self.altitude.kd,
                 self.max_tilt, 1.0 if self.accel_feedforward else 0.0,
-                math.cos(self.max_tilt), math.sin(self.max_tilt), float(INVERSIONS.index(self.inversion))]
+                math.cos(self.max_tilt), math.sin(self.max_tilt), float(INVERSIONS.index(self.inversion)),
+                float(DERIVATIVES.index(self.derivative)), self.derivative_filter]
         return np.array(attitude_block(self.attitude, self.yaw, self.i_limit) + tail)
