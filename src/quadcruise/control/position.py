@@ -126,8 +126,8 @@ NLPD_GAINS = ATT_GAINS + 11
 INVERSIONS = ("joint", "sequential")
 DERIVATIVES = ("measurement", "error")
 FILTER_X, FILTER_Y = ATT_MEMORY, ATT_MEMORY + 1
-"""Memory slots of the derivative filter's states (the filtered x and y errors [m])."""
-NLPD_MEMORY = ATT_MEMORY + 2
+"""Memory slots of the derivative filter's states (the filtered x and y errors [m]), there
+only with ``derivative="error"``: the default memory is the attitude loop's alone."""
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -466,11 +466,13 @@ class NLPD(Controller):
     >>> round(c.position.kp, 2), round(c.position.kd, 2)
     (3.01, 5.0)
     >>> c.gains().shape, c.memory().shape
-    ((18,), (5,))
+    ((18,), (3,))
+    >>> NLPD(derivative="error").memory().shape        # and the derivative filter's states
+    (5,)
     """
 
     name = "nlpd"
-    memory_size = NLPD_MEMORY
+    memory_size = ATT_MEMORY
 
     position: PDGains = _f(unit="-", doc="x and y PD loops", check=instance_of(PDGains), factory=position_pd_design)
     altitude: PDGains = _f(unit="-", doc="z PD loop", check=instance_of(PDGains), factory=altitude_pd_design)
@@ -487,6 +489,11 @@ class NLPD(Controller):
     @property
     def function(self):
         return nlpd
+
+    def memory(self) -> np.ndarray:
+        """Initial memory: the attitude integrals, and with ``derivative="error"`` the filter's
+        states (the filtered x and y errors), all at rest (zeros)."""
+        return np.zeros(ATT_MEMORY + (2 if self.derivative == "error" else 0))
 
     def gains(self) -> np.ndarray:
         tail = [self.position.kp, self.position.kd, self.altitude.kp, self.altitude.kd,

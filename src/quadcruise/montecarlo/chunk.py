@@ -20,10 +20,15 @@ __all__ = ["Case", "fly_chunk", "montecarlo_case", "reduce_chunk", "replay_case"
 
 
 # --- one chunk --------------------------------------------------------------------------
-def fly_chunk(spec: MonteCarloSpec, first: int, count: int, log_every: int | None = None):
+def fly_chunk(spec: MonteCarloSpec, first, count: int, log_every: int | None = None, controller=None):
     """Fly vehicles first .. first + count - 1 of the population as one batch:
     ``(SimResult, Draw)``. Divergence and clipping are not warned about (they are in the
-    table)."""
+    table).
+
+    ``first`` may also be the (count,) indices of the vehicles (repeats allowed), and
+    ``controller`` one controller per vehicle instead of the spec's: a tuner flies each of
+    its candidates on the same perturbed vehicles, their noise and turbulence included, as
+    one batch."""
     from quadcruise.workflows.fly import fly, hover_state
 
     draw = spec.population.draw(spec.seed, first, count, spec.vehicle, spec.dt)
@@ -31,7 +36,7 @@ def fly_chunk(spec: MonteCarloSpec, first: int, count: int, log_every: int | Non
     x0[:, X:X + 3] += draw.offsets
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = fly(spec.mission, spec.controller, vehicle=draw.vehicle,
+        res = fly(spec.mission, spec.controller if controller is None else controller, vehicle=draw.vehicle,
                   controller_vehicle=spec.vehicle if spec.population.model_error else None,
                   duration=spec.duration, dt=spec.dt, max_step=spec.max_step, x0=x0,
                   log_every=spec.log_every if log_every is None else log_every,

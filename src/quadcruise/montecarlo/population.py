@@ -132,15 +132,16 @@ class Population:
         """True if the vehicles meet wind (which acts only through drag)."""
         return self.wind_spread > 0 or (self.environment is not None and self.environment.needs_drag)
 
-    def unit_draws(self, seed: int, first: int, count: int) -> np.ndarray:
+    def unit_draws(self, seed: int, first, count: int) -> np.ndarray:
         """The unit draws of vehicles first .. first + count - 1 (see the module).
 
         Parameters
         ----------
         seed : int
             The sweep's seed.
-        first : int
-            Index of the first vehicle.
+        first : int or array of int
+            Index of the first vehicle; or the (count,) indices of the vehicles themselves
+            (repeats allowed: a tuner flies each candidate on the same vehicles).
         count : int
             Number of vehicles.
 
@@ -152,21 +153,25 @@ class Population:
         """
         out = np.empty((count, N_DRAWS))
         normal = self.distribution == "normal"
-        for k in range(count):
-            g = np.random.default_rng(np.random.SeedSequence([seed, first + k], spawn_key=(DRAW_KEY,)))
+        ids = [int(first) + k for k in range(count)] if np.ndim(first) == 0 else [int(i) for i in np.ravel(first)]
+        if len(ids) != count:
+            raise InputError(f"the population needs {count} vehicle indices, got {len(ids)}")
+        for k, i in enumerate(ids):
+            g = np.random.default_rng(np.random.SeedSequence([seed, i], spawn_key=(DRAW_KEY,)))
             out[k] = g.standard_normal(N_DRAWS) if normal else g.random(N_DRAWS)
         clip = CLIP[self.distribution]
         return np.clip(out, -clip, clip) if normal else clip * (2.0 * out - 1.0)
 
-    def draw(self, seed: int, first: int, count: int, nominal: Vehicle, dt: float = 1e-3) -> "Draw":
+    def draw(self, seed: int, first, count: int, nominal: Vehicle, dt: float = 1e-3) -> "Draw":
         """The vehicles first .. first + count - 1: parameters, offsets and environment.
 
         Parameters
         ----------
         seed : int
             The sweep's seed.
-        first : int
-            Index of the first vehicle.
+        first : int or array of int
+            Index of the first vehicle; or the (count,) indices of the vehicles (see
+            :meth:`unit_draws`).
         count : int
             Number of vehicles.
         nominal : Vehicle

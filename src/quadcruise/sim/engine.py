@@ -474,6 +474,8 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
     seed, first_vehicle : int
         Vehicle i's random stream is seeded from (seed, first_vehicle + i) only, so a
         population split into chunks draws the same numbers (see :mod:`quadcruise.sim.rng`).
+        ``first_vehicle`` may also be an (N,) array: vehicle i's stream is then
+        (seed, first_vehicle[i]).
     sensor_std : (16,) or (N, 16) array, optional
         Standard deviation of white noise added to each state the controller sees.
     sensor_delay : int

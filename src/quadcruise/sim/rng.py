@@ -142,12 +142,22 @@ def gauss(state):
     return x
 
 
-def vehicle_states(seed: int, n: int, first: int = 0) -> np.ndarray:
-    """(n, 1) uint64 generator states of vehicles first .. first + n - 1 of a run."""
+def vehicle_states(seed: int, n: int, first=0) -> np.ndarray:
+    """(n, 1) uint64 generator states of vehicles first .. first + n - 1 of a run.
+
+    ``first`` may also be an (n,) array of whole numbers: the index of each vehicle in the
+    run, so that vehicles flown side by side can share a stream (a tuner flies each
+    candidate on the same perturbed vehicles, noise included)."""
     seed = int(seed)
     if seed < 0:
         raise ValueError(f"seed must be a non-negative integer, got {seed}")
+    if np.ndim(first) == 0:
+        ids = [int(first) + k for k in range(n)]
+    else:
+        ids = [int(i) for i in np.asarray(first).ravel()]
+        if len(ids) != n or min(ids, default=0) < 0:
+            raise ValueError(f"first must be one index >= 0 or {n} of them, got {len(ids)}")
     out = np.empty((n, 1), dtype=np.uint64)
-    for k in range(n):
-        out[k, 0] = np.random.SeedSequence([seed, first + k]).generate_state(1, dtype=np.uint64)[0]
+    for k, i in enumerate(ids):
+        out[k, 0] = np.random.SeedSequence([seed, i]).generate_state(1, dtype=np.uint64)[0]
     return out

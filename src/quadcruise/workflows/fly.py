@@ -81,13 +81,13 @@ def hover_state(vehicle: Vehicle, n: int, mission: Mission) -> np.ndarray:
     return x0
 
 
-def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "nlpd", *,
+def fly(mission: Mission | str = "circle", controller: ControllerLike | str | list = "nlpd", *,
         vehicle: Vehicle | None = None, duration: float | None = None, dt: float = 1e-3,
         max_step: float | None = None, n: int | None = None, x0: Any = None,
         log_every: int = 1, limits: Limits | None = None, missions: list[Mission] | None = None,
         controller_vehicle: Vehicle | None = None, full_dynamics: bool = False,
         environment: Environment | None = None, sensors: SensorNoise | None = None,
-        seed: int = 0, first_vehicle: int = 0, max_track_error: float | None = None,
+        seed: int = 0, first_vehicle: int | np.ndarray = 0, max_track_error: float | None = None,
         **unknown: Any) -> SimResult:
     """Fly a mission with a controller and return the logged flight.
 
@@ -95,8 +95,10 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
     ----------
     mission : Mission or str
         A mission object, or a name ('hover', 'step', 'circle', 'square') for its defaults.
-    controller : Controller or str
-        A controller object, or a name ('nlpd', ...) for its defaults.
+    controller : Controller or str, or list of Controller
+        A controller object, or a name ('nlpd', ...) for its defaults; or one controller per
+        vehicle, all of one kind (the same class, the same memory size and gains layout),
+        so that each vehicle flies its own gains in the one batch (a tuner's generation).
     vehicle : Vehicle, optional
         Table I by default; a batched Vehicle gives each of the N vehicles its own values.
     duration : float, optional
@@ -129,9 +131,11 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
         of this flight's ``dt``.
     seed : int
         Seed of every random draw (turbulence, sensor noise).
-    first_vehicle : int
+    first_vehicle : int or array of int
         Index of the first vehicle in a larger population: vehicle i's random stream comes from
-        (seed, first_vehicle + i) only, so a batch split in parts flies the same numbers.
+        (seed, first_vehicle + i) only, so a batch split in parts flies the same numbers. An
+        (N,) array gives each vehicle's index itself (repeats allowed: vehicles that share an
+        index share their noise and turbulence).
     max_track_error : float, optional
         Tracking bound [m]: a vehicle whose position error (3-D, at the logged instants) exceeds
         it gets the status ``lost track`` from the first such instant on (it flies on; the
@@ -155,10 +159,13 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
         raise InputError(f"max_track_error must be a positive number [m], got {max_track_error!r}")
     if isinstance(mission, str):
         mission = mission_from_name(mission)
-    controller = as_controller(controller)
+    controllers = per_vehicle_controllers(controller)
+    controller = controllers[0]
     vehicle = vehicle or Vehicle.paper()
     sizes = {s for s in (vehicle.batch_size, None if x0 is None or np.ndim(x0) < 2 else np.shape(x0)[0],
-                         None if missions is None else len(missions), n) if s is not None}
+                         None if missions is None else len(missions), n,
+                         len(controllers) if len(controllers) > 1 else None,
+                         None if np.ndim(first_vehicle) == 0 else np.size(first_vehicle)) if s is not None}
     if len(sizes) > 1:
         raise InputError(f"the number of vehicles is ambiguous: {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
@@ -174,6 +181,7 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
         "workflow": "fly",
         "mission": [m.to_dict() for m in missions] if missions else mission.to_dict(),
         "controller": controller_record(controller),
+        **({"controllers": [controller_record(c) for c in controllers]} if len(controllers) > 1 else {}),
         "vehicle": vehicle.to_dict(),
         "duration_s": float(duration), "dt_s": float(dt),
         "max_step_s": float(max_step or dt), "n": n, "version": __version__,
@@ -187,8 +195,10 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
     if controller_vehicle is not None:
         meta["controller_vehicle"] = controller_vehicle.to_dict()
     vp_ctrl = None if controller_vehicle is None else controller_vehicle.rows(n)
-    result = simulate(grid, x0, vehicle.rows(n), controller.function, controller.gains(),
-                      first.function, mp, memory=controller.memory(), max_step=max_step or dt,
+    gains, memory = ((controller.gains(), controller.memory()) if len(controllers) == 1 else
+                     (np.stack([c.gains() for c in controllers]), np.stack([c.memory() for c in controllers])))
+    result = simulate(grid, x0, vehicle.rows(n), controller.function, gains,
+                      first.function, mp, memory=memory, max_step=max_step or dt,
                       log_every=log_every, limits=limits, meta=meta, vp_ctrl=vp_ctrl,
                       full_dynamics=full_dynamics, seed=seed, first_vehicle=first_vehicle,
                       **engine_inputs(environment, sensors, n, dt))
@@ -198,6 +208,54 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str = "n
     result = mark_lost_track(result, bound)
     _warn_about(result)
     return result
+
+
+def per_vehicle_controllers(controller: Any) -> list:
+    """The controllers of a flight: one for all vehicles, or one per vehicle, all of one kind.
+
+    Parameters
+    ----------
+    controller : ControllerLike or str, or list or tuple of them
+        One controller (or name), or one per vehicle.
+
+    Returns
+    -------
+    list of ControllerLike
+        One entry for a single controller; else one per vehicle, each checked by
+        :func:`~quadcruise.control.as_controller`.
+
+    Raises
+    ------
+    InputError
+        An empty list, or controllers of different kinds: another class, compiled function,
+        memory size or number of gains.
+
+    Examples
+    --------
+    >>> from quadcruise.control import NLPD, Gonzalez
+    >>> len(per_vehicle_controllers([NLPD(), NLPD(max_tilt=0.5)]))
+    2
+    >>> per_vehicle_controllers([NLPD(), Gonzalez()])
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: the controllers of one flight must be of one kind: vehicle 1 flies a Gonzalez (gonzalez), vehicle 0 a NLPD (nlpd)
+    """
+    if not isinstance(controller, (list, tuple)):
+        return [as_controller(controller)]
+    if not controller:
+        raise InputError("the list of controllers is empty: give one controller per vehicle")
+    out = [as_controller(c) for c in controller]
+    first = out[0]
+    shape = (np.shape(first.gains()), np.shape(first.memory()))
+    for i, c in enumerate(out[1:], start=1):
+        if type(c) is not type(first) or c.function is not first.function:
+            raise InputError(f"the controllers of one flight must be of one kind: vehicle {i} flies a "
+                             f"{type(c).__name__} ({c.name}), vehicle 0 a {type(first).__name__} ({first.name})")
+        if (np.shape(c.gains()), np.shape(c.memory())) != shape:
+            raise InputError(f"the controllers of one flight must have the same gains and memory sizes: "
+                             f"vehicle {i} has {np.size(c.gains())} gains and memory {np.size(c.memory())}, "
+                             f"vehicle 0 {np.size(first.gains())} and {np.size(first.memory())}")
+    return out
 
 
 FLY_OPTIONS = ("vehicle", "duration", "dt", "max_step", "n", "x0", "log_every", "limits", "missions",
@@ -379,4 +437,4 @@ def _warn_about(result: SimResult) -> None:
                       f"({np.count_nonzero(clipped)} of {result.n} vehicles)", stacklevel=3)
 
 
-__all__ = ["fly", "default_duration", "hover_state", "write_flight"]
+__all__ = ["fly", "default_duration", "hover_state", "per_vehicle_controllers", "write_flight"]
