@@ -12,13 +12,13 @@ from quadcruise.cli.common import (
     FORCE_OPTION,
     FORMAT_OPTION,
     REPORT_OPTION,
-    _assignments,
     controller_from_options,
     controller_with,
     friendly,
     mission_from_options,
 )
 from quadcruise.errors import InputError
+from quadcruise.fields import parse_assignments
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["fly"]
@@ -109,7 +109,7 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
         scenario = load_scenario(mission)
         the_mission = scenario.mission or mission_from_name("circle")
         if mission_params:
-            the_mission = the_mission.replace(**_assignments(mission_params, "--mission-param"))
+            the_mission = the_mission.replace(**parse_assignments(mission_params, "--mission-param"))
         if controller is not None or scenario.controller is None:
             the_controller = controller_from_options(controller or "nlpd", controller_params, position_poles)
         else:
