@@ -23,7 +23,7 @@ def test_fly_prints_metrics_and_writes_the_folder(tmp_path):
               "--animate", tmp_path / "a.gif")
     assert res.exit_code == 0, res.output
     assert "nlpd on step: 4 s" in res.output and "rise_time_s" in res.output
-    assert sorted(p.name for p in out.iterdir()) == ["flight.png", "metrics.csv", "quadcruise.json", "traces.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["flight.png", "metrics.csv", "quadcruise.json", "scenario.toml", "traces.csv"]
     traces = pd.read_csv(out / "traces.csv")
     assert len(traces) == 4001 and list(traces.columns[:5]) == ["vehicle", "t", "x", "y", "z"]
     meta = json.loads((out / "quadcruise.json").read_text())

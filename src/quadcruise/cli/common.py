@@ -138,6 +138,40 @@ def controller_from_options(name: str, params: tuple[str, ...], poles_text: str 
     return controller_from_name(name, **cparams)
 
 
+def controller_with(controller, params: tuple[str, ...], poles_text: str | None):
+    """A controller (a scenario's) with ``-c KEY=VALUE`` and ``--poles`` applied.
+
+    Parameters
+    ----------
+    controller : Controller
+        The controller to change.
+    params : tuple of str
+        ``KEY=VALUE`` parameters to change.
+    poles_text : str or None
+        Closed-loop poles of the x/y loops; their PD gains become the ``position`` gains.
+
+    Returns
+    -------
+    Controller
+    """
+    import dataclasses
+
+    from quadcruise.control.design import pd_from_poles
+
+    cparams = _assignments(params, "--controller-param")
+    poles = _poles(poles_text, "--poles")
+    if poles is not None:
+        cparams["position"] = pd_from_poles(poles)
+    if not cparams:
+        return controller
+    known = {f.name for f in dataclasses.fields(controller)}
+    unknown = sorted(set(cparams) - known)
+    if unknown:
+        raise InputError(f"--controller-param: {controller.name} has no parameter {unknown[0]!r} "
+                         f"(known: {', '.join(sorted(known))})")
+    return dataclasses.replace(controller, **cparams)
+
+
 def mission_from_options(text: str, params: tuple[str, ...], smooth: bool):
     """A mission from a name or a waypoint CSV, with KEY=VALUE parameters.
 

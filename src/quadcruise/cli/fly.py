@@ -13,10 +13,12 @@ from quadcruise.cli.common import (
     FORMAT_OPTION,
     REPORT_OPTION,
     controller_from_options,
+    controller_with,
     friendly,
     mission_from_options,
 )
 from quadcruise.errors import InputError
+from quadcruise.fields import parse_assignments
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["fly"]
@@ -24,7 +26,7 @@ __all__ = ["fly"]
 
 @click.command("fly")
 @click.argument("mission", metavar="MISSION")
-@click.option("--controller", default="nlpd", show_default=True, help="Controller name.")
+@click.option("--controller", help="Controller name (default nlpd, or the scenario's).")
 @click.option("--duration", type=float, help="Flight time [s] (default: one lap, or 10 s after a step).")
 @click.option("--dt", type=float, help="Control period [s] (default 0.001).")
 @click.option("--max-step", type=float, help="Longest RK4 substep [s] (default: dt).")
@@ -58,10 +60,10 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
     mission : str
         ``MISSION``: a mission name (:func:`quadcruise.missions.mission_from_name`), the path of
         a waypoint CSV, or the path of a TOML scenario file (ending in ``.toml``).
-    controller : str
-        ``--controller``: the controller's name (:func:`quadcruise.control.controller_from_name`).
-        With a scenario that names a controller, that one flies unless this name is not
-        ``nlpd`` or ``controller_params`` or ``position_poles`` are given.
+    controller : str or None
+        ``--controller``: the controller's name (:func:`quadcruise.control.controller_from_name`);
+        None: the scenario's controller, else ``nlpd``. ``controller_params`` and
+        ``position_poles`` change the scenario's controller when no name is given.
     duration : float or None
         ``--duration``: flight time [s]; None: the scenario's, else the mission's (one lap, or
         10 s after a step).
@@ -70,8 +72,8 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
     max_step : float or None
         ``--max-step``: longest RK4 substep [s]; None: the scenario's, else ``dt``.
     mission_params : tuple of str
-        ``-m``/``--mission-param``: the mission's parameters, each ``KEY=VALUE`` (not used with a
-        scenario).
+        ``-m``/``--mission-param``: the mission's parameters, each ``KEY=VALUE`` (with a
+        scenario, they change its mission).
     controller_params : tuple of str
         ``-c``/``--controller-param``: the controller's parameters, each ``KEY=VALUE``.
     position_poles : str or None
@@ -95,24 +97,38 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
     from quadcruise.missions import mission_from_name
 
     overrides = {k: v for k, v in (("duration", duration), ("dt", dt), ("max_step", max_step)) if v is not None}
+    given = [f"--{k.replace('_', '-')} {v}" for k, v in overrides.items()] + [f"-m {p}" for p in mission_params] \
+        + [f"-c {p}" for p in controller_params] + ([f"--controller {controller}"] if controller else []) \
+        + ([f"--poles {position_poles}"] if position_poles else [])
     if mission.lower().endswith(".toml"):
         from quadcruise.workflows.scenario import load_scenario
 
+        if smooth:
+            raise InputError("--smooth turns a waypoint CSV into a minimum-snap path; a scenario file "
+                             "says its mission kind itself (kind = \"minsnap\")")
         scenario = load_scenario(mission)
-        the_mission, the_controller = scenario.mission or mission_from_name("circle"), scenario.controller
-        if the_controller is None or controller_params or position_poles or controller != "nlpd":
-            the_controller = controller_from_options(controller, controller_params, position_poles)
+        the_mission = scenario.mission or mission_from_name("circle")
+        if mission_params:
+            the_mission = the_mission.replace(**parse_assignments(mission_params, "--mission-param"))
+        if controller is not None or scenario.controller is None:
+            the_controller = controller_from_options(controller or "nlpd", controller_params, position_poles)
+        else:
+            the_controller = controller_with(scenario.controller, controller_params, position_poles)
         kwargs = {**scenario.fly_kwargs(), **overrides}
     else:
+        scenario = None
+        if smooth and not mission.lower().endswith(".csv"):
+            raise InputError(f"--smooth turns a waypoint CSV into a minimum-snap path; {mission!r} is not one")
         the_mission = mission_from_options(mission, mission_params, smooth)
-        the_controller = controller_from_options(controller, controller_params, position_poles)
+        the_controller = controller_from_options(controller or "nlpd", controller_params, position_poles)
         kwargs = overrides
-    result = _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate)
+    result = _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate, given, scenario)
     if not result.ok.all():
         sys.exit(1)             # a vehicle did not fly its mission: diverged, lost track, out of bounds
 
 
-def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=None, animate=None) -> None:
+def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=None, animate=None, given=(),
+                    scenario=None):
     """Fly, print the metrics and each unfinished vehicle's reason, and write what was asked for.
 
     Parameters
@@ -131,6 +147,10 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
         Path of an HTML report.
     animate : str, optional
         Path of an animation (.gif, or .mp4 with ffmpeg).
+    given : sequence of str
+        The options given on the command line, recorded with the flight (``meta["command_line"]``).
+    scenario : Scenario, optional
+        The scenario file flown, recorded with the flight (source and title).
 
     Returns
     -------
@@ -146,6 +166,9 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
     if out is not None:
         check_output_dir(out, force)
     result = run_fly(mission, controller, **kwargs)
+    result.meta["command_line"] = list(given)
+    if scenario is not None:
+        result.meta["scenario"] = {"source": scenario.source, "title": scenario.title}
     metrics = result.metrics()
     click.echo(f"{controller.name} on {mission.name}: {result.t[-1]:g} s at dt = {result.meta['dt_s']:g} s")
     click.echo(vehicle_metrics_text(metrics))

@@ -278,8 +278,9 @@ class SimResult:
 
     def write(self, out: str | os.PathLike, *, fmt: str = "csv", force: bool = False, metrics=None) -> Path:
         """Write the flight's folder, whole or not at all: the traces (``traces.csv`` or
-        ``traces.parquet``), ``metrics.csv``, ``flight.png`` and the configuration
-        (``quadcruise.json``).
+        ``traces.parquet``), ``metrics.csv``, ``flight.png``, the configuration
+        (``quadcruise.json``) and ``scenario.toml``, which ``quadcruise fly`` flies again to
+        the same numbers (when the flight came from :func:`quadcruise.fly`).
 
         Parameters
         ----------
@@ -309,7 +310,35 @@ class SimResult:
             metrics.to_csv(tmp / "metrics.csv", index=False)
             save_figure(plot_flight(self), tmp / "flight.png")
             (tmp / MARKER).write_text(self.meta_json() + "\n")
+            if self.meta.get("workflow") == "fly" and "custom" not in (self.meta.get("environment") or {}):
+                (tmp / "scenario.toml").write_text(self.scenario_toml())
         return out
+
+    def scenario_toml(self) -> str:
+        """The flight's configuration as a scenario file that ``quadcruise fly`` reads back.
+
+        Returns
+        -------
+        str
+            TOML: vehicle, controller and its gains, mission, disturbances, sensors, model
+            error and simulation settings (see :mod:`quadcruise.io.scenario_file`).
+
+        Examples
+        --------
+        >>> import quadcruise as qc
+        >>> print(qc.fly("step", duration=2.0).scenario_toml().splitlines()[0])
+        # written by quadcruise ... from a flight of nlpd on step; `quadcruise fly THIS_FILE` flies it again
+        """
+        from quadcruise.io.scenario_file import scenario_document, scenario_text
+
+        scenario = self.meta.get("scenario") or {}
+        doc = scenario_document(self.meta, title=scenario.get("title", ""))
+        what = f"{self.meta.get('controller', {}).get('name', '?')} on {self.meta.get('mission', {}).get('kind', '?')}"
+        header = (f"written by quadcruise {self.meta.get('version', '')} from a flight of {what}; "
+                  f"`quadcruise fly THIS_FILE` flies it again")
+        if self.meta.get("command_line"):
+            header += "\nthe command line changed: " + " ".join(self.meta["command_line"])
+        return scenario_text(doc, header=header)
 
     def meta_json(self) -> str:
         """The recorded configuration as JSON.

@@ -176,6 +176,7 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
     duration = default_duration(first) if duration is None else duration
     grid = time_grid(float(duration), float(dt))
     check_can_hover(vehicle)
+    given_x0 = None if x0 is None else np.asarray(x0, dtype=float).tolist()
     x0 = hover_state(vehicle, n, first) if x0 is None else x0
     meta = {
         "workflow": "fly",
@@ -185,7 +186,9 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
         "vehicle": vehicle.to_dict(),
         "duration_s": float(duration), "dt_s": float(dt),
         "max_step_s": float(max_step or dt), "n": n, "version": __version__,
-        "full_dynamics": bool(full_dynamics), "seed": seed,
+        "full_dynamics": bool(full_dynamics), "seed": seed, "log_every": int(log_every),
+        "max_track_error": None if max_track_error is None else float(max_track_error),
+        "initial_state": given_x0,
     }
     if environment is not None:
         meta["environment"] = (environment.to_dict() if isinstance(environment, Environment)

@@ -69,10 +69,10 @@ from quadcruise.errors import InputError
 from quadcruise.missions import MISSIONS, Mission
 from quadcruise.model.vehicle import Vehicle
 
-TABLES = ("vehicle", "controller", "mission", "disturbances", "simulation", "montecarlo")
+TABLES = ("vehicle", "controller", "mission", "disturbances", "simulation", "montecarlo", "controller_vehicle")
 SIMULATION_KEYS = {"duration": float, "dt": float, "max_step": float, "full_dynamics": bool,
-                   "seed": int, "log_every": int, "n": int}
-DISTURBANCE_KEYS = ("wind", "gust", "turbulence", "rotor_loss", "sensor_noise")
+                   "seed": int, "log_every": int, "n": int, "max_track_error": float, "initial_state": list}
+DISTURBANCE_KEYS = ("wind", "gust", "turbulence", "rotor_loss", "force", "sensor_noise")
 
 
 @dataclass(frozen=True)
@@ -80,6 +80,7 @@ class Scenario:
     """A validated scenario: objects ready to fly, and the source it came from."""
 
     vehicle: Vehicle = field(default_factory=Vehicle.paper)
+    controller_vehicle: Vehicle | None = None
     controller: Controller | None = None
     mission: Mission | None = None
     environment: Any = None
@@ -101,9 +102,13 @@ class Scenario:
         """Keyword arguments of :func:`quadcruise.fly` for this scenario."""
         sim = self.simulation
         kw: dict[str, Any] = {"duration": sim.get("duration"), "dt": self.dt}
-        for key in ("max_step", "full_dynamics", "seed", "log_every", "n"):
+        for key in ("max_step", "full_dynamics", "seed", "log_every", "n", "max_track_error"):
             if key in sim:
                 kw[key] = sim[key]
+        if "initial_state" in sim:
+            kw["x0"] = sim["initial_state"]
+        if self.controller_vehicle is not None:
+            kw["controller_vehicle"] = self.controller_vehicle
         vehicle = self.vehicle
         if self.environment is not None:
             if self.environment.needs_drag:
@@ -148,11 +153,12 @@ def scenario_from_dict(doc: dict, *, source: str = "scenario", base: Path | None
     if not isinstance(title, str):
         raise InputError(f"{source}: 'title' must be a string")
     vehicle = _vehicle(where.at("vehicle"), doc.get("vehicle", {}))
+    model = _vehicle(where.at("controller_vehicle"), doc["controller_vehicle"]) if "controller_vehicle" in doc else None
     controller = _controller(where.at("controller"), doc.get("controller")) if "controller" in doc else None
     mission = _mission(where.at("mission"), doc.get("mission"), base) if "mission" in doc else None
     environment, noise = _disturbances(where.at("disturbances"), doc.get("disturbances", {}))
     simulation = _simulation(where.at("simulation"), doc.get("simulation", {}))
-    return Scenario(vehicle=vehicle, controller=controller, mission=mission, environment=environment,
+    return Scenario(vehicle=vehicle, controller_vehicle=model, controller=controller, mission=mission, environment=environment,
                     sensor_noise=noise, simulation=simulation, montecarlo=dict(doc.get("montecarlo", {})),
                     title=title, source=source)
 
@@ -200,8 +206,16 @@ def _vehicle(where: _Where, table: dict) -> Vehicle:
     _known(where, "", table, fields | {"preset"})
     if table.get("preset", "paper") != "paper":
         raise where.error(f"unknown preset {table['preset']!r} (known: paper)")
-    values = {k: _number(where, k, v) for k, v in table.items() if k != "preset"}
+    values = {k: _numbers(where, k, v) if isinstance(v, list) else _number(where, k, v)
+              for k, v in table.items() if k != "preset"}
     return where.wrap(Vehicle.paper().replace, **values)
+
+
+def _numbers(where: _Where, key: str, value: list):
+    """A list of numbers (one per vehicle, or a row of a table) as a float array."""
+    import numpy as np
+
+    return np.array([_numbers(where, key, v) if isinstance(v, list) else _number(where, key, v) for v in value])
 
 
 def _poles(where: _Where, key: str, value) -> list:
@@ -223,8 +237,9 @@ def _controller(where: _Where, table: dict) -> Controller:
     cls = CONTROLLERS[name]
     defaults = cls()
     fields = {f.name for f in dataclasses.fields(cls)}
-    gain_fields = {n for n in fields if isinstance(getattr(defaults, n), (PDGains, PIDGains))}
-    known = fields | {f"{n}_poles" for n in gain_fields} | {"name"}
+    gain_fields = {n for n in fields if dataclasses.is_dataclass(getattr(defaults, n))}
+    pole_fields = {n for n in gain_fields if isinstance(getattr(defaults, n), (PDGains, PIDGains))}
+    known = fields | {f"{n}_poles" for n in pole_fields} | {"name"}
     _known(where, "", table, known)
     params: dict[str, Any] = {}
     for key, value in table.items():
@@ -237,8 +252,13 @@ def _controller(where: _Where, table: dict) -> Controller:
         elif key in gain_fields:
             if not isinstance(value, dict):
                 raise where.error(f"'{key}' must be a table of gains, e.g. {{ kp = 3.01, kd = 5.0 }}")
-            cls_gains = PIDGains if "ki" in value else PDGains
-            _known(where, f"{key}.", value, {"kp", "kd", "ki"})
+            default = getattr(defaults, key)
+            if isinstance(default, (PDGains, PIDGains)):
+                cls_gains = PIDGains if "ki" in value else PDGains
+            else:
+                cls_gains = type(default)
+            _known(where, f"{key}.", value, {f.name for f in dataclasses.fields(cls_gains)}
+                   | ({"kp", "kd", "ki"} if cls_gains in (PDGains, PIDGains) else set()))
             params[key] = where.wrap(cls_gains, **{k: _number(where, f"{key}.{k}", v) for k, v in value.items()})
         elif isinstance(value, bool) or isinstance(value, str):
             params[key] = value
@@ -255,6 +275,10 @@ def _mission(where: _Where, table: dict, base: Path | None) -> Mission:
     fields = {f.name for f in dataclasses.fields(cls)}
     _known(where, "", table, fields | {"kind"})
     params = {k: v for k, v in table.items() if k != "kind"}
+    if isinstance(params.get("table"), dict):                  # a waypoint table written inline
+        from quadcruise.missions import WaypointTable
+
+        params["table"] = where.wrap(WaypointTable.from_dict, params["table"])
     if "table" in params and isinstance(params["table"], str) and base is not None:
         params["table"] = str((base / params["table"]).resolve()) if not Path(params["table"]).is_absolute() \
             else params["table"]
@@ -275,7 +299,8 @@ def _disturbances(where: _Where, table: dict):
         wind = table["wind"]
         parts["wind"] = where.wrap(d.ConstantWind, velocity=tuple(wind)) if isinstance(wind, list) \
             else where.wrap(d.ConstantWind, **_table(where, "wind", wind))
-    for key, cls in (("gust", d.Gust), ("turbulence", d.Turbulence), ("rotor_loss", d.RotorLoss)):
+    for key, cls in (("gust", d.Gust), ("turbulence", d.Turbulence), ("rotor_loss", d.RotorLoss),
+                     ("force", d.ExternalForce)):
         if key in table:
             values = {k: tuple(v) if isinstance(v, list) else v for k, v in _table(where, key, table[key]).items()}
             parts[key] = where.wrap(cls, **values)
@@ -294,10 +319,15 @@ def _table(where: _Where, key: str, value) -> dict:
 
 def _simulation(where: _Where, table: dict) -> dict:
     _known(where, "", table, set(SIMULATION_KEYS))
-    out = {k: _number(where, k, v, SIMULATION_KEYS[k]) for k, v in table.items()}
+    out = {k: _numbers(where, k, v) if SIMULATION_KEYS[k] is list else _number(where, k, v, SIMULATION_KEYS[k])
+           for k, v in table.items()}
     for key in ("duration", "dt", "max_step"):
         if key in out and out[key] <= 0:
             raise where.error(f"'{key}' must be > 0 seconds, got {out[key]!r}")
+    if "max_track_error" in out and out["max_track_error"] <= 0:
+        raise where.error(f"'max_track_error' must be > 0 metres, got {out['max_track_error']!r}")
+    if "initial_state" in out and out["initial_state"].shape[-1:] != (16,):
+        raise where.error("'initial_state' must be 16 numbers (x, y, z, vx, ..., F4), or one such list per vehicle")
     if out.get("seed", 0) < 0:
         raise where.error(f"'seed' must be >= 0, got {out['seed']!r}")
     for key in ("log_every", "n"):

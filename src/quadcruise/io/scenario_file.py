@@ -1,0 +1,119 @@
+"""A run's recorded configuration (the ``meta`` of a result) as a scenario file that
+``quadcruise fly`` reads back (:func:`quadcruise.workflows.scenario.load_scenario`).
+
+The configuration is plain data already: the vehicle, controller, mission, environment and
+sensors as their ``to_dict()``, and the simulation settings. This module only reshapes it into
+the scenario's tables and writes TOML (with ``tomli_w``): floats are written so that they read
+back to the same bits, so the file flies the same numbers. TOML has no null: an absent value is
+left out, and a missing entry of a waypoint column is written as ``nan``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+__all__ = ["scenario_document", "scenario_text"]
+
+SIMULATION_FROM_META = {"duration_s": "duration", "dt_s": "dt", "max_step_s": "max_step",
+                        "full_dynamics": "full_dynamics", "seed": "seed", "log_every": "log_every",
+                        "max_track_error": "max_track_error", "initial_state": "initial_state"}
+"""Keys of a flight's meta and the [simulation] keys they become."""
+
+
+def _plain(value: Any) -> Any:
+    """A value TOML can hold: None dropped from tables, NaN kept in lists, tuples as lists."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items() if v is not None}
+    if isinstance(value, (list, tuple)):
+        return [math.nan if v is None else _plain(v) for v in value]
+    if hasattr(value, "tolist"):
+        return _plain(value.tolist())
+    return value
+
+
+def _part(d: dict | None) -> dict | None:
+    """A disturbance part's dict without its ``model`` tag (the table's key names the part)."""
+    if d is None:
+        return None
+    return {k: v for k, v in d.items() if k != "model"}
+
+
+def scenario_document(meta: dict, *, title: str = "") -> dict:
+    """The scenario tables of a flight's recorded configuration.
+
+    Parameters
+    ----------
+    meta : dict
+        A flight's ``meta`` (:attr:`quadcruise.SimResult.meta`): ``vehicle``, ``controller``,
+        ``mission``, optionally ``environment``, ``sensors``, ``controller_vehicle``, and the
+        simulation settings (``duration_s``, ``dt_s``, ``max_step_s``, ``seed``, ...).
+    title : str
+        The scenario's title.
+
+    Returns
+    -------
+    dict
+        Tables ``vehicle``, ``controller``, ``mission``, ``disturbances``, ``simulation``
+        (and ``controller_vehicle``), ready for :func:`scenario_text`.
+
+    Examples
+    --------
+    >>> doc = scenario_document({"mission": {"kind": "step", "size": 0.5}, "controller": {"name": "nlpd"},
+    ...                          "vehicle": {"m": 1.4}, "duration_s": 8.0, "seed": 0})
+    >>> doc["mission"], doc["simulation"]
+    ({'kind': 'step', 'size': 0.5}, {'duration': 8.0, 'seed': 0})
+    """
+    doc: dict[str, Any] = {}
+    if title or meta.get("title"):
+        doc["title"] = title or meta["title"]
+    for table in ("vehicle", "controller", "mission", "controller_vehicle"):
+        if meta.get(table) is not None:
+            doc[table] = dict(meta[table])
+    disturbances = {}
+    env = meta.get("environment") or {}
+    if "custom" in env:
+        raise ValueError("a compiled disturbance of one's own (CustomDisturbance) cannot be written to a scenario")
+    for key in ("wind", "gust", "turbulence", "rotor_loss", "force"):
+        if env.get(key) is not None:
+            disturbances[key] = _part(env[key])
+    if meta.get("sensors") is not None:
+        disturbances["sensor_noise"] = _part(meta["sensors"])
+    if disturbances:
+        doc["disturbances"] = disturbances
+    simulation = {key: meta[k] for k, key in SIMULATION_FROM_META.items() if meta.get(k) is not None}
+    if meta.get("n", 1) != 1 and not any(isinstance(v, list) for v in (meta.get("vehicle") or {}).values()):
+        simulation["n"] = meta["n"]
+    if simulation:
+        doc["simulation"] = simulation
+    return _plain(doc)
+
+
+def scenario_text(doc: dict, *, header: str = "") -> str:
+    """The scenario tables as TOML text.
+
+    Parameters
+    ----------
+    doc : dict
+        Tables as :func:`scenario_document` makes them.
+    header : str
+        Comment lines put first (each line gets a ``# ``).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> print(scenario_text({"mission": {"kind": "circle", "radius": 3.0}}, header="flown by hand"))
+    # flown by hand
+    <BLANKLINE>
+    [mission]
+    kind = "circle"
+    radius = 3.0
+    <BLANKLINE>
+    """
+    import tomli_w
+
+    lines = "".join(f"# {line}\n" for line in header.splitlines())
+    return (lines + "\n" if lines else "") + tomli_w.dumps(_plain(doc))
