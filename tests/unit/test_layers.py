@@ -31,9 +31,10 @@ RANKS = {
     "quadcruise.disturbances": 8,
     "quadcruise.workflows": 9,
     "quadcruise.montecarlo": 10,
-    "quadcruise.report": 11,
-    "quadcruise.cli": 12,
-    "quadcruise": 13, "quadcruise.__main__": 13,
+    "quadcruise.tune": 11,
+    "quadcruise.report": 12,
+    "quadcruise.cli": 13,
+    "quadcruise": 14, "quadcruise.__main__": 14,
 }
 
 

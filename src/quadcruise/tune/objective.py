@@ -1,0 +1,260 @@
+"""A tuner's objective: a whole generation of candidate gains flown as one batch, each candidate
+on the same M vehicles of a population (their noise and turbulence included), reduced to one
+cost per candidate.
+
+Per flight (one candidate on one vehicle), with the metrics of a Monte Carlo table
+(:func:`quadcruise.montecarlo.chunk.sweep_metrics`)::
+
+    cost = sum over targets ((metric - value) / tolerance)^2 + sum of the minimised metrics
+
+A flight that misses a requirement costs :data:`REQUIREMENT_COST` more, plus its misses
+measured in the requirements' own values (|bound|, or 1 for a bound of 0); a flight that did
+not finish, or that has no value for a metric the cost needs (a transient that never
+settled), costs :data:`FAILURE_COST`. So every flight that meets the requirements ranks
+before every one that does not, and every finished flight before every failed one.
+
+A candidate's cost is the worst of its M flights' costs (``statistic="worst"``) or their
+quantile ``q`` (``statistic=q``, 0 < q < 1): a robust tune. With one vehicle and no
+population, the nominal flight alone.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from quadcruise.errors import InputError
+from quadcruise.montecarlo.chunk import fly_chunk, sweep_metrics
+from quadcruise.montecarlo.schema import METRICS
+from quadcruise.montecarlo.spec import MonteCarloSpec
+from quadcruise.tune.spec import GainSpace
+
+__all__ = ["FAILURE_COST", "REQUIREMENT_COST", "Evaluation", "Objective", "check_statistic"]
+
+FAILURE_COST = 1e9
+"""Cost of a flight that did not finish or lacks a metric the cost needs."""
+REQUIREMENT_COST = 1e6
+"""Added to the cost of a flight that misses a requirement."""
+
+
+def check_statistic(statistic: Any) -> str | float:
+    """The statistic over a candidate's flights: ``"worst"`` or a quantile in (0, 1).
+
+    Parameters
+    ----------
+    statistic : str or float
+        ``"worst"`` (also ``"max"``), ``"median"``, a quantile such as 0.9, or its text
+        (``"0.9"``, ``"q0.9"``, ``"q90"``).
+
+    Returns
+    -------
+    str or float
+        ``"worst"`` or the quantile.
+
+    Raises
+    ------
+    InputError
+        Anything else.
+
+    Examples
+    --------
+    >>> check_statistic("q90"), check_statistic("median"), check_statistic("max")
+    (0.9, 0.5, 'worst')
+    """
+    if isinstance(statistic, str):
+        text = statistic.strip().lower()
+        if text in ("worst", "max"):
+            return "worst"
+        if text == "median":
+            return 0.5
+        body = text[1:] if text.startswith("q") else text
+        try:
+            q = float(body)
+        except ValueError:
+            q = -1.0
+        if text.startswith("q") and q > 1:
+            q /= 100.0
+    elif isinstance(statistic, (int, float)) and not isinstance(statistic, bool):
+        q = float(statistic)
+    else:
+        q = -1.0
+    if not 0.0 < q < 1.0:
+        raise InputError(f"objective {statistic!r}: expected worst, median or a quantile such as 0.9 (or q90)")
+    return q
+
+
+@dataclass
+class Evaluation:
+    """One generation flown: each candidate's gains, cost and flights.
+
+    Parameters
+    ----------
+    values : ndarray, shape (P, G)
+        The candidates' gains.
+    cost : ndarray, shape (P,)
+        Each candidate's cost.
+    flight_cost : ndarray, shape (P, M)
+        Each flight's cost.
+    metrics : dict of str to ndarray, shape (P, M)
+        Each flight's metrics (the table's columns: :data:`~quadcruise.montecarlo.schema.METRICS`,
+        ``status``, ``failure``).
+    wall_s : float
+        Time to fly and measure the generation [s].
+    """
+
+    values: np.ndarray
+    cost: np.ndarray
+    flight_cost: np.ndarray
+    metrics: dict
+    wall_s: float
+
+
+@dataclass
+class Objective:
+    """Candidate gains -> costs, one batched flight per call.
+
+    Parameters
+    ----------
+    spec : MonteCarloSpec
+        The mission, nominal vehicle, population, seed, flight time and step, and the log
+        the metrics are measured on; its controller is the base of ``space``.
+    space : GainSpace
+        The searched gains.
+    targets, requirements : tuple
+        :class:`~quadcruise.tune.spec.Target` and :class:`~quadcruise.tune.spec.Requirement`.
+    minimize : tuple of str
+        Metrics whose values are added to the cost.
+    samples : int
+        Vehicles of the population each candidate flies (1: the nominal vehicle alone when
+        the population has no spread).
+    statistic : str or float
+        ``"worst"`` or a quantile (:func:`check_statistic`).
+    evaluations : list of Evaluation
+        Every generation flown so far (filled by calls).
+    """
+
+    spec: MonteCarloSpec
+    space: GainSpace
+    targets: tuple = ()
+    requirements: tuple = ()
+    minimize: tuple = ()
+    samples: int = 1
+    statistic: Any = "worst"
+    evaluations: list = field(default_factory=list)
+
+    @property
+    def metrics_used(self) -> list[str]:
+        """The metrics the cost reads, in order of first use."""
+        names = [t.metric for t in self.targets] + [r.metric for r in self.requirements] + list(self.minimize)
+        return list(dict.fromkeys(names))
+
+    def __call__(self, unit: np.ndarray) -> np.ndarray:
+        """The costs of candidates given as positions in the unit cube, as scipy's
+        vectorised differential evolution calls it.
+
+        Parameters
+        ----------
+        unit : ndarray, shape (G,) or (G, P)
+            One candidate per column.
+
+        Returns
+        -------
+        ndarray, shape (P,) (a float for one candidate)
+        """
+        unit = np.asarray(unit, dtype=float)
+        single = unit.ndim == 1
+        ev = self.evaluate(self.space.values(unit[:, None].T if single else unit.T))
+        return float(ev.cost[0]) if single else ev.cost
+
+    def evaluate(self, values: np.ndarray) -> Evaluation:
+        """Fly candidates (one batch: P candidates x M vehicles) and cost them; the
+        evaluation is kept in :attr:`evaluations`.
+
+        Parameters
+        ----------
+        values : ndarray, shape (P, G)
+            The candidates' gains.
+
+        Returns
+        -------
+        Evaluation
+        """
+        start = time.perf_counter()
+        values = np.atleast_2d(np.asarray(values, dtype=float))
+        p, m = values.shape[0], self.samples
+        controllers = [c for c in self.space.controllers(values) for _ in range(m)]
+        ids = np.tile(np.arange(m), p)
+        res, _ = fly_chunk(self.spec, ids, p * m, controller=controllers)
+        cols = sweep_metrics(res, self.spec)
+        metrics = {k: np.asarray(cols[k], dtype=float).reshape(p, m) for k in METRICS}
+        metrics["status"] = np.asarray(cols["status"]).reshape(p, m)
+        metrics["failure"] = np.asarray(cols["failure"]).reshape(p, m)
+        flight_cost = self.flight_cost(metrics)
+        ev = Evaluation(values=values, cost=self.reduce(flight_cost), flight_cost=flight_cost, metrics=metrics,
+                        wall_s=time.perf_counter() - start)
+        self.evaluations.append(ev)
+        return ev
+
+    def flight_cost(self, metrics: dict) -> np.ndarray:
+        """Each flight's cost (see the module).
+
+        Parameters
+        ----------
+        metrics : dict of str to ndarray
+            The flights' metrics and ``status``.
+
+        Returns
+        -------
+        ndarray
+            Same shape as each metric.
+        """
+        status = metrics["status"]
+        cost = np.zeros(status.shape)
+        for t in self.targets:
+            cost += t.cost(metrics[t.metric])
+        for name in self.minimize:
+            cost += metrics[name]
+        missed = np.zeros(status.shape)
+        failed = status != 0
+        for r in self.requirements:
+            values = metrics[r.metric]
+            failed |= np.isnan(values)
+            missed += np.where(r.met(values), 0.0, r.violation(values) / (abs(r.value) or 1.0))
+        cost = np.where(missed > 0, cost + REQUIREMENT_COST * (1.0 + missed), cost)
+        failed |= ~np.isfinite(cost)
+        return np.where(failed, FAILURE_COST, cost)
+
+    def reduce(self, flight_cost: np.ndarray) -> np.ndarray:
+        """Each candidate's cost from its flights' costs: the worst or a quantile.
+
+        Parameters
+        ----------
+        flight_cost : ndarray, shape (P, M)
+
+        Returns
+        -------
+        ndarray, shape (P,)
+        """
+        if self.statistic == "worst" or flight_cost.shape[1] == 1:
+            return flight_cost.max(axis=1)
+        return np.quantile(flight_cost, float(self.statistic), axis=1, method="higher")
+
+    def statistic_of(self, values: np.ndarray) -> np.ndarray:
+        """A metric's value over each candidate's flights, by the objective's statistic
+        (worst: the largest).
+
+        Parameters
+        ----------
+        values : ndarray, shape (P, M)
+
+        Returns
+        -------
+        ndarray, shape (P,)
+            NaN where any flight (worst) or too many flights (a quantile) have none.
+        """
+        if self.statistic == "worst" or values.shape[1] == 1:
+            return values.max(axis=1)
+        return np.quantile(values, float(self.statistic), axis=1, method="higher")
