@@ -3,7 +3,7 @@
 The group lives here, each command in its own module (:mod:`quadcruise.cli.fly`,
 :mod:`~quadcruise.cli.replay`, :mod:`~quadcruise.cli.reproduce`,
 :mod:`~quadcruise.cli.compare`, :mod:`~quadcruise.cli.analyze`,
-:mod:`~quadcruise.cli.montecarlo`), what they share in :mod:`quadcruise.cli.common`.
+:mod:`~quadcruise.cli.montecarlo`, :mod:`~quadcruise.cli.tune`), what they share in :mod:`quadcruise.cli.common`.
 Bad input prints one line, ``error: ...``, and exits with status 2.
 """
 
@@ -21,6 +21,7 @@ from quadcruise.cli.fly import fly
 from quadcruise.cli.montecarlo import montecarlo
 from quadcruise.cli.replay import replay
 from quadcruise.cli.reproduce import reproduce
+from quadcruise.cli.tune import tune
 
 __all__ = ["main", "run"]
 
@@ -37,6 +38,7 @@ main.add_command(reproduce)
 main.add_command(compare)
 main.add_command(analyze)
 main.add_command(montecarlo)
+main.add_command(tune)
 
 
 def run() -> None:

@@ -36,7 +36,12 @@ from quadcruise.tune.objective import Objective, check_statistic
 from quadcruise.tune.result import TuneResult
 from quadcruise.tune.spec import GainSpace, parse_minimize, parse_requirements, parse_targets
 
-__all__ = ["tune", "TUNE_OPTIONS"]
+__all__ = ["tune", "ABS_TOL", "TUNE_OPTIONS"]
+
+ABS_TOL = 1e-3
+"""The search also stops when the spread of a generation's costs is below this (scipy's
+``atol``): a cost of 1e-3 is a miss of 3 % of a target's tolerance, and targets that can all be
+met exactly would otherwise never stop a relative test."""
 
 TUNE_OPTIONS = ("gains", "bounds", "targets", "require", "minimize", "population", "samples", "objective",
                 "seed", "budget", "popsize", "tol", "duration", "dt", "vehicle", "log_dt", "transient_until",
@@ -87,7 +92,8 @@ def tune(mission: Mission | str = "step", controller: Any = "nlpd", *, gains=Non
     popsize : int, optional
         Candidates per generation; 15 per searched gain by default.
     tol : float
-        Relative spread of the population's costs at which the search stops (scipy's ``tol``).
+        Relative spread of the population's costs at which the search stops (scipy's ``tol``;
+        it also stops at an absolute spread of :data:`ABS_TOL`).
     duration : float, optional
         Flight time [s]; the mission's default by default.
     dt : float
@@ -168,6 +174,7 @@ def _search(obj: Objective, budget: int, popsize: int, tol: float, seed: int, pr
     seeding = {"rng": rng} if "rng" in inspect.signature(differential_evolution).parameters else {"seed": rng}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)          # scipy: "differential_evolution: the 'workers' ..."
-        out = differential_evolution(obj, [(0.0, 1.0)] * g, maxiter=budget, init=init, tol=tol, polish=False,
+        out = differential_evolution(obj, [(0.0, 1.0)] * g, maxiter=budget, init=init, tol=tol, atol=ABS_TOL,
+                                     polish=False,
                                      updating="deferred", vectorized=True, callback=callback, **seeding)
     return obj.space.values(out.x)[0]

@@ -1,0 +1,148 @@
+"""What ``quadcruise tune`` runs once its options are parsed: the mission, controller and
+population from them (or a scenario file), the tune with its progress, the summary printed and
+the folder written. The command, its options and its help are in :mod:`quadcruise.cli.tune`."""
+
+from __future__ import annotations
+
+import shlex
+from typing import Callable
+
+import click
+
+__all__ = ["command_line", "tune_command"]
+
+
+def command_line(mission: str, options: dict) -> str:
+    """The command line that runs this tune again, from its options.
+
+    Parameters
+    ----------
+    mission : str
+        The MISSION argument.
+    options : dict
+        The options given, by parameter name (None, False, () and defaults left out).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> command_line("step", {"targets": ("rise_time_s=1",), "seed": 1, "quiet": True})
+    'quadcruise tune step --target rise_time_s=1 --seed 1'
+    """
+    flags = {"mission_params": "-m", "controller_params": "-c", "targets": "--target"}
+    skip = {"out", "force", "quiet"}
+    words = ["quadcruise", "tune", mission]
+    for name, value in options.items():
+        if name in skip or value is None or value is False or value == ():
+            continue
+        flag = flags.get(name, "--" + name.replace("_", "-"))
+        for item in value if isinstance(value, tuple) else (value,):
+            words += [flag] if item is True else [flag, str(item)]
+    return " ".join(shlex.quote(w) for w in words)
+
+
+DEFAULTS = {"controller": "nlpd", "samples": 1, "objective": "worst", "mass_spread": 0.0, "inertia_spread": 0.0,
+            "wind_spread": 0.0, "seed": 0, "budget": 100}
+"""Options left out of the recorded command line when they have these values."""
+
+
+def tune_command(*, mission: str, mission_params: tuple = (), controller: str = "nlpd",
+                 controller_params: tuple = (), gains: str | None = None,
+                 bounds: tuple = (), targets: tuple = (), require: tuple = (), minimize: tuple = (),
+                 samples: int = 1, objective: str = "worst", mass_spread: float = 0.0, inertia_spread: float = 0.0,
+                 wind: str | None = None, wind_spread: float = 0.0, noise: str | None = None, seed: int = 0,
+                 budget: int = 100, popsize: int | None = None, duration: float | None = None,
+                 dt: float | None = None, out: str | None = None, force: bool = False, quiet: bool = False,
+                 echo: Callable[..., None] = click.echo):
+    """What ``quadcruise tune`` runs: build the tune, run it, print its progress and summary,
+    write ``out``.
+
+    Parameters
+    ----------
+    mission : str
+        A mission name, a waypoint CSV or a TOML scenario file.
+    mission_params : tuple of str
+        ``KEY=VALUE`` parameters of the mission (not with a scenario).
+    controller : str
+        The controller's name; a scenario's controller flies unless this is not ``nlpd`` or
+        ``controller_params`` are given.
+    controller_params : tuple of str
+        ``KEY=VALUE`` parameters of the controller.
+    gains, bounds, targets, require, minimize, samples, objective, seed, budget, popsize
+        As :func:`quadcruise.tune.tune` (text as on the command line).
+    mass_spread, inertia_spread, wind_spread : float
+        :class:`~quadcruise.montecarlo.Population` fields.
+    wind, noise : str, optional
+        A :func:`~quadcruise.disturbances.parse_wind` spec and a
+        :func:`~quadcruise.cli.montecarlo_run.parse_noise` one.
+    duration, dt : float, optional
+        Flight time and control period [s]: given, else the scenario's, else the defaults.
+    out : str, optional
+        The folder to write.
+    force, quiet : bool
+        Replace a folder quadcruise did not write; print no progress.
+    echo : callable
+        Prints a text (``err=True``: to stderr).
+
+    Returns
+    -------
+    TuneResult
+
+    Raises
+    ------
+    InputError
+        Bad input, before any flight and before anything is written.
+    """
+    from quadcruise.cli.common import controller_from_options, mission_from_options
+    from quadcruise.cli.montecarlo_run import parse_noise
+    from quadcruise.disturbances import parse_wind
+    from quadcruise.io.files import check_output_dir
+    from quadcruise.montecarlo.population import Population
+    from quadcruise.tune import tune
+
+    given = {k: v for k, v in dict(mission_params=mission_params, controller=controller,
+                                   controller_params=controller_params, gains=gains,
+                                   bounds=bounds, targets=targets, require=require, minimize=minimize,
+                                   samples=samples, objective=objective, mass_spread=mass_spread,
+                                   inertia_spread=inertia_spread, wind=wind, wind_spread=wind_spread, noise=noise,
+                                   seed=seed, budget=budget, popsize=popsize, duration=duration, dt=dt).items()
+             if DEFAULTS.get(k, object()) != v}
+    if out is not None:
+        check_output_dir(out, force)
+    kwargs: dict = {"duration": duration, "dt": dt or 1e-3, "vehicle": None}
+    environment, sensors = (parse_wind(wind) if wind is not None else None), parse_noise(noise)
+    if mission.lower().endswith(".toml"):
+        from quadcruise.errors import InputError
+        from quadcruise.workflows.scenario import load_scenario
+
+        if mission_params:
+            raise InputError("-m/--mission-param does not apply to a scenario file: change its [mission] table")
+        sc = load_scenario(mission)
+        the_mission = sc.mission or "circle"
+        the_controller = sc.controller
+        if the_controller is None or controller_params or controller != "nlpd":
+            the_controller = controller_from_options(controller, controller_params, None)
+        kwargs.update(vehicle=sc.vehicle, duration=duration or sc.duration, dt=dt or sc.dt)
+        environment = environment if environment is not None else sc.environment
+        sensors = sensors if sensors is not None else sc.sensor_noise
+    else:
+        the_mission = mission_from_options(mission, mission_params, False)
+        the_controller = controller_from_options(controller, controller_params, None)
+    population = Population(mass_spread=mass_spread, inertia_spread=inertia_spread, wind_spread=wind_spread,
+                            environment=environment if environment is not None and environment.parts else None,
+                            noise=sensors)
+
+    def progress(done: int, total: int, text: str) -> None:
+        if not quiet:
+            echo(f"[{done}/{total}] {text}", err=True)
+
+    result = tune(the_mission, the_controller, gains=gains, bounds=bounds, targets=targets, require=require,
+                  minimize=minimize, population=population, samples=samples, objective=objective, seed=seed,
+                  budget=budget, popsize=popsize, progress=progress, command=command_line(mission, given), **kwargs)
+    echo(result.summary_text())
+    if out is not None:
+        result.write(out, force=True)
+        echo(f"wrote {out}: `quadcruise fly {out}/scenario.toml` flies the tuned gains")
+    return result
