@@ -65,7 +65,7 @@ def flight_page(circle, tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def rep():
-    return reproduce(scenarios=("circle", "square"), controllers=("nlpd", "gonzalez"))
+    return reproduce(scenarios=("circle", "square"), controllers=("nlpd", "gonzalez"), fitted=False)
 
 
 class Dom(HTMLParser):

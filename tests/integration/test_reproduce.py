@@ -7,7 +7,7 @@ from click.testing import CliRunner
 
 from quadcruise import __version__
 from quadcruise.cli import main
-from quadcruise.workflows.reproduce import FIGURES, PAPER, SCENARIOS
+from quadcruise.workflows.reproduce import FIGURES, FIT_SCENARIO, FITTED, PAPER, SCENARIOS
 
 
 @pytest.fixture(scope="module")
@@ -15,7 +15,8 @@ def out(tmp_path_factory):
     path = tmp_path_factory.mktemp("repro") / "out"
     result = CliRunner().invoke(main, ["reproduce", "--out", str(path)])
     assert result.exit_code == 0, result.output
-    assert "[9/9] flew step with nlpd+ff" in result.output
+    assert "[13/13] flew entry with gonzalez (fitted)" in result.output
+    assert "| nlpd (fitted) | Kp 3.469, Kd 2.599 (zeta 0.70" in result.output
     return path
 
 
@@ -27,11 +28,12 @@ def test_metrics_json_has_the_documented_format(out):
     doc = load(out)
     assert set(doc) == {"runs", "paper", "config", "version"}
     assert doc["version"] == __version__ and doc["paper"] == PAPER
-    assert len(doc["runs"]) == 9
+    assert len(doc["runs"]) == 13
     keys = {"scenario", "controller", "axis", "rise_time_s", "settling_time_s", "overshoot_pct", "rmse_m"}
     for run in doc["runs"]:
         assert keys <= set(run)
-        assert run["scenario"] in SCENARIOS
+        assert run["scenario"] in SCENARIOS or run["scenario"] == FIT_SCENARIO[0]
+        assert run["fitted"] == (run["controller"] in FITTED)
         assert run["status"] == "finished"
         for k in ("rise_time_s", "settling_time_s", "overshoot_pct", "rmse_m"):
             assert run[k] is None or (isinstance(run[k], float) and run[k] >= 0)
@@ -67,7 +69,9 @@ def test_figures_report_and_traces_are_written(out):
     assert "Where our numbers differ from the paper's" in report
     for name in FIGURES:
         assert f"]({name})" in report
-    assert len(list((out / "traces").glob("*.csv"))) == 9
+    assert len(list((out / "traces").glob("*.csv"))) == 13
+    assert (out / "traces" / "entry_gonzalez_fitted.csv").is_file()
+    assert "gains fitted to its numbers" in report and "| gonzalez (fitted) |" in report
     header = (out / "traces" / "circle_nlpd.csv").read_text().splitlines()[0]
     assert header.startswith("vehicle,t,x,y,z")
     assert json.loads((out / "quadcruise.json").read_text())["workflow"] == "reproduce"
@@ -83,3 +87,20 @@ def test_refuses_a_foreign_folder_unless_forced(tmp_path):
     assert "not empty and was not written by quadcruise" in result.output
     assert (foreign / "notes.txt").read_text() == "keep me"
     assert not (foreign / "metrics.json").exists()
+
+
+def test_fitted_rows_reach_the_papers_transients(out):
+    """The fitted gains give the paper's numbers: nlpd within 0.3 s, 0.5 s and 1.5 points (10-90 %
+    rise), the baseline's settling and overshoot to the digit and its 0-100 % rise within 0.5 s."""
+    runs = {r["controller"]: r for r in load(out)["runs"] if r["scenario"] == FIT_SCENARIO[0]}
+    nlpd, base = runs["nlpd (fitted)"], runs["gonzalez (fitted)"]
+    paper = PAPER["nlpd"]
+    assert abs(nlpd["rise_time_s"] - paper["rise_time_s"]) <= 0.3
+    assert abs(nlpd["settling_time_s"] - paper["settling_time_s"]) <= 0.5
+    assert abs(nlpd["overshoot_pct"] - paper["overshoot_pct"]) <= 1.5
+    paper = PAPER["gonzalez"]
+    assert abs(base["settling_time_s"] - paper["settling_time_s"]) <= 0.1
+    assert abs(base["overshoot_pct"] - paper["overshoot_pct"]) <= 0.1
+    assert abs(base["rise_0_100_s"] - paper["rise_time_s"]) <= 0.5 < abs(base["rise_time_s"] - paper["rise_time_s"])
+    for name in ("nlpd", "gonzalez"):        # the paper's own gains reach neither
+        assert runs[name]["rise_time_s"] > 2 * PAPER[name]["rise_time_s"] or runs[name]["overshoot_pct"] < 1.0

@@ -479,15 +479,15 @@ def reproduction_report(rep, figures: dict | None = None, *, title: str | None =
     from quadcruise.workflows.reproduce import (
         DIFFERENCES,
         FIGURES,
-        PAPER,
         TRACE_EVERY,
         baseline_comparison,
         paper_figure,
+        paper_numbers,
     )
 
     rows = []
     for r in rep.runs:
-        paper = PAPER.get(r["controller"], {}) if r["scenario"] != "step" else {}
+        paper = paper_numbers(r)
         rows.append({"scenario": r["scenario"], "controller": r["controller"], "axis": r["axis"],
                      "rise_time_s": r["rise_time_s"], "paper: rise_time_s": paper.get("rise_time_s"),
                      "settling_time_s": r["settling_time_s"],
