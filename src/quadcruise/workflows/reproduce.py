@@ -82,7 +82,7 @@ FIT_SCENARIO = ("entry", Step(axis="x", size=2.0, time=1.0), 30.0)
 2 m entry in x as a pure step from hover, long enough for the baseline's 12 s settling."""
 
 FITTED = {
-    "nlpd (fitted)": lambda: NLPD(position=PDGains(kp=3.4690172470449637, kd=2.5990902622585664)),
+    "nlpd (fitted)": lambda: NLPD(position=PDGains(kp=3.469043256419332, kd=2.5991005547059176)),
     "gonzalez (fitted)": lambda: Gonzalez(position=PDGains(kp=0.2895194468118253, kd=0.5427829514946776)),
 }
 """Label -> factory of the controllers fitted to the paper's transients by ``quadcruise tune``
