@@ -8,10 +8,12 @@ Per flight (one candidate on one vehicle), with the metrics of a Monte Carlo tab
     cost = sum over targets ((metric - value) / tolerance)^2 + sum of the minimised metrics
 
 A flight that misses a requirement costs :data:`REQUIREMENT_COST` more, plus its misses
-measured in the requirements' own values (|bound|, or 1 for a bound of 0); a flight that did
-not finish, or that has no value for a metric the cost needs (a transient that never
-settled), costs :data:`FAILURE_COST`. So every flight that meets the requirements ranks
-before every one that does not, and every finished flight before every failed one.
+measured in the requirements' own values (|bound|, or 1 for a bound of 0). A flight that
+finished but has no value for a metric the cost needs (a transient that never settled) costs
+:data:`FAILURE_COST` times (1 + its RMSE in metres), so that among such flights the search
+still sees which is closer; a flight that did not finish (diverged, lost track) costs ten
+times :data:`FAILURE_COST`. So every flight that meets the requirements ranks before every
+one that does not, and every finished flight before every failed one.
 
 A candidate's cost is the worst of its M flights' costs (``statistic="worst"``) or their
 quantile ``q`` (``statistic=q``, 0 < q < 1): a robust tune. With one vehicle and no
@@ -35,7 +37,8 @@ from quadcruise.tune.spec import GainSpace
 __all__ = ["FAILURE_COST", "REQUIREMENT_COST", "Evaluation", "Objective", "check_statistic"]
 
 FAILURE_COST = 1e9
-"""Cost of a flight that did not finish or lacks a metric the cost needs."""
+"""Cost of a flight that lacks a metric the cost needs, times (1 + its RMSE [m]); ten times this
+for a flight that did not finish."""
 REQUIREMENT_COST = 1e6
 """Added to the cost of a flight that misses a requirement."""
 
@@ -225,7 +228,9 @@ class Objective:
             missed += np.where(r.met(values), 0.0, r.violation(values) / (abs(r.value) or 1.0))
         cost = np.where(missed > 0, cost + REQUIREMENT_COST * (1.0 + missed), cost)
         failed |= ~np.isfinite(cost)
-        return np.where(failed, FAILURE_COST, cost)
+        rmse = metrics.get("rmse_m", np.zeros(status.shape))
+        fallback = np.where((status == 0) & np.isfinite(rmse), FAILURE_COST * (1.0 + rmse), 10.0 * FAILURE_COST)
+        return np.where(failed, fallback, cost)
 
     def reduce(self, flight_cost: np.ndarray) -> np.ndarray:
         """Each candidate's cost from its flights' costs: the worst or a quantile.
