@@ -16,7 +16,7 @@ def out(tmp_path_factory):
     result = CliRunner().invoke(main, ["reproduce", "--out", str(path)])
     assert result.exit_code == 0, result.output
     assert "[13/13] flew entry with gonzalez (fitted)" in result.output
-    assert "| nlpd (fitted) | Kp 3.469, Kd 2.599 (zeta 0.70" in result.output
+    assert "| nlpd (fitted) | Kp 3.470, Kd 2.599 (zeta 0.70" in result.output
     return path
 
 
