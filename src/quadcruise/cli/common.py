@@ -20,7 +20,32 @@ __all__ = ["FORCE_OPTION", "FORMAT_OPTION", "REPORT_OPTION", "controller_from_op
 FORMAT_OPTION = click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv",
                              show_default=True, help="Format of the traces.")
 FORCE_OPTION = click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
-REPORT_OPTION = click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html",
+def writable(ctx: click.Context, param: click.Parameter, value):
+    """A click callback: refuse an output path that could not be written, before any work.
+
+    Parameters
+    ----------
+    ctx : click.Context
+    param : click.Parameter
+    value : str or None
+        The path given, or None.
+
+    Returns
+    -------
+    str or None
+        ``value``, checked.
+    """
+    if value is not None:
+        from quadcruise.io.files import check_writable_place
+
+        try:
+            check_writable_place(value)
+        except InputError as exc:
+            raise click.BadParameter(str(exc), ctx=ctx, param=param) from None
+    return value
+
+
+REPORT_OPTION = click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html", callback=writable,
                              help="Also write a self-contained HTML report (tables, figures, interactive 3-D "
                                   "view, configuration).")
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import click
 
-from quadcruise.cli.common import FORCE_OPTION, REPORT_OPTION, friendly, mission_from_options
+from quadcruise.cli.common import FORCE_OPTION, REPORT_OPTION, friendly, mission_from_options, writable
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["compare"]
@@ -19,7 +19,7 @@ __all__ = ["compare"]
 @click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
 @click.option("-m", "--mission-param", "mission_params", multiple=True, metavar="KEY=VALUE",
               help="Mission parameter (repeatable).")
-@click.option("--out", type=click.Path(file_okay=False), help="Folder for metrics.csv and comparison.png.")
+@click.option("--out", type=click.Path(file_okay=False), callback=writable, help="Folder for metrics.csv and comparison.png.")
 @FORCE_OPTION
 @click.option("--population", type=int, metavar="N",
               help="Also fly every controller on the same Monte Carlo population of N vehicles.")

@@ -16,6 +16,7 @@ from quadcruise.cli.common import (
     controller_with,
     friendly,
     mission_from_options,
+    writable,
 )
 from quadcruise.errors import InputError
 from quadcruise.fields import parse_assignments
@@ -36,12 +37,12 @@ __all__ = ["fly"]
               help="Controller parameter, e.g. -c max_tilt=0.5 (repeatable).")
 @click.option("--poles", "position_poles", metavar="P1,P2",
               help="Closed-loop poles of the x/y loops [rad/s], e.g. -0.7,-4.3 (the paper's).")
-@click.option("--out", "out", type=click.Path(file_okay=False), help="Folder for traces, figure and metrics.")
+@click.option("--out", "out", type=click.Path(file_okay=False), callback=writable, help="Folder for traces, figure and metrics.")
 @FORMAT_OPTION
 @FORCE_OPTION
 @click.option("--smooth", is_flag=True, help="Fly a waypoint file as a minimum-snap path instead of legs.")
 @REPORT_OPTION
-@click.option("--animate", type=click.Path(dir_okay=False), metavar="PATH.gif",
+@click.option("--animate", type=click.Path(dir_okay=False), metavar="PATH.gif", callback=writable,
               help="Also write an animation of the flight (.gif; .mp4 needs ffmpeg).")
 @friendly
 def fly(mission, controller, duration, dt, max_step, mission_params, controller_params, position_poles,
