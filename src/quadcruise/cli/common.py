@@ -81,32 +81,6 @@ def friendly(func: Callable) -> Callable:
     return wrapper
 
 
-def _assignments(items: tuple[str, ...], option: str) -> dict:
-    """Parse KEY=VALUE pairs with :func:`quadcruise.fields.parse_assignments`: numbers,
-    comma-separated numbers, true/false, or words.
-
-    Parameters
-    ----------
-    items : tuple of str
-        The values of a repeatable option, each ``KEY=VALUE``.
-    option : str
-        The option's name, for the error message.
-
-    Returns
-    -------
-    dict
-        Key -> an int or float, a tuple of numbers (``1,2``), a bool, or the text as given.
-
-    Raises
-    ------
-    InputError
-        An item has no ``=`` or no key.
-    """
-    from quadcruise.fields import parse_assignments
-
-    return parse_assignments(items, option)
-
-
 def _poles(text: str | None, option: str):
     """Parse comma-separated poles, e.g. ``-0.7,-4.3`` or ``-1+2j,-1-2j``.
 
@@ -137,43 +111,43 @@ def _poles(text: str | None, option: str):
         raise InputError(f"{option} {text!r}: expected comma-separated poles, e.g. -0.7,-4.3") from None
 
 
-def controller_from_options(name: str, params: tuple[str, ...], poles_text: str | None):
-    """The controller that ``--controller``, ``-c KEY=VALUE`` and ``--poles`` describe.
+def controller_params(params: tuple[str, ...], poles_text: str | None) -> dict:
+    """The controller parameters that ``-c KEY=VALUE`` and ``--poles`` give.
 
     Parameters
     ----------
-    name : str
-        The controller's name (:func:`quadcruise.control.controller_from_name`).
     params : tuple of str
-        ``KEY=VALUE`` parameters of the controller.
+        ``KEY=VALUE`` parameters.
     poles_text : str or None
         Closed-loop poles of the x/y loops; their PD gains become the ``position`` gains.
 
     Returns
     -------
-    Controller
+    dict
     """
-    from quadcruise.control import controller_from_name
     from quadcruise.control.design import pd_from_poles
+    from quadcruise.fields import parse_assignments
 
-    cparams = _assignments(params, "--controller-param")
+    out = parse_assignments(params, "--controller-param")
     poles = _poles(poles_text, "--poles")
     if poles is not None:
-        cparams["position"] = pd_from_poles(poles)
-    return controller_from_name(name, **cparams)
+        out["position"] = pd_from_poles(poles)
+    return out
 
 
-def controller_with(controller, params: tuple[str, ...], poles_text: str | None):
-    """A controller (a scenario's) with ``-c KEY=VALUE`` and ``--poles`` applied.
+def controller_from_options(name: str, params: tuple[str, ...], poles_text: str | None, base=None):
+    """The controller that ``--controller``, ``-c KEY=VALUE`` and ``--poles`` describe.
 
     Parameters
     ----------
-    controller : Controller
-        The controller to change.
+    name : str
+        The controller's name (:func:`quadcruise.control.controller_from_name`); unused with ``base``.
     params : tuple of str
-        ``KEY=VALUE`` parameters to change.
+        ``KEY=VALUE`` parameters of the controller.
     poles_text : str or None
         Closed-loop poles of the x/y loops; their PD gains become the ``position`` gains.
+    base : Controller, optional
+        A controller (a scenario's) to change instead of a new one.
 
     Returns
     -------
@@ -181,20 +155,16 @@ def controller_with(controller, params: tuple[str, ...], poles_text: str | None)
     """
     import dataclasses
 
-    from quadcruise.control.design import pd_from_poles
+    from quadcruise.control import controller_from_name
 
-    cparams = _assignments(params, "--controller-param")
-    poles = _poles(poles_text, "--poles")
-    if poles is not None:
-        cparams["position"] = pd_from_poles(poles)
-    if not cparams:
-        return controller
-    known = {f.name for f in dataclasses.fields(controller)}
-    unknown = sorted(set(cparams) - known)
+    given = controller_params(params, poles_text)
+    if base is None:
+        return controller_from_name(name, **given)
+    known = [f.name for f in dataclasses.fields(base)]
+    unknown = sorted(set(given) - set(known))
     if unknown:
-        raise InputError(f"--controller-param: {controller.name} has no parameter {unknown[0]!r} "
-                         f"(known: {', '.join(sorted(known))})")
-    return dataclasses.replace(controller, **cparams)
+        raise InputError(f"{base.name} has no parameter {unknown[0]!r}; its parameters: {', '.join(known)}")
+    return dataclasses.replace(base, **given) if given else base
 
 
 def mission_from_options(text: str, params: tuple[str, ...], smooth: bool):
@@ -213,9 +183,10 @@ def mission_from_options(text: str, params: tuple[str, ...], smooth: bool):
     -------
     Mission
     """
+    from quadcruise.fields import parse_assignments
     from quadcruise.missions import mission_from_name
 
-    mparams = _assignments(params, "--mission-param")
+    mparams = parse_assignments(params, "--mission-param")
     if text.lower().endswith(".csv"):
         mparams["table"] = text
         text = "minsnap" if smooth else "waypoints"

@@ -13,7 +13,6 @@ from quadcruise.cli.common import (
     FORMAT_OPTION,
     REPORT_OPTION,
     controller_from_options,
-    controller_with,
     friendly,
     mission_from_options,
     writable,
@@ -114,7 +113,7 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
         if controller is not None or scenario.controller is None:
             the_controller = controller_from_options(controller or "nlpd", controller_params, position_poles)
         else:
-            the_controller = controller_with(scenario.controller, controller_params, position_poles)
+            the_controller = controller_from_options("", controller_params, position_poles, base=scenario.controller)
         kwargs = {**scenario.fly_kwargs(), **overrides}
     else:
         scenario = None
