@@ -142,8 +142,9 @@ def test_sweep_metrics_equal_flight_metrics():
         states[2, states.shape[1] // 2:] = np.nan
         res = dataclasses.replace(res, states=states, status=np.where(np.arange(6) == 2, 2, res.status))
         fast, slow = sweep_metrics(res, spec), flight_metrics(res)
-        for k in ("rmse_m", "max_error_m", "rise_time_s", "settling_time_s", "settling_time_5pct_s",
-                  "overshoot_pct", "effort", "duty_clipped_s", "controller_limited_s"):
+        for k in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "rise_time_s", "settling_time_s",
+                  "settling_time_5pct_s", "overshoot_pct", "peak_time_s", "effort", "duty_clipped_s",
+                  "controller_limited_s"):
             np.testing.assert_allclose(fast[k], slow[k].to_numpy(dtype=float), rtol=1e-12, atol=1e-15,
                                        err_msg=f"{mission} {k}")
         assert np.isnan(fast["rmse_m"][2]) and fast["diverged"].tolist() == [False, False, True, False, False, False]

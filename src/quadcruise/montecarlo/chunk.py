@@ -12,6 +12,7 @@ import numpy as np
 from quadcruise.errors import InputError, whole_number
 from quadcruise.layout import CMD_U1, REF_X, X
 from quadcruise.metrics.batch import flight_metrics_batch
+from quadcruise.metrics.flight import hover_duties
 from quadcruise.montecarlo.population import Draw
 from quadcruise.montecarlo.schema import COLUMNS, FAILURES, METRICS
 from quadcruise.montecarlo.spec import MonteCarloSpec
@@ -84,11 +85,13 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
     """Per-vehicle metrics of a batch, vectorised: the columns of
     :data:`~quadcruise.montecarlo.result.COLUMNS` but the vehicle index and the drawn values.
 
-    ``rmse_m``, ``max_error_m``, ``rise_time_s``, ``settling_time_s`` (2 %),
-    ``settling_time_5pct_s``, ``overshoot_pct``, ``effort``, ``duty_clipped_s`` and
-    ``controller_limited_s`` equal :func:`quadcruise.metrics.flight_metrics` on the same
-    result (to rounding; the transient is measured on the same axis with the same rules,
-    by :func:`quadcruise.metrics.batch.flight_metrics_batch`); ``final_error_m`` is the
+    ``rmse_m``, ``max_error_m``, ``steady_rmse_m``, ``steady_max_error_m``,
+    ``rise_time_s``, ``settling_time_s`` (2 %), ``settling_time_5pct_s``,
+    ``overshoot_pct``, ``peak_time_s``, ``effort`` (about each vehicle's own hover duty),
+    ``duty_clipped_s`` and ``controller_limited_s`` equal
+    :func:`quadcruise.metrics.flight_metrics` on the same result (to rounding; the
+    transient is measured on the same axis with the same rules, by
+    :func:`quadcruise.metrics.batch.flight_metrics_batch`); ``final_error_m`` is the
     position error at the end. Every metric of a vehicle that stopped early is NaN. Each
     vehicle's numbers depend on its own rows only, so they do not change with the batch a
     vehicle is flown in. The failure of each vehicle follows the spec's rules.
@@ -107,12 +110,14 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
     not_settled = np.zeros(n, dtype=bool)
     if live.size:
         mission = result.meta.get("mission") if isinstance(result.meta.get("mission"), dict) else {}
+        hover = hover_duties(result.meta, n)
         rows = slice(None) if live.size == n else live      # all live: views, no copies
         got = flight_metrics_batch(t, result.states[rows, :, X:X + 3], refs[rows],
                                    result.commands[rows, :, CMD_U1:CMD_U1 + 4], mission=mission,
-                                   bands=(0.02, 0.05, spec.settle_band), transient_until=spec.transient_until)
-        for key in ("rmse_m", "max_error_m", "final_error_m", "effort", "transient_axis", "rise_time_s",
-                    "overshoot_pct"):
+                                   bands=(0.02, 0.05, spec.settle_band), transient_until=spec.transient_until,
+                                   hover_duty=None if hover is None else hover[rows])
+        for key in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "final_error_m", "effort",
+                    "transient_axis", "rise_time_s", "overshoot_pct", "peak_time_s"):
             out[key][live] = got[key]
         out["settling_time_s"][live], out["settling_time_5pct_s"][live] = got["settling_s"][:2]
         not_settled[live] = (got["transient_axis"] >= 0) & np.isnan(got["settling_s"][2])

@@ -10,8 +10,9 @@ __all__ = ["COLUMNS", "FAILURES", "METRICS"]
 
 FAILURES = ("ok", "diverged", "saturated", "did not settle")
 """Failure codes 0..3 of the table's ``failure`` column, in order of precedence."""
-METRICS = ("rmse_m", "max_error_m", "final_error_m", "rise_time_s", "settling_time_s",
-           "settling_time_5pct_s", "overshoot_pct", "effort", "duty_clipped_s", "controller_limited_s")
+METRICS = ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "final_error_m", "rise_time_s",
+           "settling_time_s", "settling_time_5pct_s", "overshoot_pct", "peak_time_s", "effort",
+           "duty_clipped_s", "controller_limited_s")
 """The metrics summarised by quantiles (NaN where not applicable is left out)."""
 COLUMNS = {
     "vehicle": np.int64, "status": np.int64, "stop_time_s": float, "failure": np.int64,
