@@ -13,8 +13,8 @@ import click
 
 from quadcruise.errors import InputError
 
-__all__ = ["FORCE_OPTION", "FORMAT_OPTION", "REPORT_OPTION", "controller_from_options", "friendly",
-           "mission_from_options"]
+__all__ = ["FORCE_OPTION", "FORMAT_OPTION", "REPORT_OPTION", "RISE_OPTION", "SETTLE_BAND_OPTION",
+           "controller_from_options", "friendly", "metric_options", "mission_from_options"]
 
 # options several commands share
 FORMAT_OPTION = click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv",
@@ -23,6 +23,35 @@ FORCE_OPTION = click.option("--force", is_flag=True, help="Replace a non-empty -
 REPORT_OPTION = click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html",
                              help="Also write a self-contained HTML report (tables, figures, interactive 3-D "
                                   "view, configuration).")
+
+RISE_OPTION = click.option("--rise", type=click.Choice(["10-90", "0-100"]), default="10-90", show_default=True,
+                           help="Rise time between these percents of the step.")
+SETTLE_BAND_OPTION = click.option("--settle-band", "settle_bands", type=float, multiple=True, metavar="FRACTION",
+                                  help="Settling band, a fraction of the step (default 0.02, then 0.05): the first "
+                                       "gives settling_time_s, a second (0.05 if left out) a column named after it.")
+
+
+def metric_options(rise: str = "10-90", settle_bands: tuple[float, ...] = ()) -> dict:
+    """``--rise`` and ``--settle-band`` as keywords of :func:`quadcruise.metrics.flight_metrics`, checked
+    (:func:`~quadcruise.metrics.flight.metric_conventions`) before anything flies.
+
+    Parameters
+    ----------
+    rise : {"10-90", "0-100"}
+        The rise-time levels in percent.
+    settle_bands : tuple of float
+        None (2 % and 5 %), one band (and 5 %) or two.
+
+    Returns
+    -------
+    dict
+        ``rise`` and ``settle_bands``.
+    """
+    from quadcruise.metrics.flight import metric_conventions
+
+    kw = {"rise": rise, "settle_bands": tuple(settle_bands) or (0.02, 0.05)}
+    metric_conventions(**kw)
+    return kw
 
 
 def friendly(func: Callable) -> Callable:

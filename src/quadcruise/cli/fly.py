@@ -9,8 +9,11 @@ from quadcruise.cli.common import (
     FORCE_OPTION,
     FORMAT_OPTION,
     REPORT_OPTION,
+    RISE_OPTION,
+    SETTLE_BAND_OPTION,
     controller_from_options,
     friendly,
+    metric_options,
     mission_from_options,
 )
 from quadcruise.errors import InputError
@@ -38,9 +41,11 @@ __all__ = ["fly"]
 @REPORT_OPTION
 @click.option("--animate", type=click.Path(dir_okay=False), metavar="PATH.gif",
               help="Also write an animation of the flight (.gif; .mp4 needs ffmpeg).")
+@RISE_OPTION
+@SETTLE_BAND_OPTION
 @friendly
 def fly(mission, controller, duration, dt, max_step, mission_params, controller_params, position_poles,
-        out, fmt, force, smooth, report, animate):
+        out, fmt, force, smooth, report, animate, rise, settle_bands):
     """Fly a MISSION with a controller on the paper's vehicle and print its metrics.
 
     MISSION is circle, square, step, hover, a waypoint CSV (columns x,y,z and optional yaw
@@ -51,6 +56,7 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
     """
     from quadcruise.missions import mission_from_name
 
+    conventions = metric_options(rise, settle_bands)
     overrides = {k: v for k, v in (("duration", duration), ("dt", dt), ("max_step", max_step)) if v is not None}
     if mission.lower().endswith(".toml"):
         from quadcruise.workflows.scenario import load_scenario
@@ -64,10 +70,11 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
         the_mission = mission_from_options(mission, mission_params, smooth)
         the_controller = controller_from_options(controller, controller_params, position_poles)
         kwargs = overrides
-    _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate)
+    _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate, conventions)
 
 
-def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=None, animate=None) -> None:
+def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=None, animate=None,
+                    conventions=None) -> None:
     """Fly, print the metrics, and write what was asked for.
 
     Parameters
@@ -86,8 +93,10 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
         Path of an HTML report.
     animate : str, optional
         Path of an animation (.gif, or .mp4 with ffmpeg).
+    conventions : dict, optional
+        ``rise`` and ``settle_bands`` of the metrics (:func:`~quadcruise.cli.common.metric_options`).
     """
-    from quadcruise.metrics.tables import vehicle_metrics_text
+    from quadcruise.metrics.tables import conventions_text, vehicle_metrics_text
     from quadcruise.workflows.fly import fly as run_fly
     from quadcruise.workflows.fly import write_flight
 
@@ -96,9 +105,10 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
     if out is not None:
         check_output_dir(out, force)
     result = run_fly(mission, controller, **kwargs)
-    metrics = result.metrics()
+    metrics = result.metrics(**(conventions or {}))
     click.echo(f"{controller.name} on {mission.name}: {result.t[-1]:g} s at dt = {result.meta['dt_s']:g} s")
     click.echo(vehicle_metrics_text(metrics))
+    click.echo(conventions_text(metrics.attrs.get("conventions")))
     if out is not None:
         write_flight(result, out, fmt, metrics=metrics)
         click.echo(f"wrote traces, figure and metrics to {out}")
