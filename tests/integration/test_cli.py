@@ -65,6 +65,7 @@ def test_fly_controller_options_reach_the_controller(tmp_path):
     (["compare", "hover", "--settle-band", "0.01", "--settle-band", "0.02", "--settle-band", "0.03"],
      "settle_bands must be one or two fractions"),
     (["fly", "hover", "--rise", "5-95"], "Invalid value for '--rise'"),
+    (["montecarlo", "--n", "3", "--require", "steady_max_error<=0.2"], "choose one of rmse_m, max_error_m, steady"),
     (["analyze", "--poles", "0.7,-4"], "pole 0.7 is not in the open left half plane"),
 ])
 def test_bad_options_are_one_line_with_status_two(args, words):

@@ -94,7 +94,8 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
     :func:`quadcruise.metrics.batch.flight_metrics_batch`); ``final_error_m`` is the
     position error at the end. Every metric of a vehicle that stopped early is NaN. Each
     vehicle's numbers depend on its own rows only, so they do not change with the batch a
-    vehicle is flown in. The failure of each vehicle follows the spec's rules.
+    vehicle is flown in. The failure of each vehicle follows the spec's rules
+    (:data:`~quadcruise.montecarlo.schema.FAILURES`).
     """
     t = result.t
     n = result.n
@@ -122,9 +123,17 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
         out["settling_time_s"][live], out["settling_time_5pct_s"][live] = got["settling_s"][:2]
         not_settled[live] = (got["transient_axis"] >= 0) & np.isnan(got["settling_s"][2])
     diverged = status != 0
+    bound = spec.max_track_error_m
+    after = np.where(np.isnan(out["steady_max_error_m"]), out["final_error_m"], out["steady_max_error_m"])
+    lost_track = ~diverged & (after > bound)
     saturated = out["duty_clipped_s"] > spec.max_clipped_s
-    out.update(diverged=diverged, saturated=saturated, not_settled=not_settled)
-    out["failure"] = np.select([diverged, saturated, not_settled], [1, 2, 3], 0).astype(np.int64)
+    failed_requirement = np.zeros(n, dtype=bool)
+    for req in spec.parsed_requirements:
+        failed_requirement |= ~req.met(out[req.metric])
+    out.update(diverged=diverged, lost_track=lost_track, saturated=saturated,
+               failed_requirement=failed_requirement, not_settled=not_settled)
+    out["failure"] = np.select([diverged, lost_track, saturated, failed_requirement],
+                               [FAILURES.index(r) for r in FAILURES[1:]], 0).astype(np.int64)
     return out
 
 
