@@ -5,7 +5,16 @@ from __future__ import annotations
 
 import click
 
-from quadcruise.cli.common import FORCE_OPTION, REPORT_OPTION, friendly, mission_from_options, writable
+from quadcruise.cli.common import (
+    FORCE_OPTION,
+    REPORT_OPTION,
+    RISE_OPTION,
+    SETTLE_BAND_OPTION,
+    friendly,
+    metric_options,
+    mission_from_options,
+    writable,
+)
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["compare"]
@@ -27,9 +36,11 @@ __all__ = ["compare"]
 @click.option("--mass-spread", type=float, default=0.1, show_default=True, help="Relative std of the mass.")
 @click.option("--wind", metavar="SPEC", help="Wind of the population, e.g. dryden:moderate@10.")
 @REPORT_OPTION
+@RISE_OPTION
+@SETTLE_BAND_OPTION
 @friendly
 def compare(mission, controllers, duration, dt, mission_params, out, force, population, seed, mass_spread, wind,
-            report):
+            report, rise, settle_bands):
     """Fly MISSION (a name or a waypoint CSV) with several controllers; one table, one figure.
 
     \f
@@ -62,23 +73,28 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
         spec such as ``dryden:moderate@10``; None: no wind.
     report : str or None
         ``--report``: path of a self-contained HTML report to write as well; None: no report.
+    rise : str
+        ``--rise``: the rise-time convention, ``10-90`` or ``0-100`` (% of the step).
+    settle_bands : tuple of float
+        ``--settle-band``: the settling bands (fractions of the step), given once or twice.
     """
     from quadcruise.workflows.compare import compare as run_compare
 
+    conventions = metric_options(rise, settle_bands)
     if out is not None:
         check_output_dir(out, force)
     cmp_mission = mission_from_options(mission, mission_params, smooth=False)
     cmp = run_compare(cmp_mission, controllers, duration=duration, dt=dt)
-    click.echo(cmp.text())
+    click.echo(cmp.text(**conventions))
     if population is not None:
         _compare_population(cmp_mission, controllers, population, seed, mass_spread, wind, duration, dt)
     if out is not None:
-        cmp.write(out, force=force)
+        cmp.write(out, force=force, **conventions)
         click.echo(f"wrote metrics.csv and comparison.png to {out}")
     if report is not None:
         from quadcruise.report.html import comparison_report, write_html_report
 
-        write_html_report(report, **comparison_report(cmp))
+        write_html_report(report, **comparison_report(cmp, **conventions))
         click.echo(f"wrote report {report}")
 
 

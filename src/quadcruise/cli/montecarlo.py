@@ -45,6 +45,10 @@ __all__ = ["montecarlo", "montecarlo_command", "parse_noise"]
 @click.option("--force", is_flag=True, help="Replace a folder holding something else.")
 @click.option("--resume/--no-resume", default=True, show_default=True)
 @click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv", show_default=True)
+@click.option("--require", "requirements", multiple=True, metavar="METRIC<=VALUE",
+              help='Your own pass criterion, e.g. "steady_max_error_m<=0.2" (or <, >=, >; repeatable).')
+@click.option("--max-track-error", "max_track_error_m", type=float, metavar="M",
+              help="Error after the transient [m] beyond which a flight lost track (default: max(1, extent/4)).")
 @click.option("--case", type=int, help="Fly flight I alone (replays a worst case exactly).")
 @click.option("--worst", type=int, default=5, show_default=True, help="How many worst cases to list.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
