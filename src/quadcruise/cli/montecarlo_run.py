@@ -107,12 +107,14 @@ offset, distribution, model_error : optional
     import numpy as np
 
     from quadcruise.disturbances import parse_wind
+    from quadcruise.errors import whole_number
     from quadcruise.montecarlo import montecarlo_case
     from quadcruise.montecarlo.output import case_folder, case_text, write_case
     from quadcruise.montecarlo.progress import ProgressBar
     from quadcruise.montecarlo.scenario import sweep_spec
     from quadcruise.montecarlo.sweep import run_sweep
 
+    whole_number(worst, "--worst")
     if isinstance(chunk_size, str) and chunk_size != "auto":
         try:
             chunk_size = int(chunk_size)
