@@ -61,6 +61,11 @@ def test_fly_controller_options_reach_the_controller(tmp_path):
     (["fly", "circle", "--animate", "a.png"], "the animation must be a .gif"),
     (["fly", "circle", "--bogus"], "No such option '--bogus'"),
     (["compare", "circle", "--controllers", "nlpd,pid"], "unknown controller 'pid'"),
+    (["fly", "hover", "--settle-band", "1.5"], "settle_bands must be one or two fractions in (0, 1)"),
+    (["compare", "hover", "--settle-band", "0.01", "--settle-band", "0.02", "--settle-band", "0.03"],
+     "settle_bands must be one or two fractions"),
+    (["fly", "hover", "--rise", "5-95"], "Invalid value for '--rise'"),
+    (["montecarlo", "--n", "3", "--require", "steady_max_error<=0.2"], "choose one of rmse_m, max_error_m, steady"),
     (["analyze", "--poles", "0.7,-4"], "pole 0.7 is not in the open left half plane"),
 ])
 def test_bad_options_are_one_line_with_status_two(args, words):
@@ -76,6 +81,30 @@ def test_fly_refuses_a_foreign_out_folder(tmp_path):
     res = run("fly", "hover", "--duration", "1", "--out", tmp_path)
     assert res.exit_code == 2 and "not written by quadcruise" in res.output
     assert sorted(p.name for p in tmp_path.iterdir()) == ["keep.txt"]
+
+
+def test_fly_and_compare_take_the_metric_conventions(tmp_path):
+    out = tmp_path / "flight"
+    res = run("fly", "step", "--duration", "4", "--rise", "0-100", "--settle-band", "0.03", "--out", out)
+    assert res.exit_code == 0, res.output
+    assert "settling_time_s: 3 % band" in res.output and "rise_time_s: 0-100 % of the step" in res.output
+    assert "steady_rmse_m" in res.output and "u_hover = m g / (4 K)" in res.output
+    metrics = pd.read_csv(out / "metrics.csv")
+    assert {"steady_rmse_m", "steady_max_error_m", "peak_time_s", "settling_time_5pct_s"} <= set(metrics.columns)
+    conv = json.loads((out / "quadcruise.json").read_text())["metrics_conventions"]
+    assert conv["rise"] == [0.0, 1.0] and conv["settle_bands"] == [0.03, 0.05]
+    assert conv["settling_columns"] == {"settling_time_s": 0.03, "settling_time_5pct_s": 0.05}
+    plain = run("fly", "step", "--duration", "4")
+    assert plain.output != res.output and "rise_time_s: 10-90 % of the step" in plain.output
+    res = run("compare", "step", "--duration", "4", "--controllers", "nlpd,se3", "--settle-band", "0.01",
+              "--settle-band", "0.04", "--out", tmp_path / "c", "--report", tmp_path / "c.html")
+    assert res.exit_code == 0, res.output
+    assert "settling_time_4pct_s" in res.output and "settling_time_s: 1 % band" in res.output
+    assert "settling_time_4pct_s" in pd.read_csv(tmp_path / "c" / "metrics.csv").columns
+    doc = json.loads((tmp_path / "c" / "quadcruise.json").read_text())
+    assert doc["metrics_conventions"]["settle_bands"] == [0.01, 0.04] and "steady_rmse_m" in doc["metrics"]["nlpd"]
+    page = (tmp_path / "c.html").read_text()
+    assert "settling time 1 % [s]" in page and "settling time 4 % [s]" in page
 
 
 def test_compare_and_analyze(tmp_path):

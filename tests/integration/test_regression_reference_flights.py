@@ -21,6 +21,11 @@ from quadcruise.montecarlo import Population, montecarlo
 
 REFERENCE = np.load(Path(__file__).parents[1] / "support" / "reference_flights.npz")
 TOL = dict(rtol=1e-9, atol=1e-9)
+# Columns whose meaning was changed on purpose since the recording (issue 16, "Metrics that show
+# the tracking"): ``effort`` is now measured about the hover duty, not from zero duty, and a
+# Monte Carlo flight whose transient did not settle is no longer a ``failure`` (failure codes
+# are now diverged, lost track, saturated, failed a requirement). Every other column stays equal.
+REDEFINED = {"effort", "failure"}
 
 
 #: the paper's literal inversion, which the default nlpd was before the joint one (issue: the
@@ -60,6 +65,8 @@ def test_flight_traces_and_metrics_are_unchanged(name):
     metrics = res.metrics()
     for key in (k for k in REFERENCE.files if k.startswith(f"{name}/metric/")):
         column = key.rsplit("/", 1)[1]
+        if column in REDEFINED:
+            continue
         np.testing.assert_allclose(metrics[column].to_numpy(dtype=float), REFERENCE[key], err_msg=column, **TOL)
 
 
@@ -74,4 +81,6 @@ def test_montecarlo_table_is_unchanged():
     table = mc.to_pandas() if hasattr(mc, "to_pandas") else mc.table
     for key in (k for k in REFERENCE.files if k.startswith("mc/")):
         column = key.split("/", 1)[1]
+        if column in REDEFINED:
+            continue
         np.testing.assert_allclose(table[column].to_numpy(dtype=float), REFERENCE[key], err_msg=column, **TOL)

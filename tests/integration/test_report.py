@@ -111,10 +111,12 @@ def test_page_is_self_contained(flight_page, circle):
     # the error hook is the first script, the recorder hidden and empty
     assert page.index("window.onerror") < page.index("<script", page.index("window.onerror") + 1)
     assert dom.find("pre", id="qc-errors") and dom.text["qc-errors"] == ""
-    # tables, with the formatting rules
-    assert len(dom.find("table")) == 2
+    # tables (the metrics, what they measure, the run), with the formatting rules
+    assert len(dom.find("table")) == 3
     rmse = cell(float(circle.metrics()["rmse_m"][0]))[0]                # 0.4205 m on the default circle
     assert f"<td class=\"num\">{rmse}</td>" in page and "did not settle" in page
+    assert "RMSE after the transient [m]" in page and "effort about hover [s]" in page
+    assert "10-90 % of the step" in page and "u_hover = m g / (4 K)" in page
     imgs = [a for a in dom.find("img")]
     assert len(imgs) == 1 and page.count('<img src="data:image/png;base64,') == 1
     assert len(dom.find("canvas")) == 1
@@ -238,7 +240,7 @@ def test_browser_renders_flight_page(flight_page):
     assert len(canvases) == 1 and all(c.get("data-rendered") == "1" for c in canvases)
     assert int(canvases[0]["width"]) > 300                   # sized to its box
     assert len(dom.find("input", type="checkbox")) == 2      # the flight and the reference
-    assert dom.find("input", type="range") and len(dom.find("table")) == 2
+    assert dom.find("input", type="range") and len(dom.find("table")) == 3   # metrics, conventions, run
     assert len([a for a in dom.find("img") if a["src"].startswith("data:image/png;base64,")]) == 1
 
 

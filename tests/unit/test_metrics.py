@@ -7,6 +7,7 @@ import doctest
 
 import control
 import numpy as np
+import pandas as pd
 import pytest
 from scipy.optimize import brentq
 
@@ -302,3 +303,203 @@ def test_time_in_saturation_sample_and_hold():
 def test_docstring_examples():
     result = doctest.testmod(metrics, raise_on_error=False)
     assert result.attempted > 5 and result.failed == 0
+
+
+# --- a whole flight: tracking after the transient, peak time, conventions, effort ------------
+
+def as_result(t, pos, ref, *, duties=None, status=None, meta=None):
+    """A SimResult of N vehicles from positions and references (N, L, 3) [m]."""
+    from quadcruise.layout import CMD_SIZE, CMD_U1, REF_SIZE, REF_X, STATE_SIZE, X
+    from quadcruise.sim.result import SimResult
+
+    n, length = pos.shape[:2]
+    states = np.zeros((n, length, STATE_SIZE))
+    states[:, :, X:X + 3] = pos
+    refs = np.zeros((n, length, REF_SIZE))
+    refs[:, :, REF_X:REF_X + 3] = ref
+    commands = np.zeros((n, length, CMD_SIZE))
+    commands[:, :, CMD_U1:CMD_U1 + 4] = 0.25 if duties is None else duties
+    status = np.zeros(n, dtype=np.int64) if status is None else np.asarray(status)
+    return SimResult(t=t, states=states, commands=commands, references=refs, final_state=states[:, -1],
+                     status=status, t_stop=np.full(n, t[-1]), memory=np.zeros((n, 0)),
+                     duty_clipped_s=np.zeros(n), controller_limited_s=np.zeros(n),
+                     meta={"vehicle": {"m": 1.0, "g": 10.0, "K": 10.0}} if meta is None else meta)
+
+
+def step_mission(time=0.0, size=1.0):
+    return {"kind": "step", "axis": "x", "time": time, "size": size, "x": 0.0, "y": 0.0, "z": 1.0, "yaw": 0.0}
+
+
+@pytest.fixture(scope="module")
+def default_circle():
+    import warnings
+
+    import quadcruise as qc
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return qc.fly("circle", "nlpd")
+
+
+def test_steady_tracking_of_the_default_circle(default_circle):
+    res = default_circle
+    row = res.metrics().iloc[0]
+    assert row["max_error_m"] == pytest.approx(2.0) and row["rmse_m"] > 0.4    # the start offset dominates
+    # independently: the x transient's 5 % settling, then the 3-D error from there on
+    t, pos, ref = res.t, res.states[0, :, :3], res.references[0, :, :3]
+    e = ref[:, 0] - pos[:, 0]
+    z = 1.0 - e / e[0]
+    k = np.flatnonzero(np.abs(z - 1.0) > 0.05)[-1]
+    edge = 1.05 if z[k] > 1.0 else 0.95
+    t_from = t[k] + (edge - z[k]) / (z[k + 1] - z[k]) * (t[k + 1] - t[k])
+    assert row["settling_time_5pct_s"] == pytest.approx(t_from, abs=1e-12)
+    err = np.linalg.norm(pos - ref, axis=1)
+    d_from = np.array([np.interp(t_from, t, (pos - ref)[:, a]) for a in range(3)])
+    tw, ew = np.r_[t_from, t[k + 1:]], np.r_[np.linalg.norm(d_from), err[k + 1:]]
+    rmse = np.sqrt(np.trapezoid(ew**2, tw) / (t[-1] - t_from))
+    assert row["steady_rmse_m"] == pytest.approx(rmse, rel=1e-9)
+    assert row["steady_max_error_m"] == pytest.approx(ew.max(), rel=1e-12)
+    # centimetres, far below the whole flight's RMSE
+    assert 0.01 < row["steady_rmse_m"] < 0.1 and row["steady_rmse_m"] < row["rmse_m"] / 5
+    assert row["steady_max_error_m"] < 0.2
+
+
+def test_steady_metrics_are_undefined_when_the_transient_never_settles():
+    from quadcruise.metrics import flight_metrics
+    from quadcruise.metrics.tables import vehicle_metrics_text
+
+    t = np.linspace(0.0, 10.0, 1001)
+    pos = np.zeros((3, t.size, 3))
+    pos[0, :, 0] = np.exp(-t)                           # settles
+    pos[1, :, 0] = 0.5 + 0.5 * np.exp(-t)               # halves and stays: never within 5 %
+    pos[2, :, 1] = 0.005 * np.sin(t)                    # no transient (below 1 cm): all steady
+    table = flight_metrics(as_result(t, pos, np.zeros_like(pos)))
+    assert np.isnan(table["steady_rmse_m"][1]) and np.isnan(table["steady_max_error_m"][1])
+    assert table["steady_rmse_m"][0] < 0.05 and table["steady_max_error_m"][0] == pytest.approx(0.05, rel=1e-9)
+    assert pd.isna(table["axis"][2])
+    assert table["steady_rmse_m"][2] == table["rmse_m"][2] and table["steady_max_error_m"][2] == table["max_error_m"][2]
+    text = vehicle_metrics_text(table).splitlines()
+    steady = next(line for line in text if line.startswith("steady_rmse_m"))
+    assert "did not settle" in steady and steady.count("did not settle") == 1
+
+
+def test_peak_time_of_a_second_order_step_matches_the_closed_form():
+    from quadcruise.metrics import flight_metrics, flight_metrics_batch
+
+    zeta, wn, t_step = 0.4, 3.0, 1.0
+    t = np.linspace(0.0, 12.0, 12001)
+    pos = np.zeros((1, t.size, 3))
+    pos[0, :, 2] = 1.0
+    pos[0, :, 0] = np.where(t > t_step, second_order(np.maximum(t - t_step, 0.0), zeta, wn), 0.0)
+    ref = pos.copy()
+    ref[0, :, 0] = np.where(t >= t_step, 1.0, 0.0)
+    res = as_result(t, pos, ref, meta={"mission": step_mission(t_step)})
+    row = flight_metrics(res).iloc[0]
+    assert row["peak_time_s"] == pytest.approx(np.pi / (wn * np.sqrt(1 - zeta**2)), abs=1e-3)
+    batch = flight_metrics_batch(t, pos, ref, np.zeros((1, t.size, 4)), mission=step_mission(t_step))
+    assert batch["peak_time_s"][0] == row["peak_time_s"]
+
+
+def test_rise_and_settling_conventions_against_python_control():
+    from quadcruise.metrics import flight_metrics
+
+    t = np.linspace(0.0, 10.0, 10001)
+    y = np.asarray(control.step_response(G, T=t).outputs)
+    pos = np.zeros((1, t.size, 3))
+    pos[0, :, 0], pos[0, :, 2] = y, 1.0
+    ref = pos.copy()
+    ref[0, :, 0] = 1.0
+    res = as_result(t, pos, ref, meta={"mission": step_mission(0.0)})
+    ours = flight_metrics(res, rise=(0.0, 1.0), settle_bands=(0.02, 0.03)).iloc[0]
+    theirs = control.step_info(y, T=t, yfinal=1.0, RiseTimeLimits=(0.0, 1.0), SettlingTimeThreshold=0.03)
+    assert ours["rise_time_s"] == pytest.approx(theirs["RiseTime"], abs=1e-3)          # within a sample
+    assert ours["settling_time_3pct_s"] == pytest.approx(theirs["SettlingTime"], abs=1e-3)
+    default = flight_metrics(res).iloc[0]
+    theirs = control.step_info(y, T=t, yfinal=1.0, SettlingTimeThreshold=0.05)
+    assert default["rise_time_s"] == pytest.approx(theirs["RiseTime"], abs=1e-3)
+    assert default["settling_time_5pct_s"] == pytest.approx(theirs["SettlingTime"], abs=1e-3)
+    assert ours["rise_time_s"] > default["rise_time_s"] + 0.1                    # 0-100 % is longer
+    # the columns say which band they hold, and the table records its conventions
+    table = flight_metrics(res, rise="0-100", settle_bands=(0.01, 0.03))
+    assert "settling_time_3pct_s" in table.columns and "settling_time_5pct_s" not in table.columns
+    conv = table.attrs["conventions"]
+    assert conv["rise"] == [0.0, 1.0] and conv["settle_bands"] == [0.01, 0.03] and conv["steady_band"] == 0.05
+    assert conv["settling_columns"] == {"settling_time_s": 0.01, "settling_time_3pct_s": 0.03}
+    # the steady window does not move with the bands shown
+    assert table["steady_rmse_m"][0] == default["steady_rmse_m"]
+    with pytest.raises(InputError, match="settle_bands"):
+        flight_metrics(res, settle_bands=(0.02, 1.5))
+    with pytest.raises(InputError, match="rise"):
+        flight_metrics(res, rise="5-95")
+
+
+def test_effort_is_measured_about_hover():
+    import warnings
+
+    import quadcruise as qc
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        hovers = {c: qc.fly("hover", c, duration=2.0, vehicle=qc.Vehicle(m=[2.5, 3.5, 4.5]))
+                  for c in ("nlpd", "gonzalez", "se3", "cascade")}
+        circles = qc.compare("circle", duration=6.0, log_every=10).table()
+    for name, res in hovers.items():
+        effort = res.metrics()["effort"].to_numpy()
+        assert np.all(np.abs(effort) < 1e-9), name        # each vehicle about its own hover duty
+    # from zero duty, a hover of 2 s would read 4 (m g / 4 K)^2 2 s: about 0.04 s
+    assert 4 * qc.Vehicle.paper().hover_duty ** 2 * 2.0 > 0.03
+    # controllers that fly differently spend differently
+    assert circles["effort"].nunique() == len(circles) and (circles["effort"] > 0).all()
+    # a result that records no vehicle has no hover duty to measure about
+    t = np.linspace(0.0, 1.0, 11)
+    assert np.isnan(metrics.flight_metrics(as_result(t, np.zeros((1, 11, 3)), np.zeros((1, 11, 3)), meta={}))["effort"][0])
+
+
+def test_batch_agrees_with_flight_metrics_at_the_edges():
+    from quadcruise.metrics import flight_metrics, flight_metrics_batch, hover_duties
+
+    t = np.linspace(0.0, 8.0, 801)
+    n = 5
+    rng = np.random.default_rng(4)
+    pos = np.zeros((n, t.size, 3))
+    pos[0, :, 0] = 2.0 * np.exp(-t) * np.cos(3 * t)                 # settles, with overshoot
+    pos[1, :, 1] = 0.4 + 1.6 * np.exp(-t)                             # never settles within 5 %
+    pos[2, :, 2] = 0.004 * np.sin(t)                                  # no transient
+    pos[3, :, 0] = 1.0 * np.exp(-t)                                   # stops early
+    pos[3, 400:] = np.nan
+    pos[4, :, 0] = 1.5 * np.exp(-2 * t) + 0.01 * rng.normal(size=t.size)   # noisy, settles
+    ref = np.zeros_like(pos)
+    duties = 0.2 + 0.01 * rng.normal(size=(n, t.size, 4))
+    meta = {"vehicle": {"m": [1.0, 1.2, 1.4, 1.6, 1.8], "g": 9.81, "K": 30.0}}
+    res = as_result(t, pos, ref, duties=duties, status=[0, 0, 0, 2, 0], meta=meta)
+    for kw in ({}, {"rise": (0.0, 1.0), "settle_bands": (0.01, 0.03)}, {"transient_until": 5.0}):
+        slow = flight_metrics(res, **kw)
+        bands = kw.get("settle_bands", (0.02, 0.05))
+        live = [0, 1, 2, 4]
+        fast = flight_metrics_batch(t, pos[live], ref[live], duties[live], bands=bands,
+                                    rise=kw.get("rise", (0.1, 0.9)), transient_until=kw.get("transient_until"),
+                                    hover_duty=hover_duties(meta, n)[live])
+        columns = [c for c in slow.columns if c.startswith("settling")]
+        for key in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "rise_time_s",
+                    "overshoot_pct", "peak_time_s", "effort", *columns):
+            got = fast["settling_s"][columns.index(key)] if key in columns else fast[key]
+            np.testing.assert_allclose(got, slow[key].to_numpy(dtype=float)[live], rtol=1e-12, atol=1e-15,
+                                       err_msg=f"{kw} {key}")
+        assert np.isnan(fast["steady_rmse_m"][1]) and fast["transient_axis"][2] == -1
+        assert slow[["steady_rmse_m", "peak_time_s", "effort"]].iloc[3].isna().all()   # stopped early
+
+
+def test_window_errors_batch_matches_tracking_errors():
+    from quadcruise.metrics.batch import window_errors_batch
+
+    rng = np.random.default_rng(5)
+    t = np.cumsum(rng.uniform(0.005, 0.015, 200))
+    pos, ref = rng.normal(size=(4, 200, 3)), rng.normal(size=(200, 3))
+    t_from = np.array([t[0], t[10] + 1e-4, t[-1], np.nan])
+    got = window_errors_batch(t, pos, np.broadcast_to(ref, pos.shape), t_from)
+    for i in range(2):
+        one = tracking_errors(t, pos[i], ref, t_from=t_from[i])
+        assert got["rmse"][i] == pytest.approx(float(one["rmse"]), rel=1e-12)
+        assert got["max_error"][i] == pytest.approx(float(one["max_error"]), rel=1e-12)
+    assert got["rmse"][2] == got["max_error"][2] == pytest.approx(np.linalg.norm(pos[2, -1] - ref[-1]))
+    assert np.isnan(got["rmse"][3]) and np.isnan(got["max_error"][3])

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import click
 
-from quadcruise.cli.common import FORCE_OPTION, controller_from_options, friendly
+from quadcruise.cli.common import FORCE_OPTION, controller_from_options, friendly, writable
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["analyze"]
@@ -17,7 +17,7 @@ __all__ = ["analyze"]
               help="Controller parameter (repeatable).")
 @click.option("--poles", "position_poles", metavar="P1,P2", help="Closed-loop poles of the x/y loops [rad/s].")
 @click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
-@click.option("--out", type=click.Path(file_okay=False), help="Folder for analysis.json and Bode plots.")
+@click.option("--out", type=click.Path(file_okay=False), callback=writable, help="Folder for analysis.json and Bode plots.")
 @FORCE_OPTION
 @friendly
 def analyze(controller, controller_params, position_poles, dt, out, force):

@@ -11,18 +11,73 @@ from typing import Callable
 
 import click
 
+from quadcruise.cli.objects import controller_from_options, mission_from_options
 from quadcruise.errors import InputError
 
-__all__ = ["FORCE_OPTION", "FORMAT_OPTION", "REPORT_OPTION", "controller_from_options", "friendly",
-           "mission_from_options"]
+__all__ = ["FORCE_OPTION", "FORMAT_OPTION", "REPORT_OPTION", "RISE_OPTION", "SETTLE_BAND_OPTION", "friendly",
+           "metric_options", "writable", "controller_from_options", "mission_from_options"]
 
 # options several commands share
 FORMAT_OPTION = click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv",
                              show_default=True, help="Format of the traces.")
 FORCE_OPTION = click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
-REPORT_OPTION = click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html",
+def writable(ctx: click.Context, param: click.Parameter, value):
+    """A click callback: refuse an output path that could not be written, before any work.
+
+    Parameters
+    ----------
+    ctx : click.Context
+    param : click.Parameter
+    value : str or None
+        The path given, or None.
+
+    Returns
+    -------
+    str or None
+        ``value``, checked.
+    """
+    if value is not None:
+        from quadcruise.io.files import check_writable_place
+
+        try:
+            check_writable_place(value)
+        except InputError as exc:
+            raise click.BadParameter(str(exc), ctx=ctx, param=param) from None
+    return value
+
+
+REPORT_OPTION = click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html", callback=writable,
                              help="Also write a self-contained HTML report (tables, figures, interactive 3-D "
                                   "view, configuration).")
+
+RISE_OPTION = click.option("--rise", type=click.Choice(["10-90", "0-100"]), default="10-90", show_default=True,
+                           help="Rise time between these percents of the step.")
+SETTLE_BAND_OPTION = click.option("--settle-band", "settle_bands", type=float, multiple=True, metavar="FRACTION",
+                                  help="Settling band, a fraction of the step (default 0.02, then 0.05): the first "
+                                       "gives settling_time_s, a second (0.05 if left out) a column named after it.")
+
+
+def metric_options(rise: str = "10-90", settle_bands: tuple[float, ...] = ()) -> dict:
+    """``--rise`` and ``--settle-band`` as keywords of :func:`quadcruise.metrics.flight_metrics`, checked
+    (:func:`~quadcruise.metrics.flight.metric_conventions`) before anything flies.
+
+    Parameters
+    ----------
+    rise : {"10-90", "0-100"}
+        The rise-time levels in percent.
+    settle_bands : tuple of float
+        None (2 % and 5 %), one band (and 5 %) or two.
+
+    Returns
+    -------
+    dict
+        ``rise`` and ``settle_bands``.
+    """
+    from quadcruise.metrics.flight import metric_conventions
+
+    kw = {"rise": rise, "settle_bands": tuple(settle_bands) or (0.02, 0.05)}
+    metric_conventions(**kw)
+    return kw
 
 
 def friendly(func: Callable) -> Callable:
@@ -54,144 +109,3 @@ def friendly(func: Callable) -> Callable:
                     click.echo(f"warning: {w.message}", err=True)
 
     return wrapper
-
-
-def _assignments(items: tuple[str, ...], option: str) -> dict:
-    """Parse KEY=VALUE pairs with :func:`quadcruise.fields.parse_assignments`: numbers,
-    comma-separated numbers, true/false, or words.
-
-    Parameters
-    ----------
-    items : tuple of str
-        The values of a repeatable option, each ``KEY=VALUE``.
-    option : str
-        The option's name, for the error message.
-
-    Returns
-    -------
-    dict
-        Key -> an int or float, a tuple of numbers (``1,2``), a bool, or the text as given.
-
-    Raises
-    ------
-    InputError
-        An item has no ``=`` or no key.
-    """
-    from quadcruise.fields import parse_assignments
-
-    return parse_assignments(items, option)
-
-
-def _poles(text: str | None, option: str):
-    """Parse comma-separated poles, e.g. ``-0.7,-4.3`` or ``-1+2j,-1-2j``.
-
-    Parameters
-    ----------
-    text : str or None
-        The option's value; None when it was not given.
-    option : str
-        The option's name, for the error message.
-
-    Returns
-    -------
-    list of complex or float, or None
-        The poles (:func:`quadcruise.control.design.parse_pole` of each); None for None.
-
-    Raises
-    ------
-    InputError
-        A pole is not a number.
-    """
-    if text is None:
-        return None
-    from quadcruise.control.design import parse_pole
-
-    try:
-        return [parse_pole(p) for p in text.split(",")]
-    except ValueError:
-        raise InputError(f"{option} {text!r}: expected comma-separated poles, e.g. -0.7,-4.3") from None
-
-
-def controller_from_options(name: str, params: tuple[str, ...], poles_text: str | None):
-    """The controller that ``--controller``, ``-c KEY=VALUE`` and ``--poles`` describe.
-
-    Parameters
-    ----------
-    name : str
-        The controller's name (:func:`quadcruise.control.controller_from_name`).
-    params : tuple of str
-        ``KEY=VALUE`` parameters of the controller.
-    poles_text : str or None
-        Closed-loop poles of the x/y loops; their PD gains become the ``position`` gains.
-
-    Returns
-    -------
-    Controller
-    """
-    from quadcruise.control import controller_from_name
-    from quadcruise.control.design import pd_from_poles
-
-    cparams = _assignments(params, "--controller-param")
-    poles = _poles(poles_text, "--poles")
-    if poles is not None:
-        cparams["position"] = pd_from_poles(poles)
-    return controller_from_name(name, **cparams)
-
-
-def controller_with(controller, params: tuple[str, ...], poles_text: str | None):
-    """A controller (a scenario's) with ``-c KEY=VALUE`` and ``--poles`` applied.
-
-    Parameters
-    ----------
-    controller : Controller
-        The controller to change.
-    params : tuple of str
-        ``KEY=VALUE`` parameters to change.
-    poles_text : str or None
-        Closed-loop poles of the x/y loops; their PD gains become the ``position`` gains.
-
-    Returns
-    -------
-    Controller
-    """
-    import dataclasses
-
-    from quadcruise.control.design import pd_from_poles
-
-    cparams = _assignments(params, "--controller-param")
-    poles = _poles(poles_text, "--poles")
-    if poles is not None:
-        cparams["position"] = pd_from_poles(poles)
-    if not cparams:
-        return controller
-    known = {f.name for f in dataclasses.fields(controller)}
-    unknown = sorted(set(cparams) - known)
-    if unknown:
-        raise InputError(f"--controller-param: {controller.name} has no parameter {unknown[0]!r} "
-                         f"(known: {', '.join(sorted(known))})")
-    return dataclasses.replace(controller, **cparams)
-
-
-def mission_from_options(text: str, params: tuple[str, ...], smooth: bool):
-    """A mission from a name or a waypoint CSV, with KEY=VALUE parameters.
-
-    Parameters
-    ----------
-    text : str
-        A mission name, or a path ending in ``.csv`` (a waypoint table).
-    params : tuple of str
-        ``KEY=VALUE`` parameters of the mission.
-    smooth : bool
-        Fly a waypoint table as a minimum-snap path instead of constant-speed legs.
-
-    Returns
-    -------
-    Mission
-    """
-    from quadcruise.missions import mission_from_name
-
-    mparams = _assignments(params, "--mission-param")
-    if text.lower().endswith(".csv"):
-        mparams["table"] = text
-        text = "minsnap" if smooth else "waypoints"
-    return mission_from_name(text, **mparams)

@@ -5,7 +5,16 @@ from __future__ import annotations
 
 import click
 
-from quadcruise.cli.common import FORCE_OPTION, REPORT_OPTION, friendly, mission_from_options
+from quadcruise.cli.common import (
+    FORCE_OPTION,
+    REPORT_OPTION,
+    RISE_OPTION,
+    SETTLE_BAND_OPTION,
+    friendly,
+    metric_options,
+    mission_from_options,
+    writable,
+)
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["compare"]
@@ -19,7 +28,7 @@ __all__ = ["compare"]
 @click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
 @click.option("-m", "--mission-param", "mission_params", multiple=True, metavar="KEY=VALUE",
               help="Mission parameter (repeatable).")
-@click.option("--out", type=click.Path(file_okay=False), help="Folder for metrics.csv and comparison.png.")
+@click.option("--out", type=click.Path(file_okay=False), callback=writable, help="Folder for metrics.csv and comparison.png.")
 @FORCE_OPTION
 @click.option("--population", type=int, metavar="N",
               help="Also fly every controller on the same Monte Carlo population of N vehicles.")
@@ -27,9 +36,11 @@ __all__ = ["compare"]
 @click.option("--mass-spread", type=float, default=0.1, show_default=True, help="Relative std of the mass.")
 @click.option("--wind", metavar="SPEC", help="Wind of the population, e.g. dryden:moderate@10.")
 @REPORT_OPTION
+@RISE_OPTION
+@SETTLE_BAND_OPTION
 @friendly
 def compare(mission, controllers, duration, dt, mission_params, out, force, population, seed, mass_spread, wind,
-            report):
+            report, rise, settle_bands):
     """Fly MISSION (a name or a waypoint CSV) with several controllers; one table, one figure.
 
     \f
@@ -62,27 +73,63 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
         spec such as ``dryden:moderate@10``; None: no wind.
     report : str or None
         ``--report``: path of a self-contained HTML report to write as well; None: no report.
+    rise : str
+        ``--rise``: the rise-time convention, ``10-90`` or ``0-100`` (% of the step).
+    settle_bands : tuple of float
+        ``--settle-band``: the settling bands (fractions of the step), given once or twice.
     """
     from quadcruise.workflows.compare import compare as run_compare
 
+    conventions = metric_options(rise, settle_bands)
     if out is not None:
         check_output_dir(out, force)
     cmp_mission = mission_from_options(mission, mission_params, smooth=False)
+    pop = _population(population, seed, mass_spread, wind)      # checked before anything flies
     cmp = run_compare(cmp_mission, controllers, duration=duration, dt=dt)
-    click.echo(cmp.text())
+    click.echo(cmp.text(**conventions))
     if population is not None:
-        _compare_population(cmp_mission, controllers, population, seed, mass_spread, wind, duration, dt)
+        _compare_population(cmp_mission, controllers, population, seed, pop, wind, duration, dt)
     if out is not None:
-        cmp.write(out, force=force)
+        cmp.write(out, force=force, **conventions)
         click.echo(f"wrote metrics.csv and comparison.png to {out}")
     if report is not None:
         from quadcruise.report.html import comparison_report, write_html_report
 
-        write_html_report(report, **comparison_report(cmp))
+        write_html_report(report, **comparison_report(cmp, **conventions))
         click.echo(f"wrote report {report}")
 
 
-def _compare_population(mission, controllers: str, n: int, seed: int, mass_spread: float, wind: str | None,
+def _population(n: int | None, seed: int, mass_spread: float, wind: str | None):
+    """The population that ``--population``, ``--seed``, ``--mass-spread`` and ``--wind`` describe,
+    checked even when ``--population`` is not given (so that no bad value passes unseen).
+
+    Parameters
+    ----------
+    n : int or None
+        ``--population``: number of vehicles; None: none flown.
+    seed : int
+        ``--seed``.
+    mass_spread : float
+        ``--mass-spread``: relative standard deviation of the mass.
+    wind : str or None
+        ``--wind``: a :func:`~quadcruise.disturbances.environment.parse_wind` spec.
+
+    Returns
+    -------
+    Population
+    """
+    from quadcruise.disturbances.environment import parse_wind
+    from quadcruise.errors import whole_number
+    from quadcruise.montecarlo.api import Population
+
+    if n is not None:
+        whole_number(n, "--population", minimum=1)
+    whole_number(seed, "--seed")
+    env = parse_wind(wind) if wind else None
+    return Population(mass_spread=mass_spread, environment=env if env is not None and env.parts else None)
+
+
+def _compare_population(mission, controllers: str, n: int, seed: int, pop, wind: str | None,
                         duration: float | None, dt: float) -> None:
     """Fly the controllers on the same population of perturbed vehicles, in this process,
     and print one row per controller.
@@ -96,22 +143,18 @@ def _compare_population(mission, controllers: str, n: int, seed: int, mass_sprea
         Number of vehicles.
     seed : int
         Seed of the population.
-    mass_spread : float
-        Relative standard deviation of the mass.
+    pop : Population
+        The population (:func:`_population`).
     wind : str or None
-        A :func:`~quadcruise.disturbances.environment.parse_wind` spec.
+        The ``--wind`` spec, for the printed headline.
     duration : float or None
         Flight time [s]; None: the mission's.
     dt : float
         Control period [s].
     """
-    from quadcruise.disturbances.environment import parse_wind
-    from quadcruise.montecarlo.api import Population
     from quadcruise.montecarlo.compare import compare_population
 
-    env = parse_wind(wind) if wind else None
-    pop = Population(mass_spread=mass_spread, environment=env if env is not None and env.parts else None)
     table = compare_population(mission, controllers, pop, n, seed, duration=duration, dt=dt, scheduler="none")
-    click.echo(f"\nthe same {n} perturbed vehicles (seed {seed}, mass spread {mass_spread:g}"
+    click.echo(f"\nthe same {n} perturbed vehicles (seed {seed}, mass spread {pop.mass_spread:g}"
                + (f", wind {wind}" if wind else "") + "):")
     click.echo(table.to_string(float_format=lambda v: f"{v:.4g}"))

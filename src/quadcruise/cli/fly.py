@@ -12,13 +12,14 @@ from quadcruise.cli.common import (
     FORCE_OPTION,
     FORMAT_OPTION,
     REPORT_OPTION,
-    controller_from_options,
-    controller_with,
+    RISE_OPTION,
+    SETTLE_BAND_OPTION,
     friendly,
-    mission_from_options,
+    metric_options,
+    writable,
 )
+from quadcruise.cli.objects import flight_from_options
 from quadcruise.errors import InputError
-from quadcruise.fields import parse_assignments
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["fly"]
@@ -36,16 +37,18 @@ __all__ = ["fly"]
               help="Controller parameter, e.g. -c max_tilt=0.5 (repeatable).")
 @click.option("--poles", "position_poles", metavar="P1,P2",
               help="Closed-loop poles of the x/y loops [rad/s], e.g. -0.7,-4.3 (the paper's).")
-@click.option("--out", "out", type=click.Path(file_okay=False), help="Folder for traces, figure and metrics.")
+@click.option("--out", "out", type=click.Path(file_okay=False), callback=writable, help="Folder for traces, figure and metrics.")
 @FORMAT_OPTION
 @FORCE_OPTION
 @click.option("--smooth", is_flag=True, help="Fly a waypoint file as a minimum-snap path instead of legs.")
 @REPORT_OPTION
-@click.option("--animate", type=click.Path(dir_okay=False), metavar="PATH.gif",
+@click.option("--animate", type=click.Path(dir_okay=False), metavar="PATH.gif", callback=writable,
               help="Also write an animation of the flight (.gif; .mp4 needs ffmpeg).")
+@RISE_OPTION
+@SETTLE_BAND_OPTION
 @friendly
 def fly(mission, controller, duration, dt, max_step, mission_params, controller_params, position_poles,
-        out, fmt, force, smooth, report, animate):
+        out, fmt, force, smooth, report, animate, rise, settle_bands):
     """Fly a MISSION with a controller on the paper's vehicle and print its metrics.
 
     MISSION is circle, square, step, hover, a waypoint CSV (columns x,y,z and optional yaw
@@ -93,42 +96,27 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
     animate : str or None
         ``--animate``: path of an animation of the flight to write as well (``.gif``, or
         ``.mp4`` with ffmpeg); None: no animation.
+    rise : {"10-90", "0-100"}
+        ``--rise``: the rise-time convention (% of the step).
+    settle_bands : tuple of float
+        ``--settle-band``: the settling bands (fractions of the step), given once or twice.
     """
-    from quadcruise.missions import mission_from_name
-
+    conventions = metric_options(rise, settle_bands)
     overrides = {k: v for k, v in (("duration", duration), ("dt", dt), ("max_step", max_step)) if v is not None}
     given = [f"--{k.replace('_', '-')} {v}" for k, v in overrides.items()] + [f"-m {p}" for p in mission_params] \
         + [f"-c {p}" for p in controller_params] + ([f"--controller {controller}"] if controller else []) \
         + ([f"--poles {position_poles}"] if position_poles else [])
-    if mission.lower().endswith(".toml"):
-        from quadcruise.workflows.scenario import load_scenario
-
-        if smooth:
-            raise InputError("--smooth turns a waypoint CSV into a minimum-snap path; a scenario file "
-                             "says its mission kind itself (kind = \"minsnap\")")
-        scenario = load_scenario(mission)
-        the_mission = scenario.mission or mission_from_name("circle")
-        if mission_params:
-            the_mission = the_mission.replace(**parse_assignments(mission_params, "--mission-param"))
-        if controller is not None or scenario.controller is None:
-            the_controller = controller_from_options(controller or "nlpd", controller_params, position_poles)
-        else:
-            the_controller = controller_with(scenario.controller, controller_params, position_poles)
-        kwargs = {**scenario.fly_kwargs(), **overrides}
-    else:
-        scenario = None
-        if smooth and not mission.lower().endswith(".csv"):
-            raise InputError(f"--smooth turns a waypoint CSV into a minimum-snap path; {mission!r} is not one")
-        the_mission = mission_from_options(mission, mission_params, smooth)
-        the_controller = controller_from_options(controller or "nlpd", controller_params, position_poles)
-        kwargs = overrides
-    result = _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate, given, scenario)
+    the_mission, the_controller, kwargs, scenario = flight_from_options(
+        mission, controller, mission_params, controller_params, position_poles, smooth)
+    kwargs = {**kwargs, **overrides}
+    result = _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate, given, scenario,
+                             conventions)
     if not result.ok.all():
         sys.exit(1)             # a vehicle did not fly its mission: diverged, lost track, out of bounds
 
 
 def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=None, animate=None, given=(),
-                    scenario=None):
+                    scenario=None, conventions=None):
     """Fly, print the metrics and each unfinished vehicle's reason, and write what was asked for.
 
     Parameters
@@ -151,13 +139,15 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
         The options given on the command line, recorded with the flight (``meta["command_line"]``).
     scenario : Scenario, optional
         The scenario file flown, recorded with the flight (source and title).
+    conventions : dict, optional
+        ``rise`` and ``settle_bands`` of the metrics (:func:`~quadcruise.cli.common.metric_options`).
 
     Returns
     -------
     SimResult
         The flight.
     """
-    from quadcruise.metrics.tables import vehicle_metrics_text
+    from quadcruise.metrics.tables import conventions_text, vehicle_metrics_text
     from quadcruise.workflows.fly import fly as run_fly
     from quadcruise.workflows.fly import write_flight
 
@@ -169,9 +159,10 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
     result.meta["command_line"] = list(given)
     if scenario is not None:
         result.meta["scenario"] = {"source": scenario.source, "title": scenario.title}
-    metrics = result.metrics()
+    metrics = result.metrics(**(conventions or {}))
     click.echo(f"{controller.name} on {mission.name}: {result.t[-1]:g} s at dt = {result.meta['dt_s']:g} s")
     click.echo(vehicle_metrics_text(metrics))
+    click.echo(conventions_text(metrics.attrs.get("conventions")))
     for i in np.flatnonzero(~result.ok):
         click.echo(f"vehicle {i} did not fly its mission: {result.status_text(int(i))}")
     if out is not None:

@@ -53,6 +53,10 @@ def run() -> None:
     SystemExit
         Always: 0 on success, 2 for bad input, 130 when interrupted, else the command's status.
     """
+    if len(sys.argv) <= 1:                  # bare `quadcruise`: the usage, as --help gives it
+        with click.Context(main, info_name="quadcruise") as ctx:
+            click.echo(main.get_help(ctx))
+        sys.exit(0)
     try:
         code = main(standalone_mode=False)
     except click.exceptions.UsageError as exc:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import click
 
-from quadcruise.cli.common import friendly
+from quadcruise.cli.common import friendly, writable
 from quadcruise.cli.montecarlo_run import montecarlo_command, parse_noise
 
 __all__ = ["montecarlo", "montecarlo_command", "parse_noise"]
@@ -41,10 +41,14 @@ __all__ = ["montecarlo", "montecarlo_command", "parse_noise"]
               help="local (a Dask cluster of processes here), none (in this process) or a Dask address.")
 @click.option("--workers", type=int, help="Workers of the local cluster.")
 @click.option("--connect-timeout", type=float, default=10.0, show_default=True, help="[s] for --scheduler ADDRESS.")
-@click.option("--out", type=click.Path(file_okay=False), help="Folder: chunks stream here, so a rerun resumes.")
+@click.option("--out", type=click.Path(file_okay=False), callback=writable, help="Folder: chunks stream here, so a rerun resumes.")
 @click.option("--force", is_flag=True, help="Replace a folder holding something else.")
 @click.option("--resume/--no-resume", default=True, show_default=True)
 @click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv", show_default=True)
+@click.option("--require", "requirements", multiple=True, metavar="METRIC<=VALUE",
+              help='Your own pass criterion, e.g. "steady_max_error_m<=0.2" (or <, >=, >; repeatable).')
+@click.option("--max-track-error", "max_track_error_m", type=float, metavar="M",
+              help="Error after the transient [m] beyond which a flight lost track (default: max(1, extent/4)).")
 @click.option("--case", type=int, help="Fly flight I alone (replays a worst case exactly).")
 @click.option("--worst", type=int, default=5, show_default=True, help="How many worst cases to list.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")

@@ -60,22 +60,22 @@ def parse_noise(text: str | None):
 
 def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: int | None = None,
                        seed: int | None = None, duration: float | None = None, dt: float | None = None,
-                       wind: str | None = None, wind_spread: float | None = None,
-                       mass_spread: float | None = None, inertia_spread: float | None = None,
+                       wind: str | None = None, wind_spread: float | None = None, offset: float | None = None,
+                       mass_spread: float | None = None, inertia_spread: float | None = None, noise: str | None = None,
                        thrust_spread: float | None = None, bandwidth_spread: float | None = None,
                        yaw_arm_spread: float | None = None, distribution: str | None = None,
-                       offset: float | None = None, noise: str | None = None,
                        model_error: bool | None = None, chunk_size: str | int = "auto", scheduler: str = "local",
                        workers: int | None = None, connect_timeout: float = 10.0, out: str | None = None,
                        force: bool = False, resume: bool = True, fmt: str = "csv", case: int | None = None,
                        worst: int = 5, quiet: bool = False, scenario: str | None = None,
+                       requirements: tuple[str, ...] = (), max_track_error_m: float | None = None,
                        echo: Callable[[str], None] = click.echo) -> MonteCarloResult | Case:
     """What ``quadcruise montecarlo`` runs: build the population, fly it (or one case), print
     the summary and the worst flights, write ``out``.
 
     Parameters
     ----------
-    mission, controller, n, seed, duration, dt, scenario
+    mission, controller, n, seed, duration, dt, scenario, requirements, max_track_error_m
         As :func:`quadcruise.montecarlo.scenario.sweep_spec`: None means "not given" (a
         ``scenario`` file's value, else the default).
     wind, noise : str, optional
@@ -107,12 +107,14 @@ offset, distribution, model_error : optional
     import numpy as np
 
     from quadcruise.disturbances import parse_wind
+    from quadcruise.errors import whole_number
     from quadcruise.montecarlo import montecarlo_case
-    from quadcruise.montecarlo.output import case_folder, write_case
+    from quadcruise.montecarlo.output import case_folder, case_text, write_case
     from quadcruise.montecarlo.progress import ProgressBar
     from quadcruise.montecarlo.scenario import sweep_spec
     from quadcruise.montecarlo.sweep import run_sweep
 
+    whole_number(worst, "--worst")
     if isinstance(chunk_size, str) and chunk_size != "auto":
         try:
             chunk_size = int(chunk_size)
@@ -121,16 +123,15 @@ offset, distribution, model_error : optional
     spec, n = sweep_spec(mission=mission, controller=controller, n=n, seed=seed, duration=duration, dt=dt,
                          environment=parse_wind(wind) if wind is not None else None, noise=parse_noise(noise),
                          scenario=scenario, mass_spread=mass_spread, inertia_spread=inertia_spread,
-                         thrust_spread=thrust_spread, bandwidth_spread=bandwidth_spread,
-                         yaw_arm_spread=yaw_arm_spread, offset=offset, wind_spread=wind_spread,
-                         distribution=distribution, model_error=model_error)
+                         thrust_spread=thrust_spread, bandwidth_spread=bandwidth_spread, offset=offset,
+                         yaw_arm_spread=yaw_arm_spread, wind_spread=wind_spread, distribution=distribution,
+                         model_error=model_error, requirements=requirements, max_track_error_m=max_track_error_m)
     if case is not None:
         if isinstance(case, bool) or not isinstance(case, (int, np.integer)) or not 0 <= case < n:
             raise InputError(f"--case {case} is not one of the {n} flights")
         target = case_folder(out, spec, case, force=force)
         found = montecarlo_case(spec, case)
-        echo(f"flight {case} of seed {spec.seed}: {found.row['reason']}, " + ", ".join(
-            f"{k} = {found.row[k]:.4g}" for k in ("rmse_m", "max_error_m", "settling_time_5pct_s", "m")))
+        echo(case_text(found, spec.seed))
         if target is not None:
             write_case(found, target, fmt=fmt, force=True)
             echo(f"wrote the flight to {target}")
@@ -142,10 +143,7 @@ offset, distribution, model_error : optional
     finally:
         if bar is not None:
             bar.close()
-    echo(res.summary_text())
-    if worst:
-        echo(f"worst {worst} (fly one alone again with --case VEHICLE):")
-        echo(res.worst_text(worst))
+    echo(res.summary_text(worst=worst))
     info = res.info
     echo(f"{info.get('flown', 0):,} flights flown ({info.get('resumed', 0):,} resumed) in {info.get('wall_s', 0):.1f} s "
          f"on {info.get('scheduler')}" + (f"; wrote {out}" if out is not None else ""))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from quadcruise.cli.common import FORCE_OPTION, FORMAT_OPTION, REPORT_OPTION, friendly
+from quadcruise.cli.common import FORCE_OPTION, FORMAT_OPTION, REPORT_OPTION, friendly, writable
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["reproduce"]
@@ -12,6 +12,7 @@ __all__ = ["reproduce"]
 
 @click.command("reproduce")
 @click.option("--out", "out", default="quadcruise-out", show_default=True, type=click.Path(file_okay=False),
+              callback=writable,
               help="Folder for metrics.json, figures, traces and report.md.")
 @FORMAT_OPTION
 @FORCE_OPTION

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import click
 
-from quadcruise.cli.common import friendly
+from quadcruise.cli.common import friendly, writable
 from quadcruise.cli.tune_run import tune_command
 
 __all__ = ["tune"]
@@ -44,7 +44,7 @@ __all__ = ["tune"]
 @click.option("--popsize", type=int, help="Candidates per generation (default: 15 per gain).")
 @click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
 @click.option("--dt", type=float, help="Control period [s] (default 0.001).")
-@click.option("--out", type=click.Path(file_okay=False), help="Folder: scenario.toml with the tuned gains, "
+@click.option("--out", type=click.Path(file_okay=False), callback=writable, help="Folder: scenario.toml with the tuned gains, "
               "tune.json, history, flights, figure.")
 @click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
 @click.option("--quiet", is_flag=True, help="No progress lines.")

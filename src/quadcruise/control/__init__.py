@@ -17,6 +17,7 @@ when its controller is first asked for, so flying one controller never pays for 
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 from collections.abc import Mapping
 from typing import Any
@@ -54,7 +55,12 @@ def controller_from_name(name: str, **params: Any) -> Controller:
     """A built-in controller by name, with optional parameters."""
     if name not in CONTROLLERS:
         raise InputError(f"unknown controller {name!r}; choose one of {', '.join(CONTROLLERS)}")
-    return CONTROLLERS[name](**params) if params else shared_default(CONTROLLERS[name])
+    cls = CONTROLLERS[name]
+    known = [f.name for f in dataclasses.fields(cls)]
+    unknown = sorted(set(params) - set(known))
+    if unknown:
+        raise InputError(f"{name} has no parameter {unknown[0]!r}; its parameters: {', '.join(known)}")
+    return cls(**params) if params else shared_default(cls)
 
 
 def as_controller(obj: Any) -> ControllerLike:

@@ -94,6 +94,41 @@ MARKER = "quadcruise.json"
 """Every output folder quadcruise writes holds this file (the config, seed and version)."""
 
 
+def check_writable_place(path: str | os.PathLike) -> None:
+    """Refuse a path that could not be written: its nearest existing folder must be a folder
+    this process may write into (the missing ones between are created when writing).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A file or folder to be written.
+
+    Raises
+    ------
+    InputError
+        Naming the path and why (no such folder, not a folder, permission denied).
+
+    Examples
+    --------
+    >>> check_writable_place("/proc/out")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: /proc/out: cannot write there (no such file or directory in /proc)
+    """
+    from quadcruise.errors import InputError
+
+    path = Path(path)
+    parent = path.parent if str(path.parent) else Path(".")
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
+    if not parent.is_dir():
+        raise InputError(f"{path}: cannot write there ({parent} is not a folder)")
+    try:                                    # the only sure test: make something there, and remove it
+        os.rmdir(tempfile.mkdtemp(prefix=".quadcruise-probe.", dir=parent))
+    except OSError as exc:
+        raise InputError(f"{path}: cannot write there ({exc.strerror.lower()} in {parent})") from None
+
+
 def check_output_dir(path: str | os.PathLike, force: bool = False) -> Path:
     """Refuse a non-empty folder that quadcruise did not write, unless ``force``.
 
@@ -119,6 +154,7 @@ def check_output_dir(path: str | os.PathLike, force: bool = False) -> Path:
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise InputError(f"{path}: exists and is not a folder")
+    check_writable_place(path)
     if path.is_dir() and any(path.iterdir()) and not (path / MARKER).is_file() and not force:
         raise InputError(f"{path}: folder is not empty and was not written by quadcruise "
                          "(use --force to replace it)")

@@ -1,12 +1,16 @@
-"""Metrics of a flight (rise, settling, overshoot, tracking, effort) and the same vectorised over
-vehicles; how a metric reads in a table. Pure functions of arrays: they take results duck-typed."""
+"""Metrics of a flight (rise, settling, overshoot, tracking after the transient, effort about hover)
+and the same vectorised over vehicles; how a metric reads in a table. Pure functions of arrays:
+they take results duck-typed."""
 
 from quadcruise.metrics.batch import flight_metrics_batch
 from quadcruise.metrics.flight import (
+    STEADY_BAND,
     TRANSIENT_MIN_ERROR,
     StepInfo,
     control_effort,
     flight_metrics,
+    hover_duties,
+    metric_conventions,
     step_info,
     step_info_batch,
     time_in_saturation,
@@ -14,5 +18,6 @@ from quadcruise.metrics.flight import (
     transient_info,
 )
 
-__all__ = ["TRANSIENT_MIN_ERROR", "StepInfo", "control_effort", "flight_metrics", "flight_metrics_batch",
-           "step_info", "step_info_batch", "time_in_saturation", "tracking_errors", "transient_info"]
+__all__ = ["STEADY_BAND", "TRANSIENT_MIN_ERROR", "StepInfo", "control_effort", "flight_metrics",
+           "flight_metrics_batch", "hover_duties", "metric_conventions", "step_info", "step_info_batch",
+           "time_in_saturation", "tracking_errors", "transient_info"]

@@ -25,9 +25,10 @@ from typing import Sequence
 
 import numpy as np
 
-from quadcruise.metrics.flight import TRANSIENT_MIN_ERROR, control_effort, tracking_errors
+from quadcruise.metrics.flight import STEADY_BAND, TRANSIENT_MIN_ERROR, control_effort, tracking_errors
 
-__all__ = ["first_crossing_batch", "settling_time_batch", "transient_batch", "flight_metrics_batch"]
+__all__ = ["first_crossing_batch", "settling_time_batch", "transient_batch", "window_errors_batch",
+           "flight_metrics_batch"]
 
 
 def first_crossing_batch(t: np.ndarray, z: np.ndarray, level: float) -> np.ndarray:
@@ -105,7 +106,8 @@ def settling_time_batch(t: np.ndarray, z: np.ndarray, band: float) -> np.ndarray
     return out
 
 
-def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: dict, bands: Sequence[float]):
+def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: dict, bands: Sequence[float],
+                    rise: Sequence[float] = (0.1, 0.9)) -> dict:
     """The transient of each vehicle, measured as :func:`quadcruise.metrics.flight_metrics` does.
 
     On the stepped axis of a step mission, as a step response from the hover point the
@@ -125,17 +127,17 @@ def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: di
         ``time``, ``size`` and the hover point); ``{}`` for none.
     bands : sequence of float
         Settling bands (0.02 for 2 %).
+    rise : (float, float)
+        Rise-time levels, fractions of the step (0.1 and 0.9 for 10-90 %).
 
     Returns
     -------
-    axis : ndarray of int64, shape (N,)
-        The measured axis (0, 1, 2 for x, y, z), -1 where none is measured.
-    rise : ndarray, shape (N,)
-        10-90 % rise time [s].
-    settling : list of ndarray, shape (N,)
-        Settling time [s] from the start of the transient, one array per band.
-    overshoot : ndarray, shape (N,)
-        Overshoot [%] of the step (or of the initial error).
+    dict
+        ``axis`` (int64: 0, 1, 2 for x, y, z, -1 where none is measured), ``t_step`` (start
+        of the transient [s]), ``rise_time_s`` [s], ``settling_s`` (a list of one array
+        per band: settling time [s] from the start of the transient), ``overshoot_pct``
+        [%] of the step (or of the initial error) and ``peak_time_s`` (first time of the
+        largest progress, from the start of the transient [s]); arrays of shape (N,).
 
     Notes
     -----
@@ -143,13 +145,14 @@ def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: di
     of a step whose time lies outside ``[t[0], t[-1])``.
     """
     n = pos.shape[0]
-    axis = np.full(n, -1, dtype=np.int64)
-    nan = np.full(n, np.nan)
+    out = {"axis": np.full(n, -1, dtype=np.int64), "t_step": np.full(n, np.nan),
+           "rise_time_s": np.full(n, np.nan), "settling_s": [np.full(n, np.nan) for _ in bands],
+           "overshoot_pct": np.full(n, np.nan), "peak_time_s": np.full(n, np.nan)}
     if mission.get("kind") == "step" and mission.get("axis") in ("x", "y", "z"):
         j = "xyz".index(mission["axis"])
         t_step = float(mission["time"])
         if not t[0] <= t_step < t[-1]:
-            return axis, nan, [nan] * len(bands), nan
+            return out
         y0 = float(mission[mission["axis"]])
         step = float(mission["size"])
         after = t > t_step
@@ -158,37 +161,86 @@ def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: di
         ys[:, 1:] = pos[:, after, j]
         ys[:, 0] = [np.interp(t_step, t, pos[i, :, j]) for i in range(n)]
         z = (ys - y0) / step
-        axis[:] = j
+        sel = np.arange(n)
+        out["axis"][:] = j
     else:
         e0 = np.abs(ref[:, 0] - pos[:, 0])
         j = e0.argmax(axis=1)
         rows = np.arange(n)
         measured = e0[rows, j] >= TRANSIENT_MIN_ERROR
-        axis[measured] = j[measured]
+        out["axis"][measured] = j[measured]
         if not measured.any():
-            return axis, nan, [nan] * len(bands), nan
-        rows = rows[measured]
-        e = ref[rows, :, j[measured]] - pos[rows, :, j[measured]]
+            return out
+        sel = rows[measured]
+        e = ref[sel, :, j[measured]] - pos[sel, :, j[measured]]
         z = 1.0 - e / e[:, :1]
         ts = t
-    t_lo, t_hi = first_crossing_batch(ts, z, 0.1), first_crossing_batch(ts, z, 0.9)
-    rise = t_hi - t_lo
-    settle = [settling_time_batch(ts, z, b) for b in bands]
-    over = np.maximum(0.0, 100.0 * (z.max(axis=1) - 1.0))
-    if z.shape[0] == n:
-        return axis, rise, settle, over
-    sel = axis >= 0
+    out["t_step"][sel] = ts[0]
+    out["rise_time_s"][sel] = first_crossing_batch(ts, z, float(rise[1])) - first_crossing_batch(ts, z, float(rise[0]))
+    for full, band in zip(out["settling_s"], bands):
+        full[sel] = settling_time_batch(ts, z, band)
+    out["overshoot_pct"][sel] = np.maximum(0.0, 100.0 * (z.max(axis=1) - 1.0))
+    out["peak_time_s"][sel] = ts[z.argmax(axis=1)] - ts[0]
+    return out
 
-    def put(v):
-        full = np.full(n, np.nan)
-        full[sel] = v
-        return full
-    return axis, put(rise), [put(s) for s in settle], put(over)
+
+def window_errors_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, t_from: np.ndarray) -> dict:
+    """RMS and maximum 3-D position error of each vehicle from its own start time on.
+
+    :func:`quadcruise.metrics.tracking_errors` with ``t_from``, one start per vehicle: the
+    error interpolated linearly at ``t_from``, the window ``[t_from, t[-1]]`` integrated by
+    trapezoids.
+
+    Parameters
+    ----------
+    t : ndarray, shape (L,)
+        Sample times [s], at least 2.
+    pos, ref : ndarray, shape (N, L, 3)
+        Positions and references [m].
+    t_from : ndarray, shape (N,)
+        Start of each vehicle's window [s], in ``[t[0], t[-1]]``; NaN for none.
+
+    Returns
+    -------
+    dict of ndarray, shape (N,)
+        ``rmse`` and ``max_error`` [m]; the error at the last sample where ``t_from`` is
+        ``t[-1]``; NaN where ``t_from`` is NaN.
+
+    Examples
+    --------
+    >>> t = np.array([0.0, 1.0, 2.0, 3.0])
+    >>> pos = np.zeros((2, 4, 3))
+    >>> pos[:, :, 0] = [10.0, 0.0, 0.0, 0.0]
+    >>> window_errors_batch(t, pos, np.zeros_like(pos), np.array([0.5, np.nan]))["max_error"]
+    array([ 5., nan])
+    """
+    n, length = pos.shape[:2]
+    rows = np.arange(n)
+    d = pos - ref
+    e2 = (d**2).sum(axis=-1)                                             # (N, L)
+    seg = 0.5 * (e2[:, 1:] + e2[:, :-1]) * np.diff(t)                    # (N, L - 1)
+    tail = np.zeros((n, length))
+    tail[:, :-1] = np.cumsum(seg[:, ::-1], axis=1)[:, ::-1]              # integral from t[k] to the end
+    peak = np.maximum.accumulate(np.sqrt(e2)[:, ::-1], axis=1)[:, ::-1]  # max from t[k] on
+    start = np.where(np.isfinite(t_from), t_from, t[0])
+    k = np.clip(np.searchsorted(t, start, side="right"), 1, length - 1)  # t[k - 1] <= start < t[k]
+    w = ((start - t[k - 1]) / (t[k] - t[k - 1]))[:, None]
+    d_from = d[rows, k - 1] + w * (d[rows, k] - d[rows, k - 1])
+    e2_from = (d_from**2).sum(axis=-1)
+    integral = 0.5 * (e2_from + e2[rows, k]) * (t[k] - start) + tail[rows, k]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rmse = np.sqrt(integral / (t[-1] - start))
+    max_error = np.maximum(np.sqrt(e2_from), peak[rows, k])
+    last = start >= t[-1]
+    rmse[last] = max_error[last] = np.sqrt(e2[last, -1])
+    rmse[~np.isfinite(t_from)] = max_error[~np.isfinite(t_from)] = np.nan
+    return {"rmse": rmse, "max_error": max_error}
 
 
 def flight_metrics_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, duties: np.ndarray, *,
                          mission: dict | None = None, bands: Sequence[float] = (0.02, 0.05),
-                         transient_until: float | None = None) -> dict:
+                         transient_until: float | None = None, rise: Sequence[float] = (0.1, 0.9),
+                         hover_duty=None) -> dict:
     """Tracking error, effort and transient of N vehicles that flew the whole record.
 
     The numbers of :func:`quadcruise.metrics.flight_metrics` for vehicles that did not
@@ -210,26 +262,58 @@ def flight_metrics_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, duties
         Settling bands (fractions).
     transient_until : float, optional
         End [s] of the window in which the transient is measured.
+    rise : (float, float)
+        Rise-time levels (fractions of the step).
+    hover_duty : float or ndarray of shape (N,), optional
+        Each vehicle's hover duty m g / (4 K) [-], about which the effort is measured
+        (:func:`quadcruise.metrics.hover_duties`); without it the effort is NaN.
 
     Returns
     -------
     dict of ndarray, shape (N,)
         ``rmse_m`` and ``max_error_m`` (3-D position error over the record),
-        ``final_error_m`` (at the last sample), ``effort`` (integral of the sum of squared
-        duties [s]), ``transient_axis`` (-1: none), ``rise_time_s``, ``overshoot_pct``,
+        ``steady_rmse_m`` and ``steady_max_error_m`` (the same from the settling time into
+        :data:`~quadcruise.metrics.flight.STEADY_BAND` on; the whole record without a
+        transient; NaN if it never settles into that band), ``final_error_m`` (at the last
+        sample), ``effort`` (:data:`~quadcruise.metrics.flight.EFFORT_DEFINITION` [s]),
+        ``transient_axis`` (-1: none), ``rise_time_s``, ``overshoot_pct``, ``peak_time_s``,
         and ``settling_s``: a list of one array per band. The transient is NaN (axis -1)
         when the window holds fewer than 2 samples.
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, 10.0, 1001)
+    >>> pos = np.zeros((1, t.size, 3))
+    >>> pos[0, :, 0] = np.exp(-t)                          # 1 m of x error dying out
+    >>> duties = np.full((1, t.size, 4), 0.25)
+    >>> out = flight_metrics_batch(t, pos, np.zeros_like(pos), duties, hover_duty=0.25)
+    >>> float(out["effort"][0]), round(float(out["steady_max_error_m"][0]), 6)   # 5 % of 1 m
+    (0.0, 0.05)
     """
     n = pos.shape[0]
+    bands = [float(b) for b in bands]
     err = tracking_errors(t, pos, ref)
+    if hover_duty is None:
+        effort = np.full(n, np.nan)
+    else:
+        trim = np.broadcast_to(np.asarray(hover_duty, dtype=float), (n,))
+        effort = control_effort(t, duties - trim[:, None, None])["integral"]
     out = {"rmse_m": err["rmse"], "max_error_m": err["max_error"],
-           "final_error_m": np.linalg.norm(pos[:, -1] - ref[:, -1], axis=1),
-           "effort": control_effort(t, duties)["integral"],
+           "steady_rmse_m": err["rmse"].copy(), "steady_max_error_m": err["max_error"].copy(),
+           "final_error_m": np.linalg.norm(pos[:, -1] - ref[:, -1], axis=1), "effort": effort,
            "transient_axis": np.full(n, -1, dtype=np.int64), "rise_time_s": np.full(n, np.nan),
-           "settling_s": [np.full(n, np.nan) for _ in bands], "overshoot_pct": np.full(n, np.nan)}
+           "settling_s": [np.full(n, np.nan) for _ in bands], "overshoot_pct": np.full(n, np.nan),
+           "peak_time_s": np.full(n, np.nan)}
     keep = slice(None) if transient_until is None else t <= transient_until
     tk = t[keep]
     if tk.size >= 2:
-        axis, rise, settle, over = transient_batch(tk, pos[:, keep], ref[:, keep], mission or {}, bands)
-        out.update(transient_axis=axis, rise_time_s=rise, settling_s=settle, overshoot_pct=over)
+        got = transient_batch(tk, pos[:, keep], ref[:, keep], mission or {}, bands + [STEADY_BAND], rise)
+        out.update(transient_axis=got["axis"], rise_time_s=got["rise_time_s"], settling_s=got["settling_s"][:-1],
+                   overshoot_pct=got["overshoot_pct"], peak_time_s=got["peak_time_s"])
+        measured = np.flatnonzero(got["axis"] >= 0)
+        if measured.size:
+            steady = window_errors_batch(t, pos[measured], ref[measured],
+                                         got["t_step"][measured] + got["settling_s"][-1][measured])
+            out["steady_rmse_m"][measured] = steady["rmse"]
+            out["steady_max_error_m"][measured] = steady["max_error"]
     return out

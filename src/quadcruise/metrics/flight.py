@@ -26,7 +26,9 @@ import numpy as np
 from quadcruise.errors import InputError
 
 __all__ = ["StepInfo", "step_info", "step_info_batch", "transient_info",
-           "tracking_errors", "control_effort", "time_in_saturation", "flight_metrics"]
+           "tracking_errors", "control_effort", "time_in_saturation", "flight_metrics",
+           "metric_conventions", "settling_column", "hover_duties", "STEADY_BAND", "EFFORT_DEFINITION",
+           "RISE_CONVENTIONS"]
 
 
 @dataclass(frozen=True)
@@ -477,9 +479,124 @@ def time_in_saturation(t, flags) -> dict[str, np.ndarray]:
 _AXIS_NAMES = ("x", "y", "z")
 TRANSIENT_MIN_ERROR = 0.01
 """An axis whose initial tracking error is below this [m] has no transient to measure."""
+STEADY_BAND = 0.05
+"""The steady window of a flight starts when its transient settles into this band
+(fraction of the initial error or of the step): ``steady_rmse_m`` and
+``steady_max_error_m`` are measured from then on, whatever ``settle_bands`` a table shows."""
+EFFORT_DEFINITION = "integral of sum_i (u_i - u_hover)^2 dt over the four rotor duties, u_hover = m g / (4 K) [s]"
+"""What the ``effort`` column measures, as the tables record it."""
 
 
-def flight_metrics(result, *, transient_axis: str | None = None, transient_until: float | None = None):
+def settling_column(band: float) -> str:
+    """The name of the column of the settling time into ``band``, as a metrics table names its
+    second band.
+
+    Parameters
+    ----------
+    band : float
+        The band, a fraction of the step (0.05 for 5 %).
+
+    Returns
+    -------
+    str
+        ``settling_time_<percent>pct_s``, the percent written with up to 6 significant digits
+        and a ``p`` for the decimal point.
+
+    Examples
+    --------
+    >>> settling_column(0.05), settling_column(0.03), settling_column(0.025)
+    ('settling_time_5pct_s', 'settling_time_3pct_s', 'settling_time_2p5pct_s')
+    """
+    return f"settling_time_{format(100.0 * float(band), '.6g').replace('.', 'p')}pct_s"
+
+
+RISE_CONVENTIONS = {"10-90": (0.1, 0.9), "0-100": (0.0, 1.0)}
+"""The rise-time levels a name gives (``rise="0-100"``)."""
+
+
+def metric_conventions(rise=(0.1, 0.9), settle_bands=(0.02, 0.05)) -> dict:
+    """The conventions of a metrics table, checked: what its ``attrs["conventions"]`` records.
+
+    Parameters
+    ----------
+    rise : (float, float) or {"10-90", "0-100"}
+        Rise-time levels as fractions of the step: ``(0.1, 0.9)`` for 10-90 %, ``(0.0, 1.0)``
+        for 0-100 %, or any ``0 <= low < high <= 1``; or one of :data:`RISE_CONVENTIONS`.
+    settle_bands : float or sequence of one or two floats
+        Settling bands as fractions of the step, each in (0, 1): the first is the
+        ``settling_time_s`` column, the second (:data:`STEADY_BAND` if only one is given)
+        the column :func:`settling_column` names.
+
+    Returns
+    -------
+    dict
+        ``rise`` and ``settle_bands`` (lists of two floats), ``settling_columns`` (column
+        name -> band), ``steady_band`` (:data:`STEADY_BAND`) and ``effort``
+        (:data:`EFFORT_DEFINITION`): plain values, ready for JSON.
+
+    Raises
+    ------
+    InputError
+        Levels or bands out of range, or not numbers.
+
+    Examples
+    --------
+    >>> metric_conventions(rise="0-100", settle_bands=0.03)["settling_columns"]
+    {'settling_time_s': 0.03, 'settling_time_5pct_s': 0.05}
+    """
+    if isinstance(rise, str):
+        if rise not in RISE_CONVENTIONS:
+            raise InputError(f"rise {rise!r}: choose one of {', '.join(RISE_CONVENTIONS)} or give two levels")
+        rise = RISE_CONVENTIONS[rise]
+    try:
+        levels = tuple(float(v) for v in rise)
+        bands = tuple(float(b) for b in np.atleast_1d(np.asarray(settle_bands, dtype=float)))
+    except (TypeError, ValueError):
+        raise InputError(f"rise levels and settle_bands must be numbers, got {rise!r}, {settle_bands!r}") from None
+    bands = bands + (STEADY_BAND,) if len(bands) == 1 else bands
+    if len(levels) != 2 or not 0.0 <= levels[0] < levels[1] <= 1.0:
+        raise InputError(f"rise levels must satisfy 0 <= low < high <= 1, got {rise}")
+    if len(bands) != 2 or not all(0.0 < b < 1.0 for b in bands):
+        raise InputError(f"settle_bands must be one or two fractions in (0, 1), got {settle_bands}")
+    return {"rise": list(levels), "settle_bands": list(bands),
+            "settling_columns": {"settling_time_s": bands[0], settling_column(bands[1]): bands[1]},
+            "steady_band": STEADY_BAND, "effort": EFFORT_DEFINITION}
+
+
+def hover_duties(meta, n: int) -> np.ndarray | None:
+    """Each vehicle's hover duty m g / (4 K), from the vehicle a result records.
+
+    Parameters
+    ----------
+    meta : dict
+        A result's ``meta``: its ``vehicle`` entry (the flown vehicle's ``to_dict()``: ``m``
+        [kg], ``g`` [m/s^2] and ``K`` [N], each a number or one per vehicle) is read.
+    n : int
+        Number of vehicles.
+
+    Returns
+    -------
+    ndarray, shape (n,), or None
+        The duty per rotor [-] that holds each vehicle in hover; None if ``meta`` records no
+        vehicle (a result built by :func:`quadcruise.simulate` without one).
+
+    Examples
+    --------
+    >>> hover_duties({"vehicle": {"m": [3.0, 6.0], "g": 10.0, "K": 100.0}}, 2)
+    array([0.075, 0.15 ])
+    """
+    vehicle = meta.get("vehicle") if isinstance(meta, dict) else None
+    if not isinstance(vehicle, dict) or not all(k in vehicle for k in ("m", "g", "K")):
+        return None
+    try:
+        m, g, k = (np.broadcast_to(np.asarray(vehicle[key], dtype=float), (n,)) for key in ("m", "g", "K"))
+    except ValueError:
+        raise InputError(f"the recorded vehicle does not describe {n} vehicle(s)") from None
+    return m * g / (4.0 * k)
+
+
+def flight_metrics(result, *, transient_axis: str | None = None, transient_until: float | None = None,
+                   rise=(0.1, 0.9), settle_bands=(0.02, 0.05)):
     """Per-vehicle metrics of a :class:`~quadcruise.sim.result.SimResult`, as a DataFrame.
 
     The transient is measured on ``transient_axis``, or else on the stepped axis of a
@@ -490,25 +607,46 @@ def flight_metrics(result, *, transient_axis: str | None = None, transient_until
     time that does not exist (still outside the band at the end) is NaN, and so is every
     metric of a vehicle that stopped early.
 
+    The tracking after the transient: ``steady_rmse_m`` and ``steady_max_error_m`` are the
+    3-D position error (as ``rmse_m``) from the start of the transient plus its settling
+    time into :data:`STEADY_BAND` (5 %) to the end of the flight. Without a transient to
+    measure, the whole flight is steady (they equal ``rmse_m`` and ``max_error_m``); a
+    transient that never settles into 5 % leaves them undefined (NaN: the tables read
+    "did not settle"), not zero.
+
     Parameters
     ----------
     result : SimResult
         The flight (duck-typed: ``t``, ``states``, ``references``, ``commands``,
-        ``status``, ``meta`` and the saturation times are read).
+        ``status``, ``meta`` and the saturation times are read; ``meta["vehicle"]`` gives
+        the hover duty of the effort, see :func:`hover_duties`).
     transient_axis : {"x", "y", "z"}, optional
         The axis whose transient is measured, instead of the one chosen as above.
     transient_until : float, optional
         End [s] of the window in which the transient is measured (e.g. the first corner
         of a square, after which the reference turns and the error grows again).
+    rise : (float, float) or str
+        Rise-time levels as fractions of the step: ``(0.1, 0.9)`` (10-90 %, default) or
+        ``(0.0, 1.0)`` (0-100 %, also ``"0-100"``), or any ``0 <= low < high <= 1``.
+    settle_bands : (float, float) or float
+        Settling bands as fractions of the step: the first gives ``settling_time_s``, the
+        second (5 % if only one is given) the column named after it
+        (:func:`settling_column`: ``settling_time_5pct_s`` for the default 5 %).
 
     Returns
     -------
     pandas.DataFrame
         One row per vehicle. Columns: ``vehicle``, ``status``, ``rmse_m`` and
-        ``max_error_m`` (3-D position error over the whole flight [m]), the transient of
-        one axis (``axis``, ``rise_time_s``, ``settling_time_s`` (2 %),
-        ``settling_time_5pct_s``, ``overshoot_pct``), ``effort`` (integral of the sum of
-        squared duties [s]), ``duty_clipped_s`` and ``controller_limited_s`` [s].
+        ``max_error_m`` (3-D position error over the whole flight [m]),
+        ``steady_rmse_m`` and ``steady_max_error_m`` (the same after the transient [m]),
+        the transient of one axis (``axis``, ``rise_time_s``, ``settling_time_s`` (first
+        band), ``settling_time_<band>pct_s`` (second band), ``overshoot_pct``,
+        ``peak_time_s`` (time of the peak from the start of the transient [s])),
+        ``effort`` (:data:`EFFORT_DEFINITION`: the rotor duties' squared deviation from
+        hover, integrated over the flight [s], about 0 for a hover; NaN if the result
+        records no vehicle), ``duty_clipped_s`` and ``controller_limited_s`` [s].
+        ``attrs["conventions"]`` records the rise levels, the bands, the steady band and
+        the effort's definition (:func:`metric_conventions`).
 
     Examples
     --------
@@ -517,18 +655,25 @@ def flight_metrics(result, *, transient_axis: str | None = None, transient_until
     >>> flight_metrics(res)[["vehicle", "status", "axis"]]
        vehicle    status axis
     0        0  finished    x
+    >>> flight_metrics(res, settle_bands=(0.02, 0.03)).attrs["conventions"]["settle_bands"]
+    [0.02, 0.03]
     """
     import pandas as pd
 
     from quadcruise.layout import CMD_U1, REF_X, X
 
+    conventions = metric_conventions(rise, settle_bands)
+    levels, bands = tuple(conventions["rise"]), tuple(conventions["settle_bands"])
+    second = settling_column(bands[1])
     t = result.t
     mission = result.meta.get("mission") if isinstance(result.meta.get("mission"), dict) else {}
+    hover = hover_duties(result.meta, result.n)
     rows = []
     for i in range(result.n):
         row = {"vehicle": i, "status": result.status_text(i), "rmse_m": np.nan, "max_error_m": np.nan,
+               "steady_rmse_m": np.nan, "steady_max_error_m": np.nan,
                "axis": None, "rise_time_s": np.nan, "settling_time_s": np.nan,
-               "settling_time_5pct_s": np.nan, "overshoot_pct": np.nan, "effort": np.nan,
+               second: np.nan, "overshoot_pct": np.nan, "peak_time_s": np.nan, "effort": np.nan,
                "duty_clipped_s": float(result.duty_clipped_s[i]),
                "controller_limited_s": float(result.controller_limited_s[i])}
         rows.append(row)
@@ -539,28 +684,64 @@ def flight_metrics(result, *, transient_axis: str | None = None, transient_until
             err = tracking_errors(t, pos, ref)
             row["rmse_m"], row["max_error_m"] = float(err["rmse"]), float(err["max_error"])
             keep = slice(None) if transient_until is None else t <= transient_until
-            info, axis = _flight_transient(t[keep], pos[keep], ref[keep], mission, transient_axis)
-            if info is not None:
+            transient = _flight_transient(t[keep], pos[keep], ref[keep], mission, transient_axis, levels, bands)
+            steady = (row["rmse_m"], row["max_error_m"])          # no transient: the whole flight
+            if transient is not None:
+                info, axis, t_step, settled = transient
                 row.update(axis=axis, rise_time_s=_nan(info.rise_time), settling_time_s=_nan(info.settling_time),
-                           settling_time_5pct_s=_nan(info.settling_time_5pct), overshoot_pct=info.overshoot_pct)
-        row["effort"] = float(control_effort(t, result.commands[i, :, CMD_U1:CMD_U1 + 4])["integral"])
-    return pd.DataFrame(rows)
+                           overshoot_pct=info.overshoot_pct, peak_time_s=info.peak_time)
+                row[second] = _nan(info.settling_time_5pct)
+                steady = (np.nan, np.nan) if settled is None else _steady_errors(t, pos, ref, t_step + settled)
+            row["steady_rmse_m"], row["steady_max_error_m"] = steady
+        if hover is not None:
+            duties = result.commands[i, :, CMD_U1:CMD_U1 + 4]
+            row["effort"] = float(control_effort(t, duties - hover[i])["integral"])
+    frame = pd.DataFrame(rows)
+    frame.attrs["conventions"] = conventions
+    return frame
 
 
-def _flight_transient(t, pos, ref, mission: dict, axis: str | None):
+def _steady_errors(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, t_from: float) -> tuple[float, float]:
+    """RMS and maximum 3-D error from ``t_from`` on; the error at the end if that is the last sample."""
+    if t_from >= t[-1]:
+        last = float(np.linalg.norm(pos[-1] - ref[-1]))
+        return last, last
+    err = tracking_errors(t, pos, ref, t_from=max(t_from, float(t[0])))
+    return float(err["rmse"]), float(err["max_error"])
+
+
+def _flight_transient(t, pos, ref, mission: dict, axis: str | None, rise: tuple, bands: tuple):
+    """(StepInfo, axis name, start time [s], settling time into STEADY_BAND [s] or None), or
+    None where no transient is measured."""
     if axis is None and mission.get("kind") == "step" and mission.get("axis") in _AXIS_NAMES:
         j = _AXIS_NAMES.index(mission["axis"])
         t_step = float(mission["time"])
-        if t[0] <= t_step < t[-1]:
-            before = float(mission[mission["axis"]])   # the hover point the step leaves
+        if not t[0] <= t_step < t[-1]:
+            return None
+        before = float(mission[mission["axis"]])   # the hover point the step leaves
+
+        def measure(levels, settle):
             return step_info(t, pos[:, j], y_initial=before, y_final=before + float(mission["size"]),
-                             t_step=t_step), mission["axis"]
-        return None, None
-    e0 = np.abs(ref[0] - pos[0])
-    j = _AXIS_NAMES.index(axis) if axis is not None else int(np.argmax(e0))
-    if e0[j] < TRANSIENT_MIN_ERROR:
-        return None, None
-    return transient_info(t, pos[:, j], ref[:, j]), _AXIS_NAMES[j]
+                             t_step=t_step, rise=levels, settle_bands=settle)
+        name = mission["axis"]
+    else:
+        e0 = np.abs(ref[0] - pos[0])
+        j = _AXIS_NAMES.index(axis) if axis is not None else int(np.argmax(e0))
+        if e0[j] < TRANSIENT_MIN_ERROR:
+            return None
+        t_step = float(t[0])
+
+        def measure(levels, settle):
+            return transient_info(t, pos[:, j], ref[:, j], rise=levels, settle_bands=settle)
+        name = _AXIS_NAMES[j]
+    info = measure(rise, bands)
+    if bands[1] == STEADY_BAND:
+        steady = info.settling_time_5pct
+    elif bands[0] == STEADY_BAND:
+        steady = info.settling_time
+    else:
+        steady = measure(rise, (STEADY_BAND, STEADY_BAND)).settling_time
+    return info, name, t_step, steady
 
 
 def _nan(value):

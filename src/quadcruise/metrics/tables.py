@@ -2,9 +2,10 @@
 HTML report.
 
 Numbers show 4 significant digits (scientific notation when very large or small), a
-missing value a dash, and a missing settling time of a response that did have a transient
-(its ``axis`` is named) reads "did not settle": the response never stayed in the band,
-which is not the same as "no step to measure".
+missing value a dash, and a missing settling time or steady error (``steady_rmse_m``,
+``steady_max_error_m``) of a response that did have a transient (its ``axis`` is named)
+reads "did not settle": the response never stayed in the band, which is not the same as
+"no step to measure". :func:`conventions_text` says in words what the columns measure.
 
 >>> import pandas as pd
 >>> frame = pd.DataFrame({"axis": ["x", None], "settling_time_s": [float("nan")] * 2, "rmse_m": [0.01234, 2e-5]})
@@ -22,9 +23,11 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["cell", "metric_cell", "metrics_text", "vehicle_metrics_text", "DID_NOT_SETTLE"]
+__all__ = ["cell", "metric_cell", "metrics_text", "vehicle_metrics_text", "conventions_text", "DID_NOT_SETTLE"]
 
 DID_NOT_SETTLE = "did not settle"
+UNSETTLED_METRICS = ("settling", "steady_")
+"""Prefixes of the metrics that are missing because a measured transient did not settle."""
 
 
 def cell(value: Any, missing: str = "-") -> tuple[str, bool]:
@@ -69,7 +72,8 @@ def cell(value: Any, missing: str = "-") -> tuple[str, bool]:
 def metric_cell(value: Any, metric: Any, axis: Any, missing: str = "-") -> tuple[str, bool]:
     """:func:`cell` of ``metric``'s value for a flight whose transient axis is ``axis``.
 
-    A missing settling time of a measured transient reads :data:`DID_NOT_SETTLE`.
+    A missing settling time or steady error of a measured transient reads
+    :data:`DID_NOT_SETTLE`.
 
     Parameters
     ----------
@@ -94,12 +98,12 @@ def metric_cell(value: Any, metric: Any, axis: Any, missing: str = "-") -> tuple
     --------
     >>> metric_cell(float("nan"), "settling_time_s", "x")
     ('did not settle', False)
-    >>> metric_cell(float("nan"), "settling_time_s", None)
-    ('-', False)
+    >>> metric_cell(float("nan"), "steady_rmse_m", "x"), metric_cell(float("nan"), "settling_time_s", None)
+    (('did not settle', False), ('-', False))
     """
     text, number = cell(value, missing)
     measured = isinstance(axis, str) and bool(axis.strip())
-    if text == missing and isinstance(metric, str) and metric.startswith("settling") and measured:
+    if text == missing and isinstance(metric, str) and metric.startswith(UNSETTLED_METRICS) and measured:
         return DID_NOT_SETTLE, False
     return text, number
 
@@ -153,3 +157,39 @@ def vehicle_metrics_text(frame) -> str:
     rmse_m       0.5
     """
     return metrics_text(frame.drop(columns=["vehicle"]), [f"vehicle {c}" for c in frame["vehicle"]])
+
+
+def conventions_text(conventions: dict | None) -> str:
+    """What the columns of a metrics table measure, in a few lines (for under the table).
+
+    Parameters
+    ----------
+    conventions : dict or None
+        A table's ``attrs["conventions"]``
+        (:func:`quadcruise.metrics.flight.metric_conventions`); None or empty for none.
+
+    Returns
+    -------
+    str
+        The rise levels, the band of each settling column, the steady window and the
+        effort's definition; "" without conventions.
+
+    Examples
+    --------
+    >>> from quadcruise.metrics.flight import metric_conventions
+    >>> print(conventions_text(metric_conventions(rise=(0.0, 1.0))))
+    rise_time_s: 0-100 % of the step; settling_time_s: 2 % band; settling_time_5pct_s: 5 % band
+    steady_*: 3-D position error from the 5 % settling time on (the whole flight without a transient)
+    effort: integral of sum_i (u_i - u_hover)^2 dt over the four rotor duties, u_hover = m g / (4 K) [s]
+    """
+    if not conventions:
+        return ""
+    lo, hi = (format(100.0 * float(v), ".6g") for v in conventions["rise"])
+    parts = [f"rise_time_s: {lo}-{hi} % of the step"]
+    parts += [f"{name}: {format(100.0 * float(band), '.6g')} % band"
+              for name, band in conventions["settling_columns"].items()]
+    steady = format(100.0 * float(conventions["steady_band"]), ".6g")
+    return "\n".join(["; ".join(parts),
+                      f"steady_*: 3-D position error from the {steady} % settling time on "
+                      "(the whole flight without a transient)",
+                      f"effort: {conventions['effort']}"])

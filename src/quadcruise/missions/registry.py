@@ -26,6 +26,9 @@ def mission_from_name(name: str, **kw: Any) -> Mission:
     if cls is None:
         raise InputError(f"unknown mission {name!r}; valid missions: {', '.join(MISSIONS)}")
     check_names(cls, kw)
+    if cls in (Waypoints, MinimumSnap) and kw.get("table") is None:
+        raise InputError(f"the {cls.name} mission flies a waypoint table: give its CSV file as the mission "
+                         f"(quadcruise fly path.csv{' --smooth' if cls is MinimumSnap else ''}) or table=PATH")
     return cls(**kw) if kw else shared_default(cls)
 
 

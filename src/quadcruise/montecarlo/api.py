@@ -30,7 +30,11 @@ Examples
 ...                  duration=0.5, scheduler="none")
 >>> len(res.table), res.table["vehicle"].tolist()
 (4, [0, 1, 2, 3])
->>> res.summary()["failures"]["count"]             # 0.5 s is too short to settle
+>>> s = res.summary()                           # 0.5 s is too short to settle: a metric, not a failure
+>>> s["failures"]["count"], s["not_settled"]["count"]
+(0, 4)
+>>> montecarlo("hover", "nlpd", Population(offset=0.1), n=4, seed=1, duration=0.5, scheduler="none",
+...            requirements=["steady_max_error_m<=0.05"]).summary()["requirements"][0]["failed"]
 4
 """
 
@@ -106,7 +110,9 @@ def montecarlo(mission: Mission | str = "circle", controller: Controller | str =
         Time to wait for a scheduler given by address [s].
     **spec_options
         More :class:`MonteCarloSpec` fields: duration [s], dt [s], vehicle, log_dt [s],
-        settle_band, ...
+        settle_band, ``requirements`` (your own pass criteria, e.g.
+        ``["steady_max_error_m<=0.2"]``), ``max_track_error_m`` [m] (the "lost track"
+        bound), ...
 
     Returns
     -------

@@ -12,9 +12,11 @@ import numpy as np
 from quadcruise.errors import InputError, whole_number
 from quadcruise.layout import CMD_U1, REF_X, X
 from quadcruise.metrics.batch import flight_metrics_batch
+from quadcruise.metrics.flight import hover_duties
 from quadcruise.montecarlo.population import Draw
 from quadcruise.montecarlo.schema import COLUMNS, FAILURES, METRICS
 from quadcruise.montecarlo.spec import MonteCarloSpec
+from quadcruise.sim.status import ExitStatus
 
 __all__ = ["Case", "fly_chunk", "montecarlo_case", "reduce_chunk", "replay_case", "run_chunk", "sweep_metrics"]
 
@@ -89,14 +91,17 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
     """Per-vehicle metrics of a batch, vectorised: the columns of
     :data:`~quadcruise.montecarlo.result.COLUMNS` but the vehicle index and the drawn values.
 
-    ``rmse_m``, ``max_error_m``, ``rise_time_s``, ``settling_time_s`` (2 %),
-    ``settling_time_5pct_s``, ``overshoot_pct``, ``effort``, ``duty_clipped_s`` and
-    ``controller_limited_s`` equal :func:`quadcruise.metrics.flight_metrics` on the same
-    result (to rounding; the transient is measured on the same axis with the same rules,
-    by :func:`quadcruise.metrics.batch.flight_metrics_batch`); ``final_error_m`` is the
+    ``rmse_m``, ``max_error_m``, ``steady_rmse_m``, ``steady_max_error_m``,
+    ``rise_time_s``, ``settling_time_s`` (2 %), ``settling_time_5pct_s``,
+    ``overshoot_pct``, ``peak_time_s``, ``effort`` (about each vehicle's own hover duty),
+    ``duty_clipped_s`` and ``controller_limited_s`` equal
+    :func:`quadcruise.metrics.flight_metrics` on the same result (to rounding; the
+    transient is measured on the same axis with the same rules, by
+    :func:`quadcruise.metrics.batch.flight_metrics_batch`); ``final_error_m`` is the
     position error at the end. Every metric of a vehicle that stopped early is NaN. Each
     vehicle's numbers depend on its own rows only, so they do not change with the batch a
-    vehicle is flown in. The failure of each vehicle follows the spec's rules.
+    vehicle is flown in. The failure of each vehicle follows the spec's rules
+    (:data:`~quadcruise.montecarlo.schema.FAILURES`).
     """
     t = result.t
     n = result.n
@@ -108,23 +113,36 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
     out["status"] = status
     out["stop_time_s"] = np.asarray(result.t_stop, dtype=float).copy()
     refs = result.references[:, :, REF_X:REF_X + 3]
-    live = np.flatnonzero((status == 0) & np.isfinite(refs).all(axis=(1, 2)))
+    stopped = np.asarray(result.stopped, dtype=bool)           # by the engine: later rows NaN
+    live = np.flatnonzero(~stopped & np.isfinite(refs).all(axis=(1, 2)))
     not_settled = np.zeros(n, dtype=bool)
     if live.size:
         mission = result.meta.get("mission") if isinstance(result.meta.get("mission"), dict) else {}
+        hover = hover_duties(result.meta, n)
         rows = slice(None) if live.size == n else live      # all live: views, no copies
         got = flight_metrics_batch(t, result.states[rows, :, X:X + 3], refs[rows],
                                    result.commands[rows, :, CMD_U1:CMD_U1 + 4], mission=mission,
-                                   bands=(0.02, 0.05, spec.settle_band), transient_until=spec.transient_until)
-        for key in ("rmse_m", "max_error_m", "final_error_m", "effort", "transient_axis", "rise_time_s",
-                    "overshoot_pct"):
+                                   bands=(0.02, 0.05, spec.settle_band), transient_until=spec.transient_until,
+                                   hover_duty=None if hover is None else hover[rows])
+        for key in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "final_error_m", "effort",
+                    "transient_axis", "rise_time_s", "overshoot_pct", "peak_time_s"):
             out[key][live] = got[key]
         out["settling_time_s"][live], out["settling_time_5pct_s"][live] = got["settling_s"][:2]
         not_settled[live] = (got["transient_axis"] >= 0) & np.isnan(got["settling_s"][2])
-    diverged = status != 0
+    diverged = stopped
+    bound = spec.max_track_error_m
+    after = np.where(np.isnan(out["steady_max_error_m"]), out["final_error_m"], out["steady_max_error_m"])
+    # lost track: fly's own status (the error left 1 m + the mission's size at some instant), or
+    # the error after the transient beyond the spec's bound
+    lost_track = ~diverged & ((status == int(ExitStatus.LOST_TRACK)) | (after > bound))
     saturated = out["duty_clipped_s"] > spec.max_clipped_s
-    out.update(diverged=diverged, saturated=saturated, not_settled=not_settled)
-    out["failure"] = np.select([diverged, saturated, not_settled], [1, 2, 3], 0).astype(np.int64)
+    failed_requirement = np.zeros(n, dtype=bool)
+    for req in spec.parsed_requirements:
+        failed_requirement |= ~req.met(out[req.metric])
+    out.update(diverged=diverged, lost_track=lost_track, saturated=saturated,
+               failed_requirement=failed_requirement, not_settled=not_settled)
+    out["failure"] = np.select([diverged, lost_track, saturated, failed_requirement],
+                               [FAILURES.index(r) for r in FAILURES[1:]], 0).astype(np.int64)
     return out
 
 

@@ -34,8 +34,9 @@ def compare_population(mission, controllers, population, n: int, seed: int, **mo
     -------
     pandas.DataFrame
         One row per controller, indexed by label: ``flights``, ``failure_rate`` [-], and
-        the median (p50) and p95 of ``rmse_m``, ``max_error_m`` [m] and
-        ``settling_time_5pct_s`` [s].
+        the median (p50) and p95 of ``rmse_m``, ``max_error_m``, ``steady_rmse_m``,
+        ``steady_max_error_m`` [m] (the error after the transient: over the flights whose
+        transient settled) and ``settling_time_5pct_s`` [s].
 
     Examples
     --------
@@ -52,7 +53,7 @@ def compare_population(mission, controllers, population, n: int, seed: int, **mo
         res = montecarlo(mission, ctrl, population, n, seed, **montecarlo_kw)
         s = res.summary()
         row = {"flights": s["flights"], "failure_rate": s["failures"]["rate"]}
-        for metric in ("rmse_m", "max_error_m", "settling_time_5pct_s"):
+        for metric in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "settling_time_5pct_s"):
             row[f"{metric} p50"] = s["metrics"][metric]["p50"]
             row[f"{metric} p95"] = s["metrics"][metric]["p95"]
         rows[label] = row

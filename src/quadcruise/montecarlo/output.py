@@ -17,7 +17,7 @@ from quadcruise.io.files import MARKER, atomic_dir, atomic_path, check_output_di
 from quadcruise.io.plainjson import dumps
 from quadcruise.montecarlo.store import holds_sweep, write_marker
 
-__all__ = ["write_outputs", "write_case", "case_folder", "report_markdown"]
+__all__ = ["write_outputs", "write_case", "case_folder", "case_text", "report_markdown"]
 
 
 def write_outputs(result, out, *, fmt: str = "csv", force: bool = False) -> Path:
@@ -105,6 +105,28 @@ def write_case(case, out, *, fmt: str = "csv", force: bool = False) -> Path:
     return path
 
 
+def case_text(case, seed: int) -> str:
+    """One line on a re-flown vehicle: its outcome and its main metrics.
+
+    Parameters
+    ----------
+    case : Case
+        The vehicle flown again (:func:`~quadcruise.montecarlo.montecarlo_case`).
+    seed : int
+        The sweep's seed.
+
+    Returns
+    -------
+    str
+        ``flight I of seed S: REASON, rmse_m = ..., ...``: the RMSE and maximum error, the
+        same after the transient, the 5 % settling time [s] and the mass [kg], to 4
+        significant digits.
+    """
+    keys = ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "settling_time_5pct_s", "m")
+    return f"flight {case.vehicle} of seed {seed}: {case.row['reason']}, " + ", ".join(
+        f"{k} = {case.row[k]:.4g}" for k in keys)
+
+
 def case_folder(out, spec, case: int, *, force: bool = False) -> Path | None:
     """Where flight ``case`` of the sweep ``spec``, flown again alone, is written.
 
@@ -173,11 +195,25 @@ def report_markdown(result, summary: dict, worst, table_name: str) -> str:
              "Population: " + (", ".join(f"{k} = {v}" for k, v in pop.items()) or "nominal") + ".\n",
              f"## Failures: {f['count']:,} of {summary['flights']:,} ({100 * f['rate']:.2f} %)\n",
              "Each flight counts once, under the first that applies: diverged (the engine stopped it), "
-             f"saturated (rotor duties clipped for more than {spec.max_clipped_s:g} s), did not settle "
-             f"(the transient still outside the {100 * spec.settle_band:g} % band at the end).\n",
+             f"lost track (its position error after the transient, or at the end if the transient never "
+             f"settled into 5 %, above {spec.max_track_error_m:g} m), saturated (rotor duties clipped for "
+             f"more than {spec.max_clipped_s:g} s), failed a requirement (missed one of the requirements "
+             "below).\n",
              "| reason | flights | rate |", "|---|---|---|"]
     for reason, v in f["by_reason"].items():
         lines.append(f"| {reason} | {v['count']:,} | {100 * v['rate']:.2f} % |")
+    lines.append("\n### Requirements\n")
+    if summary["requirements"]:
+        lines += ["Flights that miss a requirement, whatever else they failed (an undefined value, such as "
+                  "the error after a transient that never settled, misses it).\n",
+                  "| requirement | flights that missed it | rate |", "|---|---|---|"]
+        lines += [f"| `{r['requirement']}` | {r['failed']:,} | {100 * r['rate']:.2f} % |"
+                  for r in summary["requirements"]]
+    else:
+        lines.append("None given (`--require \"steady_max_error_m<=0.2\"`, or `requirements=` in Python).")
+    ns = summary["not_settled"]
+    lines.append(f"\nNot settled within {100 * ns['band']:g} % at the end (a metric, not a failure): "
+                 f"{ns['count']:,} flights ({100 * ns['rate']:.2f} %).")
     if summary["stopped"]:
         lines.append("\nWhy the engine stopped flights: " + "; ".join(f"{k}: {v:,}" for k, v in summary["stopped"].items()) + ".")
     lines += ["\n## Metrics\n", "| metric | flights | p5 | p50 | p95 | max |", "|---|---|---|---|---|---|"]
@@ -187,11 +223,15 @@ def report_markdown(result, summary: dict, worst, table_name: str) -> str:
     lines += ["\n## Worst flights\n",
               "Fly one alone again: `quadcruise montecarlo <the same options> --case VEHICLE`, or in Python "
               "`quadcruise.montecarlo.montecarlo_case(spec, VEHICLE)`; it gives the same row.\n",
-              "| vehicle | reason | rmse [m] | max error [m] | settling 5 % [s] | stop [s] | m [kg] |",
-              "|---|---|---|---|---|---|---|"]
+              "| vehicle | reason | rmse [m] | max error [m] | steady rmse [m] | steady max error [m] "
+              "| settling 5 % [s] | stop [s] | m [kg] |",
+              "|---|---|---|---|---|---|---|---|---|"]
     for _, r in worst.head(10).iterrows():
-        cells = " | ".join("-" if not np.isfinite(r[k]) else f"{r[k]:.4g}"
-                           for k in ("rmse_m", "max_error_m", "settling_time_5pct_s", "stop_time_s", "m"))
+        unsettled = "did not settle" if r["transient_axis"] >= 0 else "-"
+        cells = " | ".join((unsettled if k.startswith(("steady", "settling")) else "-")
+                           if not np.isfinite(r[k]) else f"{r[k]:.4g}"
+                           for k in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m",
+                                     "settling_time_5pct_s", "stop_time_s", "m"))
         lines.append(f"| {int(r['vehicle'])} | {r['reason']} | {cells} |")
     info = result.info
     lines += ["\n## Figures\n", "![histograms](histograms.png)\n", "![envelope](envelope.png)\n",

@@ -127,11 +127,17 @@ class MonteCarloResult:
         -------
         dict
             ``flights``, ``seed``; ``failures``: ``count``, ``rate`` and ``by_reason``
-            (each flight counted once, under the first of diverged, saturated, did not
-            settle: ``count`` and ``rate`` each); ``stopped``: the engine's stop reason ->
-            count; ``metrics``: for each of :data:`METRICS`, ``count`` (flights where it is
-            defined), ``p5``, ``p50``, ``p95``, ``max`` and ``mean`` over them, in the
-            metric's unit (None when no flight defines it).
+            (each flight counted once, under the first of diverged, lost track, saturated,
+            failed a requirement: ``count`` and ``rate`` each); ``criteria``: the bounds
+            that made those failures (``max_track_error_m`` [m], ``max_clipped_s`` [s]);
+            ``requirements``: for each of the spec's requirements, ``requirement`` (its
+            text), ``failed`` (flights that do not meet it, whatever else they failed; an
+            undefined value does not meet it) and ``rate``; ``not_settled``: ``count`` and
+            ``rate`` of flights whose transient was still outside the spec's
+            ``settle_band`` at the end (a metric, not a failure); ``stopped``: the engine's
+            stop reason -> count; ``metrics``: for each of :data:`METRICS`, ``count``
+            (flights where it is defined), ``p5``, ``p50``, ``p95``, ``max`` and ``mean``
+            over them, in the metric's unit (None when no flight defines it).
         """
         from quadcruise.sim.status import STATUS_REASONS
 
@@ -139,7 +145,13 @@ class MonteCarloResult:
         n = len(tab)
         failure = tab["failure"].to_numpy()
         counts = np.bincount(failure, minlength=len(FAILURES))
-        by_reason = {FAILURES[c]: {"count": int(counts[c]), "rate": float(counts[c] / n)} for c in (1, 2, 3)}
+        by_reason = {FAILURES[c]: {"count": int(counts[c]), "rate": float(counts[c] / n)}
+                     for c in range(1, len(FAILURES))}
+        requirements = []
+        for req in self.spec.parsed_requirements:
+            missed = int(np.count_nonzero(~req.met(tab[req.metric].to_numpy(dtype=float))))
+            requirements.append({"requirement": req.text, "failed": missed, "rate": missed / n})
+        unsettled = int(np.count_nonzero(tab["not_settled"].to_numpy()))
         stops = {STATUS_REASONS[c]: int(k) for c, k in zip(*np.unique(tab["status"], return_counts=True)) if c}
         metrics = {}
         for name in METRICS:
@@ -151,34 +163,56 @@ class MonteCarloResult:
         fails = int(np.count_nonzero(failure))
         return {"flights": n, "seed": self.spec.seed,
                 "failures": {"count": fails, "rate": fails / n, "by_reason": by_reason},
+                "criteria": {"max_track_error_m": self.spec.max_track_error_m,
+                             "max_clipped_s": self.spec.max_clipped_s},
+                "requirements": requirements,
+                "not_settled": {"count": unsettled, "rate": unsettled / n, "band": self.spec.settle_band},
                 "stopped": stops, "metrics": metrics}
 
-    def summary_text(self) -> str:
+    def summary_text(self, worst: int = 0) -> str:
         """The summary as aligned text (for the terminal).
+
+        Parameters
+        ----------
+        worst : int
+            Also list this many worst flights (:meth:`worst_text`); none by default.
 
         Returns
         -------
         str
             A headline (flights, controller, mission, seed, failures), a line per failure
-            reason, and a line per metric with its count, p5, p50, p95 and max.
+            reason (with its bound), a line per requirement (flights that missed it), the
+            flights whose transient did not settle, a line per metric with its count,
+            p5, p50, p95 and max, and the worst flights if asked for.
         """
         s = self.summary_data()
         f = s["failures"]
         lines = [f"{s['flights']:,} flights of {self.spec.controller.name} on {self.spec.mission.name}, "
                  f"seed {s['seed']}: {f['count']:,} failed ({100 * f['rate']:.2f} %)"]
+        bounds = {"lost track": f"error after the transient > {s['criteria']['max_track_error_m']:g} m",
+                  "saturated": f"duties clipped > {s['criteria']['max_clipped_s']:g} s",
+                  "failed a requirement": "see below" if s["requirements"] else "none given"}
         for reason, v in f["by_reason"].items():
-            lines.append(f"  {reason:<16} {v['count']:>8,}  ({100 * v['rate']:.2f} %)")
+            why = f"  [{bounds[reason]}]" if reason in bounds else ""
+            lines.append(f"  {reason:<22} {v['count']:>8,}  ({100 * v['rate']:.2f} %){why}")
+        for r in s["requirements"]:
+            lines.append(f"  requirement {r['requirement']}: missed by {r['failed']:,} ({100 * r['rate']:.2f} %)")
+        ns = s["not_settled"]
+        lines.append(f"  not settled within {100 * ns['band']:g} % (a metric, not a failure): "
+                     f"{ns['count']:,} ({100 * ns['rate']:.2f} %)")
         lines.append(f"  {'metric':<22}{'count':>8}{'p5':>11}{'p50':>11}{'p95':>11}{'max':>11}")
         for name, m in s["metrics"].items():
             lines.append(f"  {name:<22}{m['count']:>8,}" + "".join(
                 f"{'-' if m[k] is None else format(m[k], '.4g'):>11}" for k in ("p5", "p50", "p95", "max")))
+        if worst:
+            lines += [f"worst {worst} (fly one alone again with --case VEHICLE):", self.worst_text(worst)]
         return "\n".join(lines)
 
     def worst(self, k: int = 10, by: str = "rmse_m"):
         """The k worst flights.
 
-        Failures come first (diverged, earliest stop first; then saturated, then did not
-        settle), then the flights by ``by``, largest first.
+        Failures come first (diverged, earliest stop first; then lost track, saturated,
+        failed a requirement), then the flights by ``by``, largest first.
 
         Parameters
         ----------
@@ -202,7 +236,8 @@ class MonteCarloResult:
         if by not in self.table.columns:
             raise InputError(f"unknown metric {by!r}; choose one of {', '.join(METRICS)}")
         tab = self.table
-        rank = np.array([0, 3, 2, 1])[tab["failure"].to_numpy()]          # diverged first
+        rank = (len(FAILURES) - np.arange(len(FAILURES))) % len(FAILURES)  # 0 for ok, diverged highest
+        rank = rank[tab["failure"].to_numpy()]
         value = tab[by].to_numpy(dtype=float)
         stop = np.where(tab["failure"].to_numpy() == 1, tab["stop_time_s"].to_numpy(), 0.0)
         order = np.lexsort((tab["vehicle"].to_numpy(), np.nan_to_num(-value, nan=np.inf), stop, -rank))
@@ -223,10 +258,12 @@ class MonteCarloResult:
         Returns
         -------
         str
-            One line per flight: vehicle, seed, reason, RMSE, maximum error, 5 % settling
-            time, stop time and mass, numbers to 4 significant digits.
+            One line per flight: vehicle, seed, reason, RMSE, maximum error, RMSE and
+            maximum error after the transient, 5 % settling time, stop time and mass,
+            numbers to 4 significant digits.
         """
-        cols = ["vehicle", "seed", "reason", "rmse_m", "max_error_m", "settling_time_5pct_s", "stop_time_s", "m"]
+        cols = ["vehicle", "seed", "reason", "rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m",
+                "settling_time_5pct_s", "stop_time_s", "m"]
         return self.worst(k, by)[cols].to_string(index=False, float_format=lambda v: f"{v:.4g}")
 
     def case(self, i: int, **kw):

@@ -51,7 +51,8 @@ def merge_scenario(path, given: dict) -> tuple[Scenario, dict]:
 
 def sweep_spec(*, mission="circle", controller="nlpd", n: int | None = None, seed: int | None = None,
                duration: float | None = None, dt: float | None = None, environment=None, noise=None,
-               scenario=None, **population) -> tuple[MonteCarloSpec, int]:
+               scenario=None, requirements=(), max_track_error_m: float | None = None,
+               **population) -> tuple[MonteCarloSpec, int]:
     """The spec of a sweep and its number of flights; None means "not given".
 
     Parameters
@@ -71,6 +72,10 @@ def sweep_spec(*, mission="circle", controller="nlpd", n: int | None = None, see
     scenario : str or path-like, optional
         A TOML scenario file: mission, controller, nominal vehicle, disturbances, sensor
         noise, simulation settings, and a ``[montecarlo]`` table (:func:`merge_scenario`).
+    requirements : sequence of str
+        The user's pass criteria (:class:`MonteCarloSpec`'s ``requirements``).
+    max_track_error_m : float, optional
+        The "lost track" bound [m]; the spec's default if None.
     **population
         :class:`Population` fields (spreads, offset, distribution, model_error): given, else
         the scenario's, else the Population's defaults.
@@ -86,7 +91,8 @@ def sweep_spec(*, mission="circle", controller="nlpd", n: int | None = None, see
         An unknown or bad option, or a bad scenario.
     """
     given = {key: value for key, value in {**population, "n": n, "seed": seed}.items() if value is not None}
-    options: dict = dict(duration=duration, dt=1e-3 if dt is None else dt)
+    options: dict = dict(duration=duration, dt=1e-3 if dt is None else dt, requirements=requirements,
+                         max_track_error_m=max_track_error_m)
     if scenario is not None:
         sc, given = merge_scenario(scenario, given)
         mission = sc.mission or mission

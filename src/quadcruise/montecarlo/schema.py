@@ -8,18 +8,27 @@ from quadcruise.montecarlo.population import SLOTS
 
 __all__ = ["COLUMNS", "FAILURES", "METRICS"]
 
-FAILURES = ("ok", "diverged", "saturated", "did not settle")
-"""Failure codes 0..3 of the table's ``failure`` column, in order of precedence."""
-METRICS = ("rmse_m", "max_error_m", "final_error_m", "rise_time_s", "settling_time_s",
-           "settling_time_5pct_s", "overshoot_pct", "effort", "duty_clipped_s", "controller_limited_s")
-"""The metrics summarised by quantiles (NaN where not applicable is left out)."""
+FAILURES = ("ok", "diverged", "lost track", "saturated", "failed a requirement")
+"""Failure codes 0..4 of the table's ``failure`` column, in order of precedence: the engine
+stopped the flight; its error after the transient exceeded the spec's ``max_track_error_m``;
+its rotor duties were clipped for longer than ``max_clipped_s``; it missed one of the
+spec's ``requirements``. A transient that did not settle is a metric (``not_settled``),
+not a failure."""
+METRICS = ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "final_error_m", "rise_time_s",
+           "settling_time_s", "settling_time_5pct_s", "overshoot_pct", "peak_time_s", "effort",
+           "duty_clipped_s", "controller_limited_s")
+"""The metrics summarised by quantiles (NaN where not applicable is left out), and those a
+requirement may name."""
 COLUMNS = {
     "vehicle": np.int64, "status": np.int64, "stop_time_s": float, "failure": np.int64,
-    "diverged": bool, "saturated": bool, "not_settled": bool, "transient_axis": np.int64,
+    "diverged": bool, "lost_track": bool, "saturated": bool, "failed_requirement": bool, "not_settled": bool,
+    "transient_axis": np.int64,
     **{m: float for m in METRICS},
     **{k: float for k in SLOTS},
 }
 """Columns of the per-flight table and their types: engine ``status`` (see
-:data:`quadcruise.sim.status.ExitStatus`), ``failure`` (see :data:`FAILURES`),
+:data:`quadcruise.sim.status.ExitStatus`), ``failure`` (see :data:`FAILURES`), a flag per
+failure reason (a flight may have several; ``failure`` names the first), ``not_settled``
+(the transient still outside the spec's ``settle_band`` at the end),
 ``transient_axis`` (0, 1, 2 for x, y, z; -1 if none), the metrics and the drawn values
 (``dx0``..: initial offset [m]; ``wind_x``, ``wind_y``: steady wind [m/s])."""

@@ -21,17 +21,50 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from quadcruise._cache import code_digest
 from quadcruise._version import __version__
 from quadcruise.control import as_controller, controller_record
 from quadcruise.errors import InputError, whole_number
 from quadcruise.io.plainjson import dumps
-from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
+from quadcruise.layout import CMD_SIZE, REF_SIZE, REF_X, STATE_SIZE
 from quadcruise.missions import Mission, mission_from_name
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
+from quadcruise.montecarlo.requirements import Requirement, parse_requirements
 
-__all__ = ["MonteCarloSpec"]
+__all__ = ["MonteCarloSpec", "default_track_bound"]
+
+
+def default_track_bound(mission: Mission, duration: float) -> float:
+    """The default ``max_track_error_m`` of a sweep: the larger of 1 m and a quarter of the
+    mission's extent.
+
+    Parameters
+    ----------
+    mission : Mission
+        The mission flown.
+    duration : float
+        Flight time [s].
+
+    Returns
+    -------
+    float
+        The bound [m]; the extent is the longest side of the box holding the reference
+        position at 1,001 instants over the flight.
+
+    Examples
+    --------
+    >>> from quadcruise.missions import mission_from_name
+    >>> default_track_bound(mission_from_name("circle"), 20.0)
+    1.0
+    >>> default_track_bound(mission_from_name("circle", radius=10.0), 20.0)
+    5.0
+    """
+    ref = mission.reference(np.linspace(0.0, float(duration), 1001))[:, REF_X:REF_X + 3]
+    extent = float(np.max(ref.max(axis=0) - ref.min(axis=0)))
+    return max(1.0, 0.25 * extent)
 
 
 def _divisor_at_most(n: int, target: int) -> int:
@@ -75,13 +108,26 @@ class MonteCarloSpec:
         Paths kept of the first this many failed vehicles.
     settle_band : float
         A measured transient that is outside this band (fraction of the initial error) at
-        the end "did not settle".
+        the end is marked ``not_settled``: a metric, not a failure.
     max_clipped_s : float
         Clipping of rotor duties for longer than this [s] counts as "saturated".
     transient_until : float, optional
         End of the window in which the transient is measured [s].
     full_dynamics : bool
         Exact Euler-angle kinematics.
+    max_track_error_m : float, optional
+        A flight "lost track" if its position error after the transient
+        (``steady_max_error_m``; where that is undefined because the transient never
+        settled into 5 %, the error at the end, ``final_error_m``) exceeds this [m]. By
+        default (None) the larger of 1 m and a quarter of the mission's extent (the longest
+        side of the box holding its reference path over the flight): 1 m for the built-in
+        circle, square, step and hover. The value used is the field's value after
+        construction, recorded with the spec.
+    requirements : str or sequence of str
+        The user's own pass criteria, e.g. ``("steady_max_error_m<=0.2",)``: a metric of
+        :data:`~quadcruise.montecarlo.schema.METRICS`, ``<=``, ``<``, ``>=`` or ``>``, and a
+        number (:class:`~quadcruise.montecarlo.requirements.Requirement`). A flight that
+        misses one "failed a requirement"; an undefined value misses it.
 
     Raises
     ------
@@ -112,6 +158,8 @@ class MonteCarloSpec:
     max_clipped_s: float = 0.0
     transient_until: float | None = None
     full_dynamics: bool = False
+    max_track_error_m: float | None = None
+    requirements: Any = ()
 
     def __post_init__(self) -> None:
         from quadcruise.sim.engine import time_grid
@@ -142,12 +190,23 @@ class MonteCarloSpec:
         for name in ("max_traces", "max_failure_traces"):
             if int(getattr(self, name)) != getattr(self, name) or getattr(self, name) < 0:
                 raise InputError(f"{name} must be a whole number >= 0, got {getattr(self, name)!r}")
+        object.__setattr__(self, "requirements", tuple(r.text for r in parse_requirements(self.requirements)))
+        bound = default_track_bound(self.mission, self.duration) if self.max_track_error_m is None \
+            else self.max_track_error_m
+        if isinstance(bound, bool) or not (isinstance(bound, (int, float)) and math.isfinite(bound) and bound > 0):
+            raise InputError(f"max_track_error_m must be a positive number [m], got {bound!r}")
+        object.__setattr__(self, "max_track_error_m", float(bound))
         if self.population.needs_drag:
             from quadcruise.disturbances.environment import with_drag
 
             object.__setattr__(self, "vehicle", with_drag(self.vehicle))
 
     # --- derived ------------------------------------------------------------------------
+    @property
+    def parsed_requirements(self) -> tuple[Requirement, ...]:
+        """The :attr:`requirements` as :class:`~quadcruise.montecarlo.requirements.Requirement` objects."""
+        return parse_requirements(self.requirements)
+
     @property
     def periods(self) -> int:
         """Control periods per flight."""

@@ -282,6 +282,8 @@ def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", s
                                  or chunk_size < 1):
         raise InputError(f"chunk size must be a whole number >= 1 or 'auto', got {chunk_size!r}")
     workers = None if workers is None else whole_number(workers, "workers", 1)
+    if not (isinstance(connect_timeout, (int, float)) and math.isfinite(connect_timeout) and connect_timeout > 0):
+        raise InputError(f"connect_timeout must be a positive number of seconds, got {connect_timeout!r}")
     check_table_format(fmt)
     mode = _scheduler(scheduler)
     folder = SweepFolder(out, spec, force=force, resume=resume) if out is not None else None

@@ -45,10 +45,11 @@ def plot_histograms(result, metrics=None):
     axes = fig.subplots(rows, cols, squeeze=False).ravel()
     for ax, name in zip(axes, panels):
         if name == "failures":
-            names = result.failure_names          # the outcome codes 0..3 of the table's 'failure' column
+            names = result.failure_names          # the outcome codes 0..4 of the table's 'failure' column
             counts = [int(np.count_nonzero(result.table["failure"] == c)) for c in range(len(names))]
-            ax.bar(range(len(names)), counts, color=["tab:green", "tab:red", "tab:orange", "tab:purple"])
-            ax.set_xticks(range(len(names)), names, fontsize="small")
+            ax.bar(range(len(names)), counts,
+                   color=["tab:green", "tab:red", "tab:orange", "tab:brown", "tab:purple"][:len(names)])
+            ax.set_xticks(range(len(names)), [n.replace(" ", "\n", 1) for n in names], fontsize="small")
             for x, c in enumerate(counts):
                 ax.annotate(f"{c:,}", (x, c), ha="center", va="bottom", fontsize="small")
             ax.set_title(f"outcome of {result.n:,} flights", fontsize="medium")
@@ -104,7 +105,7 @@ def plot_envelope(result):
     total = result.table["failure"].value_counts()
     for code, color, what in ((0, "tab:blue", "ok"), (1, "tab:red", "diverged"), (2, "tab:orange", "failed otherwise")):
         drawn = int(np.count_nonzero(fail == code)) if code < 2 else int(np.count_nonzero(fail >= 2))
-        all_ = int(total.get(code, 0)) if code < 2 else int(total.get(2, 0) + total.get(3, 0))
+        all_ = int(total.get(code, 0)) if code < 2 else int(total[total.index >= 2].sum())
         if all_:
             top.plot([], [], color=color, lw=1, label=f"{what} ({drawn:,} drawn of {all_:,})")
     ref = next((tr.ref[k] for k in range(len(tr.vehicle)) if np.all(np.isfinite(tr.ref[k, :, :2]))), None)

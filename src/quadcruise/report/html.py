@@ -49,14 +49,19 @@ COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e3
           "#7f7f7f", "#bcbd22", "#17becf")   # matplotlib's tab10, the C0..C9 of the figures
 LABELS = {"rmse_m": "RMSE [m]", "settling_time_s": "settling time 2 % [s]",
           "settling_time_5pct_s": "settling time 5 % [s]", "overshoot_pct": "overshoot [%]",
-          "effort": "effort [s]", "axis": "transient axis"}
+          "steady_rmse_m": "RMSE after the transient [m]", "steady_max_error_m": "max error after the transient [m]",
+          "effort": "effort about hover [s]", "axis": "transient axis"}
 MISSING = "—"
 
 
-def _label(name) -> str:
-    """A column name as a heading: ``rise_time_s`` -> ``rise time [s]``."""
+def _label(name, conventions: dict | None = None) -> str:
+    """A column name as a heading: ``rise_time_s`` -> ``rise time [s]``; a settling time
+    with the band its table's conventions give it."""
     if not isinstance(name, str):
         return str(name)
+    bands = (conventions or {}).get("settling_columns", {})
+    if name in bands:
+        return f"settling time {format(100.0 * float(bands[name]), '.6g')} % [s]"
     if name in LABELS:
         return LABELS[name]
     for suffix, unit in (("_s", "s"), ("_m", "m"), ("_pct", "%"), ("_deg", "deg"), ("_rad", "rad")):
@@ -100,12 +105,13 @@ def table_html(frame) -> str:
     shown_index = not (isinstance(frame.index, pd.RangeIndex) and frame.index.start == 0
                        and frame.index.step == 1)
     idx_names = [n for n in frame.index.names] if shown_index else []
-    head = [_label(n) if n is not None else "" for n in idx_names] + [_label(c) for c in frame.columns]
+    conventions = frame.attrs.get("conventions")
+    head = [_label(n) if n is not None else "" for n in idx_names] + [_label(c, conventions) for c in frame.columns]
     out = ["<table>", "<thead><tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in head) + "</tr></thead>",
            "<tbody>"]
     for r, (key, row) in enumerate(frame.iterrows()):
         keys = key if isinstance(key, tuple) else (key,)
-        cells = [f'<th scope="row">{html.escape(_label(k))}</th>' for k in keys] if shown_index else []
+        cells = [f'<th scope="row">{html.escape(_label(k, conventions))}</th>' for k in keys] if shown_index else []
         for c, (col, value) in enumerate(row.items()):
             axis = rows_axis.iloc[r] if rows_axis is not None else None
             metric = col
@@ -381,6 +387,22 @@ def _metrics_table(frame):
     return shown
 
 
+def _conventions_table(frame) -> dict:
+    """``{"Metric conventions": table}`` of what a metrics table's columns measure (its
+    ``attrs["conventions"]``), or ``{}`` if it records none."""
+    import pandas as pd
+
+    conv = frame.attrs.get("conventions")
+    if not conv:
+        return {}
+    values = {"rise_time_s": "{:g}-{:g} % of the step".format(*(100.0 * v for v in conv["rise"]))}
+    values.update({name: f"{100.0 * band:g} % band" for name, band in conv["settling_columns"].items()})
+    values["steady_rmse_m, steady_max_error_m"] = (f"3-D position error from the {100.0 * conv['steady_band']:g} % "
+                                                   "settling time on (the whole flight without a transient)")
+    values["effort"] = conv["effort"]
+    return {"Metric conventions": pd.DataFrame({"meaning": values})}
+
+
 def flight_report(result, *, title: str | None = None, metrics=None) -> dict:
     """Keywords of :func:`html_report` for one flight (one ``fly``).
 
@@ -418,13 +440,14 @@ def flight_report(result, *, title: str | None = None, metrics=None) -> dict:
     figures = {f"Flight of vehicle 0: {label}": plot_flight(result)}
     if result.n > 1:
         figures[f"All {result.n} vehicles"] = plot_envelope(result)
+    metrics = result.metrics() if metrics is None else metrics
     return {"title": title or f"quadcruise: {label}",
-            "tables": {"Flight metrics": _metrics_table(result.metrics() if metrics is None else metrics),
+            "tables": {"Flight metrics": _metrics_table(metrics), **_conventions_table(metrics),
                        "Run": run_table},
             "figures": figures, "flights": {label: result}, "config": meta}
 
 
-def comparison_report(cmp, *, title: str | None = None) -> dict:
+def comparison_report(cmp, *, title: str | None = None, **metric_kw) -> dict:
     """Keywords of :func:`html_report` for a :class:`~quadcruise.workflows.compare.Comparison`.
 
     Parameters
@@ -433,21 +456,23 @@ def comparison_report(cmp, *, title: str | None = None) -> dict:
         The flights of several controllers.
     title : str, optional
         The page's title; by default the controllers and the mission.
+    **metric_kw
+        Keywords of :meth:`Comparison.table` (``rise``, ``settle_bands``, ...).
 
     Returns
     -------
     dict
         ``title``, ``tables`` (the metrics by controller, transposed when every flight
-        has one vehicle), ``figures`` (the paths), ``flights`` (one 3-D view of all) and
-        ``config`` (:meth:`Comparison.to_dict` without the metrics).
+        has one vehicle, and their conventions), ``figures`` (the paths), ``flights`` (one
+        3-D view of all) and ``config`` (:meth:`Comparison.to_dict` without the metrics).
     """
-    table = cmp.table()
+    table = cmp.table(**metric_kw)
     if all(r.n == 1 for r in cmp.results.values()):
         table = table.T   # metrics down, controllers across
-    config = {k: v for k, v in cmp.to_dict().items() if k != "metrics"}
+    config = {k: v for k, v in cmp.to_dict(**metric_kw).items() if k != "metrics"}
     name = getattr(cmp.mission, "name", "mission")
     return {"title": title or f"quadcruise: {' vs '.join(cmp.results)} on {name}",
-            "tables": {"Metrics by controller": table},
+            "tables": {"Metrics by controller": table, **_conventions_table(table)},
             "figures": {f"Paths on {name}": cmp.plot()},
             "flights": dict(cmp.results), "config": config}
 

@@ -408,6 +408,11 @@ def fly_vehicles(n: int, args: tuple) -> None:
         h.result()
 
 
+MAX_STEPS = 1e9
+"""Most control periods one flight may have (a day at 1 kHz is 8.6e7): beyond it the time grid
+alone would need 8 GB."""
+
+
 def time_grid(duration: float, dt: float, t0: float = 0.0) -> np.ndarray:
     """Uniform control instants t0, t0 + dt, ..., t0 + duration.
 
@@ -420,6 +425,9 @@ def time_grid(duration: float, dt: float, t0: float = 0.0) -> np.ndarray:
         raise InputError(f"dt must be a positive number of seconds, got {dt!r}")
     if dt > duration:
         raise InputError(f"dt ({dt:g} s) is larger than the duration ({duration:g} s)")
+    if duration / dt > MAX_STEPS:
+        raise InputError(f"{duration:g} s at dt = {dt:g} s is {duration / dt:.3g} control periods, more than "
+                         f"{MAX_STEPS:.0e}: shorten the duration or lengthen dt")
     n = round(duration / dt)
     if abs(n * dt - duration) > 1e-9 * max(1.0, duration):
         raise InputError(f"duration ({duration:g} s) is not a whole number of dt ({dt:g} s) periods")

@@ -213,13 +213,22 @@ class SimResult:
         Parameters
         ----------
         **kwargs
-            Keywords of :func:`quadcruise.metrics.flight_metrics` (``transient_axis``,
-            ``transient_until``).
+            Keywords of :func:`quadcruise.metrics.flight_metrics`: ``transient_axis``,
+            ``transient_until``, and the conventions ``rise`` (``(0.1, 0.9)`` or
+            ``(0.0, 1.0)``, ...) and ``settle_bands`` (``(0.02, 0.05)``, ...).
 
         Returns
         -------
         pandas.DataFrame
-            One row per vehicle (see :func:`quadcruise.metrics.flight_metrics`).
+            One row per vehicle (see :func:`quadcruise.metrics.flight_metrics`); its
+            ``attrs["conventions"]`` records the conventions.
+
+        Examples
+        --------
+        >>> import quadcruise as qc
+        >>> table = qc.fly("step", duration=4.0, log_every=10).metrics(rise=(0.0, 1.0), settle_bands=(0.02, 0.03))
+        >>> [c for c in table.columns if c.startswith("settling")], table.attrs["conventions"]["rise"]
+        (['settling_time_s', 'settling_time_3pct_s'], [0.0, 1.0])
         """
         from quadcruise.metrics.flight import flight_metrics
 
@@ -279,7 +288,8 @@ class SimResult:
     def write(self, out: str | os.PathLike, *, fmt: str = "csv", force: bool = False, metrics=None) -> Path:
         """Write the flight's folder, whole or not at all: the traces (``traces.csv`` or
         ``traces.parquet``), ``metrics.csv``, ``flight.png``, the configuration
-        (``quadcruise.json``) and ``scenario.toml``, which ``quadcruise fly`` flies again to
+        (``quadcruise.json``: :attr:`meta`, and under ``metrics_conventions`` the conventions
+        of the metrics written) and ``scenario.toml``, which ``quadcruise fly`` flies again to
         the same numbers (when the flight came from :func:`quadcruise.fly`).
 
         Parameters
@@ -291,7 +301,8 @@ class SimResult:
         force : bool
             Replace a folder holding something else.
         metrics : pandas.DataFrame, optional
-            :meth:`metrics` if already computed (saves computing them again).
+            :meth:`metrics` if already computed (saves computing them again), with the
+            conventions it was computed with.
 
         Returns
         -------
@@ -309,7 +320,7 @@ class SimResult:
             write_table(self.to_pandas(), tmp / "traces", fmt)
             metrics.to_csv(tmp / "metrics.csv", index=False)
             save_figure(plot_flight(self), tmp / "flight.png")
-            (tmp / MARKER).write_text(self.meta_json() + "\n")
+            (tmp / MARKER).write_text(self.meta_json(metrics_conventions=metrics.attrs.get("conventions")) + "\n")
             if self.meta.get("workflow") == "fly" and "custom" not in (self.meta.get("environment") or {}):
                 (tmp / "scenario.toml").write_text(self.scenario_toml())
         return out
@@ -340,16 +351,21 @@ class SimResult:
             header += "\nthe command line changed: " + " ".join(self.meta["command_line"])
         return scenario_text(doc, header=header)
 
-    def meta_json(self) -> str:
+    def meta_json(self, **extra) -> str:
         """The recorded configuration as JSON.
+
+        Parameters
+        ----------
+        **extra
+            More entries beside :attr:`meta` (None values are left out).
 
         Returns
         -------
         str
-            :attr:`meta` as strict JSON, indented, keys sorted.
+            :attr:`meta` (and ``extra``) as strict JSON, indented, keys sorted.
         """
         from quadcruise.io.plainjson import dumps
 
-        return dumps(self.meta, indent=2, sort_keys=True)
+        return dumps({**self.meta, **{k: v for k, v in extra.items() if v is not None}}, indent=2, sort_keys=True)
 
 

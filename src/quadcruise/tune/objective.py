@@ -11,8 +11,9 @@ A flight that misses a requirement costs :data:`REQUIREMENT_COST` more, plus its
 measured in the requirements' own values (|bound|, or 1 for a bound of 0). A flight that
 finished but has no value for a metric the cost needs (a transient that never settled) costs
 :data:`FAILURE_COST` times (1 + its RMSE in metres), so that among such flights the search
-still sees which is closer; a flight that did not finish (diverged, lost track) costs ten
-times :data:`FAILURE_COST`. So every flight that meets the requirements ranks before every
+still sees which is closer; a flight that lost track (the Monte Carlo rule: fly's status, or its error after the
+transient beyond the spec's bound) costs the same; a flight the engine stopped (diverged)
+costs ten times :data:`FAILURE_COST`. So every flight that meets the requirements ranks before every
 one that does not, and every finished flight before every failed one.
 
 A candidate's cost is the worst of its M flights' costs (``statistic="worst"``) or their
@@ -32,7 +33,7 @@ from quadcruise.errors import InputError
 from quadcruise.montecarlo.chunk import fly_chunk, sweep_metrics
 from quadcruise.montecarlo.schema import METRICS
 from quadcruise.montecarlo.spec import MonteCarloSpec
-from quadcruise.tune.spec import GainSpace
+from quadcruise.tune.spec import GainSpace, violation
 
 __all__ = ["FAILURE_COST", "REQUIREMENT_COST", "Evaluation", "Objective", "check_statistic"]
 
@@ -103,7 +104,7 @@ class Evaluation:
         Each flight's cost.
     metrics : dict of str to ndarray, shape (P, M)
         Each flight's metrics (the table's columns: :data:`~quadcruise.montecarlo.schema.METRICS`,
-        ``status``, ``failure``).
+        ``status``, ``failure``, ``diverged``, ``lost_track``).
     wall_s : float
         Time to fly and measure the generation [s].
     """
@@ -193,8 +194,8 @@ class Objective:
         res, _ = fly_chunk(self.spec, ids, p * m, controller=controllers)
         cols = sweep_metrics(res, self.spec)
         metrics = {k: np.asarray(cols[k], dtype=float).reshape(p, m) for k in METRICS}
-        metrics["status"] = np.asarray(cols["status"]).reshape(p, m)
-        metrics["failure"] = np.asarray(cols["failure"]).reshape(p, m)
+        for key in ("status", "failure", "diverged", "lost_track"):
+            metrics[key] = np.asarray(cols[key]).reshape(p, m)
         flight_cost = self.flight_cost(metrics)
         ev = Evaluation(values=values, cost=self.reduce(flight_cost), flight_cost=flight_cost, metrics=metrics,
                         wall_s=time.perf_counter() - start)
@@ -207,7 +208,7 @@ class Objective:
         Parameters
         ----------
         metrics : dict of str to ndarray
-            The flights' metrics and ``status``.
+            The flights' metrics, ``status`` and (if known) ``diverged`` and ``lost_track``.
 
         Returns
         -------
@@ -215,21 +216,22 @@ class Objective:
             Same shape as each metric.
         """
         status = metrics["status"]
+        stopped = metrics.get("diverged", status != 0)
         cost = np.zeros(status.shape)
         for t in self.targets:
             cost += t.cost(metrics[t.metric])
         for name in self.minimize:
             cost += metrics[name]
         missed = np.zeros(status.shape)
-        failed = status != 0
+        failed = (status != 0) | stopped | metrics.get("lost_track", False)
         for r in self.requirements:
             values = metrics[r.metric]
             failed |= np.isnan(values)
-            missed += np.where(r.met(values), 0.0, r.violation(values) / (abs(r.value) or 1.0))
+            missed += np.where(r.met(values), 0.0, violation(r, values) / (abs(r.value) or 1.0))
         cost = np.where(missed > 0, cost + REQUIREMENT_COST * (1.0 + missed), cost)
         failed |= ~np.isfinite(cost)
         rmse = metrics.get("rmse_m", np.zeros(status.shape))
-        fallback = np.where((status == 0) & np.isfinite(rmse), FAILURE_COST * (1.0 + rmse), 10.0 * FAILURE_COST)
+        fallback = np.where(~stopped & np.isfinite(rmse), FAILURE_COST * (1.0 + rmse), 10.0 * FAILURE_COST)
         return np.where(failed, fallback, cost)
 
     def reduce(self, flight_cost: np.ndarray) -> np.ndarray:

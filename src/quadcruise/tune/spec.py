@@ -13,8 +13,9 @@ any flight.
 - A **target** ``METRIC=VALUE`` or ``METRIC=VALUE+-TOLERANCE``: the cost counts the miss in
   tolerances, squared; without a tolerance, 10 % of the value (1 in the metric's unit for a
   target of 0). A target is *met* within its tolerance.
-- A **requirement** ``METRIC<=VALUE`` (``<``, ``>=``, ``>``): a candidate that misses it
-  ranks behind every candidate that meets all of them.
+- A **requirement** ``METRIC<=VALUE`` (``<``, ``>=``, ``>``), the Monte Carlo sweep's own
+  (:mod:`quadcruise.montecarlo.requirements`): a candidate that misses it ranks behind every
+  candidate that meets all of them.
 - **minimize** ``METRIC``: the metric's value, in its unit, is added to the cost.
 
 The metrics are the columns of a Monte Carlo table
@@ -39,7 +40,6 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import math
-import operator
 import re
 from dataclasses import dataclass
 from typing import Any, Iterable, Mapping, Sequence
@@ -48,10 +48,11 @@ import numpy as np
 
 from quadcruise.control.design import PDGains
 from quadcruise.errors import InputError
+from quadcruise.montecarlo.requirements import Requirement, parse_requirements
 from quadcruise.montecarlo.schema import METRICS
 
 __all__ = ["Gain", "GainSpace", "Requirement", "Target", "check_metric", "parse_bounds", "parse_minimize",
-           "parse_requirements", "parse_targets"]
+           "parse_requirements", "parse_targets", "violation"]
 
 POLE_NAMES = ("wn", "zeta")
 """The pole-pair parameters of a PD gains field: natural frequency [rad/s], damping ratio [-]."""
@@ -83,10 +84,10 @@ def check_metric(name: str, what: str) -> str:
 
     Examples
     --------
-    >>> check_metric("rise_time", "target 'rise_time=1'")
+    >>> check_metric("rise_time", "target 'rise_time=1'")          # doctest: +ELLIPSIS
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: target 'rise_time=1': unknown metric 'rise_time' (did you mean 'rise_time_s'?); metrics: rmse_m, max_error_m, final_error_m, rise_time_s, settling_time_s, settling_time_5pct_s, overshoot_pct, effort, duty_clipped_s, controller_limited_s
+    quadcruise.errors.InputError: target 'rise_time=1': unknown metric 'rise_time' (did you mean 'rise_time_s'?); metrics: rmse_m, ...
     """
     if name not in METRICS:
         close = difflib.get_close_matches(name, METRICS, n=1)
@@ -200,93 +201,29 @@ class Target:
             return np.abs(v - self.value) <= self.tolerance * (1 + 1e-12)
 
 
-_OPERATORS = {"<=": operator.le, "<": operator.lt, ">=": operator.ge, ">": operator.gt}
-_REQUIREMENT = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|<|>)\s*([^<>=\s]+)\s*$")
-
-
-@dataclass(frozen=True)
-class Requirement:
-    """A bound a metric must keep: ``metric op value``.
+def violation(requirement: Requirement, values) -> np.ndarray:
+    """How far each value is on the wrong side of a requirement's bound, in the metric's unit.
 
     Parameters
     ----------
-    metric : str
-        A metric of :data:`~quadcruise.montecarlo.schema.METRICS`.
-    op : {"<=", "<", ">=", ">"}
-        The comparison.
-    value : float
-        The bound, in the metric's unit.
+    requirement : Requirement
+        A Monte Carlo requirement (:class:`quadcruise.montecarlo.requirements.Requirement`).
+    values : array_like
+        Values of its metric.
+
+    Returns
+    -------
+    ndarray
+        0 where the value is on the right side (and at the bound of a strict comparison).
+
+    Examples
+    --------
+    >>> violation(Requirement.parse("overshoot_pct<=5"), [3.0, 7.5]).tolist()
+    [0.0, 2.5]
     """
-
-    metric: str
-    op: str
-    value: float
-
-    @classmethod
-    def parse(cls, text: str) -> "Requirement":
-        """A requirement from ``METRIC<=VALUE`` (or ``<``, ``>=``, ``>``; spaces allowed).
-
-        Parameters
-        ----------
-        text : str
-            E.g. ``"overshoot_pct<=5"``.
-
-        Returns
-        -------
-        Requirement
-
-        Raises
-        ------
-        InputError
-            Not of that form, an unknown metric, or a bound that is not a finite number.
-        """
-        if isinstance(text, Requirement):
-            return text
-        match = _REQUIREMENT.match(str(text))
-        what = f"requirement {str(text).strip()!r}"
-        if match is None:
-            raise InputError(f"{what}: expected METRIC<=VALUE (or <, >=, >), e.g. overshoot_pct<=5")
-        metric, op, number = match.groups()
-        return cls(check_metric(metric, what), op, _number(number, what))
-
-    @property
-    def text(self) -> str:
-        """The requirement as text, without spaces."""
-        return f"{self.metric}{self.op}{self.value:g}"
-
-    def met(self, values) -> np.ndarray:
-        """Which values meet the requirement.
-
-        Parameters
-        ----------
-        values : array_like
-            Values of the metric.
-
-        Returns
-        -------
-        ndarray of bool
-            False where a value is NaN.
-        """
-        v = np.asarray(values, dtype=float)
-        with np.errstate(invalid="ignore"):
-            return np.asarray(_OPERATORS[self.op](v, self.value), dtype=bool) & np.isfinite(v)
-
-    def violation(self, values) -> np.ndarray:
-        """How far each value is on the wrong side of the bound, in the metric's unit.
-
-        Parameters
-        ----------
-        values : array_like
-            Values of the metric.
-
-        Returns
-        -------
-        ndarray
-            0 where the requirement is met (also at the bound of a strict comparison).
-        """
-        v = np.asarray(values, dtype=float)
-        gap = v - self.value if self.op in ("<=", "<") else self.value - v
-        return np.maximum(gap, 0.0)
+    v = np.asarray(values, dtype=float)
+    gap = v - requirement.value if requirement.op in ("<=", "<") else requirement.value - v
+    return np.maximum(gap, 0.0)
 
 
 def parse_targets(texts: str | Iterable | None) -> tuple[Target, ...]:
@@ -310,25 +247,6 @@ def parse_targets(texts: str | Iterable | None) -> tuple[Target, ...]:
     return out
 
 
-def parse_requirements(texts: str | Iterable | None) -> tuple[Requirement, ...]:
-    """Requirements from their texts (see :meth:`Requirement.parse`).
-
-    Parameters
-    ----------
-    texts : str, Requirement, or an iterable of them, or None
-
-    Returns
-    -------
-    tuple of Requirement
-
-    Examples
-    --------
-    >>> [r.text for r in parse_requirements(["rmse_m<0.5", "overshoot_pct <= 10"])]
-    ['rmse_m<0.5', 'overshoot_pct<=10']
-    """
-    return tuple(Requirement.parse(t) for t in _items(texts))
-
-
 def parse_minimize(names: str | Iterable[str] | None) -> tuple[str, ...]:
     """The metrics to minimise, each checked; a metric at most once.
 
@@ -343,7 +261,10 @@ def parse_minimize(names: str | Iterable[str] | None) -> tuple[str, ...]:
     """
     out = []
     for item in _items(names):
-        out += [check_metric(n.strip(), f"minimize {n.strip()!r}") for n in str(item).split(",") if n.strip()]
+        found = [check_metric(n.strip(), f"minimize {n.strip()!r}") for n in str(item).split(",") if n.strip()]
+        if not found:
+            raise InputError(f"minimize {str(item)!r}: expected a metric, e.g. rmse_m; metrics: {', '.join(METRICS)}")
+        out += found
     _once(out, "minimize")
     return tuple(out)
 
@@ -351,7 +272,7 @@ def parse_minimize(names: str | Iterable[str] | None) -> tuple[str, ...]:
 def _items(texts) -> list:
     if texts is None:
         return []
-    if isinstance(texts, (str, Target, Requirement)):
+    if isinstance(texts, (str, Target)):
         return [texts]
     return list(texts)
 
@@ -504,12 +425,14 @@ def parse_bounds(items: str | Iterable[str] | Mapping | None) -> dict[str, tuple
     else:
         pairs = []
         for text in ([items] if isinstance(items, str) else list(items)):
-            for piece in str(text).split(","):
-                if piece.strip():
-                    name, sep, span = piece.partition("=")
-                    if not sep:
-                        raise InputError(f"bounds {piece.strip()!r}: expected NAME=LOW:HIGH, e.g. position.kp=0.5:10")
-                    pairs.append((name.strip(), span.strip()))
+            pieces = [piece for piece in str(text).split(",") if piece.strip()]
+            if not pieces:
+                raise InputError(f"bounds {str(text)!r}: expected NAME=LOW:HIGH, e.g. position.kp=0.5:10")
+            for piece in pieces:
+                name, sep, span = piece.partition("=")
+                if not sep or not name.strip():
+                    raise InputError(f"bounds {piece.strip()!r}: expected NAME=LOW:HIGH, e.g. position.kp=0.5:10")
+                pairs.append((name.strip(), span.strip()))
     out: dict[str, tuple[float, float]] = {}
     for name, span in pairs:
         what = f"bounds '{name}={span}'" if isinstance(span, str) else f"bounds of {name}"
@@ -581,7 +504,10 @@ class GainSpace:
             raise InputError(f"a tuner needs a built-in controller (a dataclass of gains), got {type(base).__name__}")
         values = tunable_values(base)
         if isinstance(names, str):
-            names = [n.strip() for n in names.split(",") if n.strip()]
+            text, names = names, [n.strip() for n in names.split(",") if n.strip()]
+            if not names:
+                raise InputError(f"gains {text!r}: expected gain names, e.g. position.kp,position.kd; "
+                                 f"gains of {base.name}: {', '.join(values)}")
         if not names:
             if "position.kp" not in values:
                 raise InputError(f"name the gains of {base.name} to tune (gains: {', '.join(values)})")

@@ -66,14 +66,16 @@ class Comparison:
         Parameters
         ----------
         **metric_kw : Any
-            Keywords of :func:`quadcruise.metrics.flight_metrics` (``transient_axis``,
-            ``transient_until``).
+            Keywords of :func:`quadcruise.metrics.flight_metrics`: ``transient_axis``,
+            ``transient_until``, and the conventions ``rise`` (e.g. ``(0.0, 1.0)`` for
+            0-100 %) and ``settle_bands`` (e.g. ``(0.02, 0.03)``).
 
         Returns
         -------
         pandas.DataFrame
             Every column of :func:`quadcruise.metrics.flight_metrics`, indexed by
-            controller (by controller and vehicle for a batch); a copy.
+            controller (by controller and vehicle for a batch); a copy. Its
+            ``attrs["conventions"]`` records the conventions.
         """
         key = repr(sorted(metric_kw.items()))
         if key not in self._tables:
@@ -89,6 +91,7 @@ class Comparison:
             frame.insert(0, "controller", label)
             frames.append(frame)
         table = pd.concat(frames, ignore_index=True)
+        table.attrs = dict(frames[0].attrs)
         if all(res.n == 1 for res in self.results.values()):
             return table.drop(columns="vehicle").set_index("controller")
         return table.set_index(["controller", "vehicle"])
@@ -123,8 +126,7 @@ class Comparison:
         Summary
             Controller label -> {metric: value} (NaN as None), as in :meth:`to_dict`'s ``metrics``.
         """
-        return Summary(self.to_dict()["metrics"] if not metric_kw else self._rows(self.table(**metric_kw)),
-                       self.text(**metric_kw))
+        return Summary(self._rows(self.table(**metric_kw)), self.text(**metric_kw))
 
     def text(self, **metric_kw: Any) -> str:
         """The table as aligned text, metrics down and controllers across (for a terminal).
@@ -139,12 +141,15 @@ class Comparison:
         Returns
         -------
         str
-            See :func:`quadcruise.metrics.tables.metrics_text`.
+            See :func:`quadcruise.metrics.tables.metrics_text`; below the table, what its
+            columns measure (:func:`quadcruise.metrics.tables.conventions_text`).
         """
-        from quadcruise.metrics.tables import metrics_text
+        from quadcruise.metrics.tables import conventions_text, metrics_text
 
         table = self.table(**metric_kw)
-        return metrics_text(table, [" ".join(map(str, c)) if isinstance(c, tuple) else c for c in table.index])
+        text = metrics_text(table, [" ".join(map(str, c)) if isinstance(c, tuple) else c for c in table.index])
+        notes = conventions_text(table.attrs.get("conventions"))
+        return f"{text}\n{notes}" if notes else text
 
     def plot(self, vehicle: int = 0, *, title: str | None = None):
         """Overlay of the flights: top view, and x, y, z against time, each reference once.
@@ -169,19 +174,25 @@ class Comparison:
         add_z_panel(fig, self.results, vehicle)
         return fig
 
-    def to_dict(self) -> dict:
+    def to_dict(self, **metric_kw: Any) -> dict:
         """Mission, vehicle, controllers and metrics as plain values (NaN as None), for JSON.
+
+        Parameters
+        ----------
+        **metric_kw : Any
+            Keywords of :meth:`table`.
 
         Returns
         -------
         dict
             ``workflow`` (``"compare"``), ``mission``, ``vehicle``, ``duration_s``, ``dt_s``,
             ``version`` (as the first flight recorded them), ``controllers`` (label ->
-            parameters) and ``metrics`` (label, or ``label/vehicle`` for a batch -> the row
-            of :meth:`table`).
+            parameters), ``metrics`` (label, or ``label/vehicle`` for a batch -> the row
+            of :meth:`table`) and ``metrics_conventions`` (the table's conventions).
         """
         first = next(iter(self.results.values()))
-        rows = self._rows(self.table())
+        table = self.table(**metric_kw)
+        rows = self._rows(table)
         return {
             "workflow": "compare",
             "mission": self.mission.to_dict(),
@@ -191,6 +202,7 @@ class Comparison:
             "version": first.meta.get("version"),
             "controllers": {label: controller_record(c) for label, c in self.controllers.items()},
             "metrics": rows,
+            "metrics_conventions": plain(table.attrs.get("conventions")),
         }
 
     @staticmethod
@@ -203,7 +215,7 @@ class Comparison:
             rows[label] = {k: plain(v) for k, v in rec.items()}
         return rows
 
-    def write(self, out: str | os.PathLike, *, force: bool = False) -> Path:
+    def write(self, out: str | os.PathLike, *, force: bool = False, **metric_kw: Any) -> Path:
         """Write ``metrics.csv``, ``comparison.png`` and ``quadcruise.json`` (``to_dict``)
         into the folder ``out``, whole or not at all.
 
@@ -213,6 +225,8 @@ class Comparison:
             The output folder.
         force : bool
             Replace a non-empty folder that quadcruise did not write (else InputError).
+        **metric_kw : Any
+            Keywords of :meth:`table` (the conventions of the metrics written).
 
         Returns
         -------
@@ -225,9 +239,9 @@ class Comparison:
         out = check_output_dir(out, force)
         with atomic_dir(out) as tmp:
             tmp = Path(tmp)
-            self.table().reset_index().to_csv(tmp / "metrics.csv", index=False)
+            self.table(**metric_kw).reset_index().to_csv(tmp / "metrics.csv", index=False)
             save_figure(self.plot(), tmp / "comparison.png")
-            (tmp / MARKER).write_text(dumps(self.to_dict(), indent=2, sort_keys=True) + "\n")
+            (tmp / MARKER).write_text(dumps(self.to_dict(**metric_kw), indent=2, sort_keys=True) + "\n")
         return out
 
 

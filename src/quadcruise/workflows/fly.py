@@ -13,6 +13,8 @@ True
 from __future__ import annotations
 
 import dataclasses
+import math
+import os
 import warnings
 from typing import Any
 
@@ -175,6 +177,7 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
     first = missions[0] if missions else mission
     duration = default_duration(first) if duration is None else duration
     grid = time_grid(float(duration), float(dt))
+    check_run_size(n, grid.size - 1, int(log_every))
     check_can_hover(vehicle)
     given_x0 = None if x0 is None else np.asarray(x0, dtype=float).tolist()
     x0 = hover_state(vehicle, n, first) if x0 is None else x0
@@ -264,6 +267,59 @@ def per_vehicle_controllers(controller: Any) -> list:
 FLY_OPTIONS = ("vehicle", "duration", "dt", "max_step", "n", "x0", "log_every", "limits", "missions",
                "controller_vehicle", "full_dynamics", "environment", "sensors", "seed", "first_vehicle",
                "max_track_error")
+
+MAX_LOG_FRACTION = 0.5
+"""Largest share of the machine's memory a flight's log may take: :func:`check_run_size`."""
+MAX_VEHICLE_STEPS = 2.0e10
+"""Most vehicle-steps (vehicles x control periods) a flight may have: at the engine's few million
+vehicle-steps per second on two cores, about two hours or more."""
+
+
+def check_run_size(n: int, steps: int, log_every: int) -> None:
+    """Refuse, before anything is allocated, a flight whose log would not fit in memory or that
+    would run for hours; the message says what to change.
+
+    Parameters
+    ----------
+    n : int
+        Number of vehicles.
+    steps : int
+        Control periods of the flight.
+    log_every : int
+        Log every this many periods.
+
+    Raises
+    ------
+    InputError
+        The log would take more than :data:`MAX_LOG_FRACTION` of the memory, or the flight more
+        than :data:`MAX_VEHICLE_STEPS` vehicle-steps.
+
+    Examples
+    --------
+    >>> check_run_size(10_000, 3_600_000, 1)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: 10,000 vehicles x 3,600,000 control periods is 3.6e+10 vehicle-steps, hours of computing: fly fewer vehicles or a shorter duration
+    """
+    from quadcruise.layout import CMD_SIZE, REF_SIZE
+
+    if log_every < 1:
+        raise InputError(f"log_every must be a whole number >= 1, got {log_every!r}")
+    if n * steps > MAX_VEHICLE_STEPS:
+        raise InputError(f"{n:,} vehicles x {steps:,} control periods is {n * steps:.2g} vehicle-steps, hours of "
+                         f"computing: fly fewer vehicles or a shorter duration")
+    row = 8 * (STATE_SIZE + CMD_SIZE + REF_SIZE)
+    need = n * (steps // log_every + 2) * row
+    try:
+        memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):      # not a POSIX system: assume 8 GiB
+        memory = 8 * 2**30
+    if need > MAX_LOG_FRACTION * memory:
+        every = int(math.ceil(n * (steps + 2) * row / (0.1 * memory)))
+        raise InputError(f"the flight's log would take {need / 2**30:.1f} GiB ({n:,} vehicle(s) x "
+                         f"{steps // log_every + 1:,} logged instants), more than half of this machine's "
+                         f"{memory / 2**30:.0f} GiB: log less often (log_every={every:,}) or fly shorter")
+
 
 HOVER_DUTY_WARNING = 0.7
 """A hover duty above this leaves less than 30 % of the rotors' thrust for control: ``fly`` warns."""

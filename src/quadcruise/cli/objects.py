@@ -1,0 +1,167 @@
+"""Objects from command-line options: a controller from ``--controller``, ``-c KEY=VALUE`` and
+``--poles``; a mission from a name or a waypoint CSV and ``-m KEY=VALUE``."""
+
+from __future__ import annotations
+
+from quadcruise.errors import InputError
+
+__all__ = ["controller_from_options", "controller_params", "flight_from_options", "mission_from_options"]
+
+
+def _poles(text: str | None, option: str):
+    """Parse comma-separated poles, e.g. ``-0.7,-4.3`` or ``-1+2j,-1-2j``.
+
+    Parameters
+    ----------
+    text : str or None
+        The option's value; None when it was not given.
+    option : str
+        The option's name, for the error message.
+
+    Returns
+    -------
+    list of complex or float, or None
+        The poles (:func:`quadcruise.control.design.parse_pole` of each); None for None.
+
+    Raises
+    ------
+    InputError
+        A pole is not a number.
+    """
+    if text is None:
+        return None
+    from quadcruise.control.design import parse_pole
+
+    try:
+        return [parse_pole(p) for p in text.split(",")]
+    except ValueError:
+        raise InputError(f"{option} {text!r}: expected comma-separated poles, e.g. -0.7,-4.3") from None
+
+
+def controller_params(params: tuple[str, ...], poles_text: str | None) -> dict:
+    """The controller parameters that ``-c KEY=VALUE`` and ``--poles`` give.
+
+    Parameters
+    ----------
+    params : tuple of str
+        ``KEY=VALUE`` parameters.
+    poles_text : str or None
+        Closed-loop poles of the x/y loops; their PD gains become the ``position`` gains.
+
+    Returns
+    -------
+    dict
+    """
+    from quadcruise.control.design import pd_from_poles
+    from quadcruise.fields import parse_assignments
+
+    out = parse_assignments(params, "--controller-param")
+    poles = _poles(poles_text, "--poles")
+    if poles is not None:
+        out["position"] = pd_from_poles(poles)
+    return out
+
+
+def controller_from_options(name: str, params: tuple[str, ...], poles_text: str | None, base=None):
+    """The controller that ``--controller``, ``-c KEY=VALUE`` and ``--poles`` describe.
+
+    Parameters
+    ----------
+    name : str
+        The controller's name (:func:`quadcruise.control.controller_from_name`); unused with ``base``.
+    params : tuple of str
+        ``KEY=VALUE`` parameters of the controller.
+    poles_text : str or None
+        Closed-loop poles of the x/y loops; their PD gains become the ``position`` gains.
+    base : Controller, optional
+        A controller (a scenario's) to change instead of a new one.
+
+    Returns
+    -------
+    Controller
+    """
+    import dataclasses
+
+    from quadcruise.control import controller_from_name
+
+    given = controller_params(params, poles_text)
+    if base is None:
+        return controller_from_name(name, **given)
+    known = [f.name for f in dataclasses.fields(base)]
+    unknown = sorted(set(given) - set(known))
+    if unknown:
+        raise InputError(f"{base.name} has no parameter {unknown[0]!r}; its parameters: {', '.join(known)}")
+    return dataclasses.replace(base, **given) if given else base
+
+
+def mission_from_options(text: str, params: tuple[str, ...], smooth: bool):
+    """A mission from a name or a waypoint CSV, with KEY=VALUE parameters.
+
+    Parameters
+    ----------
+    text : str
+        A mission name, or a path ending in ``.csv`` (a waypoint table).
+    params : tuple of str
+        ``KEY=VALUE`` parameters of the mission.
+    smooth : bool
+        Fly a waypoint table as a minimum-snap path instead of constant-speed legs.
+
+    Returns
+    -------
+    Mission
+    """
+    from quadcruise.fields import parse_assignments
+    from quadcruise.missions import mission_from_name
+
+    mparams = parse_assignments(params, "--mission-param")
+    if text.lower().endswith(".csv"):
+        mparams["table"] = text
+        text = "minsnap" if smooth else "waypoints"
+    return mission_from_name(text, **mparams)
+
+
+def flight_from_options(mission: str, controller: str | None, mission_params: tuple[str, ...],
+                        controller_params: tuple[str, ...], poles_text: str | None, smooth: bool):
+    """What ``quadcruise fly MISSION ...`` flies: from a mission name, a waypoint CSV or a scenario
+    file, with the options applied to it.
+
+    Parameters
+    ----------
+    mission : str
+        A mission name, a waypoint CSV (``.csv``) or a scenario file (``.toml``).
+    controller : str or None
+        ``--controller``; None: the scenario's controller, else ``nlpd``.
+    mission_params, controller_params : tuple of str
+        ``-m`` and ``-c`` ``KEY=VALUE`` parameters (with a scenario, they change its mission and controller).
+    poles_text : str or None
+        ``--poles`` of the x/y loops.
+    smooth : bool
+        ``--smooth``: a waypoint CSV as a minimum-snap path.
+
+    Returns
+    -------
+    (Mission, Controller, dict, Scenario or None)
+        The mission, the controller, the keywords of :func:`quadcruise.fly`, and the scenario read.
+    """
+    from quadcruise.fields import parse_assignments
+    from quadcruise.missions import mission_from_name
+
+    if not mission.lower().endswith(".toml"):
+        if smooth and not mission.lower().endswith(".csv"):
+            raise InputError(f"--smooth turns a waypoint CSV into a minimum-snap path; {mission!r} is not one")
+        return (mission_from_options(mission, mission_params, smooth),
+                controller_from_options(controller or "nlpd", controller_params, poles_text), {}, None)
+    from quadcruise.workflows.scenario import load_scenario
+
+    if smooth:
+        raise InputError("--smooth turns a waypoint CSV into a minimum-snap path; a scenario file "
+                         "says its mission kind itself (kind = \"minsnap\")")
+    scenario = load_scenario(mission)
+    the_mission = scenario.mission or mission_from_name("circle")
+    if mission_params:
+        the_mission = the_mission.replace(**parse_assignments(mission_params, "--mission-param"))
+    if controller is not None or scenario.controller is None:
+        the_controller = controller_from_options(controller or "nlpd", controller_params, poles_text)
+    else:
+        the_controller = controller_from_options("", controller_params, poles_text, base=scenario.controller)
+    return the_mission, the_controller, scenario.fly_kwargs(), scenario
