@@ -25,3 +25,13 @@ __all__ = [
     "Comparison", "DutySchedule", "ExitStatus", "InputError", "Limits", "STATUS_REASONS", "SimResult", "Vehicle", "__version__",
     "compare", "fly", "read_duty_csv", "replay", "simulate", "time_grid", "write_states_csv",
 ]
+
+
+def __getattr__(name: str):
+    """``qc.tune``: the tuning package (:mod:`quadcruise.tune`; its entry point ``qc.tune.tune``),
+    imported on first use so that ``import quadcruise`` does not load scipy's optimiser."""
+    if name == "tune":
+        import importlib
+
+        return importlib.import_module("quadcruise.tune")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -155,6 +155,10 @@ def test_cli_prints_progress_and_summary_and_writes_the_folder(tmp_path):
     assert flown.exit_code == 0, flown.output
 
 
+def test_qc_tune_is_the_package():
+    assert qc.tune.tune is tune and qc.tune.TuneResult is TuneResult
+
+
 def test_library_refuses_unknown_options():
     with pytest.raises(InputError, match="tune\\(\\) has no option 'sede'"):
         tune("step", targets=["rise_time_s=1"], sede=1)
