@@ -12,9 +12,9 @@ from quadcruise.cli.common import (
     SETTLE_BAND_OPTION,
     friendly,
     metric_options,
-    mission_from_options,
     writable,
 )
+from quadcruise.cli.objects import compared_from_options
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["compare"]
@@ -22,10 +22,10 @@ __all__ = ["compare"]
 
 @click.command("compare")
 @click.argument("mission", metavar="MISSION")
-@click.option("--controllers", default="nlpd,gonzalez,se3,cascade", show_default=True,
-              help="Comma-separated controller names.")
+@click.option("--controllers", help="Comma-separated controller names (default nlpd,gonzalez,se3,cascade, "
+              "or the scenario's).")
 @click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
-@click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
+@click.option("--dt", type=float, help="Control period [s] (default 0.001, or the scenario's).")
 @click.option("-m", "--mission-param", "mission_params", multiple=True, metavar="KEY=VALUE",
               help="Mission parameter (repeatable).")
 @click.option("--out", type=click.Path(file_okay=False), callback=writable, help="Folder for metrics.csv and comparison.png.")
@@ -83,12 +83,14 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
     conventions = metric_options(rise, settle_bands)
     if out is not None:
         check_output_dir(out, force)
-    cmp_mission = mission_from_options(mission, mission_params, smooth=False)
+    cmp_mission, chosen, kwargs = compared_from_options(mission, controllers, mission_params)
+    kwargs.update({k: v for k, v in (("duration", duration), ("dt", dt)) if v is not None})
     pop = _population(population, seed, mass_spread, wind)      # checked before anything flies
-    cmp = run_compare(cmp_mission, controllers, duration=duration, dt=dt)
+    cmp = run_compare(cmp_mission, chosen, **kwargs)
     click.echo(cmp.text(**conventions))
     if population is not None:
-        _compare_population(cmp_mission, controllers, population, seed, pop, wind, duration, dt)
+        _compare_population(cmp_mission, chosen, population, seed, pop, wind, kwargs.get("duration"),
+                            kwargs.get("dt", 1e-3))
     if out is not None:
         cmp.write(out, force=force, **conventions)
         click.echo(f"wrote metrics.csv and comparison.png to {out}")

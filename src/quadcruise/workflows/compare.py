@@ -205,6 +205,22 @@ class Comparison:
             "metrics_conventions": plain(table.attrs.get("conventions")),
         }
 
+    def scenario_toml(self) -> str:
+        """The comparison as a scenario file that ``quadcruise compare`` reads back.
+
+        Returns
+        -------
+        str
+            TOML: mission, vehicle, world and simulation of the flights, and each controller
+            with its label and gains under ``[[compare.controllers]]``.
+        """
+        from quadcruise.io.scenario_file import comparison_document, scenario_text
+
+        first = next(iter(self.results.values()))
+        records = {label: controller_record(c) for label, c in self.controllers.items()}
+        return scenario_text(comparison_document(first.meta, records), header=(
+            "written by quadcruise from a comparison; `quadcruise compare THIS_FILE` flies it again"))
+
     @staticmethod
     def _rows(table) -> dict:
         metrics = table.reset_index()
@@ -242,6 +258,7 @@ class Comparison:
             self.table(**metric_kw).reset_index().to_csv(tmp / "metrics.csv", index=False)
             save_figure(self.plot(), tmp / "comparison.png")
             (tmp / MARKER).write_text(dumps(self.to_dict(**metric_kw), indent=2, sort_keys=True) + "\n")
+            (tmp / "scenario.toml").write_text(self.scenario_toml())
         return out
 
 

@@ -69,7 +69,8 @@ from quadcruise.errors import InputError
 from quadcruise.missions import MISSIONS, Mission
 from quadcruise.model.vehicle import Vehicle
 
-TABLES = ("vehicle", "controller", "mission", "disturbances", "simulation", "montecarlo", "controller_vehicle")
+TABLES = ("vehicle", "controller", "mission", "disturbances", "simulation", "montecarlo", "controller_vehicle",
+          "compare")
 SIMULATION_KEYS = {"duration": float, "dt": float, "max_step": float, "full_dynamics": bool,
                    "seed": int, "log_every": int, "n": int, "max_track_error": float, "initial_state": list}
 DISTURBANCE_KEYS = ("wind", "gust", "turbulence", "rotor_loss", "force", "sensor_noise")
@@ -87,6 +88,7 @@ class Scenario:
     sensor_noise: Any = None
     simulation: dict = field(default_factory=dict)
     montecarlo: dict = field(default_factory=dict)
+    compare: dict = field(default_factory=dict)
     title: str = ""
     source: str = "scenario"
 
@@ -155,11 +157,13 @@ def scenario_from_dict(doc: dict, *, source: str = "scenario", base: Path | None
     vehicle = _vehicle(where.at("vehicle"), doc.get("vehicle", {}))
     model = _vehicle(where.at("controller_vehicle"), doc["controller_vehicle"]) if "controller_vehicle" in doc else None
     controller = _controller(where.at("controller"), doc.get("controller")) if "controller" in doc else None
+    compared = _compare(where.at("compare"), doc.get("compare", {}))
     mission = _mission(where.at("mission"), doc.get("mission"), base) if "mission" in doc else None
     environment, noise = _disturbances(where.at("disturbances"), doc.get("disturbances", {}))
     simulation = _simulation(where.at("simulation"), doc.get("simulation", {}))
     return Scenario(vehicle=vehicle, controller_vehicle=model, controller=controller, mission=mission, environment=environment,
                     sensor_noise=noise, simulation=simulation, montecarlo=dict(doc.get("montecarlo", {})),
+                    compare=compared,
                     title=title, source=source)
 
 
@@ -265,6 +269,26 @@ def _controller(where: _Where, table: dict) -> Controller:
         else:
             params[key] = _number(where, key, value)
     return where.wrap(cls, **params)
+
+
+def _compare(where: _Where, table: dict) -> dict:
+    """``[compare]``: ``controllers``, a list of names or of controller tables with a ``label``."""
+    _known(where, "", table, {"controllers"})
+    items = table.get("controllers", [])
+    if not isinstance(items, list):
+        raise where.error("'controllers' must be a list of names or of [[compare.controllers]] tables")
+    out: dict = {}
+    for k, item in enumerate(items):
+        if isinstance(item, str):
+            item = {"name": item}
+        if not isinstance(item, dict):
+            raise where.error(f"controllers[{k}] must be a name or a table, got {item!r}")
+        item = dict(item)
+        label = item.pop("label", item.get("name", "nlpd"))
+        if not isinstance(label, str) or label in out:
+            raise where.error(f"controllers[{k}]: label {label!r} must be a text given once")
+        out[label] = _controller(where, item)
+    return out
 
 
 def _mission(where: _Where, table: dict, base: Path | None) -> Mission:
