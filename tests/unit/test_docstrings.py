@@ -54,7 +54,6 @@ NOT_YET = {
     "quadcruise.control.se3",
     "quadcruise.control.so3",
     "quadcruise.disturbances.environment",
-    "quadcruise.model.vehicle",
     "quadcruise.montecarlo.chunk",
     "quadcruise.montecarlo.sweep",
     "quadcruise.sim.engine",
