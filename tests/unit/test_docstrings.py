@@ -59,7 +59,6 @@ NOT_YET = {
     "quadcruise.sim.engine",
     "quadcruise.sim.fastmath",
     "quadcruise.sim.rng",
-    "quadcruise.workflows.scenario",
 }
 
 # Public names that cannot carry the sections ("module.qualname" -> the reason). Keep it
