@@ -121,8 +121,8 @@ class Mission(Validated):
         return dataclasses.replace(self, **changes)
 
     def to_dict(self) -> dict:
-        """The mission as plain values, for result bundles; :func:`quadcruise.missions.mission_from_dict`
-        reads it back.
+        """The mission as plain values, for result bundles (read back by
+        :func:`quadcruise.missions.mission_from_dict`).
 
         Returns
         -------
