@@ -1,11 +1,12 @@
-"""What every controller object offers the engine: a compiled function, its parameter
-vector for a vehicle, and the size of its memory.
+"""What every controller object offers the engine: a name, a compiled function, its
+parameter vector, and its initial memory.
 
 A controller is a frozen dataclass of gains with units (its fields come from
 :func:`quadcruise.fields.unit_field` and are checked by :func:`quadcruise.fields.validate`);
 :meth:`Controller.gains` packs them into the flat vector the compiled function reads. A
-user's own controller only needs a function compiled with ``layout.CONTROLLER_SIG`` and
-these three members.
+user's own controller needs no base class: ``name``, a ``function`` compiled with
+``layout.CONTROLLER_SIG``, ``gains()`` and ``memory()``
+(:class:`quadcruise.protocols.ControllerLike`).
 """
 
 from __future__ import annotations
