@@ -14,7 +14,7 @@ from quadcruise.cli.common import (
     metric_options,
     writable,
 )
-from quadcruise.cli.objects import compared_from_options
+from quadcruise.cli.objects import mission_from_options
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["compare"]
@@ -160,3 +160,41 @@ def _compare_population(mission, controllers: str, n: int, seed: int, pop, wind:
     click.echo(f"\nthe same {n} perturbed vehicles (seed {seed}, mass spread {pop.mass_spread:g}"
                + (f", wind {wind}" if wind else "") + "):")
     click.echo(table.to_string(float_format=lambda v: f"{v:.4g}"))
+
+
+DEFAULT_COMPARED = "nlpd,gonzalez,se3,cascade"
+"""The controllers ``quadcruise compare`` flies when neither the options nor a scenario name any."""
+
+
+def compared_from_options(mission: str, controllers: str | None, mission_params: tuple[str, ...]):
+    """What ``quadcruise compare MISSION ...`` flies: the mission, controllers and keywords.
+
+    Parameters
+    ----------
+    mission : str
+        A mission name, a waypoint CSV (``.csv``) or a scenario file (``.toml``).
+    controllers : str or None
+        ``--controllers``, comma-separated names; None: the scenario's ``[compare]`` controllers,
+        else its ``[controller]``, else :data:`DEFAULT_COMPARED`.
+    mission_params : tuple of str
+        ``-m KEY=VALUE`` parameters of the mission.
+
+    Returns
+    -------
+    (Mission, str or dict, dict)
+        The mission, the controllers (names, or label -> controller) and the keywords.
+    """
+    from quadcruise.fields import parse_assignments
+
+    if not mission.lower().endswith(".toml"):
+        return mission_from_options(mission, mission_params, smooth=False), controllers or DEFAULT_COMPARED, {}
+    from quadcruise.missions import mission_from_name
+    from quadcruise.workflows.scenario import load_scenario
+
+    scenario = load_scenario(mission)
+    the_mission = scenario.mission or mission_from_name("circle")
+    if mission_params:
+        the_mission = the_mission.replace(**parse_assignments(mission_params, "--mission-param"))
+    chosen = controllers or scenario.compare or (
+        {scenario.controller.name: scenario.controller} if scenario.controller is not None else DEFAULT_COMPARED)
+    return the_mission, chosen, scenario.fly_kwargs()

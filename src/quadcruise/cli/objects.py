@@ -5,8 +5,7 @@ from __future__ import annotations
 
 from quadcruise.errors import InputError
 
-__all__ = ["compared_from_options", "controller_from_options", "controller_params", "flight_from_options",
-           "mission_from_options"]
+__all__ = ["controller_from_options", "controller_params", "flight_from_options", "mission_from_options"]
 
 
 def _poles(text: str | None, option: str):
@@ -167,41 +166,3 @@ def flight_from_options(mission: str, controller: str | None, mission_params: tu
         the_controller = controller_from_options("", controller_params, poles_text, base=scenario.controller)
     return the_mission, the_controller, scenario.fly_kwargs(), scenario
 
-
-DEFAULT_COMPARED = "nlpd,gonzalez,se3,cascade"
-"""The controllers ``quadcruise compare`` flies when neither the options nor a scenario name any."""
-
-
-def compared_from_options(mission: str, controllers: str | None, mission_params: tuple[str, ...]):
-    """What ``quadcruise compare MISSION ...`` flies: the mission (a name, a waypoint CSV or a
-    scenario file), the controllers and the keywords of :func:`quadcruise.compare`.
-
-    Parameters
-    ----------
-    mission : str
-        A mission name, a waypoint CSV (``.csv``) or a scenario file (``.toml``).
-    controllers : str or None
-        ``--controllers``, comma-separated names; None: the scenario's ``[compare]`` controllers,
-        else its ``[controller]``, else :data:`DEFAULT_COMPARED`.
-    mission_params : tuple of str
-        ``-m KEY=VALUE`` parameters of the mission.
-
-    Returns
-    -------
-    (Mission, str or dict, dict)
-        The mission, the controllers (names, or label -> controller) and the keywords.
-    """
-    from quadcruise.fields import parse_assignments
-
-    if not mission.lower().endswith(".toml"):
-        return mission_from_options(mission, mission_params, smooth=False), controllers or DEFAULT_COMPARED, {}
-    from quadcruise.missions import mission_from_name
-    from quadcruise.workflows.scenario import load_scenario
-
-    scenario = load_scenario(mission)
-    the_mission = scenario.mission or mission_from_name("circle")
-    if mission_params:
-        the_mission = the_mission.replace(**parse_assignments(mission_params, "--mission-param"))
-    chosen = controllers or scenario.compare or (
-        {scenario.controller.name: scenario.controller} if scenario.controller is not None else DEFAULT_COMPARED)
-    return the_mission, chosen, scenario.fly_kwargs()

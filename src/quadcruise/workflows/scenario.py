@@ -106,6 +106,8 @@ class Scenario:
         or one row per vehicle), each only if given.
     montecarlo : dict
         The ``[montecarlo]`` table as written (checked by ``quadcruise montecarlo``).
+    compare : dict
+        ``[compare]``'s controllers: label -> controller, in order (``quadcruise compare``).
     title : str
         The scenario's title.
     source : str
