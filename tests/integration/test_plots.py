@@ -14,10 +14,11 @@ import pytest
 from matplotlib.figure import Figure
 
 import quadcruise as qc
-from quadcruise.layout import CMD_FLAGS
+from quadcruise.disturbances import Environment, Gust, RotorLoss
+from quadcruise.layout import CMD_FLAGS, CMD_U1
 from quadcruise.missions import Step
 from quadcruise.plots import flight as plots
-from quadcruise.plots import plot_envelope, plot_flight, plot_paths, save_figure
+from quadcruise.plots import marks, plot_envelope, plot_flight, plot_paths, save_figure
 from quadcruise.workflows.fly import hover_state
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -52,7 +53,7 @@ def labels(ax):
 def test_plot_flight_structure_labels_and_data(step):
     fig = plot_flight(step)
     assert isinstance(fig, Figure)
-    assert len(fig.axes) == 8
+    assert len(fig.axes) == 9
     path = fig.axes[0]
     assert path.name == "3d"
     assert [path.get_xlabel(), path.get_ylabel(), path.get_zlabel()] == ["x [m]", "y [m]", "z [m]"]
@@ -101,6 +102,96 @@ def test_flagged_controller_limits_are_shaded(step):
     assert "controller limit flagged" in [c.get_label() for c in duty.collections]
     duty = axis_by_ylabel(plot_flight(step), "rotor duty")
     assert "controller limit flagged" not in [c.get_label() for c in duty.collections]
+
+
+def legend_texts(ax):
+    legend = ax.get_legend()
+    return [t.get_text() for t in legend.get_texts()] if legend is not None else []
+
+
+def all_legend_texts(fig):
+    return [text for ax in fig.axes for text in legend_texts(ax)]
+
+
+def test_flight_has_a_log_position_error_panel(step, circle):
+    """After the transient the error is centimetres on a circle, millimetres on a step: a
+    log axis keeps it readable next to the metres of the transient."""
+    for res in (step, circle):
+        ax = axis_by_ylabel(plot_flight(res), "position error")
+        assert ax.get_yscale() == "log" and ax.get_ylabel() == "position error [m]"
+        err = np.linalg.norm(res.states[0, :, :3] - res.references[0, :, :3], axis=1)
+        curve = line(ax, "|p - p_ref|")
+        np.testing.assert_array_equal(curve.get_xdata(), res.t)
+        np.testing.assert_allclose(curve.get_ydata(), np.maximum(err, marks.ERROR_FLOOR))
+        lo, hi = ax.get_ylim()
+        assert lo < err[-1] < hi and lo < err.max() < hi and hi / lo >= 10
+        assert ax.get_xlim() == (res.t[0], res.t[-1])
+    # the step holds its reference exactly before t = 1 s: drawn on the named 0.1 mm floor
+    assert "≤ 0.1 mm (drawn here)" in legend_texts(axis_by_ylabel(plot_flight(step), "position error"))
+    assert not any("≤" in text for text in legend_texts(axis_by_ylabel(plot_flight(circle), "position error")))
+
+
+def test_events_of_the_environment_are_marked():
+    env = Environment(gust=Gust(amplitude=(3.0, 4.0, 0.0), start=0.5, duration=1.0),
+                      rotor_loss=RotorLoss(rotor=2, fraction=0.3, time=2.0))
+    res = qc.fly("step", duration=3.0, log_every=10, environment=env)
+    fig = plot_flight(res)
+    err = axis_by_ylabel(fig, "position error")
+    events = [text for text in legend_texts(err) if text.startswith(("gust", "rotor"))]
+    assert events == ["gust 5 m/s, 0.5-1.5 s", "rotor 2 loses 30 % at 2 s"]
+    for ax in fig.axes[1:]:                       # on every time panel
+        loss = [ln for ln in ax.get_lines() if ln.get_color() == marks.EVENT_COLORS["rotor_loss"]]
+        assert len(loss) == 1 and list(loss[0].get_xdata()) == [2.0, 2.0]
+        gust = [p for p in ax.patches if p.get_facecolor()[:3] == pytest.approx((0.09, 0.745, 0.812), abs=0.01)]
+        assert len(gust) == 1 and gust[0].get_x() == 0.5 and gust[0].get_width() == pytest.approx(1.0)
+    # per-vehicle fields: each vehicle's own; an event after the end is left out
+    meta = {**res.meta, "environment": {"rotor_loss": {"rotor": [1, 3], "fraction": [0.1, 0.5], "time": [1.0, 9.0]}}}
+    two = dataclasses.replace(res, meta=meta)
+    assert [e.label for e in marks.flight_events(meta, 1)] == ["rotor 3 loses 50 % at 9 s"]
+    assert "rotor 1 loses 10 % at 1 s" in legend_texts(axis_by_ylabel(plot_flight(two), "position error"))
+    # no environment, or one that cannot be read: no marker
+    for meta in ({}, {"environment": None}, {"environment": {"custom": "mine"}},
+                 {"environment": {"gust": {"start": "soon"}, "rotor_loss": {"rotor": 1}}}):
+        assert marks.flight_events(meta) == []
+        fig = plot_flight(dataclasses.replace(res, meta=meta))
+        assert legend_texts(axis_by_ylabel(fig, "position error")) == ["|p - p_ref|", "≤ 0.1 mm (drawn here)"]
+
+
+def test_clipped_duties_are_shaded_and_named_only_when_they_happen(step):
+    assert not any("clip" in text for text in all_legend_texts(plot_flight(step)))
+    commands = step.commands.copy()
+    commands[0, 100:120, CMD_U1 + 2] = 1.3               # asked for more than full duty
+    commands[0, 200:201, CMD_U1] = -0.1                  # and less than none, once
+    fig = plot_flight(dataclasses.replace(step, commands=commands))
+    duty = axis_by_ylabel(fig, "rotor duty")
+    assert "duty clipped (asked outside [0, 1])" in legend_texts(duty)
+    (shaded,) = [c for c in duty.collections if c.get_label().startswith("duty clipped")]
+    spans = [(p.vertices[:, 0].min(), p.vertices[:, 0].max()) for p in shaded.get_paths()]
+    assert spans == [(pytest.approx(1.0), pytest.approx(1.2)), (pytest.approx(2.0), pytest.approx(2.01))]
+    assert not any("flagged" in text for text in legend_texts(duty))
+
+
+def test_a_brief_limit_flag_survives_thinning():
+    """The flight is thinned for drawing; its saturation intervals are not."""
+    res = qc.fly("step", duration=7.0)                 # 7,001 instants, drawn every third
+    assert len(plots.drawable(res).t) < len(res.t)
+    commands = res.commands.copy()
+    commands[0, 3001, CMD_FLAGS] = 1.0                   # one period, between drawn instants
+    duty = axis_by_ylabel(plot_flight(dataclasses.replace(res, commands=commands)), "rotor duty")
+    (shaded,) = [c for c in duty.collections if c.get_label() == "controller limit flagged"]
+    (path,) = shaded.get_paths()
+    assert path.vertices[:, 0].min() == pytest.approx(3.001)
+
+
+def test_one_vehicle_is_not_called_vehicle_0(step):
+    fig = plot_flight(step)
+    texts = [fig._suptitle.get_text()] + all_legend_texts(fig) + [ax.get_title() for ax in fig.axes]
+    assert not any("vehicle" in text for text in texts), texts
+    x0 = hover_state(qc.Vehicle.paper(), 2, Step())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        two = qc.fly("step", duration=1.0, log_every=10, x0=x0)
+    assert plot_flight(two, vehicle=1)._suptitle.get_text() == "nlpd on step — vehicle 1"
 
 
 def test_early_stop_is_marked_and_explained(diverged):

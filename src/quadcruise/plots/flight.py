@@ -9,7 +9,7 @@ Examples
 >>> from quadcruise.plots import plot_flight
 >>> fig = plot_flight(qc.fly("step", duration=2.0, log_every=10))
 >>> len(fig.axes)
-8
+9
 """
 
 from __future__ import annotations
@@ -22,12 +22,21 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from quadcruise.io.files import atomic_path
+from quadcruise.plots.marks import (
+    SATURATION_STYLE,
+    error_axes,
+    flight_events,
+    mark_events,
+    position_error,
+    saturation,
+    shade,
+)
 
 REF_STYLE = dict(color="k", ls="--", lw=1.0, label="reference")
 STOP_STYLE = dict(color="tab:red", ls=":", lw=1.5)
 
 
-FLIGHT_MARGINS = dict(left=0.05, right=0.86, bottom=0.055, top=0.92, wspace=0.32, hspace=0.14)
+FLIGHT_MARGINS = dict(left=0.05, right=0.86, bottom=0.048, top=0.93, wspace=0.32, hspace=0.14)
 """The flight figure's grid in fractions of the figure, fixed rather than found by a
 layout engine: constrained layout draws the whole figure once more to measure it, which
 slows saving it (see docs/performance.md)."""
@@ -164,33 +173,42 @@ def _time_panel(ax, t, y, ref, ylabel: str, color: str, label: str, min_span: fl
 
 
 def plot_flight(result, vehicle: int = 0, *, title: str | None = None) -> Figure:
-    """One vehicle's flight on one figure: path, position, attitude and rotor duties.
+    """One vehicle's flight on one figure: path, position, attitude, position error and
+    rotor duties.
 
     Parameters
     ----------
     result : SimResult
-        The flight; more than :data:`MAX_DRAWN` logged instants are thinned for drawing.
+        The flight; more than :data:`MAX_DRAWN` logged instants are thinned for drawing
+        (the saturation intervals are found on every logged instant).
     vehicle : int
         Which of the result's vehicles to draw.
     title : str, optional
-        Figure title; by default the controller and mission from ``result.meta``, and
-        the reason if the vehicle stopped early.
+        Figure title; by default the controller and mission from ``result.meta`` (and the
+        vehicle's index when the result holds several), and the reason if the vehicle
+        stopped early.
 
     Returns
     -------
     matplotlib.figure.Figure
-        Eight axes: the 3-D path, x, y, z [m], roll, pitch, yaw [deg] against time, and
-        the four rotor duties with their [0, 1] limits. References are drawn dashed where
-        finite, attitude setpoints only where there is a reference (an open-loop replay
-        has none); periods in which the controller flagged a limit are shaded on the duty
-        panel. An early stop is marked on every time panel, which then end shortly after it.
+        Nine axes: the 3-D path, x, y, z [m], roll, pitch, yaw [deg] against time, the
+        position error ``|p - p_ref|`` [m] on a log scale (see
+        :func:`~quadcruise.plots.marks.error_axes`), and the four rotor duties with their
+        [0, 1] limits. References are drawn dashed where finite, attitude setpoints only
+        where there is a reference (an open-loop replay has none). The events recorded in
+        ``result.meta["environment"]`` (a gust, a rotor loss) are marked on every time
+        panel and named in the error panel's legend; the periods in which the controller
+        flagged a limit, or asked for a duty outside [0, 1] that the engine clipped, are
+        shaded on the duty panel, each named in its legend only if it happened. An early
+        stop is marked on every time panel, which then end shortly after it.
     """
+    spans = saturation(result, vehicle)
     result = drawable(result)
     t = result.t
-    fig = Figure(figsize=(16, 10))
-    # row 3 and column 1 are gaps: for the time axes' labels above the duties, and between
-    # the 3-D path's labels and the position panels' own
-    gs = fig.add_gridspec(5, 4, width_ratios=(1.3, 0.02, 1, 1), height_ratios=(1, 1, 1, 0.12, 1.1),
+    fig = Figure(figsize=(16, 12))
+    # row 3 and column 1 are gaps: for the time axes' labels above the error panel, and
+    # between the 3-D path's labels and the position panels' own
+    gs = fig.add_gridspec(6, 4, width_ratios=(1.3, 0.02, 1, 1), height_ratios=(1, 1, 1, 0.06, 0.9, 1.0),
                           **FLIGHT_MARGINS)
     _path3d(fig.add_subplot(gs[0:3, 0], projection="3d"), result, vehicle)
     pos_axes = [fig.add_subplot(gs[0, 2])]
@@ -205,43 +223,50 @@ def plot_flight(result, vehicle: int = 0, *, title: str | None = None) -> Figure
         sp = np.degrees(result.state(f"{name}_d")[vehicle]) if closed_loop else None
         _time_panel(ax, t, np.degrees(result.state(name)[vehicle]), sp, f"{label} [deg]", c,
                     label, min_span=2.0, ref_label="setpoint")
-    ax_u = fig.add_subplot(gs[4, :], sharex=pos_axes[0])
-    _duties(ax_u, result, vehicle)
+    ax_e = fig.add_subplot(gs[4, :], sharex=pos_axes[0])
+    error_axes(ax_e, [(t, position_error(result, vehicle), dict(color="k", label="|p - p_ref|"))])
+    ax_u = fig.add_subplot(gs[5, :], sharex=pos_axes[0])
     stopped = int(result.status[vehicle]) != 0
     t_end = t[-1]
     if stopped:
         t_stop = float(result.t_stop[vehicle])
         step = t[1] - t[0] if t.size > 1 else 0.0
         t_end = min(t[-1], t_stop + max(0.1 * (t_stop - t[0]), 3 * step))
-        for ax in pos_axes + att_axes + [ax_u]:
+    t_end = t_end if t_end > t[0] else t[0] + 1.0
+    _duties(ax_u, result, vehicle, spans, min_width=(t_end - t[0]) / 1500)
+    time_axes = pos_axes + att_axes + [ax_e, ax_u]
+    events = flight_events(result.meta, vehicle)
+    for ax in time_axes:
+        mark_events(ax, events, (t[0], t_end), label=ax is ax_e)
+    if stopped:
+        for ax in time_axes:
             _mark_stop(ax, t_stop, label=ax in (pos_axes[0], att_axes[0], ax_u))
     for ax in pos_axes + att_axes:
         _legend(ax, loc="best")
-    _legend(ax_u, loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0)
+    for ax in (ax_e, ax_u):
+        if ax.get_legend_handles_labels()[0]:
+            _legend(ax, loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0)
     for ax in (pos_axes[2], att_axes[2], ax_u):
         ax.set_xlabel("time [s]")
-    for ax in pos_axes[:2] + att_axes[:2]:
+    for ax in pos_axes[:2] + att_axes[:2] + [ax_e]:
         ax.tick_params(labelbottom=False)
-    ax_u.set_xlim(t[0], t_end if t_end > t[0] else t[0] + 1.0)
+    ax_u.set_xlim(t[0], t_end)
     if title is None:
-        title = f"{describe(result, vehicle)} — vehicle {vehicle}"
+        title = describe(result, vehicle) + (f" — vehicle {vehicle}" if result.n > 1 else "")
         if stopped:
             title += f"\n{result.status_text(vehicle)}"
     fig.suptitle(title, color="tab:red" if stopped else "k")
     return fig
 
 
-def _duties(ax, result, vehicle: int) -> None:
+def _duties(ax, result, vehicle: int, spans: dict, min_width: float) -> None:
     t = result.t
     duties = result.commands[vehicle, :, :4]
     for j in range(4):
         ax.plot(t, duties[:, j], color=("tab:blue", "tab:orange", "tab:green", "tab:purple")[j],
                 lw=1.0, label=f"u{j + 1}")
-    flags = result.state("flags")[vehicle]
-    flagged = np.isfinite(flags) & (flags != 0)
-    if flagged.any():
-        ax.fill_between(t, 0, 1, where=flagged, transform=ax.get_xaxis_transform(), step="post",
-                        color="tab:red", alpha=0.15, lw=0, label="controller limit flagged")
+    for kind in ("flagged", "clipped"):
+        shade(ax, spans[kind], min_width=min_width, **SATURATION_STYLE[kind])
     live = duties[np.isfinite(duties)]
     lo, hi = (live.min(), live.max()) if live.size else (0.0, 1.0)
     lo, hi = min(lo, 0.0), max(hi, 0.0)
@@ -253,8 +278,8 @@ def _duties(ax, result, vehicle: int) -> None:
     for limit in (0.0, 1.0):
         ax.axhline(limit, color="0.3", lw=1.2, ls="-.", zorder=1.5,
                    label=f"duty limits 0, 1{off}" if limit == 0.0 else None)
-    for a, b in ((lo - 10 * pad - 1.0, 0.0), (1.0, hi + 10 * pad + 1.0)):
-        ax.axhspan(a, b, color="0.5", alpha=0.12, lw=0, label="clipped by the engine" if a < 0 else None)
+    for a, b in ((lo - 10 * pad - 1.0, 0.0), (1.0, hi + 10 * pad + 1.0)):   # beyond the limits
+        ax.axhspan(a, b, color="0.5", alpha=0.12, lw=0)
     ax.set_ylabel("rotor duty [-]")
     ax.grid(True, alpha=0.3)
 
