@@ -244,11 +244,11 @@ def test_plot_paths_overlays_flights_with_one_reference(step, circle, diverged):
     x0[0, 1] = 0.3                                  # start 0.3 m off in y
     other = qc.fly("step", duration=3.0, log_every=10, x0=x0)
     fig = plot_paths({"A": step, "B": other, "bad": diverged})
-    assert len(fig.axes) == 3
-    top, ax_x, ax_y = fig.axes
+    assert len(fig.axes) == 4
+    top, ax_x, ax_y, ax_e = fig.axes
     assert (top.get_xlabel(), top.get_ylabel()) == ("x [m]", "y [m]")
-    assert ax_x.get_ylabel() == "x [m]" and ax_y.get_ylabel() == "y [m]" and ax_y.get_xlabel() == "time [s]"
-    for ax in fig.axes:
+    assert ax_x.get_ylabel() == "x [m]" and ax_y.get_ylabel() == "y [m]" and ax_e.get_xlabel() == "time [s]"
+    for ax in fig.axes[:3]:
         assert labels(ax).count("reference") == 1
     np.testing.assert_array_equal(line(top, "B").get_xdata(), other.state("x")[0])
     np.testing.assert_array_equal(line(top, "B").get_ydata(), other.state("y")[0])
@@ -257,6 +257,47 @@ def test_plot_paths_overlays_flights_with_one_reference(step, circle, diverged):
     assert "A vs B vs bad" in fig._suptitle.get_text()
     with pytest.raises(ValueError):
         plot_paths({})
+
+
+def test_comparison_has_a_position_error_panel_with_events_and_saturation(step):
+    """Four controllers' positions overlap after the transient; their errors, on a log
+    axis, do not. Events and saturation are marked, and named only when drawn."""
+    cmp = qc.compare("circle", duration=8.0, log_every=10)
+    fig = cmp.plot()
+    top, ax_x, ax_y, ax_z, ax_e = fig.axes
+    assert ax_e.get_ylabel() == "position error [m]" and ax_e.get_yscale() == "log"
+    assert ax_e.get_xlabel() == "time [s]" and ax_z.get_xlabel() == ""
+    finals = []
+    for k, (label, res) in enumerate(cmp.results.items()):
+        err = np.linalg.norm(res.states[0, :, :3] - res.references[0, :, :3], axis=1)
+        (curve,) = [ln for ln in ax_e.get_lines() if ln.get_label() == label]
+        np.testing.assert_allclose(curve.get_ydata(), np.maximum(err, marks.ERROR_FLOOR))
+        assert curve.get_color() == line(top, label).get_color()
+        finals.append(err[-1])
+    lo, hi = ax_e.get_ylim()
+    assert lo < min(finals) and max(finals) / min(finals) > 5      # told apart after 7 s
+    texts = legend_texts(top)
+    assert texts[:5] == ["reference", *cmp.results] and not any(
+        word in text for text in texts for word in ("gust", "rotor", "flagged", "clipped", "vehicle"))
+    assert len(ax_e.collections) == 0                                 # no saturation: no strip
+    # the same flights in a gust, one of them saturating: marked and named
+    env = {"gust": {"amplitude": [2.0, 0.0, 0.0], "start": 1.0, "duration": 2.0}}
+    flights = {label: dataclasses.replace(res, meta={**res.meta, "environment": env})
+               for label, res in cmp.results.items()}
+    commands = flights["se3"].commands.copy()
+    commands[0, 300:350, CMD_U1] = 1.5
+    flights["se3"] = dataclasses.replace(flights["se3"], commands=commands)
+    fig = plot_paths(flights, axes="xyz")
+    texts = legend_texts(fig.axes[0])
+    assert texts.count("gust 2 m/s, 1-3 s") == 1 and "duty clipped (strip in the flight's colour)" in texts
+    assert not any("flagged" in text for text in texts)
+    ax_e = fig.axes[-1]
+    (strip,) = ax_e.collections
+    assert tuple(strip.get_facecolor()[0][:3]) == pytest.approx((0.17, 0.63, 0.17), abs=0.01)   # se3 is C2
+    for ax in fig.axes[1:]:
+        assert len([p for p in ax.patches if p.get_x() == 1.0 and p.get_width() == 2.0]) == 1
+    with pytest.raises(ValueError, match="axes must be"):
+        plot_paths({"A": step}, axes="xz")
 
 
 def test_plot_envelope_median_band_and_path_cap():

@@ -23,6 +23,7 @@ from matplotlib.ticker import MaxNLocator
 
 from quadcruise.io.files import atomic_path
 from quadcruise.plots.marks import (
+    ERROR_FLOOR,
     SATURATION_STYLE,
     error_axes,
     flight_events,
@@ -292,8 +293,24 @@ def _reference_xy(results):
     return None
 
 
-def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None) -> Figure:
-    """Overlay several flights: top view (x-y) and x(t), y(t), with the reference once.
+def _saturation_strips(ax, spans: list[dict], min_width: float) -> list:
+    """Each flight's saturation as a thin strip in its colour along the bottom of ``ax``
+    (light: a limit flagged, dark: a duty clipped); legend proxies for the kinds drawn."""
+    from matplotlib.patches import Patch
+
+    drawn = set()
+    for k, flight in enumerate(spans):
+        y = (0.012 + 0.04 * k, 0.03)
+        for kind, alpha in (("flagged", 0.35), ("clipped", 1.0)):
+            if shade(ax, flight[kind], min_width=min_width, yrange=y, color=f"C{k}", alpha=alpha) is not None:
+                drawn.add(kind)
+    return [Patch(color="0.35", alpha=alpha, lw=0, label=f"{what} (strip in the flight's colour)")
+            for kind, alpha, what in (("flagged", 0.35, "limit flagged"), ("clipped", 1.0, "duty clipped"))
+            if kind in drawn]
+
+
+def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None, axes: str = "xy") -> Figure:
+    """Overlay several flights: top view, position and position error against time.
 
     Parameters
     ----------
@@ -303,53 +320,92 @@ def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None) -> 
         Which vehicle of each result to draw.
     title : str, optional
         Figure title; by default the labels joined by " vs " and the mission's kind.
+    axes : str
+        The positions drawn against time, one panel each: ``"xy"`` or ``"xyz"``.
 
     Returns
     -------
     matplotlib.figure.Figure
-        Three axes: the top view (equal scale), x [m] and y [m] against time [s]. The
-        reference is taken from the first flight that has a finite one; a flight that
-        stopped early ends with a red cross and its label says when.
+        The top view (equal scale), then x [m], y [m] (and z [m]) and the position error
+        ``|p - p_ref|`` [m] against time [s]; 4 or 5 axes. The error is on a log scale
+        (see :func:`~quadcruise.plots.marks.error_axes`): after the transient the
+        controllers' paths lie on top of each other, their errors do not. Each reference
+        is taken from the first flight that has a finite one; a flight that stopped early
+        ends with a red cross and its label says when. The events recorded in the flights'
+        ``meta["environment"]`` are marked on the time panels; each flight's saturation
+        (a limit flagged, a duty clipped) is a strip in its colour along the bottom of the
+        error panel, drawn only if it happened. One legend, in the top view, names the
+        flights and whatever else is drawn.
 
     Raises
     ------
     ValueError
-        If ``results`` is empty.
+        If ``results`` is empty or ``axes`` is neither ``"xy"`` nor ``"xyz"``.
     """
     if not results:
         raise ValueError("plot_paths needs at least one result")
+    if axes not in ("xy", "xyz"):
+        raise ValueError(f"axes must be 'xy' or 'xyz', got {axes!r}")
+    spans = [saturation(r, vehicle) for r in results.values()]
     results = {label: drawable(r) for label, r in results.items()}
-    fig = Figure(figsize=(13, 6.5), layout="constrained")
-    gs = fig.add_gridspec(2, 2, width_ratios=(1, 1.3))
+    fig = Figure(figsize=(13, 8.5 if axes == "xy" else 10.5), layout="constrained")
+    gs = fig.add_gridspec(len(axes) + 1, 2, width_ratios=(1, 1.3))
     top = fig.add_subplot(gs[:, 0])
-    ax_x = fig.add_subplot(gs[0, 1])
-    ax_y = fig.add_subplot(gs[1, 1], sharex=ax_x)
+    first = fig.add_subplot(gs[0, 1])
+    time_axes = [first] + [fig.add_subplot(gs[i, 1], sharex=first) for i in range(1, len(axes) + 1)]
+    ax_e = time_axes[-1]
     ref = _reference_xy([(r, vehicle) for r in results.values()])
     if ref is not None:
-        tr, xr, yr = ref
-        top.plot(xr, yr, **REF_STYLE)
-        ax_x.plot(tr, xr, **REF_STYLE)
-        ax_y.plot(tr, yr, **REF_STYLE)
+        top.plot(ref[1], ref[2], **REF_STYLE)
+    for ax, name in zip(time_axes, axes):
+        for res in results.values():
+            if _has(res.state(f"{name}_ref")[vehicle]):
+                ax.plot(res.t, res.state(f"{name}_ref")[vehicle], **REF_STYLE)
+                break
+    curves, events, t_lo, t_hi = [], [], np.inf, -np.inf
     for k, (label, res) in enumerate(results.items()):
         c = f"C{k}"
         x, y = res.state("x")[vehicle], res.state("y")[vehicle]
-        if int(res.status[vehicle]) != 0:
+        stopped = int(res.status[vehicle]) != 0
+        if stopped:
             label = f"{label} (stopped at {res.t_stop[vehicle]:.2f} s)"
         top.plot(x, y, color=c, lw=1.4, label=label)
-        ax_x.plot(res.t, x, color=c, lw=1.4, label=label)
-        ax_y.plot(res.t, y, color=c, lw=1.4, label=label)
+        for ax, name in zip(time_axes, axes):
+            trace = res.state(name)[vehicle]
+            ax.plot(res.t, trace, color=c, lw=1.4, label=label)
+            live = np.flatnonzero(np.isfinite(trace))
+            if live.size and stopped:
+                ax.plot(res.t[live[-1]], trace[live[-1]], "X", color="tab:red", ms=9)
         live = np.isfinite(x) & np.isfinite(y)
-        if live.any() and int(res.status[vehicle]) != 0:
+        if live.any() and stopped:
             i = np.flatnonzero(live)[-1]
             top.plot(x[i], y[i], "X", color="tab:red", ms=9)
+        curves.append((res.t, position_error(res, vehicle), dict(color=c, label=label)))
+        events += [e for e in flight_events(res.meta, vehicle) if e not in events]
+        t_lo, t_hi = min(t_lo, res.t[0]), max(t_hi, res.t[-1])
+    if error_axes(ax_e, curves):
+        for t, err, _ in curves:
+            live = np.flatnonzero(np.isfinite(err))
+            if live.size and live[-1] < err.size - 1:          # it stopped: cross its last error
+                ax_e.plot(t[live[-1]], max(err[live[-1]], ERROR_FLOOR), "X", color="tab:red", ms=9)
+    strips = _saturation_strips(ax_e, spans, (t_hi - t_lo) / 1500)
+    for ax in time_axes:
+        mark_events(ax, events, (t_lo, t_hi), label=ax is ax_e)
     top.set_aspect("equal", adjustable="datalim")
     top.set(xlabel="x [m]", ylabel="y [m]", title="top view")
-    ax_x.set_ylabel("x [m]")
-    ax_y.set(xlabel="time [s]", ylabel="y [m]")
-    ax_x.tick_params(labelbottom=False)
-    for ax in (top, ax_x, ax_y):
+    for ax, name in zip(time_axes, axes):
+        ax.set_ylabel(f"{name} [m]")
+        ax.tick_params(labelbottom=False)
+    ax_e.set_xlabel("time [s]")
+    for ax in [top] + time_axes[:-1]:
         ax.grid(True, alpha=0.3)
-    _legend(top, loc="best")
+    # one legend, in the top view's spare room: the flights, then what else is drawn
+    handles, labels = top.get_legend_handles_labels()
+    for h, lb in zip(*ax_e.get_legend_handles_labels()):
+        if lb not in labels:
+            handles.append(h)
+            labels.append(lb)
+    _legend(top, handles=handles + strips, labels=labels + [h.get_label() for h in strips], loc="best")
     if title is None:
         kind = _names(next(iter(results.values())), vehicle)[1]
         title = " vs ".join(results) + (f" on {kind}" if kind else "")

@@ -227,8 +227,8 @@ def mark_events(ax, events, t_range, *, label: bool = True) -> list[Event]:
     return drawn
 
 
-def shade(ax, spans: np.ndarray, *, min_width: float = 0.0, **style):
-    """Shade time intervals over the full height of an axes, as one collection.
+def shade(ax, spans: np.ndarray, *, min_width: float = 0.0, yrange=(0.0, 1.0), **style):
+    """Shade time intervals over the height of an axes, as one collection.
 
     Parameters
     ----------
@@ -239,6 +239,9 @@ def shade(ax, spans: np.ndarray, *, min_width: float = 0.0, **style):
     min_width : float
         Intervals closer than this [s] are merged and each is drawn at least this wide,
         so that thousands of brief ones stay one visible, quickly drawn band.
+    yrange : (float, float)
+        Bottom and height of the shading in fractions of the axes' height (all of it by
+        default).
     **style
         Keywords of ``Axes.broken_barh`` (color, alpha, hatch, label, ...).
 
@@ -257,7 +260,7 @@ def shade(ax, spans: np.ndarray, *, min_width: float = 0.0, **style):
         else:
             merged.append([a, b])
     bars = [(a, max(b - a, min_width)) for a, b in merged]
-    return ax.broken_barh(bars, (0, 1), transform=ax.get_xaxis_transform(), lw=0, zorder=0.6, **style)
+    return ax.broken_barh(bars, yrange, transform=ax.get_xaxis_transform(), lw=0, zorder=0.6, **style)
 
 
 def _tick(value: float, _pos=None) -> str:
