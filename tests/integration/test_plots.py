@@ -8,6 +8,7 @@ import doctest
 import os
 import threading
 import warnings
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -19,6 +20,7 @@ from quadcruise.layout import CMD_FLAGS, CMD_U1
 from quadcruise.missions import Step
 from quadcruise.plots import flight as plots
 from quadcruise.plots import marks, plot_envelope, plot_flight, plot_paths, save_figure
+from quadcruise.plots import montecarlo as mc_plots
 from quadcruise.workflows.fly import hover_state
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -318,6 +320,79 @@ def test_plot_envelope_median_band_and_path_cap():
     np.testing.assert_allclose(line(ax_e, "median").get_ydata(), np.median(err, axis=0))
     assert "5-95 %" in [c.get_label() for c in ax_e.collections]
     assert plots._pick_paths(np.array([True, False, True, True, False]), 3).tolist() == [0, 1, 4]
+
+
+def sweep_like(n=30, ok=10, seed=0):
+    """A Monte Carlo result as the figures read it (duck-typed): its table, spec and traces,
+    the first ``ok`` flights finished, the others failed (diverged or saturated)."""
+    import pandas as pd
+
+    rng = np.random.default_rng(seed)
+    failure = np.r_[np.zeros(ok, int), rng.integers(1, 3, n - ok)]
+    table = pd.DataFrame({"vehicle": np.arange(n), "failure": failure,
+                          "rmse_m": rng.gamma(2.0, 0.1, n), "max_error_m": rng.gamma(3.0, 0.2, n),
+                          "final_error_m": np.r_[rng.gamma(2.0, 0.01, n - 3), [np.nan] * 3],
+                          "rise_time_s": np.full(n, np.nan), "settling_time_5pct_s": rng.uniform(2, 4, n),
+                          "overshoot_pct": rng.uniform(0, 20, n), "effort": rng.uniform(1, 2, n),
+                          "duty_clipped_s": np.zeros(n)})
+    t = np.linspace(0.0, 5.0, 51)
+    pos = np.cumsum(rng.normal(0, 0.1, (n, t.size, 3)), axis=1)
+    spec = SimpleNamespace(controller=SimpleNamespace(name="nlpd"), mission=SimpleNamespace(name="step"), seed=seed)
+    traces = SimpleNamespace(vehicle=np.arange(n), t=t, pos=pos, ref=np.zeros_like(pos), sample=np.ones(n, bool))
+    return SimpleNamespace(table=table, spec=spec, n=n, failure_names=("ok", "diverged", "saturated",
+                                                                       "did not settle"), traces=traces)
+
+
+def test_histograms_have_axis_labels_and_skip_degenerate_metrics():
+    fig = mc_plots.plot_histograms(sweep_like())
+    shown = [ax for ax in fig.axes if ax.get_visible()]
+    hists = shown[:-1]
+    assert [ax.get_title().split()[0] for ax in hists] == ["rmse_m", "max_error_m", "final_error_m",
+                                                            "settling_time_5pct_s", "overshoot_pct", "effort"]
+    assert [ax.get_xlabel() for ax in hists] == ["RMSE [m]", "max error [m]", "final error [m]",
+                                                 "settling time 5 % [s]", "overshoot [%]", "effort [s]"]
+    assert all(ax.get_ylabel() == "flights" for ax in shown)
+    assert shown[-1].get_title() == "outcome of 30 flights" and shown[-1].get_xlabel() == "outcome"
+    assert sum(p.get_height() for p in hists[0].patches) == 30 and "27, 3 n/a" in hists[2].get_title()
+    # the all-NaN and the all-zero metric have no panel, and the figure says so
+    assert not any(word in ax.get_title() for ax in shown for word in ("rise_time", "duty_clipped"))
+    assert not any("not measured" in t.get_text() for ax in fig.axes for t in ax.texts)
+    note = fig._supxlabel.get_text()
+    assert note == "not drawn: rise_time_s (not measured), duty_clipped_s (0 in all 30 flights)"
+    # nothing to leave out: no note; a metric the caller names is labelled by its unit suffix
+    fig = mc_plots.plot_histograms(sweep_like(), metrics=["rmse_m", "settling_time_5pct_s"])
+    assert fig._supxlabel is None and len([ax for ax in fig.axes if ax.get_visible()]) == 3
+    assert mc_plots.metric_label("hover_time_s") == "hover time [s]"
+    assert mc_plots.degenerate(np.array([np.nan, 2.0, 2.0]), 3) == "2 in all 2 flights measured"
+
+
+def drawn_paths(ax):
+    return [ln for ln in ax.get_lines() if ln.get_label().startswith("_") and len(ln.get_xdata()) > 1]
+
+
+@pytest.mark.parametrize("kind", ["sweep", "batch"])
+def test_envelope_keeps_the_finished_paths_visible(kind):
+    """Failed flights are drawn first, thin and translucent, underneath: however many
+    there are, the finished ones stay on top and visibly opaque."""
+    if kind == "sweep":
+        fig = mc_plots.plot_envelope(sweep_like(n=60, ok=15))
+    else:
+        n = 24
+        x0 = hover_state(qc.Vehicle.paper(), n, Step())
+        x0[:, 1] = np.linspace(-1.0, 1.0, n)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = qc.fly("step", duration=1.0, log_every=10, x0=x0)
+        status = np.where(np.arange(n) % 4 == 0, 0, 1)           # three quarters "stopped"
+        fig = plot_envelope(dataclasses.replace(res, status=status))
+    paths = drawn_paths(fig.axes[0])
+    ok = [ln for ln in paths if ln.get_color() == "tab:blue"]
+    failed = [ln for ln in paths if ln.get_color() != "tab:blue"]
+    assert len(ok) >= 6 and len(failed) >= 18
+    assert min(ln.get_zorder() for ln in ok) > max(ln.get_zorder() for ln in failed)
+    assert min(ln.get_alpha() for ln in ok) >= 0.35 and max(ln.get_alpha() for ln in failed) <= 0.4
+    assert max(paths.index(ln) for ln in failed) < min(paths.index(ln) for ln in ok)   # drawn last
+    assert min(ln.get_linewidth() for ln in ok) > max(ln.get_linewidth() for ln in failed)
 
 
 def test_save_figure_writes_png_atomically(tmp_path, step):

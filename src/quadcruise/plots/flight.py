@@ -439,24 +439,27 @@ def plot_envelope(result, *, title: str | None = None, max_paths: int = 50) -> F
     Returns
     -------
     matplotlib.figure.Figure
-        Two axes: the top view (thin translucent paths, those of stopped vehicles in red,
-        vehicle 0's reference dashed) and the median and 5-95 % band over vehicles of the
-        position error norm ``|p - p_ref|`` [m] against time [s].
+        Two axes: the top view (translucent paths: those of stopped vehicles thin, in red,
+        underneath those of finished ones, in blue, which stay visible however many
+        stopped; vehicle 0's reference dashed) and the median and 5-95 % band over
+        vehicles of the position error norm ``|p - p_ref|`` [m] against time [s].
     """
     n = result.n
     fig = Figure(figsize=(13, 5.5), layout="constrained")
     top, ax_e = fig.subplots(1, 2, width_ratios=(1, 1.4))
     picks = _pick_paths(result.ok, max_paths)
-    alpha = float(np.clip(6.0 / len(picks), 0.12, 0.8))
     x, y = result.state("x"), result.state("y")
-    for i in picks:
-        if result.ok[i]:
-            top.plot(x[i], y[i], color="tab:blue", lw=0.7, alpha=alpha)
-        else:
-            top.plot(x[i], y[i], color="tab:red", lw=0.9, alpha=max(alpha, 0.6))
-            live = np.flatnonzero(np.isfinite(x[i]) & np.isfinite(y[i]))
-            if live.size:
-                top.plot(x[i, live[-1]], y[i, live[-1]], "x", color="tab:red", ms=6)
+    # the stopped ones first, thin and translucent, underneath; the finished ones on top, as
+    # opaque as their number allows, so that many stopped paths do not hide them
+    good = picks[result.ok[picks]]
+    alpha = float(np.clip(10.0 / max(good.size, 1), 0.35, 0.8))
+    for i in picks[~result.ok[picks]]:
+        top.plot(x[i], y[i], color="tab:red", lw=0.8, alpha=0.4, zorder=2.0)
+        live = np.flatnonzero(np.isfinite(x[i]) & np.isfinite(y[i]))
+        if live.size:
+            top.plot(x[i, live[-1]], y[i, live[-1]], "x", color="tab:red", ms=6, alpha=0.7, zorder=2.1)
+    for i in good:
+        top.plot(x[i], y[i], color="tab:blue", lw=1.0, alpha=alpha, zorder=2.2)
     for ok, c, what in ((True, "tab:blue", "finished"), (False, "tab:red", "stopped early")):
         total = int(np.count_nonzero(result.ok == ok))
         if total:   # legend proxies: how many of each kind are drawn
@@ -464,7 +467,7 @@ def plot_envelope(result, *, title: str | None = None, max_paths: int = 50) -> F
             top.plot([], [], color=c, lw=1, label=f"{what} ({drawn} drawn of {total})")
     ref = _reference_xy([(result, 0)])
     if ref is not None:
-        top.plot(ref[1], ref[2], **REF_STYLE)
+        top.plot(ref[1], ref[2], **REF_STYLE, zorder=2.5)
     top.set_aspect("equal", adjustable="datalim")
     top.set(xlabel="x [m]", ylabel="y [m]", title="top view")
     _legend(top, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncols=3)
