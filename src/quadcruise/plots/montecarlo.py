@@ -8,6 +8,7 @@ Drawn with matplotlib's object-oriented API only, like :mod:`quadcruise.plots` (
 from __future__ import annotations
 
 import math
+import textwrap
 import warnings
 
 import numpy as np
@@ -140,7 +141,8 @@ def plot_histograms(result, metrics=None):
     for ax in axes[len(panels):]:
         ax.set_visible(False)
     if skipped:
-        fig.supxlabel("not drawn: " + ", ".join(f"{k} ({why})" for k, why in skipped.items()),
+        note = "not drawn: " + ", ".join(f"{k} ({why})".replace(" ", "\u00a0") for k, why in skipped.items())
+        fig.supxlabel(textwrap.fill(note, width=int(15 * fig.get_figwidth()), break_on_hyphens=False),
                       fontsize="small", color="0.3")
     fig.suptitle(f"{result.spec.controller.name} on {result.spec.mission.name}: {result.n:,} flights, seed "
                  f"{result.spec.seed} (lines: 5 %, median, 95 %)")
