@@ -184,6 +184,16 @@ def test_builders(rep):
     assert page.count("<canvas") == 2 and "did not settle" in page
 
 
+def test_a_single_flight_is_not_called_vehicle_0():
+    kw = flight_report(qc.fly("step", duration=2.0, log_every=10))
+    assert list(kw["figures"]) == ["Flight: nlpd on step"]
+    assert list(kw["tables"]["Flight metrics"].columns) == ["nlpd on step"]
+    assert "vehicle 0" not in html_report(**kw)
+    kw = flight_report(qc.fly("step", duration=2.0, log_every=10, n=2))
+    assert list(kw["figures"]) == ["Flight of vehicle 0: nlpd on step", "All 2 vehicles"]
+    assert list(kw["tables"]["Flight metrics"].columns) == ["vehicle 0", "vehicle 1"]
+
+
 def test_write_is_atomic(tmp_path, circle):
     with pytest.raises(qc.InputError, match="matplotlib Figure"):
         write_html_report(tmp_path / "r.html", title="x", figures={"bad": 42})
