@@ -138,14 +138,14 @@ def test_events_of_the_environment_are_marked():
                       rotor_loss=RotorLoss(rotor=2, fraction=0.3, time=2.0))
     res = qc.fly("step", duration=3.0, log_every=10, environment=env)
     fig = plot_flight(res)
-    err = axis_by_ylabel(fig, "position error")
-    events = [text for text in legend_texts(err) if text.startswith(("gust", "rotor"))]
-    assert events == ["gust 5 m/s, 0.5-1.5 s", "rotor 2 loses 30 % at 2 s"]
     for ax in fig.axes[1:]:                       # on every time panel
         loss = [ln for ln in ax.get_lines() if ln.get_color() == marks.EVENT_COLORS["rotor_loss"]]
         assert len(loss) == 1 and list(loss[0].get_xdata()) == [2.0, 2.0]
         gust = [p for p in ax.patches if p.get_facecolor()[:3] == pytest.approx((0.09, 0.745, 0.812), abs=0.01)]
         assert len(gust) == 1 and gust[0].get_x() == 0.5 and gust[0].get_width() == pytest.approx(1.0)
+    err = axis_by_ylabel(fig, "position error")
+    events = [text for text in legend_texts(err) if text.startswith(("gust", "rotor"))]
+    assert events == ["gust 5 m/s, 0.5-1.5 s", "rotor 2 loses 30 % at 2 s"]
     # per-vehicle fields: each vehicle's own; an event after the end is left out
     meta = {**res.meta, "environment": {"rotor_loss": {"rotor": [1, 3], "fraction": [0.1, 0.5], "time": [1.0, 9.0]}}}
     two = dataclasses.replace(res, meta=meta)
@@ -343,26 +343,31 @@ def sweep_like(n=30, ok=10, seed=0):
                                                                        "did not settle"), traces=traces)
 
 
-def test_histograms_have_axis_labels_and_skip_degenerate_metrics():
-    fig = mc_plots.plot_histograms(sweep_like())
+def test_histograms_have_axis_labels():
+    metrics = ["rmse_m", "max_error_m", "final_error_m", "settling_time_5pct_s", "overshoot_pct", "effort"]
+    fig = mc_plots.plot_histograms(sweep_like(), metrics=metrics)
     shown = [ax for ax in fig.axes if ax.get_visible()]
     hists = shown[:-1]
-    assert [ax.get_title().split()[0] for ax in hists] == ["rmse_m", "max_error_m", "final_error_m",
-                                                            "settling_time_5pct_s", "overshoot_pct", "effort"]
+    assert [ax.get_title().split()[0] for ax in hists] == metrics
     assert [ax.get_xlabel() for ax in hists] == ["RMSE [m]", "max error [m]", "final error [m]",
                                                  "settling time 5 % [s]", "overshoot [%]", "effort [s]"]
     assert all(ax.get_ylabel() == "flights" for ax in shown)
     assert shown[-1].get_title() == "outcome of 30 flights" and shown[-1].get_xlabel() == "outcome"
     assert sum(p.get_height() for p in hists[0].patches) == 30 and "27, 3 n/a" in hists[2].get_title()
-    # the all-NaN and the all-zero metric have no panel, and the figure says so
+    assert mc_plots.metric_label("hover_time_s") == "hover time [s]"
+
+
+def test_histograms_leave_out_degenerate_metrics_and_say_so():
+    fig = mc_plots.plot_histograms(sweep_like())          # rise time never measured, no duty ever clipped
+    shown = [ax for ax in fig.axes if ax.get_visible()]
+    assert len(shown) == 6 + 1
     assert not any(word in ax.get_title() for ax in shown for word in ("rise_time", "duty_clipped"))
     assert not any("not measured" in t.get_text() for ax in fig.axes for t in ax.texts)
     note = fig._supxlabel.get_text().replace("\u00a0", " ")       # no break inside an item
     assert note == "not drawn: rise_time_s (not measured), duty_clipped_s (0 in all 30 flights)"
-    # nothing to leave out: no note; a metric the caller names is labelled by its unit suffix
+    # nothing left out: no note
     fig = mc_plots.plot_histograms(sweep_like(), metrics=["rmse_m", "settling_time_5pct_s"])
     assert fig._supxlabel is None and len([ax for ax in fig.axes if ax.get_visible()]) == 3
-    assert mc_plots.metric_label("hover_time_s") == "hover time [s]"
     assert mc_plots.degenerate(np.array([np.nan, 2.0, 2.0]), 3) == "2 in all 2 flights measured"
 
 
