@@ -31,6 +31,7 @@ from quadcruise.workflows.analysis import (
     report,
     summary,
     to_json,
+    wrap_phase,
 )
 
 
@@ -228,3 +229,47 @@ def test_bode_draws_closed_loops_and_loop_transfers(lin):
         fig = bode(lin, loops=True, at="output")
     assert isinstance(fig, Figure) and len(fig.axes) == 4
     assert len(fig.axes[0].lines) == 4 + 1                   # four loops and the 0 dB line
+
+
+def test_bode_marks_each_loops_margins_at_its_crossovers(lin):
+    fig = bode(lin, loops=True)
+    mag_l, phase_l = fig.axes[1], fig.axes[3]
+    texts = [t.get_text() for t in mag_l.get_legend().get_texts()]
+    assert texts[0] == "L x: PM 18.1° @ 10.8 rad/s, GM -3.98 dB @ 7.07 rad/s"
+    for loop, text in zip(LOOPS, texts):
+        m = loop_margins(lin, loop)
+        assert text.startswith(f"L {loop}: PM {m['phase_margin']:.3g}° @ {m['gain_crossover']:.3g} rad/s, GM ")
+        curve = next(ln for ln in mag_l.get_lines() if ln.get_label() == text)
+        w, gain = curve.get_xdata(), curve.get_ydata()
+        phase = next(ln for ln in phase_l.get_lines() if ln.get_color() == curve.get_color() and len(ln.get_xdata()) > 2)
+        pw, pv = phase.get_xdata(), phase.get_ydata()
+        live = np.isfinite(pw)
+        if loop == "y":             # the same margins as x: marked once
+            assert not [ln for ln in phase_l.get_lines() if ln.get_label() == "PM y"]
+            continue
+        (pm,) = [ln for ln in phase_l.get_lines() if ln.get_label() == f"PM {loop}"]
+        wgc, pm_deg = m["gain_crossover"], m["phase_margin"]
+        assert list(pm.get_xdata()) == [wgc, wgc] and list(pm.get_ydata()) == [-180.0, -180.0 + pm_deg]
+        # the segment ends on the drawn phase and the dot on the drawn 0 dB crossing
+        assert np.interp(np.log(wgc), np.log(pw[live]), pv[live]) == pytest.approx(-180.0 + pm_deg, abs=0.5)
+        assert np.interp(np.log(wgc), np.log(w), gain) == pytest.approx(0.0, abs=0.2)
+        (gm,) = [ln for ln in mag_l.get_lines() if ln.get_label() == f"GM {loop}"]
+        wpc, gm_db = m["phase_crossover"], -20 * np.log10(m["gain_margin"])
+        assert list(gm.get_xdata()) == [wpc, wpc] and gm.get_ydata()[1] == pytest.approx(gm_db)
+        assert np.interp(np.log(wpc), np.log(w), gain) == pytest.approx(gm_db, abs=0.3)
+        assert np.interp(np.log(wpc), np.log(pw[live]), pv[live]) == pytest.approx(-180.0, abs=0.5)
+    assert len([ln for ln in mag_l.get_lines() if ln.get_label().startswith("GM ")]) == 3
+
+
+@pytest.mark.parametrize("loops, at", [(False, "input"), (True, "input"), (True, "output")])
+def test_bode_phases_are_wrapped_to_minus_360_0(lin, loops, at):
+    fig = bode(lin, loops=loops, at=at)
+    phase_axes = fig.axes[2:] if loops else fig.axes[1:]
+    for ax in phase_axes:
+        assert ax.get_ylim() == (-360.0, 0.0) and ax.get_ylabel() == "phase [deg]"
+        assert [v for v in ax.get_yticks() if -360.0 <= v <= 0.0] == [-360.0, -270.0, -180.0, -90.0, 0.0]
+        for ln in ax.get_lines():
+            y = np.asarray(ln.get_ydata(), float)
+            assert np.all((y[np.isfinite(y)] > -360.0) & (y[np.isfinite(y)] <= 0.0)), ln.get_label()
+            assert not np.any(np.abs(np.diff(y)) > 180.0)            # broken where it wraps, not joined
+    assert wrap_phase([-540.0, 360.0, 0.0, -359.0]).tolist() == [-180.0, 0.0, 0.0, -359.0]

@@ -8,16 +8,19 @@ import doctest
 import os
 import threading
 import warnings
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
 import quadcruise as qc
-from quadcruise.layout import CMD_FLAGS
+from quadcruise.disturbances import Environment, Gust, RotorLoss
+from quadcruise.layout import CMD_FLAGS, CMD_U1
 from quadcruise.missions import Step
 from quadcruise.plots import flight as plots
-from quadcruise.plots import plot_envelope, plot_flight, plot_paths, save_figure
+from quadcruise.plots import marks, plot_envelope, plot_flight, plot_paths, save_figure
+from quadcruise.plots import montecarlo as mc_plots
 from quadcruise.workflows.fly import hover_state
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -52,7 +55,7 @@ def labels(ax):
 def test_plot_flight_structure_labels_and_data(step):
     fig = plot_flight(step)
     assert isinstance(fig, Figure)
-    assert len(fig.axes) == 8
+    assert len(fig.axes) == 9
     path = fig.axes[0]
     assert path.name == "3d"
     assert [path.get_xlabel(), path.get_ylabel(), path.get_zlabel()] == ["x [m]", "y [m]", "z [m]"]
@@ -101,6 +104,96 @@ def test_flagged_controller_limits_are_shaded(step):
     assert "controller limit flagged" in [c.get_label() for c in duty.collections]
     duty = axis_by_ylabel(plot_flight(step), "rotor duty")
     assert "controller limit flagged" not in [c.get_label() for c in duty.collections]
+
+
+def legend_texts(ax):
+    legend = ax.get_legend()
+    return [t.get_text() for t in legend.get_texts()] if legend is not None else []
+
+
+def all_legend_texts(fig):
+    return [text for ax in fig.axes for text in legend_texts(ax)]
+
+
+def test_flight_has_a_log_position_error_panel(step, circle):
+    """After the transient the error is centimetres on a circle, millimetres on a step: a
+    log axis keeps it readable next to the metres of the transient."""
+    for res in (step, circle):
+        ax = axis_by_ylabel(plot_flight(res), "position error")
+        assert ax.get_yscale() == "log" and ax.get_ylabel() == "position error [m]"
+        err = np.linalg.norm(res.states[0, :, :3] - res.references[0, :, :3], axis=1)
+        curve = line(ax, "|p - p_ref|")
+        np.testing.assert_array_equal(curve.get_xdata(), res.t)
+        np.testing.assert_allclose(curve.get_ydata(), np.maximum(err, marks.ERROR_FLOOR))
+        lo, hi = ax.get_ylim()
+        assert lo < err[-1] < hi and lo < err.max() < hi and hi / lo >= 10
+        assert ax.get_xlim() == (res.t[0], res.t[-1])
+    # the step holds its reference exactly before t = 1 s: drawn on the named 0.1 mm floor
+    assert "≤ 0.1 mm (drawn here)" in legend_texts(axis_by_ylabel(plot_flight(step), "position error"))
+    assert not any("≤" in text for text in legend_texts(axis_by_ylabel(plot_flight(circle), "position error")))
+
+
+def test_events_of_the_environment_are_marked():
+    env = Environment(gust=Gust(amplitude=(3.0, 4.0, 0.0), start=0.5, duration=1.0),
+                      rotor_loss=RotorLoss(rotor=2, fraction=0.3, time=2.0))
+    res = qc.fly("step", duration=3.0, log_every=10, environment=env)
+    fig = plot_flight(res)
+    for ax in fig.axes[1:]:                       # on every time panel
+        loss = [ln for ln in ax.get_lines() if ln.get_color() == marks.EVENT_COLORS["rotor_loss"]]
+        assert len(loss) == 1 and list(loss[0].get_xdata()) == [2.0, 2.0]
+        gust = [p for p in ax.patches if p.get_facecolor()[:3] == pytest.approx((0.09, 0.745, 0.812), abs=0.01)]
+        assert len(gust) == 1 and gust[0].get_x() == 0.5 and gust[0].get_width() == pytest.approx(1.0)
+    err = axis_by_ylabel(fig, "position error")
+    events = [text for text in legend_texts(err) if text.startswith(("gust", "rotor"))]
+    assert events == ["gust 5 m/s, 0.5-1.5 s", "rotor 2 loses 30 % at 2 s"]
+    # per-vehicle fields: each vehicle's own; an event after the end is left out
+    meta = {**res.meta, "environment": {"rotor_loss": {"rotor": [1, 3], "fraction": [0.1, 0.5], "time": [1.0, 9.0]}}}
+    two = dataclasses.replace(res, meta=meta)
+    assert [e.label for e in marks.flight_events(meta, 1)] == ["rotor 3 loses 50 % at 9 s"]
+    assert "rotor 1 loses 10 % at 1 s" in legend_texts(axis_by_ylabel(plot_flight(two), "position error"))
+    # no environment, or one that cannot be read: no marker
+    for meta in ({}, {"environment": None}, {"environment": {"custom": "mine"}},
+                 {"environment": {"gust": {"start": "soon"}, "rotor_loss": {"rotor": 1}}}):
+        assert marks.flight_events(meta) == []
+        fig = plot_flight(dataclasses.replace(res, meta=meta))
+        assert legend_texts(axis_by_ylabel(fig, "position error")) == ["|p - p_ref|", "≤ 0.1 mm (drawn here)"]
+
+
+def test_clipped_duties_are_shaded_and_named_only_when_they_happen(step):
+    assert not any("clip" in text for text in all_legend_texts(plot_flight(step)))
+    commands = step.commands.copy()
+    commands[0, 100:120, CMD_U1 + 2] = 1.3               # asked for more than full duty
+    commands[0, 200:201, CMD_U1] = -0.1                  # and less than none, once
+    fig = plot_flight(dataclasses.replace(step, commands=commands))
+    duty = axis_by_ylabel(fig, "rotor duty")
+    assert "duty clipped (asked outside [0, 1])" in legend_texts(duty)
+    (shaded,) = [c for c in duty.collections if c.get_label().startswith("duty clipped")]
+    spans = [(p.vertices[:, 0].min(), p.vertices[:, 0].max()) for p in shaded.get_paths()]
+    assert spans == [(pytest.approx(1.0), pytest.approx(1.2)), (pytest.approx(2.0), pytest.approx(2.01))]
+    assert not any("flagged" in text for text in legend_texts(duty))
+
+
+def test_a_brief_limit_flag_survives_thinning():
+    """The flight is thinned for drawing; its saturation intervals are not."""
+    res = qc.fly("step", duration=7.0)                 # 7,001 instants, drawn every third
+    assert len(plots.drawable(res).t) < len(res.t)
+    commands = res.commands.copy()
+    commands[0, 3001, CMD_FLAGS] = 1.0                   # one period, between drawn instants
+    duty = axis_by_ylabel(plot_flight(dataclasses.replace(res, commands=commands)), "rotor duty")
+    (shaded,) = [c for c in duty.collections if c.get_label() == "controller limit flagged"]
+    (path,) = shaded.get_paths()
+    assert path.vertices[:, 0].min() == pytest.approx(3.001)
+
+
+def test_one_vehicle_is_not_called_vehicle_0(step):
+    fig = plot_flight(step)
+    texts = [fig._suptitle.get_text()] + all_legend_texts(fig) + [ax.get_title() for ax in fig.axes]
+    assert not any("vehicle" in text for text in texts), texts
+    x0 = hover_state(qc.Vehicle.paper(), 2, Step())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        two = qc.fly("step", duration=1.0, log_every=10, x0=x0)
+    assert plot_flight(two, vehicle=1)._suptitle.get_text() == "nlpd on step — vehicle 1"
 
 
 def test_early_stop_is_marked_and_explained(diverged):
@@ -153,11 +246,11 @@ def test_plot_paths_overlays_flights_with_one_reference(step, circle, diverged):
     x0[0, 1] = 0.3                                  # start 0.3 m off in y
     other = qc.fly("step", duration=3.0, log_every=10, x0=x0)
     fig = plot_paths({"A": step, "B": other, "bad": diverged})
-    assert len(fig.axes) == 3
-    top, ax_x, ax_y = fig.axes
+    assert len(fig.axes) == 4
+    top, ax_x, ax_y, ax_e = fig.axes
     assert (top.get_xlabel(), top.get_ylabel()) == ("x [m]", "y [m]")
-    assert ax_x.get_ylabel() == "x [m]" and ax_y.get_ylabel() == "y [m]" and ax_y.get_xlabel() == "time [s]"
-    for ax in fig.axes:
+    assert ax_x.get_ylabel() == "x [m]" and ax_y.get_ylabel() == "y [m]" and ax_e.get_xlabel() == "time [s]"
+    for ax in fig.axes[:3]:
         assert labels(ax).count("reference") == 1
     np.testing.assert_array_equal(line(top, "B").get_xdata(), other.state("x")[0])
     np.testing.assert_array_equal(line(top, "B").get_ydata(), other.state("y")[0])
@@ -166,6 +259,47 @@ def test_plot_paths_overlays_flights_with_one_reference(step, circle, diverged):
     assert "A vs B vs bad" in fig._suptitle.get_text()
     with pytest.raises(ValueError):
         plot_paths({})
+
+
+def test_comparison_has_a_position_error_panel_with_events_and_saturation(step):
+    """Four controllers' positions overlap after the transient; their errors, on a log
+    axis, do not. Events and saturation are marked, and named only when drawn."""
+    cmp = qc.compare("circle", duration=8.0, log_every=10)
+    fig = cmp.plot()
+    top, ax_x, ax_y, ax_z, ax_e = fig.axes
+    assert ax_e.get_ylabel() == "position error [m]" and ax_e.get_yscale() == "log"
+    assert ax_e.get_xlabel() == "time [s]" and ax_z.get_xlabel() == ""
+    finals = []
+    for k, (label, res) in enumerate(cmp.results.items()):
+        err = np.linalg.norm(res.states[0, :, :3] - res.references[0, :, :3], axis=1)
+        (curve,) = [ln for ln in ax_e.get_lines() if ln.get_label() == label]
+        np.testing.assert_allclose(curve.get_ydata(), np.maximum(err, marks.ERROR_FLOOR))
+        assert curve.get_color() == line(top, label).get_color()
+        finals.append(err[-1])
+    lo, hi = ax_e.get_ylim()
+    assert lo < min(finals) and max(finals) / min(finals) > 5      # told apart after 7 s
+    texts = legend_texts(top)
+    assert texts[:5] == ["reference", *cmp.results] and not any(
+        word in text for text in texts for word in ("gust", "rotor", "flagged", "clipped", "vehicle"))
+    assert len(ax_e.collections) == 0                                 # no saturation: no strip
+    # the same flights in a gust, one of them saturating: marked and named
+    env = {"gust": {"amplitude": [2.0, 0.0, 0.0], "start": 1.0, "duration": 2.0}}
+    flights = {label: dataclasses.replace(res, meta={**res.meta, "environment": env})
+               for label, res in cmp.results.items()}
+    commands = flights["se3"].commands.copy()
+    commands[0, 300:350, CMD_U1] = 1.5
+    flights["se3"] = dataclasses.replace(flights["se3"], commands=commands)
+    fig = plot_paths(flights, axes="xyz")
+    texts = legend_texts(fig.axes[0])
+    assert texts.count("gust 2 m/s, 1-3 s") == 1 and "duty clipped (strip in the flight's colour)" in texts
+    assert not any("flagged" in text for text in texts)
+    ax_e = fig.axes[-1]
+    (strip,) = ax_e.collections
+    assert tuple(strip.get_facecolor()[0][:3]) == pytest.approx((0.17, 0.63, 0.17), abs=0.01)   # se3 is C2
+    for ax in fig.axes[1:]:
+        assert len([p for p in ax.patches if p.get_x() == 1.0 and p.get_width() == 2.0]) == 1
+    with pytest.raises(ValueError, match="axes must be"):
+        plot_paths({"A": step}, axes="xz")
 
 
 def test_plot_envelope_median_band_and_path_cap():
@@ -186,6 +320,84 @@ def test_plot_envelope_median_band_and_path_cap():
     np.testing.assert_allclose(line(ax_e, "median").get_ydata(), np.median(err, axis=0))
     assert "5-95 %" in [c.get_label() for c in ax_e.collections]
     assert plots._pick_paths(np.array([True, False, True, True, False]), 3).tolist() == [0, 1, 4]
+
+
+def sweep_like(n=30, ok=10, seed=0):
+    """A Monte Carlo result as the figures read it (duck-typed): its table, spec and traces,
+    the first ``ok`` flights finished, the others failed (diverged or saturated)."""
+    import pandas as pd
+
+    rng = np.random.default_rng(seed)
+    failure = np.r_[np.zeros(ok, int), rng.integers(1, 3, n - ok)]
+    table = pd.DataFrame({"vehicle": np.arange(n), "failure": failure,
+                          "rmse_m": rng.gamma(2.0, 0.1, n), "max_error_m": rng.gamma(3.0, 0.2, n),
+                          "final_error_m": np.r_[rng.gamma(2.0, 0.01, n - 3), [np.nan] * 3],
+                          "rise_time_s": np.full(n, np.nan), "settling_time_5pct_s": rng.uniform(2, 4, n),
+                          "overshoot_pct": rng.uniform(0, 20, n), "effort": rng.uniform(1, 2, n),
+                          "duty_clipped_s": np.zeros(n)})
+    t = np.linspace(0.0, 5.0, 51)
+    pos = np.cumsum(rng.normal(0, 0.1, (n, t.size, 3)), axis=1)
+    spec = SimpleNamespace(controller=SimpleNamespace(name="nlpd"), mission=SimpleNamespace(name="step"), seed=seed)
+    traces = SimpleNamespace(vehicle=np.arange(n), t=t, pos=pos, ref=np.zeros_like(pos), sample=np.ones(n, bool))
+    return SimpleNamespace(table=table, spec=spec, n=n, failure_names=("ok", "diverged", "saturated",
+                                                                       "did not settle"), traces=traces)
+
+
+def test_histograms_have_axis_labels():
+    metrics = ["rmse_m", "max_error_m", "final_error_m", "settling_time_5pct_s", "overshoot_pct", "effort"]
+    fig = mc_plots.plot_histograms(sweep_like(), metrics=metrics)
+    shown = [ax for ax in fig.axes if ax.get_visible()]
+    hists = shown[:-1]
+    assert [ax.get_title().split()[0] for ax in hists] == metrics
+    assert [ax.get_xlabel() for ax in hists] == ["RMSE [m]", "max error [m]", "final error [m]",
+                                                 "settling time 5 % [s]", "overshoot [%]", "effort [s]"]
+    assert all(ax.get_ylabel() == "flights" for ax in shown)
+    assert shown[-1].get_title() == "outcome of 30 flights" and shown[-1].get_xlabel() == "outcome"
+    assert sum(p.get_height() for p in hists[0].patches) == 30 and "27, 3 n/a" in hists[2].get_title()
+    assert mc_plots.metric_label("hover_time_s") == "hover time [s]"
+
+
+def test_histograms_leave_out_degenerate_metrics_and_say_so():
+    fig = mc_plots.plot_histograms(sweep_like())          # rise time never measured, no duty ever clipped
+    shown = [ax for ax in fig.axes if ax.get_visible()]
+    assert len(shown) == 6 + 1
+    assert not any(word in ax.get_title() for ax in shown for word in ("rise_time", "duty_clipped"))
+    assert not any("not measured" in t.get_text() for ax in fig.axes for t in ax.texts)
+    note = fig._supxlabel.get_text().replace("\u00a0", " ")       # no break inside an item
+    assert note == "not drawn: rise_time_s (not measured), duty_clipped_s (0 in all 30 flights)"
+    # nothing left out: no note
+    fig = mc_plots.plot_histograms(sweep_like(), metrics=["rmse_m", "settling_time_5pct_s"])
+    assert fig._supxlabel is None and len([ax for ax in fig.axes if ax.get_visible()]) == 3
+    assert mc_plots.degenerate(np.array([np.nan, 2.0, 2.0]), 3) == "2 in all 2 flights measured"
+
+
+def drawn_paths(ax):
+    return [ln for ln in ax.get_lines() if ln.get_label().startswith("_") and len(ln.get_xdata()) > 1]
+
+
+@pytest.mark.parametrize("kind", ["sweep", "batch"])
+def test_envelope_keeps_the_finished_paths_visible(kind):
+    """Failed flights are drawn first, thin and translucent, underneath: however many
+    there are, the finished ones stay on top and visibly opaque."""
+    if kind == "sweep":
+        fig = mc_plots.plot_envelope(sweep_like(n=60, ok=15))
+    else:
+        n = 24
+        x0 = hover_state(qc.Vehicle.paper(), n, Step())
+        x0[:, 1] = np.linspace(-1.0, 1.0, n)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = qc.fly("step", duration=1.0, log_every=10, x0=x0)
+        status = np.where(np.arange(n) % 4 == 0, 0, 1)           # three quarters "stopped"
+        fig = plot_envelope(dataclasses.replace(res, status=status))
+    paths = drawn_paths(fig.axes[0])
+    ok = [ln for ln in paths if ln.get_color() == "tab:blue"]
+    failed = [ln for ln in paths if ln.get_color() != "tab:blue"]
+    assert len(ok) >= 6 and len(failed) >= 18
+    assert min(ln.get_zorder() for ln in ok) > max(ln.get_zorder() for ln in failed)
+    assert min(ln.get_alpha() for ln in ok) >= 0.35 and max(ln.get_alpha() for ln in failed) <= 0.4
+    assert max(paths.index(ln) for ln in failed) < min(paths.index(ln) for ln in ok)   # drawn last
+    assert min(ln.get_linewidth() for ln in ok) > max(ln.get_linewidth() for ln in failed)
 
 
 def test_save_figure_writes_png_atomically(tmp_path, step):

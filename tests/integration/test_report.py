@@ -186,6 +186,16 @@ def test_builders(rep):
     assert page.count("<canvas") == 2 and "did not settle" in page
 
 
+def test_a_single_flight_is_not_called_vehicle_0():
+    kw = flight_report(qc.fly("step", duration=2.0, log_every=10))
+    assert list(kw["figures"]) == ["Flight: nlpd on step"]
+    assert list(kw["tables"]["Flight metrics"].columns) == ["nlpd on step"]
+    assert "vehicle 0" not in html_report(**kw)
+    kw = flight_report(qc.fly("step", duration=2.0, log_every=10, n=2))
+    assert list(kw["figures"]) == ["Flight of vehicle 0: nlpd on step", "All 2 vehicles"]
+    assert list(kw["tables"]["Flight metrics"].columns) == ["vehicle 0", "vehicle 1"]
+
+
 def test_write_is_atomic(tmp_path, circle):
     with pytest.raises(qc.InputError, match="matplotlib Figure"):
         write_html_report(tmp_path / "r.html", title="x", figures={"bad": 42})
@@ -300,6 +310,47 @@ def test_browser_screenshot(circle, tmp_path):
         out = Path(os.environ["QUADCRUISE_ARTIFACTS"])
         out.mkdir(parents=True, exist_ok=True)
         shutil.copy(shot, out / "report_screenshot.png")
+
+
+VIEWS = {"home": None, "top": 1, "side (x-z)": 2, "side (y-z)": 3}     # index of the view's button
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("view", list(VIEWS))
+def test_browser_axis_labels_are_readable_in_every_view(view, circle, tmp_path):
+    """The viewer reports the axis labels it drew (data-labels): none overlaps another or
+    leaves the canvas, none is smaller than 12 px, each axis in the picture's plane is
+    labelled, and the depth axis of a side view, seen end-on, is not."""
+    button = VIEWS[view]
+    kw = flight_report(circle.decimate(10))
+    kw.pop("figures")
+    if button is not None:
+        kw["notes"] = ("<script>addEventListener('load', () => document.querySelectorAll("
+                       f"'.qc-buttons button')[{button}].click());</script>")
+    dom = rendered_dom(write_html_report(tmp_path / "view.html", **kw))
+    assert dom.text["qc-errors"] == "", dom.text["qc-errors"]
+    (canvas,) = dom.find("canvas")
+    labels = json.loads(canvas["data-labels"])
+    width, height = int(canvas["width"]), int(canvas["height"])
+    boxes = [lb["box"] for lb in labels]
+    for i, (x0, y0, x1, y1) in enumerate(boxes):
+        assert 0 <= x0 < x1 <= width and 0 <= y0 < y1 <= height, labels[i]
+        for j in range(i):
+            a0, b0, a1, b1 = boxes[j]
+            assert x1 <= a0 or a1 <= x0 or y1 <= b0 or b1 <= y0, (labels[j], labels[i])
+    assert min(lb["px"] for lb in labels) >= 12
+    by_kind = {}
+    for lb in labels:
+        by_kind.setdefault(lb["kind"], []).append(lb["text"])
+    shown = {"home": "xyz", "top": "xy", "side (x-z)": "xz", "side (y-z)": "yz"}[view]
+    for axis in shown:
+        ticks = [float(t) for t in by_kind.get(axis, [])]
+        assert len(ticks) >= (2 if axis == "z" else 4), (axis, by_kind)
+        assert np.allclose(np.diff(ticks), np.diff(ticks)[0])           # evenly thinned
+        assert by_kind[f"{axis} name"] == [f"{axis} [m]"]
+    hidden = {"side (x-z)": "y", "side (y-z)": "x", "top": "z"}.get(view)
+    if hidden:
+        assert hidden not in by_kind and f"{hidden} name" not in by_kind, by_kind
 
 
 # --- the animation ----------------------------------------------------------------------

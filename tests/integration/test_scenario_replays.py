@@ -103,3 +103,49 @@ def test_loading_a_scenario_runs_no_code(tmp_path):
     with pytest.raises(qc.InputError):
         load_scenario(path)
     assert not marker.exists()
+
+
+def test_a_comparison_folder_replays_itself_and_compare_takes_a_scenario(tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    one = RUNNER.invoke(main, ["compare", str(EXAMPLES / "scenarios" / "circle_turbulence.toml"),
+                               "--controllers", "nlpd,se3", "--duration", "3", "--out", str(a)])
+    assert one.exit_code == 0, one.output
+    sc = load_scenario(a / "scenario.toml")
+    assert list(sc.compare) == ["nlpd", "se3"] and sc.environment is not None and sc.sensor_noise is not None
+    two = RUNNER.invoke(main, ["compare", str(a / "scenario.toml"), "--out", str(b)])
+    assert two.exit_code == 0, two.output
+    assert (a / "metrics.csv").read_text() == (b / "metrics.csv").read_text()
+    csv = RUNNER.invoke(main, ["compare", str(EXAMPLES / "waypoints.csv"), "--controllers", "nlpd", "--duration", "2"])
+    assert csv.exit_code == 0, csv.output
+
+
+def test_a_montecarlo_folder_replays_itself_and_takes_every_mission_source(tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    common = ["--scheduler", "none", "--quiet"]
+    one = RUNNER.invoke(main, ["montecarlo", "--mission", "step", "--n", "5", "--seed", "3", "--duration", "3",
+                               "--mass-spread", "0.1", "--wind", "dryden:light@10", "--noise", "position=0.01",
+                               "--require", "rmse_m<=1", "--out", str(a), *common])
+    assert one.exit_code == 0, one.output
+    two = RUNNER.invoke(main, ["montecarlo", "--scenario", str(a / "scenario.toml"), "--out", str(b), *common])
+    assert two.exit_code == 0, two.output
+    assert (a / "flights.csv").read_text() == (b / "flights.csv").read_text()
+    import json
+
+    assert json.loads((a / "quadcruise.json").read_text())["spec_hash"] == \
+        json.loads((b / "quadcruise.json").read_text())["spec_hash"]
+    as_mission = RUNNER.invoke(main, ["montecarlo", "--mission", str(a / "scenario.toml"), *common])
+    assert as_mission.exit_code == 0 and "5 flights of nlpd on step" in as_mission.output
+    csv = RUNNER.invoke(main, ["montecarlo", "--mission", str(EXAMPLES / "waypoints.csv"), "--n", "2",
+                               "--duration", "2", *common])
+    assert csv.exit_code == 0 and "on waypoints" in csv.output, csv.output
+
+
+def test_a_reproduction_folder_holds_the_scenario_that_flies_it_again(tmp_path):
+    from quadcruise.workflows.reproduce import reproduce, write_reproduction
+
+    light = qc.Vehicle.paper().replace(m=1.4)
+    first = quiet(reproduce, scenarios=("step",), vehicle=light, dt=2e-3)
+    write_reproduction(first, tmp_path / "r")
+    sc = load_scenario(tmp_path / "r" / "scenario.toml")
+    again = quiet(reproduce, scenarios=("step",), vehicle=sc.vehicle, dt=sc.dt)
+    assert again.runs == first.runs and sc.vehicle.m == 1.4

@@ -387,14 +387,16 @@ def test_compare_table_plot_dict_and_write(tmp_path):
     assert {"rmse_m", "rise_time_s", "settling_time_s", "overshoot_pct", "effort"} <= set(table.columns)
     assert table.loc["cascade", "axis"] == "y"
     fig = cmp.plot()
-    top, ax_x, ax_y, ax_z = fig.axes
+    top, ax_x, ax_y, ax_z, ax_error = fig.axes
     assert ax_z.get_ylabel() == "z [m]" and len(ax_z.get_lines()) == 1 + 4
+    assert ax_error.get_ylabel() == "position error [m]"
+    assert [ln.get_label() for ln in ax_error.get_lines()][:4] == list(cmp.results)
     d = cmp.to_dict()
     assert d["mission"]["axis"] == "y" and set(d["metrics"]) == set(cmp.results)
     assert d["controllers"]["se3#2"]["max_tilt"] == 0.3
     json.dumps(d, allow_nan=False)
     out = cmp.write(tmp_path / "cmp")
-    assert sorted(p.name for p in out.iterdir()) == ["comparison.png", "metrics.csv", "quadcruise.json"]
+    assert sorted(p.name for p in out.iterdir()) == ["comparison.png", "metrics.csv", "quadcruise.json", "scenario.toml"]
     by_label = compare("hover", {"paper": "nlpd", "px4": Cascade()}, duration=0.5)
     assert list(by_label.results) == ["paper", "px4"]
     batch = compare("hover", ("se3",), duration=0.5, vehicle=qc.Vehicle(m=np.array([3.0, 4.0])))

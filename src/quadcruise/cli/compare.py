@@ -12,9 +12,9 @@ from quadcruise.cli.common import (
     SETTLE_BAND_OPTION,
     friendly,
     metric_options,
-    mission_from_options,
     writable,
 )
+from quadcruise.cli.objects import mission_from_options
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["compare"]
@@ -22,10 +22,10 @@ __all__ = ["compare"]
 
 @click.command("compare")
 @click.argument("mission", metavar="MISSION")
-@click.option("--controllers", default="nlpd,gonzalez,se3,cascade", show_default=True,
-              help="Comma-separated controller names.")
+@click.option("--controllers", help="Comma-separated controller names (default nlpd,gonzalez,se3,cascade, "
+              "or the scenario's).")
 @click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
-@click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
+@click.option("--dt", type=float, help="Control period [s] (default 0.001, or the scenario's).")
 @click.option("-m", "--mission-param", "mission_params", multiple=True, metavar="KEY=VALUE",
               help="Mission parameter (repeatable).")
 @click.option("--out", type=click.Path(file_okay=False), callback=writable, help="Folder for metrics.csv and comparison.png.")
@@ -83,12 +83,14 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
     conventions = metric_options(rise, settle_bands)
     if out is not None:
         check_output_dir(out, force)
-    cmp_mission = mission_from_options(mission, mission_params, smooth=False)
+    cmp_mission, chosen, kwargs = compared_from_options(mission, controllers, mission_params)
+    kwargs.update({k: v for k, v in (("duration", duration), ("dt", dt)) if v is not None})
     pop = _population(population, seed, mass_spread, wind)      # checked before anything flies
-    cmp = run_compare(cmp_mission, controllers, duration=duration, dt=dt)
+    cmp = run_compare(cmp_mission, chosen, **kwargs)
     click.echo(cmp.text(**conventions))
     if population is not None:
-        _compare_population(cmp_mission, controllers, population, seed, pop, wind, duration, dt)
+        _compare_population(cmp_mission, chosen, population, seed, pop, wind, kwargs.get("duration"),
+                            kwargs.get("dt", 1e-3))
     if out is not None:
         cmp.write(out, force=force, **conventions)
         click.echo(f"wrote metrics.csv and comparison.png to {out}")
@@ -158,3 +160,41 @@ def _compare_population(mission, controllers: str, n: int, seed: int, pop, wind:
     click.echo(f"\nthe same {n} perturbed vehicles (seed {seed}, mass spread {pop.mass_spread:g}"
                + (f", wind {wind}" if wind else "") + "):")
     click.echo(table.to_string(float_format=lambda v: f"{v:.4g}"))
+
+
+DEFAULT_COMPARED = "nlpd,gonzalez,se3,cascade"
+"""The controllers ``quadcruise compare`` flies when neither the options nor a scenario name any."""
+
+
+def compared_from_options(mission: str, controllers: str | None, mission_params: tuple[str, ...]):
+    """What ``quadcruise compare MISSION ...`` flies: the mission, controllers and keywords.
+
+    Parameters
+    ----------
+    mission : str
+        A mission name, a waypoint CSV (``.csv``) or a scenario file (``.toml``).
+    controllers : str or None
+        ``--controllers``, comma-separated names; None: the scenario's ``[compare]`` controllers,
+        else its ``[controller]``, else :data:`DEFAULT_COMPARED`.
+    mission_params : tuple of str
+        ``-m KEY=VALUE`` parameters of the mission.
+
+    Returns
+    -------
+    (Mission, str or dict, dict)
+        The mission, the controllers (names, or label -> controller) and the keywords.
+    """
+    from quadcruise.fields import parse_assignments
+
+    if not mission.lower().endswith(".toml"):
+        return mission_from_options(mission, mission_params, smooth=False), controllers or DEFAULT_COMPARED, {}
+    from quadcruise.missions import mission_from_name
+    from quadcruise.workflows.scenario import load_scenario
+
+    scenario = load_scenario(mission)
+    the_mission = scenario.mission or mission_from_name("circle")
+    if mission_params:
+        the_mission = the_mission.replace(**parse_assignments(mission_params, "--mission-param"))
+    chosen = controllers or scenario.compare or (
+        {scenario.controller.name: scenario.controller} if scenario.controller is not None else DEFAULT_COMPARED)
+    return the_mission, chosen, scenario.fly_kwargs()

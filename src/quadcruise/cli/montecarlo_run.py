@@ -115,6 +115,14 @@ offset, distribution, model_error : optional
     from quadcruise.montecarlo.sweep import run_sweep
 
     whole_number(worst, "--worst")
+    if str(mission).lower().endswith(".toml"):           # a scenario as the mission: the same as --scenario
+        if scenario is not None:
+            raise InputError(f"--mission {mission} and --scenario {scenario}: give the scenario once")
+        mission, scenario = "circle", mission
+    elif str(mission).lower().endswith(".csv"):
+        from quadcruise.cli.objects import mission_from_options
+
+        mission = mission_from_options(mission, (), smooth=False)
     if isinstance(chunk_size, str) and chunk_size != "auto":
         try:
             chunk_size = int(chunk_size)

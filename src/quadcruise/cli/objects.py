@@ -165,3 +165,4 @@ def flight_from_options(mission: str, controller: str | None, mission_params: tu
     else:
         the_controller = controller_from_options("", controller_params, poles_text, base=scenario.controller)
     return the_mission, the_controller, scenario.fly_kwargs(), scenario
+

@@ -6,13 +6,14 @@ Built-in controllers by name (see :func:`controller_from_name`):
 - ``gonzalez``: a reconstruction of the paper's baseline [5]: saturated (tanh) PD with the
   small-angle attitude mapping over the same attitude PID (see :mod:`.baselines`).
 - ``se3``: geometric tracking control on SE(3) (Lee, Leok, McClamroch 2010), as RotorPy
-  flies it, with the paper's position poles (see :mod:`.modern`).
+  flies it, with the paper's position poles (see :mod:`.se3`).
 - ``cascade``: a PX4-style multicopter cascade, P position, PID velocity, P attitude, PID
   body rate, with PX4's default gains and rate gains designed for the rotor lag (see
-  :mod:`.modern` and :mod:`.px4`).
+  :mod:`.cascade`).
 
-Each controller module is imported, and so compiled (or loaded from numba's cache), only
-when its controller is first asked for, so flying one controller never pays for the others.
+The ``nlpd`` module (:mod:`.position`) is imported with this package, and so compiled (or
+loaded from numba's cache) with it; each other controller module is imported only when its
+controller is first asked for, so flying ``nlpd`` never pays for the others.
 """
 
 from __future__ import annotations
@@ -52,7 +53,37 @@ CONTROLLERS: Mapping[str, type[Controller]] = _Registry()
 
 
 def controller_from_name(name: str, **params: Any) -> Controller:
-    """A built-in controller by name, with optional parameters."""
+    """A built-in controller by name, with optional parameters.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`CONTROLLERS`: 'nlpd', 'gonzalez', 'se3' or 'cascade'.
+    **params : Any
+        Parameters of that controller (its dataclass fields), in their units: gain sets
+        such as ``position`` (a :class:`~quadcruise.control.design.PDGains`, kp [1/s^2],
+        kd [1/s]), limits such as ``max_tilt`` [rad], switches such as ``accel_feedforward``.
+
+    Returns
+    -------
+    Controller
+        The controller; without parameters, the class's shared default instance
+        (:func:`quadcruise.model.vehicle.shared_default`).
+
+    Raises
+    ------
+    InputError
+        An unknown name or parameter, or a bad value.
+
+    Examples
+    --------
+    >>> controller_from_name("nlpd", max_tilt=0.5).max_tilt
+    0.5
+    >>> controller_from_name("pid")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: unknown controller 'pid'; choose one of nlpd, gonzalez, se3, cascade
+    """
     if name not in CONTROLLERS:
         raise InputError(f"unknown controller {name!r}; choose one of {', '.join(CONTROLLERS)}")
     cls = CONTROLLERS[name]

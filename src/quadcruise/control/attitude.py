@@ -77,9 +77,46 @@ def pid_axis(e, rate, integral, kp, ki, kd, i_limit, dt):
 def attitude_law(phi_d, theta_d, psi_d, phi, theta, psi, p, q, r, k, g, integrals, dt):
     """Eqs (13)-(15) with PID, on scalars: returns ((U2, U3, U4), new integrals, flags).
 
-    ``k`` is (k1, ..., k6), ``g`` the attitude gains (ATT_GAINS entries, layout ATT_*),
-    ``integrals`` the roll, pitch and yaw error integrals [rad s]. Scalars in, scalars out:
-    the controllers read their arrays once, call this, and write once.
+    Each angle is closed by :func:`pid_axis` (the yaw error wrapped into [-pi, pi) by
+    :func:`quadcruise.numeric.wrap_angle`), then eq (13) removes the coupling of eq (11).
+    Scalars in, scalars out: the controllers read their arrays once, call this, and write
+    once.
+
+    Parameters
+    ----------
+    phi_d, theta_d, psi_d : float
+        Roll, pitch and yaw setpoints [rad].
+    phi, theta, psi : float
+        Roll, pitch and yaw [rad].
+    p, q, r : float
+        Body rates [rad/s].
+    k : tuple of float
+        (k1, ..., k6) of eq (11): k1, k3, k5 [-], k2, k4 [1/(kg m)], k6 [1/(kg m^2)].
+    g : numpy.ndarray or tuple of float
+        The attitude gains, ATT_GAINS entries laid out as ``ATT_*``/``YAW_*``: kp [1/s^2],
+        ki [1/s^3], kd [1/s] of roll and pitch, the same of yaw, and i_limit [rad/s^2].
+    integrals : tuple of float
+        The roll, pitch and yaw error integrals so far [rad s].
+    dt : float
+        Control period [s].
+
+    Returns
+    -------
+    U : tuple of float
+        (U2, U3, U4): roll and pitch inputs [N] and yaw torque [N m].
+    integrals : tuple of float
+        The new roll, pitch and yaw error integrals [rad s].
+    flags : int
+        FLAG_INTEGRATOR_HOLD if anti-windup held any integral, else 0.
+
+    Examples
+    --------
+    >>> k = (0.0, 6.0, 0.0, 6.0, 0.0, 25.0)     # k2 = k4 = l / J, k6 = 1 / Jzz; zero rates
+    >>> g = (88.2, 40.5, 14.9, 88.2, 40.5, 14.9, 5.0)
+    >>> U, integrals, flags = attitude_law(0.1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, k, g,
+    ...                                    (0.0, 0.0, 0.0), 0.001)
+    >>> round(U[0], 6), integrals[0], flags
+    (1.470675, 0.0001, 0)
     """
     k1, k2, k3, k4, k5, k6 = k
     i_phi, i_theta, i_psi = integrals
@@ -96,13 +133,37 @@ def attitude_law(phi_d, theta_d, psi_d, phi, theta, psi, p, q, r, k, g, integral
 
 @njit(cache=True, inline="always", error_model="numpy")
 def decoupling_constants(vp):
-    """(k1, ..., k6) of a vehicle parameter row."""
+    """(k1, ..., k6) of a vehicle parameter row.
+
+    Parameters
+    ----------
+    vp : numpy.ndarray
+        A vehicle parameter row, PARAM_SIZE entries
+        (:meth:`quadcruise.model.vehicle.Vehicle.rows`).
+
+    Returns
+    -------
+    k1, k2, k3, k4, k5, k6 : float
+        The constants of eq (11): k1, k3, k5 [-], k2, k4 [1/(kg m)], k6 [1/(kg m^2)].
+    """
     return vp[P_K1], vp[P_K2], vp[P_K3], vp[P_K4], vp[P_K5], vp[P_K6]
 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def attitude_gains(gains):
-    """The attitude block (the first ATT_GAINS entries) of a gains vector, as a tuple."""
+    """The attitude block (the first ATT_GAINS entries) of a gains vector, as a tuple.
+
+    Parameters
+    ----------
+    gains : numpy.ndarray
+        A controller's gains vector that starts with the attitude block.
+
+    Returns
+    -------
+    tuple of float
+        The attitude gains, ATT_GAINS entries laid out as ``ATT_*``/``YAW_*``: kp [1/s^2],
+        ki [1/s^3], kd [1/s] of roll and pitch, the same of yaw, and i_limit [rad/s^2].
+    """
     return (gains[ATT_KP], gains[ATT_KI], gains[ATT_KD], gains[YAW_KP], gains[YAW_KI],
             gains[YAW_KD], gains[ATT_I_LIMIT])
 
@@ -114,6 +175,32 @@ def decoupled_attitude(x, phi_d, theta_d, psi_d, vp, g, mem, dt):
 
     The array form of :func:`attitude_law`: it reads every entry it needs first and writes
     ``mem`` last, so the controllers that inline it make no reference-count calls.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        The state the controller sees, STATE_SIZE entries (angles [rad], body rates [rad/s]
+        are read).
+    phi_d, theta_d, psi_d : float
+        Roll, pitch and yaw setpoints [rad].
+    vp : numpy.ndarray
+        The vehicle parameter row, PARAM_SIZE entries (k1..k6 are read).
+    g : numpy.ndarray
+        The controller's gains vector, starting with the attitude block (:func:`attitude_gains`).
+    mem : numpy.ndarray
+        The controller's memory: its first ATT_MEMORY entries are the roll, pitch and yaw
+        error integrals [rad s], updated in place.
+    dt : float
+        Control period [s].
+
+    Returns
+    -------
+    U2, U3 : float
+        Roll and pitch inputs [N].
+    U4 : float
+        Yaw torque [N m].
+    flags : int
+        FLAG_INTEGRATOR_HOLD if anti-windup held any integral, else 0.
     """
     U, integrals, flags = attitude_law(
         phi_d, theta_d, psi_d, x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R],

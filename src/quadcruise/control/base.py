@@ -1,11 +1,12 @@
-"""What every controller object offers the engine: a compiled function, its parameter
-vector for a vehicle, and the size of its memory.
+"""What every controller object offers the engine: a name, a compiled function, its
+parameter vector, and its initial memory.
 
 A controller is a frozen dataclass of gains with units (its fields come from
 :func:`quadcruise.fields.unit_field` and are checked by :func:`quadcruise.fields.validate`);
 :meth:`Controller.gains` packs them into the flat vector the compiled function reads. A
-user's own controller only needs a function compiled with ``layout.CONTROLLER_SIG`` and
-these three members.
+user's own controller needs no base class: ``name``, a ``function`` compiled with
+``layout.CONTROLLER_SIG``, ``gains()`` and ``memory()``
+(:class:`quadcruise.protocols.ControllerLike`).
 """
 
 from __future__ import annotations
@@ -57,15 +58,34 @@ class Controller(Validated):
         raise NotImplementedError
 
     def gains(self) -> np.ndarray:
-        """The flat float64 parameter vector of the compiled function."""
+        """The flat parameter vector of the compiled function.
+
+        Returns
+        -------
+        numpy.ndarray
+            1-D float64, laid out as the subclass's compiled function reads it (gains in
+            their SI units).
+        """
         raise NotImplementedError
 
     def memory(self) -> np.ndarray:
-        """Initial memory: zeros."""
+        """The controller's memory at the start of a flight (integrals, previous samples).
+
+        Returns
+        -------
+        numpy.ndarray
+            Zeros, ``memory_size`` float64 entries.
+        """
         return np.zeros(self.memory_size)
 
     def to_dict(self) -> dict[str, Any]:
-        """Name and parameters, for result bundles."""
+        """Name and parameters, for result bundles.
+
+        Returns
+        -------
+        dict
+            ``{'name': name, field: value, ...}``, a gain set as a dict of its gains.
+        """
         out: dict[str, Any] = {"name": self.name}
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
@@ -75,10 +95,37 @@ class Controller(Validated):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags, d, K):
-    """Fill a controller's output ``cmd``: the duties for (U1..U4) (yaw arm d [m], PWM gain
-    K [N]; see :func:`quadcruise.model.actuators.duties`), the desired inputs, the attitude
-    setpoints and the flag word. Straight-line code on scalars, so a controller that reads
-    its arrays first and calls this last makes no reference-count calls."""
+    """Fill a controller's output ``cmd``: the duties for (U1..U4) (see
+    :func:`quadcruise.model.actuators.duties`; not clipped here), the desired inputs, the
+    attitude setpoints and the flag word. Straight-line code on scalars, so a controller that
+    reads its arrays first and calls this last makes no reference-count calls.
+
+    Parameters
+    ----------
+    cmd : numpy.ndarray
+        Output, CMD_SIZE float64 entries (all written), laid out as ``CMD_*`` of
+        :mod:`quadcruise.layout`.
+    U1, U2, U3 : float
+        Desired collective thrust, roll and pitch inputs [N].
+    U4 : float
+        Desired yaw torque [N m].
+    phi_d, theta_d, psi_d : float
+        Attitude setpoints [rad].
+    flags : int or float
+        Bit mask of ``FLAG_*`` (:mod:`quadcruise.layout`), stored as a float.
+    d : float
+        Yaw arm: rotor drag torque per unit thrust [m], > 0.
+    K : float
+        PWM gain: a rotor's steady thrust at duty 1 [N].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> cmd = np.zeros(12)
+    >>> write_command(cmd, 10.0, -2.0, -2.0, -1.0, 0.1, 0.2, 0.3, 4, 0.5, 4.0)
+    >>> cmd.tolist()
+    [0.25, 0.5, 0.75, 1.0, 10.0, -2.0, -2.0, -1.0, 0.1, 0.2, 0.3, 4.0]
+    """
     u1, u2, u3, u4 = duties(U1, U2, U3, U4, d, K)
     cmd[0], cmd[1], cmd[2], cmd[3] = u1, u2, u3, u4
     cmd[CMD_THRUST], cmd[CMD_TAU_PHI], cmd[CMD_TAU_THETA], cmd[CMD_TAU_PSI] = U1, U2, U3, U4

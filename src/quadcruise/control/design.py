@@ -26,7 +26,13 @@ from quadcruise.fields import unit_field as _f
 
 
 def python_control():
-    """python-control, imported on first use (it costs about a second at start-up)."""
+    """python-control, imported on first use rather than with this module.
+
+    Returns
+    -------
+    module
+        The ``control`` package.
+    """
     import control
 
     return control
@@ -147,7 +153,27 @@ class PIDGains(_Gains):
 def parse_pole(value) -> complex:
     """A pole from a number or a string such as "-0.7" or "-1+2j" ("-1+2i" too).
 
-    Raises ValueError (TypeError for other types) if it is not one; callers name the source.
+    Parameters
+    ----------
+    value : float, complex or str
+        The pole, an s-plane value [rad/s]; blanks in a string are ignored.
+
+    Returns
+    -------
+    complex
+        The pole (not checked for stability: :func:`pd_from_poles` does that).
+
+    Raises
+    ------
+    ValueError
+        A string that is not a number; callers name the source.
+    TypeError
+        A value of another type (None, a list, ...).
+
+    Examples
+    --------
+    >>> parse_pole("-1 + 2i"), parse_pole(-0.7)
+    ((-1+2j), (-0.7+0j))
     """
     if isinstance(value, str):
         return complex(value.replace(" ", "").replace("i", "j"))
@@ -191,6 +217,17 @@ def pd_from_poles(poles) -> PDGains:
 
     s^2 + kd s + kp = (s - p1)(s - p2), so kp = p1 p2 and kd = -(p1 + p2).
 
+    Parameters
+    ----------
+    poles : sequence of float or complex
+        Two closed-loop poles [rad/s] in the open left half plane; a complex one with its
+        conjugate.
+
+    Returns
+    -------
+    PDGains
+        kp [1/s^2] and kd [1/s].
+
     Raises
     ------
     InputError
@@ -212,8 +249,26 @@ def pd_from_poles(poles) -> PDGains:
 def pid_from_poles(poles) -> PIDGains:
     """PID gains placing the three closed-loop poles of y'' = u at ``poles`` (s-plane).
 
-    s^3 + kd s^2 + kp s + ki = (s - p1)(s - p2)(s - p3). Raises InputError as :func:`pd_from_poles`.
+    s^3 + kd s^2 + kp s + ki = (s - p1)(s - p2)(s - p3).
 
+    Parameters
+    ----------
+    poles : sequence of float or complex
+        Three closed-loop poles [rad/s] in the open left half plane; a complex one with its
+        conjugate.
+
+    Returns
+    -------
+    PIDGains
+        kp [1/s^2], ki [1/s^3] and kd [1/s].
+
+    Raises
+    ------
+    InputError
+        As :func:`pd_from_poles`, for three poles.
+
+    Examples
+    --------
     >>> g = pid_from_poles((-1, -2, -3))
     >>> g.kp, g.ki, g.kd
     (11.0, 6.0, 6.0)
@@ -223,7 +278,23 @@ def pid_from_poles(poles) -> PIDGains:
 
 
 def position_pd_design(poles=PAPER_POSITION_POLES) -> PDGains:
-    """PD gains of the x/y loops (eq 16); the paper's poles give Kp = 3.01, Kd = 5.0 (eq 18)."""
+    """PD gains of the x/y loops (eq 16); the paper's poles give Kp = 3.01, Kd = 5.0 (eq 18).
+
+    Parameters
+    ----------
+    poles : sequence of float or complex
+        Two closed-loop poles [rad/s]; the paper's (-0.7, -4.3) by default.
+
+    Returns
+    -------
+    PDGains
+        kp [1/s^2] and kd [1/s] (:func:`pd_from_poles`).
+
+    Examples
+    --------
+    >>> position_pd_design((-1.0, -2.0))
+    PDGains(kp=2.0, kd=3.0)
+    """
     return pd_from_poles(poles)
 
 
@@ -232,6 +303,18 @@ def altitude_pd_design(poles=PAPER_POSITION_POLES) -> PDGains:
 
     With the 15 rad/s rotor lag, the default gains keep a 65 deg phase margin (crossover 4.8 rad/s).
 
+    Parameters
+    ----------
+    poles : sequence of float or complex
+        Two closed-loop poles [rad/s]; the paper's x/y poles (-0.7, -4.3) by default.
+
+    Returns
+    -------
+    PDGains
+        kp [1/s^2] and kd [1/s] (:func:`pd_from_poles`).
+
+    Examples
+    --------
     >>> round(loop_margins(altitude_pd_design(), 15.0)["phase_margin"], 1)
     65.1
     """
@@ -301,6 +384,24 @@ def cascade_state_space(position: PDGains, attitude: PIDGains, actuator_bandwidt
     inverse model at hover), U3* = Kp_a e + Ki_a int(e) - Kd_a q (attitude PID, derivative
     on the rate), theta'' lags U3* at the actuator bandwidth w, and x'' = g theta.
 
+    Parameters
+    ----------
+    position : PDGains
+        The x loop's gains: kp [1/s^2], kd [1/s].
+    attitude : PIDGains
+        The pitch loop's gains: kp [1/s^2], ki [1/s^3], kd [1/s].
+    actuator_bandwidth : float
+        The rotor lag's bandwidth w [rad/s].
+    g : float
+        Gravitational acceleration [m/s^2].
+
+    Returns
+    -------
+    control.StateSpace
+        Six states as above, input x_r [m], output x [m].
+
+    Examples
+    --------
     >>> from quadcruise.control.design import position_pd_design
     >>> sys = cascade_state_space(position_pd_design(), attitude_pid_design())
     >>> bool(np.all(sys.poles().real < 0)), round(float(sys.dcgain()), 6)
@@ -323,7 +424,26 @@ def cascade_state_space(position: PDGains, attitude: PIDGains, actuator_bandwidt
 
 
 def loop_transfer(gains: PDGains | PIDGains, actuator_bandwidth: float | None = None):
-    """Open loop L(s) = C(s) w/(s+w) / s^2 (without the lag factor when the bandwidth is None)."""
+    """Open loop L(s) = C(s) w/(s+w) / s^2 (without the lag factor when the bandwidth is None).
+
+    Parameters
+    ----------
+    gains : PDGains or PIDGains
+        The loop's gains: kp [1/s^2], kd [1/s] (and ki [1/s^3]).
+    actuator_bandwidth : float or None
+        The rotor lag's bandwidth w [rad/s], > 0; None leaves the lag out.
+
+    Returns
+    -------
+    control.TransferFunction
+        L(s), from the error to the loop's output.
+
+    Examples
+    --------
+    >>> L = loop_transfer(PDGains(kp=1.0, kd=2.0))
+    >>> L.num[0][0].tolist(), L.den[0][0].tolist()
+    ([2.0, 1.0], [1.0, 0.0, 0.0])
+    """
     s = python_control().tf("s")
     lag = 1 if actuator_bandwidth is None else actuator_bandwidth / (s + actuator_bandwidth)
     return gains.controller() * lag / s**2
@@ -332,10 +452,24 @@ def loop_transfer(gains: PDGains | PIDGains, actuator_bandwidth: float | None = 
 def loop_margins(gains: PDGains | PIDGains, actuator_bandwidth: float | None = 15.0) -> dict:
     """Stability margins of :func:`loop_transfer` by ``control.stability_margins``.
 
-    Returns ``gain_margin`` (factor; below 1 it is how far the gain may *fall*, as for a PID
-    on a double integrator), ``phase_margin`` [deg], ``phase_crossover`` and ``gain_crossover``
-    [rad/s], and ``stable`` (all poles of the unity-feedback loop in the open left half plane).
+    Parameters
+    ----------
+    gains : PDGains or PIDGains
+        The loop's gains: kp [1/s^2], kd [1/s] (and ki [1/s^3]).
+    actuator_bandwidth : float or None
+        The rotor lag's bandwidth w [rad/s], > 0; 15 rad/s (the Qball-X4's) by default, None
+        leaves the lag out.
 
+    Returns
+    -------
+    dict
+        ``gain_margin`` (factor; below 1 it is how far the gain may *fall*, as for a PID on a
+        double integrator), ``phase_margin`` [deg], ``phase_crossover`` and
+        ``gain_crossover`` [rad/s] (NaN where there is none), and ``stable`` (all poles of
+        the unity-feedback loop in the open left half plane).
+
+    Examples
+    --------
     >>> m = loop_margins(position_pd_design(), None)
     >>> round(m["phase_margin"], 1), m["gain_margin"], m["stable"]
     (83.2, inf, True)
@@ -352,10 +486,24 @@ def check_with_control(gains: PDGains | PIDGains) -> dict:
 
     States (y, y') for PD, (int y, y, y') for PID; ``control.place`` (``control.acker`` for
     repeated poles, which ``place`` refuses) at ``gains.poles`` must give (kp, kd) or
-    (ki, kp, kd). Returns ``place_gain``, ``gain_error`` (largest difference over the largest gain),
-    ``closed_loop_poles`` (eigenvalues of A - B K), ``pole_error`` (largest distance to
-    ``gains.poles``) and ``step_info`` of ``gains.closed_loop()``.
+    (ki, kp, kd).
 
+    Parameters
+    ----------
+    gains : PDGains or PIDGains
+        The loop's gains: kp [1/s^2], kd [1/s] (and ki [1/s^3]).
+
+    Returns
+    -------
+    dict
+        ``place_gain`` (the state-feedback gain, ordered as ``(kp, kd)`` or ``(ki, kp, kd)``),
+        ``gain_error`` (largest difference from the gains over the largest gain, [-]),
+        ``closed_loop_poles`` (eigenvalues of A - B K [rad/s]), ``pole_error`` (largest
+        distance to ``gains.poles`` [rad/s]) and ``step_info`` (python-control's
+        ``step_info`` of ``gains.closed_loop()``: times [s], overshoot [%] ...).
+
+    Examples
+    --------
     >>> r = check_with_control(position_pd_design())
     >>> r["place_gain"].round(6).tolist(), r["gain_error"] < 1e-9
     ([3.01, 5.0], True)

@@ -15,7 +15,41 @@ from quadcruise.layout import CMD_FLAGS
 
 @njit(cache=True)     # compiled (as CONTROLLER_SIG) on first use, not at import
 def duty_schedule(t, dt, x, ref, vp, gains, mem, cmd):
-    """Hold the duties of the last schedule row whose time is <= t."""
+    """Hold the duties of the last schedule row whose time is <= t (the first row before it).
+
+    An engine controller (compiled as ``CONTROLLER_SIG`` on first use). It writes the four
+    duties into ``cmd`` and NaN into the generalized inputs and setpoints (open loop: there
+    are none); the flag word is left as it is.
+
+    Parameters
+    ----------
+    t : float
+        Time at the start of the control period [s].
+    dt : float
+        Length of the control period [s] (not used).
+    x : numpy.ndarray
+        The state the controller sees, STATE_SIZE entries (not used).
+    ref : numpy.ndarray
+        The mission's reference at t, REF_SIZE entries (not used).
+    vp : numpy.ndarray
+        The vehicle parameter row, PARAM_SIZE entries (not used).
+    gains : numpy.ndarray
+        The schedule, as :func:`pack_schedule` packs it: n, the times [s], the duties [-].
+    mem : numpy.ndarray
+        One entry: the index of the current row, advanced as t passes the next row's time
+        (0 at the start).
+    cmd : numpy.ndarray
+        Output, CMD_SIZE entries: the duties u1..u4 [-] in its first four.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> gains = pack_schedule([0.0, 1.0], [[0.1, 0.2, 0.3, 0.4], [0.5, 0.6, 0.7, 0.8]])
+    >>> mem, cmd, v = np.zeros(1), np.zeros(12), np.zeros(16)
+    >>> duty_schedule(1.5, 1e-3, v, v[:11], v, gains, mem, cmd)
+    >>> cmd[:4].tolist(), float(mem[0])
+    ([0.5, 0.6, 0.7, 0.8], 1.0)
+    """
     n = int(gains[0])
     row = int(mem[0])
     tol = 1e-12 * (1.0 + abs(t))
@@ -30,7 +64,27 @@ def duty_schedule(t, dt, x, ref, vp, gains, mem, cmd):
 
 
 def pack_schedule(t: np.ndarray, duties: np.ndarray) -> np.ndarray:
-    """The gains vector of :func:`duty_schedule` for times t (n,) and duties (n, 4)."""
+    """The gains vector of :func:`duty_schedule`:
+    ``[n, t_0 .. t_{n-1}, u1_0 .. u4_0, u1_1, ...]``.
+
+    Parameters
+    ----------
+    t : array_like, shape (n,)
+        Start time of each row [s], increasing.
+    duties : array_like, shape (n, 4)
+        PWM duties of rotors 1..4 [-] from each row's time on (the engine clips them to
+        [0, 1]).
+
+    Returns
+    -------
+    numpy.ndarray
+        1-D float64, length 1 + 5 n.
+
+    Examples
+    --------
+    >>> pack_schedule([0.0, 2.0], [[0.1, 0.1, 0.1, 0.1], [0.2, 0.2, 0.2, 0.2]]).tolist()
+    [2.0, 0.0, 2.0, 0.1, 0.1, 0.1, 0.1, 0.2, 0.2, 0.2, 0.2]
+    """
     t = np.asarray(t, dtype=float)
     duties = np.asarray(duties, dtype=float)
     return np.concatenate(([float(t.shape[0])], t, duties.reshape(-1)))

@@ -13,7 +13,12 @@ from __future__ import annotations
 import math
 from typing import Any
 
-__all__ = ["scenario_document", "scenario_text"]
+__all__ = ["comparison_document", "montecarlo_document", "scenario_document", "scenario_text"]
+
+SPEC_KEYS = ("requirements", "max_track_error_m", "settle_band", "max_clipped_s", "transient_until", "log_dt",
+             "trace_dt", "max_traces", "max_failure_traces")
+"""The Monte Carlo spec's settings a scenario's [montecarlo] table holds beside n, seed and the
+population's spreads."""
 
 SIMULATION_FROM_META = {"duration_s": "duration", "dt_s": "dt", "max_step_s": "max_step",
                         "full_dynamics": "full_dynamics", "seed": "seed", "log_every": "log_every",
@@ -87,6 +92,60 @@ def scenario_document(meta: dict, *, title: str = "") -> dict:
     if simulation:
         doc["simulation"] = simulation
     return _plain(doc)
+
+
+def montecarlo_document(spec: dict, n: int, *, title: str = "") -> dict:
+    """The scenario tables of a Monte Carlo sweep: what ``quadcruise montecarlo --scenario`` reads.
+
+    Parameters
+    ----------
+    spec : dict
+        :meth:`quadcruise.montecarlo.MonteCarloSpec.to_dict`.
+    n : int
+        Number of flights.
+    title : str
+        The scenario's title.
+
+    Returns
+    -------
+    dict
+        The flight's tables (:func:`scenario_document`) and a ``[montecarlo]`` table: ``n``,
+        ``seed``, the population's fields and the spec's settings (:data:`SPEC_KEYS`).
+    """
+    population = spec["population"]
+    meta = {"mission": spec["mission"], "controller": spec["controller"], "vehicle": spec["vehicle"],
+            "environment": population.get("environment"), "sensors": population.get("noise"),
+            "duration_s": spec.get("duration"), "dt_s": spec.get("dt"), "max_step_s": spec.get("max_step"),
+            "full_dynamics": spec.get("full_dynamics")}
+    doc = scenario_document(meta, title=title)
+    table = {"n": int(n), "seed": spec["seed"]}
+    table.update({k: v for k, v in population.items() if k not in ("environment", "noise")})
+    table.update({k: spec[k] for k in SPEC_KEYS if spec.get(k) is not None})
+    doc["montecarlo"] = _plain(table)
+    return doc
+
+
+def comparison_document(meta: dict, controllers: dict, *, title: str = "") -> dict:
+    """The scenario tables of a comparison: what ``quadcruise compare`` reads.
+
+    Parameters
+    ----------
+    meta : dict
+        The recorded configuration of one of its flights (all share mission, vehicle and world).
+    controllers : dict
+        Label -> the controller's record (``to_dict()``), in the order flown.
+    title : str
+        The scenario's title.
+
+    Returns
+    -------
+    dict
+        The flight's tables without ``[controller]``, and ``[[compare.controllers]]``: one table
+        per controller, with its ``label``.
+    """
+    doc = scenario_document({k: v for k, v in meta.items() if k != "controller"}, title=title)
+    doc["compare"] = {"controllers": [_plain({"label": label, **record}) for label, record in controllers.items()]}
+    return doc
 
 
 def scenario_text(doc: dict, *, header: str = "") -> str:

@@ -62,11 +62,36 @@ class Mission(Validated):
         return 5.0
 
     def params(self) -> np.ndarray:
-        """The mission's parameter vector mp (float64, C-contiguous), laid out as ``columns``."""
+        """The mission's parameter vector mp, laid out as ``columns``.
+
+        Returns
+        -------
+        numpy.ndarray
+            1-D float64, C-contiguous: the entries of ``_row()`` in order, in the units of
+            the fields they come from.
+        """
         return np.ascontiguousarray(self._row(), dtype=np.float64)
 
     def reference(self, t: Any) -> np.ndarray:
-        """The reference at times ``t`` [s], shape (len(t), REF_SIZE), from the compiled function."""
+        """The reference at given times, from the compiled function.
+
+        Parameters
+        ----------
+        t : float or array_like
+            Time or 1-D array of times [s], all finite.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (len(t), REF_SIZE) (one row for a scalar ``t``): position [m], velocity
+            [m/s], acceleration [m/s^2], yaw [rad] and yaw rate [rad/s], in the columns of
+            :mod:`quadcruise.layout` (``REF_X`` ... ``REF_PSI_DOT``).
+
+        Raises
+        ------
+        InputError
+            ``t`` is not a scalar or 1-D array of finite numbers.
+        """
         ts = np.array(np.atleast_1d(t), dtype=np.float64)    # a writable C-ordered copy
         if ts.ndim != 1 or not np.all(np.isfinite(ts)):
             raise InputError("mission reference times must be a 1-D array of finite numbers")
@@ -75,19 +100,64 @@ class Mission(Validated):
         return out
 
     def replace(self, **changes: Any) -> "Mission":
-        """A copy with some fields changed (validated again)."""
+        """A copy with some fields changed (validated again).
+
+        Parameters
+        ----------
+        **changes : Any
+            Field name -> new value, in the field's unit.
+
+        Returns
+        -------
+        Mission
+            A new mission of the same kind.
+
+        Raises
+        ------
+        InputError
+            A name that is not a field of this kind, or a bad value.
+        """
         check_names(type(self), changes)
         return dataclasses.replace(self, **changes)
 
     def to_dict(self) -> dict:
-        """``{'kind': name, field: value, ...}`` with plain values, for result bundles."""
+        """The mission as plain values, for result bundles (read back by
+        :func:`quadcruise.missions.mission_from_dict`).
+
+        Returns
+        -------
+        dict
+            ``{'kind': name, field: value, ...}``, tuple fields as lists.
+        """
         values = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         return {"kind": self.name, **{k: list(v) if isinstance(v, tuple) else v for k, v in values.items()}}
 
 
 
 def check_names(cls: type, kw: dict) -> None:
-    """InputError naming any key of ``kw`` that is not a field of the mission kind ``cls``."""
+    """Refuse keys that are not fields of a mission kind.
+
+    Parameters
+    ----------
+    cls : type
+        A mission class (a subclass of :class:`Mission`).
+    kw : dict
+        Field name -> value; only the keys are checked.
+
+    Raises
+    ------
+    InputError
+        Naming every key of ``kw`` that is not a field of ``cls``.
+
+    Examples
+    --------
+    >>> from quadcruise.missions import Circle
+    >>> check_names(Circle, {"radius": 1.0})
+    >>> check_names(Circle, {"radiu": 1.0})
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: unknown circle field(s): radiu
+    """
     unknown = set(kw) - {f.name for f in dataclasses.fields(cls)}
     if unknown:
         raise InputError(f"unknown {cls.name} field(s): {', '.join(sorted(unknown))}")
@@ -100,6 +170,27 @@ def stack_params(missions: Mission | Sequence[Mission], n: int | None = None) ->
     A single mission (or a list of one) is broadcast to ``n`` rows when ``n`` is given.
     Rows of different lengths (waypoint tables of different sizes) are padded with zeros.
 
+    Parameters
+    ----------
+    missions : Mission or sequence of Mission
+        One mission, or one per vehicle, all of one kind.
+    n : int, optional
+        Number of vehicles N: a single mission is repeated to N rows; a list of several must
+        have N entries. None: one row per mission given.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (N, M), float64, C-contiguous; M is the longest mission's ``params()``.
+
+    Raises
+    ------
+    InputError
+        An empty list or one holding something other than missions, missions of different
+        kinds, or a list whose length is neither 1 nor ``n``.
+
+    Examples
+    --------
     >>> from quadcruise.missions import Circle, Hover
     >>> stack_params([Circle(radius=1.0), Circle(radius=2.0)])[:, 0]
     array([1., 2.])

@@ -17,9 +17,34 @@ MISSIONS = {cls.name: cls for cls in (Hover, Step, Circle, Square, Waypoints, Mi
 
 
 def mission_from_name(name: str, **kw: Any) -> Mission:
-    """Build a mission by kind name ('hover', 'step', 'circle', 'square') and fields.
+    """Build a mission by kind name and fields.
 
+    Parameters
+    ----------
+    name : str
+        A key of :data:`MISSIONS`: 'hover', 'step', 'circle', 'square', 'waypoints' or
+        'minsnap' (case and surrounding blanks ignored).
+    **kw : Any
+        Fields of that kind, in their units (e.g. ``radius`` [m], ``period`` [s]); the
+        waypoint kinds need ``table`` (a :class:`~quadcruise.missions.WaypointTable`, a CSV
+        path or a dict).
+
+    Returns
+    -------
+    Mission
+        The mission; without fields, the kind's shared default instance
+        (:func:`quadcruise.model.vehicle.shared_default`).
+
+    Raises
+    ------
+    InputError
+        An unknown kind or field, a bad value, or a waypoint kind without ``table``.
+
+    Examples
+    --------
     >>> mission_from_name("circle", radius=3.0).speed == 2 * 3.1415926535897931 * 3 / 20
+    True
+    >>> mission_from_name(" Hover ") is mission_from_name("hover")
     True
     """
     cls = MISSIONS.get(str(name).strip().lower())
@@ -33,6 +58,23 @@ def mission_from_name(name: str, **kw: Any) -> Mission:
 
 
 def mission_from_dict(d: dict) -> Mission:
-    """Inverse of :meth:`Mission.to_dict`."""
+    """Inverse of :meth:`Mission.to_dict`.
+
+    Parameters
+    ----------
+    d : dict
+        ``{'kind': name, field: value, ...}``; it is not modified.
+
+    Returns
+    -------
+    Mission
+        As :func:`mission_from_name` builds it.
+
+    Examples
+    --------
+    >>> from quadcruise.missions import Square
+    >>> mission_from_dict(Square(side=2.0).to_dict()) == Square(side=2.0)
+    True
+    """
     d = dict(d)
     return mission_from_name(d.pop("kind", ""), **d)

@@ -66,7 +66,7 @@ _AXES = {"x": REF_X, "y": REF_Y, "z": REF_Z, "yaw": REF_PSI}
 # zero-division checks, the dataclasses having ruled zero divisors out). Each compiles
 # (or loads from numba's cache) the first time a flight passes it to the engine, as a
 # function with MISSION_SIG; a signature in the decorator would compile every mission
-# when the package is imported (about 2 s of a cold start for missions not flown). -----
+# when the package is imported, missions not flown included. -----
 @njit(cache=True)
 def _clear(ref):
     for i in range(REF_SIZE):
@@ -75,14 +75,47 @@ def _clear(ref):
 
 @njit(cache=True, error_model="numpy")
 def hover_ref(t, mp, ref):
-    """mp = (x, y, z, yaw): a constant point."""
+    """Hover reference: a constant point, zero velocity and acceleration.
+
+    Parameters
+    ----------
+    t : float
+        Time [s].
+    mp : numpy.ndarray
+        The mission's parameter vector (float64, 1-D): (x [m], y [m], z [m], yaw [rad]).
+    ref : numpy.ndarray
+        Output, REF_SIZE float64 entries: position [m], velocity [m/s], acceleration
+        [m/s^2], yaw [rad] and yaw rate [rad/s] at ``t`` (overwritten).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> ref = np.empty(REF_SIZE)
+    >>> hover_ref(3.0, np.array([1.0, 2.0, 1.5, 0.5]), ref)
+    >>> ref[[REF_X, REF_Y, REF_Z, REF_PSI]]
+    array([1. , 2. , 1.5, 0.5])
+    """
     _clear(ref)
     ref[REF_X], ref[REF_Y], ref[REF_Z], ref[REF_PSI] = mp[0], mp[1], mp[2], mp[3]
 
 
 @njit(cache=True, error_model="numpy")
 def step_ref(t, mp, ref):
-    """mp = (x, y, z, yaw, column, size, time): ref[column] += size from t >= time."""
+    """Step reference: hover at (x, y, z, yaw), and ``ref[column] += size`` from t >= time.
+
+    Velocity and acceleration stay zero.
+
+    Parameters
+    ----------
+    t : float
+        Time [s].
+    mp : numpy.ndarray
+        The mission's parameter vector (float64, 1-D): (x [m], y [m], z [m], yaw [rad],
+        column [-] (the REF column stepped, as a float), size [m] or [rad] (yaw), time [s]).
+    ref : numpy.ndarray
+        Output, REF_SIZE float64 entries: position [m], velocity [m/s], acceleration
+        [m/s^2], yaw [rad] and yaw rate [rad/s] at ``t`` (overwritten).
+    """
     _clear(ref)
     ref[REF_X], ref[REF_Y], ref[REF_Z], ref[REF_PSI] = mp[0], mp[1], mp[2], mp[3]
     if t >= mp[6]:
@@ -91,7 +124,24 @@ def step_ref(t, mp, ref):
 
 @njit(cache=True, error_model="numpy")
 def circle_ref(t, mp, ref):
-    """mp = (radius, omega, altitude, start_angle, cx, cy, yaw, ramp_time)."""
+    """Circle reference with exact velocity and acceleration.
+
+    The angle is a = start_angle + omega s(t), s(t) = t without a ramp; with ``ramp_time``
+    T_r > 0 the angular rate rises as smoothstep(t / T_r) from 0 (s = 0 for t <= 0) and
+    s(t) = t - T_r / 2 after the ramp.
+
+    Parameters
+    ----------
+    t : float
+        Time [s].
+    mp : numpy.ndarray
+        The mission's parameter vector (float64, 1-D): (radius [m], omega [rad/s]
+        (signed: > 0 counter-clockwise), altitude [m], start_angle [rad], cx [m], cy [m],
+        yaw [rad], ramp_time [s]).
+    ref : numpy.ndarray
+        Output, REF_SIZE float64 entries: position [m], velocity [m/s], acceleration
+        [m/s^2], yaw [rad] and yaw rate [rad/s] at ``t`` (overwritten).
+    """
     radius, omega, ramp = mp[0], mp[1], mp[7]
     s, rate, drate = t, 1.0, 0.0          # phase time s(t) and its derivatives
     if ramp > 0.0:
@@ -120,7 +170,23 @@ def circle_ref(t, mp, ref):
 
 @njit(cache=True, error_model="numpy")
 def square_ref(t, mp, ref):
-    """mp = (side, speed, altitude, x0, y0, direction, dwell, yaw)."""
+    """Square reference: constant-speed legs +x, +y, -x, -y (y mirrored for direction -1)
+    from the corner (x0, y0), dwelling at each corner, repeating every lap.
+
+    On a leg the velocity is ``speed`` along it and the acceleration zero; during a dwell
+    both are zero (the velocity jumps at departure and arrival).
+
+    Parameters
+    ----------
+    t : float
+        Time [s].
+    mp : numpy.ndarray
+        The mission's parameter vector (float64, 1-D): (side [m], speed [m/s], altitude [m],
+        x0 [m], y0 [m], direction [-] (+1 or -1), dwell [s], yaw [rad]).
+    ref : numpy.ndarray
+        Output, REF_SIZE float64 entries: position [m], velocity [m/s], acceleration
+        [m/s^2], yaw [rad] and yaw rate [rad/s] at ``t`` (overwritten).
+    """
     side, speed, sgn, dwell = mp[0], mp[1], mp[5], mp[6]
     seg = dwell + side / speed            # one corner's dwell plus one leg
     lap = 4.0 * seg
@@ -146,6 +212,17 @@ def square_ref(t, mp, ref):
 class Hover(Mission):
     """Hold a point. mp = (x, y, z, yaw).
 
+    Parameters
+    ----------
+    x, y : float
+        Horizontal position [m].
+    z : float
+        Altitude [m] (z up).
+    yaw : float
+        Yaw [rad].
+
+    Examples
+    --------
     >>> Hover(z=2.0).reference(0.0)[0, :3]
     array([0., 0., 2.])
     """
@@ -170,6 +247,23 @@ class Step(Mission):
     Velocity and acceleration references stay zero. ``size`` is in m, or rad for yaw.
     mp = (x, y, z, yaw, column, size, time), ``column`` being the REF column stepped.
 
+    Parameters
+    ----------
+    axis : str
+        The stepped axis: 'x', 'y', 'z' or 'yaw'.
+    size : float
+        Step size [m] (or [rad] for 'yaw').
+    time : float
+        Time of the step [s], >= 0.
+    x, y : float
+        Horizontal position before the step [m].
+    z : float
+        Altitude before the step [m].
+    yaw : float
+        Yaw before the step [rad].
+
+    Examples
+    --------
     >>> Step(axis="z", size=0.5, time=2.0).reference([1.999, 2.0])[:, 2]
     array([1. , 1.5])
     """
@@ -199,9 +293,36 @@ class Step(Mission):
 class Circle(Mission):
     """The paper's search-and-rescue circle (Fig 4), with exact velocity and acceleration.
 
-    Position (cx + R cos a, cy + R sin a, altitude), a = start_angle + direction 2 pi t / period.
+    Position (cx + R cos a, cy + R sin a, altitude), a = start_angle + direction 2 pi t / period
+    (with ``ramp_time`` > 0, t is replaced by the ramped phase time of :func:`circle_ref`).
     mp = (radius, omega, altitude, start_angle, cx, cy, yaw, ramp_time) with
     omega = direction 2 pi / period [rad/s].
+
+    Parameters
+    ----------
+    radius : float
+        Circle radius R [m], > 0.
+    period : float
+        Time per lap [s], > 0.
+    altitude : float
+        Altitude [m].
+    start_angle : float
+        Angle of the start point from +x about the centre [rad].
+    center : tuple of float
+        Centre (cx, cy) [m].
+    direction : int
+        +1 counter-clockwise, -1 clockwise.
+    yaw : float
+        Yaw, held [rad].
+    ramp_time : float
+        Time over which the angular rate ramps smoothly up from 0 [s], >= 0 (0: none; the
+        phase then lags the unramped circle by omega * ramp_time / 2).
+
+    Examples
+    --------
+    >>> c = Circle(radius=1.0, period=4.0, center=(1.0, 0.0))
+    >>> c.reference(1.0)[0, :3].round(12) + 0.0       # a quarter lap: at (cx, cy + R)
+    array([1., 1., 1.])
     """
 
     radius: float = _f(2.0, "m", "circle radius", "pos")
@@ -240,6 +361,25 @@ class Square(Mission):
     Starts at ``corner``; legs +x, +y, -x, -y (y mirrored for direction -1). Only C0 at the
     corners. mp = (side, speed, altitude, x0, y0, direction, dwell, yaw).
 
+    Parameters
+    ----------
+    side : float
+        Side length [m], > 0.
+    speed : float
+        Speed on the legs [m/s], > 0.
+    altitude : float
+        Altitude [m].
+    corner : tuple of float
+        First corner (x0, y0) [m], where the square starts.
+    direction : int
+        +1 counter-clockwise (legs +x, +y, -x, -y), -1 clockwise (+x, -y, -x, +y).
+    dwell : float
+        Hold at each corner before leaving it [s], >= 0.
+    yaw : float
+        Yaw, held [rad].
+
+    Examples
+    --------
     >>> Square().reference([8.0, 16.0, 32.0])[:, :2]      # corners every side/speed = 8 s
     array([[4., 0.],
            [4., 4.],

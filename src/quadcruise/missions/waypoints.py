@@ -20,8 +20,9 @@ Kinds (both hold the last point after the end, and the first before t = 0):
   s = (t - t_i) / T_i. mp = [m, x, y, z, yaw and t of the end, then per segment: t_i, T_i,
   8 coefficients of s^0..s^7 for each of x, y, z, yaw], length 6 + 34 m, m = n - 1.
 
-A batch flies one kind but its tables may differ in length: ``stack`` pads shorter rows with
-zeros, which the compiled functions never read (the count is mp[0]). ``duration`` is the last
+A batch flies one kind but its tables may differ in length:
+:func:`~quadcruise.missions.base.stack_params` pads shorter rows with zeros, which the
+compiled functions never read (the count is mp[0]). ``duration`` is the last
 arrival + ``SETTLE_S``, rounded up to a whole second (so any usual dt divides it).
 
 Examples
@@ -65,7 +66,7 @@ __all__ = ["WaypointTable", "read_waypoints_csv", "Waypoints", "MinimumSnap",
            "minimum_snap_coefficients", "SETTLE_S", "DEFAULT_SPEED"]
 
 COLUMNS = ("x", "y", "z", "yaw", "t", "speed")
-DEFAULT_SPEED = 0.5   # m/s, the paper's square speed, for tables that give no timing
+DEFAULT_SPEED = 0.5   # m/s, the square mission's default speed, for tables that give no timing
 SETTLE_S = 5.0        # s flown after the last point by default
 _ORDER = 7            # polynomial degree of the minimum-snap segments
 _NC = _ORDER + 1
@@ -78,13 +79,29 @@ class WaypointTable:
 
     Parameters
     ----------
-    points : (n, 3) positions x, y, z [m], n >= 2
-    yaw : (n,) yaw at each point [rad], optional (0 throughout if left out)
-    t : (n,) arrival times [s], strictly increasing from 0; optional
-    speed : (n,) cruise speed on the leg ending at each point [m/s], > 0; the first entry is
-        unused (NaN allowed); optional, and not together with ``t``
-    source : name used in error messages (the file name)
+    points : array_like, shape (n, 3)
+        Positions x, y, z [m], n >= 2, all finite. Without ``t``, no point may repeat the
+        one before it (a zero-length leg).
+    yaw : array_like, shape (n,), optional
+        Yaw at each point [rad] (0 throughout if left out).
+    t : array_like, shape (n,), optional
+        Arrival times [s]: the first 0, then strictly increasing. A point repeated with a
+        later time is a dwell.
+    speed : array_like, shape (n,), optional
+        Cruise speed on the leg ending at each point [m/s], > 0; the first entry is unused
+        (NaN allowed, not negative). Not together with ``t``.
+    source : str
+        Name used in error messages (the file name).
+    lines : sequence of int, optional
+        The file line of each point, for error messages (rows are counted from 1 without it).
 
+    Raises
+    ------
+    InputError
+        One line naming the source, the row (or line) and column of the first bad value.
+
+    Examples
+    --------
     >>> WaypointTable([[0, 0, 1], [1, 0, 1]], t=[0.0, 0.0])
     Traceback (most recent call last):
         ...
@@ -158,8 +175,24 @@ class WaypointTable:
                           (self.points, self.yaw, self.t, self.speed)))
 
     def times(self, speed: float = DEFAULT_SPEED) -> np.ndarray:
-        """Arrival times [s]: ``t``, or cumulated leg length / leg speed (``speed`` on every
-        leg when the table gives no timing)."""
+        """Arrival time at each point: ``t``, or cumulated leg length / leg speed.
+
+        Parameters
+        ----------
+        speed : float
+            Speed on every leg [m/s], used only when the table gives neither ``t`` nor
+            ``speed``.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n,), arrival times [s], the first 0 (a copy).
+
+        Examples
+        --------
+        >>> WaypointTable([[0, 0, 1], [3, 4, 1]]).times(speed=2.5)
+        array([0., 2.])
+        """
         if self.t is not None:
             return np.array(self.t)
         v = self.speed[1:] if self.speed is not None else np.full(len(self) - 1, float(speed))
@@ -167,11 +200,25 @@ class WaypointTable:
         return np.concatenate([[0.0], np.cumsum(legs / v)])
 
     def yaws(self) -> np.ndarray:
-        """Yaw at each point [rad] (zeros if the table has none)."""
+        """Yaw at each point.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n,), yaw [rad] (zeros if the table has none; a copy).
+        """
         return np.zeros(len(self)) if self.yaw is None else np.array(self.yaw)
 
     def to_dict(self) -> dict:
-        """Plain lists (None for absent columns and the unused first speed), for JSON."""
+        """The table as plain lists, for JSON; :meth:`from_dict` reads it back.
+
+        Returns
+        -------
+        dict
+            ``x``, ``y``, ``z`` [m], ``yaw`` [rad], ``t`` [s], ``speed`` [m/s] as lists (None
+            for an absent column; a non-finite entry, such as the unused first speed, as
+            None) and ``source``. The file lines are not kept.
+        """
         out: dict = {name: self.points[:, j].tolist() for j, name in enumerate("xyz")}
         for name in ("yaw", "t", "speed"):
             arr = getattr(self, name)
@@ -180,7 +227,30 @@ class WaypointTable:
 
     @classmethod
     def from_dict(cls, d: dict) -> "WaypointTable":
-        """Inverse of :meth:`to_dict`."""
+        """Inverse of :meth:`to_dict`.
+
+        Parameters
+        ----------
+        d : dict
+            ``x``, ``y``, ``z`` [m] (lists of equal length), optionally ``yaw`` [rad],
+            ``t`` [s], ``speed`` [m/s] (None entries read as NaN) and ``source``.
+
+        Returns
+        -------
+        WaypointTable
+
+        Raises
+        ------
+        InputError
+            A missing coordinate or values that are not numbers, or a table
+            :class:`WaypointTable` refuses.
+
+        Examples
+        --------
+        >>> table = WaypointTable([[0, 0, 1], [1, 0, 1]], speed=[float("nan"), 0.5])
+        >>> WaypointTable.from_dict(table.to_dict()) == table
+        True
+        """
         try:
             pts = np.column_stack([np.asarray(d[c], dtype=float) for c in "xyz"])
             opt = {c: None if d.get(c) is None else np.array([np.nan if v is None else v for v in d[c]], dtype=float)
@@ -212,6 +282,23 @@ def read_waypoints_csv(path: str | os.PathLike) -> WaypointTable:
 
     Errors are one line naming the file, line and column; unknown columns are ignored with a
     warning. The first row's ``speed`` cell may be empty.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The CSV file: columns x, y, z [m], yaw [rad], t [s] (arrival times) or speed [m/s]
+        (speed on the leg ending at each row).
+
+    Returns
+    -------
+    WaypointTable
+        With ``source`` the path and ``lines`` the file line of each point.
+
+    Raises
+    ------
+    InputError
+        No such file, a missing column, a cell that is not a number, both ``t`` and
+        ``speed``, fewer than two waypoints, or a table :class:`WaypointTable` refuses.
     """
     head_line, used, data, lines = read_numeric_csv(
         path, ("x", "y", "z"), tuple(c for c in COLUMNS if c not in "xyz"),
@@ -242,7 +329,25 @@ def _last_start(t, mp, first, stride, count):
 
 @njit(cache=True, error_model="numpy")
 def waypoints_ref(t, mp, ref):
-    """mp = [n, hold_yaw, (x, y, z, yaw, t) per point]: straight legs, C0 at the points."""
+    """Waypoint reference: straight constant-speed legs, C0 at the points.
+
+    On the leg [t_k, t_k+1) the position moves linearly from point k to point k+1, the
+    velocity is constant and the acceleration zero; yaw moves linearly with its rate, or is
+    held at point k's yaw when ``hold_yaw`` is not 0. Before t = 0 the reference is the first
+    point, from the last arrival on the last point, at rest.
+
+    Parameters
+    ----------
+    t : float
+        Time [s].
+    mp : numpy.ndarray
+        The mission's parameter vector (float64, 1-D): [n, hold_yaw, then per point
+        x [m], y [m], z [m], yaw [rad], t [s]], length 2 + 5 n (entries after it are not
+        read).
+    ref : numpy.ndarray
+        Output, REF_SIZE float64 entries: position [m], velocity [m/s], acceleration
+        [m/s^2], yaw [rad] and yaw rate [rad/s] at ``t`` (overwritten).
+    """
     for i in range(REF_SIZE):
         ref[i] = 0.0
     n = int(mp[0])
@@ -269,7 +374,25 @@ def waypoints_ref(t, mp, ref):
 
 @njit(cache=True, error_model="numpy")
 def minsnap_ref(t, mp, ref):
-    """mp = [m, x, y, z, yaw and t at the end, (t_i, T_i, 4 x 8 coefficients in s) per segment]."""
+    """Minimum-snap reference: the polynomial segments of :func:`minimum_snap_coefficients`.
+
+    In segment i, s = (t - t_i) / T_i and each of x, y, z, yaw is sum_k c_k s^k; velocity,
+    acceleration and yaw rate are its time derivatives. Before t = 0 the reference is the
+    first point (s = 0), from the end time on the last point, at rest.
+
+    Parameters
+    ----------
+    t : float
+        Time [s].
+    mp : numpy.ndarray
+        The mission's parameter vector (float64, 1-D): [m, x [m], y [m], z [m], yaw [rad]
+        and t [s] of the end, then per segment t_i [s], T_i [s] and 8 coefficients of
+        s^0..s^7 for each of x [m], y [m], z [m], yaw [rad]], length 6 + 34 m (entries after
+        it are not read).
+    ref : numpy.ndarray
+        Output, REF_SIZE float64 entries: position [m], velocity [m/s], acceleration
+        [m/s^2], yaw [rad] and yaw rate [rad/s] at ``t`` (overwritten).
+    """
     for i in range(REF_SIZE):
         ref[i] = 0.0
     if t >= mp[5]:
@@ -316,15 +439,22 @@ def minimum_snap_coefficients(values: Any, times: Any, stops: Any = None) -> np.
 
     Parameters
     ----------
-    values : (n,) or (n, A) knot values (A axes solved together)
-    times : (n,) strictly increasing knot times [s]
-    stops : (n,) bool, optional; True where the path comes to rest (zero velocity,
-        acceleration and jerk). The two ends always do.
+    values : array_like, shape (n,) or (n, A)
+        Knot values, in the unit of the axis (e.g. [m], [rad]); A axes are solved together.
+    times : array_like, shape (n,)
+        Strictly increasing knot times [s], n >= 2.
+    stops : array_like of bool, shape (n,), optional
+        True where the path comes to rest (zero velocity, acceleration and jerk). The two
+        ends always do.
 
     Returns
     -------
-    (m, 8, A) array: coefficients of s^0..s^7, s = (t - times[i]) / (times[i+1] - times[i]).
+    numpy.ndarray
+        Shape (m, 8, A), m = n - 1: the coefficients of s^0..s^7 of each segment, in the
+        unit of the values, s = (t - times[i]) / (times[i+1] - times[i]).
 
+    Examples
+    --------
     >>> c = minimum_snap_coefficients([0.0, 1.0], [0.0, 2.0])   # rest to rest: 35s^4 - 84s^5 ...
     >>> c[0, :, 0].round(9) + 0.0
     array([  0.,   0.,   0.,   0.,  35., -84.,  70., -20.])
@@ -385,7 +515,7 @@ def _as_table(value: Any) -> WaypointTable:
 @dataclass(frozen=True)
 class _WaypointMission(Mission):
     """Shared parts: the table (a WaypointTable, CSV path or dict), the default speed,
-    ``duration``, ``stack`` and ``to_dict``."""
+    ``times``, ``duration`` and ``to_dict``."""
 
     table: Any = _f(None, "-", "waypoint table or CSV path", instance_of(WaypointTable), optional=False)
     speed: float = _f(DEFAULT_SPEED, "m/s", "leg speed where the table gives no timing", "pos")
@@ -417,6 +547,20 @@ class Waypoints(_WaypointMission):
     'linear' turns at a constant rate over each leg, 'hold' keeps the departure point's yaw
     until the arrival. mp = [n, hold_yaw, (x, y, z, yaw, t) per point].
 
+    Parameters
+    ----------
+    table : WaypointTable, str, os.PathLike or dict
+        The points and their timing; a path is read by :func:`read_waypoints_csv`, a dict by
+        :meth:`WaypointTable.from_dict`.
+    speed : float
+        Leg speed where the table gives no timing [m/s], > 0.
+    style : str
+        Path style: 'legs' (the only one; the smooth path is the kind 'minsnap').
+    yaw_mode : str
+        Yaw over a leg: 'linear' or 'hold'.
+
+    Examples
+    --------
     >>> Waypoints(WaypointTable([[0, 0, 1], [0, 0, 1]], t=[0, 2])).params()
     array([2., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 2.])
     """
@@ -440,6 +584,16 @@ class MinimumSnap(_WaypointMission):
     At rest at both ends and wherever the table dwells (two equal points in a row);
     C6 elsewhere. mp = [m, x, y, z, yaw, t at the end, (t_i, T_i, 32 coefficients) per segment].
 
+    Parameters
+    ----------
+    table : WaypointTable, str, os.PathLike or dict
+        The points and their timing; a path is read by :func:`read_waypoints_csv`, a dict by
+        :meth:`WaypointTable.from_dict`.
+    speed : float
+        Leg speed where the table gives no timing [m/s], > 0.
+
+    Examples
+    --------
     >>> ms = MinimumSnap(WaypointTable([[0, 0, 1], [1, 1, 1], [2, 0, 1]], t=[0, 3, 6]))
     >>> ms.params().shape, ms.reference(3.0)[0, :2] .round(12) + 0.0
     ((74,), array([1., 1.]))

@@ -89,8 +89,10 @@ class Vehicle(Validated):
         Yaw moment per unit thrust [m], > 0.
     g : float or array
         Gravitational acceleration [m/s^2], >= 0.
-    drag_linear, drag_quadratic : float or array
-        Drag coefficients [N s/m], [N s^2/m^2], >= 0.
+    drag_linear : float or array
+        Linear drag coefficient on the air-relative velocity [N s/m], >= 0.
+    drag_quadratic : float or array
+        Quadratic drag coefficient on the air-relative velocity [N s^2/m^2], >= 0.
 
     Examples
     --------
@@ -119,11 +121,38 @@ class Vehicle(Validated):
     # --- constructors -------------------------------------------------------------------
     @classmethod
     def paper(cls) -> "Vehicle":
-        """The paper's Table I (Qball-X4) with d = 4/120 m (one shared, frozen instance)."""
+        """The paper's Table I (Qball-X4) with d = 4/120 m.
+
+        Returns
+        -------
+        Vehicle
+            One shared, frozen instance (:func:`shared_default`), unbatched.
+
+        Examples
+        --------
+        >>> Vehicle.paper() is Vehicle.paper(), Vehicle.paper().m
+        (True, 3.499)
+        """
         return shared_default(cls)
 
     def replace(self, **changes: Any) -> "Vehicle":
-        """A copy with some fields changed (validated again)."""
+        """A copy with some fields changed (validated again).
+
+        Parameters
+        ----------
+        **changes : Any
+            Field name -> new value (a float, or a 1-D array for one value per vehicle), in
+            the field's unit (``m`` [kg], ``l`` [m], ...).
+
+        Returns
+        -------
+        Vehicle
+
+        Raises
+        ------
+        InputError
+            A name that is not a field, or a bad value.
+        """
         unknown = set(changes) - {f.name for f in dataclasses.fields(self)}
         if unknown:
             raise InputError(f"unknown vehicle field(s): {', '.join(sorted(unknown))}")
@@ -131,7 +160,29 @@ class Vehicle(Validated):
 
     @classmethod
     def stack(cls, vehicles: "list[Vehicle]") -> "Vehicle":
-        """One batched Vehicle from a list of single vehicles."""
+        """One batched Vehicle from a list of vehicles, in order.
+
+        Parameters
+        ----------
+        vehicles : list of Vehicle
+            Single vehicles (one row each) or batched ones (their N rows each).
+
+        Returns
+        -------
+        Vehicle
+            Every field a 1-D array, one entry per row of the inputs.
+
+        Raises
+        ------
+        InputError
+            An empty list.
+
+        Examples
+        --------
+        >>> v = Vehicle.paper()
+        >>> Vehicle.stack([v, v.replace(m=[1.0, 2.0])]).m
+        array([3.499, 1.   , 2.   ])
+        """
         if not vehicles:
             raise InputError("cannot stack an empty list of vehicles")
         cols = {f.name: np.concatenate([np.atleast_1d(getattr(v, f.name)) * np.ones(v.batch_size or 1)
@@ -166,6 +217,23 @@ class Vehicle(Validated):
         """The ``(N, PARAM_SIZE)`` parameter array for the compiled engine.
 
         ``n`` broadcasts an unbatched vehicle to N rows; a batched one must match it.
+
+        Parameters
+        ----------
+        n : int, optional
+            Number of rows N; by default the batch size (1 for an unbatched vehicle).
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (N, PARAM_SIZE), float64, columns ``P_*`` of :mod:`quadcruise.layout`:
+            the fields in SI units, k1..k6 of eq (11), the drag coefficients and 1/m
+            [1/kg], 1/Jxx, 1/Jyy, 1/Jzz [1/(kg m^2)].
+
+        Raises
+        ------
+        InputError
+            A batched vehicle whose size is not ``n``.
         """
         size = self.batch_size
         if n is None:
@@ -185,7 +253,13 @@ class Vehicle(Validated):
         return out
 
     def to_dict(self) -> dict:
-        """Plain values (lists for batched fields), for result bundles."""
+        """The fields as plain values, for result bundles.
+
+        Returns
+        -------
+        dict
+            Field name -> float, or list of floats for a batched field (SI units).
+        """
         return {f.name: (getattr(self, f.name).tolist() if isinstance(getattr(self, f.name), np.ndarray)
                          else getattr(self, f.name)) for f in dataclasses.fields(self)}
 
@@ -194,5 +268,16 @@ class Vehicle(Validated):
 @functools.cache
 def shared_default(cls: type) -> Any:
     """``cls()`` of a frozen dataclass, built and validated once and shared by every caller
-    (the default vehicle, mission or controller of each ``fly``)."""
+    (the default vehicle, mission or controller of each ``fly``).
+
+    Parameters
+    ----------
+    cls : type
+        A frozen dataclass whose fields all have defaults.
+
+    Returns
+    -------
+    object
+        The shared instance (the same object on every call with the same ``cls``).
+    """
     return cls()

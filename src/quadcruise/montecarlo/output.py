@@ -15,6 +15,7 @@ from quadcruise._version import __version__
 from quadcruise.errors import InputError
 from quadcruise.io.files import MARKER, atomic_dir, atomic_path, check_output_dir, write_table
 from quadcruise.io.plainjson import dumps
+from quadcruise.io.scenario_file import montecarlo_document, scenario_text
 from quadcruise.montecarlo.store import holds_sweep, write_marker
 
 __all__ = ["write_outputs", "write_case", "case_folder", "case_text", "report_markdown"]
@@ -65,6 +66,10 @@ def write_outputs(result, out, *, fmt: str = "csv", force: bool = False) -> Path
         save_figure(fig, path / fig_name)
     with atomic_path(path / "report.md") as tmp:
         tmp.write_text(report_markdown(result, summary, worst, name))
+    with atomic_path(path / "scenario.toml") as tmp:
+        tmp.write_text(scenario_text(montecarlo_document(result.spec.to_dict(), result.n), header=(
+            "written by quadcruise from a Monte Carlo sweep; `quadcruise montecarlo --scenario THIS_FILE` "
+            "flies the same flights")))
     write_marker(path, result.spec, result.n, complete=True, table=name,
                  chunk_size=result.info.get("chunk_size"))
     return path

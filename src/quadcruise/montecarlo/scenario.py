@@ -7,6 +7,7 @@ from __future__ import annotations
 import dataclasses
 
 from quadcruise.errors import InputError
+from quadcruise.io.scenario_file import SPEC_KEYS
 from quadcruise.montecarlo.population import Population
 from quadcruise.montecarlo.spec import MonteCarloSpec
 from quadcruise.workflows.scenario import Scenario, load_scenario
@@ -39,7 +40,7 @@ def merge_scenario(path, given: dict) -> tuple[Scenario, dict]:
     """
     sc = load_scenario(path)
     table = dict(sc.montecarlo)
-    known = {f.name for f in dataclasses.fields(Population)} - {"environment", "noise"}
+    known = ({f.name for f in dataclasses.fields(Population)} - {"environment", "noise"}) | set(SPEC_KEYS)
     unknown = set(table) - known - {"n", "seed"}
     if unknown:
         raise InputError(f"{path}: [montecarlo] unknown key(s) {', '.join(sorted(unknown))} "
@@ -103,6 +104,14 @@ def sweep_spec(*, mission="circle", controller="nlpd", n: int | None = None, see
                        dt=sc.dt if dt is None else dt, max_step=sc.simulation.get("max_step"),
                        full_dynamics=sc.simulation.get("full_dynamics", False))
     n, seed = given.pop("n", 1000), given.pop("seed", 0)
+    for key in SPEC_KEYS:                      # the scenario's settings; options given win
+        if key in given:
+            value = given.pop(key)
+            if key == "requirements" and requirements:
+                continue
+            if key == "max_track_error_m" and max_track_error_m is not None:
+                continue
+            options[key] = tuple(value) if key == "requirements" else value
     pop = Population(**given, environment=environment if environment is not None and environment.parts else None,
                      noise=noise)
     return MonteCarloSpec(mission=mission, controller=controller, population=pop, seed=seed, **options), n

@@ -9,7 +9,7 @@ Examples
 >>> from quadcruise.plots import plot_flight
 >>> fig = plot_flight(qc.fly("step", duration=2.0, log_every=10))
 >>> len(fig.axes)
-8
+9
 """
 
 from __future__ import annotations
@@ -22,12 +22,22 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from quadcruise.io.files import atomic_path
+from quadcruise.plots.marks import (
+    ERROR_FLOOR,
+    SATURATION_STYLE,
+    error_axes,
+    flight_events,
+    mark_events,
+    position_error,
+    saturation,
+    shade,
+)
 
 REF_STYLE = dict(color="k", ls="--", lw=1.0, label="reference")
 STOP_STYLE = dict(color="tab:red", ls=":", lw=1.5)
 
 
-FLIGHT_MARGINS = dict(left=0.05, right=0.86, bottom=0.055, top=0.92, wspace=0.32, hspace=0.14)
+FLIGHT_MARGINS = dict(left=0.05, right=0.86, bottom=0.048, top=0.93, wspace=0.32, hspace=0.14)
 """The flight figure's grid in fractions of the figure, fixed rather than found by a
 layout engine: constrained layout draws the whole figure once more to measure it, which
 slows saving it (see docs/performance.md)."""
@@ -164,33 +174,42 @@ def _time_panel(ax, t, y, ref, ylabel: str, color: str, label: str, min_span: fl
 
 
 def plot_flight(result, vehicle: int = 0, *, title: str | None = None) -> Figure:
-    """One vehicle's flight on one figure: path, position, attitude and rotor duties.
+    """One vehicle's flight on one figure: path, position, attitude, position error and
+    rotor duties.
 
     Parameters
     ----------
     result : SimResult
-        The flight; more than :data:`MAX_DRAWN` logged instants are thinned for drawing.
+        The flight; more than :data:`MAX_DRAWN` logged instants are thinned for drawing
+        (the saturation intervals are found on every logged instant).
     vehicle : int
         Which of the result's vehicles to draw.
     title : str, optional
-        Figure title; by default the controller and mission from ``result.meta``, and
-        the reason if the vehicle stopped early.
+        Figure title; by default the controller and mission from ``result.meta`` (and the
+        vehicle's index when the result holds several), and the reason if the vehicle
+        stopped early.
 
     Returns
     -------
     matplotlib.figure.Figure
-        Eight axes: the 3-D path, x, y, z [m], roll, pitch, yaw [deg] against time, and
-        the four rotor duties with their [0, 1] limits. References are drawn dashed where
-        finite, attitude setpoints only where there is a reference (an open-loop replay
-        has none); periods in which the controller flagged a limit are shaded on the duty
-        panel. An early stop is marked on every time panel, which then end shortly after it.
+        Nine axes: the 3-D path, x, y, z [m], roll, pitch, yaw [deg] against time, the
+        position error ``|p - p_ref|`` [m] on a log scale (see
+        :func:`~quadcruise.plots.marks.error_axes`), and the four rotor duties with their
+        [0, 1] limits. References are drawn dashed where finite, attitude setpoints only
+        where there is a reference (an open-loop replay has none). The events recorded in
+        ``result.meta["environment"]`` (a gust, a rotor loss) are marked on every time
+        panel and named in the error panel's legend; the periods in which the controller
+        flagged a limit, or asked for a duty outside [0, 1] that the engine clipped, are
+        shaded on the duty panel, each named in its legend only if it happened. An early
+        stop is marked on every time panel, which then end shortly after it.
     """
+    spans = saturation(result, vehicle)
     result = drawable(result)
     t = result.t
-    fig = Figure(figsize=(16, 10))
-    # row 3 and column 1 are gaps: for the time axes' labels above the duties, and between
-    # the 3-D path's labels and the position panels' own
-    gs = fig.add_gridspec(5, 4, width_ratios=(1.3, 0.02, 1, 1), height_ratios=(1, 1, 1, 0.12, 1.1),
+    fig = Figure(figsize=(16, 12))
+    # row 3 and column 1 are gaps: for the time axes' labels above the error panel, and
+    # between the 3-D path's labels and the position panels' own
+    gs = fig.add_gridspec(6, 4, width_ratios=(1.3, 0.02, 1, 1), height_ratios=(1, 1, 1, 0.06, 0.9, 1.0),
                           **FLIGHT_MARGINS)
     _path3d(fig.add_subplot(gs[0:3, 0], projection="3d"), result, vehicle)
     pos_axes = [fig.add_subplot(gs[0, 2])]
@@ -205,43 +224,50 @@ def plot_flight(result, vehicle: int = 0, *, title: str | None = None) -> Figure
         sp = np.degrees(result.state(f"{name}_d")[vehicle]) if closed_loop else None
         _time_panel(ax, t, np.degrees(result.state(name)[vehicle]), sp, f"{label} [deg]", c,
                     label, min_span=2.0, ref_label="setpoint")
-    ax_u = fig.add_subplot(gs[4, :], sharex=pos_axes[0])
-    _duties(ax_u, result, vehicle)
+    ax_e = fig.add_subplot(gs[4, :], sharex=pos_axes[0])
+    error_axes(ax_e, [(t, position_error(result, vehicle), dict(color="k", label="|p - p_ref|"))])
+    ax_u = fig.add_subplot(gs[5, :], sharex=pos_axes[0])
     stopped = int(result.status[vehicle]) != 0
     t_end = t[-1]
     if stopped:
         t_stop = float(result.t_stop[vehicle])
         step = t[1] - t[0] if t.size > 1 else 0.0
         t_end = min(t[-1], t_stop + max(0.1 * (t_stop - t[0]), 3 * step))
-        for ax in pos_axes + att_axes + [ax_u]:
+    t_end = t_end if t_end > t[0] else t[0] + 1.0
+    _duties(ax_u, result, vehicle, spans, min_width=(t_end - t[0]) / 1500)
+    time_axes = pos_axes + att_axes + [ax_e, ax_u]
+    events = flight_events(result.meta, vehicle)
+    for ax in time_axes:
+        mark_events(ax, events, (t[0], t_end), label=ax is ax_e)
+    if stopped:
+        for ax in time_axes:
             _mark_stop(ax, t_stop, label=ax in (pos_axes[0], att_axes[0], ax_u))
     for ax in pos_axes + att_axes:
         _legend(ax, loc="best")
-    _legend(ax_u, loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0)
+    for ax in (ax_e, ax_u):
+        if ax.get_legend_handles_labels()[0]:
+            _legend(ax, loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0)
     for ax in (pos_axes[2], att_axes[2], ax_u):
         ax.set_xlabel("time [s]")
-    for ax in pos_axes[:2] + att_axes[:2]:
+    for ax in pos_axes[:2] + att_axes[:2] + [ax_e]:
         ax.tick_params(labelbottom=False)
-    ax_u.set_xlim(t[0], t_end if t_end > t[0] else t[0] + 1.0)
+    ax_u.set_xlim(t[0], t_end)
     if title is None:
-        title = f"{describe(result, vehicle)} — vehicle {vehicle}"
+        title = describe(result, vehicle) + (f" — vehicle {vehicle}" if result.n > 1 else "")
         if stopped:
             title += f"\n{result.status_text(vehicle)}"
     fig.suptitle(title, color="tab:red" if stopped else "k")
     return fig
 
 
-def _duties(ax, result, vehicle: int) -> None:
+def _duties(ax, result, vehicle: int, spans: dict, min_width: float) -> None:
     t = result.t
     duties = result.commands[vehicle, :, :4]
     for j in range(4):
         ax.plot(t, duties[:, j], color=("tab:blue", "tab:orange", "tab:green", "tab:purple")[j],
                 lw=1.0, label=f"u{j + 1}")
-    flags = result.state("flags")[vehicle]
-    flagged = np.isfinite(flags) & (flags != 0)
-    if flagged.any():
-        ax.fill_between(t, 0, 1, where=flagged, transform=ax.get_xaxis_transform(), step="post",
-                        color="tab:red", alpha=0.15, lw=0, label="controller limit flagged")
+    for kind in ("flagged", "clipped"):
+        shade(ax, spans[kind], min_width=min_width, **SATURATION_STYLE[kind])
     live = duties[np.isfinite(duties)]
     lo, hi = (live.min(), live.max()) if live.size else (0.0, 1.0)
     lo, hi = min(lo, 0.0), max(hi, 0.0)
@@ -253,8 +279,8 @@ def _duties(ax, result, vehicle: int) -> None:
     for limit in (0.0, 1.0):
         ax.axhline(limit, color="0.3", lw=1.2, ls="-.", zorder=1.5,
                    label=f"duty limits 0, 1{off}" if limit == 0.0 else None)
-    for a, b in ((lo - 10 * pad - 1.0, 0.0), (1.0, hi + 10 * pad + 1.0)):
-        ax.axhspan(a, b, color="0.5", alpha=0.12, lw=0, label="clipped by the engine" if a < 0 else None)
+    for a, b in ((lo - 10 * pad - 1.0, 0.0), (1.0, hi + 10 * pad + 1.0)):   # beyond the limits
+        ax.axhspan(a, b, color="0.5", alpha=0.12, lw=0)
     ax.set_ylabel("rotor duty [-]")
     ax.grid(True, alpha=0.3)
 
@@ -267,8 +293,24 @@ def _reference_xy(results):
     return None
 
 
-def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None) -> Figure:
-    """Overlay several flights: top view (x-y) and x(t), y(t), with the reference once.
+def _saturation_strips(ax, spans: list[dict], min_width: float) -> list:
+    """Each flight's saturation as a thin strip in its colour along the bottom of ``ax``
+    (light: a limit flagged, dark: a duty clipped); legend proxies for the kinds drawn."""
+    from matplotlib.patches import Patch
+
+    drawn = set()
+    for k, flight in enumerate(spans):
+        y = (0.012 + 0.04 * k, 0.03)
+        for kind, alpha in (("flagged", 0.35), ("clipped", 1.0)):
+            if shade(ax, flight[kind], min_width=min_width, yrange=y, color=f"C{k}", alpha=alpha) is not None:
+                drawn.add(kind)
+    return [Patch(color="0.35", alpha=alpha, lw=0, label=f"{what} (strip in the flight's colour)")
+            for kind, alpha, what in (("flagged", 0.35, "limit flagged"), ("clipped", 1.0, "duty clipped"))
+            if kind in drawn]
+
+
+def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None, axes: str = "xy") -> Figure:
+    """Overlay several flights: top view, position and position error against time.
 
     Parameters
     ----------
@@ -278,53 +320,92 @@ def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None) -> 
         Which vehicle of each result to draw.
     title : str, optional
         Figure title; by default the labels joined by " vs " and the mission's kind.
+    axes : str
+        The positions drawn against time, one panel each: ``"xy"`` or ``"xyz"``.
 
     Returns
     -------
     matplotlib.figure.Figure
-        Three axes: the top view (equal scale), x [m] and y [m] against time [s]. The
-        reference is taken from the first flight that has a finite one; a flight that
-        stopped early ends with a red cross and its label says when.
+        The top view (equal scale), then x [m], y [m] (and z [m]) and the position error
+        ``|p - p_ref|`` [m] against time [s]; 4 or 5 axes. The error is on a log scale
+        (see :func:`~quadcruise.plots.marks.error_axes`): after the transient the
+        controllers' paths lie on top of each other, their errors do not. Each reference
+        is taken from the first flight that has a finite one; a flight that stopped early
+        ends with a red cross and its label says when. The events recorded in the flights'
+        ``meta["environment"]`` are marked on the time panels; each flight's saturation
+        (a limit flagged, a duty clipped) is a strip in its colour along the bottom of the
+        error panel, drawn only if it happened. One legend, in the top view, names the
+        flights and whatever else is drawn.
 
     Raises
     ------
     ValueError
-        If ``results`` is empty.
+        If ``results`` is empty or ``axes`` is neither ``"xy"`` nor ``"xyz"``.
     """
     if not results:
         raise ValueError("plot_paths needs at least one result")
+    if axes not in ("xy", "xyz"):
+        raise ValueError(f"axes must be 'xy' or 'xyz', got {axes!r}")
+    spans = [saturation(r, vehicle) for r in results.values()]
     results = {label: drawable(r) for label, r in results.items()}
-    fig = Figure(figsize=(13, 6.5), layout="constrained")
-    gs = fig.add_gridspec(2, 2, width_ratios=(1, 1.3))
+    fig = Figure(figsize=(13, 8.5 if axes == "xy" else 10.5), layout="constrained")
+    gs = fig.add_gridspec(len(axes) + 1, 2, width_ratios=(1, 1.3))
     top = fig.add_subplot(gs[:, 0])
-    ax_x = fig.add_subplot(gs[0, 1])
-    ax_y = fig.add_subplot(gs[1, 1], sharex=ax_x)
+    first = fig.add_subplot(gs[0, 1])
+    time_axes = [first] + [fig.add_subplot(gs[i, 1], sharex=first) for i in range(1, len(axes) + 1)]
+    ax_e = time_axes[-1]
     ref = _reference_xy([(r, vehicle) for r in results.values()])
     if ref is not None:
-        tr, xr, yr = ref
-        top.plot(xr, yr, **REF_STYLE)
-        ax_x.plot(tr, xr, **REF_STYLE)
-        ax_y.plot(tr, yr, **REF_STYLE)
+        top.plot(ref[1], ref[2], **REF_STYLE)
+    for ax, name in zip(time_axes, axes):
+        for res in results.values():
+            if _has(res.state(f"{name}_ref")[vehicle]):
+                ax.plot(res.t, res.state(f"{name}_ref")[vehicle], **REF_STYLE)
+                break
+    curves, events, t_lo, t_hi = [], [], np.inf, -np.inf
     for k, (label, res) in enumerate(results.items()):
         c = f"C{k}"
         x, y = res.state("x")[vehicle], res.state("y")[vehicle]
-        if int(res.status[vehicle]) != 0:
+        stopped = int(res.status[vehicle]) != 0
+        if stopped:
             label = f"{label} (stopped at {res.t_stop[vehicle]:.2f} s)"
         top.plot(x, y, color=c, lw=1.4, label=label)
-        ax_x.plot(res.t, x, color=c, lw=1.4, label=label)
-        ax_y.plot(res.t, y, color=c, lw=1.4, label=label)
+        for ax, name in zip(time_axes, axes):
+            trace = res.state(name)[vehicle]
+            ax.plot(res.t, trace, color=c, lw=1.4, label=label)
+            live = np.flatnonzero(np.isfinite(trace))
+            if live.size and stopped:
+                ax.plot(res.t[live[-1]], trace[live[-1]], "X", color="tab:red", ms=9)
         live = np.isfinite(x) & np.isfinite(y)
-        if live.any() and int(res.status[vehicle]) != 0:
+        if live.any() and stopped:
             i = np.flatnonzero(live)[-1]
             top.plot(x[i], y[i], "X", color="tab:red", ms=9)
+        curves.append((res.t, position_error(res, vehicle), dict(color=c, label=label)))
+        events += [e for e in flight_events(res.meta, vehicle) if e not in events]
+        t_lo, t_hi = min(t_lo, res.t[0]), max(t_hi, res.t[-1])
+    if error_axes(ax_e, curves):
+        for t, err, _ in curves:
+            live = np.flatnonzero(np.isfinite(err))
+            if live.size and live[-1] < err.size - 1:          # it stopped: cross its last error
+                ax_e.plot(t[live[-1]], max(err[live[-1]], ERROR_FLOOR), "X", color="tab:red", ms=9)
+    strips = _saturation_strips(ax_e, spans, (t_hi - t_lo) / 1500)
+    for ax in time_axes:
+        mark_events(ax, events, (t_lo, t_hi), label=ax is ax_e)
     top.set_aspect("equal", adjustable="datalim")
     top.set(xlabel="x [m]", ylabel="y [m]", title="top view")
-    ax_x.set_ylabel("x [m]")
-    ax_y.set(xlabel="time [s]", ylabel="y [m]")
-    ax_x.tick_params(labelbottom=False)
-    for ax in (top, ax_x, ax_y):
+    for ax, name in zip(time_axes, axes):
+        ax.set_ylabel(f"{name} [m]")
+        ax.tick_params(labelbottom=False)
+    ax_e.set_xlabel("time [s]")
+    for ax in [top] + time_axes[:-1]:
         ax.grid(True, alpha=0.3)
-    _legend(top, loc="best")
+    # one legend, in the top view's spare room: the flights, then what else is drawn
+    handles, labels = top.get_legend_handles_labels()
+    for h, lb in zip(*ax_e.get_legend_handles_labels()):
+        if lb not in labels:
+            handles.append(h)
+            labels.append(lb)
+    _legend(top, handles=handles + strips, labels=labels + [h.get_label() for h in strips], loc="best")
     if title is None:
         kind = _names(next(iter(results.values())), vehicle)[1]
         title = " vs ".join(results) + (f" on {kind}" if kind else "")
@@ -358,24 +439,27 @@ def plot_envelope(result, *, title: str | None = None, max_paths: int = 50) -> F
     Returns
     -------
     matplotlib.figure.Figure
-        Two axes: the top view (thin translucent paths, those of stopped vehicles in red,
-        vehicle 0's reference dashed) and the median and 5-95 % band over vehicles of the
-        position error norm ``|p - p_ref|`` [m] against time [s].
+        Two axes: the top view (translucent paths: those of stopped vehicles thin, in red,
+        underneath those of finished ones, in blue, which stay visible however many
+        stopped; vehicle 0's reference dashed) and the median and 5-95 % band over
+        vehicles of the position error norm ``|p - p_ref|`` [m] against time [s].
     """
     n = result.n
     fig = Figure(figsize=(13, 5.5), layout="constrained")
     top, ax_e = fig.subplots(1, 2, width_ratios=(1, 1.4))
     picks = _pick_paths(result.ok, max_paths)
-    alpha = float(np.clip(6.0 / len(picks), 0.12, 0.8))
     x, y = result.state("x"), result.state("y")
-    for i in picks:
-        if result.ok[i]:
-            top.plot(x[i], y[i], color="tab:blue", lw=0.7, alpha=alpha)
-        else:
-            top.plot(x[i], y[i], color="tab:red", lw=0.9, alpha=max(alpha, 0.6))
-            live = np.flatnonzero(np.isfinite(x[i]) & np.isfinite(y[i]))
-            if live.size:
-                top.plot(x[i, live[-1]], y[i, live[-1]], "x", color="tab:red", ms=6)
+    # the stopped ones first, thin and translucent, underneath; the finished ones on top, as
+    # opaque as their number allows, so that many stopped paths do not hide them
+    good = picks[result.ok[picks]]
+    alpha = float(np.clip(10.0 / max(good.size, 1), 0.35, 0.8))
+    for i in picks[~result.ok[picks]]:
+        top.plot(x[i], y[i], color="tab:red", lw=0.8, alpha=0.4, zorder=2.0)
+        live = np.flatnonzero(np.isfinite(x[i]) & np.isfinite(y[i]))
+        if live.size:
+            top.plot(x[i, live[-1]], y[i, live[-1]], "x", color="tab:red", ms=6, alpha=0.7, zorder=2.1)
+    for i in good:
+        top.plot(x[i], y[i], color="tab:blue", lw=1.0, alpha=alpha, zorder=2.2)
     for ok, c, what in ((True, "tab:blue", "finished"), (False, "tab:red", "stopped early")):
         total = int(np.count_nonzero(result.ok == ok))
         if total:   # legend proxies: how many of each kind are drawn
@@ -383,7 +467,7 @@ def plot_envelope(result, *, title: str | None = None, max_paths: int = 50) -> F
             top.plot([], [], color=c, lw=1, label=f"{what} ({drawn} drawn of {total})")
     ref = _reference_xy([(result, 0)])
     if ref is not None:
-        top.plot(ref[1], ref[2], **REF_STYLE)
+        top.plot(ref[1], ref[2], **REF_STYLE, zorder=2.5)
     top.set_aspect("equal", adjustable="datalim")
     top.set(xlabel="x [m]", ylabel="y [m]", title="top view")
     _legend(top, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncols=3)

@@ -8,17 +8,84 @@ Drawn with matplotlib's object-oriented API only, like :mod:`quadcruise.plots` (
 from __future__ import annotations
 
 import math
+import textwrap
 import warnings
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
-__all__ = ["plot_histograms", "plot_envelope"]
+__all__ = ["plot_histograms", "plot_envelope", "metric_label", "degenerate", "METRIC_LABELS"]
 
 
 HISTOGRAM_METRICS = ("rmse_m", "max_error_m", "final_error_m", "rise_time_s", "settling_time_5pct_s",
                      "overshoot_pct", "effort", "duty_clipped_s")
 """The metrics :func:`plot_histograms` draws by default."""
+
+METRIC_LABELS = {"rmse_m": "RMSE [m]", "max_error_m": "max error [m]", "final_error_m": "final error [m]",
+                 "rise_time_s": "rise time [s]", "settling_time_s": "settling time 2 % [s]",
+                 "settling_time_5pct_s": "settling time 5 % [s]", "overshoot_pct": "overshoot [%]",
+                 "effort": "effort [s]", "duty_clipped_s": "duty clipped [s]",
+                 "controller_limited_s": "controller limited [s]", "stop_time_s": "stop time [s]",
+                 "m": "mass [kg]", "dx0": "start offset x [m]", "dy0": "start offset y [m]",
+                 "dz0": "start offset z [m]", "wind_x": "wind x [m/s]", "wind_y": "wind y [m/s]"}
+"""Axis labels, with units, of the sweep table's columns."""
+
+
+def metric_label(name: str) -> str:
+    """A column of the sweep table as an axis label with its unit.
+
+    Parameters
+    ----------
+    name : str
+        The column, e.g. ``"rise_time_s"``.
+
+    Returns
+    -------
+    str
+        :data:`METRIC_LABELS`' entry, else the name with its unit suffix (``_s``, ``_m``,
+        ``_pct``, ``_deg``) written as a unit.
+
+    Examples
+    --------
+    >>> metric_label("rmse_m"), metric_label("hover_time_s"), metric_label("K")
+    ('RMSE [m]', 'hover time [s]', 'K')
+    """
+    if name in METRIC_LABELS:
+        return METRIC_LABELS[name]
+    for suffix, unit in (("_s", "s"), ("_m", "m"), ("_pct", "%"), ("_deg", "deg")):
+        if name.endswith(suffix) and len(name) > len(suffix):
+            return f"{name[:-len(suffix)].replace('_', ' ')} [{unit}]"
+    return name.replace("_", " ")
+
+
+def degenerate(values: np.ndarray, n: int) -> str | None:
+    """Why a column makes no histogram, or None if it makes one.
+
+    Parameters
+    ----------
+    values : ndarray
+        The column's values (NaN where not measured).
+    n : int
+        The number of flights.
+
+    Returns
+    -------
+    str or None
+        ``"not measured"`` if no value is finite, ``"<value> in all <k> flights measured"``
+        if every finite value is the same, else None.
+
+    Examples
+    --------
+    >>> degenerate(np.array([0.0, 0.0, np.nan]), 3), degenerate(np.array([1.0, 2.0]), 2)
+    ('0 in all 2 flights measured', None)
+    """
+    v = values[np.isfinite(values)]
+    if not v.size:
+        return "not measured"
+    if v.min() == v.max():
+        return f"{v[0]:.4g} in all {v.size:,} flights measured" if v.size < n else f"{v[0]:.4g} in all {n:,} flights"
+    return None
 
 
 def plot_histograms(result, metrics=None):
@@ -34,40 +101,50 @@ def plot_histograms(result, metrics=None):
     Returns
     -------
     matplotlib.figure.Figure
-        One panel per metric (40 bins of its finite values, in the column's unit, with
-        lines at 5 %, the median and 95 %; "not measured" if none is finite), then the
-        count of flights per outcome (:data:`~quadcruise.montecarlo.result.FAILURES`).
+        One panel per metric (40 bins of its finite values against the metric with its
+        unit (:func:`metric_label`) and the number of flights, with lines at 5 %, the
+        median and 95 %), then the count of flights per outcome
+        (:data:`~quadcruise.montecarlo.result.FAILURES`). A metric with no finite value,
+        or with one value in every flight (:func:`degenerate`), gets no panel: a note at
+        the foot of the figure says which were left out and why.
     """
-    panels = list(HISTOGRAM_METRICS if metrics is None else metrics) + ["failures"]
-    cols = 3
+    names = list(HISTOGRAM_METRICS if metrics is None else metrics)
+    columns = {name: result.table[name].to_numpy(dtype=float) for name in names}
+    skipped = {name: why for name in names if (why := degenerate(columns[name], result.n))}
+    panels = [name for name in names if name not in skipped] + ["failures"]
+    cols = min(3, len(panels))
     rows = math.ceil(len(panels) / cols)
-    fig = Figure(figsize=(4.3 * cols, 3.2 * rows), layout="constrained")
+    fig = Figure(figsize=(4.3 * max(cols, 2), 3.2 * rows + (0.4 if skipped else 0.0)), layout="constrained")
     axes = fig.subplots(rows, cols, squeeze=False).ravel()
     for ax, name in zip(axes, panels):
         if name == "failures":
-            names = result.failure_names          # the outcome codes 0..4 of the table's 'failure' column
-            counts = [int(np.count_nonzero(result.table["failure"] == c)) for c in range(len(names))]
-            ax.bar(range(len(names)), counts,
-                   color=["tab:green", "tab:red", "tab:orange", "tab:brown", "tab:purple"][:len(names)])
-            ax.set_xticks(range(len(names)), [n.replace(" ", "\n", 1) for n in names], fontsize="small")
+            outcomes = result.failure_names          # the outcome codes 0..4 of the table's 'failure' column
+            counts = [int(np.count_nonzero(result.table["failure"] == c)) for c in range(len(outcomes))]
+            ax.bar(range(len(outcomes)), counts,
+                   color=["tab:green", "tab:red", "tab:orange", "tab:brown", "tab:purple"][:len(outcomes)])
+            ax.set_xticks(range(len(outcomes)), [n.replace(" ", "\n", 1) for n in outcomes], fontsize="small")
             for x, c in enumerate(counts):
                 ax.annotate(f"{c:,}", (x, c), ha="center", va="bottom", fontsize="small")
             ax.set_title(f"outcome of {result.n:,} flights", fontsize="medium")
-            ax.set_ylabel("flights")
+            ax.set(xlabel="outcome", ylabel="flights")
+            ax.set_ylim(top=max(counts) * 1.12)
             continue
-        v = result.table[name].to_numpy(dtype=float)
+        v = columns[name]
         v = v[np.isfinite(v)]
-        if v.size:
-            ax.hist(v, bins=40, color="tab:blue", alpha=0.8)
-            for q, style in zip(np.percentile(v, [5, 50, 95]), (":", "-", ":")):
-                ax.axvline(q, color="k", ls=style, lw=1.0)
-        else:
-            ax.text(0.5, 0.5, "not measured", ha="center", va="center", transform=ax.transAxes, color="0.4")
+        ax.hist(v, bins=40, color="tab:blue", alpha=0.8)
+        for q, style in zip(np.percentile(v, [5, 50, 95]), (":", "-", ":")):
+            ax.axvline(q, color="k", ls=style, lw=1.0)
         missing = result.n - v.size
         ax.set_title(f"{name}  (n = {v.size:,}" + (f", {missing:,} n/a)" if missing else ")"), fontsize="medium")
+        ax.set(xlabel=metric_label(name), ylabel="flights")
+        ax.yaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(True, alpha=0.3)
     for ax in axes[len(panels):]:
         ax.set_visible(False)
+    if skipped:
+        note = "not drawn: " + ", ".join(f"{k} ({why})".replace(" ", "\u00a0") for k, why in skipped.items())
+        fig.supxlabel(textwrap.fill(note, width=int(15 * fig.get_figwidth()), break_on_hyphens=False),
+                      fontsize="small", color="0.3")
     fig.suptitle(f"{result.spec.controller.name} on {result.spec.mission.name}: {result.n:,} flights, seed "
                  f"{result.spec.seed} (lines: 5 %, median, 95 %)")
     return fig
@@ -85,23 +162,31 @@ def plot_envelope(result):
     -------
     matplotlib.figure.Figure
         Two axes: the top view [m] of the kept paths (the first vehicles, and the extra
-        failures kept; diverged in red, other failures in orange) and the median and 5-95 %
-        band of the position error norm [m] of the sampled flights against time [s].
+        failures kept; diverged in red, other failures in orange, both thin and translucent
+        underneath the flights that finished, in blue, which stay visible however many
+        failed) and the median and 5-95 % band of the position error norm [m] of the
+        sampled flights against time [s].
     """
     tr = result.traces
     fig = Figure(figsize=(13, 5.5), layout="constrained")
     top, ax_e = fig.subplots(1, 2, width_ratios=(1, 1.4))
     lookup = result.table.set_index("vehicle")["failure"]
     fail = lookup.reindex(tr.vehicle).to_numpy() if len(tr.vehicle) else np.zeros(0, int)
+    ok = fail == 0
     n_sample = int(np.count_nonzero(tr.sample))
-    alpha = float(np.clip(6.0 / max(n_sample, 1), 0.08, 0.8))
-    for k in range(len(tr.vehicle)):
+    # failures first, thin and translucent, underneath; the flights that finished on top, as
+    # opaque as their number allows, so that a sweep with many failures still shows them
+    alpha_ok = float(np.clip(10.0 / max(int(np.count_nonzero(ok)), 1), 0.35, 0.8))
+    for k in [*np.flatnonzero(~ok), *np.flatnonzero(ok)]:
         x, y = tr.pos[k, :, 0], tr.pos[k, :, 1]
-        color = {0: "tab:blue", 1: "tab:red"}.get(int(fail[k]), "tab:orange")
-        top.plot(x, y, color=color, lw=0.7 if fail[k] == 0 else 0.9, alpha=alpha if fail[k] == 0 else 0.7)
+        if ok[k]:
+            top.plot(x, y, color="tab:blue", lw=1.0, alpha=alpha_ok, zorder=2.2)
+            continue
+        color = "tab:red" if fail[k] == 1 else "tab:orange"
+        top.plot(x, y, color=color, lw=0.7, alpha=0.3, zorder=2.0)
         live = np.flatnonzero(np.isfinite(x) & np.isfinite(y))
         if fail[k] == 1 and live.size:
-            top.plot(x[live[-1]], y[live[-1]], "x", color="tab:red", ms=6)
+            top.plot(x[live[-1]], y[live[-1]], "x", color="tab:red", ms=6, alpha=0.6, zorder=2.1)
     total = result.table["failure"].value_counts()
     for code, color, what in ((0, "tab:blue", "ok"), (1, "tab:red", "diverged"), (2, "tab:orange", "failed otherwise")):
         drawn = int(np.count_nonzero(fail == code)) if code < 2 else int(np.count_nonzero(fail >= 2))
@@ -110,7 +195,7 @@ def plot_envelope(result):
             top.plot([], [], color=color, lw=1, label=f"{what} ({drawn:,} drawn of {all_:,})")
     ref = next((tr.ref[k] for k in range(len(tr.vehicle)) if np.all(np.isfinite(tr.ref[k, :, :2]))), None)
     if ref is not None:
-        top.plot(ref[:, 0], ref[:, 1], color="k", ls="--", lw=1.0, label="reference")
+        top.plot(ref[:, 0], ref[:, 1], color="k", ls="--", lw=1.0, label="reference", zorder=2.5)
     top.set_aspect("equal", adjustable="datalim")
     top.set(xlabel="x [m]", ylabel="y [m]", title="top view")
     top.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.12), ncols=2)

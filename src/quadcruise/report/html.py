@@ -378,12 +378,13 @@ def write_html_report(path, **kwargs) -> Path:
     return path
 
 
-def _metrics_table(frame):
-    """Metrics down, vehicles across for a few vehicles; one row per vehicle otherwise."""
+def _metrics_table(frame, label: str = "value"):
+    """Metrics down, vehicles across for a few vehicles (one flight: one column, ``label``);
+    one row per vehicle otherwise."""
     if len(frame) > 6:
         return frame
     shown = frame.set_index("vehicle").T
-    shown.columns = [f"vehicle {v}" for v in shown.columns]
+    shown.columns = [label] if len(frame) == 1 else [f"vehicle {v}" for v in shown.columns]
     return shown
 
 
@@ -420,8 +421,8 @@ def flight_report(result, *, title: str | None = None, metrics=None) -> dict:
     dict
         ``title``, ``tables`` (the metrics, vehicles across for up to 6 vehicles, and the
         run: controller, mission, duration [s], dt [s], vehicles, seed, version),
-        ``figures`` (the flight of vehicle 0, and the envelope of a batch), ``flights``
-        (the 3-D view) and ``config`` (``result.meta``).
+        ``figures`` (the flight, of vehicle 0 in a batch, and a batch's envelope),
+        ``flights`` (the 3-D view) and ``config`` (``result.meta``).
     """
     import pandas as pd
 
@@ -437,12 +438,12 @@ def flight_report(result, *, title: str | None = None, metrics=None) -> dict:
            "seed": meta.get("seed"), "version": meta.get("version")}
     run_table = pd.DataFrame({"value": {k: v for k, v in run.items() if v is not None}})
     label = describe(result)
-    figures = {f"Flight of vehicle 0: {label}": plot_flight(result)}
+    figures = {(f"Flight of vehicle 0: {label}" if result.n > 1 else f"Flight: {label}"): plot_flight(result)}
     if result.n > 1:
         figures[f"All {result.n} vehicles"] = plot_envelope(result)
     metrics = result.metrics() if metrics is None else metrics
     return {"title": title or f"quadcruise: {label}",
-            "tables": {"Flight metrics": _metrics_table(metrics), **_conventions_table(metrics),
+            "tables": {"Flight metrics": _metrics_table(metrics, label), **_conventions_table(metrics),
                        "Run": run_table},
             "figures": figures, "flights": {label: result}, "config": meta}
 

@@ -4,12 +4,16 @@
  * {flights: [{label, color, t, x, y, z, ref, ok, status}], refs: [{t, x, y, z}]}; null
  * marks an instant after a vehicle stopped. Drag to orbit, shift-drag (or right-drag) to
  * pan, wheel to zoom, double-click to reset. After each drawing the canvas gets
- * data-rendered="1" (read by the tests through the DOM).
+ * data-rendered="1" and, in data-labels, the axis labels drawn with their boxes in CSS
+ * pixels (read by the tests through the DOM): no two labels overlap, and an axis seen
+ * end-on (the depth axis of a side view) has none.
  */
 (function () {
   "use strict";
 
   const DEG = Math.PI / 180;
+  const TICK_PX = 12.5, NAME_PX = 13.5, LABEL_GAP = 8;
+  const TICK_FONT = TICK_PX + "px system-ui, sans-serif", NAME_FONT = "bold " + NAME_PX + "px system-ui, sans-serif";
   const HOME = { az: -60 * DEG, el: 28 * DEG, zoom: 1, px: 0, py: 0 };
 
   function niceStep(span, n) {
@@ -281,39 +285,86 @@
     ctx.stroke();
     const pad = 0.07 * Math.max(b.hi[0] - b.lo[0], b.hi[1] - b.lo[1]);
     ctx.fillStyle = "#4a5361";
-    ctx.font = "12px system-ui, sans-serif";
-    ctx.textAlign = "center";
-    ctx.textBaseline = "middle";
-    // x ticks along the y edge nearer the viewer, y ticks along the nearer x edge
-    const yEdge = P(this.center[0], b.lo[1], z0)[2] > P(this.center[0], b.hi[1], z0)[2] ? -1 : 1;
-    const xEdge = P(b.lo[0], this.center[1], z0)[2] > P(b.hi[0], this.center[1], z0)[2] ? -1 : 1;
-    const yAt = yEdge < 0 ? b.lo[1] - pad : b.hi[1] + pad, xAt = xEdge < 0 ? b.lo[0] - pad : b.hi[0] + pad;
-    for (const x of xs) { const p = P(x, yAt, z0); ctx.fillText(tickText(x, step), p[0], p[1]); }
-    for (const y of ys) { const p = P(xAt, y, z0); ctx.fillText(tickText(y, step), p[0], p[1]); }
-    ctx.font = "bold 13px system-ui, sans-serif";
-    let p = P(this.center[0], yAt + yEdge * 2.6 * pad, z0);
-    ctx.fillText("x [m]", p[0], p[1]);
-    p = P(xAt + xEdge * 2.6 * pad, this.center[1], z0);
-    ctx.fillText("y [m]", p[0], p[1]);
-    // z axis just outside the floor corner farthest from the viewer, ticks ~30 px apart
+    this.placed = [[6, 4, 150, 30]];          // the time readout drawn in the top left corner
+    this.labels = [];
+    // z axis just outside the floor corner farthest from the viewer, ticks ~30 px apart;
+    // none when it is seen end-on (from above)
     let back = corners[0], far = Infinity;
     for (const q of corners) { const d = P(q[0], q[1], z0)[2]; if (d < far) { far = d; back = q; } }
     back = [back[0] + (back[0] < this.center[0] ? -1.5 : 1.5) * pad, back[1] + (back[1] < this.center[1] ? -1.5 : 1.5) * pad];
     const a = P(back[0], back[1], z0), c = P(back[0], back[1], b.hi[2]);
-    const zStep = niceStep(b.hi[2] - z0, Math.max(1, Math.min(6, Math.floor(Math.hypot(c[0] - a[0], c[1] - a[1]) / 30))));
+    const zLength = Math.hypot(c[0] - a[0], c[1] - a[1]);
     ctx.strokeStyle = "#8a94a3";
     ctx.beginPath(); ctx.moveTo(a[0], a[1]); ctx.lineTo(c[0], c[1]); ctx.stroke();
-    const left = a[0] <= P(this.center[0], this.center[1], z0)[0];
-    ctx.font = "12px system-ui, sans-serif";
-    ctx.textAlign = left ? "right" : "left";
-    for (const z of ticks(z0, b.hi[2], zStep)) {
-      const q = P(back[0], back[1], z);
-      ctx.beginPath(); ctx.moveTo(q[0] - 3, q[1]); ctx.lineTo(q[0] + 3, q[1]); ctx.stroke();
-      ctx.fillText(tickText(z, zStep), q[0] + (left ? -7 : 7), q[1]);
+    if (zLength >= 30) {
+      const zStep = niceStep(b.hi[2] - z0, Math.max(1, Math.min(6, Math.floor(zLength / 30))));
+      const left = a[0] <= P(this.center[0], this.center[1], z0)[0];
+      for (const z of ticks(z0, b.hi[2], zStep)) {
+        const q = P(back[0], back[1], z);
+        ctx.beginPath(); ctx.moveTo(q[0] - 3, q[1]); ctx.lineTo(q[0] + 3, q[1]); ctx.stroke();
+        this.place(tickText(z, zStep), q[0] + (left ? -7 : 7), q[1], left ? "right" : "left", TICK_FONT, "z");
+      }
+      this.place("z [m]", c[0], c[1] - 14, "center", NAME_FONT, "z name");
     }
-    ctx.font = "bold 13px system-ui, sans-serif";
-    ctx.textAlign = "center";
-    ctx.fillText("z [m]", c[0], c[1] - 14);
+    // x ticks along the y edge nearer the viewer, y ticks along the nearer x edge
+    const yEdge = P(this.center[0], b.lo[1], z0)[2] > P(this.center[0], b.hi[1], z0)[2] ? -1 : 1;
+    const xEdge = P(b.lo[0], this.center[1], z0)[2] > P(b.hi[0], this.center[1], z0)[2] ? -1 : 1;
+    const yAt = yEdge < 0 ? b.lo[1] - pad : b.hi[1] + pad, xAt = xEdge < 0 ? b.lo[0] - pad : b.hi[0] + pad;
+    const centre = P(this.center[0], this.center[1], z0);
+    this.tickRow(xs.map(x => [x, P(x, yAt, z0)]), step, centre, "x");
+    this.tickRow(ys.map(y => [y, P(xAt, y, z0)]), step, centre, "y");
+    this.canvas.setAttribute("data-labels", JSON.stringify(this.labels));
+  };
+
+  /* Tick labels of one floor axis, thinned (every k-th tick, 0 kept) so that no two meet on
+   * the screen, then its name beyond them, away from the floor's centre (below when the
+   * floor is seen edge-on). An axis seen end-on, where fewer than two labels would fit, gets
+   * neither: in a side view the depth axis has no readable ticks. */
+  Viewer.prototype.tickRow = function (row, step, centre, axis) {
+    const ctx = this.ctx;
+    if (row.length < 2) return;
+    ctx.font = TICK_FONT;
+    const texts = row.map(([v]) => tickText(v, step));
+    const w = Math.max(...texts.map(t => ctx.measureText(t).width)) + LABEL_GAP, h = TICK_PX + LABEL_GAP;
+    let k = 1;
+    for (let i = 1; i < row.length; i++) {
+      const dx = Math.abs(row[i][1][0] - row[i - 1][1][0]), dy = Math.abs(row[i][1][1] - row[i - 1][1][1]);
+      k = Math.max(k, Math.min(Math.ceil(w / Math.max(dx, 1e-9)), Math.ceil(h / Math.max(dy, 1e-9))));
+    }
+    const kept = row.filter(([v]) => Math.round(v / step) % k === 0);
+    if (kept.length < 2) return;
+    for (const [v, p] of kept) this.place(tickText(v, step), p[0], p[1], "center", TICK_FONT, axis);
+    const first = row[0][1], last = row[row.length - 1][1];
+    const mid = [(first[0] + last[0]) / 2, (first[1] + last[1]) / 2];
+    const len = Math.hypot(last[0] - first[0], last[1] - first[1]);
+    let n = [-(last[1] - first[1]) / len, (last[0] - first[0]) / len];   // normal to the row on screen
+    const side = (mid[0] - centre[0]) * n[0] + (mid[1] - centre[1]) * n[1];
+    if (Math.abs(side) < 2) { if (n[1] < 0) n = [-n[0], -n[1]]; } else if (side < 0) n = [-n[0], -n[1]];
+    const name = axis + " [m]";
+    ctx.font = NAME_FONT;
+    const W = ctx.measureText(name).width, H = NAME_PX;
+    let d = Math.abs(n[0]) * (w + W) / 2 + Math.abs(n[1]) * (h + H) / 2 + 4;
+    for (let tries = 0; tries < 5; tries++, d += 8) {
+      if (this.place(name, mid[0] + n[0] * d, mid[1] + n[1] * d, "center", NAME_FONT, axis + " name")) break;
+    }
+  };
+
+  /* Draw text at (x, y) unless its box leaves the canvas or meets a label already drawn;
+   * keep the box (and report it in data-labels, for the tests). */
+  Viewer.prototype.place = function (text, x, y, align, font, kind) {
+    const ctx = this.ctx;
+    ctx.font = font;
+    const w = ctx.measureText(text).width, h = font === NAME_FONT ? NAME_PX : TICK_PX;
+    const x0 = align === "left" ? x : align === "right" ? x - w : x - w / 2;
+    const box = [x0 - 1, y - h / 2 - 1, x0 + w + 1, y + h / 2 + 1];
+    if (box[0] < 0 || box[1] < 0 || box[2] > this.W || box[3] > this.H) return false;
+    for (const o of this.placed) if (box[0] < o[2] && o[0] < box[2] && box[1] < o[3] && o[1] < box[3]) return false;
+    ctx.textAlign = align;
+    ctx.textBaseline = "middle";
+    ctx.fillText(text, x, y);
+    this.placed.push(box);
+    this.labels.push({ text: text, kind: kind, px: h, box: box.map(v => Math.round(v * 10) / 10) });
+    return true;
   };
 
   Viewer.prototype.draw = function () {

@@ -474,17 +474,65 @@ def loop_margins(lin: Linearization, loop: str = "x", at: str = "input") -> dict
             "open_loop_unstable_poles": int(np.sum(np.abs(np.linalg.eigvals(L.A)) > 1.0 + 1e-9))}
 
 
+def wrap_phase(degrees):
+    """Phase [deg] wrapped to (-360, 0], the range of :func:`bode`'s phase axes.
+
+    Every loop here lags (the closed loops start at 0 deg and fall), so (-360, 0] keeps
+    them whole, and it puts -180 deg, where the phase margin is read, in the middle of the
+    axis: no loop transfer is cut there, as (-180, 180] would cut one whose phase crosses
+    -180 deg.
+
+    Parameters
+    ----------
+    degrees : array_like
+        Phase [deg].
+
+    Returns
+    -------
+    ndarray
+        The same angles in (-360, 0].
+
+    Examples
+    --------
+    >>> wrap_phase([0.0, -90.0, -360.0, -450.0, 200.0, 1e-9]).round(6).tolist()
+    [0.0, -90.0, 0.0, -90.0, -160.0, -360.0]
+    """
+    degrees = np.asarray(degrees, dtype=float)
+    return degrees - 360.0 * np.ceil(degrees / 360.0)
+
+
+def _cut(w, phase):
+    """Frequencies and wrapped phases with a NaN at each wrap, so no line joins the ends."""
+    jumps = np.flatnonzero(np.abs(np.diff(phase)) > 180.0) + 1
+    return np.insert(w, jumps, np.nan), np.insert(phase, jumps, np.nan)
+
+
+def _margin_label(m: dict) -> str:
+    """``PM 18.1° @ 10.8 rad/s, GM -3.98 dB @ 7.07 rad/s``; a margin without crossover is left out."""
+    parts = []
+    if math.isfinite(m["phase_margin"]) and math.isfinite(m["gain_crossover"]):
+        parts.append(f"PM {m['phase_margin']:.3g}° @ {m['gain_crossover']:.3g} rad/s")
+    if math.isfinite(m["gain_margin"]) and m["gain_margin"] > 0 and math.isfinite(m["phase_crossover"]):
+        parts.append(f"GM {20 * math.log10(m['gain_margin']):+.3g} dB @ {m['phase_crossover']:.3g} rad/s")
+    return ", ".join(parts) or "no crossover"
+
+
 def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "input"):
-    """Bode plots of the closed loop and, optionally, of the loop transfers.
+    """Bode plots of the closed loop and, optionally, of the loop transfers with their margins.
 
     Parameters
     ----------
     lin : Linearization
         The closed loop.
     loops : bool
-        Add a second column of the loop transfers (broken ``at``), their gain crossovers
-        marked and their phase read so that the phase margin is its distance above the
-        -180 deg line there.
+        Add a second column of the loop transfers (broken ``at``), with their margins
+        (:func:`loop_margins`) marked and named: the phase margin as a segment from the
+        -180 deg line up to the phase at the gain crossover (a dot there on the 0 dB line
+        too), the gain margin as a segment from the 0 dB line to the magnitude at the phase
+        crossover (a square there on the -180 deg line too), both with their frequencies in
+        the legend ("PM 18.1° @ 10.8 rad/s, GM -3.98 dB @ 7.07 rad/s"; a negative gain
+        margin is how far the gain may fall). y's margins are x's for a symmetric vehicle
+        and are then not marked twice.
     omega : array_like, optional
         Frequencies [rad/s]; by default 800 from 0.01 rad/s to just below the Nyquist
         frequency.
@@ -496,40 +544,61 @@ def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "inpu
     matplotlib.figure.Figure
         Magnitude [dB] above phase [deg] against frequency [rad/s] of the closed loop
         x_r->x, y_r->y (dashed: the same as x for a symmetric vehicle), z_r->z,
-        psi_r->psi; 2 or 4 axes.
+        psi_r->psi; 2 or 4 axes. Every phase is wrapped to (-360, 0] (:func:`wrap_phase`),
+        with ticks every 90 deg; a line is broken where it wraps.
 
     Examples
     --------
     >>> fig = bode(linearize("nlpd"), loops=True)
-    >>> len(fig.axes)
-    4
+    >>> len(fig.axes), [float(v) for v in fig.axes[3].get_ylim()]
+    (4, [-360.0, 0.0])
     """
     w = np.logspace(-2, math.log10(0.999 * math.pi / lin.dt), 800) if omega is None else np.asarray(omega, float)
     from matplotlib.figure import Figure
+    from matplotlib.ticker import MultipleLocator
 
     fig = Figure(figsize=(12 if loops else 7, 6.5), layout="constrained")
     axes = fig.subplots(2, 2 if loops else 1, sharex="col", squeeze=False)
+    marked = []
     for (loop, (_, state)), color in zip(LOOPS.items(), ("C0", "C1", "C2", "C3")):
         style = {"color": color, "ls": "--" if loop == "y" else "-"}
         r = control.frequency_response(lin.sys[OUTPUTS.index(state), INPUTS.index(f"{state}_ref")], w).complex.ravel()
         axes[0, 0].semilogx(w, 20 * np.log10(np.abs(r)), label=f"{state}_r -> {state}", **style)
-        axes[1, 0].semilogx(w, np.degrees(np.unwrap(np.angle(r))), **style)
-        if loops:
-            r = control.frequency_response(loop_transfer(lin, loop, at), w).complex.ravel()
-            phase, wgc = np.degrees(np.unwrap(np.angle(r))), loop_margins(lin, loop, at)["gain_crossover"]
-            if math.isfinite(wgc):                       # phase at the crossover in (-360, 0]
-                phase -= 360.0 * math.ceil(np.interp(math.log(wgc), np.log(w), phase) / 360.0)
-                axes[0, 1].plot([wgc], [0.0], "o", color=color, ms=4)
-            axes[0, 1].semilogx(w, 20 * np.log10(np.abs(r)), label=f"L {loop} (at the {at})", **style)
-            axes[1, 1].semilogx(w, phase, **style)
+        axes[1, 0].semilogx(*_cut(w, wrap_phase(np.degrees(np.angle(r)))), **style)
+        if not loops:
+            continue
+        r = control.frequency_response(loop_transfer(lin, loop, at), w).complex.ravel()
+        gain, phase = 20 * np.log10(np.abs(r)), wrap_phase(np.degrees(np.unwrap(np.angle(r))))
+        m = loop_margins(lin, loop, at)
+        axes[0, 1].semilogx(w, gain, label=f"L {loop}: {_margin_label(m)}", **style)
+        axes[1, 1].semilogx(*_cut(w, phase), **style)
+        key = {k: round(m[k], 9) for k in ("phase_margin", "gain_crossover", "gain_margin", "phase_crossover")}
+        if key in marked:                               # y's margins are x's: marked once
+            continue
+        marked.append(key)
+        wgc, wpc = m["gain_crossover"], m["phase_crossover"]
+        if math.isfinite(m["phase_margin"]) and math.isfinite(wgc):
+            p = -180.0 + m["phase_margin"]              # the phase at the crossover, in (-360, 0]
+            axes[1, 1].plot([wgc, wgc], [-180.0, p], color=color, lw=2.5, solid_capstyle="butt",
+                            label=f"PM {loop}")
+            axes[1, 1].plot([wgc], [p], "o", color=color, ms=5)
+            axes[0, 1].plot([wgc], [0.0], "o", color=color, ms=5)
+        if math.isfinite(m["gain_margin"]) and m["gain_margin"] > 0 and math.isfinite(wpc):
+            g = -20.0 * math.log10(m["gain_margin"])     # the magnitude at the phase crossover
+            axes[0, 1].plot([wpc, wpc], [0.0, g], color=color, lw=2.5, solid_capstyle="butt",
+                            label=f"GM {loop}")
+            axes[0, 1].plot([wpc], [g], "s", color=color, ms=5)
+            axes[1, 1].plot([wpc], [-180.0], "s", color=color, ms=5)
     axes[0, 0].set_ylim(bottom=max(axes[0, 0].get_ylim()[0], -150.0))
     for col, title in enumerate(["closed loop (discrete, dt = %g s)" % lin.dt, "loop transfers"][:axes.shape[1]]):
         axes[0, col].set(ylabel="magnitude [dB]", title=title)
-        axes[1, col].set(ylabel="phase [deg]", xlabel="frequency [rad/s]")
+        axes[1, col].set(ylabel="phase [deg]", xlabel="frequency [rad/s]", ylim=(-360.0, 0.0))
+        axes[1, col].yaxis.set_major_locator(MultipleLocator(90.0))
         axes[0, col].axhline(0.0, color="0.6", lw=0.6)
-        if col == 1:
-            axes[1, col].axhline(-180.0, color="0.6", lw=0.6)
-        axes[0, col].legend(fontsize=8)
+        axes[1, col].axhline(-180.0, color="0.6", lw=0.6)
+        handles, labels = axes[0, col].get_legend_handles_labels()
+        keep = [(h, lb) for h, lb in zip(handles, labels) if not lb.startswith(("PM ", "GM "))]
+        axes[0, col].legend(*zip(*keep), fontsize=8, loc="lower left")
         for ax in axes[:, col]:
             ax.grid(True, which="both", alpha=0.3)
     fig.suptitle(f"{getattr(lin.controller, 'name', 'controller')}: linearised about hover")
@@ -693,5 +762,5 @@ def write_analysis(lin: Linearization, rep: dict, out, *, force: bool = False):
     return out
 
 
-__all__ = ["HoverError", "Linearization", "linearize", "loop_transfer", "loop_margins", "bode", "report",
+__all__ = ["HoverError", "Linearization", "linearize", "loop_transfer", "loop_margins", "bode", "wrap_phase", "report",
            "summary", "to_json", "write_analysis", "INPUTS", "OUTPUTS", "LOOPS"]

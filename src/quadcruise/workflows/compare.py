@@ -10,7 +10,7 @@ Examples
 >>> table.index.tolist(), bool(table["status"].eq("finished").all())
 (['nlpd', 'se3', 'cascade'], True)
 >>> [ax.get_ylabel() for ax in cmp.plot().axes]
-['y [m]', 'x [m]', 'y [m]', 'z [m]']
+['y [m]', 'x [m]', 'y [m]', 'z [m]', 'position error [m]']
 """
 
 from __future__ import annotations
@@ -21,14 +21,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from quadcruise.control import Controller, as_controller, controller_record
 from quadcruise.errors import InputError, reject_unknown
 from quadcruise.io.plainjson import dumps, plain
 from quadcruise.metrics.summary import Summary
 from quadcruise.missions import Mission, mission_from_name
-from quadcruise.sim.result import SimResult
 from quadcruise.workflows.fly import FLY_OPTIONS, fly
 
 __all__ = ["compare", "Comparison", "DEFAULT_CONTROLLERS"]
@@ -152,9 +149,9 @@ class Comparison:
         return f"{text}\n{notes}" if notes else text
 
     def plot(self, vehicle: int = 0, *, title: str | None = None):
-        """Overlay of the flights: top view, and x, y, z against time, each reference once.
+        """Overlay of the flights: top view, x, y, z and the position error against time.
 
-        :func:`quadcruise.plots.plot_paths` with a z panel added below its x and y panels.
+        :func:`quadcruise.plots.plot_paths` with a z panel.
 
         Parameters
         ----------
@@ -166,13 +163,13 @@ class Comparison:
         Returns
         -------
         matplotlib.figure.Figure
-            Four axes: the top view, x, y and z [m] against time [s].
+            Five axes: the top view, x, y and z [m] and the position error [m] (log
+            scale) against time [s], with the environment's events and each flight's
+            saturation marked.
         """
         from quadcruise.plots.flight import plot_paths
 
-        fig = plot_paths(self.results, vehicle=vehicle, title=title)
-        add_z_panel(fig, self.results, vehicle)
-        return fig
+        return plot_paths(self.results, vehicle=vehicle, title=title, axes="xyz")
 
     def to_dict(self, **metric_kw: Any) -> dict:
         """Mission, vehicle, controllers and metrics as plain values (NaN as None), for JSON.
@@ -204,6 +201,22 @@ class Comparison:
             "metrics": rows,
             "metrics_conventions": plain(table.attrs.get("conventions")),
         }
+
+    def scenario_toml(self) -> str:
+        """The comparison as a scenario file that ``quadcruise compare`` reads back.
+
+        Returns
+        -------
+        str
+            TOML: mission, vehicle, world and simulation of the flights, and each controller
+            with its label and gains under ``[[compare.controllers]]``.
+        """
+        from quadcruise.io.scenario_file import comparison_document, scenario_text
+
+        first = next(iter(self.results.values()))
+        records = {label: controller_record(c) for label, c in self.controllers.items()}
+        return scenario_text(comparison_document(first.meta, records), header=(
+            "written by quadcruise from a comparison; `quadcruise compare THIS_FILE` flies it again"))
 
     @staticmethod
     def _rows(table) -> dict:
@@ -242,54 +255,8 @@ class Comparison:
             self.table(**metric_kw).reset_index().to_csv(tmp / "metrics.csv", index=False)
             save_figure(self.plot(), tmp / "comparison.png")
             (tmp / MARKER).write_text(dumps(self.to_dict(**metric_kw), indent=2, sort_keys=True) + "\n")
+            (tmp / "scenario.toml").write_text(self.scenario_toml())
         return out
-
-
-def add_z_panel(fig, results: Mapping[str, SimResult], vehicle: int = 0):
-    """Add z(t) under the x and y panels of a :func:`~quadcruise.plots.plot_paths` figure.
-
-    Same colours, the reference dashed once, early stops crossed; the figure grows to
-    13 x 8.5 inches.
-
-    Parameters
-    ----------
-    fig : matplotlib.figure.Figure
-        A figure of :func:`~quadcruise.plots.plot_paths` of the same ``results``.
-    results : mapping of str to SimResult
-        Label -> flight, in the figure's order.
-    vehicle : int
-        Which vehicle of each flight to draw.
-
-    Returns
-    -------
-    matplotlib.axes.Axes
-        The new z [m] against time [s] axes.
-    """
-    from quadcruise.plots.flight import REF_STYLE
-
-    top, ax_x, ax_y = fig.axes[:3]
-    gs = fig.add_gridspec(3, 2, width_ratios=(1, 1.3))
-    top.set_subplotspec(gs[:, 0])
-    ax_x.set_subplotspec(gs[0, 1])
-    ax_y.set_subplotspec(gs[1, 1])
-    ax_z = fig.add_subplot(gs[2, 1], sharex=ax_x)
-    for res in results.values():
-        zr = res.state("z_ref")[vehicle]
-        if np.any(np.isfinite(zr)):
-            ax_z.plot(res.t, zr, **REF_STYLE)
-            break
-    for k, res in enumerate(results.values()):
-        z = res.state("z")[vehicle]
-        ax_z.plot(res.t, z, color=f"C{k}", lw=1.4)
-        live = np.flatnonzero(np.isfinite(z))
-        if live.size and int(res.status[vehicle]) != 0:
-            ax_z.plot(res.t[live[-1]], z[live[-1]], "X", color="tab:red", ms=9)
-    ax_y.set_xlabel("")
-    ax_y.tick_params(labelbottom=False)
-    ax_z.set(xlabel="time [s]", ylabel="z [m]")
-    ax_z.grid(True, alpha=0.3)
-    fig.set_size_inches(13, 8.5)
-    return ax_z
 
 
 def compare(mission: Mission | str = "circle",

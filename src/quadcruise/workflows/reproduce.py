@@ -49,6 +49,7 @@ from quadcruise.control.design import PDGains
 from quadcruise.errors import InputError
 from quadcruise.io.files import MARKER, atomic_dir, check_output_dir, write_table
 from quadcruise.io.plainjson import dumps
+from quadcruise.io.scenario_file import scenario_document, scenario_text
 from quadcruise.missions import Circle, Mission, Square, Step
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.result import SimResult
@@ -334,6 +335,10 @@ def write_reproduction(rep: Reproduction, out: str | Path, *, force: bool = Fals
         tmp = Path(tmp)
         (tmp / "metrics.json").write_text(dumps(rep.to_json(), indent=2) + "\n")
         (tmp / MARKER).write_text(dumps({"workflow": "reproduce", **rep.config, "version": __version__}, indent=2) + "\n")
+        (tmp / "scenario.toml").write_text(scenario_text(
+            scenario_document({"vehicle": rep.config["vehicle"], "dt_s": rep.config["dt_s"]}),
+            header="written by quadcruise reproduce; `quadcruise reproduce --scenario THIS_FILE` flies the same "
+                   "reproduction (the paper's scenarios and controllers, this vehicle and control period)"))
         traces = tmp / "traces"
         traces.mkdir()
         light = {key: result.decimate(TRACE_EVERY) for key, result in rep.results.items()}

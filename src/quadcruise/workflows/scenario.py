@@ -1,13 +1,16 @@
 """Scenario files: a whole run described in TOML, validated with messages that name the
 file, the key and what is wrong. Loading parses data only (``tomllib``); it never runs code.
 
-A scenario has up to six tables; every one is optional::
+A scenario has up to seven tables; every one is optional::
 
     title = "Circle in moderate turbulence"
 
     [vehicle]                 # the paper's Table I, with any field overridden
     m = 1.4
     drag_linear = 0.3
+
+    [controller_vehicle]      # the vehicle the controller believes it flies (its model);
+    m = 3.499                 # the flown [vehicle] when left out
 
     [controller]              # a built-in controller and its parameters
     name = "nlpd"
@@ -31,7 +34,7 @@ A scenario has up to six tables; every one is optional::
     duration = 30.0
     dt = 0.001
     full_dynamics = false
-    seed = 1
+    seed = 1                  # also: max_step, log_every, n, max_track_error, initial_state
 
     [montecarlo]              # read by `quadcruise montecarlo`
     n = 1000
@@ -69,7 +72,8 @@ from quadcruise.errors import InputError
 from quadcruise.missions import MISSIONS, Mission
 from quadcruise.model.vehicle import Vehicle
 
-TABLES = ("vehicle", "controller", "mission", "disturbances", "simulation", "montecarlo", "controller_vehicle")
+TABLES = ("vehicle", "controller", "mission", "disturbances", "simulation", "montecarlo", "controller_vehicle",
+          "compare")
 SIMULATION_KEYS = {"duration": float, "dt": float, "max_step": float, "full_dynamics": bool,
                    "seed": int, "log_every": int, "n": int, "max_track_error": float, "initial_state": list}
 DISTURBANCE_KEYS = ("wind", "gust", "turbulence", "rotor_loss", "force", "sensor_noise")
@@ -77,7 +81,44 @@ DISTURBANCE_KEYS = ("wind", "gust", "turbulence", "rotor_loss", "force", "sensor
 
 @dataclass(frozen=True)
 class Scenario:
-    """A validated scenario: objects ready to fly, and the source it came from."""
+    """A validated scenario: objects ready to fly, and the source it came from.
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+        The flown vehicle: Table I (:meth:`Vehicle.paper`) with the ``[vehicle]`` overrides.
+    controller_vehicle : Vehicle or None
+        The vehicle the controller believes it flies (its model); None: ``vehicle``.
+    controller : Controller or None
+        The controller; None flies ``nlpd`` with its defaults.
+    mission : Mission or None
+        The mission; None flies the default ``circle``.
+    environment : Environment or None
+        The disturbances of ``[disturbances]`` (wind [m/s], gust, turbulence, rotor loss,
+        external force [N]), or None.
+    sensor_noise : SensorNoise or None
+        Noise on what the controller sees (position [m], velocity [m/s], angle [rad] ...)
+        and its delay [s], or None.
+    simulation : dict
+        The checked ``[simulation]`` table: ``duration`` [s], ``dt`` [s], ``max_step`` [s],
+        ``full_dynamics``, ``seed``, ``log_every``, ``n``, ``max_track_error`` [m] and
+        ``initial_state`` (16 state values in the units of :data:`quadcruise.layout.STATE_UNITS`,
+        or one row per vehicle), each only if given.
+    montecarlo : dict
+        The ``[montecarlo]`` table as written (checked by ``quadcruise montecarlo``).
+    compare : dict
+        ``[compare]``'s controllers: label -> controller, in order (``quadcruise compare``).
+    title : str
+        The scenario's title.
+    source : str
+        Where it came from (the file name), for messages and the flight's ``meta``.
+
+    Examples
+    --------
+    >>> sc = Scenario(simulation={"duration": 2.0})
+    >>> sc.duration, sc.dt, sorted(sc.fly_kwargs())
+    (2.0, 0.001, ['dt', 'duration', 'vehicle'])
+    """
 
     vehicle: Vehicle = field(default_factory=Vehicle.paper)
     controller_vehicle: Vehicle | None = None
@@ -87,19 +128,36 @@ class Scenario:
     sensor_noise: Any = None
     simulation: dict = field(default_factory=dict)
     montecarlo: dict = field(default_factory=dict)
+    compare: dict = field(default_factory=dict)
     title: str = ""
     source: str = "scenario"
 
     @property
     def duration(self) -> float | None:
+        """Flight time [s] from ``[simulation]``, or None (``fly`` then takes the mission's)."""
         return self.simulation.get("duration")
 
     @property
     def dt(self) -> float:
+        """Control period [s] from ``[simulation]``, 1e-3 by default."""
         return self.simulation.get("dt", 1e-3)
 
     def fly_kwargs(self) -> dict:
-        """Keyword arguments of :func:`quadcruise.fly` for this scenario."""
+        """Keyword arguments of :func:`quadcruise.fly` for this scenario (all but the mission
+        and the controller).
+
+        Wind, gusts and turbulence act only through drag: with any of them, a vehicle without
+        drag is given :data:`~quadcruise.disturbances.DEFAULT_DRAG` (with a warning, see
+        :func:`~quadcruise.disturbances.with_drag`).
+
+        Returns
+        -------
+        dict
+            ``duration`` [s] (None if not given), ``dt`` [s], ``vehicle``, and those of
+            ``max_step``, ``full_dynamics``, ``seed``, ``log_every``, ``n``,
+            ``max_track_error``, ``x0`` (the initial state), ``controller_vehicle``,
+            ``environment`` and ``sensors`` the scenario gives.
+        """
         sim = self.simulation
         kw: dict[str, Any] = {"duration": sim.get("duration"), "dt": self.dt}
         for key in ("max_step", "full_dynamics", "seed", "log_every", "n", "max_track_error"):
@@ -122,7 +180,13 @@ class Scenario:
         return kw
 
     def fly(self):
-        """Fly the scenario: :func:`quadcruise.fly` with everything it describes."""
+        """Fly the scenario: :func:`quadcruise.fly` with everything it describes.
+
+        Returns
+        -------
+        SimResult
+            The flight, with ``meta["scenario"]`` holding the source and the title.
+        """
         from quadcruise.workflows.fly import fly
 
         result = fly(self.mission or "circle", self.controller or "nlpd", **self.fly_kwargs())
@@ -131,7 +195,22 @@ class Scenario:
 
 
 def load_scenario(path: str | Path) -> Scenario:
-    """Read and validate a TOML scenario; any problem is one InputError naming file and key."""
+    """Read and validate a TOML scenario; any problem is one InputError naming file and key.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The TOML file; relative file names inside it are taken relative to its folder.
+
+    Returns
+    -------
+    Scenario
+
+    Raises
+    ------
+    InputError
+        No such file, not valid TOML, or a table, key or value that is wrong.
+    """
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{path}: no such file")
@@ -143,7 +222,33 @@ def load_scenario(path: str | Path) -> Scenario:
 
 
 def scenario_from_dict(doc: dict, *, source: str = "scenario", base: Path | None = None) -> Scenario:
-    """Build a Scenario from the parsed tables (see the module docstring)."""
+    """Build a Scenario from the parsed tables (see the module docstring).
+
+    Parameters
+    ----------
+    doc : dict
+        The parsed TOML document: ``title`` and the tables of :data:`TABLES`.
+    source : str
+        The name messages and the result give the scenario (the file name).
+    base : pathlib.Path, optional
+        Folder that relative file names (a waypoint table) are taken relative to; None
+        leaves them as written.
+
+    Returns
+    -------
+    Scenario
+
+    Raises
+    ------
+    InputError
+        An unknown table or key, or a bad value, naming ``source`` and the table.
+
+    Examples
+    --------
+    >>> sc = scenario_from_dict({"title": "hover", "mission": {"kind": "hover", "z": 2.0}})
+    >>> sc.title, sc.mission.z, sc.controller
+    ('hover', 2.0, None)
+    """
     where = _Where(source)
     _known(where, "", doc, set(TABLES) | {"title"})
     for name in TABLES:
@@ -155,11 +260,13 @@ def scenario_from_dict(doc: dict, *, source: str = "scenario", base: Path | None
     vehicle = _vehicle(where.at("vehicle"), doc.get("vehicle", {}))
     model = _vehicle(where.at("controller_vehicle"), doc["controller_vehicle"]) if "controller_vehicle" in doc else None
     controller = _controller(where.at("controller"), doc.get("controller")) if "controller" in doc else None
+    compared = _compare(where.at("compare"), doc.get("compare", {}))
     mission = _mission(where.at("mission"), doc.get("mission"), base) if "mission" in doc else None
     environment, noise = _disturbances(where.at("disturbances"), doc.get("disturbances", {}))
     simulation = _simulation(where.at("simulation"), doc.get("simulation", {}))
     return Scenario(vehicle=vehicle, controller_vehicle=model, controller=controller, mission=mission, environment=environment,
                     sensor_noise=noise, simulation=simulation, montecarlo=dict(doc.get("montecarlo", {})),
+                    compare=compared,
                     title=title, source=source)
 
 
@@ -265,6 +372,26 @@ def _controller(where: _Where, table: dict) -> Controller:
         else:
             params[key] = _number(where, key, value)
     return where.wrap(cls, **params)
+
+
+def _compare(where: _Where, table: dict) -> dict:
+    """``[compare]``: ``controllers``, a list of names or of controller tables with a ``label``."""
+    _known(where, "", table, {"controllers"})
+    items = table.get("controllers", [])
+    if not isinstance(items, list):
+        raise where.error("'controllers' must be a list of names or of [[compare.controllers]] tables")
+    out: dict = {}
+    for k, item in enumerate(items):
+        if isinstance(item, str):
+            item = {"name": item}
+        if not isinstance(item, dict):
+            raise where.error(f"controllers[{k}] must be a name or a table, got {item!r}")
+        item = dict(item)
+        label = item.pop("label", item.get("name", "nlpd"))
+        if not isinstance(label, str) or label in out:
+            raise where.error(f"controllers[{k}]: label {label!r} must be a text given once")
+        out[label] = _controller(where, item)
+    return out
 
 
 def _mission(where: _Where, table: dict, base: Path | None) -> Mission:
