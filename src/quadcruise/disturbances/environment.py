@@ -103,7 +103,7 @@ exponentials, a series, three square roots) in two periods of three."""
 # in a branch, a function ending in a branch, or a call of another compiled function (its
 # error path) defeat it (numba 0.68). Hence scalar helpers, rng[0] and dmem[0] loaded
 # first and stored last, no trailing if, and the ziggurat inlined once (_five_normals).
-# tests/test_disturbances.py checks the compiled body for reference counting.
+# tests/integration/test_disturbances.py checks the compiled body for reference counting.
 @njit(cache=True, error_model="numpy")
 def _lateral_coefficients(a):
     """Exact discretisation of (1 + sqrt3 T s)/(1 + T s)^2 over a = dt/T, states scaled to the
