@@ -3,9 +3,17 @@ to batched simulation, metrics and robustness studies.
 
 Data flows one way: parameters -> model -> controllers -> engine -> results -> metrics ->
 plots, report, CLI.
+
+The names below are imported on first use (``qc.fly``, ``from quadcruise import fly``):
+``import quadcruise`` alone loads neither numba nor the engine, whose compiled code numba
+loads from its cache or, the first time, compiles. So the command line can say that it is
+compiling before it does (:mod:`quadcruise.cli.feedback`), and ``quadcruise --help`` is quick.
 """
 
 from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
 
 from quadcruise._cache import drop_stale_cache as _drop_stale_cache
 from quadcruise._version import __version__
@@ -13,13 +21,26 @@ from quadcruise._version import __version__
 _drop_stale_cache()                      # before anything compiles: see quadcruise._cache
 
 from quadcruise.errors import InputError
-from quadcruise.model.vehicle import Vehicle
-from quadcruise.sim.engine import Limits, simulate, time_grid
-from quadcruise.sim.result import SimResult
-from quadcruise.sim.status import STATUS_REASONS, ExitStatus
-from quadcruise.workflows.compare import Comparison, compare
-from quadcruise.workflows.fly import fly
-from quadcruise.workflows.replay import DutySchedule, read_duty_csv, replay, write_states_csv
+
+if TYPE_CHECKING:                        # what the names are, for readers and type checkers
+    from quadcruise.model.vehicle import Vehicle
+    from quadcruise.sim.engine import Limits, simulate, time_grid
+    from quadcruise.sim.result import SimResult
+    from quadcruise.sim.status import STATUS_REASONS, ExitStatus
+    from quadcruise.workflows.compare import Comparison, compare
+    from quadcruise.workflows.fly import fly
+    from quadcruise.workflows.replay import DutySchedule, read_duty_csv, replay, write_states_csv
+
+_LAZY = {
+    "quadcruise.model.vehicle": ("Vehicle",),
+    "quadcruise.sim.engine": ("Limits", "simulate", "time_grid"),
+    "quadcruise.sim.result": ("SimResult",),
+    "quadcruise.sim.status": ("STATUS_REASONS", "ExitStatus"),
+    "quadcruise.workflows.compare": ("Comparison", "compare"),
+    "quadcruise.workflows.fly": ("fly",),
+    "quadcruise.workflows.replay": ("DutySchedule", "read_duty_csv", "replay", "write_states_csv"),
+}
+_HOME = {name: module for module, names in _LAZY.items() for name in names}
 
 __all__ = [
     "Comparison", "DutySchedule", "ExitStatus", "InputError", "Limits", "STATUS_REASONS", "SimResult", "Vehicle", "__version__",
@@ -28,10 +49,40 @@ __all__ = [
 
 
 def __getattr__(name: str):
-    """``qc.tune``: the tuning package (:mod:`quadcruise.tune`; its entry point ``qc.tune.tune``),
-    imported on first use so that ``import quadcruise`` does not load scipy's optimiser."""
-    if name == "tune":
-        import importlib
+    """A re-exported name, imported from its module on first use and kept.
 
-        return importlib.import_module("quadcruise.tune")
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    Parameters
+    ----------
+    name : str
+        One of ``__all__``.
+
+    Returns
+    -------
+    object
+        The function, class or constant of that name.
+
+    Raises
+    ------
+    AttributeError
+        For a name the package does not export.
+    """
+    if name == "tune":                    # the tuning package: qc.tune.tune(...)
+        value = importlib.import_module("quadcruise.tune")
+        globals()[name] = value
+        return value
+    module = _HOME.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    """The module's names, the lazily imported ones included.
+
+    Returns
+    -------
+    list of str
+    """
+    return sorted(set(globals()) | set(__all__) | {"tune"})

@@ -3,7 +3,6 @@ to flight_metrics, a real Dask LocalCluster (with a worker killed mid-run), resu
 interruption, and bad input."""
 
 import dataclasses
-import io
 import json
 import os
 import signal
@@ -20,7 +19,6 @@ from quadcruise.metrics import flight_metrics
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo import MonteCarloSpec, Population, montecarlo, montecarlo_case, replay_case
 from quadcruise.montecarlo.chunk import fly_chunk, sweep_metrics
-from quadcruise.montecarlo.progress import ProgressBar
 from quadcruise.montecarlo.schema import COLUMNS
 
 POP = Population(mass_spread=0.15, inertia_spread=0.1, thrust_spread=0.1, bandwidth_spread=0.1,
@@ -405,13 +403,3 @@ def test_command_prints_the_summary_and_replays_a_case(tmp_path):
     with pytest.raises(InputError, match="other options"):
         montecarlo_command(**{**same, "seed": 5}, case=worst, out=str(tmp_path / "mc"), echo=lines.append)
 
-
-def test_progress_bar_reports_rate_and_eta():
-    buf = io.StringIO()
-    bar = ProgressBar(buf, log_interval=0.0)
-    bar(100, 1000)
-    bar(400, 1000)
-    bar(1000, 1000)
-    bar.close()
-    last = buf.getvalue().splitlines()[-1]
-    assert last.startswith("1,000/1,000 flights (100.0 %)") and "flights/s" in last and "ETA" in last

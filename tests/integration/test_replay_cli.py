@@ -85,3 +85,15 @@ def test_console_script_runs_as_a_process(tmp_path):
     bad = subprocess.run([sys.executable, "-m", "quadcruise", "replay", str(tmp_path / "x.csv"), "-o", str(out)],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "Traceback" not in bad.stderr
+
+
+def test_a_long_schedule_names_its_first_bad_row():
+    """The checks run over whole arrays and still name the first row at fault."""
+    t = np.arange(3000) * 1e-3
+    u = np.full((3000, 4), 0.5)
+    u[2000, 1], u[2500, 2] = 1.5, np.nan
+    with pytest.raises(qc.InputError, match=r"schedule, row 2001, column 'u2': duty 1.5 is outside \[0, 1\]"):
+        qc.DutySchedule(t=t, duties=u)
+    t[1200] = t[1199]
+    with pytest.raises(qc.InputError, match=r"row 1201, column 't': time 1.199 is not after"):
+        qc.DutySchedule(t=t, duties=u)

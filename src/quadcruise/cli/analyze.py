@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import click
 
-from quadcruise.cli.common import FORCE_OPTION, controller_from_options, friendly, writable
+from quadcruise.cli.common import FORCE_OPTION, Bar, controller_from_options, friendly, writable
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["analyze"]
@@ -40,14 +40,16 @@ def analyze(controller, controller_params, position_poles, dt, out, force):
     force : bool
         ``--force``: replace a non-empty ``out`` folder that quadcruise did not write.
     """
+    linearising = Bar("linearising about hover")
+    linearising(0, 3)                       # python-control takes a few seconds to load
     from quadcruise.workflows.analysis import linearize, report, summary, write_analysis
 
     the_controller = controller_from_options(controller, controller_params, position_poles)
     if out is not None:
         check_output_dir(out, force)
-    lin = linearize(the_controller, dt=dt)
-    rep = report(the_controller, lin=lin)
+    lin = linearize(the_controller, dt=dt, progress=linearising)
+    rep = report(the_controller, lin=lin, progress=Bar("margins", unit="loop"))
     click.echo(summary(rep))
     if out is not None:
-        write_analysis(lin, rep, out, force=force)
+        write_analysis(lin, rep, out, force=force, progress=Bar("Bode plots"))
         click.echo(f"wrote analysis.json and Bode plots to {out}")

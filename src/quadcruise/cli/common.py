@@ -11,10 +11,11 @@ from typing import Callable
 
 import click
 
+from quadcruise.cli.feedback import Bar, close_bars, compile_notice
 from quadcruise.cli.objects import controller_from_options, mission_from_options
 from quadcruise.errors import InputError
 
-__all__ = ["FORCE_OPTION", "FORMAT_OPTION", "REPORT_OPTION", "RISE_OPTION", "SETTLE_BAND_OPTION", "friendly",
+__all__ = ["FORCE_OPTION", "FORMAT_OPTION", "REPORT_OPTION", "RISE_OPTION", "SETTLE_BAND_OPTION", "Bar", "friendly",
            "metric_options", "writable", "controller_from_options", "mission_from_options"]
 
 # options several commands share
@@ -82,7 +83,9 @@ def metric_options(rise: str = "10-90", settle_bands: tuple[float, ...] = ()) ->
 
 def friendly(func: Callable) -> Callable:
     """Wrap a command: InputError becomes one line on stderr, ``error: ...``, and exit status
-    2; every warning raised meanwhile is shown plainly, ``warning: ...``.
+    2; every warning raised meanwhile is shown plainly, ``warning: ...``; a progress bar still
+    open is closed first, and on a terminal numba's first compilation is announced
+    (:mod:`quadcruise.cli.feedback`).
 
     Parameters
     ----------
@@ -97,14 +100,16 @@ def friendly(func: Callable) -> Callable:
 
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
-        with warnings.catch_warnings(record=True) as caught:
+        with warnings.catch_warnings(record=True) as caught, compile_notice():
             warnings.simplefilter("always")
             try:
                 return func(*args, **kwargs)
             except InputError as exc:
+                close_bars()
                 click.echo(f"error: {exc}", err=True)
                 sys.exit(2)
             finally:
+                close_bars()
                 for w in caught:
                     click.echo(f"warning: {w.message}", err=True)
 

@@ -10,6 +10,7 @@ from quadcruise.cli.common import (
     REPORT_OPTION,
     RISE_OPTION,
     SETTLE_BAND_OPTION,
+    Bar,
     friendly,
     metric_options,
     writable,
@@ -86,7 +87,7 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
     cmp_mission, chosen, kwargs = compared_from_options(mission, controllers, mission_params)
     kwargs.update({k: v for k, v in (("duration", duration), ("dt", dt)) if v is not None})
     pop = _population(population, seed, mass_spread, wind)      # checked before anything flies
-    cmp = run_compare(cmp_mission, chosen, **kwargs)
+    cmp = run_compare(cmp_mission, chosen, progress=Bar("flying", unit="controller"), **kwargs)
     click.echo(cmp.text(**conventions))
     if population is not None:
         _compare_population(cmp_mission, chosen, population, seed, pop, wind, kwargs.get("duration"),
@@ -133,8 +134,7 @@ def _population(n: int | None, seed: int, mass_spread: float, wind: str | None):
 
 def _compare_population(mission, controllers: str, n: int, seed: int, pop, wind: str | None,
                         duration: float | None, dt: float) -> None:
-    """Fly the controllers on the same population of perturbed vehicles, in this process,
-    and print one row per controller.
+    """Fly the controllers on the same perturbed vehicles, in this process; print one row each.
 
     Parameters
     ----------
@@ -149,14 +149,13 @@ def _compare_population(mission, controllers: str, n: int, seed: int, pop, wind:
         The population (:func:`_population`).
     wind : str or None
         The ``--wind`` spec, for the printed headline.
-    duration : float or None
-        Flight time [s]; None: the mission's.
-    dt : float
-        Control period [s].
+    duration, dt : float
+        Flight time [s] (None: the mission's) and control period [s].
     """
     from quadcruise.montecarlo.compare import compare_population
 
-    table = compare_population(mission, controllers, pop, n, seed, duration=duration, dt=dt, scheduler="none")
+    table = compare_population(mission, controllers, pop, n, seed, duration=duration, dt=dt, scheduler="none",
+                               progress=Bar("flying the population", unit="flight"))
     click.echo(f"\nthe same {n} perturbed vehicles (seed {seed}, mass spread {pop.mass_spread:g}"
                + (f", wind {wind}" if wind else "") + "):")
     click.echo(table.to_string(float_format=lambda v: f"{v:.4g}"))

@@ -14,6 +14,7 @@ from quadcruise.cli.common import (
     REPORT_OPTION,
     RISE_OPTION,
     SETTLE_BAND_OPTION,
+    Bar,
     friendly,
     metric_options,
     writable,
@@ -176,6 +177,6 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
     if animate is not None:
         from quadcruise.plots.animate import animate_flight
 
-        animate_flight(result, animate)
+        animate_flight(result, animate, progress=Bar("drawing the animation", unit="frame"))
         click.echo(f"wrote animation {animate}")
     return result

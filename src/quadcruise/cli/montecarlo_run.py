@@ -5,11 +5,11 @@ in :mod:`quadcruise.cli.montecarlo`, which re-exports these."""
 
 from __future__ import annotations
 
-import sys
 from typing import TYPE_CHECKING, Callable
 
 import click
 
+from quadcruise.cli.feedback import Bar
 from quadcruise.errors import InputError
 
 if TYPE_CHECKING:
@@ -110,7 +110,6 @@ offset, distribution, model_error : optional
     from quadcruise.errors import whole_number
     from quadcruise.montecarlo import montecarlo_case
     from quadcruise.montecarlo.output import case_folder, case_text, write_case
-    from quadcruise.montecarlo.progress import ProgressBar
     from quadcruise.montecarlo.scenario import sweep_spec
     from quadcruise.montecarlo.sweep import run_sweep
 
@@ -144,7 +143,7 @@ offset, distribution, model_error : optional
             write_case(found, target, fmt=fmt, force=True)
             echo(f"wrote the flight to {target}")
         return found
-    bar = None if quiet else ProgressBar(sys.stderr)
+    bar = None if quiet else Bar("flying", unit="flight")
     try:
         res = run_sweep(spec, n, chunk_size=chunk_size, scheduler=scheduler, workers=workers, out=out,
                         resume=resume, force=force, fmt=fmt, progress=bar, connect_timeout=connect_timeout)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from quadcruise.cli.common import friendly, writable
+from quadcruise.cli.common import Bar, friendly, writable
 
 __all__ = ["replay"]
 
@@ -37,10 +37,10 @@ def replay(pwm_csv: str, out: str, max_step: float) -> None:
     from quadcruise.workflows.replay import read_duty_csv, write_states_csv
     from quadcruise.workflows.replay import replay as run_replay
 
-    schedule = read_duty_csv(pwm_csv)
-    result = run_replay(schedule, max_step=max_step)
+    schedule = read_duty_csv(pwm_csv, progress=Bar(f"reading {pwm_csv}", unit="row"))
+    result = run_replay(schedule, max_step=max_step, progress=Bar("flying", unit="row"))
     if not result.ok[0]:
         click.echo(f"warning: the flight stopped early: {result.status_text(0)}", err=True)
-    write_states_csv(result, out)
+    write_states_csv(result, out, progress=Bar(f"writing {out}", unit="row"))
     click.echo(f"wrote {len(result.t)} states to {out} "
                f"(t = {result.t[0]:g} .. {result.t[-1]:g} s, final z = {result.final_state[0, 2]:.4f} m)")

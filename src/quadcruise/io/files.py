@@ -231,7 +231,7 @@ def write_table(frame, path: Path, fmt: str) -> Path:
 
 
 def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optional: tuple[str, ...] = (), *,
-                     blank_ok=None):
+                     blank_ok=None, progress=None):
     """Read a CSV of numbers with a header; any problem is one InputError naming the file,
     the line and the column.
 
@@ -248,6 +248,9 @@ def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optiona
     blank_ok : callable, optional
         ``blank_ok(column, row_index) -> bool``: whether a blank cell is allowed (it then
         reads as NaN); without it every blank cell is an error.
+    progress : callable, optional
+        ``progress(done, total)``: the data rows read into numbers, about every hundredth
+        of them, once the file's lines are split (from 0 to the number of rows).
 
     Returns
     -------
@@ -303,7 +306,10 @@ def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optiona
     used = [c for c in required + optional if c in header]
     position = [header.index(name) for name in used]
     data = np.empty((len(rows) - 1, len(used)))
+    every = max(1, data.shape[0] // 100)
     for k, (line, row) in enumerate(rows[1:]):
+        if progress is not None and k % every == 0:
+            progress(k, data.shape[0])
         if len(row) != len(header):
             raise InputError(f"{path}, line {line}: has {len(row)} cells, the header has {len(header)}")
         for j, name in enumerate(used):
@@ -318,4 +324,6 @@ def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optiona
             if math.isnan(value):
                 raise InputError(f"{path}, line {line}, column '{name}': value is NaN")
             data[k, j] = value
+    if progress is not None:
+        progress(data.shape[0], data.shape[0])
     return head, used, data, [line for line, _ in rows[1:]]

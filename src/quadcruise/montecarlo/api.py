@@ -105,7 +105,7 @@ def montecarlo(mission: Mission | str = "circle", controller: Controller | str =
         Format of the flights table.
     progress : callable, optional
         ``progress(done, total)`` after each chunk (flights done, resumed ones included);
-        :class:`quadcruise.montecarlo.progress.ProgressBar` prints a line on stderr.
+        the command line's :class:`quadcruise.cli.feedback.Bar` draws it on a terminal.
     connect_timeout : float
         Time to wait for a scheduler given by address [s].
     **spec_options

@@ -3,13 +3,17 @@ and noise for each)."""
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable
+
 from quadcruise.montecarlo.api import montecarlo
 from quadcruise.workflows.compare import labelled
 
 __all__ = ["compare_population"]
 
 
-def compare_population(mission, controllers, population, n: int, seed: int, **montecarlo_kw):
+def compare_population(mission, controllers, population, n: int, seed: int, *,
+                       progress: Callable[[int, int], None] | None = None, **montecarlo_kw):
     """The controllers on the *same* Monte Carlo population.
 
     Every controller flies the same n perturbed vehicles (same seed, so the same draws,
@@ -27,6 +31,9 @@ def compare_population(mission, controllers, population, n: int, seed: int, **mo
         Number of flights per controller.
     seed : int
         The population's seed.
+    progress : callable, optional
+        ``progress(done, total)``: the flights flown of all the controllers' (``n`` each),
+        as :func:`quadcruise.montecarlo.montecarlo` reports them.
     **montecarlo_kw
         Keywords of :func:`quadcruise.montecarlo.montecarlo` (duration, dt, scheduler, ...).
 
@@ -49,8 +56,10 @@ def compare_population(mission, controllers, population, n: int, seed: int, **mo
     import pandas as pd
 
     rows = {}
-    for label, ctrl in labelled(controllers).items():
-        res = montecarlo(mission, ctrl, population, n, seed, **montecarlo_kw)
+    chosen = labelled(controllers)
+    for k, (label, ctrl) in enumerate(chosen.items()):
+        part = None if progress is None else functools.partial(_overall, progress, k * n, len(chosen) * n)
+        res = montecarlo(mission, ctrl, population, n, seed, progress=part, **montecarlo_kw)
         s = res.summary()
         row = {"flights": s["flights"], "failure_rate": s["failures"]["rate"]}
         for metric in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "settling_time_5pct_s"):
@@ -58,3 +67,8 @@ def compare_population(mission, controllers, population, n: int, seed: int, **mo
             row[f"{metric} p95"] = s["metrics"][metric]["p95"]
         rows[label] = row
     return pd.DataFrame.from_dict(rows, orient="index")
+
+
+def _overall(progress: Callable[[int, int], None], before: int, total: int, done: int, _: int) -> None:
+    """One controller's ``done`` flights reported as flights of all of them."""
+    progress(before + done, total)

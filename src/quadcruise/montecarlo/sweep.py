@@ -37,14 +37,13 @@ from quadcruise.errors import InputError, SimulationError, whole_number
 from quadcruise.io.files import check_table_format
 from quadcruise.montecarlo.chunk import fly_chunk, reduce_chunk, run_chunk, sweep_metrics
 from quadcruise.montecarlo.output import write_outputs
-from quadcruise.montecarlo.progress import ProgressBar
 from quadcruise.montecarlo.result import MonteCarloResult, Traces
 from quadcruise.montecarlo.schema import COLUMNS, FAILURES
 from quadcruise.montecarlo.spec import MonteCarloSpec
 from quadcruise.montecarlo.store import SweepFolder
 
 __all__ = ["run_chunk", "fly_chunk", "reduce_chunk", "sweep_metrics", "run_sweep", "auto_chunk_size",
-           "ProgressBar", "CHUNK_BUDGET"]
+           "CHUNK_BUDGET"]
 
 CHUNK_BUDGET = 64 * 2**20
 """Bytes of engine log per chunk that ``chunk_size="auto"`` aims at."""

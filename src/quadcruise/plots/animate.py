@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import shutil
 import subprocess
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -66,7 +67,8 @@ def _thin(i0: int, i1: int) -> np.ndarray:
 
 
 def animate_flight(result, path, *, vehicle: int = 0, fps: float = 15, duration_s: float | None = None,
-                   every: int | None = None, trail_s: float | None = None, dpi: int = 80) -> Path:
+                   every: int | None = None, trail_s: float | None = None, dpi: int = 80,
+                   progress: Callable[[int, int], None] | None = None) -> Path:
     """Write an animation of one vehicle's flight, whole or not at all.
 
     Parameters
@@ -90,6 +92,9 @@ def animate_flight(result, path, *, vehicle: int = 0, fps: float = 15, duration_
         Length of the bold trail behind the marker [s]; a tenth of the flight by default.
     dpi : int
         Resolution; the figure is 8 x 3.6 inches (640 x 288 pixels at 80 dpi).
+    progress : callable, optional
+        ``progress(done, total)``: called with 0 before the first frame is drawn and after
+        each frame, with the frames drawn and the frame count.
 
     Returns
     -------
@@ -184,11 +189,19 @@ def animate_flight(result, path, *, vehicle: int = 0, fps: float = 15, duration_
             fig.draw_artist(artist)
         return np.asarray(canvas.buffer_rgba())
 
+    def drawn():
+        for done, k in enumerate(frames, 1):
+            yield frame(int(k))
+            if progress is not None:
+                progress(done, len(frames))
+
+    if progress is not None:
+        progress(0, len(frames))
     with atomic_path(path) as tmp:
         if kind == ".gif":
-            _write_gif(tmp, (frame(int(k)) for k in frames), fps, Image)
+            _write_gif(tmp, drawn(), fps, Image)
         else:
-            _write_mp4(tmp, (frame(int(k)) for k in frames), fps, ffmpeg, canvas.get_width_height())
+            _write_mp4(tmp, drawn(), fps, ffmpeg, canvas.get_width_height())
     return path
 
 

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import control
@@ -268,7 +269,7 @@ def _as_controller(controller):
 
 def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 1e-3, hover_z: float = 1.0,
               eps: float = 1e-6, max_step: float | None = None, memory=None, settle: int = 1,
-              tol: float = 1e-6) -> Linearization:
+              tol: float = 1e-6, progress: Callable[[int, int], None] | None = None) -> Linearization:
     """Linearise plant + controller over one control period ``dt`` about hover at ``hover_z``.
 
     Parameters
@@ -293,6 +294,9 @@ def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 
         initialise memory in its first period (a first-call flag, a derivative's last sample).
     tol : float
         Largest drift rate [unit/s] of any state or memory entry that still counts as hover.
+    progress : callable, optional
+        ``progress(done, total)`` at the start and after each of its three steps: hover
+        checked, the controller differentiated, the plant differentiated.
 
     Returns
     -------
@@ -326,6 +330,7 @@ def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 
     x0, ref0 = np.zeros(STATE_SIZE), np.zeros(len(REF_NAMES))
     x0[Z], x0[F1:F1 + 4], ref0[REF_Z] = hover_z, vp[P_M] * vp[P_G] / 4.0, hover_z
     cols = [REF_NAMES.index(name) for name in INPUTS]
+    step = _steps(progress, 3)
 
     def ctrl(v):                      # (x, memory, set-points) -> (duties, next memory, flags)
         ref, mem, cmd = ref0.copy(), v[STATE_SIZE:n].copy(), np.zeros(CMD_SIZE)
@@ -350,10 +355,13 @@ def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 
                          f"the loop is not differentiable there")
     if out0[-1] != 0.0:
         warnings.warn(f"the controller flags a limit at hover (flags {out0[-1]:g})", stacklevel=2)
+    step()
 
     # the period map's Jacobian by the chain rule: controller, then plant (a duty clip is inactive)
     G = _jacobian(lambda v: ctrl(v)[:4 + C], v0, eps)
+    step()
     P = _jacobian(lambda v: _period(v[:STATE_SIZE], v[STATE_SIZE:], vp, dt, n_sub), np.r_[x0, u0], eps)
+    step()
     Ap, Bp = P[:, :STATE_SIZE], P[:, STATE_SIZE:]
     (Kx, Km, Kr), (Hx, Hm, Hr) = np.split(G[:4], [STATE_SIZE, n], axis=1), np.split(G[4:], [STATE_SIZE, n], axis=1)
     A = np.block([[Ap + Bp @ Kx, Bp @ Km], [Hx, Hm]])
@@ -416,6 +424,20 @@ def loop_transfer(lin: Linearization, loop: str = "x", at: str = "input") -> con
     else:
         raise InputError(f"at must be 'input' or 'output', got {at!r}")
     return control.ss(A, B, Cl, 0.0, lin.dt)
+
+
+def _steps(progress: Callable[[int, int], None] | None, total: int) -> Callable[[], None]:
+    """``progress(0, total)`` now, and a function that reports one more step done each call."""
+    done = [0]
+
+    def step() -> None:
+        done[0] += 1
+        if progress is not None:
+            progress(done[0], total)
+
+    if progress is not None:
+        progress(0, total)
+    return step
 
 
 def _omega(dt, n=2000):
@@ -517,7 +539,8 @@ def _margin_label(m: dict) -> str:
     return ", ".join(parts) or "no crossover"
 
 
-def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "input"):
+def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "input",
+         progress: Callable[[int, int], None] | None = None):
     """Bode plots of the closed loop and, optionally, of the loop transfers with their margins.
 
     Parameters
@@ -538,6 +561,8 @@ def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "inpu
         frequency.
     at : str
         Where the loops are broken: ``"input"`` or ``"output"`` (see :func:`loop_transfer`).
+    progress : callable, optional
+        ``progress(done, total)`` at the start and after each of the four loops drawn.
 
     Returns
     -------
@@ -560,12 +585,14 @@ def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "inpu
     fig = Figure(figsize=(12 if loops else 7, 6.5), layout="constrained")
     axes = fig.subplots(2, 2 if loops else 1, sharex="col", squeeze=False)
     marked = []
+    step = _steps(progress, len(LOOPS))
     for (loop, (_, state)), color in zip(LOOPS.items(), ("C0", "C1", "C2", "C3")):
         style = {"color": color, "ls": "--" if loop == "y" else "-"}
         r = control.frequency_response(lin.sys[OUTPUTS.index(state), INPUTS.index(f"{state}_ref")], w).complex.ravel()
         axes[0, 0].semilogx(w, 20 * np.log10(np.abs(r)), label=f"{state}_r -> {state}", **style)
         axes[1, 0].semilogx(*_cut(w, wrap_phase(np.degrees(np.angle(r)))), **style)
         if not loops:
+            step()
             continue
         r = control.frequency_response(loop_transfer(lin, loop, at), w).complex.ravel()
         gain, phase = 20 * np.log10(np.abs(r)), wrap_phase(np.degrees(np.unwrap(np.angle(r))))
@@ -574,6 +601,7 @@ def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "inpu
         axes[1, 1].semilogx(*_cut(w, phase), **style)
         key = {k: round(m[k], 9) for k in ("phase_margin", "gain_crossover", "gain_margin", "phase_crossover")}
         if key in marked:                               # y's margins are x's: marked once
+            step()
             continue
         marked.append(key)
         wgc, wpc = m["gain_crossover"], m["phase_crossover"]
@@ -589,6 +617,7 @@ def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "inpu
                             label=f"GM {loop}")
             axes[0, 1].plot([wpc], [g], "s", color=color, ms=5)
             axes[1, 1].plot([wpc], [-180.0], "s", color=color, ms=5)
+        step()
     axes[0, 0].set_ylim(bottom=max(axes[0, 0].get_ylim()[0], -150.0))
     for col, title in enumerate(["closed loop (discrete, dt = %g s)" % lin.dt, "loop transfers"][:axes.shape[1]]):
         axes[0, col].set(ylabel="magnitude [dB]", title=title)
@@ -605,7 +634,8 @@ def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "inpu
     return fig
 
 
-def report(controller="nlpd", lin: Linearization | None = None, **kwargs) -> dict:
+def report(controller="nlpd", lin: Linearization | None = None, *,
+           progress: Callable[[int, int], None] | None = None, **kwargs) -> dict:
     """Poles, damping and margins of every loop beside the design's poles, as plain values.
 
     Parameters
@@ -614,6 +644,9 @@ def report(controller="nlpd", lin: Linearization | None = None, **kwargs) -> dic
         The controller, if ``lin`` is not given.
     lin : Linearization, optional
         A linearisation to use as is (``controller`` and ``kwargs`` are then ignored).
+    progress : callable, optional
+        ``progress(done, total)`` at the start and after each of the four loops measured
+        (its poles and its margins at the input and the output).
     **kwargs
         Keywords of :func:`linearize`.
 
@@ -642,6 +675,7 @@ def report(controller="nlpd", lin: Linearization | None = None, **kwargs) -> dic
     controller = lin.controller
     out = {"controller": getattr(controller, "name", "controller"), "dt_s": lin.dt, "stable": lin.stable,
            "spectral_radius": float(np.max(np.abs(lin.poles()))), "hover_residual": lin.residual, "loops": {}}
+    step = _steps(progress, len(LOOPS))
     for loop in LOOPS:
         p, weight = lin.loop_modes(loop)
         p, weight = p[p.imag >= 0], weight[p.imag >= 0]
@@ -662,6 +696,7 @@ def report(controller="nlpd", lin: Linearization | None = None, **kwargs) -> dic
             entry["design_poles"] = [float(z.real) if z.imag == 0 else [float(z.real), float(z.imag)] for z in d]
             entry["nearest"] = [[float(q.real), float(q.imag)] for q in near]
             entry["nearest_rel_distance"] = [float(abs(q - z) / abs(z)) for q, z in zip(near, d)]
+        step()
     return out
 
 
@@ -723,7 +758,8 @@ def to_json(rep: dict) -> str:
     return dumps(rep, indent=2)
 
 
-def write_analysis(lin: Linearization, rep: dict, out, *, force: bool = False):
+def write_analysis(lin: Linearization, rep: dict, out, *, force: bool = False,
+                   progress: Callable[[int, int], None] | None = None):
     """An analysis's folder, written whole or not at all: ``analysis.json`` (:func:`to_json`),
     the Bode plots ``bode.png`` (at the plant input) and ``bode_output.png`` (at the
     measurement), and ``quadcruise.json`` (the controller, the control period, the version).
@@ -738,6 +774,9 @@ def write_analysis(lin: Linearization, rep: dict, out, *, force: bool = False):
         The folder; a non-empty one that quadcruise did not write is refused unless ``force``.
     force : bool
         Replace such a folder.
+    progress : callable, optional
+        ``progress(done, total)``: each Bode plot counts five steps, its four loops drawn
+        (:func:`bode`) and its file saved.
 
     Returns
     -------
@@ -755,8 +794,11 @@ def write_analysis(lin: Linearization, rep: dict, out, *, force: bool = False):
     with atomic_dir(out) as tmp:
         tmp = Path(tmp)
         (tmp / "analysis.json").write_text(to_json(rep) + "\n")
-        save_figure(bode(lin, loops=True), tmp / "bode.png")
-        save_figure(bode(lin, loops=True, at="output"), tmp / "bode_output.png")
+        for k, (at, name) in enumerate((("input", "bode.png"), ("output", "bode_output.png"))):
+            part = None if progress is None else (lambda done, _, k=k: progress(5 * k + done, 10))
+            save_figure(bode(lin, loops=True, at=at, progress=part), tmp / name)
+            if progress is not None:
+                progress(5 * k + 5, 10)
         (tmp / MARKER).write_text(dumps({"workflow": "analyze", "controller": lin.controller,
                                          "dt_s": lin.dt, "version": __version__}) + "\n")
     return out

@@ -16,7 +16,7 @@ Examples
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -261,7 +261,8 @@ class Comparison:
 
 def compare(mission: Mission | str = "circle",
             controllers: Sequence[Controller | str] | Mapping[str, Controller | str] = DEFAULT_CONTROLLERS,
-            *, vehicle=None, duration: float | None = None, dt: float = 1e-3, **fly_kw: Any) -> Comparison:
+            *, vehicle=None, duration: float | None = None, dt: float = 1e-3,
+            progress: Callable[[int, int], None] | None = None, **fly_kw: Any) -> Comparison:
     """Fly ``mission`` with each controller on the same vehicle; see :class:`Comparison`.
 
     Parameters
@@ -277,6 +278,9 @@ def compare(mission: Mission | str = "circle",
         Flight time [s]; the mission's default (one lap, step time + 10 s, ...) otherwise.
     dt : float
         Control period [s].
+    progress : callable, optional
+        ``progress(done, total)``: called with 0 before the first flight and after each
+        controller's flight, with the number flown and the number of controllers.
     **fly_kw
         Any other keyword of :func:`quadcruise.fly` (``max_step``, ``log_every``, ``x0``, ...).
 
@@ -289,14 +293,19 @@ def compare(mission: Mission | str = "circle",
         if bad in fly_kw:
             raise InputError(f"compare() flies one mission with each controller; '{bad}' is not an option")
     reject_unknown("compare()", {k: v for k, v in fly_kw.items() if k not in FLY_OPTIONS},
-                   ["controllers", *(k for k in FLY_OPTIONS if k != "missions")])
+                   ["controllers", "progress", *(k for k in FLY_OPTIONS if k != "missions")])
     if isinstance(mission, str):
         mission = mission_from_name(mission)
     if not isinstance(mission, Mission):
         raise InputError(f"mission must be a name or a Mission, got {type(mission).__name__}")
     chosen = labelled(controllers)
-    results = {label: fly(mission, ctrl, vehicle=vehicle, duration=duration, dt=dt, **fly_kw)
-               for label, ctrl in chosen.items()}
+    results = {}
+    for label, ctrl in chosen.items():
+        if progress is not None:
+            progress(len(results), len(chosen))
+        results[label] = fly(mission, ctrl, vehicle=vehicle, duration=duration, dt=dt, **fly_kw)
+    if progress is not None:
+        progress(len(results), len(chosen))
     return Comparison(mission=mission, controllers=chosen, results=results)
 
 

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -91,7 +92,9 @@ def _validated(t, duties, source: str, lines: list[int] | None = None):
         raise InputError(f"{source}: needs at least two rows (a start and an end time)")
     if u.shape != (t.shape[0], 4):
         raise InputError(f"{source}: duties have shape {u.shape}, expected ({t.shape[0]}, 4)")
-    for k in range(t.shape[0]):
+    with np.errstate(invalid="ignore"):      # the rows at fault, at array speed; the first one named below
+        bad = ~np.isfinite(t) | np.r_[False, ~(t[1:] > t[:-1])] | ~np.all((u >= 0.0) & (u <= 1.0), axis=1)
+    for k in range(int(np.argmax(bad)) if bad.any() else t.shape[0], t.shape[0]):
         where = f"{source}, line {lines[k]}" if lines else f"{source}, row {k + 1}"
         if not math.isfinite(t[k]):
             raise InputError(f"{where}, column 't': time is not finite ({t[k]!r})")
@@ -105,7 +108,7 @@ def _validated(t, duties, source: str, lines: list[int] | None = None):
     return t, u
 
 
-def read_duty_csv(path: str | os.PathLike) -> DutySchedule:
+def read_duty_csv(path: str | os.PathLike, progress: Callable[[int, int], None] | None = None) -> DutySchedule:
     """Read a ``t,u1,u2,u3,u4`` CSV; errors name the file, line and column.
 
     Parameters
@@ -113,13 +116,15 @@ def read_duty_csv(path: str | os.PathLike) -> DutySchedule:
     path : str or os.PathLike
         The CSV file: a header naming at least ``t, u1, u2, u3, u4`` (others are ignored
         with a warning), then at least two rows of times [s] and duties [-].
+    progress : callable, optional
+        ``progress(done, total)``: the rows read (:func:`~quadcruise.io.files.read_numeric_csv`).
 
     Returns
     -------
     DutySchedule
         With ``source`` the file name.
     """
-    _, _, data, lines = read_numeric_csv(path, INPUT_COLUMNS)
+    _, _, data, lines = read_numeric_csv(path, INPUT_COLUMNS, progress=progress)
     if data.shape[0] < 2:
         raise InputError(f"{path}: needs at least two data rows (a start and an end time), found {data.shape[0]}")
     _validated(data[:, 0], data[:, 1:], str(path), lines)
@@ -127,7 +132,8 @@ def read_duty_csv(path: str | os.PathLike) -> DutySchedule:
 
 
 def replay(schedule: DutySchedule, vehicle: Vehicle | None = None, *, max_step: float = 1e-3,
-           limits: Limits | None = None, full_dynamics: bool = False) -> SimResult:
+           limits: Limits | None = None, full_dynamics: bool = False,
+           progress: Callable[[int, int], None] | None = None) -> SimResult:
     """Fly the duty schedule open loop and log the state at every schedule row.
 
     Parameters
@@ -142,6 +148,9 @@ def replay(schedule: DutySchedule, vehicle: Vehicle | None = None, *, max_step: 
         Divergence bounds.
     full_dynamics : bool
         Fly the plant with the exact Euler-angle kinematics instead of the paper's.
+    progress : callable, optional
+        ``progress(done, total)``: the schedule's rows flown, 0 before the flight and all
+        of them after it (the engine flies them in one call).
 
     Returns
     -------
@@ -161,12 +170,19 @@ def replay(schedule: DutySchedule, vehicle: Vehicle | None = None, *, max_step: 
         "full_dynamics": bool(full_dynamics),
         "version": __version__,
     }
-    return simulate(schedule.t, x0, vp, duty_schedule, pack_schedule(schedule.t, schedule.duties),
-                    no_reference, np.zeros(1), memory=np.zeros(1), max_step=max_step,
-                    limits=limits, meta=meta, full_dynamics=full_dynamics)
+    rows = schedule.t.shape[0]
+    if progress is not None:
+        progress(0, rows)
+    result = simulate(schedule.t, x0, vp, duty_schedule, pack_schedule(schedule.t, schedule.duties),
+                      no_reference, np.zeros(1), memory=np.zeros(1), max_step=max_step,
+                      limits=limits, meta=meta, full_dynamics=full_dynamics)
+    if progress is not None:
+        progress(rows, rows)
+    return result
 
 
-def write_states_csv(result: SimResult, path: str | os.PathLike, vehicle: int = 0) -> None:
+def write_states_csv(result: SimResult, path: str | os.PathLike, vehicle: int = 0,
+                     progress: Callable[[int, int], None] | None = None) -> None:
     """Write one vehicle's states as ``t,x,...,F4`` (SI units, radians), atomically.
 
     Parameters
@@ -177,7 +193,17 @@ def write_states_csv(result: SimResult, path: str | os.PathLike, vehicle: int = 
         The CSV file to write.
     vehicle : int
         The vehicle's index.
+    progress : callable, optional
+        ``progress(done, total)``: the rows written, about every hundredth of them.
     """
     table = np.column_stack([result.t, result.states[vehicle]])
-    with atomic_path(path) as tmp:
-        np.savetxt(tmp, table, delimiter=",", header=",".join(OUTPUT_COLUMNS), comments="", fmt="%.15g")
+    rows = table.shape[0]
+    block = max(1000, -(-rows // 100))
+    with atomic_path(path) as tmp, open(tmp, "wb") as f:
+        for start in range(0, rows, block):
+            if progress is not None:
+                progress(start, rows)
+            np.savetxt(f, table[start:start + block], delimiter=",", fmt="%.15g", comments="",
+                       header=",".join(OUTPUT_COLUMNS) if start == 0 else "")
+        if progress is not None:
+            progress(rows, rows)
