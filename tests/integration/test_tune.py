@@ -142,12 +142,13 @@ def test_bad_input_is_one_line_exit_2_before_any_flight(tmp_path, monkeypatch, a
     assert not out.exists()
 
 
-def test_cli_prints_progress_and_summary_and_writes_the_folder(tmp_path):
+def test_cli_prints_progress_and_summary_and_writes_the_folder(tmp_path, monkeypatch):
+    monkeypatch.setenv("QUADCRUISE_PROGRESS", "1")          # the bar, as on a terminal
     out = tmp_path / "tuned"
     res = run("tune", "step", "-m", "time=0.5", "--gains", "position.kp", "--target", "rise_time_s=1.2",
               "--budget", "2", "--popsize", "5", "--duration", "6", "--seed", "4", "--out", out)
     assert res.exit_code == 0, res.output
-    assert "[1/2] best cost" in res.output and "tuned nlpd on step" in res.output
+    assert "tuning" in res.output and "best cost" in res.output and "tuned nlpd on step" in res.output
     text = (out / "scenario.toml").read_text()
     command = next(line for line in text.splitlines() if line.startswith("# regenerate: "))[len("# regenerate: "):]
     assert shlex.split(command)[:3] == ["quadcruise", "tune", "step"] and "--seed 4" in command

@@ -4,6 +4,7 @@ the folder written. The command, its options and its help are in :mod:`quadcruis
 
 from __future__ import annotations
 
+import contextlib
 import shlex
 from typing import Callable
 
@@ -134,13 +135,13 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str = 
                             environment=environment if environment is not None and environment.parts else None,
                             noise=sensors)
 
-    def progress(done: int, total: int, text: str) -> None:
-        if not quiet:
-            echo(f"[{done}/{total}] {text}", err=True)
+    from quadcruise.cli.feedback import Bar
 
-    result = tune(the_mission, the_controller, gains=gains, bounds=bounds, targets=targets, require=require,
-                  minimize=minimize, population=population, samples=samples, objective=objective, seed=seed,
-                  budget=budget, popsize=popsize, progress=progress, command=command_line(mission, given), **kwargs)
+    with contextlib.nullcontext() if quiet else Bar("tuning", unit="generation") as progress:
+        result = tune(the_mission, the_controller, gains=gains, bounds=bounds, targets=targets, require=require,
+                      minimize=minimize, population=population, samples=samples, objective=objective, seed=seed,
+                      budget=budget, popsize=popsize, progress=progress, command=command_line(mission, given),
+                      **kwargs)
     echo(result.summary_text())
     if out is not None:
         result.write(out, force=True)
