@@ -46,8 +46,6 @@ NOT_YET = {
     "quadcruise.control.baselines",
     "quadcruise.control.cascade",
     "quadcruise.control.position",
-    "quadcruise.control.se3",
-    "quadcruise.control.so3",
     "quadcruise.disturbances.environment",
     "quadcruise.montecarlo.chunk",
     "quadcruise.montecarlo.sweep",

@@ -99,7 +99,52 @@ KX, KV, KX_Z, KV_Z, K_R, K_W, SE3_MAX_TILT = range(7)
 
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def se3(t, dt, x, ref, vp, gains, mem, cmd):
-    """Geometric tracking control on SE(3) (Lee et al. 2010), moments per unit inertia."""
+    """Geometric tracking control on SE(3) (Lee et al. 2010), moments per unit inertia.
+
+    One control period of :class:`SE3` (the law is in the module docstring); compiled with
+    :data:`quadcruise.layout.CONTROLLER_SIG`. It keeps no memory, reads every input array
+    first and writes ``cmd`` last.
+
+    Parameters
+    ----------
+    t : float
+        Time at the start of the control period [s] (not used: the law is static).
+    dt : float
+        Length of the control period [s] (not used: nothing is integrated).
+    x : numpy.ndarray
+        The state the controller sees, STATE_SIZE (16) float64 entries laid out as
+        :mod:`quadcruise.layout`: position [m] and velocity [m/s] (earth frame, z up),
+        roll, pitch, yaw [rad], body rates p, q, r [rad/s], rotor thrusts [N] (not read).
+    ref : numpy.ndarray
+        The mission's reference at t, REF_SIZE (11) float64 entries (``REF_*``): position
+        [m], velocity [m/s], acceleration [m/s^2] (fed forward), yaw [rad] and yaw rate
+        [rad/s] (not read: w_d = 0).
+    vp : numpy.ndarray
+        The vehicle parameter row, PARAM_SIZE (21) float64 entries (``P_*``;
+        :meth:`quadcruise.model.vehicle.Vehicle.rows`): m [kg], g [m/s^2], Jxx, Jyy, Jzz
+        [kg m^2], l [m], K [N] and d [m] are read.
+    gains : numpy.ndarray
+        :meth:`SE3.gains`, 7 float64 entries: kx [1/s^2], kv [1/s] of x and y, the same of
+        z, kR [1/s^2], kw [1/s], max_tilt [rad].
+    mem : numpy.ndarray
+        The controller's memory: empty for SE3 (``memory_size`` 0), not read or written.
+    cmd : numpy.ndarray
+        Output, CMD_SIZE (12) float64 entries, all written
+        (:func:`~quadcruise.control.so3.command_from_rotation`): the four duties [-] (not
+        clipped), U1 [N], U2 [N], U3 [N], U4 [N m], the ZYX angles of R_d as the attitude
+        setpoints [rad], and the flags FLAG_TILT_LIMIT and FLAG_THRUST_LIMIT as they apply.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import quadcruise as qc
+    >>> from quadcruise.layout import CMD_THRUST, P_G, P_M
+    >>> vp = qc.Vehicle.paper().rows()[0]
+    >>> x, ref, cmd = np.zeros(16), np.zeros(11), np.zeros(12)
+    >>> se3(0.0, 0.001, x, ref, vp, SE3().gains(), np.zeros(0), cmd)   # level, on the reference
+    >>> bool(np.isclose(cmd[CMD_THRUST], vp[P_M] * vp[P_G])), bool(np.all(cmd[5:8] == 0.0))  # m g, no moments
+    (True, True)
+    """
     # every array entry is read first and the command written last: no reference counting
     phi, theta, psi, p, q, r = x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R]
     m, g, K, l, d = vp[P_M], vp[P_G], vp[P_K], vp[P_L], vp[P_D]
@@ -194,8 +239,17 @@ class SE3(Controller):
 
     @property
     def function(self):
+        """The compiled law, :func:`se3` (``CONTROLLER_SIG``)."""
         return se3
 
     def gains(self) -> np.ndarray:
+        """The parameter vector :func:`se3` reads.
+
+        Returns
+        -------
+        numpy.ndarray
+            7 float64 entries: kx [1/s^2] and kv [1/s] of x and y (``position``), the same
+            of z (``altitude``), kR [1/s^2] and kw [1/s] (``attitude``), max_tilt [rad].
+        """
         return np.array([self.position.kp, self.position.kd, self.altitude.kp, self.altitude.kd,
                          self.attitude.kp, self.attitude.kd, self.max_tilt])

@@ -34,7 +34,26 @@ from quadcruise.numeric import clamp
 
 @njit(cache=True, error_model="numpy")
 def rotation_zyx(phi, theta, psi):
-    """Rz(psi) Ry(theta) Rx(phi): the body-to-earth rotation of the paper's angles."""
+    """Rz(psi) Ry(theta) Rx(phi): the body-to-earth rotation of the paper's angles.
+
+    Parameters
+    ----------
+    phi, theta, psi : float
+        Roll, pitch and yaw [rad] (ZYX Euler angles, as in the state).
+
+    Returns
+    -------
+    tuple of three 3-tuples of float
+        R by rows (``R[i][j]``), body to earth coordinates, z up; its third column is the
+        thrust direction b3 of eqs (5)-(7).
+
+    Examples
+    --------
+    >>> import math
+    >>> R = rotation_zyx(0.0, 0.0, math.pi / 2)
+    >>> [round(R[i][0], 12) + 0.0 for i in range(3)]       # yaw 90 deg: body x along earth y
+    [0.0, 1.0, 0.0]
+    """
     sf, cf = math.sin(phi), math.cos(phi)
     st, ct = math.sin(theta), math.cos(theta)
     sp, cp = math.sin(psi), math.cos(psi)
@@ -73,6 +92,34 @@ def limit_tilt(hx, hy, vz, max_tilt):
 
     A vector pointing level or down (vz <= 0) loses its horizontal part (and counts as
     limited): the thrust direction then falls back to straight up.
+
+    Parameters
+    ----------
+    hx, hy : float
+        Horizontal components, earth frame (any unit, the same as ``vz``: the controllers
+        pass a force [N] or an acceleration [m/s^2]).
+    vz : float
+        Vertical component, z up (same unit).
+    max_tilt : float
+        Largest angle of the vector from the vertical [rad], in (0, pi/2).
+
+    Returns
+    -------
+    hx, hy : float
+        The horizontal components, scaled by a common factor in [0, 1] (same unit).
+    limited : bool
+        True if they were scaled (or zeroed because vz <= 0).
+
+    Examples
+    --------
+    >>> import math
+    >>> limit_tilt(3.0, 4.0, 10.0, 0.5)                    # 26.6 deg from the vertical: kept
+    (3.0, 4.0, False)
+    >>> hx, hy, limited = limit_tilt(6.0, 8.0, 5.0, math.radians(45.0))
+    >>> round(hx, 6), round(hy, 6), limited
+    (3.0, 4.0, True)
+    >>> limit_tilt(3.0, 4.0, -1.0, 0.5)
+    (0.0, 0.0, True)
     """
     if vz <= 0.0:
         return 0.0, 0.0, True
@@ -88,7 +135,26 @@ def limit_tilt(hx, hy, vz, max_tilt):
 def attitude_lee(b3x, b3y, b3z, psi):
     """Desired rotation of Lee et al. (2010): b3 given (unit), b1 the projection of the
     heading c1 = (cos psi, sin psi, 0) on the plane normal to b3: b2 = b3 x c1 / |b3 x c1|,
-    b1 = b2 x b3. Needs b3 away from the horizontal heading (true for any tilt < 90 deg)."""
+    b1 = b2 x b3. Needs b3 away from the horizontal heading (true for any tilt < 90 deg).
+
+    Parameters
+    ----------
+    b3x, b3y, b3z : float
+        The desired thrust direction b3_d, a unit vector in the earth frame [-], z up.
+    psi : float
+        The yaw reference [rad] that sets the heading c1.
+
+    Returns
+    -------
+    tuple of three 3-tuples of float
+        R_d by rows (``R[i][j]``), its columns b1_d, b2_d, b3_d (body to earth). Its ZYX
+        yaw equals psi only when b3_d is vertical (:func:`attitude_px4` keeps it exactly).
+
+    Examples
+    --------
+    >>> [round(a, 12) + 0.0 for a in euler_zyx(attitude_lee(0.0, 0.0, 1.0, 0.3))]
+    [0.0, 0.0, 0.3]
+    """
     cx, cy = math.cos(psi), math.sin(psi)
     b2x, b2y, b2z = -b3z * cy, b3z * cx, b3x * cy - b3y * cx        # b3 x c1, c1z = 0
     n = math.sqrt(b2x * b2x + b2y * b2y + b2z * b2z)
@@ -101,7 +167,28 @@ def attitude_lee(b3x, b3y, b3z, psi):
 def attitude_px4(b3x, b3y, b3z, psi):
     """Desired rotation as PX4's ``bodyzToAttitude``: b3 given (unit), b1 normal to the
     yaw frame's y axis c2 = (-sin psi, cos psi, 0): b1 = c2 x b3 / |c2 x b3|, b2 = b3 x b1.
-    Its ZYX yaw is exactly psi (b1 stays in the vertical plane of the heading)."""
+    Its ZYX yaw is exactly psi (b1 stays in the vertical plane of the heading).
+
+    Parameters
+    ----------
+    b3x, b3y, b3z : float
+        The desired thrust direction b3_d, a unit vector in the earth frame [-], z up, with
+        b3z > 0 (below the horizontal the cross product c2 x b3 can vanish).
+    psi : float
+        The yaw reference [rad].
+
+    Returns
+    -------
+    tuple of three 3-tuples of float
+        R_d by rows (``R[i][j]``), its columns b1_d, b2_d, b3_d (body to earth).
+
+    Examples
+    --------
+    >>> import math
+    >>> b3 = (math.sin(0.2), 0.0, math.cos(0.2))             # tilted 0.2 rad towards +x
+    >>> [round(a, 12) + 0.0 for a in euler_zyx(attitude_px4(*b3, 0.5))][2]
+    0.5
+    """
     cx, cy = -math.sin(psi), math.cos(psi)
     b1x, b1y, b1z = cy * b3z, -cx * b3z, cx * b3y - cy * b3x        # c2 x b3, c2z = 0
     n = math.sqrt(b1x * b1x + b1y * b1y + b1z * b1z)
@@ -125,7 +212,27 @@ def _tn(A, B, i, j):
 @njit(cache=True, error_model="numpy")
 def error_lee(Rm, Rd):
     """Lee's attitude error e_R = vee(Rd^T R - R^T Rd) / 2 (body frame): sin(angle) times
-    the axis of the rotation from the desired to the current attitude."""
+    the axis of the rotation from the desired to the current attitude.
+
+    Parameters
+    ----------
+    Rm : tuple of three 3-tuples of float
+        The current rotation R, by rows (:func:`rotation_zyx` of the state's angles).
+    Rd : tuple of three 3-tuples of float
+        The desired rotation R_d, by rows.
+
+    Returns
+    -------
+    (float, float, float)
+        e_R in body axes [-] (sin of the angle times the unit axis; about the angle [rad]
+        when it is small). The controllers feed back -kR e_R.
+
+    Examples
+    --------
+    >>> e = error_lee(rotation_zyx(0.1, 0.0, 0.0), rotation_zyx(0.0, 0.0, 0.0))
+    >>> [round(v, 6) + 0.0 for v in e]                      # sin 0.1 about body x
+    [0.099833, 0.0, 0.0]
+    """
     return (0.5 * (_tn(Rd, Rm, 2, 1) - _tn(Rd, Rm, 1, 2)),
             0.5 * (_tn(Rd, Rm, 0, 2) - _tn(Rd, Rm, 2, 0)),
             0.5 * (_tn(Rd, Rm, 1, 0) - _tn(Rd, Rm, 0, 1)))
@@ -135,7 +242,28 @@ def error_lee(Rm, Rd):
 def error_quaternion(Rm, Rd):
     """PX4's attitude error 2 sign(w) (x, y, z) of the quaternion of R^T Rd (body frame):
     2 sin(angle / 2) times the axis of the rotation from the current to the desired
-    attitude, angle in [0, pi]. The quaternion is taken by Shepperd's method."""
+    attitude, angle in [0, pi]. The quaternion is taken by Shepperd's method.
+
+    Parameters
+    ----------
+    Rm : tuple of three 3-tuples of float
+        The current rotation R, by rows (:func:`rotation_zyx` of the state's angles).
+    Rd : tuple of three 3-tuples of float
+        The desired rotation R_d, by rows.
+
+    Returns
+    -------
+    (float, float, float)
+        The error in body axes [-] (2 sin(angle / 2) times the unit axis; about the angle
+        [rad] when it is small). Its sign is opposite to :func:`error_lee`'s: the rate
+        setpoint is +K times it.
+
+    Examples
+    --------
+    >>> e = error_quaternion(rotation_zyx(0.1, 0.0, 0.0), rotation_zyx(0.0, 0.0, 0.0))
+    >>> [round(v, 6) + 0.0 for v in e]                      # 2 sin(-0.05) about body x
+    [-0.099958, 0.0, 0.0]
+    """
     m00, m11, m22 = _tn(Rm, Rd, 0, 0), _tn(Rm, Rd, 1, 1), _tn(Rm, Rd, 2, 2)
     d21, d02, d10 = _tn(Rm, Rd, 2, 1) - _tn(Rm, Rd, 1, 2), _tn(Rm, Rd, 0, 2) - _tn(Rm, Rd, 2, 0), \
         _tn(Rm, Rd, 1, 0) - _tn(Rm, Rd, 0, 1)
@@ -161,6 +289,34 @@ def error_quaternion(Rm, Rd):
 @njit(cache=True, inline="always", error_model="numpy")
 def command_from_rotation(U1, U2, U3, U4, Rd, flags, d, K, cmd):
     """Write the command (:func:`~quadcruise.control.base.write_command`) with the ZYX angles
-    of the desired rotation Rd as the attitude setpoints (phi_d, theta_d, psi_d)."""
+    of the desired rotation Rd as the attitude setpoints (phi_d, theta_d, psi_d).
+
+    Parameters
+    ----------
+    U1, U2, U3 : float
+        Desired collective thrust, roll and pitch inputs [N].
+    U4 : float
+        Desired yaw torque [N m].
+    Rd : tuple of three 3-tuples of float
+        The desired rotation, by rows; its ZYX angles (:func:`euler_zyx`) are logged as
+        the attitude setpoints [rad].
+    flags : int
+        Bit mask of ``FLAG_*`` (:mod:`quadcruise.layout`).
+    d : float
+        Yaw arm: rotor drag torque per unit thrust [m], > 0.
+    K : float
+        PWM gain: a rotor's steady thrust at duty 1 [N].
+    cmd : numpy.ndarray
+        Output, CMD_SIZE (12) float64 entries, all written (``CMD_*`` of
+        :mod:`quadcruise.layout`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> cmd = np.zeros(12)
+    >>> command_from_rotation(10.0, 0.0, 0.0, 0.0, rotation_zyx(0.1, 0.2, 0.3), 0, 0.5, 4.0, cmd)
+    >>> [round(float(v), 12) for v in cmd[8:11]]            # phi_d, theta_d, psi_d
+    [0.1, 0.2, 0.3]
+    """
     phi_d, theta_d, psi_d = euler_zyx(Rd)
     write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags, d, K)
