@@ -116,8 +116,29 @@ def _derivative(value, last, state, dt, alpha, first):
 def constrain_xy(v0x, v0y, v1x, v1y, vmax):
     """PX4 ``ControlMath::constrainXY``: v0 + v1 limited to norm vmax, v0 taking priority.
 
+    If the sum is within vmax it is returned as it is; else, if v0 alone reaches vmax, v0
+    scaled to vmax; else v0 plus as much of v1 (along v1) as fits within vmax.
+
+    Parameters
+    ----------
+    v0x, v0y : float
+        The term with priority (the cascade's position P output) [m/s].
+    v1x, v1y : float
+        The other term (the velocity reference, fed forward) [m/s].
+    vmax : float
+        The largest norm of the result [m/s], > 0.
+
+    Returns
+    -------
+    (float, float)
+        The limited horizontal velocity setpoint (x, y) [m/s].
+
+    Examples
+    --------
     >>> constrain_xy(3.0, 0.0, 0.0, 5.0, 5.0)         # v0 kept, v1 scaled to fit
     (3.0, 4.0)
+    >>> constrain_xy(1.0, 0.0, 1.0, 0.0, 5.0)         # within vmax: the plain sum
+    (2.0, 0.0)
     """
     sx, sy = v0x + v1x, v0y + v1y
     if math.hypot(sx, sy) <= vmax:
@@ -148,7 +169,59 @@ def _rate_axis(setpoint, rate, integral, last, state, dt, alpha, first, kp, ki, 
 
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def cascade(t, dt, x, ref, vp, G, mem, cmd):
-    """PX4-style cascade: P position, PID velocity, P attitude, PID body rate (G: the gains)."""
+    """PX4-style cascade: P position, PID velocity, P attitude, PID body rate (G: the gains).
+
+    One control period of :class:`Cascade` (the four steps of the module docstring);
+    compiled with :data:`quadcruise.layout.CONTROLLER_SIG`. It reads every input array
+    first and writes ``mem`` and ``cmd`` last.
+
+    Parameters
+    ----------
+    t : float
+        Time at the start of the control period [s] (not used: the law is time-invariant).
+    dt : float
+        Length of the control period [s], > 0: the integrals' step, the backward differences'
+        interval and the derivative low-pass filters' discretisation.
+    x : numpy.ndarray
+        The state the controller sees, STATE_SIZE (16) float64 entries laid out as
+        :mod:`quadcruise.layout`: position [m] and velocity [m/s] (earth frame, z up),
+        roll, pitch, yaw [rad], body rates p, q, r [rad/s], rotor thrusts [N] (not read).
+    ref : numpy.ndarray
+        The mission's reference at t, REF_SIZE (11) float64 entries (``REF_*``): position
+        [m], velocity [m/s] and acceleration [m/s^2] (both fed forward), yaw [rad] and yaw
+        rate [rad/s] (fed forward in the body frame).
+    vp : numpy.ndarray
+        The vehicle parameter row, PARAM_SIZE (21) float64 entries (``P_*``;
+        :meth:`quadcruise.model.vehicle.Vehicle.rows`): m [kg], g [m/s^2], Jxx, Jyy, Jzz
+        [kg m^2], l [m], K [N] and d [m] are read.
+    G : numpy.ndarray
+        The gains, CASCADE_GAINS (27) float64 entries laid out as the ``C_*`` offsets
+        (:meth:`Cascade.gains`, in that class's order and units).
+    mem : numpy.ndarray
+        The controller's memory, CASCADE_MEMORY (19) float64 entries, zeros at the start of
+        a flight (:meth:`Cascade.memory`), updated in place: the velocity integral (x, y, z)
+        [m/s^2] from ``M_VI``, the body-rate integral (roll, pitch, yaw) [rad/s^2] from
+        ``M_RI``, the last velocity [m/s] (``M_V``) and body rates [rad/s] (``M_W``), their
+        low-passed derivatives [m/s^2] (``M_VD``) and [rad/s^2] (``M_WD``), and ``M_INIT``:
+        0 before the first period, 1 after.
+    cmd : numpy.ndarray
+        Output, CMD_SIZE (12) float64 entries, all written
+        (:func:`~quadcruise.control.so3.command_from_rotation`): the four duties [-] (not
+        clipped), U1 [N], U2 [N], U3 [N], U4 [N m], the ZYX angles of R_d as the attitude
+        setpoints [rad], and the flags FLAG_TILT_LIMIT, FLAG_THRUST_LIMIT and
+        FLAG_INTEGRATOR_HOLD as they apply.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import quadcruise as qc
+    >>> from quadcruise.layout import CMD_THRUST, P_G, P_M
+    >>> c, vp = Cascade(), qc.Vehicle.paper().rows()[0]
+    >>> mem, cmd = c.memory(), np.zeros(12)
+    >>> cascade(0.0, 0.001, np.zeros(16), np.zeros(11), vp, c.gains(), mem, cmd)   # hover, on the reference
+    >>> bool(np.isclose(cmd[CMD_THRUST], vp[P_M] * vp[P_G])), float(mem[M_INIT])
+    (True, 1.0)
+    """
     # every array entry is read first and mem and cmd written last: no reference counting
     m, g, K, l, d = vp[P_M], vp[P_G], vp[P_K], vp[P_L], vp[P_D]
     jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
@@ -322,6 +395,25 @@ def rate_loops(controller, actuator_bandwidth: float = 15.0, axis: str = "roll")
     lag and w' = alpha; ``attitude``: open loop K_att T_rate / s with T_rate the closed rate
     loop; ``closed``: angle / angle setpoint. ``axis``: 'roll' (= 'pitch') or 'yaw'.
 
+    Parameters
+    ----------
+    controller : Cascade
+        The controller whose rate gains (``rate`` or ``yaw_rate``), attitude P (``roll_p``
+        or ``yaw_p``) [1/s] and ``rate_d_cutoff`` [Hz] are read.
+    actuator_bandwidth : float
+        The rotor lag's bandwidth w [rad/s], > 0.
+    axis : {"roll", "pitch", "yaw"}
+        Which loop: "roll" and "pitch" give the same one; any value but "yaw" gives it.
+
+    Returns
+    -------
+    dict of str to control.TransferFunction
+        ``rate`` (the rate open loop, body rate over rate error), ``attitude`` (the
+        attitude open loop, angle over angle error) and ``closed`` (angle over angle
+        setpoint), each dimensionless and in the Laplace variable s [1/s].
+
+    Examples
+    --------
     >>> from quadcruise.control.cascade import Cascade
     >>> import control
     >>> loops = rate_loops(Cascade())
@@ -344,7 +436,7 @@ def rate_loops(controller, actuator_bandwidth: float = 15.0, axis: str = "roll")
 
 @dataclass(frozen=True)
 class Cascade(Controller):
-    """PX4-style multicopter cascade (see the law above for the law).
+    """PX4-style multicopter cascade (the law is in the module docstring and :func:`cascade`).
 
     Defaults are PX4's parameters (names in brackets), in SI units.
 
@@ -421,9 +513,22 @@ class Cascade(Controller):
 
     @property
     def function(self):
+        """The compiled law, :func:`cascade` (``CONTROLLER_SIG``)."""
         return cascade
 
     def gains(self) -> np.ndarray:
+        """The parameter vector :func:`cascade` reads.
+
+        Returns
+        -------
+        numpy.ndarray
+            CASCADE_GAINS (27) float64 entries at the ``C_*`` offsets: position P of xy and
+            z [1/s]; velocity P [1/s], I [1/s^2], D [-] of xy, then of z; the speed limits
+            xy, up, down [m/s]; max_tilt [rad]; thrust_min, thrust_max [-]; attitude P of
+            roll/pitch and yaw [1/s]; the rate limits of roll/pitch and yaw [rad/s]; rate
+            P [1/s], I [1/s^2], D [-] of roll/pitch, then of yaw; rate_i_limit [-]; the
+            velocity and rate derivative cutoffs [Hz].
+        """
         g = np.zeros(CASCADE_GAINS)
         for col, value in ((C_POS_XY, self.xy_p), (C_POS_Z, self.z_p), (C_VEL_P_XY, self.xy_vel_p),
                            (C_VEL_I_XY, self.xy_vel_i), (C_VEL_D_XY, self.xy_vel_d),
