@@ -101,13 +101,86 @@ UNIT_RATE = 1.0
 
 @njit(cache=True, inline="always", error_model="numpy")
 def saturated_pd(e, ev, kp, kd, ap, ad):
-    """a_p tanh(k_p e / a_p) + a_d tanh(k_d e_v / a_d): slopes k_p, k_d at 0, |.| < a_p + a_d."""
+    """a_p tanh(k_p e / a_p) + a_d tanh(k_d e_v / a_d): slopes k_p, k_d at 0, |.| < a_p + a_d.
+
+    Parameters
+    ----------
+    e : float
+        Position error x_r - x along one axis of the yaw frame [m].
+    ev : float
+        Velocity error x_r' - x' along the same axis [m/s].
+    kp : float
+        Small-signal P gain k_p [1/s^2].
+    kd : float
+        Small-signal D gain k_d [1/s].
+    ap, ad : float
+        Saturation levels a_p, a_d of the P and D terms [m/s^2], > 0.
+
+    Returns
+    -------
+    float
+        The wanted acceleration along that axis [m/s^2].
+
+    Examples
+    --------
+    >>> round(saturated_pd(0.01, 0.0, 3.01, 5.0, 3.01, 5.0), 6)   # small error: about k_p e
+    0.030099
+    >>> round(saturated_pd(100.0, 100.0, 3.01, 5.0, 3.01, 5.0), 6)  # large: a_p + a_d
+    8.01
+    """
     return ap * math.tanh(kp * e / ap) + ad * math.tanh(kd * ev / ad)
 
 
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def gonzalez(t, dt, x, ref, vp, gains, mem, cmd):
-    """Reconstructed Gonzalez baseline: saturated PD, small-angle mapping, decoupled PID."""
+    """Reconstructed Gonzalez baseline: saturated PD, small-angle mapping, decoupled PID.
+
+    One control period of :class:`Gonzalez` (the law is in the module docstring; the
+    attitude loop and the command are :func:`quadcruise.control.position.finish`'s);
+    compiled with :data:`quadcruise.layout.CONTROLLER_SIG`.
+
+    Parameters
+    ----------
+    t : float
+        Time at the start of the control period [s] (not used: the law is time-invariant).
+    dt : float
+        Length of the control period [s], > 0 (the attitude integrals' step).
+    x : numpy.ndarray
+        The state the controller sees, STATE_SIZE (16) float64 entries laid out as
+        :mod:`quadcruise.layout`: position [m] and velocity [m/s] (earth frame, z up),
+        roll, pitch, yaw [rad], body rates p, q, r [rad/s], rotor thrusts [N] (not read).
+    ref : numpy.ndarray
+        The mission's reference at t, REF_SIZE (11) float64 entries (``REF_*``): position
+        [m], velocity [m/s] and yaw [rad] are read (no acceleration feedforward, no yaw
+        rate).
+    vp : numpy.ndarray
+        The vehicle parameter row, PARAM_SIZE (21) float64 entries (``P_*``;
+        :meth:`quadcruise.model.vehicle.Vehicle.rows`): m [kg], g [m/s^2], K [N], d [m] and
+        k1..k6 are read.
+    gains : numpy.ndarray
+        :meth:`Gonzalez.gains`, GONZALEZ_GAINS (15) float64 entries: the attitude block
+        (:func:`~quadcruise.control.position.attitude_block`), then k_p [1/s^2], k_d [1/s],
+        a_p, a_d [m/s^2], the z PD gains [1/s^2], [1/s], max_tilt [rad] and its cosine.
+    mem : numpy.ndarray
+        The controller's memory, ATT_MEMORY (3) float64 entries, zeros at the start of a
+        flight: the roll, pitch and yaw error integrals [rad s], updated in place.
+    cmd : numpy.ndarray
+        Output, CMD_SIZE (12) float64 entries, all written: the four duties [-] (not
+        clipped), U1 [N], U2 [N], U3 [N], U4 [N m], the attitude setpoints [rad] and the
+        flags FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT and FLAG_INTEGRATOR_HOLD as they apply.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import quadcruise as qc
+    >>> from quadcruise.layout import CMD_THETA_D, REF_X
+    >>> c, vp = Gonzalez(), qc.Vehicle.paper().rows()[0]
+    >>> ref, cmd = np.zeros(11), np.zeros(12)
+    >>> ref[REF_X] = 0.1                                    # 10 cm ahead in x: pitch forward
+    >>> gonzalez(0.0, 0.001, np.zeros(16), ref, vp, c.gains(), c.memory(), cmd)
+    >>> round(float(cmd[CMD_THETA_D]), 4)                  # a_p tanh(k_p e / a_p) / g, no asin
+    0.0306
+    """
     kp, kd, ap, ad, tilt = gains[KP_XY], gains[KD_XY], gains[SAT_P], gains[SAT_D], gains[MAX_TILT]
     spsi, cpsi = sin_cos(x[PSI])
     ex, ey, evx, evy = ref[REF_X] - x[X], ref[REF_Y] - x[Y], ref[REF_VX] - x[VX], ref[REF_VY] - x[VY]
@@ -180,9 +253,21 @@ class Gonzalez(Controller):
 
     @property
     def function(self):
+        """The compiled law, :func:`gonzalez` (``CONTROLLER_SIG``)."""
         return gonzalez
 
     def gains(self) -> np.ndarray:
+        """The parameter vector :func:`gonzalez` reads.
+
+        Returns
+        -------
+        numpy.ndarray
+            GONZALEZ_GAINS (15) float64 entries: the attitude block
+            (:func:`~quadcruise.control.position.attitude_block`: roll/pitch and yaw kp
+            [1/s^2], ki [1/s^3], kd [1/s], i_limit [rad/s^2]), then k_p [1/s^2] and k_d
+            [1/s] of x and y, a_p and a_d [m/s^2], Kp [1/s^2] and Kd [1/s] of z, max_tilt
+            [rad] and cos(max_tilt).
+        """
         tail = [self.position.kp, self.position.kd, self.accel_p, self.accel_d,
                 self.altitude.kp, self.altitude.kd, self.max_tilt, math.cos(self.max_tilt)]
         return np.array(attitude_block(self.attitude, self.yaw, self.i_limit) + tail)

@@ -250,14 +250,68 @@ def roll_eq19(uy, stheta, spsi, cpsi, a):
 
 @njit(cache=True, error_model="numpy")
 def theta_from_eq5(ux, phi, psi, a):
-    """Eq (16): the pitch that gives x'' = ux at roll phi, yaw psi and a = U1/m [m/s^2]."""
+    """Eq (16): the pitch that gives x'' = ux at roll phi, yaw psi and a = U1/m [m/s^2].
+
+    The angle form of :func:`pitch_eq16` (the paper's sequential inversion, step 3').
+
+    Parameters
+    ----------
+    ux : float
+        Wanted x acceleration [m/s^2].
+    phi : float
+        Roll [rad] (the current one in the paper's reading).
+    psi : float
+        Yaw [rad].
+    a : float
+        U1 / m [m/s^2].
+
+    Returns
+    -------
+    theta : float
+        The pitch setpoint theta_d [rad], not limited to a tilt.
+    clipped : bool
+        Whether asin's argument left [-1, 1] and was clamped.
+
+    Examples
+    --------
+    >>> theta, clipped = theta_from_eq5(0.981, 0.0, 0.0, 9.81)
+    >>> round(theta, 6), clipped
+    (0.100167, False)
+    """
     theta, _, clipped = pitch_eq16(ux, math.sin(phi), math.cos(phi), math.sin(psi), math.cos(psi), a)
     return theta, clipped
 
 
 @njit(cache=True, error_model="numpy")
 def phi_from_eq6(uy, theta, psi, a):
-    """Eq (19), sign-preserving: the roll that gives y'' = uy at pitch theta, yaw psi."""
+    """Eq (19), sign-preserving: the roll that gives y'' = uy at pitch theta, yaw psi.
+
+    The angle form of :func:`roll_eq19` (the paper's sequential inversion, step 4').
+
+    Parameters
+    ----------
+    uy : float
+        Wanted y acceleration [m/s^2].
+    theta : float
+        Pitch [rad] (the pitch setpoint theta_d in the sequential inversion).
+    psi : float
+        Yaw [rad].
+    a : float
+        U1 / m [m/s^2].
+
+    Returns
+    -------
+    phi : float
+        The roll setpoint phi_d [rad], the root nearest level, not limited to a tilt.
+    clipped : bool
+        Whether asin's argument left [-1, 1] and was clamped.
+
+    Examples
+    --------
+    >>> phi, clipped = phi_from_eq6(0.981, 0.0, 0.0, 9.81)     # y'' > 0 needs a negative roll
+    >>> round(phi, 6), clipped
+    (-0.100167, False)
+    """
     return roll_eq19(uy, math.sin(theta), math.sin(psi), math.cos(psi), a)
 
 
@@ -338,6 +392,34 @@ def finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd):
     Like :func:`~quadcruise.control.attitude.decoupled_attitude`, it reads before it writes
     and writes last. Kept that way, the compiled controllers make no reference-count calls
     at all, which in a parallel batch would contend for the shared arrays' counters.
+
+    Parameters
+    ----------
+    U1 : float
+        Collective thrust [N], already limited (:func:`thrust_for_tilt`).
+    phi_d, theta_d, psi_d : float
+        Roll, pitch and yaw setpoints [rad].
+    flags : int
+        The position loop's flags so far (``FLAG_*`` of :mod:`quadcruise.layout`); the
+        attitude loop's FLAG_INTEGRATOR_HOLD is added.
+    dt : float
+        Control period [s] (the attitude integrals' step).
+    x : numpy.ndarray
+        The state the controller sees, STATE_SIZE (16) entries (angles [rad] and body
+        rates [rad/s] are read).
+    vp : numpy.ndarray
+        The vehicle parameter row, PARAM_SIZE (21) entries (k1..k6, d [m] and K [N] are
+        read).
+    gains : numpy.ndarray
+        The controller's gains vector, starting with the attitude block
+        (:func:`attitude_block`).
+    mem : numpy.ndarray
+        The controller's memory: its first ATT_MEMORY (3) entries, the roll, pitch and yaw
+        error integrals [rad s], are updated in place.
+    cmd : numpy.ndarray
+        Output, CMD_SIZE (12) float64 entries, all written
+        (:func:`~quadcruise.control.base.write_command`): the four duties [-] (not clipped),
+        U1 [N], U2 [N], U3 [N], U4 [N m], the setpoints [rad] and the flags.
     """
     U2, U3, U4, att_flags = decoupled_attitude(x, phi_d, theta_d, psi_d, vp, gains, mem, dt)
     write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags | att_flags, vp[P_D], vp[P_K])
@@ -381,7 +463,58 @@ def filtered_derivative(e, f, kd, n, decay):
 
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
-    """The paper's inverse-model nonlinear PD (eqs 16, 19) over decoupled attitude PID."""
+    """The paper's inverse-model nonlinear PD (eqs 16, 19) over decoupled attitude PID.
+
+    One control period of :class:`NLPD` (steps 1-5 of the module docstring, then
+    :func:`finish`); compiled with :data:`quadcruise.layout.CONTROLLER_SIG`.
+
+    Parameters
+    ----------
+    t : float
+        Time at the start of the control period [s] (not used: the law is time-invariant).
+    dt : float
+        Length of the control period [s], > 0: the attitude integrals' step and, with
+        ``derivative="error"``, the derivative filter's.
+    x : numpy.ndarray
+        The state the controller sees, STATE_SIZE (16) float64 entries laid out as
+        :mod:`quadcruise.layout`: position [m] and velocity [m/s] (earth frame, z up),
+        roll, pitch, yaw [rad], body rates p, q, r [rad/s], rotor thrusts [N] (not read).
+    ref : numpy.ndarray
+        The mission's reference at t, REF_SIZE (11) float64 entries (``REF_*``): position
+        [m], velocity [m/s], acceleration [m/s^2] (used only with acceleration
+        feedforward), yaw [rad] (the yaw setpoint) and yaw rate [rad/s] (not read).
+    vp : numpy.ndarray
+        The vehicle parameter row, PARAM_SIZE (21) float64 entries (``P_*``;
+        :meth:`quadcruise.model.vehicle.Vehicle.rows`): m [kg], g [m/s^2], K [N], d [m] and
+        k1..k6 are read.
+    gains : numpy.ndarray
+        :meth:`NLPD.gains`, NLPD_GAINS (18) float64 entries: the attitude block
+        (:func:`attitude_block`), then at the offsets ``KP_XY`` .. ``FILTER_N`` the x/y and
+        z PD gains [1/s^2], [1/s], max_tilt [rad], the feedforward switch (0 or 1), cos and
+        sin of max_tilt, the inversion (0 joint, 1 sequential), the derivative form (0 on
+        the measurement, 1 on the error) and the filter bandwidth N [1/s].
+    mem : numpy.ndarray
+        The controller's memory (:meth:`NLPD.memory`), zeros at the start of a flight,
+        updated in place: the roll, pitch and yaw error integrals [rad s], and with
+        ``derivative="error"`` the filtered x and y errors [m] at ``FILTER_X``, ``FILTER_Y``.
+    cmd : numpy.ndarray
+        Output, CMD_SIZE (12) float64 entries, all written (:func:`finish`): the four
+        duties [-] (not clipped), U1 [N], U2 [N], U3 [N], U4 [N m], the attitude setpoints
+        [rad] and the flags FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT, FLAG_ASIN_CLIP and
+        FLAG_INTEGRATOR_HOLD as they apply.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import quadcruise as qc
+    >>> from quadcruise.layout import CMD_THETA_D, REF_X
+    >>> c, vp = NLPD(), qc.Vehicle.paper().rows()[0]
+    >>> ref, cmd = np.zeros(11), np.zeros(12)
+    >>> ref[REF_X] = 0.1                                    # 10 cm ahead in x: pitch forward
+    >>> nlpd(0.0, 0.001, np.zeros(16), ref, vp, c.gains(), c.memory(), cmd)
+    >>> round(float(cmd[CMD_THETA_D]), 4)
+    0.0307
+    """
     ff, tilt = gains[ACCEL_FF], gains[MAX_TILT]
     if gains[DERIVATIVE] == 0.0:                     # on the measurement, with the reference's velocity
         ux = gains[KP_XY] * (ref[REF_X] - x[X]) + gains[KD_XY] * (ref[REF_VX] - x[VX]) + ff * ref[REF_AX]
@@ -414,7 +547,29 @@ def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
 
 
 def attitude_block(attitude: PIDGains, yaw: PIDGains, i_limit: float) -> list[float]:
-    """The first ATT_GAINS entries of a controller's gains vector."""
+    """The first ATT_GAINS entries of a controller's gains vector.
+
+    Parameters
+    ----------
+    attitude : PIDGains
+        Roll and pitch PID: kp [1/s^2], ki [1/s^3], kd [1/s].
+    yaw : PIDGains
+        Yaw PID, the same units.
+    i_limit : float
+        Anti-windup bound on the integral term [rad/s^2].
+
+    Returns
+    -------
+    list of float
+        ATT_GAINS (7) entries laid out as the ``ATT_*``/``YAW_*`` offsets of
+        :mod:`quadcruise.control.attitude`.
+
+    Examples
+    --------
+    >>> from quadcruise.control.design import PIDGains
+    >>> attitude_block(PIDGains(kp=1.0, ki=2.0, kd=3.0), PIDGains(kp=4.0, ki=5.0, kd=6.0), 7.0)
+    [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]
+    """
     block = [0.0] * ATT_GAINS
     block[ATT_KP], block[ATT_KI], block[ATT_KD] = attitude.kp, attitude.ki, attitude.kd
     block[YAW_KP], block[YAW_KI], block[YAW_KD] = yaw.kp, yaw.ki, yaw.kd
@@ -488,14 +643,34 @@ class NLPD(Controller):
 
     @property
     def function(self):
+        """The compiled law, :func:`nlpd` (``CONTROLLER_SIG``)."""
         return nlpd
 
     def memory(self) -> np.ndarray:
         """Initial memory: the attitude integrals, and with ``derivative="error"`` the filter's
-        states (the filtered x and y errors), all at rest (zeros)."""
+        states (the filtered x and y errors), all at rest (zeros).
+
+        Returns
+        -------
+        numpy.ndarray
+            Zeros: ATT_MEMORY (3) float64 entries (the roll, pitch and yaw error integrals
+            [rad s]), 5 with ``derivative="error"`` (and the filtered x and y errors [m]).
+        """
         return np.zeros(ATT_MEMORY + (2 if self.derivative == "error" else 0))
 
     def gains(self) -> np.ndarray:
+        """The parameter vector :func:`nlpd` reads.
+
+        Returns
+        -------
+        numpy.ndarray
+            NLPD_GAINS (18) float64 entries: the attitude block (:func:`attitude_block`:
+            roll/pitch and yaw kp [1/s^2], ki [1/s^3], kd [1/s], i_limit [rad/s^2]), then
+            Kp [1/s^2] and Kd [1/s] of x and y, the same of z, max_tilt [rad], the
+            feedforward switch (1.0 on, 0.0 off), cos and sin of max_tilt, the inversion
+            (index in ``INVERSIONS``), the derivative form (index in ``DERIVATIVES``) and
+            derivative_filter N [1/s].
+        """
         tail = [self.position.kp, self.position.kd, self.altitude.kp, self.altitude.kd,
                 self.max_tilt, 1.0 if self.accel_feedforward else 0.0,
                 math.cos(self.max_tilt), math.sin(self.max_tilt), float(INVERSIONS.index(self.inversion)),
