@@ -48,7 +48,6 @@ NOT_YET = {
     "quadcruise.montecarlo.sweep",
     "quadcruise.sim.engine",
     "quadcruise.sim.fastmath",
-    "quadcruise.sim.rng",
 }
 
 # Public names that cannot carry the sections ("module.qualname" -> the reason). Keep it
