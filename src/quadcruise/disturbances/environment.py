@@ -92,8 +92,8 @@ _S3 = math.sqrt(3.0)
 DT_TOLERANCE = 1e-6
 """The Dryden filters' coefficients are recomputed when the period changes by more than
 this fraction. A uniform grid's periods t[k+1] - t[k] differ in their last bits (at 1 kHz
-and t = 60 s, by up to 1e-11 relative): an exact comparison recomputed them (two
-exponentials, a series, three square roots) in two periods of three."""
+and t = 60 s, by up to 1e-11 relative): an exact comparison would recompute them (two
+exponentials, a series, three square roots) in most periods (see docs/performance.md)."""
 
 
 # --- compiled ---------------------------------------------------------------------------
@@ -155,7 +155,50 @@ def _five_normals(s):
 
 @njit(DISTURBANCE_SIG, cache=True, error_model="numpy")
 def environment_disturbance(t, dt, x, dp, dmem, rng, ext):
-    """The composite disturbance of :class:`Environment` (see the module's formulas)."""
+    """The composite disturbance of :class:`Environment` (see the module's formulas).
+
+    Compiled with :data:`quadcruise.layout.DISTURBANCE_SIG`; the engine calls it once per
+    control period and holds ``ext`` over the period.
+
+    Parameters
+    ----------
+    t : float
+        Time at the start of the period [s] (the gust's phase, the rotor loss's onset).
+    dt : float
+        Length of the period [s], > 0 (the turbulence filters' step).
+    x : numpy.ndarray
+        The true state, STATE_SIZE (16) float64 entries (not read: no part depends on it).
+    dp : numpy.ndarray
+        The vehicle's parameter row, PARAMS_SIZE (25) float64 entries
+        (:meth:`Environment.params`): force (earth frame) [N] and torque (body frame)
+        [N m]; steady wind [m/s]; gust (on 0/1, peak A [m/s] x, y, z, start [s], duration
+        [s]); turbulence (on, sigma_u, sigma_v, sigma_w [m/s], T_u, T_w [s]); rotor loss
+        (on, rotor index 0-3, effectiveness 1 - fraction [-], time [s]).
+    dmem : numpy.ndarray
+        The vehicle's disturbance memory, MEMORY_SIZE (19) float64 entries, zeros at the
+        start of a flight (:meth:`Environment.memory`), updated in place: a started flag,
+        the Dryden filters' states (dimensionless, multiplied by the sigmas on output),
+        the period the coefficients were computed for [s] and the coefficients.
+    rng : numpy.ndarray
+        The vehicle's random generator state, (1,) uint64 (:mod:`quadcruise.sim.rng`),
+        advanced in place when there is turbulence.
+    ext : numpy.ndarray
+        Output, EXT_SIZE (13) float64 entries, all written (``EXT_*`` of
+        :mod:`quadcruise.layout`): force, earth frame [N]; torque, body frame [N m]; wind
+        velocity, earth frame [m/s] (steady + gust + turbulence); each rotor's
+        effectiveness [-] (1 healthy).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> env = Environment(wind=ConstantWind(velocity=(2.0, 0.0, 0.0)),
+    ...                   rotor_loss=RotorLoss(rotor=2, fraction=0.3, time=0.0))
+    >>> ext = np.zeros(13)
+    >>> environment_disturbance(0.0, 0.001, np.zeros(16), env.params()[0], env.memory()[0],
+    ...                         np.zeros(1, np.uint64), ext)
+    >>> ext[6:9].tolist(), ext[9:].tolist()                 # wind; rotor 2 at 70 %
+    ([2.0, 0.0, 0.0], [1.0, 0.7, 1.0, 1.0])
+    """
     state, started = rng[0], dmem[0]  # loaded first, stored last (see the note above)
     for j in range(6):
         ext[EXT_FX + j] = dp[j]
@@ -230,7 +273,19 @@ class _Part(Validated):
 
 @dataclass(frozen=True)
 class ConstantWind(_Part):
-    """A steady wind (earth frame)."""
+    """A steady wind (earth frame).
+
+    Parameters
+    ----------
+    velocity : sequence of 3 (float or array), or (N, 3) array
+        Wind velocity (x, y, z), earth frame, z up [m/s]; each component a number or one
+        value per vehicle.
+
+    Examples
+    --------
+    >>> ConstantWind(velocity=(3.0, 0.0, 0.0)).to_dict()
+    {'model': 'constant', 'velocity': [3.0, 0.0, 0.0]}
+    """
 
     velocity: Any = _f((0.0, 0.0, 0.0), "m/s", "wind velocity (x, y, z)", "vec")
     name = "constant"
@@ -238,7 +293,22 @@ class ConstantWind(_Part):
 
 @dataclass(frozen=True)
 class Gust(_Part):
-    """A full "1 - cosine" gust: (A/2)(1 - cos(2 pi (t - start)/duration)) over the duration."""
+    """A full "1 - cosine" gust: (A/2)(1 - cos(2 pi (t - start)/duration)) over the duration.
+
+    Parameters
+    ----------
+    amplitude : sequence of 3 (float or array), or (N, 3) array
+        Peak wind A (x, y, z), earth frame [m/s], reached at start + duration / 2.
+    start : float or array
+        Time the gust begins [s], >= 0.
+    duration : float or array
+        Time from start until the wind is back to 0 [s], > 0.
+
+    Examples
+    --------
+    >>> Gust(amplitude=(2.0, 0.0, 0.0), start=5.0, duration=2.0).start
+    5.0
+    """
 
     amplitude: Any = _f((1.0, 0.0, 0.0), "m/s", "gust peak (x, y, z)", "vec")
     start: Any = _f(1.0, "s", "gust start", "nonneg")
@@ -248,7 +318,21 @@ class Gust(_Part):
 
 @dataclass(frozen=True)
 class Turbulence(_Part):
-    """Dryden turbulence, MIL-F-8785C low altitude; ``w20``, if given, overrides ``intensity``."""
+    """Dryden turbulence, MIL-F-8785C low altitude; ``w20``, if given, overrides ``intensity``.
+
+    Parameters
+    ----------
+    intensity : {"light", "moderate", "severe"}
+        MIL-F-8785C level: a wind speed at 20 ft of 15, 30 or 45 kt.
+    w20 : float or array, optional
+        Wind speed at 20 ft [m/s], > 0; replaces ``intensity``'s when given.
+    altitude : float or array
+        Height above ground h [m], in (0, 304.8) (below 1000 ft, the low-altitude model);
+        below 10 ft (3.048 m) it counts as 10 ft.
+    airspeed : float or array
+        Speed V through the air that carries the frozen turbulence field past the vehicle
+        [m/s], >= 0; below 0.5 m/s it counts as 0.5 m/s.
+    """
 
     intensity: str = _f("moderate", "-", "MIL-F-8785C level", "choice", tuple(INTENSITIES))
     w20: Any = _f(None, "m/s", "wind speed at 20 ft", "pos")
@@ -260,25 +344,74 @@ class Turbulence(_Part):
         return np.maximum(self.altitude, 10 * FOOT) / FOOT          # ft, 10 ft floor
 
     def scales(self) -> tuple:
-        """(L_u, L_v, L_w) [m]."""
+        """(L_u, L_v, L_w) [m].
+
+        Returns
+        -------
+        tuple of 3 (float or numpy.ndarray)
+            The turbulence scale lengths L_u = L_v = h / (0.177 + 0.000823 h)^1.2 and
+            L_w = h [m] (h in ft in the formula, with its 10 ft floor); arrays when the
+            altitude is per-vehicle.
+
+        Examples
+        --------
+        >>> [round(float(L), 2) for L in Turbulence(altitude=10.0).scales()]
+        [67.37, 67.37, 10.0]
+        """
         h = self._h()
         lu = h / (0.177 + 0.000823 * h) ** 1.2 * FOOT
         return lu, lu, h * FOOT
 
     def sigmas(self) -> tuple:
-        """(sigma_u, sigma_v, sigma_w) [m/s]."""
+        """(sigma_u, sigma_v, sigma_w) [m/s].
+
+        Returns
+        -------
+        tuple of 3 (float or numpy.ndarray)
+            The turbulence intensities sigma_w = 0.1 w20 and sigma_u = sigma_v =
+            sigma_w / (0.177 + 0.000823 h)^0.4 [m/s]; floats, or arrays when a field is
+            per-vehicle.
+
+        Examples
+        --------
+        >>> [round(s, 3) for s in Turbulence(intensity="light", altitude=10.0).sigmas()]
+        [1.457, 1.457, 0.772]
+        """
         sw = 0.1 * np.asarray(INTENSITIES[self.intensity] if self.w20 is None else self.w20, dtype=float)
         su = sw / (0.177 + 0.000823 * self._h()) ** 0.4
         return (su, su, sw) if np.ndim(su) else (float(su), float(su), float(sw))
 
     def time_constants(self) -> tuple:
-        """(T_u, T_v, T_w) = L / max(airspeed, 0.5 m/s) [s]."""
+        """(T_u, T_v, T_w) = L / max(airspeed, 0.5 m/s) [s].
+
+        Returns
+        -------
+        tuple of 3 (float or numpy.ndarray)
+            The forming filters' time constants [s] (:meth:`scales` over the floored
+            airspeed).
+
+        Examples
+        --------
+        >>> [round(float(T), 2) for T in Turbulence(altitude=10.0, airspeed=2.0).time_constants()]
+        [33.68, 33.68, 5.0]
+        """
         return tuple(L / np.maximum(self.airspeed, AIRSPEED_FLOOR) for L in self.scales())
 
 
 @dataclass(frozen=True)
 class RotorLoss(_Part):
-    """From ``time`` on, rotor ``rotor`` gives 1 - ``fraction`` of its thrust."""
+    """From ``time`` on, rotor ``rotor`` gives 1 - ``fraction`` of its thrust.
+
+    Parameters
+    ----------
+    rotor : int or array of int
+        The rotor that loses thrust, 1 to 4.
+    fraction : float or array
+        Fraction of its thrust lost [-], in [0, 1].
+    time : float or array
+        Time of the loss [s], >= 0: it acts from the first control period that starts at
+        or after it.
+    """
 
     rotor: Any = _f(1, "-", "rotor number", between(1, 4, whole=True))
     fraction: Any = _f(0.3, "-", "fraction of thrust lost", "frac")
@@ -288,7 +421,15 @@ class RotorLoss(_Part):
 
 @dataclass(frozen=True)
 class ExternalForce(_Part):
-    """A constant force (earth frame) and torque (body frame)."""
+    """A constant force (earth frame) and torque (body frame).
+
+    Parameters
+    ----------
+    force : sequence of 3 (float or array), or (N, 3) array
+        Force (x, y, z), earth frame, z up [N].
+    torque : sequence of 3 (float or array), or (N, 3) array
+        Torque about the body axes (x, y, z) [N m].
+    """
 
     force: Any = _f((0.0, 0.0, 0.0), "N", "force (x, y, z)", "vec")
     torque: Any = _f((0.0, 0.0, 0.0), "N m", "torque (x, y, z)", "vec")
@@ -307,6 +448,19 @@ def _columns(n: int, *values: Any) -> np.ndarray:
 class Environment(Validated):
     """The disturbances a flight meets, each part optional: ``fly(..., environment=env)``.
 
+    Parameters
+    ----------
+    wind : ConstantWind, optional
+        Steady wind.
+    gust : Gust, optional
+        A 1 - cosine gust, added to the wind.
+    turbulence : Turbulence, optional
+        Dryden turbulence, added to the wind.
+    rotor_loss : RotorLoss, optional
+        The loss of part of one rotor's thrust.
+    force : ExternalForce, optional
+        A constant external force and torque.
+
     Examples
     --------
     >>> Environment(gust=Gust()).units()["gust.duration"]
@@ -322,7 +476,28 @@ class Environment(Validated):
 
     @classmethod
     def from_parts(cls, *parts: _Part) -> "Environment":
-        """Each part into its slot (one of each kind)."""
+        """Each part into its slot (one of each kind).
+
+        Parameters
+        ----------
+        *parts : ConstantWind, Gust, Turbulence, RotorLoss or ExternalForce
+            The parts, in any order, at most one of each kind.
+
+        Returns
+        -------
+        Environment
+            The parts in their slots, the others empty.
+
+        Raises
+        ------
+        InputError
+            A part of another type, or a second part of one kind.
+
+        Examples
+        --------
+        >>> sorted(Environment.from_parts(Gust(), ConstantWind()).parts)
+        ['gust', 'wind']
+        """
         slots: dict = {}
         for part in parts:
             slot = next((s for s, c in _SLOTS.items() if isinstance(part, c)), None)
@@ -333,10 +508,34 @@ class Environment(Validated):
 
     @classmethod
     def from_dict(cls, d: dict) -> "Environment":
-        """Inverse of :meth:`to_dict`."""
+        """Inverse of :meth:`to_dict`.
+
+        Parameters
+        ----------
+        d : dict
+            Slot name -> a part's dict (with its ``model`` key, which is ignored) or None.
+
+        Returns
+        -------
+        Environment
+
+        Examples
+        --------
+        >>> env = Environment(gust=Gust(start=2.0))
+        >>> Environment.from_dict(env.to_dict()).gust.start
+        2.0
+        """
         return cls(**{k: v and _SLOTS[k](**{a: b for a, b in v.items() if a != "model"}) for k, v in d.items()})
 
     def to_dict(self) -> dict:
+        """Plain values of every slot (for result bundles and :meth:`from_dict`).
+
+        Returns
+        -------
+        dict
+            Slot name (``wind``, ``gust``, ``turbulence``, ``rotor_loss``, ``force``) -> the
+            part's fields as plain values with its ``model`` name, or None if empty.
+        """
         return {s: getattr(self, s) and getattr(self, s).to_dict() for s in _SLOTS}
 
     @property
@@ -360,7 +559,24 @@ class Environment(Validated):
         return _Part.one_size(set().union(*(p.sizes() for p in self.parts.values())), "disturbance")
 
     def params(self, n: int | None = None) -> np.ndarray:
-        """(N, PARAMS_SIZE) float64 parameter rows; per-vehicle arrays must have N values."""
+        """(N, PARAMS_SIZE) float64 parameter rows; per-vehicle arrays must have N values.
+
+        Parameters
+        ----------
+        n : int, optional
+            Number of vehicles N; by default the batch size (1 if no field is per-vehicle).
+
+        Returns
+        -------
+        numpy.ndarray
+            (N, PARAMS_SIZE) float64: the ``dp`` rows of :func:`environment_disturbance`
+            (absent parts are zeros, their on-column 0).
+
+        Raises
+        ------
+        InputError
+            Per-vehicle fields whose length is not n.
+        """
         size = self.batch_size
         n = (size or 1) if n is None else int(n)
         if size is not None and size != n:
@@ -380,13 +596,38 @@ class Environment(Validated):
         return out
 
     def memory(self, n: int | None = None) -> np.ndarray:
-        """(N, MEMORY_SIZE) zeros: the turbulence filters start on the first period."""
+        """(N, MEMORY_SIZE) zeros: the turbulence filters start on the first period.
+
+        Parameters
+        ----------
+        n : int, optional
+            Number of vehicles N; by default the batch size (1 if no field is per-vehicle).
+
+        Returns
+        -------
+        numpy.ndarray
+            (N, MEMORY_SIZE) float64 zeros: the ``dmem`` rows of
+            :func:`environment_disturbance`.
+        """
         return np.zeros(((self.batch_size or 1) if n is None else int(n), MEMORY_SIZE))
 
     def kwargs(self, n: int | None = None) -> dict:
         """``disturbance``, ``disturbance_params`` and ``disturbance_memory`` for simulate/fly
         ((N, ...) rows; one row each, which the engine gives every vehicle, if n is None and
-        no field is per-vehicle)."""
+        no field is per-vehicle).
+
+        Parameters
+        ----------
+        n : int, optional
+            Number of vehicles N.
+
+        Returns
+        -------
+        dict
+            ``disturbance``: the compiled function; ``disturbance_params``: :meth:`params`;
+            ``disturbance_memory``: :meth:`memory` (each a single row when n is None and no
+            field is per-vehicle).
+        """
         one = n is None and self.batch_size is None
         dp, dm = self.params(n), self.memory(n)
         return {"disturbance": self.function, "disturbance_params": dp[0] if one else dp,
@@ -395,7 +636,22 @@ class Environment(Validated):
 
 @dataclass(frozen=True)
 class SensorNoise(_Part):
-    """White noise on what the controller sees, and a delay (a whole number of periods)."""
+    """White noise on what the controller sees, and a delay (a whole number of periods).
+
+    Parameters
+    ----------
+    position_std : float or array
+        Standard deviation of the noise on x, y and z [m], >= 0.
+    velocity_std : float or array
+        On the velocity [m/s], >= 0.
+    angle_std : float or array
+        On roll, pitch and yaw [rad], >= 0.
+    rate_std : float or array
+        On the body rates p, q, r [rad/s], >= 0.
+    delay : float
+        Sensor delay [s], >= 0, a whole number of control periods, the same for every
+        vehicle.
+    """
 
     position_std: Any = _f(0.0, "m", "position noise std", "nonneg")
     velocity_std: Any = _f(0.0, "m/s", "velocity noise std", "nonneg")
@@ -405,7 +661,19 @@ class SensorNoise(_Part):
     name = "sensor"
 
     def std_vector(self) -> np.ndarray:
-        """(16,) standard deviations per state ((N, 16) if a field is per-vehicle); rotors 0."""
+        """(16,) standard deviations per state ((N, 16) if a field is per-vehicle); rotors 0.
+
+        Returns
+        -------
+        numpy.ndarray
+            (STATE_SIZE,) or (N, STATE_SIZE) float64, in the state's units ([m], [m/s],
+            [rad], [rad/s]); 0 for the rotor thrusts.
+
+        Examples
+        --------
+        >>> SensorNoise(position_std=0.01).std_vector()[:4].tolist()
+        [0.01, 0.01, 0.01, 0.0]
+        """
         size = self.one_size(self.sizes(), "sensor")
         out = np.zeros((size or 1, STATE_SIZE))
         for name, j in (("position_std", X), ("velocity_std", VX), ("angle_std", PHI), ("rate_std", P)):
@@ -413,7 +681,28 @@ class SensorNoise(_Part):
         return out if size else out[0]
 
     def delay_periods(self, dt: float) -> int:
-        """The delay in control periods; it must be a whole number of dt (to 1e-9 s)."""
+        """The delay in control periods; it must be a whole number of dt (to 1e-9 s).
+
+        Parameters
+        ----------
+        dt : float
+            Control period [s], > 0.
+
+        Returns
+        -------
+        int
+            delay / dt.
+
+        Raises
+        ------
+        InputError
+            A per-vehicle delay, or one that is not a whole number of periods.
+
+        Examples
+        --------
+        >>> SensorNoise(delay=0.005).delay_periods(0.001)
+        5
+        """
         if np.ndim(self.delay):
             raise InputError("sensor field 'delay' must be one number for the whole batch")
         k = round(self.delay / dt)
@@ -422,12 +711,36 @@ class SensorNoise(_Part):
         return int(k)
 
     def kwargs(self, dt: float) -> dict:
-        """``sensor_std`` and ``sensor_delay`` for simulate/fly."""
+        """``sensor_std`` and ``sensor_delay`` for simulate/fly.
+
+        Parameters
+        ----------
+        dt : float
+            Control period [s], > 0.
+
+        Returns
+        -------
+        dict
+            ``sensor_std``: :meth:`std_vector`; ``sensor_delay``: :meth:`delay_periods`.
+        """
         return {"sensor_std": self.std_vector(), "sensor_delay": self.delay_periods(dt)}
 
 
 def with_drag(vehicle: Vehicle) -> Vehicle:
-    """The vehicle with :data:`DEFAULT_DRAG` where both its drag coefficients are zero (warns)."""
+    """The vehicle with :data:`DEFAULT_DRAG` where both its drag coefficients are zero (warns).
+
+    Parameters
+    ----------
+    vehicle : Vehicle
+        The vehicle, batched or not.
+
+    Returns
+    -------
+    Vehicle
+        The same vehicle if every one of its vehicles has some drag; else a copy with
+        ``drag_linear`` [N s/m] and ``drag_quadratic`` [N s^2/m^2] of :data:`DEFAULT_DRAG`
+        for the vehicles that had none, and a UserWarning saying how many.
+    """
     c1, c2 = np.asarray(vehicle.drag_linear), np.asarray(vehicle.drag_quadratic)
     bare = (c1 == 0) & (c2 == 0)
     if not np.any(bare):
@@ -444,7 +757,29 @@ _NAMES = {"constant": ConstantWind, "wind": ConstantWind, "gust": Gust, "dryden"
 
 def wind_from_name(name: str, **kw: Any) -> _Part:
     """A part by name (``constant``/``wind``, ``gust``, ``dryden``/``turbulence``,
-    ``loss``/``rotor_loss``, ``force``) with its fields as keywords."""
+    ``loss``/``rotor_loss``, ``force``) with its fields as keywords.
+
+    Parameters
+    ----------
+    name : str
+        The part's name, in any case.
+    **kw
+        Its fields, in their units (see each class).
+
+    Returns
+    -------
+    ConstantWind, Gust, Turbulence, RotorLoss or ExternalForce
+
+    Raises
+    ------
+    InputError
+        An unknown name or field, or a bad value.
+
+    Examples
+    --------
+    >>> wind_from_name("Gust", start=2.0).duration
+    1.0
+    """
     cls = _NAMES.get(str(name).lower())
     if cls is None:
         raise InputError(f"unknown disturbance {name!r}; choose one of {', '.join(_NAMES)}")
@@ -498,6 +833,28 @@ def parse_wind(text: str) -> Environment:
 
     e.g. ``constant:3,0,0,gust:2,0,0@5+2,dryden:moderate@10``. Bad input raises a one-line
     :class:`InputError` quoting the part.
+
+    Parameters
+    ----------
+    text : str
+        The spec, in the grammar above.
+
+    Returns
+    -------
+    Environment
+        The parts in their slots (empty for ``none``, ``calm`` or a blank spec).
+
+    Raises
+    ------
+    InputError
+        An unknown model, a malformed or out-of-range value, or a kind given twice.
+
+    Examples
+    --------
+    >>> sorted(parse_wind("constant:3,0,0 gust:2,0,0@5+2").parts)
+    ['gust', 'wind']
+    >>> parse_wind("calm").parts
+    {}
     """
     text = str(text).strip()
     if text.lower() in ("", "none", "calm"):
