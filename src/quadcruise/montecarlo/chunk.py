@@ -30,7 +30,29 @@ def fly_chunk(spec: MonteCarloSpec, first, count: int, log_every: int | None = N
     ``first`` may also be the (count,) indices of the vehicles (repeats allowed), and
     ``controller`` one controller per vehicle instead of the spec's: a tuner flies each of
     its candidates on the same perturbed vehicles, their noise and turbulence included, as
-    one batch."""
+    one batch.
+
+    Parameters
+    ----------
+    spec : MonteCarloSpec
+        The sweep: mission, controller, population, seed, duration [s], dt [s], ...
+    first : int or array_like of int
+        Index of the first vehicle in the population, or the (count,) indices.
+    count : int
+        Number of vehicles, >= 1.
+    log_every : int, optional
+        Log every this many control periods; the spec's ``log_every`` by default.
+    controller : controller or list of controllers, optional
+        What to fly instead of the spec's controller (one per vehicle for a list).
+
+    Returns
+    -------
+    res : SimResult
+        The batch's flights (:func:`quadcruise.workflows.fly.fly`).
+    draw : Draw
+        The drawn vehicles, offsets, disturbances and table columns
+        (:meth:`quadcruise.montecarlo.population.Population.draw`).
+    """
     from quadcruise.workflows.fly import fly, hover_state
 
     draw = spec.population.draw(spec.seed, first, count, spec.vehicle, spec.dt)
@@ -56,6 +78,23 @@ def run_chunk(spec: MonteCarloSpec, first: int, count: int, threads: int | None 
     (True: one of the first ``max_traces`` vehicles; else kept as one of the first
     ``max_failure_traces`` failures). A pure function of its arguments: this is the Dask
     task. ``threads`` sets numba's threads for this call (1 on a Dask worker).
+
+    Parameters
+    ----------
+    spec : MonteCarloSpec
+        The sweep.
+    first : int
+        Index of the chunk's first vehicle in the population.
+    count : int
+        Number of vehicles, >= 1.
+    threads : int, optional
+        numba threads for this call, clipped to [1, NUMBA_NUM_THREADS]; left as set by
+        default. The setting stays in force on the calling thread afterwards.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        The chunk (:func:`reduce_chunk`).
     """
     if threads is not None:
         import numba
@@ -66,7 +105,28 @@ def run_chunk(spec: MonteCarloSpec, first: int, count: int, threads: int | None 
 
 
 def reduce_chunk(spec: MonteCarloSpec, first: int, res, draw: Draw) -> dict:
-    """The chunk of :func:`run_chunk` from a flown batch and its draw."""
+    """The chunk of :func:`run_chunk` from a flown batch and its draw.
+
+    Parameters
+    ----------
+    spec : MonteCarloSpec
+        The sweep (its hash, metric options, ``max_traces``, ``max_failure_traces`` and
+        ``trace_every`` are used).
+    first : int
+        Index of the batch's first vehicle in the population.
+    res : SimResult
+        The batch flown by :func:`fly_chunk`.
+    draw : Draw
+        Its draw.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        ``first``, ``count`` (int64), ``hash`` (str), one array per column of
+        :data:`~quadcruise.montecarlo.schema.COLUMNS` (one entry per vehicle, in the
+        column's unit), and the kept paths: ``trace_vehicle`` (k,) int64, ``trace_sample``
+        (k,) bool, ``trace_t`` (L,) [s], ``trace_pos`` and ``trace_ref`` (k, L, 3) [m].
+    """
     count = res.n
     cols = sweep_metrics(res, spec)
     cols["vehicle"] = np.arange(first, first + count, dtype=np.int64)
@@ -102,6 +162,22 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
     vehicle's numbers depend on its own rows only, so they do not change with the batch a
     vehicle is flown in. The failure of each vehicle follows the spec's rules
     (:data:`~quadcruise.montecarlo.schema.FAILURES`).
+
+    Parameters
+    ----------
+    result : SimResult
+        A flown batch of N vehicles.
+    spec : MonteCarloSpec
+        The sweep: its ``settle_band``, ``transient_until``, ``max_track_error_m`` [m],
+        ``max_clipped_s`` [s] and requirements are used.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        Column name -> (N,) array: the metrics above ([m], [s], [%], [-]), ``status``,
+        ``stop_time_s`` [s], ``transient_axis``, the failure flags ``diverged``,
+        ``lost_track``, ``saturated``, ``failed_requirement``, ``not_settled`` (bool) and
+        ``failure`` (int64, an index into FAILURES, 0 for none).
     """
     t = result.t
     n = result.n
@@ -149,7 +225,18 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
 # --- one case ---------------------------------------------------------------------------
 @dataclass
 class Case:
-    """One vehicle of a sweep flown again alone: its flight and its table row."""
+    """One vehicle of a sweep flown again alone: its flight and its table row.
+
+    Parameters
+    ----------
+    vehicle : int
+        Its index in the population.
+    result : SimResult
+        Its flight (one vehicle).
+    row : dict
+        Its row of the sweep's table: column -> plain value, with ``reason`` (the failure's
+        name).
+    """
 
     vehicle: int
     result: Any
@@ -162,6 +249,23 @@ def montecarlo_case(spec: MonteCarloSpec, i: int, *, log_every: int | None = Non
     logged at the spec's rate (or every ``log_every`` periods: 1 for all; the row is
     always computed at the spec's rate).
 
+    Parameters
+    ----------
+    spec : MonteCarloSpec
+        The sweep.
+    i : int
+        The vehicle's index in the population, >= 0.
+    log_every : int, optional
+        Log the returned flight every this many control periods (1: every period); the
+        spec's rate by default.
+
+    Returns
+    -------
+    Case
+        The vehicle's index, flight and row.
+
+    Examples
+    --------
     >>> from quadcruise.montecarlo import Population
     >>> spec = MonteCarloSpec("hover", population=Population(offset=0.2), seed=3, duration=0.5)
     >>> case = montecarlo_case(spec, 7)
@@ -179,7 +283,27 @@ def montecarlo_case(spec: MonteCarloSpec, i: int, *, log_every: int | None = Non
 
 
 def replay_case(result, i: int, **kw) -> Case:
-    """:func:`montecarlo_case` of vehicle i of a finished sweep."""
+    """:func:`montecarlo_case` of vehicle i of a finished sweep.
+
+    Parameters
+    ----------
+    result : MonteCarloResult
+        The sweep (its spec and its number of flights are used).
+    i : int
+        The vehicle's index, in [0, result.n).
+    **kw
+        Passed on to :func:`montecarlo_case` (``log_every``).
+
+    Returns
+    -------
+    Case
+        The vehicle flown again alone.
+
+    Raises
+    ------
+    InputError
+        If vehicle i is not in the sweep.
+    """
     if not 0 <= i < result.n:
         raise InputError(f"vehicle {i} is not in this sweep of {result.n} flights")
     return montecarlo_case(result.spec, i, **kw)

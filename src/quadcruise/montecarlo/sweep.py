@@ -58,10 +58,10 @@ LOCAL_CLUSTER_SETTINGS = {
 }
 """Dask settings of the local cluster: no statistical profiler (it samples each task's stack
 every 10 ms), GIL monitor or work stealing (the chunks are alike and few are in flight), and
-the event-loop tick, system monitor and memory monitor at 1-5 s instead of 20-500 ms. An
-idle cluster of 2 workers then takes 2 % of one core here instead of 12 %, and a worker's
-threads other than the task's 2.4 % of its CPU instead of 4-5 %. A cluster of the user's
-(``scheduler=ADDRESS``) keeps its own settings."""
+the event-loop tick, system monitor and memory monitor at 1-5 s instead of 20-500 ms, which
+cuts what an idle cluster and a worker's own threads take of the CPU (see
+docs/performance.md). A cluster of the user's (``scheduler=ADDRESS``) keeps its own
+settings."""
 
 
 # --- collecting chunks ------------------------------------------------------------------
@@ -259,7 +259,31 @@ def _scheduler(scheduler: str | None) -> str:
 def auto_chunk_size(spec: MonteCarloSpec, n: int, parallel: int = 1, threads: int = 1) -> int:
     """Vehicles per chunk: a log of about CHUNK_BUDGET bytes, at least 4 chunks per worker,
     and a multiple of the ``threads`` that share each chunk (when a chunk has that many), so
-    that none of them waits for the others at the chunk's end."""
+    that none of them waits for the others at the chunk's end.
+
+    Parameters
+    ----------
+    spec : MonteCarloSpec
+        The sweep (its log size per vehicle, :meth:`MonteCarloSpec.log_bytes`).
+    n : int
+        Number of flights of the sweep.
+    parallel : int
+        Chunks that run at once (Dask worker threads; 1 in this process).
+    threads : int
+        numba threads that share each chunk.
+
+    Returns
+    -------
+    int
+        Vehicles per chunk, in [1, 1024].
+
+    Examples
+    --------
+    >>> from quadcruise.montecarlo.spec import MonteCarloSpec
+    >>> spec = MonteCarloSpec("hover", duration=1.0)
+    >>> auto_chunk_size(spec, 100), auto_chunk_size(spec, 100, parallel=4, threads=2)
+    (25, 6)
+    """
     by_memory = max(1, CHUNK_BUDGET // spec.log_bytes())
     by_balance = max(1, math.ceil(n / (4 * max(1, parallel))))
     size = int(min(by_memory, by_balance, 1024))
@@ -275,6 +299,48 @@ def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", s
     ``progress(done, total)`` is called at the start (done: flights found on disk) and
     after each chunk; an exception from it (or Ctrl-C) stops the sweep, leaving the chunks
     already written for a resume.
+
+    Parameters
+    ----------
+    spec : MonteCarloSpec
+        The sweep.
+    n : int
+        Number of flights, >= 1.
+    chunk_size : int or "auto"
+        Vehicles per chunk (:func:`auto_chunk_size` for "auto"); the result does not depend
+        on it.
+    scheduler : None, "none", "local" or an address
+        Where the chunks fly: this process (None, "none"), a new Dask LocalCluster
+        ("local"), or the Dask scheduler at an address such as "tcp://host:8786".
+    workers : int, optional
+        Worker processes of the "local" cluster, >= 1; the machine's cores by default.
+    out : str or pathlib.Path, optional
+        Folder to stream the chunks to and write the results in
+        (:class:`~quadcruise.montecarlo.store.SweepFolder`); nothing is written if None.
+    resume : bool
+        Load the chunks of this same sweep found in ``out`` instead of flying them again.
+    force : bool
+        Replace a folder ``out`` that holds something else.
+    fmt : {"csv", "parquet"}
+        Format of the flights table.
+    progress : callable, optional
+        ``progress(done, total)``, flights done and n.
+    connect_timeout : float
+        Time to wait for a scheduler given by address [s], > 0.
+
+    Returns
+    -------
+    MonteCarloResult
+        One table row per flight, the kept paths, and ``info`` on how it ran (scheduler,
+        chunk size, flights flown and resumed, wall time [s], flights per second,
+        vehicle-steps per second).
+
+    Raises
+    ------
+    InputError
+        A bad argument, an unreachable scheduler, or a folder that cannot be used.
+    SimulationError
+        Chunks that do not fit together (from other code or options, or overlapping).
     """
     n = whole_number(n, "the number of flights", 1)
     if chunk_size != "auto" and (isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer))
