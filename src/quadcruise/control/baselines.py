@@ -82,7 +82,6 @@ from quadcruise.layout import (
     Y,
     Z,
 )
-from quadcruise.sim.fastmath import sin_cos
 
 # gains layout after the attitude block
 KP_XY, KD_XY, SAT_P, SAT_D, KP_Z, KD_Z, MAX_TILT, COS_MAX_TILT = range(ATT_GAINS, ATT_GAINS + 8)
@@ -109,7 +108,7 @@ def gonzalez(t, dt, x, ref, vp, gains, mem, cmd):
     uy = saturated_pd(ref[REF_Y] - x[Y], ref[REF_VY] - x[VY], kp, kd, ap, ad)
     uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ])
     g = vp[P_G]
-    U1, flags = thrust_for_tilt(uz, sin_cos(x[PHI])[1] * sin_cos(x[THETA])[1], vp[P_M], g, vp[P_K],
+    U1, flags = thrust_for_tilt(uz, math.cos(x[PHI]) * math.cos(x[THETA]), vp[P_M], g, vp[P_K],
                                 gains[COS_MAX_TILT])
     theta_d, flags = tilt_setpoint(ux / g, False, tilt, flags)           # eq (5), small angle
     phi_d, flags = tilt_setpoint(-uy / g, False, tilt, flags)            # eq (6), small angle

@@ -82,7 +82,6 @@ from quadcruise.layout import (
     Y,
     Z,
 )
-from quadcruise.sim.fastmath import sin_cos
 
 # gains layout after the attitude block
 # (COS_MAX_TILT and SIN_MAX_TILT are cos and sin of MAX_TILT, so the step calls neither)
@@ -203,9 +202,9 @@ def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
     uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ]) + ff * ref[REF_AZ]
     phi, theta, psi, psi_d = x[PHI], x[THETA], x[PSI], ref[REF_PSI]
     m, g, K = vp[P_M], vp[P_G], vp[P_K]
-    sphi, cphi = sin_cos(phi)                           # each computed once, shared
-    spsi, cpsi = sin_cos(psi)
-    U1, flags = thrust_for_tilt(uz, cphi * sin_cos(theta)[1], m, g, K, gains[COS_MAX_TILT])
+    sphi, cphi = math.sin(phi), math.cos(phi)           # each computed once, shared
+    spsi, cpsi = math.sin(psi), math.cos(psi)
+    U1, flags = thrust_for_tilt(uz, cphi * math.cos(theta), m, g, K, gains[COS_MAX_TILT])
     a = U1 / m
     pitch, stheta_d, clipped = pitch_eq16(ux, sphi, cphi, spsi, cpsi, a)      # (16)
     theta_d, flags = tilt_setpoint(pitch, clipped, tilt, flags)
