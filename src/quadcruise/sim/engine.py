@@ -56,6 +56,7 @@ from quadcruise.layout import (
     Z,
 )
 from quadcruise.model.plant import derivative_at
+from quadcruise.sim.fastmath import turned
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rng import next_normal, vehicle_states
 from quadcruise.sim.status import STATUS_REASONS, ExitStatus
@@ -95,37 +96,6 @@ class Limits:
 
     def array(self) -> np.ndarray:
         return np.array([self.max_position, self.max_speed, self.max_rate, self.max_tilt])
-
-
-SMALL_TURN = 0.03
-"""Largest change of an angle over an RK4 stage [rad] for which :func:`turned` uses the
-angle-addition series (beyond it, the library's sine and cosine)."""
-SHORT_TURN = 1.0e-3
-"""Largest change [rad] for which :func:`turned` uses the short series: the usual case, as a
-body rate of 1 rad/s turns an angle by 1 mrad in a 1 ms step."""
-
-
-@njit(cache=True, inline="always")
-def turned(angle, s, c, d):
-    """sin and cos of ``angle`` = a + d, given s = sin a and c = cos a.
-
-    For |d| <= SMALL_TURN by the angle-addition formulas with the series of sin d and
-    cos d - 1, at a fraction of the cost of a sine and a cosine; else from ``angle``
-    directly. Within SHORT_TURN the series stop at d^5 and d^6 (the next terms are below
-    2e-25 and 3e-29), and the sine's is summed as d + d^3 (...), a shorter chain of
-    dependent operations; beyond it they run to d^7 and d^8 (truncation below 1e-20). Either
-    way the result is the library's to a rounding.
-    """
-    d2 = d * d
-    if abs(d) <= SHORT_TURN:
-        sd = d + d2 * d * (-1.0 / 6.0 + d2 * (1.0 / 120.0))
-        cm1 = d2 * (-0.5 + d2 * (1.0 / 24.0 - d2 * (1.0 / 720.0)))
-    elif abs(d) <= SMALL_TURN:
-        sd = d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0) * (1.0 - d2 * (1.0 / 42.0))))
-        cm1 = -d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0) * (1.0 - d2 * (1.0 / 30.0) * (1.0 - d2 * (1.0 / 56.0))))
-    else:
-        return math.sin(angle), math.cos(angle)
-    return s + (s * cm1 + c * sd), c + (c * cm1 - s * sd)
 
 
 # rows of the RK4 workspace: the four stage derivatives, the stage state, and the sines
