@@ -8,8 +8,8 @@ from that folder; each side keeps its numba cache in its own ``__pycache__`` fol
 
 First each side runs once untimed (it compiles, or loads its cache). Then the rounds: A
 then B in odd rounds, B then A in even ones (A B B A A B ...), so a drift of the host's
-speed meets both sides alike. In each process every figure makes one untimed call, then
-its timed calls, the figures in turn. The report gives, per side and figure, the best and
+speed meets both sides alike. In each process every figure first flies 0.1 s untimed, then
+makes its timed calls, the figures in turn. The report gives, per side and figure, the best and
 the median rate over all timed calls, and the ratios B/A (above 1: B is faster), twice:
 by the wall clock, and by the process's CPU time (all its threads), which other processes
 on the host disturb much less (time spent waiting for a core is not counted). On two
@@ -57,14 +57,16 @@ FIGURES = {            # name: (vehicles, flight seconds, timed calls per proces
 
 
 # --- the child: one process of one side --------------------------------------------------
-def figure_call(name: str):
-    """A zero-argument call that flies figure ``name`` once."""
+def figure_call(name: str, duration: float | None = None):
+    """A zero-argument call that flies figure ``name`` once (for ``duration`` seconds
+    instead of the figure's, if given)."""
     import numba
     import numpy as np
 
     import quadcruise as qc
 
-    n, duration, _ = FIGURES[name]
+    n, full, _ = FIGURES[name]
+    duration = duration or full
     if name in ("single", "batch"):              # Table I's mass, spread +/- 10 % over a batch
         vehicle = qc.Vehicle(m=3.499 * np.linspace(0.9, 1.1, n)) if n > 1 else None
         return lambda: qc.fly("circle", "nlpd", vehicle=vehicle, duration=duration, dt=1.0 / HZ, log_every=1000)
@@ -92,12 +94,12 @@ def child(names: list[str], tree: str, warm: bool) -> dict:
     where = Path(quadcruise.__file__).resolve()
     if Path(tree).resolve() / "src" not in where.parents:
         raise SystemExit(f"imported quadcruise from {where}, not from {tree}")
-    calls = {name: figure_call(name) for name in names}
+    for name in names:                          # untimed, 0.1 s flights: the compiled code loads
+        figure_call(name, 0.1)()
     out: dict = {"file": str(where), "wall": {}, "cpu": {}}
-    for name, call in calls.items():
-        call()                                  # untimed: cache loading, first allocations
     if warm:
         return out
+    calls = {name: figure_call(name) for name in names}
     for name, call in calls.items():
         out["wall"][name], out["cpu"][name] = [], []
         for _ in range(FIGURES[name][2]):
