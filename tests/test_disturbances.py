@@ -384,7 +384,8 @@ def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
 def test_dryden_coefficients_follow_the_period_but_not_its_rounding():
     """Cached per period: a grid's rounding (1e-12 relative) keeps them, a new period
     (2 ms after 1 ms) recomputes them, as the exact discretisation of the new a = dt / T."""
-    from quadcruise.disturbances.environment import _CU, _CV, _MDT, DT_TOLERANCE
+    from quadcruise.disturbances.environment import _CU, _CV, _MDT
+    from quadcruise.sim.fastmath import DT_TOLERANCE
     tb = Turbulence(intensity="moderate", altitude=10.0, airspeed=5.0)
     env = Environment(turbulence=tb)
     dp, dm, rng = env.params(1)[0], env.memory(1)[0], vehicle_states(1, 1)[0]

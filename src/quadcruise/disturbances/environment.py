@@ -66,6 +66,7 @@ from quadcruise.fields import (
 )
 from quadcruise.layout import DISTURBANCE_SIG, EXT_E1, EXT_FX, EXT_WX, PHI, STATE_SIZE, VX, P, X
 from quadcruise.model.vehicle import Vehicle
+from quadcruise.sim.fastmath import same_period
 from quadcruise.sim.rng import ziggurat
 
 __all__ = ["ConstantWind", "Gust", "Turbulence", "RotorLoss", "ExternalForce", "Environment",
@@ -91,11 +92,6 @@ _GUST, _TURB, _LOSS, PARAMS_SIZE = 9, 15, 21, 25
 # v (e, a, l11, l21, l22) 9-13, w 14-18
 _MDT, _CU, _CV, _CW, MEMORY_SIZE = 6, 7, 9, 14, 19
 _S3 = math.sqrt(3.0)
-DT_TOLERANCE = 1e-6
-"""The Dryden filters' coefficients are recomputed when the period changes by more than
-this fraction. A uniform grid's periods t[k+1] - t[k] differ in their last bits (at 1 kHz
-and t = 60 s, by up to 1e-11 relative): an exact comparison recomputed them (two
-exponentials, a series, three square roots) in two periods of three."""
 
 
 # --- compiled ---------------------------------------------------------------------------
@@ -176,7 +172,7 @@ def environment_disturbance(t, dt, x, dp, dmem, rng, ext):
             dmem[2], dmem[3] = n1 / math.sqrt(2.0), math.sqrt(2.0) / 4.0 * n1 + n2 / math.sqrt(8.0)
             dmem[4], dmem[5] = n3 / math.sqrt(2.0), math.sqrt(2.0) / 4.0 * n3 + n4 / math.sqrt(8.0)
         n0, n1, n2, n3, n4, state = _five_normals(state)
-        if abs(dmem[_MDT] - dt) > DT_TOLERANCE * dt:    # coefficients, cached per dt
+        if not same_period(dmem[_MDT], dt):             # coefficients, cached per period
             a = dt / dp[_TURB + 4]
             dmem[_MDT], dmem[_CU], dmem[_CU + 1] = dt, math.exp(-a), math.sqrt(-math.expm1(-2.0 * a))
             dmem[_CV], dmem[_CV + 1], dmem[_CV + 2], dmem[_CV + 3], dmem[_CV + 4] = _lateral_coefficients(a)

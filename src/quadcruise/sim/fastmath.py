@@ -8,6 +8,8 @@ rounding (the tests check it).
 
 - :func:`turned`: the sines and cosines of the angles, carried through the RK4 stages and
   steps by the angle-addition formulas. Plain: ``math.sin(angle), math.cos(angle)``.
+- :func:`same_period`: the Dryden filters' coefficients are kept while the control period
+  stays the same up to the grid's rounding. Plain: computed afresh every period.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ import math
 
 from numba import njit
 
-__all__ = ["turned", "SMALL_TURN", "SHORT_TURN"]
+__all__ = ["turned", "SMALL_TURN", "SHORT_TURN", "same_period", "DT_TOLERANCE"]
 
 SMALL_TURN = 0.03
 """Largest change of an angle over an RK4 stage [rad] for which :func:`turned` uses the
@@ -49,3 +51,19 @@ def turned(angle, s, c, d):
     else:
         return math.sin(angle), math.cos(angle)
     return s + (s * cm1 + c * sd), c + (c * cm1 - s * sd)
+
+
+DT_TOLERANCE = 1e-6
+"""Relative change of the control period within which :func:`same_period` holds. A uniform
+grid's periods t[k+1] - t[k] differ in their last bits (at 1 kHz and t = 60 s, by up to
+1e-11 relative), so an exact comparison would fail in two periods of three."""
+
+
+@njit(cache=True, inline="always")
+def same_period(cached, dt):
+    """Whether what was computed for a period of ``cached`` seconds serves a period of ``dt``
+    (the Dryden filters' coefficients: two exponentials, a series and three square roots).
+
+    Plain: ``False``, i.e. compute them afresh every period.
+    """
+    return abs(cached - dt) <= DT_TOLERANCE * dt
