@@ -360,7 +360,7 @@ def test_bad_inputs_name_the_field():
 
 def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
     """The turbulence's normals are rng.next_normal's on the vehicle's scalar SplitMix64 state."""
-    from quadcruise.disturbances.environment import _five_normals
+    from quadcruise.sim.fastmath import five_normals
     from quadcruise.sim.rng import _GOLDEN, next_normal, next_unit, uniform
     state = vehicle_states(4, 1)[0]
     s0 = int(state[0])
@@ -372,7 +372,7 @@ def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
         got.append(u)
         s = np.uint64(s_next)
     assert got == expected
-    *five, s_after = _five_normals(np.uint64(s0))
+    *five, s_after = five_normals(np.uint64(s0))
     one_by_one, s = [], np.uint64(s0)
     for _ in range(5):
         x, s = next_normal(s)

@@ -9,8 +9,8 @@ vehicle alone, gives the same draws.
 Normal draws (sensor noise, turbulence) use the 256-layer ziggurat of Marsaglia and Tsang
 (2000), in the form of numpy's ``Generator.standard_normal``: one 64-bit word gives the
 layer (8 bits), the sign (1 bit) and a 52-bit abscissa, accepted at once about 99 % of the
-time; the wedges and the tail (beyond r = 3.654) are sampled exactly. About 3.5-5 ns a draw
-here, against 10 ns for the polar method and 20 ns for Box-Muller.
+time; the wedges and the tail (beyond r = 3.654) are sampled exactly (its cost against the
+polar method and Box-Muller: docs/performance.md).
 
 Examples
 --------
@@ -110,8 +110,8 @@ def next_normal(s):
 
 @njit(cache=True, inline="always")
 def ziggurat(s):
-    """:func:`next_normal`'s body, for compiled code that inlines it once (a loop of
-    draws): five inlined copies in the turbulence took its first compile from 1.5 s to 11 s."""
+    """:func:`next_normal`'s body, for compiled code that inlines it once in a loop of draws
+    (:func:`quadcruise.sim.fastmath.five_normals`)."""
     while True:
         s = s + _GOLDEN
         bits = _mix(s)
