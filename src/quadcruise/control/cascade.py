@@ -155,7 +155,7 @@ def _rate_axis(setpoint, rate, integral, last, state, dt, alpha, first, kp, ki, 
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def cascade(t, dt, x, ref, vp, G, mem, cmd):
     """PX4-style cascade: P position, PID velocity, P attitude, PID body rate (G: the gains)."""
-    # every array entry is read first and mem and cmd written last: no reference counting
+    # every array entry read first, mem and cmd written last (fastmath's scalar-only rule)
     m, g, K, l, d = vp[P_M], vp[P_G], vp[P_K], vp[P_L], vp[P_D]
     jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
     vx, vy, vz, p, q, r = x[VX], x[VY], x[VZ], x[P], x[Q], x[R]

@@ -186,8 +186,7 @@ def finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd):
     mixer inverse to duties, and the logged command.
 
     Like :func:`~quadcruise.control.attitude.decoupled_attitude`, it reads before it writes
-    and writes last. Kept that way, the compiled controllers make no reference-count calls
-    at all, which in a parallel batch would contend for the shared arrays' counters.
+    and writes last: the scalar-only rule of :mod:`quadcruise.sim.fastmath`.
     """
     U2, U3, U4, att_flags = decoupled_attitude(x, phi_d, theta_d, psi_d, vp, gains, mem, dt)
     write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags | att_flags, vp[P_D], vp[P_K])

@@ -97,7 +97,7 @@ KX, KV, KX_Z, KV_Z, K_R, K_W, SE3_MAX_TILT = range(7)
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def se3(t, dt, x, ref, vp, gains, mem, cmd):
     """Geometric tracking control on SE(3) (Lee et al. 2010), moments per unit inertia."""
-    # every array entry is read first and the command written last: no reference counting
+    # every array entry read first, the command written last (fastmath's scalar-only rule)
     phi, theta, psi, p, q, r = x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R]
     m, g, K, l, d = vp[P_M], vp[P_G], vp[P_K], vp[P_L], vp[P_D]
     jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]

@@ -77,7 +77,7 @@ def five_normals(s):
     Plain: ``n0, s = next_normal(s)`` five times. A call of a compiled function may fail, and
     its error path keeps numba from dropping the reference counting of the caller's array
     arguments (see the scalar-only rule above); five inlined copies of the ziggurat instead
-    of this loop over one took the turbulence's first compile from 1.5 s to 11 s.
+    of this loop over one compile several times slower (docs/performance.md).
     """
     n0 = n1 = n2 = n3 = n4 = 0.0
     for k in range(5):
