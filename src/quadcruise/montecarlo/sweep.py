@@ -137,12 +137,7 @@ class _Collector:
 
 # --- where chunks run -------------------------------------------------------------------
 class _InProcess:
-    """Chunks one after the other in this process; numba uses all cores within a chunk.
-
-    The next chunk flies on a helper thread (the kernel runs without the GIL) while this
-    thread computes the metrics of the one before, so the cores do not idle between
-    chunks; at most two chunks' logs are held at once.
-    """
+    """Chunks one after the other in this process; numba uses all cores within a chunk."""
 
     name = "this process"
     parallel = 1
@@ -154,25 +149,8 @@ class _InProcess:
         return numba.get_num_threads()
 
     def run(self, spec, ranges):
-        from concurrent.futures import ThreadPoolExecutor
-
-        threads = self.threads
-
-        def fly(first: int, count: int):
-            import numba
-
-            numba.set_num_threads(threads)          # numba's setting is per thread
-            return fly_chunk(spec, first, count)
-
-        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="quadcruise-chunk") as ahead:
-            pending = None
-            for first, count in ranges:
-                flying = ahead.submit(fly, first, count)
-                if pending is not None:
-                    yield reduce_chunk(spec, pending[0], *pending[1].result())
-                pending = (first, flying)
-            if pending is not None:
-                yield reduce_chunk(spec, pending[0], *pending[1].result())
+        for first, count in ranges:
+            yield reduce_chunk(spec, first, *fly_chunk(spec, first, count))
 
     def close(self) -> None:
         pass
