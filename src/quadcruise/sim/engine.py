@@ -226,7 +226,6 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
             max_step, log_every, limits,
             log_x, log_cmd, log_ref, x_final, status, t_stop, saturated):
     n_periods = t_grid.shape[0] - 1
-    steps_per_s = 1.0 / max_step
     for i in range(first, stop):
         x = x0[i].copy()
         seen = np.empty(STATE_SIZE)
@@ -306,8 +305,8 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
                 limited_s += dt
             if disturbed:
                 disturbance(t, dt, x, dpi, dmi, rngi, ext)
-            n_sub = max(1, int(math.ceil(dt * steps_per_s - 1e-9)))
-            h = dt if n_sub == 1 else dt / n_sub
+            n_sub = max(1, int(math.ceil(dt / max_step - 1e-9)))
+            h = dt / n_sub
             for _ in range(n_sub):
                 rk4_step(x, u, vpi, ext, full, h, work, steps == 0)
                 steps = steps + 1 if steps < TRIG_REFRESH - 1 else 0
