@@ -245,15 +245,10 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
         mi, dmi, rngi = mem[i].copy(), dmem[i].copy(), rng[i].copy()
         clipped_s = limited_s = 0.0
         max_position, max_speed, max_rate, max_tilt = limits[0], limits[1], limits[2], limits[3]
-        noisy = False
-        for j in range(STATE_SIZE):
-            if stdi[j] != 0.0:
-                noisy = True
         code = FINISHED
         t_end = t_grid[n_periods]
         rows_x = rows = 0
-        slot = 0                       # = k % (sensor_delay + 1), kept as a counter: the
-        next_log = 0                   # step has no integer division in it
+        next_log = 0
         steps = 0                      # RK4 steps since the angles' trig was computed afresh
         if not disturbed:
             still_air(0.0, 0.0, x, dpi, dmi, rngi, ext)      # and it stays so
@@ -262,23 +257,17 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
             mission(t, mpi, ref)
             # what the controller sees: the state sensor_delay periods ago, plus noise
-            if sensor_delay == 0:
-                for j in range(STATE_SIZE):
-                    seen[j] = x[j]
-            else:
-                for j in range(STATE_SIZE):
-                    history[slot, j] = x[j]
-                slot = slot + 1 if slot < sensor_delay else 0
-                old = slot if k >= sensor_delay else 0     # the oldest state kept
-                for j in range(STATE_SIZE):
-                    seen[j] = history[old, j]
-            if noisy:                  # the generator's state as a scalar: no array helper
-                state = rngi[0]
-                for j in range(STATE_SIZE):
-                    if stdi[j] != 0.0:
-                        draw, state = next_normal(state)
-                        seen[j] += stdi[j] * draw
-                rngi[0] = state
+            newest = k % (sensor_delay + 1)                     # in the ring buffer
+            oldest = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
+            for j in range(STATE_SIZE):
+                history[newest, j] = x[j]
+            state = rngi[0]
+            for j in range(STATE_SIZE):
+                seen[j] = history[oldest, j]
+                if stdi[j] != 0.0:
+                    draw, state = next_normal(state)
+                    seen[j] += stdi[j] * draw
+            rngi[0] = state
             for j in range(CMD_SIZE):
                 cmd[j] = 0.0
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
