@@ -248,7 +248,6 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
         code = FINISHED
         t_end = t_grid[n_periods]
         rows_x = rows = 0
-        next_log = 0
         steps = 0                      # RK4 steps since the angles' trig was computed afresh
         if not disturbed:
             still_air(0.0, 0.0, x, dpi, dmi, rngi, ext)      # and it stays so
@@ -271,13 +270,12 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
             for j in range(CMD_SIZE):
                 cmd[j] = 0.0
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
-            if k == next_log:
+            if k % log_every == 0:
                 log_row(log_x, i, rows, x)
                 log_row(log_cmd, i, rows, cmd)
                 log_row(log_ref, i, rows, ref)
                 rows += 1
                 rows_x = rows
-                next_log += log_every
             if k == n_periods:
                 break
             clipped, finite = False, True
@@ -314,7 +312,7 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
                 code = TILT_BOUND
             if code != FINISHED:
                 t_end = t_grid[k + 1]
-                if k + 1 == next_log:           # keep the state that broke the bound
+                if (k + 1) % log_every == 0:    # keep the state that broke the bound
                     log_row(log_x, i, rows, x)
                     rows_x += 1
                 break
