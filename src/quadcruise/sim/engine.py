@@ -297,10 +297,10 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
             for _ in range(n_sub):
                 rk4_step(x, u, vpi, ext, full, h, work, steps == 0)
                 steps = steps + 1 if steps < TRIG_REFRESH - 1 else 0
-            nonfinite = 0.0
+            finite = True
             for j in range(STATE_SIZE):
-                nonfinite += x[j] * 0.0               # 0 while every entry is finite, else NaN
-            if nonfinite != 0.0:
+                finite = finite and math.isfinite(x[j])
+            if not finite:
                 code = NONFINITE
             elif beyond(x[X], x[Y], x[Z], max_position):
                 code = POSITION_BOUND
