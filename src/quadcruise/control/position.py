@@ -84,7 +84,8 @@ from quadcruise.layout import (
 )
 
 # gains layout after the attitude block
-# (COS_MAX_TILT and SIN_MAX_TILT are cos and sin of MAX_TILT, so the step calls neither)
+# (COS_MAX_TILT and SIN_MAX_TILT are cos and sin of MAX_TILT, so the step calls neither: a
+# kept trick, see quadcruise.sim.fastmath)
 KP_XY, KD_XY, KP_Z, KD_Z, MAX_TILT, ACCEL_FF, COS_MAX_TILT, SIN_MAX_TILT = range(ATT_GAINS, ATT_GAINS + 8)
 NLPD_GAINS = ATT_GAINS + 8
 
@@ -132,7 +133,8 @@ def roll_eq19(uy, stheta, spsi, cpsi, a):
     r1 = math.asin(s)
     if A > 0.0:
         # |gamma| < pi/2 and |r1| <= pi/2: gamma - r1 lies in (-pi, pi) and, cos phi1 -
-        # cos phi2 = 2 A sqrt(1 - s^2) / R >= 0, it is the root nearest level
+        # cos phi2 = 2 A sqrt(1 - s^2) / R >= 0, it is the root nearest level (a kept trick,
+        # see quadcruise.sim.fastmath; plain: the general case below)
         return math.atan(B / A) - r1, clipped
     gamma = math.atan2(B, A)
     phi1 = gamma - r1
@@ -205,6 +207,7 @@ def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
     spsi, cpsi = math.sin(psi), math.cos(psi)
     U1, flags = thrust_for_tilt(uz, cphi * math.cos(theta), m, g, K, gains[COS_MAX_TILT])
     a = U1 / m
+    # sin theta_d is eq (16)'s asin argument, not a new sine (a kept trick: quadcruise.sim.fastmath)
     pitch, stheta_d, clipped = pitch_eq16(ux, sphi, cphi, spsi, cpsi, a)      # (16)
     theta_d, flags = tilt_setpoint(pitch, clipped, tilt, flags)
     if theta_d != pitch:                  # limited: sin theta_d is no longer asin's argument

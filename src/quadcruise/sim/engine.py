@@ -56,7 +56,7 @@ from quadcruise.layout import (
     Z,
 )
 from quadcruise.model.plant import derivative_at
-from quadcruise.sim.fastmath import turned
+from quadcruise.sim.fastmath import TRIG_REFRESH, turned
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rng import next_normal, vehicle_states
 from quadcruise.sim.status import STATUS_REASONS, ExitStatus
@@ -102,9 +102,6 @@ class Limits:
 # and cosines of the state's phi, theta and psi carried from one step to the next
 K1, K2, K3, K4, XT, TRIG = range(6)
 WORK_ROWS = 6
-TRIG_REFRESH = 256
-"""The engine computes the angles' sines and cosines afresh every this many RK4 steps and
-carries them by :func:`turned` in between (each turn adds a rounding, ~1e-16)."""
 
 
 @njit(cache=True, error_model="numpy")
@@ -159,9 +156,7 @@ def still_air(t, dt, x, dp, dmem, rng, ext):
         ext[j] = 1.0
 
 
-# The per-period helpers below take scalars, not arrays: numba inlining a helper with
-# array arguments into the kernel (or calling it) keeps a reference-count increment and
-# decrement of each array, two atomic operations, in every control period.
+# The per-period helpers below follow the scalar-only rule of quadcruise.sim.fastmath.
 
 @njit(cache=True, inline="always")
 def beyond(a, b, c, bound):
@@ -183,8 +178,8 @@ def clip_duty(v):
 
 @njit(cache=True, inline="always")
 def log_row(log, i, row, v):
-    """log[i, row, :] = v, element by element (a slice would take a reference on the shared
-    log array at every logged period)."""
+    """log[i, row, :] = v, element by element (a slice takes a reference on the shared log
+    array: the scalar-only rule of :mod:`quadcruise.sim.fastmath`)."""
     for j in range(v.shape[0]):
         log[i, row, j] = v[j]
 
@@ -238,19 +233,17 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
         ext = np.zeros(EXT_SIZE)
         work = np.empty((WORK_ROWS, STATE_SIZE))
         vpi, vci, gi, mpi, dpi, stdi = vp[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
-        # what changes every period is this vehicle's own copy (memories written back at the
-        # end; the generator's state is not returned): rows of neighbouring vehicles share
-        # cache lines, and threads flying neighbours would otherwise write to the same lines
-        # each period (false sharing)
+        # what changes every period is this vehicle's own copy, the memories written back at
+        # the end (a kept trick against false sharing: quadcruise.sim.fastmath)
         mi, dmi, rngi = mem[i].copy(), dmem[i].copy(), rng[i].copy()
         clipped_s = limited_s = 0.0
         max_position, max_speed, max_rate, max_tilt = limits[0], limits[1], limits[2], limits[3]
         code = FINISHED
         t_end = t_grid[n_periods]
         rows_x = rows = 0
-        steps = 0                      # RK4 steps since the angles' trig was computed afresh
-        if not disturbed:
-            still_air(0.0, 0.0, x, dpi, dmi, rngi, ext)      # and it stays so
+        steps = 0                      # RK4 steps flown
+        if not disturbed:              # set once (a kept trick: quadcruise.sim.fastmath)
+            still_air(0.0, 0.0, x, dpi, dmi, rngi, ext)
         for k in range(n_periods + 1):
             t = t_grid[k]
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
@@ -295,8 +288,8 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
             n_sub = max(1, int(math.ceil(dt / max_step - 1e-9)))
             h = dt / n_sub
             for _ in range(n_sub):
-                rk4_step(x, u, vpi, ext, full, h, work, steps == 0)
-                steps = steps + 1 if steps < TRIG_REFRESH - 1 else 0
+                rk4_step(x, u, vpi, ext, full, h, work, steps % TRIG_REFRESH == 0)
+                steps += 1
             finite = True
             for j in range(STATE_SIZE):
                 finite = finite and math.isfinite(x[j])

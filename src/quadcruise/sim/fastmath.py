@@ -17,12 +17,30 @@ rounding (the tests check it).
   a counter that every thread of a batch shares (the rows are views of the batch's arrays).
   ``tests/compiled_code.py`` finds them in a compiled body; the controller and disturbance
   tests use it.
-- :func:`turned`: the sines and cosines of the angles, carried through the RK4 stages and
-  steps by the angle-addition formulas. Plain: ``math.sin(angle), math.cos(angle)``.
+- :func:`turned`: the sines and cosines of the angles, carried through the four stages of
+  an RK4 step (``sim.engine.rk4_step``) by the angle-addition formulas, within
+  :data:`SHORT_TURN` by a shorter series. Plain: ``math.sin(angle), math.cos(angle)``.
+- :data:`TRIG_REFRESH`: the step carries them on to the next step too, computing them
+  afresh every TRIG_REFRESH steps. Plain: afresh at every step.
 - :func:`five_normals`: five normal draws from one inlined copy of the ziggurat in a loop.
   Plain: five calls of :func:`quadcruise.sim.rng.next_normal`.
 - :func:`same_period`: the Dryden filters' coefficients are kept while the control period
   stays the same up to the grid's rounding. Plain: computed afresh every period.
+
+Three more are ways of arranging code, not formulas, so they stay where they act:
+
+- Own copies (``sim.engine._kernel``): a vehicle's controller memory, disturbance memory
+  and generator state are copied out of the batch's rows when its flight starts and the
+  memories written back when it ends. Plain: ``mem[i]``, ``dmem[i]``, ``rng[i]`` updated in
+  place, which makes threads flying neighbouring vehicles write to the same cache lines
+  every period (false sharing).
+- Still air set once (``sim.engine._kernel``): without a disturbance, the external inputs
+  are set once per flight. Plain: ``still_air`` called every period.
+- ``nlpd``'s library calls (``control.position``): eq (19)'s root for cos psi > 0 as
+  ``atan(B / A) - asin(...)`` with R a square root (plain: ``math.hypot``, ``math.atan2``
+  and both roots wrapped, the nearer taken, as for cos psi <= 0); sin theta_d as eq (16)'s
+  asin argument (plain: ``math.sin(theta_d)``); cos and sin of the tilt limit carried in
+  the gains (plain: ``math.cos(max_tilt)``, ``math.sin(max_tilt)`` every period).
 """
 
 from __future__ import annotations
@@ -33,7 +51,7 @@ from numba import njit
 
 from quadcruise.sim.rng import ziggurat
 
-__all__ = ["turned", "SMALL_TURN", "SHORT_TURN", "five_normals", "same_period", "DT_TOLERANCE"]
+__all__ = ["turned", "SMALL_TURN", "SHORT_TURN", "TRIG_REFRESH", "five_normals", "same_period", "DT_TOLERANCE"]
 
 SMALL_TURN = 0.03
 """Largest change of an angle over an RK4 stage [rad] for which :func:`turned` uses the
@@ -66,6 +84,11 @@ def turned(angle, s, c, d):
     else:
         return math.sin(angle), math.cos(angle)
     return s + (s * cm1 + c * sd), c + (c * cm1 - s * sd)
+
+
+TRIG_REFRESH = 256
+"""The RK4 step computes the angles' sines and cosines afresh every this many steps and
+carries them by :func:`turned` in between (each turn adds a rounding, about 1e-16)."""
 
 
 
