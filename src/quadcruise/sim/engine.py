@@ -220,6 +220,23 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
             disturbance, disturbed, dp, dmem, rng, sensor_std, sensor_delay, full,
             max_step, log_every, limits,
             log_x, log_cmd, log_ref, x_final, status, t_stop, saturated):
+    """Fly vehicles first .. stop - 1 of the batch. The arguments, by role (their meaning:
+    :func:`simulate`'s parameters; one row per vehicle):
+
+    - time: ``t_grid``;
+    - plant: ``x0``, ``vp``;
+    - controller: ``vp_ctrl``, the function ``controller``, ``gains``, ``mem``;
+    - mission: the function ``mission``, ``mp``;
+    - disturbance: the function ``disturbance``, ``disturbed`` (False: still air), ``dp``,
+      ``dmem``, ``rng``;
+    - sensors: ``sensor_std``, ``sensor_delay``;
+    - options: ``full``, ``max_step``, ``log_every``, ``limits``;
+    - outputs: ``log_x``, ``log_cmd``, ``log_ref``, ``x_final``, ``status``, ``t_stop``,
+      ``saturated`` (and ``mem``, ``dmem`` written back).
+
+    A flat list: grouped into tuples (numba allows tuples of arrays, and of functions, though
+    with a warning at every call) the kernel ran 1.5-4 % slower (docs/performance.md).
+    """
     n_periods = t_grid.shape[0] - 1
     for i in range(first, stop):
         x = x0[i].copy()
