@@ -59,10 +59,9 @@ LOCAL_CLUSTER_SETTINGS = {
 }
 """Dask settings of the local cluster: no statistical profiler (it samples each task's stack
 every 10 ms), GIL monitor or work stealing (the chunks are alike and few are in flight), and
-the event-loop tick, system monitor and memory monitor at 1-5 s instead of 20-500 ms. An
-idle cluster of 2 workers then takes 2 % of one core here instead of 12 %, and a worker's
-threads other than the task's 2.4 % of its CPU instead of 4-5 %. A cluster of the user's
-(``scheduler=ADDRESS``) keeps its own settings."""
+the event-loop tick, system monitor and memory monitor at 1-5 s instead of 20-500 ms (what
+that saves: docs/performance.md). A cluster of the user's (``scheduler=ADDRESS``) keeps its
+own settings."""
 
 
 # --- collecting chunks ------------------------------------------------------------------

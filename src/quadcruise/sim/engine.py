@@ -13,7 +13,8 @@ independent, so :func:`fly_vehicles` splits a batch into pieces that numba's num
 threads (``numba.set_num_threads``) fly at once. Each vehicle's arithmetic does not depend on the
 batch it is in or the piece it falls in, so a batch reproduces single flights bit for bit.
 (A ``prange`` kernel would do the same, but numba's parallel passes on a body this size
-add about 6 s to the cold compile, and with one vehicle the idle OpenMP thread spins.)
+lengthen the cold compile, and with one vehicle the idle OpenMP thread spins:
+docs/performance.md.)
 
 Controllers and missions are compiled functions with the signatures in
 :mod:`quadcruise.layout`, passed as first-class function values: one cached kernel
@@ -235,7 +236,7 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
       ``saturated`` (and ``mem``, ``dmem`` written back).
 
     A flat list: grouped into tuples (numba allows tuples of arrays, and of functions, though
-    with a warning at every call) the kernel ran 1.5-4 % slower (docs/performance.md).
+    with a warning at every call) the kernel ran slower (docs/performance.md).
     """
     n_periods = t_grid.shape[0] - 1
     for i in range(first, stop):
