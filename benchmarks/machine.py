@@ -71,7 +71,8 @@ def _rk4_loop():
     """A compiled loop of RK4 steps of the plant, built on first use (after quadcruise is
     imported, so that importing this module does not import it)."""
     from quadcruise.layout import STATE_SIZE
-    from quadcruise.sim.engine import TRIG_REFRESH, WORK_ROWS, rk4_step
+    from quadcruise.sim.engine import WORK_ROWS, rk4_step
+    from quadcruise.sim.fastmath import TRIG_REFRESH
 
     @njit(error_model="numpy")
     def loop(x, u, vp, ext, steps):

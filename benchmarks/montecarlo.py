@@ -33,8 +33,7 @@ import time
 import warnings
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from machine import end_of_run, machine, probe  # noqa: E402
+from machine import end_of_run, machine, probe
 
 ROOT = Path(__file__).resolve().parents[1]
 TARGET = dict(n=10_000, duration=60.0, seconds=180.0)

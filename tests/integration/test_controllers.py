@@ -245,28 +245,3 @@ def test_compiled_controller_makes_no_reference_count_calls(name):
     calls = reference_count_calls(controller_from_name(name).function.py_func, CONTROLLER_SIG)
     assert calls == []
 
-
-def test_controller_sine_and_cosine_are_the_librarys_to_an_ulp():
-    """control.trig.sin_cos: the polynomials within 2.3e-16 of the library on [-pi/4, pi/4],
-    the library itself beyond, NaN in -> NaN out."""
-    import math
-
-    from numba import njit
-
-    from quadcruise.sim.fastmath import QUARTER_PI, sin_cos
-
-    @njit
-    def both(a):
-        out = np.empty((a.size, 2))
-        for i in range(a.size):
-            out[i, 0], out[i, 1] = sin_cos(a[i])
-        return out
-
-    inside = np.concatenate([np.linspace(-QUARTER_PI, QUARTER_PI, 200_001), [0.0, 1e-300, -1e-8]])
-    got = both(inside)
-    assert np.abs(got[:, 0] - np.sin(inside)).max() <= 2.3e-16
-    assert np.abs(got[:, 1] - np.cos(inside)).max() <= 2.3e-16
-    outside = np.array([0.7854, -0.8, 1.0, 3.0, -40.0, 1e6])
-    got = both(outside)
-    assert [tuple(r) for r in got] == [(math.sin(a), math.cos(a)) for a in outside]
-    assert np.isnan(both(np.array([np.nan]))).all()

@@ -360,7 +360,7 @@ def test_bad_inputs_name_the_field():
 
 def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
     """The turbulence's normals are rng.next_normal's on the vehicle's scalar SplitMix64 state."""
-    from quadcruise.disturbances.environment import _five_normals
+    from quadcruise.sim.fastmath import five_normals
     from quadcruise.sim.rng import _GOLDEN, next_normal, next_unit, uniform
     state = vehicle_states(4, 1)[0]
     s0 = int(state[0])
@@ -372,7 +372,7 @@ def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
         got.append(u)
         s = np.uint64(s_next)
     assert got == expected
-    *five, s_after = _five_normals(np.uint64(s0))
+    *five, s_after = five_normals(np.uint64(s0))
     one_by_one, s = [], np.uint64(s0)
     for _ in range(5):
         x, s = next_normal(s)
@@ -384,7 +384,8 @@ def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
 def test_dryden_coefficients_follow_the_period_but_not_its_rounding():
     """Cached per period: a grid's rounding (1e-12 relative) keeps them, a new period
     (2 ms after 1 ms) recomputes them, as the exact discretisation of the new a = dt / T."""
-    from quadcruise.disturbances.environment import _CU, _CV, _MDT, DT_TOLERANCE
+    from quadcruise.disturbances.environment import _CU, _CV, _MDT
+    from quadcruise.sim.fastmath import DT_TOLERANCE
     tb = Turbulence(intensity="moderate", altitude=10.0, airspeed=5.0)
     env = Environment(turbulence=tb)
     dp, dm, rng = env.params(1)[0], env.memory(1)[0], vehicle_states(1, 1)[0]

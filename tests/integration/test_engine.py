@@ -61,7 +61,7 @@ def test_rk4_error_falls_sixteen_fold_when_step_halves():
 def test_turned_angles_equal_the_library_sine_and_cosine():
     import math
 
-    from quadcruise.sim.engine import SHORT_TURN, SMALL_TURN, turned
+    from quadcruise.sim.fastmath import SHORT_TURN, SMALL_TURN, turned
 
     rng = np.random.default_rng(3)
     worst = 0.0

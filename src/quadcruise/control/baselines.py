@@ -86,7 +86,6 @@ from quadcruise.layout import (
     Y,
     Z,
 )
-from quadcruise.sim.fastmath import sin_cos
 
 # gains layout after the attitude block
 KP_XY, KD_XY, SAT_P, SAT_D, KP_Z, KD_Z, MAX_TILT, COS_MAX_TILT = range(ATT_GAINS, ATT_GAINS + 8)
@@ -182,13 +181,13 @@ def gonzalez(t, dt, x, ref, vp, gains, mem, cmd):
     0.0306
     """
     kp, kd, ap, ad, tilt = gains[KP_XY], gains[KD_XY], gains[SAT_P], gains[SAT_D], gains[MAX_TILT]
-    spsi, cpsi = sin_cos(x[PSI])
+    spsi, cpsi = math.sin(x[PSI]), math.cos(x[PSI])
     ex, ey, evx, evy = ref[REF_X] - x[X], ref[REF_Y] - x[Y], ref[REF_VX] - x[VX], ref[REF_VY] - x[VY]
     uf = saturated_pd(cpsi * ex + spsi * ey, cpsi * evx + spsi * evy, kp, kd, ap, ad)       # forward
     ul = saturated_pd(cpsi * ey - spsi * ex, cpsi * evy - spsi * evx, kp, kd, ap, ad)       # left
     uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ])
     g = vp[P_G]
-    U1, flags = thrust_for_tilt(uz, sin_cos(x[PHI])[1] * sin_cos(x[THETA])[1], vp[P_M], g, vp[P_K],
+    U1, flags = thrust_for_tilt(uz, math.cos(x[PHI]) * math.cos(x[THETA]), vp[P_M], g, vp[P_K],
                                 gains[COS_MAX_TILT])
     theta_d, flags = tilt_setpoint(uf / g, False, tilt, flags)           # eq (5), small angle, yaw frame
     phi_d, flags = tilt_setpoint(-ul / g, False, tilt, flags)            # eq (6), small angle, yaw frame

@@ -222,7 +222,7 @@ def cascade(t, dt, x, ref, vp, G, mem, cmd):
     >>> bool(np.isclose(cmd[CMD_THRUST], vp[P_M] * vp[P_G])), float(mem[M_INIT])
     (True, 1.0)
     """
-    # every array entry is read first and mem and cmd written last: no reference counting
+    # every array entry read first, mem and cmd written last (fastmath's scalar-only rule)
     m, g, K, l, d = vp[P_M], vp[P_G], vp[P_K], vp[P_L], vp[P_D]
     jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
     vx, vy, vz, p, q, r = x[VX], x[VY], x[VZ], x[P], x[Q], x[R]

@@ -113,10 +113,10 @@ from quadcruise.layout import (
     Z,
 )
 from quadcruise.numeric import clamp, wrap_angle
-from quadcruise.sim.fastmath import sin_cos
 
 # gains layout after the attitude block
-# (COS_MAX_TILT and SIN_MAX_TILT are cos and sin of MAX_TILT, so the step calls neither)
+# (COS_MAX_TILT and SIN_MAX_TILT are cos and sin of MAX_TILT, so the step calls neither: a
+# kept trick, see quadcruise.sim.fastmath)
 # (INVERSION: 0 joint, 1 the paper's sequential eqs 16 then 19)
 # (DERIVATIVE: 0 on the measurement with the reference's velocity, 1 on the whole error through
 #  the filter N [1/s] of FILTER_N)
@@ -239,7 +239,8 @@ def roll_eq19(uy, stheta, spsi, cpsi, a):
     r1 = math.asin(s)
     if A > 0.0:
         # |gamma| < pi/2 and |r1| <= pi/2: gamma - r1 lies in (-pi, pi) and, cos phi1 -
-        # cos phi2 = 2 A sqrt(1 - s^2) / R >= 0, it is the root nearest level
+        # cos phi2 = 2 A sqrt(1 - s^2) / R >= 0, it is the root nearest level (a kept trick,
+        # see quadcruise.sim.fastmath; plain: the general case below)
         return math.atan(B / A) - r1, clipped
     gamma = math.atan2(B, A)
     phi1 = gamma - r1
@@ -390,8 +391,7 @@ def finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd):
     mixer inverse to duties, and the logged command.
 
     Like :func:`~quadcruise.control.attitude.decoupled_attitude`, it reads before it writes
-    and writes last. Kept that way, the compiled controllers make no reference-count calls
-    at all, which in a parallel batch would contend for the shared arrays' counters.
+    and writes last: the scalar-only rule of :mod:`quadcruise.sim.fastmath`.
 
     Parameters
     ----------
@@ -530,9 +530,9 @@ def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
     uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ]) + ff * ref[REF_AZ]
     phi, theta, psi, psi_d = x[PHI], x[THETA], x[PSI], ref[REF_PSI]
     m, g, K = vp[P_M], vp[P_G], vp[P_K]
-    sphi, cphi = sin_cos(phi)                           # each computed once, shared
-    spsi, cpsi = sin_cos(psi)
-    U1, flags = thrust_for_tilt(uz, cphi * sin_cos(theta)[1], m, g, K, gains[COS_MAX_TILT])
+    sphi, cphi = math.sin(phi), math.cos(phi)           # each computed once, shared
+    spsi, cpsi = math.sin(psi), math.cos(psi)
+    U1, flags = thrust_for_tilt(uz, cphi * math.cos(theta), m, g, K, gains[COS_MAX_TILT])
     a = U1 / m
     if gains[INVERSION] == 0.0:                      # (5) and (6) together, at any yaw
         phi_d, theta_d, flags = tilt_joint(ux, uy, spsi, cpsi, a, tilt, flags)

@@ -145,7 +145,7 @@ def se3(t, dt, x, ref, vp, gains, mem, cmd):
     >>> bool(np.isclose(cmd[CMD_THRUST], vp[P_M] * vp[P_G])), bool(np.all(cmd[5:8] == 0.0))  # m g, no moments
     (True, True)
     """
-    # every array entry is read first and the command written last: no reference counting
+    # every array entry read first, the command written last (fastmath's scalar-only rule)
     phi, theta, psi, p, q, r = x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R]
     m, g, K, l, d = vp[P_M], vp[P_G], vp[P_K], vp[P_L], vp[P_D]
     jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]

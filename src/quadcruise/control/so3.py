@@ -9,9 +9,9 @@ body to earth coordinates, z up; its third column b3 = R e3 is the thrust direct
 exactly the factors of U1/m in eqs (5)-(7). Roll torque l U2 acts about body x, pitch l U3
 about body y and yaw U4 about body z (eq 11), so (p, q, r) is the body angular velocity.
 
-Compiled scalar code. A matrix is a tuple of its three rows, each a tuple of three floats
-(``R[i][j]``): a value, not an array, so the controllers allocate nothing per control period
-and take no references on shared memory. Also here: :func:`command_from_rotation`, the
+Compiled scalar code (the scalar-only rule of :mod:`quadcruise.sim.fastmath`). A matrix is a
+tuple of its three rows, each a tuple of three floats (``R[i][j]``): a value, not an array, so
+the controllers allocate nothing per control period. Also here: :func:`command_from_rotation`, the
 shared tail of these controllers (duties, logged inputs and setpoints). Limits use
 :func:`quadcruise.numeric.clamp`.
 

@@ -64,7 +64,7 @@ from quadcruise.errors import InputError
 from quadcruise.fields import Validated, between, instance_of, parse_numbers, unit_field
 from quadcruise.layout import DISTURBANCE_SIG, EXT_E1, EXT_FX, EXT_WX, PHI, STATE_SIZE, VX, P, X
 from quadcruise.model.vehicle import Vehicle
-from quadcruise.sim.rng import ziggurat
+from quadcruise.sim.fastmath import five_normals, same_period
 
 __all__ = ["ConstantWind", "Gust", "Turbulence", "RotorLoss", "ExternalForce", "Environment",
            "SensorNoise", "DEFAULT_DRAG", "with_drag", "wind_from_name", "parse_wind",
@@ -97,13 +97,8 @@ exponentials, a series, three square roots) in most periods (see docs/performanc
 
 
 # --- compiled ---------------------------------------------------------------------------
-# Note on speed: numba drops the reference counting of the array arguments (an atomic
-# NRT_incref/decref pair each on the batch's shared arrays: ~50 ns a call, contended between
-# threads) only when the function's CFG lets it prove the pairs redundant; arrays used only
-# in a branch, a function ending in a branch, or a call of another compiled function (its
-# error path) defeat it (numba 0.68). Hence scalar helpers, rng[0] and dmem[0] loaded
-# first and stored last, no trailing if, and the ziggurat inlined once (_five_normals).
-# tests/integration/test_disturbances.py checks the compiled body for reference counting.
+# The disturbance follows the scalar-only rule of quadcruise.sim.fastmath: rng[0] and dmem[0]
+# loaded first and stored last, no trailing if, the normals from fastmath.five_normals.
 @njit(cache=True, error_model="numpy")
 def _lateral_coefficients(a):
     """Exact discretisation of (1 + sqrt3 T s)/(1 + T s)^2 over a = dt/T, states scaled to the
@@ -126,31 +121,6 @@ def _lateral_coefficients(a):
     l11 = math.sqrt(i0)
     l21 = i1 / l11
     return math.exp(-a), a, l11, l21, math.sqrt(max(i2 - l21 * l21, 0.0))
-
-
-@njit(cache=True, inline="always")
-def _five_normals(s):
-    """Five standard normals from the vehicle's SplitMix64 state s (:mod:`quadcruise.sim.rng`'s
-    ziggurat on the scalar state), and the new state.
-
-    One inlined copy of the ziggurat in a loop, not five calls of ``next_normal``: a call
-    of a compiled function may fail, and its error path keeps numba from dropping the
-    reference counting of :func:`environment_disturbance`'s four array arguments (eight
-    atomic operations a period, on counters the batch's threads share)."""
-    n0 = n1 = n2 = n3 = n4 = 0.0
-    for k in range(5):
-        v, s = ziggurat(s)
-        if k == 0:
-            n0 = v
-        elif k == 1:
-            n1 = v
-        elif k == 2:
-            n2 = v
-        elif k == 3:
-            n3 = v
-        else:
-            n4 = v
-    return n0, n1, n2, n3, n4, s
 
 
 @njit(DISTURBANCE_SIG, cache=True, error_model="numpy")
@@ -212,12 +182,12 @@ def environment_disturbance(t, dt, x, dp, dmem, rng, ext):
                 ext[EXT_WX + j] += k * dp[_GUST + 1 + j]
     if dp[_TURB] != 0.0:              # Dryden: output at t, then advance the filters to t + dt
         if started == 0.0:            # first period: draw the stationary start
-            n0, n1, n2, n3, n4, state = _five_normals(state)
+            n0, n1, n2, n3, n4, state = five_normals(state)
             started, dmem[1] = 1.0, n0
             dmem[2], dmem[3] = n1 / math.sqrt(2.0), math.sqrt(2.0) / 4.0 * n1 + n2 / math.sqrt(8.0)
             dmem[4], dmem[5] = n3 / math.sqrt(2.0), math.sqrt(2.0) / 4.0 * n3 + n4 / math.sqrt(8.0)
-        n0, n1, n2, n3, n4, state = _five_normals(state)
-        if abs(dmem[_MDT] - dt) > DT_TOLERANCE * dt:    # coefficients, cached per dt
+        n0, n1, n2, n3, n4, state = five_normals(state)
+        if not same_period(dmem[_MDT], dt):             # coefficients, cached per period
             a = dt / dp[_TURB + 4]
             dmem[_MDT], dmem[_CU], dmem[_CU + 1] = dt, math.exp(-a), math.sqrt(-math.expm1(-2.0 * a))
             dmem[_CV], dmem[_CV + 1], dmem[_CV + 2], dmem[_CV + 3], dmem[_CV + 4] = _lateral_coefficients(a)

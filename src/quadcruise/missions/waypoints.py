@@ -71,6 +71,16 @@ SETTLE_S = 5.0        # s flown after the last point by default
 _ORDER = 7            # polynomial degree of the minimum-snap segments
 _NC = _ORDER + 1
 
+# offsets into the packed parameter vectors (mp) that the compiled references read
+# Waypoints: [n, hold_yaw, (x, y, z, yaw, t) per point]
+WP_N, WP_HOLD_YAW, WP_POINTS = 0, 1, 2      # count, yaw mode, first point
+WP_STRIDE = 5                               # entries per point: ...
+PT_X, PT_YAW, PT_T = 0, 3, 4                # ... x, y, z from PT_X, then yaw, arrival time
+# MinimumSnap: [m, x, y, z, yaw at the end, t at the end, (t_i, T_i, 4 x 8 coefficients) per segment]
+MS_M, MS_END, MS_T_END, MS_SEGMENTS = 0, 1, 5, 6   # segments, end point (x, y, z, yaw), end time, first segment
+MS_STRIDE = 2 + 4 * _NC                     # entries per segment: ...
+SEG_T0, SEG_DUR, SEG_COEF = 0, 1, 2         # ... start, duration, coefficients of s^0..s^7 per axis
+
 
 # --- the table -----------------------------------------------------------------------------
 @dataclass(frozen=True, eq=False)
@@ -350,26 +360,27 @@ def waypoints_ref(t, mp, ref):
     """
     for i in range(REF_SIZE):
         ref[i] = 0.0
-    n = int(mp[0])
-    last = 2 + 5 * (n - 1)
-    if t >= mp[last + 4] or t < 0.0:               # hold the last (first) point
-        at = last if t >= 0.0 else 2
+    n = int(mp[WP_N])
+    last = WP_POINTS + WP_STRIDE * (n - 1)
+    if t >= mp[last + PT_T] or t < 0.0:            # hold the last (first) point
+        at = last if t >= 0.0 else WP_POINTS
         for j in range(3):
-            ref[REF_X + j] = mp[at + j]
-        ref[REF_PSI] = mp[at + 3]
+            ref[REF_X + j] = mp[at + PT_X + j]
+        ref[REF_PSI] = mp[at + PT_YAW]
         return
-    a = 2 + 5 * _last_start(t, mp, 6, 5, n - 1)    # leg [t_k, t_k+1): departure point a
-    b = a + 5
-    dur = mp[b + 4] - mp[a + 4]
-    s = (t - mp[a + 4]) / dur
+    # leg [t_k, t_k+1): departure point a, arrival point b
+    a = WP_POINTS + WP_STRIDE * _last_start(t, mp, WP_POINTS + PT_T, WP_STRIDE, n - 1)
+    b = a + WP_STRIDE
+    dur = mp[b + PT_T] - mp[a + PT_T]
+    s = (t - mp[a + PT_T]) / dur
     for j in range(3):                             # REF_X.. and REF_VX.. are x, y, z in order
-        ref[REF_X + j] = mp[a + j] + s * (mp[b + j] - mp[a + j])
-        ref[REF_VX + j] = (mp[b + j] - mp[a + j]) / dur
-    if mp[1] != 0.0:
-        ref[REF_PSI] = mp[a + 3]
+        ref[REF_X + j] = mp[a + PT_X + j] + s * (mp[b + PT_X + j] - mp[a + PT_X + j])
+        ref[REF_VX + j] = (mp[b + PT_X + j] - mp[a + PT_X + j]) / dur
+    if mp[WP_HOLD_YAW] != 0.0:
+        ref[REF_PSI] = mp[a + PT_YAW]
     else:
-        ref[REF_PSI] = mp[a + 3] + s * (mp[b + 3] - mp[a + 3])
-        ref[REF_PSI_DOT] = (mp[b + 3] - mp[a + 3]) / dur
+        ref[REF_PSI] = mp[a + PT_YAW] + s * (mp[b + PT_YAW] - mp[a + PT_YAW])
+        ref[REF_PSI_DOT] = (mp[b + PT_YAW] - mp[a + PT_YAW]) / dur
 
 
 @njit(cache=True, error_model="numpy")
@@ -395,18 +406,18 @@ def minsnap_ref(t, mp, ref):
     """
     for i in range(REF_SIZE):
         ref[i] = 0.0
-    if t >= mp[5]:
+    if t >= mp[MS_T_END]:
         for j in range(3):
-            ref[REF_X + j] = mp[1 + j]
-        ref[REF_PSI] = mp[4]
+            ref[REF_X + j] = mp[MS_END + j]
+        ref[REF_PSI] = mp[MS_END + 3]
         return
-    off = 6 + 34 * _last_start(t, mp, 6, 34, int(mp[0]))
-    dur = mp[off + 1]
-    s = max(t - mp[off], 0.0) / dur               # before t = 0: the first point, at rest
+    off = MS_SEGMENTS + MS_STRIDE * _last_start(t, mp, MS_SEGMENTS + SEG_T0, MS_STRIDE, int(mp[MS_M]))
+    dur = mp[off + SEG_DUR]
+    s = max(t - mp[off + SEG_T0], 0.0) / dur      # before t = 0: the first point, at rest
     for j in range(4):                            # Horner for p, p' and p'' / 2 (in s)
-        c = off + 2 + 8 * j
-        p, dp, ddp = mp[c + 7], 0.0, 0.0
-        for k in range(6, -1, -1):
+        c = off + SEG_COEF + _NC * j              # x, y, z, yaw: coefficients of s^0..s^7
+        p, dp, ddp = mp[c + _ORDER], 0.0, 0.0
+        for k in range(_ORDER - 1, -1, -1):
             ddp = ddp * s + dp
             dp = dp * s + p
             p = p * s + mp[c + k]

@@ -70,10 +70,9 @@ from quadcruise.layout import (
     P_CD2,
     P_D,
     P_G,
-    P_INV_JXX,
-    P_INV_JYY,
-    P_INV_JZZ,
-    P_INV_M,
+    P_JXX,
+    P_JYY,
+    P_JZZ,
     P_K,
     P_K1,
     P_K2,
@@ -81,6 +80,7 @@ from quadcruise.layout import (
     P_K4,
     P_K5,
     P_K6,
+    P_M,
     P_OMEGA,
     PHI,
     PSI,
@@ -152,10 +152,10 @@ def derivative_at(x, sphi, cphi, sth, cth, spsi, cpsi, u, vp, ext, full, dx):
     dx : ndarray, shape (16,)
         Output: the state's time derivative [unit/s].
     """
-    inv_m = vp[P_INV_M]                          # 1/m and 1/J come with the row: no division
+    m = vp[P_M]
     p, q, r = x[P], x[Q], x[R]
     U1, U2, U3, U4 = mix(x[F1], x[F2], x[F3], x[F4], vp[P_D])             # (1)-(4)
-    a = U1 * inv_m
+    a = U1 / m
 
     fx, fy, fz = ext[EXT_FX], ext[EXT_FY], ext[EXT_FZ]
     c1, c2 = vp[P_CD1], vp[P_CD2]
@@ -169,9 +169,9 @@ def derivative_at(x, sphi, cphi, sth, cth, spsi, cpsi, u, vp, ext, full, dx):
     dx[X] = x[VX]
     dx[Y] = x[VY]
     dx[Z] = x[VZ]
-    dx[VX] = (sphi * spsi + cphi * sth * cpsi) * a + fx * inv_m             # (5)
-    dx[VY] = (-sphi * cpsi + cphi * sth * spsi) * a + fy * inv_m            # (6)
-    dx[VZ] = cphi * cth * a - vp[P_G] + fz * inv_m                          # (7)
+    dx[VX] = (sphi * spsi + cphi * sth * cpsi) * a + fx / m                 # (5)
+    dx[VY] = (-sphi * cpsi + cphi * sth * spsi) * a + fy / m                # (6)
+    dx[VZ] = cphi * cth * a - vp[P_G] + fz / m                              # (7)
     if full:
         s = q * sphi + r * cphi
         dx[PHI] = p + s * sth / cth
@@ -181,9 +181,9 @@ def derivative_at(x, sphi, cphi, sth, cth, spsi, cpsi, u, vp, ext, full, dx):
         dx[PHI] = p
         dx[THETA] = q
         dx[PSI] = r
-    dx[P] = vp[P_K1] * q * r + vp[P_K2] * U2 + ext[EXT_TX] * vp[P_INV_JXX]  # (11) roll
-    dx[Q] = vp[P_K3] * p * r + vp[P_K4] * U3 + ext[EXT_TY] * vp[P_INV_JYY]  # (11) pitch
-    dx[R] = vp[P_K5] * p * q + vp[P_K6] * U4 + ext[EXT_TZ] * vp[P_INV_JZZ]  # (11) yaw
+    dx[P] = vp[P_K1] * q * r + vp[P_K2] * U2 + ext[EXT_TX] / vp[P_JXX]      # (11) roll
+    dx[Q] = vp[P_K3] * p * r + vp[P_K4] * U3 + ext[EXT_TY] / vp[P_JYY]      # (11) pitch
+    dx[R] = vp[P_K5] * p * q + vp[P_K6] * U4 + ext[EXT_TZ] / vp[P_JZZ]      # (11) yaw
     w, K = vp[P_OMEGA], vp[P_K]
     dx[F1] = w * (ext[EXT_E1] * K * u[0] - x[F1])                           # rotor lag
     dx[F2] = w * (ext[EXT_E2] * K * u[1] - x[F2])

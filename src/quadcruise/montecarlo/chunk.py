@@ -195,11 +195,10 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
     if live.size:
         mission = result.meta.get("mission") if isinstance(result.meta.get("mission"), dict) else {}
         hover = hover_duties(result.meta, n)
-        rows = slice(None) if live.size == n else live      # all live: views, no copies
-        got = flight_metrics_batch(t, result.states[rows, :, X:X + 3], refs[rows],
-                                   result.commands[rows, :, CMD_U1:CMD_U1 + 4], mission=mission,
+        got = flight_metrics_batch(t, result.states[live, :, X:X + 3], refs[live],
+                                   result.commands[live, :, CMD_U1:CMD_U1 + 4], mission=mission,
                                    bands=(0.02, 0.05, spec.settle_band), transient_until=spec.transient_until,
-                                   hover_duty=None if hover is None else hover[rows])
+                                   hover_duty=None if hover is None else hover[live])
         for key in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "final_error_m", "effort",
                     "transient_axis", "rise_time_s", "overshoot_pct", "peak_time_s"):
             out[key][live] = got[key]

@@ -58,10 +58,9 @@ LOCAL_CLUSTER_SETTINGS = {
 }
 """Dask settings of the local cluster: no statistical profiler (it samples each task's stack
 every 10 ms), GIL monitor or work stealing (the chunks are alike and few are in flight), and
-the event-loop tick, system monitor and memory monitor at 1-5 s instead of 20-500 ms, which
-cuts what an idle cluster and a worker's own threads take of the CPU (see
-docs/performance.md). A cluster of the user's (``scheduler=ADDRESS``) keeps its own
-settings."""
+the event-loop tick, system monitor and memory monitor at 1-5 s instead of 20-500 ms (what
+that saves: docs/performance.md). A cluster of the user's (``scheduler=ADDRESS``) keeps its
+own settings."""
 
 
 # --- collecting chunks ------------------------------------------------------------------
@@ -136,12 +135,7 @@ class _Collector:
 
 # --- where chunks run -------------------------------------------------------------------
 class _InProcess:
-    """Chunks one after the other in this process; numba uses all cores within a chunk.
-
-    The next chunk flies on a helper thread (the kernel runs without the GIL) while this
-    thread computes the metrics of the one before, so the cores do not idle between
-    chunks; at most two chunks' logs are held at once.
-    """
+    """Chunks one after the other in this process; numba uses all cores within a chunk."""
 
     name = "this process"
     parallel = 1
@@ -153,25 +147,8 @@ class _InProcess:
         return numba.get_num_threads()
 
     def run(self, spec, ranges):
-        from concurrent.futures import ThreadPoolExecutor
-
-        threads = self.threads
-
-        def fly(first: int, count: int):
-            import numba
-
-            numba.set_num_threads(threads)          # numba's setting is per thread
-            return fly_chunk(spec, first, count)
-
-        with ThreadPoolExecutor(max_workers=1, thread_name_prefix="quadcruise-chunk") as ahead:
-            pending = None
-            for first, count in ranges:
-                flying = ahead.submit(fly, first, count)
-                if pending is not None:
-                    yield reduce_chunk(spec, pending[0], *pending[1].result())
-                pending = (first, flying)
-            if pending is not None:
-                yield reduce_chunk(spec, pending[0], *pending[1].result())
+        for first, count in ranges:
+            yield reduce_chunk(spec, first, *fly_chunk(spec, first, count))
 
     def close(self) -> None:
         pass

@@ -13,7 +13,8 @@ independent, so :func:`fly_vehicles` splits a batch into pieces that numba's num
 threads (``numba.set_num_threads``) fly at once. Each vehicle's arithmetic does not depend on the
 batch it is in or the piece it falls in, so a batch reproduces single flights bit for bit.
 (A ``prange`` kernel would do the same, but numba's parallel passes on a body this size
-add about 6 s to the cold compile, and with one vehicle the idle OpenMP thread spins.)
+lengthen the cold compile, and with one vehicle the idle OpenMP thread spins:
+docs/performance.md.)
 
 Controllers and missions are compiled functions with the signatures in
 :mod:`quadcruise.layout`, passed as first-class function values: one cached kernel
@@ -56,6 +57,7 @@ from quadcruise.layout import (
     Z,
 )
 from quadcruise.model.plant import EULER_PITCH_LIMIT, derivative_at
+from quadcruise.sim.fastmath import TRIG_REFRESH, turned
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rng import next_normal, vehicle_states
 from quadcruise.sim.status import STATUS_REASONS, ExitStatus
@@ -100,44 +102,10 @@ class Limits:
         return np.array([self.max_position, self.max_speed, self.max_rate, self.max_tilt])
 
 
-SMALL_TURN = 0.03
-"""Largest change of an angle over an RK4 stage [rad] for which :func:`turned` uses the
-angle-addition series (beyond it, the library's sine and cosine)."""
-SHORT_TURN = 1.0e-3
-"""Largest change [rad] for which :func:`turned` uses the short series: the usual case, as a
-body rate of 1 rad/s turns an angle by 1 mrad in a 1 ms step."""
-
-
-@njit(cache=True, inline="always")
-def turned(angle, s, c, d):
-    """sin and cos of ``angle`` = a + d, given s = sin a and c = cos a.
-
-    For |d| <= SMALL_TURN by the angle-addition formulas with the series of sin d and
-    cos d - 1, at a fraction of the cost of a sine and a cosine; else from ``angle``
-    directly. Within SHORT_TURN the series stop at d^5 and d^6 (the next terms are below
-    2e-25 and 3e-29), and the sine's is summed as d + d^3 (...), a shorter chain of
-    dependent operations; beyond it they run to d^7 and d^8 (truncation below 1e-20). Either
-    way the result is the library's to a rounding.
-    """
-    d2 = d * d
-    if abs(d) <= SHORT_TURN:
-        sd = d + d2 * d * (-1.0 / 6.0 + d2 * (1.0 / 120.0))
-        cm1 = d2 * (-0.5 + d2 * (1.0 / 24.0 - d2 * (1.0 / 720.0)))
-    elif abs(d) <= SMALL_TURN:
-        sd = d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0) * (1.0 - d2 * (1.0 / 42.0))))
-        cm1 = -d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0) * (1.0 - d2 * (1.0 / 30.0) * (1.0 - d2 * (1.0 / 56.0))))
-    else:
-        return math.sin(angle), math.cos(angle)
-    return s + (s * cm1 + c * sd), c + (c * cm1 - s * sd)
-
-
 # rows of the RK4 workspace: the four stage derivatives, the stage state, and the sines
 # and cosines of the state's phi, theta and psi carried from one step to the next
 K1, K2, K3, K4, XT, TRIG = range(6)
 WORK_ROWS = 6
-TRIG_REFRESH = 256
-"""The engine computes the angles' sines and cosines afresh every this many RK4 steps and
-carries them by :func:`turned` in between (each turn adds a rounding, ~1e-16)."""
 
 
 @njit(cache=True, error_model="numpy")
@@ -192,9 +160,7 @@ def still_air(t, dt, x, dp, dmem, rng, ext):
         ext[j] = 1.0
 
 
-# The per-period helpers below take scalars, not arrays: numba inlining a helper with
-# array arguments into the kernel (or calling it) keeps a reference-count increment and
-# decrement of each array, two atomic operations, in every control period.
+# The per-period helpers below follow the scalar-only rule of quadcruise.sim.fastmath.
 
 @njit(cache=True, inline="always")
 def beyond(a, b, c, bound):
@@ -216,8 +182,8 @@ def clip_duty(v):
 
 @njit(cache=True, inline="always")
 def log_row(log, i, row, v):
-    """log[i, row, :] = v, element by element (a slice would take a reference on the shared
-    log array at every logged period)."""
+    """log[i, row, :] = v, element by element (a slice takes a reference on the shared log
+    array: the scalar-only rule of :mod:`quadcruise.sim.fastmath`)."""
     for j in range(v.shape[0]):
         log[i, row, j] = v[j]
 
@@ -258,8 +224,24 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
             disturbance, disturbed, dp, dmem, rng, sensor_std, sensor_delay, full,
             max_step, log_every, limits,
             log_x, log_cmd, log_ref, x_final, status, t_stop, saturated):
+    """Fly vehicles first .. stop - 1 of the batch. The arguments, by role (their meaning:
+    :func:`simulate`'s parameters; one row per vehicle):
+
+    - time: ``t_grid``;
+    - plant: ``x0``, ``vp``;
+    - controller: ``vp_ctrl``, the function ``controller``, ``gains``, ``mem``;
+    - mission: the function ``mission``, ``mp``;
+    - disturbance: the function ``disturbance``, ``disturbed`` (False: still air), ``dp``,
+      ``dmem``, ``rng``;
+    - sensors: ``sensor_std``, ``sensor_delay``;
+    - options: ``full``, ``max_step``, ``log_every``, ``limits``;
+    - outputs: ``log_x``, ``log_cmd``, ``log_ref``, ``x_final``, ``status``, ``t_stop``,
+      ``saturated`` (and ``mem``, ``dmem`` written back).
+
+    A flat list: grouped into tuples (numba allows tuples of arrays, and of functions, though
+    with a warning at every call) the kernel ran slower (docs/performance.md).
+    """
     n_periods = t_grid.shape[0] - 1
-    steps_per_s = 1.0 / max_step
     for i in range(first, stop):
         x = x0[i].copy()
         seen = np.empty(STATE_SIZE)
@@ -272,57 +254,42 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
         ext = np.zeros(EXT_SIZE)
         work = np.empty((WORK_ROWS, STATE_SIZE))
         vpi, vci, gi, mpi, dpi, stdi = vp[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
-        # what changes every period is this vehicle's own copy (memories written back at the
-        # end; the generator's state is not returned): rows of neighbouring vehicles share
-        # cache lines, and threads flying neighbours would otherwise write to the same lines
-        # each period (false sharing)
+        # what changes every period is this vehicle's own copy, the memories written back at
+        # the end (a kept trick against false sharing: quadcruise.sim.fastmath)
         mi, dmi, rngi = mem[i].copy(), dmem[i].copy(), rng[i].copy()
         clipped_s = limited_s = 0.0
         max_position, max_speed, max_rate, max_tilt = limits[0], limits[1], limits[2], limits[3]
-        noisy = False
-        for j in range(STATE_SIZE):
-            if stdi[j] != 0.0:
-                noisy = True
         code = FINISHED
         t_end = t_grid[n_periods]
         rows_x = rows = 0
-        slot = 0                       # = k % (sensor_delay + 1), kept as a counter: the
-        next_log = 0                   # step has no integer division in it
-        steps = 0                      # RK4 steps since the angles' trig was computed afresh
-        if not disturbed:
-            still_air(0.0, 0.0, x, dpi, dmi, rngi, ext)      # and it stays so
+        steps = 0                      # RK4 steps flown
+        if not disturbed:              # set once (a kept trick: quadcruise.sim.fastmath)
+            still_air(0.0, 0.0, x, dpi, dmi, rngi, ext)
         for k in range(n_periods + 1):
             t = t_grid[k]
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
             mission(t, mpi, ref)
             # what the controller sees: the state sensor_delay periods ago, plus noise
-            if sensor_delay == 0:
-                for j in range(STATE_SIZE):
-                    seen[j] = x[j]
-            else:
-                for j in range(STATE_SIZE):
-                    history[slot, j] = x[j]
-                slot = slot + 1 if slot < sensor_delay else 0
-                old = slot if k >= sensor_delay else 0     # the oldest state kept
-                for j in range(STATE_SIZE):
-                    seen[j] = history[old, j]
-            if noisy:                  # the generator's state as a scalar: no array helper
-                state = rngi[0]
-                for j in range(STATE_SIZE):
-                    if stdi[j] != 0.0:
-                        draw, state = next_normal(state)
-                        seen[j] += stdi[j] * draw
-                rngi[0] = state
+            newest = k % (sensor_delay + 1)                     # in the ring buffer
+            oldest = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
+            for j in range(STATE_SIZE):
+                history[newest, j] = x[j]
+            state = rngi[0]
+            for j in range(STATE_SIZE):
+                seen[j] = history[oldest, j]
+                if stdi[j] != 0.0:
+                    draw, state = next_normal(state)
+                    seen[j] += stdi[j] * draw
+            rngi[0] = state
             for j in range(CMD_SIZE):
                 cmd[j] = 0.0
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
-            if k == next_log:
+            if k % log_every == 0:
                 log_row(log_x, i, rows, x)
                 log_row(log_cmd, i, rows, cmd)
                 log_row(log_ref, i, rows, ref)
                 rows += 1
                 rows_x = rows
-                next_log += log_every
             if k == n_periods:
                 break
             clipped, finite = False, True
@@ -339,15 +306,15 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
                 limited_s += dt
             if disturbed:
                 disturbance(t, dt, x, dpi, dmi, rngi, ext)
-            n_sub = max(1, int(math.ceil(dt * steps_per_s - 1e-9)))
-            h = dt if n_sub == 1 else dt / n_sub
+            n_sub = max(1, int(math.ceil(dt / max_step - 1e-9)))
+            h = dt / n_sub
             for _ in range(n_sub):
-                rk4_step(x, u, vpi, ext, full, h, work, steps == 0)
-                steps = steps + 1 if steps < TRIG_REFRESH - 1 else 0
-            nonfinite = 0.0
+                rk4_step(x, u, vpi, ext, full, h, work, steps % TRIG_REFRESH == 0)
+                steps += 1
+            finite = True
             for j in range(STATE_SIZE):
-                nonfinite += x[j] * 0.0               # 0 while every entry is finite, else NaN
-            if nonfinite != 0.0:
+                finite = finite and math.isfinite(x[j])
+            if not finite:
                 code = NONFINITE
             elif beyond(x[X], x[Y], x[Z], max_position):
                 code = POSITION_BOUND
@@ -361,7 +328,7 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
                 code = PITCH_SINGULAR
             if code != FINISHED:
                 t_end = t_grid[k + 1]
-                if k + 1 == next_log:           # keep the state that broke the bound
+                if (k + 1) % log_every == 0:    # keep the state that broke the bound
                     log_row(log_x, i, rows, x)
                     rows_x += 1
                 break

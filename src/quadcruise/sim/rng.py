@@ -224,7 +224,8 @@ def next_normal(s):
 def ziggurat(s):
     """:func:`next_normal`'s body, for compiled code that inlines it once (a loop of
     draws): every inlined copy adds to the first compile of the function holding it, so
-    the turbulence inlines one copy in a loop rather than five (see docs/performance.md).
+    the turbulence inlines one copy in a loop rather than five
+    (:func:`quadcruise.sim.fastmath.five_normals`; see docs/performance.md).
 
     Parameters
     ----------
