@@ -72,7 +72,7 @@ FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, TILT_BOUND, BAD_CO
 class Limits:
     """Bounds beyond which a flight counts as diverged (and stops).
 
-    Attributes
+    Parameters
     ----------
     max_position : float
         |x|, |y| or |z| above this [m] ends the flight.
@@ -99,6 +99,13 @@ class Limits:
                 raise InputError(f"limit '{name}' must be > 0, got {value!r}")
 
     def array(self) -> np.ndarray:
+        """The four bounds as the kernel reads them.
+
+        Returns
+        -------
+        numpy.ndarray
+            (4,) max_position [m], max_speed [m/s], max_rate [rad/s], max_tilt [rad].
+        """
         return np.array([self.max_position, self.max_speed, self.max_rate, self.max_tilt])
 
 
@@ -121,6 +128,26 @@ def rk4_step(x, u, vp, ext, full, h, work, fresh):
     by the step's increment, so their sines and cosines follow by :func:`turned`. The four
     stages run through one loop, so the step holds one copy of the plant: it compiles once,
     and the engine calls it as one function with few arguments.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        (16,) the state (SI units of :data:`quadcruise.layout.STATE_UNITS`), advanced in place.
+    u : numpy.ndarray
+        (4,) PWM duties [-], held over the step.
+    vp : numpy.ndarray
+        The vehicle parameter row (PARAM_SIZE).
+    ext : numpy.ndarray
+        (EXT_SIZE,) external inputs held over the step: force [N], torque [N m], wind [m/s],
+        rotor effectiveness [-].
+    full : bool
+        Exact Euler-angle kinematics instead of the paper's.
+    h : float
+        Step length [s].
+    work : numpy.ndarray
+        (WORK_ROWS, STATE_SIZE) scratch array, its row TRIG carried between steps.
+    fresh : bool
+        Compute the angles' sines and cosines from x instead of carrying them.
     """
     xt, trig = work[XT], work[TRIG]
     if fresh:
@@ -153,7 +180,21 @@ def rk4_step(x, u, vp, ext, full, h, work, fresh):
 
 @njit(DISTURBANCE_SIG, cache=True)
 def still_air(t, dt, x, dp, dmem, rng, ext):
-    """No disturbance: no force, torque or wind; every rotor healthy."""
+    """No disturbance: no force, torque or wind; every rotor healthy (``DISTURBANCE_SIG``).
+
+    Parameters
+    ----------
+    t, dt : float
+        The period's start and length [s] (not read).
+    x : numpy.ndarray
+        The true state (not read).
+    dp, dmem : numpy.ndarray
+        The disturbance's parameters and memory (not read).
+    rng : numpy.ndarray
+        The vehicle's random generator state (not read).
+    ext : numpy.ndarray
+        (EXT_SIZE,) output: zeros, and the four rotor effectiveness entries 1.
+    """
     for j in range(EXT_SIZE):
         ext[j] = 0.0
     for j in range(EXT_E1, EXT_E1 + 4):
@@ -164,13 +205,37 @@ def still_air(t, dt, x, dp, dmem, rng, ext):
 
 @njit(cache=True, inline="always")
 def beyond(a, b, c, bound):
-    """Whether |a|, |b| or |c| exceeds bound."""
+    """Whether |a|, |b| or |c| exceeds bound.
+
+    Parameters
+    ----------
+    a, b, c : float
+        Three components (of a position [m], velocity [m/s], rates [rad/s] or angles [rad]).
+    bound : float
+        The bound, in their unit.
+
+    Returns
+    -------
+    bool
+    """
     return abs(a) > bound or abs(b) > bound or abs(c) > bound
 
 
 @njit(cache=True, inline="always")
 def clip_duty(v):
-    """A commanded duty held in [0, 1]: (duty, clipped?, finite?)."""
+    """A commanded duty held in [0, 1].
+
+    Parameters
+    ----------
+    v : float
+        The duty the controller asked for [-].
+
+    Returns
+    -------
+    (float, bool, bool)
+        The duty applied, whether it was clipped, whether the command was finite (a
+        non-finite one applies 0 and stops the vehicle).
+    """
     if not math.isfinite(v):
         return 0.0, False, False
     if v < 0.0:
@@ -183,7 +248,17 @@ def clip_duty(v):
 @njit(cache=True, inline="always")
 def log_row(log, i, row, v):
     """log[i, row, :] = v, element by element (a slice takes a reference on the shared log
-    array: the scalar-only rule of :mod:`quadcruise.sim.fastmath`)."""
+    array: the scalar-only rule of :mod:`quadcruise.sim.fastmath`).
+
+    Parameters
+    ----------
+    log : numpy.ndarray
+        (N, L, W) log of the batch.
+    i, row : int
+        The vehicle and the logged instant.
+    v : numpy.ndarray
+        (W,) the values to log.
+    """
     for j in range(v.shape[0]):
         log[i, row, j] = v[j]
 
@@ -191,7 +266,17 @@ def log_row(log, i, row, v):
 @njit(cache=True, inline="always")
 def put_row(a, i, v):
     """a[i, :] = v, element by element: numba compiles a slice assignment with a shape
-    check of its own, which costs seconds of compile time."""
+    check of its own, which costs seconds of compile time.
+
+    Parameters
+    ----------
+    a : numpy.ndarray
+        (N, W) array of the batch.
+    i : int
+        The vehicle.
+    v : numpy.ndarray
+        (W,) the values.
+    """
     for j in range(v.shape[0]):
         a[i, j] = v[j]
 
@@ -199,7 +284,17 @@ def put_row(a, i, v):
 @njit(cache=True, inline="always")
 def blank_rows(log, i, first):
     """NaN in the rows of vehicle i from ``first`` on: the log is allocated empty, and a
-    vehicle that stopped early leaves its last rows unwritten."""
+    vehicle that stopped early leaves its last rows unwritten.
+
+    Parameters
+    ----------
+    log : numpy.ndarray
+        (N, L, W) log of the batch.
+    i : int
+        The vehicle.
+    first : int
+        The first logged instant to blank.
+    """
     for row in range(first, log.shape[1]):
         for j in range(log.shape[2]):
             log[i, row, j] = np.nan
@@ -354,7 +449,15 @@ _pool: ThreadPoolExecutor | None = None
 def fly_vehicles(n: int, args: tuple) -> None:
     """Run the kernel over vehicles 0..n-1 of the batch arrays in ``args``, on numba's
     number of threads (``numba.get_num_threads()``): one range on this thread when that is
-    1 or n is 1, else ``PIECES_PER_THREAD`` ranges per thread, handed out in turn."""
+    1 or n is 1, else ``PIECES_PER_THREAD`` ranges per thread, handed out in turn.
+
+    Parameters
+    ----------
+    n : int
+        Number of vehicles.
+    args : tuple
+        The kernel's arguments after the vehicle range (its batch arrays, by role).
+    """
     global _pool
     threads = min(n, get_num_threads())
     if threads <= 1:
@@ -385,6 +488,25 @@ def time_grid(duration: float, dt: float, t0: float = 0.0) -> np.ndarray:
 
     ``duration`` must be a whole number of periods (to 1e-9 relative) so the grid ends
     exactly at t0 + duration.
+
+    Parameters
+    ----------
+    duration : float
+        Flight time [s], > 0.
+    dt : float
+        Control period [s], in (0, duration].
+    t0 : float
+        First instant [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        The instants [s], duration / dt + 1 of them.
+
+    Examples
+    --------
+    >>> time_grid(0.003, 0.001).tolist()
+    [0.0, 0.001, 0.002, 0.003]
     """
     if not (math.isfinite(duration) and duration > 0):
         raise InputError(f"duration must be a positive number of seconds, got {duration!r}")
@@ -465,6 +587,11 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
         Divergence bounds.
     meta : dict
         Recorded in the result (config, seed, version).
+
+    Returns
+    -------
+    SimResult
+        The logged flight of every vehicle, its exit status and saturation times.
     """
     t_grid = np.ascontiguousarray(t_grid, dtype=float)
     if t_grid.ndim != 1 or t_grid.shape[0] < 2:

@@ -73,6 +73,20 @@ def turned(angle, s, c, d):
     2e-25 and 3e-29), and the sine's is summed as d + d^3 (...), a shorter chain of
     dependent operations; beyond it they run to d^7 and d^8 (truncation below 1e-20). Either
     way the result is the library's to a rounding.
+
+    Parameters
+    ----------
+    angle : float
+        The new angle a + d [rad].
+    s, c : float
+        sin a and cos a [-].
+    d : float
+        The turn d [rad].
+
+    Returns
+    -------
+    (float, float)
+        sin(angle), cos(angle) [-].
     """
     d2 = d * d
     if abs(d) <= SHORT_TURN:
@@ -101,6 +115,16 @@ def five_normals(s):
     its error path keeps numba from dropping the reference counting of the caller's array
     arguments (see the scalar-only rule above); five inlined copies of the ziggurat instead
     of this loop over one compile several times slower (docs/performance.md).
+
+    Parameters
+    ----------
+    s : int
+        A SplitMix64 generator state (uint64).
+
+    Returns
+    -------
+    (float, float, float, float, float, int)
+        Five standard normal draws [-] and the advanced state.
     """
     n0 = n1 = n2 = n3 = n4 = 0.0
     for k in range(5):
@@ -130,5 +154,17 @@ def same_period(cached, dt):
     (the Dryden filters' coefficients: two exponentials, a series and three square roots).
 
     Plain: ``False``, i.e. compute them afresh every period.
+
+    Parameters
+    ----------
+    cached : float
+        The period the cached values were computed for [s].
+    dt : float
+        This period [s].
+
+    Returns
+    -------
+    bool
+        True when they differ by at most ``DT_TOLERANCE`` relative.
     """
     return abs(cached - dt) <= DT_TOLERANCE * dt
