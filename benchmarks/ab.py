@@ -22,7 +22,9 @@ Figures (``--figures``, comma-separated; the default: single,batch):
 - ``mc``: the Monte Carlo benchmark's population (benchmarks/montecarlo.py), 136 flights of
   60 s swept in this process (chunks of 34 on numba's threads, metrics included);
 - ``mc1``: one chunk of that population, 34 flights of 60 s on one thread: the task of
-  one Dask worker.
+  one Dask worker;
+- ``mcplain``: 272 flights of that population in one batched call on numba's threads,
+  logging the start and the end only: the Monte Carlo benchmark's ``plain`` run.
 
 Rates are vehicle-steps per second. Before each process the script waits (up to
 ``--wait`` seconds) until the other processes of the host leave its cores idle: less than
@@ -53,6 +55,7 @@ FIGURES = {            # name: (vehicles, flight seconds, timed calls per proces
     "batch": (2000, 10.0, 2),
     "mc": (136, 60.0, 2),
     "mc1": (34, 60.0, 3),
+    "mcplain": (272, 60.0, 2),
 }
 
 
@@ -73,11 +76,13 @@ def figure_call(name: str, duration: float | None = None):
     # the Monte Carlo benchmark's population (benchmarks/, this script's folder, is on sys.path)
     from montecarlo import make_spec
 
-    from quadcruise.montecarlo.sweep import run_chunk, run_sweep
+    from quadcruise.montecarlo.sweep import fly_chunk, run_chunk, run_sweep
 
     spec = make_spec(duration)
     if name == "mc":
         return lambda: run_sweep(spec, n, scheduler="none")
+    if name == "mcplain":
+        return lambda: fly_chunk(spec, 0, n, log_every=spec.periods)
     threads = numba.get_num_threads()
 
     def one_task():
