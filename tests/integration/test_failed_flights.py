@@ -58,6 +58,35 @@ def test_the_command_line_exits_1_after_printing_the_reason():
     assert good.exit_code == 0, good.output
 
 
+FAST_AND_NOMINAL = """
+[mission]
+kind = "circle"
+[[compare.controllers]]
+name = "nlpd"
+[[compare.controllers]]
+name = "nlpd"
+label = "fast"
+position_poles = [-1000, -2000]
+"""
+
+
+def test_compare_names_the_controller_whose_flight_failed_and_exits_1(tmp_path):
+    with pytest.warns(UserWarning, match=r"^fast: vehicle 0 lost track"):
+        cmp = qc.compare("circle", {"nominal": "nlpd", "fast": NLPD(position=pd_from_poles([-1000.0, -2000.0]))},
+                         duration=6.0)
+    assert cmp.ok == {"nominal": True, "fast": False}
+    assert list(cmp.failed) == ["fast"] and cmp.failed["fast"] == cmp.results["fast"].status_text(0)
+    assert cmp.table().loc["fast", "status"].startswith("lost track")
+    scenario = tmp_path / "fast.toml"
+    scenario.write_text(FAST_AND_NOMINAL)
+    bad = RUNNER.invoke(main, ["compare", str(scenario), "--duration", "6", "--out", str(tmp_path / "out")])
+    assert bad.exit_code == 1, bad.output
+    assert "fast: vehicle 0 lost track" in bad.output and "rmse_m" in bad.output
+    assert (tmp_path / "out" / "metrics.csv").exists()            # written before the exit
+    good = RUNNER.invoke(main, ["compare", "step", "--controllers", "nlpd,se3", "--duration", "4"])
+    assert good.exit_code == 0, good.output
+
+
 @pytest.mark.parametrize("mass", [60.0, 1e300])
 def test_a_vehicle_that_cannot_lift_itself_is_refused_before_flying(mass, tmp_path):
     with pytest.raises(qc.InputError, match="cannot lift itself"):

@@ -145,15 +145,27 @@ def test_bad_input_is_one_line_exit_2_before_any_flight(tmp_path, monkeypatch, a
 def test_cli_prints_progress_and_summary_and_writes_the_folder(tmp_path, monkeypatch):
     monkeypatch.setenv("QUADCRUISE_PROGRESS", "1")          # the bar, as on a terminal
     out = tmp_path / "tuned"
-    res = run("tune", "step", "-m", "time=0.5", "--gains", "position.kp", "--target", "rise_time_s=1.2",
+    res = run("tune", "step", "-m", "time=0.5", "--gains", "position.kp", "--target", "rise_time_s=1.2+-0.2",
               "--budget", "2", "--popsize", "5", "--duration", "6", "--seed", "4", "--out", out)
     assert res.exit_code == 0, res.output
+    assert "every target and requirement met" in res.output
     assert "tuning" in res.output and "best cost" in res.output and "tuned nlpd on step" in res.output
     text = (out / "scenario.toml").read_text()
     command = next(line for line in text.splitlines() if line.startswith("# regenerate: "))[len("# regenerate: "):]
     assert shlex.split(command)[:3] == ["quadcruise", "tune", "step"] and "--seed 4" in command
     flown = run("fly", out / "scenario.toml")
     assert flown.exit_code == 0, flown.output
+
+
+def test_cli_exits_1_when_the_tuned_gains_miss_a_target_and_still_writes_them(tmp_path):
+    out = tmp_path / "missed"       # two generations cannot bring the rise within 10 % of 1.2 s
+    res = run("tune", "step", "-m", "time=0.5", "--gains", "position.kp", "--target", "rise_time_s=1.2",
+              "--budget", "2", "--popsize", "5", "--duration", "6", "--seed", "4", "--out", out)
+    assert res.exit_code == 1, res.output
+    assert "rise_time_s                1.2 +- 0.12" in res.output and "NO" in res.output
+    assert "not every target or requirement met" in res.output
+    assert json.loads((out / "tune.json").read_text())["met"] is False
+    assert (out / "scenario.toml").exists()               # the best gains found, to look at or fly
 
 
 def test_qc_tune_is_the_package():

@@ -3,6 +3,8 @@ Carlo population; one table, one figure."""
 
 from __future__ import annotations
 
+import sys
+
 import click
 
 from quadcruise.cli.common import (
@@ -15,7 +17,7 @@ from quadcruise.cli.common import (
     metric_options,
     writable,
 )
-from quadcruise.cli.objects import mission_from_options
+from quadcruise.cli.compare_run import compared_from_options, echo_population_comparison, population_from_options
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["compare"]
@@ -86,11 +88,11 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
         check_output_dir(out, force)
     cmp_mission, chosen, kwargs = compared_from_options(mission, controllers, mission_params)
     kwargs.update({k: v for k, v in (("duration", duration), ("dt", dt)) if v is not None})
-    pop = _population(population, seed, mass_spread, wind)      # checked before anything flies
+    pop = population_from_options(population, seed, mass_spread, wind)      # checked before anything flies
     cmp = run_compare(cmp_mission, chosen, progress=Bar("flying", unit="controller"), **kwargs)
     click.echo(cmp.text(**conventions))
     if population is not None:
-        _compare_population(cmp_mission, chosen, population, seed, pop, wind, kwargs.get("duration"),
+        echo_population_comparison(cmp_mission, chosen, population, seed, pop, wind, kwargs.get("duration"),
                             kwargs.get("dt", 1e-3))
     if out is not None:
         cmp.write(out, force=force, **conventions)
@@ -100,100 +102,5 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
 
         write_html_report(report, **comparison_report(cmp, **conventions))
         click.echo(f"wrote report {report}")
-
-
-def _population(n: int | None, seed: int, mass_spread: float, wind: str | None):
-    """The population that ``--population``, ``--seed``, ``--mass-spread`` and ``--wind`` describe,
-    checked even when ``--population`` is not given (so that no bad value passes unseen).
-
-    Parameters
-    ----------
-    n : int or None
-        ``--population``: number of vehicles; None: none flown.
-    seed : int
-        ``--seed``.
-    mass_spread : float
-        ``--mass-spread``: relative standard deviation of the mass.
-    wind : str or None
-        ``--wind``: a :func:`~quadcruise.disturbances.environment.parse_wind` spec.
-
-    Returns
-    -------
-    Population
-    """
-    from quadcruise.disturbances.environment import parse_wind
-    from quadcruise.errors import whole_number
-    from quadcruise.montecarlo.api import Population
-
-    if n is not None:
-        whole_number(n, "--population", minimum=1)
-    whole_number(seed, "--seed")
-    env = parse_wind(wind) if wind else None
-    return Population(mass_spread=mass_spread, environment=env if env is not None and env.parts else None)
-
-
-def _compare_population(mission, controllers: str, n: int, seed: int, pop, wind: str | None,
-                        duration: float | None, dt: float) -> None:
-    """Fly the controllers on the same perturbed vehicles, in this process; print one row each.
-
-    Parameters
-    ----------
-    mission : Mission
-    controllers : str
-        Comma-separated controller names.
-    n : int
-        Number of vehicles.
-    seed : int
-        Seed of the population.
-    pop : Population
-        The population (:func:`_population`).
-    wind : str or None
-        The ``--wind`` spec, for the printed headline.
-    duration, dt : float
-        Flight time [s] (None: the mission's) and control period [s].
-    """
-    from quadcruise.montecarlo.compare import compare_population
-
-    table = compare_population(mission, controllers, pop, n, seed, duration=duration, dt=dt, scheduler="none",
-                               progress=Bar("flying the population", unit="flight"))
-    click.echo(f"\nthe same {n} perturbed vehicles (seed {seed}, mass spread {pop.mass_spread:g}"
-               + (f", wind {wind}" if wind else "") + "):")
-    click.echo(table.to_string(float_format=lambda v: f"{v:.4g}"))
-
-
-DEFAULT_COMPARED = "nlpd,gonzalez,se3,cascade"
-"""The controllers ``quadcruise compare`` flies when neither the options nor a scenario name any."""
-
-
-def compared_from_options(mission: str, controllers: str | None, mission_params: tuple[str, ...]):
-    """What ``quadcruise compare MISSION ...`` flies: the mission, controllers and keywords.
-
-    Parameters
-    ----------
-    mission : str
-        A mission name, a waypoint CSV (``.csv``) or a scenario file (``.toml``).
-    controllers : str or None
-        ``--controllers``, comma-separated names; None: the scenario's ``[compare]`` controllers,
-        else its ``[controller]``, else :data:`DEFAULT_COMPARED`.
-    mission_params : tuple of str
-        ``-m KEY=VALUE`` parameters of the mission.
-
-    Returns
-    -------
-    (Mission, str or dict, dict)
-        The mission, the controllers (names, or label -> controller) and the keywords.
-    """
-    from quadcruise.fields import parse_assignments
-
-    if not mission.lower().endswith(".toml"):
-        return mission_from_options(mission, mission_params, smooth=False), controllers or DEFAULT_COMPARED, {}
-    from quadcruise.missions import mission_from_name
-    from quadcruise.workflows.scenario import load_scenario
-
-    scenario = load_scenario(mission)
-    the_mission = scenario.mission or mission_from_name("circle")
-    if mission_params:
-        the_mission = the_mission.replace(**parse_assignments(mission_params, "--mission-param"))
-    chosen = controllers or scenario.compare or (
-        {scenario.controller.name: scenario.controller} if scenario.controller is not None else DEFAULT_COMPARED)
-    return the_mission, chosen, scenario.fly_kwargs()
+    if cmp.failed:
+        sys.exit(1)             # a controller's flight did not finish: diverged, lost track, out of bounds

@@ -4,6 +4,8 @@ the library does the work (:func:`quadcruise.tune.tune`)."""
 
 from __future__ import annotations
 
+import sys
+
 import click
 
 from quadcruise.cli.common import friendly, writable
@@ -104,4 +106,5 @@ def tune(**options):
         force, quiet : bool
             ``--force``: replace a folder quadcruise did not write; ``--quiet``: no progress.
     """
-    tune_command(**options, echo=click.echo)
+    if not tune_command(**options, echo=click.echo).met:
+        sys.exit(1)             # the tuned gains miss a target or a requirement (the summary says which)

@@ -16,10 +16,13 @@ Examples
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from quadcruise.control import Controller, as_controller, controller_record
 from quadcruise.errors import InputError, reject_unknown
@@ -54,6 +57,34 @@ class Comparison:
     controllers: dict
     results: dict
     _tables: dict = field(default_factory=dict, init=False, repr=False)   # table() per keywords
+
+    @property
+    def ok(self) -> dict:
+        """Label -> True where every vehicle of that controller flew the whole mission (finished).
+
+        Returns
+        -------
+        dict of str to bool
+        """
+        return {label: bool(res.ok.all()) for label, res in self.results.items()}
+
+    @property
+    def failed(self) -> dict:
+        """Label -> why its first unfinished vehicle stopped, for each controller that did not finish.
+
+        Returns
+        -------
+        dict of str to str
+            Empty when every flight finished; e.g. ``{"fast": "lost track: the position error
+            left the tracking bound at t = 3.2480 s"}``.
+        """
+        out = {}
+        for label, res in self.results.items():
+            bad = np.flatnonzero(~res.ok)
+            if bad.size:
+                more = f" ({bad.size} of {res.n} vehicles)" if res.n > 1 else ""
+                out[label] = res.status_text(int(bad[0])) + more
+        return out
 
     def table(self, **metric_kw: Any):
         """The metrics of every flight, one row per controller.
@@ -303,7 +334,11 @@ def compare(mission: Mission | str = "circle",
     for label, ctrl in chosen.items():
         if progress is not None:
             progress(len(results), len(chosen))
-        results[label] = fly(mission, ctrl, vehicle=vehicle, duration=duration, dt=dt, **fly_kw)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            results[label] = fly(mission, ctrl, vehicle=vehicle, duration=duration, dt=dt, **fly_kw)
+        for w in caught:                    # say whose flight it was
+            warnings.warn(f"{label}: {w.message}", w.category, stacklevel=2)
     if progress is not None:
         progress(len(results), len(chosen))
     return Comparison(mission=mission, controllers=chosen, results=results)
