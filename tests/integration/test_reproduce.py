@@ -13,9 +13,9 @@ from quadcruise.workflows.reproduce import FIGURES, FIT_SCENARIO, FITTED, PAPER,
 @pytest.fixture(scope="module")
 def out(tmp_path_factory):
     path = tmp_path_factory.mktemp("repro") / "out"
-    result = CliRunner().invoke(main, ["reproduce", "--out", str(path)])
+    result = CliRunner().invoke(main, ["reproduce", "--out", str(path)], env={"QUADCRUISE_PROGRESS": "1"})
     assert result.exit_code == 0, result.output
-    assert "[13/13] flew entry with gonzalez (fitted)" in result.output
+    assert "flying:" in result.output and "/13 [" in result.output and "circle with" in result.output   # the bar
     assert "| nlpd (fitted) | Kp 3.470, Kd 2.599 (zeta 0.70" in result.output
     return path
 
@@ -104,3 +104,20 @@ def test_fitted_rows_reach_the_papers_transients(out):
     assert abs(base["rise_0_100_s"] - paper["rise_time_s"]) <= 0.5 < abs(base["rise_time_s"] - paper["rise_time_s"])
     for name in ("nlpd", "gonzalez"):        # the paper's own gains reach neither
         assert runs[name]["rise_time_s"] > 2 * PAPER[name]["rise_time_s"] or runs[name]["overshoot_pct"] < 1.0
+
+
+def test_a_flight_that_did_not_finish_is_marked_in_the_tables_and_exits_1(tmp_path):
+    # at 46 kg the vehicle hovers at 94 % duty: the paper's nlpd cannot tilt enough to follow the circle
+    scenario = tmp_path / "heavy.toml"
+    scenario.write_text("[vehicle]\nm = 46.0\n[simulation]\ndt = 0.005\n")
+    res = CliRunner().invoke(main, ["reproduce", "--scenario", str(scenario), "--out", str(tmp_path / "out")])
+    assert res.exit_code == 1, res.output
+    runs = load(tmp_path / "out")["runs"]
+    failed = [r for r in runs if r["status"] != "finished"]
+    assert failed and all(r["status"].startswith("lost track") for r in failed)
+    for r in failed:                        # the row, the warning and the count all say so
+        assert f"| {r['scenario']} | {r['controller']} **({r['status']})** |" in res.output
+        assert f"warning: {r['scenario']} with {r['controller']} did not fly its mission: {r['status']}" in res.output
+    report = (tmp_path / "out" / "report.md").read_text()
+    assert f"**{len(failed)} of {len(runs)} flights did not finish**" in report
+    assert any(r["status"] == "finished" for r in runs)     # gonzalez's bounded tilt still flies it

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import sys
+
 import click
 
-from quadcruise.cli.common import FORCE_OPTION, FORMAT_OPTION, REPORT_OPTION, friendly, writable
+from quadcruise.cli.common import FORCE_OPTION, FORMAT_OPTION, REPORT_OPTION, Bar, friendly, writable
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["reproduce"]
@@ -55,38 +57,21 @@ def reproduce(out, fmt, force, report, scenario):
 
         sc = load_scenario(scenario)
         settings = {"vehicle": sc.vehicle, "dt": sc.dt}
-    rep = run_reproduce(progress=_flown, **settings)
+    with Bar("flying", unit="flight") as flown:
+        rep = run_reproduce(progress=flown, **settings)
     click.echo(results_table(rep))
     click.echo("\nFitted to the paper's transients (not its gains; docs/paper.md explains):")
     click.echo(fitted_table(rep))
-    write_reproduction(rep, out, force=force, fmt=fmt, progress=_drawn)
+    with Bar("drawing", unit="figure") as drawn:
+        write_reproduction(rep, out, force=force, fmt=fmt, progress=drawn)
     if report is not None:
         from quadcruise.report.html import reproduction_report, write_html_report
 
         write_html_report(report, **reproduction_report(rep, written_figures(out)))
         click.echo(f"wrote report {report}")
     click.echo(f"wrote {out}/report.md, metrics.json, figures and traces in {time.perf_counter() - start:.1f} s")
+    for flight, why in rep.failed.items():
+        click.echo(f"warning: {flight} did not fly its mission: {why}", err=True)
+    if rep.failed:
+        sys.exit(1)             # a flight did not finish (e.g. a --scenario vehicle the paper's gains cannot fly)
 
-
-def _flown(done: int, total: int, label: str) -> None:
-    """Say on stderr that a flight is done.
-
-    Parameters
-    ----------
-    done, total : int
-        Flights flown so far, and in all.
-    label : str
-        The flight just flown, e.g. "circle with nlpd".
-    """
-    click.echo(f"[{done}/{total}] flew {label}", err=True)
-
-
-def _drawn(name: str) -> None:
-    """Say on stderr that a figure is drawn.
-
-    Parameters
-    ----------
-    name : str
-        The figure's file name.
-    """
-    click.echo(f"drew {name}", err=True)

@@ -164,6 +164,18 @@ class Reproduction:
     config: dict
     timings: dict = field(default_factory=dict)
 
+    @property
+    def failed(self) -> dict:
+        """``"scenario with controller"`` -> why it stopped, for each flight that did not finish.
+
+        Returns
+        -------
+        dict of str to str
+            Empty when every flight finished.
+        """
+        return {f"{scen} with {ctrl}": res.status_text(0)
+                for (scen, ctrl), res in self.results.items() if not res.ok[0]}
+
     def to_json(self) -> dict:
         """The ``metrics.json`` document.
 
@@ -304,7 +316,7 @@ def _json_number(value) -> float | None:
 
 
 def write_reproduction(rep: Reproduction, out: str | Path, *, force: bool = False, fmt: str = "csv",
-                       progress: Callable[[str], None] | None = None) -> Path:
+                       progress: Callable[[int, int, str], None] | None = None) -> Path:
     """Write metrics.json, the figures, the traces and report.md into ``out``, atomically.
 
     The folder also holds ``quadcruise.json`` (the configuration); traces and figures are
@@ -321,7 +333,8 @@ def write_reproduction(rep: Reproduction, out: str | Path, *, force: bool = Fals
     fmt : str
         Format of the traces: ``"csv"`` or ``"parquet"``.
     progress : callable, optional
-        Called as ``progress(name)`` after each figure written.
+        Called as ``progress(done, total, name)`` after each figure written (``total``: the
+        figures that may be drawn; one with nothing to show is left out).
 
     Returns
     -------
@@ -351,7 +364,7 @@ def write_reproduction(rep: Reproduction, out: str | Path, *, force: bool = Fals
                 save_figure(fig, tmp / name)
                 written.append(name)
                 if progress:
-                    progress(name)
+                    progress(len(written), len(FIGURES), name)
         (tmp / "report.md").write_text(report_markdown(rep, written))
     return out
 
@@ -435,7 +448,9 @@ def results_table(rep: Reproduction) -> str:
     -------
     str
         One row per run; the paper's value in brackets after ours where it reports one
-        (:func:`paper_numbers`: not for the ``step`` scenario).
+        (:func:`paper_numbers`: not for the ``step`` scenario). A flight that did not finish
+        says so in bold after its controller, and a line under the table counts them: its
+        metrics describe a failed flight.
     """
     lines = ["| scenario | controller | rise [s] (paper) | settling 2 % [s] (paper) | settling 5 % [s] "
              "| overshoot [%] (paper) | RMSE [m] | max error [m] |",
@@ -443,11 +458,16 @@ def results_table(rep: Reproduction) -> str:
     for r in rep.runs:
         paper = paper_numbers(r)
         p = {k: (f" ({paper[k]:g})" if k in paper else "") for k in ("rise_time_s", "settling_time_s", "overshoot_pct")}
+        who = r["controller"] if r["status"] == "finished" else f"{r['controller']} **({r['status']})**"
         lines.append(
-            f"| {r['scenario']} | {r['controller']} | {_cell(r['rise_time_s'])}{p['rise_time_s']} "
+            f"| {r['scenario']} | {who} | {_cell(r['rise_time_s'])}{p['rise_time_s']} "
             f"| {_cell(r['settling_time_s'], 'did not settle')}{p['settling_time_s']} "
             f"| {_cell(r['settling_time_5pct_s'], 'did not settle')} "
             f"| {_cell(r['overshoot_pct'])}{p['overshoot_pct']} | {_cell(r['rmse_m'])} | {_cell(r['max_error_m'])} |")
+    failed = sum(r["status"] != "finished" for r in rep.runs)
+    if failed:
+        lines.append(f"\n**{failed} of {len(rep.runs)} flights did not finish**: their metrics describe a failed flight, "
+                     "not the controller's design.")
     return "\n".join(lines)
 
 
@@ -478,7 +498,8 @@ def fitted_table(rep: Reproduction) -> str:
              "| paper: rise, settling, overshoot |", "|---|---|---|---|---|---|---|"]
     for r in rows:
         paper = paper_numbers(r)
-        label = r["controller"] + (" **(fitted)**" if r["fitted"] and "fitted" not in r["controller"] else "")
+        label = r["controller"] + (" **(fitted)**" if r["fitted"] and "fitted" not in r["controller"] else "") \
+            + ("" if r["status"] == "finished" else f" **({r['status']})**")
         lines.append(f"| {label} | {_gains_text(factories[r['controller']]())} | {_cell(r['rise_time_s'])} "
                      f"| {_cell(r.get('rise_0_100_s'))} | {_cell(r['settling_time_s'], 'did not settle')} "
                      f"| {_cell(r['overshoot_pct'])} | {paper['rise_time_s']:g} s, {paper['settling_time_s']:g} s, "
