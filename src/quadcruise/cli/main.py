@@ -3,8 +3,11 @@
 The group lives here, each command in its own module (:mod:`quadcruise.cli.fly`,
 :mod:`~quadcruise.cli.replay`, :mod:`~quadcruise.cli.reproduce`,
 :mod:`~quadcruise.cli.compare`, :mod:`~quadcruise.cli.analyze`,
-:mod:`~quadcruise.cli.montecarlo`, :mod:`~quadcruise.cli.tune`), what they share in :mod:`quadcruise.cli.common`.
-Bad input prints one line, ``error: ...``, and exits with status 2.
+:mod:`~quadcruise.cli.montecarlo`, :mod:`~quadcruise.cli.tune`), what they share in :mod:`quadcruise.cli.common`;
+the larger commands keep what they run after parsing in a ``*_run`` module beside them
+(:mod:`~quadcruise.cli.compare_run`, :mod:`~quadcruise.cli.montecarlo_run`, :mod:`~quadcruise.cli.tune_run`).
+Bad input prints one line, ``error: ...``, and exits with status 2; a flight that did not
+finish (``fly``, ``compare``, ``reproduce``) or a tune that missed its targets, status 1.
 """
 
 from __future__ import annotations
