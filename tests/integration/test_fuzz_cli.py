@@ -121,7 +121,7 @@ def scenario_keys() -> list[tuple[str, str, str]]:
     from quadcruise.control import CONTROLLERS
     from quadcruise.missions import MISSIONS
     from quadcruise.model.vehicle import Vehicle
-    from quadcruise.workflows.scenario import SIMULATION_KEYS
+    from quadcruise.workflows.scenario import OFF_WHEN_INFINITE, SIMULATION_KEYS
 
     keys = [("vehicle", f.name, "number") for f in dataclasses.fields(Vehicle)]
     for name in ("hover", "step", "circle", "square"):
@@ -134,12 +134,14 @@ def scenario_keys() -> list[tuple[str, str, str]]:
             kind = ("table" if dataclasses.is_dataclass(default) else "text" if isinstance(default, str)
                     else "flag" if isinstance(default, bool) else "number")
             keys.append((f"controller:{name}", f.name, kind))
-    keys += [("simulation", k, "flag" if t is bool else "number") for k, t in SIMULATION_KEYS.items()]
+    keys += [("simulation", k, "flag" if t is bool else "bound" if k in OFF_WHEN_INFINITE else "number")
+             for k, t in SIMULATION_KEYS.items()]
     keys += [("disturbances", k, "table") for k in ("gust", "turbulence", "rotor_loss", "force", "sensor_noise")]
     return keys
 
 
 BAD_TOML = {"number": ['"xyz"', "[]", "{}", "true", "nan", "inf"], "text": ["1", "[]", "true"],
+            "bound": ['"xyz"', "[]", "true", "nan", "-inf", "0", "-1"],      # inf turns a bound off: not bad
             "flag": ['"xyz"', "2", "[]"], "table": ["1", '"xyz"', "[1, 2]", "{ nonsense = 1 }"]}
 
 

@@ -22,7 +22,8 @@ population's spreads."""
 
 SIMULATION_FROM_META = {"duration_s": "duration", "dt_s": "dt", "max_step_s": "max_step",
                         "full_dynamics": "full_dynamics", "seed": "seed", "log_every": "log_every",
-                        "max_track_error": "max_track_error", "initial_state": "initial_state"}
+                        "max_track_error": "max_track_error", "max_steady_error": "max_steady_error",
+                        "initial_state": "initial_state"}
 """Keys of a flight's meta and the [simulation] keys they become."""
 
 

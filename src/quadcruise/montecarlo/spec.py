@@ -21,14 +21,12 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
 from quadcruise._cache import code_digest
 from quadcruise._version import __version__
 from quadcruise.control import as_controller, controller_record
 from quadcruise.errors import InputError, whole_number
 from quadcruise.io.plainjson import dumps
-from quadcruise.layout import CMD_SIZE, REF_SIZE, REF_X, STATE_SIZE
+from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from quadcruise.missions import Mission, mission_from_name
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
@@ -39,7 +37,8 @@ __all__ = ["MonteCarloSpec", "default_track_bound"]
 
 def default_track_bound(mission: Mission, duration: float) -> float:
     """The default ``max_track_error_m`` of a sweep: the larger of 1 m and a quarter of the
-    mission's extent.
+    mission's extent (:func:`quadcruise.workflows.fly.steady_bound`, fly's default
+    ``max_steady_error``).
 
     Parameters
     ----------
@@ -62,9 +61,9 @@ def default_track_bound(mission: Mission, duration: float) -> float:
     >>> default_track_bound(mission_from_name("circle", radius=10.0), 20.0)
     5.0
     """
-    ref = mission.reference(np.linspace(0.0, float(duration), 1001))[:, REF_X:REF_X + 3]
-    extent = float(np.max(ref.max(axis=0) - ref.min(axis=0)))
-    return max(1.0, 0.25 * extent)
+    from quadcruise.workflows.fly import steady_bound
+
+    return steady_bound(mission, duration)           # one rule: fly's off-track bound
 
 
 def _divisor_at_most(n: int, target: int) -> int:

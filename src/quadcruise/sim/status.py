@@ -9,8 +9,8 @@ Examples
 'diverged: position left the bound'
 >>> ExitStatus.FINISHED.ok, ExitStatus.NONFINITE.ok, ExitStatus.LOST_TRACK.ok
 (True, False, False)
->>> ExitStatus.LOST_TRACK.stopped, ExitStatus.TILT_BOUND.stopped
-(False, True)
+>>> ExitStatus.LOST_TRACK.stopped, ExitStatus.OFF_TRACK.stopped, ExitStatus.TILT_BOUND.stopped
+(False, False, True)
 """
 
 from __future__ import annotations
@@ -25,8 +25,10 @@ class ExitStatus(IntEnum):
 
     ``FINISHED`` flew the whole mission. ``LOST_TRACK`` flew it too, but its position error
     left the tracking bound at the time recorded in :attr:`quadcruise.SimResult.t_stop` (see
-    :func:`quadcruise.fly`'s ``max_track_error``). Every other status is the engine's: it
-    stopped the vehicle at ``t_stop``, and its later log rows are NaN.
+    :func:`quadcruise.fly`'s ``max_track_error``: a runaway). ``OFF_TRACK`` flew it too, but
+    its position error after the transient exceeded the steady bound, first at ``t_stop``
+    (``max_steady_error``: a vehicle that never got onto its path, or left it). Every other
+    status is the engine's: it stopped the vehicle at ``t_stop``, and its later log rows are NaN.
     """
 
     FINISHED = 0
@@ -38,6 +40,7 @@ class ExitStatus(IntEnum):
     BAD_COMMAND = 6
     LOST_TRACK = 7
     PITCH_SINGULAR = 8
+    OFF_TRACK = 9
 
     @property
     def reason(self) -> str:
@@ -52,7 +55,7 @@ class ExitStatus(IntEnum):
     @property
     def stopped(self) -> bool:
         """True for a vehicle the engine stopped before the end (diverged or a bad command)."""
-        return self not in (ExitStatus.FINISHED, ExitStatus.LOST_TRACK)
+        return self not in (ExitStatus.FINISHED, ExitStatus.LOST_TRACK, ExitStatus.OFF_TRACK)
 
 
 _REASONS = {
@@ -65,6 +68,8 @@ _REASONS = {
     ExitStatus.BAD_COMMAND: "stopped: the controller returned a non-finite command",
     ExitStatus.LOST_TRACK: "lost track: the position error left the tracking bound",
     ExitStatus.PITCH_SINGULAR: "stopped: pitch beyond 85 degrees, near the full plant's Euler-angle singularity",
+    ExitStatus.OFF_TRACK: "off track: the position error after the transient (at the end, if it never settled) "
+                          "exceeded the steady bound",
 }
 
 STATUS_REASONS = tuple(status.reason for status in ExitStatus)

@@ -24,7 +24,7 @@ from quadcruise._version import __version__
 from quadcruise.control import as_controller, controller_record
 from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import InputError, reject_unknown
-from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, REF_Z, STATE_SIZE, X, Z
+from quadcruise.layout import CMD_U1, F1, P_G, P_M, PSI, REF_PSI, REF_X, REF_Z, STATE_SIZE, X, Z
 from quadcruise.missions import Mission, mission_from_name, stack_params
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
@@ -90,7 +90,7 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
         controller_vehicle: Vehicle | None = None, full_dynamics: bool = False,
         environment: Environment | None = None, sensors: SensorNoise | None = None,
         seed: int = 0, first_vehicle: int | np.ndarray = 0, max_track_error: float | None = None,
-        **unknown: Any) -> SimResult:
+        max_steady_error: float | None = None, **unknown: Any) -> SimResult:
     """Fly a mission with a controller and return the logged flight.
 
     Parameters
@@ -144,7 +144,16 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
         result says so, and ``fly`` warns). By default :func:`track_bound`: 1 m, plus the
         diagonal of the box the mission's reference path spans, plus the vehicle's initial
         position error (the default circle of radius 2 m: 8.66 m; a 1 m step: 2 m; hover:
-        1 m); ``numpy.inf`` turns it off.
+        1 m); ``numpy.inf`` turns it off. It catches a runaway.
+    max_steady_error : float, optional
+        Steady bound [m]: a vehicle that flew the whole mission within ``max_track_error``
+        but whose position error after the transient (from its settling into 5 % on; the
+        whole flight without a step; the error at the end if it never settles) exceeds it
+        gets the status ``off track``, from the first such instant: it never got onto its
+        path, or left it (a circle too fast to fly, a vehicle that sags or falls, a limit
+        cycle). By default :func:`steady_bound`: the larger of 1 m and a quarter of the
+        longest side of the box the reference spans over the flight (1 m for the built-in
+        missions), the rule a Monte Carlo sweep applies; ``numpy.inf`` turns it off.
     **unknown : Any
         Refused: any other keyword is an InputError naming the options (see
         :data:`FLY_OPTIONS`), so a misspelt one is not silently ignored.
@@ -157,8 +166,9 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
         of the rotor duties.
     """
     reject_unknown("fly()", unknown, FLY_OPTIONS)
-    if max_track_error is not None and not (isinstance(max_track_error, (int, float)) and max_track_error > 0):
-        raise InputError(f"max_track_error must be a positive number [m], got {max_track_error!r}")
+    for name, value in (("max_track_error", max_track_error), ("max_steady_error", max_steady_error)):
+        if value is not None and not (isinstance(value, (int, float)) and not isinstance(value, bool) and value > 0):
+            raise InputError(f"{name} must be a positive number [m], got {value!r}")
     if isinstance(mission, str):
         mission = mission_from_name(mission)
     controllers = per_vehicle_controllers(controller)
@@ -191,6 +201,7 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
         "max_step_s": float(max_step or dt), "n": n, "version": __version__,
         "full_dynamics": bool(full_dynamics), "seed": seed, "log_every": int(log_every),
         "max_track_error": None if max_track_error is None else float(max_track_error),
+        "max_steady_error": None if max_steady_error is None else float(max_steady_error),
         "initial_state": given_x0,
     }
     if environment is not None:
@@ -212,6 +223,11 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
              if max_track_error is None else np.full(n, float(max_track_error)))
     result.meta["max_track_error_m"] = bound.tolist() if n > 1 else float(bound[0])
     result = mark_lost_track(result, bound)
+    steady = (np.array([steady_bound(m, duration) for m in missions]) if missions else
+              np.full(n, steady_bound(first, duration))) if max_steady_error is None else \
+        np.full(n, float(max_steady_error))
+    result.meta["max_steady_error_m"] = steady.tolist() if n > 1 else float(steady[0])
+    result = mark_off_track(result, steady)
     _warn_about(result)
     return result
 
@@ -266,7 +282,8 @@ def per_vehicle_controllers(controller: Any) -> list:
 
 FLY_OPTIONS = ("vehicle", "duration", "dt", "max_step", "n", "x0", "log_every", "limits", "missions",
                "controller_vehicle", "full_dynamics", "environment", "sensors", "seed", "first_vehicle",
-               "max_track_error")
+               "max_track_error", "max_steady_error")
+"""The keywords :func:`fly` takes besides the mission and the controller."""
 
 MAX_LOG_FRACTION = 0.5
 """Largest share of the machine's memory a flight's log may take: :func:`check_run_size`."""
@@ -402,6 +419,83 @@ def track_bound(missions: list[Mission], x0: np.ndarray, n: int) -> np.ndarray:
     return 1.0 + size + offset
 
 
+def steady_bound(mission: Mission, duration: float) -> float:
+    """The default steady bound [m] of a flight (``fly(max_steady_error=)``) and of a Monte
+    Carlo sweep (``MonteCarloSpec.max_track_error_m``): the larger of 1 m and a quarter of
+    the mission's extent.
+
+    Parameters
+    ----------
+    mission : Mission
+        The mission flown.
+    duration : float
+        Flight time [s].
+
+    Returns
+    -------
+    float
+        The bound [m]; the extent is the longest side of the box holding the reference
+        position at 1,001 instants over the flight.
+
+    Examples
+    --------
+    >>> from quadcruise.missions import mission_from_name
+    >>> steady_bound(mission_from_name("circle"), 20.0)
+    1.0
+    >>> steady_bound(mission_from_name("circle", radius=10.0), 20.0)
+    5.0
+    """
+    ref = mission.reference(np.linspace(0.0, float(duration), 1001))[:, REF_X:REF_X + 3]
+    extent = float(np.max(ref.max(axis=0) - ref.min(axis=0)))
+    return max(1.0, 0.25 * extent)
+
+
+def mark_off_track(result: SimResult, bound: np.ndarray) -> SimResult:
+    """The result, with ``off track`` as the status of each finished vehicle whose position
+    error after the transient exceeded the bound, and the first instant it did as its ``t_stop``.
+
+    After the transient: from the settling time into
+    :data:`~quadcruise.metrics.flight.STEADY_BAND` on (the steady window of ``steady_*``
+    metrics); the whole flight without a step; the last instant if it never settles (the
+    error at the end), as a Monte Carlo sweep judges its flights.
+
+    Parameters
+    ----------
+    result : SimResult
+    bound : numpy.ndarray
+        (N,) bounds [m]; ``inf`` skips a vehicle.
+
+    Returns
+    -------
+    SimResult
+        The same object when no vehicle is off track.
+    """
+    from quadcruise.metrics.batch import flight_metrics_batch
+
+    live = np.flatnonzero((result.status == int(ExitStatus.FINISHED)) & np.isfinite(bound))
+    if not live.size or result.t.size < 2:
+        return result
+    pos, ref = result.states[live, :, X:X + 3], result.references[live, :, REF_X:REF_X + 3]
+    if not (np.isfinite(pos).all() and np.isfinite(ref).all()):
+        return result
+    mission = result.meta.get("mission")
+    got = flight_metrics_batch(result.t, pos, ref, result.commands[live, :, CMD_U1:CMD_U1 + 4],
+                               mission=mission if isinstance(mission, dict) else None)
+    settled = np.isfinite(got["steady_max_error_m"])
+    after = np.where(settled, got["steady_max_error_m"], got["final_error_m"])
+    off = after > bound[live]
+    if not off.any():
+        return result
+    start = np.where(settled, got["steady_from_s"], result.t[-1])
+    err = np.linalg.norm(pos - ref, axis=2)
+    beyond = (err > bound[live, None]) & (result.t[None, :] >= start[:, None])
+    first = np.where(beyond.any(axis=1), result.t[np.argmax(beyond, axis=1)], start)
+    status, t_stop = result.status.copy(), result.t_stop.copy()
+    status[live[off]] = int(ExitStatus.OFF_TRACK)
+    t_stop[live[off]] = first[off]
+    return dataclasses.replace(result, status=status, t_stop=t_stop)
+
+
 def mark_lost_track(result: SimResult, bound: np.ndarray) -> SimResult:
     """The result, with ``lost track`` as the status of each finished vehicle whose position
     error left the bound, and the first logged instant it did as its ``t_stop``.
@@ -426,7 +520,6 @@ def mark_lost_track(result: SimResult, bound: np.ndarray) -> SimResult:
     status[lost] = int(ExitStatus.LOST_TRACK)
     t_stop[lost] = result.t[np.argmax(beyond[lost], axis=1)]
     return dataclasses.replace(result, status=status, t_stop=t_stop)
-"""The keywords :func:`fly` takes besides the mission and the controller."""
 
 
 def engine_inputs(environment: Environment | None, sensors: SensorNoise | None, n: int, dt: float) -> dict:
@@ -496,4 +589,4 @@ def _warn_about(result: SimResult) -> None:
                       f"({np.count_nonzero(clipped)} of {result.n} vehicles)", stacklevel=3)
 
 
-__all__ = ["fly", "default_duration", "hover_state", "per_vehicle_controllers", "write_flight"]
+__all__ = ["fly", "default_duration", "hover_state", "per_vehicle_controllers", "steady_bound", "write_flight"]

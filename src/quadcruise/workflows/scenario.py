@@ -34,7 +34,7 @@ A scenario has up to seven tables; every one is optional::
     duration = 30.0
     dt = 0.001
     full_dynamics = false
-    seed = 1                  # also: max_step, log_every, n, max_track_error, initial_state
+    seed = 1                  # also: max_step, log_every, n, max_track_error, max_steady_error, initial_state
 
     [montecarlo]              # read by `quadcruise montecarlo`
     n = 1000
@@ -75,7 +75,8 @@ from quadcruise.model.vehicle import Vehicle
 TABLES = ("vehicle", "controller", "mission", "disturbances", "simulation", "montecarlo", "controller_vehicle",
           "compare")
 SIMULATION_KEYS = {"duration": float, "dt": float, "max_step": float, "full_dynamics": bool,
-                   "seed": int, "log_every": int, "n": int, "max_track_error": float, "initial_state": list}
+                   "seed": int, "log_every": int, "n": int, "max_track_error": float,
+                   "max_steady_error": float, "initial_state": list}
 DISTURBANCE_KEYS = ("wind", "gust", "turbulence", "rotor_loss", "force", "sensor_noise")
 
 
@@ -101,8 +102,8 @@ class Scenario:
         and its delay [s], or None.
     simulation : dict
         The checked ``[simulation]`` table: ``duration`` [s], ``dt`` [s], ``max_step`` [s],
-        ``full_dynamics``, ``seed``, ``log_every``, ``n``, ``max_track_error`` [m] and
-        ``initial_state`` (16 state values in the units of :data:`quadcruise.layout.STATE_UNITS`,
+        ``full_dynamics``, ``seed``, ``log_every``, ``n``, ``max_track_error`` [m],
+        ``max_steady_error`` [m] and ``initial_state`` (16 state values in the units of :data:`quadcruise.layout.STATE_UNITS`,
         or one row per vehicle), each only if given.
     montecarlo : dict
         The ``[montecarlo]`` table as written (checked by ``quadcruise montecarlo``).
@@ -155,12 +156,12 @@ class Scenario:
         dict
             ``duration`` [s] (None if not given), ``dt`` [s], ``vehicle``, and those of
             ``max_step``, ``full_dynamics``, ``seed``, ``log_every``, ``n``,
-            ``max_track_error``, ``x0`` (the initial state), ``controller_vehicle``,
+            ``max_track_error``, ``max_steady_error``, ``x0`` (the initial state), ``controller_vehicle``,
             ``environment`` and ``sensors`` the scenario gives.
         """
         sim = self.simulation
         kw: dict[str, Any] = {"duration": sim.get("duration"), "dt": self.dt}
-        for key in ("max_step", "full_dynamics", "seed", "log_every", "n", "max_track_error"):
+        for key in ("max_step", "full_dynamics", "seed", "log_every", "n", "max_track_error", "max_steady_error"):
             if key in sim:
                 kw[key] = sim[key]
         if "initial_state" in sim:
@@ -322,7 +323,12 @@ def _numbers(where: _Where, key: str, value: list):
     """A list of numbers (one per vehicle, or a row of a table) as a float array."""
     import numpy as np
 
-    return np.array([_numbers(where, key, v) if isinstance(v, list) else _number(where, key, v) for v in value])
+    if not isinstance(value, list) or not value:
+        raise where.error(f"'{key}' must be a list of numbers, got {value!r}")
+    rows = [_numbers(where, key, v) if isinstance(v, list) else _number(where, key, v) for v in value]
+    if len({np.shape(r) for r in rows}) > 1:
+        raise where.error(f"'{key}' must be a list of numbers or of equal lists of numbers (one per vehicle)")
+    return np.array(rows)
 
 
 def _poles(where: _Where, key: str, value) -> list:
@@ -444,15 +450,22 @@ def _table(where: _Where, key: str, value) -> dict:
     return value
 
 
+OFF_WHEN_INFINITE = ("max_track_error", "max_steady_error")
+"""[simulation] bounds that ``inf`` turns off (as in :func:`quadcruise.fly`); every other number is finite."""
+
+
 def _simulation(where: _Where, table: dict) -> dict:
     _known(where, "", table, set(SIMULATION_KEYS))
-    out = {k: _numbers(where, k, v) if SIMULATION_KEYS[k] is list else _number(where, k, v, SIMULATION_KEYS[k])
+    out = {k: _numbers(where, k, v) if SIMULATION_KEYS[k] is list else
+           (math.inf if k in OFF_WHEN_INFINITE and isinstance(v, float) and v == math.inf
+            else _number(where, k, v, SIMULATION_KEYS[k]))
            for k, v in table.items()}
     for key in ("duration", "dt", "max_step"):
         if key in out and out[key] <= 0:
             raise where.error(f"'{key}' must be > 0 seconds, got {out[key]!r}")
-    if "max_track_error" in out and out["max_track_error"] <= 0:
-        raise where.error(f"'max_track_error' must be > 0 metres, got {out['max_track_error']!r}")
+    for key in ("max_track_error", "max_steady_error"):
+        if key in out and out[key] <= 0:
+            raise where.error(f"'{key}' must be > 0 metres, got {out[key]!r}")
     if "initial_state" in out and out["initial_state"].shape[-1:] != (16,):
         raise where.error("'initial_state' must be 16 numbers (x, y, z, vx, ..., F4), or one such list per vehicle")
     if out.get("seed", 0) < 0:
