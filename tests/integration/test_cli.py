@@ -58,7 +58,7 @@ def test_fly_controller_options_reach_the_controller(tmp_path):
     (["fly", "circle", "--controller", "pid"], "unknown controller 'pid'"),
     (["fly", "circle", "-m", "radius"], "--mission-param 'radius': expected KEY=VALUE"),
     (["fly", "circle", "-m", "radius=-2"], "circle field 'radius' (circle radius, m) must be > 0"),
-    (["fly", "circle", "--animate", "a.png"], "the animation must be a .gif"),
+    (["fly", "circle", "--animate", "a.png"], "an animation is written as .gif or .mp4"),
     (["fly", "circle", "--bogus"], "No such option '--bogus'"),
     (["compare", "circle", "--controllers", "nlpd,pid"], "unknown controller 'pid'"),
     (["fly", "hover", "--settle-band", "1.5"], "settle_bands must be one or two fractions in (0, 1)"),

@@ -19,8 +19,18 @@ __all__ = ["FORCE_OPTION", "FORMAT_OPTION", "REPORT_OPTION", "RISE_OPTION", "SET
            "metric_options", "writable", "controller_from_options", "mission_from_options"]
 
 # options several commands share
+def _table_format(ctx: click.Context, param: click.Parameter, value: str) -> str:
+    from quadcruise.io.files import check_table_format
+
+    try:
+        check_table_format(value)           # Parquet needs pyarrow: said before anything flies
+    except InputError as exc:
+        raise click.BadParameter(str(exc), ctx=ctx, param=param) from None
+    return value
+
+
 FORMAT_OPTION = click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv",
-                             show_default=True, help="Format of the traces.")
+                             show_default=True, callback=_table_format, help="Format of the traces.")
 FORCE_OPTION = click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
 def writable(ctx: click.Context, param: click.Parameter, value):
     """A click callback: refuse an output path that could not be written, before any work.

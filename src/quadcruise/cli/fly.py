@@ -20,7 +20,6 @@ from quadcruise.cli.common import (
     writable,
 )
 from quadcruise.cli.objects import flight_from_options
-from quadcruise.errors import InputError
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["fly"]
@@ -152,8 +151,10 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
     from quadcruise.workflows.fly import fly as run_fly
     from quadcruise.workflows.fly import write_flight
 
-    if animate is not None and not animate.lower().endswith((".gif", ".mp4")):
-        raise InputError(f"--animate {animate}: the animation must be a .gif (or .mp4, with ffmpeg)")
+    if animate is not None:
+        from quadcruise.plots.animate import check_animation_path
+
+        check_animation_path(animate)       # suffix, and ffmpeg for .mp4: before anything flies
     if out is not None:
         check_output_dir(out, force)
     result = run_fly(mission, controller, **kwargs)

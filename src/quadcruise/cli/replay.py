@@ -12,6 +12,7 @@ __all__ = ["replay"]
 @click.command("replay")
 @click.argument("pwm_csv", metavar="PWM.csv")
 @click.option("-o", "--out", "out", required=True, metavar="STATES.csv", callback=writable,
+              type=click.Path(dir_okay=False),
               help="Where to write the states (t,x,y,z,vx,vy,vz,phi,theta,psi,p,q,r,F1..F4).")
 @click.option("--max-step", default=1e-3, show_default=True, type=float,
               help="Longest RK4 substep [s].")
@@ -34,8 +35,13 @@ def replay(pwm_csv: str, out: str, max_step: float) -> None:
     max_step : float
         ``--max-step``: longest RK4 substep [s].
     """
+    import os
+
     from quadcruise.workflows.replay import read_duty_csv, write_states_csv
     from quadcruise.workflows.replay import replay as run_replay
+
+    if os.path.exists(out) and os.path.exists(pwm_csv) and os.path.samefile(pwm_csv, out):
+        raise click.BadParameter(f"{out} is the input file: write the states elsewhere", param_hint="'-o'")
 
     schedule = read_duty_csv(pwm_csv, progress=Bar(f"reading {pwm_csv}", unit="row"))
     result = run_replay(schedule, max_step=max_step, progress=Bar("flying", unit="row"))

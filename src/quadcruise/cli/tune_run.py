@@ -112,7 +112,7 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str = 
              if DEFAULTS.get(k, object()) != v}
     if out is not None:
         check_output_dir(out, force)
-    kwargs: dict = {"duration": duration, "dt": dt or 1e-3, "vehicle": None}
+    kwargs: dict = {"duration": duration, "dt": 1e-3 if dt is None else dt, "vehicle": None}
     environment, sensors = (parse_wind(wind) if wind is not None else None), parse_noise(noise)
     if mission.lower().endswith(".toml"):
         from quadcruise.errors import InputError
@@ -125,7 +125,8 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str = 
         the_controller = sc.controller
         if the_controller is None or controller_params or controller != "nlpd":
             the_controller = controller_from_options(controller, controller_params, None)
-        kwargs.update(vehicle=sc.vehicle, duration=duration or sc.duration, dt=dt or sc.dt)
+        kwargs.update(vehicle=sc.vehicle, duration=sc.duration if duration is None else duration,
+                      dt=sc.dt if dt is None else dt)
         environment = environment if environment is not None else sc.environment
         sensors = sensors if sensors is not None else sc.sensor_noise
     else:

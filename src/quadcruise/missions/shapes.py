@@ -53,6 +53,7 @@ from typing import ClassVar
 
 from numba import njit
 
+from quadcruise.errors import InputError
 from quadcruise.fields import unit_field as _f
 from quadcruise.layout import REF_AX, REF_AY, REF_PSI, REF_SIZE, REF_VX, REF_VY, REF_X, REF_Y, REF_Z
 from quadcruise.missions.base import Mission
@@ -354,6 +355,11 @@ class Circle(Mission):
                 self.start_angle, *self.center, self.yaw, self.ramp_time)
 
 
+MIN_LEG_S = 1e-6
+"""The shortest leg of a square [s] (side / speed): shorter is a hover, and the reference's
+arithmetic underflows."""
+
+
 @dataclass(frozen=True)
 class Square(Mission):
     """The paper's mapping square (Fig 6): constant-speed legs, explicit corners, repeating.
@@ -398,6 +404,13 @@ class Square(Mission):
     columns: ClassVar[tuple] = ("side", "speed", "altitude", "x0", "y0", "direction",
                                 "dwell", "yaw")
     function = staticmethod(square_ref)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        leg = float(self.side) / float(self.speed)
+        if not leg >= MIN_LEG_S:
+            raise InputError(f"square: a side of {self.side:g} m at {self.speed:g} m/s takes {leg:g} s, "
+                             f"under {MIN_LEG_S:g} s: too short a leg to fly")
 
     @property
     def lap_time(self) -> float:

@@ -523,6 +523,11 @@ def _as_table(value: Any) -> WaypointTable:
     raise InputError(f"a waypoint table must be a WaypointTable, a CSV path or a dict, got {type(value).__name__}")
 
 
+MAX_PATH_S = 1.0e7
+"""The longest a waypoint path may take to fly [s] (about 116 days): beyond it a coordinate or a
+speed is surely wrong, and the flight's size check would refuse it anyway."""
+
+
 @dataclass(frozen=True)
 class _WaypointMission(Mission):
     """Shared parts: the table (a WaypointTable, CSV path or dict), the default speed,
@@ -534,6 +539,11 @@ class _WaypointMission(Mission):
     def __post_init__(self) -> None:
         object.__setattr__(self, "table", _as_table(self.table))
         super().__post_init__()
+        with np.errstate(over="ignore", invalid="ignore"):
+            last = float(self.times[-1])
+        if not (math.isfinite(last) and last <= MAX_PATH_S):
+            raise InputError(f"{self.table.source}: flying the path takes {last:g} s at its speeds, more than {MAX_PATH_S:g} s "
+                             "(a coordinate too large, or a speed too small?)")
 
     @property
     def times(self) -> np.ndarray:

@@ -43,7 +43,8 @@ def compare_population(mission, controllers, population, n: int, seed: int, *,
         One row per controller, indexed by label: ``flights``, ``failure_rate`` [-], and
         the median (p50) and p95 of ``rmse_m``, ``max_error_m``, ``steady_rmse_m``,
         ``steady_max_error_m`` [m] (the error after the transient: over the flights whose
-        transient settled) and ``settling_time_5pct_s`` [s].
+        transient settled) and ``settling_time_5pct_s`` [s], over the flights that kept
+        track (:meth:`MonteCarloResult.summary_data`).
 
     Examples
     --------

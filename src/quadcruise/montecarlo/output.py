@@ -221,7 +221,11 @@ def report_markdown(result, summary: dict, worst, table_name: str) -> str:
                  f"{ns['count']:,} flights ({100 * ns['rate']:.2f} %).")
     if summary["stopped"]:
         lines.append("\nWhy the engine stopped flights: " + "; ".join(f"{k}: {v:,}" for k, v in summary["stopped"].items()) + ".")
-    lines += ["\n## Metrics\n", "| metric | flights | p5 | p50 | p95 | max |", "|---|---|---|---|---|---|"]
+    left_out = summary["flights"] - summary["metrics_over"]
+    lines += ["\n## Metrics\n", f"Over the {summary['metrics_over']:,} flights that kept track"
+              + (f": the {left_out:,} that diverged or lost track are left out, so that their numbers do not pass "
+                 "for a good flight's." if left_out else ".") + "\n",
+              "| metric | flights | p5 | p50 | p95 | max |", "|---|---|---|---|---|---|"]
     for name, m in summary["metrics"].items():
         cells = " | ".join("-" if m[k] is None else f"{m[k]:.4g}" for k in ("p5", "p50", "p95", "max"))
         lines.append(f"| {name} | {m['count']:,} | {cells} |")

@@ -136,8 +136,11 @@ class MonteCarloResult:
             ``rate`` of flights whose transient was still outside the spec's
             ``settle_band`` at the end (a metric, not a failure); ``stopped``: the engine's
             stop reason -> count; ``metrics``: for each of :data:`METRICS`, ``count``
-            (flights where it is defined), ``p5``, ``p50``, ``p95``, ``max`` and ``mean``
-            over them, in the metric's unit (None when no flight defines it).
+            (flights where it is defined, among those that kept track: a flight that diverged
+            or lost track is left out, so that its numbers do not pass for a good flight's),
+            ``p5``, ``p50``, ``p95``, ``max`` and ``mean`` over them, in the metric's unit
+            (None when no flight defines it); ``metrics_over``: the number of flights that
+            kept track.
         """
         from quadcruise.sim.status import STATUS_REASONS
 
@@ -154,8 +157,9 @@ class MonteCarloResult:
         unsettled = int(np.count_nonzero(tab["not_settled"].to_numpy()))
         stops = {STATUS_REASONS[c]: int(k) for c, k in zip(*np.unique(tab["status"], return_counts=True)) if c}
         metrics = {}
+        kept = ~(tab["diverged"].to_numpy(dtype=bool) | tab["lost_track"].to_numpy(dtype=bool))
         for name in METRICS:
-            v = tab[name].to_numpy(dtype=float)
+            v = tab[name].to_numpy(dtype=float)[kept]
             v = v[np.isfinite(v)]
             q = np.percentile(v, [5, 50, 95]) if v.size else [np.nan] * 3
             metrics[name] = {"count": int(v.size), "p5": _num(q[0]), "p50": _num(q[1]), "p95": _num(q[2]),
@@ -167,7 +171,7 @@ class MonteCarloResult:
                              "max_clipped_s": self.spec.max_clipped_s},
                 "requirements": requirements,
                 "not_settled": {"count": unsettled, "rate": unsettled / n, "band": self.spec.settle_band},
-                "stopped": stops, "metrics": metrics}
+                "stopped": stops, "metrics": metrics, "metrics_over": int(np.count_nonzero(kept))}
 
     def summary_text(self, worst: int = 0) -> str:
         """The summary as aligned text (for the terminal).
@@ -200,6 +204,9 @@ class MonteCarloResult:
         ns = s["not_settled"]
         lines.append(f"  not settled within {100 * ns['band']:g} % (a metric, not a failure): "
                      f"{ns['count']:,} ({100 * ns['rate']:.2f} %)")
+        left_out = s["flights"] - s["metrics_over"]
+        lines.append(f"  metrics over the {s['metrics_over']:,} flights that kept track"
+                     + (f" ({left_out:,} that diverged or lost track left out)" if left_out else "") + ":")
         lines.append(f"  {'metric':<22}{'count':>8}{'p5':>11}{'p50':>11}{'p95':>11}{'max':>11}")
         for name, m in s["metrics"].items():
             lines.append(f"  {name:<22}{m['count']:>8,}" + "".join(

@@ -32,7 +32,7 @@ from quadcruise.errors import InputError, SimulationError
 from quadcruise.io.files import atomic_path
 from quadcruise.plots.thin import thinned
 
-__all__ = ["animate_flight"]
+__all__ = ["animate_flight", "check_animation_path"]
 
 MAX_LINE_POINTS = 1500
 """Most points of a line drawn per frame (the trail, the altitude trace)."""
@@ -44,6 +44,37 @@ def _ffmpeg() -> str | None:
 
     configured = matplotlib.rcParams.get("animation.ffmpeg_path", "ffmpeg")
     return shutil.which(configured) or shutil.which("ffmpeg")
+
+
+def check_animation_path(path) -> None:
+    """Refuse an animation path this machine cannot write: a suffix other than .gif or
+    .mp4, or .mp4 without ffmpeg.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Where the animation would go.
+
+    Raises
+    ------
+    InputError
+        Naming the path and what to do instead.
+
+    Examples
+    --------
+    >>> check_animation_path("flight.gif")
+    >>> check_animation_path("flight.avi")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: flight.avi: an animation is written as .gif or .mp4, not '.avi'
+    """
+    path = Path(path)
+    kind = path.suffix.lower()
+    if kind not in (".gif", ".mp4"):
+        raise InputError(f"{path}: an animation is written as .gif or .mp4, not {path.suffix or 'no suffix'!r}")
+    if kind == ".mp4" and _ffmpeg() is None:
+        raise InputError(f"{path}: writing .mp4 needs ffmpeg, which is not installed; "
+                         "write a .gif instead (e.g. flight.gif)")
 
 
 def _frame_indices(t: np.ndarray, end: int, fps: float, duration_s, every) -> np.ndarray:
@@ -109,12 +140,8 @@ def animate_flight(result, path, *, vehicle: int = 0, fps: float = 15, duration_
 
     path = Path(path)
     kind = path.suffix.lower()
-    if kind not in (".gif", ".mp4"):
-        raise InputError(f"{path}: an animation is written as .gif or .mp4, not {path.suffix or 'no suffix'!r}")
+    check_animation_path(path)
     ffmpeg = _ffmpeg() if kind == ".mp4" else None
-    if kind == ".mp4" and ffmpeg is None:
-        raise InputError(f"{path}: writing .mp4 needs ffmpeg, which is not installed; "
-                         "write a .gif instead (e.g. flight.gif)")
     if not 0 <= vehicle < result.n:
         raise InputError(f"vehicle {vehicle} is not in this result of {result.n} vehicle(s)")
     if not (np.isfinite(fps) and fps > 0):

@@ -142,6 +142,9 @@ def tune(mission: Mission | str = "step", controller: Any = "nlpd", *, gains=Non
         raise InputError(f"population must be a Population, got {type(population).__name__}")
     spec = MonteCarloSpec(mission, base, population, seed=seed, duration=duration, dt=dt,
                           vehicle=vehicle or Vehicle.paper(), log_dt=log_dt, transient_until=transient_until)
+    from quadcruise.workflows.fly import check_run_size
+
+    check_run_size(popsize * samples, spec.periods, spec.log_every)   # one generation is one batch: size it first
     obj = Objective(spec, space, targets, requirements, minimize, samples, statistic)
     _search(obj, budget, popsize, tol, seed, progress)
     return TuneResult.from_search(obj, budget=budget, popsize=popsize, command=command)

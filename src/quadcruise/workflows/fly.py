@@ -166,6 +166,8 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
         of the rotor duties.
     """
     reject_unknown("fly()", unknown, FLY_OPTIONS)
+    if max_step is not None and not (isinstance(max_step, (int, float)) and max_step > 0):
+        raise InputError(f"max_step must be a positive number of seconds, got {max_step!r}")
     for name, value in (("max_track_error", max_track_error), ("max_steady_error", max_steady_error)):
         if value is not None and not (isinstance(value, (int, float)) and not isinstance(value, bool) and value > 0):
             raise InputError(f"{name} must be a positive number [m], got {value!r}")
@@ -187,7 +189,10 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
     first = missions[0] if missions else mission
     duration = default_duration(first) if duration is None else duration
     grid = time_grid(float(duration), float(dt))
-    check_run_size(n, grid.size - 1, int(log_every))
+    if sensors is not None and np.max(sensors.delay) > duration:
+        raise InputError(f"sensor field 'delay' ({np.max(sensors.delay):g} s) is longer than the flight "
+                         f"({float(duration):g} s)")
+    check_run_size(n, grid.size - 1, int(log_every), max(1, math.ceil(float(dt) / float(max_step or dt) - 1e-9)))
     check_can_hover(vehicle)
     given_x0 = None if x0 is None else np.asarray(x0, dtype=float).tolist()
     x0 = hover_state(vehicle, n, first) if x0 is None else x0
@@ -292,7 +297,7 @@ MAX_VEHICLE_STEPS = 2.0e10
 vehicle-steps per second on two cores, about two hours or more."""
 
 
-def check_run_size(n: int, steps: int, log_every: int) -> None:
+def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1) -> None:
     """Refuse, before anything is allocated, a flight whose log would not fit in memory or that
     would run for hours; the message says what to change.
 
@@ -304,6 +309,8 @@ def check_run_size(n: int, steps: int, log_every: int) -> None:
         Control periods of the flight.
     log_every : int
         Log every this many periods.
+    substeps : int
+        RK4 substeps per control period (``ceil(dt / max_step)``).
 
     Raises
     ------
@@ -325,6 +332,10 @@ def check_run_size(n: int, steps: int, log_every: int) -> None:
     if n * steps > MAX_VEHICLE_STEPS:
         raise InputError(f"{n:,} vehicles x {steps:,} control periods is {n * steps:.2g} vehicle-steps, hours of "
                          f"computing: fly fewer vehicles or a shorter duration")
+    if n * steps * substeps > MAX_VEHICLE_STEPS * 4:        # an RK4 substep costs about a quarter of a period
+        raise InputError(f"{n:,} vehicles x {steps:,} control periods x {substeps:,} RK4 substeps each is "
+                         f"{n * steps * substeps:.2g} substeps, hours of computing: a larger max_step, fewer "
+                         "vehicles or a shorter duration")
     row = 8 * (STATE_SIZE + CMD_SIZE + REF_SIZE)
     need = n * (steps // log_every + 2) * row
     try:

@@ -345,7 +345,7 @@ def _poles(where: _Where, key: str, value) -> list:
 
 def _controller(where: _Where, table: dict) -> Controller:
     name = table.get("name", "nlpd")
-    if name not in CONTROLLERS:
+    if not isinstance(name, str) or name not in CONTROLLERS:
         raise where.error(f"unknown controller name {name!r} (known: {', '.join(CONTROLLERS)})")
     cls = CONTROLLERS[name]
     defaults = cls()
@@ -402,7 +402,7 @@ def _compare(where: _Where, table: dict) -> dict:
 
 def _mission(where: _Where, table: dict, base: Path | None) -> Mission:
     kind = table.get("kind")
-    if kind not in MISSIONS:
+    if not isinstance(kind, str) or kind not in MISSIONS:
         raise where.error(f"'kind' must be one of {', '.join(MISSIONS)}, got {kind!r}")
     cls = MISSIONS[kind]
     fields = {f.name for f in dataclasses.fields(cls)}
