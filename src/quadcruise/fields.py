@@ -715,6 +715,8 @@ def parse_assignments(items: str | Iterable[str], what: str, keys: Iterable[str]
                 hint = f" (did you mean '{close[0]}'?)" if close else ""
                 raise InputError(f"{what} {item!r}: unknown key {key!r}{hint}; keys: {', '.join(rename)}")
             key = lower[key.lower()]
+        if key in out:
+            raise InputError(f"{what} {item!r}: {key!r} is given twice; give each key once")
         values = [_value(r) for r in raws]
         numeric = all(_is_number(v) for v in values)
         if numbers and not numeric:

@@ -60,3 +60,46 @@ def test_probed_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, args, 
     assert len(lines) == 1 and lines[0].startswith("error: ") and words in lines[0], proc.stderr
     assert "Traceback" not in proc.stdout + proc.stderr and not proc.stdout.strip()      # nothing flew
     assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+@pytest.mark.parametrize("args, words", [
+    (["compare", "circle", "--wind", "dryden:moderate@10"], "--wind describes the population that --population N flies"),
+    (["compare", "circle", "--seed", "3"], "--seed describes the population"),
+    (["fly", "circle", "-m", "radius=3", "-m", "radius=4"], "'radius' is given twice"),
+    (["tune", "step", "--target", "rise_time_s=1", "--bounds", "position.kp=1:2", "--bounds", "position.kp=3:4"],
+     "position.kp is bounded twice"),
+])
+def test_an_option_that_would_change_nothing_or_is_given_twice_is_refused(tmp_path, args, words):
+    proc = quadcruise(*args, cwd=tmp_path)
+    assert proc.returncode == 2, proc.stdout + proc.stderr
+    assert proc.stderr.strip().splitlines() == [proc.stderr.strip()] and words in proc.stderr
+
+
+POPULATION_SCENARIO = '[vehicle]\nm = 1.4\n[mission]\nkind = "step"\nsize = 1.0\n[disturbances]\nwind = [4.0, 0.0, 0.0]\n'
+
+
+def test_options_given_with_a_scenario_win_and_the_scenario_fills_the_rest(tmp_path):
+    from click.testing import CliRunner
+
+    from quadcruise.cli import main
+
+    scenario = tmp_path / "pop.toml"
+    scenario.write_text(POPULATION_SCENARIO + '[controller]\nname = "gonzalez"\n')
+    run = CliRunner().invoke
+    # montecarlo: --mission and --controller replace the scenario's; left out, the scenario's fly
+    res = run(main, ["montecarlo", "--scenario", str(scenario), "--mission", "square", "--controller", "se3", "-n", "2",
+                     "--duration", "2", "--quiet"])
+    assert res.exit_code == 0 and "2 flights of se3 on square" in res.output, res.output
+    res = run(main, ["montecarlo", "--scenario", str(scenario), "-n", "2", "--duration", "2", "--quiet"])
+    assert res.exit_code == 0 and "2 flights of gonzalez on step" in res.output, res.output
+    # tune: --controller replaces the scenario's; -c alone changes the scenario's controller
+    tuned = [run(main, ["tune", str(scenario), *extra, "--target", "rise_time_s=3", "--budget", "1", "--popsize", "5",
+                        "--duration", "6", "--quiet"]) for extra in (["--controller", "nlpd", "--gains", "position.kp"],
+                                                                       ["-c", "max_tilt=0.5", "--gains", "accel_p"])]
+    assert "tuned nlpd on step" in tuned[0].output and "tuned gonzalez on step" in tuned[1].output, tuned[1].output
+    # compare --population: the scenario's vehicle and wind act on the population too
+    res = run(main, ["compare", str(scenario), "--controllers", "nlpd", "--population", "2", "--mass-spread", "0"])
+    assert res.exit_code == 0, res.output
+    nominal = float(next(ln for ln in res.output.splitlines() if ln.startswith("rmse_m")).split()[1])
+    population = float(next(ln for ln in res.output.splitlines() if ln.startswith("nlpd ")).split()[3])
+    assert population == pytest.approx(nominal, rel=0.01)        # the same vehicle in the same wind

@@ -252,12 +252,14 @@ def test_parse_assignments_values():
     assert got == {"radius": 3, "center": (1, 2.5), "axis": "x", "ff": True, "scale": -0.002, "path": "a,b.csv"}
     assert type(got["radius"]) is int
     assert parse_assignments("a=1, b = 2 ,c=3", "-m") == {"a": 1, "b": 2, "c": 3}
-    assert parse_assignments([], "-m") == {} and parse_assignments(("a=1", "a=2"), "-m") == {"a": 2}
+    assert parse_assignments([], "-m") == {}
     assert parse_assignments("Position=0.1", "noise", keys={"position": "position_std"}) == {"position_std": 0.1}
 
 
 @pytest.mark.parametrize("items, kw, words", [
     (["radius"], {}, "-m 'radius': expected KEY=VALUE"),
+    (("a=1", "a=2"), {}, "-m 'a=2': 'a' is given twice; give each key once"),
+    ("Position=0.1,position=0.2", {"keys": {"position": "position_std"}}, "'position_std' is given twice"),
     (["=3"], {}, "-m '=3': expected KEY=VALUE"),
     (["radius="], {}, "-m 'radius=': expected KEY=VALUE"),
     ("jitter=1", {"keys": ["position", "rate"]}, "-m 'jitter=1': unknown key 'jitter'; keys: position, rate"),

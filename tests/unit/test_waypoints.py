@@ -357,3 +357,16 @@ def test_both_styles_fly_the_example():
         out[mission.name] = row
     # no velocity jumps: the smooth path never lags as far behind as the corners do
     assert out["minsnap"]["max_error_m"] < out["waypoints"]["max_error_m"]
+
+
+@pytest.mark.parametrize("kind", ["waypoints", "minsnap"])
+def test_yaw_through_plus_minus_pi_turns_the_short_way(kind):
+    from quadcruise.layout import REF_PSI
+    from quadcruise.missions import MinimumSnap, Waypoints, WaypointTable
+
+    table = WaypointTable([[0, 0, 1], [2, 0, 1], [4, 0, 1]], yaw=[3.0, -3.0, 3.0])
+    mission = (Waypoints if kind == "waypoints" else MinimumSnap)(table)
+    psi = mission.reference(np.linspace(0.0, mission.duration, 2001))[:, REF_PSI]
+    travel = np.abs(np.diff(psi)).sum()
+    assert travel == pytest.approx(2 * (2 * np.pi - 6.0), rel=0.05)          # 0.57 rad, not 12
+    assert np.allclose(np.cos(psi[[0, -1]]), np.cos(3.0)) and np.allclose(np.sin(psi[[0, -1]]), np.sin(3.0))

@@ -92,8 +92,7 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
     cmp = run_compare(cmp_mission, chosen, progress=Bar("flying", unit="controller"), **kwargs)
     click.echo(cmp.text(**conventions))
     if population is not None:
-        echo_population_comparison(cmp_mission, chosen, population, seed, pop, wind, kwargs.get("duration"),
-                            kwargs.get("dt", 1e-3))
+        echo_population_comparison(cmp_mission, chosen, population, seed, pop, wind, kwargs)
     if out is not None:
         cmp.write(out, force=force, **conventions)
         click.echo(f"wrote metrics.csv and comparison.png to {out}")

@@ -8,6 +8,7 @@ import click
 
 from quadcruise.cli.common import Bar
 from quadcruise.cli.objects import mission_from_options
+from quadcruise.errors import InputError
 
 __all__ = ["DEFAULT_COMPARED", "compared_from_options", "population_from_options", "echo_population_comparison"]
 
@@ -30,6 +31,11 @@ def population_from_options(n: int | None, seed: int, mass_spread: float, wind: 
     Returns
     -------
     Population
+
+    Raises
+    ------
+    InputError
+        A bad value, or ``--seed``, ``--mass-spread`` or ``--wind`` without ``--population``.
     """
     from quadcruise.disturbances.environment import parse_wind
     from quadcruise.errors import whole_number
@@ -38,12 +44,18 @@ def population_from_options(n: int | None, seed: int, mass_spread: float, wind: 
     if n is not None:
         whole_number(n, "--population", minimum=1)
     whole_number(seed, "--seed")
+    if n is None:
+        given = [o for o, v, default in (("--seed", seed, 0), ("--mass-spread", mass_spread, 0.1), ("--wind", wind, None))
+                 if v != default]
+        if given:
+            raise InputError(f"{given[0]} describes the population that --population N flies; without it, "
+                             "it would change nothing")
     env = parse_wind(wind) if wind else None
     return Population(mass_spread=mass_spread, environment=env if env is not None and env.parts else None)
 
 
 def echo_population_comparison(mission, controllers: str, n: int, seed: int, pop, wind: str | None,
-                        duration: float | None, dt: float) -> None:
+                               flight: dict) -> None:
     """Fly the controllers on the same perturbed vehicles, in this process; print one row each.
 
     Parameters
@@ -59,13 +71,23 @@ def echo_population_comparison(mission, controllers: str, n: int, seed: int, pop
         The population (:func:`population_from_options`).
     wind : str or None
         The ``--wind`` spec, for the printed headline.
-    duration, dt : float
-        Flight time [s] (None: the mission's) and control period [s].
+    flight : dict
+        The nominal flights' keywords (a scenario's): its ``vehicle`` is the population's
+        nominal, its ``environment`` and ``sensors`` act unless ``--wind`` replaces the
+        first; ``duration``, ``dt``, ``max_step`` and ``full_dynamics`` as the nominal flights.
     """
+    import dataclasses
+
     from quadcruise.montecarlo.compare import compare_population
 
-    table = compare_population(mission, controllers, pop, n, seed, duration=duration, dt=dt, scheduler="none",
-                               progress=Bar("flying the population", unit="flight"))
+    if pop.environment is None and flight.get("environment") is not None and flight["environment"].parts:
+        pop = dataclasses.replace(pop, environment=flight["environment"])
+    if pop.noise is None and flight.get("sensors") is not None:
+        pop = dataclasses.replace(pop, noise=flight["sensors"])
+    same = {k: flight[k] for k in ("vehicle", "max_step", "full_dynamics") if flight.get(k) is not None}
+    table = compare_population(mission, controllers, pop, n, seed, duration=flight.get("duration"),
+                               dt=flight.get("dt", 1e-3), scheduler="none",
+                               progress=Bar("flying the population", unit="flight"), **same)
     click.echo(f"\nthe same {n} perturbed vehicles (seed {seed}, mass spread {pop.mass_spread:g}"
                + (f", wind {wind}" if wind else "") + "):")
     click.echo(table.to_string(float_format=lambda v: f"{v:.4g}"))

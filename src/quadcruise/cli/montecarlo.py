@@ -14,8 +14,9 @@ __all__ = ["montecarlo", "montecarlo_command", "parse_noise"]
 
 
 @click.command("montecarlo")
-@click.option("--mission", default="circle", show_default=True, help="Mission: a name, a waypoint CSV or a scenario file (as --scenario).")
-@click.option("--controller", default="nlpd", show_default=True, help="Controller name.")
+@click.option("--mission", help="Mission: a name, a waypoint CSV or a scenario file (as --scenario); "
+              "default: the scenario's, else circle.")
+@click.option("--controller", help="Controller name (default: the scenario's, else nlpd).")
 @click.option("-n", "--n", "n", type=int, show_default="1000", help="Number of flights.")
 @click.option("--seed", type=int, show_default="0", help="Seed of every random draw.")
 @click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")

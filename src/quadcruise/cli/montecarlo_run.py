@@ -58,7 +58,7 @@ def parse_noise(text: str | None):
     return SensorNoise(**parse_assignments(text, "noise spec", keys=names, numbers=True))
 
 
-def montecarlo_command(*, mission: str = "circle", controller: str = "nlpd", n: int | None = None,
+def montecarlo_command(*, mission: str | None = None, controller: str | None = None, n: int | None = None,
                        seed: int | None = None, duration: float | None = None, dt: float | None = None,
                        wind: str | None = None, wind_spread: float | None = None, offset: float | None = None,
                        mass_spread: float | None = None, inertia_spread: float | None = None, noise: str | None = None,
@@ -114,11 +114,11 @@ offset, distribution, model_error : optional
     from quadcruise.montecarlo.sweep import run_sweep
 
     whole_number(worst, "--worst")
-    if str(mission).lower().endswith(".toml"):           # a scenario as the mission: the same as --scenario
+    if mission is not None and str(mission).lower().endswith(".toml"):   # a scenario as the mission: as --scenario
         if scenario is not None:
             raise InputError(f"--mission {mission} and --scenario {scenario}: give the scenario once")
-        mission, scenario = "circle", mission
-    elif str(mission).lower().endswith(".csv"):
+        mission, scenario = None, mission
+    elif mission is not None and str(mission).lower().endswith(".csv"):
         from quadcruise.cli.objects import mission_from_options
 
         mission = mission_from_options(mission, (), smooth=False)

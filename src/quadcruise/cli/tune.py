@@ -18,7 +18,7 @@ __all__ = ["tune"]
 @click.argument("mission", metavar="MISSION")
 @click.option("-m", "--mission-param", "mission_params", multiple=True, metavar="KEY=VALUE",
               help="Mission parameter, e.g. -m size=2 (repeatable).")
-@click.option("--controller", default="nlpd", show_default=True, help="Controller name.")
+@click.option("--controller", help="Controller name (default: the scenario's, else nlpd).")
 @click.option("-c", "--controller-param", "controller_params", multiple=True, metavar="KEY=VALUE",
               help="Controller parameter kept during the search, e.g. -c derivative=error (repeatable).")
 @click.option("--gains", metavar="NAMES", help="Gains to search, comma-separated: position.kp,position.kd "

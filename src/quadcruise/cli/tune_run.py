@@ -44,12 +44,12 @@ def command_line(mission: str, options: dict) -> str:
     return " ".join(shlex.quote(w) for w in words)
 
 
-DEFAULTS = {"controller": "nlpd", "samples": 1, "objective": "worst", "mass_spread": 0.0, "inertia_spread": 0.0,
+DEFAULTS = {"controller": None, "samples": 1, "objective": "worst", "mass_spread": 0.0, "inertia_spread": 0.0,
             "wind_spread": 0.0, "seed": 0, "budget": 100}
 """Options left out of the recorded command line when they have these values."""
 
 
-def tune_command(*, mission: str, mission_params: tuple = (), controller: str = "nlpd",
+def tune_command(*, mission: str, mission_params: tuple = (), controller: str | None = None,
                  controller_params: tuple = (), gains: str | None = None,
                  bounds: tuple = (), targets: tuple = (), require: tuple = (), minimize: tuple = (),
                  samples: int = 1, objective: str = "worst", mass_spread: float = 0.0, inertia_spread: float = 0.0,
@@ -66,9 +66,9 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str = 
         A mission name, a waypoint CSV or a TOML scenario file.
     mission_params : tuple of str
         ``KEY=VALUE`` parameters of the mission (not with a scenario).
-    controller : str
-        The controller's name; a scenario's controller flies unless this is not ``nlpd`` or
-        ``controller_params`` are given.
+    controller : str, optional
+        The controller's name; None: the scenario's controller (``controller_params``
+        change it), else ``nlpd``.
     controller_params : tuple of str
         ``KEY=VALUE`` parameters of the controller.
     gains, bounds, targets, require, minimize, samples, objective, seed, budget, popsize
@@ -122,16 +122,17 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str = 
             raise InputError("-m/--mission-param does not apply to a scenario file: change its [mission] table")
         sc = load_scenario(mission)
         the_mission = sc.mission or "circle"
-        the_controller = sc.controller
-        if the_controller is None or controller_params or controller != "nlpd":
-            the_controller = controller_from_options(controller, controller_params, None)
+        if controller is not None or sc.controller is None:     # as fly: -c changes the scenario's controller
+            the_controller = controller_from_options(controller or "nlpd", controller_params, None)
+        else:
+            the_controller = controller_from_options("", controller_params, None, base=sc.controller)
         kwargs.update(vehicle=sc.vehicle, duration=sc.duration if duration is None else duration,
                       dt=sc.dt if dt is None else dt)
         environment = environment if environment is not None else sc.environment
         sensors = sensors if sensors is not None else sc.sensor_noise
     else:
         the_mission = mission_from_options(mission, mission_params, False)
-        the_controller = controller_from_options(controller, controller_params, None)
+        the_controller = controller_from_options(controller or "nlpd", controller_params, None)
     population = Population(mass_spread=mass_spread, inertia_spread=inertia_spread, wind_spread=wind_spread,
                             environment=environment if environment is not None and environment.parts else None,
                             noise=sensors)

@@ -210,14 +210,23 @@ class WaypointTable:
         return np.concatenate([[0.0], np.cumsum(legs / v)])
 
     def yaws(self) -> np.ndarray:
-        """Yaw at each point.
+        """Yaw at each point, each leg turning the short way.
+
+        A yaw is an angle: from 3.0 rad to -3.0 rad the vehicle turns 0.28 rad through
+        +-pi, not 6 rad through 0. Each point's yaw is moved by whole turns (``numpy.unwrap``)
+        so that no leg turns more than pi; a larger turn takes intermediate points.
 
         Returns
         -------
         numpy.ndarray
             Shape (n,), yaw [rad] (zeros if the table has none; a copy).
+
+        Examples
+        --------
+        >>> WaypointTable([[0, 0, 1], [1, 0, 1], [2, 0, 1]], yaw=[3.0, -3.0, 3.0]).yaws().round(3)
+        array([3.   , 3.283, 3.   ])
         """
-        return np.zeros(len(self)) if self.yaw is None else np.array(self.yaw)
+        return np.zeros(len(self)) if self.yaw is None else np.unwrap(np.asarray(self.yaw, dtype=float))
 
     def to_dict(self) -> dict:
         """The table as plain lists, for JSON; :meth:`from_dict` reads it back.

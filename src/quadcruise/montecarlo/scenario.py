@@ -50,7 +50,7 @@ def merge_scenario(path, given: dict) -> tuple[Scenario, dict]:
     return sc, {**table, **given}
 
 
-def sweep_spec(*, mission="circle", controller="nlpd", n: int | None = None, seed: int | None = None,
+def sweep_spec(*, mission=None, controller=None, n: int | None = None, seed: int | None = None,
                duration: float | None = None, dt: float | None = None, environment=None, noise=None,
                scenario=None, requirements=(), max_track_error_m: float | None = None,
                **population) -> tuple[MonteCarloSpec, int]:
@@ -58,8 +58,8 @@ def sweep_spec(*, mission="circle", controller="nlpd", n: int | None = None, see
 
     Parameters
     ----------
-    mission, controller : names or objects
-        Those of ``scenario`` if it has them.
+    mission, controller : names or objects, optional
+        Given, else those of ``scenario``, else the circle and nlpd.
     n, seed : int, optional
         Number of flights and seed: given, else the scenario's, else 1000 and 0.
     duration : float, optional
@@ -96,8 +96,8 @@ def sweep_spec(*, mission="circle", controller="nlpd", n: int | None = None, see
                          max_track_error_m=max_track_error_m)
     if scenario is not None:
         sc, given = merge_scenario(scenario, given)
-        mission = sc.mission or mission
-        controller = sc.controller or controller
+        mission = sc.mission if mission is None else mission
+        controller = sc.controller if controller is None else controller
         environment = environment if environment is not None else sc.environment
         noise = noise if noise is not None else sc.sensor_noise
         options.update(vehicle=sc.vehicle, duration=duration or sc.duration,
@@ -112,6 +112,8 @@ def sweep_spec(*, mission="circle", controller="nlpd", n: int | None = None, see
             if key == "max_track_error_m" and max_track_error_m is not None:
                 continue
             options[key] = tuple(value) if key == "requirements" else value
+    mission = "circle" if mission is None else mission
+    controller = "nlpd" if controller is None else controller
     pop = Population(**given, environment=environment if environment is not None and environment.parts else None,
                      noise=noise)
     return MonteCarloSpec(mission=mission, controller=controller, population=pop, seed=seed, **options), n

@@ -449,7 +449,9 @@ def parse_bounds(items: str | Iterable[str] | Mapping | None) -> dict[str, tuple
             _number(low, what), _number(high, what)
         if not low < high:
             raise InputError(f"{what} are reversed or empty: LOW must be below HIGH")
-        out[name] = (low, high)
+        if name.strip() in out:
+            raise InputError(f"{what}: {name.strip()} is bounded twice; give its bounds once")
+        out[name.strip()] = (low, high)
     return out
 
 
