@@ -45,11 +45,25 @@ def quadcruise(*args, cwd):
     (["tune", "step", "--target", "rise_time_s=1", "--samples", "100000000", "--popsize", "5", "--duration", "2"],
      "vehicle-steps, hours of computing"),
     (["tune", "step", "--target", "rise_time_s=1", "--dt", "0", "--duration", "2"], "dt must be a positive number"),
+    (["fly", "circle", "--duration", "100000", "--dt", "0.0001"], "log less often"),     # said at once, not after 23 s
+    (["replay", "{long_pwm}", "-o", "s.csv"], "RK4 substeps, hours of computing"),
+    (["replay", "{pwm}", "-o", "s.csv", "--max-step", "1e-12"], "RK4 substeps, hours of computing"),
+    (["montecarlo", "--scheduler", "none", "-n", "100000000000", "--out", "mc"], "days of computing"),
+    (["compare", "circle", "--controllers", "nlpd", "--population", "100000000000"], "days of computing"),
+    (["fly", "circle", "--report", "r.txt"], "the file is written as .html or .htm"),
+    (["replay", "{pwm}", "-o", "s.parquet"], "the file is written as .csv"),
+    (["fly", "circle", "--force"], "--force shapes the --out folder"),
+    (["compare", "circle", "--force"], "--force shapes the --out folder"),
+    (["fly", "circle", "--controller", ""], "unknown controller ''"),
+    (["compare", "circle", "--controllers", "nlpd,,se3"], "an empty name"),
+    (["fly", "{folder}"], "is a folder, not a file"),
 ])
 def test_probed_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, args, words):
+    (tmp_path / "folder.csv").mkdir()
     files = {"huge_path": ("huge.csv", HUGE_PATH), "pwm": ("pwm.csv", "t,u1,u2,u3,u4\n0,0.3,0.3,0.3,0.3\n1,0.3,0.3,0.3,0.3\n"),
+             "long_pwm": ("long.csv", "t,u1,u2,u3,u4\n0,0.3,0.3,0.3,0.3\n1e12,0.3,0.3,0.3,0.3\n"),
              **{k: (f"{k}.toml", v) for k, v in SCENARIOS.items()}}
-    names = {}
+    names = {"folder": "folder.csv"}
     for key, (name, text) in files.items():
         (tmp_path / name).write_text(text)
         names[key] = name
@@ -103,3 +117,24 @@ def test_options_given_with_a_scenario_win_and_the_scenario_fills_the_rest(tmp_p
     nominal = float(next(ln for ln in res.output.splitlines() if ln.startswith("rmse_m")).split()[1])
     population = float(next(ln for ln in res.output.splitlines() if ln.startswith("nlpd ")).split()[3])
     assert population == pytest.approx(nominal, rel=0.01)        # the same vehicle in the same wind
+
+
+def test_a_byte_order_mark_is_read_as_nothing(tmp_path):
+    bom = "\ufeff"
+    (tmp_path / "path.csv").write_text(bom + "x,y,z\n0,0,1\n1,0,1\n", encoding="utf-8")
+    (tmp_path / "duties.csv").write_text(bom + "t,u1,u2,u3,u4\n0,0.07,0.07,0.07,0.07\n0.05,0.07,0.07,0.07,0.07\n",
+                                         encoding="utf-8")
+    (tmp_path / "s.toml").write_text(bom + '[mission]\nkind = "hover"\n', encoding="utf-8")
+    for args in (["fly", "path.csv", "--duration", "1"], ["replay", "duties.csv", "-o", "s.csv"],
+                 ["fly", "s.toml", "--duration", "0.5"]):
+        proc = quadcruise(*args, cwd=tmp_path)
+        assert proc.returncode == 0, proc.stderr
+
+
+def test_another_command_does_not_replace_a_monte_carlo_sweep_unless_forced(tmp_path):
+    assert quadcruise("montecarlo", "-n", "2", "--duration", "1", "--out", "mc", "--quiet", cwd=tmp_path).returncode == 0
+    proc = quadcruise("fly", "hover", "--duration", "0.5", "--out", "mc", cwd=tmp_path)
+    assert proc.returncode == 2 and "holds a Monte Carlo sweep" in proc.stderr
+    assert (tmp_path / "mc" / "chunks").is_dir()
+    assert quadcruise("fly", "hover", "--duration", "0.5", "--out", "mc", "--force", cwd=tmp_path).returncode == 0
+    assert not (tmp_path / "mc" / "chunks").exists()

@@ -16,6 +16,7 @@ from quadcruise.cli.objects import controller_from_options, mission_from_options
 from quadcruise.errors import InputError
 
 __all__ = ["FORCE_OPTION", "FORMAT_OPTION", "REPORT_OPTION", "RISE_OPTION", "SETTLE_BAND_OPTION", "Bar", "friendly",
+           "needs_out", "writable_with",
            "metric_options", "writable", "controller_from_options", "mission_from_options"]
 
 # options several commands share
@@ -57,7 +58,50 @@ def writable(ctx: click.Context, param: click.Parameter, value):
     return value
 
 
-REPORT_OPTION = click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html", callback=writable,
+def needs_out(out, **given) -> None:
+    """Refuse options that only shape the ``--out`` folder when no ``--out`` is given.
+
+    Parameters
+    ----------
+    out : str or None
+        ``--out``.
+    **given
+        Option name (``force``, ``format``) -> True where the user gave it.
+
+    Raises
+    ------
+    InputError
+        Naming the first such option.
+    """
+    if out is None:
+        for name, was_given in given.items():
+            if was_given:
+                raise InputError(f"--{name} shapes the --out folder; without --out it would change nothing")
+
+
+def writable_with(*suffixes: str):
+    """A click callback: :func:`writable`, and the path must end in one of ``suffixes``.
+
+    Parameters
+    ----------
+    *suffixes : str
+        E.g. ``".html", ".htm"``.
+
+    Returns
+    -------
+    callable
+        The callback.
+    """
+    def check(ctx: click.Context, param: click.Parameter, value):
+        if value is not None and str(value).strip() and not str(value).lower().endswith(suffixes):
+            raise click.BadParameter(f"{value}: the file is written as {' or '.join(suffixes)}; name it so",
+                                     ctx=ctx, param=param)
+        return writable(ctx, param, value)
+    return check
+
+
+REPORT_OPTION = click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html",
+                             callback=writable_with(".html", ".htm"),
                              help="Also write a self-contained HTML report (tables, figures, interactive 3-D "
                                   "view, configuration).")
 

@@ -15,6 +15,7 @@ from quadcruise.cli.common import (
     Bar,
     friendly,
     metric_options,
+    needs_out,
     writable,
 )
 from quadcruise.cli.compare_run import compared_from_options, echo_population_comparison, population_from_options
@@ -83,12 +84,19 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
     """
     from quadcruise.workflows.compare import compare as run_compare
 
+    needs_out(out, force=force)
     conventions = metric_options(rise, settle_bands)
     if out is not None:
         check_output_dir(out, force)
     cmp_mission, chosen, kwargs = compared_from_options(mission, controllers, mission_params)
     kwargs.update({k: v for k, v in (("duration", duration), ("dt", dt)) if v is not None})
     pop = population_from_options(population, seed, mass_spread, wind)      # checked before anything flies
+    if population is not None:
+        from quadcruise.montecarlo.sweep import check_sweep_size
+        from quadcruise.workflows.fly import default_duration
+
+        duration_s = kwargs.get("duration") or default_duration(cmp_mission)
+        check_sweep_size(population, round(duration_s / kwargs.get("dt", 1e-3)))
     cmp = run_compare(cmp_mission, chosen, progress=Bar("flying", unit="controller"), **kwargs)
     click.echo(cmp.text(**conventions))
     if population is not None:

@@ -118,7 +118,7 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
     from quadcruise.fields import parse_assignments
 
     if not mission.lower().endswith(".toml"):
-        return mission_from_options(mission, mission_params, smooth=False), controllers or DEFAULT_COMPARED, {}
+        return mission_from_options(mission, mission_params, smooth=False), DEFAULT_COMPARED if controllers is None else controllers, {}
     from quadcruise.missions import mission_from_name
     from quadcruise.workflows.scenario import load_scenario
 
@@ -126,6 +126,6 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
     the_mission = scenario.mission or mission_from_name("circle")
     if mission_params:
         the_mission = the_mission.replace(**parse_assignments(mission_params, "--mission-param"))
-    chosen = controllers or scenario.compare or (
+    chosen = controllers if controllers is not None else scenario.compare or (
         {scenario.controller.name: scenario.controller} if scenario.controller is not None else DEFAULT_COMPARED)
     return the_mission, chosen, scenario.fly_kwargs()

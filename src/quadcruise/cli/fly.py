@@ -17,6 +17,7 @@ from quadcruise.cli.common import (
     Bar,
     friendly,
     metric_options,
+    needs_out,
     writable,
 )
 from quadcruise.cli.objects import flight_from_options
@@ -101,6 +102,7 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
     settle_bands : tuple of float
         ``--settle-band``: the settling bands (fractions of the step), given once or twice.
     """
+    needs_out(out, force=force, format=fmt != "csv")
     conventions = metric_options(rise, settle_bands)
     overrides = {k: v for k, v in (("duration", duration), ("dt", dt), ("max_step", max_step)) if v is not None}
     given = [f"--{k.replace('_', '-')} {v}" for k, v in overrides.items()] + [f"-m {p}" for p in mission_params] \

@@ -150,7 +150,7 @@ def flight_from_options(mission: str, controller: str | None, mission_params: tu
         if smooth and not mission.lower().endswith(".csv"):
             raise InputError(f"--smooth turns a waypoint CSV into a minimum-snap path; {mission!r} is not one")
         return (mission_from_options(mission, mission_params, smooth),
-                controller_from_options(controller or "nlpd", controller_params, poles_text), {}, None)
+                controller_from_options("nlpd" if controller is None else controller, controller_params, poles_text), {}, None)
     from quadcruise.workflows.scenario import load_scenario
 
     if smooth:
@@ -161,7 +161,7 @@ def flight_from_options(mission: str, controller: str | None, mission_params: tu
     if mission_params:
         the_mission = the_mission.replace(**parse_assignments(mission_params, "--mission-param"))
     if controller is not None or scenario.controller is None:
-        the_controller = controller_from_options(controller or "nlpd", controller_params, poles_text)
+        the_controller = controller_from_options("nlpd" if controller is None else controller, controller_params, poles_text)
     else:
         the_controller = controller_from_options("", controller_params, poles_text, base=scenario.controller)
     return the_mission, the_controller, scenario.fly_kwargs(), scenario

@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import click
 
-from quadcruise.cli.common import Bar, friendly, writable
+from quadcruise.cli.common import Bar, friendly, writable_with
 
 __all__ = ["replay"]
 
 
 @click.command("replay")
 @click.argument("pwm_csv", metavar="PWM.csv")
-@click.option("-o", "--out", "out", required=True, metavar="STATES.csv", callback=writable,
+@click.option("-o", "--out", "out", required=True, metavar="STATES.csv", callback=writable_with(".csv"),
               type=click.Path(dir_okay=False),
               help="Where to write the states (t,x,y,z,vx,vy,vz,phi,theta,psi,p,q,r,F1..F4).")
 @click.option("--max-step", default=1e-3, show_default=True, type=float,

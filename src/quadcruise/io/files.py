@@ -133,7 +133,7 @@ def check_writable_place(path: str | os.PathLike) -> None:
         raise InputError(f"{path}: cannot write there ({exc.strerror.lower()} in {parent})") from None
 
 
-def check_output_dir(path: str | os.PathLike, force: bool = False) -> Path:
+def check_output_dir(path: str | os.PathLike, force: bool = False, *, workflow: str | None = None) -> Path:
     """Refuse a non-empty folder that quadcruise did not write, unless ``force``.
 
     Parameters
@@ -141,7 +141,11 @@ def check_output_dir(path: str | os.PathLike, force: bool = False) -> Path:
     path : str or os.PathLike
         The output folder; it need not exist.
     force : bool
-        Accept a non-empty folder without a :data:`MARKER` file (it will be replaced).
+        Accept a non-empty folder without a :data:`MARKER` file (it will be replaced), or
+        one that holds a Monte Carlo sweep when another workflow writes.
+    workflow : str, optional
+        What will write there; ``"montecarlo"`` may resume a sweep's folder (its own rules
+        apply), any other writer must be forced to replace one.
 
     Returns
     -------
@@ -162,6 +166,16 @@ def check_output_dir(path: str | os.PathLike, force: bool = False) -> Path:
     if path.is_dir() and any(path.iterdir()) and not (path / MARKER).is_file() and not force:
         raise InputError(f"{path}: folder is not empty and was not written by quadcruise "
                          "(use --force to replace it)")
+    if not force and workflow != "montecarlo" and (path / MARKER).is_file():
+        import json
+
+        try:
+            held = json.loads((path / MARKER).read_text()).get("workflow")
+        except (ValueError, OSError, AttributeError):
+            held = None
+        if held == "montecarlo":
+            raise InputError(f"{path}: holds a Monte Carlo sweep (hours of flights, resumable); use --force to "
+                             "replace it or choose another --out")
     return path
 
 
@@ -286,10 +300,12 @@ def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optiona
     from quadcruise.errors import InputError
 
     path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{path}: is a folder, not a file")
     if not path.is_file():
         raise InputError(f"{path}: no such file")
     try:
-        with path.open(newline="") as f:
+        with path.open(newline="", encoding="utf-8-sig") as f:       # a byte-order mark (Excel's) is dropped
             rows = [(n, r) for n, r in enumerate(csv.reader(f), start=1) if any(c.strip() for c in r)]
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
         raise InputError(f"{path}: cannot be read ({exc.__class__.__name__}: {exc})") from None

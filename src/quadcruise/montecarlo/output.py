@@ -48,7 +48,7 @@ def write_outputs(result, out, *, fmt: str = "csv", force: bool = False) -> Path
     path = Path(out)
     meta, ours = holds_sweep(path, result.spec)
     if not ours:
-        check_output_dir(path, force)
+        check_output_dir(path, force, workflow="montecarlo")
         if meta is not None and not force:
             raise InputError(f"{path}: holds another quadcruise result; use --force to replace it")
         if path.is_dir() and any(path.iterdir()):

@@ -115,7 +115,7 @@ class SweepFolder:
     """
 
     def __init__(self, out, spec: MonteCarloSpec, *, force: bool, resume: bool) -> None:
-        self.path = check_output_dir(out, force)
+        self.path = check_output_dir(out, force, workflow="montecarlo")
         self.hash = spec.hash()
         self.spec = spec
         meta, same = holds_sweep(self.path, spec)

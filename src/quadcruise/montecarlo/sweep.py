@@ -42,7 +42,7 @@ from quadcruise.montecarlo.schema import COLUMNS, FAILURES
 from quadcruise.montecarlo.spec import MonteCarloSpec
 from quadcruise.montecarlo.store import SweepFolder
 
-__all__ = ["run_chunk", "fly_chunk", "reduce_chunk", "sweep_metrics", "run_sweep", "auto_chunk_size",
+__all__ = ["run_chunk", "fly_chunk", "reduce_chunk", "sweep_metrics", "run_sweep", "check_sweep_size", "auto_chunk_size",
            "CHUNK_BUDGET"]
 
 CHUNK_BUDGET = 64 * 2**20
@@ -267,6 +267,31 @@ def auto_chunk_size(spec: MonteCarloSpec, n: int, parallel: int = 1, threads: in
     return size - size % threads if size >= threads > 1 else size
 
 
+MAX_SWEEP_STEPS = 1.0e13
+"""The most vehicle-steps a sweep may take (flights x control periods): days of computing on a
+cluster of a hundred cores; beyond it the number of flights is surely a slip."""
+
+
+def check_sweep_size(n: int, periods: int) -> None:
+    """Refuse a sweep beyond :data:`MAX_SWEEP_STEPS` before anything flies.
+
+    Parameters
+    ----------
+    n : int
+        Flights.
+    periods : int
+        Control periods per flight.
+
+    Raises
+    ------
+    InputError
+        Saying how many vehicle-steps that is, and what to change.
+    """
+    if n * periods > MAX_SWEEP_STEPS:
+        raise InputError(f"{n:,} flights x {periods:,} control periods is {n * periods:.2g} vehicle-steps, "
+                         "days of computing even on a cluster: fewer flights or a shorter duration")
+
+
 def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", scheduler: str | None = None,
               workers: int | None = None, out=None, resume: bool = True, force: bool = False, fmt: str = "csv",
               progress: Callable[[int, int], None] | None = None, connect_timeout: float = 10.0) -> MonteCarloResult:
@@ -320,6 +345,7 @@ def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", s
         Chunks that do not fit together (from other code or options, or overlapping).
     """
     n = whole_number(n, "the number of flights", 1)
+    check_sweep_size(n, spec.periods)
     if chunk_size != "auto" and (isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer))
                                  or chunk_size < 1):
         raise InputError(f"chunk size must be a whole number >= 1 or 'auto', got {chunk_size!r}")

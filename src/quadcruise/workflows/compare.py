@@ -370,7 +370,9 @@ def labelled(controllers) -> dict:
     ['nlpd', 'nlpd#2', 'se3']
     """
     if isinstance(controllers, str):
-        controllers = [c.strip() for c in controllers.split(",") if c.strip()]
+        text, controllers = controllers, [c.strip() for c in controllers.split(",")]
+        if any(not c for c in controllers):
+            raise InputError(f"controllers {text!r}: an empty name; give comma-separated names such as nlpd,se3")
     items = list(controllers.items()) if isinstance(controllers, Mapping) else [(None, c) for c in controllers]
     if not items:
         raise InputError("compare() needs at least one controller")

@@ -188,11 +188,16 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
     mp = stack_params(missions if missions is not None else mission, n=None if missions else n)
     first = missions[0] if missions else mission
     duration = default_duration(first) if duration is None else duration
+    try:
+        d, h = float(duration), float(dt)
+    except (TypeError, ValueError):
+        raise InputError(f"duration and dt must be numbers of seconds, got {duration!r} and {dt!r}") from None
+    if 0 < h <= d < math.inf:                               # sized before the grid is allocated
+        check_run_size(n, round(d / h), int(log_every), max(1, math.ceil(h / float(max_step or h) - 1e-9)))
     grid = time_grid(float(duration), float(dt))
     if sensors is not None and np.max(sensors.delay) > duration:
         raise InputError(f"sensor field 'delay' ({np.max(sensors.delay):g} s) is longer than the flight "
                          f"({float(duration):g} s)")
-    check_run_size(n, grid.size - 1, int(log_every), max(1, math.ceil(float(dt) / float(max_step or dt) - 1e-9)))
     check_can_hover(vehicle)
     given_x0 = None if x0 is None else np.asarray(x0, dtype=float).tolist()
     x0 = hover_state(vehicle, n, first) if x0 is None else x0
@@ -332,7 +337,7 @@ def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1) -> Non
     if n * steps > MAX_VEHICLE_STEPS:
         raise InputError(f"{n:,} vehicles x {steps:,} control periods is {n * steps:.2g} vehicle-steps, hours of "
                          f"computing: fly fewer vehicles or a shorter duration")
-    if n * steps * substeps > MAX_VEHICLE_STEPS * 4:        # an RK4 substep costs about a quarter of a period
+    if n * steps * substeps > MAX_VEHICLE_STEPS:
         raise InputError(f"{n:,} vehicles x {steps:,} control periods x {substeps:,} RK4 substeps each is "
                          f"{n * steps * substeps:.2g} substeps, hours of computing: a larger max_step, fewer "
                          "vehicles or a shorter duration")
@@ -346,7 +351,8 @@ def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1) -> Non
         every = int(math.ceil(n * (steps + 2) * row / (0.1 * memory)))
         raise InputError(f"the flight's log would take {need / 2**30:.1f} GiB ({n:,} vehicle(s) x "
                          f"{steps // log_every + 1:,} logged instants), more than half of this machine's "
-                         f"{memory / 2**30:.0f} GiB: log less often (log_every={every:,}) or fly shorter")
+                         f"{memory / 2**30:.0f} GiB: log less often (log_every={every:,}: in Python, or a scenario's "
+                         "[simulation]) or fly shorter")
 
 
 HOVER_DUTY_WARNING = 0.7

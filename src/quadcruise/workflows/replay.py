@@ -131,6 +131,10 @@ def read_duty_csv(path: str | os.PathLike, progress: Callable[[int, int], None] 
     return DutySchedule(t=data[:, 0], duties=data[:, 1:], source=str(path))
 
 
+MAX_SUBSTEPS = 2.0e10
+"""The most RK4 substeps a replay may take (at about ten million a second, half an hour or more)."""
+
+
 def replay(schedule: DutySchedule, vehicle: Vehicle | None = None, *, max_step: float = 1e-3,
            limits: Limits | None = None, full_dynamics: bool = False,
            progress: Callable[[int, int], None] | None = None) -> SimResult:
@@ -171,6 +175,12 @@ def replay(schedule: DutySchedule, vehicle: Vehicle | None = None, *, max_step: 
         "version": __version__,
     }
     rows = schedule.t.shape[0]
+    if isinstance(max_step, (int, float)) and max_step > 0:     # (simulate refuses the others)
+        substeps = float(np.sum(np.ceil(np.diff(schedule.t) / max_step - 1e-9)))
+        if substeps > MAX_SUBSTEPS:
+            raise InputError(f"{schedule.source}: {schedule.t[-1] - schedule.t[0]:g} s of duties at max_step "
+                             f"{max_step:g} s is {substeps:.3g} RK4 substeps, hours of computing: a larger "
+                             "--max-step or a shorter table")
     if progress is not None:
         progress(0, rows)
     result = simulate(schedule.t, x0, vp, duty_schedule, pack_schedule(schedule.t, schedule.duties),

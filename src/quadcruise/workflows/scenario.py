@@ -213,10 +213,12 @@ def load_scenario(path: str | Path) -> Scenario:
         No such file, not valid TOML, or a table, key or value that is wrong.
     """
     path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{path}: is a folder, not a scenario file")
     if not path.is_file():
         raise InputError(f"{path}: no such file")
     try:
-        doc = tomllib.loads(path.read_text())
+        doc = tomllib.loads(path.read_text(encoding="utf-8-sig"))     # a byte-order mark is dropped
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: not valid TOML ({exc})") from None
     return scenario_from_dict(doc, source=str(path), base=path.parent)
