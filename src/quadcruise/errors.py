@@ -17,6 +17,11 @@ class SimulationError(RuntimeError):
     """A simulation could not be carried out as asked (not bad input, not divergence)."""
 
 
+class FlightWarning(UserWarning):
+    """How a flight went, when it went wrong: a vehicle that did not finish, rotor duties
+    clipped. Workflows that fly several (compare, reproduce) say whose flight it was."""
+
+
 def whole_number(value, what: str, minimum: int = 0) -> int:
     """``value`` as an int if it is a whole number >= ``minimum`` (not a bool, not a float).
 

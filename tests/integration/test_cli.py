@@ -179,6 +179,8 @@ def test_montecarlo_and_reproduce_accept_a_scenario(tmp_path):
     res = run("reproduce", "--scenario", scen / "light_vehicle_square.toml", "--out", tmp_path / "r")
     assert res.exit_code == 0, res.output
     assert json.loads((tmp_path / "r" / "metrics.json").read_text())["config"]["vehicle"]["m"] == 1.4
+    assert "with the scenario's vehicle and dt only; not used: [mission], [controller], [simulation] duration" \
+        in res.output                                           # not silently
 
 
 def test_compare_on_the_same_population():

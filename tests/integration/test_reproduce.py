@@ -117,7 +117,7 @@ def test_a_flight_that_did_not_finish_is_marked_in_the_tables_and_exits_1(tmp_pa
     assert failed and all(r["status"].startswith("lost track") for r in failed)
     for r in failed:                        # the row, the warning and the count all say so
         assert f"| {r['scenario']} | {r['controller']} **({r['status']})** |" in res.output
-        assert f"warning: {r['scenario']} with {r['controller']} did not fly its mission: {r['status']}" in res.output
+        assert f"warning: {r['scenario']} with {r['controller']}: vehicle 0 {r['status']}" in res.output
     report = (tmp_path / "out" / "report.md").read_text()
     assert f"**{len(failed)} of {len(runs)} flights did not finish**" in report
     assert any(r["status"] == "finished" for r in runs)     # gonzalez's bounded tilt still flies it

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from quadcruise.control import Controller, as_controller, controller_record
-from quadcruise.errors import InputError, reject_unknown
+from quadcruise.errors import FlightWarning, InputError, reject_unknown
 from quadcruise.io.plainjson import dumps, plain
 from quadcruise.metrics.summary import Summary
 from quadcruise.missions import Mission, mission_from_name
@@ -337,8 +337,9 @@ def compare(mission: Mission | str = "circle",
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             results[label] = fly(mission, ctrl, vehicle=vehicle, duration=duration, dt=dt, **fly_kw)
-        for w in caught:                    # say whose flight it was
-            warnings.warn(f"{label}: {w.message}", w.category, stacklevel=2)
+        for w in caught:                    # say whose flight it went wrong; the vehicle's own warnings once
+            labelled_text = f"{label}: {w.message}" if issubclass(w.category, FlightWarning) else str(w.message)
+            warnings.warn(labelled_text, w.category, stacklevel=2)
     if progress is not None:
         progress(len(results), len(chosen))
     return Comparison(mission=mission, controllers=chosen, results=results)

@@ -23,7 +23,7 @@ import numpy as np
 from quadcruise._version import __version__
 from quadcruise.control import as_controller, controller_record
 from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
-from quadcruise.errors import InputError, reject_unknown
+from quadcruise.errors import FlightWarning, InputError, reject_unknown
 from quadcruise.layout import CMD_U1, F1, P_G, P_M, PSI, REF_PSI, REF_X, REF_Z, STATE_SIZE, X, Z
 from quadcruise.missions import Mission, mission_from_name, stack_params
 from quadcruise.model.vehicle import Vehicle
@@ -599,11 +599,11 @@ def _warn_about(result: SimResult) -> None:
     if bad.size:
         first = int(bad[0])
         more = f" ({bad.size} of {result.n} vehicles)" if result.n > 1 else ""
-        warnings.warn(f"vehicle {first} {result.status_text(first)}{more}", stacklevel=3)
+        warnings.warn(f"vehicle {first} {result.status_text(first)}{more}", FlightWarning, stacklevel=3)
     clipped = result.duty_clipped_s
     if np.any(clipped > 0):
         warnings.warn(f"rotor duties were clipped to [0, 1] for up to {clipped.max():.3f} s "
-                      f"({np.count_nonzero(clipped)} of {result.n} vehicles)", stacklevel=3)
+                      f"({np.count_nonzero(clipped)} of {result.n} vehicles)", FlightWarning, stacklevel=3)
 
 
 __all__ = ["fly", "default_duration", "hover_state", "per_vehicle_controllers", "steady_bound", "write_flight"]

@@ -37,6 +37,7 @@ from __future__ import annotations
 import math
 import re
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
@@ -46,7 +47,7 @@ import numpy as np
 from quadcruise._version import __version__
 from quadcruise.control import NLPD, Gonzalez, controller_from_name
 from quadcruise.control.design import PDGains
-from quadcruise.errors import InputError
+from quadcruise.errors import FlightWarning, InputError
 from quadcruise.io.files import MARKER, atomic_dir, check_output_dir, write_table
 from quadcruise.io.plainjson import dumps
 from quadcruise.io.scenario_file import scenario_document, scenario_text
@@ -272,7 +273,12 @@ def reproduce(*, scenarios=tuple(SCENARIOS), controllers=tuple(CONTROLLERS), dt:
         flights += [(fit_name, fit_mission, fit_duration, None, name, f) for name, f in factories.items()]
     for scen, mission, duration, until, ctrl_name, factory in flights:
         start = time.perf_counter()
-        result = fly(mission, factory(), vehicle=vehicle, duration=duration, dt=dt)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            result = fly(mission, factory(), vehicle=vehicle, duration=duration, dt=dt)
+        for w in caught:                    # say whose flight went wrong; the vehicle's own warnings once
+            text = f"{scen} with {ctrl_name}: {w.message}" if issubclass(w.category, FlightWarning) else str(w.message)
+            warnings.warn(text, w.category, stacklevel=2)
         row = result.metrics(transient_until=until).iloc[0].to_dict()
         run = {"scenario": scen, "controller": ctrl_name, "axis": row["axis"], "status": row["status"],
                **{k: _json_number(row[k]) for k in METRIC_KEYS}, "fitted": ctrl_name in FITTED}
