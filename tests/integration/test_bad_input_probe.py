@@ -57,6 +57,7 @@ def quadcruise(*args, cwd):
     (["fly", "circle", "--controller", ""], "unknown controller ''"),
     (["compare", "circle", "--controllers", "nlpd,,se3"], "an empty name"),
     (["fly", "{folder}"], "is a folder, not a file"),
+    (["analyze", "--dt", "1e-12"], "would lie within rounding of 1"),     # it answered UNSTABLE
 ])
 def test_probed_bad_input_is_one_line_exit_2_and_writes_nothing(tmp_path, args, words):
     (tmp_path / "folder.csv").mkdir()

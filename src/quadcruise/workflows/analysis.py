@@ -267,6 +267,11 @@ def _as_controller(controller):
     return controller
 
 
+MIN_DT = 1e-9
+"""The shortest control period :func:`linearize` takes [s]: at 1e-12 s the poles z = exp(s dt) are
+within rounding of 1, and the s-plane poles computed from them are noise."""
+
+
 def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 1e-3, hover_z: float = 1.0,
               eps: float = 1e-6, max_step: float | None = None, memory=None, settle: int = 1,
               tol: float = 1e-6, progress: Callable[[int, int], None] | None = None) -> Linearization:
@@ -322,6 +327,9 @@ def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 
         raise InputError(f"linearize takes one vehicle, got a batch of {vehicle.batch_size}")
     if not (math.isfinite(dt) and dt > 0):
         raise InputError(f"dt must be a positive number of seconds, got {dt!r}")
+    if dt < MIN_DT:
+        raise InputError(f"dt = {dt:g} s is below {MIN_DT:g} s: the discrete poles would lie within rounding of 1 "
+                         "and read as unstable; linearise at a real control period")
     vp = np.ascontiguousarray(vehicle.rows()[0])
     gains = np.ascontiguousarray(controller.gains(), dtype=float)
     mem0 = np.array(controller.memory() if memory is None else memory, dtype=float).ravel()
