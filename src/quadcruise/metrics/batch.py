@@ -277,8 +277,7 @@ def flight_metrics_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, duties
         transient; NaN if it never settles into that band), ``final_error_m`` (at the last
         sample), ``effort`` (:data:`~quadcruise.metrics.flight.EFFORT_DEFINITION` [s]),
         ``transient_axis`` (-1: none), ``rise_time_s``, ``overshoot_pct``, ``peak_time_s``,
-        ``steady_from_s`` (where the steady window starts [s]: the first sample without a
-        transient, NaN if it never settles), and ``settling_s``: a list of one array per band. The transient is NaN (axis -1)
+        and ``settling_s``: a list of one array per band. The transient is NaN (axis -1)
         when the window holds fewer than 2 samples.
 
     Examples
@@ -304,7 +303,7 @@ def flight_metrics_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, duties
            "final_error_m": np.linalg.norm(pos[:, -1] - ref[:, -1], axis=1), "effort": effort,
            "transient_axis": np.full(n, -1, dtype=np.int64), "rise_time_s": np.full(n, np.nan),
            "settling_s": [np.full(n, np.nan) for _ in bands], "overshoot_pct": np.full(n, np.nan),
-           "peak_time_s": np.full(n, np.nan), "steady_from_s": np.full(n, float(t[0]))}
+           "peak_time_s": np.full(n, np.nan)}
     keep = slice(None) if transient_until is None else t <= transient_until
     tk = t[keep]
     if tk.size >= 2:
@@ -313,8 +312,8 @@ def flight_metrics_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, duties
                    overshoot_pct=got["overshoot_pct"], peak_time_s=got["peak_time_s"])
         measured = np.flatnonzero(got["axis"] >= 0)
         if measured.size:
-            out["steady_from_s"][measured] = got["t_step"][measured] + got["settling_s"][-1][measured]
-            steady = window_errors_batch(t, pos[measured], ref[measured], out["steady_from_s"][measured])
+            steady = window_errors_batch(t, pos[measured], ref[measured],
+                                         got["t_step"][measured] + got["settling_s"][-1][measured])
             out["steady_rmse_m"][measured] = steady["rmse"]
             out["steady_max_error_m"][measured] = steady["max_error"]
     return out

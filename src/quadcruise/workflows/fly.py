@@ -24,7 +24,7 @@ from quadcruise._version import __version__
 from quadcruise.control import as_controller, controller_record
 from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import FlightWarning, InputError, reject_unknown
-from quadcruise.layout import CMD_U1, F1, P_G, P_M, PSI, REF_PSI, REF_X, REF_Z, STATE_SIZE, X, Z
+from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, REF_Z, STATE_SIZE, X, Z
 from quadcruise.missions import Mission, mission_from_name, stack_params
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
@@ -232,12 +232,13 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
     bound = (track_bound(missions or [first], np.broadcast_to(x0, (n, STATE_SIZE)), n)
              if max_track_error is None else np.full(n, float(max_track_error)))
     result.meta["max_track_error_m"] = bound.tolist() if n > 1 else float(bound[0])
-    result = mark_lost_track(result, bound)
+    err = position_error(result)
+    result = mark_lost_track(result, bound, err)
     steady = (np.array([steady_bound(m, duration) for m in missions]) if missions else
               np.full(n, steady_bound(first, duration))) if max_steady_error is None else \
         np.full(n, float(max_steady_error))
     result.meta["max_steady_error_m"] = steady.tolist() if n > 1 else float(steady[0])
-    result = mark_off_track(result, steady)
+    result = mark_off_track(result, steady, err)
     _warn_about(result)
     return result
 
@@ -467,7 +468,7 @@ def steady_bound(mission: Mission, duration: float) -> float:
     return max(1.0, 0.25 * extent)
 
 
-def mark_off_track(result: SimResult, bound: np.ndarray) -> SimResult:
+def mark_off_track(result: SimResult, bound: np.ndarray, err: np.ndarray | None = None) -> SimResult:
     """The result, with ``off track`` as the status of each finished vehicle whose position
     error after the transient exceeded the bound, and the first instant it did as its ``t_stop``.
 
@@ -481,39 +482,59 @@ def mark_off_track(result: SimResult, bound: np.ndarray) -> SimResult:
     result : SimResult
     bound : numpy.ndarray
         (N,) bounds [m]; ``inf`` skips a vehicle.
+    err : numpy.ndarray, optional
+        (N, L) position errors [m] (:func:`position_error`), if already computed.
 
     Returns
     -------
     SimResult
         The same object when no vehicle is off track.
     """
-    from quadcruise.metrics.batch import flight_metrics_batch
+    from quadcruise.metrics.batch import transient_batch
+    from quadcruise.metrics.flight import STEADY_BAND
 
     live = np.flatnonzero((result.status == int(ExitStatus.FINISHED)) & np.isfinite(bound))
-    if not live.size or result.t.size < 2:
+    t = result.t
+    if not live.size or t.size < 2:
+        return result
+    err = (position_error(result) if err is None else err)[live]
+    if not np.isfinite(err).all():
         return result
     pos, ref = result.states[live, :, X:X + 3], result.references[live, :, REF_X:REF_X + 3]
-    if not (np.isfinite(pos).all() and np.isfinite(ref).all()):
-        return result
     mission = result.meta.get("mission")
-    got = flight_metrics_batch(result.t, pos, ref, result.commands[live, :, CMD_U1:CMD_U1 + 4],
-                               mission=mission if isinstance(mission, dict) else None)
-    settled = np.isfinite(got["steady_max_error_m"])
-    after = np.where(settled, got["steady_max_error_m"], got["final_error_m"])
-    off = after > bound[live]
+    got = transient_batch(t, pos, ref, mission if isinstance(mission, dict) else {}, [STEADY_BAND])
+    settle = got["settling_s"][0]
+    start = np.where(got["axis"] < 0, t[0], np.where(np.isnan(settle), t[-1], got["t_step"] + settle))
+    beyond = (err > bound[live, None]) & (t[None, :] >= start[:, None] - 1e-12)
+    off = beyond.any(axis=1)
     if not off.any():
         return result
-    start = np.where(settled, got["steady_from_s"], result.t[-1])
-    err = np.linalg.norm(pos - ref, axis=2)
-    beyond = (err > bound[live, None]) & (result.t[None, :] >= start[:, None])
-    first = np.where(beyond.any(axis=1), result.t[np.argmax(beyond, axis=1)], start)
+    first = t[np.argmax(beyond, axis=1)]
     status, t_stop = result.status.copy(), result.t_stop.copy()
     status[live[off]] = int(ExitStatus.OFF_TRACK)
     t_stop[live[off]] = first[off]
     return dataclasses.replace(result, status=status, t_stop=t_stop)
 
 
-def mark_lost_track(result: SimResult, bound: np.ndarray) -> SimResult:
+def position_error(result: SimResult) -> np.ndarray:
+    """The 3-D position error of every vehicle at every logged instant.
+
+    Parameters
+    ----------
+    result : SimResult
+
+    Returns
+    -------
+    numpy.ndarray
+        (N, L) [m]; NaN after a vehicle stopped. Written out per axis: the same sums as
+        ``numpy.linalg.norm(..., axis=2)``, a few times faster on the log's strided rows.
+    """
+    s, r = result.states, result.references
+    dx, dy, dz = (s[:, :, X + k] - r[:, :, REF_X + k] for k in range(3))
+    return np.sqrt(dx * dx + dy * dy + dz * dz)
+
+
+def mark_lost_track(result: SimResult, bound: np.ndarray, err: np.ndarray | None = None) -> SimResult:
     """The result, with ``lost track`` as the status of each finished vehicle whose position
     error left the bound, and the first logged instant it did as its ``t_stop``.
 
@@ -522,13 +543,15 @@ def mark_lost_track(result: SimResult, bound: np.ndarray) -> SimResult:
     result : SimResult
     bound : numpy.ndarray
         (N,) bounds [m].
+    err : numpy.ndarray, optional
+        (N, L) position errors [m] (:func:`position_error`), if already computed.
 
     Returns
     -------
     SimResult
         The same object when no vehicle lost track.
     """
-    err = np.linalg.norm(result.states[:, :, X:X + 3] - result.references[:, :, REF_X:REF_X + 3], axis=2)
+    err = position_error(result) if err is None else err
     beyond = (err > bound[:, None]) & (result.status == int(ExitStatus.FINISHED))[:, None]
     lost = np.flatnonzero(beyond.any(axis=1))
     if not lost.size:
