@@ -16,7 +16,6 @@ Examples
 from __future__ import annotations
 
 import os
-import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,11 +24,11 @@ from typing import Any
 import numpy as np
 
 from quadcruise.control import Controller, as_controller, controller_record
-from quadcruise.errors import FlightWarning, InputError, reject_unknown
+from quadcruise.errors import InputError, reject_unknown
 from quadcruise.io.plainjson import dumps, plain
 from quadcruise.metrics.summary import Summary
 from quadcruise.missions import Mission, mission_from_name
-from quadcruise.workflows.fly import FLY_OPTIONS, fly
+from quadcruise.workflows.fly import FLY_OPTIONS, flight_warnings_named, fly
 
 __all__ = ["compare", "Comparison", "DEFAULT_CONTROLLERS"]
 
@@ -334,12 +333,8 @@ def compare(mission: Mission | str = "circle",
     for label, ctrl in chosen.items():
         if progress is not None:
             progress(len(results), len(chosen))
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
+        with flight_warnings_named(label):
             results[label] = fly(mission, ctrl, vehicle=vehicle, duration=duration, dt=dt, **fly_kw)
-        for w in caught:                    # say whose flight it went wrong; the vehicle's own warnings once
-            labelled_text = f"{label}: {w.message}" if issubclass(w.category, FlightWarning) else str(w.message)
-            warnings.warn(labelled_text, w.category, stacklevel=2)
     if progress is not None:
         progress(len(results), len(chosen))
     return Comparison(mission=mission, controllers=chosen, results=results)

@@ -12,6 +12,7 @@ True
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import os
@@ -617,6 +618,29 @@ def write_flight(result: SimResult, out, fmt: str = "csv", metrics=None) -> None
     result.write(out, fmt=fmt, force=True, metrics=metrics)
 
 
+@contextlib.contextmanager
+def flight_warnings_named(label: str):
+    """Within it, the warnings of the flights flown say whose flight they are: each
+    :class:`~quadcruise.errors.FlightWarning` (a vehicle that did not finish, clipped duties)
+    gets ``label: `` in front; the others (the vehicle's own) pass as they were, once.
+
+    Parameters
+    ----------
+    label : str
+        Whose flights, e.g. a controller's label or ``"circle with nlpd"``.
+
+    Yields
+    ------
+    None
+    """
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        yield
+    for w in caught:
+        text = f"{label}: {w.message}" if issubclass(w.category, FlightWarning) else str(w.message)
+        warnings.warn(text, w.category, stacklevel=3)
+
+
 def _warn_about(result: SimResult) -> None:
     bad = np.flatnonzero(~result.ok)
     if bad.size:
@@ -629,4 +653,5 @@ def _warn_about(result: SimResult) -> None:
                       f"({np.count_nonzero(clipped)} of {result.n} vehicles)", FlightWarning, stacklevel=3)
 
 
-__all__ = ["fly", "default_duration", "hover_state", "per_vehicle_controllers", "steady_bound", "write_flight"]
+__all__ = ["fly", "default_duration", "flight_warnings_named", "hover_state", "per_vehicle_controllers", "steady_bound",
+           "write_flight"]

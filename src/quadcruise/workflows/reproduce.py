@@ -37,7 +37,6 @@ from __future__ import annotations
 import math
 import re
 import time
-import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
@@ -47,14 +46,14 @@ import numpy as np
 from quadcruise._version import __version__
 from quadcruise.control import NLPD, Gonzalez, controller_from_name
 from quadcruise.control.design import PDGains
-from quadcruise.errors import FlightWarning, InputError
+from quadcruise.errors import InputError
 from quadcruise.io.files import MARKER, atomic_dir, check_output_dir, write_table
 from quadcruise.io.plainjson import dumps
 from quadcruise.io.scenario_file import scenario_document, scenario_text
 from quadcruise.missions import Circle, Mission, Square, Step
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.result import SimResult
-from quadcruise.workflows.fly import fly
+from quadcruise.workflows.fly import flight_warnings_named, fly
 
 PAPER = {
     "nlpd": {"rise_time_s": 1.0, "settling_time_s": 2.0, "overshoot_pct": 4.0},
@@ -273,12 +272,8 @@ def reproduce(*, scenarios=tuple(SCENARIOS), controllers=tuple(CONTROLLERS), dt:
         flights += [(fit_name, fit_mission, fit_duration, None, name, f) for name, f in factories.items()]
     for scen, mission, duration, until, ctrl_name, factory in flights:
         start = time.perf_counter()
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
+        with flight_warnings_named(f"{scen} with {ctrl_name}"):
             result = fly(mission, factory(), vehicle=vehicle, duration=duration, dt=dt)
-        for w in caught:                    # say whose flight went wrong; the vehicle's own warnings once
-            text = f"{scen} with {ctrl_name}: {w.message}" if issubclass(w.category, FlightWarning) else str(w.message)
-            warnings.warn(text, w.category, stacklevel=2)
         row = result.metrics(transient_until=until).iloc[0].to_dict()
         run = {"scenario": scen, "controller": ctrl_name, "axis": row["axis"], "status": row["status"],
                **{k: _json_number(row[k]) for k in METRIC_KEYS}, "fitted": ctrl_name in FITTED}
