@@ -34,38 +34,7 @@ from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
 from quadcruise.montecarlo.requirements import Requirement, parse_requirements
 
-__all__ = ["MonteCarloSpec", "default_track_bound"]
-
-
-def default_track_bound(mission: Mission, duration: float) -> float:
-    """The default ``max_track_error_m`` of a sweep: the larger of 1 m and a quarter of the
-    mission's extent (:func:`quadcruise.workflows.fly.steady_bound`, fly's default
-    ``max_steady_error``).
-
-    Parameters
-    ----------
-    mission : Mission
-        The mission flown.
-    duration : float
-        Flight time [s].
-
-    Returns
-    -------
-    float
-        The bound [m]; the extent is the longest side of the box holding the reference
-        position at 1,001 instants over the flight.
-
-    Examples
-    --------
-    >>> from quadcruise.missions import mission_from_name
-    >>> default_track_bound(mission_from_name("circle"), 20.0)
-    1.0
-    >>> default_track_bound(mission_from_name("circle", radius=10.0), 20.0)
-    5.0
-    """
-    from quadcruise.workflows.fly import steady_bound
-
-    return steady_bound(mission, duration)           # one rule: fly's off-track bound
+__all__ = ["MonteCarloSpec"]
 
 
 def _divisor_at_most(n: int, target: int) -> int:
@@ -121,8 +90,9 @@ class MonteCarloSpec:
         (``steady_max_error_m``; where that is undefined because the transient never
         settled into 5 %, the error at the end, ``final_error_m``) exceeds this [m]. By
         default (None) the larger of 1 m and a quarter of the mission's extent (the longest
-        side of the box holding its reference path over the flight): 1 m for the built-in
-        circle, square, step and hover. The value used is the field's value after
+        side of the box holding its reference path over the flight,
+        :func:`quadcruise.workflows.fly.steady_bound`, the default of ``fly``'s
+        ``max_steady_error``): 1 m for the built-in circle, square, step and hover. The value used is the field's value after
         construction, recorded with the spec.
     requirements : str or sequence of str
         The user's own pass criteria, e.g. ``("steady_max_error_m<=0.2",)``: a metric of
@@ -164,7 +134,7 @@ class MonteCarloSpec:
 
     def __post_init__(self) -> None:
         from quadcruise.sim.engine import time_grid
-        from quadcruise.workflows.fly import default_duration
+        from quadcruise.workflows.fly import default_duration, steady_bound
 
         if isinstance(self.mission, str):
             object.__setattr__(self, "mission", mission_from_name(self.mission))
@@ -196,7 +166,7 @@ class MonteCarloSpec:
             if int(getattr(self, name)) != getattr(self, name) or getattr(self, name) < 0:
                 raise InputError(f"{name} must be a whole number >= 0, got {getattr(self, name)!r}")
         object.__setattr__(self, "requirements", tuple(r.text for r in parse_requirements(self.requirements)))
-        bound = default_track_bound(self.mission, self.duration) if self.max_track_error_m is None \
+        bound = steady_bound(self.mission, self.duration) if self.max_track_error_m is None \
             else self.max_track_error_m
         if isinstance(bound, bool) or not (isinstance(bound, (int, float)) and math.isfinite(bound) and bound > 0):
             raise InputError(f"max_track_error_m must be a positive number [m], got {bound!r}")
