@@ -680,6 +680,30 @@ class SensorNoise(_Part):
             raise InputError(f"sensor field 'delay' ({self.delay:g} s) is not a whole number of dt ({dt:g} s) periods")
         return int(k)
 
+    def check_fits(self, duration: float) -> None:
+        """Refuse a delay longer than the flight (its history buffer would be allocated first).
+
+        Parameters
+        ----------
+        duration : float
+            Flight time [s].
+
+        Raises
+        ------
+        InputError
+            Saying the delay and the flight time.
+
+        Examples
+        --------
+        >>> SensorNoise(delay=30.0).check_fits(20.0)
+        Traceback (most recent call last):
+            ...
+        quadcruise.errors.InputError: sensor field 'delay' (30 s) is longer than the flight (20 s)
+        """
+        if np.max(self.delay) > duration:
+            raise InputError(f"sensor field 'delay' ({np.max(self.delay):g} s) is longer than the flight "
+                             f"({float(duration):g} s)")
+
     def kwargs(self, dt: float) -> dict:
         """``sensor_std`` and ``sensor_delay`` for simulate/fly.
 

@@ -21,8 +21,6 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
 from quadcruise._cache import code_digest
 from quadcruise._version import __version__
 from quadcruise.control import as_controller, controller_record
@@ -149,10 +147,8 @@ class MonteCarloSpec:
         duration = default_duration(self.mission) if self.duration is None else self.duration
         time_grid(float(duration), float(self.dt))          # validates duration and dt
         object.__setattr__(self, "duration", float(duration))
-        noise = self.population.noise
-        if noise is not None and np.max(noise.delay) > self.duration:
-            raise InputError(f"sensor field 'delay' ({np.max(noise.delay):g} s) is longer than the flight "
-                             f"({self.duration:g} s)")
+        if self.population.noise is not None:
+            self.population.noise.check_fits(self.duration)
         object.__setattr__(self, "dt", float(self.dt))
         for name in ("log_dt", "trace_dt", "settle_band"):
             value = getattr(self, name)

@@ -196,9 +196,8 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
     if 0 < h <= d < math.inf:                               # sized before the grid is allocated
         check_run_size(n, round(d / h), int(log_every), max(1, math.ceil(h / float(max_step or h) - 1e-9)))
     grid = time_grid(float(duration), float(dt))
-    if sensors is not None and np.max(sensors.delay) > duration:
-        raise InputError(f"sensor field 'delay' ({np.max(sensors.delay):g} s) is longer than the flight "
-                         f"({float(duration):g} s)")
+    if sensors is not None:
+        sensors.check_fits(duration)
     check_can_hover(vehicle)
     given_x0 = None if x0 is None else np.asarray(x0, dtype=float).tolist()
     x0 = hover_state(vehicle, n, first) if x0 is None else x0
