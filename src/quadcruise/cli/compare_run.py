@@ -45,8 +45,8 @@ def population_from_options(n: int | None, seed: int, mass_spread: float, wind: 
         whole_number(n, "--population", minimum=1)
     whole_number(seed, "--seed")
     if n is None:
-        given = [o for o, v, default in (("--seed", seed, 0), ("--mass-spread", mass_spread, 0.1), ("--wind", wind, None))
-                 if v != default]
+        defaults = (("--seed", seed, 0), ("--mass-spread", mass_spread, 0.1), ("--wind", wind, None))
+        given = [option for option, value, default in defaults if value != default]
         if given:
             raise InputError(f"{given[0]} describes the population that --population N flies; without it, "
                              "it would change nothing")
@@ -118,7 +118,8 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
     from quadcruise.fields import parse_assignments
 
     if not mission.lower().endswith(".toml"):
-        return mission_from_options(mission, mission_params, smooth=False), DEFAULT_COMPARED if controllers is None else controllers, {}
+        chosen = DEFAULT_COMPARED if controllers is None else controllers
+        return mission_from_options(mission, mission_params, smooth=False), chosen, {}
     from quadcruise.missions import mission_from_name
     from quadcruise.workflows.scenario import load_scenario
 

@@ -62,19 +62,20 @@ def controller_params(params: tuple[str, ...], poles_text: str | None) -> dict:
     return out
 
 
-def controller_from_options(name: str, params: tuple[str, ...], poles_text: str | None, base=None):
+def controller_from_options(name: str | None, params: tuple[str, ...], poles_text: str | None, base=None):
     """The controller that ``--controller``, ``-c KEY=VALUE`` and ``--poles`` describe.
 
     Parameters
     ----------
-    name : str
-        The controller's name (:func:`quadcruise.control.controller_from_name`); unused with ``base``.
+    name : str or None
+        The controller's name (:func:`quadcruise.control.controller_from_name`): a new one,
+        whatever ``base`` is. None: ``base`` changed by the parameters, else ``nlpd``.
     params : tuple of str
         ``KEY=VALUE`` parameters of the controller.
     poles_text : str or None
         Closed-loop poles of the x/y loops; their PD gains become the ``position`` gains.
     base : Controller, optional
-        A controller (a scenario's) to change instead of a new one.
+        A controller (a scenario's) that the parameters change when no name is given.
 
     Returns
     -------
@@ -85,8 +86,8 @@ def controller_from_options(name: str, params: tuple[str, ...], poles_text: str 
     from quadcruise.control import controller_from_name
 
     given = controller_params(params, poles_text)
-    if base is None:
-        return controller_from_name(name, **given)
+    if name is not None or base is None:
+        return controller_from_name("nlpd" if name is None else name, **given)
     known = [f.name for f in dataclasses.fields(base)]
     unknown = sorted(set(given) - set(known))
     if unknown:
@@ -150,7 +151,7 @@ def flight_from_options(mission: str, controller: str | None, mission_params: tu
         if smooth and not mission.lower().endswith(".csv"):
             raise InputError(f"--smooth turns a waypoint CSV into a minimum-snap path; {mission!r} is not one")
         return (mission_from_options(mission, mission_params, smooth),
-                controller_from_options("nlpd" if controller is None else controller, controller_params, poles_text), {}, None)
+                controller_from_options(controller, controller_params, poles_text), {}, None)
     from quadcruise.workflows.scenario import load_scenario
 
     if smooth:
@@ -160,9 +161,6 @@ def flight_from_options(mission: str, controller: str | None, mission_params: tu
     the_mission = scenario.mission or mission_from_name("circle")
     if mission_params:
         the_mission = the_mission.replace(**parse_assignments(mission_params, "--mission-param"))
-    if controller is not None or scenario.controller is None:
-        the_controller = controller_from_options("nlpd" if controller is None else controller, controller_params, poles_text)
-    else:
-        the_controller = controller_from_options("", controller_params, poles_text, base=scenario.controller)
+    the_controller = controller_from_options(controller, controller_params, poles_text, base=scenario.controller)
     return the_mission, the_controller, scenario.fly_kwargs(), scenario
 

@@ -122,17 +122,14 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str | 
             raise InputError("-m/--mission-param does not apply to a scenario file: change its [mission] table")
         sc = load_scenario(mission)
         the_mission = sc.mission or "circle"
-        if controller is not None or sc.controller is None:     # as fly: -c changes the scenario's controller
-            the_controller = controller_from_options("nlpd" if controller is None else controller, controller_params, None)
-        else:
-            the_controller = controller_from_options("", controller_params, None, base=sc.controller)
+        the_controller = controller_from_options(controller, controller_params, None, base=sc.controller)
         kwargs.update(vehicle=sc.vehicle, duration=sc.duration if duration is None else duration,
                       dt=sc.dt if dt is None else dt)
         environment = environment if environment is not None else sc.environment
         sensors = sensors if sensors is not None else sc.sensor_noise
     else:
         the_mission = mission_from_options(mission, mission_params, False)
-        the_controller = controller_from_options("nlpd" if controller is None else controller, controller_params, None)
+        the_controller = controller_from_options(controller, controller_params, None)
     population = Population(mass_spread=mass_spread, inertia_spread=inertia_spread, wind_spread=wind_spread,
                             environment=environment if environment is not None and environment.parts else None,
                             noise=sensors)

@@ -121,7 +121,8 @@ def check_writable_place(path: str | os.PathLike) -> None:
         raise InputError("an output path is empty: name a file or folder to write")
     path = Path(path)
     if not path.resolve().name or path.name in ("", ".", ".."):
-        raise InputError(f"{path}: name a new file or folder to write, not {'the root' if not path.resolve().name else 'this folder or its parent'}")
+        what = "the root" if not path.resolve().name else "this folder or its parent"
+        raise InputError(f"{path}: name a new file or folder to write, not {what}")
     parent = path.parent if str(path.parent) else Path(".")
     while not parent.exists() and parent != parent.parent:
         parent = parent.parent

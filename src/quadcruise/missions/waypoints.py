@@ -551,8 +551,8 @@ class _WaypointMission(Mission):
         with np.errstate(over="ignore", invalid="ignore"):
             last = float(self.times[-1])
         if not (math.isfinite(last) and last <= MAX_PATH_S):
-            raise InputError(f"{self.table.source}: flying the path takes {last:g} s at its speeds, more than {MAX_PATH_S:g} s "
-                             "(a coordinate too large, or a speed too small?)")
+            raise InputError(f"{self.table.source}: flying the path takes {last:g} s at its speeds, more than "
+                             f"{MAX_PATH_S:g} s (a coordinate too large, or a speed too small?)")
 
     @property
     def times(self) -> np.ndarray:

@@ -90,8 +90,8 @@ class MonteCarloSpec:
         default (None) the larger of 1 m and a quarter of the mission's extent (the longest
         side of the box holding its reference path over the flight,
         :func:`quadcruise.workflows.fly.steady_bound`, the default of ``fly``'s
-        ``max_steady_error``): 1 m for the built-in circle, square, step and hover. The value used is the field's value after
-        construction, recorded with the spec.
+        ``max_steady_error``): 1 m for the built-in circle, square, step and hover. The
+        value used is the field's value after construction, recorded with the spec.
     requirements : str or sequence of str
         The user's own pass criteria, e.g. ``("steady_max_error_m<=0.2",)``: a metric of
         :data:`~quadcruise.montecarlo.schema.METRICS`, ``<=``, ``<``, ``>=`` or ``>``, and a

@@ -42,8 +42,8 @@ from quadcruise.montecarlo.schema import COLUMNS, FAILURES
 from quadcruise.montecarlo.spec import MonteCarloSpec
 from quadcruise.montecarlo.store import SweepFolder
 
-__all__ = ["run_chunk", "fly_chunk", "reduce_chunk", "sweep_metrics", "run_sweep", "check_sweep_size", "auto_chunk_size",
-           "CHUNK_BUDGET"]
+__all__ = ["run_chunk", "fly_chunk", "reduce_chunk", "sweep_metrics", "run_sweep", "check_sweep_size",
+           "auto_chunk_size", "CHUNK_BUDGET"]
 
 CHUNK_BUDGET = 64 * 2**20
 """Bytes of engine log per chunk that ``chunk_size="auto"`` aims at."""

@@ -467,8 +467,8 @@ def results_table(rep: Reproduction) -> str:
             f"| {_cell(r['overshoot_pct'])}{p['overshoot_pct']} | {_cell(r['rmse_m'])} | {_cell(r['max_error_m'])} |")
     failed = sum(r["status"] != "finished" for r in rep.runs)
     if failed:
-        lines.append(f"\n**{failed} of {len(rep.runs)} flights did not finish**: their metrics describe a failed flight, "
-                     "not the controller's design.")
+        lines.append(f"\n**{failed} of {len(rep.runs)} flights did not finish**: their metrics describe a failed "
+                     "flight, not the controller's design.")
     return "\n".join(lines)
 
 

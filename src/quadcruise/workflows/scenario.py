@@ -103,8 +103,8 @@ class Scenario:
     simulation : dict
         The checked ``[simulation]`` table: ``duration`` [s], ``dt`` [s], ``max_step`` [s],
         ``full_dynamics``, ``seed``, ``log_every``, ``n``, ``max_track_error`` [m],
-        ``max_steady_error`` [m] and ``initial_state`` (16 state values in the units of :data:`quadcruise.layout.STATE_UNITS`,
-        or one row per vehicle), each only if given.
+        ``max_steady_error`` [m] and ``initial_state`` (16 state values in the units of
+        :data:`quadcruise.layout.STATE_UNITS`, or one row per vehicle), each only if given.
     montecarlo : dict
         The ``[montecarlo]`` table as written (checked by ``quadcruise montecarlo``).
     compare : dict
