@@ -446,15 +446,6 @@ def _derivative_row(r: int, s: float) -> np.ndarray:
     return np.array([math.perm(k, r) * s ** max(k - r, 0) for k in range(_NC)], dtype=float)
 
 
-def _snap_hessian() -> np.ndarray:
-    """H with int_0^1 (d^4 p / ds^4)^2 ds = a^T H a for p = sum a_k s^k."""
-    k = np.arange(4, _NC)
-    fall = np.array([math.perm(i, 4) for i in k], dtype=float)
-    h = np.zeros((_NC, _NC))
-    h[4:, 4:] = np.outer(fall, fall) / (k[:, None] + k[None, :] - 7)
-    return h
-
-
 def _hermite_matrices() -> tuple[np.ndarray, np.ndarray]:
     """(Minv, K), computed exactly in rationals and rounded once: Minv turns the value and the
     first three s-derivatives at s = 0 and at s = 1 (in that order) into the coefficients of
