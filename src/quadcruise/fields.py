@@ -260,6 +260,7 @@ def between(low: float, high: float, closed: str = "[]", *, whole: bool = False,
     Returns
     -------
     Check
+        With ``bounds``: ``(low, high, closed)``.
 
     Examples
     --------
@@ -279,7 +280,9 @@ def between(low: float, high: float, closed: str = "[]", *, whole: bool = False,
         out = ((a < low) if lo_in else (a <= low)) | ((a > high) if hi_in else (a >= high))
         return out | (a != np.floor(a)) if whole else out
 
-    return _Number("range", want, refuse)
+    check = _Number("range", want, refuse)
+    check.bounds = (float(low), float(high), closed)     # for callers that search within the range
+    return check
 
 
 def one_of(*options: Any) -> Check:

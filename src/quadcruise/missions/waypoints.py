@@ -623,9 +623,9 @@ class Waypoints(_WaypointMission):
     columns: ClassVar[tuple] = ("n", "hold_yaw", "x[k]", "y[k]", "z[k]", "yaw[k]", "t[k]")
     function = staticmethod(waypoints_ref)
 
-    def _row(self) -> tuple:
+    def _row(self) -> np.ndarray:                   # an array, not a tuple: 10^6 points stay quick
         per_point = np.column_stack([self.table.points, self.table.yaws(), self.times])
-        return (len(self.table), float(self.yaw_mode == "hold"), *per_point.ravel())
+        return np.concatenate([[len(self.table), float(self.yaw_mode == "hold")], per_point.ravel()])
 
 
 @dataclass(frozen=True)
@@ -667,7 +667,7 @@ class MinimumSnap(_WaypointMission):
         coef.setflags(write=False)
         return coef
 
-    def _row(self) -> tuple:
+    def _row(self) -> np.ndarray:                   # an array, not a tuple: 10^6 points stay quick
         tk, end = self.times, np.append(self.table.points[-1], self.table.yaws()[-1])
         segs = np.column_stack([tk[:-1], np.diff(tk), self.coefficients.transpose(0, 2, 1).reshape(len(tk) - 1, -1)])
-        return (len(tk) - 1, *end, tk[-1], *segs.ravel())
+        return np.concatenate([[len(tk) - 1], end, [tk[-1]], segs.ravel()])
