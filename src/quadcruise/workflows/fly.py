@@ -205,6 +205,7 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
     if 0 < h <= d < math.inf:                               # sized before the grid is allocated
         check_run_size(n, round(d / h), int(log_every), max(1, math.ceil(h / float(max_step or h) - 1e-9)))
     grid = time_grid(float(duration), float(dt))
+    check_log_every(log_every, grid.size - 1)
     if sensors is not None:
         sensors.check_fits(duration)
     check_can_hover(vehicle)
@@ -461,6 +462,39 @@ def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1) -> Non
                          f"{steps // log_every + 1:,} logged instants), more than half of this machine's "
                          f"{memory / 2**30:.0f} GiB: log less often (log_every={every:,}: in Python, or a scenario's "
                          "[simulation]) or fly shorter")
+
+
+def check_log_every(log_every: int, periods: int) -> None:
+    """Refuse a ``log_every`` that does not divide the flight's control periods: the log would
+    end before the flight does (``log_every=1500`` on a 2 s flight at 1 kHz logs 0 and 1.5 s
+    only, and the result would read as a 1.5 s flight). A Monte Carlo sweep picks such a
+    divisor itself (``MonteCarloSpec.log_every``).
+
+    Parameters
+    ----------
+    log_every : int
+        Control periods between logged instants.
+    periods : int
+        The flight's control periods.
+
+    Raises
+    ------
+    InputError
+        Naming the nearest divisors below and above.
+
+    Examples
+    --------
+    >>> check_log_every(1500, 2000)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: fly() argument log_every must be a divisor of the flight's 2,000 control periods (so that the log ends where the flight does), got int 1500; the nearest: 1000, 2000
+    """
+    if periods % log_every == 0:
+        return
+    below = next(k for k in range(min(log_every, periods), 0, -1) if periods % k == 0)
+    above = next((k for k in range(log_every, periods + 1) if periods % k == 0), periods)
+    checks.fail("fly()", "log_every", log_every, f"a divisor of the flight's {periods:,} control periods (so that "
+                "the log ends where the flight does)", kind=False, hint=f"the nearest: {below}, {above}")
 
 
 HOVER_DUTY_WARNING = 0.7
