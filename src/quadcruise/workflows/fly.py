@@ -166,6 +166,17 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
         With ``metrics()``, ``to_pandas()`` and ``plot()``. A vehicle that diverged stops
         and its status says why and when (a warning says so too), as does any clipping
         of the rotor duties.
+
+    Raises
+    ------
+    ArgumentTypeError
+        An argument of the wrong type (a TypeError too): text for a number, a class for an
+        object, a float or a bool for ``seed``, ``n`` or ``log_every``, anything but a bool for
+        ``full_dynamics``, a controller whose ``function`` is not compiled with ``CONTROLLER_SIG``
+        (:mod:`quadcruise.checks`); before any work.
+    InputError
+        A value out of range (a ValueError), e.g. ``dt <= 0``, ``seed < 0``, a ``log_every``
+        that does not divide the flight's control periods, a flight too large to log.
     """
     reject_unknown("fly()", unknown, FLY_OPTIONS)
     w = "fly()"                                       # every argument checked before any work
