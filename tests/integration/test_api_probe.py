@@ -261,7 +261,7 @@ def quadcruise_cli(*args, cwd):
                           "'sensor_noise.position_std'?)"),
     (["fly", "{log_every}"], "[simulation] 'log_every' = 1500 does not divide the flight's 2,000 control periods"),
     (["fly", "{batch}"], "the number of vehicles contradicts itself: [vehicle] m gives 2, [simulation] n gives 3"),
-    (["fly", "{dt}"], "[simulation] 'dt' = 0.003 s does not fit 'duration' = 2 s"),
+    (["fly", "{dt}"], "[simulation] 'dt' = 0.003 s does not divide 'duration' = 2 s into whole control periods"),
 ])
 def test_scenario_and_number_messages_are_one_short_line_naming_where(tmp_path, args, words):
     files = {"inline": "[disturbances]\nsensor_noise = { position = 0.01 }\n",

@@ -502,10 +502,36 @@ def check_log_every(log_every: int, periods: int) -> None:
     """
     if periods % log_every == 0:
         return
-    below = next(k for k in range(min(log_every, periods), 0, -1) if periods % k == 0)
-    above = next((k for k in range(log_every, periods + 1) if periods % k == 0), periods)
+    below, above = nearest_divisors(log_every, periods)
     checks.fail("fly()", "log_every", log_every, f"a divisor of the flight's {periods:,} control periods (so that "
                 "the log ends where the flight does)", kind=False, hint=f"the nearest: {below}, {above}")
+
+
+def nearest_divisors(k: int, n: int) -> tuple[int, int]:
+    """The divisors of ``n`` nearest to ``k``, below and above (``n`` itself above all).
+
+    Parameters
+    ----------
+    k : int
+        A whole number >= 1.
+    n : int
+        A whole number >= 1.
+
+    Returns
+    -------
+    tuple of int
+        (the largest divisor <= k, the smallest divisor >= k), in sqrt(n) steps.
+
+    Examples
+    --------
+    >>> nearest_divisors(1500, 2000), nearest_divisors(3, 2000)
+    ((1000, 2000), (2, 4))
+    """
+    small = [d for d in range(1, math.isqrt(n) + 1) if n % d == 0]
+    divisors = sorted(set(small + [n // d for d in small]))
+    below = max((d for d in divisors if d <= k), default=1)
+    above = min((d for d in divisors if d >= k), default=n)
+    return below, above
 
 
 HOVER_DUTY_WARNING = 0.7

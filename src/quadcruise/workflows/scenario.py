@@ -296,17 +296,15 @@ def _consistent(where: _Where, doc: dict, vehicle: Vehicle, model: Vehicle | Non
         raise InputError(f"{where.source}: the number of vehicles contradicts itself: {told}")
     if "duration" not in simulation or "dt" not in simulation:   # else the command line may give them
         return
-    from quadcruise.sim.engine import time_grid
-
     sim, duration, dt = where.at("simulation"), simulation["duration"], simulation["dt"]
-    try:
-        periods = time_grid(duration, dt).size - 1
-    except InputError as exc:
-        raise sim.error(f"'dt' = {dt:g} s does not fit 'duration' = {duration:g} s: {exc}") from None
+    periods = round(duration / dt)                # as sim.engine.time_grid counts them, without the grid
+    if dt > duration or abs(periods * dt - duration) > 1e-9 * max(1.0, duration):
+        raise sim.error(f"'dt' = {dt:g} s does not divide 'duration' = {duration:g} s into whole control periods")
     every = simulation.get("log_every", 1)
     if periods % every:
-        near = [max(k for k in range(1, min(every, periods) + 1) if periods % k == 0),
-                min((k for k in range(every, periods + 1) if periods % k == 0), default=periods)]
+        from quadcruise.workflows.fly import nearest_divisors
+
+        near = nearest_divisors(every, periods)
         raise sim.error(f"'log_every' = {every} does not divide the flight's {periods:,} control periods "
                         f"('duration' / 'dt'): the log would end before the flight does; the nearest that do: "
                         f"{near[0]}, {near[1]}")
