@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import resource
 import statistics
@@ -72,7 +73,8 @@ def figure_call(name: str, duration: float | None = None):
     duration = duration or full
     if name in ("single", "batch"):              # Table I's mass, spread +/- 10 % over a batch
         vehicle = qc.Vehicle(m=3.499 * np.linspace(0.9, 1.1, n)) if n > 1 else None
-        return lambda: qc.fly("circle", "nlpd", vehicle=vehicle, duration=duration, dt=1.0 / HZ, log_every=1000)
+        every = math.gcd(1000, round(duration * HZ))     # log_every must divide the periods (0.1 s warm-up: 100)
+        return lambda: qc.fly("circle", "nlpd", vehicle=vehicle, duration=duration, dt=1.0 / HZ, log_every=every)
     # the Monte Carlo benchmark's population (benchmarks/, this script's folder, is on sys.path)
     from montecarlo import make_spec
 

@@ -139,8 +139,9 @@ def closed_loop(n: int, duration: float) -> Timing:
     """The paper's controller on the default circle (R 2 m, 20 s a lap: 60 s is 3 laps)."""
     import quadcruise as qc
     vehicle = qc.Vehicle(m=masses(n)) if n > 1 else None
-    return Timing(lambda dur: lambda: qc.fly("circle", "nlpd", vehicle=vehicle, duration=dur,
-                                             dt=1.0 / HZ, log_every=1000), n, duration)
+    # log every second, or the whole warm-up call's 10 periods (log_every must divide the periods)
+    return Timing(lambda dur: lambda: qc.fly("circle", "nlpd", vehicle=vehicle, duration=dur, dt=1.0 / HZ,
+                                             log_every=math.gcd(1000, round(dur * HZ))), n, duration)
 
 
 def rhs_batch(x: np.ndarray, u: np.ndarray, m: np.ndarray, Jxx=0.03, Jyy=0.03, Jzz=0.04, l=0.2,
