@@ -138,7 +138,6 @@ CASES = {
     "linearize vehicle": (lambda: linearize("nlpd", vehicle=3), WRONG, ["vehicle"]),
     "linearize controller class": (lambda: linearize(NLPD), WRONG, ["controller", "NLPD()"]),
     "linearize settle 1.5": (lambda: linearize("nlpd", settle=1.5), WRONG, ["settle"]),
-    "linearize plain controller": (lambda: linearize(PlainController()), WRONG, ["CONTROLLER_SIG"]),
     # parameter objects: the vehicle, missions, disturbances, controllers, limits
     "Vehicle m str": (lambda: qc.Vehicle(m="3.5"), WRONG, ["'m'", "mass", "'3.5'"]),
     "Vehicle m -1": (lambda: qc.Vehicle(m=-1.0), BAD, ["'m'", "> 0"]),

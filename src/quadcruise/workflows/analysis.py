@@ -257,6 +257,19 @@ def _check_loop(loop: str) -> str:
     return loop
 
 
+def _as_controller(controller):
+    if isinstance(controller, str):
+        from quadcruise.control import controller_from_name
+        return controller_from_name(controller)
+    if isinstance(controller, type):
+        checks.fail("linearize()", "controller", controller, "a controller name or object")
+    missing = [m for m in ("function", "gains", "memory") if not hasattr(controller, m)]
+    if missing:
+        raise InputError(f"controller must be a name or have .function, .gains() and .memory(); "
+                         f"{type(controller).__name__} lacks {', '.join(missing)}")
+    return controller
+
+
 MIN_DT = 1e-9
 """The shortest control period :func:`linearize` takes [s]: at 1e-12 s the poles z = exp(s dt) are
 within rounding of 1, and the s-plane poles computed from them are noise."""
@@ -311,10 +324,8 @@ def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 
     >>> bool(lin.residual < 1e-9), lin.sys.state_labels[-3:]
     (True, ['mem0', 'mem1', 'mem2'])
     """
-    from quadcruise.control import as_controller
-
     w = "linearize()"                                # every argument checked before any work
-    controller = as_controller(controller, w)
+    controller = _as_controller(controller)          # (its function may be plain Python: it is called here)
     vehicle = checks.instance(w, "vehicle", vehicle, Vehicle) or Vehicle.paper()
     dt = checks.number(w, "dt", dt, "pos", unit="s")
     hover_z = checks.number(w, "hover_z", hover_z, unit="m")
