@@ -48,15 +48,20 @@ from quadcruise.layout import (
     FLAG_THRUST_LIMIT,
     FLAG_TILT_LIMIT,
     P_G,
+    P_JXX,
+    P_JYY,
+    P_JZZ,
     P_K1,
     P_K2,
     P_K3,
     P_K4,
     P_K5,
     P_K6,
+    P_L,
     P_M,
     PSI,
     REF_PSI,
+    REF_PSI_DOT,
     REF_SIZE,
     REF_X,
     REF_Y,
@@ -69,6 +74,7 @@ from quadcruise.layout import (
 )
 from quadcruise.metrics import tracking_errors
 from quadcruise.missions import Circle, Hover, Step
+from quadcruise.missions.waypoints import MinimumSnap, WaypointTable
 from quadcruise.model.actuators import mix
 from quadcruise.workflows.compare import Comparison, compare
 
@@ -192,6 +198,92 @@ def test_se3_moments_cancel_the_gyroscopic_terms():
     assert vp[P_K1] * x[Q] * x[R] + vp[P_K2] * U2 == pytest.approx(-kw * x[P])
     assert vp[P_K3] * x[P] * x[R] + vp[P_K4] * U3 == pytest.approx(-kw * x[Q])
     assert vp[P_K5] * x[P] * x[Q] + vp[P_K6] * U4 == pytest.approx(-kw * x[R])
+
+
+def rotorpy_se3(ctrl: SE3, vp=VP):
+    """RotorPy 3.0's SE3Control with ctrl's gains and vp's mass and inertia (None without RotorPy)."""
+    quadrotor_control = pytest.importorskip("rotorpy.controllers.quadrotor_control")
+    from rotorpy.vehicles.crazyflie_params import quad_params
+
+    params = dict(quad_params, mass=vp[P_M], Ixx=vp[P_JXX], Iyy=vp[P_JYY], Izz=vp[P_JZZ],
+                  kp_att=ctrl.attitude.kp, kd_att=ctrl.attitude.kd)
+    theirs = quadrotor_control.SE3Control(params)
+    assert theirs.g == vp[P_G]                  # RotorPy's g is fixed at 9.81, the paper's
+    theirs.kp_pos = np.array([ctrl.position.kp, ctrl.position.kp, ctrl.altitude.kp])
+    theirs.kd_pos = np.array([ctrl.position.kd, ctrl.position.kd, ctrl.altitude.kd])
+    return theirs
+
+
+def test_se3_equals_rotorpy_se3control_with_a_yaw_rate_reference():
+    """Thrust, moments and R_d of se3 against RotorPy's SE3Control (an independent code path) at
+    random tilted, rotating states and references that turn the yaw (psi_dot_d != 0)."""
+    from scipy.spatial.transform import Rotation
+
+    ctrl = SE3()
+    theirs = rotorpy_se3(ctrl)
+    rng = np.random.default_rng(21)
+    for _ in range(50):
+        x = np.zeros(STATE_SIZE)
+        x[:3], x[3:6] = rng.uniform(-1, 1, 3), rng.uniform(-1, 1, 3)
+        x[6:8], x[8] = rng.uniform(-0.3, 0.3, 2), rng.uniform(-math.pi, math.pi)   # roll, pitch, yaw
+        x[P:R + 1] = rng.uniform(-2, 2, 3)
+        ref = np.zeros(REF_SIZE)
+        ref[:9] = x[:9] + rng.uniform(-0.3, 0.3, 9)           # position, velocity, acceleration
+        ref[REF_PSI], ref[REF_PSI_DOT] = rng.uniform(-math.pi, math.pi), rng.uniform(-1.0, 1.0)
+        cmd = np.zeros(CMD_SIZE)
+        se3(0.0, 1e-3, x, ref, VP, ctrl.gains(), np.zeros(0), cmd)
+        assert cmd[CMD_FLAGS] == 0                           # neither limit acts: Lee's law alone
+        state = {"x": x[:3], "v": x[3:6], "w": x[P:R + 1],
+                 "q": Rotation.from_euler("ZYX", [x[8], x[7], x[6]]).as_quat()}
+        flat = {"x": ref[:3], "x_dot": ref[3:6], "x_ddot": ref[6:9], "yaw": ref[REF_PSI],
+                "yaw_dot": ref[REF_PSI_DOT]}
+        out = theirs.update(0.0, state, flat)
+        l = VP[P_L]
+        np.testing.assert_allclose(cmd[CMD_THRUST], out["cmd_thrust"], rtol=1e-12)
+        np.testing.assert_allclose([cmd[CMD_TAU_PHI] * l, cmd[CMD_TAU_THETA] * l, cmd[CMD_TAU_PSI]],
+                                   out["cmd_moment"], rtol=0, atol=1e-10)
+        psi_d, theta_d, phi_d = Rotation.from_quat(out["cmd_q"]).as_euler("ZYX")
+        np.testing.assert_allclose([cmd[CMD_PHI_D], cmd[CMD_THETA_D], cmd[CMD_PSI_D]],
+                                   [phi_d, theta_d, psi_d], rtol=0, atol=1e-10)
+
+
+def yawing_minimum_snap() -> MinimumSnap:
+    """A 2 m square flown as one minimum-snap path in 16 s, the heading turning a full lap
+    (psi_dot_d up to 0.83 rad/s)."""
+    return MinimumSnap(WaypointTable([[0, 0, 1], [2, 0, 1], [2, 2, 1], [0, 2, 1], [0, 0, 1]],
+                                     yaw=[0, math.pi / 2, math.pi, 1.5 * math.pi, 2 * math.pi],
+                                     t=[0, 4, 8, 12, 16]))
+
+
+def yaw_error_deg(res) -> np.ndarray:
+    """The yaw reference minus the flown yaw, wrapped to (-180, 180] [deg]."""
+    e = res.references[0, :, REF_PSI] - res.states[0, :, PSI]
+    return np.degrees(np.angle(np.exp(1j * e)))
+
+
+@pytest.mark.slow
+def test_se3_follows_the_yaw_rate_of_a_minimum_snap_path():
+    """With w_d = (0, 0, psi_dot_d) se3 keeps the heading of a turning path within 0.6 deg;
+    without it the rate term kw would hold it back by kw / kR psi_dot_d, more than 8 deg here."""
+    mission = yawing_minimum_snap()
+    ctrl = SE3()
+    res = qc.fly(mission, ctrl)
+    assert res.ok[0]
+    rate = np.max(np.abs(res.references[0, :, REF_PSI_DOT]))
+    assert math.degrees(ctrl.attitude.kd / ctrl.attitude.kp * rate) > 8.0     # the lag this path would show
+    assert np.max(np.abs(yaw_error_deg(res))) < 0.6
+
+
+@pytest.mark.slow
+def test_cascade_feeds_the_yaw_rate_forward_on_a_minimum_snap_path():
+    """The cascade adds psi_dot_d to its yaw rate setpoint: its yaw error stays a small part of
+    the psi_dot_d / K_yaw a P attitude loop without feedforward would lag by (17 deg here)."""
+    ctrl = Cascade()
+    res = qc.fly(yawing_minimum_snap(), ctrl)
+    assert res.ok[0]
+    lag_without = math.degrees(np.max(np.abs(res.references[0, :, REF_PSI_DOT])) / ctrl.yaw_p)
+    assert lag_without > 15.0
+    assert np.max(np.abs(yaw_error_deg(res))) < 0.1 * lag_without
 
 
 @pytest.mark.parametrize("ctrl", MODERN, ids=IDS)
