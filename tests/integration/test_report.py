@@ -42,7 +42,7 @@ from quadcruise.report.html import (
     write_html_report,
 )
 from quadcruise.workflows.compare import compare
-from quadcruise.workflows.reproduce import reproduce
+from quadcruise.workflows.reproduce import fitted_nlpd_loop, reproduce
 
 CHROMIUM = os.environ.get("QUADCRUISE_CHROMIUM", "/usr/bin/chromium")
 FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -182,6 +182,9 @@ def test_builders(rep):
     table = kw["tables"]["Results against the paper"]
     assert len(table) == 4 and table["paper: settling_time_s"].tolist() == [2.0, 12.0, 2.0, 12.0]
     assert "<strong>Rise time" in kw["notes"] and "<h3>" in kw["notes"]
+    dom = fitted_nlpd_loop()["dom_pole"]                  # computed from analyze's linearised loop
+    assert f"dominant pair at {dom.real:.2f} +- {dom.imag:.2f}j" in " ".join(kw["notes"].split())
+    assert "does not say which convention" in kw["notes"]
     page = html_report(**kw)
     assert page.count("<canvas") == 2 and "did not settle" in page
 

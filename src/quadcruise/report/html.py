@@ -503,10 +503,11 @@ def reproduction_report(rep, figures: dict | None = None, *, title: str | None =
 
     from quadcruise._version import __version__
     from quadcruise.workflows.reproduce import (
-        DIFFERENCES,
         FIGURES,
+        INTRO,
         TRACE_EVERY,
         baseline_comparison,
+        differences,
         paper_figure,
         paper_numbers,
     )
@@ -528,10 +529,7 @@ def reproduction_report(rep, figures: dict | None = None, *, title: str | None =
         figures = {cap: fig for name, cap in FIGURES.items()
                    if (fig := paper_figure(name, cap, light)) is not None}
     flights = {scen: {c: res for (s, c), res in rep.results.items() if s == scen} for scen in ("circle", "square")}
-    intro = ("Our values beside the paper's. Transients are measured on x from hover; settling uses the "
-             "2 % band (5 % beside it); RMSE is the 3-D position error over the whole flight, transient "
-             "included.")
-    notes = markdown_html(intro + "\n" + DIFFERENCES + baseline_comparison(rep))
+    notes = markdown_html(INTRO + "\n" + differences(rep) + baseline_comparison(rep))
     return {"title": title or f"quadcruise {__version__}: reproduction of the paper",
             "tables": {"Results against the paper": table}, "figures": figures,
             "flights": {k: v for k, v in flights.items() if v},
