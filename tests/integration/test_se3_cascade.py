@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import re
 import warnings
 
 import control
@@ -522,3 +523,29 @@ def test_cascade_integrators_remove_a_mass_error_that_se3_keeps():
     assert pid.final_state[0, Z] == pytest.approx(1.0, abs=0.01)
     # no integrator: m (g + kx e) = 1.2 m g, the offset e = 0.2 g / kx = 0.65 m
     assert pd.final_state[0, Z] == pytest.approx(1.0 - 0.2 * V.g / SE3().altitude.kp, abs=0.01)
+
+
+def test_readme_states_the_tilt_flown_at_a_square_corner_as_measured():
+    """README's flown-tilt figures at 45 deg max_tilt: each controller's largest tilt on the corners of
+    a 4 m square at 2 m/s, and what it asked for, measured here (to the degree the README gives)."""
+    from pathlib import Path
+
+    from quadcruise.layout import CMD_PHI_D, CMD_THETA_D, PHI, THETA
+    from quadcruise.missions import Square
+
+    text = " ".join(Path(__file__).parents[2].joinpath("README.md").read_text().split())
+    m = re.search(r"the largest tilt flown is (\d+)° for `nlpd`, (\d+)° for `gonzalez`, (\d+)° for `se3` and "
+                  r"(\d+)° for `cascade` \(asked: (\d+)°, (\d+)°, (\d+)°, (\d+)°\)", text)
+    assert m, "README lost its flown-tilt sentence"
+    stated = [int(v) for v in m.groups()]
+    flown, asked = [], []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for name in ("nlpd", "gonzalez", "se3", "cascade"):
+            res = qc.fly(Square(side=4.0, speed=2.0), name, duration=12.0)
+            s, c = res.states[0], res.commands[0]
+            flown.append(math.degrees(np.arccos(np.min(np.cos(s[:, PHI]) * np.cos(s[:, THETA])))))
+            asked.append(math.degrees(np.arccos(np.min(np.cos(c[:, CMD_PHI_D]) * np.cos(c[:, CMD_THETA_D])))))
+    assert np.all(np.abs(np.array(flown + asked) - stated) < 0.6), (flown, asked)   # README's whole degrees
+    assert flown[0] > 45.0 + 15.0 and asked[0] == pytest.approx(60.0, abs=0.1)   # per-axis limits: acos(cos^2 45)
+    assert asked[2] == pytest.approx(45.0, abs=0.1)                              # se3: the thrust axis's tilt
