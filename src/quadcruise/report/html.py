@@ -529,7 +529,7 @@ def reproduction_report(rep, figures: dict | None = None, *, title: str | None =
         figures = {cap: fig for name, cap in FIGURES.items()
                    if (fig := paper_figure(name, cap, light)) is not None}
     flights = {scen: {c: res for (s, c), res in rep.results.items() if s == scen} for scen in ("circle", "square")}
-    notes = markdown_html(INTRO + "\n" + differences(rep) + baseline_comparison(rep))
+    notes = markdown_html(INTRO + "\n" + differences() + baseline_comparison(rep))
     return {"title": title or f"quadcruise {__version__}: reproduction of the paper",
             "tables": {"Results against the paper": table}, "figures": figures,
             "flights": {k: v for k, v in flights.items() if v},

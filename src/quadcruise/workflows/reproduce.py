@@ -553,7 +553,7 @@ def report_markdown(rep: Reproduction, figures: list[str]) -> str:
     text.append("\n## Figures\n")
     for name in figures:
         text.append(f"![{FIGURES[name]}]({name})\n\n*{FIGURES[name]}*\n")
-    text.append(differences(rep))
+    text.append(differences())
     text.append(baseline_comparison(rep))
     return "\n".join(text)
 
@@ -639,16 +639,11 @@ def _pole_text(p: complex) -> str:
     return f"{p.real:.2f}" if p.imag == 0 else f"{p.real:.2f} +- {abs(p.imag):.2f}j"
 
 
-def differences(rep: Reproduction | None = None) -> str:
+def differences() -> str:
     """The report's section on where our numbers differ from the paper's, and why.
 
     The fitted nlpd's poles and its linear step response in it are computed
     (:func:`fitted_nlpd_loop`), not typed in.
-
-    Parameters
-    ----------
-    rep : Reproduction, optional
-        The runs (not read yet: the section holds for any set of them).
 
     Returns
     -------
