@@ -861,8 +861,9 @@ def summary(rep: dict) -> str:
     table = [[""] + list(rep["loops"])] + [[name] + [cell(e) for e in rep["loops"].values()] for name, cell in rows]
     w = [max(len(row[j]) for row in table) + 2 for j in range(len(table[0]))]
     short = [loop for loop, e in rep["loops"].items() if any(e.get("low_margins", {}).values())]
-    head = f"{rep['controller']} about hover, dt = {rep['dt_s']:g} s: " + (
-        "stable (every pole inside the unit circle)" if rep["stable"] else "UNSTABLE (a pole on or outside the unit circle)")
+    verdict = ("stable (every pole inside the unit circle)" if rep["stable"]
+               else "UNSTABLE (a pole on or outside the unit circle)")
+    head = f"{rep['controller']} about hover, dt = {rep['dt_s']:g} s: {verdict}"
     if short:
         head += f", margins short on {', '.join(short)} (!)"
     return "\n".join([head] + [r[0].ljust(w[0]) + "".join(c.rjust(k) for c, k in zip(r[1:], w[1:])) for r in table]
