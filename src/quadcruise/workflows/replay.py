@@ -318,8 +318,8 @@ def read_speed_csv(path: str | os.PathLike, n_rotors: int,
     ----------
     path : str or os.PathLike
         The CSV file: a header naming ``t`` and ``w1`` .. ``wn`` (other columns are ignored
-        with a warning, but a ``w`` column beyond the vehicle's rotors is refused), then at
-        least two rows of times [s] and speeds [rad/s].
+        with a warning, but a column ``w<n+1>`` is refused: the file is for another vehicle),
+        then at least two rows of times [s] and speeds [rad/s].
     n_rotors : int
         The vehicle's number of rotors, n.
     progress : callable, optional
@@ -331,8 +331,7 @@ def read_speed_csv(path: str | os.PathLike, n_rotors: int,
         With ``source`` the file name and the file line of each row.
     """
     columns = speed_columns(n_rotors)
-    beyond = tuple(f"w{k}" for k in range(n_rotors + 1, n_rotors + 33))
-    _, used, data, lines = read_numeric_csv(path, columns, beyond, progress=progress)
+    _, used, data, lines = read_numeric_csv(path, columns, (f"w{n_rotors + 1}",), progress=progress)
     if len(used) > len(columns):
         raise InputError(f"{path}: column '{used[len(columns)]}', but the vehicle has {n_rotors} rotors "
                          f"(columns {', '.join(columns)})")
