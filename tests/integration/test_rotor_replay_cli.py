@@ -110,3 +110,23 @@ def test_a_vehicle_that_cannot_lift_itself_is_refused_before_any_work(tmp_path):
     assert result.exit_code == 2
     assert result.output.strip().startswith(f"error: {mine}: [vehicle] vehicle cannot lift itself")
     assert not out.exists()
+
+
+def test_a_crash_on_the_ground_writes_the_states_says_so_and_exits_one(tmp_path):
+    src = tmp_path / "drop.csv"
+    src.write_text("t,w1,w2,w3,w4\n0,2300,2300,2300,2300\n0.5,0,0,0,0\n3,0,0,0,0\n")
+    out = tmp_path / "states.csv"
+    result = run("replay", str(src), "--vehicle", "crazyflie", "--ground", "-o", str(out))
+    assert result.exit_code == 1, result.output
+    assert "the flight stopped early: crashed: hit the ground faster" in result.output
+    data = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert np.isfinite(data[1]).all() and np.isnan(data[2, 1:]).all()     # states until the crash, then NaN
+    free = run("replay", str(src), "--vehicle", "crazyflie", "-o", str(tmp_path / "free.csv"))
+    assert free.exit_code == 0                                             # no ground: it falls on
+
+
+def test_ground_needs_a_rotor_vehicle(tmp_path):
+    pwm = Path(__file__).resolve().parents[2] / "examples" / "pwm_step.csv"
+    result = run("replay", str(pwm), "--ground", "-o", str(tmp_path / "s.csv"))
+    assert result.exit_code == 2 and "'--ground'" in result.output and "paper's plant has no ground" in result.output
+    assert len(result.output.strip().splitlines()) == 1

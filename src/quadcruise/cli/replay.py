@@ -19,16 +19,20 @@ __all__ = ["replay"]
 @click.option("--vehicle", "vehicle_name", default=None, metavar="NAME|FILE.toml",
               help="The vehicle: a preset (paper, crazyflie, hummingbird, iris) or a vehicle file "
                    "([vehicle] preset = \"iris\" and the fields to change). Default: the paper's Table I.")
+@click.option("--ground", is_flag=True,
+              help="A ground at z = 0 (rotor-plant vehicles): the vehicle starts and rests on it; meeting it faster "
+                   "than the vehicle's touchdown_speed, or upside down, ends the flight 'crashed'.")
 @click.option("--max-step", default=None, type=float,
               help="Longest RK4 substep [s]. Default: 1e-3 for the paper's plant, 1e-4 for a rotor-plant vehicle.")
 @friendly
-def replay(pwm_csv: str, out: str, vehicle_name: str | None, max_step: float | None) -> None:
+def replay(pwm_csv: str, out: str, vehicle_name: str | None, ground: bool, max_step: float | None) -> None:
     """Replay commands open loop and write the states.
 
     For the paper's plant the columns are t,u1,u2,u3,u4 (PWM duties); for a rotor-plant
     vehicle, t,w1,..,wn (commanded rotor speeds, rad/s, in the vehicle's range). Each row's
     commands hold until the next row's time. The vehicle starts at rest at the origin, level,
-    each rotor at the first row's command.
+    each rotor at the first row's command. The states are written even when the flight stops
+    early (diverged, crashed); the exit status is then 1.
 
     \f
     Parameters
@@ -42,11 +46,15 @@ def replay(pwm_csv: str, out: str, vehicle_name: str | None, max_step: float | N
         F1..F4 [N] or rotor speeds [rad/s]).
     vehicle_name : str or None
         ``--vehicle``: a preset's name or a vehicle TOML file; None: the paper's Table I.
+    ground : bool
+        ``--ground``: a ground at z = 0 (rotor-plant vehicles only).
     max_step : float or None
         ``--max-step``: longest RK4 substep [s]; None: 1e-3 s (paper) or 1e-4 s (rotor plant).
     """
     import os
+    import sys
 
+    from quadcruise.errors import InputError
     from quadcruise.model.rotor_vehicle import RotorVehicle
     from quadcruise.model.vehicle import Vehicle
     from quadcruise.workflows import replay as workflow
@@ -54,20 +62,22 @@ def replay(pwm_csv: str, out: str, vehicle_name: str | None, max_step: float | N
     if os.path.exists(out) and os.path.exists(pwm_csv) and os.path.samefile(pwm_csv, out):
         raise click.BadParameter(f"{out} is the input file: write the states elsewhere", param_hint="'-o'")
     vehicle = Vehicle.paper() if vehicle_name is None else Vehicle.load(vehicle_name)
+    if ground and not isinstance(vehicle, RotorVehicle):
+        raise InputError("option '--ground': the paper's plant has no ground: give a rotor-plant --vehicle "
+                         "(crazyflie, hummingbird, iris or a file)")
 
     if isinstance(vehicle, RotorVehicle):
         schedule = workflow.read_speed_csv(pwm_csv, vehicle.n_rotors, progress=Bar(f"reading {pwm_csv}", unit="row"))
         result = workflow.replay_rotors(schedule, vehicle, max_step=workflow.ROTOR_MAX_STEP if max_step is None
-                                        else max_step, progress=Bar("flying", unit="row"))
-        if not result.ok[0]:
-            click.echo(f"warning: the flight stopped early: {result.status_text(0)}", err=True)
+                                        else max_step, ground=ground, progress=Bar("flying", unit="row"))
         workflow.write_rotor_states_csv(result, out)
     else:
         schedule = workflow.read_duty_csv(pwm_csv, progress=Bar(f"reading {pwm_csv}", unit="row"))
         result = workflow.replay(schedule, vehicle, max_step=1e-3 if max_step is None else max_step,
                                  progress=Bar("flying", unit="row"))
-        if not result.ok[0]:
-            click.echo(f"warning: the flight stopped early: {result.status_text(0)}", err=True)
         workflow.write_states_csv(result, out, progress=Bar(f"writing {out}", unit="row"))
     click.echo(f"wrote {len(result.t)} states to {out} "
                f"(t = {result.t[0]:g} .. {result.t[-1]:g} s, final z = {result.final_state[0, 2]:.4f} m)")
+    if not result.ok[0]:
+        click.echo(f"the flight stopped early: {result.status_text(0)}", err=True)
+        sys.exit(1)             # diverged or crashed: the states up to then are written

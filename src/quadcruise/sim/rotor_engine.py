@@ -7,7 +7,10 @@ paper plant's engine (:mod:`quadcruise.sim.engine`) splits a control period. Aft
 the quaternion is scaled back to unit length (RK4 keeps it there only to its own order);
 after each interval the state is logged and checked against the same :class:`Limits` and
 exit codes as the paper plant's flights (:class:`quadcruise.ExitStatus`). A vehicle that
-leaves them stops there, its later log rows NaN.
+leaves them stops there, its later log rows NaN. With a ground (``touchdown_speed``), each
+step that ends below z = 0 meets it (:func:`ground_contact`): held there, or ``CRASHED`` at
+that step, its state then in ``final_state`` at ``t_stop`` and its log NaN from the next row
+on (the row's time is not the crash's).
 
 This path stands beside the engine's kernel and shares no code with its hot loop, so the
 paper plant's flights and speed are untouched.
@@ -43,8 +46,9 @@ from quadcruise.sim.engine import Limits
 from quadcruise.sim.rotor_result import RotorResult
 from quadcruise.sim.status import ExitStatus
 
-FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND = (
-    int(ExitStatus[name]) for name in ("FINISHED", "NONFINITE", "POSITION_BOUND", "SPEED_BOUND", "RATE_BOUND"))
+FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, CRASHED = (
+    int(ExitStatus[name]) for name in ("FINISHED", "NONFINITE", "POSITION_BOUND", "SPEED_BOUND", "RATE_BOUND",
+                                       "CRASHED"))
 
 ROTOR_WORK_ROWS = 5
 """Rows of the RK4 workspace: the four stage derivatives and the stage state."""
@@ -90,8 +94,43 @@ def rotor_rk4_step(x, w_cmd, rp, ext, h, work):
         x[j] /= norm
 
 
+@njit(cache=True, error_model="numpy")
+def ground_contact(x, touchdown_speed):
+    """Meet the ground at z = 0 after a step that ended below it: True for a crash (the state
+    is left as it is), else the vehicle is set on the ground, in place on x.
+
+    A crash is a descent faster than ``touchdown_speed`` or the body's z axis pointing below
+    the horizon (upside down). Otherwise the landing gear holds the vehicle: z = 0, no
+    descent, no sliding (vx = vy = 0), no rotation, roll and pitch zero, yaw kept (as RotorPy's
+    ground does). A vehicle at rest on the ground whose thrust is under its weight stays there;
+    one whose thrust is over it lifts off in its next step.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        (13 + n,) the state after the step, z < 0.
+    touchdown_speed : float
+        The fastest descent its gear survives [m/s].
+
+    Returns
+    -------
+    bool
+        Whether it crashed.
+    """
+    qw, qx, qy, qz = x[QW], x[QX], x[QY], x[QZ]
+    if -x[RVZ] > touchdown_speed or 1.0 - 2.0 * (qx * qx + qy * qy) < 0.0:
+        return True
+    yaw = math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+    x[RZ] = 0.0
+    x[RVX] = x[RVY] = 0.0
+    x[RVZ] = max(x[RVZ], 0.0)
+    x[RP] = x[RQ] = x[RR] = 0.0
+    x[QW], x[QX], x[QY], x[QZ] = math.cos(0.5 * yaw), 0.0, 0.0, math.sin(0.5 * yaw)
+    return False
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
-def _replay_kernel(t, w_cmd, x0, rp, ext, max_step, limits, log_x, x_final, status, t_stop):
+def _replay_kernel(t, w_cmd, x0, rp, ext, max_step, limits, ground, touchdown, log_x, x_final, status, t_stop):
     """Fly every vehicle of the batch through the schedule (arguments: :func:`replay_rotor_speeds`'s,
     one row per vehicle; outputs ``log_x``, ``x_final``, ``status``, ``t_stop``)."""
     n_rows = t.shape[0]
@@ -111,8 +150,14 @@ def _replay_kernel(t, w_cmd, x0, rp, ext, max_step, limits, log_x, x_final, stat
             n_sub = max(1, int(math.ceil(dt / max_step - 1e-9)))
             h = dt / n_sub
             cmd = w_cmd[k]
-            for _ in range(n_sub):
+            for sub in range(n_sub):
                 rotor_rk4_step(x, cmd, rpi, exti, h, work)
+                if ground and x[RZ] < 0.0 and ground_contact(x, touchdown[i]):
+                    code = CRASHED
+                    t_end = t[k] + (sub + 1) * h
+                    break
+            if code == CRASHED:        # mid-interval: its state is x_final at t_stop, not row k + 1's
+                break
             finite = True
             for j in range(size):
                 finite = finite and math.isfinite(x[j])
@@ -140,7 +185,7 @@ def _replay_kernel(t, w_cmd, x0, rp, ext, max_step, limits, log_x, x_final, stat
 
 
 def replay_rotor_speeds(t, w_cmd, x0, rp, *, ext=None, max_step: float = 1e-3, limits: Limits | None = None,
-                        names: tuple[str, ...] = (), meta: dict | None = None) -> RotorResult:
+                        touchdown_speed=None, names: tuple[str, ...] = (), meta: dict | None = None) -> RotorResult:
     """Fly N rotor-plant vehicles open loop through a schedule of rotor speeds.
 
     The array-level entry point that :func:`quadcruise.workflows.replay.replay_rotors` builds on.
@@ -163,6 +208,10 @@ def replay_rotor_speeds(t, w_cmd, x0, rp, *, ext=None, max_step: float = 1e-3, l
         Longest RK4 substep [s].
     limits : Limits, optional
         Divergence bounds (position, speed, body rate; tilt is not bounded: a flip flies on).
+    touchdown_speed : float or (N,) array, optional
+        With it, a ground at z = 0 (:func:`ground_contact`): the fastest descent [m/s] each
+        vehicle may meet it at; faster, or upside down, ends the flight ``CRASHED``. None:
+        free flight, no ground.
     names : tuple of str
         The state's column names, kept in the result.
     meta : dict, optional
@@ -202,6 +251,12 @@ def replay_rotor_speeds(t, w_cmd, x0, rp, *, ext=None, max_step: float = 1e-3, l
     x_final = np.empty((N, ROTOR_W1 + n))
     status = np.zeros(N, dtype=np.int64)
     t_stop = np.empty(N)
-    _replay_kernel(t, w_cmd, x0, rp, ext, float(max_step), limits.array(), log_x, x_final, status, t_stop)
+    ground = touchdown_speed is not None
+    touchdown = np.ascontiguousarray(np.broadcast_to(np.inf if touchdown_speed is None else touchdown_speed, (N,)),
+                                     dtype=float)
+    if ground and not np.all(touchdown > 0):
+        raise InputError(f"touchdown speed must be > 0 m/s, got {touchdown_speed!r}")
+    _replay_kernel(t, w_cmd, x0, rp, ext, float(max_step), limits.array(), ground, touchdown, log_x, x_final,
+                   status, t_stop)
     return RotorResult(t=t.copy(), states=log_x, final_state=x_final, status=status, t_stop=t_stop,
                        names=tuple(names), meta=dict(meta or {}))

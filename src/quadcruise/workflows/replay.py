@@ -347,7 +347,7 @@ at 1e-4 s (tests/integration/test_rotorpy_agreement.py); 3 s cost 30,000 steps, 
 
 
 def replay_rotors(schedule: SpeedSchedule, vehicle: RotorVehicle, *, max_step: float = ROTOR_MAX_STEP,
-                  limits: Limits | None = None, wind=(0.0, 0.0, 0.0),
+                  limits: Limits | None = None, wind=(0.0, 0.0, 0.0), ground: bool = False,
                   progress: Callable[[int, int], None] | None = None) -> RotorResult:
     """Fly the commanded rotor speeds open loop on the rotor-speed plant and log every row.
 
@@ -369,6 +369,10 @@ def replay_rotors(schedule: SpeedSchedule, vehicle: RotorVehicle, *, max_step: f
         Divergence bounds (position, speed, body rate).
     wind : sequence of 3 floats
         A steady wind [m/s], world frame; it acts through the vehicle's aerodynamics.
+    ground : bool
+        A ground at z = 0: the vehicle starts on it, rests on it while its thrust is under
+        its weight, and meeting it faster than the vehicle's ``touchdown_speed`` or upside
+        down ends the flight ``CRASHED`` (:func:`quadcruise.sim.rotor_engine.ground_contact`).
     progress : callable, optional
         ``progress(done, total)``: the schedule's rows flown (0, then all of them).
 
@@ -408,12 +412,13 @@ def replay_rotors(schedule: SpeedSchedule, vehicle: RotorVehicle, *, max_step: f
     x0[ROTOR_W1:] = schedule.speeds[0]
     ext = np.r_[np.zeros(6), wind, np.ones(n)]
     meta = {"workflow": "replay", "plant": "rotor", "source": schedule.source, "vehicle": vehicle.to_dict(),
-            "max_step_s": max_step, "wind": wind.tolist(), "version": __version__}
+            "max_step_s": max_step, "wind": wind.tolist(), "ground": bool(ground), "version": __version__}
     rows = schedule.t.shape[0]
     if progress is not None:
         progress(0, rows)
     result = replay_rotor_speeds(schedule.t, schedule.speeds, x0, vehicle.row(), ext=ext, max_step=max_step,
-                                 limits=limits, names=state_names(n), meta=meta)
+                                 limits=limits, touchdown_speed=vehicle.touchdown_speed if ground else None,
+                                 names=state_names(n), meta=meta)
     if progress is not None:
         progress(rows, rows)
     return result
