@@ -130,3 +130,14 @@ def test_ground_needs_a_rotor_vehicle(tmp_path):
     result = run("replay", str(pwm), "--ground", "-o", str(tmp_path / "s.csv"))
     assert result.exit_code == 2 and "'--ground'" in result.output and "paper's plant has no ground" in result.output
     assert len(result.output.strip().splitlines()) == 1
+
+
+def test_vehicles_lists_every_preset_with_its_source_and_file():
+    from quadcruise.model.vehicle_files import PRESETS, preset_source
+
+    result = run("vehicles")
+    assert result.exit_code == 0, result.output
+    for name, path in PRESETS.items():
+        assert preset_source(name) in result.output and f"file: {path}" in result.output
+        assert path.is_file()
+    assert "iris         rotor    1.535 kg  4 rotors" in result.output

@@ -109,6 +109,29 @@ def preset_plant(name: str) -> str:
     return str(_preset_table(name)["plant"])
 
 
+def preset_table() -> list[dict]:
+    """Every preset, one row each: what ``quadcruise vehicles`` lists.
+
+    Returns
+    -------
+    list of dict
+        ``name``, ``plant``, ``m`` [kg], ``rotors`` (their number; 4 for the paper's "+"),
+        ``source``, ``file`` (the TOML file to copy), in name order.
+
+    Examples
+    --------
+    >>> [(r["name"], r["plant"], r["m"]) for r in preset_table()][:2]
+    [('crazyflie', 'rotor', 0.03), ('hummingbird', 'rotor', 0.5)]
+    """
+    rows = []
+    for name in sorted(PRESETS):
+        table = _preset_table(name)
+        rows.append({"name": name, "plant": table["plant"], "m": float(table["m"]),
+                     "rotors": len(table.get("rotors", ())) or 4, "source": str(table.get("source", "")),
+                     "file": str(PRESETS[name])})
+    return rows
+
+
 def load_vehicle(name_or_path: str | Path, plants: Mapping[str, type]) -> Any:
     """A vehicle from a preset's name or a vehicle file.
 
