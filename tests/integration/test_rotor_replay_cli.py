@@ -141,3 +141,12 @@ def test_vehicles_lists_every_preset_with_its_source_and_file():
         assert preset_source(name) in result.output and f"file: {path}" in result.output
         assert path.is_file()
     assert "iris         rotor    1.535 kg  4 rotors" in result.output
+
+
+def test_a_batched_vehicle_file_is_refused_not_cut_to_its_first(tmp_path):
+    pwm = Path(__file__).resolve().parents[2] / "examples" / "pwm_step.csv"
+    mine = tmp_path / "two.toml"
+    mine.write_text('[vehicle]\npreset = "paper"\nm = [1.0, 2.0]\n')
+    out = tmp_path / "s.csv"
+    result = run("replay", str(pwm), "--vehicle", str(mine), "-o", str(out))
+    assert result.exit_code == 2 and "replay flies one vehicle" in result.output and not out.exists()

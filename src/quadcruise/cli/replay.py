@@ -62,6 +62,9 @@ def replay(pwm_csv: str, out: str, vehicle_name: str | None, ground: bool, max_s
     if os.path.exists(out) and os.path.exists(pwm_csv) and os.path.samefile(pwm_csv, out):
         raise click.BadParameter(f"{out} is the input file: write the states elsewhere", param_hint="'-o'")
     vehicle = Vehicle.paper() if vehicle_name is None else Vehicle.load(vehicle_name)
+    if getattr(vehicle, "batch_size", None) is not None:
+        raise InputError(f"{vehicle_name}: replay flies one vehicle and writes its states: give one value per field, "
+                         f"not a list")
     if ground and not isinstance(vehicle, RotorVehicle):
         raise InputError("option '--ground': the paper's plant has no ground: give a rotor-plant --vehicle "
                          "(crazyflie, hummingbird, iris or a file)")

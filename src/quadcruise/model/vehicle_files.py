@@ -248,4 +248,5 @@ def vehicle_from_table(table: dict, plants: Mapping[str, type], where: str = "ve
 
 def _plain(table: dict) -> dict[str, Any]:
     """TOML integers as floats for the number fields (``k_d = 0``), the rest as they are."""
-    return {k: float(v) if isinstance(v, int) and not isinstance(v, bool) else v for k, v in table.items()}
+    return {k: float(v) if isinstance(v, int) and not isinstance(v, bool) and k != "source" else v
+            for k, v in table.items()}
