@@ -3,7 +3,8 @@
 The group lives here, each command in its own module (:mod:`quadcruise.cli.fly`,
 :mod:`~quadcruise.cli.replay`, :mod:`~quadcruise.cli.reproduce`,
 :mod:`~quadcruise.cli.compare`, :mod:`~quadcruise.cli.analyze`,
-:mod:`~quadcruise.cli.montecarlo`, :mod:`~quadcruise.cli.tune`), what they share in :mod:`quadcruise.cli.common`;
+:mod:`~quadcruise.cli.montecarlo`, :mod:`~quadcruise.cli.tune`, :mod:`~quadcruise.cli.vehicles`), what they share
+in :mod:`quadcruise.cli.common`;
 the larger commands keep what they run after parsing in a ``*_run`` module beside them
 (:mod:`~quadcruise.cli.compare_run`, :mod:`~quadcruise.cli.montecarlo_run`, :mod:`~quadcruise.cli.tune_run`).
 Bad input prints one line, ``error: ...``, and exits with status 2; a flight that did not
@@ -25,6 +26,7 @@ from quadcruise.cli.montecarlo import montecarlo
 from quadcruise.cli.replay import replay
 from quadcruise.cli.reproduce import reproduce
 from quadcruise.cli.tune import tune
+from quadcruise.cli.vehicles import vehicles
 
 __all__ = ["main", "run"]
 
@@ -42,6 +44,7 @@ main.add_command(compare)
 main.add_command(analyze)
 main.add_command(montecarlo)
 main.add_command(tune)
+main.add_command(vehicles)
 
 
 def run() -> None:
