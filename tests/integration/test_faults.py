@@ -193,6 +193,25 @@ def test_a_write_that_fails_in_a_sweep_keeps_its_chunks_and_it_resumes(reference
     same_sweep(out, ref_out)
 
 
+def test_a_sweep_whose_folder_is_removed_meanwhile_still_writes_its_results_there(reference, tmp_path):
+    ref, ref_out = reference
+    out = tmp_path / "sweep"
+    calls = []
+
+    def remove_after_two_chunks(done, total):
+        calls.append(done)
+        if len(calls) == 3:
+            shutil.rmtree(out)
+
+    res = sweep(out, progress=remove_after_two_chunks)
+    pd.testing.assert_frame_equal(res.table, ref.table, check_exact=True)
+    assert (out / "flights.csv").read_bytes() == (ref_out / "flights.csv").read_bytes()
+    assert sorted(p.name for p in (out / "chunks").iterdir()) == ["chunk-000000020.npz", "chunk-000000030.npz"]
+    again = sweep(out)                               # the two lost chunks are flown again, to the same bytes
+    assert again.info["flown"] == 20 and again.info["resumed"] == 20
+    same_sweep(out, ref_out)
+
+
 def test_a_file_is_written_whole_or_not_at_all_and_the_error_names_it(tmp_path):
     target = tmp_path / "a" / "table.csv"
     with pytest.raises(WriteError, match=f"^{target}: {ENOSPC.replace('(', '.').replace(')', '.')}$"):

@@ -214,6 +214,25 @@ class SweepFolder:
         except OSError as exc:
             raise WriteError(self.path, exc) from None
 
+    def reclaim(self, n: int, chunk_size: int) -> None:
+        """Write the marker again if it is gone or damaged since :meth:`prepare` (the folder
+        removed or changed while the sweep ran), so that the results go where they were asked
+        for instead of being refused as another's.
+
+        Parameters
+        ----------
+        n : int
+            Number of flights of the sweep.
+        chunk_size : int
+            Vehicles per chunk.
+        """
+        try:
+            held = read_marker(self.path)
+        except InputError:
+            held = None
+        if not held or held.get("spec_hash") != self.hash:
+            write_marker(self.path, self.spec, n, chunk_size=chunk_size, complete=False)
+
     def write_chunk(self, chunk: dict) -> None:
         """Write one chunk as ``chunks/chunk-<first>.npz``, whole or not at all.
 

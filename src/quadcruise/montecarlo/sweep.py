@@ -434,6 +434,7 @@ def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", s
     result = collector.result(info)
     if folder is not None:
         try:
+            folder.reclaim(n, size)
             write_outputs(result, folder.path, fmt=fmt)
         except WriteError as exc:
             raise _saying_what_is_kept(exc, folder, n, n) from None
