@@ -13,7 +13,11 @@ with one thread each (numba runs one thread per task there) and without Dask's p
 a bounded number in flight, gathered as they finish.
 A worker that dies loses its tasks, the scheduler runs them again elsewhere, and since a
 chunk is keyed by its first vehicle and written whole, every flight is counted once. Each
-worker process loads the compiled engine from numba's cache once.
+worker process loads the compiled engine from numba's cache once. Only the main process sees
+Ctrl-C (:func:`_ctrl_c_for_this_process_only`) and closes the cluster, which ends the
+workers; the cluster logs only what is CRITICAL: a chunk that fails raises here, and what
+Dask would log besides (a worker restarted, the heartbeats lost while it closes after Ctrl-C)
+is no news to a user.
 
 **Memory.** One row per flight is kept; paths only for the first ``max_traces`` vehicles
 and the first ``max_failure_traces`` failed ones; a chunk's log is held only while it is
