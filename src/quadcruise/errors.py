@@ -48,6 +48,14 @@ class WriteError(OSError):
         cause = self.strerror[:1].lower() + self.strerror[1:]
         return f"{self.filename}: cannot write ({cause})" + (f"; {self.kept}" if self.kept else "")
 
+class ArgumentTypeError(InputError, TypeError):
+    """Bad input of the wrong kind: a Python argument of another type than the one expected
+    (a string for a number, a class for an object, a float for a seed).
+
+    An :class:`InputError` (so the command line prints it in one line and exits 2) that is
+    also a :class:`TypeError`, as a Python caller expects of a wrong type.
+    """
+
 
 class SimulationError(RuntimeError):
     """A simulation could not be carried out as asked (not bad input, not divergence)."""
@@ -77,8 +85,11 @@ def whole_number(value, what: str, minimum: int = 0) -> int:
 
     Raises
     ------
+    ArgumentTypeError
+        "<what> must be a whole number >= <minimum>, got <value>", for a value that is not a
+        whole number (a float, a bool, a string).
     InputError
-        "<what> must be a whole number >= <minimum>, got <value>".
+        The same message, for a whole number below ``minimum``.
 
     Examples
     --------
@@ -87,10 +98,12 @@ def whole_number(value, what: str, minimum: int = 0) -> int:
     >>> whole_number(2.0, "n", 1)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: n must be a whole number >= 1, got 2.0
+    quadcruise.errors.ArgumentTypeError: n must be a whole number >= 1, got 2.0
     """
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
-        raise InputError(f"{what} must be a whole number >= {minimum}, got {value!r}")
+    wrong_type = isinstance(value, bool) or not isinstance(value, numbers.Integral)
+    if wrong_type or value < minimum:
+        raise (ArgumentTypeError if wrong_type else InputError)(
+            f"{what} must be a whole number >= {minimum}, got {value!r}")
     return int(value)
 
 

@@ -10,7 +10,7 @@ one-line :class:`~quadcruise.errors.InputError` naming the owner, the field, its
 unit, and what was wrong, e.g.
 ``circle field 'radius' (circle radius, m) must be > 0, got 0.0``.
 
-The checks by name: ``real`` (a finite number), ``pos`` (> 0), ``nonneg`` (>= 0), ``frac``
+The checks by name: ``real`` (a finite number), ``pos`` (> 0), ``nonneg`` (>= 0), ``nonzero``, ``frac``
 (in [0, 1]), ``sign`` (+1 or -1), ``whole`` (a whole number >= 0), ``flag`` (true or false),
 ``pair`` and ``vec`` (2 or 3 numbers), ``choice`` (one of the field's ``choices``); and made
 to measure: :func:`between` (a range, open or closed at each end), :func:`one_of`,
@@ -49,7 +49,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from quadcruise.errors import InputError
+from quadcruise.errors import ArgumentTypeError, InputError
 
 __all__ = ["CHECKS", "Check", "Validated", "between", "check_number", "check_value", "instance_of", "one_of",
            "parse_assignments", "parse_numbers", "unit_field", "units_of", "validate", "vector"]
@@ -136,8 +136,10 @@ class _Site:
     def __init__(self, label: str, batch: bool, optional: bool) -> None:
         self.label, self.batch, self.optional = label, batch, optional
 
-    def fail(self, want: str, got: str) -> None:
-        raise InputError(f"{self.label} must be {want}{' or None' if self.optional else ''}, got {_short(got)}")
+    def fail(self, want: str, got: str, wrong_type: bool = False) -> None:
+        """Raise the message; an ArgumentTypeError (a TypeError too) for a value of the wrong kind."""
+        error = ArgumentTypeError if wrong_type else InputError
+        raise error(f"{self.label} must be {want}{' or None' if self.optional else ''}, got {_short(got)}")
 
 
 def _short(text: str, limit: int = 120) -> str:
@@ -165,7 +167,7 @@ class _Number(Check):
         if site.batch and isinstance(value, (list, tuple, np.ndarray)):
             return self._array(site, value)
         if not _is_number(value):
-            site.fail("a number or a 1-D array of numbers" if site.batch else "a number", repr(value))
+            site.fail("a number or a 1-D array of numbers" if site.batch else "a number", repr(value), True)
         x = float(value)
         if not math.isfinite(x):
             site.fail("finite", repr(x))
@@ -179,7 +181,7 @@ class _Number(Check):
         except (TypeError, ValueError):
             arr = np.zeros((0, 0))
         if arr.ndim != 1 or arr.size == 0 or arr.dtype.kind not in "iuf":
-            site.fail("a number or a 1-D array of numbers", repr(value))
+            site.fail("a number or a 1-D array of numbers", repr(value), True)
         arr = arr.astype(float)
         for bad, want in ((~np.isfinite(arr), "finite"),
                           (self.refuse(arr) if self.refuse is not None else None, self.want)):
@@ -206,7 +208,7 @@ class _Vector(Check):
         if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") \
                 or (isinstance(value, np.ndarray) and value.ndim != 1) or len(value) != n:
             want = self.want + (f", each a number or a 1-D array, or an (N, {n}) array" if site.batch else "")
-            site.fail(want, repr(value))
+            site.fail(want, repr(value), True)
         return tuple(self.element.convert(site, v) for v in value)
 
 
@@ -230,7 +232,7 @@ class _InstanceOf(Check):
 
     def convert(self, site: _Site, value: Any) -> Any:
         if not isinstance(value, self.cls):
-            site.fail(self.want, repr(value))
+            site.fail(self.want, repr(value), True)
         return value
 
 
@@ -238,7 +240,7 @@ class _Flag(Check):
     def convert(self, site: _Site, value: Any) -> bool:
         if isinstance(value, (bool, np.bool_)) or (_is_number(value) and value in (0, 1)):
             return bool(value)
-        site.fail(self.want, repr(value))
+        site.fail(self.want, repr(value), not _is_number(value))
 
 
 def between(low: float, high: float, closed: str = "[]", *, whole: bool = False, text: str | None = None) -> Check:
@@ -258,6 +260,7 @@ def between(low: float, high: float, closed: str = "[]", *, whole: bool = False,
     Returns
     -------
     Check
+        With ``bounds``: ``(low, high, closed)``.
 
     Examples
     --------
@@ -277,7 +280,9 @@ def between(low: float, high: float, closed: str = "[]", *, whole: bool = False,
         out = ((a < low) if lo_in else (a <= low)) | ((a > high) if hi_in else (a >= high))
         return out | (a != np.floor(a)) if whole else out
 
-    return _Number("range", want, refuse)
+    check = _Number("range", want, refuse)
+    check.bounds = (float(low), float(high), closed)     # for callers that search within the range
+    return check
 
 
 def one_of(*options: Any) -> Check:
@@ -342,7 +347,7 @@ def instance_of(cls: type) -> Check:
     >>> instance_of(tuple)("nlpd parameter 'position' (x and y loops, -)", [3.01, 5.0])
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: nlpd parameter 'position' (x and y loops, -) must be a tuple, got [3.01, 5.0]
+    quadcruise.errors.ArgumentTypeError: nlpd parameter 'position' (x and y loops, -) must be a tuple, got [3.01, 5.0]
     """
     return _InstanceOf(cls)
 
@@ -351,6 +356,7 @@ CHECKS: dict[str, Check] = {c.name: c for c in (
     _Number("real", "finite"),
     _Number("pos", "> 0", lambda a: a <= 0),
     _Number("nonneg", ">= 0", lambda a: a < 0),
+    _Number("nonzero", "nonzero", lambda a: a == 0),
     _Number("frac", "in [0, 1]", lambda a: (a < 0) | (a > 1)),
     _Number("sign", "+1 or -1", lambda a: (a != 1) & (a != -1), cast=int),
     _Number("whole", "a whole number >= 0", lambda a: (a < 0) | (a != np.floor(a)), cast=int),
@@ -409,7 +415,7 @@ def check_number(label: str, value: Any) -> float:
     >>> check_number("circle field 'radius'", "2")
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: circle field 'radius' must be a number, got '2'
+    quadcruise.errors.ArgumentTypeError: circle field 'radius' must be a number, got '2'
     """
     return check_value(label, value, "real")
 

@@ -39,7 +39,7 @@ def quiet(func, *args, **kwargs):
 
 FLIGHTS = {
     "everything": lambda: qc.fly(
-        "circle", "nlpd", duration=4.0, dt=2e-3, log_every=3, seed=5,
+        "circle", "nlpd", duration=4.0, dt=2e-3, log_every=4, seed=5,
         vehicle=with_drag(qc.Vehicle.paper().replace(m=3.8)), controller_vehicle=qc.Vehicle.paper(),
         environment=Environment(wind=ConstantWind((1.0, 0.5, 0.0)), gust=Gust((0.0, 2.0, 0.0), 1.0, 1.0),
                                 turbulence=Turbulence(intensity="moderate"),

@@ -21,7 +21,7 @@ RANKS = {
     "quadcruise._version": 0, "quadcruise.errors": 0, "quadcruise.layout": 0, "quadcruise._cache": 0,
     "quadcruise.protocols": 0,
     "quadcruise.numeric": 0,
-    "quadcruise.fields": 1, "quadcruise.io": 1,
+    "quadcruise.fields": 1, "quadcruise.checks": 1, "quadcruise.io": 1,
     "quadcruise.model": 2,
     "quadcruise.metrics": 3,
     "quadcruise.plots": 4,

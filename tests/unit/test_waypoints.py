@@ -370,3 +370,81 @@ def test_yaw_through_plus_minus_pi_turns_the_short_way(kind):
     travel = np.abs(np.diff(psi)).sum()
     assert travel == pytest.approx(2 * (2 * np.pi - 6.0), rel=0.05)          # 0.57 rad, not 12
     assert np.allclose(np.cos(psi[[0, -1]]), np.cos(3.0)) and np.allclose(np.sin(psi[[0, -1]]), np.sin(3.0))
+
+
+def kkt_minimum_snap(values, times, stops):
+    """The minimum-snap QP in its other form, for comparison: all 8 coefficients of every
+    segment as unknowns, the interpolation, rest and C1-C3 conditions as equality constraints,
+    solved through the (dense) KKT system of min sum_i T_i^-7 a_i^T H a_i."""
+    from quadcruise.missions.waypoints import _derivative_row
+
+    w = np.asarray(values, dtype=float).reshape(len(times), -1)
+    dur = np.diff(np.asarray(times, dtype=float))
+    n, m = w.shape[0], w.shape[0] - 1
+    stop = np.asarray(stops, bool).copy()
+    stop[[0, -1]] = True
+    g = (dur / dur[0]) ** 3.5                       # unknowns b_i = a_i / g_i: every block weighs H alone
+    rows, rhs = [], []
+
+    def constrain(value, *terms):
+        row = np.zeros(8 * m)
+        for seg, d in terms:
+            row[8 * seg:8 * seg + 8] += d * g[seg]
+        scale = np.abs(row).max()
+        rows.append(row / scale)
+        rhs.append(np.broadcast_to(value, (w.shape[1],)) / scale)
+
+    for j in range(n):
+        if j > 0:
+            constrain(w[j], (j - 1, _derivative_row(0, 1.0)))
+        if j < m:
+            constrain(w[j], (j, _derivative_row(0, 0.0)))
+        for r in range(1, 4):
+            if stop[j]:
+                if j > 0:
+                    constrain(0.0, (j - 1, _derivative_row(r, 1.0)))
+                if j < m:
+                    constrain(0.0, (j, _derivative_row(r, 0.0)))
+            else:
+                constrain(0.0, (j - 1, _derivative_row(r, 1.0) / dur[j - 1] ** r),
+                          (j, -_derivative_row(r, 0.0) / dur[j] ** r))
+    k = np.arange(4, 8)
+    fall = np.array([math.perm(int(i), 4) for i in k], dtype=float)
+    h = np.zeros((8, 8))
+    h[4:, 4:] = np.outer(fall, fall) / (k[:, None] + k[None, :] - 7)
+    a_eq = np.array(rows)
+    kkt = np.block([[np.kron(np.eye(m), h), a_eq.T], [a_eq, np.zeros((len(rows), len(rows)))]])
+    sol = np.linalg.solve(kkt, np.vstack([np.zeros((8 * m, w.shape[1])), np.array(rhs)]))
+    return g[:, None, None] * sol[:8 * m].reshape(m, 8, -1)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_banded_minimum_snap_equals_the_kkt_solution(seed):
+    """The banded solver (the knots' derivatives as unknowns) and the KKT system over all
+    coefficients are two forms of one QP: the same coefficients, dwells and uneven legs included."""
+    rng = np.random.default_rng(seed)
+    n = 12
+    times = np.r_[0.0, np.cumsum(rng.uniform(0.2, 5.0, n - 1))]
+    values = 3.0 * rng.standard_normal((n, 4))
+    stops = rng.random(n) < 0.25
+    want = kkt_minimum_snap(values, times, stops)
+    got = minimum_snap_coefficients(values, times, stops)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-9 * np.abs(want).max())
+    # and a wrong answer would be seen: the same path without its stops differs
+    assert np.abs(minimum_snap_coefficients(values, times) - want).max() > 1e-3 * np.abs(want).max()
+
+
+def test_minimum_snap_through_many_waypoints_is_the_septic_spline():
+    """20,000 knots (a banded solve, linear in the knots): still scipy's clamped septic spline."""
+    rng = np.random.default_rng(3)
+    n = 20_000
+    times = np.r_[0.0, np.cumsum(rng.uniform(0.05, 0.2, n - 1))]
+    values = np.cumsum(rng.standard_normal((n, 3)) * 0.05, axis=0)
+    coef = minimum_snap_coefficients(values, times)
+    bc = [(1, np.zeros(3)), (2, np.zeros(3)), (3, np.zeros(3))]
+    spline = make_interp_spline(times, values, k=7, bc_type=(bc, bc))
+    seg = rng.integers(0, n - 1, 500)
+    s = rng.random(500)
+    ours = np.einsum("ik,ika->ia", s[:, None] ** np.arange(8), coef[seg])
+    t = times[seg] + s * np.diff(times)[seg]
+    np.testing.assert_allclose(ours, spline(t), rtol=0, atol=1e-9 * np.abs(values).max())

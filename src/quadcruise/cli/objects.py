@@ -58,7 +58,7 @@ def controller_params(params: tuple[str, ...], poles_text: str | None) -> dict:
     out = parse_assignments(params, "--controller-param")
     poles = _poles(poles_text, "--poles")
     if poles is not None:
-        out["position"] = pd_from_poles(poles)
+        out["position"] = pd_from_poles(poles, source="--poles")
     return out
 
 

@@ -20,11 +20,13 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import inspect
 from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
+from quadcruise import checks
 from quadcruise.control.base import Controller
 from quadcruise.control.position import NLPD
 from quadcruise.errors import InputError
@@ -94,7 +96,7 @@ def controller_from_name(name: str, **params: Any) -> Controller:
     return cls(**params) if params else shared_default(cls)
 
 
-def as_controller(obj: Any) -> ControllerLike:
+def as_controller(obj: Any, where: str = "fly()") -> ControllerLike:
     """A controller from a name or any object that offers what the engine needs.
 
     Parameters
@@ -103,11 +105,21 @@ def as_controller(obj: Any) -> ControllerLike:
         A built-in controller's name (see :data:`CONTROLLERS`), or an object with ``name``,
         ``function`` (compiled with :data:`quadcruise.layout.CONTROLLER_SIG`), ``gains()`` and
         ``memory()`` (see :class:`quadcruise.protocols.ControllerLike`); it need not subclass
-        :class:`Controller`.
+        :class:`Controller`. Its ``function`` must be compiled with ``CONTROLLER_SIG``.
+    where : str
+        The function that was given it, for the message.
 
     Returns
     -------
     ControllerLike
+
+    Raises
+    ------
+    ArgumentTypeError
+        Anything else: a class, an object that lacks one of the four, or whose ``function``
+        is not compiled with ``CONTROLLER_SIG`` (the message shows how to compile it).
+    InputError
+        An unknown name.
 
     Examples
     --------
@@ -116,14 +128,54 @@ def as_controller(obj: Any) -> ControllerLike:
     >>> as_controller(3.0)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: controller must be a name (nlpd, gonzalez, se3, cascade) or an object with name, function, gains() and memory() (quadcruise.protocols.ControllerLike), got float
+    quadcruise.errors.ArgumentTypeError: fly() argument controller must be a name (nlpd, gonzalez, se3, cascade) or an object with name, function, gains() and memory() (quadcruise.protocols.ControllerLike), got float 3.0
     """
     if isinstance(obj, str):
         return controller_from_name(obj)
-    if not isinstance(obj, ControllerLike) or not callable(getattr(obj, "function", None)):
-        raise InputError(f"controller must be a name ({', '.join(CONTROLLERS)}) or an object with name, function, "
-                         f"gains() and memory() (quadcruise.protocols.ControllerLike), got {type(obj).__name__}")
+    if inspect.isclass(obj) or not isinstance(obj, ControllerLike) or not callable(getattr(obj, "function", None)):
+        checks.fail(where, "controller", obj, f"a name ({', '.join(CONTROLLERS)}) or an object with name, function, "
+                    "gains() and memory() (quadcruise.protocols.ControllerLike)")
+    if not compiled_for_engine(obj.function):
+        checks.fail(where, "controller", obj, "an object whose function is compiled with CONTROLLER_SIG",
+                    hint=f"its function {getattr(obj.function, '__name__', '?')!r} is {_compiled_how(obj.function)}: "
+                    "compile it with `from numba import njit; from quadcruise.layout import CONTROLLER_SIG` "
+                    "and `@njit(CONTROLLER_SIG, cache=True)` above its def")
     return obj
+
+
+def compiled_for_engine(function: Any) -> bool:
+    """Whether ``function`` is a numba-compiled function the engine can call: a dispatcher
+    holding a compiled :data:`~quadcruise.layout.CONTROLLER_SIG` (or a compiled function type).
+
+    Parameters
+    ----------
+    function : Any
+        A controller's ``function``.
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> from quadcruise.control import NLPD
+    >>> compiled_for_engine(NLPD().function), compiled_for_engine(print)
+    (True, False)
+    """
+    from quadcruise.layout import CONTROLLER_SIG
+
+    signatures = getattr(function, "signatures", None)
+    if signatures is not None and hasattr(function, "py_func"):
+        return tuple(CONTROLLER_SIG.args) in [tuple(sig) for sig in signatures]
+    return hasattr(function, "_numba_type_") or hasattr(function, "address")    # a cfunc or a wrapped pointer
+
+
+def _compiled_how(function: Any) -> str:
+    if hasattr(function, "py_func"):
+        return "compiled by numba without CONTROLLER_SIG (its signatures: " \
+            f"{', '.join(str(s) for s in function.signatures) or 'none yet'})"
+    plain = inspect.isfunction(function) or inspect.ismethod(function)
+    return "a plain Python function" if plain else f"a {type(function).__name__}"
 
 
 def controller_record(controller: ControllerLike) -> dict:
@@ -155,4 +207,5 @@ def __getattr__(name: str):
 
 
 __all__ = ["CONTROLLERS", "NLPD", "Gonzalez", "SE3", "Cascade", "Controller", "ControllerLike", "as_controller",
+           "compiled_for_engine",
            "controller_from_name", "controller_record"]

@@ -212,7 +212,7 @@ def _char_from_poles(poles, n: int, who: str) -> np.ndarray:
     return np.poly(p).real
 
 
-def pd_from_poles(poles) -> PDGains:
+def pd_from_poles(poles, source: str = "pd_from_poles") -> PDGains:
     """PD gains placing the closed-loop poles of y'' = u at ``poles`` (two, s-plane).
 
     s^2 + kd s + kp = (s - p1)(s - p2), so kp = p1 p2 and kd = -(p1 + p2).
@@ -222,6 +222,8 @@ def pd_from_poles(poles) -> PDGains:
     poles : sequence of float or complex
         Two closed-loop poles [rad/s] in the open left half plane; a complex one with its
         conjugate.
+    source : str
+        Where the poles came from, as a message names it (the command line: ``--poles``).
 
     Returns
     -------
@@ -242,11 +244,11 @@ def pd_from_poles(poles) -> PDGains:
     Traceback (most recent call last):
     quadcruise.errors.InputError: pd_from_poles: pole 0.7 is not in the open left half plane (did you mean -0.7?)
     """
-    c = _char_from_poles(poles, 2, "pd_from_poles")
+    c = _char_from_poles(poles, 2, source)
     return PDGains(kp=c[2], kd=c[1])
 
 
-def pid_from_poles(poles) -> PIDGains:
+def pid_from_poles(poles, source: str = "pid_from_poles") -> PIDGains:
     """PID gains placing the three closed-loop poles of y'' = u at ``poles`` (s-plane).
 
     s^3 + kd s^2 + kp s + ki = (s - p1)(s - p2)(s - p3).
@@ -256,6 +258,8 @@ def pid_from_poles(poles) -> PIDGains:
     poles : sequence of float or complex
         Three closed-loop poles [rad/s] in the open left half plane; a complex one with its
         conjugate.
+    source : str
+        Where the poles came from, as a message names it.
 
     Returns
     -------
@@ -273,7 +277,7 @@ def pid_from_poles(poles) -> PIDGains:
     >>> g.kp, g.ki, g.kd
     (11.0, 6.0, 6.0)
     """
-    c = _char_from_poles(poles, 3, "pid_from_poles")
+    c = _char_from_poles(poles, 3, source)
     return PIDGains(kp=c[2], ki=c[3], kd=c[1])
 
 

@@ -4,13 +4,14 @@ from __future__ import annotations
 
 from typing import Any
 
+from quadcruise import checks
 from quadcruise.errors import InputError
 from quadcruise.missions.base import Mission, check_names
 from quadcruise.missions.shapes import Circle, Hover, Square, Step
 from quadcruise.missions.waypoints import MinimumSnap, Waypoints
 from quadcruise.model.vehicle import shared_default
 
-__all__ = ["MISSIONS", "mission_from_dict", "mission_from_name"]
+__all__ = ["MISSIONS", "as_mission", "mission_from_dict", "mission_from_name"]
 
 MISSIONS = {cls.name: cls for cls in (Hover, Step, Circle, Square, Waypoints, MinimumSnap)}
 """Mission kind name -> class."""
@@ -78,3 +79,40 @@ def mission_from_dict(d: dict) -> Mission:
     """
     d = dict(d)
     return mission_from_name(d.pop("kind", ""), **d)
+
+
+def as_mission(value: Any, where: str = "fly()", name: str = "mission") -> Mission:
+    """A mission from a name or a Mission object: the API's one check of a mission argument.
+
+    Parameters
+    ----------
+    value : str or Mission
+        A kind name (see :func:`mission_from_name`, its defaults) or a mission object.
+    where, name : str
+        The function and the argument, for the message.
+
+    Returns
+    -------
+    Mission
+
+    Raises
+    ------
+    ArgumentTypeError
+        Anything else, a mission class included (the message says to make one).
+    InputError
+        An unknown name.
+
+    Examples
+    --------
+    >>> from quadcruise.missions import Circle
+    >>> as_mission("circle") == Circle()
+    True
+    >>> as_mission(Circle)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.ArgumentTypeError: fly() argument mission must be a mission name (hover, step, circle, square, waypoints, minsnap) or a Mission, got the class Circle; give an object, e.g. Circle()
+    """
+    if isinstance(value, str):
+        return mission_from_name(value)
+    return checks.instance(where, name, value, Mission, optional=False,
+                           want=f"a mission name ({', '.join(MISSIONS)}) or a Mission")

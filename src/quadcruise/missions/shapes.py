@@ -253,7 +253,7 @@ class Step(Mission):
     axis : str
         The stepped axis: 'x', 'y', 'z' or 'yaw'.
     size : float
-        Step size [m] (or [rad] for 'yaw').
+        Step size [m] (or [rad] for 'yaw'), nonzero.
     time : float
         Time of the step [s], >= 0.
     x, y : float
@@ -270,7 +270,7 @@ class Step(Mission):
     """
 
     axis: str = _f("x", "-", "stepped axis", "choice", tuple(_AXES))
-    size: float = _f(1.0, "m or rad", "step size")
+    size: float = _f(1.0, "m or rad", "step size", "nonzero")    # a step of 0 is a hover: no step to measure
     time: float = _f(1.0, "s", "step time", "nonneg")
     x: float = _f(0.0, "m", "base x")
     y: float = _f(0.0, "m", "base y")

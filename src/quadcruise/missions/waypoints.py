@@ -49,6 +49,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass, field
+from fractions import Fraction
 from functools import cached_property
 from typing import Any, ClassVar
 
@@ -445,17 +446,35 @@ def _derivative_row(r: int, s: float) -> np.ndarray:
     return np.array([math.perm(k, r) * s ** max(k - r, 0) for k in range(_NC)], dtype=float)
 
 
-def _snap_hessian() -> np.ndarray:
-    """H with int_0^1 (d^4 p / ds^4)^2 ds = a^T H a for p = sum a_k s^k."""
-    k = np.arange(4, _NC)
-    fall = np.array([math.perm(i, 4) for i in k], dtype=float)
-    h = np.zeros((_NC, _NC))
-    h[4:, 4:] = np.outer(fall, fall) / (k[:, None] + k[None, :] - 7)
-    return h
+def _hermite_matrices() -> tuple[np.ndarray, np.ndarray]:
+    """(Minv, K), computed exactly in rationals and rounded once: Minv turns the value and the
+    first three s-derivatives at s = 0 and at s = 1 (in that order) into the coefficients of
+    s^0..s^7; K = Minv^T H Minv is a segment's snap cost in those end values. (K annihilates
+    every cubic: rounded in floating point term by term, it would lose seven digits.)"""
+    rows = np.array([_derivative_row(r, s) for s in (0.0, 1.0) for r in range(4)])
+    exact = np.vectorize(lambda x: Fraction(x).limit_denominator(10_000), otypes=[object])
+    minv = exact(np.linalg.inv(rows))                      # small rationals (halves, sixths, ...)
+    if not np.all(exact(rows) @ minv == np.eye(_NC, dtype=int)):
+        raise ArithmeticError("the Hermite inverse is not a matrix of small rationals")
+    k = np.arange(_NC)
+    fall = np.array([math.perm(int(i), 4) for i in k], dtype=object)
+    hess = np.array([[Fraction(int(fall[i] * fall[j]), int(i + j - 7)) if i >= 4 and j >= 4 else Fraction(0)
+                      for j in k] for i in k], dtype=object)
+    return minv.astype(float), (minv.T @ hess @ minv).astype(float)
 
 
 def minimum_snap_coefficients(values: Any, times: Any, stops: Any = None) -> np.ndarray:
     """Minimum-snap 7th-order segments through ``values`` at ``times``.
+
+    Each segment is the 7th-order Hermite polynomial of the value and the first three time
+    derivatives (velocity, acceleration, jerk) at its two knots; those derivatives are the
+    unknowns at every knot that is not a stop (zero at a stop). The cost
+    ``sum_i int |d^4p/dt^4|^2 dt`` is a quadratic in them whose Hessian is block tridiagonal
+    (3 x 3 blocks: a knot is coupled to its neighbours only), a banded symmetric positive
+    definite system solved by Cholesky (``scipy.linalg.solveh_banded``) in time and memory
+    linear in the number of knots (10^6 knots in seconds). It is the same QP as the
+    equality-constrained KKT system over all 8 coefficients per segment, and gives its
+    solution to rounding (``tests/unit/test_waypoints.py`` solves both).
 
     Parameters
     ----------
@@ -479,46 +498,48 @@ def minimum_snap_coefficients(values: Any, times: Any, stops: Any = None) -> np.
     >>> c[0, :, 0].round(9) + 0.0
     array([  0.,   0.,   0.,   0.,  35., -84.,  70., -20.])
     """
-    import scipy.sparse  # here, not at the top: importing quadcruise stays
-    import scipy.sparse.linalg  # free of scipy
+    import scipy.linalg  # here, not at the top: importing quadcruise stays free of scipy
 
     w = np.asarray(values, dtype=float).reshape(len(times), -1)
     dur = np.diff(np.asarray(times, dtype=float))
     n, m, axes = w.shape[0], w.shape[0] - 1, w.shape[1]
-    stop = np.zeros(n, bool) if stops is None else np.asarray(stops, bool).copy()
-    stop[[0, -1]] = True
-    # cost int |d^4p/dt^4|^2 dt = sum_i T_i^-7 a_i^T H a_i; with a_i = g_i b_i, g_i = (T_i/T_0)^3.5,
-    # every block weighs H alone, and rows scaled to a largest entry of 1 keep the KKT balanced
-    g = (dur / dur[0]) ** 3.5
-    ii, jj, vv, rhs = [], [], [], []
+    fixed = np.zeros(n, bool) if stops is None else np.asarray(stops, bool).copy()
+    fixed[[0, -1]] = True
+    minv, k_s = _hermite_matrices()                # a segment's cost y^T K y, y: value and s-derivatives at both ends
+    # with time derivatives instead (y_a = T^r_a times them) a segment of duration T costs
+    # T^-7 sum K[a, b] T^(r_a + r_b) y_a y_b; entry (a, b) over all segments as one vector:
+    order, log_t = np.array([0, 1, 2, 3, 0, 1, 2, 3]), np.log(dur)
 
-    def constrain(value, *terms) -> None:          # sum of d^r p_seg / dt^r terms = value
-        scale = max(np.abs(row).max() * g[seg] for seg, row in terms)
-        for seg, row in terms:
-            ii.extend([len(rhs)] * _NC)
-            jj.extend(range(_NC * seg, _NC * seg + _NC))
-            vv.extend(row * g[seg] / scale)
-        rhs.append(np.broadcast_to(value, (axes,)) / scale)
+    def q(a: int, b: int) -> np.ndarray:
+        return k_s[a, b] * np.exp((order[a] + order[b] - 7) * log_t)
 
-    for j in range(n):
-        if j > 0:
-            constrain(w[j], (j - 1, _derivative_row(0, 1.0)))
-        if j < m:
-            constrain(w[j], (j, _derivative_row(0, 0.0)))
-        for r in range(1, 4):
-            if stop[j]:                            # at rest on both sides
-                if j > 0:
-                    constrain(0.0, (j - 1, _derivative_row(r, 1.0)))
-                if j < m:
-                    constrain(0.0, (j, _derivative_row(r, 0.0)))
-            else:                                  # d^r/dt^r continuous
-                constrain(0.0, (j - 1, _derivative_row(r, 1.0) / dur[j - 1] ** r),
-                          (j, -_derivative_row(r, 0.0) / dur[j] ** r))
-    a_eq = scipy.sparse.csr_matrix((vv, (ii, jj)), shape=(len(rhs), _NC * m))
-    kkt = scipy.sparse.bmat([[scipy.sparse.block_diag([_snap_hessian()] * m), a_eq.T], [a_eq, None]])
-    sol = scipy.sparse.linalg.spsolve(kkt.tocsc(), np.vstack([np.zeros((_NC * m, axes)), *rhs]))
-    b = np.asarray(sol).reshape(-1, axes)[:_NC * m].reshape(m, _NC, axes)
-    return g[:, None, None] * b
+    size = 3 * n                                   # unknowns: velocity, acceleration, jerk at each knot
+    band = np.zeros((6, size))                     # upper band storage: band[5 + row - col, col]
+    rhs = np.zeros((size, axes))
+    start = 3 * np.arange(m)                       # a segment's first unknown at its start knot; + 3 at its end
+    for ra in range(3):
+        for rb in range(3):
+            if rb >= ra:                           # start-start and end-end blocks (upper triangle)
+                band[5 - (rb - ra), start + rb] += q(1 + ra, 1 + rb)
+                band[5 - (rb - ra), start + 3 + rb] += q(5 + ra, 5 + rb)
+            band[5 - (3 + rb - ra), start + 3 + rb] += q(1 + ra, 5 + rb)      # start-end block
+        for local, row in ((1 + ra, start + ra), (5 + ra, start + 3 + ra)):      # the values' pull
+            rhs[row] -= q(local, 0)[:, None] * w[:-1] + q(local, 4)[:, None] * w[1:]
+    fixed = np.repeat(fixed, 3)                    # a stop's derivatives are 0: an identity row
+    for o in range(1, 6):
+        band[5 - o, o:][fixed[o:] | fixed[:-o]] = 0.0
+    band[5, fixed] = 1.0
+    rhs[fixed] = 0.0
+    scale = 1.0 / np.sqrt(band[5])                 # unit diagonal, whatever the spread of durations
+    for o in range(6):
+        band[5 - o, o:] *= scale[o:] * scale[:size - o]
+    deriv = scipy.linalg.solveh_banded(band, rhs * scale[:, None], check_finite=False) * scale[:, None]
+    d = deriv.reshape(n, 3, axes)
+    powers = (dur[:, None] ** np.arange(1, 4))[:, :, None]     # a time derivative times T^r: the s-derivative
+    y = np.empty((m, 8, axes))
+    y[:, 0], y[:, 4] = w[:-1], w[1:]
+    y[:, 1:4], y[:, 5:8] = d[:-1] * powers, d[1:] * powers
+    return np.einsum("kj,ija->ika", minv, y)
 
 
 # --- the mission kinds -----------------------------------------------------------------------
@@ -602,9 +623,9 @@ class Waypoints(_WaypointMission):
     columns: ClassVar[tuple] = ("n", "hold_yaw", "x[k]", "y[k]", "z[k]", "yaw[k]", "t[k]")
     function = staticmethod(waypoints_ref)
 
-    def _row(self) -> tuple:
+    def _row(self) -> np.ndarray:                   # an array, not a tuple: 10^6 points stay quick
         per_point = np.column_stack([self.table.points, self.table.yaws(), self.times])
-        return (len(self.table), float(self.yaw_mode == "hold"), *per_point.ravel())
+        return np.concatenate([[len(self.table), float(self.yaw_mode == "hold")], per_point.ravel()])
 
 
 @dataclass(frozen=True)
@@ -646,7 +667,7 @@ class MinimumSnap(_WaypointMission):
         coef.setflags(write=False)
         return coef
 
-    def _row(self) -> tuple:
+    def _row(self) -> np.ndarray:                   # an array, not a tuple: 10^6 points stay quick
         tk, end = self.times, np.append(self.table.points[-1], self.table.yaws()[-1])
         segs = np.column_stack([tk[:-1], np.diff(tk), self.coefficients.transpose(0, 2, 1).reshape(len(tk) - 1, -1)])
-        return (len(tk) - 1, *end, tk[-1], *segs.ravel())
+        return np.concatenate([[len(tk) - 1], end, [tk[-1]], segs.ravel()])

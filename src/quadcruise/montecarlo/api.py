@@ -41,13 +41,16 @@ Examples
 from __future__ import annotations
 
 import dataclasses
+import os
 from pathlib import Path
 from typing import Any, Callable
 
-from quadcruise.control import Controller
-from quadcruise.disturbances import Environment, SensorNoise
+from quadcruise import checks
+from quadcruise.control import Controller, as_controller
+from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import InputError, reject_unknown
-from quadcruise.missions import Mission
+from quadcruise.missions import Mission, as_mission
+from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.chunk import Case, montecarlo_case, replay_case
 from quadcruise.montecarlo.population import Population
 from quadcruise.montecarlo.result import MonteCarloResult
@@ -123,6 +126,8 @@ def montecarlo(mission: Mission | str = "circle", controller: Controller | str =
     reject_unknown("montecarlo()", {k: v for k, v in spec_options.items() if k not in spec_fields},
                    ["chunk_size", "environment", "force", "fmt", "out", "progress", "resume", "scheduler", "sensors",
                     "workers", "connect_timeout", *(f for f in spec_fields if f not in ("mission", "controller"))])
+    check_montecarlo_arguments(mission, controller, population, n, seed, environment, sensors, chunk_size,
+                               scheduler, workers, out, resume, force, progress, connect_timeout, spec_options)
     population = population or Population()
     if environment is not None or sensors is not None:
         if (environment is not None and population.environment is not None) or \
@@ -135,6 +140,44 @@ def montecarlo(mission: Mission | str = "circle", controller: Controller | str =
                           seed=seed, **spec_options)
     return run_sweep(spec, n, chunk_size=chunk_size, scheduler=scheduler, workers=workers, out=out,
                      resume=resume, force=force, fmt=fmt, progress=progress, connect_timeout=connect_timeout)
+
+
+def check_montecarlo_arguments(mission, controller, population, n, seed, environment, sensors, chunk_size,
+                               scheduler, workers, out, resume, force, progress, connect_timeout,
+                               spec_options: dict) -> None:
+    """:func:`montecarlo`'s arguments checked, before any work, in the API's one message form
+    (:mod:`quadcruise.checks`): a wrong type is an ArgumentTypeError, a bad value an InputError.
+
+    Parameters
+    ----------
+    mission, controller, population, n, seed, environment, sensors, chunk_size, scheduler, workers, out, \
+resume, force, progress, connect_timeout
+        As :func:`montecarlo` was given them.
+    spec_options : dict
+        Its other keywords (``duration``, ``dt``, ``vehicle``, ...), checked by type here.
+    """
+    w = "montecarlo()"
+    as_mission(mission, w)
+    as_controller(controller, w)
+    checks.instance(w, "population", population, Population)
+    checks.whole(w, "n", n, 1)
+    checks.whole(w, "seed", seed)
+    checks.instance(w, "environment", environment, (Environment, CustomDisturbance))
+    checks.instance(w, "sensors", sensors, SensorNoise)
+    if not (isinstance(chunk_size, str) and chunk_size == "auto"):
+        checks.whole(w, "chunk_size", chunk_size, 1)
+    checks.instance(w, "scheduler", scheduler, str, want="\"none\", \"local\" or a scheduler address")
+    checks.whole(w, "workers", workers, 1, optional=True)
+    checks.instance(w, "out", out, (str, os.PathLike), want="a folder path")
+    checks.flag(w, "resume", resume)
+    checks.flag(w, "force", force)
+    checks.callback(w, "progress", progress)
+    checks.number(w, "connect_timeout", connect_timeout, "pos", unit="s")
+    for name in ("duration", "dt", "log_dt", "trace_dt"):
+        if name in spec_options:
+            checks.number(w, name, spec_options[name], "pos", unit="s", optional=name == "duration")
+    if "vehicle" in spec_options:
+        checks.instance(w, "vehicle", spec_options["vehicle"], Vehicle, optional=False)
 
 
 # --- command line -----------------------------------------------------------------------

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from quadcruise.errors import InputError
+from quadcruise.errors import ArgumentTypeError, InputError
 from quadcruise.model.vehicle import Vehicle
 
 __all__ = ["Population", "Draw", "DRAW_KEY", "N_DRAWS", "SLOTS", "SPREADS", "CLIP"]
@@ -104,9 +104,10 @@ class Population:
             raise InputError(f"population field 'distribution' must be normal or uniform, got {self.distribution!r}")
         for name in (*SPREADS, "offset", "wind_spread"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
-                    or not math.isfinite(value) or value < 0:
-                raise InputError(f"population field '{name}' must be a number >= 0, got {value!r}")
+            wrong_type = isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating))
+            if wrong_type or not math.isfinite(value) or value < 0:
+                raise (ArgumentTypeError if wrong_type else InputError)(
+                    f"population field '{name}' must be a number >= 0, got {value!r}")
             object.__setattr__(self, name, float(value))
             limit = 1.0 / CLIP[self.distribution]
             if name in SPREADS and value >= limit:

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import config, get_num_threads, njit, types
 
+from quadcruise import checks
 from quadcruise.errors import InputError
 from quadcruise.layout import (
     CMD_FLAGS,
@@ -94,9 +95,7 @@ class Limits:
 
     def __post_init__(self) -> None:
         for name in ("max_position", "max_speed", "max_rate", "max_tilt"):
-            value = getattr(self, name)
-            if not value > 0:
-                raise InputError(f"limit '{name}' must be > 0, got {value!r}")
+            object.__setattr__(self, name, checks.number("Limits()", name, getattr(self, name), "pos", infinite=True))
 
     def array(self) -> np.ndarray:
         """The four bounds as the kernel reads them.

@@ -26,9 +26,10 @@ from typing import Any, Callable
 
 import numpy as np
 
+from quadcruise import checks
 from quadcruise.control import as_controller
 from quadcruise.errors import InputError, reject_unknown, whole_number
-from quadcruise.missions import Mission, mission_from_name
+from quadcruise.missions import Mission, as_mission
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
 from quadcruise.montecarlo.spec import MonteCarloSpec
@@ -130,16 +131,21 @@ def tune(mission: Mission | str = "step", controller: Any = "nlpd", *, gains=Non
     targets, requirements, minimize = parse_targets(targets), parse_requirements(require), parse_minimize(minimize)
     if not targets and not minimize:
         raise InputError("nothing to tune for: give a target (METRIC=VALUE) or a metric to minimize")
-    if not (isinstance(tol, (int, float)) and np.isfinite(tol) and tol >= 0):
-        raise InputError(f"tol must be a number >= 0, got {tol!r}")
-    base = as_controller(controller)
+    w = "tune()"                                    # every argument checked before any flight
+    checks.number(w, "tol", tol, "nonneg")
+    mission = as_mission(mission, w)
+    checks.instance(w, "population", population, Population)
+    checks.instance(w, "vehicle", vehicle, Vehicle)
+    checks.number(w, "duration", duration, "pos", unit="s", optional=True)
+    checks.number(w, "dt", dt, "pos", unit="s")
+    checks.number(w, "log_dt", log_dt, "pos", unit="s")
+    checks.number(w, "transient_until", transient_until, "pos", unit="s", optional=True)
+    checks.callback(w, "progress", progress)
+    checks.instance(w, "command", command, str, optional=False)
+    base = as_controller(controller, w)
     space = GainSpace.build(base, gains, bounds)
     popsize = 15 * len(space.gains) if popsize is None else whole_number(popsize, "popsize (candidates per generation)", 5)
-    if isinstance(mission, str):
-        mission = mission_from_name(mission)
     population = population or Population()
-    if not isinstance(population, Population):
-        raise InputError(f"population must be a Population, got {type(population).__name__}")
     spec = MonteCarloSpec(mission, base, population, seed=seed, duration=duration, dt=dt,
                           vehicle=vehicle or Vehicle.paper(), log_dt=log_dt, transient_until=transient_until)
     from quadcruise.workflows.fly import check_run_size

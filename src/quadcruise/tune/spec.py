@@ -7,8 +7,8 @@ any flight.
   can also be searched by its pole pair through the design rule of
   :mod:`quadcruise.control.design` (s^2 + kd s + kp = s^2 + 2 zeta wn s + wn^2):
   ``position.wn`` [rad/s] and ``position.zeta`` [-].
-- **Bounds** ``NAME=LOW:HIGH``; by default a decade either side of the controller's value
-  (the damping ratio: [0.1, 2]). A gain whose bounds are positive and a decade or more apart
+- **Bounds** ``NAME=LOW:HIGH``; by default a decade either side of the controller's value, cut
+  to the range the field allows (``max_tilt`` stays below pi/2; the damping ratio: [0.1, 2]). A gain whose bounds are positive and a decade or more apart
   is searched on a log scale.
 - A **target** ``METRIC=VALUE`` or ``METRIC=VALUE+-TOLERANCE``: the cost counts the miss in
   tolerances, squared; without a tolerance, 10 % of the value (1 in the metric's unit for a
@@ -392,6 +392,26 @@ def _is_number(value: Any) -> bool:
     return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
 
 
+def _within_range(base: Any, name: str, low: float, high: float) -> tuple[float, float]:
+    """Default bounds cut to the range the gain's field allows (``fields.between``): a decade
+    above ``max_tilt`` = 0.785 rad would be 7.85 rad, beyond its (0, pi/2). An open end is
+    approached to a relative 1e-9, a closed one reached."""
+    owner, _, leaf = name.rpartition(".")
+    obj = getattr(base, owner) if owner else base
+    if not dataclasses.is_dataclass(obj):
+        return low, high
+    check = next((f.metadata.get("check") for f in dataclasses.fields(obj) if f.name == leaf), None)
+    limits = getattr(check, "bounds", None)
+    if limits is None:
+        return low, high
+    lo, hi, closed = limits
+    if low <= lo:
+        low = lo if closed[0] == "[" else lo + 1e-9 * max(abs(lo), hi - lo)
+    if high >= hi:
+        high = hi if closed[1] == "]" else hi - 1e-9 * max(abs(hi), hi - lo)
+    return low, high
+
+
 def parse_bounds(items: str | Iterable[str] | Mapping | None) -> dict[str, tuple[float, float]]:
     """Bounds from ``NAME=LOW:HIGH`` texts (or a mapping of name to a pair or such a text).
 
@@ -488,7 +508,8 @@ class GainSpace:
             The gains (comma-separated in a string); ``position.kp, position.kd`` by default
             where the controller has them.
         bounds : mapping or str or iterable of str, optional
-            :func:`parse_bounds` input; by default a decade either side of each value.
+            :func:`parse_bounds` input; by default a decade either side of each value, cut to
+            the range its field allows (``max_tilt``: below pi/2).
 
         Returns
         -------
@@ -537,7 +558,7 @@ class GainSpace:
             elif name.endswith(".zeta"):
                 low, high = ZETA_BOUNDS
             elif value > 0:
-                low, high = value / DEFAULT_SPAN, value * DEFAULT_SPAN
+                low, high = _within_range(base, name, value / DEFAULT_SPAN, value * DEFAULT_SPAN)
             else:
                 raise InputError(f"{name} is {value:g}: give its bounds (NAME=LOW:HIGH)")
             gains.append(Gain(name, low, high, bool(low > 0 and high / low >= 10.0), unit))

@@ -41,6 +41,7 @@ import numpy as np
 import scipy.linalg
 from scipy.sparse.csgraph import connected_components
 
+from quadcruise import checks
 from quadcruise.errors import InputError
 from quadcruise.layout import (
     CMD_FLAGS,
@@ -257,17 +258,6 @@ def _check_loop(loop: str) -> str:
     return loop
 
 
-def _as_controller(controller):
-    if isinstance(controller, str):
-        from quadcruise.control import controller_from_name
-        return controller_from_name(controller)
-    missing = [m for m in ("function", "gains", "memory") if not hasattr(controller, m)]
-    if missing:
-        raise InputError(f"controller must be a name or have .function, .gains() and .memory(); "
-                         f"{type(controller).__name__} lacks {', '.join(missing)}")
-    return controller
-
-
 MIN_DT = 1e-9
 """The shortest control period :func:`linearize` takes [s]: at 1e-12 s the poles z = exp(s dt) are
 within rounding of 1, and the s-plane poles computed from them are noise."""
@@ -322,8 +312,18 @@ def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 
     >>> bool(lin.residual < 1e-9), lin.sys.state_labels[-3:]
     (True, ['mem0', 'mem1', 'mem2'])
     """
-    controller = _as_controller(controller)
-    vehicle = vehicle or Vehicle.paper()
+    from quadcruise.control import as_controller
+
+    w = "linearize()"                                # every argument checked before any work
+    controller = as_controller(controller, w)
+    vehicle = checks.instance(w, "vehicle", vehicle, Vehicle) or Vehicle.paper()
+    dt = checks.number(w, "dt", dt, "pos", unit="s")
+    hover_z = checks.number(w, "hover_z", hover_z, unit="m")
+    eps = checks.number(w, "eps", eps, "pos")
+    max_step = checks.number(w, "max_step", max_step, "pos", unit="s", optional=True)
+    settle = checks.whole(w, "settle", settle)
+    tol = checks.number(w, "tol", tol, "pos")
+    checks.callback(w, "progress", progress)
     if vehicle.batch_size not in (None, 1):
         raise InputError(f"linearize takes one vehicle, got a batch of {vehicle.batch_size}")
     if not (math.isfinite(dt) and dt > 0):

@@ -23,11 +23,13 @@ from typing import Any
 
 import numpy as np
 
+from quadcruise import checks
 from quadcruise.control import Controller, as_controller, controller_record
 from quadcruise.errors import InputError, reject_unknown
 from quadcruise.io.plainjson import dumps, plain
 from quadcruise.metrics.summary import Summary
-from quadcruise.missions import Mission, mission_from_name
+from quadcruise.missions import Mission, as_mission
+from quadcruise.model.vehicle import Vehicle
 from quadcruise.workflows.fly import FLY_OPTIONS, flight_warnings_named, fly
 
 __all__ = ["compare", "Comparison", "DEFAULT_CONTROLLERS"]
@@ -324,10 +326,12 @@ def compare(mission: Mission | str = "circle",
             raise InputError(f"compare() flies one mission with each controller; '{bad}' is not an option")
     reject_unknown("compare()", {k: v for k, v in fly_kw.items() if k not in FLY_OPTIONS},
                    ["controllers", "progress", *(k for k in FLY_OPTIONS if k != "missions")])
-    if isinstance(mission, str):
-        mission = mission_from_name(mission)
-    if not isinstance(mission, Mission):
-        raise InputError(f"mission must be a name or a Mission, got {type(mission).__name__}")
+    w = "compare()"                                 # its own arguments checked before any flight
+    mission = as_mission(mission, w)
+    checks.instance(w, "vehicle", vehicle, Vehicle)
+    checks.number(w, "duration", duration, "pos", unit="s", optional=True)
+    checks.number(w, "dt", dt, "pos", unit="s")
+    checks.callback(w, "progress", progress)
     chosen = labelled(controllers)
     results = {}
     for label, ctrl in chosen.items():
@@ -369,12 +373,15 @@ def labelled(controllers) -> dict:
         text, controllers = controllers, [c.strip() for c in controllers.split(",")]
         if any(not c for c in controllers):
             raise InputError(f"controllers {text!r}: an empty name; give comma-separated names such as nlpd,se3")
+    if not isinstance(controllers, (Mapping, list, tuple)):
+        checks.fail("compare()", "controllers", controllers, "comma-separated names, a list of controllers "
+                    "(names or objects) or a mapping label -> controller")
     items = list(controllers.items()) if isinstance(controllers, Mapping) else [(None, c) for c in controllers]
     if not items:
         raise InputError("compare() needs at least one controller")
     out: dict = {}
     for label, c in items:
-        ctrl = as_controller(c)
+        ctrl = as_controller(c, "compare()")
         name = str(label) if label is not None else ctrl.name
         k, unique = 1, name
         while unique in out:

@@ -21,12 +21,13 @@ from typing import Any
 
 import numpy as np
 
+from quadcruise import checks
 from quadcruise._version import __version__
 from quadcruise.control import as_controller, controller_record
 from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import FlightWarning, InputError, reject_unknown
 from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, REF_Z, STATE_SIZE, X, Z
-from quadcruise.missions import Mission, mission_from_name, stack_params
+from quadcruise.missions import Mission, as_mission, stack_params
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
 from quadcruise.sim.engine import Limits, simulate, time_grid
@@ -165,18 +166,40 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
         With ``metrics()``, ``to_pandas()`` and ``plot()``. A vehicle that diverged stops
         and its status says why and when (a warning says so too), as does any clipping
         of the rotor duties.
+
+    Raises
+    ------
+    ArgumentTypeError
+        An argument of the wrong type (a TypeError too): text for a number, a class for an
+        object, a float or a bool for ``seed``, ``n`` or ``log_every``, anything but a bool for
+        ``full_dynamics``, a controller whose ``function`` is not compiled with ``CONTROLLER_SIG``
+        (:mod:`quadcruise.checks`); before any work.
+    InputError
+        A value out of range (a ValueError), e.g. ``dt <= 0``, ``seed < 0``, a ``log_every``
+        that does not divide the flight's control periods, a flight too large to log.
     """
     reject_unknown("fly()", unknown, FLY_OPTIONS)
-    if max_step is not None and not (isinstance(max_step, (int, float)) and max_step > 0):
-        raise InputError(f"max_step must be a positive number of seconds, got {max_step!r}")
-    for name, value in (("max_track_error", max_track_error), ("max_steady_error", max_steady_error)):
-        if value is not None and not (isinstance(value, (int, float)) and not isinstance(value, bool) and value > 0):
-            raise InputError(f"{name} must be a positive number [m], got {value!r}")
-    if isinstance(mission, str):
-        mission = mission_from_name(mission)
+    w = "fly()"                                       # every argument checked before any work
+    mission = as_mission(mission, w)
+    missions = fly_missions(missions)
     controllers = per_vehicle_controllers(controller)
     controller = controllers[0]
-    vehicle = vehicle or Vehicle.paper()
+    vehicle = checks.instance(w, "vehicle", vehicle, Vehicle) or Vehicle.paper()
+    checks.instance(w, "controller_vehicle", controller_vehicle, Vehicle)
+    duration = checks.number(w, "duration", duration, "pos", unit="s", optional=True)
+    dt = checks.number(w, "dt", dt, "pos", unit="s")
+    max_step = checks.number(w, "max_step", max_step, "pos", unit="s", optional=True)
+    n = checks.whole(w, "n", n, 1, optional=True)
+    log_every = checks.whole(w, "log_every", log_every, 1)
+    checks.instance(w, "limits", limits, Limits)
+    full_dynamics = checks.flag(w, "full_dynamics", full_dynamics)
+    checks.instance(w, "environment", environment, (Environment, CustomDisturbance))
+    checks.instance(w, "sensors", sensors, SensorNoise)
+    seed = checks.whole(w, "seed", seed)
+    first_vehicle = vehicle_indices(first_vehicle)
+    for name, value in (("max_track_error", max_track_error), ("max_steady_error", max_steady_error)):
+        checks.number(w, name, value, "pos", unit="m", optional=True, infinite=True)
+    x0 = initial_states(x0)
     sizes = {s for s in (vehicle.batch_size, None if x0 is None or np.ndim(x0) < 2 else np.shape(x0)[0],
                          None if missions is None else len(missions), n,
                          len(controllers) if len(controllers) > 1 else None,
@@ -189,13 +212,11 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
     mp = stack_params(missions if missions is not None else mission, n=None if missions else n)
     first = missions[0] if missions else mission
     duration = default_duration(first) if duration is None else duration
-    try:
-        d, h = float(duration), float(dt)
-    except (TypeError, ValueError):
-        raise InputError(f"duration and dt must be numbers of seconds, got {duration!r} and {dt!r}") from None
+    d, h = duration, dt
     if 0 < h <= d < math.inf:                               # sized before the grid is allocated
         check_run_size(n, round(d / h), int(log_every), max(1, math.ceil(h / float(max_step or h) - 1e-9)))
     grid = time_grid(float(duration), float(dt))
+    check_log_every(log_every, grid.size - 1)
     if sensors is not None:
         sensors.check_fits(duration)
     check_can_hover(vehicle)
@@ -291,6 +312,101 @@ def per_vehicle_controllers(controller: Any) -> list:
     return out
 
 
+def fly_missions(missions: Any) -> list | None:
+    """``fly(missions=)`` checked: None, or a non-empty list or tuple of Mission objects.
+
+    Parameters
+    ----------
+    missions : Any
+        The value given.
+
+    Returns
+    -------
+    list of Mission or None
+
+    Raises
+    ------
+    ArgumentTypeError
+        Not a list or tuple, or an entry that is not a Mission (named by its index).
+    InputError
+        An empty list.
+    """
+    if missions is None:
+        return None
+    if not isinstance(missions, (list, tuple)):
+        checks.fail("fly()", "missions", missions, "a list of Mission objects (one per vehicle) or None")
+    if not missions:
+        checks.fail("fly()", "missions", missions, "a non-empty list of Mission objects", kind=False)
+    for i, m in enumerate(missions):
+        checks.instance("fly()", f"missions[{i}]", m, Mission, optional=False)
+    return list(missions)
+
+
+def vehicle_indices(first_vehicle: Any) -> int | np.ndarray:
+    """``fly(first_vehicle=)`` checked: a whole number >= 0, or a 1-D array of them.
+
+    Parameters
+    ----------
+    first_vehicle : Any
+        The value given.
+
+    Returns
+    -------
+    int or numpy.ndarray
+        The index, or an int64 array of indices.
+
+    Raises
+    ------
+    ArgumentTypeError
+        Not a whole number nor a 1-D array of whole numbers.
+    InputError
+        A negative index.
+    """
+    if np.ndim(first_vehicle) == 0:
+        return checks.whole("fly()", "first_vehicle", first_vehicle)
+    arr = np.asarray(first_vehicle)
+    if arr.ndim != 1 or arr.size == 0 or arr.dtype.kind not in "iu":
+        checks.fail("fly()", "first_vehicle", first_vehicle, "a whole number >= 0 or a 1-D array of them")
+    if arr.min() < 0:
+        checks.fail("fly()", "first_vehicle", first_vehicle, "a whole number >= 0 or a 1-D array of them",
+                    kind=False)
+    return arr.astype(np.int64)
+
+
+def initial_states(x0: Any) -> np.ndarray | None:
+    """``fly(x0=)`` checked: None, or finite numbers of shape (16,) or (N, 16).
+
+    Parameters
+    ----------
+    x0 : Any
+        The value given.
+
+    Returns
+    -------
+    numpy.ndarray or None
+        A float copy.
+
+    Raises
+    ------
+    ArgumentTypeError
+        Not numbers, or another shape.
+    InputError
+        A value that is not finite.
+    """
+    if x0 is None:
+        return None
+    want = f"None or finite numbers of shape ({STATE_SIZE},) or (N, {STATE_SIZE})"
+    try:
+        arr = np.array(x0, dtype=float)
+    except (TypeError, ValueError):
+        checks.fail("fly()", "x0", x0, want)
+    if isinstance(x0, (str, bytes)) or arr.ndim not in (1, 2) or arr.shape[-1] != STATE_SIZE or arr.size == 0:
+        checks.fail("fly()", "x0", x0, want)
+    if not np.isfinite(arr).all():
+        checks.fail("fly()", "x0", x0, want, kind=False)
+    return arr
+
+
 FLY_OPTIONS = ("vehicle", "duration", "dt", "max_step", "n", "x0", "log_every", "limits", "missions",
                "controller_vehicle", "full_dynamics", "environment", "sensors", "seed", "first_vehicle",
                "max_track_error", "max_steady_error")
@@ -335,11 +451,14 @@ def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1) -> Non
 
     if log_every < 1:
         raise InputError(f"log_every must be a whole number >= 1, got {log_every!r}")
+    def many(k: int) -> str:                       # a count as a message writes it: short, whatever its size
+        return f"{k:,}" if k < 10**12 else f"{float(k):.3g}"
+
     if n * steps > MAX_VEHICLE_STEPS:
-        raise InputError(f"{n:,} vehicles x {steps:,} control periods is {n * steps:.2g} vehicle-steps, hours of "
-                         f"computing: fly fewer vehicles or a shorter duration")
+        raise InputError(f"{many(n)} vehicles x {many(steps)} control periods is {n * steps:.2g} vehicle-steps, "
+                         f"hours of computing: fly fewer vehicles or a shorter duration")
     if n * steps * substeps > MAX_VEHICLE_STEPS:
-        raise InputError(f"{n:,} vehicles x {steps:,} control periods x {substeps:,} RK4 substeps each is "
+        raise InputError(f"{many(n)} vehicles x {many(steps)} control periods x {many(substeps)} RK4 substeps each is "
                          f"{n * steps * substeps:.2g} substeps, hours of computing: a larger max_step, fewer "
                          "vehicles or a shorter duration")
     row = 8 * (STATE_SIZE + CMD_SIZE + REF_SIZE)
@@ -354,6 +473,65 @@ def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1) -> Non
                          f"{steps // log_every + 1:,} logged instants), more than half of this machine's "
                          f"{memory / 2**30:.0f} GiB: log less often (log_every={every:,}: in Python, or a scenario's "
                          "[simulation]) or fly shorter")
+
+
+def check_log_every(log_every: int, periods: int) -> None:
+    """Refuse a ``log_every`` that does not divide the flight's control periods: the log would
+    end before the flight does (``log_every=1500`` on a 2 s flight at 1 kHz logs 0 and 1.5 s
+    only, and the result would read as a 1.5 s flight). A Monte Carlo sweep picks such a
+    divisor itself (``MonteCarloSpec.log_every``).
+
+    Parameters
+    ----------
+    log_every : int
+        Control periods between logged instants.
+    periods : int
+        The flight's control periods.
+
+    Raises
+    ------
+    InputError
+        Naming the nearest divisors below and above.
+
+    Examples
+    --------
+    >>> check_log_every(1500, 2000)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: fly() argument log_every must be a divisor of the flight's 2,000 control periods (so that the log ends where the flight does), got int 1500; the nearest: 1000, 2000
+    """
+    if periods % log_every == 0:
+        return
+    below, above = nearest_divisors(log_every, periods)
+    checks.fail("fly()", "log_every", log_every, f"a divisor of the flight's {periods:,} control periods (so that "
+                "the log ends where the flight does)", kind=False, hint=f"the nearest: {below}, {above}")
+
+
+def nearest_divisors(k: int, n: int) -> tuple[int, int]:
+    """The divisors of ``n`` nearest to ``k``, below and above (``n`` itself above all).
+
+    Parameters
+    ----------
+    k : int
+        A whole number >= 1.
+    n : int
+        A whole number >= 1.
+
+    Returns
+    -------
+    tuple of int
+        (the largest divisor <= k, the smallest divisor >= k), in sqrt(n) steps.
+
+    Examples
+    --------
+    >>> nearest_divisors(1500, 2000), nearest_divisors(3, 2000)
+    ((1000, 2000), (2, 4))
+    """
+    small = [d for d in range(1, math.isqrt(n) + 1) if n % d == 0]
+    divisors = sorted(set(small + [n // d for d in small]))
+    below = max((d for d in divisors if d <= k), default=1)
+    above = min((d for d in divisors if d >= k), default=n)
+    return below, above
 
 
 HOVER_DUTY_WARNING = 0.7

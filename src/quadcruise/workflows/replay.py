@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from quadcruise import checks
 from quadcruise._version import __version__
 from quadcruise.control.openloop import duty_schedule, pack_schedule
 from quadcruise.errors import InputError
@@ -142,15 +143,16 @@ MAX_SUBSTEPS = 2.0e10
 """The most RK4 substeps a replay may take (at about ten million a second, half an hour or more)."""
 
 
-def replay(schedule: DutySchedule, vehicle: Vehicle | None = None, *, max_step: float = 1e-3,
+def replay(schedule: DutySchedule | str | os.PathLike, vehicle: Vehicle | None = None, *, max_step: float = 1e-3,
            limits: Limits | None = None, full_dynamics: bool = False,
            progress: Callable[[int, int], None] | None = None) -> SimResult:
     """Fly the duty schedule open loop and log the state at every schedule row.
 
     Parameters
     ----------
-    schedule : DutySchedule
-        The duties and their times.
+    schedule : DutySchedule or str or os.PathLike
+        The duties and their times, or the path of a ``t,u1,u2,u3,u4`` CSV file
+        (read by :func:`read_duty_csv`).
     vehicle : Vehicle, optional
         Table I by default. A batched vehicle replays the same schedule on each.
     max_step : float
@@ -169,7 +171,16 @@ def replay(schedule: DutySchedule, vehicle: Vehicle | None = None, *, max_step: 
         One logged instant per schedule row (the first is the initial state); the
         references are NaN.
     """
-    vehicle = vehicle or Vehicle.paper()
+    w = "replay()"                                  # every argument checked before any work
+    checks.instance(w, "schedule", schedule, (DutySchedule, str, os.PathLike), optional=False,
+                    want="a DutySchedule or the path of a t,u1,u2,u3,u4 CSV file")
+    vehicle = checks.instance(w, "vehicle", vehicle, Vehicle) or Vehicle.paper()
+    max_step = checks.number(w, "max_step", max_step, "pos", unit="s")
+    checks.instance(w, "limits", limits, Limits)
+    full_dynamics = checks.flag(w, "full_dynamics", full_dynamics)
+    checks.callback(w, "progress", progress)
+    if not isinstance(schedule, DutySchedule):
+        schedule = read_duty_csv(schedule)
     vp = vehicle.rows()
     x0 = np.zeros((vp.shape[0], STATE_SIZE))
     x0[:, F1:F1 + 4] = vp[:, [P_K]] * schedule.duties[0]   # thrust K * u of the first row
@@ -182,12 +193,11 @@ def replay(schedule: DutySchedule, vehicle: Vehicle | None = None, *, max_step: 
         "version": __version__,
     }
     rows = schedule.t.shape[0]
-    if isinstance(max_step, (int, float)) and max_step > 0:     # (simulate refuses the others)
-        substeps = float(np.sum(np.ceil(np.diff(schedule.t) / max_step - 1e-9)))
-        if substeps > MAX_SUBSTEPS:
-            raise InputError(f"{schedule.source}: {schedule.t[-1] - schedule.t[0]:g} s of duties at max_step "
-                             f"{max_step:g} s is {substeps:.3g} RK4 substeps, hours of computing: a larger "
-                             "--max-step or a shorter table")
+    substeps = float(np.sum(np.ceil(np.diff(schedule.t) / max_step - 1e-9)))
+    if substeps > MAX_SUBSTEPS:
+        raise InputError(f"{schedule.source}: {schedule.t[-1] - schedule.t[0]:g} s of duties at max_step "
+                         f"{max_step:g} s is {substeps:.3g} RK4 substeps, hours of computing: a larger "
+                         "--max-step or a shorter table")
     if progress is not None:
         progress(0, rows)
     result = simulate(schedule.t, x0, vp, duty_schedule, pack_schedule(schedule.t, schedule.duties),

@@ -54,7 +54,7 @@ Examples
 >>> load_scenario(path)
 Traceback (most recent call last):
     ...
-quadcruise.errors.InputError: ...s.toml: [mission] unknown key 'radiu' (known: ...)
+quadcruise.errors.InputError: ...s.toml: [mission] unknown key 'radiu' (did you mean 'radius'?) (known: ...)
 """
 
 from __future__ import annotations
@@ -267,10 +267,47 @@ def scenario_from_dict(doc: dict, *, source: str = "scenario", base: Path | None
     mission = _mission(where.at("mission"), doc.get("mission"), base) if "mission" in doc else None
     environment, noise = _disturbances(where.at("disturbances"), doc.get("disturbances", {}))
     simulation = _simulation(where.at("simulation"), doc.get("simulation", {}))
+    _consistent(where, doc, vehicle, model, mission, simulation)
     return Scenario(vehicle=vehicle, controller_vehicle=model, controller=controller, mission=mission, environment=environment,
                     sensor_noise=noise, simulation=simulation, montecarlo=dict(doc.get("montecarlo", {})),
                     compare=compared,
                     title=title, source=source)
+
+
+def _consistent(where: _Where, doc: dict, vehicle: Vehicle, model: Vehicle | None, mission: Mission | None,
+                simulation: dict) -> None:
+    """Refuse a scenario whose tables contradict each other (one hand-edited after the tool wrote
+    it), naming the file and the keys: the number of vehicles given by per-vehicle values, ``n``
+    and ``initial_state``; and, when the file gives both ``duration`` and ``dt``, a ``dt`` that
+    does not divide the duration or a ``log_every`` that does not divide the flight's control
+    periods (as :func:`~quadcruise.workflows.fly.check_log_every`)."""
+    counts: dict[str, int] = {}
+    for table, v in (("vehicle", vehicle), ("controller_vehicle", model)):
+        if v is not None and v.batch_size is not None:
+            key = next((k for k, x in doc.get(table, {}).items() if isinstance(x, list)), "?")
+            counts[f"[{table}] {key}"] = v.batch_size
+    if "n" in simulation:
+        counts["[simulation] n"] = simulation["n"]
+    state = simulation.get("initial_state")
+    if state is not None and state.ndim == 2:
+        counts["[simulation] initial_state"] = state.shape[0]
+    if len(set(counts.values())) > 1:
+        told = ", ".join(f"{k} gives {v}" for k, v in counts.items())
+        raise InputError(f"{where.source}: the number of vehicles contradicts itself: {told}")
+    if "duration" not in simulation or "dt" not in simulation:   # else the command line may give them
+        return
+    sim, duration, dt = where.at("simulation"), simulation["duration"], simulation["dt"]
+    periods = round(duration / dt)                # as sim.engine.time_grid counts them, without the grid
+    if dt > duration or abs(periods * dt - duration) > 1e-9 * max(1.0, duration):
+        raise sim.error(f"'dt' = {dt:g} s does not divide 'duration' = {duration:g} s into whole control periods")
+    every = simulation.get("log_every", 1)
+    if periods % every:
+        from quadcruise.workflows.fly import nearest_divisors
+
+        near = nearest_divisors(every, periods)
+        raise sim.error(f"'log_every' = {every} does not divide the flight's {periods:,} control periods "
+                        f"('duration' / 'dt'): the log would end before the flight does; the nearest that do: "
+                        f"{near[0]}, {near[1]}")
 
 
 class _Where:
@@ -294,9 +331,13 @@ class _Where:
 
 
 def _known(where: _Where, prefix: str, table: dict, known: set) -> None:
+    import difflib
+
     for key in table:
         if key not in known:
-            raise where.error(f"unknown key '{prefix}{key}' (known: {', '.join(sorted(known))})")
+            close = difflib.get_close_matches(str(key), sorted(known), n=1)
+            hint = f" (did you mean '{prefix}{close[0]}'?)" if close else ""
+            raise where.error(f"unknown key '{prefix}{key}'{hint} (known: {', '.join(sorted(known))})")
 
 
 def _number(where: _Where, key: str, value, kind=float):
@@ -433,22 +474,25 @@ def _disturbances(where: _Where, table: dict):
     if "wind" in table:
         wind = table["wind"]
         parts["wind"] = where.wrap(d.ConstantWind, velocity=tuple(wind)) if isinstance(wind, list) \
-            else where.wrap(d.ConstantWind, **_table(where, "wind", wind))
+            else where.wrap(d.ConstantWind, **_table(where, "wind", wind, d.ConstantWind))
     for key, cls in (("gust", d.Gust), ("turbulence", d.Turbulence), ("rotor_loss", d.RotorLoss),
                      ("force", d.ExternalForce)):
         if key in table:
-            values = {k: tuple(v) if isinstance(v, list) else v for k, v in _table(where, key, table[key]).items()}
+            values = {k: tuple(v) if isinstance(v, list) else v for k, v in _table(where, key, table[key], cls).items()}
             parts[key] = where.wrap(cls, **values)
     noise = None
     if "sensor_noise" in table:
-        noise = where.wrap(d.SensorNoise, **_table(where, "sensor_noise", table["sensor_noise"]))
+        noise = where.wrap(d.SensorNoise, **_table(where, "sensor_noise", table["sensor_noise"], d.SensorNoise))
     environment = where.wrap(d.Environment, **parts) if parts else None
     return environment, noise
 
 
-def _table(where: _Where, key: str, value) -> dict:
+def _table(where: _Where, key: str, value, cls: type) -> dict:
+    """An inline table whose keys are the fields of ``cls``: an unknown one is named with the
+    table and the keys known, before ``cls`` is made."""
     if not isinstance(value, dict):
         raise where.error(f"'{key}' must be a table, e.g. {key} = {{ ... }}")
+    _known(where, f"{key}.", value, {f.name for f in dataclasses.fields(cls) if f.init})
     return value
 
 

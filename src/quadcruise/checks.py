@@ -1,0 +1,309 @@
+"""The Python API's argument checks: one message form for every public function.
+
+Every public entry (``fly``, ``compare``, ``montecarlo``, ``tune``, ``replay``, ``analyze``)
+checks its arguments here, before any work, and a bad one raises one line::
+
+    fly() argument dt must be a positive number of seconds, got str '0.001'
+
+naming the function, the argument, what is expected and what was given (its type and a
+short form of its value). A value of the wrong kind raises
+:class:`~quadcruise.errors.ArgumentTypeError` (a ``TypeError``); a value of the right kind
+out of its range raises :class:`~quadcruise.errors.InputError` (a ``ValueError``). Both are
+InputErrors, so the command line turns either into ``error: ...`` and exit status 2.
+
+The library takes objects, not strings: a number given as text (``duration="10"``) is
+refused, as is a bool where a number is wanted, a float where a whole number is wanted
+(``seed=1.5``), and anything but ``True``/``False`` for a switch (``full_dynamics="no"``).
+The parameter objects themselves (``Vehicle``, missions, disturbances, controllers) check
+their fields with :mod:`quadcruise.fields`, in the same words.
+
+Examples
+--------
+>>> number("fly()", "dt", 0.001, "pos", unit="s")
+0.001
+>>> number("fly()", "dt", "0.001", "pos", unit="s")
+Traceback (most recent call last):
+    ...
+quadcruise.errors.ArgumentTypeError: fly() argument dt must be a positive number of seconds, got str '0.001'
+>>> whole("fly()", "seed", 1.5)
+Traceback (most recent call last):
+    ...
+quadcruise.errors.ArgumentTypeError: fly() argument seed must be a whole number >= 0, got float 1.5
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+import numbers
+from typing import Any
+
+import numpy as np
+
+from quadcruise.errors import ArgumentTypeError, InputError
+
+__all__ = ["callback", "describe", "fail", "flag", "instance", "number", "short_number", "whole"]
+
+_UNITS = {"s": " of seconds", "m": " of metres"}
+
+
+def short_number(x: float) -> str:
+    """A number as a message writes it: its repr when short, else 6 significant digits.
+
+    Parameters
+    ----------
+    x : float
+        Any real number (an int of any size too).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> short_number(0.1), short_number(10**300), short_number(2)
+    ('0.1', '1e+300', '2')
+    """
+    if isinstance(x, (int, np.integer)) and not isinstance(x, bool) and abs(int(x)) < 10**12:
+        return str(int(x))
+    try:
+        text = repr(float(x))
+    except OverflowError:
+        return f"{x:.6g}" if not isinstance(x, int) else f"{len(str(abs(x)))}-digit integer"
+    return text if len(text) <= 12 else f"{float(x):.6g}"
+
+
+def describe(value: Any, limit: int = 60) -> str:
+    """What was given, for a message: its type and a short form of it.
+
+    Parameters
+    ----------
+    value : Any
+        The value given.
+    limit : int
+        Most characters of its repr shown.
+
+    Returns
+    -------
+    str
+        E.g. ``str '0.001'``, ``int 3``, ``the class Circle``, ``None``.
+
+    Examples
+    --------
+    >>> describe(3), describe("x"), describe(None), describe(1e300)
+    ('int 3', "str 'x'", 'None', 'float 1e+300')
+    """
+    if value is None:
+        return "None"
+    if isinstance(value, bool):
+        return f"bool {value}"
+    if inspect.isclass(value):
+        return f"the class {value.__name__}"
+    kind = type(value).__name__
+    if isinstance(value, numbers.Real) and not isinstance(value, np.ndarray):
+        return f"{kind} {short_number(value)}"
+    if isinstance(value, np.ndarray):
+        return f"{kind} of shape {value.shape}"
+    text = " ".join(repr(value).split())
+    text = text if len(text) <= limit else text[:limit - 3] + "..."
+    return f"{kind} {text}"
+
+
+def fail(where: str, name: str, value: Any, want: str, *, kind: bool = True, hint: str = "") -> None:
+    """Raise the one message: ``<where> argument <name> must be <want>, got <value>``.
+
+    Parameters
+    ----------
+    where : str
+        The function, e.g. ``"fly()"``.
+    name : str
+        The argument.
+    value : Any
+        What was given.
+    want : str
+        What is expected.
+    kind : bool
+        True: the value is of the wrong type (ArgumentTypeError); False: of the right type but
+        out of range (InputError).
+    hint : str
+        What to do, appended after a semicolon.
+
+    Raises
+    ------
+    ArgumentTypeError or InputError
+        Always.
+    """
+    text = f"{where} argument {name} must be {want}, got {describe(value)}"
+    if inspect.isclass(value) and not hint:
+        hint = f"give an object, e.g. {value.__name__}()"
+    if hint:
+        text += f"; {hint}"
+    raise (ArgumentTypeError if kind else InputError)(text)
+
+
+def _is_real(value: Any) -> bool:
+    return isinstance(value, (numbers.Real, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
+def number(where: str, name: str, value: Any, check: str = "real", *, unit: str = "",
+           optional: bool = False, infinite: bool = False) -> float | None:
+    """A finite number (an int or a float, not a bool nor a string), as a float.
+
+    Parameters
+    ----------
+    where, name : str
+        The function and the argument, for the message.
+    value : Any
+        The value given.
+    check : {"real", "pos", "nonneg"}
+        Any finite number, > 0, or >= 0.
+    unit : str
+        Its unit ("s", "m", ...), for the message.
+    optional : bool
+        None is allowed (and returned).
+    infinite : bool
+        ``inf`` is allowed too (a bound that ``numpy.inf`` turns off).
+
+    Returns
+    -------
+    float or None
+
+    Examples
+    --------
+    >>> number("fly()", "duration", 0, "pos", unit="s")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: fly() argument duration must be a positive number of seconds, got int 0
+    """
+    if value is None and optional:
+        return None
+    of = _UNITS.get(unit, f" [{unit}]" if unit else "")
+    want = {"real": f"a finite number{of}", "pos": f"a positive number{of}", "nonneg": f"a number{of} >= 0"}[check]
+    want += " (inf allowed)" * infinite + " or None" * optional
+    if not _is_real(value) or (isinstance(value, np.ndarray) and value.ndim):
+        fail(where, name, value, want)
+    x = float(value)
+    if math.isnan(x) or (math.isinf(x) and not (infinite and x > 0)) or (check == "pos" and x <= 0) \
+            or (check == "nonneg" and x < 0):
+        fail(where, name, value, want, kind=False)
+    return x
+
+
+def whole(where: str, name: str, value: Any, minimum: int = 0, *, optional: bool = False) -> int | None:
+    """A whole number >= ``minimum`` (an int or a numpy integer; not a bool, not a float).
+
+    Parameters
+    ----------
+    where, name : str
+        The function and the argument, for the message.
+    value : Any
+        The value given.
+    minimum : int
+        The smallest value accepted.
+    optional : bool
+        None is allowed (and returned).
+
+    Returns
+    -------
+    int or None
+
+    Examples
+    --------
+    >>> whole("fly()", "seed", True)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.ArgumentTypeError: fly() argument seed must be a whole number >= 0, got bool True
+    """
+    if value is None and optional:
+        return None
+    want = f"a whole number >= {minimum}" + (" or None" if optional else "")
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Integral, np.integer)):
+        fail(where, name, value, want)
+    if value < minimum:
+        fail(where, name, value, want, kind=False)
+    return int(value)
+
+
+def flag(where: str, name: str, value: Any) -> bool:
+    """``True`` or ``False`` (a numpy bool too), nothing else: a string such as ``"no"`` is
+    refused, not read as true.
+
+    Parameters
+    ----------
+    where, name : str
+        The function and the argument, for the message.
+    value : Any
+        The value given.
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> flag("fly()", "full_dynamics", "no")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.ArgumentTypeError: fly() argument full_dynamics must be True or False, got str 'no'
+    """
+    if not isinstance(value, (bool, np.bool_)):
+        fail(where, name, value, "True or False")
+    return bool(value)
+
+
+def instance(where: str, name: str, value: Any, cls: type | tuple, *, optional: bool = True,
+             want: str | None = None) -> Any:
+    """An object of ``cls`` (None too if ``optional``), returned as given.
+
+    Parameters
+    ----------
+    where, name : str
+        The function and the argument, for the message.
+    value : Any
+        The value given.
+    cls : type or tuple of type
+        The class(es) accepted.
+    optional : bool
+        None is allowed.
+    want : str, optional
+        How the message names what is expected; "a <cls>" by default.
+
+    Returns
+    -------
+    Any
+        ``value``.
+
+    Examples
+    --------
+    >>> from quadcruise.model.vehicle import Vehicle
+    >>> instance("fly()", "vehicle", 3, Vehicle)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.ArgumentTypeError: fly() argument vehicle must be a Vehicle or None, got int 3
+    """
+    if value is None and optional:
+        return None
+    if not isinstance(value, cls):
+        classes = cls if isinstance(cls, tuple) else (cls,)
+        want = want or " or ".join(f"a {c.__name__}" for c in classes)
+        fail(where, name, value, want + (" or None" if optional else ""))
+    return value
+
+
+def callback(where: str, name: str, value: Any) -> Any:
+    """None or a callable (a ``progress`` function), returned as given.
+
+    Parameters
+    ----------
+    where, name : str
+        The function and the argument, for the message.
+    value : Any
+        The value given.
+
+    Returns
+    -------
+    callable or None
+    """
+    if value is not None and not callable(value):
+        fail(where, name, value, "a callable or None")
+    return value
