@@ -75,10 +75,11 @@ def tracking_transient_batch(t: np.ndarray, err: np.ndarray, bands: Sequence[flo
       error stayed under that line over at least the last half of the flight (a level
       measured on the last quarter is a steady level only if the quarter before agrees);
       otherwise NaN: it had not converged;
-    * overshoot: the error going below anything it does in steady state before it
-      settles into :data:`~quadcruise.metrics.STEADY_BAND`: ``100 (min e over the last
-      quarter - min e before settling) / (e0 - E)``, 0 if none; its peak time is that
-      lowest error's time (NaN without an overshoot). A peak at the last sample is never one.
+    * overshoot: the error going below anything it does in steady state during the entry
+      (up to twice its settling time into :data:`~quadcruise.metrics.STEADY_BAND`, and not
+      into the last half): ``100 (min e over the last quarter - min e over the entry) /
+      (e0 - E)``, 0 if none; its peak time is that lowest error's time (NaN without an
+      overshoot). A peak at the last sample is never one.
 
     Parameters
     ----------
@@ -147,7 +148,8 @@ def tracking_transient_batch(t: np.ndarray, err: np.ndarray, bands: Sequence[flo
         else:
             full[sel] = settle
     floor = err[sel][:, final].min(axis=1)
-    entry = t[None, :] <= np.where(np.isnan(steady_k), -np.inf, t[0] + steady_k)[:, None]
+    entry_end = np.minimum(t[0] + 2.0 * steady_k, held)             # twice the settling time: the dip of
+    entry = t[None, :] <= np.where(np.isnan(steady_k), -np.inf, entry_end)[:, None]   # an underdamped entry
     low = np.where(entry, e, np.inf)
     k_low = low.argmin(axis=1)
     dip = floor - low[np.arange(sel.size), k_low]
