@@ -71,7 +71,7 @@ def settling_time_batch(t: np.ndarray, z: np.ndarray, band: float) -> np.ndarray
 
 
 def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: dict, bands: Sequence[float],
-                    rise: Sequence[float] = (0.1, 0.9)) -> dict:
+                    rise: Sequence[float] = (0.1, 0.9), err: np.ndarray | None = None) -> dict:
     """The transient of each vehicle, measured as :func:`quadcruise.metrics.flight_metrics` does.
 
     A moving reference (:func:`moving_reference`: circle, square, waypoints, ...) on the
@@ -95,6 +95,8 @@ def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: di
         Settling bands (0.02 for 2 %).
     rise : (float, float)
         Rise-time levels, fractions of the step (0.1 and 0.9 for 10-90 %).
+    err : ndarray, shape (N, L), optional
+        The 3-D position errors [m], if already computed (a moving reference reads them).
 
     Returns
     -------
@@ -122,8 +124,10 @@ def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: di
            "overshoot_pct": np.full(n, np.nan), "peak_time_s": np.full(n, np.nan),
            "settled_at": np.full(n, np.nan), "steady_from": np.full(n, np.nan)}
     if moving_reference(t, ref, mission):
-        d = pos - ref
-        got = tracking_transient_batch(t, np.sqrt((d * d).sum(axis=-1)), bands, rise)
+        if err is None:
+            d = pos - ref
+            err = np.sqrt((d * d).sum(axis=-1))
+        got = tracking_transient_batch(t, err, bands, rise)
         sel = got["measured"]
         out["axis"][sel] = TRACKING_AXIS
         out["t_step"][sel] = t[0]

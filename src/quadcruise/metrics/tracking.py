@@ -56,8 +56,13 @@ def moving_reference(t: np.ndarray, ref: np.ndarray, mission: dict) -> bool:
     """
     if mission.get("kind") == "step":
         return False
-    with np.errstate(invalid="ignore"):
-        return bool(np.nanmax(np.abs(ref - ref[:, :1]), initial=0.0) >= TRANSIENT_MIN_ERROR)
+    for k in range(ref.shape[-1]):                 # axis by axis: the log's strided rows, without copies of (N, L, 3)
+        axis = ref[..., k]
+        with np.errstate(invalid="ignore"):
+            moved = np.fmax.reduce(np.abs(axis - axis[:, :1]), axis=None, initial=0.0)   # NaN (stopped) ignored
+        if moved >= TRANSIENT_MIN_ERROR:
+            return True
+    return False
 
 
 def tracking_transient_batch(t: np.ndarray, err: np.ndarray, bands: Sequence[float],

@@ -624,7 +624,7 @@ def mark_off_track(result: SimResult, bound: np.ndarray, err: np.ndarray | None 
         return result
     pos, ref = result.states[live, :, X:X + 3], result.references[live, :, REF_X:REF_X + 3]
     mission = result.meta.get("mission")
-    got = transient_batch(t, pos, ref, mission if isinstance(mission, dict) else {}, [])
+    got = transient_batch(t, pos, ref, mission if isinstance(mission, dict) else {}, [], err=err)
     first = off_track_since(t, err, pos[:, :, 2] - ref[:, :, 2], got["axis"] >= 0, got["settled_at"],
                             bound[live], zbound[live])
     off = np.isfinite(first)
