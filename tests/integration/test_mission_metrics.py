@@ -198,3 +198,30 @@ def test_the_square_without_an_entry_says_so_and_one_settle_band_gives_two_colum
     assert "settling_time_5pct_s" not in res.output
     same = RUNNER.invoke(main, ["fly", "circle", "--settle-band", "0.05", "--settle-band", "0.05"])
     assert same.exit_code == 2 and "the two bands are the same" in same.output
+
+
+def test_fly_and_a_sweep_agree_flight_by_flight_on_a_moving_reference():
+    from quadcruise.metrics.batch import transient_batch
+    from quadcruise.montecarlo import Population, montecarlo
+    from quadcruise.workflows.fly import hover_state
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        mc = montecarlo("circle", "nlpd", Population(mass_spread=0.15), 16, seed=2, scheduler="none")
+        spec = mc.spec
+        draw = spec.population.draw(spec.seed, 0, 16, spec.vehicle, spec.dt)
+        x0 = hover_state(draw.vehicle, 16, spec.mission)
+        res = qc.fly(spec.mission, spec.controller, vehicle=draw.vehicle, controller_vehicle=spec.vehicle,
+                     duration=spec.duration, dt=spec.dt, x0=x0)
+    failed = res.status == int(ExitStatus.OFF_TRACK)
+    lost = mc.table["lost_track"].to_numpy()
+    # the worse of the two errors after the entry, each over its bound, on fly's full-rate log
+    pos, ref = res.states[:, :, :3], res.references[:, :, :3]
+    settled = transient_batch(res.t, pos, ref, res.meta["mission"], [])["settled_at"]
+    start = np.where(np.isnan(settled), res.t[-1], settled)
+    worst = np.where(res.t[None, :] >= start[:, None] - 1e-12,
+                     np.maximum(np.linalg.norm(pos - ref, axis=2) / 1.0, np.abs(pos[:, :, 2] - ref[:, :, 2]) / 0.5),
+                     0.0).max(axis=1)
+    clear = np.abs(worst - 1.0) > 0.02                  # the sweep's log is 10 ms: not at the edge
+    assert 2 <= failed.sum() <= 14 and clear.sum() >= 12
+    assert np.array_equal(failed, worst > 1.0) and np.array_equal(failed[clear], lost[clear])
