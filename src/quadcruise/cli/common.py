@@ -111,7 +111,8 @@ RISE_OPTION = click.option("--rise", type=click.Choice(["10-90", "0-100"]), defa
                            help="Rise time between these percents of the step.")
 SETTLE_BAND_OPTION = click.option("--settle-band", "settle_bands", type=float, multiple=True, metavar="FRACTION",
                                   help="Settling band, a fraction of the step (default 0.02, then 0.05): the first "
-                                       "gives settling_time_s, a second (0.05 if left out) a column named after it.")
+                                       "gives settling_time_s, a second (0.05 if left out; 0.02 beside a first "
+                                       "0.05) a column named after it.")
 
 
 def metric_options(rise: str = "10-90", settle_bands: tuple[float, ...] = ()) -> dict:

@@ -15,8 +15,8 @@ from typing import Any
 
 __all__ = ["comparison_document", "montecarlo_document", "scenario_document", "scenario_text"]
 
-SPEC_KEYS = ("requirements", "max_track_error_m", "settle_band", "max_clipped_s", "transient_until", "log_dt",
-             "trace_dt", "max_traces", "max_failure_traces")
+SPEC_KEYS = ("requirements", "max_track_error_m", "max_altitude_error_m", "settle_band", "max_clipped_s",
+             "transient_until", "log_dt", "trace_dt", "max_traces", "max_failure_traces")
 """The Monte Carlo spec's settings a scenario's [montecarlo] table holds beside n, seed and the
 population's spreads."""
 

@@ -204,7 +204,8 @@ def report_markdown(result, summary: dict, worst, table_name: str) -> str:
              f"## Failures: {f['count']:,} of {summary['flights']:,} ({100 * f['rate']:.2f} %)\n",
              "Each flight counts once, under the first that applies: diverged (the engine stopped it), "
              f"lost track (its position error after the transient, or at the end if the transient never "
-             f"settled into 5 %, above {spec.max_track_error_m:g} m), saturated (rotor duties clipped for "
+             f"settled into 5 %, above {spec.max_track_error_m:g} m, or its altitude error above "
+             f"{spec.max_altitude_error_m:g} m), saturated (rotor duties clipped for "
              f"more than {spec.max_clipped_s:g} s), failed a requirement (missed one of the requirements "
              "below).\n",
              "| reason | flights | rate |", "|---|---|---|"]

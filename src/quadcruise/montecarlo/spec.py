@@ -92,6 +92,11 @@ class MonteCarloSpec:
         :func:`quadcruise.workflows.fly.steady_bound`, the default of ``fly``'s
         ``max_steady_error``): 1 m for the built-in circle, square, step and hover. The
         value used is the field's value after construction, recorded with the spec.
+    max_altitude_error_m : float, optional
+        A flight is off track (counted as "lost track") too if its altitude error after the
+        transient exceeds this [m]. By default (None) :func:`quadcruise.workflows.fly.altitude_bound`
+        (half the mission's lowest altitude: 0.5 m for the built-in missions), or
+        ``max_track_error_m`` where that is given, as ``fly``'s ``max_steady_error`` bounds both.
     requirements : str or sequence of str
         The user's own pass criteria, e.g. ``("steady_max_error_m<=0.2",)``: a metric of
         :data:`~quadcruise.montecarlo.schema.METRICS`, ``<=``, ``<``, ``>=`` or ``>``, and a
@@ -129,10 +134,11 @@ class MonteCarloSpec:
     full_dynamics: bool = False
     max_track_error_m: float | None = None
     requirements: Any = ()
+    max_altitude_error_m: float | None = None
 
     def __post_init__(self) -> None:
         from quadcruise.sim.engine import time_grid
-        from quadcruise.workflows.fly import default_duration, steady_bound
+        from quadcruise.workflows.fly import altitude_bound, default_duration, steady_bound
 
         if isinstance(self.mission, str):
             object.__setattr__(self, "mission", mission_from_name(self.mission))
@@ -166,7 +172,13 @@ class MonteCarloSpec:
             else self.max_track_error_m
         if isinstance(bound, bool) or not (isinstance(bound, (int, float)) and math.isfinite(bound) and bound > 0):
             raise InputError(f"max_track_error_m must be a positive number [m], got {bound!r}")
+        zbound = self.max_altitude_error_m
+        if zbound is None:
+            zbound = altitude_bound(self.mission, self.duration) if self.max_track_error_m is None else bound
+        if isinstance(zbound, bool) or not (isinstance(zbound, (int, float)) and math.isfinite(zbound) and zbound > 0):
+            raise InputError(f"max_altitude_error_m must be a positive number [m], got {zbound!r}")
         object.__setattr__(self, "max_track_error_m", float(bound))
+        object.__setattr__(self, "max_altitude_error_m", float(zbound))
         if self.population.needs_drag:
             from quadcruise.disturbances.environment import with_drag
 

@@ -158,7 +158,8 @@ def replay(schedule: DutySchedule | str | os.PathLike, vehicle: Vehicle | None =
     max_step : float
         Longest RK4 substep [s]; each row interval is split into equal substeps.
     limits : Limits, optional
-        Divergence bounds.
+        Divergence bounds; by default :class:`Limits` without the tilt bound: recorded duties
+        may flip the vehicle on purpose, and a replay is a model's check, not a mission.
     full_dynamics : bool
         Fly the plant with the exact Euler-angle kinematics instead of the paper's.
     progress : callable, optional
@@ -202,7 +203,8 @@ def replay(schedule: DutySchedule | str | os.PathLike, vehicle: Vehicle | None =
         progress(0, rows)
     result = simulate(schedule.t, x0, vp, duty_schedule, pack_schedule(schedule.t, schedule.duties),
                       no_reference, np.zeros(1), memory=np.zeros(1), max_step=max_step,
-                      limits=limits, meta=meta, full_dynamics=full_dynamics)
+                      limits=Limits(max_tilt=math.inf) if limits is None else limits, meta=meta,
+                      full_dynamics=full_dynamics)
     if progress is not None:
         progress(rows, rows)
     return result
