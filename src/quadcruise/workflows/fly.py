@@ -504,13 +504,14 @@ def check_log_every(log_every: int, periods: int) -> None:
     >>> check_log_every(1500, 2000)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: fly() argument log_every must be a divisor of the flight's 2,000 control periods (so that the log ends where the flight does), got int 1500; the nearest: 1000, 2000
+    quadcruise.errors.InputError: fly() argument log_every must be a divisor of the flight's 2,000 control periods (so that the log ends where the flight does), got int 1500; the nearest: 1,000, 2,000
     """
     if periods % log_every == 0:
         return
     below, above = nearest_divisors(log_every, periods)
+    hint = f"at most {periods:,}" if log_every > periods else f"the nearest: {below:,}, {above:,}"
     checks.fail("fly()", "log_every", log_every, f"a divisor of the flight's {periods:,} control periods (so that "
-                "the log ends where the flight does)", kind=False, hint=f"the nearest: {below}, {above}")
+                "the log ends where the flight does)", kind=False, hint=hint)
 
 
 def nearest_divisors(k: int, n: int) -> tuple[int, int]:
