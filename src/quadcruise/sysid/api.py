@@ -1,0 +1,240 @@
+"""``quadcruise.identify``: a flight log in, the vehicle's parameters out, checked on held-out data.
+
+The path (each stage reported to ``progress``): read the log (:mod:`quadcruise.io.flightlog`),
+filter it (:func:`quadcruise.sysid.equations.signals`), fit the equation-error regressions on
+the first ``1 - holdout`` of the airborne time (:func:`quadcruise.sysid.estimate.fit`), turn
+the coefficients into the vehicle's parameters with 95 % intervals
+(:func:`quadcruise.sysid.physical.parameters`), and predict the held-out tail
+(:func:`quadcruise.sysid.validate.validate`). docs/identify.md says why this estimator.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from quadcruise.errors import InputError
+from quadcruise.io.flightlog import FlightLog, parse_commands, read_flight_log
+from quadcruise.model.vehicle import Vehicle
+from quadcruise.sysid.equations import signals
+from quadcruise.sysid.estimate import fit
+from quadcruise.sysid.physical import Z95, parameters
+from quadcruise.sysid.result import IdentifyResult
+from quadcruise.sysid.validate import validate
+
+STAGES = ("reading the log", "filtering", "fitting", "intervals", "validating")
+"""The stages ``progress`` counts."""
+WINDOW_S = 0.08
+"""The Savitzky-Golay window [s] (at least 5 samples): about a third of the fastest rotor lag it
+must pass (omega up to ~40 rad/s), and long enough to average gyro noise."""
+SHAPE_SPAN = 0.25
+"""The least spread (5th to 95th percentile) of the rotor commands over which the thrust
+curve's shape f is fitted; over a narrower span u and u^2 cannot be told apart."""
+UNITS = {"K": "N", "Jxx": "kg m^2", "Jyy": "kg m^2", "Jzz": "kg m^2", "d": "m", "omega": "rad/s",
+         "hover_duty": "-", "thrust_curve_f": "-", "K_per_m": "N/kg", "Jxx_per_m": "m^2", "Jyy_per_m": "m^2",
+         "Jzz_per_m": "m^2"}
+"""Each parameter's unit."""
+
+
+def identify(log: str | os.PathLike | FlightLog, vehicle: Vehicle | None = None, *, mass: float | None = None,
+             frame: str | None = None, commands: str = "duty", holdout: float = 0.3,
+             progress: Callable[[int, int], None] | None = None) -> IdentifyResult:
+    """Identify the paper's plant from a flight log by equation error; validate on a held-out tail.
+
+    Parameters
+    ----------
+    log : str, os.PathLike or FlightLog
+        A PX4 log (``.ulg``), a CSV (see :mod:`quadcruise.io.flightlog`), or a log already read.
+    vehicle : Vehicle, optional
+        The base vehicle (the paper's Table I by default): the rotor arm when the log has no
+        ``CA_ROTOR*`` geometry, gravity, the starting rotor bandwidth, and the values reported
+        for what the log cannot identify.
+    mass : float, optional
+        The vehicle's mass [kg]. Without it, K and the inertias are identified per unit mass
+        (``K_per_m``, ``Jxx_per_m``, ...), and the result says so.
+    frame : {"enu", "ned"}, optional
+        A CSV's frames (ENU/FLU by default); a ULog is always PX4's NED/FRD.
+    commands : str
+        ``duty`` or ``pwm:MIN:MAX`` (see :func:`quadcruise.io.flightlog.read_flight_log`).
+    holdout : float
+        The fraction of the airborne time, at its end, kept out of the fit and predicted.
+    progress : callable, optional
+        ``progress(done, total, stage)`` after each of :data:`STAGES`.
+
+    Returns
+    -------
+    IdentifyResult
+
+    Raises
+    ------
+    InputError
+        A bad argument or log (one line, before any work), or a log too short to fit.
+
+    Examples
+    --------
+    >>> identify("flight.ulg", holdout=1.5)
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: holdout must be a fraction in [0.05, 0.6], got 1.5
+    """
+    if isinstance(holdout, bool) or not isinstance(holdout, (int, float)) or not 0.05 <= holdout <= 0.6:
+        raise InputError(f"holdout must be a fraction in [0.05, 0.6], got {holdout!r}")
+    if mass is not None and (isinstance(mass, bool) or not isinstance(mass, (int, float))
+                             or not math.isfinite(mass) or mass <= 0):
+        raise InputError(f"mass must be a positive number of kg, got {mass!r}")
+    if vehicle is not None and not isinstance(vehicle, Vehicle):
+        raise InputError(f"vehicle must be a quadcruise Vehicle, got {type(vehicle).__name__}")
+    base = vehicle or Vehicle.paper()
+    if base.batch_size is not None:
+        raise InputError("vehicle: the base vehicle must be one vehicle, not a batch")
+    parse_commands(commands)
+    report = progress or (lambda done, total, stage="": None)
+
+    flight = log if isinstance(log, FlightLog) else read_flight_log(log, frame=frame, commands=commands)
+    report(1, len(STAGES), STAGES[0])
+    rotors = flight.rotors
+    if rotors is None:
+        if flight.n_rotors != 4:
+            raise InputError(f"{flight.source}: {flight.n_rotors} rotor commands and no CA_ROTOR* geometry: "
+                             "the base vehicle has the paper's four '+' rotors")
+        arm = float(base.l)
+        rotors = np.array([[-arm, 0.0, 1.0], [0.0, arm, -1.0], [arm, 0.0, 1.0], [0.0, -arm, -1.0]])
+    g = float(base.g)
+    force_z = _specific_force_z(flight, g)
+    sig = signals(flight.t, flight.segment, flight.u, flight.rates, force_z, WINDOW_S)
+    report(2, len(STAGES), STAGES[1])
+
+    omega0 = float(base.omega)
+    fit_rows, held = _split(flight, sig.window, omega0, holdout)
+    if fit_rows.sum() < 10 * sig.window or held.sum() < 2 * sig.window:
+        raise InputError(f"{flight.source}: {flight.duration:.1f} s airborne is too short to fit and hold out "
+                         f"{holdout:g} of it")
+    cmd_hz = _command_rate(flight)
+    lag_seen = cmd_hz >= 2.0 * omega0                         # a sample at least every tau/2
+    u_fit = sig.u[fit_rows]
+    span = float(np.percentile(u_fit, 95) - np.percentile(u_fit, 5))
+    fit_shape = span >= SHAPE_SPAN
+    f0 = float(flight.parameters.get("THR_MDL_FAC", 0.0) or 0.0)
+    bounds = (0.5, min(500.0, 0.5 / sig.dt))
+    result = fit(sig, fit_rows, rotors, omega0, f0, fit_omega=lag_seen, fit_shape=fit_shape, omega_bounds=bounds)
+    report(3, len(STAGES), STAGES[2])
+
+    found = parameters(result, mass, flight.n_rotors, g,
+                       systematic=_timing_error(flight, force_z, fit_rows, rotors, result, mass, g, cmd_hz, bounds))
+    notes: dict[str, str] = {}
+    if not lag_seen:
+        notes["omega"] = (f"commands logged at {cmd_hz:g} Hz: too slow to see a rotor lag of {1 / omega0:.3g} s "
+                          "(a sample every half time constant at least)")
+    elif result.omega <= bounds[0] * 1.01 or result.omega >= bounds[1] * 0.99:
+        found["omega"]["identifiable"] = False
+        notes["omega"] = f"the fit ran to the end of its search interval {bounds[0]:g}..{bounds[1]:g} rad/s"
+    if not fit_shape:
+        notes["thrust_curve_f"] = (f"the commands span only {span:.2f} (5th to 95th percentile): the thrust curve's "
+                                   f"shape is not seen; f fixed at {f0:g} (the log's THR_MDL_FAC, else 0)")
+    table = _table(found, base, notes, f0)
+    report(4, len(STAGES), STAGES[3])
+
+    validation, traces = validate(sig, held, result, rotors, flight, g)
+    report(5, len(STAGES), STAGES[4])
+    return IdentifyResult(parameters=table, validation=validation, traces=traces, log=_log_info(flight, sig),
+                          fit={"rows": result.rows, "held_out_rows": int(held.sum()), "holdout": float(holdout),
+                               "window_samples": sig.window, "window_s": sig.window * sig.dt,
+                               "newey_west_bandwidth": result.bandwidth, "omega_fitted": result.omega_fitted,
+                               "omega_used": result.omega, "thrust_curve_fitted": fit_shape,
+                               "residual_std": result.sigma, "coefficients": dict(zip(result.names,
+                                                                                      result.values.tolist()))},
+                          base=base, mass=mass, rotors=rotors)
+
+
+def _timing_error(flight, force_z, rows, rotors, result, mass, g, cmd_hz, bounds) -> dict[str, float]:
+    """Half the change of each parameter when the commands are shifted by half their logging
+    interval either way: a log sampling its commands says when they were, to that much."""
+    shift = 0.5 / cmd_hz
+    values = []
+    for sign in (-1.0, 1.0):
+        moved = np.empty_like(flight.u)
+        for k in np.unique(flight.segment):
+            seg = flight.segment == k
+            for j in range(flight.u.shape[1]):
+                moved[seg, j] = np.interp(flight.t[seg] - sign * shift, flight.t[seg], flight.u[seg, j])
+        sig = signals(flight.t, flight.segment, moved, flight.rates, force_z, WINDOW_S)
+        again = fit(sig, rows, rotors, result.omega, result.shape_f, fit_omega=result.omega_fitted,
+                    fit_shape="KQ" in result.names, omega_bounds=bounds)
+        values.append({k: v["value"] for k, v in parameters(again, mass, flight.n_rotors, g).items()})
+    return {k: 0.5 * abs(values[1][k] - values[0][k]) for k in values[0]}
+
+
+def _specific_force_z(flight: FlightLog, g: float) -> np.ndarray:
+    if flight.specific_force is not None:
+        return flight.specific_force[:, 2]
+    accel = np.zeros_like(flight.velocity)
+    for k in np.unique(flight.segment):
+        rows = flight.segment == k
+        accel[rows] = np.gradient(flight.velocity[rows], flight.t[rows], axis=0)
+    body = flight.rotation().inv().apply(accel + np.array([0.0, 0.0, g]))
+    return body[:, 2]
+
+
+def _split(flight: FlightLog, window: int, omega0: float, holdout: float) -> tuple[np.ndarray, np.ndarray]:
+    """Rows fitted and rows held out: the tail ``holdout`` of the samples is held out; each
+    segment's first samples (the lag and filter settling) and last half window are used by neither."""
+    n = len(flight.t)
+    dt = float(np.median(np.diff(flight.t)))
+    settle = window + math.ceil(3.0 / (omega0 * dt))
+    usable = np.zeros(n, bool)
+    for k in np.unique(flight.segment):
+        idx = np.flatnonzero(flight.segment == k)
+        usable[idx[settle: len(idx) - window // 2]] = True
+    cut = round(n * (1.0 - holdout))
+    fit_rows, held = usable.copy(), usable.copy()
+    fit_rows[cut:] = False
+    held[:cut + window] = False                          # a window's gap: no filtered sample in both
+    return fit_rows, held
+
+
+def _command_rate(flight: FlightLog) -> float:
+    for key in ("actuator_motors", "actuator_outputs", "csv"):
+        if key in flight.rates_hz and key in (flight.commands.split()[0], "csv"):
+            return float(flight.rates_hz[key])
+    return float(min(flight.rates_hz.values())) if flight.rates_hz else 0.0
+
+
+def _table(found: dict, base: Vehicle, notes: dict, f0: float) -> dict[str, dict]:
+    prior = {"K": base.K, "Jxx": base.Jxx, "Jyy": base.Jyy, "Jzz": base.Jzz, "d": base.d, "omega": base.omega,
+             "thrust_curve_f": f0, "hover_duty": base.hover_duty}
+    out: dict[str, dict[str, Any]] = {}
+    order = list(found) + [n for n in ("omega", "thrust_curve_f") if n not in found]
+    for name in order:
+        field = name.removesuffix("_per_m")
+        entry = found.get(name)
+        base_value = float(prior[field]) / (float(base.m) if name.endswith("_per_m") else 1.0)
+        row: dict[str, Any] = {"unit": UNITS[name]}
+        if entry is not None and entry["identifiable"] and name not in notes:
+            row.update(value=entry["value"], ci95=entry["ci95"], identifiable=True, source="log")
+        else:
+            why = notes.get(name)
+            if why is None and entry is not None:
+                half = Z95 * entry["se"] / abs(entry["value"]) if entry["value"] else float("inf")
+                why = (f"the log does not excite it enough: estimate {entry['value']:.4g} with a 95 % half-width of "
+                       f"{100 * half:.0f} %" if np.isfinite(half) else "no excitation")
+            row.update(value=base_value, ci95=[None, None], identifiable=False,
+                       source="base vehicle", note=why or "not fitted")
+            if entry is not None:
+                row["estimate"] = entry["value"]
+        out[name] = row
+    return out
+
+
+def _log_info(flight: FlightLog, sig) -> dict:
+    info = {"source": flight.source, "airborne_s": flight.duration, "segments": len(np.unique(flight.segment)),
+            "samples": len(flight.t), "grid_hz": 1.0 / sig.dt, "commands": flight.commands,
+            "resampling": flight.resampling, "topic_rates_hz": flight.rates_hz, "rotors": flight.n_rotors,
+            "rotor_geometry": "log (CA_ROTOR*)" if flight.rotors is not None else "base vehicle ('+', arm l)",
+            "parameters": flight.parameters}
+    if flight.hover_thrust is not None:
+        info["px4_hover_thrust_estimate"] = float(np.median(flight.hover_thrust[1]))
+    return info
