@@ -26,6 +26,10 @@ from quadcruise.sysid.physical import Z95, parameters
 from quadcruise.sysid.result import IdentifyResult
 from quadcruise.sysid.validate import validate
 
+MIN_EXCITATION = 1e-3
+"""The least excitation of an axis (:func:`_excitation`: the command combination's standard
+deviation, relative to the mean command) for its parameters to be identifiable at all: below it,
+whatever interval the residuals give reflects the absence of noise, not information."""
 STAGES = ("reading the log", "filtering", "fitting", "intervals", "validating")
 """The stages ``progress`` counts."""
 WINDOW_S = 0.08
@@ -126,6 +130,15 @@ def identify(log: str | os.PathLike | FlightLog, vehicle: Vehicle | None = None,
     found = parameters(result, mass, flight.n_rotors, g,
                        systematic=_timing_error(flight, force_z, fit_rows, rotors, result, mass, g, cmd_hz, bounds))
     notes: dict[str, str] = {}
+    excited = _excitation(sig.u[fit_rows], rotors)
+    needs = {"Jxx": ("roll",), "Jyy": ("pitch",), "Jzz": ("roll", "pitch"), "d": ("roll", "pitch", "yaw"),
+             "omega": ("thrust", "roll", "pitch", "yaw")}
+    for name, axes in needs.items():
+        key = name if name in found or name == "omega" else f"{name}_per_m"
+        flat = [a for a in axes if excited[a] < MIN_EXCITATION]
+        if (name == "omega" and len(flat) == len(axes)) or (name != "omega" and flat):
+            notes[key] = ("no variation on the " + " and ".join(flat) + " axis: the commands there vary by "
+                          + ", ".join(f"{100 * excited[a]:.2g} %" for a in flat) + " of their mean")
     if not lag_seen:
         notes["omega"] = (f"commands logged at {cmd_hz:g} Hz: too slow to see a rotor lag of {1 / omega0:.3g} s "
                           "(a sample every half time constant at least)")
@@ -142,12 +155,23 @@ def identify(log: str | os.PathLike | FlightLog, vehicle: Vehicle | None = None,
     report(5, len(STAGES), STAGES[4])
     return IdentifyResult(parameters=table, validation=validation, traces=traces, log=_log_info(flight, sig),
                           fit={"rows": result.rows, "held_out_rows": int(held.sum()), "holdout": float(holdout),
-                               "window_samples": sig.window, "window_s": sig.window * sig.dt,
+                               "window_samples": sig.window, "window_s": sig.window * sig.dt, "excitation": excited,
                                "newey_west_bandwidth": result.bandwidth, "omega_fitted": result.omega_fitted,
                                "omega_used": result.omega, "thrust_curve_fitted": fit_shape,
                                "residual_std": result.sigma, "coefficients": dict(zip(result.names,
                                                                                       result.values.tolist()))},
                           base=base, mass=mass, rotors=rotors)
+
+
+def _excitation(u: np.ndarray, rotors: np.ndarray) -> dict[str, float]:
+    """How much the commands move each axis: the standard deviation of the thrust command and
+    of each moment's command combination, relative to the mean rotor command (times the arm)."""
+    mean = max(float(np.mean(u)), 1e-12)
+    arm = max(float(np.mean(np.hypot(rotors[:, 0], rotors[:, 1]))), 1e-12)
+    return {"thrust": float(np.std(u.sum(1))) / (u.shape[1] * mean),
+            "roll": float(np.std(u @ rotors[:, 1])) / (arm * mean),
+            "pitch": float(np.std(u @ -rotors[:, 0])) / (arm * mean),
+            "yaw": float(np.std(u @ rotors[:, 2])) / mean}
 
 
 def _timing_error(flight, force_z, rows, rotors, result, mass, g, cmd_hz, bounds) -> dict[str, float]:

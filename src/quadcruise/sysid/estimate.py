@@ -208,10 +208,48 @@ def fit(sig: Signals, rows: np.ndarray, rotors: np.ndarray, omega0: float, shape
         same = (seg[j:] == seg[:-j])[:, None]
         gamma = (score[j:] * same).T @ score[:-j]
         meat += (1.0 - j / (lag + 1.0)) * (gamma + gamma.T)
-    inv = np.linalg.pinv(bread)
-    cov = inv @ meat @ inv
+    cov = sandwich(bread, meat)
     return Fit(names=tuple(names), values=values, cov=cov, omega=omega, omega_fitted=fit_omega, shape_f=f,
                sigma=sigma, bandwidth=lag, rows=n)
+
+
+def sandwich(bread: np.ndarray, meat: np.ndarray, tol: float = 1e-10) -> np.ndarray:
+    """``A^-1 S A^-1``, with infinite variance for what the data do not determine.
+
+    A direction of the (scaled) bread with an eigenvalue below ``tol`` times the largest is
+    one the regressors do not excite; every coefficient with a share in it gets an infinite
+    variance (a pseudo-inverse would give it zero: a tight interval on nothing).
+
+    Parameters
+    ----------
+    bread : ndarray, shape (p, p)
+        ``A``, the weighted sum of the Jacobians' outer products.
+    meat : ndarray, shape (p, p)
+        ``S``, the long-run covariance of the score.
+    tol : float
+        Relative eigenvalue below which a direction counts as not excited.
+
+    Returns
+    -------
+    ndarray, shape (p, p)
+
+    Examples
+    --------
+    >>> cov = sandwich(np.diag([1.0, 0.0]), np.eye(2))
+    >>> np.diag(cov).tolist()
+    [1.0, inf]
+    """
+    scale = np.sqrt(np.clip(np.diag(bread), 1e-300, None))
+    scaled = bread / np.outer(scale, scale)
+    vals, vecs = np.linalg.eigh(scaled)
+    good = vals > tol * max(vals.max(), 1e-300)
+    inv = (vecs[:, good] / vals[good]) @ vecs[:, good].T / np.outer(scale, scale)
+    cov = inv @ meat @ inv
+    blind = np.any(np.abs(vecs[:, ~good]) > 1e-6, axis=1) | (np.diag(bread) <= 1e-300)
+    cov[blind, :] = 0.0
+    cov[:, blind] = 0.0
+    cov[blind, blind] = np.inf
+    return cov
 
 
 def hac_bandwidth(resid: dict, segment: np.ndarray, window: int) -> int:

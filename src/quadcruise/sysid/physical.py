@@ -126,6 +126,11 @@ def jacobian(func, v: np.ndarray) -> tuple[list[str], np.ndarray, np.ndarray]:
     values : ndarray
     jac : ndarray, shape (len(names), len(v))
     """
+    with np.errstate(all="ignore"):
+        return _jacobian(func, v)
+
+
+def _jacobian(func, v):
     base = func(v)
     names = list(base)
     jac = np.zeros((len(names), len(v)))
@@ -164,14 +169,22 @@ def parameters(fit: Fit, mass: float | None, n_rotors: int, g: float,
     """
     # Jzz's two estimates, weighted by their inverse variances
     est = []
+    finite = np.where(np.isfinite(fit.cov), fit.cov, 0.0)
+    blind = ~np.isfinite(np.diag(fit.cov))
     for w in ((1.0, 0.0), (0.0, 1.0)):
         names, values, jac = jacobian(mapping(fit, mass, n_rotors, g, w), fit.values)
         k = next(i for i, n in enumerate(names) if n.startswith("Jzz"))
-        est.append(float(jac[k] @ fit.cov @ jac[k]))
+        row = jac[k]
+        seen = np.all(np.isfinite(row)) and not np.any(row[blind] != 0)
+        est.append(float(np.nan_to_num(row) @ finite @ np.nan_to_num(row)) if seen else np.inf)
     inv = [1.0 / v if v > 0 and np.isfinite(v) else 0.0 for v in est]
     weights = (0.5, 0.5) if sum(inv) == 0 else (inv[0] / sum(inv), inv[1] / sum(inv))
     names, values, jac = jacobian(mapping(fit, mass, n_rotors, g, weights), fit.values)
-    cov = jac @ fit.cov @ jac.T
+    blind = ~np.isfinite(np.diag(fit.cov))
+    finite = np.where(np.isfinite(fit.cov), fit.cov, 0.0)
+    cov = np.nan_to_num(jac) @ finite @ np.nan_to_num(jac).T
+    unseen = ~np.all(np.isfinite(jac), axis=1) | np.any(np.abs(np.nan_to_num(jac[:, blind], nan=1.0)) > 0, axis=1)
+    cov[unseen, unseen] = np.inf
     out = {}
     for i, name in enumerate(names):
         extra = (systematic or {}).get(name, 0.0)
