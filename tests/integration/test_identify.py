@@ -217,3 +217,63 @@ def test_cli_not_a_log(tmp_path):
     res = run("identify", bad, "--out", tmp_path / "out")
     assert res.exit_code == 2 and "not a PX4 log" in res.output
     assert not (tmp_path / "out").exists()
+
+
+def test_pwm_outputs_give_the_same_hover_command():
+    """The SITL log's actuator_outputs (PWM, 900 us disarmed, 1000..2000 us) read with their range
+    give the hover command the normalised actuator_motors give."""
+    motors = qc.identify(SITL)
+    pwm = qc.identify(SITL, commands="pwm:1000:2000")
+    assert pwm.log["commands"].startswith("actuator_outputs")
+    assert pwm.hover_duty == pytest.approx(motors.hover_duty, rel=0.01)
+    wrong = qc.identify(SITL, commands="pwm:1100:2000")        # a wrong range moves it: the check can fail
+    assert abs(wrong.hover_duty / motors.hover_duty - 1) > 0.05
+
+
+def identify_options():
+    import click
+
+    from quadcruise.cli.identify import identify as command
+
+    return [p for p in command.params if isinstance(p, click.Option) and not p.is_flag]
+
+
+def run_entry(args, capsys):
+    """The installed entry point (click's usage errors made one line there), as a process would."""
+    import sys
+
+    from quadcruise.cli.main import run as entry
+
+    old = sys.argv
+    sys.argv = ["quadcruise", *map(str, args)]
+    try:
+        with pytest.raises(SystemExit) as stop:
+            entry()
+    finally:
+        sys.argv = old
+    out = capsys.readouterr()
+    return stop.value.code, out.out + out.err
+
+
+@pytest.mark.parametrize("option", identify_options(), ids=lambda p: p.name)
+def test_cli_any_bad_option_value_is_one_line(tmp_path, option, capsys):
+    """Every option of identify (read from the command itself), given garbage: one line, exit 2,
+    nothing written."""
+    import click
+
+    if isinstance(option.type, click.types.FloatParamType):
+        values = ["abc", "nan", "inf", "-1", "1e999"]
+    elif isinstance(option.type, click.Choice):
+        values = ["xyz", ""]
+    elif option.name == "out":
+        values = ["/proc/quadcruise/out"]
+    else:
+        values = ["xyz", "=", "pwm:2:1", "missing.toml"]
+    for value in values:
+        args = ["identify", SITL, "--out", tmp_path / "out"]
+        args = args[:-2] + [max(option.opts, key=len), value] if option.name == "out" else args + [
+            max(option.opts, key=len), value]
+        code, output = run_entry(args, capsys)
+        assert code == 2, (value, output)
+        assert len(output.strip().splitlines()) == 1 and output.startswith("error: "), (value, output)
+        assert not (tmp_path / "out").exists()

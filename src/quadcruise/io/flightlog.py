@@ -21,7 +21,8 @@ The grid (a ULog)
 
 Commands (a ULog)
     ``actuator_motors.control`` (already normalised to [0, 1]) when the log has it, else
-    ``actuator_outputs.output`` (PWM [us]) mapped with the log's own ``PWM_MAIN_MINi`` /
+    ``actuator_outputs.output`` (PWM [us]; motor k on the output whose ``PWM_MAIN_FUNCi`` is
+    101 + k where the log says, else outputs 1..n) mapped with the log's own ``PWM_MAIN_MINi`` /
     ``PWM_MAIN_MAXi`` (older logs: ``PWM_MIN`` / ``PWM_MAX``; PX4's defaults 1000 / 2000 us),
     or with ``commands="pwm:MIN:MAX"`` given by the user.
 
@@ -337,7 +338,12 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
     n_rot = int(params.get("CA_ROTOR_COUNT", 0)) or 4
     cmd = topics[cmd_topic]
     prefix = "control" if cmd_topic == "actuator_motors" else "output"
-    cols = [f"{prefix}[{i}]" for i in range(n_rot)]
+    channels = list(range(n_rot))
+    if cmd_topic == "actuator_outputs":             # PX4 >= 1.13: PWM_MAIN_FUNCi = 101 + k puts motor k on output i
+        funcs = {int(params[f"PWM_MAIN_FUNC{i + 1}"]): i for i in range(16) if f"PWM_MAIN_FUNC{i + 1}" in params}
+        if all(101 + k in funcs for k in range(n_rot)):
+            channels = [funcs[101 + k] for k in range(n_rot)]
+    cols = [f"{prefix}[{i}]" for i in channels]
     if any(c not in cmd for c in cols):
         raise InputError(f"{path}: {cmd_topic} has fewer than the {n_rot} rotor channels CA_ROTOR_COUNT says")
     raw = np.column_stack([cmd[c].astype(np.float64) for c in cols])
@@ -346,8 +352,8 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
             lows, highs = np.full(n_rot, lo), np.full(n_rot, hi)
             how = f"actuator_outputs PWM mapped with {lo:g}..{hi:g} us (given)"
         else:
-            lows = np.array([_pwm_param(params, "MIN", i, 1000.0) for i in range(n_rot)])
-            highs = np.array([_pwm_param(params, "MAX", i, 2000.0) for i in range(n_rot)])
+            lows = np.array([_pwm_param(params, "MIN", i, 1000.0) for i in channels])
+            highs = np.array([_pwm_param(params, "MAX", i, 2000.0) for i in channels])
             how = "actuator_outputs PWM mapped with the log's PWM_MAIN_MIN/MAX"
         u_raw = (raw - lows) / (highs - lows)
     else:
