@@ -277,3 +277,50 @@ def test_cli_any_bad_option_value_is_one_line(tmp_path, option, capsys):
         assert code == 2, (value, output)
         assert len(output.strip().splitlines()) == 1 and output.startswith("error: "), (value, output)
         assert not (tmp_path / "out").exists()
+
+
+def test_thrust_curve_and_lag_from_an_independent_simulation(tmp_path):
+    """A vertical flight with PX4's thrust curve T = K ((1 - f) u + f u^2) behind a first-order lag,
+    integrated by scipy's solve_ivp at tight tolerance (not quadcruise's engine), written as a CSV
+    with an accelerometer: K, f, omega and the hover command come back; the rotation, which the
+    log never excites, is said not identifiable."""
+    from scipy.integrate import solve_ivp
+
+    K, f, omega, m, g = 20.0, 0.4, 20.0, 2.0, 9.81
+    rng = np.random.default_rng(3)
+    edges = np.arange(0.0, 30.0, 0.37)                           # steps off the log's grid
+    levels = rng.uniform(0.2, 0.8, edges.size)
+
+    def rhs(t, x, u):
+        thrust = K * ((1 - f) * u + f * u * u)
+        return [omega * (thrust - x[0]), 4 * x[0] / m - g]
+
+    x = [K * ((1 - f) * levels[0] + f * levels[0] ** 2), 0.0]
+    t_log = np.arange(0.0, 29.5, 0.004)
+    force, vz = np.zeros(t_log.size), np.zeros(t_log.size)
+    for k, start in enumerate(edges):
+        end = edges[k + 1] if k + 1 < edges.size else 30.0
+        inside = (t_log >= start) & (t_log < end)
+        sol = solve_ivp(rhs, (start, end), x, args=(levels[k],), rtol=1e-10, atol=1e-12, dense_output=True)
+        if inside.any():
+            states = sol.sol(t_log[inside])
+            force[inside], vz[inside] = 4 * states[0] / m, states[1]
+        x = sol.y[:, -1]
+    u = levels[np.searchsorted(edges, t_log, side="right") - 1]
+    zeros = np.zeros(t_log.size)
+    table = pd.DataFrame({"t": t_log, "vx": zeros, "vy": zeros, "vz": vz, "qw": zeros + 1, "qx": zeros, "qy": zeros,
+                          "qz": zeros, "p": zeros, "q": zeros, "r": zeros, "ax": zeros, "ay": zeros,
+                          "az": force + rng.normal(0, 0.05, t_log.size)})
+    for i in range(4):
+        table[f"u{i + 1}"] = u
+    table.to_csv(tmp_path / "vertical.csv", index=False)
+    result = qc.identify(tmp_path / "vertical.csv", mass=m)
+    p = result.parameters
+    assert p["thrust_curve_f"]["identifiable"] and abs(p["thrust_curve_f"]["value"] - f) < 0.05
+    assert p["K"]["value"] == pytest.approx(K, rel=0.05) and p["omega"]["value"] == pytest.approx(omega, rel=0.1)
+    for key, truth in (("K", K), ("thrust_curve_f", f), ("omega", omega)):
+        assert p[key]["ci95"][0] <= truth <= p[key]["ci95"][1], (key, p[key])
+    hover = (-(1 - f) + np.sqrt((1 - f) ** 2 + 4 * f * m * g / (4 * K))) / (2 * f)
+    assert result.hover_duty == pytest.approx(hover, rel=0.01)
+    for key in ("Jxx", "Jyy", "Jzz", "d"):
+        assert not p[key]["identifiable"] and "no variation" in p[key]["note"]
