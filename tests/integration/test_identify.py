@@ -147,6 +147,29 @@ def test_sitl_hover_command_agrees_with_px4():
         assert not result.parameters[key]["identifiable"], key
     assert "10 Hz" in result.parameters["omega"]["note"]
     assert "K" not in result.parameters and "K_per_m" in result.parameters      # no mass: per unit mass
+    from quadcruise.protocols import ResultLike
+
+    assert isinstance(result, ResultLike)
+    table = result.to_pandas()
+    assert list(table["parameter"]) == list(result.parameters)
+    assert table.set_index("parameter").loc["hover_duty", "identifiable"]
+    assert len(result.plot().axes) == 6
+    assert result.summary()["hover_duty"] == result.hover_duty
+
+
+def test_too_short_a_flight_is_refused(tmp_path):
+    flight = excitation_flight(qc.Vehicle.paper(), 1)
+    short = tmp_path / "short.csv"
+    states = flight.states[0][flight.t <= 1.6]
+    t = flight.t[flight.t <= 1.6]
+    table = pd.DataFrame({"t": t, "vx": states[:, VX], "vy": states[:, VX + 1], "vz": states[:, VX + 2],
+                          "qw": 1.0, "qx": 0.0, "qy": 0.0, "qz": 0.0, "p": states[:, P], "q": states[:, P + 1],
+                          "r": states[:, P + 2]})
+    for i in range(4):
+        table[f"u{i + 1}"] = flight.commands[0][: t.size, i]
+    table.to_csv(short, index=False)
+    with pytest.raises(qc.InputError, match="short.csv: 1.6 s airborne is too short"):
+        qc.identify(short)
 
 
 def test_without_mass_the_ratios(tmp_path):

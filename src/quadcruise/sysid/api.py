@@ -30,6 +30,8 @@ MIN_EXCITATION = 1e-3
 """The least excitation of an axis (:func:`_excitation`: the command combination's standard
 deviation, relative to the mean command) for its parameters to be identifiable at all: below it,
 whatever interval the residuals give reflects the absence of noise, not information."""
+MIN_FIT_S, MIN_HELD_S = 2.0, 0.5
+"""The least airborne time fitted and held out [s] (after each segment's settling)."""
 STAGES = ("reading the log", "filtering", "fitting", "intervals", "validating")
 """The stages ``progress`` counts."""
 WINDOW_S = 0.08
@@ -114,7 +116,7 @@ def identify(log: str | os.PathLike | FlightLog, vehicle: Vehicle | None = None,
 
     omega0 = float(base.omega)
     fit_rows, held = _split(flight, sig.window, omega0, holdout)
-    if fit_rows.sum() < 10 * sig.window or held.sum() < 2 * sig.window:
+    if fit_rows.sum() * sig.dt < MIN_FIT_S or held.sum() * sig.dt < MIN_HELD_S:
         raise InputError(f"{flight.source}: {flight.duration:.1f} s airborne is too short to fit and hold out "
                          f"{holdout:g} of it")
     cmd_hz = _command_rate(flight)
