@@ -128,6 +128,29 @@ def test_csv_log_without_accelerometer(tmp_path):
                                                                  rel=0.1 if key == "omega" else 0.05), key
 
 
+def test_two_airborne_segments(tmp_path):
+    """A CSV whose ``landed`` column splits the flight in two: each stretch is filtered on its own
+    (no filter or lag reaching across the gap) and the vehicle still comes back."""
+    vehicle = qc.Vehicle.paper().replace(Jyy=0.035)
+    flight = excitation_flight(vehicle, 9)
+    states = flight.states[0]
+    from scipy.spatial.transform import Rotation
+
+    xyzw = Rotation.from_euler("ZYX", states[:, [PSI, THETA, PHI]]).as_quat()
+    table = pd.DataFrame({"t": flight.t, "vx": states[:, VX], "vy": states[:, VX + 1], "vz": states[:, VX + 2],
+                          "qw": xyzw[:, 3], "qx": xyzw[:, 0], "qy": xyzw[:, 1], "qz": xyzw[:, 2],
+                          "p": states[:, P], "q": states[:, P + 1], "r": states[:, P + 2],
+                          "landed": ((flight.t > 9.0) & (flight.t < 10.5)).astype(int)})
+    for i in range(4):
+        table[f"u{i + 1}"] = flight.commands[0][:, i]
+    table.to_csv(tmp_path / "two.csv", index=False)
+    result = qc.identify(tmp_path / "two.csv", mass=3.499)
+    assert result.log["segments"] == 2
+    for key in TRUTH:
+        assert result.parameters[key]["value"] == pytest.approx(float(getattr(vehicle, key)),
+                                                                 rel=0.1 if key == "omega" else 0.05), key
+
+
 def px4_hover_estimate(path: Path) -> float:
     """PX4's hover_thrust_estimate while it was valid, read with pyulog alone."""
     log = ULog(str(path), message_name_filter_list=["hover_thrust_estimate"])
@@ -154,6 +177,7 @@ def test_sitl_hover_command_agrees_with_px4():
     assert list(table["parameter"]) == list(result.parameters)
     assert table.set_index("parameter").loc["hover_duty", "identifiable"]
     assert len(result.plot().axes) == 6
+    assert result.vehicle().hover_duty == pytest.approx(result.hover_duty, rel=1e-9)   # vehicle.toml hovers there
     assert result.summary()["hover_duty"] == result.hover_duty
 
 

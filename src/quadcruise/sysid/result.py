@@ -71,7 +71,10 @@ class IdentifyResult:
     def vehicle(self) -> Vehicle:
         """The identified vehicle in the paper's plant (base values where the log could not tell).
 
-        Without a mass, the base vehicle's mass scales the per-unit-mass values.
+        Without a mass, the base vehicle's mass scales the per-unit-mass values. The paper's
+        plant has four "+" rotors at distance ``l``: ``l`` is the log's mean rotor distance,
+        and a log with n != 4 rotors gets ``K`` scaled by n/4 so that the total thrust and the
+        hover hold (its moments then only approximate the real layout's).
 
         Returns
         -------
@@ -84,6 +87,7 @@ class IdentifyResult:
             values[name] = float(self.parameters[key]["value"]) * (1.0 if self.mass is not None else m)
         for name in ("d", "omega"):
             values[name] = float(self.parameters[name]["value"])
+        values["K"] *= len(self.rotors) / 4.0
         arm = float(np.mean(np.hypot(self.rotors[:, 0], self.rotors[:, 1])))
         values["l"] = arm
         return self.base.replace(**values)
@@ -187,6 +191,9 @@ class IdentifyResult:
                 "# " + ", ".join(f"{k}: {s}" for k, s in origin.items()),
                 (f"# m: {'given' if self.mass is not None else 'base vehicle (no mass given: K, J scaled by it)'}"
                 f"; l: mean rotor distance of the {self.log['rotor_geometry']}")]
+        if len(self.rotors) != 4:
+            head.append(f"# the log's vehicle has {len(self.rotors)} rotors, the paper's plant 4: K scaled by "
+                        f"{len(self.rotors)}/4 (same total thrust and hover; moments approximate)")
         body = tomli_w.dumps({"vehicle": {"preset": "paper", **{k: float(x) for k, x in v.to_dict().items()}}})
         return "\n".join(head) + "\n" + body
 
