@@ -215,8 +215,10 @@ def test_cli_writes_a_vehicle_that_flies(tmp_path):
     vehicle = qc.Vehicle.paper().replace(Jzz=0.05)
     log = excitation_flight(vehicle, 11).to_ulog(tmp_path / "f.ulg")
     out = tmp_path / "ident"
-    res = run("identify", log, "--mass", 3.499, "--out", out)
+    res = run("identify", log, "--mass", 3.499, "--out", out, "--report", tmp_path / "ident.html")
     assert res.exit_code == 0, res.output
+    page = (tmp_path / "ident.html").read_text()
+    assert "Jzz" in page and "data:image/png;base64" in page and "Held-out validation" in page
     doc = json.loads((out / "identify.json").read_text())
     assert set(doc["parameters"]) >= {"K", "Jxx", "Jyy", "Jzz", "d", "omega", "hover_duty"}
     for entry in doc["parameters"].values():

@@ -6,7 +6,7 @@ import shlex
 
 import click
 
-from quadcruise.cli.common import Bar, friendly, writable
+from quadcruise.cli.common import Bar, friendly, writable, writable_with
 from quadcruise.errors import InputError
 
 __all__ = ["identify"]
@@ -60,10 +60,12 @@ def base_vehicle(text: str):
               help="Fraction of the airborne time, at its end, kept out of the fit and predicted.")
 @click.option("--out", "out", required=True, type=click.Path(file_okay=False), callback=writable,
               help="Folder for identify.json, vehicle.toml, report.md and the figure.")
+@click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html", callback=writable_with(".html", ".htm"),
+              help="Also write a self-contained HTML report (parameters, validation, figure, configuration).")
 @click.option("--force", is_flag=True, help="Replace a non-empty --out folder that quadcruise did not write.")
 @friendly
 def identify(log: str, vehicle: str, mass: float | None, frame: str | None, commands: str, holdout: float,
-             out: str, force: bool) -> None:
+             out: str, report: str | None, force: bool) -> None:
     """Identify the vehicle that flew LOG (a PX4 .ulg or a CSV) and check it on held-out data.
 
     Fits thrust, inertias, yaw moment and rotor lag by equation error, with 95 % intervals;
@@ -86,6 +88,8 @@ def identify(log: str, vehicle: str, mass: float | None, frame: str | None, comm
         ``--holdout``: fraction held out.
     out : str
         ``--out``: the output folder.
+    report : str or None
+        ``--report``: path of a self-contained HTML report to write as well.
     force : bool
         ``--force``: replace a folder quadcruise did not write.
     """
@@ -101,7 +105,7 @@ def identify(log: str, vehicle: str, mass: float | None, frame: str | None, comm
     check_output_dir(out, force)
     words = ["quadcruise", "identify", log, "--vehicle", vehicle, "--commands", commands, "--holdout", f"{holdout:g}",
              "--out", out] + (["--mass", f"{mass:g}"] if mass is not None else []) \
-        + (["--frame", frame] if frame else [])
+        + (["--frame", frame] if frame else []) + (["--report", report] if report else [])
     bar = Bar("identifying", unit="stage")
     result = run_identify(log, base, mass=mass, frame=frame, commands=commands, holdout=holdout,
                           progress=lambda done, total, stage="": bar(done, total, stage))
@@ -110,3 +114,9 @@ def identify(log: str, vehicle: str, mass: float | None, frame: str | None, comm
     click.echo(str(result.summary()))
     result.write(out, force=force)
     click.echo(f"wrote identify.json, vehicle.toml, report.md and fit.png to {out} ({len(STAGES)} stages)")
+    if report is not None:
+        from quadcruise.report.html import write_html_report
+        from quadcruise.report.identify import identification_report
+
+        write_html_report(report, **identification_report(result))
+        click.echo(f"wrote report {report}")
