@@ -177,6 +177,21 @@ def test_ulog_without_needed_topics(flight, tmp_path):
     refused(path, "missing topic.*vehicle_attitude.*actuator_motors")
 
 
+def test_ulog_armed_but_never_airborne(flight, tmp_path):
+    from quadcruise.io.ulog import Topic, write_ulog
+    from quadcruise.sim.px4 import px4_topics
+
+    topics = px4_topics(flight.t, flight.states[0], np.clip(flight.commands[0][:, :4], 0, 1), g=9.81)
+    grounded = []
+    for tp in topics:
+        if tp.name == "vehicle_land_detected":
+            tp = Topic(tp.name, tp.fields, {**tp.values, "landed": np.ones(len(tp.values["timestamp"]), bool)})
+        grounded.append(tp)
+    path = tmp_path / "grounded.ulg"
+    write_ulog(path, grounded, parameters={"MAV_TYPE": 2})
+    refused(path, "armed but never airborne")
+
+
 def test_ulog_of_a_fixed_wing(flight, tmp_path):
     from quadcruise.io.ulog import write_ulog
     from quadcruise.sim.px4 import px4_topics
