@@ -373,3 +373,27 @@ def test_thrust_curve_and_lag_from_an_independent_simulation(tmp_path):
     assert result.hover_duty == pytest.approx(hover, rel=0.01)
     for key in ("Jxx", "Jyy", "Jzz", "d"):
         assert not p[key]["identifiable"] and "no variation" in p[key]["note"]
+
+
+def test_cli_base_vehicle_gives_the_geometry_a_csv_lacks(tmp_path):
+    """A CSV has no rotor geometry: the base vehicle's arm l is used, so a base with l 25 % longer
+    gives inertias 25 % larger (the option is not ignored), and the right base gives the truth."""
+    flight = excitation_flight(qc.Vehicle.paper(), 2)
+    states = flight.states[0]
+    from scipy.spatial.transform import Rotation
+
+    xyzw = Rotation.from_euler("ZYX", states[:, [PSI, THETA, PHI]]).as_quat()
+    table = pd.DataFrame({"t": flight.t, "vx": states[:, VX], "vy": states[:, VX + 1], "vz": states[:, VX + 2],
+                          "qw": xyzw[:, 3], "qx": xyzw[:, 0], "qy": xyzw[:, 1], "qz": xyzw[:, 2],
+                          "p": states[:, P], "q": states[:, P + 1], "r": states[:, P + 2]})
+    for i in range(4):
+        table[f"u{i + 1}"] = flight.commands[0][:, i]
+    table.to_csv(tmp_path / "f.csv", index=False)
+    (tmp_path / "long.toml").write_text("[vehicle]\nl = 0.25\n")
+    for base, factor in (("paper", 1.0), (tmp_path / "long.toml", 1.25)):
+        out = tmp_path / f"out{factor}"
+        res = run("identify", tmp_path / "f.csv", "--vehicle", base, "--mass", 3.499, "--out", out)
+        assert res.exit_code == 0, res.output
+        doc = json.loads((out / "identify.json").read_text())
+        assert doc["parameters"]["Jxx"]["value"] == pytest.approx(0.03 * factor, rel=0.05)
+        assert doc["log"]["rotor_geometry"].startswith("base vehicle")
