@@ -150,7 +150,8 @@ def identify(log: str | os.PathLike | FlightLog, vehicle: Vehicle | None = None,
     if not fit_shape:
         notes["thrust_curve_f"] = (f"the commands span only {span:.2f} (5th to 95th percentile): the thrust curve's "
                                    f"shape is not seen; f fixed at {f0:g} (the log's THR_MDL_FAC, else 0)")
-    table = _table(found, base, notes, f0)
+    f0_source = "the log's THR_MDL_FAC" if "THR_MDL_FAC" in flight.parameters else "linear thrust, f = 0"
+    table = _table(found, base, notes, f0, f0_source)
     report(4, len(STAGES), STAGES[3])
 
     validation, traces = validate(sig, held, result, rotors, flight, g)
@@ -229,7 +230,7 @@ def _command_rate(flight: FlightLog) -> float:
     return float(min(flight.rates_hz.values())) if flight.rates_hz else 0.0
 
 
-def _table(found: dict, base: Vehicle, notes: dict, f0: float) -> dict[str, dict]:
+def _table(found: dict, base: Vehicle, notes: dict, f0: float, f0_source: str) -> dict[str, dict]:
     prior = {"K": base.K, "Jxx": base.Jxx, "Jyy": base.Jyy, "Jzz": base.Jzz, "d": base.d, "omega": base.omega,
              "thrust_curve_f": f0, "hover_duty": base.hover_duty}
     out: dict[str, dict[str, Any]] = {}
@@ -247,8 +248,11 @@ def _table(found: dict, base: Vehicle, notes: dict, f0: float) -> dict[str, dict
                 half = Z95 * entry["se"] / abs(entry["value"]) if entry["value"] else float("inf")
                 why = (f"the log does not excite it enough: estimate {entry['value']:.4g} with a 95 % half-width of "
                        f"{100 * half:.0f} %" if np.isfinite(half) else "no excitation")
+            source = "base vehicle"
+            if name == "thrust_curve_f":
+                source = f0_source
             row.update(value=base_value, ci95=[None, None], identifiable=False,
-                       source="base vehicle", note=why or "not fitted")
+                       source=source, note=why or "not fitted")
             if entry is not None:
                 row["estimate"] = entry["value"]
         out[name] = row

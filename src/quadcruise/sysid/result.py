@@ -217,7 +217,8 @@ class IdentifyResult:
                  "| parameter | value | 95 % interval | unit | identifiable | note |", "|---|---|---|---|---|---|"]
         for name, p in self.parameters.items():
             ci = f"[{p['ci95'][0]:.4g}, {p['ci95'][1]:.4g}]" if p["identifiable"] else "-"
-            lines.append(f"| {name} | {p['value']:.5g} | {ci} | {p['unit']} | {'yes' if p['identifiable'] else 'no'} "
+            value = f"{p['value']:.5g}" + ("" if p["identifiable"] else f" ({p['source']})")
+            lines.append(f"| {name} | {value} | {ci} | {p['unit']} | {'yes' if p['identifiable'] else 'no'} "
                          f"| {p.get('note', '')} |")
         if "px4_hover_thrust_estimate" in self.log:
             lines += ["", (f"PX4's own hover_thrust_estimate in this log (median): "
@@ -227,6 +228,10 @@ class IdentifyResult:
         for name in CHANNEL_LABELS:
             v = self.validation[name]
             lines.append(f"| {name} | {v['r2']:.4f} | {v['rmse']:.4g} | {v['unit']} |")
+        low = [name for name in CHANNEL_LABELS if not self.validation[name]["r2"] >= 0.5]
+        if low:
+            lines += ["", (f"R² below 0.5 on {', '.join(low)}: the held-out tail moves little there (or the model "
+                           "misses something); read the RMSE against the sensors' noise before trusting either.")]
         ol = self.validation["open_loop"]
         lines += ["", f"Open loop over {ol['windows']} windows of {ol['window_s']:.3f} s (rates at the window's end):", ""]
         for name in "pqr":
