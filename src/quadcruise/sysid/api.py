@@ -30,6 +30,12 @@ MIN_EXCITATION = 1e-3
 """The least excitation of an axis (:func:`_excitation`: the command combination's standard
 deviation, relative to the mean command) for its parameters to be identifiable at all: below it,
 whatever interval the residuals give reflects the absence of noise, not information."""
+MIN_SIGNAL_SHARE = 0.95
+"""The least share of a gyroscopic product's variance (q r, p r) that must be signal, not sensor
+noise, for it to give Jzz: noise in a regressor biases its coefficient toward zero by about the
+noise share (errors in variables), which the intervals do not cover."""
+CAUTION_SHARE = 0.99
+"""Below this share of signal (not jitter) in a moment command, the result carries a caution."""
 MIN_FIT_S, MIN_HELD_S = 2.0, 0.5
 """The least airborne time fitted and held out [s] (after each segment's settling)."""
 STAGES = ("reading the log", "filtering", "fitting", "intervals", "validating")
@@ -129,9 +135,35 @@ def identify(log: str | os.PathLike | FlightLog, vehicle: Vehicle | None = None,
     result = fit(sig, fit_rows, rotors, omega0, f0, fit_omega=lag_seen, fit_shape=fit_shape, omega_bounds=bounds)
     report(3, len(STAGES), STAGES[2])
 
+    signal_share = _coupling_signal(flight, sig, fit_rows)
+    signal_share.update(_command_signal(sig, fit_rows, rotors, result.omega))
+    coupling = (signal_share["qr"] >= MIN_SIGNAL_SHARE, signal_share["pr"] >= MIN_SIGNAL_SHARE)
     found = parameters(result, mass, flight.n_rotors, g,
-                       systematic=_timing_error(flight, force_z, fit_rows, rotors, result, mass, g, cmd_hz, bounds))
+                       systematic=_sensitivity(flight, force_z, fit_rows, rotors, result, mass, g, cmd_hz, bounds,
+                                               coupling),
+                       coupling=coupling)
     notes: dict[str, str] = {}
+    cautions = []
+    jittery = [a for a in ("roll", "pitch", "yaw") if signal_share[a] < CAUTION_SHARE]
+    if jittery:
+        cautions.append("the " + ", ".join(f"{a} ({100 * (1 - signal_share[a]):.1f} %)" for a in jittery)
+                        + " commands carry sample-to-sample jitter: commands that change faster than they are "
+                          "logged bias Jzz and d low (errors in variables) beyond their intervals; see docs/identify.md")
+    jitter_axes = {"roll": ("Jxx",), "pitch": ("Jyy",), "yaw": ("d",)}
+    for axis, names in jitter_axes.items():
+        if signal_share[axis] < MIN_SIGNAL_SHARE:
+            for name in names:
+                key = name if mass is not None or name == "d" else f"{name}_per_m"
+                notes[key] = (f"the {axis} commands are {100 * (1 - signal_share[axis]):.0f} % sample-to-sample "
+                              "jitter (commands logged slower than they change): their effect is underestimated")
+    if signal_share["roll"] < MIN_SIGNAL_SHARE or signal_share["pitch"] < MIN_SIGNAL_SHARE:
+        coupling = (False, False)
+    if not any(coupling):
+        why = ("the gyroscopic terms that separate Jzz from d (q r, p r) are mostly sensor noise here "
+               f"(signal {100 * signal_share['qr']:.0f} % and {100 * signal_share['pr']:.0f} % of their variance; "
+               "roll or pitch while yawing to see them)")
+        notes["Jzz" if mass is not None else "Jzz_per_m"] = why
+        notes["d"] = why
     excited = _excitation(sig.u[fit_rows], rotors)
     needs = {"Jxx": ("roll",), "Jyy": ("pitch",), "Jzz": ("roll", "pitch"), "d": ("roll", "pitch", "yaw"),
              "omega": ("thrust", "roll", "pitch", "yaw")}
@@ -158,7 +190,7 @@ def identify(log: str | os.PathLike | FlightLog, vehicle: Vehicle | None = None,
     report(5, len(STAGES), STAGES[4])
     return IdentifyResult(parameters=table, validation=validation, traces=traces, log=_log_info(flight, sig),
                           fit={"rows": result.rows, "held_out_rows": int(held.sum()), "holdout": float(holdout),
-                               "window_samples": sig.window, "window_s": sig.window * sig.dt, "excitation": excited,
+                               "window_samples": sig.window, "window_s": sig.window * sig.dt, "excitation": excited, "signal_share": signal_share, "cautions": cautions,
                                "newey_west_bandwidth": result.bandwidth, "omega_fitted": result.omega_fitted,
                                "omega_used": result.omega, "thrust_curve_fitted": fit_shape,
                                "residual_std": result.sigma, "coefficients": dict(zip(result.names,
@@ -177,22 +209,90 @@ def _excitation(u: np.ndarray, rotors: np.ndarray) -> dict[str, float]:
             "yaw": float(np.std(u @ rotors[:, 2])) / mean}
 
 
-def _timing_error(flight, force_z, rows, rotors, result, mass, g, cmd_hz, bounds) -> dict[str, float]:
-    """Half the change of each parameter when the commands are shifted by half their logging
-    interval either way: a log sampling its commands says when they were, to that much."""
+def _coupling_signal(flight: FlightLog, sig, rows: np.ndarray) -> dict[str, float]:
+    """The share of the filtered gyroscopic products' variance that is not sensor noise.
+
+    Each rate's white-noise level is read from its second differences (robust: median absolute
+    deviation); the noise a product ``q r`` carries is ``E[q^2] s_r^2 + E[r^2] s_q^2 + s_q^2 s_r^2``,
+    through the filter (times the sum of its squared weights)."""
+    from quadcruise.sysid.equations import kernels
+
+    noise = np.array([_noise_level(flight.rates[:, j], flight.segment) for j in range(3)])
+    gain = float(np.sum(kernels(sig.window, sig.dt)[1] ** 2))
+    raw = flight.rates[rows]
+    out = {}
+    for name, (a, b), col in (("qr", (1, 2), 0), ("pr", (0, 2), 1)):
+        noise_var = gain * (np.mean(raw[:, a] ** 2) * noise[b] ** 2 + np.mean(raw[:, b] ** 2) * noise[a] ** 2
+                            + noise[a] ** 2 * noise[b] ** 2)
+        total = float(np.var(sig.products[rows, col]))
+        out[name] = max(0.0, 1.0 - noise_var / total) if total > 0 else 0.0
+    return out
+
+
+def _noise_level(x: np.ndarray, segment: np.ndarray) -> float:
+    """A white noise's standard deviation under a smooth signal: from second differences, robustly."""
+    second = []
+    for k in np.unique(segment):
+        v = x[segment == k]
+        second.append(v[2:] - 2 * v[1:-1] + v[:-2])
+    d2 = np.concatenate(second)
+    return 1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / np.sqrt(6.0)
+
+
+def _command_signal(sig, rows: np.ndarray, rotors: np.ndarray, omega: float) -> dict[str, float]:
+    """The share of each moment regressor's filtered variance that is not sample-to-sample jitter
+    of the logged commands (a command changing faster than it is logged is sampled, not seen:
+    that part of the regressor is noise, and biases its coefficient toward zero)."""
+    from quadcruise.sysid.equations import lagged, smooth
+
+    n = sig.window + int(np.ceil(8.0 / (omega * sig.dt)))
+    impulse = np.zeros((2 * n, 1))
+    impulse[n // 2, 0] = 1.0
+    seg = np.zeros(2 * n, int)
+    response = smooth(lagged(impulse, seg, omega, sig.dt) - lagged(np.zeros_like(impulse), seg, omega, sig.dt),
+                      seg, sig.window)
+    gain = float(np.nansum(response ** 2))
+    combos = {"roll": rotors[:, 1], "pitch": -rotors[:, 0], "yaw": rotors[:, 2]}
+    out = {}
+    for axis, weights in combos.items():
+        command = sig.u @ weights
+        noise_var = gain * _noise_level(command, sig.segment) ** 2
+        regressor = smooth(lagged(command[:, None], sig.segment, omega, sig.dt), sig.segment, sig.window)[rows, 0]
+        total = float(np.var(regressor))
+        out[axis] = max(0.0, 1.0 - noise_var / total) if total > 0 else 0.0
+    return out
+
+
+def _sensitivity(flight, force_z, rows, rotors, result, mass, g, cmd_hz, bounds,
+                 coupling=(True, True)) -> dict[str, float]:
+    """Systematic half-ranges: each parameter refitted (1) with the commands shifted by half
+    their logging interval either way (a log that samples its commands says when they changed
+    to that much) and (2) with the filter window halved and doubled (the model holds at every
+    time scale, or the estimate moves: commands that change faster than they are logged, unmodelled
+    dynamics). The two half-ranges are combined in quadrature."""
+    def refit(u, window_s):
+        sig = signals(flight.t, flight.segment, u, flight.rates, force_z, window_s)
+        again = fit(sig, rows, rotors, result.omega, result.shape_f, fit_omega=result.omega_fitted,
+                    fit_shape="KQ" in result.names, omega_bounds=bounds)
+        return {k: v["value"] for k, v in parameters(again, mass, flight.n_rotors, g, coupling=coupling).items()}
+
     shift = 0.5 / cmd_hz
-    values = []
+    shifted = []
     for sign in (-1.0, 1.0):
         moved = np.empty_like(flight.u)
         for k in np.unique(flight.segment):
             seg = flight.segment == k
             for j in range(flight.u.shape[1]):
                 moved[seg, j] = np.interp(flight.t[seg] - sign * shift, flight.t[seg], flight.u[seg, j])
-        sig = signals(flight.t, flight.segment, moved, flight.rates, force_z, WINDOW_S)
-        again = fit(sig, rows, rotors, result.omega, result.shape_f, fit_omega=result.omega_fitted,
-                    fit_shape="KQ" in result.names, omega_bounds=bounds)
-        values.append({k: v["value"] for k, v in parameters(again, mass, flight.n_rotors, g).items()})
-    return {k: 0.5 * abs(values[1][k] - values[0][k]) for k in values[0]}
+        shifted.append(refit(moved, WINDOW_S))
+    windows = [refit(flight.u, WINDOW_S * factor) for factor in (0.5, 2.0)]
+    out = {}
+    for k in shifted[0]:
+        timing = 0.5 * abs(shifted[1][k] - shifted[0][k])
+        spread = [w[k] for w in windows] + [float(np.mean([x[k] for x in shifted]))]
+        window = 0.5 * (max(spread) - min(spread)) if np.all(np.isfinite(spread)) else np.inf
+        out[k] = float(np.hypot(timing, window))
+    return out
 
 
 def _specific_force_z(flight: FlightLog, g: float) -> np.ndarray:
@@ -208,14 +308,14 @@ def _specific_force_z(flight: FlightLog, g: float) -> np.ndarray:
 
 def _split(flight: FlightLog, window: int, omega0: float, holdout: float) -> tuple[np.ndarray, np.ndarray]:
     """Rows fitted and rows held out: the tail ``holdout`` of the samples is held out; each
-    segment's first samples (the lag and filter settling) and last half window are used by neither."""
+    segment's first samples (the lag and filter settling) and last window are used by neither."""
     n = len(flight.t)
     dt = float(np.median(np.diff(flight.t)))
     settle = window + math.ceil(3.0 / (omega0 * dt))
     usable = np.zeros(n, bool)
     for k in np.unique(flight.segment):
         idx = np.flatnonzero(flight.segment == k)
-        usable[idx[settle: len(idx) - window // 2]] = True
+        usable[idx[settle: len(idx) - window]] = True        # room for the doubled window too
     cut = round(n * (1.0 - holdout))
     fit_rows, held = usable.copy(), usable.copy()
     fit_rows[cut:] = False
@@ -243,7 +343,7 @@ def _table(found: dict, base: Vehicle, notes: dict, f0: float, f0_source: str) -
         if entry is not None and entry["identifiable"] and name not in notes:
             row.update(value=entry["value"], ci95=entry["ci95"], identifiable=True, source="log")
         else:
-            why = notes.get(name)
+            why = notes.get(name) or (entry or {}).get("inconsistent")
             if why is None and entry is not None:
                 half = Z95 * entry["se"] / abs(entry["value"]) if entry["value"] else float("inf")
                 why = (f"the log does not excite it enough: estimate {entry['value']:.4g} with a 95 % half-width of "

@@ -29,6 +29,9 @@ RELATIVE_HALF_WIDTH = 0.25
 SHAPE_HALF_WIDTH = 0.1
 """The largest 95 % half-width of an identifiable thrust-curve factor f (a number in [0, 1],
 whose true value may be 0: an absolute bound)."""
+CONSISTENCY_SIGMAS = 3.0
+"""How many standard errors apart the two estimates of Jzz (from roll's and pitch's gyroscopic
+terms) may be before Jzz and d are reported not identifiable."""
 Z95 = 1.959963984540054
 """The two-sided 95 % normal quantile."""
 
@@ -145,7 +148,8 @@ def _jacobian(func, v):
 
 
 def parameters(fit: Fit, mass: float | None, n_rotors: int, g: float,
-               systematic: dict[str, float] | None = None) -> dict[str, dict]:
+               systematic: dict[str, float] | None = None,
+               coupling: tuple[bool, bool] = (True, True)) -> dict[str, dict]:
     """The physical parameters with 95 % intervals and identifiability.
 
     Parameters
@@ -161,6 +165,10 @@ def parameters(fit: Fit, mass: float | None, n_rotors: int, g: float,
     systematic : dict, optional
         Name -> half-range of a systematic error (uniformly distributed: its variance,
         half^2 / 3, is added to the statistical one).
+    coupling : tuple of bool
+        Whether roll's (``k1 q r``) and pitch's (``k3 p r``) gyroscopic terms may give Jzz; one
+        whose regressor is mostly sensor noise is biased toward zero (errors in variables) and
+        must not.
 
     Returns
     -------
@@ -168,7 +176,7 @@ def parameters(fit: Fit, mass: float | None, n_rotors: int, g: float,
         Name -> ``{"value", "se", "ci95": [lo, hi], "identifiable"}``.
     """
     # Jzz's two estimates, weighted by their inverse variances
-    est = []
+    est, jzz, rows = [], [], []
     finite = np.where(np.isfinite(fit.cov), fit.cov, 0.0)
     blind = ~np.isfinite(np.diag(fit.cov))
     for w in ((1.0, 0.0), (0.0, 1.0)):
@@ -177,7 +185,14 @@ def parameters(fit: Fit, mass: float | None, n_rotors: int, g: float,
         row = jac[k]
         seen = np.all(np.isfinite(row)) and not np.any(row[blind] != 0)
         est.append(float(np.nan_to_num(row) @ finite @ np.nan_to_num(row)) if seen else np.inf)
-    inv = [1.0 / v if v > 0 and np.isfinite(v) else 0.0 for v in est]
+        jzz.append(float(values[k]))
+        rows.append(np.nan_to_num(row))
+    # the two estimates of Jzz must agree: if not, the gyroscopic terms do not fit the model (a
+    # test of the over-determined part of the model, with their covariance)
+    diff_var = float((rows[0] - rows[1]) @ finite @ (rows[0] - rows[1]))
+    consistent = not (all(np.isfinite(est)) and all(coupling) and diff_var > 0
+                      and abs(jzz[0] - jzz[1]) > CONSISTENCY_SIGMAS * np.sqrt(diff_var))
+    inv = [1.0 / v if v > 0 and np.isfinite(v) and ok else 0.0 for v, ok in zip(est, coupling)]
     weights = (0.5, 0.5) if sum(inv) == 0 else (inv[0] / sum(inv), inv[1] / sum(inv))
     names, values, jac = jacobian(mapping(fit, mass, n_rotors, g, weights), fit.values)
     blind = ~np.isfinite(np.diag(fit.cov))
@@ -185,6 +200,10 @@ def parameters(fit: Fit, mass: float | None, n_rotors: int, g: float,
     cov = np.nan_to_num(jac) @ finite @ np.nan_to_num(jac).T
     unseen = ~np.all(np.isfinite(jac), axis=1) | np.any(np.abs(np.nan_to_num(jac[:, blind], nan=1.0)) > 0, axis=1)
     cov[unseen, unseen] = np.inf
+    if not consistent:
+        for i, name in enumerate(names):
+            if name.startswith("Jzz") or name == "d":
+                cov[i, i] = np.inf
     out = {}
     for i, name in enumerate(names):
         extra = (systematic or {}).get(name, 0.0)
@@ -194,4 +213,8 @@ def parameters(fit: Fit, mass: float | None, n_rotors: int, g: float,
         ok = bool(np.isfinite(value) and np.isfinite(se) and (value != 0.0 or name == "thrust_curve_f")
                   and Z95 * se <= bound)
         out[name] = {"value": value, "se": se, "ci95": [value - Z95 * se, value + Z95 * se], "identifiable": ok}
+        if not consistent and (name.startswith("Jzz") or name == "d"):
+            out[name]["inconsistent"] = (f"roll's and pitch's gyroscopic terms give Jzz {jzz[0]:.4g} and {jzz[1]:.4g} "
+                                         f"(more than {CONSISTENCY_SIGMAS:g} standard errors apart): the log does not "
+                                         "fit the model there (commands changing faster than logged, a missing term)")
     return out

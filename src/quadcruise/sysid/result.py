@@ -126,6 +126,7 @@ class IdentifyResult:
                 lines.append(f"  {name:<16} {p['value']:>11.5g} {p['unit']:<7} 95 % {ci}")
             else:
                 lines.append(f"  {name:<16} {p['value']:>11.5g} {p['unit']:<7} not identifiable ({p['note']})")
+        lines += [f"  caution: {c}" for c in self.fit.get("cautions", [])]
         r2 = {k: v["r2"] for k, v in self.validation.items() if k in CHANNEL_LABELS}
         lines.append("  held-out R^2: " + ", ".join(f"{k} {v:.3f}" for k, v in r2.items()))
         data = {"parameters": {k: v["value"] for k, v in self.parameters.items()},
@@ -220,6 +221,8 @@ class IdentifyResult:
             value = f"{p['value']:.5g}" + ("" if p["identifiable"] else f" ({p['source']})")
             lines.append(f"| {name} | {value} | {ci} | {p['unit']} | {'yes' if p['identifiable'] else 'no'} "
                          f"| {p.get('note', '')} |")
+        if self.fit.get("cautions"):
+            lines += [""] + [f"**Caution**: {c}" for c in self.fit["cautions"]]
         if "px4_hover_thrust_estimate" in self.log:
             lines += ["", (f"PX4's own hover_thrust_estimate in this log (median): "
                           f"{self.log['px4_hover_thrust_estimate']:.4f}")]
