@@ -169,9 +169,9 @@ def identify(log: str | os.PathLike | FlightLog, vehicle: Vehicle | None = None,
         notes[jzz_key] = notes["d"] = ("Jzz and d come through the roll and pitch equations, whose commands are "
                                        "jitter-dominated here (see Jxx, Jyy)")
     elif not any(coupling):
-        why = ("the gyroscopic terms that separate Jzz from d (q r, p r) are mostly sensor noise here "
-               f"(signal {100 * signal_share['qr']:.0f} % and {100 * signal_share['pr']:.0f} % of their variance; "
-               "roll or pitch while yawing to see them)")
+        why = ("the gyroscopic terms that separate Jzz from d (q r, p r) are too noisy here: signal "
+               f"{100 * signal_share['qr']:.0f} % and {100 * signal_share['pr']:.0f} % of their variance, under "
+               f"{100 * MIN_SIGNAL_SHARE:.0f} % (roll or pitch while yawing to see them)")
         notes[jzz_key] = why
         notes["d"] = why
     excited = _excitation(sig.u[fit_rows], rotors)
