@@ -103,9 +103,11 @@ def test_options_given_with_a_scenario_win_and_the_scenario_fills_the_rest(tmp_p
     run = CliRunner().invoke
     # montecarlo: --mission and --controller replace the scenario's; left out, the scenario's fly
     res = run(main, ["montecarlo", "--scenario", str(scenario), "--mission", "square", "--controller", "se3", "-n", "2",
+                     "--offset", "0.01",
                      "--duration", "2", "--quiet"])
     assert res.exit_code == 0 and "2 flights of se3 on square" in res.output, res.output
-    res = run(main, ["montecarlo", "--scenario", str(scenario), "-n", "2", "--duration", "2", "--quiet"])
+    res = run(main, ["montecarlo", "--scenario", str(scenario), "-n", "2", "--duration", "2", "--offset", "0.01",
+                     "--quiet"])
     assert res.exit_code == 0 and "2 flights of gonzalez on step" in res.output, res.output
     # tune: --controller replaces the scenario's; -c alone changes the scenario's controller
     tuned = [run(main, ["tune", str(scenario), *extra, "--target", "rise_time_s=3", "--budget", "1", "--popsize", "5",
@@ -113,7 +115,8 @@ def test_options_given_with_a_scenario_win_and_the_scenario_fills_the_rest(tmp_p
                                                                        ["-c", "max_tilt=0.5", "--gains", "accel_p"])]
     assert "tuned nlpd on step" in tuned[0].output and "tuned gonzalez on step" in tuned[1].output, tuned[1].output
     # compare --population: the scenario's vehicle and wind act on the population too
-    res = run(main, ["compare", str(scenario), "--controllers", "nlpd", "--population", "2", "--mass-spread", "0"])
+    res = run(main, ["compare", str(scenario), "--controllers", "nlpd", "--population", "2",
+                     "--mass-spread", "0.001"])
     assert res.exit_code == 0, res.output
     nominal = float(next(ln for ln in res.output.splitlines() if ln.startswith("rmse_m")).split()[1])
     population = float(next(ln for ln in res.output.splitlines() if ln.startswith("nlpd ")).split()[3])
@@ -133,7 +136,8 @@ def test_a_byte_order_mark_is_read_as_nothing(tmp_path):
 
 
 def test_another_command_does_not_replace_a_monte_carlo_sweep_unless_forced(tmp_path):
-    assert quadcruise("montecarlo", "-n", "2", "--duration", "1", "--out", "mc", "--quiet", cwd=tmp_path).returncode == 0
+    assert quadcruise("montecarlo", "-n", "2", "--duration", "1", "--mass-spread", "0.1", "--out", "mc", "--quiet",
+                      cwd=tmp_path).returncode == 0
     proc = quadcruise("fly", "hover", "--duration", "0.5", "--out", "mc", cwd=tmp_path)
     assert proc.returncode == 2 and "holds a Monte Carlo sweep" in proc.stderr
     assert (tmp_path / "mc" / "chunks").is_dir()

@@ -136,7 +136,7 @@ def test_a_montecarlo_folder_replays_itself_and_takes_every_mission_source(tmp_p
     as_mission = RUNNER.invoke(main, ["montecarlo", "--mission", str(a / "scenario.toml"), *common])
     assert as_mission.exit_code == 0 and "5 flights of nlpd on step" in as_mission.output
     csv = RUNNER.invoke(main, ["montecarlo", "--mission", str(EXAMPLES / "waypoints.csv"), "--n", "2",
-                               "--duration", "2", *common])
+                               "--duration", "2", "--offset", "0.01", *common])
     assert csv.exit_code == 0 and "on waypoints" in csv.output, csv.output
 
 

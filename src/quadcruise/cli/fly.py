@@ -14,13 +14,15 @@ from quadcruise.cli.common import (
     REPORT_OPTION,
     RISE_OPTION,
     SETTLE_BAND_OPTION,
+    WORLD_OPTIONS,
     Bar,
     friendly,
     metric_options,
     needs_out,
+    note,
     writable,
 )
-from quadcruise.cli.objects import flight_from_options
+from quadcruise.cli.objects import flight_from_options, flight_world
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["fly"]
@@ -45,11 +47,13 @@ __all__ = ["fly"]
 @REPORT_OPTION
 @click.option("--animate", type=click.Path(dir_okay=False), metavar="PATH.gif", callback=writable,
               help="Also write an animation of the flight (.gif; .mp4 needs ffmpeg).")
+@WORLD_OPTIONS
 @RISE_OPTION
 @SETTLE_BAND_OPTION
 @friendly
 def fly(mission, controller, duration, dt, max_step, mission_params, controller_params, position_poles,
-        out, fmt, force, smooth, report, animate, rise, settle_bands):
+        out, fmt, force, smooth, report, animate, vehicle, controller_vehicle, wind, turbulence, log_every, seed,
+        rise, settle_bands):
     """Fly a MISSION with a controller on the paper's vehicle and print its metrics.
 
     MISSION is circle, square, step, hover, a waypoint CSV (columns x,y,z and optional yaw
@@ -97,28 +101,51 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
     animate : str or None
         ``--animate``: path of an animation of the flight to write as well (``.gif``, or
         ``.mp4`` with ffmpeg); None: no animation.
+    vehicle, controller_vehicle : str or None
+        ``--vehicle``, ``--controller-vehicle``: the flown vehicle and the controller's model of
+        it (:func:`~quadcruise.cli.objects.vehicle_from_option`); None: the scenario's, else
+        Table I and the flown vehicle.
+    wind, turbulence : str or None
+        ``--wind``: a :func:`~quadcruise.disturbances.parse_wind` spec replacing the scenario's
+        disturbances; ``--turbulence``: Dryden turbulence added
+        (:func:`~quadcruise.cli.objects.environment_from_options`).
+    log_every : int or None
+        ``--log-every``: log every this many control periods; None: the scenario's, else 1.
+    seed : int or None
+        ``--seed``: seed of the turbulence and the sensor noise; None: the scenario's, else 0.
     rise : {"10-90", "0-100"}
         ``--rise``: the rise-time convention (% of the step).
     settle_bands : tuple of float
         ``--settle-band``: the settling bands (fractions of the step), given once or twice.
     """
+    from quadcruise.errors import whole_number
+
     needs_out(out, force=force, format=fmt != "csv")
     conventions = metric_options(rise, settle_bands)
-    overrides = {k: v for k, v in (("duration", duration), ("dt", dt), ("max_step", max_step)) if v is not None}
-    given = [f"--{k.replace('_', '-')} {v}" for k, v in overrides.items()] + [f"-m {p}" for p in mission_params] \
-        + [f"-c {p}" for p in controller_params] + ([f"--controller {controller}"] if controller else []) \
+    if seed is not None:
+        whole_number(seed, "--seed")
+    if log_every is not None:
+        whole_number(log_every, "--log-every", minimum=1)
+    overrides = {k: v for k, v in (("duration", duration), ("dt", dt), ("max_step", max_step), ("seed", seed),
+                                   ("log_every", log_every)) if v is not None}
+    world = {"vehicle": vehicle, "controller_vehicle": controller_vehicle, "wind": wind, "turbulence": turbulence}
+    given = [f"--{k.replace('_', '-')} {v}" for k, v in {**overrides, **world}.items() if v is not None] \
+        + [f"-m {p}" for p in mission_params] + [f"-c {p}" for p in controller_params] \
+        + ([f"--controller {controller}"] if controller else []) \
         + ([f"--poles {position_poles}"] if position_poles else [])
     the_mission, the_controller, kwargs, scenario = flight_from_options(
         mission, controller, mission_params, controller_params, position_poles, smooth)
-    kwargs = {**kwargs, **overrides}
+    flown, notes = flight_world(**world, scenario=scenario)
+    kwargs = {**{k: v for k, v in kwargs.items() if k not in flown}, **overrides,
+              **{k: v for k, v in flown.items() if v is not None}}
     result = _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate, given, scenario,
-                             conventions)
+                             conventions, notes)
     if not result.ok.all():
         sys.exit(1)             # a vehicle did not fly its mission: diverged, lost track, out of bounds
 
 
 def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=None, animate=None, given=(),
-                    scenario=None, conventions=None):
+                    scenario=None, conventions=None, notes=()):
     """Fly, print the metrics and each unfinished vehicle's reason, and write what was asked for.
 
     Parameters
@@ -143,6 +170,8 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
         The scenario file flown, recorded with the flight (source and title).
     conventions : dict, optional
         ``rise`` and ``settle_bands`` of the metrics (:func:`~quadcruise.cli.common.metric_options`).
+    notes : sequence of str
+        Lines printed on stderr (``note: ...``) once the options are checked, before flying.
 
     Returns
     -------
@@ -159,6 +188,8 @@ def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=N
         check_animation_path(animate)       # suffix, and ffmpeg for .mp4: before anything flies
     if out is not None:
         check_output_dir(out, force)
+    for line in notes:
+        note(line)
     result = run_fly(mission, controller, **kwargs)
     result.meta["command_line"] = list(given)
     if scenario is not None:
