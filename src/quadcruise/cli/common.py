@@ -15,8 +15,7 @@ from quadcruise.cli.feedback import Bar, close_bars, compile_notice
 from quadcruise.cli.objects import controller_from_options, mission_from_options
 from quadcruise.errors import InputError
 
-__all__ = ["FORCE_OPTION", "FORMAT_OPTION", "REPORT_OPTION", "RISE_OPTION", "SETTLE_BAND_OPTION", "WORLD_OPTIONS",
-           "Bar", "friendly", "note",
+__all__ = ["FORCE_OPTION", "FORMAT_OPTION", "REPORT_OPTION", "RISE_OPTION", "SETTLE_BAND_OPTION", "Bar", "friendly",
            "needs_out", "writable_with",
            "metric_options", "writable", "controller_from_options", "mission_from_options"]
 
@@ -111,66 +110,6 @@ RISE_OPTION = click.option("--rise", type=click.Choice(["10-90", "0-100"]), defa
 SETTLE_BAND_OPTION = click.option("--settle-band", "settle_bands", type=float, multiple=True, metavar="FRACTION",
                                   help="Settling band, a fraction of the step (default 0.02, then 0.05): the first "
                                        "gives settling_time_s, a second (0.05 if left out) a column named after it.")
-
-
-VEHICLE_HELP = ("the paper's (or a preset's: paper) fields changed, e.g. m=1.4,K=48; or a FILE.toml of them "
-                "(a scenario's [vehicle] too)")
-
-
-def world_options(wind_help: str = "Wind, gusts, turbulence, rotor loss, force: constant:WX,WY,WZ | "
-                  "gust:AX,AY,AZ@START+DURATION | dryden:light|moderate|severe@ALTITUDE | loss:ROTOR,FRACTION@TIME "
-                  "(comma-separable; none: still air).", seed: bool = True):
-    """The options that say what is flown and in what world, shared by ``fly``, ``compare``,
-    ``tune`` and ``montecarlo``: ``--vehicle``, ``--controller-vehicle``, ``--wind``,
-    ``--turbulence``, ``--seed`` and ``--log-every``.
-
-    Parameters
-    ----------
-    wind_help : str
-        The help of ``--wind`` (what it acts on differs between the commands).
-    seed : bool
-        Add ``--seed`` (False where the command has its own).
-
-    Returns
-    -------
-    callable
-        A decorator adding the options to a click command.
-    """
-    options = [
-        click.option("--vehicle", metavar="KEY=VALUE,...|NAME|FILE.toml",
-                     help=f"The flown vehicle: {VEHICLE_HELP}; with a scenario, its [vehicle] changed."),
-        click.option("--controller-vehicle", "controller_vehicle", metavar="KEY=VALUE,...|NAME|FILE.toml",
-                     help="The vehicle the controller believes it flies (its model), as --vehicle; default: the "
-                          "flown one (no model error)."),
-        click.option("--wind", metavar="SPEC", help=wind_help),
-        click.option("--turbulence", metavar="light|moderate|severe[@ALTITUDE]",
-                     help="Dryden turbulence (MIL-F-8785C level; altitude [m], default 10)."),
-        click.option("--log-every", "log_every", type=int, metavar="N",
-                     help="Log every N control periods (default 1; a scenario's)."),
-    ]
-    if seed:
-        options.append(click.option("--seed", type=int, help="Seed of every random draw: turbulence, sensor "
-                                                              "noise (default 0, or the scenario's)."))
-
-    def add(func):
-        for option in reversed(options):
-            func = option(func)
-        return func
-    return add
-
-
-WORLD_OPTIONS = world_options()
-
-
-def note(text: str) -> None:
-    """Print one line of information on stderr, ``note: ...`` (not a warning: nothing is wrong).
-
-    Parameters
-    ----------
-    text : str
-        The line.
-    """
-    click.echo(f"note: {text}", err=True)
 
 
 def metric_options(rise: str = "10-90", settle_bands: tuple[float, ...] = ()) -> dict:

@@ -16,8 +16,6 @@ from quadcruise.cli.common import (
     friendly,
     metric_options,
     needs_out,
-    note,
-    world_options,
     writable,
 )
 from quadcruise.cli.compare_run import (
@@ -26,7 +24,7 @@ from quadcruise.cli.compare_run import (
     population_from_options,
     population_record,
 )
-from quadcruise.cli.objects import flight_world
+from quadcruise.cli.world import flight_world, note, world_options
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["compare"]

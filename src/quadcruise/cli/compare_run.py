@@ -7,7 +7,8 @@ from __future__ import annotations
 import click
 
 from quadcruise.cli.common import Bar
-from quadcruise.cli.objects import mission_from_options, refuse_vehicle_fields
+from quadcruise.cli.objects import mission_from_options
+from quadcruise.cli.vehicle import refuse_vehicle_fields
 from quadcruise.errors import InputError
 
 __all__ = ["DEFAULT_COMPARED", "compared_from_options", "echo_population_comparison", "population_from_options",

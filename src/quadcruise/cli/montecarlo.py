@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import click
 
-from quadcruise.cli.common import friendly, world_options, writable
+from quadcruise.cli.common import friendly, writable
 from quadcruise.cli.montecarlo_run import montecarlo_command, parse_noise
+from quadcruise.cli.world import world_options
 
 __all__ = ["montecarlo", "montecarlo_command", "parse_noise"]
 

@@ -140,13 +140,12 @@ offset, distribution, model_error : optional
             raise InputError(f"--chunk-size must be a whole number or auto, got {chunk_size!r}") from None
     if log_every is not None:
         whole_number(log_every, "--log-every", minimum=1)
-    sc = None
-    if scenario is not None:
-        from quadcruise.workflows.scenario import load_scenario
-
-        sc = load_scenario(scenario)
-    from quadcruise.cli.objects import environment_from_options, vehicle_from_option
+    from quadcruise.cli.vehicle import vehicle_from_option
+    from quadcruise.cli.world import environment_from_options
     from quadcruise.model.vehicle import Vehicle
+    from quadcruise.workflows.scenario import load_scenario
+
+    sc = load_scenario(scenario) if scenario is not None else None
 
     nominal = vehicle_from_option(vehicle, "--vehicle", sc.vehicle if sc is not None else None)
     believed = vehicle_from_option(controller_vehicle, "--controller-vehicle",
@@ -172,7 +171,7 @@ offset, distribution, model_error : optional
                         "spreads'; --controller-vehicle paper (or KEY=VALUE,...) gives them another belief")
     if case is None:
         spec.population.check_perturbs(n)
-    if case is not None:
+    else:
         if isinstance(case, bool) or not isinstance(case, (int, np.integer)) or not 0 <= case < n:
             raise InputError(f"--case {case} is not one of the {n} flights")
         target = case_folder(out, spec, case, force=force)

@@ -8,8 +8,9 @@ import sys
 
 import click
 
-from quadcruise.cli.common import friendly, world_options, writable
+from quadcruise.cli.common import friendly, writable
 from quadcruise.cli.tune_run import tune_command
+from quadcruise.cli.world import world_options
 
 __all__ = ["tune"]
 

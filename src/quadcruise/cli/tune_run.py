@@ -117,7 +117,7 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str | 
                                    vehicle=vehicle, controller_vehicle=controller_vehicle, turbulence=turbulence,
                                    log_every=log_every).items()
              if DEFAULTS.get(k, object()) != v}
-    from quadcruise.cli.objects import flight_world
+    from quadcruise.cli.world import flight_world
     from quadcruise.errors import InputError, whole_number
 
     if log_every is not None:

@@ -18,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -136,7 +137,7 @@ class MonteCarloSpec:
 
     def __post_init__(self) -> None:
         from quadcruise.sim.engine import time_grid
-        from quadcruise.workflows.fly import default_duration, steady_bound
+        from quadcruise.workflows.fly import check_can_hover, default_duration, steady_bound
 
         if isinstance(self.mission, str):
             object.__setattr__(self, "mission", mission_from_name(self.mission))
@@ -147,6 +148,9 @@ class MonteCarloSpec:
             raise InputError("population must be a Population")
         if not isinstance(self.vehicle, Vehicle) or self.vehicle.batch_size is not None:
             raise InputError("the nominal vehicle must be one (unbatched) Vehicle")
+        with warnings.catch_warnings():            # fly() warns of a vehicle with little left for control
+            warnings.simplefilter("ignore")
+            check_can_hover(self.vehicle)              # before any chunk flies: a nominal that cannot lift
         if self.controller_vehicle is not None:
             if not isinstance(self.controller_vehicle, Vehicle) or self.controller_vehicle.batch_size is not None:
                 raise InputError("the controller's vehicle must be one (unbatched) Vehicle")
