@@ -218,8 +218,8 @@ def test_a_population_comparison_replays_itself(tmp_path):
     assert sc.compare_population == {"n": 4, "seed": 2, "mass_spread": 0.05}
     assert sc.simulation["seed"] == 2 and sorted(sc.environment.parts) == ["turbulence", "wind"]
     # the drag the wind needs is said once, before the tables; no warning after them
-    assert one.output.count("note: wind acts only through drag") == 1 and "warning:" not in one.output
-    assert one.output.index("note: wind acts") < one.output.index("rmse_m")
+    assert one.output.count("note: the vehicle has no drag, and wind acts only through drag") == 1
+    assert "warning:" not in one.output and one.output.index("no drag") < one.output.index("rmse_m")
     two = RUNNER.invoke(main, ["compare", str(a / "scenario.toml"), "--out", str(b)])
     assert two.exit_code == 0, two.output
     for name in ("metrics.csv", "population.csv"):

@@ -103,7 +103,7 @@ offset, distribution, model_error : optional
     worst, quiet : int, bool
         How many worst flights to print; no progress bar.
     echo : callable
-        Prints one text (``err=True``: on stderr).
+        Prints one text (the notes before flying go to stderr, :func:`quadcruise.cli.world.note`).
 
     Returns
     -------
@@ -141,7 +141,7 @@ offset, distribution, model_error : optional
     if log_every is not None:
         whole_number(log_every, "--log-every", minimum=1)
     from quadcruise.cli.vehicle import vehicle_from_option
-    from quadcruise.cli.world import environment_from_options
+    from quadcruise.cli.world import environment_from_options, note
     from quadcruise.model.vehicle import Vehicle
     from quadcruise.workflows.scenario import load_scenario
 
@@ -176,7 +176,7 @@ offset, distribution, model_error : optional
             raise InputError(f"--case {case} is not one of the {n} flights")
         target = case_folder(out, spec, case, force=force)
         for line in notes:
-            echo(f"note: {line}", err=True)
+            note(line)
         found = montecarlo_case(spec, case)
         echo(case_text(found, spec.seed))
         if target is not None:
@@ -184,7 +184,7 @@ offset, distribution, model_error : optional
             echo(f"wrote the flight to {target}")
         return found
     for line in notes:
-        echo(f"note: {line}", err=True)
+        note(line)
     bar = None if quiet else Bar("flying", unit="flight")
     try:
         res = run_sweep(spec, n, chunk_size=chunk_size, scheduler=scheduler, workers=workers, out=out,

@@ -143,7 +143,7 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str | 
     world, notes = flight_world(vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind,
                                 turbulence=turbulence, scenario=sc)
     environment = world["environment"]
-    if wind_spread > 0 and not any(line.startswith("wind acts only through drag") for line in notes):
+    if wind_spread > 0 and not any("wind acts only through drag" in line for line in notes):
         from quadcruise.disturbances.environment import default_drag_text, with_drag
 
         if world["vehicle"].drag_linear == 0 and world["vehicle"].drag_quadratic == 0:

@@ -755,18 +755,18 @@ def with_drag(vehicle: Vehicle, *, warn: bool = False) -> Vehicle:
     if not np.any(bare):
         return vehicle
     if warn:
-        warnings.warn(default_drag_text(int(np.count_nonzero(bare))), stacklevel=2)
+        warnings.warn(default_drag_text(int(np.count_nonzero(bare)), int(bare.size)), stacklevel=2)
     new = {k: np.where(bare, v, c) for (k, v), c in zip(DEFAULT_DRAG.items(), (c1, c2))}
     return vehicle.replace(**{k: float(v) if v.ndim == 0 else v for k, v in new.items()})
 
 
-def default_drag_text(count: int = 1) -> str:
+def default_drag_text(count: int = 1, total: int = 1) -> str:
     """What :func:`with_drag` does to a vehicle without drag, in one line.
 
     Parameters
     ----------
-    count : int
-        How many vehicles had no drag.
+    count, total : int
+        How many vehicles had no drag, of how many.
 
     Returns
     -------
@@ -775,13 +775,14 @@ def default_drag_text(count: int = 1) -> str:
     Examples
     --------
     >>> print(default_drag_text())
-    wind acts only through drag and the vehicle has none: it flies with DEFAULT_DRAG, drag_linear 0.3 N s/m \
+    the vehicle has no drag, and wind acts only through drag: it flies with DEFAULT_DRAG, drag_linear 0.3 N s/m \
 and drag_quadratic 0.06125 N s^2/m^2 (estimates; give the vehicle's own drag_linear and drag_quadratic to choose)
     """
-    which = "the vehicle has none: it flies" if count == 1 else f"{count} vehicles have none: they fly"
-    return (f"wind acts only through drag and {which} with DEFAULT_DRAG, drag_linear {DEFAULT_DRAG['drag_linear']:g} "
-            f"N s/m and drag_quadratic {DEFAULT_DRAG['drag_quadratic']:.4g} N s^2/m^2 (estimates; give the "
-            "vehicle's own drag_linear and drag_quadratic to choose)")
+    which = "the vehicle has no drag" if total == 1 else f"{count:,} of {total:,} vehicles have no drag"
+    return (f"{which}, and wind acts only through drag: {'it flies' if count == 1 else 'they fly'} with "
+            f"DEFAULT_DRAG, drag_linear {DEFAULT_DRAG['drag_linear']:g} N s/m and drag_quadratic "
+            f"{DEFAULT_DRAG['drag_quadratic']:.4g} N s^2/m^2 (estimates; give the vehicle's own drag_linear and "
+            "drag_quadratic to choose)")
 
 
 _NAMES = {"constant": ConstantWind, "wind": ConstantWind, "gust": Gust, "dryden": Turbulence,
