@@ -51,7 +51,7 @@ __all__ = ["fly"]
 def fly(mission, controller, duration, dt, max_step, mission_params, controller_params, position_poles,
         out, fmt, force, smooth, report, animate, vehicle, controller_vehicle, wind, turbulence, log_every, seed,
         rise, settle_bands):
-    """Fly a MISSION with a controller on the paper's vehicle and print its metrics.
+    """Fly a MISSION with a controller on the paper's vehicle (or --vehicle) and print its metrics.
 
     MISSION is circle, square, step, hover, a waypoint CSV (columns x,y,z and optional yaw
     and t or speed), flown as constant-speed legs or, with --smooth, a minimum-snap path, or
