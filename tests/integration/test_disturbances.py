@@ -284,16 +284,20 @@ def test_sensor_noise_vector_and_delay():
         SensorNoise(delay=0.0015).delay_periods(1e-3)
 
 
-def test_with_drag_fills_only_drag_free_vehicles_and_warns():
-    with pytest.warns(UserWarning, match="no drag"):
+def test_with_drag_fills_only_drag_free_vehicles_and_warns_only_when_asked():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")                  # asked for on purpose: no warning
         v = with_drag(V)
+    with pytest.warns(UserWarning, match="the vehicle has no drag, and wind acts only through drag: it flies with "
+                                         "DEFAULT_DRAG, drag_linear 0.3 N s/m"):
+        with_drag(V, warn=True)                         # a workflow's own choice: said
     assert (v.drag_linear, v.drag_quadratic) == (DEFAULT_DRAG["drag_linear"], DEFAULT_DRAG["drag_quadratic"])
     assert DEFAULT_DRAG["drag_quadratic"] == pytest.approx(0.06, abs=0.005)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert with_drag(V.replace(drag_linear=1.0)).drag_quadratic == 0.0
-    with pytest.warns(UserWarning):
-        mixed = with_drag(V.replace(drag_linear=np.array([0.0, 2.0])))
+    with pytest.warns(UserWarning, match="1 of 2 vehicles have no drag"):
+        mixed = with_drag(V.replace(drag_linear=np.array([0.0, 2.0])), warn=True)
     np.testing.assert_array_equal(mixed.drag_linear, [0.3, 2.0])
     np.testing.assert_array_equal(mixed.drag_quadratic, [DEFAULT_DRAG["drag_quadratic"], 0.0])
 

@@ -393,7 +393,8 @@ def test_other_code_makes_another_sweep(reference, tmp_path, monkeypatch):
 ])
 def test_bad_input_is_one_line_and_writes_nothing(tmp_path, kw, words):
     out = tmp_path / "out"
-    options = dict(n=4, seed=1, duration=1.0, scheduler="none", out=str(out), quiet=True, echo=lambda s: None)
+    options = dict(n=4, seed=1, duration=1.0, mass_spread=0.1, scheduler="none", out=str(out), quiet=True,
+                   echo=lambda s: None)
     options.update(kw)
     with pytest.raises(InputError, match=words) as err:
         montecarlo_command(**options)

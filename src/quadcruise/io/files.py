@@ -234,7 +234,8 @@ def check_output_dir(path: str | os.PathLike, force: bool = False, *, workflow: 
         writes.
     workflow : str, optional
         What will write there; ``"montecarlo"`` may resume a sweep's folder (its own rules
-        apply), any other writer must be forced to replace one.
+        apply), any other writer must be forced to replace one. ``"reproduce"``, whose
+        folder has a default name, replaces only a reproduction's folder unless forced.
 
     Returns
     -------
@@ -262,6 +263,9 @@ def check_output_dir(path: str | os.PathLike, force: bool = False, *, workflow: 
     if workflow != "montecarlo" and held is not None and held.get("workflow") == "montecarlo":
         raise InputError(f"{path}: holds a Monte Carlo sweep (hours of flights, resumable); use --force to "
                          "replace it or choose another --out")
+    if workflow == "reproduce" and held is not None and held.get("workflow") != "reproduce":
+        raise InputError(f"{path}: holds the output of quadcruise {held.get('workflow') or 'another command'}, not of "
+                         "reproduce; use --force to replace it or choose another --out")
     return path
 
 

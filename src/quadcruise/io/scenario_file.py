@@ -115,6 +115,7 @@ def montecarlo_document(spec: dict, n: int, *, title: str = "") -> dict:
     """
     population = spec["population"]
     meta = {"mission": spec["mission"], "controller": spec["controller"], "vehicle": spec["vehicle"],
+            "controller_vehicle": spec.get("controller_vehicle"),
             "environment": population.get("environment"), "sensors": population.get("noise"),
             "duration_s": spec.get("duration"), "dt_s": spec.get("dt"), "max_step_s": spec.get("max_step"),
             "full_dynamics": spec.get("full_dynamics")}

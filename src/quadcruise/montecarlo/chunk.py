@@ -61,7 +61,7 @@ def fly_chunk(spec: MonteCarloSpec, first, count: int, log_every: int | None = N
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = fly(spec.mission, spec.controller if controller is None else controller, vehicle=draw.vehicle,
-                  controller_vehicle=spec.vehicle if spec.population.model_error else None,
+                  controller_vehicle=spec.model_vehicle,
                   duration=spec.duration, dt=spec.dt, max_step=spec.max_step, x0=x0,
                   log_every=spec.log_every if log_every is None else log_every,
                   full_dynamics=spec.full_dynamics, seed=spec.seed, first_vehicle=first,

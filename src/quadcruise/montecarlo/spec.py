@@ -18,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -63,6 +64,9 @@ class MonteCarloSpec:
         Control period [s].
     vehicle : Vehicle
         The nominal vehicle (Table I); given drag if the population meets wind.
+    controller_vehicle : Vehicle, optional
+        The vehicle every controller believes it flies (its model); None: the nominal
+        ``vehicle`` (or, with the population's ``model_error`` False, each vehicle's own).
     max_step : float, optional
         Longest RK4 substep [s]; dt by default.
     log_dt : float
@@ -123,6 +127,7 @@ class MonteCarloSpec:
     duration: float | None = None
     dt: float = 1e-3
     vehicle: Vehicle = field(default_factory=Vehicle.paper)
+    controller_vehicle: Vehicle | None = None
     max_step: float | None = None
     log_dt: float = 0.01
     trace_dt: float = 0.1
@@ -138,7 +143,7 @@ class MonteCarloSpec:
 
     def __post_init__(self) -> None:
         from quadcruise.sim.engine import time_grid
-        from quadcruise.workflows.fly import altitude_bound, default_duration, steady_bound
+        from quadcruise.workflows.fly import altitude_bound, check_can_hover, default_duration, steady_bound
 
         if isinstance(self.mission, str):
             object.__setattr__(self, "mission", mission_from_name(self.mission))
@@ -149,6 +154,15 @@ class MonteCarloSpec:
             raise InputError("population must be a Population")
         if not isinstance(self.vehicle, Vehicle) or self.vehicle.batch_size is not None:
             raise InputError("the nominal vehicle must be one (unbatched) Vehicle")
+        with warnings.catch_warnings():            # fly() warns of a vehicle with little left for control
+            warnings.simplefilter("ignore")
+            check_can_hover(self.vehicle)              # before any chunk flies: a nominal that cannot lift
+        if self.controller_vehicle is not None:
+            if not isinstance(self.controller_vehicle, Vehicle) or self.controller_vehicle.batch_size is not None:
+                raise InputError("the controller's vehicle must be one (unbatched) Vehicle")
+            if not self.population.model_error:
+                raise InputError("a controller_vehicle (the model every controller flies with) contradicts the "
+                                 "population's model_error=False (each controller knows its own vehicle)")
         object.__setattr__(self, "seed", whole_number(self.seed, "seed"))
         duration = default_duration(self.mission) if self.duration is None else self.duration
         time_grid(float(duration), float(self.dt))          # validates duration and dt
@@ -182,9 +196,17 @@ class MonteCarloSpec:
         if self.population.needs_drag:
             from quadcruise.disturbances.environment import with_drag
 
-            object.__setattr__(self, "vehicle", with_drag(self.vehicle))
+            object.__setattr__(self, "vehicle", with_drag(self.vehicle, warn=True))
 
     # --- derived ------------------------------------------------------------------------
+    @property
+    def model_vehicle(self) -> Vehicle | None:
+        """The vehicle the controllers compute with: ``controller_vehicle``, else the nominal one,
+        or None (each vehicle's own) when the population has no model error."""
+        if self.controller_vehicle is not None:
+            return self.controller_vehicle
+        return self.vehicle if self.population.model_error else None
+
     @property
     def parsed_requirements(self) -> tuple[Requirement, ...]:
         """The :attr:`requirements` as :class:`~quadcruise.montecarlo.requirements.Requirement` objects."""
@@ -226,7 +248,8 @@ class MonteCarloSpec:
             ``to_dict()``), and ``log_every`` and ``trace_every``.
         """
         out = {"mission": self.mission.to_dict(), "controller": controller_record(self.controller),
-               "population": self.population.to_dict(), "vehicle": self.vehicle.to_dict()}
+               "population": self.population.to_dict(), "vehicle": self.vehicle.to_dict(),
+               "controller_vehicle": None if self.controller_vehicle is None else self.controller_vehicle.to_dict()}
         for f in dataclasses.fields(self):
             if f.name not in out:
                 out[f.name] = getattr(self, f.name)

@@ -346,7 +346,7 @@ def write_reproduction(rep: Reproduction, out: str | Path, *, force: bool = Fals
     """
     from quadcruise.plots.flight import save_figure
 
-    out = check_output_dir(out, force)
+    out = check_output_dir(out, force, workflow="reproduce")
     with atomic_dir(out) as tmp:
         tmp = Path(tmp)
         (tmp / "metrics.json").write_text(dumps(rep.to_json(), indent=2) + "\n")
