@@ -27,24 +27,31 @@ if TYPE_CHECKING:                        # what the names are, for readers and t
     from quadcruise.sim.engine import Limits, simulate, time_grid
     from quadcruise.sim.result import SimResult
     from quadcruise.sim.status import STATUS_REASONS, ExitStatus
+    from quadcruise.sysid.api import identify
+    from quadcruise.sysid.result import IdentifyResult
     from quadcruise.workflows.compare import Comparison, compare
     from quadcruise.workflows.fly import fly
-    from quadcruise.workflows.replay import DutySchedule, read_duty_csv, replay, write_states_csv
+    from quadcruise.workflows.replay import (DutySchedule, SpeedSchedule, read_duty_csv, read_speed_csv, replay,
+                                             replay_rotors, write_rotor_states_csv, write_states_csv)
 
 _LAZY = {
     "quadcruise.model.vehicle": ("Vehicle",),
     "quadcruise.sim.engine": ("Limits", "simulate", "time_grid"),
     "quadcruise.sim.result": ("SimResult",),
     "quadcruise.sim.status": ("STATUS_REASONS", "ExitStatus"),
+    "quadcruise.sysid.api": ("identify",),
+    "quadcruise.sysid.result": ("IdentifyResult",),
     "quadcruise.workflows.compare": ("Comparison", "compare"),
     "quadcruise.workflows.fly": ("fly",),
-    "quadcruise.workflows.replay": ("DutySchedule", "read_duty_csv", "replay", "write_states_csv"),
+    "quadcruise.workflows.replay": ("DutySchedule", "SpeedSchedule", "read_duty_csv", "read_speed_csv", "replay",
+                                    "replay_rotors", "write_rotor_states_csv", "write_states_csv"),
 }
 _HOME = {name: module for module, names in _LAZY.items() for name in names}
 
 __all__ = [
-    "Comparison", "DutySchedule", "ExitStatus", "InputError", "Limits", "STATUS_REASONS", "SimResult", "Vehicle", "__version__",
-    "compare", "fly", "read_duty_csv", "replay", "simulate", "time_grid", "write_states_csv",
+    "Comparison", "DutySchedule", "ExitStatus", "IdentifyResult", "InputError", "Limits", "STATUS_REASONS", "SimResult",
+    "SpeedSchedule", "Vehicle", "__version__", "compare", "fly", "identify", "read_duty_csv", "read_speed_csv", "replay",
+    "replay_rotors", "simulate", "time_grid", "write_rotor_states_csv", "write_states_csv",
 ]
 
 

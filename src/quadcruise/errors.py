@@ -1,4 +1,5 @@
-"""The one exception type for bad input, so the CLI can turn it into a one-line message."""
+"""The exception types the command line turns into one line: bad input (:class:`InputError`), a
+file the machine could not write (:class:`WriteError`)."""
 
 from __future__ import annotations
 
@@ -12,6 +13,40 @@ class InputError(ValueError):
     The command line prints it as ``error: <message>`` and exits with status 2.
     """
 
+
+class WriteError(OSError):
+    """A file or folder that could not be written: a fault of the machine (a full disk, a
+    folder removed or made read-only meanwhile), not of the input.
+
+    It is an ``OSError`` (``errno``, ``strerror`` and ``filename`` are the cause's, the
+    filename being the path asked for, not a temporary one) whose message is one line:
+    ``<path>: cannot write (<cause>)``, then what was kept. The command line prints it as
+    ``error: <message>`` and exits with status 74 (``EX_IOERR`` of BSD's sysexits.h).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file or folder that was being written.
+    cause : OSError
+        What the system said.
+    kept : str, optional
+        What was kept and how to go on, e.g. ``"the sweep resumes ..."``.
+
+    Examples
+    --------
+    >>> import errno
+    >>> print(WriteError("out/flights.csv", OSError(errno.ENOSPC, "No space left on device")))
+    out/flights.csv: cannot write (no space left on device)
+    """
+
+    def __init__(self, path, cause: OSError, kept: str = "") -> None:
+        text = cause.strerror or str(cause) or type(cause).__name__
+        super().__init__(cause.errno, text, str(path))
+        self.kept = kept
+
+    def __str__(self) -> str:
+        cause = self.strerror[:1].lower() + self.strerror[1:]
+        return f"{self.filename}: cannot write ({cause})" + (f"; {self.kept}" if self.kept else "")
 
 class ArgumentTypeError(InputError, TypeError):
     """Bad input of the wrong kind: a Python argument of another type than the one expected

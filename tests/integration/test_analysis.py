@@ -31,7 +31,7 @@ from quadcruise.workflows.analysis import (
     report,
     summary,
     to_json,
-    wrap_phase,
+    unwrapped_phase,
 )
 
 
@@ -209,7 +209,9 @@ def test_hover_elsewhere_and_heavier_vehicle_still_linearise():
 
 def test_report_compares_with_the_design_poles(lin):
     r = report("nlpd", lin=lin)
-    assert json.loads(to_json(r)) == json.loads(json.dumps(r))           # all finite here
+    doc = json.loads(to_json(r))                  # strict JSON: -inf dB (no lower gain limit) is null
+    assert doc["loops"]["z"]["margins_input"]["gain_decrease_db"] is None
+    assert doc["loops"]["x"]["margins_input"] == json.loads(json.dumps(r["loops"]["x"]["margins_input"]))
     assert "nlpd about hover, dt = 0.001 s: stable" in summary(r) and "-4.3:85%" in summary(r)
     assert json.loads(to_json({"gm": float("inf")})) == {"gm": None}
     x = r["loops"]["x"]
@@ -235,41 +237,117 @@ def test_bode_marks_each_loops_margins_at_its_crossovers(lin):
     fig = bode(lin, loops=True)
     mag_l, phase_l = fig.axes[1], fig.axes[3]
     texts = [t.get_text() for t in mag_l.get_legend().get_texts()]
-    assert texts[0] == "L x: PM 18.1° @ 10.8 rad/s, GM -3.98 dB @ 7.07 rad/s"
+    assert texts[0] == ("L x: PM 18.1° @ 10.8 rad/s (< 30°), GM down -3.98 dB @ 7.07 rad/s (> -6 dB), "
+                        "up +38.2 dB @ 134 rad/s")
+    assert texts[2] == "L z: PM 65° @ 4.8 rad/s, GM up +51.7 dB @ 169 rad/s"       # nothing short
     for loop, text in zip(LOOPS, texts):
         m = loop_margins(lin, loop)
-        assert text.startswith(f"L {loop}: PM {m['phase_margin']:.3g}° @ {m['gain_crossover']:.3g} rad/s, GM ")
+        assert text.startswith(f"L {loop}: PM {m['phase_margin']:.3g}° @ {m['gain_crossover']:.3g} rad/s")
         curve = next(ln for ln in mag_l.get_lines() if ln.get_label() == text)
         w, gain = curve.get_xdata(), curve.get_ydata()
         phase = next(ln for ln in phase_l.get_lines() if ln.get_color() == curve.get_color() and len(ln.get_xdata()) > 2)
         pw, pv = phase.get_xdata(), phase.get_ydata()
-        live = np.isfinite(pw)
         if loop == "y":             # the same margins as x: marked once
             assert not [ln for ln in phase_l.get_lines() if ln.get_label() == "PM y"]
             continue
         (pm,) = [ln for ln in phase_l.get_lines() if ln.get_label() == f"PM {loop}"]
         wgc, pm_deg = m["gain_crossover"], m["phase_margin"]
-        assert list(pm.get_xdata()) == [wgc, wgc] and list(pm.get_ydata()) == [-180.0, -180.0 + pm_deg]
+        base = pm.get_ydata()[0]
+        assert list(pm.get_xdata()) == [wgc, wgc] and (base + 180.0) % 360.0 == 0.0   # from a -180 deg line
+        assert pm.get_ydata()[1] == pytest.approx(base + pm_deg)
         # the segment ends on the drawn phase and the dot on the drawn 0 dB crossing
-        assert np.interp(np.log(wgc), np.log(pw[live]), pv[live]) == pytest.approx(-180.0 + pm_deg, abs=0.5)
+        assert np.interp(np.log(wgc), np.log(pw), pv) == pytest.approx(base + pm_deg, abs=0.5)
         assert np.interp(np.log(wgc), np.log(w), gain) == pytest.approx(0.0, abs=0.2)
-        (gm,) = [ln for ln in mag_l.get_lines() if ln.get_label() == f"GM {loop}"]
-        wpc, gm_db = m["phase_crossover"], -20 * np.log10(m["gain_margin"])
-        assert list(gm.get_xdata()) == [wpc, wpc] and gm.get_ydata()[1] == pytest.approx(gm_db)
-        assert np.interp(np.log(wpc), np.log(w), gain) == pytest.approx(gm_db, abs=0.3)
-        assert np.interp(np.log(wpc), np.log(pw[live]), pv[live]) == pytest.approx(-180.0, abs=0.5)
-    assert len([ln for ln in mag_l.get_lines() if ln.get_label().startswith("GM ")]) == 3
+        for way, key in (("down", "gain_decrease"), ("up", "gain_increase")):
+            marks = [ln for ln in mag_l.get_lines() if ln.get_label() == f"GM {way} {loop}"]
+            if not 0.0 < m[key] < np.inf:
+                assert not marks
+                continue
+            (gm,) = marks
+            wpc, gm_db = m[key + "_frequency"], -20 * np.log10(m[key])
+            assert list(gm.get_xdata()) == [wpc, wpc] and gm.get_ydata()[1] == pytest.approx(gm_db)
+            assert np.interp(np.log(wpc), np.log(w), gain) == pytest.approx(gm_db, abs=0.3)
+            at_wpc = np.interp(np.log(wpc), np.log(pw), pv)               # on a -180 + 360 k line
+            assert abs((at_wpc + 180.0 + 180.0) % 360.0 - 180.0) < 0.5
+    assert [ln.get_label() for ln in mag_l.get_lines() if ln.get_label().startswith("GM ")] == \
+        ["GM down x", "GM up x", "GM up z", "GM down yaw", "GM up yaw"]
 
 
 @pytest.mark.parametrize("loops, at", [(False, "input"), (True, "input"), (True, "output")])
-def test_bode_phases_are_wrapped_to_minus_360_0(lin, loops, at):
+def test_bode_phases_are_unwrapped(lin, loops, at):
+    """No phase jumps by a turn: each curve is continuous, a closed loop's starting near 0 deg,
+    a loop transfer's near -180 deg, and equal to the response's angle up to whole turns."""
     fig = bode(lin, loops=loops, at=at)
     phase_axes = fig.axes[2:] if loops else fig.axes[1:]
-    for ax in phase_axes:
-        assert ax.get_ylim() == (-360.0, 0.0) and ax.get_ylabel() == "phase [deg]"
-        assert [v for v in ax.get_yticks() if -360.0 <= v <= 0.0] == [-360.0, -270.0, -180.0, -90.0, 0.0]
-        for ln in ax.get_lines():
-            y = np.asarray(ln.get_ydata(), float)
-            assert np.all((y[np.isfinite(y)] > -360.0) & (y[np.isfinite(y)] <= 0.0)), ln.get_label()
-            assert not np.any(np.abs(np.diff(y)) > 180.0)            # broken where it wraps, not joined
-    assert wrap_phase([-540.0, 360.0, 0.0, -359.0]).tolist() == [-180.0, 0.0, 0.0, -359.0]
+    for col, ax in enumerate(phase_axes):
+        assert ax.get_ylabel() == "phase [deg]"
+        curves = [ln for ln in ax.get_lines() if len(ln.get_xdata()) > 2]
+        assert len(curves) == 4
+        for ln in curves:
+            w, y = np.asarray(ln.get_xdata(), float), np.asarray(ln.get_ydata(), float)
+            assert np.all(np.isfinite(y)) and np.max(np.abs(np.diff(y))) < 90.0, ln.get_label()
+            assert abs(y[0] - (0.0 if col == 0 else -180.0)) <= 180.0
+        low, high = ax.get_ylim()
+        lines = sorted(ln.get_ydata()[0] for ln in ax.get_lines() if len(ln.get_xdata()) == 2
+                       and list(ln.get_xdata()) == [0.0, 1.0])           # axhline: x in axes units
+        assert lines and all((v + 180.0) % 360.0 == 0.0 and low <= v <= high for v in lines)
+    # the x loop transfer's phase is the angle of its response, unwrapped
+    w = np.logspace(-2, np.log10(0.9 * np.pi / lin.dt), 800)
+    r = control.frequency_response(loop_transfer(lin, "x", at), w).complex.ravel()
+    y = unwrapped_phase(r, -180.0)
+    np.testing.assert_allclose(np.exp(1j * np.radians(y)), r / np.abs(r), atol=1e-9)
+    w = np.linspace(0.0, 100.0, 1001)                        # a 0.1 s delay: phase -w 0.1 rad, 1.6 turns
+    assert unwrapped_phase(np.exp(-0.1j * w)) == pytest.approx(np.degrees(-0.1 * w))
+
+
+def test_gain_margins_in_db_bound_the_loop_gain_both_ways(lin):
+    """A loop gain just inside either gain margin keeps the closed loop stable; just beyond it,
+    unstable (independent of the margin code: the poles of the loop closed at k L)."""
+    for loop in ("x", "yaw"):
+        L = loop_transfer(lin, loop, "input")
+        m = loop_margins(lin, loop, "input")
+
+        def stable_at(k, L=L):
+            return bool(np.max(np.abs(np.linalg.eigvals(L.A - k * L.B @ L.C))) < 1.0)
+
+        assert stable_at(1.0)
+        for key in ("gain_decrease", "gain_increase"):
+            assert m[key + "_db"] == pytest.approx(20 * np.log10(m[key]))
+            assert stable_at(m[key] * (1.02 if key == "gain_decrease" else 0.98))
+            assert not stable_at(m[key] * (0.98 if key == "gain_decrease" else 1.02))
+    z = loop_margins(lin, "z", "input")
+    assert z["gain_decrease"] == 0.0 and z["gain_decrease_db"] == -np.inf       # no lower limit
+
+
+def test_summary_gives_margins_with_units_flags_and_explains_them(lin):
+    text = summary(report("nlpd", lin=lin))
+    lines = text.splitlines()
+    assert lines[0] == ("nlpd about hover, dt = 0.001 s: stable (every pole inside the unit circle), "
+                        "margins short on x, y, yaw (!)")
+    row = {ln[:36].strip(): ln[36:].split("  ") for ln in lines[2:10]}
+    assert "PM at the input [deg] @ [rad/s]" in row and "GM at the input [dB]: down, up" in row
+    cells = " ".join(lines[7].split())
+    assert cells.startswith("GM at the input [dB]: down, up -3.98 (!), +38.2 -3.98 (!), +38.2 none, +51.7 -25.8, +38.2")
+    assert "18.1 (!) @ 10.8" in lines[6] and "65.0 @ 4.8" in lines[6]
+    assert "conditionally stable" in text and "(!): below 30 deg of phase margin or within 6 dB" in text
+    r = report("cascade")
+    assert not any(r["loops"]["z"]["low_margins"].values())
+    assert r["loops"]["x"]["low_margins"]["input"] == ["PM 28.9 deg < 30 deg"]
+
+
+@pytest.mark.parametrize("name, loop", [("se3", "yaw"), ("nlpd", "x")])
+def test_dominant_pole_is_defined_once_and_a_pair_counts_as_one_mode(name, loop):
+    """The dominant mode is the one of largest step-response weight, a complex pair weighing
+    both its poles; for se3's yaw loop that is the lightly damped pair, which is also the slowest."""
+    lin = linearize(name)
+    r = report(name, lin=lin)["loops"][loop]
+    p, weight = lin.loop_modes(loop)
+    modes = {}
+    for z, wt in zip(p, weight):
+        key = (round(z.real, 6), round(abs(z.imag), 6))
+        modes[key] = modes.get(key, 0.0) + wt
+    assert tuple(r["dominant"]) == max(modes, key=modes.get)
+    if name == "se3":
+        assert r["dominant"] == r["slowest"] and r["dominant"][1] > 10.0
+    else:                                                     # a slow pole nearly cancelled: not dominant
+        assert r["slowest"][0] > r["dominant"][0]

@@ -79,7 +79,7 @@ CASES = {
     "fly log_every 0": (lambda: qc.fly("step", log_every=0), BAD, ["log_every", ">= 1"]),
     "fly log_every 1.5": (lambda: qc.fly("step", log_every=1.5), WRONG, ["log_every"]),
     "fly log_every 1500 of 2000": (lambda: qc.fly("step", duration=2.0, log_every=1500), BAD,
-                                   ["log_every", "2,000 control periods", "1000, 2000"]),
+                                   ["log_every", "2,000 control periods", "1,000, 2,000"]),
     "fly x0 short": (lambda: qc.fly("step", x0=[1.0, 2.0]), WRONG, ["x0", "(16,)"]),
     "fly x0 nan": (lambda: qc.fly("step", x0=np.full(16, np.nan)), BAD, ["x0", "finite"]),
     "fly x0 str": (lambda: qc.fly("step", x0="hover"), WRONG, ["x0"]),

@@ -139,7 +139,8 @@ def test_montecarlo_runs_writes_and_replays_a_case(tmp_path):
     (["montecarlo", "-n", "0"], "the number of flights must be a whole number >= 1"),
     (["montecarlo", "--mass-spread", "-0.1"], "'mass_spread' must be a number >= 0"),
     (["montecarlo", "--wind", "tornado:3"], "unknown model 'tornado'"),
-    (["montecarlo", "-n", "4", "--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "1"], "scheduler"),
+    (["montecarlo", "-n", "4", "--mass-spread", "0.1", "--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "1"],
+     "scheduler"),
 ])
 def test_montecarlo_bad_input(tmp_path, args, words):
     res = run(*args, "--out", tmp_path / "mc")

@@ -43,7 +43,8 @@ def invoke(monkeypatch, forced: bool, args: list[str]):
 
 # each command that can take long: its arguments (tmp_path for "{tmp}") and what its bar says
 COMMANDS = {
-    "montecarlo": (["montecarlo", "--n", "6", "--duration", "1", "--scheduler", "none"], ["flying", "/6 ["]),
+    "montecarlo": (["montecarlo", "--n", "6", "--duration", "1", "--mass-spread", "0.1", "--scheduler", "none"],
+                   ["flying", "/6 ["]),
     "compare": (["compare", "step", "--duration", "2", "--controllers", "nlpd,se3"], ["flying", "/2 [", "controller"]),
     "compare-population": (["compare", "step", "--duration", "1", "--controllers", "nlpd,se3", "--population", "3"],
                            ["flying the population", "/6 ["]),
@@ -76,7 +77,7 @@ def test_each_long_command_shows_a_bar_when_asked_and_nothing_otherwise(name, tm
 
 
 def test_montecarlo_quiet_draws_no_bar(monkeypatch):
-    args = ["montecarlo", "--n", "4", "--duration", "1", "--scheduler", "none"]
+    args = ["montecarlo", "--n", "4", "--duration", "1", "--mass-spread", "0.1", "--scheduler", "none"]
     assert "flying" in invoke(monkeypatch, True, args).stderr
     assert invoke(monkeypatch, True, args + ["--quiet"]).stderr == ""
 

@@ -140,25 +140,28 @@ def test_sweep_metrics_equal_flight_metrics():
         states[2, states.shape[1] // 2:] = np.nan
         res = dataclasses.replace(res, states=states, status=np.where(np.arange(6) == 2, 2, res.status))
         fast, slow = sweep_metrics(res, spec), flight_metrics(res)
+        kept = ~fast["lost_track"]            # the sweep judged the others off track: no transient to show
+        assert np.isnan(fast["rise_time_s"][~kept]).all() and np.isfinite(fast["rmse_m"][~kept]).all()
         for k in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "rise_time_s", "settling_time_s",
                   "settling_time_5pct_s", "overshoot_pct", "peak_time_s", "effort", "duty_clipped_s",
                   "controller_limited_s"):
-            np.testing.assert_allclose(fast[k], slow[k].to_numpy(dtype=float), rtol=1e-12, atol=1e-15,
+            np.testing.assert_allclose(fast[k][kept], slow[k].to_numpy(dtype=float)[kept], rtol=1e-12, atol=1e-15,
                                        err_msg=f"{mission} {k}")
         assert np.isnan(fast["rmse_m"][2]) and fast["diverged"].tolist() == [False, False, True, False, False, False]
-        axes = [-1 if not isinstance(a, str) else "xyz".index(a) for a in slow["axis"]]
+        axes = [{"x": 0, "y": 1, "z": 2, "xyz": 3}.get(a, -1) if isinstance(a, str) else -1 for a in slow["axis"]]
         assert fast["transient_axis"].tolist() == axes
 
 
 # --- failures and requirements ---------------------------------------------------------------
 def test_not_settling_within_2pct_is_a_metric_not_a_failure():
-    """Mass spread leaves a steady lag on the circle: few flights settle into 2 % of the 2 m
-    start offset, yet every one tracks within centimetres to decimetres."""
-    res = montecarlo("circle", "nlpd", Population(mass_spread=0.1), 24, seed=1, scheduler="none", settle_band=0.02)
+    """A 6 s circle has not converged onto its steady lag within 2 % by half its length (the
+    entry settles there in about 4.2 s): marked, not failed; every one tracks within decimetres."""
+    res = montecarlo("circle", "nlpd", Population(mass_spread=0.05), 24, seed=1, scheduler="none", settle_band=0.02,
+                     duration=6.0)
     tab = res.table
     assert tab["not_settled"].mean() > 0.8
     assert (tab["failure"] == 0).all() and (tab["reason"] == "ok").all()
-    assert tab["steady_max_error_m"].max() < 1.0 and tab["steady_rmse_m"].median() < 0.5
+    assert tab["steady_max_error_m"].max() < 0.5 and tab["final_error_m"].max() < 0.5
     s = res.summary()
     assert s["failures"]["count"] == 0 and s["not_settled"]["count"] == tab["not_settled"].sum()
     assert list(s["failures"]["by_reason"]) == ["diverged", "lost track", "saturated", "failed a requirement"]
@@ -171,9 +174,12 @@ def test_lost_track_is_the_error_after_the_transient_beyond_a_bound():
     res = montecarlo("circle", "nlpd", Population(mass_spread=0.1), 24, seed=1, scheduler="none",
                      max_track_error_m=0.3)
     tab = res.table
-    lost = tab["steady_max_error_m"] > 0.3
-    assert 0 < lost.sum() < len(tab)
-    assert tab["lost_track"].tolist() == lost.tolist() and (tab.loc[lost, "reason"] == "lost track").all()
+    lost = tab["lost_track"]
+    assert 0 < lost.sum() < len(tab) and (tab.loc[lost, "reason"] == "lost track").all()
+    # the kept flights' steady window (the last half) lies after the transient, where the bound held;
+    # the lost ones have no steady state to show
+    assert (tab.loc[~lost, "steady_max_error_m"] <= 0.3).all() and tab.loc[lost, "steady_max_error_m"].isna().all()
+    assert res.spec.max_altitude_error_m == 0.3                 # a bound given bounds the altitude too
     assert "lost track" in res.summary_text() and "> 0.3 m" in res.summary_text()
     with pytest.raises(InputError, match="max_track_error_m"):
         MonteCarloSpec("circle", max_track_error_m=-1.0)
@@ -184,13 +190,15 @@ def test_a_requirement_that_fails_is_counted_and_shown(tmp_path):
     res = montecarlo("circle", "nlpd", Population(mass_spread=0.1), 24, seed=1, scheduler="none",
                      requirements=[req], out=tmp_path / "mc")
     tab = res.table
-    missed = ~(tab["steady_max_error_m"] <= 0.2)
-    assert 0 < missed.sum() < len(tab)
+    missed = ~(tab["steady_max_error_m"] <= 0.2)            # a lost flight (no steady metric) misses it too
+    lost = tab["lost_track"]
+    assert 0 < (missed & ~lost).sum() and missed.sum() < len(tab)
     assert tab["failed_requirement"].tolist() == missed.tolist()
-    assert (tab.loc[missed, "reason"] == "failed a requirement").all() and (tab.loc[~missed, "failure"] == 0).all()
+    assert (tab.loc[missed & ~lost, "reason"] == "failed a requirement").all()
+    assert (tab.loc[lost, "reason"] == "lost track").all() and (tab.loc[~missed, "failure"] == 0).all()
     s = res.summary()
     assert s["requirements"] == [{"requirement": req, "failed": int(missed.sum()), "rate": missed.mean()}]
-    assert s["failures"]["by_reason"]["failed a requirement"]["count"] == missed.sum()
+    assert s["failures"]["by_reason"]["failed a requirement"]["count"] == (missed & ~lost).sum()
     assert f"requirement {req}: missed by {missed.sum()}" in str(s)
     report = (tmp_path / "mc" / "report.md").read_text()
     assert f"| `{req}` | {missed.sum()} |" in report
@@ -226,10 +234,12 @@ def test_metrics_on_the_decimated_log_are_close_to_full_rate():
     spec = MonteCarloSpec("circle", population=POP, seed=2, duration=8.0)
     fast = sweep_metrics(fly_chunk(spec, 0, 5)[0], spec)              # 10 ms log
     full = flight_metrics(fly_chunk(spec, 0, 5, log_every=1)[0])      # every 1 ms period
+    kept = ~fast["lost_track"]                                        # the others show no transient
     for k, tol in (("rmse_m", 1e-5), ("max_error_m", 1e-4)):
         np.testing.assert_allclose(fast[k], full[k].to_numpy(dtype=float), rtol=tol, err_msg=k)
     for k in ("rise_time_s", "settling_time_5pct_s"):         # crossings interpolated on the 10 ms log:
-        np.testing.assert_allclose(fast[k], full[k].to_numpy(dtype=float), atol=1e-3, err_msg=k)   # 1/10 of it
+        np.testing.assert_allclose(fast[k][kept], full[k].to_numpy(dtype=float)[kept], atol=1e-3,
+                                   err_msg=k)                 # 1/10 of it
 
 
 def test_the_world_acts_and_drag_is_added_with_a_warning():
@@ -383,7 +393,8 @@ def test_other_code_makes_another_sweep(reference, tmp_path, monkeypatch):
 ])
 def test_bad_input_is_one_line_and_writes_nothing(tmp_path, kw, words):
     out = tmp_path / "out"
-    options = dict(n=4, seed=1, duration=1.0, scheduler="none", out=str(out), quiet=True, echo=lambda s: None)
+    options = dict(n=4, seed=1, duration=1.0, mass_spread=0.1, scheduler="none", out=str(out), quiet=True,
+                   echo=lambda s: None)
     options.update(kw)
     with pytest.raises(InputError, match=words) as err:
         montecarlo_command(**options)

@@ -26,3 +26,38 @@ def test_readme_python_example_runs_as_a_script(tmp_path):
     assert "Traceback" not in run.stderr
     assert "flights of nlpd on circle" in run.stdout        # the Monte Carlo summary, as a table
     assert (tmp_path / "mc-out" / "quadcruise.json").is_file()
+    assert "every target and requirement met" in run.stdout     # the tune example meets what it asks for
+
+
+def readme_command(name: str) -> list[str]:
+    """The README table's example of a command, its optional [...] parts left out."""
+    text = (ROOT / "README.md").read_text()
+    line = next(ln for ln in text.splitlines() if ln.startswith(f"| `quadcruise {name} "))
+    command = line.split("`")[1]
+    return re.sub(r"\s*\[[^\[\]]*\]", "", command).split()[1:]
+
+
+@pytest.mark.slow
+def test_readme_tune_and_montecarlo_commands_do_what_the_table_says(tmp_path):
+    """Run as written (the Monte Carlo with fewer flights, in this process): the tune meets its
+    targets and exits 0; the population is perturbed (its quantiles differ)."""
+    def quadcruise(args):
+        return subprocess.run([sys.executable, "-m", "quadcruise", *args], cwd=tmp_path, capture_output=True,
+                              text=True, timeout=600)
+
+    tune = readme_command("tune")
+    assert "--target" in tune and "DIR" in tune
+    run = quadcruise([("out" if word == "DIR" else word) for word in tune])
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "every target and requirement met" in run.stdout and (tmp_path / "out" / "scenario.toml").is_file()
+    again = quadcruise(["fly", "out/scenario.toml"])                 # the folder flies the tuned gains
+    assert again.returncode == 0, again.stderr
+
+    montecarlo = readme_command("montecarlo")
+    assert montecarlo[montecarlo.index("--n") + 1] == "10000"
+    montecarlo[montecarlo.index("--n") + 1] = "20"
+    run = quadcruise(montecarlo + ["--scheduler", "none", "--quiet"])
+    assert run.returncode == 0, run.stdout + run.stderr
+    row = next(ln for ln in run.stdout.splitlines() if ln.strip().startswith("rmse_m")).split()
+    count, p5, p50, p95 = int(row[1]), *map(float, row[2:5])
+    assert count == 20 and p5 < p50 < p95, row

@@ -26,6 +26,13 @@ TOL = dict(rtol=1e-9, atol=1e-9)
 # Monte Carlo flight whose transient did not settle is no longer a ``failure`` (failure codes
 # are now diverged, lost track, saturated, failed a requirement). Every other column stays equal.
 REDEFINED = {"effort", "failure"}
+# Issue 21 ("metrics defined for what each mission is"): the transient and steady columns of a
+# moving reference (circle, square) are now measured on the size of the 3-D tracking error
+# against its own steady level, not on one axis's progress; those of a step are unchanged, and
+# so is every trace.
+MOVING = {"circle_nlpd", "square_gonzalez", "circle_env", "batch_mass", "mc"}
+REDEFINED_MOVING = {"rise_time_s", "settling_time_s", "settling_time_5pct_s", "overshoot_pct", "peak_time_s",
+                    "steady_rmse_m", "steady_max_error_m", "not_settled", "transient_axis"}
 
 
 #: the paper's literal inversion, which the default nlpd was before the joint one (issue: the
@@ -65,7 +72,7 @@ def test_flight_traces_and_metrics_are_unchanged(name):
     metrics = res.metrics()
     for key in (k for k in REFERENCE.files if k.startswith(f"{name}/metric/")):
         column = key.rsplit("/", 1)[1]
-        if column in REDEFINED:
+        if column in REDEFINED or (name in MOVING and column in REDEFINED_MOVING):
             continue
         np.testing.assert_allclose(metrics[column].to_numpy(dtype=float), REFERENCE[key], err_msg=column, **TOL)
 
@@ -81,6 +88,6 @@ def test_montecarlo_table_is_unchanged():
     table = mc.to_pandas() if hasattr(mc, "to_pandas") else mc.table
     for key in (k for k in REFERENCE.files if k.startswith("mc/")):
         column = key.split("/", 1)[1]
-        if column in REDEFINED:
+        if column in REDEFINED | REDEFINED_MOVING:
             continue
         np.testing.assert_allclose(table[column].to_numpy(dtype=float), REFERENCE[key], err_msg=column, **TOL)

@@ -42,7 +42,7 @@ from quadcruise.report.html import (
     write_html_report,
 )
 from quadcruise.workflows.compare import compare
-from quadcruise.workflows.reproduce import reproduce
+from quadcruise.workflows.reproduce import fitted_nlpd_loop, reproduce
 
 CHROMIUM = os.environ.get("QUADCRUISE_CHROMIUM", "/usr/bin/chromium")
 FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -114,7 +114,7 @@ def test_page_is_self_contained(flight_page, circle):
     # tables (the metrics, what they measure, the run), with the formatting rules
     assert len(dom.find("table")) == 3
     rmse = cell(float(circle.metrics()["rmse_m"][0]))[0]                # 0.4205 m on the default circle
-    assert f"<td class=\"num\">{rmse}</td>" in page and "did not settle" in page
+    assert f"<td class=\"num\">{rmse}</td>" in page and "no overshoot" in page
     assert "RMSE after the transient [m]" in page and "effort about hover [s]" in page
     assert "10-90 % of the step" in page and "u_hover = m g / (4 K)" in page
     imgs = [a for a in dom.find("img")]
@@ -182,8 +182,11 @@ def test_builders(rep):
     table = kw["tables"]["Results against the paper"]
     assert len(table) == 4 and table["paper: settling_time_s"].tolist() == [2.0, 12.0, 2.0, 12.0]
     assert "<strong>Rise time" in kw["notes"] and "<h3>" in kw["notes"]
+    dom = fitted_nlpd_loop()["dom_pole"]                  # computed from analyze's linearised loop
+    assert f"dominant pair at {dom.real:.2f} +- {dom.imag:.2f}j" in " ".join(kw["notes"].split())
+    assert "does not say which convention" in kw["notes"]
     page = html_report(**kw)
-    assert page.count("<canvas") == 2 and "did not settle" in page
+    assert page.count("<canvas") == 2 and "did not settle" not in page
 
 
 def test_a_single_flight_is_not_called_vehicle_0():

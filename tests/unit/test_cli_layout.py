@@ -71,4 +71,5 @@ def test_the_entry_points_stay():
 
     module = importlib.import_module("quadcruise.cli.main")
     assert module.main is main and quadcruise.cli.main is main and quadcruise.cli.run is module.run
-    assert set(main.commands) == {"analyze", "compare", "fly", "montecarlo", "replay", "reproduce", "tune"}
+    assert set(main.commands) == {"analyze", "compare", "fly", "identify", "montecarlo", "replay", "reproduce", "tune",
+                                  "vehicles"}

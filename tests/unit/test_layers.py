@@ -30,6 +30,7 @@ RANKS = {
     "quadcruise.control": 7,
     "quadcruise.disturbances": 8,
     "quadcruise.workflows": 9,
+    "quadcruise.sysid": 9,
     "quadcruise.montecarlo": 10,
     "quadcruise.tune": 11,
     "quadcruise.report": 12,

@@ -1,5 +1,6 @@
 """What the commands share: their common options, the error handling that turns bad input
-into one line ``error: ...`` with exit status 2, and the parsing of the options that name a
+into one line ``error: ...`` with exit status 2 (and a fault of the machine, Ctrl-C, into one
+line too: :mod:`quadcruise.cli.faults`), and the parsing of the options that name a
 mission or a controller."""
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ from typing import Callable
 
 import click
 
+from quadcruise.cli.faults import EXIT_FAULT, fault_text, interrupt_text
 from quadcruise.cli.feedback import Bar, close_bars, compile_notice
 from quadcruise.cli.objects import controller_from_options, mission_from_options
 from quadcruise.errors import InputError
@@ -109,7 +111,8 @@ RISE_OPTION = click.option("--rise", type=click.Choice(["10-90", "0-100"]), defa
                            help="Rise time between these percents of the step.")
 SETTLE_BAND_OPTION = click.option("--settle-band", "settle_bands", type=float, multiple=True, metavar="FRACTION",
                                   help="Settling band, a fraction of the step (default 0.02, then 0.05): the first "
-                                       "gives settling_time_s, a second (0.05 if left out) a column named after it.")
+                                       "gives settling_time_s, a second (0.05 if left out; 0.02 beside a first "
+                                       "0.05) a column named after it.")
 
 
 def metric_options(rise: str = "10-90", settle_bands: tuple[float, ...] = ()) -> dict:
@@ -137,8 +140,10 @@ def metric_options(rise: str = "10-90", settle_bands: tuple[float, ...] = ()) ->
 
 def friendly(func: Callable) -> Callable:
     """Wrap a command: InputError becomes one line on stderr, ``error: ...``, and exit status
-    2; every warning raised meanwhile is shown plainly, ``warning: ...``; a progress bar still
-    open is closed first, and on a terminal numba's first compilation is announced
+    2; a fault of the machine (an ``OSError``: a file it could not write), Ctrl-C and SIGTERM
+    one line each too, with the statuses of :mod:`quadcruise.cli.faults`; every warning
+    raised meanwhile is shown plainly, ``warning: ...``; a progress bar still open is closed
+    first, and on a terminal numba's first compilation is announced
     (:mod:`quadcruise.cli.feedback`).
 
     Parameters
@@ -162,6 +167,15 @@ def friendly(func: Callable) -> Callable:
                 close_bars()
                 click.echo(f"error: {exc}", err=True)
                 sys.exit(2)
+            except OSError as exc:
+                close_bars()
+                click.echo(f"error: {fault_text(exc)}", err=True)
+                sys.exit(EXIT_FAULT)
+            except KeyboardInterrupt as exc:
+                close_bars()
+                text, status = interrupt_text(exc)
+                click.echo(("\n" if sys.stderr.isatty() else "") + f"error: {text}", err=True)   # after a ^C
+                sys.exit(status)
             finally:
                 close_bars()
                 for w in caught:

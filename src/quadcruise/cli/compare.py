@@ -18,7 +18,13 @@ from quadcruise.cli.common import (
     needs_out,
     writable,
 )
-from quadcruise.cli.compare_run import compared_from_options, echo_population_comparison, population_from_options
+from quadcruise.cli.compare_run import (
+    compared_from_options,
+    echo_population_comparison,
+    population_from_options,
+    population_record,
+)
+from quadcruise.cli.world import flight_world, note, world_options
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["compare"]
@@ -36,15 +42,18 @@ __all__ = ["compare"]
 @FORCE_OPTION
 @click.option("--population", type=int, metavar="N",
               help="Also fly every controller on the same Monte Carlo population of N vehicles.")
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the population.")
-@click.option("--mass-spread", type=float, default=0.1, show_default=True, help="Relative std of the mass.")
-@click.option("--wind", metavar="SPEC", help="Wind of the population, e.g. dryden:moderate@10.")
+@click.option("--seed", type=int, help="Seed of every random draw: the population's, and the turbulence and "
+              "sensor noise of every flight (default 0, or the scenario's).")
+@click.option("--mass-spread", type=float, help="Relative std of the population's mass (default 0.1).")
+@world_options(wind_help="Wind of every flight (and of the population): constant:WX,WY,WZ | "
+               "gust:AX,AY,AZ@START+DURATION | dryden:light|moderate|severe@ALTITUDE | loss:ROTOR,FRACTION@TIME "
+               "(comma-separable; none: still air).", seed=False)
 @REPORT_OPTION
 @RISE_OPTION
 @SETTLE_BAND_OPTION
 @friendly
-def compare(mission, controllers, duration, dt, mission_params, out, force, population, seed, mass_spread, wind,
-            report, rise, settle_bands):
+def compare(mission, controllers, duration, dt, mission_params, out, force, population, seed, mass_spread,
+            vehicle, controller_vehicle, wind, turbulence, log_every, report, rise, settle_bands):
     """Fly MISSION (a name or a waypoint CSV) with several controllers; one table, one figure.
 
     \f
@@ -67,14 +76,23 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
         ``--force``: replace a non-empty ``out`` folder that quadcruise did not write.
     population : int or None
         ``--population``: also fly every controller on the same Monte Carlo population of this
-        many perturbed vehicles; None: the nominal vehicle only.
-    seed : int
-        ``--seed``: seed of the population.
-    mass_spread : float
-        ``--mass-spread``: relative standard deviation of the population's mass.
-    wind : str or None
-        ``--wind``: wind of the population, a :func:`~quadcruise.disturbances.environment.parse_wind`
-        spec such as ``dryden:moderate@10``; None: no wind.
+        many perturbed vehicles; None: the scenario's ``[compare] population``, else the
+        nominal vehicle only.
+    seed : int or None
+        ``--seed``: seed of the population and of every flight's turbulence and sensor noise;
+        None: the scenario's, else 0.
+    mass_spread : float or None
+        ``--mass-spread``: relative standard deviation of the population's mass; None: the
+        scenario's, else 0.1.
+    vehicle, controller_vehicle : str or None
+        ``--vehicle``, ``--controller-vehicle``: the flown (nominal) vehicle and the
+        controllers' model of it (:func:`~quadcruise.cli.objects.vehicle_from_option`).
+    wind, turbulence : str or None
+        ``--wind``: the flights' (and the population's) disturbances, a
+        :func:`~quadcruise.disturbances.environment.parse_wind` spec such as
+        ``dryden:moderate@10``, replacing a scenario's; ``--turbulence``: Dryden turbulence added.
+    log_every : int or None
+        ``--log-every``: log every this many control periods.
     report : str or None
         ``--report``: path of a self-contained HTML report to write as well; None: no report.
     rise : str
@@ -82,25 +100,40 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
     settle_bands : tuple of float
         ``--settle-band``: the settling bands (fractions of the step), given once or twice.
     """
+    import dataclasses
+
+    from quadcruise.errors import whole_number
     from quadcruise.workflows.compare import compare as run_compare
 
     needs_out(out, force=force)
     conventions = metric_options(rise, settle_bands)
+    if log_every is not None:
+        whole_number(log_every, "--log-every", minimum=1)
     if out is not None:
         check_output_dir(out, force)
-    cmp_mission, chosen, kwargs = compared_from_options(mission, controllers, mission_params)
-    kwargs.update({k: v for k, v in (("duration", duration), ("dt", dt)) if v is not None})
-    pop = population_from_options(population, seed, mass_spread, wind)      # checked before anything flies
-    if population is not None:
+    cmp_mission, chosen, kwargs, scenario = compared_from_options(mission, controllers, mission_params)
+    world, notes = flight_world(vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind,
+                                turbulence=turbulence, scenario=scenario)
+    kwargs = {**{k: v for k, v in kwargs.items() if k not in world},
+              **{k: v for k, v in world.items() if v is not None}}
+    kwargs.update({k: v for k, v in (("duration", duration), ("dt", dt), ("log_every", log_every)) if v is not None})
+    count, pop_seed, pop = population_from_options(population, seed, mass_spread, scenario,
+                                                   kwargs.get("environment"), kwargs.get("sensors"))
+    if seed is not None or "seed" not in kwargs:           # the flights' seed: given, the scenario's, the population's
+        kwargs["seed"] = pop_seed if seed is None else seed
+    if count is not None:
         from quadcruise.montecarlo.sweep import check_sweep_size
         from quadcruise.workflows.fly import default_duration
 
         duration_s = kwargs.get("duration") or default_duration(cmp_mission)
-        check_sweep_size(population, round(duration_s / kwargs.get("dt", 1e-3)))
+        check_sweep_size(count, round(duration_s / kwargs.get("dt", 1e-3)))
+    for line in notes:
+        note(line)
     cmp = run_compare(cmp_mission, chosen, progress=Bar("flying", unit="controller"), **kwargs)
     click.echo(cmp.text(**conventions))
-    if population is not None:
-        echo_population_comparison(cmp_mission, chosen, population, seed, pop, wind, kwargs)
+    if count is not None:
+        table = echo_population_comparison(cmp_mission, cmp.controllers, count, pop_seed, pop, kwargs)
+        cmp = dataclasses.replace(cmp, population=population_record(count, pop_seed, pop), population_table=table)
     if out is not None:
         cmp.write(out, force=force, **conventions)
         click.echo(f"wrote metrics.csv and comparison.png to {out}")

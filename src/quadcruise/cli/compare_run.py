@@ -8,89 +8,129 @@ import click
 
 from quadcruise.cli.common import Bar
 from quadcruise.cli.objects import mission_from_options
+from quadcruise.cli.vehicle import refuse_vehicle_fields
 from quadcruise.errors import InputError
 
-__all__ = ["DEFAULT_COMPARED", "compared_from_options", "population_from_options", "echo_population_comparison"]
+__all__ = ["DEFAULT_COMPARED", "compared_from_options", "echo_population_comparison", "population_from_options",
+           "population_record"]
 
 
-def population_from_options(n: int | None, seed: int, mass_spread: float, wind: str | None):
-    """The population that ``--population``, ``--seed``, ``--mass-spread`` and ``--wind`` describe,
-    checked even when ``--population`` is not given (so that no bad value passes unseen).
+def population_from_options(n: int | None, seed: int | None, mass_spread: float | None, scenario=None,
+                            environment=None, sensors=None):
+    """The population that ``--population``, ``--seed`` and ``--mass-spread`` describe, a
+    scenario's ``[compare] population`` changed by them; checked before anything flies.
 
     Parameters
     ----------
     n : int or None
-        ``--population``: number of vehicles; None: none flown.
-    seed : int
-        ``--seed``.
-    mass_spread : float
-        ``--mass-spread``: relative standard deviation of the mass.
-    wind : str or None
-        ``--wind``: a :func:`~quadcruise.disturbances.environment.parse_wind` spec.
+        ``--population``: number of vehicles; None: the scenario's, else none flown.
+    seed : int or None
+        ``--seed``: the population's seed (and the flights'); None: the scenario's, else 0.
+    mass_spread : float or None
+        ``--mass-spread``: relative standard deviation of the mass; None: the scenario's, else 0.1.
+    scenario : Scenario, optional
+        Its ``compare_population`` (n, seed, the spreads) is the starting point.
+    environment, sensors : optional
+        The flights' disturbances and sensor noise, which the population meets too.
 
     Returns
     -------
-    Population
+    (int or None, int, Population or None)
+        The number of vehicles, the seed, the population (None when none is flown).
 
     Raises
     ------
     InputError
-        A bad value, or ``--seed``, ``--mass-spread`` or ``--wind`` without ``--population``.
+        A bad value; ``--mass-spread`` without a population; a population that perturbs nothing.
     """
-    from quadcruise.disturbances.environment import parse_wind
     from quadcruise.errors import whole_number
     from quadcruise.montecarlo.api import Population
 
+    table = dict(scenario.compare_population) if scenario is not None else {}
     if n is not None:
         whole_number(n, "--population", minimum=1)
-    whole_number(seed, "--seed")
-    if n is None:
-        defaults = (("--seed", seed, 0), ("--mass-spread", mass_spread, 0.1), ("--wind", wind, None))
-        given = [option for option, value, default in defaults if value != default]
-        if given:
-            raise InputError(f"{given[0]} describes the population that --population N flies; without it, "
+        table["n"] = n
+    if seed is not None:
+        whole_number(seed, "--seed")
+        table["seed"] = seed
+    if mass_spread is not None:
+        table["mass_spread"] = mass_spread
+    if "n" not in table:
+        if mass_spread is not None:
+            raise InputError("--mass-spread describes the population that --population N flies; without it, "
                              "it would change nothing")
-    env = parse_wind(wind) if wind else None
-    return Population(mass_spread=mass_spread, environment=env if env is not None and env.parts else None)
+        return None, table.get("seed", 0), None
+    count, pop_seed = table.pop("n"), table.pop("seed", 0)
+    table.setdefault("mass_spread", 0.1)
+    pop = Population(**table, environment=environment if environment is not None and environment.parts else None,
+                     noise=sensors)
+    pop.check_perturbs(count, hint="a --mass-spread > 0, turbulence (--turbulence "
+                       "moderate) or a scenario's sensor noise or spreads ([compare] population)")
+    return count, pop_seed, pop
 
 
-def echo_population_comparison(mission, controllers: str, n: int, seed: int, pop, wind: str | None,
-                               flight: dict) -> None:
+def population_record(n: int, seed: int, pop) -> dict:
+    """``[compare] population`` of a scenario: what :func:`population_from_options` reads back.
+
+    Parameters
+    ----------
+    n, seed : int
+        Number of vehicles and seed.
+    pop : Population
+        The population (its disturbances are the flights' own, recorded with them).
+
+    Returns
+    -------
+    dict
+        ``n``, ``seed`` and the population's fields that differ from the defaults (the mass
+        spread always).
+    """
+    import dataclasses
+
+    from quadcruise.montecarlo.api import Population
+
+    default = Population()
+    fields = {f.name: getattr(pop, f.name) for f in dataclasses.fields(pop) if f.name not in ("environment", "noise")}
+    kept = {k: v for k, v in fields.items() if k == "mass_spread" or v != getattr(default, k)}
+    return {"n": int(n), "seed": int(seed), **kept}
+
+
+def echo_population_comparison(mission, controllers, n: int, seed: int, pop, flight: dict):
     """Fly the controllers on the same perturbed vehicles, in this process; print one row each.
 
     Parameters
     ----------
     mission : Mission
-    controllers : str
-        Comma-separated controller names.
+    controllers : str or dict
+        Comma-separated controller names, or label -> controller.
     n : int
         Number of vehicles.
     seed : int
         Seed of the population.
     pop : Population
-        The population (:func:`population_from_options`).
-    wind : str or None
-        The ``--wind`` spec, for the printed headline.
+        The population (:func:`population_from_options`), its disturbances the flights'.
     flight : dict
-        The nominal flights' keywords (a scenario's): its ``vehicle`` is the population's
-        nominal, its ``environment`` and ``sensors`` act unless ``--wind`` replaces the
-        first; ``duration``, ``dt``, ``max_step`` and ``full_dynamics`` as the nominal flights.
-    """
-    import dataclasses
+        The nominal flights' keywords: its ``vehicle`` is the population's nominal (given
+        drag already where wind meets it), its ``controller_vehicle`` the controllers' model;
+        ``duration``, ``dt``, ``max_step`` and ``full_dynamics`` as the nominal flights.
 
+    Returns
+    -------
+    pandas.DataFrame
+        :func:`quadcruise.montecarlo.compare.compare_population`'s table.
+    """
     from quadcruise.montecarlo.compare import compare_population
 
-    if pop.environment is None and flight.get("environment") is not None and flight["environment"].parts:
-        pop = dataclasses.replace(pop, environment=flight["environment"])
-    if pop.noise is None and flight.get("sensors") is not None:
-        pop = dataclasses.replace(pop, noise=flight["sensors"])
-    same = {k: flight[k] for k in ("vehicle", "max_step", "full_dynamics") if flight.get(k) is not None}
+    same = {k: flight[k] for k in ("vehicle", "controller_vehicle", "max_step", "full_dynamics")
+            if flight.get(k) is not None}
     table = compare_population(mission, controllers, pop, n, seed, duration=flight.get("duration"),
                                dt=flight.get("dt", 1e-3), scheduler="none",
                                progress=Bar("flying the population", unit="flight"), **same)
+    world = ", ".join(pop.environment.parts) if pop.environment is not None else ""
     click.echo(f"\nthe same {n} perturbed vehicles (seed {seed}, mass spread {pop.mass_spread:g}"
-               + (f", wind {wind}" if wind else "") + "):")
+               + (f", {world}" if world else "") + "):")
     click.echo(table.to_string(float_format=lambda v: f"{v:.4g}"))
+    return table
 
 
 DEFAULT_COMPARED = "nlpd,gonzalez,se3,cascade"
@@ -112,21 +152,24 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
 
     Returns
     -------
-    (Mission, str or dict, dict)
-        The mission, the controllers (names, or label -> controller) and the keywords.
+    (Mission, str or dict, dict, Scenario or None)
+        The mission, the controllers (names, or label -> controller), the keywords (the
+        scenario's vehicle as written, without drag added) and the scenario read.
     """
     from quadcruise.fields import parse_assignments
 
     if not mission.lower().endswith(".toml"):
         chosen = DEFAULT_COMPARED if controllers is None else controllers
-        return mission_from_options(mission, mission_params, smooth=False), chosen, {}
+        return mission_from_options(mission, mission_params, smooth=False), chosen, {}, None
     from quadcruise.missions import mission_from_name
     from quadcruise.workflows.scenario import load_scenario
 
     scenario = load_scenario(mission)
     the_mission = scenario.mission or mission_from_name("circle")
     if mission_params:
-        the_mission = the_mission.replace(**parse_assignments(mission_params, "--mission-param"))
+        changes = parse_assignments(mission_params, "--mission-param")
+        refuse_vehicle_fields(changes, type(the_mission))
+        the_mission = the_mission.replace(**changes)
     chosen = controllers if controllers is not None else scenario.compare or (
         {scenario.controller.name: scenario.controller} if scenario.controller is not None else DEFAULT_COMPARED)
-    return the_mission, chosen, scenario.fly_kwargs()
+    return the_mission, chosen, scenario.fly_kwargs(drag=False), scenario

@@ -6,7 +6,6 @@ from __future__ import annotations
 import sys
 
 import click
-import numpy as np
 
 from quadcruise.cli.common import (
     FORCE_OPTION,
@@ -14,14 +13,14 @@ from quadcruise.cli.common import (
     REPORT_OPTION,
     RISE_OPTION,
     SETTLE_BAND_OPTION,
-    Bar,
     friendly,
     metric_options,
     needs_out,
     writable,
 )
+from quadcruise.cli.fly_run import fly_and_report
 from quadcruise.cli.objects import flight_from_options
-from quadcruise.io.files import check_output_dir
+from quadcruise.cli.world import WORLD_OPTIONS, flight_world
 
 __all__ = ["fly"]
 
@@ -45,12 +44,14 @@ __all__ = ["fly"]
 @REPORT_OPTION
 @click.option("--animate", type=click.Path(dir_okay=False), metavar="PATH.gif", callback=writable,
               help="Also write an animation of the flight (.gif; .mp4 needs ffmpeg).")
+@WORLD_OPTIONS
 @RISE_OPTION
 @SETTLE_BAND_OPTION
 @friendly
 def fly(mission, controller, duration, dt, max_step, mission_params, controller_params, position_poles,
-        out, fmt, force, smooth, report, animate, rise, settle_bands):
-    """Fly a MISSION with a controller on the paper's vehicle and print its metrics.
+        out, fmt, force, smooth, report, animate, vehicle, controller_vehicle, wind, turbulence, log_every, seed,
+        rise, settle_bands):
+    """Fly a MISSION with a controller on the paper's vehicle (or --vehicle) and print its metrics.
 
     MISSION is circle, square, step, hover, a waypoint CSV (columns x,y,z and optional yaw
     and t or speed), flown as constant-speed legs or, with --smooth, a minimum-snap path, or
@@ -97,89 +98,44 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
     animate : str or None
         ``--animate``: path of an animation of the flight to write as well (``.gif``, or
         ``.mp4`` with ffmpeg); None: no animation.
+    vehicle, controller_vehicle : str or None
+        ``--vehicle``, ``--controller-vehicle``: the flown vehicle and the controller's model of
+        it (:func:`~quadcruise.cli.objects.vehicle_from_option`); None: the scenario's, else
+        Table I and the flown vehicle.
+    wind, turbulence : str or None
+        ``--wind``: a :func:`~quadcruise.disturbances.parse_wind` spec replacing the scenario's
+        disturbances; ``--turbulence``: Dryden turbulence added
+        (:func:`~quadcruise.cli.objects.environment_from_options`).
+    log_every : int or None
+        ``--log-every``: log every this many control periods; None: the scenario's, else 1.
+    seed : int or None
+        ``--seed``: seed of the turbulence and the sensor noise; None: the scenario's, else 0.
     rise : {"10-90", "0-100"}
         ``--rise``: the rise-time convention (% of the step).
     settle_bands : tuple of float
         ``--settle-band``: the settling bands (fractions of the step), given once or twice.
     """
+    from quadcruise.errors import whole_number
+
     needs_out(out, force=force, format=fmt != "csv")
     conventions = metric_options(rise, settle_bands)
-    overrides = {k: v for k, v in (("duration", duration), ("dt", dt), ("max_step", max_step)) if v is not None}
-    given = [f"--{k.replace('_', '-')} {v}" for k, v in overrides.items()] + [f"-m {p}" for p in mission_params] \
-        + [f"-c {p}" for p in controller_params] + ([f"--controller {controller}"] if controller else []) \
+    if seed is not None:
+        whole_number(seed, "--seed")
+    if log_every is not None:
+        whole_number(log_every, "--log-every", minimum=1)
+    overrides = {k: v for k, v in (("duration", duration), ("dt", dt), ("max_step", max_step), ("seed", seed),
+                                   ("log_every", log_every)) if v is not None}
+    world = {"vehicle": vehicle, "controller_vehicle": controller_vehicle, "wind": wind, "turbulence": turbulence}
+    given = [f"--{k.replace('_', '-')} {v}" for k, v in {**overrides, **world}.items() if v is not None] \
+        + [f"-m {p}" for p in mission_params] + [f"-c {p}" for p in controller_params] \
+        + ([f"--controller {controller}"] if controller else []) \
         + ([f"--poles {position_poles}"] if position_poles else [])
     the_mission, the_controller, kwargs, scenario = flight_from_options(
         mission, controller, mission_params, controller_params, position_poles, smooth)
-    kwargs = {**kwargs, **overrides}
-    result = _fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate, given, scenario,
-                             conventions)
+    flown, notes = flight_world(**world, scenario=scenario)
+    kwargs = {**{k: v for k, v in kwargs.items() if k not in flown}, **overrides,
+              **{k: v for k, v in flown.items() if v is not None}}
+    result = fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate, given, scenario,
+                             conventions, notes)
     if not result.ok.all():
         sys.exit(1)             # a vehicle did not fly its mission: diverged, lost track, out of bounds
-
-
-def _fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=None, animate=None, given=(),
-                    scenario=None, conventions=None):
-    """Fly, print the metrics and each unfinished vehicle's reason, and write what was asked for.
-
-    Parameters
-    ----------
-    mission : Mission
-    controller : Controller
-    kwargs : dict
-        More keywords of :func:`quadcruise.workflows.fly.fly` (duration, dt, vehicle, ...).
-    out : str or None
-        Folder for the traces, figure, metrics and configuration.
-    fmt : {"csv", "parquet"}
-        Format of the traces.
-    force : bool
-        Replace a non-empty ``out`` that quadcruise did not write.
-    report : str, optional
-        Path of an HTML report.
-    animate : str, optional
-        Path of an animation (.gif, or .mp4 with ffmpeg).
-    given : sequence of str
-        The options given on the command line, recorded with the flight (``meta["command_line"]``).
-    scenario : Scenario, optional
-        The scenario file flown, recorded with the flight (source and title).
-    conventions : dict, optional
-        ``rise`` and ``settle_bands`` of the metrics (:func:`~quadcruise.cli.common.metric_options`).
-
-    Returns
-    -------
-    SimResult
-        The flight.
-    """
-    from quadcruise.metrics.tables import conventions_text, vehicle_metrics_text
-    from quadcruise.workflows.fly import fly as run_fly
-    from quadcruise.workflows.fly import write_flight
-
-    if animate is not None:
-        from quadcruise.plots.animate import check_animation_path
-
-        check_animation_path(animate)       # suffix, and ffmpeg for .mp4: before anything flies
-    if out is not None:
-        check_output_dir(out, force)
-    result = run_fly(mission, controller, **kwargs)
-    result.meta["command_line"] = list(given)
-    if scenario is not None:
-        result.meta["scenario"] = {"source": scenario.source, "title": scenario.title}
-    metrics = result.metrics(**(conventions or {}))
-    click.echo(f"{controller.name} on {mission.name}: {result.t[-1]:g} s at dt = {result.meta['dt_s']:g} s")
-    click.echo(vehicle_metrics_text(metrics))
-    click.echo(conventions_text(metrics.attrs.get("conventions")))
-    for i in np.flatnonzero(~result.ok):
-        click.echo(f"vehicle {i} did not fly its mission: {result.status_text(int(i))}")
-    if out is not None:
-        write_flight(result, out, fmt, metrics=metrics)
-        click.echo(f"wrote traces, figure and metrics to {out}")
-    if report is not None:
-        from quadcruise.report.html import flight_report, write_html_report
-
-        write_html_report(report, **flight_report(result, metrics=metrics))
-        click.echo(f"wrote report {report}")
-    if animate is not None:
-        from quadcruise.plots.animate import animate_flight
-
-        animate_flight(result, animate, progress=Bar("drawing the animation", unit="frame"))
-        click.echo(f"wrote animation {animate}")
-    return result

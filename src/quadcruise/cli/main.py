@@ -3,11 +3,14 @@
 The group lives here, each command in its own module (:mod:`quadcruise.cli.fly`,
 :mod:`~quadcruise.cli.replay`, :mod:`~quadcruise.cli.reproduce`,
 :mod:`~quadcruise.cli.compare`, :mod:`~quadcruise.cli.analyze`,
-:mod:`~quadcruise.cli.montecarlo`, :mod:`~quadcruise.cli.tune`), what they share in :mod:`quadcruise.cli.common`;
+:mod:`~quadcruise.cli.montecarlo`, :mod:`~quadcruise.cli.tune`, :mod:`~quadcruise.cli.vehicles`,
+:mod:`~quadcruise.cli.identify`), what they share in :mod:`quadcruise.cli.common`;
 the larger commands keep what they run after parsing in a ``*_run`` module beside them
 (:mod:`~quadcruise.cli.compare_run`, :mod:`~quadcruise.cli.montecarlo_run`, :mod:`~quadcruise.cli.tune_run`).
 Bad input prints one line, ``error: ...``, and exits with status 2; a flight that did not
-finish (``fly``, ``compare``, ``reproduce``) or a tune that missed its targets, status 1.
+finish (``fly``, ``compare``, ``reproduce``) or a tune that missed its targets, status 1; a
+file or standard output that could not be written, one line and status 74; Ctrl-C, 130;
+SIGTERM, 143 (:mod:`quadcruise.cli.faults`).
 """
 
 from __future__ import annotations
@@ -20,11 +23,14 @@ import click
 from quadcruise._version import __version__
 from quadcruise.cli.analyze import analyze
 from quadcruise.cli.compare import compare
+from quadcruise.cli.faults import EXIT_FAULT, fault_text, guard_stdout, interrupt_text, stop_on_sigterm
 from quadcruise.cli.fly import fly
+from quadcruise.cli.identify import identify
 from quadcruise.cli.montecarlo import montecarlo
 from quadcruise.cli.replay import replay
 from quadcruise.cli.reproduce import reproduce
 from quadcruise.cli.tune import tune
+from quadcruise.cli.vehicles import vehicles
 
 __all__ = ["main", "run"]
 
@@ -42,11 +48,16 @@ main.add_command(compare)
 main.add_command(analyze)
 main.add_command(montecarlo)
 main.add_command(tune)
+main.add_command(vehicles)
+main.add_command(identify)
 
 
 def run() -> None:
     """Entry point: click's own usage errors become one line with exit status 2 too.
 
+    Standard output is guarded (:func:`~quadcruise.cli.faults.guard_stdout`): a write that
+    fails is one line and status 74, a reader that stops reading drops the rest quietly.
+    SIGTERM stops a command as Ctrl-C does (:func:`~quadcruise.cli.faults.stop_on_sigterm`).
     The process ends here, so what it made is first moved out of the garbage collector's
     sight (``gc.freeze``): the interpreter's last collection at exit would otherwise walk
     every object that numba, pandas and matplotlib left, about 0.2 s.
@@ -54,20 +65,29 @@ def run() -> None:
     Raises
     ------
     SystemExit
-        Always: 0 on success, 2 for bad input, 130 when interrupted, else the command's status.
+        Always: 0 on success, 2 for bad input, 74 for a file or standard output that could
+        not be written, 130 when interrupted, 143 when terminated, else the command's status.
     """
-    if len(sys.argv) <= 1:                  # bare `quadcruise`: the usage, as --help gives it
-        with click.Context(main, info_name="quadcruise") as ctx:
-            click.echo(main.get_help(ctx))
-        sys.exit(0)
+    guard_stdout()
+    stop_on_sigterm()
     try:
-        code = main(standalone_mode=False)
+        if len(sys.argv) <= 1:              # bare `quadcruise`: the usage, as --help gives it
+            with click.Context(main, info_name="quadcruise") as ctx:
+                click.echo(main.get_help(ctx))
+            code = 0
+        else:
+            code = main(standalone_mode=False)
+        sys.stdout.flush()                  # a fault of standard output is said here, not at exit
     except click.exceptions.UsageError as exc:
         click.echo(f"error: {exc.format_message()}", err=True)
         sys.exit(2)
-    except (click.exceptions.Abort, KeyboardInterrupt):
-        click.echo("error: interrupted (a montecarlo sweep with --out resumes if run again)", err=True)
-        sys.exit(130)
+    except OSError as exc:                  # outside a command: --help, --version
+        click.echo(f"error: {fault_text(exc)}", err=True)
+        sys.exit(EXIT_FAULT)
+    except (click.exceptions.Abort, KeyboardInterrupt) as exc:
+        text, status = interrupt_text(exc if isinstance(exc, KeyboardInterrupt) else KeyboardInterrupt())
+        click.echo(f"error: {text}", err=True)
+        sys.exit(status)
     finally:
         gc.freeze()
     sys.exit(code if isinstance(code, int) else 0)

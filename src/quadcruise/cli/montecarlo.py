@@ -9,6 +9,7 @@ import click
 
 from quadcruise.cli.common import friendly, writable
 from quadcruise.cli.montecarlo_run import montecarlo_command, parse_noise
+from quadcruise.cli.world import world_options
 
 __all__ = ["montecarlo", "montecarlo_command", "parse_noise"]
 
@@ -21,8 +22,8 @@ __all__ = ["montecarlo", "montecarlo_command", "parse_noise"]
 @click.option("--seed", type=int, show_default="0", help="Seed of every random draw.")
 @click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
 @click.option("--dt", type=float, help="Control period [s] (default 0.001, or the scenario's).")
-@click.option("--wind", metavar="SPEC", help="Wind: constant:WX,WY,WZ | gust:AX,AY,AZ@START+DURATION | "
-              "dryden:light|moderate|severe@ALTITUDE (comma-separable).")
+@world_options(wind_help="Wind of every flight: constant:WX,WY,WZ | gust:AX,AY,AZ@START+DURATION | "
+               "dryden:light|moderate|severe@ALTITUDE | loss:ROTOR,FRACTION@TIME (comma-separable).", seed=False)
 @click.option("--wind-spread", type=float, show_default="0",
               help="Std of a random steady horizontal wind per flight [m/s].")
 @click.option("--mass-spread", type=float, show_default="0", help="Relative std of the mass.")
@@ -81,9 +82,18 @@ def montecarlo(**options):
             ``--duration``: flight time [s]; None: the scenario's, else the mission's.
         dt : float or None
             ``--dt``: control period [s]; None: the scenario's, else 0.001 s.
+        vehicle, controller_vehicle : str or None
+            ``--vehicle``: the nominal vehicle (the population's centre);
+            ``--controller-vehicle``: the vehicle every controller believes it flies (its model;
+            default the nominal one). See :func:`~quadcruise.cli.objects.vehicle_from_option`.
         wind : str or None
             ``--wind``: wind, gust and turbulence of every flight, a
             :func:`~quadcruise.disturbances.parse_wind` spec; None: the scenario's, else none.
+        turbulence : str or None
+            ``--turbulence``: Dryden turbulence added (its random stream differs by vehicle).
+        log_every : int or None
+            ``--log-every``: the metrics are measured on a log of every this many control
+            periods (the spec's ``log_dt``; default 10 ms).
         wind_spread : float or None
             ``--wind-spread``: standard deviation of a random steady horizontal wind drawn per
             flight [m/s].

@@ -5,6 +5,7 @@ in :mod:`quadcruise.cli.montecarlo`, which re-exports these."""
 
 from __future__ import annotations
 
+import warnings
 from typing import TYPE_CHECKING, Callable
 
 import click
@@ -69,6 +70,8 @@ def montecarlo_command(*, mission: str | None = None, controller: str | None = N
                        force: bool = False, resume: bool = True, fmt: str = "csv", case: int | None = None,
                        worst: int = 5, quiet: bool = False, scenario: str | None = None,
                        requirements: tuple[str, ...] = (), max_track_error_m: float | None = None,
+                       vehicle: str | None = None, controller_vehicle: str | None = None,
+                       turbulence: str | None = None, log_every: int | None = None,
                        echo: Callable[[str], None] = click.echo) -> MonteCarloResult | Case:
     """What ``quadcruise montecarlo`` runs: build the population, fly it (or one case), print
     the summary and the worst flights, write ``out``.
@@ -80,6 +83,14 @@ def montecarlo_command(*, mission: str | None = None, controller: str | None = N
         ``scenario`` file's value, else the default).
     wind, noise : str, optional
         A :func:`~quadcruise.disturbances.parse_wind` spec and a :func:`parse_noise` one.
+    turbulence : str, optional
+        Dryden turbulence added (:func:`~quadcruise.cli.objects.environment_from_options`).
+    vehicle, controller_vehicle : str, optional
+        The nominal vehicle and the controllers' model
+        (:func:`~quadcruise.cli.objects.vehicle_from_option`); ``KEY=VALUE`` fields change the
+        scenario's.
+    log_every : int, optional
+        Control periods between the logged instants the metrics are measured on.
     mass_spread, inertia_spread, thrust_spread, bandwidth_spread, yaw_arm_spread, wind_spread, \
 offset, distribution, model_error : optional
         :class:`~quadcruise.montecarlo.Population` fields.
@@ -92,7 +103,7 @@ offset, distribution, model_error : optional
     worst, quiet : int, bool
         How many worst flights to print; no progress bar.
     echo : callable
-        Prints one text.
+        Prints one text (the notes before flying go to stderr, :func:`quadcruise.cli.world.note`).
 
     Returns
     -------
@@ -127,22 +138,53 @@ offset, distribution, model_error : optional
             chunk_size = int(chunk_size)
         except ValueError:
             raise InputError(f"--chunk-size must be a whole number or auto, got {chunk_size!r}") from None
-    spec, n = sweep_spec(mission=mission, controller=controller, n=n, seed=seed, duration=duration, dt=dt,
-                         environment=parse_wind(wind) if wind is not None else None, noise=parse_noise(noise),
-                         scenario=scenario, mass_spread=mass_spread, inertia_spread=inertia_spread,
-                         thrust_spread=thrust_spread, bandwidth_spread=bandwidth_spread, offset=offset,
-                         yaw_arm_spread=yaw_arm_spread, wind_spread=wind_spread, distribution=distribution,
-                         model_error=model_error, requirements=requirements, max_track_error_m=max_track_error_m)
-    if case is not None:
+    if log_every is not None:
+        whole_number(log_every, "--log-every", minimum=1)
+    from quadcruise.cli.vehicle import vehicle_from_option
+    from quadcruise.cli.world import environment_from_options, note
+    from quadcruise.model.vehicle import Vehicle
+    from quadcruise.workflows.scenario import load_scenario
+
+    sc = load_scenario(scenario) if scenario is not None else None
+
+    nominal = vehicle_from_option(vehicle, "--vehicle", sc.vehicle if sc is not None else None)
+    believed = vehicle_from_option(controller_vehicle, "--controller-vehicle",
+                                   sc.controller_vehicle if sc is not None and sc.controller_vehicle else None)
+    environment = None
+    if wind is not None or turbulence is not None:
+        environment = environment_from_options(wind, turbulence, sc.environment if sc is not None else None)
+        environment = environment if environment is not None else parse_wind("none")    # given as still air
+    with warnings.catch_warnings(record=True) as caught:       # the default drag, said before flying
+        warnings.simplefilter("always")
+        spec, n = sweep_spec(mission=mission, controller=controller, n=n, seed=seed, duration=duration, dt=dt,
+                             environment=environment, noise=parse_noise(noise),
+                             scenario=scenario, mass_spread=mass_spread, inertia_spread=inertia_spread,
+                             thrust_spread=thrust_spread, bandwidth_spread=bandwidth_spread, offset=offset,
+                             yaw_arm_spread=yaw_arm_spread, wind_spread=wind_spread, distribution=distribution,
+                             model_error=model_error, requirements=requirements,
+                             max_track_error_m=max_track_error_m, vehicle=nominal, controller_vehicle=believed,
+                             log_every=log_every)
+    notes = [str(w.message) for w in caught]
+    if nominal is not None and spec.controller_vehicle is None and spec.population.model_error \
+            and nominal != Vehicle.paper():
+        notes.insert(0, f"the controllers are told the nominal vehicle ({vehicle}): their only model error is the "
+                        "spreads'; --controller-vehicle paper (or KEY=VALUE,...) gives them another belief")
+    if case is None:
+        spec.population.check_perturbs(n)
+    else:
         if isinstance(case, bool) or not isinstance(case, (int, np.integer)) or not 0 <= case < n:
             raise InputError(f"--case {case} is not one of the {n} flights")
         target = case_folder(out, spec, case, force=force)
+        for line in notes:
+            note(line)
         found = montecarlo_case(spec, case)
         echo(case_text(found, spec.seed))
         if target is not None:
             write_case(found, target, fmt=fmt, force=True)
             echo(f"wrote the flight to {target}")
         return found
+    for line in notes:
+        note(line)
     bar = None if quiet else Bar("flying", unit="flight")
     try:
         res = run_sweep(spec, n, chunk_size=chunk_size, scheduler=scheduler, workers=workers, out=out,

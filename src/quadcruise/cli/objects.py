@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+from quadcruise.cli.vehicle import refuse_vehicle_fields
 from quadcruise.errors import InputError
 
 __all__ = ["controller_from_options", "controller_params", "flight_from_options", "mission_from_options"]
@@ -112,12 +113,14 @@ def mission_from_options(text: str, params: tuple[str, ...], smooth: bool):
     Mission
     """
     from quadcruise.fields import parse_assignments
-    from quadcruise.missions import mission_from_name
+    from quadcruise.missions import MISSIONS, mission_from_name
 
     mparams = parse_assignments(params, "--mission-param")
     if text.lower().endswith(".csv"):
         mparams["table"] = text
         text = "minsnap" if smooth else "waypoints"
+    if text in MISSIONS:
+        refuse_vehicle_fields(mparams, MISSIONS[text])
     return mission_from_name(text, **mparams)
 
 
@@ -160,7 +163,8 @@ def flight_from_options(mission: str, controller: str | None, mission_params: tu
     scenario = load_scenario(mission)
     the_mission = scenario.mission or mission_from_name("circle")
     if mission_params:
-        the_mission = the_mission.replace(**parse_assignments(mission_params, "--mission-param"))
+        changes = parse_assignments(mission_params, "--mission-param")
+        refuse_vehicle_fields(changes, type(the_mission))
+        the_mission = the_mission.replace(**changes)
     the_controller = controller_from_options(controller, controller_params, poles_text, base=scenario.controller)
-    return the_mission, the_controller, scenario.fly_kwargs(), scenario
-
+    return the_mission, the_controller, scenario.fly_kwargs(drag=False), scenario

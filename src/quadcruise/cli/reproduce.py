@@ -50,7 +50,7 @@ def reproduce(out, fmt, force, report, scenario):
     from quadcruise.workflows.reproduce import reproduce as run_reproduce
 
     start = time.perf_counter()
-    check_output_dir(out, force)
+    check_output_dir(out, force, workflow="reproduce")
     settings = {}
     if scenario is not None:
         from quadcruise.workflows.scenario import load_scenario

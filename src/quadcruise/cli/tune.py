@@ -10,6 +10,7 @@ import click
 
 from quadcruise.cli.common import friendly, writable
 from quadcruise.cli.tune_run import tune_command
+from quadcruise.cli.world import world_options
 
 __all__ = ["tune"]
 
@@ -36,8 +37,8 @@ __all__ = ["tune"]
               help="Over a candidate's vehicles: worst, median, or a quantile such as q90.")
 @click.option("--mass-spread", type=float, default=0.0, show_default=True, help="Relative std of the mass.")
 @click.option("--inertia-spread", type=float, default=0.0, show_default=True, help="Relative std of each inertia.")
-@click.option("--wind", metavar="SPEC", help="Wind of every flight (as quadcruise montecarlo --wind), "
-              "e.g. dryden:moderate@10.")
+@world_options(wind_help="Wind of every flight (as quadcruise montecarlo --wind), e.g. dryden:moderate@10.",
+               seed=False)
 @click.option("--wind-spread", type=float, default=0.0, show_default=True,
               help="Std of a random steady horizontal wind per vehicle [m/s].")
 @click.option("--noise", metavar="position=STD,...,delay=S", help="Sensor noise and delay.")
@@ -95,6 +96,14 @@ def tune(**options):
         wind, noise : str or None
             ``--wind``: a :func:`~quadcruise.disturbances.parse_wind` spec; ``--noise``: a
             :func:`~quadcruise.cli.montecarlo_run.parse_noise` spec.
+        turbulence : str or None
+            ``--turbulence``: Dryden turbulence added.
+        vehicle, controller_vehicle : str or None
+            ``--vehicle``, ``--controller-vehicle``: the nominal vehicle and the controller's
+            model of it (:func:`~quadcruise.cli.objects.vehicle_from_option`).
+        log_every : int or None
+            ``--log-every``: the metrics are measured on a log of every this many control
+            periods (default: 10 ms).
         seed, budget : int
             ``--seed``: seed of everything random; ``--budget``: the most generations.
         popsize : int or None

@@ -56,7 +56,8 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str | 
                  wind: str | None = None, wind_spread: float = 0.0, noise: str | None = None, seed: int = 0,
                  budget: int = 100, popsize: int | None = None, duration: float | None = None,
                  dt: float | None = None, out: str | None = None, force: bool = False, quiet: bool = False,
-                 echo: Callable[..., None] = click.echo):
+                 vehicle: str | None = None, controller_vehicle: str | None = None, turbulence: str | None = None,
+                 log_every: int | None = None, echo: Callable[..., None] = click.echo):
     """What ``quadcruise tune`` runs: build the tune, run it, print its progress and summary,
     write ``out``.
 
@@ -78,6 +79,11 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str | 
     wind, noise : str, optional
         A :func:`~quadcruise.disturbances.parse_wind` spec and a
         :func:`~quadcruise.cli.montecarlo_run.parse_noise` one.
+    vehicle, controller_vehicle, turbulence : str, optional
+        ``--vehicle``, ``--controller-vehicle``, ``--turbulence``
+        (:func:`~quadcruise.cli.objects.flight_world`), changing a scenario's.
+    log_every : int, optional
+        Control periods between the logged instants the metrics are measured on.
     duration, dt : float, optional
         Flight time and control period [s]: given, else the scenario's, else the defaults.
     out : str, optional
@@ -98,7 +104,6 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str | 
     """
     from quadcruise.cli.common import controller_from_options, mission_from_options
     from quadcruise.cli.montecarlo_run import parse_noise
-    from quadcruise.disturbances import parse_wind
     from quadcruise.io.files import check_output_dir
     from quadcruise.montecarlo.population import Population
     from quadcruise.tune import tune
@@ -108,14 +113,21 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str | 
                                    bounds=bounds, targets=targets, require=require, minimize=minimize,
                                    samples=samples, objective=objective, mass_spread=mass_spread,
                                    inertia_spread=inertia_spread, wind=wind, wind_spread=wind_spread, noise=noise,
-                                   seed=seed, budget=budget, popsize=popsize, duration=duration, dt=dt).items()
+                                   seed=seed, budget=budget, popsize=popsize, duration=duration, dt=dt,
+                                   vehicle=vehicle, controller_vehicle=controller_vehicle, turbulence=turbulence,
+                                   log_every=log_every).items()
              if DEFAULTS.get(k, object()) != v}
+    from quadcruise.cli.world import flight_world
+    from quadcruise.errors import InputError, whole_number
+
+    if log_every is not None:
+        whole_number(log_every, "--log-every", minimum=1)
     if out is not None:
         check_output_dir(out, force)
-    kwargs: dict = {"duration": duration, "dt": 1e-3 if dt is None else dt, "vehicle": None}
-    environment, sensors = (parse_wind(wind) if wind is not None else None), parse_noise(noise)
+    kwargs: dict = {"duration": duration, "dt": 1e-3 if dt is None else dt}
+    sensors = parse_noise(noise)
+    sc = None
     if mission.lower().endswith(".toml"):
-        from quadcruise.errors import InputError
         from quadcruise.workflows.scenario import load_scenario
 
         if mission_params:
@@ -123,17 +135,26 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str | 
         sc = load_scenario(mission)
         the_mission = sc.mission or "circle"
         the_controller = controller_from_options(controller, controller_params, None, base=sc.controller)
-        kwargs.update(vehicle=sc.vehicle, duration=sc.duration if duration is None else duration,
-                      dt=sc.dt if dt is None else dt)
-        environment = environment if environment is not None else sc.environment
+        kwargs.update(duration=sc.duration if duration is None else duration, dt=sc.dt if dt is None else dt)
         sensors = sensors if sensors is not None else sc.sensor_noise
     else:
         the_mission = mission_from_options(mission, mission_params, False)
         the_controller = controller_from_options(controller, controller_params, None)
+    world, notes = flight_world(vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind,
+                                turbulence=turbulence, scenario=sc)
+    environment = world["environment"]
+    if wind_spread > 0 and not any("wind acts only through drag" in line for line in notes):
+        from quadcruise.disturbances.environment import default_drag_text, with_drag
+
+        if world["vehicle"].drag_linear == 0 and world["vehicle"].drag_quadratic == 0:
+            world["vehicle"] = with_drag(world["vehicle"])
+            notes.append(default_drag_text())
+    kwargs.update(vehicle=world["vehicle"], controller_vehicle=world["controller_vehicle"])
+    if log_every is not None:
+        kwargs["log_dt"] = log_every * kwargs["dt"]
     population = Population(mass_spread=mass_spread, inertia_spread=inertia_spread, wind_spread=wind_spread,
                             environment=environment if environment is not None and environment.parts else None,
                             noise=sensors)
-
     from quadcruise.cli.feedback import Bar
 
     with contextlib.nullcontext() if quiet else Bar("tuning", unit="generation") as progress:
@@ -141,6 +162,8 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str | 
                       minimize=minimize, population=population, samples=samples, objective=objective, seed=seed,
                       budget=budget, popsize=popsize, progress=progress, command=command_line(mission, given),
                       **kwargs)
+    for line in notes:                  # after tune() has checked its own input: an error stays one line
+        echo(f"note: {line}", err=True)
     echo(result.summary_text())
     if out is not None:
         result.write(out, force=True)

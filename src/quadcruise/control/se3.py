@@ -7,15 +7,20 @@ UAV on SE(3)", CDC 2010, in the form RotorPy and crazyflow fly it. With e = ref 
     F = m (kx e_x + kv e_v + a_ref + g e3)           desired force, earth frame [N]
     b3_d = F / |F|,  b1_d from the yaw reference,    R_d = [b1_d, b2_d, b3_d]
     U1 = F . R e3                                    thrust along the current b3 [N]
-    e_R = vee(R_d^T R - R^T R_d) / 2,  e_w = w - R^T R_d w_d,  w_d = 0
+    e_R = vee(R_d^T R - R^T R_d) / 2,  e_w = w - w_d,  w_d = (0, 0, psi_dot_d)
     M = J (-kR e_R - kw e_w) + w x J w               moments, body frame [N m]
     U2 = M_x / l,  U3 = M_y / l,  U4 = M_z
 
 R = Rz(psi) Ry(theta) Rx(phi) from the state's angles (so R e3 is eqs 5-7's thrust
-direction), w = (p, q, r) the state's body rates. w_d = 0: the missions' yaw references are
-holds and steps (no yaw rate) and the rate of a tilting R_d is left out, as RotorPy does by
-default. kR and kw multiply the inertia (RotorPy's form), i.e. they are per unit inertia; the
-w x J w term cancels the gyroscopic terms of eq (11) exactly, so J w' = J (-kR e_R - kw w).
+direction), w = (p, q, r) the state's body rates. The desired body rate w_d is the
+reference's yaw rate psi_dot_d about b3, exactly as RotorPy's ``SE3Control`` writes it
+(``w_des = [0, 0, yaw_dot]``): waypoint and minimum-snap paths turn the yaw, and without w_d
+the kw term would hold the vehicle back by kw / kR psi_dot_d (2.6 deg at 0.26 rad/s). Lee's
+full term R^T R_d w_d, with the roll and pitch rates of a tilting R_d, needs the reference's
+jerk, which missions do not carry; it differs from (0, 0, psi_dot_d) by terms of the order of
+the tilt times psi_dot_d. kR and kw multiply the inertia (RotorPy's form), i.e. they are per
+unit inertia; the w x J w term cancels the gyroscopic terms of eq (11) exactly, so
+J w' = J (-kR e_R - kw e_w).
 Added to Lee's law: the horizontal part of F is scaled down to keep b3_d within ``max_tilt``
 (FLAG_TILT_LIMIT) and U1 is limited to [0, 4 K] (FLAG_THRUST_LIMIT); neither acts in the
 default missions.
@@ -72,6 +77,7 @@ from quadcruise.layout import (
     REF_AY,
     REF_AZ,
     REF_PSI,
+    REF_PSI_DOT,
     REF_VX,
     REF_VY,
     REF_VZ,
@@ -118,7 +124,7 @@ def se3(t, dt, x, ref, vp, gains, mem, cmd):
     ref : numpy.ndarray
         The mission's reference at t, REF_SIZE (11) float64 entries (``REF_*``): position
         [m], velocity [m/s], acceleration [m/s^2] (fed forward), yaw [rad] and yaw rate
-        [rad/s] (not read: w_d = 0).
+        [rad/s] (the desired body rate about b3, w_d = (0, 0, psi_dot_d)).
     vp : numpy.ndarray
         The vehicle parameter row, PARAM_SIZE (21) float64 entries (``P_*``;
         :meth:`quadcruise.model.vehicle.Vehicle.rows`): m [kg], g [m/s^2], Jxx, Jyy, Jzz
@@ -151,7 +157,7 @@ def se3(t, dt, x, ref, vp, gains, mem, cmd):
     jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
     kx, kv, kx_z, kv_z = gains[KX], gains[KV], gains[KX_Z], gains[KV_Z]
     kr, kw, max_tilt = gains[K_R], gains[K_W], gains[SE3_MAX_TILT]
-    psi_d = ref[REF_PSI]
+    psi_d, yaw_rate_d = ref[REF_PSI], ref[REF_PSI_DOT]
     fx = m * (kx * (ref[REF_X] - x[X]) + kv * (ref[REF_VX] - x[VX]) + ref[REF_AX])
     fy = m * (kx * (ref[REF_Y] - x[Y]) + kv * (ref[REF_VY] - x[VY]) + ref[REF_AY])
     fz = m * (kx_z * (ref[REF_Z] - x[Z]) + kv_z * (ref[REF_VZ] - x[VZ]) + ref[REF_AZ] + g)
@@ -169,7 +175,7 @@ def se3(t, dt, x, ref, vp, gains, mem, cmd):
     ex, ey, ez = error_lee(Rm, Rd)
     mx = -jx * (kr * ex + kw * p) + (jz - jy) * q * r          # + (w x J w)_x
     my = -jy * (kr * ey + kw * q) + (jx - jz) * p * r
-    mz = -jz * (kr * ez + kw * r) + (jy - jx) * p * q
+    mz = -jz * (kr * ez + kw * (r - yaw_rate_d)) + (jy - jx) * p * q
     command_from_rotation(U1, mx / l, my / l, mz, Rd, flags, d, K, cmd)
 
 

@@ -67,7 +67,7 @@ from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.fastmath import five_normals, same_period
 
 __all__ = ["ConstantWind", "Gust", "Turbulence", "RotorLoss", "ExternalForce", "Environment",
-           "SensorNoise", "DEFAULT_DRAG", "with_drag", "wind_from_name", "parse_wind",
+           "SensorNoise", "DEFAULT_DRAG", "default_drag_text", "with_drag", "wind_from_name", "parse_wind",
            "environment_disturbance", "PARAMS_SIZE", "MEMORY_SIZE"]
 
 KNOT = 0.514444                      # m/s
@@ -720,29 +720,69 @@ class SensorNoise(_Part):
         return {"sensor_std": self.std_vector(), "sensor_delay": self.delay_periods(dt)}
 
 
-def with_drag(vehicle: Vehicle) -> Vehicle:
-    """The vehicle with :data:`DEFAULT_DRAG` where both its drag coefficients are zero (warns).
+def with_drag(vehicle: Vehicle, *, warn: bool = False) -> Vehicle:
+    """The vehicle with :data:`DEFAULT_DRAG` where both its drag coefficients are zero.
+
+    Wind acts on a vehicle only through its drag, and the paper's vehicle has none. Calling
+    this is asking for the default drag, so it says nothing; a workflow that gives the drag
+    on its own (a scenario or a sweep with wind on a vehicle without drag) passes
+    ``warn=True``, and the warning says what the vehicles fly with.
 
     Parameters
     ----------
     vehicle : Vehicle
         The vehicle, batched or not.
+    warn : bool
+        Warn (UserWarning) when a vehicle is given the default drag.
 
     Returns
     -------
     Vehicle
         The same vehicle if every one of its vehicles has some drag; else a copy with
         ``drag_linear`` [N s/m] and ``drag_quadratic`` [N s^2/m^2] of :data:`DEFAULT_DRAG`
-        for the vehicles that had none, and a UserWarning saying how many.
+        for the vehicles that had none.
+
+    Examples
+    --------
+    >>> from quadcruise.model.vehicle import Vehicle
+    >>> with_drag(Vehicle.paper()).drag_linear
+    0.3
+    >>> with_drag(Vehicle.paper().replace(drag_linear=0.1)).drag_quadratic
+    0.0
     """
     c1, c2 = np.asarray(vehicle.drag_linear), np.asarray(vehicle.drag_quadratic)
     bare = (c1 == 0) & (c2 == 0)
     if not np.any(bare):
         return vehicle
-    warnings.warn(f"the vehicle has no drag, so wind could not act on it: using DEFAULT_DRAG "
-                  f"{DEFAULT_DRAG} for {int(np.count_nonzero(bare))} vehicle(s)", stacklevel=2)
+    if warn:
+        warnings.warn(default_drag_text(int(np.count_nonzero(bare)), int(bare.size)), stacklevel=2)
     new = {k: np.where(bare, v, c) for (k, v), c in zip(DEFAULT_DRAG.items(), (c1, c2))}
     return vehicle.replace(**{k: float(v) if v.ndim == 0 else v for k, v in new.items()})
+
+
+def default_drag_text(count: int = 1, total: int = 1) -> str:
+    """What :func:`with_drag` does to a vehicle without drag, in one line.
+
+    Parameters
+    ----------
+    count, total : int
+        How many vehicles had no drag, of how many.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> print(default_drag_text())
+    the vehicle has no drag, and wind acts only through drag: it flies with DEFAULT_DRAG, drag_linear 0.3 N s/m \
+and drag_quadratic 0.06125 N s^2/m^2 (estimates; give the vehicle's own drag_linear and drag_quadratic to choose)
+    """
+    which = "the vehicle has no drag" if total == 1 else f"{count:,} of {total:,} vehicles have no drag"
+    return (f"{which}, and wind acts only through drag: {'it flies' if count == 1 else 'they fly'} with "
+            f"DEFAULT_DRAG, drag_linear {DEFAULT_DRAG['drag_linear']:g} N s/m and drag_quadratic "
+            f"{DEFAULT_DRAG['drag_quadratic']:.4g} N s^2/m^2 (estimates; give the vehicle's own drag_linear and "
+            "drag_quadratic to choose)")
 
 
 _NAMES = {"constant": ConstantWind, "wind": ConstantWind, "gust": Gust, "dryden": Turbulence,

@@ -6,10 +6,12 @@ from quadcruise.io.files import (
     atomic_path,
     check_output_dir,
     check_table_format,
+    check_writable_place,
+    read_marker,
     read_numeric_csv,
     write_table,
 )
 from quadcruise.io.plainjson import dumps, plain
 
 __all__ = ["MARKER", "atomic_dir", "atomic_path", "check_output_dir", "check_table_format", "check_writable_place", "dumps",
-           "plain", "read_numeric_csv", "write_table"]
+           "plain", "read_marker", "read_numeric_csv", "write_table"]

@@ -8,6 +8,8 @@ import shutil
 import tempfile
 from pathlib import Path
 
+from quadcruise.errors import WriteError
+
 
 def _umask() -> int:
     mask = os.umask(0)
@@ -19,7 +21,9 @@ def _umask() -> int:
 def atomic_path(path: str | os.PathLike):
     """Yield a temporary path beside ``path``; move it into place only on success.
 
-    A failure (or an interrupt) leaves no file at ``path`` and no temporary behind.
+    A failure (or an interrupt) leaves no file at ``path`` and no temporary behind. An
+    ``OSError`` on the way (a full disk, a folder removed meanwhile) is raised as a
+    :class:`~quadcruise.errors.WriteError` that names ``path``, not the temporary.
 
     Parameters
     ----------
@@ -31,6 +35,11 @@ def atomic_path(path: str | os.PathLike):
     pathlib.Path
         The temporary file (empty, already created) to write to.
 
+    Raises
+    ------
+    WriteError
+        If ``path`` could not be written.
+
     Examples
     --------
     >>> import tempfile
@@ -41,17 +50,25 @@ def atomic_path(path: str | os.PathLike):
     ['out.txt']
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    os.chmod(tmp, 0o666 & ~_umask())     # mkstemp makes 0600; a result file is an ordinary file
+    tmp = None
     try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        os.close(fd)
+        os.chmod(tmp, 0o666 & ~_umask())     # mkstemp makes 0600; a result file is an ordinary file
         yield Path(tmp)
         os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
+    except BaseException as exc:
+        if tmp is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise WriteError(path, exc) from None
         raise
+
+
+def _remove(folder: Path) -> None:
+    shutil.rmtree(folder, ignore_errors=True)
 
 
 @contextlib.contextmanager
@@ -59,7 +76,9 @@ def atomic_dir(path: str | os.PathLike):
     """Yield a temporary folder beside ``path``; it becomes ``path`` only on success.
 
     An existing ``path`` is replaced only after the new one is complete. A failure (or an
-    interrupt) leaves ``path`` as it was and removes the temporary folder.
+    interrupt) leaves ``path`` as it was and removes the temporary folder. An ``OSError`` on
+    the way (a full disk, a folder removed meanwhile) is raised as a
+    :class:`~quadcruise.errors.WriteError` that names ``path``.
 
     Parameters
     ----------
@@ -70,23 +89,36 @@ def atomic_dir(path: str | os.PathLike):
     ------
     pathlib.Path
         The temporary folder (empty) to fill.
+
+    Raises
+    ------
+    WriteError
+        If ``path`` could not be written.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent))
-    os.chmod(tmp, 0o777 & ~_umask())
+    tmp = None
     try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent))
+        os.chmod(tmp, 0o777 & ~_umask())
         yield tmp
         if path.exists():
             old = path.with_name(f".{path.name}.old")
-            shutil.rmtree(old, ignore_errors=True)
+            _remove(old)
             os.replace(path, old)
-            os.replace(tmp, path)
-            shutil.rmtree(old, ignore_errors=True)
+            try:
+                os.replace(tmp, path)
+            except BaseException:
+                os.replace(old, path)       # the old folder back where it was
+                raise
+            _remove(old)
         else:
             os.replace(tmp, path)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
+    except BaseException as exc:
+        if tmp is not None:
+            _remove(tmp)
+        if isinstance(exc, OSError):
+            raise WriteError(path, exc) from None
         raise
 
 
@@ -134,6 +166,61 @@ def check_writable_place(path: str | os.PathLike) -> None:
         raise InputError(f"{path}: cannot write there ({exc.strerror.lower()} in {parent})") from None
 
 
+def read_marker(folder: str | os.PathLike) -> dict | None:
+    """The :data:`MARKER` of an output folder: what quadcruise wrote there.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        The folder; it need not exist.
+
+    Returns
+    -------
+    dict or None
+        The marker's JSON object, or None if the folder holds no marker.
+
+    Raises
+    ------
+    InputError
+        If the marker cannot be read or is not a JSON object (truncated, filled with NUL
+        bytes, a list): what the folder holds (a Monte Carlo sweep's chunks, perhaps) is
+        then unknown, so it is not to be replaced unless forced. The message says how.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     _ = (Path(folder) / MARKER).write_text("[1, 2]")
+    ...     read_marker(folder)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: .../quadcruise.json: damaged (a JSON array, not an object), so what ... holds ...
+    """
+    import json
+
+    from quadcruise.errors import InputError
+
+    folder = Path(folder)
+    path = folder / MARKER
+    if not os.path.lexists(path):
+        return None
+    try:
+        text = path.read_bytes().decode("utf-8")
+        doc = json.loads(text)
+        why = None if isinstance(doc, dict) else f"a JSON {type(doc).__name__.replace('list', 'array')}, not an object"
+    except OSError as exc:
+        why = f"cannot be read: {(exc.strerror or str(exc)).lower()}"
+    except UnicodeDecodeError:
+        why = "not UTF-8 text"
+    except json.JSONDecodeError as exc:
+        why = ("empty" if not text.strip() else "NUL bytes" if "\0" in text
+               else f"not JSON: {exc.msg.lower()} at line {exc.lineno}, column {exc.colno}")
+    if why is None:
+        return doc
+    raise InputError(f"{path}: damaged ({why}), so what {folder} holds (a Monte Carlo sweep's chunks, perhaps) "
+                     "is unknown: use --force to replace the folder, or delete it")
+
+
 def check_output_dir(path: str | os.PathLike, force: bool = False, *, workflow: str | None = None) -> Path:
     """Refuse a non-empty folder that quadcruise did not write, unless ``force``.
 
@@ -142,11 +229,13 @@ def check_output_dir(path: str | os.PathLike, force: bool = False, *, workflow: 
     path : str or os.PathLike
         The output folder; it need not exist.
     force : bool
-        Accept a non-empty folder without a :data:`MARKER` file (it will be replaced), or
-        one that holds a Monte Carlo sweep when another workflow writes.
+        Accept a non-empty folder without a :data:`MARKER` file (it will be replaced), one
+        whose marker is damaged, or one that holds a Monte Carlo sweep when another workflow
+        writes.
     workflow : str, optional
         What will write there; ``"montecarlo"`` may resume a sweep's folder (its own rules
-        apply), any other writer must be forced to replace one.
+        apply), any other writer must be forced to replace one. ``"reproduce"``, whose
+        folder has a default name, replaces only a reproduction's folder unless forced.
 
     Returns
     -------
@@ -156,7 +245,8 @@ def check_output_dir(path: str | os.PathLike, force: bool = False, *, workflow: 
     Raises
     ------
     InputError
-        If ``path`` is a file, or a non-empty folder without :data:`MARKER` and not ``force``.
+        If ``path`` is a file; or, unless ``force``, a non-empty folder without
+        :data:`MARKER`, with a damaged one (:func:`read_marker`), or holding a sweep.
     """
     from quadcruise.errors import InputError
 
@@ -164,19 +254,18 @@ def check_output_dir(path: str | os.PathLike, force: bool = False, *, workflow: 
     if path.exists() and not path.is_dir():
         raise InputError(f"{path}: exists and is not a folder")
     check_writable_place(path)
-    if path.is_dir() and any(path.iterdir()) and not (path / MARKER).is_file() and not force:
+    if force or not path.is_dir():
+        return path
+    held = read_marker(path)
+    if held is None and any(path.iterdir()):
         raise InputError(f"{path}: folder is not empty and was not written by quadcruise "
                          "(use --force to replace it)")
-    if not force and workflow != "montecarlo" and (path / MARKER).is_file():
-        import json
-
-        try:
-            held = json.loads((path / MARKER).read_text()).get("workflow")
-        except (ValueError, OSError, AttributeError):
-            held = None
-        if held == "montecarlo":
-            raise InputError(f"{path}: holds a Monte Carlo sweep (hours of flights, resumable); use --force to "
-                             "replace it or choose another --out")
+    if workflow != "montecarlo" and held is not None and held.get("workflow") == "montecarlo":
+        raise InputError(f"{path}: holds a Monte Carlo sweep (hours of flights, resumable); use --force to "
+                         "replace it or choose another --out")
+    if workflow == "reproduce" and held is not None and held.get("workflow") != "reproduce":
+        raise InputError(f"{path}: holds the output of quadcruise {held.get('workflow') or 'another command'}, not of "
+                         "reproduce; use --force to replace it or choose another --out")
     return path
 
 

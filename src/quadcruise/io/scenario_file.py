@@ -15,8 +15,8 @@ from typing import Any
 
 __all__ = ["comparison_document", "montecarlo_document", "scenario_document", "scenario_text"]
 
-SPEC_KEYS = ("requirements", "max_track_error_m", "settle_band", "max_clipped_s", "transient_until", "log_dt",
-             "trace_dt", "max_traces", "max_failure_traces")
+SPEC_KEYS = ("requirements", "max_track_error_m", "max_altitude_error_m", "settle_band", "max_clipped_s",
+             "transient_until", "log_dt", "trace_dt", "max_traces", "max_failure_traces")
 """The Monte Carlo spec's settings a scenario's [montecarlo] table holds beside n, seed and the
 population's spreads."""
 
@@ -115,6 +115,7 @@ def montecarlo_document(spec: dict, n: int, *, title: str = "") -> dict:
     """
     population = spec["population"]
     meta = {"mission": spec["mission"], "controller": spec["controller"], "vehicle": spec["vehicle"],
+            "controller_vehicle": spec.get("controller_vehicle"),
             "environment": population.get("environment"), "sensors": population.get("noise"),
             "duration_s": spec.get("duration"), "dt_s": spec.get("dt"), "max_step_s": spec.get("max_step"),
             "full_dynamics": spec.get("full_dynamics")}

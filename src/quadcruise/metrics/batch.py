@@ -26,46 +26,10 @@ from typing import Sequence
 import numpy as np
 
 from quadcruise.metrics.flight import STEADY_BAND, TRANSIENT_MIN_ERROR, control_effort, tracking_errors
+from quadcruise.metrics.tracking import TRACKING_AXIS, first_crossing_batch, moving_reference, tracking_transient_batch
 
 __all__ = ["first_crossing_batch", "settling_time_batch", "transient_batch", "window_errors_batch",
            "flight_metrics_batch"]
-
-
-def first_crossing_batch(t: np.ndarray, z: np.ndarray, level: float) -> np.ndarray:
-    """Time at which each row of ``z`` first reaches ``level``, interpolated.
-
-    Parameters
-    ----------
-    t : ndarray, shape (L,)
-        Sample times [s].
-    z : ndarray, shape (N, L)
-        One response per row (normalised: 0 at the start of a step, 1 at its end).
-    level : float
-        The level to reach, on the scale of ``z`` (0.1 and 0.9 for a 10-90 % rise).
-
-    Returns
-    -------
-    ndarray, shape (N,)
-        The time [s] on the scale of ``t``, interpolated linearly between the samples
-        around the first one at or above ``level``; ``t[0]`` if the row starts there; NaN
-        if it never gets there.
-
-    Examples
-    --------
-    >>> first_crossing_batch(np.array([0.0, 1.0, 2.0]), np.array([[0.0, 0.5, 1.0], [0.0, 0.2, 0.4]]), 0.9)
-    array([1.8, nan])
-    """
-    rows = np.arange(z.shape[0])
-    hit = z >= level
-    k = hit.argmax(axis=1)
-    km = np.maximum(k - 1, 0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        frac = (level - z[rows, km]) / (z[rows, k] - z[rows, km])
-        out = t[km] + frac * (t[k] - t[km])
-    out[k == 0] = t[0]
-    out[~hit[rows, k]] = np.nan
-    return out
-
 
 def settling_time_batch(t: np.ndarray, z: np.ndarray, band: float) -> np.ndarray:
     """Time from ``t[0]`` after which each row of ``z`` stays within ``band`` of 1.
@@ -107,13 +71,15 @@ def settling_time_batch(t: np.ndarray, z: np.ndarray, band: float) -> np.ndarray
 
 
 def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: dict, bands: Sequence[float],
-                    rise: Sequence[float] = (0.1, 0.9)) -> dict:
+                    rise: Sequence[float] = (0.1, 0.9), err: np.ndarray | None = None) -> dict:
     """The transient of each vehicle, measured as :func:`quadcruise.metrics.flight_metrics` does.
 
-    On the stepped axis of a step mission, as a step response from the hover point the
-    step leaves to the one it commands (from the step time on); otherwise on the axis
-    with the largest initial tracking error, as the progress ``1 - e(t) / e(t[0])`` of
-    that axis's error, if that error is at least
+    A moving reference (:func:`moving_reference`: circle, square, waypoints, ...) on the
+    size of the 3-D tracking error, :func:`tracking_transient_batch`. Otherwise on the
+    stepped axis of a step mission, as a step response from the hover point the step
+    leaves to the one it commands (from the step time on); or, for a reference that holds
+    still, on the axis with the largest initial error, as the progress ``1 - e(t) / e(t[0])``
+    of that axis's error, if that error is at least
     :data:`~quadcruise.metrics.TRANSIENT_MIN_ERROR`.
 
     Parameters
@@ -129,25 +95,47 @@ def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: di
         Settling bands (0.02 for 2 %).
     rise : (float, float)
         Rise-time levels, fractions of the step (0.1 and 0.9 for 10-90 %).
+    err : ndarray, shape (N, L), optional
+        The 3-D position errors [m], if already computed (a moving reference reads them).
 
     Returns
     -------
     dict
-        ``axis`` (int64: 0, 1, 2 for x, y, z, -1 where none is measured), ``t_step`` (start
-        of the transient [s]), ``rise_time_s`` [s], ``settling_s`` (a list of one array
-        per band: settling time [s] from the start of the transient), ``overshoot_pct``
-        [%] of the step (or of the initial error) and ``peak_time_s`` (first time of the
-        largest progress, from the start of the transient [s]); arrays of shape (N,).
+        ``axis`` (int64: 0, 1, 2 for x, y, z, :data:`TRACKING_AXIS` for a moving
+        reference's error, -1 where none is measured), ``t_step`` (start of the transient
+        [s]), ``rise_time_s`` [s], ``settling_s`` (a list of one array per band: settling
+        time [s] from the start of the transient), ``overshoot_pct`` [%] and ``peak_time_s``
+        (from the start of the transient [s]), ``settled_at`` (the end of the transient [s]:
+        its settling into :data:`~quadcruise.metrics.STEADY_BAND`) and ``steady_from``
+        (the start of the steady window [s]: ``settled_at``, or for a moving reference the
+        last half of the flight, over which it was shown to have converged); arrays of
+        shape (N,).
 
     Notes
     -----
     Every value of a vehicle without a measured transient is NaN, and so is every value
-    of a step whose time lies outside ``[t[0], t[-1])``.
+    of a step whose time lies outside ``[t[0], t[-1])``; ``settled_at`` and ``steady_from``
+    are NaN for one that did not settle.
     """
     n = pos.shape[0]
+    bands = [float(b) for b in bands]
     out = {"axis": np.full(n, -1, dtype=np.int64), "t_step": np.full(n, np.nan),
            "rise_time_s": np.full(n, np.nan), "settling_s": [np.full(n, np.nan) for _ in bands],
-           "overshoot_pct": np.full(n, np.nan), "peak_time_s": np.full(n, np.nan)}
+           "overshoot_pct": np.full(n, np.nan), "peak_time_s": np.full(n, np.nan),
+           "settled_at": np.full(n, np.nan), "steady_from": np.full(n, np.nan)}
+    if moving_reference(t, ref, mission):
+        if err is None:
+            d = pos - ref
+            err = np.sqrt((d * d).sum(axis=-1))
+        got = tracking_transient_batch(t, err, bands, rise)
+        sel = got["measured"]
+        out["axis"][sel] = TRACKING_AXIS
+        out["t_step"][sel] = t[0]
+        for key in ("rise_time_s", "overshoot_pct", "peak_time_s", "settled_at", "steady_from"):
+            out[key][sel] = got[key][sel]
+        for full, got_band in zip(out["settling_s"], got["settling_s"]):
+            full[sel] = got_band[sel]
+        return out
     if mission.get("kind") == "step" and mission.get("axis") in ("x", "y", "z"):
         j = "xyz".index(mission["axis"])
         t_step = float(mission["time"])
@@ -179,6 +167,7 @@ def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: di
     out["rise_time_s"][sel] = first_crossing_batch(ts, z, float(rise[1])) - first_crossing_batch(ts, z, float(rise[0]))
     for full, band in zip(out["settling_s"], bands):
         full[sel] = settling_time_batch(ts, z, band)
+    out["settled_at"][sel] = out["steady_from"][sel] = ts[0] + settling_time_batch(ts, z, STEADY_BAND)
     out["overshoot_pct"][sel] = np.maximum(0.0, 100.0 * (z.max(axis=1) - 1.0))
     out["peak_time_s"][sel] = ts[z.argmax(axis=1)] - ts[0]
     return out
@@ -303,17 +292,16 @@ def flight_metrics_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, duties
            "final_error_m": np.linalg.norm(pos[:, -1] - ref[:, -1], axis=1), "effort": effort,
            "transient_axis": np.full(n, -1, dtype=np.int64), "rise_time_s": np.full(n, np.nan),
            "settling_s": [np.full(n, np.nan) for _ in bands], "overshoot_pct": np.full(n, np.nan),
-           "peak_time_s": np.full(n, np.nan)}
+           "peak_time_s": np.full(n, np.nan), "settled_at": np.full(n, np.nan)}
     keep = slice(None) if transient_until is None else t <= transient_until
     tk = t[keep]
     if tk.size >= 2:
-        got = transient_batch(tk, pos[:, keep], ref[:, keep], mission or {}, bands + [STEADY_BAND], rise)
-        out.update(transient_axis=got["axis"], rise_time_s=got["rise_time_s"], settling_s=got["settling_s"][:-1],
-                   overshoot_pct=got["overshoot_pct"], peak_time_s=got["peak_time_s"])
+        got = transient_batch(tk, pos[:, keep], ref[:, keep], mission or {}, bands, rise)
+        out.update(transient_axis=got["axis"], rise_time_s=got["rise_time_s"], settling_s=got["settling_s"],
+                   overshoot_pct=got["overshoot_pct"], peak_time_s=got["peak_time_s"], settled_at=got["settled_at"])
         measured = np.flatnonzero(got["axis"] >= 0)
         if measured.size:
-            steady = window_errors_batch(t, pos[measured], ref[measured],
-                                         got["t_step"][measured] + got["settling_s"][-1][measured])
+            steady = window_errors_batch(t, pos[measured], ref[measured], got["steady_from"][measured])
             out["steady_rmse_m"][measured] = steady["rmse"]
             out["steady_max_error_m"][measured] = steady["max_error"]
     return out

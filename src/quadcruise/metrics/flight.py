@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from quadcruise.errors import InputError
+from quadcruise.metrics.tracking import STEADY_BAND, TRANSIENT_MIN_ERROR, moving_reference, tracking_transient_batch
 
 __all__ = ["StepInfo", "step_info", "step_info_batch", "transient_info",
            "tracking_errors", "control_effort", "time_in_saturation", "flight_metrics",
@@ -477,12 +478,12 @@ def time_in_saturation(t, flags) -> dict[str, np.ndarray]:
 
 # --- a whole flight --------------------------------------------------------------------
 _AXIS_NAMES = ("x", "y", "z")
-TRANSIENT_MIN_ERROR = 0.01
-"""An axis whose initial tracking error is below this [m] has no transient to measure."""
-STEADY_BAND = 0.05
-"""The steady window of a flight starts when its transient settles into this band
-(fraction of the initial error or of the step): ``steady_rmse_m`` and
-``steady_max_error_m`` are measured from then on, whatever ``settle_bands`` a table shows."""
+FAILED_FLIGHT_METRICS = ("rise_time_s", "settling_time_s", "overshoot_pct", "peak_time_s", "steady_rmse_m",
+                         "steady_max_error_m")
+"""The metrics (besides the second settling column) that are NaN for a flight that did not finish:
+a vehicle that lost its track has no transient or steady state to measure."""
+TRACKING_AXIS_NAME = "xyz"
+"""The ``axis`` a moving reference's transient is measured on: the size of the 3-D error."""
 EFFORT_DEFINITION = "integral of sum_i (u_i - u_hover)^2 dt over the four rotor duties, u_hover = m g / (4 K) [s]"
 """What the ``effort`` column measures, as the tables record it."""
 
@@ -524,8 +525,9 @@ def metric_conventions(rise=(0.1, 0.9), settle_bands=(0.02, 0.05)) -> dict:
         for 0-100 %, or any ``0 <= low < high <= 1``; or one of :data:`RISE_CONVENTIONS`.
     settle_bands : float or sequence of one or two floats
         Settling bands as fractions of the step, each in (0, 1): the first is the
-        ``settling_time_s`` column, the second (:data:`STEADY_BAND` if only one is given)
-        the column :func:`settling_column` names.
+        ``settling_time_s`` column, the second (if only one is given: :data:`STEADY_BAND`,
+        or 2 % when the first is that 5 %) the column :func:`settling_column` names; two
+        equal bands are refused (they would print two identical columns).
 
     Returns
     -------
@@ -553,7 +555,10 @@ def metric_conventions(rise=(0.1, 0.9), settle_bands=(0.02, 0.05)) -> dict:
         bands = tuple(float(b) for b in np.atleast_1d(np.asarray(settle_bands, dtype=float)))
     except (TypeError, ValueError):
         raise InputError(f"rise levels and settle_bands must be numbers, got {rise!r}, {settle_bands!r}") from None
-    bands = bands + (STEADY_BAND,) if len(bands) == 1 else bands
+    if len(bands) == 1:                          # the second column: 5 %, or 2 % beside a first 5 %
+        bands = bands + ((0.02,) if bands[0] == STEADY_BAND else (STEADY_BAND,))
+    if len(bands) == 2 and bands[0] == bands[1]:
+        raise InputError(f"settle_bands: the two bands are the same ({bands[0]:g}): give two different bands, or one")
     if len(levels) != 2 or not 0.0 <= levels[0] < levels[1] <= 1.0:
         raise InputError(f"rise levels must satisfy 0 <= low < high <= 1, got {rise}")
     if len(bands) != 2 or not all(0.0 < b < 1.0 for b in bands):
@@ -693,6 +698,8 @@ def flight_metrics(result, *, transient_axis: str | None = None, transient_until
                 row[second] = _nan(info.settling_time_5pct)
                 steady = (np.nan, np.nan) if settled is None else _steady_errors(t, pos, ref, t_step + settled)
             row["steady_rmse_m"], row["steady_max_error_m"] = steady
+            if not result.ok[i]:                 # lost or off track: no transient or steady state to speak of
+                row.update({key: np.nan for key in FAILED_FLIGHT_METRICS + (second,)})
         if hover is not None:
             duties = result.commands[i, :, CMD_U1:CMD_U1 + 4]
             row["effort"] = float(control_effort(t, duties - hover[i])["integral"])
@@ -711,8 +718,20 @@ def _steady_errors(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, t_from: floa
 
 
 def _flight_transient(t, pos, ref, mission: dict, axis: str | None, rise: tuple, bands: tuple):
-    """(StepInfo, axis name, start time [s], settling time into STEADY_BAND [s] or None), or
-    None where no transient is measured."""
+    """(StepInfo, axis name, start time [s], start of the steady window from the start time [s]
+    or None if it did not settle), or None where no transient is measured."""
+    if axis is None and moving_reference(t, ref[None], mission):
+        got = tracking_transient_batch(t, np.linalg.norm(pos - ref, axis=1)[None], list(bands) + [STEADY_BAND], rise)
+        if not got["measured"][0]:
+            return None
+        settle = [None if np.isnan(s[0]) else float(s[0]) for s in got["settling_s"]]
+        info = StepInfo(rise_time=None if np.isnan(got["rise_time_s"][0]) else float(got["rise_time_s"][0]),
+                        settling_time=settle[0], settling_time_5pct=settle[1],
+                        overshoot_pct=float(got["overshoot_pct"][0]), undershoot_pct=np.nan, peak=np.nan,
+                        peak_time=float(got["peak_time_s"][0]), y_initial=0.0, y_final=1.0,
+                        settled=settle[0] is not None)
+        steady_from = float(got["steady_from"][0])
+        return info, TRACKING_AXIS_NAME, float(t[0]), None if np.isnan(steady_from) else steady_from - float(t[0])
     if axis is None and mission.get("kind") == "step" and mission.get("axis") in _AXIS_NAMES:
         j = _AXIS_NAMES.index(mission["axis"])
         t_step = float(mission["time"])

@@ -10,10 +10,10 @@ reads "did not settle": the response never stayed in the band, which is not the 
 >>> import pandas as pd
 >>> frame = pd.DataFrame({"axis": ["x", None], "settling_time_s": [float("nan")] * 2, "rmse_m": [0.01234, 2e-5]})
 >>> print(metrics_text(frame, ["vehicle 0", "vehicle 1"]))
-                      vehicle 0  vehicle 1
-axis                          x          -
-settling_time_s  did not settle          -
-rmse_m                  0.01234  2.000e-05
+                      vehicle 0     vehicle 1
+axis                          x             -
+settling_time_s  did not settle  no transient
+rmse_m                  0.01234     2.000e-05
 """
 
 from __future__ import annotations
@@ -23,11 +23,22 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["cell", "metric_cell", "metrics_text", "vehicle_metrics_text", "conventions_text", "DID_NOT_SETTLE"]
+__all__ = ["cell", "metric_cell", "metrics_text", "vehicle_metrics_text", "conventions_text", "DID_NOT_SETTLE",
+           "FAILED_FLIGHT", "NO_TRANSIENT", "NO_OVERSHOOT"]
 
 DID_NOT_SETTLE = "did not settle"
-UNSETTLED_METRICS = ("settling", "steady_")
+FAILED_FLIGHT = "failed flight"
+"""A transient or steady metric of a flight that did not finish: there is none to measure."""
+NO_TRANSIENT = "no transient"
+"""A transient metric of a flight that started on its reference (the default square): nothing to measure."""
+NO_OVERSHOOT = "no overshoot"
+"""The peak time of a moving reference's entry that never went below its steady level."""
+UNSETTLED_METRICS = ("settling", "steady_", "overshoot")
 """Prefixes of the metrics that are missing because a measured transient did not settle."""
+TRANSIENT_METRICS = ("rise_time", "settling", "overshoot", "peak_time")
+"""Prefixes of the transient metrics."""
+FAILED_METRICS = TRANSIENT_METRICS + ("steady_",)
+"""Prefixes of the metrics a failed flight does not have."""
 
 
 def cell(value: Any, missing: str = "-") -> tuple[str, bool]:
@@ -69,11 +80,14 @@ def cell(value: Any, missing: str = "-") -> tuple[str, bool]:
     return str(value), False
 
 
-def metric_cell(value: Any, metric: Any, axis: Any, missing: str = "-") -> tuple[str, bool]:
+def metric_cell(value: Any, metric: Any, axis: Any, missing: str = "-", status: Any = None) -> tuple[str, bool]:
     """:func:`cell` of ``metric``'s value for a flight whose transient axis is ``axis``.
 
-    A missing settling time or steady error of a measured transient reads
-    :data:`DID_NOT_SETTLE`.
+    A missing transient or steady metric reads :data:`FAILED_FLIGHT` for a flight whose
+    ``status`` is not "finished"; a missing settling time, overshoot or steady error of a
+    measured transient :data:`DID_NOT_SETTLE`, its missing peak time :data:`NO_OVERSHOOT`;
+    a missing transient metric of a flight without a transient (``axis`` ``""``)
+    :data:`NO_TRANSIENT`.
 
     Parameters
     ----------
@@ -82,10 +96,12 @@ def metric_cell(value: Any, metric: Any, axis: Any, missing: str = "-") -> tuple
     metric : Any
         The metric's name (a column of :func:`~quadcruise.metrics.flight_metrics`).
     axis : Any
-        The flight's transient axis (``"x"``, ``"y"``, ``"z"``), None or empty if none
-        was measured.
+        The flight's transient axis (``"x"``, ``"y"``, ``"z"``, ``"xyz"``), ``""`` if the
+        table measured none for this flight, None if unknown.
     missing : str
         The text of a missing value.
+    status : Any
+        The flight's status text, if known.
 
     Returns
     -------
@@ -100,11 +116,21 @@ def metric_cell(value: Any, metric: Any, axis: Any, missing: str = "-") -> tuple
     ('did not settle', False)
     >>> metric_cell(float("nan"), "steady_rmse_m", "x"), metric_cell(float("nan"), "settling_time_s", None)
     (('did not settle', False), ('-', False))
+    >>> metric_cell(float("nan"), "rise_time_s", ""), metric_cell(float("nan"), "rise_time_s", "x", status="off track")
+    (('no transient', False), ('failed flight', False))
     """
     text, number = cell(value, missing)
+    if text != missing or not isinstance(metric, str):
+        return text, number
+    if isinstance(status, str) and status != "finished" and metric.startswith(FAILED_METRICS):
+        return FAILED_FLIGHT, False
     measured = isinstance(axis, str) and bool(axis.strip())
-    if text == missing and isinstance(metric, str) and metric.startswith(UNSETTLED_METRICS) and measured:
+    if measured and metric.startswith(UNSETTLED_METRICS):
         return DID_NOT_SETTLE, False
+    if measured and metric.startswith("peak_time"):
+        return NO_OVERSHOOT, False
+    if axis == "" and metric.startswith(TRANSIENT_METRICS):
+        return NO_TRANSIENT, False
     return text, number
 
 
@@ -126,9 +152,11 @@ def metrics_text(frame, labels) -> str:
     """
     import pandas as pd
 
-    axes = frame["axis"].tolist() if "axis" in frame.columns else [None] * len(frame)
-    shown = pd.DataFrame({label: [metric_cell(v, col, axis)[0] for col, v in row.items()]
-                          for label, axis, (_, row) in zip(labels, axes, frame.iterrows())},
+    axes = ([a if isinstance(a, str) else "" for a in frame["axis"]] if "axis" in frame.columns
+            else [None] * len(frame))
+    statuses = frame["status"].tolist() if "status" in frame.columns else [None] * len(frame)
+    shown = pd.DataFrame({label: [metric_cell(v, col, axis, status=status)[0] for col, v in row.items()]
+                          for label, axis, status, (_, row) in zip(labels, axes, statuses, frame.iterrows())},
                          index=list(frame.columns))
     return shown.to_string()
 
@@ -178,18 +206,19 @@ def conventions_text(conventions: dict | None) -> str:
     --------
     >>> from quadcruise.metrics.flight import metric_conventions
     >>> print(conventions_text(metric_conventions(rise=(0.0, 1.0))))
-    rise_time_s: 0-100 % of the step; settling_time_s: 2 % band; settling_time_5pct_s: 5 % band
-    steady_*: 3-D position error from the 5 % settling time on (the whole flight without a transient)
+    rise_time_s: 0-100 % of the step (axis xyz: of the error's way to its steady level); settling_time_s: 2 % band; settling_time_5pct_s: 5 % band
+    steady_*: 3-D position error from the 5 % settling time on (axis xyz, a moving reference: over the last half of the flight, once converged; the whole flight without a transient)
     effort: integral of sum_i (u_i - u_hover)^2 dt over the four rotor duties, u_hover = m g / (4 K) [s]
     """
     if not conventions:
         return ""
     lo, hi = (format(100.0 * float(v), ".6g") for v in conventions["rise"])
-    parts = [f"rise_time_s: {lo}-{hi} % of the step"]
+    parts = [f"rise_time_s: {lo}-{hi} % of the step (axis xyz: of the error's way to its steady level)"]
     parts += [f"{name}: {format(100.0 * float(band), '.6g')} % band"
               for name, band in conventions["settling_columns"].items()]
     steady = format(100.0 * float(conventions["steady_band"]), ".6g")
     return "\n".join(["; ".join(parts),
-                      f"steady_*: 3-D position error from the {steady} % settling time on "
-                      "(the whole flight without a transient)",
+                      f"steady_*: 3-D position error from the {steady} % settling time on (axis xyz, a moving "
+                      "reference: over the last half of the flight, once converged; the whole flight without a "
+                      "transient)",
                       f"effort: {conventions['effort']}"])

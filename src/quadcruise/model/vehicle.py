@@ -135,6 +135,57 @@ class Vehicle(Validated):
         """
         return shared_default(cls)
 
+    @classmethod
+    def preset(cls, name: str) -> Any:
+        """A preset vehicle from published data (:mod:`quadcruise.model.vehicle_files`).
+
+        Parameters
+        ----------
+        name : str
+            ``paper`` (Table I: a :class:`Vehicle`, flown by the paper's plant) or a rotor-plant
+            vehicle: ``crazyflie``, ``hummingbird``, ``iris``.
+
+        Returns
+        -------
+        Vehicle or quadcruise.model.rotor_vehicle.RotorVehicle
+
+        Raises
+        ------
+        InputError
+            An unknown name.
+
+        Examples
+        --------
+        >>> Vehicle.preset("paper") == Vehicle.paper(), type(Vehicle.preset("iris")).__name__
+        (True, 'RotorVehicle')
+        """
+        return cls.load(name)
+
+    @classmethod
+    def load(cls, name_or_path: Any) -> Any:
+        """A vehicle from a preset's name or a vehicle file (``[vehicle] preset = "iris"`` and
+        the fields to change, or every field).
+
+        Parameters
+        ----------
+        name_or_path : str or pathlib.Path
+            A preset's name, or a TOML file (a name ending in ``.toml``).
+
+        Returns
+        -------
+        Vehicle or quadcruise.model.rotor_vehicle.RotorVehicle
+
+        Raises
+        ------
+        InputError
+            An unknown preset, a missing or bad file, an unknown key or a bad value, naming
+            the file and the key.
+        """
+        from quadcruise.model.rotor_vehicle import RotorVehicle
+        from quadcruise.model.vehicle_files import load_vehicle
+
+        return load_vehicle(name_or_path, {"paper": cls, "rotor": RotorVehicle})
+
     def replace(self, **changes: Any) -> "Vehicle":
         """A copy with some fields changed (validated again).
 

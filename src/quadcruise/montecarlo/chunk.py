@@ -12,7 +12,7 @@ import numpy as np
 from quadcruise.errors import InputError, whole_number
 from quadcruise.layout import CMD_U1, REF_X, X
 from quadcruise.metrics.batch import flight_metrics_batch
-from quadcruise.metrics.flight import hover_duties
+from quadcruise.metrics.flight import FAILED_FLIGHT_METRICS, hover_duties
 from quadcruise.montecarlo.population import Draw
 from quadcruise.montecarlo.schema import COLUMNS, FAILURES, METRICS
 from quadcruise.montecarlo.spec import MonteCarloSpec
@@ -61,7 +61,7 @@ def fly_chunk(spec: MonteCarloSpec, first, count: int, log_every: int | None = N
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = fly(spec.mission, spec.controller if controller is None else controller, vehicle=draw.vehicle,
-                  controller_vehicle=spec.vehicle if spec.population.model_error else None,
+                  controller_vehicle=spec.model_vehicle,
                   duration=spec.duration, dt=spec.dt, max_step=spec.max_step, x0=x0,
                   log_every=spec.log_every if log_every is None else log_every,
                   full_dynamics=spec.full_dynamics, seed=spec.seed, first_vehicle=first,
@@ -206,11 +206,20 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
         out["settling_time_s"][live], out["settling_time_5pct_s"][live] = got["settling_s"][:2]
         not_settled[live] = (got["transient_axis"] >= 0) & np.isnan(got["settling_s"][2])
     diverged = stopped
-    bound = spec.max_track_error_m
-    after = np.where(np.isnan(out["steady_max_error_m"]), out["final_error_m"], out["steady_max_error_m"])
+    off = np.zeros(n, dtype=bool)
+    if live.size:                  # fly's rule (off_track_since), by the spec's bounds, on the sweep's log
+        from quadcruise.workflows.fly import off_track_since
+
+        d = result.states[live, :, X:X + 3] - refs[live]
+        first = off_track_since(t, np.sqrt((d * d).sum(axis=-1)), d[:, :, 2], got["transient_axis"] >= 0,
+                                got["settled_at"], np.full(live.size, spec.max_track_error_m),
+                                np.full(live.size, spec.max_altitude_error_m))
+        off[live] = np.isfinite(first)
     # lost track: fly's own status (the error left 1 m + the mission's size at some instant), or
-    # the error after the transient beyond the spec's bound
-    lost_track = ~diverged & ((status == int(ExitStatus.LOST_TRACK)) | (after > bound))
+    # off track after the transient by the spec's bounds
+    lost_track = ~diverged & ((status == int(ExitStatus.LOST_TRACK)) | off)
+    for key in FAILED_FLIGHT_METRICS + ("settling_time_5pct_s",):   # no transient or steady state to speak of
+        out[key][lost_track] = np.nan
     saturated = out["duty_clipped_s"] > spec.max_clipped_s
     failed_requirement = np.zeros(n, dtype=bool)
     for req in spec.parsed_requirements:

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from quadcruise._version import __version__
-from quadcruise.errors import InputError
+from quadcruise.errors import InputError, WriteError
 from quadcruise.io.files import MARKER, atomic_dir, atomic_path, check_output_dir, write_table
 from quadcruise.io.plainjson import dumps
 from quadcruise.io.scenario_file import montecarlo_document, scenario_text
@@ -46,14 +46,17 @@ def write_outputs(result, out, *, fmt: str = "csv", force: bool = False) -> Path
     from quadcruise.plots.flight import save_figure
 
     path = Path(out)
-    meta, ours = holds_sweep(path, result.spec)
+    meta, ours = holds_sweep(path, result.spec, force=force)
     if not ours:
         check_output_dir(path, force, workflow="montecarlo")
         if meta is not None and not force:
             raise InputError(f"{path}: holds another quadcruise result; use --force to replace it")
-        if path.is_dir() and any(path.iterdir()):
+    try:
+        if not ours and path.is_dir() and any(path.iterdir()):
             shutil.rmtree(path)
-    path.mkdir(parents=True, exist_ok=True)
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise WriteError(path, exc) from None
     name = write_table(result.table, path / "flights", fmt).name
     summary = result.summary_data()
     with atomic_path(path / "summary.json") as tmp:
@@ -162,7 +165,7 @@ def case_folder(out, spec, case: int, *, force: bool = False) -> Path | None:
     if out is None:
         return None
     target = Path(out)
-    meta, same = holds_sweep(target, spec)
+    meta, same = holds_sweep(target, spec, force=force)
     if meta and meta.get("workflow") == "montecarlo":      # a sweep's folder: the case goes inside
         if not same:
             raise InputError(f"{out}: holds a sweep flown with other options or code (spec {meta.get('spec_hash')}, "
@@ -201,7 +204,8 @@ def report_markdown(result, summary: dict, worst, table_name: str) -> str:
              f"## Failures: {f['count']:,} of {summary['flights']:,} ({100 * f['rate']:.2f} %)\n",
              "Each flight counts once, under the first that applies: diverged (the engine stopped it), "
              f"lost track (its position error after the transient, or at the end if the transient never "
-             f"settled into 5 %, above {spec.max_track_error_m:g} m), saturated (rotor duties clipped for "
+             f"settled into 5 %, above {spec.max_track_error_m:g} m, or its altitude error above "
+             f"{spec.max_altitude_error_m:g} m), saturated (rotor duties clipped for "
              f"more than {spec.max_clipped_s:g} s), failed a requirement (missed one of the requirements "
              "below).\n",
              "| reason | flights | rate |", "|---|---|---|"]

@@ -133,6 +133,53 @@ class Population:
         """True if the vehicles meet wind (which acts only through drag)."""
         return self.wind_spread > 0 or (self.environment is not None and self.environment.needs_drag)
 
+    @property
+    def perturbs(self) -> bool:
+        """True if its vehicles can differ from one another: a spread, a start offset, a random
+        steady wind, turbulence (a random stream per vehicle) or sensor noise.
+
+        Examples
+        --------
+        >>> Population().perturbs, Population(offset=0.1).perturbs
+        (False, True)
+        """
+        if any(getattr(self, name) > 0 for name in (*SPREADS, "offset", "wind_spread")):
+            return True
+        if self.environment is not None and self.environment.turbulence is not None:
+            return True
+        return self.noise is not None and bool(np.any(np.asarray(self.noise.std_vector()) > 0))
+
+    def check_perturbs(self, n: int, hint: str | None = None) -> None:
+        """Refuse n > 1 vehicles that could not differ: they would fly the same flight n times
+        and every quantile of theirs would be the same number.
+
+        Parameters
+        ----------
+        n : int
+            Number of vehicles.
+        hint : str, optional
+            What perturbs, said after "give"; the options of ``quadcruise montecarlo`` by default.
+
+        Raises
+        ------
+        InputError
+            One line with the options that perturb.
+
+        Examples
+        --------
+        >>> Population().check_perturbs(3)
+        Traceback (most recent call last):
+            ...
+        quadcruise.errors.InputError: the population perturbs nothing: its 3 vehicles would fly the same flight; \
+give a spread (--mass-spread 0.1, --inertia-spread, --thrust-spread, --bandwidth-spread, --yaw-arm-spread), \
+a start --offset, a --wind-spread, turbulence (--turbulence moderate) or sensor --noise
+        """
+        hint = hint or ("a spread (--mass-spread 0.1, --inertia-spread, --thrust-spread, --bandwidth-spread, "
+                        "--yaw-arm-spread), a start --offset, a --wind-spread, turbulence (--turbulence moderate) "
+                        "or sensor --noise")
+        if n > 1 and not self.perturbs:
+            raise InputError(f"the population perturbs nothing: its {n:,} vehicles would fly the same flight; give {hint}")
+
     def unit_draws(self, seed: int, first, count: int) -> np.ndarray:
         """The unit draws of vehicles first .. first + count - 1 (see the module).
 

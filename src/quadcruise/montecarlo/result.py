@@ -168,6 +168,7 @@ class MonteCarloResult:
         return {"flights": n, "seed": self.spec.seed,
                 "failures": {"count": fails, "rate": fails / n, "by_reason": by_reason},
                 "criteria": {"max_track_error_m": self.spec.max_track_error_m,
+                             "max_altitude_error_m": self.spec.max_altitude_error_m,
                              "max_clipped_s": self.spec.max_clipped_s},
                 "requirements": requirements,
                 "not_settled": {"count": unsettled, "rate": unsettled / n, "band": self.spec.settle_band},
@@ -193,7 +194,8 @@ class MonteCarloResult:
         f = s["failures"]
         lines = [f"{s['flights']:,} flights of {self.spec.controller.name} on {self.spec.mission.name}, "
                  f"seed {s['seed']}: {f['count']:,} failed ({100 * f['rate']:.2f} %)"]
-        bounds = {"lost track": f"error after the transient > {s['criteria']['max_track_error_m']:g} m",
+        bounds = {"lost track": f"error after the transient > {s['criteria']['max_track_error_m']:g} m "
+                                f"or altitude error > {s['criteria']['max_altitude_error_m']:g} m",
                   "saturated": f"duties clipped > {s['criteria']['max_clipped_s']:g} s",
                   "failed a requirement": "see below" if s["requirements"] else "none given"}
         for reason, v in f["by_reason"].items():

@@ -52,7 +52,8 @@ def merge_scenario(path, given: dict) -> tuple[Scenario, dict]:
 
 def sweep_spec(*, mission=None, controller=None, n: int | None = None, seed: int | None = None,
                duration: float | None = None, dt: float | None = None, environment=None, noise=None,
-               scenario=None, requirements=(), max_track_error_m: float | None = None,
+               scenario=None, requirements=(), max_track_error_m: float | None = None, vehicle=None,
+               controller_vehicle=None, log_every: int | None = None,
                **population) -> tuple[MonteCarloSpec, int]:
     """The spec of a sweep and its number of flights; None means "not given".
 
@@ -77,6 +78,12 @@ def sweep_spec(*, mission=None, controller=None, n: int | None = None, seed: int
         The user's pass criteria (:class:`MonteCarloSpec`'s ``requirements``).
     max_track_error_m : float, optional
         The "lost track" bound [m]; the spec's default if None.
+    vehicle, controller_vehicle : Vehicle, optional
+        The nominal vehicle and the controllers' model of it: given, else the scenario's
+        ``[vehicle]`` and ``[controller_vehicle]``, else Table I and the nominal vehicle.
+    log_every : int, optional
+        Control periods between the logged instants the metrics are measured on (the
+        spec's ``log_dt`` is ``log_every * dt``): given, else the scenario's ``log_dt``, else 10 ms.
     **population
         :class:`Population` fields (spreads, offset, distribution, model_error): given, else
         the scenario's, else the Population's defaults.
@@ -100,7 +107,7 @@ def sweep_spec(*, mission=None, controller=None, n: int | None = None, seed: int
         controller = sc.controller if controller is None else controller
         environment = environment if environment is not None else sc.environment
         noise = noise if noise is not None else sc.sensor_noise
-        options.update(vehicle=sc.vehicle, duration=duration or sc.duration,
+        options.update(vehicle=sc.vehicle, controller_vehicle=sc.controller_vehicle, duration=duration or sc.duration,
                        dt=sc.dt if dt is None else dt, max_step=sc.simulation.get("max_step"),
                        full_dynamics=sc.simulation.get("full_dynamics", False))
     n, seed = given.pop("n", 1000), given.pop("seed", 0)
@@ -112,6 +119,12 @@ def sweep_spec(*, mission=None, controller=None, n: int | None = None, seed: int
             if key == "max_track_error_m" and max_track_error_m is not None:
                 continue
             options[key] = tuple(value) if key == "requirements" else value
+    if vehicle is not None:
+        options["vehicle"] = vehicle
+    if controller_vehicle is not None:
+        options["controller_vehicle"] = controller_vehicle
+    if log_every is not None:
+        options["log_dt"] = log_every * options["dt"]
     mission = "circle" if mission is None else mission
     controller = "nlpd" if controller is None else controller
     pop = Population(**given, environment=environment if environment is not None and environment.parts else None,

@@ -10,7 +10,8 @@ __all__ = ["COLUMNS", "FAILURES", "METRICS"]
 
 FAILURES = ("ok", "diverged", "lost track", "saturated", "failed a requirement")
 """Failure codes 0..4 of the table's ``failure`` column, in order of precedence: the engine
-stopped the flight; its error after the transient exceeded the spec's ``max_track_error_m``;
+stopped the flight; its error after the transient exceeded the spec's ``max_track_error_m``
+(or its altitude error ``max_altitude_error_m``: fly's off-track rule);
 its rotor duties were clipped for longer than ``max_clipped_s``; it missed one of the
 spec's ``requirements``. A transient that did not settle is a metric (``not_settled``),
 not a failure."""

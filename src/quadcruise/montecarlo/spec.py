@@ -18,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import math
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -63,6 +64,9 @@ class MonteCarloSpec:
         Control period [s].
     vehicle : Vehicle
         The nominal vehicle (Table I); given drag if the population meets wind.
+    controller_vehicle : Vehicle, optional
+        The vehicle every controller believes it flies (its model); None: the nominal
+        ``vehicle`` (or, with the population's ``model_error`` False, each vehicle's own).
     max_step : float, optional
         Longest RK4 substep [s]; dt by default.
     log_dt : float
@@ -92,6 +96,11 @@ class MonteCarloSpec:
         :func:`quadcruise.workflows.fly.steady_bound`, the default of ``fly``'s
         ``max_steady_error``): 1 m for the built-in circle, square, step and hover. The
         value used is the field's value after construction, recorded with the spec.
+    max_altitude_error_m : float, optional
+        A flight is off track (counted as "lost track") too if its altitude error after the
+        transient exceeds this [m]. By default (None) :func:`quadcruise.workflows.fly.altitude_bound`
+        (half the mission's lowest altitude: 0.5 m for the built-in missions), or
+        ``max_track_error_m`` where that is given, as ``fly``'s ``max_steady_error`` bounds both.
     requirements : str or sequence of str
         The user's own pass criteria, e.g. ``("steady_max_error_m<=0.2",)``: a metric of
         :data:`~quadcruise.montecarlo.schema.METRICS`, ``<=``, ``<``, ``>=`` or ``>``, and a
@@ -118,6 +127,7 @@ class MonteCarloSpec:
     duration: float | None = None
     dt: float = 1e-3
     vehicle: Vehicle = field(default_factory=Vehicle.paper)
+    controller_vehicle: Vehicle | None = None
     max_step: float | None = None
     log_dt: float = 0.01
     trace_dt: float = 0.1
@@ -129,10 +139,11 @@ class MonteCarloSpec:
     full_dynamics: bool = False
     max_track_error_m: float | None = None
     requirements: Any = ()
+    max_altitude_error_m: float | None = None
 
     def __post_init__(self) -> None:
         from quadcruise.sim.engine import time_grid
-        from quadcruise.workflows.fly import default_duration, steady_bound
+        from quadcruise.workflows.fly import altitude_bound, check_can_hover, default_duration, steady_bound
 
         if isinstance(self.mission, str):
             object.__setattr__(self, "mission", mission_from_name(self.mission))
@@ -143,6 +154,15 @@ class MonteCarloSpec:
             raise InputError("population must be a Population")
         if not isinstance(self.vehicle, Vehicle) or self.vehicle.batch_size is not None:
             raise InputError("the nominal vehicle must be one (unbatched) Vehicle")
+        with warnings.catch_warnings():            # fly() warns of a vehicle with little left for control
+            warnings.simplefilter("ignore")
+            check_can_hover(self.vehicle)              # before any chunk flies: a nominal that cannot lift
+        if self.controller_vehicle is not None:
+            if not isinstance(self.controller_vehicle, Vehicle) or self.controller_vehicle.batch_size is not None:
+                raise InputError("the controller's vehicle must be one (unbatched) Vehicle")
+            if not self.population.model_error:
+                raise InputError("a controller_vehicle (the model every controller flies with) contradicts the "
+                                 "population's model_error=False (each controller knows its own vehicle)")
         object.__setattr__(self, "seed", whole_number(self.seed, "seed"))
         duration = default_duration(self.mission) if self.duration is None else self.duration
         time_grid(float(duration), float(self.dt))          # validates duration and dt
@@ -166,13 +186,27 @@ class MonteCarloSpec:
             else self.max_track_error_m
         if isinstance(bound, bool) or not (isinstance(bound, (int, float)) and math.isfinite(bound) and bound > 0):
             raise InputError(f"max_track_error_m must be a positive number [m], got {bound!r}")
+        zbound = self.max_altitude_error_m
+        if zbound is None:
+            zbound = altitude_bound(self.mission, self.duration) if self.max_track_error_m is None else bound
+        if isinstance(zbound, bool) or not (isinstance(zbound, (int, float)) and math.isfinite(zbound) and zbound > 0):
+            raise InputError(f"max_altitude_error_m must be a positive number [m], got {zbound!r}")
         object.__setattr__(self, "max_track_error_m", float(bound))
+        object.__setattr__(self, "max_altitude_error_m", float(zbound))
         if self.population.needs_drag:
             from quadcruise.disturbances.environment import with_drag
 
-            object.__setattr__(self, "vehicle", with_drag(self.vehicle))
+            object.__setattr__(self, "vehicle", with_drag(self.vehicle, warn=True))
 
     # --- derived ------------------------------------------------------------------------
+    @property
+    def model_vehicle(self) -> Vehicle | None:
+        """The vehicle the controllers compute with: ``controller_vehicle``, else the nominal one,
+        or None (each vehicle's own) when the population has no model error."""
+        if self.controller_vehicle is not None:
+            return self.controller_vehicle
+        return self.vehicle if self.population.model_error else None
+
     @property
     def parsed_requirements(self) -> tuple[Requirement, ...]:
         """The :attr:`requirements` as :class:`~quadcruise.montecarlo.requirements.Requirement` objects."""
@@ -214,7 +248,8 @@ class MonteCarloSpec:
             ``to_dict()``), and ``log_every`` and ``trace_every``.
         """
         out = {"mission": self.mission.to_dict(), "controller": controller_record(self.controller),
-               "population": self.population.to_dict(), "vehicle": self.vehicle.to_dict()}
+               "population": self.population.to_dict(), "vehicle": self.vehicle.to_dict(),
+               "controller_vehicle": None if self.controller_vehicle is None else self.controller_vehicle.to_dict()}
         for f in dataclasses.fields(self):
             if f.name not in out:
                 out[f.name] = getattr(self, f.name)

@@ -19,7 +19,6 @@ anything else, is refused unless ``force``. The results are written at the end
 
 from __future__ import annotations
 
-import json
 import shutil
 import warnings
 from pathlib import Path
@@ -29,9 +28,10 @@ import numpy as np
 
 from quadcruise._cache import code_digest
 from quadcruise._version import __version__
-from quadcruise.errors import InputError
-from quadcruise.io.files import MARKER, atomic_path, check_output_dir
+from quadcruise.errors import InputError, WriteError
+from quadcruise.io.files import MARKER, atomic_path, check_output_dir, read_marker
 from quadcruise.io.plainjson import dumps
+from quadcruise.montecarlo.schema import COLUMNS
 from quadcruise.montecarlo.spec import MonteCarloSpec
 
 __all__ = ["CHUNKS", "write_marker", "holds_sweep"]
@@ -49,29 +49,70 @@ def _write_chunk(folder: Path, chunk: dict) -> None:
             np.savez(f, **chunk)
 
 
+TRACES = ("trace_vehicle", "trace_sample", "trace_t", "trace_pos", "trace_ref")
+"""The arrays of a chunk file besides ``first``, ``count``, ``hash`` and the table's columns."""
+
+
+def _load_chunk(path: Path) -> dict:
+    """The arrays of one chunk file; ValueError or OSError if it is not a whole .npz archive."""
+    with open(path, "rb") as f:              # closed whatever np.load makes of it
+        if f.read(4) not in (b"PK\x03\x04", b"PK\x05\x06"):
+            raise ValueError("not an .npz archive")
+        f.seek(0)
+        with np.load(f, allow_pickle=False) as data:
+            return {k: data[k] for k in data.files}
+
+
+def _chunk_problem(chunk: dict, first: int) -> str | None:
+    """What makes a loaded chunk unusable (missing arrays, lengths that do not agree), or None."""
+    missing = [k for k in ("first", "count", "hash", *COLUMNS, *TRACES) if k not in chunk]
+    if missing:
+        return f"it lacks {', '.join(missing[:3])}{' ...' if len(missing) > 3 else ''}"
+    if chunk["first"].shape != () or chunk["count"].shape != () or int(chunk["first"]) != first:
+        return "its first vehicle is not the one its name says"
+    count = int(chunk["count"])
+    if count < 1 or any(chunk[k].shape != (count,) for k in COLUMNS):
+        return "its columns do not hold one value per flight"
+    if not np.array_equal(chunk["vehicle"], np.arange(first, first + count)):
+        return "its vehicles are not numbered in order"
+    kept, samples = chunk["trace_vehicle"].shape, chunk["trace_t"].shape
+    if (len(kept) != 1 or chunk["trace_sample"].shape != kept or len(samples) != 1
+            or any(chunk[k].shape != (*kept, *samples, 3) for k in ("trace_pos", "trace_ref"))):
+        return "its paths do not fit together"
+    return None
+
+
 def _read_chunks(folder: Path, spec_hash: str) -> Iterator[dict]:
     """The complete chunks of this spec in ``folder``; others are skipped with a warning."""
     for path in sorted((folder / CHUNKS).glob("chunk-*.npz")):
         try:
-            with np.load(path, allow_pickle=False) as data:
-                chunk = {k: data[k] for k in data.files}
+            first = int(path.stem.split("-")[1])
+            chunk = _load_chunk(path)
         except Exception as exc:              # a foreign or damaged file: fly it again
-            warnings.warn(f"{path}: unreadable ({exc}); its flights are flown again", stacklevel=3)
+            warnings.warn(f"{path}: damaged or unreadable ({' '.join(str(exc).split()) or type(exc).__name__}); "
+                          "its flights are flown again", stacklevel=3)
             continue
-        if str(chunk.get("hash")) != spec_hash or int(chunk["first"]) != int(path.stem.split("-")[1]):
+        if str(chunk.get("hash")) != spec_hash:
             warnings.warn(f"{path}: belongs to another sweep; its flights are flown again", stacklevel=3)
+            continue
+        problem = _chunk_problem(chunk, first)
+        if problem is not None:
+            warnings.warn(f"{path}: damaged ({problem}); its flights are flown again", stacklevel=3)
             continue
         yield chunk
 
 
-def _marker(path: Path) -> dict | None:
+def _marker(path: Path, force: bool = False) -> dict | None:
+    """The folder's marker; a damaged one is refused (InputError) unless ``force``, then None."""
     try:
-        return json.loads((path / MARKER).read_text())
-    except (OSError, ValueError):
-        return None
+        return read_marker(path)
+    except InputError:
+        if force:
+            return None
+        raise
 
 
-def holds_sweep(path: Path, spec: MonteCarloSpec) -> tuple[dict | None, bool]:
+def holds_sweep(path: Path, spec: MonteCarloSpec, *, force: bool = False) -> tuple[dict | None, bool]:
     """What folder ``path`` holds, and whether it is this very sweep.
 
     Parameters
@@ -80,15 +121,23 @@ def holds_sweep(path: Path, spec: MonteCarloSpec) -> tuple[dict | None, bool]:
         The folder; it need not exist.
     spec : MonteCarloSpec
         The sweep.
+    force : bool
+        Read a damaged marker as none (the folder is to be replaced) instead of refusing it.
 
     Returns
     -------
     meta : dict or None
-        The folder's quadcruise.json, or None if it has none (or it is unreadable).
+        The folder's quadcruise.json, or None if it has none.
     same : bool
         True if it is a Monte Carlo folder of the same spec hash.
+
+    Raises
+    ------
+    InputError
+        If the folder's quadcruise.json is damaged (:func:`~quadcruise.io.files.read_marker`)
+        and not ``force``: the folder is never replaced for that alone.
     """
-    meta = _marker(path) if path.is_dir() else None
+    meta = _marker(path, force) if path.is_dir() else None
     return meta, bool(meta) and meta.get("workflow") == "montecarlo" and meta.get("spec_hash") == spec.hash()
 
 
@@ -118,7 +167,7 @@ class SweepFolder:
         self.path = check_output_dir(out, force, workflow="montecarlo")
         self.hash = spec.hash()
         self.spec = spec
-        meta, same = holds_sweep(self.path, spec)
+        meta, same = holds_sweep(self.path, spec, force=force)
         if meta is not None and not same and not force:
             what = (f"a different sweep (spec {meta.get('spec_hash')})" if meta.get("workflow") == "montecarlo"
                     else f"a quadcruise {meta.get('workflow', 'result')} result")
@@ -140,6 +189,36 @@ class SweepFolder:
     def prepare(self, n: int, chunk_size: int) -> None:
         """Clear a folder that is not resumed, and write the marker (not complete).
 
+        The marker comes before the chunks' folder, so that a fault leaves either a folder
+        this sweep resumes or none of its own.
+
+        Parameters
+        ----------
+        n : int
+            Number of flights of the sweep.
+        chunk_size : int
+            Vehicles per chunk.
+
+        Raises
+        ------
+        WriteError
+            If the folder could not be cleared or written.
+        """
+        try:
+            if self.clear:
+                shutil.rmtree(self.path)
+            write_marker(self.path, self.spec, n, chunk_size=chunk_size, complete=False)
+            (self.path / CHUNKS).mkdir(exist_ok=True)
+        except WriteError:
+            raise
+        except OSError as exc:
+            raise WriteError(self.path, exc) from None
+
+    def reclaim(self, n: int, chunk_size: int) -> None:
+        """Write the marker again if it is gone or damaged since :meth:`prepare` (the folder
+        removed or changed while the sweep ran), so that the results go where they were asked
+        for instead of being refused as another's.
+
         Parameters
         ----------
         n : int
@@ -147,10 +226,12 @@ class SweepFolder:
         chunk_size : int
             Vehicles per chunk.
         """
-        if self.clear:
-            shutil.rmtree(self.path)
-        (self.path / CHUNKS).mkdir(parents=True, exist_ok=True)
-        write_marker(self.path, self.spec, n, chunk_size=chunk_size, complete=False)
+        try:
+            held = read_marker(self.path)
+        except InputError:
+            held = None
+        if not held or held.get("spec_hash") != self.hash:
+            write_marker(self.path, self.spec, n, chunk_size=chunk_size, complete=False)
 
     def write_chunk(self, chunk: dict) -> None:
         """Write one chunk as ``chunks/chunk-<first>.npz``, whole or not at all.

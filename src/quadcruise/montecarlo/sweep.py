@@ -13,7 +13,11 @@ with one thread each (numba runs one thread per task there) and without Dask's p
 a bounded number in flight, gathered as they finish.
 A worker that dies loses its tasks, the scheduler runs them again elsewhere, and since a
 chunk is keyed by its first vehicle and written whole, every flight is counted once. Each
-worker process loads the compiled engine from numba's cache once.
+worker process loads the compiled engine from numba's cache once. Only the main process sees
+Ctrl-C (:func:`_ctrl_c_for_this_process_only`) and closes the cluster, which ends the
+workers; the cluster logs only what is CRITICAL: a chunk that fails raises here, and what
+Dask would log besides (a worker restarted, the heartbeats lost while it closes after Ctrl-C)
+is no news to a user.
 
 **Memory.** One row per flight is kept; paths only for the first ``max_traces`` vehicles
 and the first ``max_failure_traces`` failed ones; a chunk's log is held only while it is
@@ -33,7 +37,7 @@ from typing import Callable
 
 import numpy as np
 
-from quadcruise.errors import InputError, SimulationError, whole_number
+from quadcruise.errors import InputError, SimulationError, WriteError, whole_number
 from quadcruise.io.files import check_table_format
 from quadcruise.montecarlo.chunk import fly_chunk, reduce_chunk, run_chunk, sweep_metrics
 from quadcruise.montecarlo.output import write_outputs
@@ -85,6 +89,8 @@ class _Collector:
         count = min(int(chunk["count"]), self.n - first)
         if count <= 0:
             return 0
+        if self.trace_t is not None and not np.array_equal(chunk["trace_t"], self.trace_t):
+            raise SimulationError(f"the chunk of vehicles from {first} keeps its paths at other instants")
         for a, b in self.covered:
             if first < b and a < first + count:
                 raise SimulationError(f"chunk of vehicles {first}..{first + count - 1} overlaps {a}..{b - 1}")
@@ -160,16 +166,20 @@ class _Dask:
     def __init__(self, scheduler: str, workers: int | None, timeout: float) -> None:
         from distributed import Client, LocalCluster
 
-        self.cluster = None
+        self.cluster = self.client = None
         if scheduler == "local":
             import dask
 
             n_workers = workers or os.cpu_count() or 1
-            with dask.config.set(LOCAL_CLUSTER_SETTINGS):
-                self.cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                                            dashboard_address=":0", silence_logs=logging.ERROR,
-                                            env={"NUMBA_NUM_THREADS": "1"})
-            self.client = Client(self.cluster, set_as_default=False)
+            try:
+                with dask.config.set(LOCAL_CLUSTER_SETTINGS), _ctrl_c_for_this_process_only():
+                    self.cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                                                dashboard_address=":0", silence_logs=logging.CRITICAL,
+                                                env={"NUMBA_NUM_THREADS": "1"})
+                    self.client = Client(self.cluster, set_as_default=False)
+            except BaseException:           # Ctrl-C while the workers started (it arrives at the end)
+                self.close()
+                raise
             self.name = f"a local Dask cluster of {n_workers} processes"
         else:
             try:
@@ -217,11 +227,45 @@ class _Dask:
                     self.client.cancel(list(pending))
 
     def close(self) -> None:
-        with contextlib.suppress(Exception):
-            self.client.close()
+        if self.client is not None:
+            with contextlib.suppress(Exception):
+                self.client.close()
         if self.cluster is not None:
             with contextlib.suppress(Exception):
                 self.cluster.close()
+
+
+@contextlib.contextmanager
+def _ctrl_c_for_this_process_only():
+    """Processes and threads started inside never see Ctrl-C (SIGINT); this one still does.
+
+    A terminal sends Ctrl-C to every process of the foreground group, local Dask workers
+    included, and each worker would print its own KeyboardInterrupt traceback. SIGINT is
+    blocked in this thread meanwhile: the threads started inside (Dask's event loop, which
+    starts the workers, and starts them again if one dies) and the processes they start keep it
+    blocked, and a Ctrl-C that came meanwhile is delivered here at the end. This process
+    then stops the sweep and closes the cluster, which ends its workers. multiprocessing's
+    resource tracker is started first: starting it unblocks SIGINT in the thread that does.
+    Outside the main thread, or where signal masks do not exist, it does nothing.
+
+    Yields
+    ------
+    None
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    from multiprocessing import resource_tracker
+
+    resource_tracker.ensure_running()
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 def _scheduler(scheduler: str | None) -> str:
@@ -382,6 +426,8 @@ def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", s
                     progress(collector.done, n)
         finally:
             chunks.close()                  # cancels the tasks still out (an interruption)
+    except WriteError as exc:
+        raise _saying_what_is_kept(exc, folder, collector.done, n) from None
     finally:
         runner.close()
     wall = time.perf_counter() - start
@@ -391,5 +437,20 @@ def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", s
             "out": None if out is None else str(out)}
     result = collector.result(info)
     if folder is not None:
-        write_outputs(result, folder.path, fmt=fmt)
+        try:
+            folder.reclaim(n, size)
+            write_outputs(result, folder.path, fmt=fmt)
+        except WriteError as exc:
+            raise _saying_what_is_kept(exc, folder, n, n) from None
     return result
+
+
+def _saying_what_is_kept(exc: WriteError, folder, done: int, n: int) -> WriteError:
+    """``exc`` (a file of the sweep's folder that could not be written) saying which flights
+    are safe on disk and that the same command goes on from them."""
+    if folder is None or done == 0:
+        return exc
+    where = folder.path / "chunks"
+    kept = (f"all {n:,} flights are kept in {where}: the same command writes the results without flying them again"
+            if done == n else f"the {done:,} flights done are kept in {where}: the same command resumes from them")
+    return WriteError(exc.filename, exc, kept=kept)

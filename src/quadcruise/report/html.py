@@ -35,7 +35,7 @@ import numpy as np
 from quadcruise.errors import InputError
 from quadcruise.io.files import atomic_path
 from quadcruise.io.plainjson import dumps
-from quadcruise.metrics.tables import DID_NOT_SETTLE, metric_cell
+from quadcruise.metrics.tables import DID_NOT_SETTLE, FAILED_FLIGHT, NO_OVERSHOOT, NO_TRANSIENT, metric_cell
 from quadcruise.plots.thin import thinned
 
 __all__ = ["html_report", "write_html_report", "flight_report", "comparison_report",
@@ -73,9 +73,10 @@ def _label(name, conventions: dict | None = None) -> str:
 def table_html(frame) -> str:
     """A DataFrame as an HTML table.
 
-    Numbers show 4 significant digits, NaN "—", and a NaN settling time of a measured
-    transient (a non-empty ``axis``, as a column or, in a transposed table, as a row)
-    "did not settle"; a status other than "finished" is shown in red. Column names become
+    Numbers show 4 significant digits, NaN "—", and a NaN transient or steady metric as
+    :func:`~quadcruise.metrics.tables.metric_cell` names it ("did not settle", "failed flight",
+    "no transient", from the ``axis`` and ``status``, as columns or, in a transposed table, as
+    rows); a status other than "finished" is shown in red. Column names become
     headings with their unit (``rise_time_s`` -> "rise time [s]").
 
     Parameters
@@ -100,8 +101,13 @@ def table_html(frame) -> str:
     """
     import pandas as pd
 
-    rows_axis = frame["axis"] if "axis" in frame.columns else None
-    cols_axis = frame.loc["axis"] if rows_axis is None and "axis" in frame.index else None
+    def _axes(values):                                   # "" where the table measured no transient
+        return None if values is None else values.map(lambda a: a if isinstance(a, str) else "")
+
+    rows_axis = _axes(frame["axis"] if "axis" in frame.columns else None)
+    cols_axis = _axes(frame.loc["axis"] if rows_axis is None and "axis" in frame.index else None)
+    rows_status = frame["status"] if "status" in frame.columns else None
+    cols_status = frame.loc["status"] if rows_status is None and "status" in frame.index else None
     shown_index = not (isinstance(frame.index, pd.RangeIndex) and frame.index.start == 0
                        and frame.index.step == 1)
     idx_names = [n for n in frame.index.names] if shown_index else []
@@ -114,12 +120,15 @@ def table_html(frame) -> str:
         cells = [f'<th scope="row">{html.escape(_label(k, conventions))}</th>' for k in keys] if shown_index else []
         for c, (col, value) in enumerate(row.items()):
             axis = rows_axis.iloc[r] if rows_axis is not None else None
+            status = rows_status.iloc[r] if rows_status is not None else None
             metric = col
-            if cols_axis is not None:                    # a transposed table: metrics down
-                axis, metric = cols_axis.iloc[c], key
-            text, num = metric_cell(value, metric, axis, MISSING)
+            if cols_axis is not None or cols_status is not None:    # a transposed table: metrics down
+                metric = key
+                axis = cols_axis.iloc[c] if cols_axis is not None else None
+                status = cols_status.iloc[c] if cols_status is not None else None
+            text, num = metric_cell(value, metric, axis, MISSING, status=status)
             cls = ["num"] if num else []
-            if text in (MISSING, DID_NOT_SETTLE):
+            if text in (MISSING, DID_NOT_SETTLE, FAILED_FLIGHT, NO_TRANSIENT, NO_OVERSHOOT):
                 cls.append("missing")
             if (col == "status" or key == "status") and isinstance(value, str):
                 cls.append("ok" if value == "finished" else "bad")
@@ -396,10 +405,13 @@ def _conventions_table(frame) -> dict:
     conv = frame.attrs.get("conventions")
     if not conv:
         return {}
-    values = {"rise_time_s": "{:g}-{:g} % of the step".format(*(100.0 * v for v in conv["rise"]))}
+    values = {"rise_time_s": "{:g}-{:g} % of the step (axis xyz: of the error's way to its steady level)".format(
+        *(100.0 * v for v in conv["rise"]))}
     values.update({name: f"{100.0 * band:g} % band" for name, band in conv["settling_columns"].items()})
     values["steady_rmse_m, steady_max_error_m"] = (f"3-D position error from the {100.0 * conv['steady_band']:g} % "
-                                                   "settling time on (the whole flight without a transient)")
+                                                   "settling time on (axis xyz, a moving reference: over the last "
+                                                   "half of the flight, once converged; the whole flight without a "
+                                                   "transient)")
     values["effort"] = conv["effort"]
     return {"Metric conventions": pd.DataFrame({"meaning": values})}
 
@@ -503,10 +515,11 @@ def reproduction_report(rep, figures: dict | None = None, *, title: str | None =
 
     from quadcruise._version import __version__
     from quadcruise.workflows.reproduce import (
-        DIFFERENCES,
         FIGURES,
+        INTRO,
         TRACE_EVERY,
         baseline_comparison,
+        differences,
         paper_figure,
         paper_numbers,
     )
@@ -528,10 +541,7 @@ def reproduction_report(rep, figures: dict | None = None, *, title: str | None =
         figures = {cap: fig for name, cap in FIGURES.items()
                    if (fig := paper_figure(name, cap, light)) is not None}
     flights = {scen: {c: res for (s, c), res in rep.results.items() if s == scen} for scen in ("circle", "square")}
-    intro = ("Our values beside the paper's. Transients are measured on x from hover; settling uses the "
-             "2 % band (5 % beside it); RMSE is the 3-D position error over the whole flight, transient "
-             "included.")
-    notes = markdown_html(intro + "\n" + DIFFERENCES + baseline_comparison(rep))
+    notes = markdown_html(INTRO + "\n" + differences() + baseline_comparison(rep))
     return {"title": title or f"quadcruise {__version__}: reproduction of the paper",
             "tables": {"Results against the paper": table}, "figures": figures,
             "flights": {k: v for k, v in flights.items() if v},

@@ -82,16 +82,18 @@ class Limits:
     max_rate : float
         any body rate above this [rad/s].
     max_tilt : float
-        |roll| or |pitch| above this [rad]; infinite by default, since the paper's
-        model has no singularity at 90 degrees. (The full plant, ``full_dynamics=True``,
-        stops anyway at |pitch| > :data:`quadcruise.model.plant.EULER_PITCH_LIMIT`, 85
-        degrees, with the status ``PITCH_SINGULAR``.)
+        |roll| or |pitch| above this [rad]; 90 degrees by default: beyond it the vehicle is
+        on its side or upside down, its thrust pulls it towards the ground, and no mission
+        is being flown (the paper's model has no singularity there: it is the flight that
+        has failed, whatever the mission). (The full plant, ``full_dynamics=True``, stops
+        anyway at |pitch| > :data:`quadcruise.model.plant.EULER_PITCH_LIMIT`, 85 degrees,
+        with the status ``PITCH_SINGULAR``.)
     """
 
     max_position: float = 1.0e4
     max_speed: float = 1.0e3
     max_rate: float = 1.0e3
-    max_tilt: float = math.inf
+    max_tilt: float = math.pi / 2.0
 
     def __post_init__(self) -> None:
         for name in ("max_position", "max_speed", "max_rate", "max_tilt"):

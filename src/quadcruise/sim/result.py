@@ -253,6 +253,66 @@ class SimResult:
 
         return plot_flight(self, vehicle=vehicle, **kwargs)
 
+    def to_ulog(self, path: str | os.PathLike, vehicle: int = 0) -> Path:
+        """Write one vehicle's flight as a PX4 log (ULog), in PX4's conventions.
+
+        NED world, FRD body, quaternions w first, microsecond timestamps; the topics
+        ``vehicle_local_position``, ``vehicle_attitude``, ``vehicle_angular_velocity``,
+        ``actuator_motors``, ``sensor_combined`` (a simulated IMU), ``vehicle_status`` and
+        ``vehicle_land_detected``, at the rates of :data:`quadcruise.sim.px4.RATES_HZ` (at most
+        the flight's log rate), the rotors as ``CA_ROTOR*`` parameters. pyulog, PX4 Flight Review
+        and PlotJuggler read it. See :mod:`quadcruise.sim.px4`.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The ``.ulg`` file, written whole or not at all.
+        vehicle : int
+            The vehicle's index.
+
+        Returns
+        -------
+        pathlib.Path
+            The file written.
+
+        Examples
+        --------
+        >>> import tempfile, quadcruise as qc
+        >>> from pyulog import ULog
+        >>> with tempfile.TemporaryDirectory() as folder:
+        ...     log = ULog(str(qc.fly("hover", duration=1.0).to_ulog(Path(folder) / "hover.ulg")))
+        >>> round(float(log.get_dataset("vehicle_local_position").data["z"][0]), 3)   # 1 m up: NED z = -1
+        -1.0
+        """
+        from quadcruise._version import __version__
+        from quadcruise.io.ulog import write_ulog
+        from quadcruise.sim.px4 import NOISE_STREAM, duties_of, px4_topics, rotor_parameters
+
+        if isinstance(vehicle, bool) or not isinstance(vehicle, (int, np.integer)) or not 0 <= vehicle < self.n:
+            raise InputError(f"to_ulog: vehicle must be an index in [0, {self.n}), got {vehicle!r}")
+        if not str(path).endswith(".ulg"):
+            raise InputError(f"to_ulog: a PX4 log's name ends in .ulg, got {str(path)!r}")
+        rows = np.isfinite(self.states[vehicle]).all(axis=1)
+        t, states = self.t[rows], self.states[vehicle][rows]
+
+        def field_of(name, default):
+            value = (self.meta.get("vehicle") or {}).get(name, default)
+            return float(value[vehicle] if isinstance(value, (list, tuple, np.ndarray)) else value)
+
+        sensors = self.meta.get("sensors") or {}
+        std = np.zeros(states.shape[1])
+        for key, first in (("position_std", 0), ("velocity_std", 3), ("angle_std", 6), ("rate_std", 9)):
+            value = sensors.get(key, 0.0)
+            std[first:first + 3] = value[vehicle] if isinstance(value, (list, tuple)) else value
+        seed = self.meta.get("seed") or 0
+        rng = np.random.default_rng([int(seed), int(vehicle), NOISE_STREAM])
+        topics = px4_topics(t, states, duties_of(self.commands[vehicle][rows]), g=field_of("g", 9.81),
+                            noise_std=std, rng=rng)
+        params = rotor_parameters(field_of("l", 0.2), field_of("d", 0.0), field_of("K", 0.0))
+        write_ulog(path, topics, info={"sys_name": "quadcruise", "ver_sw": __version__, "ver_hw": "SIMULATION"},
+                   parameters=params)
+        return Path(path)
+
     def summary(self) -> Summary:
         """The headline numbers: vehicles by exit status, and the longest saturation times.
 

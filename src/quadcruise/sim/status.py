@@ -41,6 +41,7 @@ class ExitStatus(IntEnum):
     LOST_TRACK = 7
     PITCH_SINGULAR = 8
     OFF_TRACK = 9
+    CRASHED = 10
 
     @property
     def reason(self) -> str:
@@ -68,8 +69,9 @@ _REASONS = {
     ExitStatus.BAD_COMMAND: "stopped: the controller returned a non-finite command",
     ExitStatus.LOST_TRACK: "lost track: the position error left the tracking bound",
     ExitStatus.PITCH_SINGULAR: "stopped: pitch beyond 85 degrees, near the full plant's Euler-angle singularity",
-    ExitStatus.OFF_TRACK: "off track: the position error after the transient (at the end, if it never settled) "
-                          "exceeded the steady bound",
+    ExitStatus.OFF_TRACK: "off track: the position or altitude error after the transient (at the end, if it never "
+                          "settled) exceeded the steady bound",
+    ExitStatus.CRASHED: "crashed: hit the ground faster than the vehicle's touchdown speed, or upside down",
 }
 
 STATUS_REASONS = tuple(status.reason for status in ExitStatus)

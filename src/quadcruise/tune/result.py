@@ -123,7 +123,8 @@ class TuneResult:
                                 **{m: ev.metrics[m][k] for m in METRICS},
                                 "status": ev.metrics["status"][k], "cost": ev.flight_cost[k]})
         spec = obj.spec
-        kw = dict(vehicle=spec.vehicle, duration=spec.duration, dt=spec.dt, seed=spec.seed,
+        kw = dict(vehicle=spec.vehicle, controller_vehicle=spec.controller_vehicle, duration=spec.duration,
+                  dt=spec.dt, seed=spec.seed,
                   environment=spec.population.environment, sensors=spec.population.noise)
         import warnings
 

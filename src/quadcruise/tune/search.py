@@ -45,7 +45,8 @@ ABS_TOL = 1e-3
 met exactly would otherwise never stop a relative test."""
 
 TUNE_OPTIONS = ("gains", "bounds", "targets", "require", "minimize", "population", "samples", "objective",
-                "seed", "budget", "popsize", "tol", "duration", "dt", "vehicle", "log_dt", "transient_until",
+                "seed", "budget", "popsize", "tol", "duration", "dt", "vehicle", "controller_vehicle", "log_dt",
+                "transient_until",
                 "progress", "command")
 """The keywords :func:`tune` takes besides the mission and the controller."""
 
@@ -54,7 +55,7 @@ def tune(mission: Mission | str = "step", controller: Any = "nlpd", *, gains=Non
          require=(), minimize=(), population: Population | None = None, samples: int = 1,
          objective: str | float = "worst", seed: int = 0, budget: int = 100, popsize: int | None = None,
          tol: float = 0.01, duration: float | None = None, dt: float = 1e-3, vehicle: Vehicle | None = None,
-         log_dt: float = 0.01, transient_until: float | None = None,
+         controller_vehicle: Vehicle | None = None, log_dt: float = 0.01, transient_until: float | None = None,
          progress: Callable[[int, int, str], None] | None = None, command: str = "",
          **unknown: Any) -> TuneResult:
     """Tune a controller's gains, within bounds, towards targets on its metrics.
@@ -101,6 +102,8 @@ def tune(mission: Mission | str = "step", controller: Any = "nlpd", *, gains=Non
         Control period [s].
     vehicle : Vehicle, optional
         The nominal vehicle; Table I by default.
+    controller_vehicle : Vehicle, optional
+        The vehicle the controller believes it flies (its model); the nominal ``vehicle`` by default.
     log_dt : float
         Sampling of the log the metrics are measured on [s].
     transient_until : float, optional
@@ -147,7 +150,8 @@ def tune(mission: Mission | str = "step", controller: Any = "nlpd", *, gains=Non
     popsize = 15 * len(space.gains) if popsize is None else whole_number(popsize, "popsize (candidates per generation)", 5)
     population = population or Population()
     spec = MonteCarloSpec(mission, base, population, seed=seed, duration=duration, dt=dt,
-                          vehicle=vehicle or Vehicle.paper(), log_dt=log_dt, transient_until=transient_until)
+                          vehicle=vehicle or Vehicle.paper(), controller_vehicle=controller_vehicle, log_dt=log_dt,
+                          transient_until=transient_until)
     from quadcruise.workflows.fly import check_run_size
 
     check_run_size(popsize * samples, spec.periods, spec.log_every)   # one generation is one batch: size it first

@@ -31,6 +31,7 @@ velocity and attitude feedback closed: the outer loop's own margins.
 from __future__ import annotations
 
 import math
+import textwrap
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -483,11 +484,17 @@ def loop_margins(lin: Linearization, loop: str = "x", at: str = "input") -> dict
     dict
         ``phase_margin`` [deg] at ``gain_crossover`` [rad/s]; ``gain_margin`` [-] (the one
         python-control picks, nearest 1) at ``phase_crossover`` [rad/s]; ``gain_increase``
-        (the smallest destabilising factor > 1, inf if none) and ``gain_decrease`` (the
-        largest < 1, 0 if none; a PID on a double integrator has one);
+        [-] (the smallest destabilising factor > 1, inf if none) at
+        ``gain_increase_frequency`` [rad/s] and ``gain_decrease`` [-] (the largest < 1, 0 if
+        none) at ``gain_decrease_frequency`` [rad/s], and both in decibels,
+        ``gain_increase_db`` (> 0, inf if none) and ``gain_decrease_db`` (< 0, -inf if none);
         ``stability_margin`` (least distance of L to -1) and its frequency
         ``stability_margin_frequency`` [rad/s]; ``open_loop_unstable_poles`` (of L; when
-        not 0 the margins alone do not tell stability).
+        not 0 the margins alone do not tell stability). A loop with a ``gain_decrease`` is
+        conditionally stable: it is stable at its own gain and goes unstable if the gain
+        falls by that factor (a PID's integral on a double integrator makes the phase
+        cross -180 deg below the gain crossover), as well as if it rises by
+        ``gain_increase``.
 
     Examples
     --------
@@ -504,58 +511,123 @@ def loop_margins(lin: Linearization, loop: str = "x", at: str = "input") -> dict
     with np.errstate(divide="ignore"):
         g = int(np.argmin(np.abs(np.log(gms)))) if gms.size and not np.isinf(gms).all() else None
     p, s = (int(np.argmin(np.abs(pms))) if pms.size else None), (int(np.argmin(sms)) if sms.size else None)
+    up, down = np.flatnonzero(gms > 1), np.flatnonzero(gms < 1)
+    up = up[np.argmin(gms[up])] if up.size else None
+    down = down[np.argmax(gms[down])] if down.size else None
+    increase, decrease = (math.inf if up is None else float(gms[up])), (0.0 if down is None else float(gms[down]))
     return {"phase_margin": math.inf if p is None else float(pms[p]),
             "gain_crossover": math.nan if p is None else float(wgcs[p]),
             "gain_margin": math.inf if g is None else float(gms[g]),
             "phase_crossover": math.nan if g is None else float(wpcs[g]),
-            "gain_increase": float(min(gms[gms > 1], default=math.inf)),
-            "gain_decrease": float(max(gms[gms < 1], default=0.0)),
+            "gain_increase": increase,
+            "gain_increase_frequency": math.nan if up is None else float(wpcs[up]),
+            "gain_increase_db": _db(increase),
+            "gain_decrease": decrease,
+            "gain_decrease_frequency": math.nan if down is None else float(wpcs[down]),
+            "gain_decrease_db": _db(decrease),
             "stability_margin": math.nan if s is None else float(sms[s]),
             "stability_margin_frequency": math.nan if s is None else float(wsms[s]),
             "open_loop_unstable_poles": int(np.sum(np.abs(np.linalg.eigvals(L.A)) > 1.0 + 1e-9))}
 
 
-def wrap_phase(degrees):
-    """Phase [deg] wrapped to (-360, 0], the range of :func:`bode`'s phase axes.
+def _db(factor: float) -> float:
+    """20 log10(factor) [dB]; -inf for 0."""
+    return -math.inf if factor == 0.0 else 20.0 * math.log10(factor)
 
-    Every loop here lags (the closed loops start at 0 deg and fall), so (-360, 0] keeps
-    them whole, and it puts -180 deg, where the phase margin is read, in the middle of the
-    axis: no loop transfer is cut there, as (-180, 180] would cut one whose phase crosses
-    -180 deg.
+
+MIN_PHASE_MARGIN_DEG = 30.0
+"""A phase margin below this [deg] is flagged: the usual floor for a loop that must tolerate
+unmodelled lag (delay, a slower motor) without ringing."""
+MIN_GAIN_MARGIN_DB = 6.0
+"""A gain margin within this [dB] of 0 dB, up or down, is flagged: a loop gain error of a
+factor 2 (thrust coefficient, inertia, battery sag) must not destabilise it."""
+
+
+def low_margins(m: dict) -> list[str]:
+    """What is short in one loop's margins (:func:`loop_margins`), in words.
+
+    Flagged: a phase margin below :data:`MIN_PHASE_MARGIN_DEG`, a gain margin up or down
+    within :data:`MIN_GAIN_MARGIN_DB` of 0 dB.
 
     Parameters
     ----------
-    degrees : array_like
-        Phase [deg].
+    m : dict
+        What :func:`loop_margins` returns.
+
+    Returns
+    -------
+    list of str
+        One phrase per margin that is short (empty if none), e.g. ``"PM 18.1 deg < 30 deg"``.
+
+    Examples
+    --------
+    >>> low_margins({"phase_margin": 18.1, "gain_increase_db": 38.2, "gain_decrease_db": -3.98})
+    ['PM 18.1 deg < 30 deg', 'GM down -3.98 dB > -6 dB']
+    """
+    out = []
+    if m["phase_margin"] < MIN_PHASE_MARGIN_DEG:
+        out.append(f"PM {m['phase_margin']:.3g} deg < {MIN_PHASE_MARGIN_DEG:g} deg")
+    if m["gain_increase_db"] < MIN_GAIN_MARGIN_DB:
+        out.append(f"GM up {m['gain_increase_db']:+.3g} dB < {MIN_GAIN_MARGIN_DB:+g} dB")
+    if m["gain_decrease_db"] > -MIN_GAIN_MARGIN_DB:
+        out.append(f"GM down {m['gain_decrease_db']:+.3g} dB > {-MIN_GAIN_MARGIN_DB:+g} dB")
+    return out
+
+
+def unwrapped_phase(response, start: float = 0.0) -> np.ndarray:
+    """The phase of a frequency response [deg], continuous over frequency (``numpy.unwrap``),
+    shifted by whole turns so that it starts (at the lowest frequency) nearest ``start``.
+
+    A phase wrapped to a fixed 360 deg window jumps where it leaves the window and hides how
+    far a loop lags; unwrapped, a curve reads straight off the plot, and the -180 deg lines
+    (every 360 deg) mark where a margin is read.
+
+    Parameters
+    ----------
+    response : array_like of complex
+        The response at increasing frequencies.
+    start : float
+        The phase [deg] the first point is brought nearest to: 0 for a closed loop (unit DC
+        gain), -180 for a loop transfer (python-control's ``bode_plot`` default, its
+        ``initial_phase``).
 
     Returns
     -------
     ndarray
-        The same angles in (-360, 0].
+        Phase [deg], no step between neighbours larger than 180 deg.
 
     Examples
     --------
-    >>> wrap_phase([0.0, -90.0, -360.0, -450.0, 200.0, 1e-9]).round(6).tolist()
-    [0.0, -90.0, 0.0, -90.0, -160.0, -360.0]
+    >>> r = np.exp(-1j * np.radians([170.0, 190.0, 350.0, 370.0]))
+    >>> unwrapped_phase(r).round(6).tolist(), unwrapped_phase(-r, start=-180.0).round(6).tolist()
+    ([-170.0, -190.0, -350.0, -370.0], [-350.0, -370.0, -530.0, -550.0])
     """
-    degrees = np.asarray(degrees, dtype=float)
-    return degrees - 360.0 * np.ceil(degrees / 360.0)
-
-
-def _cut(w, phase):
-    """Frequencies and wrapped phases with a NaN at each wrap, so no line joins the ends."""
-    jumps = np.flatnonzero(np.abs(np.diff(phase)) > 180.0) + 1
-    return np.insert(w, jumps, np.nan), np.insert(phase, jumps, np.nan)
+    phase = np.degrees(np.unwrap(np.angle(np.asarray(response, complex))))
+    return phase - 360.0 * np.round((phase[0] - start) / 360.0)
 
 
 def _margin_label(m: dict) -> str:
-    """``PM 18.1° @ 10.8 rad/s, GM -3.98 dB @ 7.07 rad/s``; a margin without crossover is left out."""
+    """``PM 18.1° @ 10.8 rad/s (< 30°), GM down -3.98 dB @ 7.07 rad/s (> -6 dB), up +38.2 dB @ 300 rad/s``:
+    each margin with its unit and frequency, a short one marked; one without crossover left out."""
     parts = []
     if math.isfinite(m["phase_margin"]) and math.isfinite(m["gain_crossover"]):
-        parts.append(f"PM {m['phase_margin']:.3g}° @ {m['gain_crossover']:.3g} rad/s")
-    if math.isfinite(m["gain_margin"]) and m["gain_margin"] > 0 and math.isfinite(m["phase_crossover"]):
-        parts.append(f"GM {20 * math.log10(m['gain_margin']):+.3g} dB @ {m['phase_crossover']:.3g} rad/s")
+        short = f" (< {MIN_PHASE_MARGIN_DEG:g}°)" if m["phase_margin"] < MIN_PHASE_MARGIN_DEG else ""
+        parts.append(f"PM {m['phase_margin']:.3g}° @ {m['gain_crossover']:.3g} rad/s{short}")
+    gms = []
+    if math.isfinite(m["gain_decrease_db"]):
+        short = f" (> {-MIN_GAIN_MARGIN_DB:+g} dB)" if m["gain_decrease_db"] > -MIN_GAIN_MARGIN_DB else ""
+        gms.append(f"down {m['gain_decrease_db']:+.3g} dB @ {m['gain_decrease_frequency']:.3g} rad/s{short}")
+    if math.isfinite(m["gain_increase_db"]):
+        short = f" (< {MIN_GAIN_MARGIN_DB:+g} dB)" if m["gain_increase_db"] < MIN_GAIN_MARGIN_DB else ""
+        gms.append(f"up {m['gain_increase_db']:+.3g} dB @ {m['gain_increase_frequency']:.3g} rad/s{short}")
+    if gms:
+        parts.append("GM " + ", ".join(gms))
     return ", ".join(parts) or "no crossover"
+
+
+def _nearest_minus_180(phase: float) -> float:
+    """The line -180 + 360 k [deg] nearest ``phase``: where a margin is read on an unwrapped phase."""
+    return -180.0 + 360.0 * round((phase + 180.0) / 360.0)
 
 
 def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "input",
@@ -570,14 +642,17 @@ def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "inpu
         Add a second column of the loop transfers (broken ``at``), with their margins
         (:func:`loop_margins`) marked and named: the phase margin as a segment from the
         -180 deg line up to the phase at the gain crossover (a dot there on the 0 dB line
-        too), the gain margin as a segment from the 0 dB line to the magnitude at the phase
-        crossover (a square there on the -180 deg line too), both with their frequencies in
-        the legend ("PM 18.1° @ 10.8 rad/s, GM -3.98 dB @ 7.07 rad/s"; a negative gain
-        margin is how far the gain may fall). y's margins are x's for a symmetric vehicle
-        and are then not marked twice.
+        too), each gain margin (down and up) as a segment from the 0 dB line to the magnitude
+        at its phase crossover (a square there on the -180 deg line too), all with units and
+        frequencies in the legend ("PM 18.1° @ 10.8 rad/s (< 30°), GM down -3.98 dB @ 7.07
+        rad/s (> -6 dB), up +38.2 dB @ 300 rad/s": the loop is stable and stays so while its
+        gain falls by less than 3.98 dB or rises by less than 38.2 dB; a margin short of
+        30 deg or 6 dB is marked). y's margins are x's for a symmetric vehicle and are then
+        not marked twice.
     omega : array_like, optional
-        Frequencies [rad/s]; by default 800 from 0.01 rad/s to just below the Nyquist
-        frequency.
+        Frequencies [rad/s]; by default 800 from 0.01 rad/s to 0.9 of the Nyquist frequency
+        pi / dt (closer to it the sampling zeros near z = -1 turn the phase by half a turn
+        between two samples, which no unwrapping can tell from a jump).
     at : str
         Where the loops are broken: ``"input"`` or ``"output"`` (see :func:`loop_transfer`).
     progress : callable, optional
@@ -588,16 +663,17 @@ def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "inpu
     matplotlib.figure.Figure
         Magnitude [dB] above phase [deg] against frequency [rad/s] of the closed loop
         x_r->x, y_r->y (dashed: the same as x for a symmetric vehicle), z_r->z,
-        psi_r->psi; 2 or 4 axes. Every phase is wrapped to (-360, 0] (:func:`wrap_phase`),
-        with ticks every 90 deg; a line is broken where it wraps.
+        psi_r->psi; 2 or 4 axes. Every phase is unwrapped (:func:`unwrapped_phase`): a closed
+        loop's starts nearest 0 deg, a loop transfer's nearest -180 deg; grey lines mark
+        -180 deg and every full turn from it.
 
     Examples
     --------
     >>> fig = bode(linearize("nlpd"), loops=True)
-    >>> len(fig.axes), [float(v) for v in fig.axes[3].get_ylim()]
-    (4, [-360.0, 0.0])
+    >>> len(fig.axes), fig.axes[3].get_ylabel()
+    (4, 'phase [deg]')
     """
-    w = np.logspace(-2, math.log10(0.999 * math.pi / lin.dt), 800) if omega is None else np.asarray(omega, float)
+    w = np.logspace(-2, math.log10(0.9 * math.pi / lin.dt), 800) if omega is None else np.asarray(omega, float)
     from matplotlib.figure import Figure
     from matplotlib.ticker import MultipleLocator
 
@@ -609,44 +685,53 @@ def bode(lin: Linearization, *, loops: bool = False, omega=None, at: str = "inpu
         style = {"color": color, "ls": "--" if loop == "y" else "-"}
         r = control.frequency_response(lin.sys[OUTPUTS.index(state), INPUTS.index(f"{state}_ref")], w).complex.ravel()
         axes[0, 0].semilogx(w, 20 * np.log10(np.abs(r)), label=f"{state}_r -> {state}", **style)
-        axes[1, 0].semilogx(*_cut(w, wrap_phase(np.degrees(np.angle(r)))), **style)
+        axes[1, 0].semilogx(w, unwrapped_phase(r, 0.0), **style)
         if not loops:
             step()
             continue
         r = control.frequency_response(loop_transfer(lin, loop, at), w).complex.ravel()
-        gain, phase = 20 * np.log10(np.abs(r)), wrap_phase(np.degrees(np.unwrap(np.angle(r))))
+        gain, phase = 20 * np.log10(np.abs(r)), unwrapped_phase(r, -180.0)
         m = loop_margins(lin, loop, at)
         axes[0, 1].semilogx(w, gain, label=f"L {loop}: {_margin_label(m)}", **style)
-        axes[1, 1].semilogx(*_cut(w, phase), **style)
-        key = {k: round(m[k], 9) for k in ("phase_margin", "gain_crossover", "gain_margin", "phase_crossover")}
+        axes[1, 1].semilogx(w, phase, **style)
+        key = {k: round(m[k], 9) for k in ("phase_margin", "gain_crossover", "gain_increase", "gain_decrease")}
         if key in marked:                               # y's margins are x's: marked once
             step()
             continue
         marked.append(key)
-        wgc, wpc = m["gain_crossover"], m["phase_crossover"]
+        wgc = m["gain_crossover"]
         if math.isfinite(m["phase_margin"]) and math.isfinite(wgc):
-            p = -180.0 + m["phase_margin"]              # the phase at the crossover, in (-360, 0]
-            axes[1, 1].plot([wgc, wgc], [-180.0, p], color=color, lw=2.5, solid_capstyle="butt",
-                            label=f"PM {loop}")
-            axes[1, 1].plot([wgc], [p], "o", color=color, ms=5)
+            p = float(np.interp(np.log(wgc), np.log(w), phase))      # the phase at the crossover
+            base = _nearest_minus_180(p - m["phase_margin"])
+            axes[1, 1].plot([wgc, wgc], [base, base + m["phase_margin"]], color=color, lw=2.5,
+                            solid_capstyle="butt", label=f"PM {loop}")
+            axes[1, 1].plot([wgc], [base + m["phase_margin"]], "o", color=color, ms=5)
             axes[0, 1].plot([wgc], [0.0], "o", color=color, ms=5)
-        if math.isfinite(m["gain_margin"]) and m["gain_margin"] > 0 and math.isfinite(wpc):
-            g = -20.0 * math.log10(m["gain_margin"])     # the magnitude at the phase crossover
+        for way in ("down", "up"):
+            factor = m["gain_decrease" if way == "down" else "gain_increase"]
+            wpc = m["gain_decrease_frequency" if way == "down" else "gain_increase_frequency"]
+            if not (0.0 < factor < math.inf and math.isfinite(wpc)):
+                continue
+            g = -_db(factor)                            # the magnitude at the phase crossover
             axes[0, 1].plot([wpc, wpc], [0.0, g], color=color, lw=2.5, solid_capstyle="butt",
-                            label=f"GM {loop}")
+                            label=f"GM {way} {loop}")
             axes[0, 1].plot([wpc], [g], "s", color=color, ms=5)
-            axes[1, 1].plot([wpc], [-180.0], "s", color=color, ms=5)
+            axes[1, 1].plot([wpc], [_nearest_minus_180(float(np.interp(np.log(wpc), np.log(w), phase)))], "s",
+                            color=color, ms=5)
         step()
     axes[0, 0].set_ylim(bottom=max(axes[0, 0].get_ylim()[0], -150.0))
     for col, title in enumerate(["closed loop (discrete, dt = %g s)" % lin.dt, "loop transfers"][:axes.shape[1]]):
         axes[0, col].set(ylabel="magnitude [dB]", title=title)
-        axes[1, col].set(ylabel="phase [deg]", xlabel="frequency [rad/s]", ylim=(-360.0, 0.0))
-        axes[1, col].yaxis.set_major_locator(MultipleLocator(90.0))
+        axes[1, col].set(ylabel="phase [deg]", xlabel="frequency [rad/s]")
+        low, high = axes[1, col].get_ylim()
+        axes[1, col].yaxis.set_major_locator(MultipleLocator(90.0 if high - low <= 720.0 else 180.0))
         axes[0, col].axhline(0.0, color="0.6", lw=0.6)
-        axes[1, col].axhline(-180.0, color="0.6", lw=0.6)
+        for k in range(math.ceil((low + 180.0) / 360.0), math.floor((high + 180.0) / 360.0) + 1):
+            axes[1, col].axhline(-180.0 + 360.0 * k, color="0.6", lw=0.6)
+        axes[1, col].set_ylim(low, high)
         handles, labels = axes[0, col].get_legend_handles_labels()
         keep = [(h, lb) for h, lb in zip(handles, labels) if not lb.startswith(("PM ", "GM "))]
-        axes[0, col].legend(*zip(*keep), fontsize=8, loc="lower left")
+        axes[0, col].legend(*zip(*keep), fontsize=7 if col else 8, loc="upper right" if col else "lower left")
         for ax in axes[:, col]:
             ax.grid(True, which="both", alpha=0.3)
     fig.suptitle(f"{getattr(lin.controller, 'name', 'controller')}: linearised about hover")
@@ -674,10 +759,14 @@ def report(controller="nlpd", lin: Linearization | None = None, *,
     dict
         ``controller`` (name), ``dt_s`` [s], ``stable``, ``spectral_radius``,
         ``hover_residual`` and ``loops``: per loop, ``poles`` [rad/s] as [re, im] (one of
-        each pair) with their ``natural_frequency`` [rad/s], ``damping`` and
-        ``step_weight`` (:meth:`Linearization.loop_modes`); the ``dominant`` pole (largest
-        weight); ``min_damping``; ``margins_input`` and ``margins_output``
-        (:func:`loop_margins`); and where the controller has design gains for the loop
+        each pair, slowest first) with their ``natural_frequency`` [rad/s], ``damping`` and
+        ``step_weight`` (:meth:`Linearization.loop_modes`, a complex pair's two weights
+        added: a pair is one mode); the ``dominant`` pole, the mode of largest weight in the
+        loop's step response, and the ``slowest`` (least decay rate), which need not be the
+        same: a slow pole nearly cancelled by a zero weighs little; ``min_damping``;
+        ``margins_input`` and ``margins_output`` (:func:`loop_margins`) and
+        ``low_margins``, per break point the margins short of 30 deg or 6 dB
+        (:func:`low_margins`); and where the controller has design gains for the loop
         (``position`` for x and y, ``altitude``, ``yaw``), their ``design_poles``, the
         ``nearest`` full-loop pole to each and its ``nearest_rel_distance``.
 
@@ -697,16 +786,19 @@ def report(controller="nlpd", lin: Linearization | None = None, *,
     step = _steps(progress, len(LOOPS))
     for loop in LOOPS:
         p, weight = lin.loop_modes(loop)
-        p, weight = p[p.imag >= 0], weight[p.imag >= 0]
+        p, weight = p[p.imag >= 0], np.where(p.imag > 0, 2.0, 1.0)[p.imag >= 0] * weight[p.imag >= 0]
         wn = np.abs(p)
         with np.errstate(invalid="ignore"):
             zeta = np.where(np.isinf(wn), 1.0, -p.real / np.where(wn > 0, wn, 1.0))
         dom = p[np.argmax(weight)]
+        margins = {at: loop_margins(lin, loop, at) for at in ("input", "output")}
         entry = out["loops"][loop] = {
             "poles": [[round(float(z.real), 6), round(float(z.imag), 6)] for z in p],
             "natural_frequency": wn.tolist(), "damping": zeta.tolist(), "step_weight": weight.tolist(),
-            "dominant": [round(float(dom.real), 6), round(float(dom.imag), 6)], "min_damping": float(zeta.min()),
-            "margins_input": loop_margins(lin, loop, "input"), "margins_output": loop_margins(lin, loop, "output")}
+            "dominant": [round(float(dom.real), 6), round(float(dom.imag), 6)],
+            "slowest": [round(float(p[0].real), 6), round(float(p[0].imag), 6)], "min_damping": float(zeta.min()),
+            "margins_input": margins["input"], "margins_output": margins["output"],
+            "low_margins": {at: low_margins(m) for at, m in margins.items()}}
         design = getattr(getattr(controller, DESIGN[loop], None), "poles", None)
         if design is not None:
             d = np.atleast_1d(np.asarray(design, complex)).round(9)
@@ -717,6 +809,17 @@ def report(controller="nlpd", lin: Linearization | None = None, *,
             entry["nearest_rel_distance"] = [float(abs(q - z) / abs(z)) for q, z in zip(near, d)]
         step()
     return out
+
+
+SUMMARY_NOTES = (
+    ("dominant: the pole (a complex pair counted as one mode) with the largest weight in the loop's step "
+     "response; slowest: the least decay rate."),
+    ("GM down / up: how far the loop gain may fall / rise before the loop goes unstable [dB]; a loop with a GM "
+     "down is conditionally stable (stable at its gain, unstable at a lower one, e.g. a PID's integral on a "
+     "double integrator); none: no limit that way."),
+    f"(!): below {MIN_PHASE_MARGIN_DEG:g} deg of phase margin or within {MIN_GAIN_MARGIN_DB:g} dB of 0 dB.",
+)
+"""The lines :func:`summary` ends with: what its rows mean."""
 
 
 def summary(rep: dict) -> str:
@@ -730,13 +833,17 @@ def summary(rep: dict) -> str:
     Returns
     -------
     str
-        A heading line (controller, dt, stable or not), then one row per quantity: the
-        dominant and slowest poles [rad/s], the least damping, how far the design poles
-        moved, and the phase margins [deg] and gain margins at the input and the output.
+        A heading line (controller, dt, stable or not, and the loops whose margins are short),
+        then one row per quantity: the dominant and slowest poles [rad/s], the least damping,
+        how far the design poles moved, and the phase margins [deg] and gain margins [dB]
+        at the input and the output, a short one marked (!); then :data:`SUMMARY_NOTES`.
 
     Examples
     --------
-    >>> print(summary(report("nlpd")).splitlines()[4].split())
+    >>> text = summary(report("nlpd"))
+    >>> print(text.splitlines()[0])
+    nlpd about hover, dt = 0.001 s: stable (every pole inside the unit circle), margins short on x, y, yaw (!)
+    >>> print(text.splitlines()[4].split())
     ['min', 'damping', '0.363', '0.363', '0.884', '0.272']
     """
     def pole(p):
@@ -746,17 +853,32 @@ def summary(rep: dict) -> str:
         return ", ".join(f"{z if isinstance(z, float) else complex(*z)}:{d:.0%}" for z, d in
                          zip(e.get("design_poles", []), e.get("nearest_rel_distance", []))) or "-"
 
+    def pm(m):
+        short = " (!)" if m["phase_margin"] < MIN_PHASE_MARGIN_DEG else ""
+        return f"{m['phase_margin']:.1f}{short} @ {m['gain_crossover']:.3g}"
+
+    def gm(m):
+        down, up = m["gain_decrease_db"], m["gain_increase_db"]
+        down = "none" if not math.isfinite(down) else f"{down:+.3g}" + (" (!)" if down > -MIN_GAIN_MARGIN_DB else "")
+        up = "none" if not math.isfinite(up) else f"{up:+.3g}" + (" (!)" if up < MIN_GAIN_MARGIN_DB else "")
+        return f"{down}, {up}"
+
     rows = [("dominant pole [rad/s]", lambda e: pole(e["dominant"])),
-            ("slowest pole [rad/s]", lambda e: pole(e["poles"][0])),
+            ("slowest pole [rad/s]", lambda e: pole(e["slowest"])),
             ("min damping", lambda e: f"{e['min_damping']:.3f}"), ("design poles: nearest off by", design)]
     for at in ("input", "output"):
-        rows += [(f"PM at the {at} [deg] @ [rad/s]", lambda e, m="margins_" + at: f"{e[m]['phase_margin']:.1f} @ "
-                  f"{e[m]['gain_crossover']:.3g}"), (f"GM at the {at} (down, up)", lambda e, m="margins_" + at:
-                  f"{e[m]['gain_decrease']:.3g}, {e[m]['gain_increase']:.3g}")]
+        rows += [(f"PM at the {at} [deg] @ [rad/s]", lambda e, m="margins_" + at: pm(e[m])),
+                 (f"GM at the {at} [dB]: down, up", lambda e, m="margins_" + at: gm(e[m]))]
     table = [[""] + list(rep["loops"])] + [[name] + [cell(e) for e in rep["loops"].values()] for name, cell in rows]
     w = [max(len(row[j]) for row in table) + 2 for j in range(len(table[0]))]
-    head = f"{rep['controller']} about hover, dt = {rep['dt_s']:g} s: " + ("stable" if rep["stable"] else "UNSTABLE")
-    return "\n".join([head] + [r[0].ljust(w[0]) + "".join(c.rjust(k) for c, k in zip(r[1:], w[1:])) for r in table])
+    short = [loop for loop, e in rep["loops"].items() if any(e.get("low_margins", {}).values())]
+    verdict = ("stable (every pole inside the unit circle)" if rep["stable"]
+               else "UNSTABLE (a pole on or outside the unit circle)")
+    head = f"{rep['controller']} about hover, dt = {rep['dt_s']:g} s: {verdict}"
+    if short:
+        head += f", margins short on {', '.join(short)} (!)"
+    return "\n".join([head] + [r[0].ljust(w[0]) + "".join(c.rjust(k) for c, k in zip(r[1:], w[1:])) for r in table]
+                     + [""] + [textwrap.fill(note, 100, subsequent_indent="  ") for note in SUMMARY_NOTES])
 
 
 def to_json(rep: dict) -> str:
@@ -823,5 +945,6 @@ def write_analysis(lin: Linearization, rep: dict, out, *, force: bool = False,
     return out
 
 
-__all__ = ["HoverError", "Linearization", "linearize", "loop_transfer", "loop_margins", "bode", "wrap_phase", "report",
-           "summary", "to_json", "write_analysis", "INPUTS", "OUTPUTS", "LOOPS"]
+__all__ = ["HoverError", "Linearization", "linearize", "loop_transfer", "loop_margins", "low_margins", "bode",
+           "unwrapped_phase", "report", "summary", "SUMMARY_NOTES", "MIN_PHASE_MARGIN_DEG", "MIN_GAIN_MARGIN_DB",
+           "to_json", "write_analysis", "INPUTS", "OUTPUTS", "LOOPS"]

@@ -52,11 +52,18 @@ class Comparison:
         Label -> controller, in the order flown.
     results : dict of str to SimResult
         Label -> flight, in the same order.
+    population : dict
+        The Monte Carlo population the controllers also flew, as a scenario's ``[compare]
+        population`` records it (``n``, ``seed``, the spreads); empty if none.
+    population_table : pandas.DataFrame, optional
+        Its table (:func:`quadcruise.montecarlo.compare.compare_population`), one row per controller.
     """
 
     mission: Mission
     controllers: dict
     results: dict
+    population: dict = field(default_factory=dict)
+    population_table: Any = None
     _tables: dict = field(default_factory=dict, init=False, repr=False)   # table() per keywords
 
     @property
@@ -232,6 +239,7 @@ class Comparison:
             "controllers": {label: controller_record(c) for label, c in self.controllers.items()},
             "metrics": rows,
             "metrics_conventions": plain(table.attrs.get("conventions")),
+            **({"population": plain(self.population)} if self.population else {}),
         }
 
     def scenario_toml(self) -> str:
@@ -240,14 +248,18 @@ class Comparison:
         Returns
         -------
         str
-            TOML: mission, vehicle, world and simulation of the flights, and each controller
-            with its label and gains under ``[[compare.controllers]]``.
+            TOML: mission, vehicle, world and simulation of the flights, each controller with
+            its label and gains under ``[[compare.controllers]]``, and the population flown
+            (``[compare] population``).
         """
         from quadcruise.io.scenario_file import comparison_document, scenario_text
 
         first = next(iter(self.results.values()))
         records = {label: controller_record(c) for label, c in self.controllers.items()}
-        return scenario_text(comparison_document(first.meta, records), header=(
+        doc = comparison_document(first.meta, records)
+        if self.population:
+            doc["compare"]["population"] = plain(self.population)
+        return scenario_text(doc, header=(
             "written by quadcruise from a comparison; `quadcruise compare THIS_FILE` flies it again"))
 
     @staticmethod
@@ -261,8 +273,9 @@ class Comparison:
         return rows
 
     def write(self, out: str | os.PathLike, *, force: bool = False, **metric_kw: Any) -> Path:
-        """Write ``metrics.csv``, ``comparison.png`` and ``quadcruise.json`` (``to_dict``)
-        into the folder ``out``, whole or not at all.
+        """Write ``metrics.csv``, ``comparison.png``, ``quadcruise.json`` (``to_dict``),
+        ``scenario.toml`` and, with a population, ``population.csv`` into the folder ``out``,
+        whole or not at all.
 
         Parameters
         ----------
@@ -288,6 +301,8 @@ class Comparison:
             save_figure(self.plot(), tmp / "comparison.png")
             (tmp / MARKER).write_text(dumps(self.to_dict(**metric_kw), indent=2, sort_keys=True) + "\n")
             (tmp / "scenario.toml").write_text(self.scenario_toml())
+            if self.population_table is not None:
+                self.population_table.rename_axis("controller").to_csv(tmp / "population.csv")
         return out
 
 

@@ -155,7 +155,9 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
         path, or left it (a circle too fast to fly, a vehicle that sags or falls, a limit
         cycle). By default :func:`steady_bound`: the larger of 1 m and a quarter of the
         longest side of the box the reference spans over the flight (1 m for the built-in
-        missions), the rule a Monte Carlo sweep applies; ``numpy.inf`` turns it off.
+        missions), and on the altitude error alone :func:`altitude_bound` (half the
+        mission's lowest altitude: 0.5 m for the built-in missions at 1 m), the rule a Monte
+        Carlo sweep applies; a value given here bounds both; ``numpy.inf`` turns it off.
     **unknown : Any
         Refused: any other keyword is an InputError naming the options (see
         :data:`FLY_OPTIONS`), so a misspelt one is not silently ignored.
@@ -220,6 +222,7 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
     if sensors is not None:
         sensors.check_fits(duration)
     check_can_hover(vehicle)
+    check_reference_fits(missions or [first], float(duration), limits or Limits())
     given_x0 = None if x0 is None else np.asarray(x0, dtype=float).tolist()
     x0 = hover_state(vehicle, n, first) if x0 is None else x0
     meta = {
@@ -259,7 +262,10 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
               np.full(n, steady_bound(first, duration))) if max_steady_error is None else \
         np.full(n, float(max_steady_error))
     result.meta["max_steady_error_m"] = steady.tolist() if n > 1 else float(steady[0])
-    result = mark_off_track(result, steady, err)
+    vertical = (np.array([altitude_bound(m, duration) for m in missions]) if missions else
+                np.full(n, altitude_bound(first, duration))) if max_steady_error is None else steady
+    result.meta["max_altitude_error_m"] = vertical.tolist() if n > 1 else float(vertical[0])
+    result = mark_off_track(result, steady, err, vertical)
     _warn_about(result)
     return result
 
@@ -498,13 +504,14 @@ def check_log_every(log_every: int, periods: int) -> None:
     >>> check_log_every(1500, 2000)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: fly() argument log_every must be a divisor of the flight's 2,000 control periods (so that the log ends where the flight does), got int 1500; the nearest: 1000, 2000
+    quadcruise.errors.InputError: fly() argument log_every must be a divisor of the flight's 2,000 control periods (so that the log ends where the flight does), got int 1500; the nearest: 1,000, 2,000
     """
     if periods % log_every == 0:
         return
     below, above = nearest_divisors(log_every, periods)
+    hint = f"at most {periods:,}" if log_every > periods else f"the nearest: {below:,}, {above:,}"
     checks.fail("fly()", "log_every", log_every, f"a divisor of the flight's {periods:,} control periods (so that "
-                "the log ends where the flight does)", kind=False, hint=f"the nearest: {below}, {above}")
+                "the log ends where the flight does)", kind=False, hint=hint)
 
 
 def nearest_divisors(k: int, n: int) -> tuple[int, int]:
@@ -577,6 +584,43 @@ def check_can_hover(vehicle: Vehicle) -> None:
                       f"leaving {100 * (1 - duty[i]):.0f} % of its thrust for control", stacklevel=3)
 
 
+def check_reference_fits(missions: list[Mission], duration: float, limits: Limits) -> None:
+    """Refuse, before flying, a mission whose reference leaves the position bound (and the
+    default one, 10 km: a tighter bound given is the engine's to apply, as a divergence): the
+    vehicle would be stopped as diverged for following it, and its numbers could overflow.
+
+    Parameters
+    ----------
+    missions : list of Mission
+        One mission for every vehicle, or one for all.
+    duration : float
+        Flight time [s].
+    limits : Limits
+        The divergence bounds (``max_position`` [m]).
+
+    Raises
+    ------
+    InputError
+        Naming the mission, how far its reference goes and the bound.
+
+    Examples
+    --------
+    >>> from quadcruise.missions import mission_from_name
+    >>> check_reference_fits([mission_from_name("circle", radius=1e200)], 20.0, Limits())
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: the circle's reference goes 1e+200 m from the origin, beyond the position bound of 1e+04 m (Limits.max_position)
+    """
+    for mission in missions:
+        with np.errstate(all="ignore"):
+            ref = mission.reference(np.linspace(0.0, duration, 1001))[:, REF_X:REF_X + 3]
+            reach = float(np.max(np.abs(ref))) if np.isfinite(ref).all() else math.inf
+        if reach > max(limits.max_position, Limits().max_position):   # a tighter bound given: the engine stops it
+            kind = mission.to_dict().get("kind", type(mission).__name__.lower())
+            raise InputError(f"the {kind}'s reference goes {reach:.3g} m from the origin, beyond the position bound "
+                             f"of {limits.max_position:.3g} m (Limits.max_position)")
+
+
 def track_bound(missions: list[Mission], x0: np.ndarray, n: int) -> np.ndarray:
     """The default tracking bound of each vehicle [m]: 1 m, plus the diagonal of the box its
     mission's reference path spans over the mission's default duration, plus its initial
@@ -646,22 +690,101 @@ def steady_bound(mission: Mission, duration: float) -> float:
     return max(1.0, 0.25 * extent)
 
 
-def mark_off_track(result: SimResult, bound: np.ndarray, err: np.ndarray | None = None) -> SimResult:
-    """The result, with ``off track`` as the status of each finished vehicle whose position
-    error after the transient exceeded the bound, and the first instant it did as its ``t_stop``.
+ALTITUDE_FRACTION = 0.5
+"""A vehicle that sags (or climbs) by more than this fraction of its mission's lowest reference
+altitude after the transient is off track: half-way to the ground is not flying the mission."""
+MIN_ALTITUDE_BOUND = 0.1
+"""The vertical bound [m] is never below this (a mission flown at or near the ground)."""
 
-    After the transient: from the settling time into
-    :data:`~quadcruise.metrics.flight.STEADY_BAND` on (the steady window of ``steady_*``
-    metrics); the whole flight without a step; the last instant if it never settles (the
-    error at the end), as a Monte Carlo sweep judges its flights.
+
+def altitude_bound(mission: Mission, duration: float) -> float:
+    """The default vertical steady bound [m] of a flight and of a Monte Carlo sweep: half the
+    lowest altitude the mission's reference flies at, at least :data:`MIN_ALTITUDE_BOUND`
+    and at most :func:`steady_bound`.
+
+    Parameters
+    ----------
+    mission : Mission
+        The mission flown.
+    duration : float
+        Flight time [s].
+
+    Returns
+    -------
+    float
+        The bound [m] on the altitude error after the transient, from the reference at
+        1,001 instants over the flight.
+
+    Examples
+    --------
+    >>> from quadcruise.missions import mission_from_name
+    >>> altitude_bound(mission_from_name("circle"), 20.0)             # at 1 m
+    0.5
+    >>> altitude_bound(mission_from_name("circle", altitude=30.0), 20.0)  # capped by the 3-D bound
+    1.0
+    """
+    z = mission.reference(np.linspace(0.0, float(duration), 1001))[:, REF_Z]
+    return min(steady_bound(mission, duration), max(MIN_ALTITUDE_BOUND, ALTITUDE_FRACTION * float(z.min())))
+
+
+def off_track_since(t: np.ndarray, err: np.ndarray, dz: np.ndarray, measured: np.ndarray, settled_at: np.ndarray,
+                    bound: np.ndarray, zbound: np.ndarray) -> np.ndarray:
+    """The first instant after the transient at which each vehicle was off track: the one rule
+    of ``fly`` (:func:`mark_off_track`) and of a Monte Carlo sweep.
+
+    After the transient: from its settling into :data:`~quadcruise.metrics.flight.STEADY_BAND`
+    on (``settled_at``); the whole flight where no transient is measured; the last instant
+    if it never settled (the error at the end).
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        (L,) logged instants [s].
+    err, dz : numpy.ndarray
+        (N, L) 3-D position error and altitude error [m].
+    measured : numpy.ndarray
+        (N,) bool: a transient was measured.
+    settled_at : numpy.ndarray
+        (N,) end of the transient [s]; NaN if it did not settle.
+    bound, zbound : numpy.ndarray
+        (N,) bounds on the 3-D error and on the altitude error [m]; ``inf`` turns one off.
+
+    Returns
+    -------
+    numpy.ndarray
+        (N,) the first instant [s] beyond either bound; NaN for a vehicle never beyond.
+
+    Examples
+    --------
+    >>> t = np.arange(4.0)
+    >>> err = np.array([[2.0, 0.1, 0.2, 1.5], [2.0, 0.1, 0.1, 0.1]])
+    >>> off_track_since(t, err, 0 * err, np.array([True, True]), np.array([1.0, np.nan]),
+    ...                 np.array([1.0, 1.0]), np.array([0.5, 0.5]))
+    array([ 3., nan])
+    """
+    start = np.where(~measured, t[0], np.where(np.isnan(settled_at), t[-1], settled_at))
+    with np.errstate(invalid="ignore"):
+        beyond = (err > bound[:, None]) | (np.abs(dz) > zbound[:, None])
+    beyond &= t[None, :] >= start[:, None] - 1e-12
+    return np.where(beyond.any(axis=1), t[np.argmax(beyond, axis=1)], np.nan)
+
+
+def mark_off_track(result: SimResult, bound: np.ndarray, err: np.ndarray | None = None,
+                   zbound: np.ndarray | None = None) -> SimResult:
+    """The result, with ``off track`` as the status of each finished vehicle whose position
+    error after the transient exceeded the bound, or whose altitude error exceeded the
+    vertical bound, and the first instant it did as its ``t_stop`` (:func:`off_track_since`,
+    the rule a Monte Carlo sweep applies).
 
     Parameters
     ----------
     result : SimResult
     bound : numpy.ndarray
-        (N,) bounds [m]; ``inf`` skips a vehicle.
+        (N,) bounds on the 3-D error [m]; ``inf`` skips a vehicle.
     err : numpy.ndarray, optional
         (N, L) position errors [m] (:func:`position_error`), if already computed.
+    zbound : numpy.ndarray, optional
+        (N,) bounds on the altitude error [m]; ``bound`` by default.
 
     Returns
     -------
@@ -669,9 +792,9 @@ def mark_off_track(result: SimResult, bound: np.ndarray, err: np.ndarray | None 
         The same object when no vehicle is off track.
     """
     from quadcruise.metrics.batch import transient_batch
-    from quadcruise.metrics.flight import STEADY_BAND
 
-    live = np.flatnonzero((result.status == int(ExitStatus.FINISHED)) & np.isfinite(bound))
+    zbound = bound if zbound is None else zbound
+    live = np.flatnonzero((result.status == int(ExitStatus.FINISHED)) & (np.isfinite(bound) | np.isfinite(zbound)))
     t = result.t
     if not live.size or t.size < 2:
         return result
@@ -680,14 +803,12 @@ def mark_off_track(result: SimResult, bound: np.ndarray, err: np.ndarray | None 
         return result
     pos, ref = result.states[live, :, X:X + 3], result.references[live, :, REF_X:REF_X + 3]
     mission = result.meta.get("mission")
-    got = transient_batch(t, pos, ref, mission if isinstance(mission, dict) else {}, [STEADY_BAND])
-    settle = got["settling_s"][0]
-    start = np.where(got["axis"] < 0, t[0], np.where(np.isnan(settle), t[-1], got["t_step"] + settle))
-    beyond = (err > bound[live, None]) & (t[None, :] >= start[:, None] - 1e-12)
-    off = beyond.any(axis=1)
+    got = transient_batch(t, pos, ref, mission if isinstance(mission, dict) else {}, [], err=err)
+    first = off_track_since(t, err, pos[:, :, 2] - ref[:, :, 2], got["axis"] >= 0, got["settled_at"],
+                            bound[live], zbound[live])
+    off = np.isfinite(first)
     if not off.any():
         return result
-    first = t[np.argmax(beyond, axis=1)]
     status, t_stop = result.status.copy(), result.t_stop.copy()
     status[live[off]] = int(ExitStatus.OFF_TRACK)
     t_stop[live[off]] = first[off]
@@ -831,4 +952,4 @@ def _warn_about(result: SimResult) -> None:
 
 
 __all__ = ["fly", "default_duration", "flight_warnings_named", "hover_state", "per_vehicle_controllers", "steady_bound",
-           "write_flight"]
+           "altitude_bound", "off_track_since", "write_flight"]

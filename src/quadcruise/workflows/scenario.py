@@ -40,6 +40,10 @@ A scenario has up to seven tables; every one is optional::
     n = 1000
     mass_spread = 0.1
 
+    [compare]                 # read by `quadcruise compare`
+    controllers = ["nlpd", "se3"]
+    population = { n = 20, seed = 1, mass_spread = 0.1 }   # also the same perturbed vehicles
+
 Relative file names (a waypoint table) are taken relative to the scenario file.
 
 Examples
@@ -72,6 +76,12 @@ from quadcruise.errors import InputError
 from quadcruise.missions import MISSIONS, Mission
 from quadcruise.model.vehicle import Vehicle
 
+VEHICLE_PRESETS = {"paper": Vehicle.paper}
+"""Vehicles by name: ``preset = "paper"`` in a ``[vehicle]`` table, ``--vehicle paper`` on the command line."""
+COMPARE_POPULATION_KEYS = ("n", "seed", "mass_spread", "inertia_spread", "thrust_spread", "bandwidth_spread",
+                           "yaw_arm_spread", "offset", "wind_spread", "distribution", "model_error")
+"""Keys of ``[compare] population``: the number of vehicles, the seed and the
+:class:`~quadcruise.montecarlo.Population` fields (its disturbances are the scenario's)."""
 TABLES = ("vehicle", "controller", "mission", "disturbances", "simulation", "montecarlo", "controller_vehicle",
           "compare")
 SIMULATION_KEYS = {"duration": float, "dt": float, "max_step": float, "full_dynamics": bool,
@@ -109,6 +119,9 @@ class Scenario:
         The ``[montecarlo]`` table as written (checked by ``quadcruise montecarlo``).
     compare : dict
         ``[compare]``'s controllers: label -> controller, in order (``quadcruise compare``).
+    compare_population : dict
+        ``[compare] population`` as written: ``n``, ``seed`` and the population's spreads
+        (:data:`COMPARE_POPULATION_KEYS`), which ``quadcruise compare`` flies every controller on.
     title : str
         The scenario's title.
     source : str
@@ -130,6 +143,7 @@ class Scenario:
     simulation: dict = field(default_factory=dict)
     montecarlo: dict = field(default_factory=dict)
     compare: dict = field(default_factory=dict)
+    compare_population: dict = field(default_factory=dict)
     title: str = ""
     source: str = "scenario"
 
@@ -143,13 +157,19 @@ class Scenario:
         """Control period [s] from ``[simulation]``, 1e-3 by default."""
         return self.simulation.get("dt", 1e-3)
 
-    def fly_kwargs(self) -> dict:
+    def fly_kwargs(self, drag: bool = True) -> dict:
         """Keyword arguments of :func:`quadcruise.fly` for this scenario (all but the mission
         and the controller).
 
         Wind, gusts and turbulence act only through drag: with any of them, a vehicle without
-        drag is given :data:`~quadcruise.disturbances.DEFAULT_DRAG` (with a warning, see
-        :func:`~quadcruise.disturbances.with_drag`).
+        drag is given :data:`~quadcruise.disturbances.DEFAULT_DRAG`, with a warning saying so
+        (:func:`~quadcruise.disturbances.with_drag`).
+
+        Parameters
+        ----------
+        drag : bool
+            False: leave the vehicle as written (a caller that changes the vehicle or the wind
+            first gives it drag itself).
 
         Returns
         -------
@@ -170,10 +190,10 @@ class Scenario:
             kw["controller_vehicle"] = self.controller_vehicle
         vehicle = self.vehicle
         if self.environment is not None:
-            if self.environment.needs_drag:
+            if drag and self.environment.needs_drag:
                 from quadcruise.disturbances.environment import with_drag
 
-                vehicle = with_drag(vehicle)
+                vehicle = with_drag(vehicle, warn=True)
             kw["environment"] = self.environment
         if self.sensor_noise is not None:
             kw["sensors"] = self.sensor_noise
@@ -270,7 +290,7 @@ def scenario_from_dict(doc: dict, *, source: str = "scenario", base: Path | None
     _consistent(where, doc, vehicle, model, mission, simulation)
     return Scenario(vehicle=vehicle, controller_vehicle=model, controller=controller, mission=mission, environment=environment,
                     sensor_noise=noise, simulation=simulation, montecarlo=dict(doc.get("montecarlo", {})),
-                    compare=compared,
+                    compare=compared, compare_population=dict(doc.get("compare", {}).get("population", {})),
                     title=title, source=source)
 
 
@@ -352,14 +372,79 @@ def _number(where: _Where, key: str, value, kind=float):
     return kind(value)
 
 
+def vehicle_preset(name: str) -> Vehicle:
+    """A vehicle by its name (:data:`VEHICLE_PRESETS`).
+
+    Parameters
+    ----------
+    name : str
+        The preset's name, e.g. ``"paper"`` (Table I).
+
+    Returns
+    -------
+    Vehicle
+
+    Raises
+    ------
+    InputError
+        No preset has this name.
+
+    Examples
+    --------
+    >>> vehicle_preset("paper").m
+    3.499
+    """
+    if not isinstance(name, str) or name not in VEHICLE_PRESETS:
+        raise InputError(f"unknown vehicle preset {name!r} (known: {', '.join(VEHICLE_PRESETS)})")
+    return VEHICLE_PRESETS[name]()
+
+
+def read_vehicle_file(path: str | Path) -> Vehicle:
+    """A vehicle from a TOML file: its fields (and ``preset``) at the top level, or a scenario's
+    ``[vehicle]`` table (an output folder's ``scenario.toml`` gives the vehicle it flew).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The TOML file.
+
+    Returns
+    -------
+    Vehicle
+        The preset (Table I by default) with the file's fields.
+
+    Raises
+    ------
+    InputError
+        No such file, not valid TOML, or a key or value that is wrong, naming the file.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "light.toml"
+    >>> _ = path.write_text("m = 1.4\\nK = 48.0\\n")
+    >>> read_vehicle_file(path).m
+    1.4
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{path}: no such file")
+    try:
+        doc = tomllib.loads(path.read_text(encoding="utf-8-sig"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: not valid TOML ({exc})") from None
+    if isinstance(doc.get("vehicle"), dict):
+        return _vehicle(_Where(str(path), "vehicle"), doc["vehicle"])
+    return _vehicle(_Where(str(path)), doc)
+
+
 def _vehicle(where: _Where, table: dict) -> Vehicle:
     fields = {f.name for f in dataclasses.fields(Vehicle)}
     _known(where, "", table, fields | {"preset"})
-    if table.get("preset", "paper") != "paper":
-        raise where.error(f"unknown preset {table['preset']!r} (known: paper)")
+    base = where.wrap(vehicle_preset, table.get("preset", "paper"))
     values = {k: _numbers(where, k, v) if isinstance(v, list) else _number(where, k, v)
               for k, v in table.items() if k != "preset"}
-    return where.wrap(Vehicle.paper().replace, **values)
+    return where.wrap(base.replace, **values)
 
 
 def _numbers(where: _Where, key: str, value: list):
@@ -424,8 +509,23 @@ def _controller(where: _Where, table: dict) -> Controller:
 
 
 def _compare(where: _Where, table: dict) -> dict:
-    """``[compare]``: ``controllers``, a list of names or of controller tables with a ``label``."""
-    _known(where, "", table, {"controllers"})
+    """``[compare]``: ``controllers``, a list of names or of controller tables with a ``label``;
+    ``population``, checked here and kept as written (``quadcruise compare`` flies it)."""
+    _known(where, "", table, {"controllers", "population"})
+    if "population" in table:
+        pop = _table(where, "population", table["population"])
+        _known(where, "population.", pop, set(COMPARE_POPULATION_KEYS))
+        if "n" not in pop:
+            raise where.error("'population' needs n, the number of vehicles")
+        for key, value in pop.items():
+            if key == "distribution":
+                if value not in ("normal", "uniform"):
+                    raise where.error(f"'population.distribution' must be normal or uniform, got {value!r}")
+            else:
+                kind = int if key in ("n", "seed") else bool if key == "model_error" else float
+                _number(where, f"population.{key}", value, kind)
+        if isinstance(pop["n"], int) and pop["n"] < 1 or pop.get("seed", 0) < 0:
+            raise where.error("'population' needs n >= 1 and seed >= 0")
     items = table.get("controllers", [])
     if not isinstance(items, list):
         raise where.error("'controllers' must be a list of names or of [[compare.controllers]] tables")

@@ -1,0 +1,122 @@
+"""``quadcruise identify``: a flight log in, an identified vehicle out (a folder)."""
+
+from __future__ import annotations
+
+import shlex
+
+import click
+
+from quadcruise.cli.common import Bar, friendly, writable, writable_with
+from quadcruise.errors import InputError
+
+__all__ = ["identify"]
+
+
+def base_vehicle(text: str):
+    """``--vehicle``: ``paper`` (Table I) or a TOML file with a ``[vehicle]`` table.
+
+    Parameters
+    ----------
+    text : str
+        The option's value.
+
+    Returns
+    -------
+    Vehicle
+
+    Raises
+    ------
+    InputError
+        An unknown name, or a file that is not a readable vehicle.
+    """
+    from pathlib import Path
+
+    from quadcruise.model.vehicle import Vehicle
+
+    if text.strip().lower() == "paper":
+        return Vehicle.paper()
+    path = Path(text)
+    if path.suffix.lower() != ".toml":
+        raise InputError(f"--vehicle: 'paper' or a TOML file with a [vehicle] table, got {text!r}")
+    if not path.is_file():
+        raise InputError(f"--vehicle: {text}: no such file")
+    from quadcruise.workflows.scenario import load_scenario
+
+    return load_scenario(path).vehicle
+
+
+@click.command("identify")
+@click.argument("log", metavar="LOG")
+@click.option("--vehicle", "vehicle", default="paper", show_default=True, metavar="BASE",
+              help="Base vehicle: 'paper' or a TOML file with a [vehicle] table (geometry when the log has none, "
+                   "starting values, values for what the log cannot identify).")
+@click.option("--mass", type=float, default=None, metavar="KG",
+              help="The vehicle's mass [kg]; without it K and the inertias are per unit mass.")
+@click.option("--frame", type=click.Choice(["enu", "ned"]), default=None,
+              help="A CSV's frames (default enu: ENU world, FLU body); a ULog is always PX4's NED/FRD.")
+@click.option("--commands", default="duty", show_default=True, metavar="duty|pwm:MIN:MAX",
+              help="Rotor commands: normalised duties, or PWM [us] with their range.")
+@click.option("--holdout", type=float, default=0.3, show_default=True,
+              help="Fraction of the airborne time, at its end, kept out of the fit and predicted.")
+@click.option("--out", "out", required=True, type=click.Path(file_okay=False), callback=writable,
+              help="Folder for identify.json, vehicle.toml, report.md and the figure.")
+@click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html", callback=writable_with(".html", ".htm"),
+              help="Also write a self-contained HTML report (parameters, validation, figure, configuration).")
+@click.option("--force", is_flag=True, help="Replace a non-empty --out folder that quadcruise did not write.")
+@friendly
+def identify(log: str, vehicle: str, mass: float | None, frame: str | None, commands: str, holdout: float,
+             out: str, report: str | None, force: bool) -> None:
+    """Identify the vehicle that flew LOG (a PX4 .ulg or a CSV) and check it on held-out data.
+
+    Fits thrust, inertias, yaw moment and rotor lag by equation error, with 95 % intervals;
+    what the log cannot identify is said so and taken from --vehicle.
+
+    \f
+    Parameters
+    ----------
+    log : str
+        ``LOG``: the flight log, ``.ulg`` or ``.csv``.
+    vehicle : str
+        ``--vehicle``: the base vehicle (``paper`` or a TOML file).
+    mass : float or None
+        ``--mass``: the mass [kg].
+    frame : str or None
+        ``--frame``: a CSV's frames.
+    commands : str
+        ``--commands``: ``duty`` or ``pwm:MIN:MAX``.
+    holdout : float
+        ``--holdout``: fraction held out.
+    out : str
+        ``--out``: the output folder.
+    report : str or None
+        ``--report``: path of a self-contained HTML report to write as well.
+    force : bool
+        ``--force``: replace a folder quadcruise did not write.
+    """
+    import dataclasses
+
+    from quadcruise.io.files import check_output_dir
+    from quadcruise.io.flightlog import parse_commands
+    from quadcruise.sysid.api import STAGES
+    from quadcruise.sysid.api import identify as run_identify
+
+    base = base_vehicle(vehicle)
+    parse_commands(commands)
+    check_output_dir(out, force)
+    words = ["quadcruise", "identify", log, "--vehicle", vehicle, "--commands", commands, "--holdout", f"{holdout:g}",
+             "--out", out] + (["--mass", f"{mass:g}"] if mass is not None else []) \
+        + (["--frame", frame] if frame else []) + (["--report", report] if report else [])
+    bar = Bar("identifying", unit="stage")
+    result = run_identify(log, base, mass=mass, frame=frame, commands=commands, holdout=holdout,
+                          progress=lambda done, total, stage="": bar(done, total, stage))
+    bar.close()
+    result = dataclasses.replace(result, command=shlex.join(words))
+    click.echo(str(result.summary()))
+    result.write(out, force=force)
+    click.echo(f"wrote identify.json, vehicle.toml, report.md and fit.png to {out} ({len(STAGES)} stages)")
+    if report is not None:
+        from quadcruise.report.html import write_html_report
+        from quadcruise.report.identify import identification_report
+
+        write_html_report(report, **identification_report(result))
+        click.echo(f"wrote report {report}")

@@ -1,0 +1,547 @@
+"""A flight log (PX4 ULog or CSV) read into one typed record in quadcruise's frames.
+
+:func:`read_flight_log` reads a PX4 log (``.ulg``, with pyulog) or a CSV into a
+:class:`FlightLog`: ENU world, FLU body, quaternions w first (body to world), seconds, the
+rotor commands normalised to [0, 1], only the armed, airborne stretches of the flight, all on
+one time grid.
+
+The grid (a ULog)
+    Uniform, at the rate of the body-rate topic (the faster of ``vehicle_angular_velocity``
+    and ``sensor_combined``'s gyro, the former on a tie), over each airborne segment where
+    every topic it needs has samples on both sides. Vectors (velocity, position, rates,
+    specific force) and commands are interpolated linearly between their samples (PX4 logs
+    a topic by sampling it, so a straight line between two samples is the best guess of what
+    happened between them); the attitude by spherical linear interpolation (scipy ``Slerp``);
+    arming and landed states are held from their last message. Airborne: armed
+    (``vehicle_status.arming_state == 2``), neither landed, maybe landed nor touching the
+    ground (``vehicle_land_detected``: PX4 clears ``landed`` when it starts a take-off, seconds
+    before the rotors lift the vehicle) and, where the log has a distance to the ground,
+    at least :data:`MIN_HEIGHT` above it (``vehicle_local_position.dist_bottom``, PX4's own
+    estimate of it); all at once for at least :data:`MIN_SEGMENT_S`.
+
+Commands (a ULog)
+    ``actuator_motors.control`` (already normalised to [0, 1]) when the log has it, else
+    ``actuator_outputs.output`` (PWM [us]; motor k on the output whose ``PWM_MAIN_FUNCi`` is
+    101 + k where the log says, else outputs 1..n) mapped with the log's own ``PWM_MAIN_MINi`` /
+    ``PWM_MAIN_MAXi`` (older logs: ``PWM_MIN`` / ``PWM_MAX``; PX4's defaults 1000 / 2000 us),
+    or with ``commands="pwm:MIN:MAX"`` given by the user.
+
+A CSV
+    Columns ``t,u1..un,vx,vy,vz,qw,qx,qy,qz,p,q,r`` and optionally ``x,y,z``, ``ax,ay,az``
+    (accelerometer: specific force in the body frame) and ``landed`` (1 on the ground). Its
+    rows are the grid; a row with ``landed`` = 1 is left out. ``frame="ned"`` reads PX4's NED
+    world and FRD body instead of ENU and FLU.
+
+Frames: with ``A`` the NED/ENU axis swap and ``B = diag(1, -1, -1)`` (FRD/FLU),
+``v_enu = A v_ned``, ``w_flu = B w_frd``, ``R_enu_flu = A R_ned_frd B``.
+
+Every check runs before anything is computed, and a bad file is refused with one line that
+names the file and what is wrong (:class:`quadcruise.errors.InputError`).
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy.spatial.transform import Rotation, Slerp
+
+from quadcruise.errors import InputError
+
+NED_TO_ENU = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
+"""``A``: NED vectors to ENU (its own inverse)."""
+FRD_TO_FLU = np.diag([1.0, -1.0, -1.0])
+"""``B``: FRD body vectors to FLU (its own inverse)."""
+ARMED = 2
+"""``vehicle_status.arming_state`` of an armed vehicle (PX4's ARMING_STATE_ARMED)."""
+MULTICOPTER_TYPES = {2: "quadrotor", 3: "coaxial", 4: "helicopter", 13: "hexarotor", 14: "octorotor",
+                     15: "tricopter"}
+"""MAVLink MAV_TYPE values of the multicopters this reader accepts."""
+MIN_SEGMENT_S = 1.0
+"""Shortest airborne segment kept [s]: shorter ones are left out (a bounce, not a flight)."""
+MIN_HEIGHT = 0.3
+"""Height above the ground [m] (``vehicle_local_position.dist_bottom``, where valid) under which a
+sample is left out: touching the ground, or in its strongest effect on the rotors' thrust."""
+CSV_COLUMNS = ("t", "vx", "vy", "vz", "qw", "qx", "qy", "qz", "p", "q", "r")
+"""The columns a CSV log must have, besides its commands ``u1..un``."""
+ULOG_TOPICS = ("vehicle_status", "vehicle_land_detected", "vehicle_attitude", "vehicle_angular_velocity",
+               "sensor_combined", "vehicle_local_position", "actuator_motors", "actuator_outputs",
+               "hover_thrust_estimate")
+"""The topics read from a ULog (others are skipped)."""
+
+
+@dataclass(frozen=True, eq=False)
+class FlightLog:
+    """A flight's airborne stretches on one time grid, in quadcruise's frames.
+
+    Parameters
+    ----------
+    source : str
+        The file it was read from.
+    t : ndarray, shape (L,)
+        Time [s] from the log's start; uniform within each segment.
+    segment : ndarray, shape (L,)
+        The airborne segment each sample belongs to (0, 1, ...).
+    u : ndarray, shape (L, n)
+        Rotor commands, normalised [-] (0 idle, 1 full).
+    velocity : ndarray, shape (L, 3)
+        Velocity in the world frame (ENU) [m/s].
+    quaternion : ndarray, shape (L, 4)
+        Attitude, body (FLU) to world (ENU), w first.
+    rates : ndarray, shape (L, 3)
+        Body rates p, q, r (FLU) [rad/s].
+    specific_force : ndarray or None, shape (L, 3)
+        Accelerometer, FLU [m/s^2] ((0, 0, g) at rest, level); None if the log has none.
+    position : ndarray or None, shape (L, 3)
+        Position in the world frame (ENU) [m].
+    rotors : ndarray or None, shape (n, 3)
+        Each rotor's x, y (FLU, [m]) and yaw sign (+1 when its drag torque is positive about
+        body z up), from the log's ``CA_ROTOR*`` parameters; None when the log has none.
+    yaw_per_thrust : float or None
+        ``|CA_ROTOR0_KM|`` [m], the log's own value (a starting point, not a measurement).
+    parameters : dict
+        The log's parameters that matter here (``THR_MDL_FAC``, ``MAV_TYPE``, ...).
+    hover_thrust : tuple of ndarray or None
+        PX4's own ``hover_thrust_estimate`` (time [s], value [-]) inside the airborne
+        segments, when the log has it.
+    rates_hz : dict
+        Each topic's median rate in the log [Hz].
+    commands : str
+        Where the commands came from (topic and scaling).
+    resampling : str
+        How the samples were put on the grid, in words.
+    """
+
+    source: str
+    t: np.ndarray
+    segment: np.ndarray
+    u: np.ndarray
+    velocity: np.ndarray
+    quaternion: np.ndarray
+    rates: np.ndarray
+    specific_force: np.ndarray | None = None
+    position: np.ndarray | None = None
+    rotors: np.ndarray | None = None
+    yaw_per_thrust: float | None = None
+    parameters: dict = field(default_factory=dict)
+    hover_thrust: tuple | None = None
+    rates_hz: dict = field(default_factory=dict)
+    commands: str = ""
+    resampling: str = ""
+
+    @property
+    def n_rotors(self) -> int:
+        """The number of rotor commands per sample."""
+        return int(self.u.shape[1])
+
+    @property
+    def duration(self) -> float:
+        """Airborne time [s], all segments together."""
+        total = 0.0
+        for k in np.unique(self.segment):
+            tk = self.t[self.segment == k]
+            total += float(tk[-1] - tk[0])
+        return total
+
+    def rotation(self) -> Rotation:
+        """The attitudes as a scipy Rotation (body FLU to world ENU).
+
+        Returns
+        -------
+        scipy.spatial.transform.Rotation
+        """
+        return Rotation.from_quat(self.quaternion[:, [1, 2, 3, 0]])
+
+
+def parse_commands(commands: str) -> tuple[str, float, float]:
+    """``"duty"`` or ``"pwm:MIN:MAX"`` as (kind, min, max).
+
+    Parameters
+    ----------
+    commands : str
+        ``duty`` (already in [0, 1]) or ``pwm:MIN:MAX`` (PWM [us], MIN idle, MAX full).
+
+    Returns
+    -------
+    tuple
+        ``("duty", 0.0, 1.0)`` or ``("pwm", MIN, MAX)``.
+
+    Raises
+    ------
+    InputError
+        Anything else, or MIN >= MAX.
+
+    Examples
+    --------
+    >>> parse_commands("pwm:1000:2000")
+    ('pwm', 1000.0, 2000.0)
+    """
+    text = str(commands).strip().lower()
+    if text == "duty":
+        return "duty", 0.0, 1.0
+    parts = text.split(":")
+    if parts[0] == "pwm" and len(parts) in (1, 3):
+        if len(parts) == 1:
+            return "pwm", float("nan"), float("nan")
+        try:
+            lo, hi = float(parts[1]), float(parts[2])
+        except ValueError:
+            lo = hi = float("nan")
+        if np.isfinite(lo) and np.isfinite(hi) and lo < hi:
+            return "pwm", lo, hi
+    raise InputError(f"commands must be 'duty' or 'pwm:MIN:MAX' (MIN < MAX, in us), got {commands!r}")
+
+
+def read_flight_log(path: str | os.PathLike, *, frame: str | None = None, commands: str = "duty") -> FlightLog:
+    """Read a PX4 log (``.ulg``) or a CSV into a :class:`FlightLog`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The log.
+    frame : {"enu", "ned"}, optional
+        A CSV's frames: ENU world / FLU body (default) or PX4's NED / FRD. A ULog is always
+        PX4's: "ned" or None.
+    commands : str
+        ``duty`` (default: ``actuator_motors``, or a CSV's ``u`` columns in [0, 1]) or
+        ``pwm:MIN:MAX`` (PWM [us]: a ULog's ``actuator_outputs``, a CSV's ``u`` columns).
+        A ULog without ``actuator_motors`` uses ``actuator_outputs`` with its own PWM limits.
+
+    Returns
+    -------
+    FlightLog
+
+    Raises
+    ------
+    InputError
+        One line naming the file and what is wrong: not a ULog, a truncated one, a topic or
+        column missing, time not increasing, never armed or never airborne, not a
+        multicopter.
+
+    Examples
+    --------
+    >>> read_flight_log("flight.txt")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: flight.txt: a flight log is a PX4 log (.ulg) or a CSV (.csv), got '.txt'
+    """
+    path = Path(path)
+    kind = path.suffix.lower()
+    if kind not in (".ulg", ".csv"):
+        raise InputError(f"{path}: a flight log is a PX4 log (.ulg) or a CSV (.csv), got {path.suffix!r}")
+    if not path.is_file():
+        raise InputError(f"{path}: no such file")
+    frame_name = None if frame is None else str(frame).strip().lower()
+    if frame_name not in (None, "enu", "ned"):
+        raise InputError(f"{path}: frame must be 'enu' or 'ned', got {frame!r}")
+    spec = parse_commands(commands)
+    if kind == ".ulg":
+        if frame_name == "enu":
+            raise InputError(f"{path}: a PX4 log is always in PX4's frames (NED world, FRD body); "
+                             "frame 'enu' is for CSV logs")
+        return _read_ulog(path, spec)
+    return _read_csv(path, frame_name or "enu", spec)
+
+
+# --- ULog ---------------------------------------------------------------------------------
+
+def check_ulog_framing(path: Path) -> None:
+    """Refuse a file that is not a ULog, or whose last message runs past its end (truncated).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file.
+
+    Raises
+    ------
+    InputError
+        Not a ULog (no ULog magic), or a message cut off by the end of the file.
+    """
+    data = path.read_bytes()
+    if len(data) < 16 or data[:7] != b"ULog\x01\x12\x35":
+        raise InputError(f"{path}: not a PX4 log (ULog): its first bytes are not ULog's header")
+    pos, size = 16, len(data)
+    while pos + 3 <= size:
+        (length,) = struct.unpack_from("<H", data, pos)
+        if pos + 3 + length > size:
+            raise InputError(f"{path}: truncated PX4 log: the message at byte {pos} needs {length} bytes, "
+                             f"the file ends after {size - pos - 3}")
+        pos += 3 + length
+    if pos != size:
+        raise InputError(f"{path}: truncated PX4 log: {size - pos} stray byte(s) at its end")
+
+
+def _median_rate(t: np.ndarray) -> float:
+    dt = np.diff(t)
+    dt = dt[dt > 0]
+    return float(1.0 / np.median(dt)) if dt.size else 0.0
+
+
+def _held(t_msg: np.ndarray, values: np.ndarray, t: np.ndarray, before: Any) -> np.ndarray:
+    """The last message's value at each time (``before`` ahead of the first message)."""
+    idx = np.searchsorted(t_msg, t, side="right") - 1
+    out = np.where(idx >= 0, values[np.clip(idx, 0, None)], before)
+    return out
+
+
+def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
+    from pyulog import ULog
+    from pyulog.core import ULogException
+
+    check_ulog_framing(path)
+    try:
+        log = ULog(str(path), message_name_filter_list=list(ULOG_TOPICS))
+    except (ULogException, struct.error, ValueError, IndexError) as exc:
+        raise InputError(f"{path}: not a readable PX4 log ({exc})") from None
+    topics: dict[str, dict[str, np.ndarray]] = {}
+    for d in log.data_list:
+        if d.multi_id == 0 or d.name not in topics:
+            topics[d.name] = d.data
+    params = dict(log.initial_parameters)
+
+    status = topics.get("vehicle_status")
+    if status is None:
+        raise InputError(f"{path}: no vehicle_status topic: cannot tell when the vehicle was armed")
+    mav_type = int(params.get("MAV_TYPE", status.get("system_type", [2])[0]))
+    system_types = set(np.unique(status["system_type"]).tolist()) if "system_type" in status else {mav_type}
+    vtol = bool(np.any(status.get("is_vtol", np.zeros(1)))) or mav_type in range(19, 26)
+    if vtol or mav_type not in MULTICOPTER_TYPES or not system_types <= set(MULTICOPTER_TYPES):
+        what = "a VTOL" if vtol else f"MAV_TYPE {mav_type}"
+        raise InputError(f"{path}: not a multicopter ({what}, MAV_TYPE {mav_type}): identify models multicopters")
+    if not np.any(status["arming_state"] == ARMED):
+        raise InputError(f"{path}: nothing to identify: the vehicle was never armed in this log")
+
+    need = ["vehicle_attitude", "vehicle_local_position"]
+    missing = [n for n in need if n not in topics]
+    if "vehicle_angular_velocity" not in topics and "sensor_combined" not in topics:
+        missing.append("vehicle_angular_velocity or sensor_combined")
+    kind, lo, hi = spec
+    if kind == "duty" and "actuator_motors" in topics:
+        cmd_topic = "actuator_motors"
+    elif "actuator_outputs" in topics:
+        cmd_topic = "actuator_outputs"
+    else:
+        cmd_topic = None
+        missing.append("actuator_motors or actuator_outputs")
+    if missing:
+        raise InputError(f"{path}: missing topic(s) {', '.join(missing)}")
+
+    def times(name: str) -> np.ndarray:
+        return (topics[name]["timestamp"].astype(np.float64) - float(log.start_timestamp)) * 1e-6
+
+    # commands
+    n_rot = int(params.get("CA_ROTOR_COUNT", 0)) or 4
+    cmd = topics[cmd_topic]
+    prefix = "control" if cmd_topic == "actuator_motors" else "output"
+    channels = list(range(n_rot))
+    if cmd_topic == "actuator_outputs":             # PX4 >= 1.13: PWM_MAIN_FUNCi = 101 + k puts motor k on output i
+        funcs = {int(params[f"PWM_MAIN_FUNC{i + 1}"]): i for i in range(16) if f"PWM_MAIN_FUNC{i + 1}" in params}
+        if all(101 + k in funcs for k in range(n_rot)):
+            channels = [funcs[101 + k] for k in range(n_rot)]
+    cols = [f"{prefix}[{i}]" for i in channels]
+    if any(c not in cmd for c in cols):
+        raise InputError(f"{path}: {cmd_topic} has fewer than the {n_rot} rotor channels CA_ROTOR_COUNT says")
+    raw = np.column_stack([cmd[c].astype(np.float64) for c in cols])
+    if cmd_topic == "actuator_outputs":
+        if kind == "pwm" and np.isfinite(lo):
+            lows, highs = np.full(n_rot, lo), np.full(n_rot, hi)
+            how = f"actuator_outputs PWM mapped with {lo:g}..{hi:g} us (given)"
+        else:
+            lows = np.array([_pwm_param(params, "MIN", i, 1000.0) for i in channels])
+            highs = np.array([_pwm_param(params, "MAX", i, 2000.0) for i in channels])
+            how = "actuator_outputs PWM mapped with the log's PWM_MAIN_MIN/MAX"
+        u_raw = (raw - lows) / (highs - lows)
+    else:
+        u_raw = raw
+        how = "actuator_motors (normalised)"
+
+    # airborne, armed
+    t_status = times("vehicle_status")
+    land = topics.get("vehicle_land_detected")
+    rate_topic = "vehicle_angular_velocity"
+    if "sensor_combined" in topics and (rate_topic not in topics or _median_rate(times("sensor_combined"))
+                                        > 1.01 * _median_rate(times(rate_topic))):
+        rate_topic = "sensor_combined"
+    t_rate = times(rate_topic)
+    step = 1.0 / _median_rate(t_rate)
+    used = ["vehicle_attitude", "vehicle_local_position", cmd_topic, rate_topic]
+    accel_topic = "sensor_combined" if "sensor_combined" in topics else None
+    if accel_topic:
+        used.append(accel_topic)
+    start = max(times(n)[0] for n in used)
+    end = min(times(n)[-1] for n in used)
+    grid = np.arange(start, end, step) if end > start else np.zeros(0)
+    armed = _held(t_status, status["arming_state"], grid, 0) == ARMED
+    landed = np.zeros(grid.shape, bool)
+    if land is not None:
+        for flag in ("landed", "maybe_landed", "ground_contact"):
+            if flag in land:
+                landed |= _held(times("vehicle_land_detected"), land[flag].astype(bool), grid, True)
+    lp = topics["vehicle_local_position"]
+    if "dist_bottom" in lp:        # PX4's estimate, also while its own valid flag is down (no range sensor)
+        height = _interp(times("vehicle_local_position"), lp["dist_bottom"][:, None], grid)[:, 0]
+        landed |= np.isfinite(height) & (height < MIN_HEIGHT)
+    air = armed & ~landed & np.all(np.isfinite(_interp(times(cmd_topic), u_raw, grid)), axis=1)
+    segment = _segments(air, grid, step)
+    if not np.any(segment >= 0):
+        raise InputError(f"{path}: nothing to identify: the vehicle was armed but never airborne "
+                         f"for {MIN_SEGMENT_S:g} s")
+    keep = segment >= 0
+    t = grid[keep]
+
+    att = topics["vehicle_attitude"]
+    q_ned = np.column_stack([att[f"q[{i}]"] for i in range(4)]).astype(np.float64)
+    r_ned = Rotation.from_quat(q_ned[:, [1, 2, 3, 0]])
+    t_att, first = np.unique(times("vehicle_attitude"), return_index=True)
+    r_enu = Rotation.from_matrix(NED_TO_ENU) * Slerp(t_att, r_ned[first])(np.clip(t, t_att[0], t_att[-1])) \
+        * Rotation.from_matrix(FRD_TO_FLU)
+    xyzw = r_enu.as_quat()
+    quat = np.column_stack([xyzw[:, 3], xyzw[:, :3]])
+
+    t_lp = times("vehicle_local_position")
+    vel = _interp(t_lp, np.column_stack([lp["vx"], lp["vy"], lp["vz"]]), t) @ NED_TO_ENU.T
+    pos = _interp(t_lp, np.column_stack([lp["x"], lp["y"], lp["z"]]), t) @ NED_TO_ENU.T
+    rt = topics[rate_topic]
+    keys = [f"xyz[{i}]" for i in range(3)] if rate_topic == "vehicle_angular_velocity" else \
+        [f"gyro_rad[{i}]" for i in range(3)]
+    rates = _interp(t_rate, np.column_stack([rt[k] for k in keys]), t) @ FRD_TO_FLU.T
+    force = None
+    if accel_topic:
+        sc = topics[accel_topic]
+        force = _interp(times(accel_topic), np.column_stack([sc[f"accelerometer_m_s2[{i}]"] for i in range(3)]),
+                        t) @ FRD_TO_FLU.T
+    u = _interp(times(cmd_topic), u_raw, t)
+
+    rotors, km = _rotors(params, n_rot)
+    hover = None
+    if "hover_thrust_estimate" in topics:
+        h = topics["hover_thrust_estimate"]
+        th = times("hover_thrust_estimate")
+        valid = h.get("valid", np.ones(th.shape, bool)).astype(bool)
+        seg = segment[keep]
+        inside = valid & np.zeros(th.shape, bool)
+        for k in np.unique(seg):
+            tk = t[seg == k]
+            inside |= valid & (th >= tk[0]) & (th <= tk[-1])
+        if np.any(inside):
+            hover = (th[inside], h["hover_thrust"][inside].astype(np.float64))
+    rates_hz = {n: round(_median_rate(times(n)), 1) for n in topics}
+    resampling = (f"uniform grid at the rate of {rate_topic} ({1 / step:.0f} Hz) over each airborne segment "
+                  f"(armed, not landed or touching the ground, "
+                  f"and >= {MIN_HEIGHT:g} m above the ground by dist_bottom, for >= {MIN_SEGMENT_S:g} s); vectors and commands interpolated linearly, "
+                  "attitude by slerp, arming and landed states held from their last message")
+    kept = {k: params[k] for k in ("MAV_TYPE", "THR_MDL_FAC", "CA_ROTOR_COUNT", "SYS_AUTOSTART") if k in params}
+    return FlightLog(source=str(path), t=t, segment=segment[keep], u=u, velocity=vel, quaternion=quat,
+                     rates=rates, specific_force=force, position=pos, rotors=rotors, yaw_per_thrust=km,
+                     parameters=kept, hover_thrust=hover, rates_hz=rates_hz, commands=how, resampling=resampling)
+
+
+def _pwm_param(params: dict, which: str, i: int, default: float) -> float:
+    for key in (f"PWM_MAIN_{which}{i + 1}", f"PWM_{which}"):
+        value = params.get(key)
+        if value is not None and value > 0:
+            return float(value)
+    return default
+
+
+def _interp(t_src: np.ndarray, values: np.ndarray, t: np.ndarray) -> np.ndarray:
+    t_src, first = np.unique(t_src, return_index=True)
+    values = values[first].astype(np.float64)
+    return np.column_stack([np.interp(t, t_src, values[:, j]) for j in range(values.shape[1])])
+
+
+def _segments(air: np.ndarray, t: np.ndarray, step: float) -> np.ndarray:
+    """Each sample's segment index (-1 outside): runs of ``air`` at least MIN_SEGMENT_S long."""
+    out = np.full(air.shape, -1)
+    edges = np.flatnonzero(np.diff(np.r_[0, air.astype(np.int8), 0]))
+    k = 0
+    for a, b in zip(edges[::2], edges[1::2]):
+        if (b - a) * step >= MIN_SEGMENT_S:
+            out[a:b] = k
+            k += 1
+    return out
+
+
+def _rotors(params: dict, n: int) -> tuple[np.ndarray | None, float | None]:
+    keys = [f"CA_ROTOR{i}_{w}" for i in range(n) for w in ("PX", "PY", "KM")]
+    if not all(k in params for k in keys):
+        return None, None
+    rows = [(float(params[f"CA_ROTOR{i}_PX"]), -float(params[f"CA_ROTOR{i}_PY"]),
+             -float(np.sign(params[f"CA_ROTOR{i}_KM"]))) for i in range(n)]
+    return np.array(rows), abs(float(params["CA_ROTOR0_KM"]))
+
+
+# --- CSV ----------------------------------------------------------------------------------
+
+def _read_csv(path: Path, frame: str, spec: tuple[str, float, float]) -> FlightLog:
+    import pandas as pd
+
+    try:
+        table = pd.read_csv(path)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: not a readable CSV ({str(exc).splitlines()[0] if str(exc) else exc})") from None
+    table.columns = [str(c).strip() for c in table.columns]
+    missing = [c for c in CSV_COLUMNS if c not in table.columns]
+    n_rot = 0
+    while f"u{n_rot + 1}" in table.columns:
+        n_rot += 1
+    if n_rot == 0:
+        missing.append("u1..un (rotor commands)")
+    if missing:
+        raise InputError(f"{path}: missing column(s) {', '.join(missing)}")
+    optional = [c for c in ("x", "y", "z", "ax", "ay", "az", "landed") if c in table.columns]
+    names = list(CSV_COLUMNS) + [f"u{i + 1}" for i in range(n_rot)] + optional
+    for name in names:
+        col = pd.to_numeric(table[name], errors="coerce").to_numpy(np.float64)
+        bad = np.flatnonzero(~np.isfinite(col))
+        if bad.size:
+            raise InputError(f"{path}: row {bad[0] + 2}, column {name}: not a finite number "
+                             f"({table[name].iloc[bad[0]]!r})")
+        table[name] = col
+    t = table["t"].to_numpy(np.float64)
+    back = np.flatnonzero(np.diff(t) <= 0)
+    if back.size:
+        raise InputError(f"{path}: row {back[0] + 3}: time t={t[back[0] + 1]:g} does not increase "
+                         f"(previous {t[back[0]]:g}); the rows must be sorted by time")
+    for group in (("x", "y", "z"), ("ax", "ay", "az")):
+        if 0 < sum(c in table.columns for c in group) < 3:
+            raise InputError(f"{path}: give all of {', '.join(group)} or none of them")
+    landed = table["landed"].to_numpy() > 0.5 if "landed" in table.columns else np.zeros(len(t), bool)
+    step = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
+    segment = _segments(~landed, t, step)
+    keep = segment >= 0
+    if not np.any(keep):
+        raise InputError(f"{path}: nothing to identify: no airborne stretch of {MIN_SEGMENT_S:g} s "
+                         "(landed column, or too few rows)")
+    kind, lo, hi = spec
+    u = table[[f"u{i + 1}" for i in range(n_rot)]].to_numpy()
+    if kind == "pwm":
+        if not np.isfinite(lo):
+            raise InputError(f"{path}: a CSV's PWM commands need their range: commands='pwm:MIN:MAX'")
+        u = (u - lo) / (hi - lo)
+        how = f"CSV u columns, PWM mapped with {lo:g}..{hi:g} us"
+    else:
+        how = "CSV u columns (normalised)"
+    world = np.eye(3) if frame == "enu" else NED_TO_ENU
+    body = np.eye(3) if frame == "enu" else FRD_TO_FLU
+    q = table[["qw", "qx", "qy", "qz"]].to_numpy()
+    norm = np.linalg.norm(q, axis=1)
+    if np.any(np.abs(norm - 1.0) > 1e-2):
+        row = int(np.flatnonzero(np.abs(norm - 1.0) > 1e-2)[0])
+        raise InputError(f"{path}: row {row + 2}: the quaternion qw,qx,qy,qz has norm {norm[row]:.4g}, not 1")
+    rot = Rotation.from_matrix(world) * Rotation.from_quat(q[:, [1, 2, 3, 0]]) * Rotation.from_matrix(body)
+    xyzw = rot.as_quat()
+    quat = np.column_stack([xyzw[:, 3], xyzw[:, :3]])
+    pick = (lambda cols: table[list(cols)].to_numpy()[keep])
+    position = pick(("x", "y", "z")) @ world.T if "x" in table.columns else None
+    force = pick(("ax", "ay", "az")) @ body.T if "ax" in table.columns else None
+    return FlightLog(source=str(path), t=t[keep], segment=segment[keep], u=u[keep],
+                     velocity=pick(("vx", "vy", "vz")) @ world.T, quaternion=quat[keep],
+                     rates=pick(("p", "q", "r")) @ body.T, specific_force=force, position=position,
+                     rates_hz={"csv": round(1.0 / step, 1)}, commands=how,
+                     resampling=f"the CSV's own rows ({frame.upper()} frames), landed rows left out")

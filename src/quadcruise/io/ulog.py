@@ -1,0 +1,180 @@
+"""PX4's ULog file format, written: the definitions, then every topic's samples in time order.
+
+The format (PX4's ``dev/log/ulog_file_format``): a 16-byte header (magic, version 1, start
+time in microseconds), a flag-bits message, one format message per topic (``name:type
+field;...``), information and parameter messages, one subscription per topic, then the data
+messages, each a 3-byte header (payload size, ``'D'``) followed by the topic's id and its
+fields packed little-endian (a format's trailing ``_padding`` field is declared but, as PX4
+writes it, not sent). A topic's samples are one numpy structured
+array, so a flight of any length is written without a Python loop over its samples.
+
+Examples
+--------
+>>> import tempfile, numpy as np
+>>> from pathlib import Path
+>>> from pyulog import ULog
+>>> topic = Topic("vehicle_angular_velocity",
+...               (("uint64_t", 0, "timestamp"), ("float", 3, "xyz")),
+...               {"timestamp": np.array([1000, 2000]), "xyz": np.zeros((2, 3))})
+>>> with tempfile.TemporaryDirectory() as folder:
+...     write_ulog(Path(folder) / "a.ulg", [topic], info={"sys_name": "quadcruise"})
+...     log = ULog(str(Path(folder) / "a.ulg"))
+>>> log.get_dataset("vehicle_angular_velocity").data["timestamp"].tolist()
+[1000, 2000]
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from quadcruise.io.files import atomic_path
+
+MAGIC = b"ULog\x01\x12\x35"
+"""The first seven bytes of every ULog file."""
+
+NUMPY_TYPES = {
+    "int8_t": "i1", "uint8_t": "u1", "bool": "u1", "char": "S1",
+    "int16_t": "<i2", "uint16_t": "<u2", "int32_t": "<i4", "uint32_t": "<u4",
+    "int64_t": "<i8", "uint64_t": "<u8", "float": "<f4", "double": "<f8",
+}
+"""ULog's field types and the little-endian numpy types they are packed as."""
+
+
+@dataclass(frozen=True)
+class Topic:
+    """One topic's format and samples.
+
+    Parameters
+    ----------
+    name : str
+        The topic's name, e.g. ``"vehicle_attitude"``.
+    fields : sequence of (type, length, name)
+        The format in PX4's order: a ULog type (:data:`NUMPY_TYPES`), the array length (0 for a
+        scalar) and the field's name. The first field is ``uint64_t timestamp`` [us].
+    values : mapping of str to array
+        Each field's samples: shape (L,) for a scalar, (L, length) for an array. A field not
+        given is written as zeros (PX4's default for a field a module does not fill).
+    """
+
+    name: str
+    fields: Sequence[tuple[str, int, str]]
+    values: Mapping[str, np.ndarray]
+
+    def records(self, msg_id: int) -> np.ndarray:
+        """The topic's data messages, header included, as one packed structured array.
+
+        Parameters
+        ----------
+        msg_id : int
+            The id its subscription gave the topic.
+
+        Returns
+        -------
+        numpy.ndarray
+            Structured, shape (L,): ``size``, ``type``, ``msg_id``, then the fields.
+        """
+        if not self.fields or self.fields[0][2] != "timestamp":
+            raise ValueError(f"topic {self.name!r}: the first field must be the timestamp")
+        packed = self.fields[:-1] if self.fields[-1][2].startswith("_padding") else self.fields   # as PX4 does
+        fields = [(name, NUMPY_TYPES[kind], (length,) if length else ()) for kind, length, name in packed]
+        dtype = np.dtype([("size", "<u2"), ("type", "u1"), ("msg_id", "<u2"), *fields])
+        n = len(self.values["timestamp"])
+        out = np.zeros(n, dtype)
+        out["size"] = dtype.itemsize - 3
+        out["type"] = ord("D")
+        out["msg_id"] = msg_id
+        for name, value in self.values.items():
+            if name not in dtype.names:
+                raise ValueError(f"topic {self.name!r} has no field {name!r}")
+            out[name] = value
+        return out
+
+    def format_message(self) -> bytes:
+        """The topic's format message payload, ``name:type field;...``.
+
+        Returns
+        -------
+        bytes
+        """
+        text = "".join(f"{kind}[{length}] {name};" if length else f"{kind} {name};"
+                       for kind, length, name in self.fields)
+        return f"{self.name}:{text}".encode()
+
+
+def _message(kind: str, payload: bytes) -> bytes:
+    return struct.pack("<HB", len(payload), ord(kind)) + payload
+
+
+def _key_value(kind: str, name: str, value) -> bytes:
+    if isinstance(value, str):
+        data, type_name = value.encode(), f"char[{len(value.encode())}]"
+    elif isinstance(value, (int, np.integer)) and not isinstance(value, bool):
+        data, type_name = struct.pack("<i", int(value)), "int32_t"
+    else:
+        data, type_name = struct.pack("<f", float(value)), "float"
+    key = f"{type_name} {name}".encode()
+    return _message(kind, struct.pack("<B", len(key)) + key + data)
+
+
+def ulog_bytes(topics: Sequence[Topic], *, info: Mapping[str, object] | None = None,
+               parameters: Mapping[str, float | int] | None = None, start_us: int = 0) -> bytes:
+    """A whole ULog file's bytes.
+
+    Parameters
+    ----------
+    topics : sequence of Topic
+        The topics, each written under its own id (0, 1, ...), instance 0.
+    info : mapping, optional
+        Information messages (``sys_name``, ``ver_hw``, ...): str, int (int32) or float.
+    parameters : mapping, optional
+        Parameters: int (int32_t) or float.
+    start_us : int
+        The header's start time [us].
+
+    Returns
+    -------
+    bytes
+    """
+    head = [MAGIC + b"\x01" + struct.pack("<Q", start_us),
+            _message("B", bytes(16) + struct.pack("<QQQ", 0, 0, 0))]
+    head += [_message("F", topic.format_message()) for topic in topics]
+    head += [_key_value("I", name, value) for name, value in (info or {}).items()]
+    head += [_key_value("P", name, value) for name, value in (parameters or {}).items()]
+    head += [_message("A", struct.pack("<BH", 0, msg_id) + topic.name.encode()) for msg_id, topic in enumerate(topics)]
+
+    records = [topic.records(msg_id) for msg_id, topic in enumerate(topics)]
+    stamps = np.concatenate([r["timestamp"] for r in records])
+    sizes = np.concatenate([np.full(len(r), r.dtype.itemsize) for r in records])
+    order = np.argsort(stamps, kind="stable")                  # time order; ties keep the topic order
+    offsets = np.empty(len(order), np.int64)
+    offsets[order] = np.concatenate([[0], np.cumsum(sizes[order])[:-1]]) if len(order) else []
+    body = np.empty(int(sizes.sum()), np.uint8)
+    first = 0
+    for r in records:
+        rows = r.view(np.uint8).reshape(len(r), r.dtype.itemsize)
+        where = offsets[first:first + len(r), None] + np.arange(r.dtype.itemsize)
+        body[where] = rows
+        first += len(r)
+    return b"".join(head) + body.tobytes()
+
+
+def write_ulog(path: str | os.PathLike, topics: Sequence[Topic], **kwargs) -> None:
+    """Write a ULog file whole or not at all (:func:`ulog_bytes`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+    topics : sequence of Topic
+        The topics.
+    **kwargs
+        ``info``, ``parameters``, ``start_us`` of :func:`ulog_bytes`.
+    """
+    data = ulog_bytes(topics, **kwargs)
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(data)

@@ -1,0 +1,162 @@
+"""The rotor-speed plant: a rigid body with any number of rotors, its attitude a unit
+quaternion, its motors first-order in rotor speed, its aerodynamics those of RotorPy's
+``Multirotor`` (RotorPy 3.0); one compiled derivative for one vehicle, on scalars, like
+:mod:`quadcruise.model.plant` is for the paper's plant.
+
+State (``ROTOR_STATE_NAMES``; SI units, world frame z up, body frame x forward, y left, z up):
+position x, y, z; velocity vx, vy, vz; the unit quaternion qw, qx, qy, qz (scalar first, body
+to world); body rates p, q, r; rotor speeds w1..wn [rad/s], n = the vehicle's rotor count.
+
+With R(q) the body-to-world rotation, Omega = (p, q, r), r_i rotor i's position in the body
+frame, s_i its direction (+1: its drag moment pushes the body about +z, i.e. the rotor spins
+clockwise seen from above), e_i its effectiveness (1 when healthy) and w the wind (world):
+
+    v_b   = R^T (v - w)                                  airspeed, body frame
+    v_i   = v_b + Omega x r_i                            airspeed at rotor i's hub
+    T_i   = e_i kf w_i^2 + k_h (v_i,x^2 + v_i,y^2)       thrust, along body z (+ translational lift)
+    H_i   = -w_i diag(k_d, k_d, k_z) v_i                 rotor drag and induced inflow
+    D     = -|v_b| diag(c_Dx, c_Dy, c_Dz) v_b            parasitic drag, at the centre of mass
+    F_b   = sum_i (T_i e3 + H_i) + D
+    M_b   = sum_i [ r_i x (T_i e3 + H_i) - k_flap w_i (v_i x e3) + s_i e_i km w_i^2 e3 ]
+    x'    = v
+    v'    = (R F_b + F_ext) / m - g e3
+    q'    = q (x) (0, Omega) / 2
+    J Omega' = M_b + tau_ext - Omega x (J Omega + h e3) - h' e3,   h = -J_r sum_i s_i w_i
+    w_i'  = (w_cmd,i - w_i) / tau,   tau = tau_up if w_cmd,i > w_i else tau_down
+
+J = diag(Jxx, Jyy, Jzz). h is the rotors' own angular momentum about body z (J_r: one rotor's
+inertia about its axis; RotorPy has none, so its presets set J_r = 0): Omega x h e3 is their
+gyroscopic torque and -h' e3 the motors' reaction while they speed up or slow down. The
+thrust and aerodynamic terms are RotorPy's ``Multirotor.compute_body_wrench`` term by term.
+The command w_cmd is held in [w_min, w_max] by whoever gives it (the replay refuses one
+outside); then w_i stays in that range too. R is the rotation of q / |q| (as RotorPy's
+``Rotation.from_quat``), so an RK4 stage state a little off the unit sphere still rotates.
+
+``ext`` follows :mod:`quadcruise.layout`'s ``EXT_*`` columns: an external force [N] (world),
+a torque [N m] (body), the wind [m/s] (world), then one effectiveness per rotor
+(``EXT_E1 + i``), so ``9 + n`` entries.
+
+The vehicle's parameters reach the compiled code as one flat row (``RP_*`` below, then four
+entries per rotor: x, y, z [m] and s), built by :meth:`quadcruise.model.rotor_vehicle.RotorVehicle.row`.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from quadcruise.layout import EXT_E1, EXT_FX, EXT_FY, EXT_FZ, EXT_TX, EXT_TY, EXT_TZ, EXT_WX, EXT_WY, EXT_WZ
+
+# --- state columns ----------------------------------------------------------------------------
+RX, RY, RZ, RVX, RVY, RVZ, QW, QX, QY, QZ, RP, RQ, RR = range(13)
+ROTOR_W1 = 13
+"""Column of rotor 1's speed; rotor i (from 0) is at ``ROTOR_W1 + i``."""
+ROTOR_BODY_NAMES = ("x", "y", "z", "vx", "vy", "vz", "qw", "qx", "qy", "qz", "p", "q", "r")
+ROTOR_BODY_UNITS = ("m", "m", "m", "m/s", "m/s", "m/s", "-", "-", "-", "-", "rad/s", "rad/s", "rad/s")
+
+# --- parameter row ----------------------------------------------------------------------------
+(RP_M, RP_JXX, RP_JYY, RP_JZZ, RP_KF, RP_KM, RP_TAU_UP, RP_TAU_DOWN, RP_W_MIN, RP_W_MAX, RP_G,
+ RP_CDX, RP_CDY, RP_CDZ, RP_KD, RP_KZ, RP_KH, RP_KFLAP, RP_J_ROTOR, RP_N_ROTORS) = range(20)
+RP_ROTORS = 20
+"""First column of the rotors: rotor i's x, y, z [m] and direction s at ``RP_ROTORS + 4 i`` on."""
+
+
+def state_names(n_rotors: int) -> tuple[str, ...]:
+    """The state's column names for a vehicle with ``n_rotors`` rotors.
+
+    Parameters
+    ----------
+    n_rotors : int
+        Number of rotors.
+
+    Returns
+    -------
+    tuple of str
+        ``x, y, z, vx, vy, vz, qw, qx, qy, qz, p, q, r, w1 .. wn``.
+
+    Examples
+    --------
+    >>> state_names(4)[-5:]
+    ('r', 'w1', 'w2', 'w3', 'w4')
+    """
+    return ROTOR_BODY_NAMES + tuple(f"w{i + 1}" for i in range(n_rotors))
+
+
+@njit(cache=True, error_model="numpy")
+def rotor_derivative(x, w_cmd, rp, ext, dx):
+    """Write dx/dt of one rotor-speed vehicle into ``dx`` (the equations of this module).
+
+    Parameters
+    ----------
+    x : ndarray, shape (13 + n,)
+        The state: position [m], velocity [m/s], quaternion [-], body rates [rad/s], rotor
+        speeds [rad/s].
+    w_cmd : ndarray, shape (n,)
+        Commanded rotor speeds [rad/s], within [w_min, w_max].
+    rp : ndarray, shape (RP_ROTORS + 4 n,)
+        The vehicle's parameter row.
+    ext : ndarray, shape (9 + n,)
+        External force [N] (world), torque [N m] (body), wind [m/s] (world), rotor
+        effectiveness [-].
+    dx : ndarray, shape (13 + n,)
+        Output: the state's time derivative.
+    """
+    n = int(rp[RP_N_ROTORS])
+    kf, km, kd, kz, kh, kflap = rp[RP_KF], rp[RP_KM], rp[RP_KD], rp[RP_KZ], rp[RP_KH], rp[RP_KFLAP]
+    tau_up, tau_down, j_rotor = rp[RP_TAU_UP], rp[RP_TAU_DOWN], rp[RP_J_ROTOR]
+    qw, qx, qy, qz = x[QW], x[QX], x[QY], x[QZ]
+    p, q, r = x[RP], x[RQ], x[RR]
+    s = 2.0 / (qw * qw + qx * qx + qy * qy + qz * qz)      # R of q / |q|
+    r00, r01, r02 = 1.0 - s * (qy * qy + qz * qz), s * (qx * qy - qw * qz), s * (qx * qz + qw * qy)
+    r10, r11, r12 = s * (qx * qy + qw * qz), 1.0 - s * (qx * qx + qz * qz), s * (qy * qz - qw * qx)
+    r20, r21, r22 = s * (qx * qz - qw * qy), s * (qy * qz + qw * qx), 1.0 - s * (qx * qx + qy * qy)
+    ax, ay, az = x[RVX] - ext[EXT_WX], x[RVY] - ext[EXT_WY], x[RVZ] - ext[EXT_WZ]
+    ub = r00 * ax + r10 * ay + r20 * az                    # airspeed, body frame: R^T (v - w)
+    vb = r01 * ax + r11 * ay + r21 * az
+    wb = r02 * ax + r12 * ay + r22 * az
+    fx = fy = fz = 0.0                                     # body force [N]
+    mx = my = mz = 0.0                                     # body moment [N m]
+    h = h_dot = 0.0                                        # rotors' angular momentum about body z
+    for i in range(n):
+        base = RP_ROTORS + 4 * i
+        px, py, pz, sign = rp[base], rp[base + 1], rp[base + 2], rp[base + 3]
+        w = x[ROTOR_W1 + i]
+        e = ext[EXT_E1 + i]
+        lx = ub + q * pz - r * py                          # airspeed at the hub: v_b + Omega x r_i
+        ly = vb + r * px - p * pz
+        lz = wb + p * py - q * px
+        f_x = -w * kd * lx                                 # rotor drag (H force) ...
+        f_y = -w * kd * ly
+        f_z = e * kf * w * w + kh * (lx * lx + ly * ly) - w * kz * lz    # ... thrust, lift, inflow
+        fx += f_x
+        fy += f_y
+        fz += f_z
+        mx += py * f_z - pz * f_y - kflap * w * ly         # r_i x F_i, and flapping
+        my += pz * f_x - px * f_z + kflap * w * lx
+        mz += px * f_y - py * f_x + sign * e * km * w * w  # and the rotor's drag moment
+        c = w_cmd[i]
+        w_dot = (c - w) / (tau_up if c > w else tau_down)
+        dx[ROTOR_W1 + i] = w_dot
+        h -= sign * j_rotor * w
+        h_dot -= sign * j_rotor * w_dot
+    speed = math.sqrt(ub * ub + vb * vb + wb * wb)          # parasitic drag
+    fx -= speed * rp[RP_CDX] * ub
+    fy -= speed * rp[RP_CDY] * vb
+    fz -= speed * rp[RP_CDZ] * wb
+    inv_m = 1.0 / rp[RP_M]
+    dx[RX] = x[RVX]
+    dx[RY] = x[RVY]
+    dx[RZ] = x[RVZ]
+    dx[RVX] = (r00 * fx + r01 * fy + r02 * fz + ext[EXT_FX]) * inv_m
+    dx[RVY] = (r10 * fx + r11 * fy + r12 * fz + ext[EXT_FY]) * inv_m
+    dx[RVZ] = (r20 * fx + r21 * fy + r22 * fz + ext[EXT_FZ]) * inv_m - rp[RP_G]
+    dx[QW] = -0.5 * (qx * p + qy * q + qz * r)             # q (x) (0, Omega) / 2
+    dx[QX] = 0.5 * (qw * p + qy * r - qz * q)
+    dx[QY] = 0.5 * (qw * q + qz * p - qx * r)
+    dx[QZ] = 0.5 * (qw * r + qx * q - qy * p)
+    jxx, jyy, jzz = rp[RP_JXX], rp[RP_JYY], rp[RP_JZZ]
+    lx_, ly_, lz_ = jxx * p, jyy * q, jzz * r + h          # body and rotors' angular momentum
+    dx[RP] = (mx + ext[EXT_TX] - (q * lz_ - r * ly_)) / jxx
+    dx[RQ] = (my + ext[EXT_TY] - (r * lx_ - p * lz_)) / jyy
+    dx[RR] = (mz + ext[EXT_TZ] - (p * ly_ - q * lx_) - h_dot) / jzz
