@@ -4,7 +4,8 @@
   its initial memory is a controller; the built-in ones subclass
   :class:`quadcruise.control.Controller`, a user's need not.
 - :class:`ResultLike`: every result of the package (:class:`~quadcruise.SimResult`,
-  :class:`~quadcruise.Comparison`, :class:`~quadcruise.montecarlo.MonteCarloResult`) speaks one
+  :class:`~quadcruise.Comparison`, :class:`~quadcruise.montecarlo.MonteCarloResult`,
+  :class:`~quadcruise.workflows.analysis.Linearization`) speaks one
   vocabulary: ``to_pandas()`` (its data as a DataFrame), ``summary()`` (its headline numbers: a
   :class:`~quadcruise.metrics.summary.Summary`, a mapping that prints as a readable table),
   ``plot()`` (a matplotlib Figure) and ``write(folder)`` (a folder written whole or not at all).

@@ -19,20 +19,10 @@ from quadcruise.control.design import loop_margins as design_margins
 from quadcruise.control.design import loop_transfer as design_loop
 from quadcruise.control.position import NLPD
 from quadcruise.errors import InputError
+from quadcruise.io.plainjson import dumps
 from quadcruise.layout import CONTROLLER_SIG
 from quadcruise.missions import Step
-from quadcruise.workflows.analysis import (
-    LOOPS,
-    HoverError,
-    bode,
-    linearize,
-    loop_margins,
-    loop_transfer,
-    report,
-    summary,
-    to_json,
-    unwrapped_phase,
-)
+from quadcruise.workflows.analysis import LOOPS, HoverError, linearize
 
 
 @pytest.fixture(scope="module")
@@ -65,7 +55,7 @@ def test_x_loop_poles_are_those_of_the_hand_built_cascade(dt, tol):
 def test_yaw_and_z_loops_are_the_design_loops_with_rotor_lag(lin):
     """Broken at U4 and U1, the yaw and z loops are design.loop_margins' C(s) w/(s+w)/s^2."""
     for loop, gains in (("yaw", NLPD().yaw), ("z", NLPD().altitude)):
-        ours, theirs = loop_margins(lin, loop), design_margins(gains, 15.0)
+        ours, theirs = lin.margins(loop), design_margins(gains, 15.0)
         assert ours["phase_margin"] == pytest.approx(theirs["phase_margin"], abs=1.0)
         assert ours["gain_crossover"] == pytest.approx(theirs["gain_crossover"], rel=0.02)
     closed = control.feedback(design_loop(NLPD().yaw, 15.0), 1).poles()
@@ -119,7 +109,7 @@ def test_closing_a_broken_loop_gives_the_closed_loop_back(lin):
     want = lin.poles()
     for loop in LOOPS:
         for at in ("input", "output"):
-            L = loop_transfer(lin, loop, at)
+            L = lin.loop_transfer(loop, at)
             closed = np.linalg.eigvals(L.A - L.B @ L.C)        # w = -L w: negative unity feedback
             assert _matched(closed, want)[0] < 1e-8, (loop, at)
 
@@ -129,8 +119,8 @@ def test_faster_position_poles_erode_the_margins():
     for k in (0.8, 1.0, 1.2, 1.4, 2.0):
         c = NLPD(position=pd_from_poles((-0.7 * k, -4.3 * k)))
         lin = linearize(c)
-        rows.append((lin.stable, loop_margins(lin, "x")["phase_margin"],
-                     loop_margins(lin, "x", "output")["gain_increase"]))
+        rows.append((lin.stable, lin.margins("x")["phase_margin"],
+                     lin.margins("x", "output")["gain_increase"]))
     stable, pm, gm = map(np.array, zip(*rows))
     assert np.all(np.diff(pm) < 0) and np.all(np.diff(gm[:4]) < 0)
     assert stable[:4].all() and pm[3] > 5.0
@@ -139,9 +129,9 @@ def test_faster_position_poles_erode_the_margins():
 
 def test_unknown_loop_or_break_point_is_refused(lin):
     with pytest.raises(InputError, match="unknown loop 'pitch'"):
-        loop_margins(lin, "pitch")
+        lin.margins("pitch")
     with pytest.raises(InputError, match="at must be"):
-        loop_transfer(lin, "x", at="middle")
+        lin.loop_transfer("x", at="middle")
 
 
 # (e) no hover, no linearisation ---------------------------------------------------------------
@@ -208,12 +198,12 @@ def test_hover_elsewhere_and_heavier_vehicle_still_linearise():
 # report and figure -----------------------------------------------------------------------------
 
 def test_report_compares_with_the_design_poles(lin):
-    r = report("nlpd", lin=lin)
-    doc = json.loads(to_json(r))                  # strict JSON: -inf dB (no lower gain limit) is null
+    r = lin.summary()
+    doc = json.loads(dumps(r.to_dict()))                  # strict JSON: -inf dB (no lower gain limit) is null
     assert doc["loops"]["z"]["margins_input"]["gain_decrease_db"] is None
     assert doc["loops"]["x"]["margins_input"] == json.loads(json.dumps(r["loops"]["x"]["margins_input"]))
-    assert "nlpd about hover, dt = 0.001 s: stable" in summary(r) and "-4.3:85%" in summary(r)
-    assert json.loads(to_json({"gm": float("inf")})) == {"gm": None}
+    assert "nlpd about hover, dt = 0.001 s: stable" in str(r) and "-4.3:85%" in str(r)
+    assert json.loads(dumps({"gm": float("inf")})) == {"gm": None}
     x = r["loops"]["x"]
     assert x["design_poles"] == [-0.7, -4.3]
     assert x["dominant"] == pytest.approx([-0.658, 0.0], abs=1e-3)   # the design's slow pole survives
@@ -227,21 +217,21 @@ def test_report_compares_with_the_design_poles(lin):
 def test_bode_draws_closed_loops_and_loop_transfers(lin):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        assert len(bode(lin).axes) == 2
-        fig = bode(lin, loops=True, at="output")
+        assert len(lin.plot(loops=False).axes) == 2
+        fig = lin.plot(at="output")
     assert isinstance(fig, Figure) and len(fig.axes) == 4
     assert len(fig.axes[0].lines) == 4 + 1                   # four loops and the 0 dB line
 
 
 def test_bode_marks_each_loops_margins_at_its_crossovers(lin):
-    fig = bode(lin, loops=True)
+    fig = lin.plot()
     mag_l, phase_l = fig.axes[1], fig.axes[3]
     texts = [t.get_text() for t in mag_l.get_legend().get_texts()]
     assert texts[0] == ("L x: PM 18.1° @ 10.8 rad/s (< 30°), GM down -3.98 dB @ 7.07 rad/s (> -6 dB), "
                         "up +38.2 dB @ 134 rad/s")
     assert texts[2] == "L z: PM 65° @ 4.8 rad/s, GM up +51.7 dB @ 169 rad/s"       # nothing short
     for loop, text in zip(LOOPS, texts):
-        m = loop_margins(lin, loop)
+        m = lin.margins(loop)
         assert text.startswith(f"L {loop}: PM {m['phase_margin']:.3g}° @ {m['gain_crossover']:.3g} rad/s")
         curve = next(ln for ln in mag_l.get_lines() if ln.get_label() == text)
         w, gain = curve.get_xdata(), curve.get_ydata()
@@ -277,7 +267,7 @@ def test_bode_marks_each_loops_margins_at_its_crossovers(lin):
 def test_bode_phases_are_unwrapped(lin, loops, at):
     """No phase jumps by a turn: each curve is continuous, a closed loop's starting near 0 deg,
     a loop transfer's near -180 deg, and equal to the response's angle up to whole turns."""
-    fig = bode(lin, loops=loops, at=at)
+    fig = lin.plot(loops=loops, at=at)
     phase_axes = fig.axes[2:] if loops else fig.axes[1:]
     for col, ax in enumerate(phase_axes):
         assert ax.get_ylabel() == "phase [deg]"
@@ -291,21 +281,44 @@ def test_bode_phases_are_unwrapped(lin, loops, at):
         lines = sorted(ln.get_ydata()[0] for ln in ax.get_lines() if len(ln.get_xdata()) == 2
                        and list(ln.get_xdata()) == [0.0, 1.0])           # axhline: x in axes units
         assert lines and all((v + 180.0) % 360.0 == 0.0 and low <= v <= high for v in lines)
-    # the x loop transfer's phase is the angle of its response, unwrapped
-    w = np.logspace(-2, np.log10(0.9 * np.pi / lin.dt), 800)
-    r = control.frequency_response(loop_transfer(lin, "x", at), w).complex.ravel()
-    y = unwrapped_phase(r, -180.0)
+    # the x curve drawn last (the loop transfer, or the closed loop) is the angle of its response, unwrapped
+    x_curve = next(ln for ln in phase_axes[-1].get_lines() if len(ln.get_xdata()) > 2)
+    w, y = np.asarray(x_curve.get_xdata(), float), np.asarray(x_curve.get_ydata(), float)
+    system = lin.loop_transfer("x", at) if loops else lin.closed_loop("x")
+    r = control.frequency_response(system, w).complex.ravel()
     np.testing.assert_allclose(np.exp(1j * np.radians(y)), r / np.abs(r), atol=1e-9)
-    w = np.linspace(0.0, 100.0, 1001)                        # a 0.1 s delay: phase -w 0.1 rad, 1.6 turns
-    assert unwrapped_phase(np.exp(-0.1j * w)) == pytest.approx(np.degrees(-0.1 * w))
+
+
+class _Delay:
+    """A duck-typed linearisation whose one closed loop is a pure delay of n periods."""
+    controller, dt, loops = "delay", 0.001, {"x": None}
+
+    def __init__(self, n):
+        self.n = n
+
+    def closed_loop(self, loop):
+        shift = np.eye(self.n, k=-1)                        # x+ = shift x + e1 u, y = x_n: y = z^-n u
+        return control.ss(shift, np.eye(self.n)[:, :1], np.eye(self.n)[-1:], 0.0, self.dt,
+                          inputs=["x_ref"], outputs=["x"])
+
+
+def test_bode_unwraps_a_delay_over_several_turns():
+    """A delay of 4 periods turns the phase by -4 w dt: 1.8 turns up to 0.9 of the Nyquist frequency."""
+    from quadcruise.plots.bode import plot_bode
+
+    fig = plot_bode(_Delay(4))
+    (curve,) = [ln for ln in fig.axes[1].get_lines() if len(ln.get_xdata()) > 2]
+    w = np.asarray(curve.get_xdata(), float)
+    assert curve.get_ydata() == pytest.approx(np.degrees(-4 * 0.001 * w), abs=1e-6)
+    assert curve.get_ydata()[-1] < -600.0
 
 
 def test_gain_margins_in_db_bound_the_loop_gain_both_ways(lin):
     """A loop gain just inside either gain margin keeps the closed loop stable; just beyond it,
     unstable (independent of the margin code: the poles of the loop closed at k L)."""
     for loop in ("x", "yaw"):
-        L = loop_transfer(lin, loop, "input")
-        m = loop_margins(lin, loop, "input")
+        L = lin.loop_transfer(loop, "input")
+        m = lin.margins(loop, "input")
 
         def stable_at(k, L=L):
             return bool(np.max(np.abs(np.linalg.eigvals(L.A - k * L.B @ L.C))) < 1.0)
@@ -315,12 +328,12 @@ def test_gain_margins_in_db_bound_the_loop_gain_both_ways(lin):
             assert m[key + "_db"] == pytest.approx(20 * np.log10(m[key]))
             assert stable_at(m[key] * (1.02 if key == "gain_decrease" else 0.98))
             assert not stable_at(m[key] * (0.98 if key == "gain_decrease" else 1.02))
-    z = loop_margins(lin, "z", "input")
+    z = lin.margins("z", "input")
     assert z["gain_decrease"] == 0.0 and z["gain_decrease_db"] == -np.inf       # no lower limit
 
 
 def test_summary_gives_margins_with_units_flags_and_explains_them(lin):
-    text = summary(report("nlpd", lin=lin))
+    text = str(lin.summary())
     lines = text.splitlines()
     assert lines[0] == ("nlpd about hover, dt = 0.001 s: stable (every pole inside the unit circle), "
                         "margins short on x, y, yaw (!)")
@@ -330,7 +343,7 @@ def test_summary_gives_margins_with_units_flags_and_explains_them(lin):
     assert cells.startswith("GM at the input [dB]: down, up -3.98 (!), +38.2 -3.98 (!), +38.2 none, +51.7 -25.8, +38.2")
     assert "18.1 (!) @ 10.8" in lines[6] and "65.0 @ 4.8" in lines[6]
     assert "conditionally stable" in text and "(!): below 30 deg of phase margin or within 6 dB" in text
-    r = report("cascade")
+    r = linearize("cascade").summary()
     assert not any(r["loops"]["z"]["low_margins"].values())
     assert r["loops"]["x"]["low_margins"]["input"] == ["PM 28.9 deg < 30 deg"]
 
@@ -340,7 +353,7 @@ def test_dominant_pole_is_defined_once_and_a_pair_counts_as_one_mode(name, loop)
     """The dominant mode is the one of largest step-response weight, a complex pair weighing
     both its poles; for se3's yaw loop that is the lightly damped pair, which is also the slowest."""
     lin = linearize(name)
-    r = report(name, lin=lin)["loops"][loop]
+    r = lin.summary()["loops"][loop]
     p, weight = lin.loop_modes(loop)
     modes = {}
     for z, wt in zip(p, weight):
@@ -351,3 +364,55 @@ def test_dominant_pole_is_defined_once_and_a_pair_counts_as_one_mode(name, loop)
         assert r["dominant"] == r["slowest"] and r["dominant"][1] > 10.0
     else:                                                     # a slow pole nearly cancelled: not dominant
         assert r["slowest"][0] > r["dominant"][0]
+
+
+# the result's four methods -----------------------------------------------------------------------
+
+def test_the_table_holds_every_pole_with_python_controls_damping(lin):
+    """One row per loop and mode; with each pair's conjugate the rows are the poles of the whole loop,
+    and each row's natural frequency and damping are those control.damp gives for the same pole."""
+    from quadcruise.protocols import ResultLike
+
+    assert isinstance(lin, ResultLike)
+    table = lin.to_pandas()
+    assert list(table["loop"].unique()) == list(LOOPS)
+    poles = table["real"].to_numpy() + 1j * table["imag"].to_numpy()
+    both = np.concatenate([poles, np.conj(poles[table["imag"].to_numpy() > 0])])
+    assert _matched(both, lin.poles_continuous())[0] < 1e-6 and len(both) == lin.sys.nstates
+    wn, zeta, _ = control.damp(lin.sys, doprint=False)
+    for p, w, z in zip(poles, table["natural_frequency"], table["damping"]):
+        k = int(np.argmin(np.abs(wn - w) + np.abs(zeta - z)))
+        assert wn[k] == pytest.approx(w, rel=1e-6) and zeta[k] == pytest.approx(z, abs=1e-6), p
+    summary = lin.summary()
+    for loop, rows in table.groupby("loop", sort=False):
+        assert rows["dominant"].sum() == 1 and rows["slowest"].sum() == 1
+        dom = rows[rows["dominant"]].iloc[0]
+        assert [dom["real"], dom["imag"]] == summary["loops"][loop]["dominant"]
+        for at in ("input", "output"):
+            m = lin.margins(loop, at)
+            assert (rows[f"{at}_phase_margin_deg"] == m["phase_margin"]).all()
+            assert (rows[f"{at}_gain_increase_db"] == m["gain_increase_db"]).all()
+
+
+def test_the_folder_is_written_whole_or_not_at_all(lin, tmp_path, monkeypatch):
+    out = lin.write(tmp_path / "a")
+    assert sorted(p.name for p in out.iterdir()) == ["analysis.json", "bode.png", "bode_output.png", "quadcruise.json"]
+    doc = json.loads((out / "analysis.json").read_text())         # strict JSON: no lower gain limit is null
+    assert doc["loops"]["z"]["margins_input"]["gain_decrease_db"] is None
+    assert doc["loops"]["x"]["dominant"] == lin.summary()["loops"]["x"]["dominant"]
+    assert json.loads((out / "quadcruise.json").read_text())["dt_s"] == 0.001
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("keep")
+    with pytest.raises(InputError, match="mine"):
+        lin.write(tmp_path / "mine")
+    assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"
+
+    def broken(self, *, at="input", **kwargs):
+        if at == "output":
+            raise RuntimeError("disk full")
+        return Figure()
+
+    monkeypatch.setattr(type(lin), "plot", broken)
+    with pytest.raises(RuntimeError, match="disk full"):
+        lin.write(tmp_path / "b")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a", "mine"]          # no half-written folder

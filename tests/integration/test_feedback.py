@@ -205,17 +205,17 @@ def test_compare_population_reports_every_flight():
 
 
 def test_the_analysis_reports_its_steps():
-    from quadcruise.workflows.analysis import bode, linearize, report
+    from quadcruise.workflows.analysis import linearize
 
     seen, progress = calls()
     lin = linearize("nlpd", progress=progress)
     assert seen == [(0, 3), (1, 3), (2, 3), (3, 3)]
     np.testing.assert_array_equal(lin.sys.A, linearize("nlpd").sys.A)
     seen.clear()
-    rep = report(lin=lin, progress=progress)
-    assert seen == [(k, 4) for k in range(5)] and rep == report(lin=lin)
+    rep = lin.summary(progress=progress)
+    assert seen == [(k, 4) for k in range(5)] and rep == lin.summary()
     seen.clear()
-    bode(lin, progress=progress)
+    lin.plot(loops=False, progress=progress)
     assert seen == [(k, 4) for k in range(5)]
 
 

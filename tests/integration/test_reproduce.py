@@ -12,7 +12,6 @@ from click.testing import CliRunner
 from quadcruise import __version__
 from quadcruise.cli import main
 from quadcruise.workflows.analysis import linearize
-from quadcruise.workflows.analysis import report as loop_report
 from quadcruise.workflows.reproduce import FIGURES, FIT_SCENARIO, FITTED, PAPER, SCENARIOS, fitted_nlpd_loop
 
 
@@ -137,7 +136,7 @@ def test_fitted_transient_is_that_of_the_linearised_loops_dominant_pair(out):
     s^2 + Kd s + Kp, does not (its settling is a second late)."""
     loop = fitted_nlpd_loop()
     c = FITTED["nlpd (fitted)"]()
-    dom = loop_report(c, lin=linearize(c))["loops"]["x"]["dominant"]
+    dom = linearize(c).summary()["loops"]["x"]["dominant"]
     assert loop["dom_pole"] == complex(*dom) and loop["dom_zeta"] == pytest.approx(-dom[0] / np.hypot(*dom))
     report = " ".join((out / "report.md").read_text().split())
     assert f"dominant pair at {dom[0]:.2f} +- {dom[1]:.2f}j" in report

@@ -42,14 +42,13 @@ def analyze(controller, controller_params, position_poles, dt, out, force):
     """
     linearising = Bar("linearising about hover")
     linearising(0, 3)                       # python-control takes a few seconds to load
-    from quadcruise.workflows.analysis import linearize, report, summary, write_analysis
+    from quadcruise.workflows.analysis import linearize
 
     the_controller = controller_from_options(controller, controller_params, position_poles)
     if out is not None:
         check_output_dir(out, force)
     lin = linearize(the_controller, dt=dt, progress=linearising)
-    rep = report(the_controller, lin=lin, progress=Bar("margins", unit="loop"))
-    click.echo(summary(rep))
+    click.echo(str(lin.summary(progress=Bar("margins", unit="loop"))))
     if out is not None:
-        write_analysis(lin, rep, out, force=force, progress=Bar("Bode plots"))
+        lin.write(out, force=force, progress=Bar("Bode plots"))
         click.echo(f"wrote analysis.json and Bode plots to {out}")

@@ -1,6 +1,6 @@
 """What a user runs: :mod:`~quadcruise.workflows.fly`, :mod:`~quadcruise.workflows.replay`,
 :mod:`~quadcruise.workflows.compare`, :mod:`~quadcruise.workflows.reproduce` (the paper),
-:mod:`~quadcruise.workflows.analysis` (the loop linearised about hover) and
+:mod:`~quadcruise.workflows.analysis` (the loop linearised about hover: ``linearize``, ``Linearization``) and
 :mod:`~quadcruise.workflows.scenario` (TOML files).
 
 The functions are re-exported by :mod:`quadcruise` itself (``qc.fly``, ``qc.compare``, ...);

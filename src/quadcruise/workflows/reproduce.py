@@ -599,7 +599,7 @@ def fitted_nlpd_loop() -> dict:
         ``kp`` [1/s^2], ``kd`` [1/s]; ``pd_pole`` [rad/s] (complex, Im >= 0), ``pd_zeta``,
         ``pd_wn`` [rad/s]: the pair of s^2 + Kd s + Kp alone; ``dom_pole`` [rad/s], ``dom_zeta``,
         ``dom_wn`` [rad/s]: the linearised closed loop's dominant pole
-        (:func:`~quadcruise.workflows.analysis.report`); ``lin_rise`` (10-90 %),
+        (:meth:`~quadcruise.workflows.analysis.Linearization.summary`); ``lin_rise`` (10-90 %),
         ``lin_rise_0_100``, ``lin_settling`` (2 %) [s] and ``lin_overshoot`` [%]: that linear
         loop's step response by ``control.step_info``.
 
@@ -616,14 +616,13 @@ def fitted_nlpd_loop() -> dict:
 def _fitted_nlpd_loop() -> tuple:
     import control
 
-    from quadcruise.workflows.analysis import INPUTS, OUTPUTS, linearize
-    from quadcruise.workflows.analysis import report as loop_report
+    from quadcruise.workflows.analysis import linearize
 
     c = FITTED["nlpd (fitted)"]()
     lin = linearize(c)
-    dom = complex(*loop_report(c, lin=lin)["loops"]["x"]["dominant"])
+    dom = complex(*lin.summary()["loops"]["x"]["dominant"])
     pd = complex(max(np.asarray(c.position.poles, complex), key=lambda z: z.imag))
-    x = lin.sys[OUTPUTS.index("x"), INPUTS.index("x_ref")]
+    x = lin.closed_loop("x")
     t = np.arange(0.0, 20.0 + lin.dt / 2, lin.dt)
     info = control.step_info(x, T=t, SettlingTimeThreshold=0.02, RiseTimeLimits=(0.1, 0.9))
     full = control.step_info(x, T=t, RiseTimeLimits=(0.0, 1.0))
