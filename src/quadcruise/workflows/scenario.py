@@ -513,7 +513,9 @@ def _compare(where: _Where, table: dict) -> dict:
     ``population``, checked here and kept as written (``quadcruise compare`` flies it)."""
     _known(where, "", table, {"controllers", "population"})
     if "population" in table:
-        pop = _table(where, "population", table["population"])
+        pop = table["population"]
+        if not isinstance(pop, dict):
+            raise where.error("'population' must be a table, e.g. population = { n = 100, mass_spread = 0.1 }")
         _known(where, "population.", pop, set(COMPARE_POPULATION_KEYS))
         if "n" not in pop:
             raise where.error("'population' needs n, the number of vehicles")
