@@ -338,6 +338,46 @@ def write_table(frame, path: Path, fmt: str) -> Path:
     return out
 
 
+def _read_at_once(path: Path, required, optional, blank_ok):
+    """:func:`read_numeric_csv`'s result by pandas' C reader, for a plain file (no quotes, no blank
+    line, every row as wide as the header, every cell a number); None otherwise, and the reader
+    that names each line and cell takes over."""
+    import io
+
+    import numpy as np
+    import pandas as pd
+
+    try:
+        raw = path.read_bytes()
+        raw = raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw
+        text = raw.rstrip(b"\r\n")
+        if b'"' in text:
+            return None                                        # quoted cells: the csv module's
+        header = [h.strip() for h in text.split(b"\n", 1)[0].decode().rstrip("\r").split(",")]
+        rows = text.count(b"\n")
+        if (len(set(header)) != len(header) or not set(required) <= set(header)
+                or not set(header) <= set(required) | set(optional) or text.count(b",") != (rows + 1) * (len(header) - 1)):
+            return None
+        if b"nan" in text.lower():
+            return None                                        # a NaN cell: refused, by line
+        used = [c for c in required + tuple(optional) if c in header]
+        table = pd.read_csv(io.BytesIO(text), header=0, names=header, usecols=used, dtype=float,
+                            na_values=[""], keep_default_na=False, skipinitialspace=True, engine="c")
+        if len(table) != rows:
+            return None                                        # a blank line (pandas skips it): lines to count
+        columns = []
+        for name in used:
+            column = table[name].to_numpy(dtype=float)
+            blank = np.flatnonzero(np.isnan(column))            # only a blank cell reads as NaN here
+            if blank.size and (blank_ok is None or not all(blank_ok(name, int(k)) for k in blank)):
+                return None
+            columns.append(column)
+    except (OSError, ValueError, UnicodeDecodeError, pd.errors.ParserError):
+        return None
+    data = np.column_stack(columns) if columns else np.empty((rows, 0))
+    return 1, used, data, list(range(2, rows + 2))
+
+
 def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optional: tuple[str, ...] = (), *,
                      blank_ok=None, progress=None):
     """Read a CSV of numbers with a header; any problem is one InputError naming the file,
@@ -394,6 +434,11 @@ def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optiona
         raise InputError(f"{path}: is a folder, not a file")
     if not path.is_file():
         raise InputError(f"{path}: no such file")
+    fast = _read_at_once(path, required, optional, blank_ok)
+    if fast is not None:
+        if progress is not None:
+            progress(fast[2].shape[0], fast[2].shape[0])
+        return fast
     try:
         with path.open(newline="", encoding="utf-8-sig") as f:       # a byte-order mark (Excel's) is dropped
             rows = [(n, r) for n, r in enumerate(csv.reader(f), start=1) if any(c.strip() for c in r)]
