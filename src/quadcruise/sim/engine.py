@@ -525,10 +525,10 @@ waiting at the end."""
 _pool: ThreadPoolExecutor | None = None
 
 
-def fly_vehicles(n: int, args: tuple) -> None:
+def fly_vehicles(n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD) -> None:
     """Run the kernel over vehicles 0..n-1 of the batch arrays in ``args``, on numba's
     number of threads (``numba.get_num_threads()``): one range on this thread when that is
-    1 or n is 1, else ``PIECES_PER_THREAD`` ranges per thread, handed out in turn.
+    1 or n is 1, else ``pieces_per_thread`` ranges per thread, handed out in turn.
 
     Parameters
     ----------
@@ -536,13 +536,15 @@ def fly_vehicles(n: int, args: tuple) -> None:
         Number of vehicles.
     args : tuple
         The kernel's arguments after the vehicle range (its batch arrays, by role).
+    pieces_per_thread : int
+        Ranges per thread: fewer for short calls (a step), where each call's fixed cost counts.
     """
     global _pool
     threads = min(n, get_num_threads())
     if threads <= 1:
         _kernel(0, n, *args)
         return
-    bounds = np.linspace(0, n, min(n, PIECES_PER_THREAD * threads) + 1).round().astype(np.int64)
+    bounds = np.linspace(0, n, min(n, pieces_per_thread * threads) + 1).round().astype(np.int64)
     pieces = itertools.count()                  # next() on it is atomic under the GIL
 
     def work() -> None:
