@@ -31,7 +31,7 @@ def main(argv=None) -> int:
     import gymnasium
 
     import quadcruise as qc
-    import quadcruise.gym  # noqa: F401  (registers the environments)
+    import quadcruise.gym  # registers the environments
 
     n = 64 if args.quick else args.num_envs
     steps = 20 if args.quick else 200

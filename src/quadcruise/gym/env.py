@@ -176,12 +176,11 @@ class QuadVectorEnv(VectorEnv):
         s = self.stepper
         draw = self._draw(self._seed, ids, k)
         s.vp[rows], s.vp_ctrl[rows], s.mp[rows] = draw["vp"], draw["vp_ctrl"], draw["mp"]
-        if draw["environment"] is not None:
-            env = draw["environment"]
+        env = draw["environment"]
+        if env is not None:
             s.disturbance_params[rows] = env.params(k)
-            s._dmem0[rows] = env.memory(k)
-        s.reset(self._mask(rows), x0=draw["x0"],
-                rng=vehicle_states(self._seed, k, ids) if s.drawn else None)
+        s.reset(self._mask(rows), x0=draw["x0"], rng=vehicle_states(self._seed, k, ids) if s.drawn else None,
+                disturbance_memory=None if env is None else env.memory(k))
         self._episode[rows] += 1
         self.returns[rows] = 0.0
 
@@ -218,7 +217,7 @@ class QuadVectorEnv(VectorEnv):
                 raise InputError(f"seed must be >= 0, got {seed}")
             self._seeded = True
             self._episode[:] = 0
-        rows = np.arange(self.num_envs) if mask is None else np.flatnonzero(self.stepper._mask(np.asarray(mask)))
+        rows = np.arange(self.num_envs) if mask is None else np.flatnonzero(self.stepper.check_mask(mask))
         self._start(rows)
         self._pending[rows] = False
         self._observe()

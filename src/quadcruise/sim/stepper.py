@@ -162,7 +162,7 @@ class Stepper:
         """(N,) bool: the vehicle stopped (its status is not FINISHED) or flew its whole grid."""
         return (self.status != int(ExitStatus.FINISHED)) | (self.clock[:, 0] >= self.t_grid.shape[0] - 1)
 
-    def reset(self, mask=None, *, x0=None, rng=None, seed: int | None = None) -> None:
+    def reset(self, mask=None, *, x0=None, rng=None, seed: int | None = None, disturbance_memory=None) -> None:
         """Start some vehicles (or all) again at the grid's first instant.
 
         Parameters
@@ -176,13 +176,15 @@ class Stepper:
         seed : int, optional
             Without ``rng``: draw their streams from (seed, first_vehicle + i) again; the
             constructor's seed by default.
+        disturbance_memory : (K, D) array, optional
+            Their disturbance's initial memory (kept for later resets); the constructor's by default.
 
         Raises
         ------
         InputError
             A mask or an array of the wrong shape, a non-finite x0.
         """
-        rows = np.arange(self.n) if mask is None else np.flatnonzero(self._mask(mask))
+        rows = np.arange(self.n) if mask is None else np.flatnonzero(self.check_mask(mask))
         k = rows.size
         if not k:
             return
@@ -194,6 +196,12 @@ class Stepper:
                 else start
             if start.shape != (k, STATE_SIZE) or not np.isfinite(start).all():
                 raise InputError(f"reset: x0 must be finite and of shape (16,) or ({k}, 16), got {np.shape(x0)}")
+        if disturbance_memory is not None:
+            dmem = np.asarray(disturbance_memory, dtype=float)
+            if dmem.shape != (k, self._dmem0.shape[1]):
+                raise InputError(f"reset: disturbance_memory must have shape ({k}, {self._dmem0.shape[1]}), "
+                                 f"got {dmem.shape}")
+            self._dmem0[rows] = dmem
         self.state[rows] = start
         self.memory[rows] = self._mem0[rows]
         self.disturbance_memory[rows] = self._dmem0[rows]
@@ -210,7 +218,23 @@ class Stepper:
         self.status[rows] = int(ExitStatus.FINISHED)
         self.t_stop[rows] = np.nan
 
-    def _mask(self, mask) -> np.ndarray:
+    def check_mask(self, mask) -> np.ndarray:
+        """The mask as an (N,) bool array, or one InputError line.
+
+        Parameters
+        ----------
+        mask : array_like
+            (N,) bool.
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        InputError
+            Not an (N,) bool array.
+        """
         mask = np.asarray(mask)
         if mask.shape != (self.n,) or mask.dtype != bool:
             raise InputError(f"reset: mask must be a ({self.n},) bool array, got {mask.shape} {mask.dtype}")
