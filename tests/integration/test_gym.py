@@ -121,6 +121,22 @@ def test_bad_actions_are_one_clear_error(action, message):
         QuadVectorEnv(2, action="thrust")
 
 
+def test_a_rollout_keeps_each_flight_as_it_ended():
+    env = QuadVectorEnv(3, mission="hover", action="rotors", duration=1.0)
+
+    def climb_one(obs):
+        a = np.zeros((3, 4), dtype=np.float32)
+        a[1] = 1.0
+        return a
+    returns, flights = rollout(env, climb_one, seed=0)
+    assert flights.status.tolist() == [0, int(ExitStatus.LOST_TRACK), 0]
+    assert 0.0 < flights.t_stop[1] < 1.0 and flights.t_stop[0] == 1.0
+    lost_at = round(float(flights.t_stop[1]) / env.dt)
+    assert np.isfinite(flights.states[1, :lost_at + 1]).all() and np.isnan(flights.states[1, lost_at + 1:]).all()
+    assert np.linalg.norm(flights.final_state[1, :3] - flights.references[1, 0, :3]) > 2.0   # where it was lost
+    assert returns[1] < returns[0]
+
+
 def test_a_baseline_in_the_env_flies_what_fly_flies():
     env = QuadVectorEnv(2, mission="circle", controller="nlpd", dt=0.002, duration=2.0)
     returns, flights = rollout(env, seed=0)

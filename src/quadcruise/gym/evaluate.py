@@ -62,8 +62,9 @@ def rollout(env: QuadVectorEnv, policy: Callable | None = None, *, seed: int = 0
     states[:, 0] = s.state
     returns = np.zeros(n)
     alive = np.ones(n, dtype=bool)
+    status, t_stop, final = np.zeros(n, dtype=np.int64), np.full(n, s.t_grid[-1]), s.state.copy()
     for k in range(length - 1):
-        obs, reward, terminated, truncated, _ = env.step(None if policy is None else policy(obs))
+        obs, reward, terminated, truncated, info = env.step(None if policy is None else policy(obs))
         returns[alive] += reward[alive]
         commands[alive, k] = s.log_cmd[alive, 0]
         refs[alive, k] = s.log_ref[alive, 0]
@@ -71,15 +72,16 @@ def rollout(env: QuadVectorEnv, policy: Callable | None = None, *, seed: int = 0
         if k == length - 2:                         # the last instant's reference and command
             commands[alive, k + 1] = s.log_cmd[alive, 1]
             refs[alive, k + 1] = s.log_ref[alive, 1]
-        alive &= ~(terminated | truncated)
+        ended = alive & (terminated | truncated)          # as they ended: the next step restarts them
+        status[ended], final[ended] = info["status"][ended], s.state[ended]
+        t_stop[ended & terminated] = s.t_stop[ended & terminated]
+        alive &= ~ended
         if not alive.any():
             break
-    status, t_stop = s.status.copy(), s.t_stop.copy()
-    t_stop[status == 0] = s.t_grid[-1]
     meta = {"workflow": "gym", "mission": env.mission.to_dict(), "dt_s": env.dt, "seed": seed, "n": n,
             "controller": {"name": env.baseline.name} if env.baseline is not None else {"name": "policy"}}
     result = SimResult(t=s.t_grid.copy(), states=states, commands=commands, references=refs,
-                       final_state=s.state.copy(), status=status, t_stop=t_stop, memory=s.memory.copy(),
+                       final_state=final, status=status, t_stop=t_stop, memory=s.memory.copy(),
                        duty_clipped_s=s.saturated[:, 0].copy(), controller_limited_s=s.saturated[:, 1].copy(),
                        meta=meta, disturbance_memory=s.disturbance_memory.copy())
     return returns, result
