@@ -6,6 +6,7 @@ baseline controller in the environment flies what `fly` flies from the same star
 import subprocess
 import sys
 import warnings
+from pathlib import Path
 
 import gymnasium
 import numpy as np
@@ -19,6 +20,7 @@ from quadcruise.errors import InputError
 from quadcruise.gym.env import QuadVectorEnv
 from quadcruise.gym.evaluate import baselines, rollout
 from quadcruise.layout import PHI, VX, P
+from quadcruise.missions import MinimumSnap, Waypoints
 from quadcruise.montecarlo.population import Population
 from quadcruise.sim.status import ExitStatus
 
@@ -41,6 +43,22 @@ def test_gymnasium_checker_passes(env_id, mode):
     assert isinstance(vec, QuadVectorEnv)
     obs, _ = vec.reset(seed=0)
     assert obs.shape == (3, 21) and obs.dtype == np.float32 and vec.observation_space.contains(obs)
+
+
+@pytest.mark.parametrize("mission", ["square", "waypoints", "minsnap", "random"])
+def test_track_flies_every_mission_kind(mission):
+    csv = str(Path(__file__).resolve().parents[2] / "examples" / "waypoints.csv")
+    kind = {"waypoints": Waypoints(table=csv), "minsnap": MinimumSnap(table=csv)}.get(mission, mission)
+    env = gymnasium.make_vec("quadcruise/Track-v0", num_envs=2, vectorization_mode="vector_entry_point",
+                             mission=kind, controller="se3")
+    obs, _ = env.reset(seed=4)
+    assert np.abs(obs[:, :3]).max() < 1e-9            # each episode starts on its reference
+    for _ in range(100):
+        obs, reward, terminated, _, _ = env.step(None)
+    assert not terminated.any() and (reward > 0.5).all()
+    if mission == "random":                            # two vehicles, two different circles
+        assert not np.array_equal(env.stepper.mp[0], env.stepper.mp[1])
+        assert env.duration == 20.0
 
 
 def _hold(mode, action, seconds, **kw):

@@ -32,6 +32,8 @@ EPISODE_STRIDE = 2 ** 32
 (seed, i, e) only, never on the number of vehicles."""
 RANDOM_MISSION_KEY = 2
 """spawn_key of a random reference's draws (the population's is 1, the engine's none)."""
+RANDOM_DURATION = 20.0
+"""[s]: the default episode of a random reference (from a lap of the slowest circle to 2.5 of the fastest)."""
 DEFAULT_LIMITS = Limits(max_position=1.0e3, max_speed=50.0, max_rate=30.0, max_tilt=1.4)
 """The environments' divergence bounds: a vehicle past 80 degrees of tilt, 30 rad/s or 50 m/s
 has crashed for any purpose of training."""
@@ -78,7 +80,8 @@ class QuadVectorEnv(VectorEnv):
     max_step : float, optional
         Longest RK4 substep [s]; ``dt`` by default.
     duration : float, optional
-        Episode length [s]; the mission's default duration by default.
+        Episode length [s]; the mission's default duration by default (:data:`RANDOM_DURATION`
+        for random references).
     population : Population, optional
         Domain randomisation: each episode's vehicle, initial offset, environment and sensors
         drawn from it (and ``model_error``: the action loops compute with the nominal vehicle).
@@ -116,7 +119,8 @@ class QuadVectorEnv(VectorEnv):
             raise InputError("the environment's vehicle must not be batched: use a population to vary it")
         check_can_hover(self.nominal)
         self.population, self.action_mode, self.max_track_error = population, action, float(max_track_error)
-        self.duration = float(self.mission.duration if duration is None else duration)
+        default = RANDOM_DURATION if self.random_mission else self.mission.duration
+        self.duration = float(default if duration is None else duration)
         grid = time_grid(self.duration, float(dt))
         self.baseline = None if controller is None else as_controller(controller)
         try:
