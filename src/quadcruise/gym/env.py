@@ -17,7 +17,7 @@ from quadcruise.control import as_controller
 from quadcruise.control.setpoint import ACTION_CONTROLLERS, setpoint_gains
 from quadcruise.errors import InputError
 from quadcruise.gym.observe import OBS_SIZE, REF_SIZE, observe, references
-from quadcruise.layout import PSI, REF_PSI, REF_X, X
+from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, STATE_SIZE, X
 from quadcruise.missions import Circle, Mission, mission_from_name, stack_params
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
@@ -25,7 +25,7 @@ from quadcruise.sim.engine import Limits, time_grid
 from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.stepper import Stepper
-from quadcruise.workflows.fly import check_can_hover, hover_state
+from quadcruise.workflows.fly import check_can_hover
 
 EPISODE_STRIDE = 2 ** 32
 """Episode e of vehicle i draws from the stream ``(seed, i * EPISODE_STRIDE + e)``: it depends on
@@ -162,11 +162,16 @@ class QuadVectorEnv(VectorEnv):
             d = pop.draw(seed, ids, k, self.nominal)
             vehicle, offsets, environment = d.vehicle, d.offsets, d.environment
         missions = [random_circle(seed, int(i)) for i in ids] if self.random_mission else [self.mission]
-        x0 = hover_state(vehicle, k, missions[0])            # level, rotors at the hover thrust
-        start = np.concatenate([m.reference(0.0) for m in missions])
+        if self.random_mission:
+            start = np.concatenate([m.reference(0.0) for m in missions])
+        else:                                                 # computed once: a reset is on the hot path
+            start = self._start_ref if hasattr(self, "_start_ref") else self.mission.reference(0.0)
+            self._start_ref = start
+        vp = vehicle.rows(k)
+        x0 = np.zeros((k, STATE_SIZE))                        # level, still, rotors at the hover thrust
         x0[:, X:X + 3] = start[:, REF_X:REF_X + 3] + offsets  # on the reference, plus the drawn offset
         x0[:, PSI] = start[:, REF_PSI]
-        vp = vehicle.rows(k)
+        x0[:, F1:F1 + 4] = (vp[:, P_M] * vp[:, P_G] / 4.0)[:, None]
         vp_ctrl = self.nominal.rows(k) if pop is None or pop.model_error else vp
         return {"vp": vp, "vp_ctrl": vp_ctrl, "x0": x0, "mp": stack_params(missions, n=k),
                 "environment": environment}
