@@ -396,6 +396,17 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
     with a warning at every call) the kernel ran slower (docs/performance.md).
     """
     n_periods = t_grid.shape[0] - 1
+    # scratch of this call, reused by its vehicles (a step of one period would otherwise spend
+    # more on allocating it than on flying); every entry is set for each vehicle before use
+    x = np.empty(STATE_SIZE)
+    seen = np.empty(STATE_SIZE)
+    history = np.empty((sensor_delay + 1, STATE_SIZE))   # ring buffer of past states
+    ref = np.empty(REF_SIZE)
+    cmd = np.empty(CMD_SIZE)
+    u = np.empty(4)
+    ext = np.empty(EXT_SIZE)
+    work = np.empty((WORK_ROWS, STATE_SIZE))
+    mi, dmi, rngi = np.empty(mem.shape[1]), np.empty(dmem.shape[1]), np.empty(rng.shape[1], dtype=np.uint64)
     for i in range(first, stop):
         k0 = clock[i, 0]
         if status[i] != FINISHED or k0 >= n_periods:      # stopped, or its grid flown
@@ -405,23 +416,28 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
             continue
         k1 = min(k0 + n_step, n_periods)
         k_reached = k1
-        x = x0[i].copy()
-        seen = np.empty(STATE_SIZE)
-        history = np.empty((sensor_delay + 1, STATE_SIZE))   # ring buffer of past states
+        for j in range(STATE_SIZE):
+            x[j] = x0[i, j]
         for d in range(sensor_delay + 1):
             for j in range(STATE_SIZE):
                 history[d, j] = carry[i, TRIG_WIDTH + d * STATE_SIZE + j]
-        ref = np.zeros(REF_SIZE)
-        cmd = np.zeros(CMD_SIZE)
-        u = np.zeros(4)
-        ext = np.zeros(EXT_SIZE)
-        work = np.empty((WORK_ROWS, STATE_SIZE))
+        for j in range(REF_SIZE):
+            ref[j] = 0.0
+        for j in range(4):
+            u[j] = 0.0
+        for j in range(EXT_SIZE):
+            ext[j] = 0.0
         for j in range(TRIG_WIDTH):
             work[TRIG, j] = carry[i, j]
         vpi, vci, gi, mpi, dpi, stdi = vp[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
         # what changes every period is this vehicle's own copy, the memories written back at
         # the end (a kept trick against false sharing: quadcruise.sim.fastmath)
-        mi, dmi, rngi = mem[i].copy(), dmem[i].copy(), rng[i].copy()
+        for j in range(mi.shape[0]):
+            mi[j] = mem[i, j]
+        for j in range(dmi.shape[0]):
+            dmi[j] = dmem[i, j]
+        for j in range(rngi.shape[0]):
+            rngi[j] = rng[i, j]
         clipped_s, limited_s = saturated[i, 0], saturated[i, 1]
         max_position, max_speed, max_rate, max_tilt = limits[0], limits[1], limits[2], limits[3]
         code = FINISHED
