@@ -40,3 +40,15 @@ def test_quick_benchmark_writes_positive_figures(tmp_path):
     assert positive(startup["python_warm_s"]), startup
     assert "python_cold_s" not in startup                               # no --cold: warm only
     assert positive(startup["cli_warm_s"]) or "cli_skipped" in startup, startup
+
+
+def test_quick_gym_benchmark_writes_positive_figures(tmp_path):
+    out = tmp_path / "gym.json"
+    script = SCRIPT.parent / "gym.py"
+    proc = subprocess.run([sys.executable, str(script), "--quick", "--json", str(out)],
+                          check=False, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    data = json.loads(out.read_text())
+    assert positive(data["fly_rate"])
+    assert set(data["modes"]) == {"rotors", "rates", "attitude", "velocity"}
+    assert all(positive(m["rate"]) and positive(m["ratio_to_fly"]) for m in data["modes"].values())

@@ -32,7 +32,7 @@ RANKS = {
     "quadcruise.workflows": 9,
     "quadcruise.sysid": 9,
     "quadcruise.montecarlo": 10,
-    "quadcruise.tune": 11,
+    "quadcruise.tune": 11, "quadcruise.gym": 11,
     "quadcruise.report": 12,
     "quadcruise.cli": 13,
     "quadcruise": 14, "quadcruise.__main__": 14,

@@ -114,6 +114,51 @@ class Limits:
 # and cosines of the state's phi, theta and psi carried from one step to the next
 K1, K2, K3, K4, XT, TRIG = range(6)
 WORK_ROWS = 6
+TRIG_WIDTH = 6      # the entries of row TRIG in use, carried from one call of the kernel to the next
+
+
+def carry_width(sensor_delay: int) -> int:
+    """Width of the kernel's ``carry`` rows: the 6 carried sines and cosines of the angles,
+    then the sensor-delay ring buffer of ``sensor_delay + 1`` states.
+
+    Parameters
+    ----------
+    sensor_delay : int
+        The sensor delay [control periods].
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> carry_width(0), carry_width(2)
+    (22, 54)
+    """
+    return TRIG_WIDTH + (int(sensor_delay) + 1) * STATE_SIZE
+
+
+def fresh_carry(x0: np.ndarray, sensor_delay: int) -> np.ndarray:
+    """The ``carry`` rows of vehicles about to start from the states ``x0``: every slot of the
+    ring buffer holds x0 (the controller sees the initial state until the delay has passed).
+
+    Parameters
+    ----------
+    x0 : numpy.ndarray
+        (N, 16) initial states.
+    sensor_delay : int
+        The sensor delay [control periods].
+
+    Returns
+    -------
+    numpy.ndarray
+        (N, :func:`carry_width`) rows; the sines and cosines are zero: a vehicle whose
+        ``clock`` RK4 count is 0 computes them afresh.
+    """
+    n = x0.shape[0]
+    out = np.zeros((n, carry_width(sensor_delay)))
+    out[:, TRIG_WIDTH:] = np.tile(x0, (1, int(sensor_delay) + 1))
+    return out
 
 
 @njit(cache=True, error_model="numpy")
@@ -305,12 +350,13 @@ _f8v = types.float64[::1]
 _f8m = types.float64[:, ::1]
 _f8c = types.float64[:, :, ::1]
 _i8v = types.int64[::1]
+_i8m = types.int64[:, ::1]
 _u8m = types.uint64[:, ::1]
 
 KERNEL_SIG = types.void(
     types.int64, types.int64, _f8v, _f8m, _f8m, _f8m, ControllerType, _f8m, _f8m, MissionType, _f8m,
     DisturbanceType, types.boolean, _f8m, _f8m, _u8m, _f8m, types.int64, types.boolean,
-    types.float64, types.int64, _f8v,
+    types.float64, types.int64, _f8v, types.int64, _i8m, _f8m,
     _f8c, _f8c, _f8c, _f8m, _i8v, _f8v, _f8m,
 )
 
@@ -318,7 +364,7 @@ KERNEL_SIG = types.void(
 @njit(KERNEL_SIG, cache=True, nogil=True, error_model="numpy")
 def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
             disturbance, disturbed, dp, dmem, rng, sensor_std, sensor_delay, full,
-            max_step, log_every, limits,
+            max_step, log_every, limits, n_step, clock, carry,
             log_x, log_cmd, log_ref, x_final, status, t_stop, saturated):
     """Fly vehicles first .. stop - 1 of the batch. The arguments, by role (their meaning:
     :func:`simulate`'s parameters; one row per vehicle):
@@ -331,37 +377,77 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
       ``dmem``, ``rng``;
     - sensors: ``sensor_std``, ``sensor_delay``;
     - options: ``full``, ``max_step``, ``log_every``, ``limits``;
+    - resuming: ``n_step``, ``clock``, ``carry`` (below);
     - outputs: ``log_x``, ``log_cmd``, ``log_ref``, ``x_final``, ``status``, ``t_stop``,
-      ``saturated`` (and ``mem``, ``dmem`` written back).
+      ``saturated`` (and ``mem``, ``dmem``, ``rng`` written back).
+
+    Each vehicle flies on from its period ``clock[i, 0]`` for at most ``n_step`` periods,
+    then stops at the next instant without asking for its command there, unless that
+    instant ends the grid (then its reference and command are logged, as a whole flight's
+    last row). Everything a vehicle carries from one period to the next is read at the start
+    and written back at the end, so that a flight cut into calls is bit for bit the flight
+    flown in one: its state (``x0`` in, ``x_final`` out: they may be one array), ``clock``
+    (the period reached and the RK4 steps flown, for the ``TRIG_REFRESH`` count), ``carry``
+    (:func:`carry_width`: the sines and cosines of row TRIG, then the sensor-delay ring
+    buffer), ``mem``, ``dmem``, ``rng``, ``saturated`` (accumulated) and ``status`` (a
+    vehicle whose status is not FINISHED, or whose grid is flown, is left as it is). The log
+    rows count from the first instant flown in this call.
 
     A flat list: grouped into tuples (numba allows tuples of arrays, and of functions, though
     with a warning at every call) the kernel ran slower (docs/performance.md).
     """
     n_periods = t_grid.shape[0] - 1
+    # scratch of this call, reused by its vehicles (a step of one period would otherwise spend
+    # more on allocating it than on flying); every entry is set for each vehicle before use
+    x = np.empty(STATE_SIZE)
+    seen = np.empty(STATE_SIZE)
+    history = np.empty((sensor_delay + 1, STATE_SIZE))   # ring buffer of past states
+    ref = np.empty(REF_SIZE)
+    cmd = np.empty(CMD_SIZE)
+    u = np.empty(4)
+    ext = np.empty(EXT_SIZE)
+    work = np.empty((WORK_ROWS, STATE_SIZE))
+    mi, dmi, rngi = np.empty(mem.shape[1]), np.empty(dmem.shape[1]), np.empty(rng.shape[1], dtype=np.uint64)
     for i in range(first, stop):
-        x = x0[i].copy()
-        seen = np.empty(STATE_SIZE)
-        history = np.empty((sensor_delay + 1, STATE_SIZE))   # ring buffer of past states
+        k0 = clock[i, 0]
+        if status[i] != FINISHED or k0 >= n_periods:      # stopped, or its grid flown
+            blank_rows(log_x, i, 0)
+            blank_rows(log_cmd, i, 0)
+            blank_rows(log_ref, i, 0)
+            continue
+        k1 = min(k0 + n_step, n_periods)
+        k_reached = k1
+        for j in range(STATE_SIZE):
+            x[j] = x0[i, j]
         for d in range(sensor_delay + 1):
-            put_row(history, d, x)
-        ref = np.zeros(REF_SIZE)
-        cmd = np.zeros(CMD_SIZE)
-        u = np.zeros(4)
-        ext = np.zeros(EXT_SIZE)
-        work = np.empty((WORK_ROWS, STATE_SIZE))
+            for j in range(STATE_SIZE):
+                history[d, j] = carry[i, TRIG_WIDTH + d * STATE_SIZE + j]
+        for j in range(REF_SIZE):
+            ref[j] = 0.0
+        for j in range(4):
+            u[j] = 0.0
+        for j in range(EXT_SIZE):
+            ext[j] = 0.0
+        for j in range(TRIG_WIDTH):
+            work[TRIG, j] = carry[i, j]
         vpi, vci, gi, mpi, dpi, stdi = vp[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
         # what changes every period is this vehicle's own copy, the memories written back at
         # the end (a kept trick against false sharing: quadcruise.sim.fastmath)
-        mi, dmi, rngi = mem[i].copy(), dmem[i].copy(), rng[i].copy()
-        clipped_s = limited_s = 0.0
+        for j in range(mi.shape[0]):
+            mi[j] = mem[i, j]
+        for j in range(dmi.shape[0]):
+            dmi[j] = dmem[i, j]
+        for j in range(rngi.shape[0]):
+            rngi[j] = rng[i, j]
+        clipped_s, limited_s = saturated[i, 0], saturated[i, 1]
         max_position, max_speed, max_rate, max_tilt = limits[0], limits[1], limits[2], limits[3]
         code = FINISHED
         t_end = t_grid[n_periods]
         rows_x = rows = 0
-        steps = 0                      # RK4 steps flown
+        steps = clock[i, 1]            # RK4 steps flown
         if not disturbed:              # set once (a kept trick: quadcruise.sim.fastmath)
             still_air(0.0, 0.0, x, dpi, dmi, rngi, ext)
-        for k in range(n_periods + 1):
+        for k in range(k0, k1 + 1 if k1 == n_periods else k1):
             t = t_grid[k]
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
             mission(t, mpi, ref)
@@ -395,6 +481,7 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
             if not finite:
                 code = BAD_COMMAND
                 t_end = t
+                k_reached = k
                 break
             if clipped:
                 clipped_s += dt
@@ -424,6 +511,7 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
                 code = PITCH_SINGULAR
             if code != FINISHED:
                 t_end = t_grid[k + 1]
+                k_reached = k + 1
                 if (k + 1) % log_every == 0:    # keep the state that broke the bound
                     log_row(log_x, i, rows, x)
                     rows_x += 1
@@ -434,6 +522,13 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
         put_row(x_final, i, x)
         put_row(mem, i, mi)
         put_row(dmem, i, dmi)
+        put_row(rng, i, rngi)
+        clock[i, 0], clock[i, 1] = k_reached, steps
+        for j in range(TRIG_WIDTH):
+            carry[i, j] = work[TRIG, j]
+        for d in range(sensor_delay + 1):
+            for j in range(STATE_SIZE):
+                carry[i, TRIG_WIDTH + d * STATE_SIZE + j] = history[d, j]
         saturated[i, 0], saturated[i, 1] = clipped_s, limited_s
         status[i] = code
         t_stop[i] = t_end
@@ -447,10 +542,10 @@ waiting at the end."""
 _pool: ThreadPoolExecutor | None = None
 
 
-def fly_vehicles(n: int, args: tuple) -> None:
+def fly_vehicles(n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD) -> None:
     """Run the kernel over vehicles 0..n-1 of the batch arrays in ``args``, on numba's
     number of threads (``numba.get_num_threads()``): one range on this thread when that is
-    1 or n is 1, else ``PIECES_PER_THREAD`` ranges per thread, handed out in turn.
+    1 or n is 1, else ``pieces_per_thread`` ranges per thread, handed out in turn.
 
     Parameters
     ----------
@@ -458,13 +553,15 @@ def fly_vehicles(n: int, args: tuple) -> None:
         Number of vehicles.
     args : tuple
         The kernel's arguments after the vehicle range (its batch arrays, by role).
+    pieces_per_thread : int
+        Ranges per thread: fewer for short calls (a step), where each call's fixed cost counts.
     """
     global _pool
     threads = min(n, get_num_threads())
     if threads <= 1:
         _kernel(0, n, *args)
         return
-    bounds = np.linspace(0, n, min(n, PIECES_PER_THREAD * threads) + 1).round().astype(np.int64)
+    bounds = np.linspace(0, n, min(n, pieces_per_thread * threads) + 1).round().astype(np.int64)
     pieces = itertools.count()                  # next() on it is atomic under the GIL
 
     def work() -> None:
@@ -535,6 +632,65 @@ def _batch(name: str, a, n: int, width: int | None) -> np.ndarray:
     return np.array(arr, dtype=float, order="C")  # a writable copy, never a broadcast view
 
 
+def batch_inputs(t_grid, x0, vp, gains, mp, *, memory=None, vp_ctrl=None, disturbance=None,
+                 disturbance_params=None, disturbance_memory=None, seed: int = 0, first_vehicle=0,
+                 sensor_std=None, sensor_delay: int = 0, max_step: float = 1e-3, log_every: int = 1) -> dict:
+    """The kernel's batch arrays, checked and made C-contiguous writable copies: what
+    :func:`simulate` and :class:`quadcruise.sim.stepper.Stepper` hand to the kernel.
+
+    Parameters
+    ----------
+    t_grid, x0, vp, gains, mp, memory, vp_ctrl, disturbance, disturbance_params, disturbance_memory : array or None
+        As in :func:`simulate` (``disturbance`` only says whether there is one).
+    seed, first_vehicle, sensor_std, sensor_delay, max_step, log_every : optional
+        As in :func:`simulate`.
+
+    Returns
+    -------
+    dict
+        The arrays by name (``t_grid``, ``x0``, ``vp``, ``gains``, ``mp``, ``memory``, ``vp_ctrl``,
+        ``disturbance_params``, ``disturbance_memory``, ``sensor_std``, ``rng``), the number of
+        vehicles ``n``, ``disturbed`` and ``drawn`` (whether anything draws random numbers).
+
+    Raises
+    ------
+    InputError
+        One line naming the argument that is wrong.
+    """
+    t_grid = np.ascontiguousarray(t_grid, dtype=float)
+    if t_grid.ndim != 1 or t_grid.shape[0] < 2:
+        raise InputError("the time grid needs at least two instants")
+    if not np.all(np.isfinite(t_grid)) or np.any(np.diff(t_grid) <= 0):
+        raise InputError("the time grid must be finite and strictly increasing")
+    if not (math.isfinite(max_step) and max_step > 0):
+        raise InputError(f"max_step must be a positive number of seconds, got {max_step!r}")
+    if int(log_every) != log_every or log_every < 1:
+        raise InputError(f"log_every must be a positive integer, got {log_every!r}")
+    vp = np.ascontiguousarray(vp, dtype=float)
+    n = vp.shape[0]
+    x0 = _batch("initial state", x0, n, STATE_SIZE)
+    if not np.all(np.isfinite(x0)):
+        raise InputError("the initial state must be finite")
+    gains = _batch("controller gains", gains, n, None)
+    mp = _batch("mission parameters", mp, n, None)
+    mem = _batch("controller memory", np.zeros(0) if memory is None else memory, n, None)
+    vp_ctrl = vp if vp_ctrl is None else _batch("controller parameters", vp_ctrl, n, vp.shape[1])
+    dp = _batch("disturbance parameters", np.zeros(0) if disturbance_params is None else disturbance_params, n, None)
+    dmem = _batch("disturbance memory", np.zeros(0) if disturbance_memory is None else disturbance_memory, n, None)
+    std = _batch("sensor noise", np.zeros(STATE_SIZE) if sensor_std is None else sensor_std, n, STATE_SIZE)
+    if not np.all(np.isfinite(std)) or np.any(std < 0):
+        raise InputError("sensor noise standard deviations must be finite and >= 0")
+    if int(sensor_delay) != sensor_delay or sensor_delay < 0:
+        raise InputError(f"sensor delay must be a whole number of periods >= 0, got {sensor_delay!r}")
+    # the random streams, when anything draws from them (SeedSequence: ~25 us a vehicle)
+    disturbed = disturbance is not None
+    drawn = disturbed or bool(np.any(std))
+    rng = vehicle_states(seed, n, first_vehicle) if drawn else np.zeros((n, 1), dtype=np.uint64)
+    return {"t_grid": t_grid, "x0": x0, "vp": vp, "n": n, "gains": gains, "mp": mp, "memory": mem,
+            "vp_ctrl": vp_ctrl, "disturbance_params": dp, "disturbance_memory": dmem, "sensor_std": std,
+            "rng": rng, "disturbed": disturbed, "drawn": drawn}
+
+
 def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
              vp_ctrl=None, disturbance=None, disturbance_params=None, disturbance_memory=None,
              seed: int = 0, first_vehicle: int = 0, sensor_std=None, sensor_delay: int = 0,
@@ -594,37 +750,15 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
     SimResult
         The logged flight of every vehicle, its exit status and saturation times.
     """
-    t_grid = np.ascontiguousarray(t_grid, dtype=float)
-    if t_grid.ndim != 1 or t_grid.shape[0] < 2:
-        raise InputError("the time grid needs at least two instants")
-    if not np.all(np.isfinite(t_grid)) or np.any(np.diff(t_grid) <= 0):
-        raise InputError("the time grid must be finite and strictly increasing")
-    if not (math.isfinite(max_step) and max_step > 0):
-        raise InputError(f"max_step must be a positive number of seconds, got {max_step!r}")
-    if int(log_every) != log_every or log_every < 1:
-        raise InputError(f"log_every must be a positive integer, got {log_every!r}")
-    vp = np.ascontiguousarray(vp, dtype=float)
-    n = vp.shape[0]
-    x0 = _batch("initial state", x0, n, STATE_SIZE)
-    if not np.all(np.isfinite(x0)):
-        raise InputError("the initial state must be finite")
-    gains = _batch("controller gains", gains, n, None)
-    mp = _batch("mission parameters", mp, n, None)
-    mem = _batch("controller memory", np.zeros(0) if memory is None else memory, n, None)
-    vp_ctrl = vp if vp_ctrl is None else _batch("controller parameters", vp_ctrl, n, vp.shape[1])
-    dp = _batch("disturbance parameters", np.zeros(0) if disturbance_params is None else disturbance_params, n, None)
-    dmem = _batch("disturbance memory", np.zeros(0) if disturbance_memory is None else disturbance_memory, n, None)
-    std = _batch("sensor noise", np.zeros(STATE_SIZE) if sensor_std is None else sensor_std, n, STATE_SIZE)
-    if not np.all(np.isfinite(std)) or np.any(std < 0):
-        raise InputError("sensor noise standard deviations must be finite and >= 0")
-    if int(sensor_delay) != sensor_delay or sensor_delay < 0:
-        raise InputError(f"sensor delay must be a whole number of periods >= 0, got {sensor_delay!r}")
-    # the random streams, when anything draws from them (SeedSequence: ~25 us a vehicle)
-    disturbed = disturbance is not None
-    drawn = disturbed or bool(np.any(std))
-    rng = vehicle_states(seed, n, first_vehicle) if drawn else np.zeros((n, 1), dtype=np.uint64)
+    inp = batch_inputs(t_grid, x0, vp, gains, mp, memory=memory, vp_ctrl=vp_ctrl,
+                       disturbance=disturbance, disturbance_params=disturbance_params,
+                       disturbance_memory=disturbance_memory, seed=seed, first_vehicle=first_vehicle,
+                       sensor_std=sensor_std, sensor_delay=sensor_delay, max_step=max_step, log_every=log_every)
+    t_grid, x0, vp, n = inp["t_grid"], inp["x0"], inp["vp"], inp["n"]
+    mem, dmem, rng, disturbed = inp["memory"], inp["disturbance_memory"], inp["rng"], inp["disturbed"]
+    vp_ctrl, gains, mp, dp = inp["vp_ctrl"], inp["gains"], inp["mp"], inp["disturbance_params"]
+    std = inp["sensor_std"]
     limits = limits or Limits()
-
     n_periods = t_grid.shape[0] - 1
     n_log = n_periods // log_every + 1
     log_x = np.empty((n, n_log, STATE_SIZE))      # every row is written by the kernel:
@@ -637,6 +771,7 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
     fly_vehicles(n, (t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
                      disturbance or still_air, disturbed, dp, dmem, rng, std, int(sensor_delay),
                      bool(full_dynamics), float(max_step), int(log_every), limits.array(),
+                     n_periods, np.zeros((n, 2), dtype=np.int64), fresh_carry(x0, int(sensor_delay)),
                      log_x, log_cmd, log_ref, x_final, status, t_stop, saturated))
     return SimResult(
         t=t_grid[::log_every][:n_log].copy(), states=log_x, commands=log_cmd, references=log_ref,
@@ -646,4 +781,5 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
     )
 
 
-__all__ = ["Limits", "simulate", "time_grid", "rk4_step", "STATUS_REASONS"]
+__all__ = ["Limits", "simulate", "time_grid", "rk4_step", "STATUS_REASONS", "batch_inputs", "carry_width",
+           "fresh_carry"]

@@ -30,8 +30,9 @@ rounding (the tests check it).
 Three more are ways of arranging code, not formulas, so they stay where they act:
 
 - Own copies (``sim.engine._kernel``): a vehicle's controller memory, disturbance memory
-  and generator state are copied out of the batch's rows when its flight starts and the
-  memories written back when it ends. Plain: ``mem[i]``, ``dmem[i]``, ``rng[i]`` updated in
+  and generator state are copied out of the batch's rows when its flight (or a resumed
+  call's part of it) starts, into scratch arrays of the kernel call, and written back
+  when it ends. Plain: ``mem[i]``, ``dmem[i]``, ``rng[i]`` updated in
   place, which makes threads flying neighbouring vehicles write to the same cache lines
   every period (false sharing).
 - Still air set once (``sim.engine._kernel``): without a disturbance, the external inputs

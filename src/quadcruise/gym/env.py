@@ -1,0 +1,370 @@
+"""Gymnasium environments over the step-wise engine: N vehicles in one
+:class:`~quadcruise.sim.stepper.Stepper`, so a step of all of them is one call of the
+compiled kernel. See docs/gym.md for observations, actions, reward, termination and seeding.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, ClassVar
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode, VectorEnv
+
+from quadcruise.control import as_controller
+from quadcruise.control.setpoint import ACTION_CONTROLLERS, setpoint_gains
+from quadcruise.errors import InputError
+from quadcruise.gym.observe import OBS_SIZE, REF_SIZE, observe, references
+from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, STATE_SIZE, X
+from quadcruise.missions import Circle, Mission, mission_from_name, stack_params
+from quadcruise.model.vehicle import Vehicle
+from quadcruise.montecarlo.population import Population
+from quadcruise.sim.engine import Limits, time_grid
+from quadcruise.sim.rng import vehicle_states
+from quadcruise.sim.status import ExitStatus
+from quadcruise.sim.stepper import Stepper
+from quadcruise.workflows.fly import check_can_hover
+
+EPISODE_STRIDE = 2 ** 32
+"""Episode e of vehicle i draws from the stream ``(seed, i * EPISODE_STRIDE + e)``: it depends on
+(seed, i, e) only, never on the number of vehicles."""
+RANDOM_MISSION_KEY = 2
+"""spawn_key of a random reference's draws (the population's is 1, the engine's none)."""
+RANDOM_DURATION = 20.0
+"""[s]: the default episode of a random reference (from a lap of the slowest circle to 2.5 of the fastest)."""
+DEFAULT_LIMITS = Limits(max_position=1.0e3, max_speed=50.0, max_rate=30.0, max_tilt=1.4)
+"""The environments' divergence bounds: a vehicle past 80 degrees of tilt, 30 rad/s or 50 m/s
+has crashed for any purpose of training."""
+
+
+def random_circle(seed: int, episode_id: int) -> Circle:
+    """A random circle reference: radius U[0.5, 3] m, lap U[8, 20] s, either direction, any start angle.
+
+    Parameters
+    ----------
+    seed : int
+        The environment's seed.
+    episode_id : int
+        ``vehicle * EPISODE_STRIDE + episode``.
+
+    Returns
+    -------
+    Circle
+        At 1 m altitude, around the origin.
+    """
+    u = np.random.default_rng(np.random.SeedSequence([seed, episode_id], spawn_key=(RANDOM_MISSION_KEY,))).random(4)
+    return Circle(radius=0.5 + 2.5 * u[0], period=8.0 + 12.0 * u[1], direction=1 if u[2] < 0.5 else -1,
+                  start_angle=2.0 * math.pi * u[3])
+
+
+class QuadVectorEnv(VectorEnv):
+    """N quadrotors of one mission kind, stepped together (``gymnasium.vector.VectorEnv``).
+
+    Parameters
+    ----------
+    num_envs : int
+        Number of vehicles N.
+    mission : Mission or str
+        'hover', 'circle', 'square', 'waypoints', 'minsnap' (a name flies its defaults), a
+        Mission object, or 'random' (a :func:`random_circle` per episode).
+    action : {'rotors', 'rates', 'attitude', 'velocity'}
+        The action mode (:mod:`quadcruise.control.setpoint`).
+    controller : Controller or str, optional
+        Fly this controller instead of the policy (a baseline: ``step`` then takes no actions).
+    vehicle : Vehicle, optional
+        The nominal vehicle (Table I by default).
+    dt : float
+        The policy's period [s] (100 Hz by default), one control period of the engine.
+    max_step : float, optional
+        Longest RK4 substep [s]; ``dt`` by default.
+    duration : float, optional
+        Episode length [s]; the mission's default duration by default (:data:`RANDOM_DURATION`
+        for random references).
+    population : Population, optional
+        Domain randomisation: each episode's vehicle, initial offset, environment and sensors
+        drawn from it (and ``model_error``: the action loops compute with the nominal vehicle).
+    max_track_error : float
+        A position error beyond this [m] terminates the episode with ``lost track``.
+    limits : Limits, optional
+        Divergence bounds; :data:`DEFAULT_LIMITS` by default.
+    scales : dict, optional
+        Action scales and loop gains (:data:`quadcruise.control.setpoint.DEFAULT_SCALES`).
+    """
+
+    metadata: ClassVar[dict] = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+
+    def __init__(self, num_envs: int = 1, *, mission: Mission | str = "hover", action: str = "attitude",
+                 controller: Any = None, vehicle: Vehicle | None = None, dt: float = 0.01,
+                 max_step: float | None = None, duration: float | None = None,
+                 population: Population | None = None, max_track_error: float = 2.0,
+                 limits: Limits | None = None, scales: dict | None = None) -> None:
+        if not (isinstance(num_envs, (int, np.integer)) and num_envs >= 1):
+            raise InputError(f"num_envs must be a whole number >= 1, got {num_envs!r}")
+        if action not in ACTION_CONTROLLERS:
+            raise InputError(f"unknown action mode {action!r}; valid: {', '.join(ACTION_CONTROLLERS)}")
+        if population is not None and not isinstance(population, Population):
+            raise InputError(f"population must be a quadcruise Population, got {type(population).__name__}")
+        if not (isinstance(max_track_error, (int, float)) and max_track_error > 0):
+            raise InputError(f"max_track_error must be a positive number [m], got {max_track_error!r}")
+        n = self.num_envs = int(num_envs)
+        self.random_mission = isinstance(mission, str) and mission.strip().lower() == "random"
+        self.mission = random_circle(0, 0) if self.random_mission else (
+            mission_from_name(mission) if isinstance(mission, str) else mission)
+        if not isinstance(self.mission, Mission):
+            raise InputError(f"mission must be a Mission or a name, got {type(mission).__name__}")
+        self.nominal = vehicle or Vehicle.paper()
+        if self.nominal.batch_size is not None:
+            raise InputError("the environment's vehicle must not be batched: use a population to vary it")
+        check_can_hover(self.nominal)
+        self.population, self.action_mode, self.max_track_error = population, action, float(max_track_error)
+        default = RANDOM_DURATION if self.random_mission else self.mission.duration
+        self.duration = float(default if duration is None else duration)
+        grid = time_grid(self.duration, float(dt))
+        self.baseline = None if controller is None else as_controller(controller)
+        try:
+            gains = setpoint_gains(**(scales or {}))
+        except ValueError as err:
+            raise InputError(str(err)) from None
+        draw = self._draw(0, np.arange(n) * EPISODE_STRIDE, n)
+        self.sensors = None if population is None else population.noise
+        if self.baseline is not None:
+            function, gains, memory, width = (self.baseline.function, self.baseline.gains(), self.baseline.memory(),
+                                              0)
+        else:
+            function, memory, width = ACTION_CONTROLLERS[action], None, 4
+        env_kw = {} if draw["environment"] is None else draw["environment"].kwargs(n)
+        sens_kw = {} if self.sensors is None else self.sensors.kwargs(float(dt))
+        self.stepper = Stepper(grid, draw["x0"], draw["vp"], function, gains, self.mission.function, draw["mp"],
+                               memory=memory, vp_ctrl=draw["vp_ctrl"], max_step=max_step or dt,
+                               limits=limits or DEFAULT_LIMITS, setpoint_width=width, **env_kw, **sens_kw)
+        self.dt = float(dt)
+        self.single_action_space = spaces.Box(-1.0, 1.0, (4,), dtype=np.float32)
+        self.single_observation_space = spaces.Box(-np.inf, np.inf, (OBS_SIZE,), dtype=np.float32)
+        self.action_space = spaces.Box(-1.0, 1.0, (n, 4), dtype=np.float32)
+        self.observation_space = spaces.Box(-np.inf, np.inf, (n, OBS_SIZE), dtype=np.float32)
+        self._ref = np.empty((n, REF_SIZE))
+        self._obs = np.empty((n, OBS_SIZE), dtype=np.float32)
+        self._reward = np.empty(n)
+        self._lost = np.zeros(n, dtype=bool)
+        self._episode = np.zeros(n, dtype=np.int64)
+        self._pending = np.zeros(n, dtype=bool)
+        self._seed = 0
+        self.returns = np.zeros(n)
+
+    def _draw(self, seed: int, ids: np.ndarray, k: int) -> dict:
+        """The vehicle rows, initial states, mission rows and environment of k episodes."""
+        pop = self.population
+        if pop is None:
+            vehicle, offsets, environment = self.nominal, np.zeros((k, 3)), None
+        else:
+            d = pop.draw(seed, ids, k, self.nominal)
+            vehicle, offsets, environment = d.vehicle, d.offsets, d.environment
+        missions = [random_circle(seed, int(i)) for i in ids] if self.random_mission else [self.mission]
+        if self.random_mission:
+            start = np.concatenate([m.reference(0.0) for m in missions])
+        else:                                                 # computed once: a reset is on the hot path
+            start = self._start_ref if hasattr(self, "_start_ref") else self.mission.reference(0.0)
+            self._start_ref = start
+        vp = vehicle.rows(k)
+        x0 = np.zeros((k, STATE_SIZE))                        # level, still, rotors at the hover thrust
+        x0[:, X:X + 3] = start[:, REF_X:REF_X + 3] + offsets  # on the reference, plus the drawn offset
+        x0[:, PSI] = start[:, REF_PSI]
+        x0[:, F1:F1 + 4] = (vp[:, P_M] * vp[:, P_G] / 4.0)[:, None]
+        vp_ctrl = self.nominal.rows(k) if pop is None or pop.model_error else vp
+        return {"vp": vp, "vp_ctrl": vp_ctrl, "x0": x0, "mp": stack_params(missions, n=k),
+                "environment": environment}
+
+    def _start(self, rows: np.ndarray) -> None:
+        """Start new episodes of the vehicles ``rows``, each from its own (seed, vehicle, episode) stream."""
+        k = rows.size
+        if not k:
+            return
+        ids = rows * EPISODE_STRIDE + self._episode[rows]
+        s = self.stepper
+        draw = self._draw(self._seed, ids, k)
+        s.vp[rows], s.vp_ctrl[rows], s.mp[rows] = draw["vp"], draw["vp_ctrl"], draw["mp"]
+        env = draw["environment"]
+        if env is not None:
+            s.disturbance_params[rows] = env.params(k)
+        s.reset(self._mask(rows), x0=draw["x0"], rng=vehicle_states(self._seed, k, ids) if s.drawn else None,
+                disturbance_memory=None if env is None else env.memory(k))
+        self._episode[rows] += 1
+        self.returns[rows] = 0.0
+
+    def _mask(self, rows: np.ndarray) -> np.ndarray:
+        mask = np.zeros(self.num_envs, dtype=bool)
+        mask[rows] = True
+        return mask
+
+    def _observe(self) -> None:
+        s = self.stepper
+        references(s.mission, s.time, s.mp, self._ref)
+        observe(s.state, self._ref, s.vp_ctrl, self.max_track_error, self._obs, self._reward, self._lost)
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        """Start every vehicle's episode again (``options={"reset_mask": mask}``: some of them).
+
+        Parameters
+        ----------
+        seed : int, optional
+            The seed of every draw from now on (episode counters restart at 0); a fresh one
+            from the operating system when None on the first reset.
+        options : dict, optional
+            ``reset_mask``: (N,) bool, the vehicles to reset.
+
+        Returns
+        -------
+        (numpy.ndarray, dict)
+            The observations (N, OBS_SIZE) and infos.
+        """
+        mask = None if not options else options.get("reset_mask")
+        if seed is not None or not hasattr(self, "_seeded"):
+            self._seed = int(np.random.SeedSequence().entropy % (2 ** 63)) if seed is None else int(seed)
+            if self._seed < 0:
+                raise InputError(f"seed must be >= 0, got {seed}")
+            self._seeded = True
+            self._episode[:] = 0
+        rows = np.arange(self.num_envs) if mask is None else np.flatnonzero(self.stepper.check_mask(mask))
+        self._start(rows)
+        self._pending[rows] = False
+        self._observe()
+        return self._obs.copy(), self._info()
+
+    def _info(self) -> dict:
+        s = self.stepper
+        return {"status": s.status.copy(), "t": s.time.copy(), "episode_return": self.returns.copy()}
+
+    def check_action(self, actions) -> np.ndarray:
+        """The actions as a (N, 4) float64 array, or one InputError line naming what is wrong.
+
+        Parameters
+        ----------
+        actions : array_like
+            (N, 4) normalised actions in [-1, 1].
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        InputError
+            Wrong shape, not a number, not finite, or outside [-1, 1] (the vehicle and entry named).
+        """
+        try:
+            a = np.asarray(actions, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError(f"action: expected numbers of shape ({self.num_envs}, 4), got {type(actions).__name__}"
+                             ) from None
+        if a.shape != (self.num_envs, 4):
+            raise InputError(f"action: expected shape ({self.num_envs}, 4), got {a.shape}")
+        bad = ~np.isfinite(a)
+        if bad.any():
+            i, j = np.argwhere(bad)[0]
+            raise InputError(f"action: vehicle {i}, entry {j} is {a[i, j]} (must be finite, in [-1, 1])")
+        out = np.abs(a) > 1.0
+        if out.any():
+            i, j = np.argwhere(out)[0]
+            raise InputError(f"action: vehicle {i}, entry {j} is {a[i, j]:.6g}, outside the action space [-1, 1] "
+                             f"(mode '{self.action_mode}')")
+        return a
+
+    def step(self, actions):
+        """Fly every vehicle one period with its action; reset those whose episode ended at
+        the previous step (their actions are ignored: gymnasium's NEXT_STEP autoreset).
+
+        Parameters
+        ----------
+        actions : array_like or None
+            (N, 4) normalised actions; None when the environment flies a baseline controller.
+
+        Returns
+        -------
+        (obs, reward, terminated, truncated, info)
+            Arrays over the N vehicles; ``info["status"]`` the engine's statuses.
+        """
+        s = self.stepper
+        if self.baseline is None:
+            a = self.check_action(actions)
+            s.step(a)
+        else:
+            if actions is not None:
+                raise InputError("action: this environment flies a baseline controller; step(None)")
+            s.step()
+        pending = np.flatnonzero(self._pending)
+        self._observe()
+        lost = self._lost & (s.status == int(ExitStatus.FINISHED))
+        if lost.any():
+            s.status[lost] = int(ExitStatus.LOST_TRACK)
+            s.t_stop[lost] = s.time[lost]
+        terminated = s.status != int(ExitStatus.FINISHED)
+        truncated = ~terminated & (s.period >= s.t_grid.shape[0] - 1)
+        reward = np.where(terminated, 0.0, self._reward)
+        reward[pending] = 0.0
+        terminated[pending] = truncated[pending] = False
+        self.returns += reward
+        info = self._info()
+        if pending.size:
+            self._start(pending)
+            self._observe()
+        self._pending = terminated | truncated
+        return self._obs.copy(), reward, terminated, truncated, info
+
+
+class QuadEnv(gymnasium.Env):
+    """One quadrotor (``gymnasium.make``): a :class:`QuadVectorEnv` of one vehicle, without autoreset.
+
+    Parameters
+    ----------
+    **kwargs : Any
+        As :class:`QuadVectorEnv` (not ``num_envs``).
+    """
+
+    metadata: ClassVar[dict] = {"render_modes": []}
+
+    def __init__(self, **kwargs: Any) -> None:
+        self.vec = QuadVectorEnv(1, **kwargs)
+        self.action_space = self.vec.single_action_space
+        self.observation_space = self.vec.single_observation_space
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        """Start an episode (see :meth:`QuadVectorEnv.reset`).
+
+        Parameters
+        ----------
+        seed : int, optional
+            The seed of every draw from now on.
+        options : dict, optional
+            Not used.
+
+        Returns
+        -------
+        (numpy.ndarray, dict)
+        """
+        super().reset(seed=seed)
+        obs, info = self.vec.reset(seed=seed)
+        return obs[0], {k: v[0] for k, v in info.items()}
+
+    def step(self, action):
+        """One period (see :meth:`QuadVectorEnv.step`).
+
+        Parameters
+        ----------
+        action : array_like
+            (4,) normalised action.
+
+        Returns
+        -------
+        (obs, reward, terminated, truncated, info)
+        """
+        a = None if action is None else np.asarray(action)
+        if a is not None and a.shape != (4,):
+            raise InputError(f"action: expected shape (4,), got {a.shape}")
+        self.vec._pending[:] = False        # no autoreset: the user resets
+        obs, r, term, trunc, info = self.vec.step(None if a is None else a[None, :])
+        return obs[0], float(r[0]), bool(term[0]), bool(trunc[0]), {k: v[0] for k, v in info.items()}
+
+
+__all__ = ["DEFAULT_LIMITS", "EPISODE_STRIDE", "QuadEnv", "QuadVectorEnv", "random_circle"]

@@ -1,0 +1,100 @@
+"""The compiled per-step work of the environments: references, observations, rewards and
+the tracking check of N vehicles in one call (no Python loop over vehicles).
+
+Observation of a vehicle (:data:`OBS_NAMES`, float32), body frame = the paper's ZYX Euler
+rotation R (z up); ``R^T v`` is an earth-frame vector v seen in the body frame:
+
+- 0-2: position error R^T (p - p_ref) [m];
+- 3-5: velocity error R^T (v - v_ref) [m/s];
+- 6-8: the earth's up axis in the body frame, R^T e_z (roll and pitch) [-];
+- 9-10: sin and cos of the yaw error psi - psi_ref [-];
+- 11-13: body rates p, q, r [rad/s];
+- 14-16: the reference acceleration R^T a_ref [m/s^2];
+- 17-20: rotor thrusts over the hover thrust, minus 1: F_i / (m g / 4) - 1 [-].
+
+Reward of a period: ``exp(-|p - p_ref| / 0.5 m - 0.05 |omega| / (1 rad/s))``, in (0, 1]: 1 on
+the reference without rotating, 1/e at 0.5 m off; so a vehicle earns more by flying on
+(a terminated episode earns nothing after its end).
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from quadcruise.control.so3 import rotation_zyx
+from quadcruise.layout import F1, P_G, P_M, PHI, PSI, REF_AX, REF_PSI, REF_SIZE, REF_VX, REF_X, THETA, VX, P, X
+
+OBS_NAMES = ("ex_b", "ey_b", "ez_b", "evx_b", "evy_b", "evz_b", "up_x", "up_y", "up_z", "sin_epsi", "cos_epsi",
+             "p", "q", "r", "ax_ref_b", "ay_ref_b", "az_ref_b", "f1_rel", "f2_rel", "f3_rel", "f4_rel")
+OBS_SIZE = len(OBS_NAMES)
+REWARD_DISTANCE = 0.5
+"""[m]: the reward falls by 1/e per this distance from the reference."""
+REWARD_RATE = 0.05
+"""[1/(rad/s)]: and by exp(-0.05) per rad/s of body rate."""
+
+
+@njit(cache=True)
+def references(mission, t, mp, ref):
+    """The mission's reference of every vehicle at its own time.
+
+    Parameters
+    ----------
+    mission : compiled function with ``MISSION_SIG``
+    t : numpy.ndarray
+        (N,) each vehicle's time [s].
+    mp : numpy.ndarray
+        (N, Mp) mission parameter rows.
+    ref : numpy.ndarray
+        (N, REF_SIZE) output.
+    """
+    for i in range(t.shape[0]):
+        mission(t[i], mp[i], ref[i])
+
+
+@njit(cache=True)
+def observe(x, ref, vp, bound, obs, reward, lost):
+    """Observations, rewards and the tracking check of N vehicles (the module docstring's layout).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        (N, 16) true states.
+    ref : numpy.ndarray
+        (N, REF_SIZE) references at the vehicles' times.
+    vp : numpy.ndarray
+        (N, PARAM_SIZE) the vehicle parameter rows the observation scales rotor thrusts by.
+    bound : float
+        Tracking bound [m]: a position error beyond it sets ``lost``.
+    obs : numpy.ndarray
+        (N, OBS_SIZE) float32 output.
+    reward : numpy.ndarray
+        (N,) float64 output.
+    lost : numpy.ndarray
+        (N,) bool output.
+    """
+    for i in range(x.shape[0]):
+        Rm = rotation_zyx(x[i, PHI], x[i, THETA], x[i, PSI])
+        ex, ey, ez = x[i, X] - ref[i, REF_X], x[i, X + 1] - ref[i, REF_X + 1], x[i, X + 2] - ref[i, REF_X + 2]
+        ux, uy, uz = (x[i, VX] - ref[i, REF_VX], x[i, VX + 1] - ref[i, REF_VX + 1],
+                      x[i, VX + 2] - ref[i, REF_VX + 2])
+        ax, ay, az = ref[i, REF_AX], ref[i, REF_AX + 1], ref[i, REF_AX + 2]
+        for j in range(3):
+            obs[i, j] = Rm[0][j] * ex + Rm[1][j] * ey + Rm[2][j] * ez
+            obs[i, 3 + j] = Rm[0][j] * ux + Rm[1][j] * uy + Rm[2][j] * uz
+            obs[i, 6 + j] = Rm[2][j]
+            obs[i, 14 + j] = Rm[0][j] * ax + Rm[1][j] * ay + Rm[2][j] * az
+            obs[i, 11 + j] = x[i, P + j]
+        e_psi = x[i, PSI] - ref[i, REF_PSI]
+        obs[i, 9], obs[i, 10] = math.sin(e_psi), math.cos(e_psi)
+        hover = vp[i, P_M] * vp[i, P_G] / 4.0
+        for j in range(4):
+            obs[i, 17 + j] = x[i, F1 + j] / hover - 1.0
+        dist = math.sqrt(ex * ex + ey * ey + ez * ez)
+        rate = math.sqrt(x[i, P] ** 2 + x[i, P + 1] ** 2 + x[i, P + 2] ** 2)
+        reward[i] = math.exp(-dist / REWARD_DISTANCE - REWARD_RATE * rate) if math.isfinite(dist + rate) else 0.0
+        lost[i] = not dist <= bound
+
+
+__all__ = ["OBS_NAMES", "OBS_SIZE", "REF_SIZE", "REWARD_DISTANCE", "REWARD_RATE", "observe", "references"]

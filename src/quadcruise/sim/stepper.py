@@ -1,0 +1,281 @@
+"""A step-wise engine: N vehicles advanced a few control periods per call, through the same
+compiled kernel as a whole flight.
+
+:class:`Stepper` holds everything a vehicle carries from one period to the next (its state,
+its controller's and disturbance's memories, its random stream, the sensor-delay ring
+buffer, its period on the time grid, its saturation times and status) and hands it to
+:func:`quadcruise.sim.engine.fly_vehicles` for ``periods`` periods per :meth:`Stepper.step`.
+The kernel reads all of it at the start of a call and writes it back at the end, so a flight
+cut into steps is bit for bit the flight :func:`~quadcruise.sim.engine.simulate` flies in one
+call. Each vehicle keeps its own period: after :meth:`Stepper.reset` of some of them, they
+start their grid again while the others fly on.
+
+A policy reaches the plant through the controller too: a controller that reads its setpoint
+from the first ``setpoint_width`` entries of its gains row (the action modes of
+:mod:`quadcruise.gym`) is given that setpoint by ``step(commands)``.
+
+Examples
+--------
+>>> import numpy as np
+>>> from quadcruise.workflows.stepwise import stepper
+>>> s = stepper("hover", "nlpd", duration=0.01, n=2)
+>>> s.step(); s.period.tolist(), s.status.tolist()
+([1, 1], [0, 0])
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba.core.dispatcher import Dispatcher
+from numba.core.types.function_type import CompileResultWAP
+
+from quadcruise.errors import InputError
+from quadcruise.layout import CMD_SIZE, CONTROLLER_SIG, DISTURBANCE_SIG, MISSION_SIG, REF_SIZE, STATE_SIZE
+from quadcruise.sim.engine import Limits, batch_inputs, fly_vehicles, fresh_carry, still_air
+from quadcruise.sim.rng import vehicle_states
+from quadcruise.sim.status import ExitStatus
+
+STEP_PIECES_PER_THREAD = 1
+"""A step is short: one range of vehicles per thread, as each kernel call has a fixed cost."""
+
+
+def compiled_address(function, signature):
+    """A compiled function as the kernel takes it, its address looked up once.
+
+    numba hands a jit function (a ``Dispatcher``) to the kernel by looking up its compiled
+    code at every call, a fixed cost of about 0.1-0.4 ms per function that a whole flight
+    never notices but a step of a few microseconds per vehicle does. A
+    ``CompileResultWAP`` holds the address instead (the same machine code, called through
+    its C wrapper; the flight is bit for bit the same, tests/integration/test_stepper.py).
+
+    Parameters
+    ----------
+    function : numba Dispatcher, cfunc or wrapper-address object
+        The controller, mission or disturbance.
+    signature : numba signature
+        Its signature (``CONTROLLER_SIG``, ``MISSION_SIG``, ``DISTURBANCE_SIG``).
+
+    Returns
+    -------
+    object
+        A ``CompileResultWAP`` for a jit function; anything else as given.
+    """
+    if isinstance(function, Dispatcher):
+        return CompileResultWAP(function.get_compile_result(signature))
+    return function
+
+
+class Stepper:
+    """N vehicles flown a few control periods per call (the arguments as in
+    :func:`quadcruise.sim.engine.simulate`).
+
+    Parameters
+    ----------
+    t_grid : (M+1,) array
+        Control instants [s] shared by the vehicles; each vehicle has its own place on it.
+    x0 : (16,) or (N, 16) array
+        Initial states, restored by :meth:`reset`.
+    vp : (N, PARAM_SIZE) array
+        Vehicle parameter rows.
+    controller : compiled function with ``CONTROLLER_SIG``
+    gains : (G,) or (N, G) array
+        The controller's parameters; :attr:`gains` may be written between steps.
+    mission : compiled function with ``MISSION_SIG``
+    mp : (Mp,) or (N, Mp) array
+        The mission's parameters.
+    memory, vp_ctrl, disturbance, disturbance_params, disturbance_memory : optional
+        As in :func:`~quadcruise.sim.engine.simulate`; the memories are restored by :meth:`reset`.
+    seed, first_vehicle : int
+        Vehicle i's random stream is seeded from (seed, first_vehicle + i), as in a flight.
+    sensor_std : (16,) or (N, 16) array, optional
+    sensor_delay : int
+        The controller sees the state this many control periods late.
+    full_dynamics : bool
+    max_step : float
+        Longest RK4 substep [s].
+    limits : Limits, optional
+    periods : int
+        Control periods flown per :meth:`step`.
+    setpoint_width : int
+        Number of leading gains entries that ``step(commands)`` writes (0: the controller
+        flies alone, and ``step`` takes no commands).
+    """
+
+    def __init__(self, t_grid, x0, vp, controller, gains, mission, mp, *, memory=None, vp_ctrl=None,
+                 disturbance=None, disturbance_params=None, disturbance_memory=None, seed: int = 0,
+                 first_vehicle=0, sensor_std=None, sensor_delay: int = 0, full_dynamics: bool = False,
+                 max_step: float = 1e-3, limits: Limits | None = None, periods: int = 1,
+                 setpoint_width: int = 0) -> None:
+        inp = batch_inputs(t_grid, x0, vp, gains, mp, memory=memory, vp_ctrl=vp_ctrl, disturbance=disturbance,
+                           disturbance_params=disturbance_params, disturbance_memory=disturbance_memory,
+                           seed=seed, first_vehicle=first_vehicle, sensor_std=sensor_std,
+                           sensor_delay=sensor_delay, max_step=max_step)
+        if int(periods) != periods or periods < 1:
+            raise InputError(f"periods must be a whole number >= 1, got {periods!r}")
+        self.n = n = inp["n"]
+        if not (0 <= int(setpoint_width) <= inp["gains"].shape[1]):
+            raise InputError(f"setpoint_width must be in 0..{inp['gains'].shape[1]} (the gains' width), "
+                             f"got {setpoint_width!r}")
+        self.t_grid = inp["t_grid"]
+        self.periods, self.setpoint_width = int(periods), int(setpoint_width)
+        self.sensor_delay = int(sensor_delay)
+        self.drawn = inp["drawn"]
+        self.seed = int(seed)
+        self.first_vehicle = (np.arange(n) + int(first_vehicle) if np.ndim(first_vehicle) == 0
+                              else np.asarray(first_vehicle, dtype=np.int64).ravel().copy())
+        self.vp, self.vp_ctrl, self.mp = inp["vp"], inp["vp_ctrl"], inp["mp"]
+        self.gains = inp["gains"]
+        self.disturbance_params = inp["disturbance_params"]
+        self.sensor_std = inp["sensor_std"]
+        self._x0, self._mem0, self._dmem0 = inp["x0"], inp["memory"], inp["disturbance_memory"]
+        self.state = self._x0.copy()
+        self.memory = self._mem0.copy()
+        self.disturbance_memory = self._dmem0.copy()
+        self.rng = inp["rng"]
+        self.clock = np.zeros((n, 2), dtype=np.int64)
+        self.carry = fresh_carry(self._x0, self.sensor_delay)
+        self.saturated = np.zeros((n, 2))
+        self.status = np.zeros(n, dtype=np.int64)
+        self.t_stop = np.full(n, np.nan)
+        rows = self.periods + 1
+        self.log_x = np.empty((n, rows, STATE_SIZE))
+        self.log_cmd = np.empty((n, rows, CMD_SIZE))
+        self.log_ref = np.empty((n, rows, REF_SIZE))
+        self.controller, self.mission = compiled_address(controller, CONTROLLER_SIG), compiled_address(mission, MISSION_SIG)
+        self.disturbance = compiled_address(disturbance or still_air, DISTURBANCE_SIG)
+        self.disturbed = disturbance is not None
+        self.full_dynamics, self.max_step = bool(full_dynamics), float(max_step)
+        self.limits = (limits or Limits()).array()
+
+    @property
+    def period(self) -> np.ndarray:
+        """(N,) each vehicle's control period index on the grid (0 at a reset)."""
+        return self.clock[:, 0]
+
+    @property
+    def time(self) -> np.ndarray:
+        """(N,) each vehicle's time on the grid [s]."""
+        return self.t_grid[self.clock[:, 0]]
+
+    @property
+    def done(self) -> np.ndarray:
+        """(N,) bool: the vehicle stopped (its status is not FINISHED) or flew its whole grid."""
+        return (self.status != int(ExitStatus.FINISHED)) | (self.clock[:, 0] >= self.t_grid.shape[0] - 1)
+
+    def reset(self, mask=None, *, x0=None, rng=None, seed: int | None = None, disturbance_memory=None) -> None:
+        """Start some vehicles (or all) again at the grid's first instant.
+
+        Parameters
+        ----------
+        mask : (N,) bool array, optional
+            The vehicles to reset; all by default. The others are not touched.
+        x0 : (16,) or (K, 16) array, optional
+            Their new initial states (K the vehicles in ``mask``); the constructor's by default.
+        rng : (K, 1) uint64 array, optional
+            Their new random generator states (:mod:`quadcruise.sim.rng`).
+        seed : int, optional
+            Without ``rng``: draw their streams from (seed, first_vehicle + i) again; the
+            constructor's seed by default.
+        disturbance_memory : (K, D) array, optional
+            Their disturbance's initial memory (kept for later resets); the constructor's by default.
+
+        Raises
+        ------
+        InputError
+            A mask or an array of the wrong shape, a non-finite x0.
+        """
+        rows = np.arange(self.n) if mask is None else np.flatnonzero(self.check_mask(mask))
+        k = rows.size
+        if not k:
+            return
+        if x0 is None:
+            start = self._x0[rows]
+        else:
+            start = np.asarray(x0, dtype=float)
+            start = np.broadcast_to(start, (k, STATE_SIZE)) if start.shape in ((STATE_SIZE,), (1, STATE_SIZE)) \
+                else start
+            if start.shape != (k, STATE_SIZE) or not np.isfinite(start).all():
+                raise InputError(f"reset: x0 must be finite and of shape (16,) or ({k}, 16), got {np.shape(x0)}")
+        if disturbance_memory is not None:
+            dmem = np.asarray(disturbance_memory, dtype=float)
+            if dmem.shape != (k, self._dmem0.shape[1]):
+                raise InputError(f"reset: disturbance_memory must have shape ({k}, {self._dmem0.shape[1]}), "
+                                 f"got {dmem.shape}")
+            self._dmem0[rows] = dmem
+        self.state[rows] = start
+        self.memory[rows] = self._mem0[rows]
+        self.disturbance_memory[rows] = self._dmem0[rows]
+        if rng is not None:
+            rng = np.asarray(rng)
+            if rng.shape != (k, 1) or rng.dtype != np.uint64:
+                raise InputError(f"reset: rng must be a ({k}, 1) uint64 array, got {rng.shape} {rng.dtype}")
+            self.rng[rows] = rng
+        elif self.drawn:
+            self.rng[rows] = vehicle_states(self.seed if seed is None else seed, k, self.first_vehicle[rows])
+        self.clock[rows] = 0
+        self.carry[rows] = fresh_carry(np.ascontiguousarray(start), self.sensor_delay)
+        self.saturated[rows] = 0.0
+        self.status[rows] = int(ExitStatus.FINISHED)
+        self.t_stop[rows] = np.nan
+
+    def check_mask(self, mask) -> np.ndarray:
+        """The mask as an (N,) bool array, or one InputError line.
+
+        Parameters
+        ----------
+        mask : array_like
+            (N,) bool.
+
+        Returns
+        -------
+        numpy.ndarray
+
+        Raises
+        ------
+        InputError
+            Not an (N,) bool array.
+        """
+        mask = np.asarray(mask)
+        if mask.shape != (self.n,) or mask.dtype != bool:
+            raise InputError(f"reset: mask must be a ({self.n},) bool array, got {mask.shape} {mask.dtype}")
+        return mask
+
+    def step(self, commands=None) -> None:
+        """Fly every vehicle that is not :attr:`done` on for :attr:`periods` control periods.
+
+        Parameters
+        ----------
+        commands : (N, setpoint_width) array, optional
+            Written into the first ``setpoint_width`` entries of each vehicle's gains row
+            before the step (the setpoint a policy gives its action-mode controller).
+
+        Raises
+        ------
+        InputError
+            Commands of the wrong shape or not finite, or commands to a stepper without setpoints.
+
+        Notes
+        -----
+        After the step, :attr:`log_x`, :attr:`log_cmd`, :attr:`log_ref` hold, from row 0, the
+        state, command and reference at each instant flown (NaN in the rows not flown), and
+        :attr:`state` the state reached.
+        """
+        if commands is not None:
+            if not self.setpoint_width:
+                raise InputError("step: this stepper's controller takes no commands (setpoint_width is 0)")
+            c = np.asarray(commands, dtype=float)
+            if c.shape != (self.n, self.setpoint_width):
+                raise InputError(f"step: commands must have shape ({self.n}, {self.setpoint_width}), got {c.shape}")
+            if not np.isfinite(c).all():
+                raise InputError("step: commands must be finite (row "
+                                 f"{int(np.flatnonzero(~np.isfinite(c).all(axis=1))[0])} is not)")
+            self.gains[:, :self.setpoint_width] = c
+        fly_vehicles(self.n, (self.t_grid, self.state, self.vp, self.vp_ctrl, self.controller, self.gains,
+                              self.memory, self.mission, self.mp, self.disturbance, self.disturbed,
+                              self.disturbance_params, self.disturbance_memory, self.rng, self.sensor_std,
+                              self.sensor_delay, self.full_dynamics, self.max_step, 1, self.limits,
+                              self.periods, self.clock, self.carry, self.log_x, self.log_cmd, self.log_ref,
+                              self.state, self.status, self.t_stop, self.saturated), STEP_PIECES_PER_THREAD)
+
+
+__all__ = ["Stepper"]
