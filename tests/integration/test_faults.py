@@ -31,7 +31,7 @@ from quadcruise.cli.main import main
 from quadcruise.cli.montecarlo import montecarlo_command
 from quadcruise.errors import InputError, WriteError
 from quadcruise.io.files import MARKER, atomic_dir, atomic_path
-from quadcruise.montecarlo import montecarlo
+from quadcruise.montecarlo import Population, montecarlo
 
 SRC = str(Path(quadcruise.__file__).resolve().parents[1])      # this tree's code, in every subprocess
 PWM = Path(__file__).resolve().parents[2] / "examples" / "pwm_step.csv"
@@ -59,7 +59,7 @@ def files_under(folder: Path) -> list[str]:
 
 
 def sweep(out=None, **kw):
-    return montecarlo("circle", "nlpd", None, N, out=out, **{**SWEEP, **kw})
+    return montecarlo("circle", "nlpd", Population(mass_spread=0.1), N, out=out, **{**SWEEP, **kw})
 
 
 @pytest.fixture(scope="module")
@@ -123,7 +123,8 @@ def test_a_full_disk_is_one_line_exit_74_and_leaves_nothing(small_disk, tmp_path
 def test_a_sweep_on_a_full_disk_keeps_its_chunks_and_resumes_to_the_same_bytes(small_disk, reference, tmp_path):
     _, ref_out = reference
     disk = small_disk(60)                            # the marker and two chunks of 24 kB fit, not a third
-    args = ["montecarlo", "--mission", "circle", "-n", N, "--seed", 3, "--duration", 2, "--chunk-size", 10,
+    args = ["montecarlo", "--mission", "circle", "-n", N, "--seed", 3, "--mass-spread", 0.1, "--duration", 2,
+            "--chunk-size", 10,
             "--scheduler", "none", "--out", disk / "mc", "--quiet"]
     proc = quadcruise_cli(*args, cwd=tmp_path)
     assert proc.returncode == 74
@@ -277,7 +278,7 @@ def test_a_stopped_sweep_ends_its_workers_says_one_line_and_resumes_to_the_same_
                                                                                      status, word):
     psutil = pytest.importorskip("psutil")
     n = 2000
-    options = ["--mission", "circle", "-n", n, "--seed", 5, "--duration", 1, "--chunk-size", 10]
+    options = ["--mission", "circle", "-n", n, "--seed", 5, "--mass-spread", 0.1, "--duration", 1, "--chunk-size", 10]
     args = ["montecarlo", *options, "--scheduler", "local", "--workers", 2, "--out", "mc", "--quiet"]
     env = {**os.environ, "PYTHONPATH": SRC, "QUADCRUISE_PROGRESS": "0"}
     proc = subprocess.Popen([sys.executable, "-m", "quadcruise", *map(str, args)], cwd=tmp_path, env=env,
@@ -306,7 +307,7 @@ def test_a_stopped_sweep_ends_its_workers_says_one_line_and_resumes_to_the_same_
     again = quadcruise_cli(*args, cwd=tmp_path)
     assert again.returncode == 0 and again.stderr == "", again.stderr
     assert f"({len(kept) * 10:,} resumed)" in again.stdout
-    montecarlo_command(mission="circle", n=n, seed=5, duration=1.0, chunk_size=10, scheduler="none",
+    montecarlo_command(mission="circle", n=n, seed=5, mass_spread=0.1, duration=1.0, chunk_size=10, scheduler="none",
                        out=str(tmp_path / "ref"), quiet=True, echo=lambda text: None)       # untroubled, in one go
     same_sweep(tmp_path / "mc", tmp_path / "ref")
 
@@ -347,7 +348,7 @@ def test_a_damaged_marker_is_one_line_exit_2_on_the_command_line(reference, tmp_
     shutil.copytree(ref_out, tmp_path / "mc")
     (tmp_path / "mc" / MARKER).write_bytes(b"\0" * 100)
     for args in (["fly", "hover", "--duration", "0.2", "--out", "mc"],
-                 ["montecarlo", "-n", 4, "--duration", 1, "--scheduler", "none", "--out", "mc"]):
+                 ["montecarlo", "-n", 4, "--mass-spread", 0.1, "--duration", 1, "--scheduler", "none", "--out", "mc"]):
         proc = quadcruise_cli(*args, cwd=tmp_path)
         assert proc.returncode == 2
         assert one_line(proc.stderr).startswith("error: mc/quadcruise.json: damaged (NUL bytes)")

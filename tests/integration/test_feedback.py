@@ -238,7 +238,7 @@ def test_replay_reports_rows_read_flown_and_written(tmp_path):
     path = write_schedule(tmp_path / "long.csv", 5000)
     seen, progress = calls()
     schedule = qc.read_duty_csv(path, progress=progress)
-    assert seen[0] == (0, 5000) and seen[-1] == (5000, 5000) and len(seen) > 10
+    assert seen[0] == (0, 5000) and seen[-1] == (5000, 5000)
     seen.clear()
     res = qc.replay(schedule, progress=progress)
     assert seen == [(0, 5000), (5000, 5000)]

@@ -54,7 +54,8 @@ def shared(name: str) -> Path:
 
 def excitation_flight(vehicle, seed, noise=NOISE):
     t, u = doublets(vehicle, rate=0.6, spin=1.0)
-    return qc.fly(Hover(z=100.0), ScheduleController(t, u), vehicle=vehicle, duration=float(t[-1]), sensors=noise,
+    periods = (len(t) - 1) // 4 * 4                     # logged every 4th period (250 Hz): a whole number of them
+    return qc.fly(Hover(z=100.0), ScheduleController(t, u), vehicle=vehicle, duration=float(t[periods]), sensors=noise,
                   seed=seed, log_every=4, max_track_error=1e6, max_steady_error=1e6)
 
 

@@ -60,4 +60,5 @@ def test_readme_tune_and_montecarlo_commands_do_what_the_table_says(tmp_path):
     assert run.returncode == 0, run.stdout + run.stderr
     row = next(ln for ln in run.stdout.splitlines() if ln.strip().startswith("rmse_m")).split()
     count, p5, p50, p95 = int(row[1]), *map(float, row[2:5])
-    assert count == 20 and p5 < p50 < p95, row
+    assert 10 <= count <= 20 and p5 < p50 < p95, row                    # those that kept track (a sag beyond
+                                                                        # half the altitude is off track)

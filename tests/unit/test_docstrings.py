@@ -56,8 +56,8 @@ def public_names(module: str) -> list[str]:
                     continue
                 if callable(member) or isinstance(member, (property, classmethod, staticmethod)):
                     out.append(f"{module}.{name}.{attr}")
-        elif callable(obj) and (inspect.isfunction(getattr(obj, "py_func", obj))):
-            out.append(f"{module}.{name}")
+        elif inspect.isfunction(getattr(obj, "py_func", obj)) and getattr(obj, "__name__", name) == name:
+            out.append(f"{module}.{name}")          # a function defined under this name (not a constant made by one)
     return out
 
 

@@ -145,7 +145,8 @@ def as_controller(obj: Any, where: str = "fly()") -> ControllerLike:
 
 def compiled_for_engine(function: Any) -> bool:
     """Whether ``function`` is a numba-compiled function the engine can call: a dispatcher
-    holding a compiled :data:`~quadcruise.layout.CONTROLLER_SIG` (or a compiled function type).
+    holding a compiled :data:`~quadcruise.layout.CONTROLLER_SIG`, or one that compiles for it
+    (an ``@njit`` without a signature, compiled here), or a compiled function type.
 
     Parameters
     ----------
@@ -166,7 +167,13 @@ def compiled_for_engine(function: Any) -> bool:
 
     signatures = getattr(function, "signatures", None)
     if signatures is not None and hasattr(function, "py_func"):
-        return tuple(CONTROLLER_SIG.args) in [tuple(sig) for sig in signatures]
+        if tuple(CONTROLLER_SIG.args) in [tuple(sig) for sig in signatures]:
+            return True
+        try:                            # an @njit without a signature compiles on first use: do it now
+            function.compile(CONTROLLER_SIG)
+        except Exception:               # noqa: BLE001 - numba's typing errors: it cannot take the signature
+            return False
+        return True
     return hasattr(function, "_numba_type_") or hasattr(function, "address")    # a cfunc or a wrapped pointer
 
 

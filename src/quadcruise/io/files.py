@@ -397,8 +397,8 @@ def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optiona
         ``blank_ok(column, row_index) -> bool``: whether a blank cell is allowed (it then
         reads as NaN); without it every blank cell is an error.
     progress : callable, optional
-        ``progress(done, total)``: the data rows read into numbers, about every hundredth
-        of them, once the file's lines are split (from 0 to the number of rows).
+        ``progress(done, total)``: the data rows read into numbers, from 0 to the number of
+        rows (about every hundredth of them when the file is read cell by cell).
 
     Returns
     -------
@@ -437,6 +437,7 @@ def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optiona
     fast = _read_at_once(path, required, optional, blank_ok)
     if fast is not None:
         if progress is not None:
+            progress(0, fast[2].shape[0])
             progress(fast[2].shape[0], fast[2].shape[0])
         return fast
     try:

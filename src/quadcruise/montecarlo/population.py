@@ -167,12 +167,11 @@ class Population:
 
         Examples
         --------
-        >>> Population().check_perturbs(3)
-        Traceback (most recent call last):
-            ...
-        quadcruise.errors.InputError: the population perturbs nothing: its 3 vehicles would fly the same flight; \
-give a spread (--mass-spread 0.1, --inertia-spread, --thrust-spread, --bandwidth-spread, --yaw-arm-spread), \
-a start --offset, a --wind-spread, turbulence (--turbulence moderate) or sensor --noise
+        >>> try:
+        ...     Population().check_perturbs(3)
+        ... except InputError as exc:
+        ...     print(str(exc).split(";")[0])
+        the population perturbs nothing: its 3 vehicles would fly the same flight
         """
         hint = hint or ("a spread (--mass-spread 0.1, --inertia-spread, --thrust-spread, --bandwidth-spread, "
                         "--yaw-arm-spread), a start --offset, a --wind-spread, turbulence (--turbulence moderate) "
