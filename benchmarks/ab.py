@@ -51,7 +51,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 HZ = 1000.0
 CLOCKS = {"wall": "wall clock", "cpu": "CPU time (all threads)"}
-FIGURES = {            # name: (vehicles, flight seconds, timed calls per process)
+FIGURES = {  # name: (vehicles, flight seconds, timed calls per process)
     "single": (1, 60.0, 20),
     "batch": (2000, 10.0, 2),
     "mc": (136, 60.0, 2),
@@ -71,9 +71,9 @@ def figure_call(name: str, duration: float | None = None):
 
     n, full, _ = FIGURES[name]
     duration = duration or full
-    if name in ("single", "batch"):              # Table I's mass, spread +/- 10 % over a batch
+    if name in ("single", "batch"):  # Table I's mass, spread +/- 10 % over a batch
         vehicle = qc.Vehicle(m=3.499 * np.linspace(0.9, 1.1, n)) if n > 1 else None
-        every = math.gcd(1000, round(duration * HZ))     # log_every must divide the periods (0.1 s warm-up: 100)
+        every = math.gcd(1000, round(duration * HZ))  # log_every must divide the periods (0.1 s warm-up: 100)
         return lambda: qc.fly("circle", "nlpd", vehicle=vehicle, duration=duration, dt=1.0 / HZ, log_every=every)
     # the Monte Carlo benchmark's population (benchmarks/, this script's folder, is on sys.path)
     from montecarlo import make_spec
@@ -92,6 +92,7 @@ def figure_call(name: str, duration: float | None = None):
             return run_chunk(spec, 0, n, threads=1)
         finally:
             numba.set_num_threads(threads)
+
     return one_task
 
 
@@ -101,7 +102,7 @@ def child(names: list[str], tree: str, warm: bool) -> dict:
     where = Path(quadcruise.__file__).resolve()
     if Path(tree).resolve() / "src" not in where.parents:
         raise SystemExit(f"imported quadcruise from {where}, not from {tree}")
-    for name in names:                          # untimed, 0.1 s flights: the compiled code loads
+    for name in names:  # untimed, 0.1 s flights: the compiled code loads
         figure_call(name, 0.1)()
     out: dict = {"file": str(where), "wall": {}, "cpu": {}}
     if warm:
@@ -124,13 +125,18 @@ def side_tree(spec: str, trees: Path) -> Path:
     path = Path(spec).expanduser()
     if (path / "src" / "quadcruise").is_dir():
         return path.resolve()
-    sha = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--verify", f"{spec}^{{commit}}"],
-                         capture_output=True, text=True, check=True).stdout.strip()
+    sha = subprocess.run(
+        ["git", "-C", str(ROOT), "rev-parse", "--verify", f"{spec}^{{commit}}"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.strip()
     tree = trees / sha[:12]
     if not (tree / "src" / "quadcruise").is_dir():
         tree.mkdir(parents=True, exist_ok=True)
-        archive = subprocess.run(["git", "-C", str(ROOT), "archive", sha, "src", "benchmarks"],
-                                 capture_output=True, check=True).stdout
+        archive = subprocess.run(
+            ["git", "-C", str(ROOT), "archive", sha, "src", "benchmarks"], capture_output=True, check=True
+        ).stdout
         subprocess.run(["tar", "-x", "-C", str(tree)], input=archive, check=True)
     return tree
 
@@ -161,7 +167,7 @@ def cpu_ticks() -> tuple[int, int]:
             v = [int(x) for x in f.readline().split()[1:9]]
     except OSError:
         return 0, 0
-    return sum(v), sum(v) - v[3] - v[4]              # less idle and iowait
+    return sum(v), sum(v) - v[3] - v[4]  # less idle and iowait
 
 
 def busy_fraction(seconds: float = 2.0) -> float:
@@ -192,10 +198,18 @@ def main(argv=None) -> int:
     ap.add_argument("b", nargs="?", help="side B: the same")
     ap.add_argument("--rounds", type=int, default=5, help="processes per side (5)")
     ap.add_argument("--figures", default="single,batch", help=f"comma-separated, of {', '.join(FIGURES)}")
-    ap.add_argument("--trees", type=Path, default=Path(tempfile.gettempdir()) / "quadcruise-ab",
-                    help="where git revisions are exported")
-    ap.add_argument("--busy", type=float, default=0.25,
-                    help="start a process when less than this fraction of the CPU time is busy (0.25)")
+    ap.add_argument(
+        "--trees",
+        type=Path,
+        default=Path(tempfile.gettempdir()) / "quadcruise-ab",
+        help="where git revisions are exported",
+    )
+    ap.add_argument(
+        "--busy",
+        type=float,
+        default=0.25,
+        help="start a process when less than this fraction of the CPU time is busy (0.25)",
+    )
     ap.add_argument("--wait", type=float, default=30.0, help="the longest wait for that, in seconds (30)")
     ap.add_argument("--redo", type=int, default=0, help="runs again of a process that met a busy host (0)")
     ap.add_argument("--json", type=Path, help="also write the times and the summary as JSON")
@@ -213,9 +227,12 @@ def main(argv=None) -> int:
     if unknown:
         ap.error(f"unknown figure(s) {', '.join(unknown)}; choose from {', '.join(FIGURES)}")
     sides = {"A": side_tree(args.a, args.trees), "B": side_tree(args.b, args.trees)}
-    print(f"A = {args.a} ({sides['A']})\nB = {args.b} ({sides['B']})\n"
-          f"{time.strftime('%Y-%m-%d %H:%M')}, {os.cpu_count()} cores, load {os.getloadavg()[0]:.2f}; "
-          f"{args.rounds} rounds of {', '.join(f'{n} x{FIGURES[n][2]}' for n in names)}", flush=True)
+    print(
+        f"A = {args.a} ({sides['A']})\nB = {args.b} ({sides['B']})\n"
+        f"{time.strftime('%Y-%m-%d %H:%M')}, {os.cpu_count()} cores, load {os.getloadavg()[0]:.2f}; "
+        f"{args.rounds} rounds of {', '.join(f'{n} x{FIGURES[n][2]}' for n in names)}",
+        flush=True,
+    )
     for label, tree in sides.items():
         t0 = time.perf_counter()
         got = run_side(tree, names, warm=True)
@@ -227,29 +244,47 @@ def main(argv=None) -> int:
             for attempt in range(args.redo + 1):
                 before = wait_for_idle(args.busy, args.wait)
                 got = run_side(sides[label], names, warm=False)
-                print(f"  round {r + 1} {label}: host busy {before:.2f} before, others {got['others']:.2f} "
-                      "during: " + ", ".join(f"{n} {min(got['wall'][n]) * 1e3:.0f} ms" for n in names)
-                      + ("" if got["others"] < args.busy or attempt == args.redo else "  (again)"), flush=True)
+                print(
+                    f"  round {r + 1} {label}: host busy {before:.2f} before, others {got['others']:.2f} "
+                    "during: "
+                    + ", ".join(f"{n} {min(got['wall'][n]) * 1e3:.0f} ms" for n in names)
+                    + ("" if got["others"] < args.busy or attempt == args.redo else "  (again)"),
+                    flush=True,
+                )
                 if got["others"] < args.busy:
                     break
             others.append(got["others"])
             for clock in CLOCKS:
                 for n in names:
                     times[clock][label][n] += got[clock][n]
-    print(f"\nM vehicle-steps per second, best and median of all calls (other processes took "
-          f"{min(others):.2f}-{max(others):.2f} of the CPU time while the timed processes ran)")
-    result: dict = {"a": args.a, "b": args.b, "rounds": args.rounds, "date": time.strftime("%Y-%m-%d %H:%M"),
-                    "others": others, "figures": {}}
+    print(
+        f"\nM vehicle-steps per second, best and median of all calls (other processes took "
+        f"{min(others):.2f}-{max(others):.2f} of the CPU time while the timed processes ran)"
+    )
+    result: dict = {
+        "a": args.a,
+        "b": args.b,
+        "rounds": args.rounds,
+        "date": time.strftime("%Y-%m-%d %H:%M"),
+        "others": others,
+        "figures": {},
+    }
     for clock, label in CLOCKS.items():
         print(f"  {label:<30} {'A best':>7} {'A med':>7} {'B best':>7} {'B med':>7} {'B/A best':>9} {'B/A med':>8}")
         for n in names:
             work = FIGURES[n][0] * round(FIGURES[n][1] * HZ)
             a, b = summary(times[clock]["A"][n], work), summary(times[clock]["B"][n], work)
             ratio = {"best": b["best"] / a["best"], "median": b["median"] / a["median"]}
-            result["figures"].setdefault(n, {})[clock] = {"A": a, "B": b, "ratio": ratio,
-                                                          "times": {k: times[clock][k][n] for k in sides}}
-            print(f"    {n:<28} {a['best'] / 1e6:7.2f} {a['median'] / 1e6:7.2f} {b['best'] / 1e6:7.2f} "
-                  f"{b['median'] / 1e6:7.2f} {ratio['best']:9.3f} {ratio['median']:8.3f}")
+            result["figures"].setdefault(n, {})[clock] = {
+                "A": a,
+                "B": b,
+                "ratio": ratio,
+                "times": {k: times[clock][k][n] for k in sides},
+            }
+            print(
+                f"    {n:<28} {a['best'] / 1e6:7.2f} {a['median'] / 1e6:7.2f} {b['best'] / 1e6:7.2f} "
+                f"{b['median'] / 1e6:7.2f} {ratio['best']:9.3f} {ratio['median']:8.3f}"
+            )
     if args.json:
         args.json.write_text(json.dumps(result, indent=1) + "\n")
     return 0

@@ -37,13 +37,16 @@ def main(argv=None) -> int:
     steps = 20 if args.quick else 200
     rounds = 2 if args.quick else args.rounds
     rng = np.random.default_rng(0)
-    out: dict = {"num_envs": n, "steps_per_call": steps, "rounds": rounds, "load_start": os.getloadavg(),
-                 "modes": {}}
-    envs = {mode: gymnasium.make_vec("quadcruise/Hover-v0", num_envs=n, vectorization_mode="vector_entry_point",
-                                     action=mode) for mode in ("rotors", "rates", "attitude", "velocity")}
+    out: dict = {"num_envs": n, "steps_per_call": steps, "rounds": rounds, "load_start": os.getloadavg(), "modes": {}}
+    envs = {
+        mode: gymnasium.make_vec(
+            "quadcruise/Hover-v0", num_envs=n, vectorization_mode="vector_entry_point", action=mode
+        )
+        for mode in ("rotors", "rates", "attitude", "velocity")
+    }
     for env in envs.values():
         env.reset(seed=0)
-        env.step(env.action_space.sample())                       # load the compiled code
+        env.step(env.action_space.sample())  # load the compiled code
     qc.fly("hover", "nlpd", n=n, dt=0.01, duration=0.1)
     fly_best, env_best = 0.0, dict.fromkeys(envs, 0.0)
     for _ in range(rounds):
@@ -58,8 +61,10 @@ def main(argv=None) -> int:
             env_best[mode] = max(env_best[mode], n * steps / (time.perf_counter() - t))
     out["fly_rate"] = fly_best
     out["load_end"] = os.getloadavg()
-    print(f"num_envs = {n}, {steps} steps a call, best of {rounds} rounds; load average "
-          f"{out['load_start'][0]:.1f} at the start, {out['load_end'][0]:.1f} at the end")
+    print(
+        f"num_envs = {n}, {steps} steps a call, best of {rounds} rounds; load average "
+        f"{out['load_start'][0]:.1f} at the start, {out['load_end'][0]:.1f} at the end"
+    )
     print(f"batched fly (hover, nlpd, 100 Hz): {fly_best / 1e6:.3f} M vehicle-steps/s")
     ok = True
     for mode, rate in env_best.items():

@@ -37,8 +37,17 @@ def main() -> None:
     keep = t <= args.seconds
     t, u = t[keep], u[keep]
     noise = SensorNoise(position_std=0.01, velocity_std=0.02, angle_std=0.005, rate_std=0.01)
-    flight = qc.fly(Hover(z=300.0), ScheduleController(t, u), vehicle=vehicle, duration=float(t[-1]), sensors=noise,
-                    seed=1, log_every=4, max_track_error=1e6, max_steady_error=1e6)
+    flight = qc.fly(
+        Hover(z=300.0),
+        ScheduleController(t, u),
+        vehicle=vehicle,
+        duration=float(t[-1]),
+        sensors=noise,
+        seed=1,
+        log_every=4,
+        max_track_error=1e6,
+        max_steady_error=1e6,
+    )
     with tempfile.TemporaryDirectory() as folder:
         path = flight.to_ulog(Path(folder) / "sysid.ulg")
         size = os.path.getsize(path)
@@ -48,10 +57,15 @@ def main() -> None:
             result = qc.identify(path, mass=float(vehicle.m))
             times.append(time.perf_counter() - start)
     print(f"log: {flight.t[-1]:.1f} s at 250 Hz, {size / 1e6:.1f} MB; load average {os.getloadavg()[0]:.2f}")
-    print(f"identify: best {min(times):.2f} s, median {statistics.median(times):.2f} s over {args.rounds} rounds "
-          f"(target < 20 s)")
-    print("K {K:.3f} N, Jxx {Jxx:.5f}, Jyy {Jyy:.5f}, Jzz {Jzz:.5f} kg m^2, d {d:.5f} m, omega {omega:.2f} rad/s"
-          .format(**{k: result.parameters[k]["value"] for k in ("K", "Jxx", "Jyy", "Jzz", "d", "omega")}))
+    print(
+        f"identify: best {min(times):.2f} s, median {statistics.median(times):.2f} s over {args.rounds} rounds "
+        f"(target < 20 s)"
+    )
+    print(
+        "K {K:.3f} N, Jxx {Jxx:.5f}, Jyy {Jyy:.5f}, Jzz {Jzz:.5f} kg m^2, d {d:.5f} m, omega {omega:.2f} rad/s".format(
+            **{k: result.parameters[k]["value"] for k in ("K", "Jxx", "Jyy", "Jzz", "d", "omega")}
+        )
+    )
 
 
 if __name__ == "__main__":

@@ -26,10 +26,18 @@ def machine(**versions: str) -> dict:
 
     lines = Path("/proc/cpuinfo").read_text().splitlines() if Path("/proc/cpuinfo").exists() else []
     cpu = next((ln.split(":", 1)[1].strip() for ln in lines if ln.startswith("model name")), platform.processor())
-    return {"cpu": cpu, "cores": os.cpu_count(), "numba_threads": numba.get_num_threads(),
-            "python": platform.python_version(), "numba": numba.__version__, "numpy": np.__version__,
-            **versions, "quadcruise": quadcruise.__version__, "load_avg_start": list(os.getloadavg()),
-            "probe_ns_start": probe()}
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "numba_threads": numba.get_num_threads(),
+        "python": platform.python_version(),
+        "numba": numba.__version__,
+        "numpy": np.__version__,
+        **versions,
+        "quadcruise": quadcruise.__version__,
+        "load_avg_start": list(os.getloadavg()),
+        "probe_ns_start": probe(),
+    }
 
 
 def probe(steps: int = 200_000, repeats: int = 3) -> float:
@@ -43,10 +51,10 @@ def probe(steps: int = 200_000, repeats: int = 3) -> float:
     vp = qc.Vehicle.paper().rows(1)[0]
     x = np.zeros(STATE_SIZE)
     x[Z], x[PHI], x[THETA], x[PSI] = 1.0, 0.02, -0.01, 0.3
-    x[F1:F1 + 4] = vp[P_M] * vp[P_G] / 4.0
+    x[F1 : F1 + 4] = vp[P_M] * vp[P_G] / 4.0
     u = np.full(4, qc.Vehicle.paper().hover_duty)
     ext = np.zeros(EXT_SIZE)
-    ext[EXT_E1:EXT_E1 + 4] = 1.0
+    ext[EXT_E1 : EXT_E1 + 4] = 1.0
     loop = _rk4_loop()
     loop(x.copy(), u, vp, ext, 10)
     best = float("inf")
@@ -62,8 +70,10 @@ def end_of_run(info: dict) -> str:
     that reports them."""
     info["load_avg_end"] = list(os.getloadavg())
     info["probe_ns_end"] = probe()
-    return (f"load average at the end: {', '.join(f'{v:.2f}' for v in info['load_avg_end'])}; speed probe "
-            f"{info['probe_ns_end']:.0f} ns (at the start {info['probe_ns_start']:.0f} ns)")
+    return (
+        f"load average at the end: {', '.join(f'{v:.2f}' for v in info['load_avg_end'])}; speed probe "
+        f"{info['probe_ns_end']:.0f} ns (at the start {info['probe_ns_start']:.0f} ns)"
+    )
 
 
 @functools.cache

@@ -40,9 +40,12 @@ def robust_population():
     from quadcruise.disturbances import Environment, SensorNoise, Turbulence
     from quadcruise.montecarlo import Population
 
-    return Population(mass_spread=0.1, inertia_spread=0.1,
-                      environment=Environment(turbulence=Turbulence(w20=1.0, altitude=10.0)),
-                      noise=SensorNoise(position_std=0.005, delay=0.001))
+    return Population(
+        mass_spread=0.1,
+        inertia_spread=0.1,
+        environment=Environment(turbulence=Turbulence(w20=1.0, altitude=10.0)),
+        noise=SensorNoise(position_std=0.005, delay=0.001),
+    )
 
 
 def cases(quick: bool) -> dict:
@@ -51,9 +54,18 @@ def cases(quick: bool) -> dict:
     budget = 3 if quick else 100
     return {
         "nominal": dict(mission="step", controller="nlpd", targets=TARGETS, seed=1, budget=budget),
-        "robust": dict(mission=Step(size=1.0, time=0.5), controller="nlpd", targets=TARGETS, seed=1,
-                       population=robust_population(), samples=5 if quick else 50, objective="worst",
-                       popsize=20, duration=6.0, budget=budget),
+        "robust": dict(
+            mission=Step(size=1.0, time=0.5),
+            controller="nlpd",
+            targets=TARGETS,
+            seed=1,
+            population=robust_population(),
+            samples=5 if quick else 50,
+            objective="worst",
+            popsize=20,
+            duration=6.0,
+            budget=budget,
+        ),
     }
 
 
@@ -74,9 +86,17 @@ def run(name: str, kw: dict) -> dict:
     res = tune(**kw)
     wall = time.perf_counter() - start
     steps = res.info["flights"] * round(res.spec.duration / res.spec.dt)
-    return {"wall_s": wall, "limit_s": LIMITS[name], "generations": res.generations, "flights": res.info["flights"],
-            "vehicle_steps_per_s": steps / wall, "gains": res.gains, "cost": res.cost, "met": res.met,
-            "reached": {t.metric: res.reached(t.metric) for t in res.targets}}
+    return {
+        "wall_s": wall,
+        "limit_s": LIMITS[name],
+        "generations": res.generations,
+        "flights": res.info["flights"],
+        "vehicle_steps_per_s": steps / wall,
+        "gains": res.gains,
+        "cost": res.cost,
+        "met": res.met,
+        "reached": {t.metric: res.reached(t.metric) for t in res.targets},
+    }
 
 
 def main(argv=None) -> int:
@@ -87,9 +107,11 @@ def main(argv=None) -> int:
     import scipy
 
     info = machine(scipy=scipy.__version__)
-    print(f"{info['cpu']}, {info['cores']} cores, numba threads {info['numba_threads']}; "
-          f"load average {', '.join(f'{v:.2f}' for v in info['load_avg_start'])}; "
-          f"speed probe {info['probe_ns_start']:.0f} ns")
+    print(
+        f"{info['cpu']}, {info['cores']} cores, numba threads {info['numba_threads']}; "
+        f"load average {', '.join(f'{v:.2f}' for v in info['load_avg_start'])}; "
+        f"speed probe {info['probe_ns_start']:.0f} ns"
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         info["warm_up_s"] = warm_up()
@@ -97,10 +119,15 @@ def main(argv=None) -> int:
         for name, kw in cases(args.quick).items():
             r = results[name] = run(name, kw)
             gains = ", ".join(f"{k} {v:.4g}" for k, v in r["gains"].items())
-            verdict = "" if args.quick else (" (target < %.0f s: %s)" % (r["limit_s"], "met" if r["wall_s"] < r["limit_s"]
-                                                                          else "MISSED"))
-            print(f"{name}: {r['wall_s']:.1f} s{verdict}; {r['generations']} generations, {r['flights']:,} flights, "
-                  f"{r['vehicle_steps_per_s'] / 1e6:.2f} M vehicle-steps/s; {gains}; cost {r['cost']:.3g}")
+            verdict = (
+                ""
+                if args.quick
+                else f" (target < {r['limit_s']:.0f} s: {'met' if r['wall_s'] < r['limit_s'] else 'MISSED'})"
+            )
+            print(
+                f"{name}: {r['wall_s']:.1f} s{verdict}; {r['generations']} generations, {r['flights']:,} flights, "
+                f"{r['vehicle_steps_per_s'] / 1e6:.2f} M vehicle-steps/s; {gains}; cost {r['cost']:.3g}"
+            )
     print(end_of_run(info))
     if args.json:
         args.json.write_text(json.dumps({"machine": info, "quick": args.quick, "results": results}, indent=2))

@@ -27,7 +27,7 @@ import numpy as np
 
 def linear_policy(params: np.ndarray, obs_size: int = 21) -> tuple[np.ndarray, np.ndarray]:
     """(W, b) of a flat parameter vector: W (4, obs_size), b (4,)."""
-    return params[:4 * obs_size].reshape(4, obs_size), params[4 * obs_size:]
+    return params[: 4 * obs_size].reshape(4, obs_size), params[4 * obs_size :]
 
 
 def main(argv=None) -> int:
@@ -55,12 +55,14 @@ def main(argv=None) -> int:
 
     args.out.mkdir(parents=True, exist_ok=True)
     n = args.popsize * args.repeats
-    env = gymnasium.make_vec("quadcruise/Hover-v0", num_envs=n, vectorization_mode="vector_entry_point",
-                             action="attitude")
+    env = gymnasium.make_vec(
+        "quadcruise/Hover-v0", num_envs=n, vectorization_mode="vector_entry_point", action="attitude"
+    )
     periods = env.stepper.t_grid.shape[0] - 1
     obs_size = env.single_observation_space.shape[0]
-    es = cma.CMAEvolutionStrategy(np.zeros(4 * obs_size + 4), 0.1,
-                                  {"popsize": args.popsize, "seed": args.seed, "verbose": -9})
+    es = cma.CMAEvolutionStrategy(
+        np.zeros(4 * obs_size + 4), 0.1, {"popsize": args.popsize, "seed": args.seed, "verbose": -9}
+    )
     curve, steps, start = [], 0, time.perf_counter()
     for gen in range(args.generations):
         candidates = np.array(es.ask())
@@ -75,8 +77,11 @@ def main(argv=None) -> int:
         es.tell(list(candidates), list(-reward))
         steps += n * periods
         curve.append((steps, float(reward.mean()), float(reward.max())))
-        print(f"generation {gen + 1:3d}: {steps / 1e6:6.2f} M env-steps, mean reward {reward.mean():.3f}, "
-              f"best {reward.max():.3f}, {time.perf_counter() - start:6.1f} s", flush=True)
+        print(
+            f"generation {gen + 1:3d}: {steps / 1e6:6.2f} M env-steps, mean reward {reward.mean():.3f}, "
+            f"best {reward.max():.3f}, {time.perf_counter() - start:6.1f} s",
+            flush=True,
+        )
         if reward.mean() >= args.target:
             break
     W, b = linear_policy(np.asarray(es.result.xfavorite), obs_size)
@@ -92,17 +97,22 @@ def main(argv=None) -> int:
     fig.savefig(args.out / "learning_curve.png", dpi=120)
 
     # the trained policy and nlpd on the same 16 unseen episodes
-    test = quadcruise.gym.QuadVectorEnv(16, mission="hover", action="attitude",
-                                        population=quadcruise.gym.HOVER_POPULATION)
+    test = quadcruise.gym.QuadVectorEnv(
+        16, mission="hover", action="attitude", population=quadcruise.gym.HOVER_POPULATION
+    )
     returns, flights = rollout(test, lambda obs: np.tanh(obs @ W.T + b).astype(np.float32), seed=999)
     table = flights.metrics().select_dtypes("number").drop(columns=["vehicle"], errors="ignore").mean()
-    row = {"mean_reward": returns.mean() / periods, "finished": float(np.mean(flights.status == 0)),
-           **table.to_dict()}
+    row = {"mean_reward": returns.mean() / periods, "finished": float(np.mean(flights.status == 0)), **table.to_dict()}
     import pandas as pd
 
-    both = pd.concat([pd.DataFrame([row], index=["linear policy (CMA-ES)"]),
-                      baselines(("nlpd",), num_envs=16, seed=999, mission="hover",
-                                population=quadcruise.gym.HOVER_POPULATION).drop(columns=["mean_return"])])
+    both = pd.concat(
+        [
+            pd.DataFrame([row], index=["linear policy (CMA-ES)"]),
+            baselines(
+                ("nlpd",), num_envs=16, seed=999, mission="hover", population=quadcruise.gym.HOVER_POPULATION
+            ).drop(columns=["mean_return"]),
+        ]
+    )
     both.to_csv(args.out / "evaluation.csv")
     cols = [c for c in ("mean_reward", "finished", "rmse_m", "max_error_m", "steady_rmse_m") if c in both]
     print(both[cols].to_string(float_format=lambda v: f"{v:.4f}"))

@@ -18,11 +18,11 @@ from typing import TYPE_CHECKING
 from quadcruise._cache import drop_stale_cache as _drop_stale_cache
 from quadcruise._version import __version__
 
-_drop_stale_cache()                      # before anything compiles: see quadcruise._cache
+_drop_stale_cache()  # before anything compiles: see quadcruise._cache
 
-from quadcruise.errors import InputError
+from quadcruise.errors import InputError  # noqa: E402 - after the stale cache is dropped
 
-if TYPE_CHECKING:                        # what the names are, for readers and type checkers
+if TYPE_CHECKING:  # what the names are, for readers and type checkers
     from quadcruise.model.vehicle import Vehicle
     from quadcruise.sim.engine import Limits, simulate, time_grid
     from quadcruise.sim.result import SimResult
@@ -31,8 +31,16 @@ if TYPE_CHECKING:                        # what the names are, for readers and t
     from quadcruise.sysid.result import IdentifyResult
     from quadcruise.workflows.compare import Comparison, compare
     from quadcruise.workflows.fly import fly
-    from quadcruise.workflows.replay import (DutySchedule, SpeedSchedule, read_duty_csv, read_speed_csv, replay,
-                                             replay_rotors, write_rotor_states_csv, write_states_csv)
+    from quadcruise.workflows.replay import (
+        DutySchedule,
+        SpeedSchedule,
+        read_duty_csv,
+        read_speed_csv,
+        replay,
+        replay_rotors,
+        write_rotor_states_csv,
+        write_states_csv,
+    )
 
 _LAZY = {
     "quadcruise.model.vehicle": ("Vehicle",),
@@ -43,15 +51,42 @@ _LAZY = {
     "quadcruise.sysid.result": ("IdentifyResult",),
     "quadcruise.workflows.compare": ("Comparison", "compare"),
     "quadcruise.workflows.fly": ("fly",),
-    "quadcruise.workflows.replay": ("DutySchedule", "SpeedSchedule", "read_duty_csv", "read_speed_csv", "replay",
-                                    "replay_rotors", "write_rotor_states_csv", "write_states_csv"),
+    "quadcruise.workflows.replay": (
+        "DutySchedule",
+        "SpeedSchedule",
+        "read_duty_csv",
+        "read_speed_csv",
+        "replay",
+        "replay_rotors",
+        "write_rotor_states_csv",
+        "write_states_csv",
+    ),
 }
 _HOME = {name: module for module, names in _LAZY.items() for name in names}
 
 __all__ = [
-    "Comparison", "DutySchedule", "ExitStatus", "IdentifyResult", "InputError", "Limits", "STATUS_REASONS", "SimResult",
-    "SpeedSchedule", "Vehicle", "__version__", "compare", "fly", "identify", "read_duty_csv", "read_speed_csv", "replay",
-    "replay_rotors", "simulate", "time_grid", "write_rotor_states_csv", "write_states_csv",
+    "Comparison",
+    "DutySchedule",
+    "ExitStatus",
+    "IdentifyResult",
+    "InputError",
+    "Limits",
+    "STATUS_REASONS",
+    "SimResult",
+    "SpeedSchedule",
+    "Vehicle",
+    "__version__",
+    "compare",
+    "fly",
+    "identify",
+    "read_duty_csv",
+    "read_speed_csv",
+    "replay",
+    "replay_rotors",
+    "simulate",
+    "time_grid",
+    "write_rotor_states_csv",
+    "write_states_csv",
 ]
 
 
@@ -73,7 +108,7 @@ def __getattr__(name: str):
     AttributeError
         For a name the package does not export.
     """
-    if name == "tune":                    # the tuning package: qc.tune.tune(...)
+    if name == "tune":  # the tuning package: qc.tune.tune(...)
         value = importlib.import_module("quadcruise.tune")
         globals()[name] = value
         return value

@@ -5,7 +5,8 @@ numba keys each cached function on the file that defines it, not on the files of
 functions it calls and inlines: the engine's kernel inlines the plant's derivative, so an
 edit to ``model/plant.py`` alone would leave a stale kernel in the cache (a checkout of
 another commit, an edited source tree). At import, before anything compiles, we stamp the
-package's compiled sources (the contents of every ``.py`` file that uses numba) and, when the stamp differs from the one stored beside the cache, remove the
+package's compiled sources (the contents of every ``.py`` file that uses numba) and, when the stamp differs from the
+one stored beside the cache, remove the
 package's cached machine code (in the ``__pycache__`` folders, or under ``NUMBA_CACHE_DIR``
 when it is set), which numba then compiles afresh. A read-only install is left alone
 (numba caches such a package elsewhere, and an upgrade replaces every file there anyway).
@@ -19,7 +20,7 @@ import hashlib
 import os
 from pathlib import Path
 
-PACKAGE = Path(os.path.abspath(__file__)).parent     # as numba names the source files
+PACKAGE = Path(os.path.abspath(__file__)).parent  # as numba names the source files
 STAMP = "quadcruise-sources.stamp"
 
 

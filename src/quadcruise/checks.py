@@ -105,7 +105,7 @@ def describe(value: Any, limit: int = 60) -> str:
     if isinstance(value, np.ndarray):
         return f"{kind} of shape {value.shape}"
     text = " ".join(repr(value).split())
-    text = text if len(text) <= limit else text[:limit - 3] + "..."
+    text = text if len(text) <= limit else text[: limit - 3] + "..."
     return f"{kind} {text}"
 
 
@@ -145,8 +145,16 @@ def _is_real(value: Any) -> bool:
     return isinstance(value, (numbers.Real, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
 
 
-def number(where: str, name: str, value: Any, check: str = "real", *, unit: str = "",
-           optional: bool = False, infinite: bool = False) -> float | None:
+def number(
+    where: str,
+    name: str,
+    value: Any,
+    check: str = "real",
+    *,
+    unit: str = "",
+    optional: bool = False,
+    infinite: bool = False,
+) -> float | None:
     """A finite number (an int or a float, not a bool nor a string), as a float.
 
     Parameters
@@ -183,8 +191,12 @@ def number(where: str, name: str, value: Any, check: str = "real", *, unit: str 
     if not _is_real(value) or (isinstance(value, np.ndarray) and value.ndim):
         fail(where, name, value, want)
     x = float(value)
-    if math.isnan(x) or (math.isinf(x) and not (infinite and x > 0)) or (check == "pos" and x <= 0) \
-            or (check == "nonneg" and x < 0):
+    if (
+        math.isnan(x)
+        or (math.isinf(x) and not (infinite and x > 0))
+        or (check == "pos" and x <= 0)
+        or (check == "nonneg" and x < 0)
+    ):
         fail(where, name, value, want, kind=False)
     return x
 
@@ -251,8 +263,9 @@ def flag(where: str, name: str, value: Any) -> bool:
     return bool(value)
 
 
-def instance(where: str, name: str, value: Any, cls: type | tuple, *, optional: bool = True,
-             want: str | None = None) -> Any:
+def instance(
+    where: str, name: str, value: Any, cls: type | tuple, *, optional: bool = True, want: str | None = None
+) -> Any:
     """An object of ``cls`` (None too if ``optional``), returned as given.
 
     Parameters

@@ -48,6 +48,7 @@ class WriteError(OSError):
         cause = self.strerror[:1].lower() + self.strerror[1:]
         return f"{self.filename}: cannot write ({cause})" + (f"; {self.kept}" if self.kept else "")
 
+
 class ArgumentTypeError(InputError, TypeError):
     """Bad input of the wrong kind: a Python argument of another type than the one expected
     (a string for a number, a class for an object, a float for a seed).
@@ -103,7 +104,8 @@ def whole_number(value, what: str, minimum: int = 0) -> int:
     wrong_type = isinstance(value, bool) or not isinstance(value, numbers.Integral)
     if wrong_type or value < minimum:
         raise (ArgumentTypeError if wrong_type else InputError)(
-            f"{what} must be a whole number >= {minimum}, got {value!r}")
+            f"{what} must be a whole number >= {minimum}, got {value!r}"
+        )
     return int(value)
 
 

@@ -51,8 +51,22 @@ import numpy as np
 
 from quadcruise.errors import ArgumentTypeError, InputError
 
-__all__ = ["CHECKS", "Check", "Validated", "between", "check_number", "check_value", "instance_of", "one_of",
-           "parse_assignments", "parse_numbers", "unit_field", "units_of", "validate", "vector"]
+__all__ = [
+    "CHECKS",
+    "Check",
+    "Validated",
+    "between",
+    "check_number",
+    "check_value",
+    "instance_of",
+    "one_of",
+    "parse_assignments",
+    "parse_numbers",
+    "unit_field",
+    "units_of",
+    "validate",
+    "vector",
+]
 
 
 # --- checks --------------------------------------------------------------------------------
@@ -78,7 +92,7 @@ class Check:
     >>> compiled("push field 'function' (its law, -)", print)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: push field 'function' (its law, -) must be a compiled function, got <built-in function print>
+    quadcruise.errors.InputError: push field 'function' (its law, -) must be a compiled function, got <built-in ...
     """
 
     def __init__(self, name: str, want: str, test: Callable[[Any], bool] | None = None) -> None:
@@ -110,7 +124,7 @@ class Check:
             return None
         return self.convert(_Site(label, batch, optional), value)
 
-    def convert(self, site: "_Site", value: Any) -> Any:
+    def convert(self, site: _Site, value: Any) -> Any:
         """The stored form of a value that is not an allowed None (subclasses override).
 
         Parameters
@@ -145,7 +159,7 @@ class _Site:
 def _short(text: str, limit: int = 120) -> str:
     """``text`` on one line (an array's repr spans several) and at most ``limit`` characters."""
     text = " ".join(text.split())
-    return text if len(text) <= limit else text[:limit - 3] + "..."
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def _is_number(value: Any) -> bool:
@@ -183,8 +197,10 @@ class _Number(Check):
         if arr.ndim != 1 or arr.size == 0 or arr.dtype.kind not in "iuf":
             site.fail("a number or a 1-D array of numbers", repr(value), True)
         arr = arr.astype(float)
-        for bad, want in ((~np.isfinite(arr), "finite"),
-                          (self.refuse(arr) if self.refuse is not None else None, self.want)):
+        for bad, want in (
+            (~np.isfinite(arr), "finite"),
+            (self.refuse(arr) if self.refuse is not None else None, self.want),
+        ):
             if bad is not None and np.any(bad):
                 k = int(np.argmax(bad))
                 site.fail(want, f"{float(arr[k])!r} (entry {k} of {arr.size})")
@@ -198,15 +214,21 @@ class _Vector(Check):
 
     def __init__(self, n: int, element: _Number) -> None:
         names = {2: "pair", 3: "vec"}
-        super().__init__(names.get(n, f"vec{n}"), "a pair of numbers" if n == 2 else f"{n} numbers" + " (x, y, z)" * (n == 3))
+        super().__init__(
+            names.get(n, f"vec{n}"), "a pair of numbers" if n == 2 else f"{n} numbers" + " (x, y, z)" * (n == 3)
+        )
         self.n, self.element = n, element
 
     def convert(self, site: _Site, value: Any) -> tuple:
         n = self.n
         if site.batch and isinstance(value, np.ndarray) and value.ndim == 2 and value.shape[1] == n:
             value = tuple(value.T)
-        if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") \
-                or (isinstance(value, np.ndarray) and value.ndim != 1) or len(value) != n:
+        if (
+            isinstance(value, (str, bytes))
+            or not hasattr(value, "__len__")
+            or (isinstance(value, np.ndarray) and value.ndim != 1)
+            or len(value) != n
+        ):
             want = self.want + (f", each a number or a 1-D array, or an (N, {n}) array" if site.batch else "")
             site.fail(want, repr(value), True)
         return tuple(self.element.convert(site, v) for v in value)
@@ -219,7 +241,7 @@ class _OneOf(Check):
 
     def convert(self, site: _Site, value: Any) -> Any:
         if not isinstance(value, np.ndarray):
-            for option in self.options:             # the option itself: 'x', not np.str_('x')
+            for option in self.options:  # the option itself: 'x', not np.str_('x')
                 if isinstance(value, type(option)) and value == option:
                     return option
         site.fail(self.want, repr(value))
@@ -281,7 +303,7 @@ def between(low: float, high: float, closed: str = "[]", *, whole: bool = False,
         return out | (a != np.floor(a)) if whole else out
 
     check = _Number("range", want, refuse)
-    check.bounds = (float(low), float(high), closed)     # for callers that search within the range
+    check.bounds = (float(low), float(high), closed)  # for callers that search within the range
     return check
 
 
@@ -352,16 +374,19 @@ def instance_of(cls: type) -> Check:
     return _InstanceOf(cls)
 
 
-CHECKS: dict[str, Check] = {c.name: c for c in (
-    _Number("real", "finite"),
-    _Number("pos", "> 0", lambda a: a <= 0),
-    _Number("nonneg", ">= 0", lambda a: a < 0),
-    _Number("nonzero", "nonzero", lambda a: a == 0),
-    _Number("frac", "in [0, 1]", lambda a: (a < 0) | (a > 1)),
-    _Number("sign", "+1 or -1", lambda a: (a != 1) & (a != -1), cast=int),
-    _Number("whole", "a whole number >= 0", lambda a: (a < 0) | (a != np.floor(a)), cast=int),
-    _Flag("flag", "true or false"),
-)}
+CHECKS: dict[str, Check] = {
+    c.name: c
+    for c in (
+        _Number("real", "finite"),
+        _Number("pos", "> 0", lambda a: a <= 0),
+        _Number("nonneg", ">= 0", lambda a: a < 0),
+        _Number("nonzero", "nonzero", lambda a: a == 0),
+        _Number("frac", "in [0, 1]", lambda a: (a < 0) | (a > 1)),
+        _Number("sign", "+1 or -1", lambda a: (a != 1) & (a != -1), cast=int),
+        _Number("whole", "a whole number >= 0", lambda a: (a < 0) | (a != np.floor(a)), cast=int),
+        _Flag("flag", "true or false"),
+    )
+}
 """The checks by name (``choice`` is made from a field's ``choices``)."""
 CHECKS["pair"], CHECKS["vec"] = _Vector(2, CHECKS["real"]), _Vector(3, CHECKS["real"])
 
@@ -421,9 +446,17 @@ def check_number(label: str, value: Any) -> float:
 
 
 # --- declaration and validation --------------------------------------------------------------
-def unit_field(default: Any = dataclasses.MISSING, unit: str = "", doc: str = "", check: str | Check = "real",
-               choices: tuple = (), *, factory: Any = dataclasses.MISSING, batch: bool = False,
-               optional: bool | None = None):
+def unit_field(
+    default: Any = dataclasses.MISSING,
+    unit: str = "",
+    doc: str = "",
+    check: str | Check = "real",
+    choices: tuple = (),
+    *,
+    factory: Any = dataclasses.MISSING,
+    batch: bool = False,
+    optional: bool | None = None,
+):
     """A dataclass field with its unit [SI], meaning and check.
 
     Parameters
@@ -652,8 +685,9 @@ def _value(raw: str) -> Any:
         return word
 
 
-def parse_assignments(items: str | Iterable[str], what: str, keys: Iterable[str] | Mapping[str, str] | None = None,
-                      numbers: bool = False) -> dict[str, Any]:
+def parse_assignments(
+    items: str | Iterable[str], what: str, keys: Iterable[str] | Mapping[str, str] | None = None, numbers: bool = False
+) -> dict[str, Any]:
     """``KEY=VALUE`` options as a dict: the one parser of the command line's options.
 
     Items are separated by commas, or given as several strings; a comma-separated piece
@@ -698,9 +732,9 @@ def parse_assignments(items: str | Iterable[str], what: str, keys: Iterable[str]
     texts = [items] if isinstance(items, str) else list(items)
     rename = None if keys is None else (dict(keys) if isinstance(keys, Mapping) else {k: k for k in keys})
     lower = None if rename is None else {k.lower(): v for k, v in rename.items()}
-    pairs: list[list] = []                 # [key, [raw pieces], item as written]
+    pairs: list[list] = []  # [key, [raw pieces], item as written]
     for text in texts:
-        current = None                     # the pair a piece without "=" continues
+        current = None  # the pair a piece without "=" continues
         for piece in str(text).split(","):
             key, sep, raw = piece.partition("=")
             if sep:

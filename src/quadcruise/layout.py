@@ -28,51 +28,127 @@ from numba import types
 X, Y, Z, VX, VY, VZ, PHI, THETA, PSI, P, Q, R, F1, F2, F3, F4 = range(16)
 STATE_SIZE = 16
 STATE_NAMES = (
-    "x", "y", "z", "vx", "vy", "vz", "phi", "theta", "psi",
-    "p", "q", "r", "F1", "F2", "F3", "F4",
+    "x",
+    "y",
+    "z",
+    "vx",
+    "vy",
+    "vz",
+    "phi",
+    "theta",
+    "psi",
+    "p",
+    "q",
+    "r",
+    "F1",
+    "F2",
+    "F3",
+    "F4",
 )
 STATE_UNITS = (
-    "m", "m", "m", "m/s", "m/s", "m/s", "rad", "rad", "rad",
-    "rad/s", "rad/s", "rad/s", "N", "N", "N", "N",
+    "m",
+    "m",
+    "m",
+    "m/s",
+    "m/s",
+    "m/s",
+    "rad",
+    "rad",
+    "rad",
+    "rad/s",
+    "rad/s",
+    "rad/s",
+    "N",
+    "N",
+    "N",
+    "N",
 )
 
 # --- reference: 11 columns -----------------------------------------------------------
 # what a mission asks for at time t: position, velocity, acceleration, yaw and yaw rate.
-(REF_X, REF_Y, REF_Z, REF_VX, REF_VY, REF_VZ,
- REF_AX, REF_AY, REF_AZ, REF_PSI, REF_PSI_DOT) = range(11)
+(REF_X, REF_Y, REF_Z, REF_VX, REF_VY, REF_VZ, REF_AX, REF_AY, REF_AZ, REF_PSI, REF_PSI_DOT) = range(11)
 REF_SIZE = 11
 REF_NAMES = (
-    "x_ref", "y_ref", "z_ref", "vx_ref", "vy_ref", "vz_ref",
-    "ax_ref", "ay_ref", "az_ref", "psi_ref", "psi_dot_ref",
+    "x_ref",
+    "y_ref",
+    "z_ref",
+    "vx_ref",
+    "vy_ref",
+    "vz_ref",
+    "ax_ref",
+    "ay_ref",
+    "az_ref",
+    "psi_ref",
+    "psi_dot_ref",
 )
 
 # --- command: 12 columns -------------------------------------------------------------
 # what a controller returns each control period. Only the four duties drive the plant;
 # the rest is for logging and metrics. The engine clips the duties to [0, 1] and counts
 # the periods in which it had to (never silently).
-(CMD_U1, CMD_U2, CMD_U3, CMD_U4,            # PWM duties asked of rotors 1..4 [-]
- CMD_THRUST, CMD_TAU_PHI, CMD_TAU_THETA, CMD_TAU_PSI,  # desired U1 [N], U2 [N], U3 [N], U4 [N m]
- CMD_PHI_D, CMD_THETA_D, CMD_PSI_D,          # attitude setpoints [rad]
- CMD_FLAGS) = range(12)                      # controller saturation bit mask
+(
+    CMD_U1,
+    CMD_U2,
+    CMD_U3,
+    CMD_U4,  # PWM duties asked of rotors 1..4 [-]
+    CMD_THRUST,
+    CMD_TAU_PHI,
+    CMD_TAU_THETA,
+    CMD_TAU_PSI,  # desired U1 [N], U2 [N], U3 [N], U4 [N m]
+    CMD_PHI_D,
+    CMD_THETA_D,
+    CMD_PSI_D,  # attitude setpoints [rad]
+    CMD_FLAGS,
+) = range(12)  # controller saturation bit mask
 CMD_SIZE = 12
 CMD_NAMES = (
-    "u1", "u2", "u3", "u4", "U1_d", "U2_d", "U3_d", "U4_d",
-    "phi_d", "theta_d", "psi_d", "flags",
+    "u1",
+    "u2",
+    "u3",
+    "u4",
+    "U1_d",
+    "U2_d",
+    "U3_d",
+    "U4_d",
+    "phi_d",
+    "theta_d",
+    "psi_d",
+    "flags",
 )
 
 # Bits a controller may set in cmd[CMD_FLAGS]; the engine counts periods with any bit set.
-FLAG_TILT_LIMIT = 1      # a roll/pitch setpoint was limited to the tilt limit
-FLAG_ASIN_CLIP = 2       # an inverse-model asin argument left [-1, 1] and was clipped
-FLAG_THRUST_LIMIT = 4    # the collective thrust was limited
+FLAG_TILT_LIMIT = 1  # a roll/pitch setpoint was limited to the tilt limit
+FLAG_ASIN_CLIP = 2  # an inverse-model asin argument left [-1, 1] and was clipped
+FLAG_THRUST_LIMIT = 4  # the collective thrust was limited
 FLAG_INTEGRATOR_HOLD = 8  # anti-windup held an integrator
 
 # --- vehicle parameter row: 21 columns -------------------------------------------------
 # The physical parameters; k1..k6 (Section III of the paper) are derived from them when the
 # row is built, and so are 1/m and 1/J, so the compiled step never divides; then the drag
 # coefficients.
-(P_M, P_JXX, P_JYY, P_JZZ, P_L, P_K, P_OMEGA, P_D, P_G,
- P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, P_CD1, P_CD2,
- P_INV_M, P_INV_JXX, P_INV_JYY, P_INV_JZZ) = range(21)
+(
+    P_M,
+    P_JXX,
+    P_JYY,
+    P_JZZ,
+    P_L,
+    P_K,
+    P_OMEGA,
+    P_D,
+    P_G,
+    P_K1,
+    P_K2,
+    P_K3,
+    P_K4,
+    P_K5,
+    P_K6,
+    P_CD1,
+    P_CD2,
+    P_INV_M,
+    P_INV_JXX,
+    P_INV_JYY,
+    P_INV_JZZ,
+) = range(21)
 PARAM_SIZE = 21
 
 # --- compiled signatures ---------------------------------------------------------------
@@ -97,8 +173,7 @@ MissionType = types.FunctionType(MISSION_SIG)
 # force in the earth frame [N], a torque in the body frame [N m], the wind velocity in the
 # earth frame [m/s] (it acts through the vehicle's drag) and each rotor's effectiveness
 # (1 = healthy, 0.7 = lost 30 % of its thrust).
-(EXT_FX, EXT_FY, EXT_FZ, EXT_TX, EXT_TY, EXT_TZ, EXT_WX, EXT_WY, EXT_WZ,
- EXT_E1, EXT_E2, EXT_E3, EXT_E4) = range(13)
+(EXT_FX, EXT_FY, EXT_FZ, EXT_TX, EXT_TY, EXT_TZ, EXT_WX, EXT_WY, EXT_WZ, EXT_E1, EXT_E2, EXT_E3, EXT_E4) = range(13)
 EXT_SIZE = 13
 
 #: ``disturbance(t, dt, x, dp, dmem, rng, ext) -> None``: writes the external inputs held

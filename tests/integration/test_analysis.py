@@ -41,15 +41,16 @@ def _matched(found, wanted):
 
 # (a) the full loop against design.cascade_state_space -----------------------------------------
 
+
 @pytest.mark.parametrize("dt, tol", [(1e-3, 0.02), (1e-4, 0.002)])
 def test_x_loop_poles_are_those_of_the_hand_built_cascade(dt, tol):
     c = NLPD()
     cascade = cascade_state_space(c.position, c.attitude).poles()
     full = linearize(c, dt=dt)
     worst, left = _matched(full.poles_continuous(), cascade)
-    assert worst < tol                           # and the gap shrinks with dt: it is the sampling
+    assert worst < tol  # and the gap shrinks with dt: it is the sampling
     worst_x, left_x = _matched(full.loop_poles("x"), cascade)
-    assert worst_x < tol and left_x == []        # the x loop is exactly the cascade's 6 states
+    assert worst_x < tol and left_x == []  # the x loop is exactly the cascade's 6 states
 
 
 def test_yaw_and_z_loops_are_the_design_loops_with_rotor_lag(lin):
@@ -63,6 +64,7 @@ def test_yaw_and_z_loops_are_the_design_loops_with_rotor_lag(lin):
 
 
 # (b) stability, and the baseline is the paper's controller to first order ---------------------
+
 
 @pytest.mark.parametrize("name", ["nlpd", "gonzalez"])
 def test_discrete_closed_loop_is_stable(name):
@@ -94,6 +96,7 @@ def test_loops_partition_the_state(lin):
 
 # (c) the linear model predicts the nonlinear flight -------------------------------------------
 
+
 def test_linear_step_follows_nonlinear_small_step(lin):
     res = qc.fly(Step(axis="x", size=0.01, time=1.0), duration=11.0)
     k0 = int(np.searchsorted(res.t, 1.0))
@@ -105,12 +108,13 @@ def test_linear_step_follows_nonlinear_small_step(lin):
 
 # (d) margins -----------------------------------------------------------------------------------
 
+
 def test_closing_a_broken_loop_gives_the_closed_loop_back(lin):
     want = lin.poles()
     for loop in LOOPS:
         for at in ("input", "output"):
             L = lin.loop_transfer(loop, at)
-            closed = np.linalg.eigvals(L.A - L.B @ L.C)        # w = -L w: negative unity feedback
+            closed = np.linalg.eigvals(L.A - L.B @ L.C)  # w = -L w: negative unity feedback
             assert _matched(closed, want)[0] < 1e-8, (loop, at)
 
 
@@ -119,12 +123,11 @@ def test_faster_position_poles_erode_the_margins():
     for k in (0.8, 1.0, 1.2, 1.4, 2.0):
         c = NLPD(position=pd_from_poles((-0.7 * k, -4.3 * k)))
         lin = linearize(c)
-        rows.append((lin.stable, lin.margins("x")["phase_margin"],
-                     lin.margins("x", "output")["gain_increase"]))
-    stable, pm, gm = map(np.array, zip(*rows))
+        rows.append((lin.stable, lin.margins("x")["phase_margin"], lin.margins("x", "output")["gain_increase"]))
+    stable, pm, gm = map(np.array, zip(*rows, strict=False))
     assert np.all(np.diff(pm) < 0) and np.all(np.diff(gm[:4]) < 0)
     assert stable[:4].all() and pm[3] > 5.0
-    assert not stable[4] and pm[4] < 0                         # twice as fast: unstable
+    assert not stable[4] and pm[4] < 0  # twice as fast: unstable
 
 
 def test_unknown_loop_or_break_point_is_refused(lin):
@@ -135,6 +138,7 @@ def test_unknown_loop_or_break_point_is_refused(lin):
 
 
 # (e) no hover, no linearisation ---------------------------------------------------------------
+
 
 @njit(CONTROLLER_SIG)
 def _idle(t, dt, x, ref, vp, gains, mem, cmd):
@@ -164,6 +168,7 @@ def test_a_controller_that_cannot_hover_is_refused():
 class FirstCallFlag:
     """nlpd plus a memory entry set in its first period (as a derivative's first sample is):
     a plain Python function, which linearize can call as well as a compiled one."""
+
     name = "flagged"
 
     @staticmethod
@@ -184,7 +189,7 @@ def test_memory_set_in_the_first_period_settles(lin):
         linearize(FirstCallFlag(), settle=0)
     flagged = linearize(FirstCallFlag())
     np.testing.assert_allclose(flagged.sys.A[:19, :19], lin.sys.A, atol=1e-12)
-    assert flagged.stable and flagged.poles_continuous()[-1].real == -np.inf   # the flag: z = 0
+    assert flagged.stable and flagged.poles_continuous()[-1].real == -np.inf  # the flag: z = 0
     with pytest.raises(InputError, match="no continuous equivalent"):
         flagged.continuous()
     np.testing.assert_allclose(flagged.loop_poles("x"), lin.loop_poles("x"), rtol=1e-9)
@@ -197,20 +202,21 @@ def test_hover_elsewhere_and_heavier_vehicle_still_linearise():
 
 # report and figure -----------------------------------------------------------------------------
 
+
 def test_report_compares_with_the_design_poles(lin):
     r = lin.summary()
-    doc = json.loads(dumps(r.to_dict()))                  # strict JSON: -inf dB (no lower gain limit) is null
+    doc = json.loads(dumps(r.to_dict()))  # strict JSON: -inf dB (no lower gain limit) is null
     assert doc["loops"]["z"]["margins_input"]["gain_decrease_db"] is None
     assert doc["loops"]["x"]["margins_input"] == json.loads(json.dumps(r["loops"]["x"]["margins_input"]))
     assert "nlpd about hover, dt = 0.001 s: stable" in str(r) and "-4.3:85%" in str(r)
     assert json.loads(dumps({"gm": float("inf")})) == {"gm": None}
     x = r["loops"]["x"]
     assert x["design_poles"] == [-0.7, -4.3]
-    assert x["dominant"] == pytest.approx([-0.658, 0.0], abs=1e-3)   # the design's slow pole survives
-    assert x["nearest_rel_distance"][0] < 0.1 < 0.5 < x["nearest_rel_distance"][1]   # its -4.3 does not
-    assert 0.3 < x["min_damping"] < 0.45                    # design.py: worst damping 0.37
+    assert x["dominant"] == pytest.approx([-0.658, 0.0], abs=1e-3)  # the design's slow pole survives
+    assert x["nearest_rel_distance"][0] < 0.1 < 0.5 < x["nearest_rel_distance"][1]  # its -4.3 does not
+    assert 0.3 < x["min_damping"] < 0.45  # design.py: worst damping 0.37
     assert r["loops"]["y"]["poles"] == x["poles"]
-    assert r["loops"]["yaw"]["margins_input"]["gain_decrease"] > 0   # PID on a double integrator
+    assert r["loops"]["yaw"]["margins_input"]["gain_decrease"] > 0  # PID on a double integrator
     assert all(e["margins_input"]["open_loop_unstable_poles"] == 0 for e in r["loops"].values())
 
 
@@ -220,30 +226,33 @@ def test_bode_draws_closed_loops_and_loop_transfers(lin):
         assert len(lin.plot(loops=False).axes) == 2
         fig = lin.plot(at="output")
     assert isinstance(fig, Figure) and len(fig.axes) == 4
-    assert len(fig.axes[0].lines) == 4 + 1                   # four loops and the 0 dB line
+    assert len(fig.axes[0].lines) == 4 + 1  # four loops and the 0 dB line
 
 
 def test_bode_marks_each_loops_margins_at_its_crossovers(lin):
     fig = lin.plot()
     mag_l, phase_l = fig.axes[1], fig.axes[3]
     texts = [t.get_text() for t in mag_l.get_legend().get_texts()]
-    assert texts[0] == ("L x: PM 18.1° @ 10.8 rad/s (< 30°), GM down -3.98 dB @ 7.07 rad/s (> -6 dB), "
-                        "up +38.2 dB @ 134 rad/s")
-    assert texts[2] == "L z: PM 65° @ 4.8 rad/s, GM up +51.7 dB @ 169 rad/s"       # nothing short
-    for loop, text in zip(LOOPS, texts):
+    assert texts[0] == (
+        "L x: PM 18.1° @ 10.8 rad/s (< 30°), GM down -3.98 dB @ 7.07 rad/s (> -6 dB), up +38.2 dB @ 134 rad/s"
+    )
+    assert texts[2] == "L z: PM 65° @ 4.8 rad/s, GM up +51.7 dB @ 169 rad/s"  # nothing short
+    for loop, text in zip(LOOPS, texts, strict=False):
         m = lin.margins(loop)
         assert text.startswith(f"L {loop}: PM {m['phase_margin']:.3g}° @ {m['gain_crossover']:.3g} rad/s")
         curve = next(ln for ln in mag_l.get_lines() if ln.get_label() == text)
         w, gain = curve.get_xdata(), curve.get_ydata()
-        phase = next(ln for ln in phase_l.get_lines() if ln.get_color() == curve.get_color() and len(ln.get_xdata()) > 2)
+        phase = next(
+            ln for ln in phase_l.get_lines() if ln.get_color() == curve.get_color() and len(ln.get_xdata()) > 2
+        )
         pw, pv = phase.get_xdata(), phase.get_ydata()
-        if loop == "y":             # the same margins as x: marked once
+        if loop == "y":  # the same margins as x: marked once
             assert not [ln for ln in phase_l.get_lines() if ln.get_label() == "PM y"]
             continue
         (pm,) = [ln for ln in phase_l.get_lines() if ln.get_label() == f"PM {loop}"]
         wgc, pm_deg = m["gain_crossover"], m["phase_margin"]
         base = pm.get_ydata()[0]
-        assert list(pm.get_xdata()) == [wgc, wgc] and (base + 180.0) % 360.0 == 0.0   # from a -180 deg line
+        assert list(pm.get_xdata()) == [wgc, wgc] and (base + 180.0) % 360.0 == 0.0  # from a -180 deg line
         assert pm.get_ydata()[1] == pytest.approx(base + pm_deg)
         # the segment ends on the drawn phase and the dot on the drawn 0 dB crossing
         assert np.interp(np.log(wgc), np.log(pw), pv) == pytest.approx(base + pm_deg, abs=0.5)
@@ -257,10 +266,15 @@ def test_bode_marks_each_loops_margins_at_its_crossovers(lin):
             wpc, gm_db = m[key + "_frequency"], -20 * np.log10(m[key])
             assert list(gm.get_xdata()) == [wpc, wpc] and gm.get_ydata()[1] == pytest.approx(gm_db)
             assert np.interp(np.log(wpc), np.log(w), gain) == pytest.approx(gm_db, abs=0.3)
-            at_wpc = np.interp(np.log(wpc), np.log(pw), pv)               # on a -180 + 360 k line
+            at_wpc = np.interp(np.log(wpc), np.log(pw), pv)  # on a -180 + 360 k line
             assert abs((at_wpc + 180.0 + 180.0) % 360.0 - 180.0) < 0.5
-    assert [ln.get_label() for ln in mag_l.get_lines() if ln.get_label().startswith("GM ")] == \
-        ["GM down x", "GM up x", "GM up z", "GM down yaw", "GM up yaw"]
+    assert [ln.get_label() for ln in mag_l.get_lines() if ln.get_label().startswith("GM ")] == [
+        "GM down x",
+        "GM up x",
+        "GM up z",
+        "GM down yaw",
+        "GM up yaw",
+    ]
 
 
 @pytest.mark.parametrize("loops, at", [(False, "input"), (True, "input"), (True, "output")])
@@ -278,8 +292,11 @@ def test_bode_phases_are_unwrapped(lin, loops, at):
             assert np.all(np.isfinite(y)) and np.max(np.abs(np.diff(y))) < 90.0, ln.get_label()
             assert abs(y[0] - (0.0 if col == 0 else -180.0)) <= 180.0
         low, high = ax.get_ylim()
-        lines = sorted(ln.get_ydata()[0] for ln in ax.get_lines() if len(ln.get_xdata()) == 2
-                       and list(ln.get_xdata()) == [0.0, 1.0])           # axhline: x in axes units
+        lines = sorted(
+            ln.get_ydata()[0]
+            for ln in ax.get_lines()
+            if len(ln.get_xdata()) == 2 and list(ln.get_xdata()) == [0.0, 1.0]
+        )  # axhline: x in axes units
         assert lines and all((v + 180.0) % 360.0 == 0.0 and low <= v <= high for v in lines)
     # the x curve drawn last (the loop transfer, or the closed loop) is the angle of its response, unwrapped
     x_curve = next(ln for ln in phase_axes[-1].get_lines() if len(ln.get_xdata()) > 2)
@@ -291,15 +308,17 @@ def test_bode_phases_are_unwrapped(lin, loops, at):
 
 class _Delay:
     """A duck-typed linearisation whose one closed loop is a pure delay of n periods."""
+
     controller, dt, loops = "delay", 0.001, {"x": None}
 
     def __init__(self, n):
         self.n = n
 
     def closed_loop(self, loop):
-        shift = np.eye(self.n, k=-1)                        # x+ = shift x + e1 u, y = x_n: y = z^-n u
-        return control.ss(shift, np.eye(self.n)[:, :1], np.eye(self.n)[-1:], 0.0, self.dt,
-                          inputs=["x_ref"], outputs=["x"])
+        shift = np.eye(self.n, k=-1)  # x+ = shift x + e1 u, y = x_n: y = z^-n u
+        return control.ss(
+            shift, np.eye(self.n)[:, :1], np.eye(self.n)[-1:], 0.0, self.dt, inputs=["x_ref"], outputs=["x"]
+        )
 
 
 def test_bode_unwraps_a_delay_over_several_turns():
@@ -329,14 +348,15 @@ def test_gain_margins_in_db_bound_the_loop_gain_both_ways(lin):
             assert stable_at(m[key] * (1.02 if key == "gain_decrease" else 0.98))
             assert not stable_at(m[key] * (0.98 if key == "gain_decrease" else 1.02))
     z = lin.margins("z", "input")
-    assert z["gain_decrease"] == 0.0 and z["gain_decrease_db"] == -np.inf       # no lower limit
+    assert z["gain_decrease"] == 0.0 and z["gain_decrease_db"] == -np.inf  # no lower limit
 
 
 def test_summary_gives_margins_with_units_flags_and_explains_them(lin):
     text = str(lin.summary())
     lines = text.splitlines()
-    assert lines[0] == ("nlpd about hover, dt = 0.001 s: stable (every pole inside the unit circle), "
-                        "margins short on x, y, yaw (!)")
+    assert lines[0] == (
+        "nlpd about hover, dt = 0.001 s: stable (every pole inside the unit circle), margins short on x, y, yaw (!)"
+    )
     row = {ln[:36].strip(): ln[36:].split("  ") for ln in lines[2:10]}
     assert "PM at the input [deg] @ [rad/s]" in row and "GM at the input [dB]: down, up" in row
     cells = " ".join(lines[7].split())
@@ -356,17 +376,18 @@ def test_dominant_pole_is_defined_once_and_a_pair_counts_as_one_mode(name, loop)
     r = lin.summary()["loops"][loop]
     p, weight = lin.loop_modes(loop)
     modes = {}
-    for z, wt in zip(p, weight):
+    for z, wt in zip(p, weight, strict=False):
         key = (round(z.real, 6), round(abs(z.imag), 6))
         modes[key] = modes.get(key, 0.0) + wt
     assert tuple(r["dominant"]) == max(modes, key=modes.get)
     if name == "se3":
         assert r["dominant"] == r["slowest"] and r["dominant"][1] > 10.0
-    else:                                                     # a slow pole nearly cancelled: not dominant
+    else:  # a slow pole nearly cancelled: not dominant
         assert r["slowest"][0] > r["dominant"][0]
 
 
 # the result's four methods -----------------------------------------------------------------------
+
 
 def test_the_table_holds_every_pole_with_python_controls_damping(lin):
     """One row per loop and mode; with each pair's conjugate the rows are the poles of the whole loop,
@@ -380,7 +401,7 @@ def test_the_table_holds_every_pole_with_python_controls_damping(lin):
     both = np.concatenate([poles, np.conj(poles[table["imag"].to_numpy() > 0])])
     assert _matched(both, lin.poles_continuous())[0] < 1e-6 and len(both) == lin.sys.nstates
     wn, zeta, _ = control.damp(lin.sys, doprint=False)
-    for p, w, z in zip(poles, table["natural_frequency"], table["damping"]):
+    for p, w, z in zip(poles, table["natural_frequency"], table["damping"], strict=False):
         k = int(np.argmin(np.abs(wn - w) + np.abs(zeta - z)))
         assert wn[k] == pytest.approx(w, rel=1e-6) and zeta[k] == pytest.approx(z, abs=1e-6), p
     summary = lin.summary()
@@ -397,7 +418,7 @@ def test_the_table_holds_every_pole_with_python_controls_damping(lin):
 def test_the_folder_is_written_whole_or_not_at_all(lin, tmp_path, monkeypatch):
     out = lin.write(tmp_path / "a")
     assert sorted(p.name for p in out.iterdir()) == ["analysis.json", "bode.png", "bode_output.png", "quadcruise.json"]
-    doc = json.loads((out / "analysis.json").read_text())         # strict JSON: no lower gain limit is null
+    doc = json.loads((out / "analysis.json").read_text())  # strict JSON: no lower gain limit is null
     assert doc["loops"]["z"]["margins_input"]["gain_decrease_db"] is None
     assert doc["loops"]["x"]["dominant"] == lin.summary()["loops"]["x"]["dominant"]
     assert json.loads((out / "quadcruise.json").read_text())["dt_s"] == 0.001
@@ -415,4 +436,4 @@ def test_the_folder_is_written_whole_or_not_at_all(lin, tmp_path, monkeypatch):
     monkeypatch.setattr(type(lin), "plot", broken)
     with pytest.raises(RuntimeError, match="disk full"):
         lin.write(tmp_path / "b")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["a", "mine"]          # no half-written folder
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a", "mine"]  # no half-written folder

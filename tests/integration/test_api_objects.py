@@ -49,11 +49,14 @@ def test_a_controller_is_anything_with_the_protocol():
         qc.fly("step", object())
 
 
-@pytest.mark.parametrize("call,name", [
-    (lambda: qc.fly("hover", sede=1), "fly()"),
-    (lambda: qc.compare("hover", sede=1), "compare()"),
-    (lambda: montecarlo("hover", n=1, sede=1), "montecarlo()"),
-])
+@pytest.mark.parametrize(
+    "call,name",
+    [
+        (lambda: qc.fly("hover", sede=1), "fly()"),
+        (lambda: qc.compare("hover", sede=1), "compare()"),
+        (lambda: montecarlo("hover", n=1, sede=1), "montecarlo()"),
+    ],
+)
 def test_a_misspelt_keyword_is_named_with_the_choices(call, name):
     with pytest.raises(qc.InputError) as err:
         call()
@@ -98,7 +101,7 @@ def test_every_result_speaks_one_vocabulary(tmp_path):
         summary = result.summary()
         assert isinstance(summary, Summary) and len(summary) > 0
         text = str(summary)
-        assert "{" not in text and len(text.splitlines()) >= 2        # a table, not a raw dict
+        assert "{" not in text and len(text.splitlines()) >= 2  # a table, not a raw dict
         assert hasattr(result.plot(), "savefig")
         folder = result.write(tmp_path / f"r{i}")
         assert (folder / "quadcruise.json").is_file()

@@ -17,7 +17,7 @@ import pytest
 
 import quadcruise as qc
 from quadcruise.control import NLPD
-from quadcruise.disturbances import ConstantWind, Environment, SensorNoise
+from quadcruise.disturbances import ConstantWind, SensorNoise
 from quadcruise.errors import ArgumentTypeError, InputError
 from quadcruise.missions import Circle, Step
 from quadcruise.montecarlo import Population, montecarlo
@@ -60,12 +60,18 @@ CASES = {
     "fly duration str": (lambda: qc.fly("step", duration="10"), WRONG, ["duration", "str '10'"]),
     "fly full_dynamics str": (lambda: qc.fly("step", full_dynamics="no"), WRONG, ["full_dynamics", "True or False"]),
     "fly full_dynamics 1": (lambda: qc.fly("step", full_dynamics=1), WRONG, ["full_dynamics"]),
-    "fly seed 1.5": (lambda: qc.fly("step", **quick(seed=1.5, sensors=SensorNoise(position_std=0.01))), WRONG,
-                     ["seed", "whole number", "float 1.5"]),
+    "fly seed 1.5": (
+        lambda: qc.fly("step", **quick(seed=1.5, sensors=SensorNoise(position_std=0.01))),
+        WRONG,
+        ["seed", "whole number", "float 1.5"],
+    ),
     "fly seed True": (lambda: qc.fly("step", **quick(seed=True)), WRONG, ["seed", "bool True"]),
     "fly seed -1": (lambda: qc.fly("step", **quick(seed=-1)), BAD, ["seed", ">= 0"]),
-    "fly plain controller": (lambda: qc.fly("step", PlainController(), **quick()), WRONG,
-                             ["controller", "CONTROLLER_SIG", "plain Python function", "@njit(CONTROLLER_SIG"]),
+    "fly plain controller": (
+        lambda: qc.fly("step", PlainController(), **quick()),
+        WRONG,
+        ["controller", "CONTROLLER_SIG", "plain Python function", "@njit(CONTROLLER_SIG"],
+    ),
     "fly controller class": (lambda: qc.fly("step", NLPD), WRONG, ["controller", "the class NLPD", "NLPD()"]),
     "fly controller float": (lambda: qc.fly("step", 3.0), WRONG, ["controller", "float 3"]),
     # fly: the other arguments
@@ -78,14 +84,20 @@ CASES = {
     "fly n 2.0": (lambda: qc.fly("step", n=2.0), WRONG, ["n", "float 2"]),
     "fly log_every 0": (lambda: qc.fly("step", log_every=0), BAD, ["log_every", ">= 1"]),
     "fly log_every 1.5": (lambda: qc.fly("step", log_every=1.5), WRONG, ["log_every"]),
-    "fly log_every 1500 of 2000": (lambda: qc.fly("step", duration=2.0, log_every=1500), BAD,
-                                   ["log_every", "2,000 control periods", "1,000, 2,000"]),
+    "fly log_every 1500 of 2000": (
+        lambda: qc.fly("step", duration=2.0, log_every=1500),
+        BAD,
+        ["log_every", "2,000 control periods", "1,000, 2,000"],
+    ),
     "fly x0 short": (lambda: qc.fly("step", x0=[1.0, 2.0]), WRONG, ["x0", "(16,)"]),
     "fly x0 nan": (lambda: qc.fly("step", x0=np.full(16, np.nan)), BAD, ["x0", "finite"]),
     "fly x0 str": (lambda: qc.fly("step", x0="hover"), WRONG, ["x0"]),
     "fly limits dict": (lambda: qc.fly("step", limits={"max_tilt": 1}), WRONG, ["limits", "Limits"]),
-    "fly environment": (lambda: qc.fly("step", environment=ConstantWind((1, 0, 0))), WRONG,
-                        ["environment", "Environment"]),
+    "fly environment": (
+        lambda: qc.fly("step", environment=ConstantWind((1, 0, 0))),
+        WRONG,
+        ["environment", "Environment"],
+    ),
     "fly sensors": (lambda: qc.fly("step", sensors={"position_std": 0.1}), WRONG, ["sensors", "SensorNoise"]),
     "fly missions empty": (lambda: qc.fly(missions=[]), BAD, ["missions", "non-empty"]),
     "fly missions class": (lambda: qc.fly(missions=[Circle(), Circle]), WRONG, ["missions[1]", "Circle()"]),
@@ -102,8 +114,11 @@ CASES = {
     "compare dt str": (lambda: qc.compare("step", ["nlpd"], dt="1e-3"), WRONG, ["compare()", "dt"]),
     "compare vehicle": (lambda: qc.compare("step", ["nlpd"], vehicle=1), WRONG, ["compare()", "vehicle"]),
     "compare progress": (lambda: qc.compare("step", ["nlpd"], progress=1), WRONG, ["progress", "callable"]),
-    "compare plain controller": (lambda: qc.compare("step", [PlainController()]), WRONG,
-                                 ["compare()", "CONTROLLER_SIG"]),
+    "compare plain controller": (
+        lambda: qc.compare("step", [PlainController()]),
+        WRONG,
+        ["compare()", "CONTROLLER_SIG"],
+    ),
     # montecarlo
     "montecarlo n 0": (lambda: montecarlo("step", n=0), BAD, ["n", ">= 1"]),
     "montecarlo n 2.5": (lambda: montecarlo("step", n=2.5), WRONG, ["n", "float 2.5"]),
@@ -130,8 +145,11 @@ CASES = {
     "replay int": (lambda: qc.replay(3), WRONG, ["schedule", "DutySchedule", "path"]),
     "replay max_step 0": (lambda: qc.replay(EXAMPLES / "pwm_step.csv", max_step=0.0), BAD, ["max_step"]),
     "replay vehicle": (lambda: qc.replay(EXAMPLES / "pwm_step.csv", vehicle="paper"), WRONG, ["vehicle"]),
-    "replay full_dynamics": (lambda: qc.replay(EXAMPLES / "pwm_step.csv", full_dynamics="no"), WRONG,
-                             ["full_dynamics"]),
+    "replay full_dynamics": (
+        lambda: qc.replay(EXAMPLES / "pwm_step.csv", full_dynamics="no"),
+        WRONG,
+        ["full_dynamics"],
+    ),
     "replay no such file": (lambda: qc.replay("no_such_file.csv"), BAD, ["no_such_file.csv"]),
     # analyze (linearize)
     "linearize dt str": (lambda: linearize("nlpd", dt="1e-3"), WRONG, ["linearize()", "dt"]),
@@ -164,12 +182,12 @@ def test_a_bad_argument_is_one_line_naming_it(name):
     with pytest.raises(error) as caught:
         call()
     message = str(caught.value)
-    assert isinstance(caught.value, InputError), type(caught.value)          # the CLI's exit 2
+    assert isinstance(caught.value, InputError), type(caught.value)  # the CLI's exit 2
     assert (error is WRONG) == isinstance(caught.value, TypeError), type(caught.value)
     assert "\n" not in message and len(message) < 400, message
     for word in words:
         assert word in message, (word, message)
-    assert time.perf_counter() - start < 30.0                                # before any work
+    assert time.perf_counter() - start < 30.0  # before any work
 
 
 def test_the_type_error_is_an_input_error_and_a_type_error():
@@ -187,13 +205,20 @@ def test_a_bad_argument_is_refused_before_the_flight_is_sized_or_flown():
 
 def test_what_must_pass_passes_and_numbers_of_any_numeric_type_fly_the_same():
     ref = qc.fly("step", duration=2.0, dt=1e-3, seed=3, log_every=10, sensors=SensorNoise(position_std=0.01))
-    same = qc.fly("step", duration=2, dt=np.float64(1e-3), seed=np.int64(3), log_every=np.int32(10),
-                  full_dynamics=np.bool_(False), sensors=SensorNoise(position_std=0.01))
+    same = qc.fly(
+        "step",
+        duration=2,
+        dt=np.float64(1e-3),
+        seed=np.int64(3),
+        log_every=np.int32(10),
+        full_dynamics=np.bool_(False),
+        sensors=SensorNoise(position_std=0.01),
+    )
     np.testing.assert_array_equal(ref.states, same.states)
     other = qc.fly("step", duration=2.0, seed=4, log_every=10, sensors=SensorNoise(position_std=0.01))
-    assert not np.array_equal(ref.states, other.states)                     # the seed is used
+    assert not np.array_equal(ref.states, other.states)  # the seed is used
     assert ref.meta["seed"] == 3 and isinstance(same.meta["seed"], int)
-    assert ref.t[-1] == pytest.approx(2.0)                                  # the log ends where the flight does
+    assert ref.t[-1] == pytest.approx(2.0)  # the log ends where the flight does
     assert qc.fly("hover", duration=1.0, max_track_error=np.inf, first_vehicle=np.array([0, 5]), n=2).ok.all()
     assert qc.fly(Circle(), missions=None, duration=20.0, log_every=100, limits=Limits(max_tilt=math.inf)).ok.all()
 
@@ -204,7 +229,7 @@ def test_replay_takes_a_path_as_well_as_a_schedule():
     by_schedule = qc.replay(qc.read_duty_csv(path))
     np.testing.assert_array_equal(by_path.states, by_schedule.states)
     assert by_path.meta["source"] == str(path)
-    assert qc.replay(path).t.size == by_path.t.size                        # a pathlib.Path too
+    assert qc.replay(path).t.size == by_path.t.size  # a pathlib.Path too
 
 
 def test_a_compiled_controller_of_ones_own_passes_the_check():
@@ -218,7 +243,7 @@ def test_a_compiled_controller_of_ones_own_passes_the_check():
 
     assert compiled_for_engine(Mine().function) and not compiled_for_engine(PlainController().function)
     assert as_controller(Mine()).name == "plain"
-    lazily = njit(PlainController.function)                 # compiled by numba, but not for the engine
+    lazily = njit(PlainController.function)  # compiled by numba, but not for the engine
     assert not compiled_for_engine(lazily)
 
 
@@ -235,7 +260,7 @@ def test_default_tuning_bounds_stay_within_the_fields_range():
     for name in ("nlpd", "gonzalez", "se3", "cascade"):
         gain = GainSpace.build(qc_controller(name), "max_tilt").gains[0]
         assert 0 < gain.low < math.radians(45.0) < gain.high < math.pi / 2
-        assert gain.high > math.pi / 2 * (1 - 1e-6)                      # up to the field's limit
+        assert gain.high > math.pi / 2 * (1 - 1e-6)  # up to the field's limit
 
 
 def qc_controller(name):
@@ -247,26 +272,39 @@ def qc_controller(name):
 def quadcruise_cli(*args, cwd):
     """The command line of this tree's package, whatever the folder it runs in."""
     env = {**os.environ, "PYTHONPATH": str(Path(qc.__file__).parents[1])}
-    return subprocess.run([sys.executable, "-m", "quadcruise", *map(str, args)], capture_output=True, text=True,
-                          cwd=cwd, timeout=300, env=env)
+    return subprocess.run(
+        [sys.executable, "-m", "quadcruise", *map(str, args)],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=300,
+        env=env,
+    )
 
 
-@pytest.mark.parametrize("args, words", [
-    (["fly", "step", "-m", "size=0"], "step field 'size' (step size, m or rad) must be nonzero, got 0.0"),
-    (["fly", "circle", "-m", "period=1e300"], "x 1e+303 control periods is 1e+303 vehicle-steps"),
-    (["fly", "circle", "--poles", "0.7,4.3"], "--poles: pole 0.7 is not in the open left half plane"),
-    (["fly", "circle", "--poles", "-1,-2,-3"], "--poles needs 2 poles, got 3"),
-    (["fly", "{inline}"], "[disturbances] unknown key 'sensor_noise.position' (did you mean "
-                          "'sensor_noise.position_std'?)"),
-    (["fly", "{log_every}"], "[simulation] 'log_every' = 1500 does not divide the flight's 2,000 control periods"),
-    (["fly", "{batch}"], "the number of vehicles contradicts itself: [vehicle] m gives 2, [simulation] n gives 3"),
-    (["fly", "{dt}"], "[simulation] 'dt' = 0.003 s does not divide 'duration' = 2 s into whole control periods"),
-])
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["fly", "step", "-m", "size=0"], "step field 'size' (step size, m or rad) must be nonzero, got 0.0"),
+        (["fly", "circle", "-m", "period=1e300"], "x 1e+303 control periods is 1e+303 vehicle-steps"),
+        (["fly", "circle", "--poles", "0.7,4.3"], "--poles: pole 0.7 is not in the open left half plane"),
+        (["fly", "circle", "--poles", "-1,-2,-3"], "--poles needs 2 poles, got 3"),
+        (
+            ["fly", "{inline}"],
+            "[disturbances] unknown key 'sensor_noise.position' (did you mean 'sensor_noise.position_std'?)",
+        ),
+        (["fly", "{log_every}"], "[simulation] 'log_every' = 1500 does not divide the flight's 2,000 control periods"),
+        (["fly", "{batch}"], "the number of vehicles contradicts itself: [vehicle] m gives 2, [simulation] n gives 3"),
+        (["fly", "{dt}"], "[simulation] 'dt' = 0.003 s does not divide 'duration' = 2 s into whole control periods"),
+    ],
+)
 def test_scenario_and_number_messages_are_one_short_line_naming_where(tmp_path, args, words):
-    files = {"inline": "[disturbances]\nsensor_noise = { position = 0.01 }\n",
-             "log_every": "[simulation]\nduration = 2.0\ndt = 0.001\nlog_every = 1500\n",
-             "batch": "[vehicle]\nm = [3.4, 3.5]\n[simulation]\nn = 3\n",
-             "dt": "[simulation]\nduration = 2.0\ndt = 0.003\n"}
+    files = {
+        "inline": "[disturbances]\nsensor_noise = { position = 0.01 }\n",
+        "log_every": "[simulation]\nduration = 2.0\ndt = 0.001\nlog_every = 1500\n",
+        "batch": "[vehicle]\nm = [3.4, 3.5]\n[simulation]\nn = 3\n",
+        "dt": "[simulation]\nduration = 2.0\ndt = 0.003\n",
+    }
     for key, text in files.items():
         (tmp_path / f"{key}.toml").write_text(text)
     proc = quadcruise_cli(*(a.format(**{k: f"{k}.toml" for k in files}) for a in args), cwd=tmp_path)
@@ -275,6 +313,5 @@ def test_scenario_and_number_messages_are_one_short_line_naming_where(tmp_path, 
     assert len(lines) == 1 and lines[0].startswith("error: ") and words in lines[0], proc.stderr
     assert len(lines[0]) < 300 and "Traceback" not in proc.stderr and "pd_from_poles" not in lines[0]
     if args[1].startswith("{"):
-        assert f"{args[1][1:-1]}.toml" in lines[0]                          # the file is named
-    assert not proc.stdout.strip() and sorted(p.name for p in tmp_path.iterdir()) == sorted(
-        f"{k}.toml" for k in files)
+        assert f"{args[1][1:-1]}.toml" in lines[0]  # the file is named
+    assert not proc.stdout.strip() and sorted(p.name for p in tmp_path.iterdir()) == sorted(f"{k}.toml" for k in files)

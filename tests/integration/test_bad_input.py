@@ -18,6 +18,7 @@ def invoke(args, capsys, monkeypatch) -> tuple[int, str]:
     out = capsys.readouterr()
     return stop.value.code, out.out + out.err
 
+
 CASES = [
     (["fly", "circle", "-c", "foo=1"], "nlpd has no parameter 'foo'"),
     (["fly", "circle", "--duration", "1e9"], "control periods"),

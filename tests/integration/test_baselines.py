@@ -41,7 +41,7 @@ def command(controller, ex=0.0, ey=0.0, evx=0.0, evy=0.0, fn=None):
     """One control period from level hover at (0, 0, 1), the reference offset by the errors."""
     x = np.zeros(STATE_SIZE)
     x[Z] = 1.0
-    x[F1:F1 + 4] = VP[P_M] * VP[P_G] / 4.0
+    x[F1 : F1 + 4] = VP[P_M] * VP[P_G] / 4.0
     x[VX], x[VY] = -evx, -evy
     ref = np.zeros(REF_SIZE)
     ref[REF_X], ref[REF_Y], ref[REF_Z] = ex, ey, 1.0
@@ -69,7 +69,7 @@ def test_saturation_bounds_the_law_and_the_tilt():
     for e, ev in [(1e6, 1e6), (-1e6, 3e5), (50.0, -80.0), (1e-3, 0.0)]:
         assert abs(saturated_pd(e, ev, kp, kd, ap, ad)) <= ap + ad
     assert saturated_pd(1e6, 1e6, kp, kd, ap, ad) == pytest.approx(ap + ad)
-    c = Gonzalez()                                   # default: literal k tanh(e) form
+    c = Gonzalez()  # default: literal k tanh(e) form
     assert (c.accel_p, c.accel_d) == pytest.approx((c.position.kp * 1.0, c.position.kd * 1.0))
     cmd = command(c, ex=1e4, evx=1e4, ey=-1e4, evy=-1e4)
     assert abs(cmd[CMD_THETA_D]) <= c.max_tilt + 1e-12 and abs(cmd[CMD_PHI_D]) <= c.max_tilt + 1e-12
@@ -85,38 +85,45 @@ def test_saturation_bounds_the_law_and_the_tilt():
 
 def test_signs_match_eqs_5_and_6():
     c = Gonzalez()
-    assert command(c, ex=0.5)[CMD_THETA_D] > 0       # short of x: pitch up (x'' ~ sin theta)
+    assert command(c, ex=0.5)[CMD_THETA_D] > 0  # short of x: pitch up (x'' ~ sin theta)
     assert command(c, ex=-0.5)[CMD_THETA_D] < 0
-    assert command(c, ey=0.5)[CMD_PHI_D] < 0         # short of y: roll negative (y'' ~ -sin phi)
+    assert command(c, ey=0.5)[CMD_PHI_D] < 0  # short of y: roll negative (y'' ~ -sin phi)
     assert command(c, ey=-0.5)[CMD_PHI_D] > 0
     assert command(c, evx=0.5)[CMD_THETA_D] > 0 and command(c, evy=0.5)[CMD_PHI_D] < 0
 
 
 def test_flies_the_step():
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")              # duty clipping at the step instant
+        warnings.simplefilter("ignore")  # duty clipping at the step instant
         res = qc.fly("step", controller="gonzalez", duration=10)
     assert res.ok.tolist() == [True]
     assert abs(res.final_state[0, 0] - 1.0) < 0.03
-    assert np.abs(res.state("y")[0]).max() < 5e-3        # cross-coupling only (as for nlpd)
+    assert np.abs(res.state("y")[0]).max() < 5e-3  # cross-coupling only (as for nlpd)
 
 
 def test_flies_the_circle():
     res = qc.fly("circle", controller="gonzalez")
     assert res.ok.tolist() == [True]
     err = np.linalg.norm(res.states[0, :, :2] - res.references[0, :, :2], axis=1)
-    assert err.max() <= 2.0 + 1e-6                   # never worse than the initial 2 m offset
-    assert err[res.t >= 10.0].max() < 0.1            # then tracks within 10 cm
+    assert err.max() <= 2.0 + 1e-6  # never worse than the initial 2 m offset
+    assert err[res.t >= 10.0].max() < 0.1  # then tracks within 10 cm
     assert res.controller_limited_s[0] == 0.0
 
 
-@pytest.mark.parametrize("kwargs, name", [
-    ({"max_tilt": 0.0}, "max_tilt"), ({"max_tilt": 1.6}, "max_tilt"),
-    ({"accel_p": -1.0}, "accel_p"), ({"accel_d": float("nan")}, "accel_d"),
-    ({"accel_p": "big"}, "accel_p"), ({"i_limit": 0.0}, "i_limit"),
-    ({"i_limit": float("inf")}, "i_limit"), ({"position": (3.01, 5.0)}, "position"),
-    ({"attitude": None}, "attitude"),
-])
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        ({"max_tilt": 0.0}, "max_tilt"),
+        ({"max_tilt": 1.6}, "max_tilt"),
+        ({"accel_p": -1.0}, "accel_p"),
+        ({"accel_d": float("nan")}, "accel_d"),
+        ({"accel_p": "big"}, "accel_p"),
+        ({"i_limit": 0.0}, "i_limit"),
+        ({"i_limit": float("inf")}, "i_limit"),
+        ({"position": (3.01, 5.0)}, "position"),
+        ({"attitude": None}, "attitude"),
+    ],
+)
 def test_bad_parameters_name_the_field(kwargs, name):
     with pytest.raises(InputError, match=f"gonzalez parameter '{name}'"):
         Gonzalez(**kwargs)
@@ -129,7 +136,7 @@ def test_registry_and_gains_layout():
     g = c.gains()
     assert g.shape == (GONZALEZ_GAINS,) == (ATT_GAINS + 8,) and np.all(np.isfinite(g))
     assert g[MAX_TILT] == 0.3 and g[COS_MAX_TILT] == math.cos(0.3)
-    np.testing.assert_array_equal(g[:ATT_GAINS], NLPD().gains()[:ATT_GAINS])   # same attitude loop
+    np.testing.assert_array_equal(g[:ATT_GAINS], NLPD().gains()[:ATT_GAINS])  # same attitude loop
     assert c.to_dict()["name"] == "gonzalez" and c.function is gonzalez
 
 
@@ -137,4 +144,5 @@ def test_docstring_examples_run():
     import doctest
 
     from quadcruise.control import baselines
+
     assert doctest.testmod(baselines, raise_on_error=False).failed == 0

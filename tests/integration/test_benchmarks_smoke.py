@@ -17,8 +17,12 @@ def positive(value) -> bool:
 
 def test_quick_benchmark_writes_positive_figures(tmp_path):
     out = tmp_path / "bench.json"
-    proc = subprocess.run([sys.executable, str(SCRIPT), "--quick", "--skip-scipy", "--json", str(out)],
-                          capture_output=True, text=True, timeout=600)
+    proc = subprocess.run(
+        [sys.executable, str(SCRIPT), "--quick", "--skip-scipy", "--json", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert "open loop, 1 vehicle" in proc.stdout
     data = json.loads(out.read_text())
@@ -34,19 +38,24 @@ def test_quick_benchmark_writes_positive_figures(tmp_path):
             assert positive(results[bench][key]), (bench, key, results[bench].get(key))
         assert all(positive(t) for t in results[bench]["runs_s"])
     assert results["openloop_batch"]["vehicle_steps"] > results["openloop_single"]["vehicle_steps"]
-    assert not any(key.startswith("scipy") for key in results)       # --skip-scipy
+    assert not any(key.startswith("scipy") for key in results)  # --skip-scipy
 
     startup = results["startup"]
     assert positive(startup["python_warm_s"]), startup
-    assert "python_cold_s" not in startup                               # no --cold: warm only
+    assert "python_cold_s" not in startup  # no --cold: warm only
     assert positive(startup["cli_warm_s"]) or "cli_skipped" in startup, startup
 
 
 def test_quick_gym_benchmark_writes_positive_figures(tmp_path):
     out = tmp_path / "gym.json"
     script = SCRIPT.parent / "gym.py"
-    proc = subprocess.run([sys.executable, str(script), "--quick", "--json", str(out)],
-                          check=False, capture_output=True, text=True, timeout=600)
+    proc = subprocess.run(
+        [sys.executable, str(script), "--quick", "--json", str(out)],
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert proc.returncode == 0, proc.stderr[-2000:]
     data = json.loads(out.read_text())
     assert positive(data["fly_rate"])

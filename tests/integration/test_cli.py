@@ -19,11 +19,18 @@ def run(*args):
 
 def test_fly_prints_metrics_and_writes_the_folder(tmp_path):
     out = tmp_path / "flight"
-    res = run("fly", "step", "--duration", "4", "--out", out, "--report", tmp_path / "r.html",
-              "--animate", tmp_path / "a.gif")
+    res = run(
+        "fly", "step", "--duration", "4", "--out", out, "--report", tmp_path / "r.html", "--animate", tmp_path / "a.gif"
+    )
     assert res.exit_code == 0, res.output
     assert "nlpd on step: 4 s" in res.output and "rise_time_s" in res.output
-    assert sorted(p.name for p in out.iterdir()) == ["flight.png", "metrics.csv", "quadcruise.json", "scenario.toml", "traces.csv"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        "flight.png",
+        "metrics.csv",
+        "quadcruise.json",
+        "scenario.toml",
+        "traces.csv",
+    ]
     traces = pd.read_csv(out / "traces.csv")
     assert len(traces) == 4001 and list(traces.columns[:5]) == ["vehicle", "t", "x", "y", "z"]
     meta = json.loads((out / "quadcruise.json").read_text())
@@ -41,33 +48,52 @@ def test_fly_parquet(tmp_path):
 
 
 def test_fly_controller_options_reach_the_controller(tmp_path):
-    res = run("fly", "step", "--duration", "3", "--controller", "gonzalez", "--poles", "-1,-2",
-              "-c", "max_tilt=0.3", "-m", "size=0.5", "--out", tmp_path / "o")
+    res = run(
+        "fly",
+        "step",
+        "--duration",
+        "3",
+        "--controller",
+        "gonzalez",
+        "--poles",
+        "-1,-2",
+        "-c",
+        "max_tilt=0.3",
+        "-m",
+        "size=0.5",
+        "--out",
+        tmp_path / "o",
+    )
     assert res.exit_code == 0, res.output
     meta = json.loads((tmp_path / "o" / "quadcruise.json").read_text())
     assert meta["controller"]["position"] == {"kp": 2.0, "kd": 3.0}
     assert meta["controller"]["max_tilt"] == 0.3 and meta["mission"]["size"] == 0.5
 
 
-@pytest.mark.parametrize("args, words", [
-    (["fly", "loop"], "unknown mission 'loop'"),
-    (["fly", "circle", "--duration", "-1"], "duration must be a positive number"),
-    (["fly", "circle", "--dt", "30"], "dt (30 s) is larger than the duration (20 s)"),
-    (["fly", "circle", "--poles", "0.7,-4.3"], "pole 0.7 is not in the open left half plane"),
-    (["fly", "circle", "--poles", "fast"], "--poles 'fast': expected comma-separated poles"),
-    (["fly", "circle", "--controller", "pid"], "unknown controller 'pid'"),
-    (["fly", "circle", "-m", "radius"], "--mission-param 'radius': expected KEY=VALUE"),
-    (["fly", "circle", "-m", "radius=-2"], "circle field 'radius' (circle radius, m) must be > 0"),
-    (["fly", "circle", "--animate", "a.png"], "an animation is written as .gif or .mp4"),
-    (["fly", "circle", "--bogus"], "No such option '--bogus'"),
-    (["compare", "circle", "--controllers", "nlpd,pid"], "unknown controller 'pid'"),
-    (["fly", "hover", "--settle-band", "1.5"], "settle_bands must be one or two fractions in (0, 1)"),
-    (["compare", "hover", "--settle-band", "0.01", "--settle-band", "0.02", "--settle-band", "0.03"],
-     "settle_bands must be one or two fractions"),
-    (["fly", "hover", "--rise", "5-95"], "Invalid value for '--rise'"),
-    (["montecarlo", "--n", "3", "--require", "steady_max_error<=0.2"], "choose one of rmse_m, max_error_m, steady"),
-    (["analyze", "--poles", "0.7,-4"], "pole 0.7 is not in the open left half plane"),
-])
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["fly", "loop"], "unknown mission 'loop'"),
+        (["fly", "circle", "--duration", "-1"], "duration must be a positive number"),
+        (["fly", "circle", "--dt", "30"], "dt (30 s) is larger than the duration (20 s)"),
+        (["fly", "circle", "--poles", "0.7,-4.3"], "pole 0.7 is not in the open left half plane"),
+        (["fly", "circle", "--poles", "fast"], "--poles 'fast': expected comma-separated poles"),
+        (["fly", "circle", "--controller", "pid"], "unknown controller 'pid'"),
+        (["fly", "circle", "-m", "radius"], "--mission-param 'radius': expected KEY=VALUE"),
+        (["fly", "circle", "-m", "radius=-2"], "circle field 'radius' (circle radius, m) must be > 0"),
+        (["fly", "circle", "--animate", "a.png"], "an animation is written as .gif or .mp4"),
+        (["fly", "circle", "--bogus"], "No such option '--bogus'"),
+        (["compare", "circle", "--controllers", "nlpd,pid"], "unknown controller 'pid'"),
+        (["fly", "hover", "--settle-band", "1.5"], "settle_bands must be one or two fractions in (0, 1)"),
+        (
+            ["compare", "hover", "--settle-band", "0.01", "--settle-band", "0.02", "--settle-band", "0.03"],
+            "settle_bands must be one or two fractions",
+        ),
+        (["fly", "hover", "--rise", "5-95"], "Invalid value for '--rise'"),
+        (["montecarlo", "--n", "3", "--require", "steady_max_error<=0.2"], "choose one of rmse_m, max_error_m, steady"),
+        (["analyze", "--poles", "0.7,-4"], "pole 0.7 is not in the open left half plane"),
+    ],
+)
 def test_bad_options_are_one_line_with_status_two(args, words):
     """Through the real entry point (click's own usage errors included), as a process."""
     proc = subprocess.run([sys.executable, "-m", "quadcruise", *args], capture_output=True, text=True)
@@ -96,8 +122,22 @@ def test_fly_and_compare_take_the_metric_conventions(tmp_path):
     assert conv["settling_columns"] == {"settling_time_s": 0.03, "settling_time_5pct_s": 0.05}
     plain = run("fly", "step", "--duration", "4")
     assert plain.output != res.output and "rise_time_s: 10-90 % of the step" in plain.output
-    res = run("compare", "step", "--duration", "4", "--controllers", "nlpd,se3", "--settle-band", "0.01",
-              "--settle-band", "0.04", "--out", tmp_path / "c", "--report", tmp_path / "c.html")
+    res = run(
+        "compare",
+        "step",
+        "--duration",
+        "4",
+        "--controllers",
+        "nlpd,se3",
+        "--settle-band",
+        "0.01",
+        "--settle-band",
+        "0.04",
+        "--out",
+        tmp_path / "c",
+        "--report",
+        tmp_path / "c.html",
+    )
     assert res.exit_code == 0, res.output
     assert "settling_time_4pct_s" in res.output and "settling_time_s: 1 % band" in res.output
     assert "settling_time_4pct_s" in pd.read_csv(tmp_path / "c" / "metrics.csv").columns
@@ -121,8 +161,20 @@ def test_compare_and_analyze(tmp_path):
 
 def test_montecarlo_runs_writes_and_replays_a_case(tmp_path):
     out = tmp_path / "mc"
-    args = ["montecarlo", "-n", "6", "--duration", "2", "--mass-spread", "0.05", "--seed", "3",
-            "--scheduler", "none", "--quiet"]
+    args = [
+        "montecarlo",
+        "-n",
+        "6",
+        "--duration",
+        "2",
+        "--mass-spread",
+        "0.05",
+        "--seed",
+        "3",
+        "--scheduler",
+        "none",
+        "--quiet",
+    ]
     res = run(*args, "--out", out)
     assert res.exit_code == 0, res.output
     assert "6 flights of nlpd on circle, seed 3" in res.output
@@ -135,13 +187,28 @@ def test_montecarlo_runs_writes_and_replays_a_case(tmp_path):
     assert f"{row['rmse_m']:.4g}" in case.output
 
 
-@pytest.mark.parametrize("args, words", [
-    (["montecarlo", "-n", "0"], "the number of flights must be a whole number >= 1"),
-    (["montecarlo", "--mass-spread", "-0.1"], "'mass_spread' must be a number >= 0"),
-    (["montecarlo", "--wind", "tornado:3"], "unknown model 'tornado'"),
-    (["montecarlo", "-n", "4", "--mass-spread", "0.1", "--scheduler", "tcp://127.0.0.1:9", "--connect-timeout", "1"],
-     "scheduler"),
-])
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["montecarlo", "-n", "0"], "the number of flights must be a whole number >= 1"),
+        (["montecarlo", "--mass-spread", "-0.1"], "'mass_spread' must be a number >= 0"),
+        (["montecarlo", "--wind", "tornado:3"], "unknown model 'tornado'"),
+        (
+            [
+                "montecarlo",
+                "-n",
+                "4",
+                "--mass-spread",
+                "0.1",
+                "--scheduler",
+                "tcp://127.0.0.1:9",
+                "--connect-timeout",
+                "1",
+            ],
+            "scheduler",
+        ),
+    ],
+)
 def test_montecarlo_bad_input(tmp_path, args, words):
     res = run(*args, "--out", tmp_path / "mc")
     assert res.exit_code == 2 and words in res.output, res.output
@@ -151,26 +218,70 @@ def test_montecarlo_bad_input(tmp_path, args, words):
 
 def test_montecarlo_and_reproduce_accept_a_scenario(tmp_path):
     scen = Path(__file__).resolve().parents[2] / "examples" / "scenarios"
-    res = run("montecarlo", "--scenario", scen / "montecarlo_circle.toml", "-n", "5", "--duration", "2",
-              "--scheduler", "none", "--quiet", "--out", tmp_path / "mc")
+    res = run(
+        "montecarlo",
+        "--scenario",
+        scen / "montecarlo_circle.toml",
+        "-n",
+        "5",
+        "--duration",
+        "2",
+        "--scheduler",
+        "none",
+        "--quiet",
+        "--out",
+        tmp_path / "mc",
+    )
     assert res.exit_code == 0, res.output
-    assert "5 flights of nlpd on circle, seed 1" in res.output          # seed from [montecarlo]
+    assert "5 flights of nlpd on circle, seed 1" in res.output  # seed from [montecarlo]
     meta = json.loads((tmp_path / "mc" / "quadcruise.json").read_text())
     assert "0.1" in json.dumps(meta) and "turbulence" in json.dumps(meta)
     # an option given explicitly wins over the scenario, even when it equals the default
-    res = run("montecarlo", "--scenario", scen / "montecarlo_circle.toml", "-n", "3", "--duration", "2",
-              "--seed", "0", "--mass-spread", "0", "--scheduler", "none", "--quiet", "--worst", "0",
-              "--out", tmp_path / "mc0")
+    res = run(
+        "montecarlo",
+        "--scenario",
+        scen / "montecarlo_circle.toml",
+        "-n",
+        "3",
+        "--duration",
+        "2",
+        "--seed",
+        "0",
+        "--mass-spread",
+        "0",
+        "--scheduler",
+        "none",
+        "--quiet",
+        "--worst",
+        "0",
+        "--out",
+        tmp_path / "mc0",
+    )
     assert res.exit_code == 0, res.output
     assert "3 flights of nlpd on circle, seed 0" in res.output
     meta = json.dumps(json.loads((tmp_path / "mc0" / "quadcruise.json").read_text()))
     assert '"mass_spread": 0.0' in meta and '"inertia_spread": 0.05' in meta
     # the control period too: the scenario's unless --dt is given
     coarse = tmp_path / "coarse.toml"
-    coarse.write_text((scen / "montecarlo_circle.toml").read_text().replace("duration = 20.0", "duration = 1.0\ndt = 0.002"))
+    coarse.write_text(
+        (scen / "montecarlo_circle.toml").read_text().replace("duration = 20.0", "duration = 1.0\ndt = 0.002")
+    )
     for extra, dt in (((), 0.002), (("--dt", "0.001"), 0.001)):
-        res = run("montecarlo", "--scenario", coarse, "-n", "2", *extra, "--scheduler", "none", "--quiet",
-                  "--worst", "0", "--out", tmp_path / f"dt{dt}")
+        res = run(
+            "montecarlo",
+            "--scenario",
+            coarse,
+            "-n",
+            "2",
+            *extra,
+            "--scheduler",
+            "none",
+            "--quiet",
+            "--worst",
+            "0",
+            "--out",
+            tmp_path / f"dt{dt}",
+        )
         assert res.exit_code == 0, res.output
         assert json.loads((tmp_path / f"dt{dt}" / "quadcruise.json").read_text())["spec"]["dt"] == dt
     bad = tmp_path / "bad.toml"
@@ -180,13 +291,27 @@ def test_montecarlo_and_reproduce_accept_a_scenario(tmp_path):
     res = run("reproduce", "--scenario", scen / "light_vehicle_square.toml", "--out", tmp_path / "r")
     assert res.exit_code == 0, res.output
     assert json.loads((tmp_path / "r" / "metrics.json").read_text())["config"]["vehicle"]["m"] == 1.4
-    assert "with the scenario's vehicle and dt only; not used: [mission], [controller], [simulation] duration" \
-        in res.output                                           # not silently
+    assert (
+        "with the scenario's vehicle and dt only; not used: [mission], [controller], [simulation] duration"
+        in res.output
+    )  # not silently
 
 
 def test_compare_on_the_same_population():
-    res = run("compare", "step", "--duration", "9", "--controllers", "nlpd, gonzalez", "--population", "5",
-              "--mass-spread", "0.05", "--seed", "2")
+    res = run(
+        "compare",
+        "step",
+        "--duration",
+        "9",
+        "--controllers",
+        "nlpd, gonzalez",
+        "--population",
+        "5",
+        "--mass-spread",
+        "0.05",
+        "--seed",
+        "2",
+    )
     assert res.exit_code == 0, res.output
     assert "the same 5 perturbed vehicles (seed 2" in res.output
     table = res.output.split("perturbed vehicles")[1]

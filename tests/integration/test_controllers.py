@@ -131,10 +131,11 @@ def test_decoupling_cancels_gyroscopic_terms():
     x = np.zeros(STATE_SIZE)
     x[P], x[Q], x[R] = 2.0, -3.0, 1.5
     x[PHI], x[THETA], x[PSI] = 0.1, -0.05, 0.2
-    gains = np.array([10.0, 0.0, 0.0, 4.0, 0.0, 0.0, 1.0])   # P only: U* = Kp e
+    gains = np.array([10.0, 0.0, 0.0, 4.0, 0.0, 0.0, 1.0])  # P only: U* = Kp e
     U2, U3, U4, _ = decoupled_attitude(x, 0.3, 0.1, -0.1, vp, gains, np.zeros(ATT_MEMORY), 1e-3)
     from quadcruise.model.actuators import unmix
-    x[12:] = unmix(30.0, U2, U3, U4, vp[7])          # thrusts that realise (U1, U2, U3, U4)
+
+    x[12:] = unmix(30.0, U2, U3, U4, vp[7])  # thrusts that realise (U1, U2, U3, U4)
     dx = np.empty(STATE_SIZE)
     derivative(x, x[12:] / vp[5], vp, still_air_ext(), False, dx)
     assert dx[P] == pytest.approx(10.0 * (0.3 - 0.1))
@@ -192,7 +193,7 @@ def test_circle_is_tracked_after_the_transient():
     assert err.max() < 0.1
     ff = qc.fly(Circle(), NLPD(accel_feedforward=True), duration=40.0)
     err_ff = np.linalg.norm(ff.states[0, late, :3] - ref[late], axis=1)
-    assert err_ff.max() < err.max() / 3     # feedforward removes most of the steady lag
+    assert err_ff.max() < err.max() / 3  # feedforward removes most of the steady lag
 
 
 def test_batch_with_per_vehicle_parameters_equals_single_flights():
@@ -226,8 +227,7 @@ def test_diverging_flight_warns_and_stops():
     g = attitude_pid_design()
     weak = NLPD(attitude=PIDGains(kp=g.kp / 200, ki=g.ki / 200, kd=g.kd / 200))
     with pytest.warns(UserWarning, match="diverged: position left the bound at t = "):
-        res = qc.fly(Step(axis="x", size=1.0, time=0.1), weak, duration=20.0,
-                     limits=qc.Limits(max_position=100.0))
+        res = qc.fly(Step(axis="x", size=1.0, time=0.1), weak, duration=20.0, limits=qc.Limits(max_position=100.0))
     assert not res.ok[0] and res.t_stop[0] < 20.0
     assert res.metrics().iloc[0].status.startswith("diverged")
 
@@ -244,4 +244,3 @@ def test_compiled_controller_makes_no_reference_count_calls(name):
 
     calls = reference_count_calls(controller_from_name(name).function.py_func, CONTROLLER_SIG)
     assert calls == []
-

@@ -74,15 +74,25 @@ def open_loop(vehicle, env, n=1, duration=10.0, dt=0.01, limits=None):
     gains = pack_schedule(grid[[0, -1]], np.full((2, 4), float(V.hover_duty)))
     x0 = np.zeros((n, STATE_SIZE))
     x0[:, F1:] = V.m * V.g / 4
-    return grid, qc.simulate(grid, x0, vehicle.rows(n), duty_schedule, gains, no_reference, np.zeros(1),
-                             memory=np.zeros(1), limits=limits, **env.kwargs(n))
+    return grid, qc.simulate(
+        grid,
+        x0,
+        vehicle.rows(n),
+        duty_schedule,
+        gains,
+        no_reference,
+        np.zeros(1),
+        memory=np.zeros(1),
+        limits=limits,
+        **env.kwargs(n),
+    )
 
 
 # --- constant wind -----------------------------------------------------------------------
 def test_constant_wind_with_linear_drag_gives_the_exponential_approach():
     c = 1.5
     grid, res = open_loop(V.replace(drag_linear=c), Environment(wind=ConstantWind((3.0, -1.0, 0.0))))
-    lag = 1 - np.exp(-c * grid / V.m)             # vx' = c (w - vx) / m
+    lag = 1 - np.exp(-c * grid / V.m)  # vx' = c (w - vx) / m
     np.testing.assert_allclose(res.states[0, :, VX], 3.0 * lag, atol=1e-6)
     np.testing.assert_allclose(res.states[0, :, VY], -1.0 * lag, atol=1e-6)
 
@@ -106,7 +116,7 @@ def test_empty_environment_is_still_air_bit_for_bit():
 
 def test_external_force_and_torque():
     out = ext_history(Environment(force=ExternalForce((1.0, 2.0, 3.0), (0.1, 0.2, 0.3))), [0.0], 0.01)[0, 0]
-    np.testing.assert_array_equal(out[EXT_FX:EXT_TX + 3], [1, 2, 3, 0.1, 0.2, 0.3])
+    np.testing.assert_array_equal(out[EXT_FX : EXT_TX + 3], [1, 2, 3, 0.1, 0.2, 0.3])
     np.testing.assert_array_equal(out[EXT_E1:], 1.0)
 
 
@@ -115,7 +125,7 @@ def test_gust_follows_one_minus_cosine_at_the_sample_times():
     dt, amp, start, dur = 0.01, np.array([2.0, -1.0, 0.5]), 5.0, 2.0
     env = Environment(wind=ConstantWind((1.0, 0.0, 0.0)), gust=Gust(amp, start=start, duration=dur))
     t = np.arange(0.0, 10.0, dt)
-    wind = ext_history(env, t, dt)[0, :, EXT_WX:EXT_WX + 3]
+    wind = ext_history(env, t, dt)[0, :, EXT_WX : EXT_WX + 3]
     s = t - start
     shape = np.where((s >= 0) & (s <= dur), 0.5 * (1 - np.cos(2 * np.pi * s / dur)), 0.0)
     np.testing.assert_allclose(wind, [1.0, 0.0, 0.0] + shape[:, None] * amp, atol=1e-12)
@@ -138,12 +148,12 @@ def test_gust_pushes_a_vehicle_with_drag_as_the_held_wind_predicts():
 
 # --- Dryden turbulence -------------------------------------------------------------------
 def test_dryden_intensities_and_scales_follow_mil_f_8785c():
-    tb = Turbulence(intensity="moderate", altitude=100 * 0.3048)     # h = 100 ft
+    tb = Turbulence(intensity="moderate", altitude=100 * 0.3048)  # h = 100 ft
     q = 0.177 + 0.000823 * 100
     su, sv, sw = tb.sigmas()
-    assert sw == pytest.approx(0.1 * 30 * 0.514444) and su == sv == pytest.approx(sw / q ** 0.4)
+    assert sw == pytest.approx(0.1 * 30 * 0.514444) and su == sv == pytest.approx(sw / q**0.4)
     lu, lv, lw = tb.scales()
-    assert lu == lv == pytest.approx(100 / q ** 1.2 * 0.3048) and lw == pytest.approx(30.48)
+    assert lu == lv == pytest.approx(100 / q**1.2 * 0.3048) and lw == pytest.approx(30.48)
     assert Turbulence(w20=10.0).sigmas()[2] == pytest.approx(1.0)
     assert Turbulence(altitude=1.0).scales()[2] == pytest.approx(3.048)  # 10 ft floor
     assert Turbulence(airspeed=0.0).time_constants()[2] == pytest.approx(10.0 / 0.5)  # speed floor
@@ -159,14 +169,14 @@ def test_lateral_filter_discretisation_is_exact(a):
     P = np.array([[0.5, 0.25], [0.25, 0.25]])
     np.testing.assert_allclose(phi @ P @ phi.T + low @ low.T, P, rtol=0, atol=1e-14)
     # and the noise covariance is int_0^a e^-2u [1 u; u u^2] du (checked by quadrature)
-    q = [quad(lambda u: math.exp(-2 * u) * u ** k, 0, a, epsabs=0, epsrel=1e-13)[0] for k in range(3)]
-    np.testing.assert_allclose([l11 ** 2, l11 * l21, l21 ** 2 + l22 ** 2], q, rtol=1e-9, atol=0)
-    assert l22 ** 2 == pytest.approx(q[2] - q[1] ** 2 / q[0], rel=1e-7)      # a^3/12 for small a
+    q = [quad(lambda u: math.exp(-2 * u) * u**k, 0, a, epsabs=0, epsrel=1e-13)[0] for k in range(3)]  # noqa: B023 - called here
+    np.testing.assert_allclose([l11**2, l11 * l21, l21**2 + l22**2], q, rtol=1e-9, atol=0)
+    assert l22**2 == pytest.approx(q[2] - q[1] ** 2 / q[0], rel=1e-7)  # a^3/12 for small a
 
 
 def test_dryden_output_has_the_specified_sigmas_and_correlations():
     tb = Turbulence(intensity="moderate", altitude=10.0, airspeed=10.0)
-    dt, n, steps = 0.05, 16, 200_000                 # 16 x 1e4 s: ~2e4 correlation times of w
+    dt, n, steps = 0.05, 16, 200_000  # 16 x 1e4 s: ~2e4 correlation times of w
     w = wind_run(Environment(turbulence=tb), n, steps, dt, seed=3)
     np.testing.assert_allclose(w.std(axis=(0, 1)), tb.sigmas(), rtol=0.02)
     assert np.all(np.abs(w.mean(axis=(0, 1))) < 0.05 * np.array(tb.sigmas()))
@@ -175,7 +185,7 @@ def test_dryden_output_has_the_specified_sigmas_and_correlations():
         for tau in (0.5 * T, T, 1.5 * T):
             lag = round(tau / dt)
             r = (y[:, :-lag, ax] * y[:, lag:, ax]).mean() / (y[:, :, ax] ** 2).mean()
-            s = lag * dt / T                             # V tau / L
+            s = lag * dt / T  # V tau / L
             expected = math.exp(-s) if ax == 0 else (1 - s / 2) * math.exp(-s)
             assert r == pytest.approx(expected, abs=0.02), (ax, tau)
 
@@ -202,7 +212,7 @@ def test_turbulence_is_seeded_per_vehicle_and_independent_of_the_batching():
     np.testing.assert_array_equal(part.disturbance_memory, a.disturbance_memory[2:])
     assert not np.allclose(a.states[0, :, X], a.states[1, :, X])
     assert not np.allclose(flight(seed=6).states[0, :, X], a.states[0, :, X])
-    assert np.abs(a.states[:, -1, X:Z] - 0.0).max() > 1e-3     # the wind moved them
+    assert np.abs(a.states[:, -1, X:Z] - 0.0).max() > 1e-3  # the wind moved them
     # the same holds for the wind itself
     w = wind_run(env, 4, 500, 0.01, seed=5)
     np.testing.assert_array_equal(wind_run(env, 2, 500, 0.01, seed=5, first=2), w[2:])
@@ -216,13 +226,13 @@ def test_nlpd_survives_moderate_turbulence_on_the_circle():
     assert res.ok.all() and res.duty_clipped_s.max() == 0
 
     def error(r):
-        late = r.t > 10.0                              # after the 2 m start-up step
+        late = r.t > 10.0  # after the 2 m start-up step
         return np.linalg.norm(r.states[:, late, :3] - r.references[:, late, :3], axis=2)
 
     e, e0 = error(res), error(calm)
-    assert e.max() < 1.0                              # bounded (measured ~0.53 m)
-    assert np.sqrt((e ** 2).mean()) < 0.4             # measured ~0.25 m rms
-    assert e.max() > 3 * e0.max()                     # and the turbulence really acts (calm: 0.06 m)
+    assert e.max() < 1.0  # bounded (measured ~0.53 m)
+    assert np.sqrt((e**2).mean()) < 0.4  # measured ~0.25 m rms
+    assert e.max() > 3 * e0.max()  # and the turbulence really acts (calm: 0.06 m)
     assert np.abs(res.states[:, :, [PHI, THETA]]).max() < np.radians(45)
 
 
@@ -236,8 +246,12 @@ def test_rotor_loss_changes_effectiveness_at_exactly_its_time():
         np.testing.assert_array_equal(np.delete(e[i], rotor, axis=1), 1.0)
     # through the engine: the thrust leaves the hover value right after t = 0.5 s
     # open loop the vehicle tumbles past 90 degrees (diverged by default): let it, to read the thrusts
-    grid, res = open_loop(V, Environment(rotor_loss=RotorLoss(rotor=2, fraction=0.3, time=0.5)), duration=3.0,
-                          limits=qc.Limits(max_tilt=np.inf))
+    grid, res = open_loop(
+        V,
+        Environment(rotor_loss=RotorLoss(rotor=2, fraction=0.3, time=0.5)),
+        duration=3.0,
+        limits=qc.Limits(max_tilt=np.inf),
+    )
     F2, k = res.states[0, :, F1 + 1], 50
     assert F2[k] == pytest.approx(V.m * V.g / 4, rel=1e-12) and F2[k + 1] < F2[k] * 0.99
     assert res.states[0, -1, F1] == pytest.approx(V.m * V.g / 4, rel=1e-12)
@@ -254,12 +268,12 @@ def test_nlpd_hover_after_losing_30_percent_of_rotor_1():
     s, t = res.states[0], res.t
     assert res.ok.all() and res.duty_clipped_s[0] == 0
     np.testing.assert_array_equal(s[t <= 5.0, :3], [[0.0, 0.0, 1.0]] * np.count_nonzero(t <= 5.0))
-    assert np.abs(s[-1, PHI:PSI + 1]).max() < 1e-4                     # attitude and yaw held
-    assert np.degrees(np.abs(s[t > 5, THETA]).max()) < 20               # transient ~15 deg
-    assert np.degrees(np.abs(s[t > 5, PSI]).max()) < 5                  # ~2.3 deg of yaw
+    assert np.abs(s[-1, PHI : PSI + 1]).max() < 1e-4  # attitude and yaw held
+    assert np.degrees(np.abs(s[t > 5, THETA]).max()) < 20  # transient ~15 deg
+    assert np.degrees(np.abs(s[t > 5, PSI]).max()) < 5  # ~2.3 deg of yaw
     assert s[-1, X] == pytest.approx(-0.79, abs=0.02) and abs(s[-1, Y]) < 1e-3
     assert 1.0 - s[-1, Z] == pytest.approx(0.35, abs=0.02)
-    assert res.controller_limited_s[0] > 20                             # integrator held
+    assert res.controller_limited_s[0] > 20  # integrator held
     wide = qc.fly(Hover(), qc.control.NLPD(i_limit=30.0), duration=30.0, environment=env)
     assert abs(wide.final_state[0, X]) < 1e-3 and 1.0 - wide.final_state[0, Z] == pytest.approx(0.35, abs=0.02)
 
@@ -273,8 +287,9 @@ def test_sensor_noise_vector_and_delay():
     assert sn.kwargs(1e-3)["sensor_delay"] == 5
     batch = SensorNoise(position_std=np.array([0.0, 0.1, 0.2])).std_vector()
     assert batch.shape == (3, STATE_SIZE) and batch[2, Z] == 0.2
-    res = qc.fly("hover", n=3, duration=1.0, seed=2,
-                 sensors=SensorNoise(position_std=np.array([0.0, 0.1, 0.2]), delay=0.005))
+    res = qc.fly(
+        "hover", n=3, duration=1.0, seed=2, sensors=SensorNoise(position_std=np.array([0.0, 0.1, 0.2]), delay=0.005)
+    )
     assert res.ok.all()
     # a delay is a time: 4 ms is 2 periods at dt = 2 ms
     assert SensorNoise(delay=0.004).kwargs(2e-3)["sensor_delay"] == 2
@@ -286,11 +301,14 @@ def test_sensor_noise_vector_and_delay():
 
 def test_with_drag_fills_only_drag_free_vehicles_and_warns_only_when_asked():
     with warnings.catch_warnings():
-        warnings.simplefilter("error")                  # asked for on purpose: no warning
+        warnings.simplefilter("error")  # asked for on purpose: no warning
         v = with_drag(V)
-    with pytest.warns(UserWarning, match="the vehicle has no drag, and wind acts only through drag: it flies with "
-                                         "DEFAULT_DRAG, drag_linear 0.3 N s/m"):
-        with_drag(V, warn=True)                         # a workflow's own choice: said
+    with pytest.warns(
+        UserWarning,
+        match="the vehicle has no drag, and wind acts only through drag: it flies with "
+        "DEFAULT_DRAG, drag_linear 0.3 N s/m",
+    ):
+        with_drag(V, warn=True)  # a workflow's own choice: said
     assert (v.drag_linear, v.drag_quadratic) == (DEFAULT_DRAG["drag_linear"], DEFAULT_DRAG["drag_quadratic"])
     assert DEFAULT_DRAG["drag_quadratic"] == pytest.approx(0.06, abs=0.005)
     with warnings.catch_warnings():
@@ -322,18 +340,21 @@ def test_parse_wind_grammar_and_round_trip():
     assert not np.allclose(res.states[0, :, X], res.states[1, :, X])
 
 
-@pytest.mark.parametrize("spec, match", [
-    ("breeze:1,2,3", "unknown model 'breeze'"),
-    ("constant:3,0", "needs 3 values"),
-    ("constant:a,b,c", "must be numbers"),
-    ("gust:2,0,0@5+-2", "'duration'"),
-    ("gust:2,0,0@5", "expected gust:"),
-    ("dryden:hurricane@10", "LEVEL"),
-    ("dryden:moderate@500", "'altitude'"),
-    ("loss:5,0.3@1", "'rotor'"),
-    ("loss:1,1.3@1", "'fraction'"),
-    ("constant:1,0,0,wind:2,0,0", "a second"),
-])
+@pytest.mark.parametrize(
+    "spec, match",
+    [
+        ("breeze:1,2,3", "unknown model 'breeze'"),
+        ("constant:3,0", "needs 3 values"),
+        ("constant:a,b,c", "must be numbers"),
+        ("gust:2,0,0@5+-2", "'duration'"),
+        ("gust:2,0,0@5", "expected gust:"),
+        ("dryden:hurricane@10", "LEVEL"),
+        ("dryden:moderate@500", "'altitude'"),
+        ("loss:5,0.3@1", "'rotor'"),
+        ("loss:1,1.3@1", "'fraction'"),
+        ("constant:1,0,0,wind:2,0,0", "a second"),
+    ],
+)
 def test_parse_wind_rejects_bad_specs_in_one_line(spec, match):
     with pytest.raises(qc.InputError, match=match) as err:
         parse_wind(spec)
@@ -353,8 +374,10 @@ def test_bad_inputs_name_the_field():
         (lambda: RotorLoss(fraction=-0.1), "'fraction'"),
         (lambda: SensorNoise(rate_std=-1.0), "'rate_std'"),
         (lambda: Environment(wind=Gust()), "'wind'"),
-        (lambda: Environment(wind=ConstantWind((np.ones(3), 0, 0)), gust=Gust(start=np.ones(2))).params(),
-         "batch lengths"),
+        (
+            lambda: Environment(wind=ConstantWind((np.ones(3), 0, 0)), gust=Gust(start=np.ones(2))).params(),
+            "batch lengths",
+        ),
         (lambda: Environment(wind=ConstantWind((np.ones(3), 0, 0))).params(4), "3 values but 4"),
         (lambda: wind_from_name("tornado"), "unknown disturbance"),
         (lambda: wind_from_name("gust", length=3.0), "gust"),
@@ -368,13 +391,14 @@ def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
     """The turbulence's normals are rng.next_normal's on the vehicle's scalar SplitMix64 state."""
     from quadcruise.sim.fastmath import five_normals
     from quadcruise.sim.rng import _GOLDEN, next_normal, next_unit, uniform
+
     state = vehicle_states(4, 1)[0]
     s0 = int(state[0])
     expected = [uniform(state) for _ in range(3)]
     got, s = [], np.uint64(s0)
     for _ in range(3):
         u, s_next = next_unit(s)
-        assert int(s_next) == (int(s) + int(_GOLDEN)) % 2 ** 64
+        assert int(s_next) == (int(s) + int(_GOLDEN)) % 2**64
         got.append(u)
         s = np.uint64(s_next)
     assert got == expected
@@ -382,7 +406,7 @@ def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
     one_by_one, s = [], np.uint64(s0)
     for _ in range(5):
         x, s = next_normal(s)
-        s = np.uint64(s)                 # back from Python: keep the state unsigned
+        s = np.uint64(s)  # back from Python: keep the state unsigned
         one_by_one.append(x)
     assert five == one_by_one and s_after == s != s0
 
@@ -392,6 +416,7 @@ def test_dryden_coefficients_follow_the_period_but_not_its_rounding():
     (2 ms after 1 ms) recomputes them, as the exact discretisation of the new a = dt / T."""
     from quadcruise.disturbances.environment import _CU, _CV, _MDT
     from quadcruise.sim.fastmath import DT_TOLERANCE
+
     tb = Turbulence(intensity="moderate", altitude=10.0, airspeed=5.0)
     env = Environment(turbulence=tb)
     dp, dm, rng = env.params(1)[0], env.memory(1)[0], vehicle_states(1, 1)[0]
@@ -403,7 +428,7 @@ def test_dryden_coefficients_follow_the_period_but_not_its_rounding():
     env.function(2e-3, 2e-3, x, dp, dm, rng, ext)
     T_u, T_v = tb.time_constants()[:2]
     assert dm[_MDT] == 2e-3 and dm[_CU] == pytest.approx(math.exp(-2e-3 / T_u), rel=1e-15)
-    np.testing.assert_allclose(dm[_CV:_CV + 5], _lateral_coefficients(2e-3 / T_v), rtol=1e-15)
+    np.testing.assert_allclose(dm[_CV : _CV + 5], _lateral_coefficients(2e-3 / T_v), rtol=1e-15)
     assert 1e-11 < DT_TOLERANCE < 1e-3
 
 

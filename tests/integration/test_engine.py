@@ -30,8 +30,14 @@ def solve_ivp_replay(schedule, **vehicle):
     out = [x.copy()]
     for k in range(len(schedule.t) - 1):
         u = schedule.duties[k]
-        sol = solve_ivp(lambda _t, s: rhs(s, u, **vehicle), (schedule.t[k], schedule.t[k + 1]), x,
-                        method="DOP853", rtol=1e-10, atol=1e-12)
+        sol = solve_ivp(
+            lambda _t, s: rhs(s, u, **vehicle),  # noqa: B023 - called here
+            (schedule.t[k], schedule.t[k + 1]),
+            x,
+            method="DOP853",
+            rtol=1e-10,
+            atol=1e-12,
+        )
         x = sol.y[:, -1]
         out.append(x.copy())
     return np.array(out)
@@ -65,12 +71,14 @@ def test_turned_angles_equal_the_library_sine_and_cosine():
 
     rng = np.random.default_rng(3)
     worst = 0.0
-    for a, d in zip(rng.uniform(-4.0, 4.0, 2000), rng.uniform(-SMALL_TURN, SMALL_TURN, 2000) ** 3 / SMALL_TURN ** 2):
+    for a, d in zip(
+        rng.uniform(-4.0, 4.0, 2000), rng.uniform(-SMALL_TURN, SMALL_TURN, 2000) ** 3 / SMALL_TURN**2, strict=False
+    ):
         s, c = turned(a + d, math.sin(a), math.cos(a), d)
         worst = max(worst, abs(s - math.sin(a + d)), abs(c - math.cos(a + d)))
     assert worst < 5e-16, worst
-    for d in (SMALL_TURN, -SMALL_TURN, SHORT_TURN, -SHORT_TURN):   # each series' edge: its
-        s, c = turned(1.0 + d, math.sin(1.0), math.cos(1.0), d)   # largest truncation
+    for d in (SMALL_TURN, -SMALL_TURN, SHORT_TURN, -SHORT_TURN):  # each series' edge: its
+        s, c = turned(1.0 + d, math.sin(1.0), math.cos(1.0), d)  # largest truncation
         assert abs(s - math.sin(1.0 + d)) < 5e-16 and abs(c - math.cos(1.0 + d)) < 5e-16
     # a larger turn than the series covers: the library's values exactly
     assert turned(2.5, 0.0, 1.0, 0.5) == (math.sin(2.5), math.cos(2.5))
@@ -88,15 +96,15 @@ def test_rk4_step_equals_four_plain_derivative_calls():
 
     vp = V.rows(1)[0]
     ext = np.zeros(EXT_SIZE)
-    ext[EXT_E1:EXT_E1 + 4] = 1.0
+    ext[EXT_E1 : EXT_E1 + 4] = 1.0
     u = np.array([0.9, 0.1, 0.6, 0.3])
-    for rates in ((0.3, -0.2, 0.1), (40.0, -25.0, 3.0)):          # slow turns, and a tumble
+    for rates in ((0.3, -0.2, 0.1), (40.0, -25.0, 3.0)):  # slow turns, and a tumble
         x = np.zeros(STATE_SIZE)
-        x[PHI:PHI + 3], x[P:P + 3], x[F1:] = (0.2, -0.4, 2.0), rates, 5.0
+        x[PHI : PHI + 3], x[P : P + 3], x[F1:] = (0.2, -0.4, 2.0), rates, 5.0
         y, h, k = x.copy(), 2e-3, [np.empty(STATE_SIZE) for _ in range(4)]
         work = np.empty((WORK_ROWS, STATE_SIZE))
         for i in range(200):
-            rk4_step(x, u, vp, ext, True, h, work, i == 0)        # trig computed afresh once
+            rk4_step(x, u, vp, ext, True, h, work, i == 0)  # trig computed afresh once
             derivative(y, u, vp, ext, True, k[0])
             derivative(y + 0.5 * h * k[0], u, vp, ext, True, k[1])
             derivative(y + 0.5 * h * k[1], u, vp, ext, True, k[2])
@@ -127,8 +135,7 @@ def test_batched_initial_states_and_schedules_through_simulate():
     x0 = np.zeros((3, STATE_SIZE))
     x0[:, F1:] = V.K * schedule.duties[0]
     x0[:, X] = [0.0, 1.0, -2.0]
-    res = qc.simulate(schedule.t, x0, V.rows(3), duty_schedule, gains, no_reference, np.zeros(1),
-                      memory=np.zeros(1))
+    res = qc.simulate(schedule.t, x0, V.rows(3), duty_schedule, gains, no_reference, np.zeros(1), memory=np.zeros(1))
     np.testing.assert_allclose(res.states[1, :, X] - res.states[0, :, X], 1.0, atol=1e-12)
     np.testing.assert_allclose(res.states[2, :, X] - res.states[0, :, X], -2.0, atol=1e-12)
 
@@ -157,8 +164,8 @@ def test_divergence_stops_the_vehicle_and_says_why_and_when():
     assert 0 < res.t_stop[0] < 10
     assert "body rate" in res.status_text(0) and "t = " in res.status_text(0)
     stop = np.searchsorted(res.t, res.t_stop[0])
-    assert np.all(np.isnan(res.states[0, stop + 1:]))
-    assert np.all(np.isfinite(res.states[0, :stop + 1]))
+    assert np.all(np.isnan(res.states[0, stop + 1 :]))
+    assert np.all(np.isfinite(res.states[0, : stop + 1]))
 
 
 @pytest.mark.parametrize("log_every", [1, 3])
@@ -170,21 +177,36 @@ def test_rows_after_a_stop_are_nan_and_the_rest_of_the_batch_flies_on(log_every)
     mission = qc.missions.Hover()
     x0 = qc.workflows.fly.hover_state(V, 2, mission)
     gains = np.stack([pack_schedule(t, spin), pack_schedule(t, hover)])
-    res = qc.simulate(grid, x0, V.rows(2), duty_schedule, gains, mission.function, mission.params(),
-                      memory=np.zeros(1), log_every=log_every, limits=qc.Limits(max_rate=50.0))
+    res = qc.simulate(
+        grid,
+        x0,
+        V.rows(2),
+        duty_schedule,
+        gains,
+        mission.function,
+        mission.params(),
+        memory=np.zeros(1),
+        log_every=log_every,
+        limits=qc.Limits(max_rate=50.0),
+    )
     assert list(res.ok) == [False, True]
-    last = int(np.searchsorted(res.t, res.t_stop[0], side="right"))   # rows up to the stop
+    last = int(np.searchsorted(res.t, res.t_stop[0], side="right"))  # rows up to the stop
     for log in (res.states, res.commands[..., :4], res.references):
         assert np.all(np.isnan(log[0, last:]))
         assert np.all(np.isfinite(log[1]))
-    assert np.all(np.isfinite(res.commands[0, :last - 1, :4]))
-    assert np.all(np.isfinite(res.states[0, :last - 1]))
+    assert np.all(np.isfinite(res.commands[0, : last - 1, :4]))
+    assert np.all(np.isfinite(res.states[0, : last - 1]))
 
 
-@pytest.mark.parametrize("limit, status", [
-    (dict(max_position=0.5), 2), (dict(max_speed=0.3), 3), (dict(max_rate=0.05), 4),
-    (dict(max_tilt=0.01), 5),
-])
+@pytest.mark.parametrize(
+    "limit, status",
+    [
+        (dict(max_position=0.5), 2),
+        (dict(max_speed=0.3), 3),
+        (dict(max_rate=0.05), 4),
+        (dict(max_tilt=0.01), 5),
+    ],
+)
 def test_each_bound_stops_the_flight_with_its_own_status(limit, status):
     with pytest.warns(UserWarning, match="diverged"):
         res = qc.fly("step", duration=5.0, limits=qc.Limits(**limit))
@@ -219,7 +241,7 @@ def test_threads_and_pieces_do_not_change_a_batch():
     from quadcruise.sim import engine
 
     masses = np.linspace(3.0, 4.0, 37)
-    drag = dict(drag_linear=0.1, drag_quadratic=0.05)         # so that the turbulence acts
+    drag = dict(drag_linear=0.1, drag_quadratic=0.05)  # so that the turbulence acts
     vehicle = qc.Vehicle(m=masses, **drag)
     env = Environment(turbulence=Turbulence(intensity="severe", altitude=10.0))
     noise = SensorNoise(position_std=1e-3, velocity_std=1e-3, angle_std=1e-3, rate_std=1e-3)
@@ -256,8 +278,9 @@ def test_nonfinite_controller_command_stops_cleanly():
         for j in range(4):
             cmd[j] = np.nan if t >= 0.5 else 0.1
 
-    res = qc.simulate(np.linspace(0, 1, 11), np.zeros(STATE_SIZE), V.rows(), broken, np.zeros(0),
-                      no_reference, np.zeros(1))
+    res = qc.simulate(
+        np.linspace(0, 1, 11), np.zeros(STATE_SIZE), V.rows(), broken, np.zeros(0), no_reference, np.zeros(1)
+    )
     assert res.status[0] == 6 and res.t_stop[0] == pytest.approx(0.5)
     assert "non-finite command" in res.status_text(0)
 
@@ -272,22 +295,35 @@ def test_user_controller_plugs_in_and_engine_clips_and_reports_duties():
         for j in range(4):
             cmd[j] = 1.5
 
-    res = qc.simulate(np.linspace(0, 1, 101), np.zeros(STATE_SIZE), V.rows(), too_much, np.zeros(0),
-                      no_reference, np.zeros(1))
+    res = qc.simulate(
+        np.linspace(0, 1, 101), np.zeros(STATE_SIZE), V.rows(), too_much, np.zeros(0), no_reference, np.zeros(1)
+    )
     assert res.duty_clipped_s[0] == pytest.approx(1.0)
-    assert res.final_state[0, F1] < V.K * 1.0 + 1e-9   # the plant saw duty 1, not 1.5
+    assert res.final_state[0, F1] < V.K * 1.0 + 1e-9  # the plant saw duty 1, not 1.5
 
 
-@pytest.mark.parametrize("kwargs, words", [
-    ({"max_step": 0.0}, "max_step"),
-    ({"log_every": 0}, "log_every"),
-])
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        ({"max_step": 0.0}, "max_step"),
+        ({"log_every": 0}, "log_every"),
+    ],
+)
 def test_bad_engine_options(kwargs, words):
     schedule = wobbly_schedule(duration=0.2)
     gains = pack_schedule(schedule.t, schedule.duties)
     with pytest.raises(qc.InputError, match=words):
-        qc.simulate(schedule.t, np.zeros(STATE_SIZE), V.rows(), duty_schedule, gains, no_reference,
-                    np.zeros(1), memory=np.zeros(1), **kwargs)
+        qc.simulate(
+            schedule.t,
+            np.zeros(STATE_SIZE),
+            V.rows(),
+            duty_schedule,
+            gains,
+            no_reference,
+            np.zeros(1),
+            memory=np.zeros(1),
+            **kwargs,
+        )
 
 
 def test_time_grid():

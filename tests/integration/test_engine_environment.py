@@ -1,7 +1,6 @@
 """The engine's environment: sensor delay and noise, model error, wind through drag,
 rotor damage, and the full-kinematics plant."""
 
-
 import numpy as np
 import pytest
 from numba import njit
@@ -64,7 +63,7 @@ def hover_x0(n=1):
 def probe(n=1, **kw):
     grid = qc.time_grid(1.0, 0.01)
     x0 = hover_x0(n)
-    x0[:, VX] = 1.0                       # drift at 1 m/s so that delays show
+    x0[:, VX] = 1.0  # drift at 1 m/s so that delays show
     return qc.simulate(grid, x0, V.rows(n), hover_probe, np.zeros(0), no_reference, np.zeros(1), **kw)
 
 
@@ -72,7 +71,7 @@ def test_sensor_delay_shows_the_state_d_periods_late():
     res = probe(sensor_delay=3)
     seen, true = res.commands[0, :, CMD_PHI_D], res.states[0, :, X]
     np.testing.assert_allclose(seen[3:], true[:-3], atol=1e-12)
-    np.testing.assert_allclose(seen[:3], true[0], atol=1e-12)    # before that: the start
+    np.testing.assert_allclose(seen[:3], true[0], atol=1e-12)  # before that: the start
 
 
 def test_sensor_noise_has_its_std_and_depends_only_on_seed_and_vehicle():
@@ -119,14 +118,34 @@ def test_wind_acts_through_drag_and_damaged_rotor_loses_thrust():
     h = float(V.hover_duty)
     gains = pack_schedule(grid[[0, -1]], np.full((2, 4), h))
     vehicle = V.replace(drag_linear=1.5)
-    res = qc.simulate(grid, hover_x0(), vehicle.rows(), duty_schedule, gains, no_reference, np.zeros(1),
-                      memory=np.zeros(1), disturbance=wind_and_damage, disturbance_params=[3.0, 1.0])
+    res = qc.simulate(
+        grid,
+        hover_x0(),
+        vehicle.rows(),
+        duty_schedule,
+        gains,
+        no_reference,
+        np.zeros(1),
+        memory=np.zeros(1),
+        disturbance=wind_and_damage,
+        disturbance_params=[3.0, 1.0],
+    )
     # open loop, level: vx' = c (w - vx) / m, so vx = w (1 - exp(-c t / m))
     expected = 3.0 * (1 - np.exp(-1.5 * grid / V.m))
     np.testing.assert_allclose(res.states[0, :, VX], expected, atol=1e-6)
-    damaged = qc.simulate(grid, hover_x0(), V.rows(), duty_schedule, gains, no_reference, np.zeros(1),
-                          memory=np.zeros(1), disturbance=wind_and_damage, disturbance_params=[0.0, 0.6],
-                          limits=qc.Limits(max_tilt=np.inf))     # open loop it tumbles: let it, to read the thrust
+    damaged = qc.simulate(
+        grid,
+        hover_x0(),
+        V.rows(),
+        duty_schedule,
+        gains,
+        no_reference,
+        np.zeros(1),
+        memory=np.zeros(1),
+        disturbance=wind_and_damage,
+        disturbance_params=[0.0, 0.6],
+        limits=qc.Limits(max_tilt=np.inf),
+    )  # open loop it tumbles: let it, to read the thrust
     assert damaged.final_state[0, F1] == pytest.approx(0.6 * V.K * h, rel=1e-6)
     assert damaged.final_state[0, F1 + 1] == pytest.approx(V.K * h, rel=1e-6)
 
@@ -137,14 +156,24 @@ def test_full_kinematics_agree_with_a_rotation_matrix_integration():
     J = np.array([0.02, 0.03, 0.05])
     vehicle = qc.Vehicle(Jxx=J[0], Jyy=J[1], Jzz=J[2], g=0.0)
     w0 = np.array([0.3, -0.2, 0.4])
-    att0 = np.array([0.1, -0.2, 0.3])            # phi, theta, psi
+    att0 = np.array([0.1, -0.2, 0.3])  # phi, theta, psi
     t = np.linspace(0.0, 3.0, 31)
     x0 = np.zeros(STATE_SIZE)
-    x0[PHI:PSI + 1] = att0
-    x0[P:R + 1] = w0
+    x0[PHI : PSI + 1] = att0
+    x0[P : R + 1] = w0
     sched = pack_schedule(t[[0, -1]], np.zeros((2, 4)))
-    res = qc.simulate(t, x0, vehicle.rows(), duty_schedule, sched, no_reference, np.zeros(1),
-                      memory=np.zeros(1), full_dynamics=True, max_step=1e-3)
+    res = qc.simulate(
+        t,
+        x0,
+        vehicle.rows(),
+        duty_schedule,
+        sched,
+        no_reference,
+        np.zeros(1),
+        memory=np.zeros(1),
+        full_dynamics=True,
+        max_step=1e-3,
+    )
 
     def rhs(_t, s):
         Rm, w = s[:9].reshape(3, 3), s[9:]
@@ -155,12 +184,13 @@ def test_full_kinematics_agree_with_a_rotation_matrix_integration():
     R0 = Rotation.from_euler("ZYX", att0[::-1]).as_matrix()
     sol = solve_ivp(rhs, (0, 3), np.concatenate([R0.ravel(), w0]), t_eval=t, rtol=1e-11, atol=1e-12)
     angles = Rotation.from_matrix(sol.y[:9].T.reshape(-1, 3, 3)).as_euler("ZYX")[:, ::-1]
-    np.testing.assert_allclose(res.states[0, :, PHI:PSI + 1], angles, atol=1e-7)
-    np.testing.assert_allclose(res.states[0, :, P:R + 1], sol.y[9:].T, atol=1e-8)
+    np.testing.assert_allclose(res.states[0, :, PHI : PSI + 1], angles, atol=1e-7)
+    np.testing.assert_allclose(res.states[0, :, P : R + 1], sol.y[9:].T, atol=1e-8)
     # the paper's kinematics (phi' = p, ...) do not: the simplification is visible here
-    paper = qc.simulate(t, x0, vehicle.rows(), duty_schedule, sched, no_reference, np.zeros(1),
-                        memory=np.zeros(1), max_step=1e-3)
-    assert np.max(np.abs(paper.states[0, :, PHI:PSI + 1] - angles)) > 1e-2
+    paper = qc.simulate(
+        t, x0, vehicle.rows(), duty_schedule, sched, no_reference, np.zeros(1), memory=np.zeros(1), max_step=1e-3
+    )
+    assert np.max(np.abs(paper.states[0, :, PHI : PSI + 1] - angles)) > 1e-2
 
 
 def test_bad_environment_options():

@@ -33,9 +33,9 @@ from quadcruise.errors import InputError, WriteError
 from quadcruise.io.files import MARKER, atomic_dir, atomic_path
 from quadcruise.montecarlo import Population, montecarlo
 
-SRC = str(Path(quadcruise.__file__).resolve().parents[1])      # this tree's code, in every subprocess
+SRC = str(Path(quadcruise.__file__).resolve().parents[1])  # this tree's code, in every subprocess
 PWM = Path(__file__).resolve().parents[2] / "examples" / "pwm_step.csv"
-SWEEP = {"seed": 3, "scheduler": "none", "chunk_size": 10, "duration": 2.0}     # 4 chunks of 10 flights
+SWEEP = {"seed": 3, "scheduler": "none", "chunk_size": 10, "duration": 2.0}  # 4 chunks of 10 flights
 N = 40
 ENOSPC = "cannot write (no space left on device)"
 
@@ -43,8 +43,16 @@ ENOSPC = "cannot write (no space left on device)"
 def quadcruise_cli(*args, cwd, timeout=300, stdout=subprocess.PIPE):
     """Run the command line of this tree's code in a new process; stderr captured, stdout too unless given."""
     env = {**os.environ, "PYTHONPATH": SRC, "QUADCRUISE_PROGRESS": "0"}
-    return subprocess.run([sys.executable, "-m", "quadcruise", *map(str, args)], stdout=stdout,
-                          stderr=subprocess.PIPE, text=True, cwd=cwd, env=env, timeout=timeout, check=False)
+    return subprocess.run(
+        [sys.executable, "-m", "quadcruise", *map(str, args)],
+        stdout=stdout,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=cwd,
+        env=env,
+        timeout=timeout,
+        check=False,
+    )
 
 
 def one_line(stderr: str) -> str:
@@ -87,12 +95,18 @@ def small_disk(tmp_path):
 
     def mount(kib: int) -> Path:
         if not hasattr(os, "geteuid") or os.geteuid() != 0:
-            pytest.skip("a small filesystem is mounted only when the tests run as root; "
-                        "test_a_write_that_fails_* make the same faults without one")
+            pytest.skip(
+                "a small filesystem is mounted only when the tests run as root; "
+                "test_a_write_that_fails_* make the same faults without one"
+            )
         point = tmp_path / f"disk{len(mounted)}"
         point.mkdir()
-        proc = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={kib}k", "tmpfs", str(point)],
-                              capture_output=True, text=True, check=False)
+        proc = subprocess.run(
+            ["mount", "-t", "tmpfs", "-o", f"size={kib}k", "tmpfs", str(point)],
+            capture_output=True,
+            text=True,
+            check=False,
+        )
         if proc.returncode != 0:
             pytest.skip(f"cannot mount a tmpfs here: {proc.stderr.strip() or proc.returncode}")
         mounted.append(point)
@@ -107,37 +121,64 @@ def resize(point: Path, kib: int) -> None:
     subprocess.run(["mount", "-o", f"remount,size={kib}k", str(point)], check=True)
 
 
-@pytest.mark.parametrize("args, target", [
-    (["fly", "hover", "--duration", "1", "--out", "{disk}/flight"], "{disk}/flight"),
-    (["replay", str(PWM), "-o", "{disk}/states.csv"], "{disk}/states.csv"),
-    (["fly", "hover", "--duration", "1", "--report", "{disk}/r.html"], "{disk}/r.html"),
-])
+@pytest.mark.parametrize(
+    "args, target",
+    [
+        (["fly", "hover", "--duration", "1", "--out", "{disk}/flight"], "{disk}/flight"),
+        (["replay", str(PWM), "-o", "{disk}/states.csv"], "{disk}/states.csv"),
+        (["fly", "hover", "--duration", "1", "--report", "{disk}/r.html"], "{disk}/r.html"),
+    ],
+)
 def test_a_full_disk_is_one_line_exit_74_and_leaves_nothing(small_disk, tmp_path, args, target):
     disk = small_disk(8)
     proc = quadcruise_cli(*[a.format(disk=disk) for a in args], cwd=tmp_path)
     assert proc.returncode == 74
     assert one_line(proc.stderr) == f"error: {target.format(disk=disk)}: {ENOSPC}"
-    assert files_under(disk) == []                   # no half-written file, no temporary
+    assert files_under(disk) == []  # no half-written file, no temporary
 
 
 def test_a_sweep_on_a_full_disk_keeps_its_chunks_and_resumes_to_the_same_bytes(small_disk, reference, tmp_path):
     _, ref_out = reference
-    disk = small_disk(60)                            # the marker and two chunks of 24 kB fit, not a third
-    args = ["montecarlo", "--mission", "circle", "-n", N, "--seed", 3, "--mass-spread", 0.1, "--duration", 2,
-            "--chunk-size", 10,
-            "--scheduler", "none", "--out", disk / "mc", "--quiet"]
+    disk = small_disk(60)  # the marker and two chunks of 24 kB fit, not a third
+    args = [
+        "montecarlo",
+        "--mission",
+        "circle",
+        "-n",
+        N,
+        "--seed",
+        3,
+        "--mass-spread",
+        0.1,
+        "--duration",
+        2,
+        "--chunk-size",
+        10,
+        "--scheduler",
+        "none",
+        "--out",
+        disk / "mc",
+        "--quiet",
+    ]
     proc = quadcruise_cli(*args, cwd=tmp_path)
     assert proc.returncode == 74
-    assert one_line(proc.stderr) == (f"error: {disk}/mc/chunks/chunk-000000020.npz: {ENOSPC}; the 20 flights done "
-                                     f"are kept in {disk}/mc/chunks: the same command resumes from them")
-    assert files_under(disk) == ["mc", "mc/chunks", "mc/chunks/chunk-000000000.npz",
-                                 "mc/chunks/chunk-000000010.npz", f"mc/{MARKER}"]
+    assert one_line(proc.stderr) == (
+        f"error: {disk}/mc/chunks/chunk-000000020.npz: {ENOSPC}; the 20 flights done "
+        f"are kept in {disk}/mc/chunks: the same command resumes from them"
+    )
+    assert files_under(disk) == [
+        "mc",
+        "mc/chunks",
+        "mc/chunks/chunk-000000000.npz",
+        "mc/chunks/chunk-000000010.npz",
+        f"mc/{MARKER}",
+    ]
     assert json.loads((disk / "mc" / MARKER).read_text())["complete"] is False
-    resize(disk, 140)                                # every chunk fits now, but not the figures
+    resize(disk, 140)  # every chunk fits now, but not the figures
     proc = quadcruise_cli(*args, cwd=tmp_path)
     assert proc.returncode == 74 and f"all {N} flights are kept in {disk}/mc/chunks" in one_line(proc.stderr)
     assert not [p for p in (disk / "mc").rglob("*") if p.name.endswith(".tmp")]
-    resize(disk, 1024)                               # the fault is fixed
+    resize(disk, 1024)  # the fault is fixed
     proc = quadcruise_cli(*args, cwd=tmp_path)
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
     assert f"0 flights flown ({N} resumed)" in proc.stdout
@@ -165,6 +206,7 @@ def failing_after(count: int, write):
         else:
             file.write(b"PK\x03\x04 half")
         raise OSError(errno.ENOSPC, "No space left on device")
+
     return fails
 
 
@@ -185,8 +227,10 @@ def test_a_write_that_fails_in_a_sweep_keeps_its_chunks_and_it_resumes(reference
         with pytest.raises(WriteError) as caught:
             sweep(out)
     assert isinstance(caught.value, OSError) and caught.value.errno == errno.ENOSPC
-    assert str(caught.value) == (f"{out}/chunks/chunk-000000020.npz: {ENOSPC}; the 20 flights done are kept in "
-                                 f"{out}/chunks: the same command resumes from them")
+    assert str(caught.value) == (
+        f"{out}/chunks/chunk-000000020.npz: {ENOSPC}; the 20 flights done are kept in "
+        f"{out}/chunks: the same command resumes from them"
+    )
     assert files_under(out) == ["chunks", "chunks/chunk-000000000.npz", "chunks/chunk-000000010.npz", MARKER]
     res = sweep(out)
     assert res.info["resumed"] == 20 and res.info["flown"] == 20
@@ -208,7 +252,7 @@ def test_a_sweep_whose_folder_is_removed_meanwhile_still_writes_its_results_ther
     pd.testing.assert_frame_equal(res.table, ref.table, check_exact=True)
     assert (out / "flights.csv").read_bytes() == (ref_out / "flights.csv").read_bytes()
     assert sorted(p.name for p in (out / "chunks").iterdir()) == ["chunk-000000020.npz", "chunk-000000030.npz"]
-    again = sweep(out)                               # the two lost chunks are flown again, to the same bytes
+    again = sweep(out)  # the two lost chunks are flown again, to the same bytes
     assert again.info["flown"] == 20 and again.info["resumed"] == 20
     same_sweep(out, ref_out)
 
@@ -223,7 +267,7 @@ def test_a_file_is_written_whole_or_not_at_all_and_the_error_names_it(tmp_path):
     folder = tmp_path / "b" / "out"
     with pytest.raises(WriteError) as caught, atomic_dir(folder) as tmp:
         (tmp / "x.csv").write_text("half")
-        shutil.rmtree(folder.parent)                 # its parent vanishes mid-run
+        shutil.rmtree(folder.parent)  # its parent vanishes mid-run
         (tmp / "y.csv").write_text("lost")
     assert caught.value.filename == str(folder) and caught.value.errno == errno.ENOENT
     assert str(caught.value) == f"{folder}: cannot write (no such file or directory)"
@@ -259,9 +303,15 @@ def test_a_full_standard_output_is_one_line_exit_74(tmp_path, args):
 
 def test_a_reader_that_stops_reading_is_no_fault_and_the_folder_is_written(tmp_path):
     env = {**os.environ, "PYTHONPATH": SRC, "QUADCRUISE_PROGRESS": "0"}
-    proc = subprocess.Popen([sys.executable, "-m", "quadcruise", "fly", "hover", "--duration", "0.5", "--out", "f"],
-                            cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    proc.stdout.close()                              # as `| head -0`: every line it prints meets a broken pipe
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "quadcruise", "fly", "hover", "--duration", "0.5", "--out", "f"],
+        cwd=tmp_path,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    proc.stdout.close()  # as `| head -0`: every line it prints meets a broken pipe
     stderr = proc.stderr.read()
     assert proc.wait(timeout=300) == 0 and stderr == ""
     assert (tmp_path / "f" / "traces.csv").is_file() and (tmp_path / "f" / MARKER).is_file()
@@ -270,22 +320,33 @@ def test_a_reader_that_stops_reading_is_no_fault_and_the_folder_is_written(tmp_p
 # --- Ctrl-C and SIGTERM during a sweep on local Dask workers -----------------------------------------
 @pytest.mark.dask
 @pytest.mark.slow
-@pytest.mark.parametrize("sig, to_group, status, word", [
-    (signal.SIGINT, True, 130, "interrupted"),       # Ctrl-C: the terminal signals the whole group
-    (signal.SIGTERM, False, 143, "terminated"),      # kill PID
-])
-def test_a_stopped_sweep_ends_its_workers_says_one_line_and_resumes_to_the_same_bytes(tmp_path, sig, to_group,
-                                                                                     status, word):
+@pytest.mark.parametrize(
+    "sig, to_group, status, word",
+    [
+        (signal.SIGINT, True, 130, "interrupted"),  # Ctrl-C: the terminal signals the whole group
+        (signal.SIGTERM, False, 143, "terminated"),  # kill PID
+    ],
+)
+def test_a_stopped_sweep_ends_its_workers_says_one_line_and_resumes_to_the_same_bytes(
+    tmp_path, sig, to_group, status, word
+):
     psutil = pytest.importorskip("psutil")
     n = 2000
     options = ["--mission", "circle", "-n", n, "--seed", 5, "--mass-spread", 0.1, "--duration", 1, "--chunk-size", 10]
     args = ["montecarlo", *options, "--scheduler", "local", "--workers", 2, "--out", "mc", "--quiet"]
     env = {**os.environ, "PYTHONPATH": SRC, "QUADCRUISE_PROGRESS": "0"}
-    proc = subprocess.Popen([sys.executable, "-m", "quadcruise", *map(str, args)], cwd=tmp_path, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "quadcruise", *map(str, args)],
+        cwd=tmp_path,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
     try:
         deadline = time.monotonic() + 300
-        while len(list((tmp_path / "mc" / "chunks").glob("*.npz"))) < 3:        # mid-run: chunks being written
+        while len(list((tmp_path / "mc" / "chunks").glob("*.npz"))) < 3:  # mid-run: chunks being written
             assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
             time.sleep(0.05)
         workers = psutil.Process(proc.pid).children(recursive=True)
@@ -301,14 +362,24 @@ def test_a_stopped_sweep_ends_its_workers_says_one_line_and_resumes_to_the_same_
     assert proc.returncode == status
     assert one_line(stderr) == f"error: {word} (a montecarlo sweep with --out resumes if run again)"
     _, alive = psutil.wait_procs(workers, timeout=30)
-    assert alive == [], alive                        # every worker ended with the sweep
+    assert alive == [], alive  # every worker ended with the sweep
     kept = sorted((tmp_path / "mc" / "chunks").glob("*.npz"))
     assert 3 <= len(kept) < n // 10 and not list((tmp_path / "mc").rglob("*.tmp"))
     again = quadcruise_cli(*args, cwd=tmp_path)
     assert again.returncode == 0 and again.stderr == "", again.stderr
     assert f"({len(kept) * 10:,} resumed)" in again.stdout
-    montecarlo_command(mission="circle", n=n, seed=5, mass_spread=0.1, duration=1.0, chunk_size=10, scheduler="none",
-                       out=str(tmp_path / "ref"), quiet=True, echo=lambda text: None)       # untroubled, in one go
+    montecarlo_command(
+        mission="circle",
+        n=n,
+        seed=5,
+        mass_spread=0.1,
+        duration=1.0,
+        chunk_size=10,
+        scheduler="none",
+        out=str(tmp_path / "ref"),
+        quiet=True,
+        echo=lambda text: None,
+    )  # untroubled, in one go
     same_sweep(tmp_path / "mc", tmp_path / "ref")
 
 
@@ -331,14 +402,18 @@ def test_a_damaged_marker_never_costs_the_chunks(reference, tmp_path, kind):
     (out / MARKER).write_bytes((ref_out / MARKER).read_bytes()[:300] if content is None else content)
     before = {p: p.read_bytes() for p in (out / "chunks").iterdir()}
     refusal = f"{out / MARKER}: damaged ({why}"
-    for attempt in (lambda: sweep(out), lambda: ref.write(out),
-                    lambda: quadcruise.fly("hover", duration=0.2).write(out)):
+    for attempt in (
+        lambda: sweep(out),
+        lambda: ref.write(out),
+        lambda: quadcruise.fly("hover", duration=0.2).write(out),
+    ):
         with pytest.raises(InputError) as caught:
             attempt()
         assert str(caught.value).startswith(refusal) and "use --force to replace the folder, or delete it" in str(
-            caught.value)
+            caught.value
+        )
     assert {p: p.read_bytes() for p in (out / "chunks").iterdir()} == before
-    res = sweep(out, force=True)                      # the way out: forced, it is flown anew
+    res = sweep(out, force=True)  # the way out: forced, it is flown anew
     assert res.info["flown"] == N
     same_sweep(out, ref_out)
 
@@ -347,8 +422,10 @@ def test_a_damaged_marker_is_one_line_exit_2_on_the_command_line(reference, tmp_
     _, ref_out = reference
     shutil.copytree(ref_out, tmp_path / "mc")
     (tmp_path / "mc" / MARKER).write_bytes(b"\0" * 100)
-    for args in (["fly", "hover", "--duration", "0.2", "--out", "mc"],
-                 ["montecarlo", "-n", 4, "--mass-spread", 0.1, "--duration", 1, "--scheduler", "none", "--out", "mc"]):
+    for args in (
+        ["fly", "hover", "--duration", "0.2", "--out", "mc"],
+        ["montecarlo", "-n", 4, "--mass-spread", 0.1, "--duration", 1, "--scheduler", "none", "--out", "mc"],
+    ):
         proc = quadcruise_cli(*args, cwd=tmp_path)
         assert proc.returncode == 2
         assert one_line(proc.stderr).startswith("error: mc/quadcruise.json: damaged (NUL bytes)")

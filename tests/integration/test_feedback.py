@@ -18,7 +18,7 @@ from quadcruise.cli import main
 
 ENV = "QUADCRUISE_PROGRESS"
 COMPILING = "compiling the engine and controllers for this machine, once"
-BAR_TEXT = re.compile(r"\r|\d+ ?%|\d+/\d+")      # a carriage return, "40%", "2/5": any progress text
+BAR_TEXT = re.compile(r"\r|\d+ ?%|\d+/\d+")  # a carriage return, "40%", "2/5": any progress text
 
 
 def write_schedule(path: Path, rows: int) -> Path:
@@ -43,15 +43,23 @@ def invoke(monkeypatch, forced: bool, args: list[str]):
 
 # each command that can take long: its arguments (tmp_path for "{tmp}") and what its bar says
 COMMANDS = {
-    "montecarlo": (["montecarlo", "--n", "6", "--duration", "1", "--mass-spread", "0.1", "--scheduler", "none"],
-                   ["flying", "/6 ["]),
+    "montecarlo": (
+        ["montecarlo", "--n", "6", "--duration", "1", "--mass-spread", "0.1", "--scheduler", "none"],
+        ["flying", "/6 ["],
+    ),
     "compare": (["compare", "step", "--duration", "2", "--controllers", "nlpd,se3"], ["flying", "/2 [", "controller"]),
-    "compare-population": (["compare", "step", "--duration", "1", "--controllers", "nlpd,se3", "--population", "3"],
-                           ["flying the population", "/6 ["]),
-    "animate": (["fly", "step", "--duration", "2", "--animate", "{tmp}/flight.gif"],
-                ["drawing the animation", "frame"]),
-    "replay": (["replay", "{tmp}/long.csv", "-o", "{tmp}/states.csv"],
-               ["reading", "flying", "writing", "/5000 [", "row"]),
+    "compare-population": (
+        ["compare", "step", "--duration", "1", "--controllers", "nlpd,se3", "--population", "3"],
+        ["flying the population", "/6 ["],
+    ),
+    "animate": (
+        ["fly", "step", "--duration", "2", "--animate", "{tmp}/flight.gif"],
+        ["drawing the animation", "frame"],
+    ),
+    "replay": (
+        ["replay", "{tmp}/long.csv", "-o", "{tmp}/states.csv"],
+        ["reading", "flying", "writing", "/5000 [", "row"],
+    ),
     "analyze": (["analyze", "--out", "{tmp}/analysis"], ["linearising about hover", "margins", "Bode plots"]),
 }
 
@@ -71,9 +79,9 @@ def test_each_long_command_shows_a_bar_when_asked_and_nothing_otherwise(name, tm
         assert word in shown, f"{name}: {word!r} not in {shown!r}"
     assert not BAR_TEXT.search(quiet), quiet
     assert not any(word in quiet for word in words), quiet
-    if name == "montecarlo":                    # its last line says how long it took
+    if name == "montecarlo":  # its last line says how long it took
         shown_out, quiet_out = shown_out.rsplit("\n", 2)[0], quiet_out.rsplit("\n", 2)[0]
-    assert shown_out == quiet_out               # the results are the same, and stdout holds no bar
+    assert shown_out == quiet_out  # the results are the same, and stdout holds no bar
 
 
 def test_montecarlo_quiet_draws_no_bar(monkeypatch):
@@ -89,7 +97,7 @@ def test_an_error_starts_on_a_line_of_its_own(tmp_path, monkeypatch):
     bad.write_text("t,u1,u2,u3,u4\n0,0.5,0.5,0.5,0.5\n1,0.5,abc,0.5,0.5\n")
     res = CliRunner().invoke(main, ["replay", str(bad), "-o", str(tmp_path / "s.csv")])
     assert res.exit_code == 2
-    assert "reading" in res.stderr                         # the bar was drawn
+    assert "reading" in res.stderr  # the bar was drawn
     assert res.stderr.split("\r")[-1] == f"error: {bad}, line 3, column 'u2': 'abc' is not a number\n"
 
 
@@ -107,7 +115,7 @@ def test_feedback_follows_the_terminal_unless_the_variable_says(monkeypatch):
             pass
 
     monkeypatch.delenv(ENV, raising=False)
-    assert not feedback.feedback_on()                      # pytest's captured stderr
+    assert not feedback.feedback_on()  # pytest's captured stderr
     monkeypatch.setattr(sys, "stderr", Terminal())
     assert feedback.feedback_on()
     monkeypatch.setenv(ENV, "0")
@@ -131,7 +139,7 @@ def test_the_bar_takes_a_note_for_reuse(capsys, monkeypatch):
     bar(3, 3)
     assert bar.closed
     bar(2, 3)
-    assert capsys.readouterr().err.strip() == ""          # cleared, and nothing after
+    assert capsys.readouterr().err.strip() == ""  # cleared, and nothing after
 
 
 def test_compiling_is_said_once_when_numba_compiles_and_only_then(capsys, monkeypatch):
@@ -140,14 +148,14 @@ def test_compiling_is_said_once_when_numba_compiles_and_only_then(capsys, monkey
     from quadcruise.cli.feedback import compile_notice
 
     def fresh():
-        return njit(lambda x: x + 1)           # a new function: numba compiles it at its first call
+        return njit(lambda x: x + 1)  # a new function: numba compiles it at its first call
 
     monkeypatch.setenv(ENV, "1")
     with compile_notice():
         fresh()(1)
         fresh()(2.0)
     assert capsys.readouterr().err.count(COMPILING) == 1
-    fresh()(3)                                 # outside: nothing
+    fresh()(3)  # outside: nothing
     monkeypatch.setenv(ENV, "0")
     with compile_notice():
         fresh()(4)
@@ -178,6 +186,7 @@ def test_a_cold_cache_says_it_compiles_once_and_a_warm_one_says_nothing(tmp_path
 
 # the library: progress(done, total), results unchanged
 
+
 def calls():
     seen = []
     return seen, lambda done, total: seen.append((done, total))
@@ -196,11 +205,20 @@ def test_compare_population_reports_every_flight():
     from quadcruise.montecarlo.compare import compare_population
 
     seen, progress = calls()
-    table = compare_population("step", ["nlpd", "se3"], Population(mass_spread=0.05), n=3, seed=1, duration=1.0,
-                               scheduler="none", progress=progress)
+    table = compare_population(
+        "step",
+        ["nlpd", "se3"],
+        Population(mass_spread=0.05),
+        n=3,
+        seed=1,
+        duration=1.0,
+        scheduler="none",
+        progress=progress,
+    )
     assert seen[-1] == (6, 6) and all(t == 6 for _, t in seen) and [d for d, _ in seen] == sorted(d for d, _ in seen)
-    plain = compare_population("step", ["nlpd", "se3"], Population(mass_spread=0.05), n=3, seed=1, duration=1.0,
-                               scheduler="none")
+    plain = compare_population(
+        "step", ["nlpd", "se3"], Population(mass_spread=0.05), n=3, seed=1, duration=1.0, scheduler="none"
+    )
     assert table.equals(plain)
 
 
@@ -247,7 +265,12 @@ def test_replay_reports_rows_read_flown_and_written(tmp_path):
     assert seen[0] == (0, 5000) and seen[-1] == (5000, 5000) and len(seen) > 2
     # written in blocks, the same bytes as in one go
     whole = tmp_path / "whole.csv"
-    np.savetxt(whole, np.column_stack([res.t, res.states[0]]), delimiter=",",
-               header="t,x,y,z,vx,vy,vz,phi,theta,psi,p,q,r,F1,F2,F3,F4", comments="", fmt="%.15g")
+    np.savetxt(
+        whole,
+        np.column_stack([res.t, res.states[0]]),
+        delimiter=",",
+        header="t,x,y,z,vx,vy,vz,phi,theta,psi,p,q,r,F1,F2,F3,F4",
+        comments="",
+        fmt="%.15g",
+    )
     assert (tmp_path / "states.csv").read_bytes() == whole.read_bytes()
-

@@ -35,10 +35,22 @@ def shared(name: str) -> Path:
 
 def euler_to_quat(phi, theta, psi):
     """(w, x, y, z) of Rz(psi) Ry(theta) Rx(phi), the half-angle formulas written out."""
-    cr, sr, cp, sp, cy, sy = (np.cos(phi / 2), np.sin(phi / 2), np.cos(theta / 2), np.sin(theta / 2),
-                              np.cos(psi / 2), np.sin(psi / 2))
-    return np.column_stack([cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy,
-                            cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy])
+    cr, sr, cp, sp, cy, sy = (
+        np.cos(phi / 2),
+        np.sin(phi / 2),
+        np.cos(theta / 2),
+        np.sin(theta / 2),
+        np.cos(psi / 2),
+        np.sin(psi / 2),
+    )
+    return np.column_stack(
+        [
+            cr * cp * cy + sr * sp * sy,
+            sr * cp * cy - cr * sp * sy,
+            cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy,
+        ]
+    )
 
 
 @pytest.fixture(scope="module")
@@ -55,9 +67,9 @@ def test_sitl_log_reads_its_airborne_stretch():
     log = read_flight_log(SITL)
     raw = ULog(str(SITL), message_name_filter_list=["vehicle_local_position"]).data_list[0].data
     assert log.n_rotors == 4 and log.commands.startswith("actuator_motors")
-    assert 4.0 < log.duration < 9.0                    # lifts off at ~19 s, touches down at ~26 s
+    assert 4.0 < log.duration < 9.0  # lifts off at ~19 s, touches down at ~26 s
     step = np.diff(log.t)
-    assert np.allclose(step, 1 / 250, rtol=1e-6)       # the grid: sensor_combined's 250 Hz
+    assert np.allclose(step, 1 / 250, rtol=1e-6)  # the grid: sensor_combined's 250 Hz
     # the airborne samples are up: PX4's distance to the ground (raw, pyulog) above 0.3 m, the climb ~2 m
     t_raw = (raw["timestamp"] - ULog(str(SITL), message_name_filter_list=["vehicle_status"]).start_timestamp) * 1e-6
     assert np.interp(log.t, t_raw, raw["dist_bottom"]).min() >= 0.3
@@ -78,11 +90,11 @@ def test_ulog_of_a_flight_comes_back_in_quadcruise_frames(flight, flight_ulog):
     pick = np.searchsorted(flight.t, log.t - 1e-9)
     assert np.allclose(flight.t[pick], log.t, atol=1e-6)
     truth = states[pick]
-    at_50hz = np.isclose(log.t * 50, np.round(log.t * 50))            # vehicle_local_position's own samples
+    at_50hz = np.isclose(log.t * 50, np.round(log.t * 50))  # vehicle_local_position's own samples
     assert at_50hz.sum() >= 190
-    assert np.allclose(log.velocity[at_50hz], truth[at_50hz, VX:VX + 3], atol=1e-5)
-    assert np.allclose(log.velocity, truth[:, VX:VX + 3], atol=2e-3)  # linear in between
-    assert np.allclose(log.rates, truth[:, P:P + 3], atol=1e-5)
+    assert np.allclose(log.velocity[at_50hz], truth[at_50hz, VX : VX + 3], atol=1e-5)
+    assert np.allclose(log.velocity, truth[:, VX : VX + 3], atol=2e-3)  # linear in between
+    assert np.allclose(log.rates, truth[:, P : P + 3], atol=1e-5)
     q = euler_to_quat(truth[:, PHI], truth[:, THETA], truth[:, PSI])
     assert np.allclose(np.abs(np.einsum("ij,ij->i", log.quaternion, q)), 1.0, atol=1e-6)
     assert np.allclose(log.u, np.clip(flight.commands[0][pick, 0:4], 0, 1), atol=1e-6)
@@ -93,7 +105,7 @@ def test_ulog_of_a_flight_comes_back_in_quadcruise_frames(flight, flight_ulog):
 def csv_of(flight, frame="enu", landed=None):
     states = flight.states[0]
     q = euler_to_quat(states[:, PHI], states[:, THETA], states[:, PSI])
-    v, w = states[:, VX:VX + 3], states[:, P:P + 3]
+    v, w = states[:, VX : VX + 3], states[:, P : P + 3]
     if frame == "ned":
         v = v[:, [1, 0, 2]] * [1, 1, -1]
         w = w * [1, -1, -1]
@@ -104,11 +116,31 @@ def csv_of(flight, frame="enu", landed=None):
         def mul(x, y):
             w1, x1, y1, z1 = x.T
             w2, x2, y2, z2 = y.T
-            return np.column_stack([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                                    w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
+            return np.column_stack(
+                [
+                    w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+                    w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                    w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+                    w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+                ]
+            )
+
         q = mul(mul(np.tile(a, (len(q), 1)), q), np.tile([0.0, 1.0, 0.0, 0.0], (len(q), 1)))
-    table = pd.DataFrame({"t": flight.t, "vx": v[:, 0], "vy": v[:, 1], "vz": v[:, 2], "qw": q[:, 0],
-                          "qx": q[:, 1], "qy": q[:, 2], "qz": q[:, 3], "p": w[:, 0], "q": w[:, 1], "r": w[:, 2]})
+    table = pd.DataFrame(
+        {
+            "t": flight.t,
+            "vx": v[:, 0],
+            "vy": v[:, 1],
+            "vz": v[:, 2],
+            "qw": q[:, 0],
+            "qx": q[:, 1],
+            "qy": q[:, 2],
+            "qz": q[:, 3],
+            "p": w[:, 0],
+            "q": w[:, 1],
+            "r": w[:, 2],
+        }
+    )
     for i in range(4):
         table[f"u{i + 1}"] = np.clip(flight.commands[0][:, i], 0, 1)
     if landed is not None:
@@ -122,8 +154,8 @@ def test_csv_in_either_frame_reads_the_same(flight, tmp_path, frame):
     csv_of(flight, frame).to_csv(path, index=False)
     log = read_flight_log(path, frame=frame)
     states = flight.states[0]
-    assert np.allclose(log.velocity, states[:, VX:VX + 3], atol=1e-9)
-    assert np.allclose(log.rates, states[:, P:P + 3], atol=1e-9)
+    assert np.allclose(log.velocity, states[:, VX : VX + 3], atol=1e-9)
+    assert np.allclose(log.rates, states[:, P : P + 3], atol=1e-9)
     q = euler_to_quat(states[:, PHI], states[:, THETA], states[:, PSI])
     assert np.allclose(np.abs(np.einsum("ij,ij->i", log.quaternion, q)), 1.0, atol=1e-9)
 
@@ -137,6 +169,7 @@ def test_csv_landed_rows_are_left_out(flight, tmp_path):
 
 
 # --- bad input: one line, naming the file and what is wrong ----------------------------------
+
 
 def refused(path, match, **kw):
     with pytest.raises(InputError, match=match) as info:
@@ -202,13 +235,16 @@ def test_ulog_of_a_fixed_wing(flight, tmp_path):
     refused(path, "not a multicopter.*MAV_TYPE 1")
 
 
-@pytest.mark.parametrize("change,match", [
-    (lambda t: t.drop(columns=["qz"]), "missing column.*qz"),
-    (lambda t: t.drop(columns=["u1", "u2", "u3", "u4"]), "missing column.*u1..un"),
-    (lambda t: t.assign(t=t["t"].to_numpy()[::-1]), "row 3: time .* does not increase"),
-    (lambda t: t.assign(landed=1), "nothing to identify"),
-    (lambda t: t.assign(vx=["a"] + [0.0] * (len(t) - 1)), "row 2, column vx"),
-])
+@pytest.mark.parametrize(
+    "change,match",
+    [
+        (lambda t: t.drop(columns=["qz"]), "missing column.*qz"),
+        (lambda t: t.drop(columns=["u1", "u2", "u3", "u4"]), "missing column.*u1..un"),
+        (lambda t: t.assign(t=t["t"].to_numpy()[::-1]), "row 3: time .* does not increase"),
+        (lambda t: t.assign(landed=1), "nothing to identify"),
+        (lambda t: t.assign(vx=["a"] + [0.0] * (len(t) - 1)), "row 2, column vx"),
+    ],
+)
 def test_bad_csv(flight, tmp_path, change, match):
     path = tmp_path / "bad.csv"
     change(csv_of(flight)).to_csv(path, index=False)

@@ -40,7 +40,7 @@ def rotation_reference(schedule: qc.DutySchedule, t_end: float) -> np.ndarray:
         t0, t1 = schedule.t[k], min(schedule.t[k + 1], t_end)
         if t1 <= t0:
             break
-        sol = solve_ivp(lambda _, s: rotation_rhs(s, schedule.duties[k]), (t0, t1), y, rtol=1e-12, atol=1e-12)
+        sol = solve_ivp(lambda _, s: rotation_rhs(s, schedule.duties[k]), (t0, t1), y, rtol=1e-12, atol=1e-12)  # noqa: B023
         y = sol.y[:, -1]
     return y[6:15].reshape(3, 3)
 
@@ -55,11 +55,11 @@ def test_an_aggressive_manoeuvre_matches_a_rotation_matrix_integration_to_fourth
     runs = {h: qc.replay(schedule, max_step=h, full_dynamics=True) for h in (2e-3, 1e-3)}
     res = runs[1e-3]
     angles = np.abs(res.states[0, :, 6:8]).max(axis=0)
-    assert res.ok[0] and angles[0] > 1.4 and 0.8 < angles[1] < EULER_PITCH_LIMIT    # roll 80+, pitch 45+ degrees
+    assert res.ok[0] and angles[0] > 1.4 and 0.8 < angles[1] < EULER_PITCH_LIMIT  # roll 80+, pitch 45+ degrees
     R_ref = rotation_reference(schedule, res.t[-1])
     coarse, fine = (rotation_error(runs[h], -1, R_ref) for h in (2e-3, 1e-3))
     assert fine < 1e-6
-    assert 10.0 < coarse / fine < 22.0                                          # RK4: 16 per halving
+    assert 10.0 < coarse / fine < 22.0  # RK4: 16 per halving
 
 
 def test_a_flip_through_90_degrees_stops_with_its_own_status_before_the_singularity():

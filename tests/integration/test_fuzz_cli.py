@@ -25,17 +25,40 @@ BASE = {
     "fly": ["fly", "hover", "--duration", "0.05"],
     "compare": ["compare", "hover", "--controllers", "nlpd", "--duration", "0.05"],
     "analyze": ["analyze"],
-    "montecarlo": ["montecarlo", "--mission", "hover", "--n", "2", "--duration", "0.05", "--mass-spread", "0.1",
-                   "--scheduler", "none", "--quiet"],
+    "montecarlo": [
+        "montecarlo",
+        "--mission",
+        "hover",
+        "--n",
+        "2",
+        "--duration",
+        "0.05",
+        "--mass-spread",
+        "0.1",
+        "--scheduler",
+        "none",
+        "--quiet",
+    ],
     "replay": ["replay", "pwm.csv", "-o", "states.csv"],
     "reproduce": ["reproduce", "--out", "rep"],
-    "tune": ["tune", "hover", "--target", "rmse_m=0.1", "--budget", "1", "--popsize", "5", "--duration", "0.05",
-             "--quiet"],
+    "tune": [
+        "tune",
+        "hover",
+        "--target",
+        "rmse_m=0.1",
+        "--budget",
+        "1",
+        "--popsize",
+        "5",
+        "--duration",
+        "0.05",
+        "--quiet",
+    ],
 }
 NUMBER_GARBAGE = ["abc", "", "nan", "inf", "-inf", "-1", "1e999", "0x10", "1,2"]
 TEXT_GARBAGE = ["xyz", "=", ",", "foo=", "=1", "1,2,3,4,5,6,7", "@@"]
 UNWRITABLE = "/proc/quadcruise/out"
-SKIP = {("replay", "pwm_csv"), ("replay", "out")}       # the base's own file arguments, fuzzed below
+SKIP = {("replay", "pwm_csv"), ("replay", "out")}  # the base's own file arguments, fuzzed below
 
 
 def options():
@@ -82,13 +105,16 @@ def invoke(args: list[str], capsys) -> tuple[int, str]:
 def with_value(command: str, p: click.Parameter, value: str) -> list[str]:
     args = list(BASE[command])
     if isinstance(p, click.Argument):
-        position = 1                                        # every fuzzed argument is the command's first
-        return args[:position] + [value] + (args[position + 1:] if len(args) > position and
-                                            not args[position].startswith("-") else args[position:])
+        position = 1  # every fuzzed argument is the command's first
+        return (
+            args[:position]
+            + [value]
+            + (args[position + 1 :] if len(args) > position and not args[position].startswith("-") else args[position:])
+        )
     flag = max(p.opts, key=len)
-    if flag in args:                                        # replace the base's own value
+    if flag in args:  # replace the base's own value
         i = args.index(flag)
-        return args[:i] + [flag, value] + args[i + 2:]
+        return args[:i] + [flag, value] + args[i + 2 :]
     return args + [flag, value]
 
 
@@ -105,8 +131,12 @@ def check(args: list[str], capsys) -> None:
 
 
 @pytest.mark.slow
-@settings(max_examples=120, deadline=None, derandomize=True,
-          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@settings(
+    max_examples=120,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 @given(data=st.data())
 def test_a_bad_value_for_any_option_is_one_line_and_exit_2(data, capsys):
     command, p = data.draw(st.sampled_from([o for o in OPTIONS if (o[0], o[1].name) not in SKIP]), label="option")
@@ -131,23 +161,40 @@ def scenario_keys() -> list[tuple[str, str, str]]:
         cls = CONTROLLERS[name]
         for f in dataclasses.fields(cls):
             default = getattr(cls(), f.name)
-            kind = ("table" if dataclasses.is_dataclass(default) else "text" if isinstance(default, str)
-                    else "flag" if isinstance(default, bool) else "number")
+            kind = (
+                "table"
+                if dataclasses.is_dataclass(default)
+                else "text"
+                if isinstance(default, str)
+                else "flag"
+                if isinstance(default, bool)
+                else "number"
+            )
             keys.append((f"controller:{name}", f.name, kind))
-    keys += [("simulation", k, "flag" if t is bool else "bound" if k in OFF_WHEN_INFINITE else "number")
-             for k, t in SIMULATION_KEYS.items()]
+    keys += [
+        ("simulation", k, "flag" if t is bool else "bound" if k in OFF_WHEN_INFINITE else "number")
+        for k, t in SIMULATION_KEYS.items()
+    ]
     keys += [("disturbances", k, "table") for k in ("gust", "turbulence", "rotor_loss", "force", "sensor_noise")]
     return keys
 
 
-BAD_TOML = {"number": ['"xyz"', "[]", "{}", "true", "nan", "inf"], "text": ["1", "[]", "true"],
-            "bound": ['"xyz"', "[]", "true", "nan", "-inf", "0", "-1"],      # inf turns a bound off: not bad
-            "flag": ['"xyz"', "2", "[]"], "table": ["1", '"xyz"', "[1, 2]", "{ nonsense = 1 }"]}
+BAD_TOML = {
+    "number": ['"xyz"', "[]", "{}", "true", "nan", "inf"],
+    "text": ["1", "[]", "true"],
+    "bound": ['"xyz"', "[]", "true", "nan", "-inf", "0", "-1"],  # inf turns a bound off: not bad
+    "flag": ['"xyz"', "2", "[]"],
+    "table": ["1", '"xyz"', "[1, 2]", "{ nonsense = 1 }"],
+}
 
 
 @pytest.mark.slow
-@settings(max_examples=120, deadline=None, derandomize=True,
-          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@settings(
+    max_examples=120,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 @given(data=st.data())
 def test_a_bad_value_for_any_scenario_key_is_one_line_and_exit_2(data, capsys):
     table, key, kind = data.draw(st.sampled_from(scenario_keys()), label="key")

@@ -49,14 +49,15 @@ def test_gymnasium_checker_passes(env_id, mode):
 def test_track_flies_every_mission_kind(mission):
     csv = str(Path(__file__).resolve().parents[2] / "examples" / "waypoints.csv")
     kind = {"waypoints": Waypoints(table=csv), "minsnap": MinimumSnap(table=csv)}.get(mission, mission)
-    env = gymnasium.make_vec("quadcruise/Track-v0", num_envs=2, vectorization_mode="vector_entry_point",
-                             mission=kind, controller="se3")
+    env = gymnasium.make_vec(
+        "quadcruise/Track-v0", num_envs=2, vectorization_mode="vector_entry_point", mission=kind, controller="se3"
+    )
     obs, _ = env.reset(seed=4)
-    assert np.abs(obs[:, :3]).max() < 1e-9            # each episode starts on its reference
+    assert np.abs(obs[:, :3]).max() < 1e-9  # each episode starts on its reference
     for _ in range(100):
         obs, reward, terminated, _, _ = env.step(None)
     assert not terminated.any() and (reward > 0.5).all()
-    if mission == "random":                            # two vehicles, two different circles
+    if mission == "random":  # two vehicles, two different circles
         assert not np.array_equal(env.stepper.mp[0], env.stepper.mp[1])
         assert env.duration == 20.0
 
@@ -70,15 +71,15 @@ def _hold(mode, action, seconds, **kw):
 
 
 def test_each_action_mode_flies_its_setpoint():
-    x = _hold("rotors", [0.0, 0.0, 0.0, 0.0], 2.0)            # hover duties: stays where it started
-    assert np.abs(x[VX:VX + 3]).max() < 1e-9
-    x = _hold("rotors", [0.2, 0.2, 0.2, 0.2], 0.5)            # 20 % more thrust on every rotor climbs
+    x = _hold("rotors", [0.0, 0.0, 0.0, 0.0], 2.0)  # hover duties: stays where it started
+    assert np.abs(x[VX : VX + 3]).max() < 1e-9
+    x = _hold("rotors", [0.2, 0.2, 0.2, 0.2], 0.5)  # 20 % more thrust on every rotor climbs
     assert x[VX + 2] > 0.3
-    x = _hold("rates", [0.0, 0.1, 0.0, 0.0], 0.4)             # 0.1 of 3 rad/s of roll rate
+    x = _hold("rates", [0.0, 0.1, 0.0, 0.0], 0.4)  # 0.1 of 3 rad/s of roll rate
     assert x[P] == pytest.approx(0.3, abs=0.01)
-    x = _hold("attitude", [0.0, 0.4, 0.0, 0.0], 2.0)          # 0.4 of 0.5 rad of roll
+    x = _hold("attitude", [0.0, 0.4, 0.0, 0.0], 2.0)  # 0.4 of 0.5 rad of roll
     assert x[PHI] == pytest.approx(0.2, abs=0.005)
-    x = _hold("velocity", [1 / 3, 0.0, 0.0, 0.0], 5.0)        # 1 m/s in x, level
+    x = _hold("velocity", [1 / 3, 0.0, 0.0, 0.0], 5.0)  # 1 m/s in x, level
     assert x[VX] == pytest.approx(1.0, abs=0.02) and abs(x[VX + 1]) < 0.02 and abs(x[VX + 2]) < 0.02
 
 
@@ -86,8 +87,8 @@ def test_autoreset_is_per_vehicle():
     env = QuadVectorEnv(3, mission="hover", action="rotors", duration=1.0)
     env.reset(seed=0)
     push = np.zeros((3, 4), dtype=np.float32)
-    push[1] = 1.0                                              # vehicle 1 climbs away at twice the hover thrust
-    for k in range(100):
+    push[1] = 1.0  # vehicle 1 climbs away at twice the hover thrust
+    for _ in range(100):
         obs, reward, terminated, truncated, info = env.step(push)
         if terminated[1]:
             break
@@ -95,41 +96,51 @@ def test_autoreset_is_per_vehicle():
     assert info["status"][1] == int(ExitStatus.LOST_TRACK) and reward[1] == 0.0
     t_before = env.stepper.time.copy()
     obs, reward, terminated, truncated, info = env.step(push)
-    assert env.stepper.period[1] == 0 and reward[1] == 0.0 and not terminated[1]   # restarted
-    assert np.linalg.norm(obs[1, :3]) < 2.0                                       # back near its reference
-    assert np.allclose(env.stepper.time[[0, 2]], t_before[[0, 2]] + env.dt)        # the others flew on
+    assert env.stepper.period[1] == 0 and reward[1] == 0.0 and not terminated[1]  # restarted
+    assert np.linalg.norm(obs[1, :3]) < 2.0  # back near its reference
+    assert np.allclose(env.stepper.time[[0, 2]], t_before[[0, 2]] + env.dt)  # the others flew on
     for _ in range(200):
         _, reward, terminated, truncated, info = env.step(np.zeros((3, 4), dtype=np.float32))
         if truncated[0]:
             break
-    assert truncated[0] and truncated[2] and not terminated[0]       # the mission's end truncates
+    assert truncated[0] and truncated[2] and not terminated[0]  # the mission's end truncates
 
 
 def test_seeds_reproduce_and_do_not_depend_on_n():
-    pop = Population(offset=0.3, mass_spread=0.05, noise=SensorNoise(rate_std=0.01),
-                     environment=Environment(turbulence=Turbulence()), wind_spread=1.0)
+    pop = Population(
+        offset=0.3,
+        mass_spread=0.05,
+        noise=SensorNoise(rate_std=0.01),
+        environment=Environment(turbulence=Turbulence()),
+        wind_spread=1.0,
+    )
     runs = []
     for n in (2, 5, 5):
-        env = QuadVectorEnv(n, mission="random", action="attitude", population=pop, duration=0.5,
-                            vehicle=with_drag(qc.Vehicle.paper()))
+        env = QuadVectorEnv(
+            n, mission="random", action="attitude", population=pop, duration=0.5, vehicle=with_drag(qc.Vehicle.paper())
+        )
         obs, _ = env.reset(seed=11)
         actions = np.tile(np.array([0.05, 0.1, -0.1, 0.0], dtype=np.float32), (n, 1))
-        for _ in range(80):                                   # past one episode: autoreset draws episode 1
+        for _ in range(80):  # past one episode: autoreset draws episode 1
             obs, *_ = env.step(actions)
         runs.append(obs)
     assert np.array_equal(runs[0], runs[1][:2]) and np.array_equal(runs[1], runs[2])
-    assert not np.array_equal(runs[1][0], runs[1][1])             # vehicles do differ
-    env = QuadVectorEnv(2, mission="random", action="attitude", population=pop, duration=0.5,
-                        vehicle=with_drag(qc.Vehicle.paper()))
+    assert not np.array_equal(runs[1][0], runs[1][1])  # vehicles do differ
+    env = QuadVectorEnv(
+        2, mission="random", action="attitude", population=pop, duration=0.5, vehicle=with_drag(qc.Vehicle.paper())
+    )
     assert not np.array_equal(env.reset(seed=12)[0], runs[0])
 
 
-@pytest.mark.parametrize(("action", "message"), [
-    (np.full((2, 4), np.nan), r"vehicle 0, entry 0 is nan \(must be finite"),
-    (np.zeros((2, 3)), r"expected shape \(2, 4\), got \(2, 3\)"),
-    (np.array([[0, 0, 0, 0], [0, 1.5, 0, 0]]), r"vehicle 1, entry 1 is 1.5, outside the action space"),
-    ("up", r"expected numbers of shape \(2, 4\)"),
-])
+@pytest.mark.parametrize(
+    ("action", "message"),
+    [
+        (np.full((2, 4), np.nan), r"vehicle 0, entry 0 is nan \(must be finite"),
+        (np.zeros((2, 3)), r"expected shape \(2, 4\), got \(2, 3\)"),
+        (np.array([[0, 0, 0, 0], [0, 1.5, 0, 0]]), r"vehicle 1, entry 1 is 1.5, outside the action space"),
+        ("up", r"expected numbers of shape \(2, 4\)"),
+    ],
+)
 def test_bad_actions_are_one_clear_error(action, message):
     env = QuadVectorEnv(2, mission="hover", action="rates")
     env.reset(seed=0)
@@ -146,12 +157,13 @@ def test_a_rollout_keeps_each_flight_as_it_ended():
         a = np.zeros((3, 4), dtype=np.float32)
         a[1] = 1.0
         return a
+
     returns, flights = rollout(env, climb_one, seed=0)
     assert flights.status.tolist() == [0, int(ExitStatus.LOST_TRACK), 0]
     assert 0.0 < flights.t_stop[1] < 1.0 and flights.t_stop[0] == 1.0
     lost_at = round(float(flights.t_stop[1]) / env.dt)
-    assert np.isfinite(flights.states[1, :lost_at + 1]).all() and np.isnan(flights.states[1, lost_at + 1:]).all()
-    assert np.linalg.norm(flights.final_state[1, :3] - flights.references[1, 0, :3]) > 2.0   # where it was lost
+    assert np.isfinite(flights.states[1, : lost_at + 1]).all() and np.isnan(flights.states[1, lost_at + 1 :]).all()
+    assert np.linalg.norm(flights.final_state[1, :3] - flights.references[1, 0, :3]) > 2.0  # where it was lost
     assert returns[1] < returns[0]
 
 

@@ -54,9 +54,18 @@ def shared(name: str) -> Path:
 
 def excitation_flight(vehicle, seed, noise=NOISE):
     t, u = doublets(vehicle, rate=0.6, spin=1.0)
-    periods = (len(t) - 1) // 4 * 4                     # logged every 4th period (250 Hz): a whole number of them
-    return qc.fly(Hover(z=100.0), ScheduleController(t, u), vehicle=vehicle, duration=float(t[periods]), sensors=noise,
-                  seed=seed, log_every=4, max_track_error=1e6, max_steady_error=1e6)
+    periods = (len(t) - 1) // 4 * 4  # logged every 4th period (250 Hz): a whole number of them
+    return qc.fly(
+        Hover(z=100.0),
+        ScheduleController(t, u),
+        vehicle=vehicle,
+        duration=float(t[periods]),
+        sensors=noise,
+        seed=seed,
+        log_every=4,
+        max_track_error=1e6,
+        max_steady_error=1e6,
+    )
 
 
 def identified(vehicle, seed, folder):
@@ -76,7 +85,7 @@ def test_round_trip_recovers_the_vehicle(name, tmp_path):
         assert p["ci95"][0] <= truth <= p["ci95"][1], (key, p, truth)
     hover = result.parameters["hover_duty"]
     assert hover["value"] == pytest.approx(float(vehicle.hover_duty), rel=0.01)
-    assert not result.parameters["thrust_curve_f"]["identifiable"]      # duties span ~0.01 around hover
+    assert not result.parameters["thrust_curve_f"]["identifiable"]  # duties span ~0.01 around hover
     for channel in ("p_dot", "q_dot", "r_dot"):
         assert result.validation[channel]["r2"] > 0.95, (channel, result.validation[channel])
     for rate in "pqr":
@@ -117,16 +126,29 @@ def test_csv_log_without_accelerometer(tmp_path):
     from scipy.spatial.transform import Rotation
 
     xyzw = Rotation.from_euler("ZYX", states[:, [PSI, THETA, PHI]]).as_quat()
-    table = pd.DataFrame({"t": flight.t, "vx": states[:, VX], "vy": states[:, VX + 1], "vz": states[:, VX + 2],
-                          "qw": xyzw[:, 3], "qx": xyzw[:, 0], "qy": xyzw[:, 1], "qz": xyzw[:, 2],
-                          "p": states[:, P], "q": states[:, P + 1], "r": states[:, P + 2]})
+    table = pd.DataFrame(
+        {
+            "t": flight.t,
+            "vx": states[:, VX],
+            "vy": states[:, VX + 1],
+            "vz": states[:, VX + 2],
+            "qw": xyzw[:, 3],
+            "qx": xyzw[:, 0],
+            "qy": xyzw[:, 1],
+            "qz": xyzw[:, 2],
+            "p": states[:, P],
+            "q": states[:, P + 1],
+            "r": states[:, P + 2],
+        }
+    )
     for i in range(4):
         table[f"u{i + 1}"] = flight.commands[0][:, i]
     table.to_csv(tmp_path / "flight.csv", index=False)
     result = qc.identify(tmp_path / "flight.csv", mass=3.499)
     for key in TRUTH:
-        assert result.parameters[key]["value"] == pytest.approx(float(getattr(vehicle, key)),
-                                                                 rel=0.1 if key == "omega" else 0.05), key
+        assert result.parameters[key]["value"] == pytest.approx(
+            float(getattr(vehicle, key)), rel=0.1 if key == "omega" else 0.05
+        ), key
 
 
 def test_two_airborne_segments(tmp_path):
@@ -138,18 +160,31 @@ def test_two_airborne_segments(tmp_path):
     from scipy.spatial.transform import Rotation
 
     xyzw = Rotation.from_euler("ZYX", states[:, [PSI, THETA, PHI]]).as_quat()
-    table = pd.DataFrame({"t": flight.t, "vx": states[:, VX], "vy": states[:, VX + 1], "vz": states[:, VX + 2],
-                          "qw": xyzw[:, 3], "qx": xyzw[:, 0], "qy": xyzw[:, 1], "qz": xyzw[:, 2],
-                          "p": states[:, P], "q": states[:, P + 1], "r": states[:, P + 2],
-                          "landed": ((flight.t > 9.0) & (flight.t < 10.5)).astype(int)})
+    table = pd.DataFrame(
+        {
+            "t": flight.t,
+            "vx": states[:, VX],
+            "vy": states[:, VX + 1],
+            "vz": states[:, VX + 2],
+            "qw": xyzw[:, 3],
+            "qx": xyzw[:, 0],
+            "qy": xyzw[:, 1],
+            "qz": xyzw[:, 2],
+            "p": states[:, P],
+            "q": states[:, P + 1],
+            "r": states[:, P + 2],
+            "landed": ((flight.t > 9.0) & (flight.t < 10.5)).astype(int),
+        }
+    )
     for i in range(4):
         table[f"u{i + 1}"] = flight.commands[0][:, i]
     table.to_csv(tmp_path / "two.csv", index=False)
     result = qc.identify(tmp_path / "two.csv", mass=3.499)
     assert result.log["segments"] == 2
     for key in TRUTH:
-        assert result.parameters[key]["value"] == pytest.approx(float(getattr(vehicle, key)),
-                                                                 rel=0.1 if key == "omega" else 0.05), key
+        assert result.parameters[key]["value"] == pytest.approx(
+            float(getattr(vehicle, key)), rel=0.1 if key == "omega" else 0.05
+        ), key
 
 
 def px4_hover_estimate(path: Path) -> float:
@@ -170,7 +205,7 @@ def test_sitl_hover_command_agrees_with_px4():
     for key in ("Jxx_per_m", "Jyy_per_m", "Jzz_per_m", "d", "omega"):
         assert not result.parameters[key]["identifiable"], key
     assert "10 Hz" in result.parameters["omega"]["note"]
-    assert "K" not in result.parameters and "K_per_m" in result.parameters      # no mass: per unit mass
+    assert "K" not in result.parameters and "K_per_m" in result.parameters  # no mass: per unit mass
     from quadcruise.protocols import ResultLike
 
     assert isinstance(result, ResultLike)
@@ -178,7 +213,7 @@ def test_sitl_hover_command_agrees_with_px4():
     assert list(table["parameter"]) == list(result.parameters)
     assert table.set_index("parameter").loc["hover_duty", "identifiable"]
     assert len(result.plot().axes) == 6
-    assert result.vehicle().hover_duty == pytest.approx(result.hover_duty, rel=1e-9)   # vehicle.toml hovers there
+    assert result.vehicle().hover_duty == pytest.approx(result.hover_duty, rel=1e-9)  # vehicle.toml hovers there
     assert result.summary()["hover_duty"] == result.hover_duty
 
 
@@ -187,9 +222,21 @@ def test_too_short_a_flight_is_refused(tmp_path):
     short = tmp_path / "short.csv"
     states = flight.states[0][flight.t <= 1.6]
     t = flight.t[flight.t <= 1.6]
-    table = pd.DataFrame({"t": t, "vx": states[:, VX], "vy": states[:, VX + 1], "vz": states[:, VX + 2],
-                          "qw": 1.0, "qx": 0.0, "qy": 0.0, "qz": 0.0, "p": states[:, P], "q": states[:, P + 1],
-                          "r": states[:, P + 2]})
+    table = pd.DataFrame(
+        {
+            "t": t,
+            "vx": states[:, VX],
+            "vy": states[:, VX + 1],
+            "vz": states[:, VX + 2],
+            "qw": 1.0,
+            "qx": 0.0,
+            "qy": 0.0,
+            "qz": 0.0,
+            "p": states[:, P],
+            "q": states[:, P + 1],
+            "r": states[:, P + 2],
+        }
+    )
     for i in range(4):
         table[f"u{i + 1}"] = flight.commands[0][: t.size, i]
     table.to_csv(short, index=False)
@@ -246,13 +293,16 @@ def test_cli_real_logs_that_cannot_be_identified(tmp_path, name, match):
     assert not out.exists()
 
 
-@pytest.mark.parametrize("args,match", [
-    (["--holdout", "0.95"], "holdout must be"),
-    (["--mass", "-1"], "mass must be"),
-    (["--commands", "rpm"], "commands must be"),
-    (["--vehicle", "iris"], "--vehicle"),
-    (["--frame", "enu"], "frame 'enu' is for CSV"),
-])
+@pytest.mark.parametrize(
+    "args,match",
+    [
+        (["--holdout", "0.95"], "holdout must be"),
+        (["--mass", "-1"], "mass must be"),
+        (["--commands", "rpm"], "commands must be"),
+        (["--vehicle", "iris"], "--vehicle"),
+        (["--frame", "enu"], "frame 'enu' is for CSV"),
+    ],
+)
 def test_cli_bad_options(tmp_path, args, match):
     out = tmp_path / "out"
     res = run("identify", SITL, "--out", out, *args)
@@ -276,7 +326,7 @@ def test_pwm_outputs_give_the_same_hover_command():
     pwm = qc.identify(SITL, commands="pwm:1000:2000")
     assert pwm.log["commands"].startswith("actuator_outputs")
     assert pwm.hover_duty == pytest.approx(motors.hover_duty, rel=0.01)
-    wrong = qc.identify(SITL, commands="pwm:1100:2000")        # a wrong range moves it: the check can fail
+    wrong = qc.identify(SITL, commands="pwm:1100:2000")  # a wrong range moves it: the check can fail
     assert abs(wrong.hover_duty / motors.hover_duty - 1) > 0.05
 
 
@@ -321,8 +371,11 @@ def test_cli_any_bad_option_value_is_one_line(tmp_path, option, capsys):
         values = ["xyz", "=", "pwm:2:1", "missing.toml"]
     for value in values:
         args = ["identify", SITL, "--out", tmp_path / "out"]
-        args = args[:-2] + [max(option.opts, key=len), value] if option.name == "out" else args + [
-            max(option.opts, key=len), value]
+        args = (
+            args[:-2] + [max(option.opts, key=len), value]
+            if option.name == "out"
+            else args + [max(option.opts, key=len), value]
+        )
         code, output = run_entry(args, capsys)
         assert code == 2, (value, output)
         assert len(output.strip().splitlines()) == 1 and output.startswith("error: "), (value, output)
@@ -338,7 +391,7 @@ def test_thrust_curve_and_lag_from_an_independent_simulation(tmp_path):
 
     K, f, omega, m, g = 20.0, 0.4, 20.0, 2.0, 9.81
     rng = np.random.default_rng(3)
-    edges = np.arange(0.0, 30.0, 0.37)                           # steps off the log's grid
+    edges = np.arange(0.0, 30.0, 0.37)  # steps off the log's grid
     levels = rng.uniform(0.2, 0.8, edges.size)
 
     def rhs(t, x, u):
@@ -358,9 +411,24 @@ def test_thrust_curve_and_lag_from_an_independent_simulation(tmp_path):
         x = sol.y[:, -1]
     u = levels[np.searchsorted(edges, t_log, side="right") - 1]
     zeros = np.zeros(t_log.size)
-    table = pd.DataFrame({"t": t_log, "vx": zeros, "vy": zeros, "vz": vz, "qw": zeros + 1, "qx": zeros, "qy": zeros,
-                          "qz": zeros, "p": zeros, "q": zeros, "r": zeros, "ax": zeros, "ay": zeros,
-                          "az": force + rng.normal(0, 0.05, t_log.size)})
+    table = pd.DataFrame(
+        {
+            "t": t_log,
+            "vx": zeros,
+            "vy": zeros,
+            "vz": vz,
+            "qw": zeros + 1,
+            "qx": zeros,
+            "qy": zeros,
+            "qz": zeros,
+            "p": zeros,
+            "q": zeros,
+            "r": zeros,
+            "ax": zeros,
+            "ay": zeros,
+            "az": force + rng.normal(0, 0.05, t_log.size),
+        }
+    )
     for i in range(4):
         table[f"u{i + 1}"] = u
     table.to_csv(tmp_path / "vertical.csv", index=False)
@@ -384,9 +452,21 @@ def test_cli_base_vehicle_gives_the_geometry_a_csv_lacks(tmp_path):
     from scipy.spatial.transform import Rotation
 
     xyzw = Rotation.from_euler("ZYX", states[:, [PSI, THETA, PHI]]).as_quat()
-    table = pd.DataFrame({"t": flight.t, "vx": states[:, VX], "vy": states[:, VX + 1], "vz": states[:, VX + 2],
-                          "qw": xyzw[:, 3], "qx": xyzw[:, 0], "qy": xyzw[:, 1], "qz": xyzw[:, 2],
-                          "p": states[:, P], "q": states[:, P + 1], "r": states[:, P + 2]})
+    table = pd.DataFrame(
+        {
+            "t": flight.t,
+            "vx": states[:, VX],
+            "vy": states[:, VX + 1],
+            "vz": states[:, VX + 2],
+            "qw": xyzw[:, 3],
+            "qx": xyzw[:, 0],
+            "qy": xyzw[:, 1],
+            "qz": xyzw[:, 2],
+            "p": states[:, P],
+            "q": states[:, P + 1],
+            "r": states[:, P + 2],
+        }
+    )
     for i in range(4):
         table[f"u{i + 1}"] = flight.commands[0][:, i]
     table.to_csv(tmp_path / "f.csv", index=False)

@@ -32,21 +32,21 @@ def test_the_joint_pair_satisfies_eqs_5_and_6_together_at_random_yaw_tilt_and_th
     for _ in range(2000):
         psi = rng.uniform(-math.pi, math.pi)
         a = rng.uniform(2.0, 40.0)
-        phi, theta = rng.uniform(-1.2, 1.2, 2)                    # any attitude up to 69 degrees
-        ux, uy = eq5_eq6(phi, theta, psi, a)                       # a feasible wish
+        phi, theta = rng.uniform(-1.2, 1.2, 2)  # any attitude up to 69 degrees
+        ux, uy = eq5_eq6(phi, theta, psi, a)  # a feasible wish
         phi_d, theta_d, flags = tilt_joint(ux, uy, math.sin(psi), math.cos(psi), a, 1.5, 0)
         assert flags == 0
         np.testing.assert_allclose(eq5_eq6(phi_d, theta_d, psi, a), (ux, uy), atol=1e-9 * a)
-        np.testing.assert_allclose((phi_d, theta_d), (phi, theta), atol=1e-9)     # and it is the unique one
+        np.testing.assert_allclose((phi_d, theta_d), (phi, theta), atol=1e-9)  # and it is the unique one
 
 
 def test_the_sequential_pair_does_not_satisfy_eq_5_with_its_own_roll():
     """Eq (16) solves eq (5) with the *current* roll: with the roll it then sets, eq (5) misses."""
     psi, a, ux, uy = math.radians(45.0), 9.81, 1.0, 0.0
-    theta_d, _ = theta_from_eq5(ux, 0.0, psi, a)                   # level now
+    theta_d, _ = theta_from_eq5(ux, 0.0, psi, a)  # level now
     phi_d, _ = phi_from_eq6(uy, theta_d, psi, a)
     x_acc, y_acc = eq5_eq6(phi_d, theta_d, psi, a)
-    assert abs(y_acc - uy) < 1e-9 and abs(x_acc - ux) > 0.2        # eq (6) holds, eq (5) does not
+    assert abs(y_acc - uy) < 1e-9 and abs(x_acc - ux) > 0.2  # eq (6) holds, eq (5) does not
 
 
 STEP_YAWS = [-80.0, -60.0, -45.0, -20.0, 0.0, 30.0, 45.0, 60.0, 80.0]
@@ -88,13 +88,14 @@ def test_a_circle_flown_at_yaw_60_degrees_is_tracked():
         return np.linalg.norm(res.states[0, :, :3] - res.references[0, :, :3], axis=1)[res.t > 20].max()
 
     level = fly(Circle(), "nlpd", duration=40.0)
-    assert late_error(joint) == pytest.approx(late_error(level), rel=0.02)     # as good as at yaw 0
-    assert late_error(literal) > 0.5                                            # the literal form lags
+    assert late_error(joint) == pytest.approx(late_error(level), rel=0.02)  # as good as at yaw 0
+    assert late_error(literal) > 0.5  # the literal form lags
 
 
 def test_a_minimum_snap_path_that_yaws_from_0_to_90_degrees_ends_on_its_last_point():
-    table = WaypointTable([[0, 0, 1], [2, 1, 1], [4, 0, 1.5], [5, 2, 1]], yaw=[0.0, 0.5, 1.0, math.pi / 2],
-                          t=[0, 4, 8, 12])
+    table = WaypointTable(
+        [[0, 0, 1], [2, 1, 1], [4, 0, 1.5], [5, 2, 1]], yaw=[0.0, 0.5, 1.0, math.pi / 2], t=[0, 4, 8, 12]
+    )
     res = fly(MinimumSnap(table), "nlpd")
     assert res.ok[0]
     assert np.linalg.norm(res.final_state[0, :3] - [5.0, 2.0, 1.0]) < 0.05

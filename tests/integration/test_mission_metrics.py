@@ -44,6 +44,7 @@ def tilt_deg(res, i=0):
 
 # --- the definitions, against closed forms and python-control ----------------------------
 
+
 def test_a_decaying_error_onto_a_steady_level_has_the_closed_form_transient():
     # e = E + (e0 - E) exp(-t / tau): the progress to E is 1 - exp(-t / tau), a first-order step
     t = np.linspace(0.0, 40.0, 40001)
@@ -55,7 +56,7 @@ def test_a_decaying_error_onto_a_steady_level_has_the_closed_form_transient():
     assert got["settling_s"][0][0] == pytest.approx(tau * np.log(50.0), abs=2e-3)
     assert got["settling_s"][1][0] == pytest.approx(tau * np.log(20.0), abs=2e-3)
     assert got["overshoot_pct"][0] == 0.0 and np.isnan(got["peak_time_s"][0])
-    assert got["steady_from"][0] == pytest.approx(20.0)          # the last half of the flight
+    assert got["steady_from"][0] == pytest.approx(20.0)  # the last half of the flight
     # python-control's step_info on the same normalised response (its crossings are samples)
     z = (e0 - e) / (e0 - got["level"][0])
     info = control.step_info(z, t, yfinal=1.0, SettlingTimeThreshold=0.02)
@@ -71,16 +72,17 @@ def test_an_entry_that_dips_below_its_steady_level_overshoots_and_a_periodic_ste
     # a steady wind: 0.1 +- 0.04 m with the lap's period, after a 2 m entry
     wind = 0.1 + 0.04 * np.sin(2 * np.pi * t / 20.0) + 1.9 * np.exp(-t)
     got = tracking_transient_batch(t, np.vstack([dip, wind]), [0.02, 0.05])
-    assert got["overshoot_pct"][0] == pytest.approx(100.0 * 0.1 / 1.9, abs=0.05)   # to the 5 ms sampling
+    assert got["overshoot_pct"][0] == pytest.approx(100.0 * 0.1 / 1.9, abs=0.05)  # to the 5 ms sampling
     assert 0.0 < got["peak_time_s"][0] < got["settling_s"][0][0]
     assert got["overshoot_pct"][1] == 0.0 and np.isnan(got["peak_time_s"][1])
-    assert np.isfinite(got["settling_s"][1][1]) and got["settling_s"][1][1] < 5.0   # settles in a wind
+    assert np.isfinite(got["settling_s"][1][1]) and got["settling_s"][1][1] < 5.0  # settles in a wind
     # still falling at the end (time constant 10 s in 40 s): not converged, nothing steady
     slow = tracking_transient_batch(t, (2.0 * np.exp(-t / 10.0))[None], [0.05])
     assert np.isnan(slow["settling_s"][0][0]) and np.isnan(slow["steady_from"][0])
 
 
 # --- the same numbers whatever the flight's length ------------------------------------------
+
 
 @pytest.fixture(scope="module")
 def circles():
@@ -91,7 +93,7 @@ def test_the_circle_measures_the_same_at_15_20_and_40_s(circles):
     rows = list(circles.values())
     for row in rows:
         assert row["status"] == "finished" and row["axis"] == "xyz"
-        assert row["overshoot_pct"] == 0.0 and np.isnan(row["peak_time_s"])    # the lag at the end is not one
+        assert row["overshoot_pct"] == 0.0 and np.isnan(row["peak_time_s"])  # the lag at the end is not one
     for key in ("rise_time_s", "settling_time_s", "settling_time_5pct_s"):
         values = [r[key] for r in rows]
         assert max(values) - min(values) < 0.02, (key, values)
@@ -105,8 +107,9 @@ def test_a_steady_wind_comparison_has_a_steady_error_for_every_controller():
     env = Environment(wind=ConstantWind(velocity=(3.0, 0.0, 0.0)))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        cmp = qc.compare("circle", ["nlpd", "gonzalez", "se3", "cascade"], environment=env,
-                         vehicle=with_drag(qc.Vehicle.paper()))
+        cmp = qc.compare(
+            "circle", ["nlpd", "gonzalez", "se3", "cascade"], environment=env, vehicle=with_drag(qc.Vehicle.paper())
+        )
     table = cmp.table()
     assert (table["status"] == "finished").all()
     steady = table["steady_rmse_m"].to_numpy(dtype=float)
@@ -115,6 +118,7 @@ def test_a_steady_wind_comparison_has_a_steady_error_for_every_controller():
 
 
 # --- statuses from physics ------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("controller", ["se3", "cascade"])
 @pytest.mark.parametrize("mission", ["hover", "circle", "step"])
@@ -129,11 +133,12 @@ def test_a_vehicle_that_flips_has_diverged_on_every_mission(controller, mission)
 
 
 def test_a_vehicle_heavier_than_its_controller_believes_that_sags_to_the_ground_is_off_track():
-    res = quietly("circle", vehicle=qc.Vehicle.paper().replace(m=4.55),
-                  controller_vehicle=qc.Vehicle.paper().replace(m=3.499))
+    res = quietly(
+        "circle", vehicle=qc.Vehicle.paper().replace(m=4.55), controller_vehicle=qc.Vehicle.paper().replace(m=3.499)
+    )
     assert res.exit_status(0) is ExitStatus.OFF_TRACK and res.meta["max_altitude_error_m"] == 0.5
     sag = res.references[0, :, 2] - res.states[0, :, 2]
-    assert sag[res.t > 10.0].min() > 0.9                      # it flies 2 cm to 10 cm above the ground
+    assert sag[res.t > 10.0].min() > 0.9  # it flies 2 cm to 10 cm above the ground
     assert res.metrics()[TRANSIENT + STEADY].iloc[0].isna().all()
 
 
@@ -144,19 +149,36 @@ def test_the_sequential_inversion_limit_cycle_at_60_degrees_of_yaw_is_not_finish
     assert quietly(Circle(yaw=np.radians(60.0)), "nlpd").ok[0]
 
 
-@pytest.mark.parametrize("case", ["wind 3 m/s", "start 1.5 m off", "slow gonzalez", "12 % heavier, model error",
-                                  "square from a corner", "20 % rotor loss"])
+@pytest.mark.parametrize(
+    "case",
+    [
+        "wind 3 m/s",
+        "start 1.5 m off",
+        "slow gonzalez",
+        "12 % heavier, model error",
+        "square from a corner",
+        "20 % rotor loss",
+    ],
+)
 def test_mild_flights_stay_finished(case):
-    fly = {"wind 3 m/s": lambda: quietly("circle", vehicle=with_drag(qc.Vehicle.paper()),
-                                         environment=Environment(wind=ConstantWind(velocity=(3.0, 0.0, 0.0)))),
-           "start 1.5 m off": lambda: quietly("hover", x0=np.r_[1.5, 0.0, 1.0, np.zeros(9),
-                                                                np.full(4, qc.Vehicle.paper().hover_duty * 120.0)]),
-           "slow gonzalez": lambda: quietly(Step(size=2.0), "gonzalez", duration=20.0),
-           "12 % heavier, model error": lambda: quietly("circle", vehicle=qc.Vehicle.paper().replace(m=3.92),
-                                                        controller_vehicle=qc.Vehicle.paper()),
-           "square from a corner": lambda: quietly(Square(corner=(-2.0, -2.0)), "gonzalez", duration=32.0),
-           "20 % rotor loss": lambda: quietly("circle", "cascade",
-                                              environment=Environment(rotor_loss=RotorLoss(fraction=0.2, time=3.0)))}
+    fly = {
+        "wind 3 m/s": lambda: quietly(
+            "circle",
+            vehicle=with_drag(qc.Vehicle.paper()),
+            environment=Environment(wind=ConstantWind(velocity=(3.0, 0.0, 0.0))),
+        ),
+        "start 1.5 m off": lambda: quietly(
+            "hover", x0=np.r_[1.5, 0.0, 1.0, np.zeros(9), np.full(4, qc.Vehicle.paper().hover_duty * 120.0)]
+        ),
+        "slow gonzalez": lambda: quietly(Step(size=2.0), "gonzalez", duration=20.0),
+        "12 % heavier, model error": lambda: quietly(
+            "circle", vehicle=qc.Vehicle.paper().replace(m=3.92), controller_vehicle=qc.Vehicle.paper()
+        ),
+        "square from a corner": lambda: quietly(Square(corner=(-2.0, -2.0)), "gonzalez", duration=32.0),
+        "20 % rotor loss": lambda: quietly(
+            "circle", "cascade", environment=Environment(rotor_loss=RotorLoss(fraction=0.2, time=3.0))
+        ),
+    }
     res = fly[case]()
     assert res.ok[0], res.status_text(0)
     row = res.metrics().iloc[0]
@@ -164,6 +186,7 @@ def test_mild_flights_stay_finished(case):
 
 
 # --- the command line ------------------------------------------------------------------------
+
 
 def test_a_reference_beyond_the_position_bound_is_refused_in_one_line(tmp_path):
     for extra in ([], ["--out", str(tmp_path / "out")]):
@@ -211,17 +234,26 @@ def test_fly_and_a_sweep_agree_flight_by_flight_on_a_moving_reference():
         spec = mc.spec
         draw = spec.population.draw(spec.seed, 0, 16, spec.vehicle, spec.dt)
         x0 = hover_state(draw.vehicle, 16, spec.mission)
-        res = qc.fly(spec.mission, spec.controller, vehicle=draw.vehicle, controller_vehicle=spec.vehicle,
-                     duration=spec.duration, dt=spec.dt, x0=x0)
+        res = qc.fly(
+            spec.mission,
+            spec.controller,
+            vehicle=draw.vehicle,
+            controller_vehicle=spec.vehicle,
+            duration=spec.duration,
+            dt=spec.dt,
+            x0=x0,
+        )
     failed = res.status == int(ExitStatus.OFF_TRACK)
     lost = mc.table["lost_track"].to_numpy()
     # the worse of the two errors after the entry, each over its bound, on fly's full-rate log
     pos, ref = res.states[:, :, :3], res.references[:, :, :3]
     settled = transient_batch(res.t, pos, ref, res.meta["mission"], [])["settled_at"]
     start = np.where(np.isnan(settled), res.t[-1], settled)
-    worst = np.where(res.t[None, :] >= start[:, None] - 1e-12,
-                     np.maximum(np.linalg.norm(pos - ref, axis=2) / 1.0, np.abs(pos[:, :, 2] - ref[:, :, 2]) / 0.5),
-                     0.0).max(axis=1)
-    clear = np.abs(worst - 1.0) > 0.02                  # the sweep's log is 10 ms: not at the edge
+    worst = np.where(
+        res.t[None, :] >= start[:, None] - 1e-12,
+        np.maximum(np.linalg.norm(pos - ref, axis=2) / 1.0, np.abs(pos[:, :, 2] - ref[:, :, 2]) / 0.5),
+        0.0,
+    ).max(axis=1)
+    clear = np.abs(worst - 1.0) > 0.02  # the sweep's log is 10 ms: not at the edge
     assert 2 <= failed.sum() <= 14 and clear.sum() >= 12
     assert np.array_equal(failed, worst > 1.0) and np.array_equal(failed[clear], lost[clear])

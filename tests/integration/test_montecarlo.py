@@ -21,15 +21,20 @@ from quadcruise.montecarlo import MonteCarloSpec, Population, montecarlo, montec
 from quadcruise.montecarlo.chunk import fly_chunk, sweep_metrics
 from quadcruise.montecarlo.schema import COLUMNS
 
-POP = Population(mass_spread=0.15, inertia_spread=0.1, thrust_spread=0.1, bandwidth_spread=0.1,
-                 yaw_arm_spread=0.1, offset=0.2)
+POP = Population(
+    mass_spread=0.15, inertia_spread=0.1, thrust_spread=0.1, bandwidth_spread=0.1, yaw_arm_spread=0.1, offset=0.2
+)
 # and the world: turbulence and sensor noise draw from the engine's per-vehicle streams
-WORLD = dataclasses.replace(POP, environment=Environment(turbulence=Turbulence(intensity="light", altitude=5.0)),
-                            wind_spread=0.5, noise=SensorNoise(position_std=0.005, rate_std=0.01, delay=0.002))
+WORLD = dataclasses.replace(
+    POP,
+    environment=Environment(turbulence=Turbulence(intensity="light", altitude=5.0)),
+    wind_spread=0.5,
+    noise=SensorNoise(position_std=0.005, rate_std=0.01, delay=0.002),
+)
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")
     DRAG = with_drag(Vehicle.paper())
-FAST = dict(duration=3.0, dt=2e-3)          # short flights: 1,500 periods
+FAST = dict(duration=3.0, dt=2e-3)  # short flights: 1,500 periods
 FIGURES = ("histograms.png", "envelope.png")
 
 
@@ -51,8 +56,9 @@ def reference(tmp_path_factory):
 def cluster():
     from distributed import LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
-                      env={"NUMBA_NUM_THREADS": "1"}) as c:
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0", env={"NUMBA_NUM_THREADS": "1"}
+    ) as c:
         yield c
 
 
@@ -88,15 +94,20 @@ def test_draws_depend_on_seed_and_index_only():
     m = Population(mass_spread=0.3).draw(0, 0, 2000, v).columns["m"]
     assert m.min() >= v.m * (1 - 0.9) - 1e-12 and m.max() <= v.m * (1 + 0.9) + 1e-12
     u = Population(mass_spread=0.1, distribution="uniform").draw(0, 0, 4000, v).columns["m"]
-    assert abs(np.std(u / v.m) - 0.1) < 0.005 and np.all(np.abs(u / v.m - 1) <= 0.1 * 3 ** 0.5)
+    assert abs(np.std(u / v.m) - 0.1) < 0.005 and np.all(np.abs(u / v.m - 1) <= 0.1 * 3**0.5)
 
 
-@pytest.mark.parametrize("kw, words", [
-    (dict(mass_spread=-0.1), "mass_spread"), (dict(inertia_spread=0.4), "too large"),
-    (dict(thrust_spread=0.6, distribution="uniform"), "too large"), (dict(offset=float("nan")), "offset"),
-    (dict(distribution="cauchy"), "distribution"),
-    (dict(environment=Environment(wind=ConstantWind(velocity=([1.0, 2.0], 0.0, 0.0)))), "same for every vehicle"),
-])
+@pytest.mark.parametrize(
+    "kw, words",
+    [
+        (dict(mass_spread=-0.1), "mass_spread"),
+        (dict(inertia_spread=0.4), "too large"),
+        (dict(thrust_spread=0.6, distribution="uniform"), "too large"),
+        (dict(offset=float("nan")), "offset"),
+        (dict(distribution="cauchy"), "distribution"),
+        (dict(environment=Environment(wind=ConstantWind(velocity=([1.0, 2.0], 0.0, 0.0)))), "same for every vehicle"),
+    ],
+)
 def test_population_rejects_bad_values(kw, words):
     with pytest.raises(InputError, match=words) as err:
         Population(**kw)
@@ -109,7 +120,7 @@ def test_table_does_not_depend_on_chunking(reference):
     other = sweep(chunk_size=25)
     pd.testing.assert_frame_equal(res.table, other.table, check_exact=True)
     assert res.table["vehicle"].tolist() == list(range(24))
-    assert list(res.table.columns[:len(COLUMNS)]) == list(COLUMNS)
+    assert list(res.table.columns[: len(COLUMNS)]) == list(COLUMNS)
     assert not sweep(seed=2).table["m"].equals(res.table["m"])
     # memory stays bounded: paths of the first max_traces vehicles and of the first
     # max_failure_traces failed ones (3 s is mostly too short to settle into 2 %)
@@ -127,7 +138,7 @@ def test_a_case_flown_alone_equals_its_row(reference):
     for i in (int(worst["vehicle"][0]), 17):
         case = replay_case(res, i)
         assert same_row(case.row, res.table.iloc[i].to_dict()), i
-    full = montecarlo_case(res.spec, 3, log_every=1)          # every period, for a close look
+    full = montecarlo_case(res.spec, 3, log_every=1)  # every period, for a close look
     assert full.result.t.size == res.spec.periods + 1 and same_row(full.row, res.table.iloc[3].to_dict())
 
 
@@ -137,16 +148,28 @@ def test_sweep_metrics_equal_flight_metrics():
         res, _ = fly_chunk(spec, 0, 6)
         # vehicle 2 "diverged" half way: its metrics are NaN in both
         states = res.states.copy()
-        states[2, states.shape[1] // 2:] = np.nan
+        states[2, states.shape[1] // 2 :] = np.nan
         res = dataclasses.replace(res, states=states, status=np.where(np.arange(6) == 2, 2, res.status))
         fast, slow = sweep_metrics(res, spec), flight_metrics(res)
-        kept = ~fast["lost_track"]            # the sweep judged the others off track: no transient to show
+        kept = ~fast["lost_track"]  # the sweep judged the others off track: no transient to show
         assert np.isnan(fast["rise_time_s"][~kept]).all() and np.isfinite(fast["rmse_m"][~kept]).all()
-        for k in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "rise_time_s", "settling_time_s",
-                  "settling_time_5pct_s", "overshoot_pct", "peak_time_s", "effort", "duty_clipped_s",
-                  "controller_limited_s"):
-            np.testing.assert_allclose(fast[k][kept], slow[k].to_numpy(dtype=float)[kept], rtol=1e-12, atol=1e-15,
-                                       err_msg=f"{mission} {k}")
+        for k in (
+            "rmse_m",
+            "max_error_m",
+            "steady_rmse_m",
+            "steady_max_error_m",
+            "rise_time_s",
+            "settling_time_s",
+            "settling_time_5pct_s",
+            "overshoot_pct",
+            "peak_time_s",
+            "effort",
+            "duty_clipped_s",
+            "controller_limited_s",
+        ):
+            np.testing.assert_allclose(
+                fast[k][kept], slow[k].to_numpy(dtype=float)[kept], rtol=1e-12, atol=1e-15, err_msg=f"{mission} {k}"
+            )
         assert np.isnan(fast["rmse_m"][2]) and fast["diverged"].tolist() == [False, False, True, False, False, False]
         axes = [{"x": 0, "y": 1, "z": 2, "xyz": 3}.get(a, -1) if isinstance(a, str) else -1 for a in slow["axis"]]
         assert fast["transient_axis"].tolist() == axes
@@ -156,8 +179,9 @@ def test_sweep_metrics_equal_flight_metrics():
 def test_not_settling_within_2pct_is_a_metric_not_a_failure():
     """A 6 s circle has not converged onto its steady lag within 2 % by half its length (the
     entry settles there in about 4.2 s): marked, not failed; every one tracks within decimetres."""
-    res = montecarlo("circle", "nlpd", Population(mass_spread=0.05), 24, seed=1, scheduler="none", settle_band=0.02,
-                     duration=6.0)
+    res = montecarlo(
+        "circle", "nlpd", Population(mass_spread=0.05), 24, seed=1, scheduler="none", settle_band=0.02, duration=6.0
+    )
     tab = res.table
     assert tab["not_settled"].mean() > 0.8
     assert (tab["failure"] == 0).all() and (tab["reason"] == "ok").all()
@@ -171,15 +195,14 @@ def test_not_settling_within_2pct_is_a_metric_not_a_failure():
 def test_lost_track_is_the_error_after_the_transient_beyond_a_bound():
     spec = MonteCarloSpec("circle", population=Population(mass_spread=0.1), seed=1)
     assert spec.max_track_error_m == 1.0 and spec.to_dict()["max_track_error_m"] == 1.0
-    res = montecarlo("circle", "nlpd", Population(mass_spread=0.1), 24, seed=1, scheduler="none",
-                     max_track_error_m=0.3)
+    res = montecarlo("circle", "nlpd", Population(mass_spread=0.1), 24, seed=1, scheduler="none", max_track_error_m=0.3)
     tab = res.table
     lost = tab["lost_track"]
     assert 0 < lost.sum() < len(tab) and (tab.loc[lost, "reason"] == "lost track").all()
     # the kept flights' steady window (the last half) lies after the transient, where the bound held;
     # the lost ones have no steady state to show
     assert (tab.loc[~lost, "steady_max_error_m"] <= 0.3).all() and tab.loc[lost, "steady_max_error_m"].isna().all()
-    assert res.spec.max_altitude_error_m == 0.3                 # a bound given bounds the altitude too
+    assert res.spec.max_altitude_error_m == 0.3  # a bound given bounds the altitude too
     assert "lost track" in res.summary_text() and "> 0.3 m" in res.summary_text()
     with pytest.raises(InputError, match="max_track_error_m"):
         MonteCarloSpec("circle", max_track_error_m=-1.0)
@@ -187,10 +210,18 @@ def test_lost_track_is_the_error_after_the_transient_beyond_a_bound():
 
 def test_a_requirement_that_fails_is_counted_and_shown(tmp_path):
     req = "steady_max_error_m<=0.2"
-    res = montecarlo("circle", "nlpd", Population(mass_spread=0.1), 24, seed=1, scheduler="none",
-                     requirements=[req], out=tmp_path / "mc")
+    res = montecarlo(
+        "circle",
+        "nlpd",
+        Population(mass_spread=0.1),
+        24,
+        seed=1,
+        scheduler="none",
+        requirements=[req],
+        out=tmp_path / "mc",
+    )
     tab = res.table
-    missed = ~(tab["steady_max_error_m"] <= 0.2)            # a lost flight (no steady metric) misses it too
+    missed = ~(tab["steady_max_error_m"] <= 0.2)  # a lost flight (no steady metric) misses it too
     lost = tab["lost_track"]
     assert 0 < (missed & ~lost).sum() and missed.sum() < len(tab)
     assert tab["failed_requirement"].tolist() == missed.tolist()
@@ -205,24 +236,54 @@ def test_a_requirement_that_fails_is_counted_and_shown(tmp_path):
     assert json.loads((tmp_path / "mc" / "summary.json").read_text())["requirements"][0]["failed"] == missed.sum()
     # other criteria are another sweep: a folder of this one is not resumed with them
     with pytest.raises(InputError, match="different sweep"):
-        montecarlo("circle", "nlpd", Population(mass_spread=0.1), 24, seed=1, scheduler="none",
-                   requirements=["steady_max_error_m<=0.3"], out=tmp_path / "mc")
+        montecarlo(
+            "circle",
+            "nlpd",
+            Population(mass_spread=0.1),
+            24,
+            seed=1,
+            scheduler="none",
+            requirements=["steady_max_error_m<=0.3"],
+            out=tmp_path / "mc",
+        )
     assert MonteCarloSpec("circle", requirements="rmse_m < 0.5").requirements == ("rmse_m<0.5",)
 
 
-@pytest.mark.parametrize("text, words", [
-    ("steady_max_error<=0.2", "unknown metric 'steady_max_error'; choose one of rmse_m, max_error_m, steady_rmse_m"),
-    ("rmse_m=<0.2", "expected METRIC<=VALUE"),
-    ("rmse_m<=fast", "'fast' is not a finite number"),
-])
+@pytest.mark.parametrize(
+    "text, words",
+    [
+        (
+            "steady_max_error<=0.2",
+            "unknown metric 'steady_max_error'; choose one of rmse_m, max_error_m, steady_rmse_m",
+        ),
+        ("rmse_m=<0.2", "expected METRIC<=VALUE"),
+        ("rmse_m<=fast", "'fast' is not a finite number"),
+    ],
+)
 def test_a_bad_requirement_is_refused_before_any_flight(tmp_path, text, words):
     from click.testing import CliRunner
 
     from quadcruise.cli import main
 
     out = tmp_path / "mc"
-    res = CliRunner().invoke(main, ["montecarlo", "--n", "4", "--duration", "1", "--scheduler", "none",
-                                    "--out", str(out), "--require", "rmse_m<1", "--require", text])
+    res = CliRunner().invoke(
+        main,
+        [
+            "montecarlo",
+            "--n",
+            "4",
+            "--duration",
+            "1",
+            "--scheduler",
+            "none",
+            "--out",
+            str(out),
+            "--require",
+            "rmse_m<1",
+            "--require",
+            text,
+        ],
+    )
     assert res.exit_code == 2, res.output
     assert words in res.output and f"requirement {text!r}" in res.output and len(res.output.strip().splitlines()) == 1
     assert not out.exists()
@@ -232,14 +293,15 @@ def test_a_bad_requirement_is_refused_before_any_flight(tmp_path, text, words):
 
 def test_metrics_on_the_decimated_log_are_close_to_full_rate():
     spec = MonteCarloSpec("circle", population=POP, seed=2, duration=8.0)
-    fast = sweep_metrics(fly_chunk(spec, 0, 5)[0], spec)              # 10 ms log
-    full = flight_metrics(fly_chunk(spec, 0, 5, log_every=1)[0])      # every 1 ms period
-    kept = ~fast["lost_track"]                                        # the others show no transient
+    fast = sweep_metrics(fly_chunk(spec, 0, 5)[0], spec)  # 10 ms log
+    full = flight_metrics(fly_chunk(spec, 0, 5, log_every=1)[0])  # every 1 ms period
+    kept = ~fast["lost_track"]  # the others show no transient
     for k, tol in (("rmse_m", 1e-5), ("max_error_m", 1e-4)):
         np.testing.assert_allclose(fast[k], full[k].to_numpy(dtype=float), rtol=tol, err_msg=k)
-    for k in ("rise_time_s", "settling_time_5pct_s"):         # crossings interpolated on the 10 ms log:
-        np.testing.assert_allclose(fast[k][kept], full[k].to_numpy(dtype=float)[kept], atol=1e-3,
-                                   err_msg=k)                 # 1/10 of it
+    for k in ("rise_time_s", "settling_time_5pct_s"):  # crossings interpolated on the 10 ms log:
+        np.testing.assert_allclose(
+            fast[k][kept], full[k].to_numpy(dtype=float)[kept], atol=1e-3, err_msg=k
+        )  # 1/10 of it
 
 
 def test_the_world_acts_and_drag_is_added_with_a_warning():
@@ -283,6 +345,7 @@ def test_a_worker_killed_mid_run_costs_nothing(reference, cluster, tmp_path):
     ref, ref_out = reference
     killed = []
     with Client(cluster.scheduler_address) as client:
+
         def held():
             """Chunks of this run on each worker: running, waiting there, or done and not yet fetched."""
             keys = {w: {k for k in ks if "quadcruise-chunk" in str(k)} for w, ks in client.processing().items()}
@@ -302,8 +365,10 @@ def test_a_worker_killed_mid_run_costs_nothing(reference, cluster, tmp_path):
             os.kill(pid, signal.SIGKILL)
             killed.append((victim, busy.get(victim, 0)))
 
-        res = sweep(scheduler=cluster.scheduler_address, out=tmp_path / "killed", chunk_size=3, progress=kill_a_busy_worker)
-    assert killed and killed[0][1] >= 1, killed         # it died holding work
+        res = sweep(
+            scheduler=cluster.scheduler_address, out=tmp_path / "killed", chunk_size=3, progress=kill_a_busy_worker
+        )
+    assert killed and killed[0][1] >= 1, killed  # it died holding work
     assert res.table["vehicle"].tolist() == list(range(24))
     pd.testing.assert_frame_equal(res.table, ref.table, check_exact=True)
     same_outputs(tmp_path / "killed", ref_out)
@@ -318,7 +383,7 @@ def test_an_interrupted_sweep_resumes_where_it_stopped(reference, tmp_path):
 
     def stop_after_two_chunks(done, total):
         calls.append(done)
-        if len(calls) == 3:                  # the start, then two chunks
+        if len(calls) == 3:  # the start, then two chunks
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
@@ -333,7 +398,7 @@ def test_an_interrupted_sweep_resumes_where_it_stopped(reference, tmp_path):
     pd.testing.assert_frame_equal(res.table, ref.table, check_exact=True)
     same_outputs(out, ref_out)
     assert json.loads((out / "quadcruise.json").read_text())["complete"] is True
-    again = sweep(out=out)                                   # complete: nothing to fly
+    again = sweep(out=out)  # complete: nothing to fly
     assert again.info["flown"] == 0 and again.info["resumed"] == 24
 
 
@@ -361,8 +426,8 @@ def test_auto_chunks_fit_the_memory_budget_and_split_evenly_over_threads():
     for threads in (2, 3, 4):
         size = auto_chunk_size(spec, 10_000, threads=threads)
         assert size % threads == 0 and alone - threads < size <= alone
-    assert auto_chunk_size(spec, 8, parallel=2) == 1                  # 4 chunks per worker
-    assert auto_chunk_size(spec, 8, parallel=2, threads=2) == 1       # fewer vehicles than threads
+    assert auto_chunk_size(spec, 8, parallel=2) == 1  # 4 chunks per worker
+    assert auto_chunk_size(spec, 8, parallel=2, threads=2) == 1  # fewer vehicles than threads
 
 
 def test_other_code_makes_another_sweep(reference, tmp_path, monkeypatch):
@@ -383,18 +448,22 @@ def test_other_code_makes_another_sweep(reference, tmp_path, monkeypatch):
 
 
 # --- bad input ------------------------------------------------------------------------------
-@pytest.mark.parametrize("kw, words", [
-    (dict(mass_spread=-0.1), "mass_spread"),
-    (dict(n=0), "number of flights"),
-    (dict(wind="hurricane:3"), "unknown model 'hurricane'"),
-    (dict(scheduler="tcp://127.0.0.1:9", connect_timeout=1.0), "cannot reach the Dask scheduler"),
-    (dict(chunk_size="many"), "chunk-size"),
-    (dict(noise="jitter=1"), "noise spec"),
-])
+@pytest.mark.parametrize(
+    "kw, words",
+    [
+        (dict(mass_spread=-0.1), "mass_spread"),
+        (dict(n=0), "number of flights"),
+        (dict(wind="hurricane:3"), "unknown model 'hurricane'"),
+        (dict(scheduler="tcp://127.0.0.1:9", connect_timeout=1.0), "cannot reach the Dask scheduler"),
+        (dict(chunk_size="many"), "chunk-size"),
+        (dict(noise="jitter=1"), "noise spec"),
+    ],
+)
 def test_bad_input_is_one_line_and_writes_nothing(tmp_path, kw, words):
     out = tmp_path / "out"
-    options = dict(n=4, seed=1, duration=1.0, mass_spread=0.1, scheduler="none", out=str(out), quiet=True,
-                   echo=lambda s: None)
+    options = dict(
+        n=4, seed=1, duration=1.0, mass_spread=0.1, scheduler="none", out=str(out), quiet=True, echo=lambda s: None
+    )
     options.update(kw)
     with pytest.raises(InputError, match=words) as err:
         montecarlo_command(**options)
@@ -406,9 +475,19 @@ def test_bad_input_is_one_line_and_writes_nothing(tmp_path, kw, words):
 @pytest.mark.filterwarnings("ignore:the vehicle has no drag")
 def test_command_prints_the_summary_and_replays_a_case(tmp_path):
     lines = []
-    res = montecarlo_command(mission="hover", n=6, seed=4, duration=1.0, offset=0.05, mass_spread=0.1,
-                             wind="constant:1,0,0", scheduler="none", out=str(tmp_path / "mc"), quiet=True,
-                             echo=lines.append)
+    res = montecarlo_command(
+        mission="hover",
+        n=6,
+        seed=4,
+        duration=1.0,
+        offset=0.05,
+        mass_spread=0.1,
+        wind="constant:1,0,0",
+        scheduler="none",
+        out=str(tmp_path / "mc"),
+        quiet=True,
+        echo=lines.append,
+    )
     text = "\n".join(lines)
     assert "6 flights of nlpd on hover, seed 4" in text and "worst 5" in text
     for name in ("flights.csv", "summary.json", "worst.csv", "report.md", "quadcruise.json", *FIGURES):
@@ -418,9 +497,8 @@ def test_command_prints_the_summary_and_replays_a_case(tmp_path):
     same = dict(mission="hover", n=6, seed=4, duration=1.0, offset=0.05, mass_spread=0.1, wind="constant:1,0,0")
     case = montecarlo_command(**same, case=worst, out=str(tmp_path / "mc"), echo=lines.append)
     assert case.row["rmse_m"] == res.table["rmse_m"][worst]
-    folder = tmp_path / "mc" / f"case-{worst:06d}"             # beside the sweep's results, which stay
+    folder = tmp_path / "mc" / f"case-{worst:06d}"  # beside the sweep's results, which stay
     assert (folder / "flight.png").is_file() and (folder / "case.json").is_file()
     assert (tmp_path / "mc" / "flights.csv").is_file()
     with pytest.raises(InputError, match="other options"):
         montecarlo_command(**{**same, "seed": 5}, case=worst, out=str(tmp_path / "mc"), echo=lines.append)
-

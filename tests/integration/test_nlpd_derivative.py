@@ -34,7 +34,7 @@ def test_error_form_kicks_a_small_step_by_kd_n_per_metre():
     c = NLPD(derivative="error", derivative_filter=n)
     theta, _ = pitch_at_step(step_flight(size, derivative="error", derivative_filter=n))
     g = qc.Vehicle.paper().g
-    kick = c.position.kp * size + c.position.kd * n * size           # Kp E + Kd N E at the jump
+    kick = c.position.kp * size + c.position.kd * n * size  # Kp E + Kd N E at the jump
     assert theta == pytest.approx(math.asin(kick / g), rel=1e-6)
     plain, _ = pitch_at_step(step_flight(size))
     assert plain == pytest.approx(math.asin(c.position.kp * size / g), rel=1e-6)
@@ -47,7 +47,7 @@ def test_the_kick_decays_with_the_filter():
     # the kick is Kd N E: ten times smaller with N ten times smaller, and it lasts ten times longer
     ratio = fast.commands[0, k, CMD_THETA_D] / slow.commands[0, k, CMD_THETA_D]
     assert 8.0 < ratio < 10.5
-    late = k + 100                                                    # 0.1 s later: 10 / N = 0.1 s vs 1 s
+    late = k + 100  # 0.1 s later: 10 / N = 0.1 s vs 1 s
     assert fast.commands[0, late, CMD_THETA_D] < slow.commands[0, late, CMD_THETA_D]
 
 
@@ -55,10 +55,10 @@ def test_on_a_large_step_the_limits_absorb_the_kick():
     plain, error = step_flight(1.0), step_flight(1.0, derivative="error")
     theta, flags = pitch_at_step(error)
     assert theta == pytest.approx(NLPD().max_tilt) and flags & FLAG_TILT_LIMIT
-    assert 0.0 < error.controller_limited_s[0] < 0.1                 # held at the limit a few hundredths of a second
+    assert 0.0 < error.controller_limited_s[0] < 0.1  # held at the limit a few hundredths of a second
     m, e = plain.metrics().iloc[0], error.metrics().iloc[0]
     assert e.overshoot_pct < 0.5 and m.overshoot_pct < 0.5
-    assert e.rise_time_s == pytest.approx(m.rise_time_s, rel=0.1)     # 3.3 s against 3.1 s: the kick is gone
+    assert e.rise_time_s == pytest.approx(m.rise_time_s, rel=0.1)  # 3.3 s against 3.1 s: the kick is gone
 
 
 def test_unknown_derivative_form_is_refused():

@@ -37,11 +37,12 @@ def test_controllers_of_another_kind_or_count_are_refused():
 
 
 def test_repeated_vehicle_indices_share_draws_and_noise():
-    spec = MonteCarloSpec(STEP, "nlpd", Population(mass_spread=0.1, noise=SensorNoise(position_std=0.01)),
-                          seed=4, duration=2.0)
+    spec = MonteCarloSpec(
+        STEP, "nlpd", Population(mass_spread=0.1, noise=SensorNoise(position_std=0.01)), seed=4, duration=2.0
+    )
     ids = np.array([0, 1, 0, 1])
     res, draw = fly_chunk(spec, ids, 4, controller=[NLPD()] * 2 + [NLPD(position=PDGains(kp=2.0, kd=3.0))] * 2)
     np.testing.assert_array_equal(draw.vehicle.m[:2], draw.vehicle.m[2:])
-    alone, _ = fly_chunk(spec, 0, 2)                     # the sweep's vehicles 0 and 1
+    alone, _ = fly_chunk(spec, 0, 2)  # the sweep's vehicles 0 and 1
     np.testing.assert_array_equal(res.states[:2], alone.states)
-    assert not np.array_equal(res.states[0], res.states[2])          # other gains, same vehicle
+    assert not np.array_equal(res.states[0], res.states[2])  # other gains, same vehicle

@@ -84,7 +84,7 @@ def test_plot_flight_structure_labels_and_data(step):
 
 
 def test_plot_flight_path_3d_has_markers_and_dashed_reference(circle):
-    fig = circle.plot(title="my title")          # SimResult.plot delegates here
+    fig = circle.plot(title="my title")  # SimResult.plot delegates here
     assert fig._suptitle.get_text() == "my title"
     path = fig.axes[0]
     ref = line(path, "reference")
@@ -134,11 +134,13 @@ def test_flight_has_a_log_position_error_panel(step, circle):
 
 
 def test_events_of_the_environment_are_marked():
-    env = Environment(gust=Gust(amplitude=(3.0, 4.0, 0.0), start=0.5, duration=1.0),
-                      rotor_loss=RotorLoss(rotor=2, fraction=0.3, time=2.0))
+    env = Environment(
+        gust=Gust(amplitude=(3.0, 4.0, 0.0), start=0.5, duration=1.0),
+        rotor_loss=RotorLoss(rotor=2, fraction=0.3, time=2.0),
+    )
     res = qc.fly("step", duration=3.0, log_every=10, environment=env)
     fig = plot_flight(res)
-    for ax in fig.axes[1:]:                       # on every time panel
+    for ax in fig.axes[1:]:  # on every time panel
         loss = [ln for ln in ax.get_lines() if ln.get_color() == marks.EVENT_COLORS["rotor_loss"]]
         assert len(loss) == 1 and list(loss[0].get_xdata()) == [2.0, 2.0]
         gust = [p for p in ax.patches if p.get_facecolor()[:3] == pytest.approx((0.09, 0.745, 0.812), abs=0.01)]
@@ -152,8 +154,12 @@ def test_events_of_the_environment_are_marked():
     assert [e.label for e in marks.flight_events(meta, 1)] == ["rotor 3 loses 50 % at 9 s"]
     assert "rotor 1 loses 10 % at 1 s" in legend_texts(axis_by_ylabel(plot_flight(two), "position error"))
     # no environment, or one that cannot be read: no marker
-    for meta in ({}, {"environment": None}, {"environment": {"custom": "mine"}},
-                 {"environment": {"gust": {"start": "soon"}, "rotor_loss": {"rotor": 1}}}):
+    for meta in (
+        {},
+        {"environment": None},
+        {"environment": {"custom": "mine"}},
+        {"environment": {"gust": {"start": "soon"}, "rotor_loss": {"rotor": 1}}},
+    ):
         assert marks.flight_events(meta) == []
         fig = plot_flight(dataclasses.replace(res, meta=meta))
         assert legend_texts(axis_by_ylabel(fig, "position error")) == ["|p - p_ref|", "≤ 0.1 mm (drawn here)"]
@@ -162,8 +168,8 @@ def test_events_of_the_environment_are_marked():
 def test_clipped_duties_are_shaded_and_named_only_when_they_happen(step):
     assert not any("clip" in text for text in all_legend_texts(plot_flight(step)))
     commands = step.commands.copy()
-    commands[0, 100:120, CMD_U1 + 2] = 1.3               # asked for more than full duty
-    commands[0, 200:201, CMD_U1] = -0.1                  # and less than none, once
+    commands[0, 100:120, CMD_U1 + 2] = 1.3  # asked for more than full duty
+    commands[0, 200:201, CMD_U1] = -0.1  # and less than none, once
     fig = plot_flight(dataclasses.replace(step, commands=commands))
     duty = axis_by_ylabel(fig, "rotor duty")
     assert "duty clipped (asked outside [0, 1])" in legend_texts(duty)
@@ -175,10 +181,10 @@ def test_clipped_duties_are_shaded_and_named_only_when_they_happen(step):
 
 def test_a_brief_limit_flag_survives_thinning():
     """The flight is thinned for drawing; its saturation intervals are not."""
-    res = qc.fly("step", duration=7.0)                 # 7,001 instants, drawn every third
+    res = qc.fly("step", duration=7.0)  # 7,001 instants, drawn every third
     assert len(plots.drawable(res).t) < len(res.t)
     commands = res.commands.copy()
-    commands[0, 3001, CMD_FLAGS] = 1.0                   # one period, between drawn instants
+    commands[0, 3001, CMD_FLAGS] = 1.0  # one period, between drawn instants
     duty = axis_by_ylabel(plot_flight(dataclasses.replace(res, commands=commands)), "rotor duty")
     (shaded,) = [c for c in duty.collections if c.get_label() == "controller limit flagged"]
     (path,) = shaded.get_paths()
@@ -243,7 +249,7 @@ def test_nan_references_are_skipped(diverged):
 
 def test_plot_paths_overlays_flights_with_one_reference(step, circle, diverged):
     x0 = hover_state(qc.Vehicle.paper(), 1, Step())
-    x0[0, 1] = 0.3                                  # start 0.3 m off in y
+    x0[0, 1] = 0.3  # start 0.3 m off in y
     other = qc.fly("step", duration=3.0, log_every=10, x0=x0)
     fig = plot_paths({"A": step, "B": other, "bad": diverged})
     assert len(fig.axes) == 4
@@ -270,22 +276,24 @@ def test_comparison_has_a_position_error_panel_with_events_and_saturation(step):
     assert ax_e.get_ylabel() == "position error [m]" and ax_e.get_yscale() == "log"
     assert ax_e.get_xlabel() == "time [s]" and ax_z.get_xlabel() == ""
     finals = []
-    for k, (label, res) in enumerate(cmp.results.items()):
+    for label, res in cmp.results.items():
         err = np.linalg.norm(res.states[0, :, :3] - res.references[0, :, :3], axis=1)
         (curve,) = [ln for ln in ax_e.get_lines() if ln.get_label() == label]
         np.testing.assert_allclose(curve.get_ydata(), np.maximum(err, marks.ERROR_FLOOR))
         assert curve.get_color() == line(top, label).get_color()
         finals.append(err[-1])
     lo, hi = ax_e.get_ylim()
-    assert lo < min(finals) and max(finals) / min(finals) > 5      # told apart after 7 s
+    assert lo < min(finals) and max(finals) / min(finals) > 5  # told apart after 7 s
     texts = legend_texts(top)
     assert texts[:5] == ["reference", *cmp.results] and not any(
-        word in text for text in texts for word in ("gust", "rotor", "flagged", "clipped", "vehicle"))
-    assert len(ax_e.collections) == 0                                 # no saturation: no strip
+        word in text for text in texts for word in ("gust", "rotor", "flagged", "clipped", "vehicle")
+    )
+    assert len(ax_e.collections) == 0  # no saturation: no strip
     # the same flights in a gust, one of them saturating: marked and named
     env = {"gust": {"amplitude": [2.0, 0.0, 0.0], "start": 1.0, "duration": 2.0}}
-    flights = {label: dataclasses.replace(res, meta={**res.meta, "environment": env})
-               for label, res in cmp.results.items()}
+    flights = {
+        label: dataclasses.replace(res, meta={**res.meta, "environment": env}) for label, res in cmp.results.items()
+    }
     commands = flights["se3"].commands.copy()
     commands[0, 300:350, CMD_U1] = 1.5
     flights["se3"] = dataclasses.replace(flights["se3"], commands=commands)
@@ -295,7 +303,7 @@ def test_comparison_has_a_position_error_panel_with_events_and_saturation(step):
     assert not any("flagged" in text for text in texts)
     ax_e = fig.axes[-1]
     (strip,) = ax_e.collections
-    assert tuple(strip.get_facecolor()[0][:3]) == pytest.approx((0.17, 0.63, 0.17), abs=0.01)   # se3 is C2
+    assert tuple(strip.get_facecolor()[0][:3]) == pytest.approx((0.17, 0.63, 0.17), abs=0.01)  # se3 is C2
     for ax in fig.axes[1:]:
         assert len([p for p in ax.patches if p.get_x() == 1.0 and p.get_width() == 2.0]) == 1
     with pytest.raises(ValueError, match="axes must be"):
@@ -329,18 +337,27 @@ def sweep_like(n=30, ok=10, seed=0):
 
     rng = np.random.default_rng(seed)
     failure = np.r_[np.zeros(ok, int), rng.integers(1, 3, n - ok)]
-    table = pd.DataFrame({"vehicle": np.arange(n), "failure": failure,
-                          "rmse_m": rng.gamma(2.0, 0.1, n), "max_error_m": rng.gamma(3.0, 0.2, n),
-                          "final_error_m": np.r_[rng.gamma(2.0, 0.01, n - 3), [np.nan] * 3],
-                          "rise_time_s": np.full(n, np.nan), "settling_time_5pct_s": rng.uniform(2, 4, n),
-                          "overshoot_pct": rng.uniform(0, 20, n), "effort": rng.uniform(1, 2, n),
-                          "duty_clipped_s": np.zeros(n)})
+    table = pd.DataFrame(
+        {
+            "vehicle": np.arange(n),
+            "failure": failure,
+            "rmse_m": rng.gamma(2.0, 0.1, n),
+            "max_error_m": rng.gamma(3.0, 0.2, n),
+            "final_error_m": np.r_[rng.gamma(2.0, 0.01, n - 3), [np.nan] * 3],
+            "rise_time_s": np.full(n, np.nan),
+            "settling_time_5pct_s": rng.uniform(2, 4, n),
+            "overshoot_pct": rng.uniform(0, 20, n),
+            "effort": rng.uniform(1, 2, n),
+            "duty_clipped_s": np.zeros(n),
+        }
+    )
     t = np.linspace(0.0, 5.0, 51)
     pos = np.cumsum(rng.normal(0, 0.1, (n, t.size, 3)), axis=1)
     spec = SimpleNamespace(controller=SimpleNamespace(name="nlpd"), mission=SimpleNamespace(name="step"), seed=seed)
     traces = SimpleNamespace(vehicle=np.arange(n), t=t, pos=pos, ref=np.zeros_like(pos), sample=np.ones(n, bool))
-    return SimpleNamespace(table=table, spec=spec, n=n, failure_names=("ok", "diverged", "saturated",
-                                                                       "did not settle"), traces=traces)
+    return SimpleNamespace(
+        table=table, spec=spec, n=n, failure_names=("ok", "diverged", "saturated", "did not settle"), traces=traces
+    )
 
 
 def test_histograms_have_axis_labels():
@@ -349,8 +366,14 @@ def test_histograms_have_axis_labels():
     shown = [ax for ax in fig.axes if ax.get_visible()]
     hists = shown[:-1]
     assert [ax.get_title().split()[0] for ax in hists] == metrics
-    assert [ax.get_xlabel() for ax in hists] == ["RMSE [m]", "max error [m]", "final error [m]",
-                                                 "settling time 5 % [s]", "overshoot [%]", "effort [s]"]
+    assert [ax.get_xlabel() for ax in hists] == [
+        "RMSE [m]",
+        "max error [m]",
+        "final error [m]",
+        "settling time 5 % [s]",
+        "overshoot [%]",
+        "effort [s]",
+    ]
     assert all(ax.get_ylabel() == "flights" for ax in shown)
     assert shown[-1].get_title() == "outcome of 30 flights" and shown[-1].get_xlabel() == "outcome"
     assert sum(p.get_height() for p in hists[0].patches) == 30 and "27, 3 n/a" in hists[2].get_title()
@@ -358,12 +381,12 @@ def test_histograms_have_axis_labels():
 
 
 def test_histograms_leave_out_degenerate_metrics_and_say_so():
-    fig = mc_plots.plot_histograms(sweep_like())          # rise time never measured, no duty ever clipped
+    fig = mc_plots.plot_histograms(sweep_like())  # rise time never measured, no duty ever clipped
     shown = [ax for ax in fig.axes if ax.get_visible()]
     assert len(shown) == 6 + 1
     assert not any(word in ax.get_title() for ax in shown for word in ("rise_time", "duty_clipped"))
     assert not any("not measured" in t.get_text() for ax in fig.axes for t in ax.texts)
-    note = fig._supxlabel.get_text().replace("\u00a0", " ")       # no break inside an item
+    note = fig._supxlabel.get_text().replace("\u00a0", " ")  # no break inside an item
     assert note == "not drawn: rise_time_s (not measured), duty_clipped_s (0 in all 30 flights)"
     # nothing left out: no note
     fig = mc_plots.plot_histograms(sweep_like(), metrics=["rmse_m", "settling_time_5pct_s"])
@@ -388,7 +411,7 @@ def test_envelope_keeps_the_finished_paths_visible(kind):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             res = qc.fly("step", duration=1.0, log_every=10, x0=x0)
-        status = np.where(np.arange(n) % 4 == 0, 0, 1)           # three quarters "stopped"
+        status = np.where(np.arange(n) % 4 == 0, 0, 1)  # three quarters "stopped"
         fig = plot_envelope(dataclasses.replace(res, status=status))
     paths = drawn_paths(fig.axes[0])
     ok = [ln for ln in paths if ln.get_color() == "tab:blue"]
@@ -396,7 +419,7 @@ def test_envelope_keeps_the_finished_paths_visible(kind):
     assert len(ok) >= 6 and len(failed) >= 18
     assert min(ln.get_zorder() for ln in ok) > max(ln.get_zorder() for ln in failed)
     assert min(ln.get_alpha() for ln in ok) >= 0.35 and max(ln.get_alpha() for ln in failed) <= 0.4
-    assert max(paths.index(ln) for ln in failed) < min(paths.index(ln) for ln in ok)   # drawn last
+    assert max(paths.index(ln) for ln in failed) < min(paths.index(ln) for ln in ok)  # drawn last
     assert min(ln.get_linewidth() for ln in ok) > max(ln.get_linewidth() for ln in failed)
 
 
@@ -421,7 +444,7 @@ def test_figures_can_be_drawn_in_threads(step, tmp_path):
     def work(i):
         try:
             save_figure(plot_flight(step), tmp_path / f"f{i}.png")
-        except Exception as exc:   # pragma: no cover - reported below
+        except Exception as exc:  # pragma: no cover - reported below
             errors.append(exc)
 
     threads = [threading.Thread(target=work, args=(i,)) for i in range(3)]

@@ -24,9 +24,9 @@ def test_readme_python_example_runs_as_a_script(tmp_path):
     run = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr[-3000:]
     assert "Traceback" not in run.stderr
-    assert "flights of nlpd on circle" in run.stdout        # the Monte Carlo summary, as a table
+    assert "flights of nlpd on circle" in run.stdout  # the Monte Carlo summary, as a table
     assert (tmp_path / "mc-out" / "quadcruise.json").is_file()
-    assert "every target and requirement met" in run.stdout     # the tune example meets what it asks for
+    assert "every target and requirement met" in run.stdout  # the tune example meets what it asks for
 
 
 def readme_command(name: str) -> list[str]:
@@ -41,16 +41,18 @@ def readme_command(name: str) -> list[str]:
 def test_readme_tune_and_montecarlo_commands_do_what_the_table_says(tmp_path):
     """Run as written (the Monte Carlo with fewer flights, in this process): the tune meets its
     targets and exits 0; the population is perturbed (its quantiles differ)."""
+
     def quadcruise(args):
-        return subprocess.run([sys.executable, "-m", "quadcruise", *args], cwd=tmp_path, capture_output=True,
-                              text=True, timeout=600)
+        return subprocess.run(
+            [sys.executable, "-m", "quadcruise", *args], cwd=tmp_path, capture_output=True, text=True, timeout=600
+        )
 
     tune = readme_command("tune")
     assert "--target" in tune and "DIR" in tune
     run = quadcruise([("out" if word == "DIR" else word) for word in tune])
     assert run.returncode == 0, run.stdout + run.stderr
     assert "every target and requirement met" in run.stdout and (tmp_path / "out" / "scenario.toml").is_file()
-    again = quadcruise(["fly", "out/scenario.toml"])                 # the folder flies the tuned gains
+    again = quadcruise(["fly", "out/scenario.toml"])  # the folder flies the tuned gains
     assert again.returncode == 0, again.stderr
 
     montecarlo = readme_command("montecarlo")
@@ -60,5 +62,5 @@ def test_readme_tune_and_montecarlo_commands_do_what_the_table_says(tmp_path):
     assert run.returncode == 0, run.stdout + run.stderr
     row = next(ln for ln in run.stdout.splitlines() if ln.strip().startswith("rmse_m")).split()
     count, p5, p50, p95 = int(row[1]), *map(float, row[2:5])
-    assert 10 <= count <= 20 and p5 < p50 < p95, row                    # those that kept track (a sag beyond
-                                                                        # half the altitude is off track)
+    assert 10 <= count <= 20 and p5 < p50 < p95, row  # those that kept track (a sag beyond
+    # half the altitude is off track)

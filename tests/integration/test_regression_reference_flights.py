@@ -31,8 +31,17 @@ REDEFINED = {"effort", "failure"}
 # against its own steady level, not on one axis's progress; those of a step are unchanged, and
 # so is every trace.
 MOVING = {"circle_nlpd", "square_gonzalez", "circle_env", "batch_mass", "mc"}
-REDEFINED_MOVING = {"rise_time_s", "settling_time_s", "settling_time_5pct_s", "overshoot_pct", "peak_time_s",
-                    "steady_rmse_m", "steady_max_error_m", "not_settled", "transient_axis"}
+REDEFINED_MOVING = {
+    "rise_time_s",
+    "settling_time_s",
+    "settling_time_5pct_s",
+    "overshoot_pct",
+    "peak_time_s",
+    "steady_rmse_m",
+    "steady_max_error_m",
+    "not_settled",
+    "transient_axis",
+}
 
 
 #: the paper's literal inversion, which the default nlpd was before the joint one (issue: the
@@ -41,8 +50,11 @@ NLPD_SEQUENTIAL = NLPD(inversion="sequential")
 
 
 def flights():
-    env = Environment(wind=ConstantWind(velocity=(1.0, 0.5, 0.0)), turbulence=Turbulence(intensity="moderate"),
-                      rotor_loss=RotorLoss(rotor=1, fraction=0.2, time=4.0))
+    env = Environment(
+        wind=ConstantWind(velocity=(1.0, 0.5, 0.0)),
+        turbulence=Turbulence(intensity="moderate"),
+        rotor_loss=RotorLoss(rotor=1, fraction=0.2, time=4.0),
+    )
     return {
         "circle_nlpd": lambda: qc.fly("circle", NLPD_SEQUENTIAL, log_every=10),
         "square_gonzalez": lambda: qc.fly("square", "gonzalez", duration=12.0, log_every=10),
@@ -50,14 +62,28 @@ def flights():
         "step_cascade": lambda: qc.fly("step", "cascade", log_every=10),
         "step_full": lambda: qc.fly("step", NLPD_SEQUENTIAL, full_dynamics=True, log_every=10),
         "circle_env": lambda: qc.fly(
-            "circle", NLPD_SEQUENTIAL, duration=8.0, vehicle=with_drag(qc.Vehicle.paper().replace(m=3.8)),
-            controller_vehicle=qc.Vehicle.paper(), seed=7, log_every=10, environment=env,
-            sensors=SensorNoise(position_std=0.01, angle_std=0.002, delay=0.004)),
-        "batch_mass": lambda: qc.fly("circle", NLPD_SEQUENTIAL, vehicle=qc.Vehicle(m=np.linspace(2.5, 4.5, 6)),
-                                     duration=5.0, log_every=50),
+            "circle",
+            NLPD_SEQUENTIAL,
+            duration=8.0,
+            vehicle=with_drag(qc.Vehicle.paper().replace(m=3.8)),
+            controller_vehicle=qc.Vehicle.paper(),
+            seed=7,
+            log_every=10,
+            environment=env,
+            sensors=SensorNoise(position_std=0.01, angle_std=0.002, delay=0.004),
+        ),
+        "batch_mass": lambda: qc.fly(
+            "circle", NLPD_SEQUENTIAL, vehicle=qc.Vehicle(m=np.linspace(2.5, 4.5, 6)), duration=5.0, log_every=50
+        ),
         "gust_dt2": lambda: qc.fly(
-            "step", NLPD_SEQUENTIAL, dt=2e-3, vehicle=with_drag(qc.Vehicle.paper()), duration=6.0, log_every=5,
-            environment=Environment(gust=Gust(amplitude=(2.0, 0.0, 0.0), start=1.0, duration=1.0))),
+            "step",
+            NLPD_SEQUENTIAL,
+            dt=2e-3,
+            vehicle=with_drag(qc.Vehicle.paper()),
+            duration=6.0,
+            log_every=5,
+            environment=Environment(gust=Gust(amplitude=(2.0, 0.0, 0.0), start=1.0, duration=1.0)),
+        ),
     }
 
 

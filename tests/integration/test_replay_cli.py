@@ -28,19 +28,31 @@ def test_example_replays_and_writes_states(tmp_path):
     schedule = qc.read_duty_csv(EXAMPLE)
     assert data.shape == (len(schedule.t), 17)
     np.testing.assert_array_equal(data[:, 0], schedule.t)
-    np.testing.assert_allclose(data, np.column_stack([schedule.t, qc.replay(schedule).states[0]]),
-                               rtol=1e-14, atol=1e-14)
-    assert list(tmp_path.iterdir()) == [out]   # no temporary left behind
+    np.testing.assert_allclose(
+        data, np.column_stack([schedule.t, qc.replay(schedule).states[0]]), rtol=1e-14, atol=1e-14
+    )
+    assert list(tmp_path.iterdir()) == [out]  # no temporary left behind
 
 
 BAD = {
     "missing_column": ("t,u1,u2,u3\n0,0.1,0.1,0.1\n1,0.1,0.1,0.1\n", "column(s) 'u4': missing"),
-    "not_a_number": ("t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,0.1,abc,0.1,0.1\n", "line 3, column 'u2': 'abc' is not a number"),
+    "not_a_number": (
+        "t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,0.1,abc,0.1,0.1\n",
+        "line 3, column 'u2': 'abc' is not a number",
+    ),
     "nan": ("t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,0.1,0.1,nan,0.1\n", "line 3, column 'u3': value is NaN"),
-    "time_not_increasing": ("t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,0.1,0.1,0.1,0.1\n1,0.1,0.1,0.1,0.1\n",
-                            "line 4, column 't': time 1 is not after"),
-    "duty_above_one": ("t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,1.2,0.1,0.1,0.1\n", "line 3, column 'u1': duty 1.2 is outside [0, 1]"),
-    "duty_negative": ("t,u1,u2,u3,u4\n0,0.1,0.1,0.1,-0.1\n1,0.1,0.1,0.1,0.1\n", "line 2, column 'u4': duty -0.1 is outside"),
+    "time_not_increasing": (
+        "t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,0.1,0.1,0.1,0.1\n1,0.1,0.1,0.1,0.1\n",
+        "line 4, column 't': time 1 is not after",
+    ),
+    "duty_above_one": (
+        "t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,1.2,0.1,0.1,0.1\n",
+        "line 3, column 'u1': duty 1.2 is outside [0, 1]",
+    ),
+    "duty_negative": (
+        "t,u1,u2,u3,u4\n0,0.1,0.1,0.1,-0.1\n1,0.1,0.1,0.1,0.1\n",
+        "line 2, column 'u4': duty -0.1 is outside",
+    ),
     "empty": ("", "the file is empty"),
     "header_only": ("t,u1,u2,u3,u4\n", "needs at least two data rows"),
     "ragged": ("t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,0.1,0.1\n", "line 3: has 3 cells"),
@@ -79,11 +91,15 @@ def test_extra_columns_warn(tmp_path):
 
 def test_console_script_runs_as_a_process(tmp_path):
     out = tmp_path / "s.csv"
-    proc = subprocess.run([sys.executable, "-m", "quadcruise", "replay", str(EXAMPLE), "-o", str(out)],
-                          capture_output=True, text=True)
+    proc = subprocess.run(
+        [sys.executable, "-m", "quadcruise", "replay", str(EXAMPLE), "-o", str(out)], capture_output=True, text=True
+    )
     assert proc.returncode == 0, proc.stderr
-    bad = subprocess.run([sys.executable, "-m", "quadcruise", "replay", str(tmp_path / "x.csv"), "-o", str(out)],
-                         capture_output=True, text=True)
+    bad = subprocess.run(
+        [sys.executable, "-m", "quadcruise", "replay", str(tmp_path / "x.csv"), "-o", str(out)],
+        capture_output=True,
+        text=True,
+    )
     assert bad.returncode == 2 and "Traceback" not in bad.stderr
 
 

@@ -45,16 +45,25 @@ from quadcruise.workflows.compare import compare
 from quadcruise.workflows.reproduce import fitted_nlpd_loop, reproduce
 
 CHROMIUM = os.environ.get("QUADCRUISE_CHROMIUM", "/usr/bin/chromium")
-FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync")
+FLAGS = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+)
 WINDOW = (1280, 2000)
 
 
 # --- fixtures ----------------------------------------------------------------------------
 
+
 @pytest.fixture(scope="module")
 def circle():
-    return qc.fly("circle")          # 20 s at 1 kHz: 20,001 logged instants
+    return qc.fly("circle")  # 20 s at 1 kHz: 20,001 logged instants
 
 
 @pytest.fixture(scope="module")
@@ -100,6 +109,7 @@ class Dom(HTMLParser):
 
 # --- the page as text -------------------------------------------------------------------
 
+
 def test_page_is_self_contained(flight_page, circle):
     page = flight_page.read_text()
     dom = Dom(page)
@@ -113,8 +123,8 @@ def test_page_is_self_contained(flight_page, circle):
     assert dom.find("pre", id="qc-errors") and dom.text["qc-errors"] == ""
     # tables (the metrics, what they measure, the run), with the formatting rules
     assert len(dom.find("table")) == 3
-    rmse = cell(float(circle.metrics()["rmse_m"][0]))[0]                # 0.4205 m on the default circle
-    assert f"<td class=\"num\">{rmse}</td>" in page and "no overshoot" in page
+    rmse = cell(float(circle.metrics()["rmse_m"][0]))[0]  # 0.4205 m on the default circle
+    assert f'<td class="num">{rmse}</td>' in page and "no overshoot" in page
     assert "RMSE after the transient [m]" in page and "effort about hover [s]" in page
     assert "10-90 % of the step" in page and "u_hover = m g / (4 K)" in page
     imgs = [a for a in dom.find("img")]
@@ -140,7 +150,7 @@ def test_stopped_flight_without_reference(diverged):
     data = report._view_data(kwargs["flights"])
     (f,) = data["flights"]
     assert data["refs"] == [] and f["ref"] is None and not f["ok"] and "diverged" in f["status"]
-    assert None not in f["x"]           # cut where the vehicle stopped
+    assert None not in f["x"]  # cut where the vehicle stopped
     dom = Dom(html_report(**kwargs))
     for key in ("qc-data", "qc-config"):
         assert "Infinity" not in dom.text[key] and "NaN" not in dom.text[key]
@@ -149,23 +159,32 @@ def test_stopped_flight_without_reference(diverged):
 def test_table_formatting():
     import pandas as pd
 
-    frame = pd.DataFrame({"status": ["finished", "diverged: x"], "axis": ["x", None],
-                          "rise_time_s": [2.86515, np.nan], "settling_time_s": [np.nan, np.nan],
-                          "effort": [12345.6, 1e-5], "n": [3, 4]})
+    frame = pd.DataFrame(
+        {
+            "status": ["finished", "diverged: x"],
+            "axis": ["x", None],
+            "rise_time_s": [2.86515, np.nan],
+            "settling_time_s": [np.nan, np.nan],
+            "effort": [12345.6, 1e-5],
+            "n": [3, 4],
+        }
+    )
     text = table_html(frame)
-    assert "did not settle" in text and text.count("did not settle") == 1   # not where no axis
+    assert "did not settle" in text and text.count("did not settle") == 1  # not where no axis
     assert "2.865" in text and "12,346" in text and "1.000e-05" in text and "—" in text
     assert '<td class="bad">diverged: x</td>' in text and '<td class="ok">finished</td>' in text
     assert "rise time [s]" in text and "settling time 2 % [s]" in text
-    assert "<th>" in text and "scope=\"row\"" not in text            # a 0, 1, ... index is not shown
+    assert "<th>" in text and 'scope="row"' not in text  # a 0, 1, ... index is not shown
     flipped = table_html(frame.iloc[:1].T.rename(columns={0: "nlpd"}))  # metrics down
     assert "did not settle" in flipped and 'scope="row"' in flipped
 
 
 def test_markdown():
     out = markdown_html("## Why\n\nThe **pole** at <1 and `code`.\n\n- one\n- two *three*")
-    assert out == ("<h3>Why</h3>\n<p>The <strong>pole</strong> at &lt;1 and <code>code</code>.</p>\n"
-                   "<ul><li>one</li><li>two <em>three</em></li></ul>")
+    assert out == (
+        "<h3>Why</h3>\n<p>The <strong>pole</strong> at &lt;1 and <code>code</code>.</p>\n"
+        "<ul><li>one</li><li>two <em>three</em></li></ul>"
+    )
 
 
 def test_builders(rep):
@@ -182,7 +201,7 @@ def test_builders(rep):
     table = kw["tables"]["Results against the paper"]
     assert len(table) == 4 and table["paper: settling_time_s"].tolist() == [2.0, 12.0, 2.0, 12.0]
     assert "<strong>Rise time" in kw["notes"] and "<h3>" in kw["notes"]
-    dom = fitted_nlpd_loop()["dom_pole"]                  # computed from analyze's linearised loop
+    dom = fitted_nlpd_loop()["dom_pole"]  # computed from analyze's linearised loop
     assert f"dominant pair at {dom.real:.2f} +- {dom.imag:.2f}j" in " ".join(kw["notes"].split())
     assert "does not say which convention" in kw["notes"]
     page = html_report(**kw)
@@ -209,24 +228,37 @@ def test_write_is_atomic(tmp_path, circle):
 
 # --- the page in a real browser ---------------------------------------------------------
 
+
 def browser(path: str = CHROMIUM) -> str:
     """The browser's path; skip without one, fail if QUADCRUISE_REQUIRE_BROWSER=1."""
     if os.path.isfile(path) and os.access(path, os.X_OK):
         return path
     if os.environ.get("QUADCRUISE_REQUIRE_BROWSER") == "1":
-        pytest.fail(f"QUADCRUISE_REQUIRE_BROWSER=1 but there is no browser at {path} "
-                    "(apt-get install chromium)")
-    pytest.skip(f"no headless browser at {path}: apt-get install chromium to run this test "
-                "(QUADCRUISE_REQUIRE_BROWSER=1 turns this skip into a failure)")
+        pytest.fail(f"QUADCRUISE_REQUIRE_BROWSER=1 but there is no browser at {path} (apt-get install chromium)")
+    pytest.skip(
+        f"no headless browser at {path}: apt-get install chromium to run this test "
+        "(QUADCRUISE_REQUIRE_BROWSER=1 turns this skip into a failure)"
+    )
 
 
 def chromium(page: Path, *args: str) -> str:
     """Run headless Chromium on a local page; its stdout."""
     exe = browser()
     with tempfile.TemporaryDirectory(ignore_cleanup_errors=True) as profile:
-        proc = subprocess.run([exe, *FLAGS, f"--user-data-dir={profile}", "--virtual-time-budget=5000",
-                               f"--window-size={WINDOW[0]},{WINDOW[1]}", *args, page.resolve().as_uri()],
-                              capture_output=True, text=True, timeout=120)
+        proc = subprocess.run(
+            [
+                exe,
+                *FLAGS,
+                f"--user-data-dir={profile}",
+                "--virtual-time-budget=5000",
+                f"--window-size={WINDOW[0]},{WINDOW[1]}",
+                *args,
+                page.resolve().as_uri(),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
     assert proc.returncode == 0, proc.stderr[-3000:]
     return proc.stdout
 
@@ -251,16 +283,16 @@ def test_browser_renders_flight_page(flight_page):
     assert dom.text["qc-errors"] == "", dom.text["qc-errors"]
     canvases = dom.find("canvas")
     assert len(canvases) == 1 and all(c.get("data-rendered") == "1" for c in canvases)
-    assert int(canvases[0]["width"]) > 300                   # sized to its box
-    assert len(dom.find("input", type="checkbox")) == 2      # the flight and the reference
-    assert dom.find("input", type="range") and len(dom.find("table")) == 3   # metrics, conventions, run
+    assert int(canvases[0]["width"]) > 300  # sized to its box
+    assert len(dom.find("input", type="checkbox")) == 2  # the flight and the reference
+    assert dom.find("input", type="range") and len(dom.find("table")) == 3  # metrics, conventions, run
     assert len([a for a in dom.find("img") if a["src"].startswith("data:image/png;base64,")]) == 1
 
 
 @pytest.mark.browser
 def test_browser_renders_several_views(rep, diverged, tmp_path):
     kw = reproduction_report(rep, figures={})
-    kw["flights"]["replay"] = {"stopped": diverged}          # no reference, stops early
+    kw["flights"]["replay"] = {"stopped": diverged}  # no reference, stops early
     page = write_html_report(tmp_path / "rep.html", **kw)
     dom = rendered_dom(page)
     assert dom.text["qc-errors"] == "", dom.text["qc-errors"]
@@ -270,25 +302,31 @@ def test_browser_renders_several_views(rep, diverged, tmp_path):
 
 
 @pytest.mark.browser
-@pytest.mark.parametrize("notes, expected", [
-    ("<script>undefined_function()</script>", "undefined_function"),
-    ("<script>console.error('bad thing')</script>", "bad thing"),
-    ('<img alt="remote" src="https://example.invalid/x.png">', "blocked"),
-])
+@pytest.mark.parametrize(
+    "notes, expected",
+    [
+        ("<script>undefined_function()</script>", "undefined_function"),
+        ("<script>console.error('bad thing')</script>", "bad thing"),
+        ('<img alt="remote" src="https://example.invalid/x.png">', "blocked"),
+    ],
+)
 def test_browser_catches_a_broken_page(notes, expected, tmp_path, circle):
-    page = write_html_report(tmp_path / "broken.html", title="broken", notes=notes,
-                             flights={"circle": circle.decimate(10)})
+    page = write_html_report(
+        tmp_path / "broken.html", title="broken", notes=notes, flights={"circle": circle.decimate(10)}
+    )
     dom = rendered_dom(page)
     assert expected in dom.text["qc-errors"], dom.text["qc-errors"]
-    assert dom.find("canvas")[0].get("data-rendered") == "1"   # the rest of the page still works
+    assert dom.find("canvas")[0].get("data-rendered") == "1"  # the rest of the page still works
 
 
 @pytest.mark.browser
 def test_browser_screenshot(circle, tmp_path):
     # a test-only script reports where the canvas is, in page pixels
-    where = ("<script>addEventListener('load', () => { const r = document.querySelector('canvas')"
-             ".getBoundingClientRect(); document.body.setAttribute('data-canvas', [r.left + scrollX, "
-             "r.top + scrollY, r.width, r.height].map(Math.round).join(',')); });</script>")
+    where = (
+        "<script>addEventListener('load', () => { const r = document.querySelector('canvas')"
+        ".getBoundingClientRect(); document.body.setAttribute('data-canvas', [r.left + scrollX, "
+        "r.top + scrollY, r.width, r.height].map(Math.round).join(',')); });</script>"
+    )
     kw = flight_report(circle)
     kw["notes"] = where
     page = write_html_report(tmp_path / "flight.html", **kw)
@@ -302,10 +340,10 @@ def test_browser_screenshot(circle, tmp_path):
     print(f"screenshot in {time.perf_counter() - start:.1f} s")
     img = np.asarray(Image.open(shot).convert("RGB")).astype(int)
     assert img.shape[:2] == (WINDOW[1], WINDOW[0])
-    assert img.reshape(-1, 3).std(axis=0).max() > 20                  # not one colour
-    view = img[y + 5:y + h - 5, x + 5:x + w - 5]
-    assert view.reshape(-1, 3).std(axis=0).max() > 10                 # the 3-D view is not blank
-    blue = np.all(np.abs(view - [0x1F, 0x77, 0xB4]) < 40, axis=2)     # the path, in tab:blue
+    assert img.reshape(-1, 3).std(axis=0).max() > 20  # not one colour
+    view = img[y + 5 : y + h - 5, x + 5 : x + w - 5]
+    assert view.reshape(-1, 3).std(axis=0).max() > 10  # the 3-D view is not blank
+    blue = np.all(np.abs(view - [0x1F, 0x77, 0xB4]) < 40, axis=2)  # the path, in tab:blue
     assert blue.sum() > 500, blue.sum()
     colours = np.unique(view.reshape(-1, 3) // 16, axis=0)
     assert len(colours) > 20
@@ -315,7 +353,7 @@ def test_browser_screenshot(circle, tmp_path):
         shutil.copy(shot, out / "report_screenshot.png")
 
 
-VIEWS = {"home": None, "top": 1, "side (x-z)": 2, "side (y-z)": 3}     # index of the view's button
+VIEWS = {"home": None, "top": 1, "side (x-z)": 2, "side (y-z)": 3}  # index of the view's button
 
 
 @pytest.mark.browser
@@ -328,8 +366,10 @@ def test_browser_axis_labels_are_readable_in_every_view(view, circle, tmp_path):
     kw = flight_report(circle.decimate(10))
     kw.pop("figures")
     if button is not None:
-        kw["notes"] = ("<script>addEventListener('load', () => document.querySelectorAll("
-                       f"'.qc-buttons button')[{button}].click());</script>")
+        kw["notes"] = (
+            "<script>addEventListener('load', () => document.querySelectorAll("
+            f"'.qc-buttons button')[{button}].click());</script>"
+        )
     dom = rendered_dom(write_html_report(tmp_path / "view.html", **kw))
     assert dom.text["qc-errors"] == "", dom.text["qc-errors"]
     (canvas,) = dom.find("canvas")
@@ -349,7 +389,7 @@ def test_browser_axis_labels_are_readable_in_every_view(view, circle, tmp_path):
     for axis in shown:
         ticks = [float(t) for t in by_kind.get(axis, [])]
         assert len(ticks) >= (2 if axis == "z" else 4), (axis, by_kind)
-        assert np.allclose(np.diff(ticks), np.diff(ticks)[0])           # evenly thinned
+        assert np.allclose(np.diff(ticks), np.diff(ticks)[0])  # evenly thinned
         assert by_kind[f"{axis} name"] == [f"{axis} [m]"]
     hidden = {"side (x-z)": "y", "side (y-z)": "x", "top": "z"}.get(view)
     if hidden:
@@ -358,6 +398,7 @@ def test_browser_axis_labels_are_readable_in_every_view(view, circle, tmp_path):
 
 # --- the animation ----------------------------------------------------------------------
 
+
 def test_gif_frames_and_no_temp(tmp_path):
     res = qc.fly("circle", duration=4.0, log_every=10)
     out = animate.animate_flight(res, tmp_path / "a.gif", fps=10)
@@ -365,7 +406,7 @@ def test_gif_frames_and_no_temp(tmp_path):
     with Image.open(out) as img:
         assert img.n_frames == 40 and img.size == (640, 288)
     with Image.open(animate.animate_flight(res, tmp_path / "b.gif", every=20)) as img:
-        assert img.n_frames == 21           # 401 instants, one frame per 20
+        assert img.n_frames == 21  # 401 instants, one frame per 20
     with Image.open(animate.animate_flight(res, tmp_path / "c.gif", fps=5, duration_s=2.0)) as img:
         assert img.n_frames == 10
 
@@ -383,7 +424,7 @@ def test_gif_of_twenty_seconds_is_fast(circle, tmp_path):
 def test_gif_of_a_stopped_vehicle(diverged, tmp_path):
     out = animate.animate_flight(diverged, tmp_path / "d.gif", fps=20)
     end = diverged.t[np.flatnonzero(np.isfinite(diverged.states[0, :, 0]))[-1]]
-    with Image.open(out) as img:            # frames cover the flight up to the stop
+    with Image.open(out) as img:  # frames cover the flight up to the stop
         assert img.n_frames == max(2, round(20 * end))
 
 
@@ -412,4 +453,4 @@ def test_labels_cannot_break_out_of_the_page(circle):
     evil = "</script><script>alert(1)</script>"
     dom = Dom(html_report(title=evil, flights={evil: circle.decimate(50)}, config={"x": evil}))
     assert evil not in dom.text["qc-data"] and json.loads(dom.text["qc-data"])["flights"][0]["label"] == evil
-    assert not dom.find("script", src="") and len(dom.find("script")) == 3   # hook, data, viewer
+    assert not dom.find("script", src="") and len(dom.find("script")) == 3  # hook, data, viewer

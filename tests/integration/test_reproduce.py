@@ -20,7 +20,7 @@ def out(tmp_path_factory):
     path = tmp_path_factory.mktemp("repro") / "out"
     result = CliRunner().invoke(main, ["reproduce", "--out", str(path)], env={"QUADCRUISE_PROGRESS": "1"})
     assert result.exit_code == 0, result.output
-    assert "flying:" in result.output and "/13 [" in result.output and "circle with" in result.output   # the bar
+    assert "flying:" in result.output and "/13 [" in result.output and "circle with" in result.output  # the bar
     assert "| nlpd (fitted) | Kp 3.470, Kd 2.599 (zeta 0.70" in result.output
     return path
 
@@ -109,7 +109,7 @@ def test_fitted_rows_reach_the_papers_transients(out):
     assert abs(base["settling_time_s"] - paper["settling_time_s"]) <= 0.1
     assert abs(base["overshoot_pct"] - paper["overshoot_pct"]) <= 0.1
     assert abs(base["rise_0_100_s"] - paper["rise_time_s"]) <= 0.5 < abs(base["rise_time_s"] - paper["rise_time_s"])
-    for name in ("nlpd", "gonzalez"):        # the paper's own gains reach neither
+    for name in ("nlpd", "gonzalez"):  # the paper's own gains reach neither
         assert runs[name]["rise_time_s"] > 2 * PAPER[name]["rise_time_s"] or runs[name]["overshoot_pct"] < 1.0
 
 
@@ -122,12 +122,12 @@ def test_a_flight_that_did_not_finish_is_marked_in_the_tables_and_exits_1(tmp_pa
     runs = load(tmp_path / "out")["runs"]
     failed = [r for r in runs if r["status"] != "finished"]
     assert failed and all(r["status"].startswith("lost track") for r in failed)
-    for r in failed:                        # the row, the warning and the count all say so
+    for r in failed:  # the row, the warning and the count all say so
         assert f"| {r['scenario']} | {r['controller']} **({r['status']})** |" in res.output
         assert f"warning: {r['scenario']} with {r['controller']}: vehicle 0 {r['status']}" in res.output
     report = (tmp_path / "out" / "report.md").read_text()
     assert f"**{len(failed)} of {len(runs)} flights did not finish**" in report
-    assert any(r["status"] == "finished" for r in runs)     # gonzalez's bounded tilt still flies it
+    assert any(r["status"] == "finished" for r in runs)  # gonzalez's bounded tilt still flies it
 
 
 def test_fitted_transient_is_that_of_the_linearised_loops_dominant_pair(out):
@@ -153,8 +153,8 @@ def test_fitted_transient_is_that_of_the_linearised_loops_dominant_pair(out):
 
 def test_rise_conventions_are_stated_and_the_papers_is_a_hypothesis(out):
     report = " ".join((out / "report.md").read_text().split())
-    assert "| rise 10-90 % [s] (paper) |" in report                       # one convention per column
-    assert "| rise 10-90 % [s] | rise 0-100 % [s] |" in report            # both where it is unknown
+    assert "| rise 10-90 % [s] (paper) |" in report  # one convention per column
+    assert "| rise 10-90 % [s] | rise 0-100 % [s] |" in report  # both where it is unknown
     assert "does not say which convention" in report
     assert "the paper's 6 s is a 0-100 % rise." not in report and "is a hypothesis, not a finding" in report
 

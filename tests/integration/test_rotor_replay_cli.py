@@ -28,15 +28,14 @@ def test_the_flip_example_replays_through_inverted_and_writes_states(tmp_path):
     data = np.loadtxt(out, delimiter=",", skiprows=1)
     vehicle = Vehicle.preset("crazyflie")
     res = replay_rotors(read_speed_csv(FLIP, 4), vehicle)
-    np.testing.assert_allclose(data[:, 1:18], res.states[0], rtol=1e-14, atol=1e-14)     # written to 15 digits
+    np.testing.assert_allclose(data[:, 1:18], res.states[0], rtol=1e-14, atol=1e-14)  # written to 15 digits
     # the first row is the start: at rest, level, at the origin, rotors at the first command
     np.testing.assert_array_equal(data[0, 1:14], [0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0])
     np.testing.assert_array_equal(data[0, 14:18], [1788.55] * 4)
     # the Euler angles beside the quaternion: phi = atan2(2 (qw qx + qy qz), 1 - 2 (qx^2 + qy^2))
     qw, qx, qy, qz = data[:, 7:11].T
-    np.testing.assert_allclose(data[:, 18], np.arctan2(2 * (qw * qx + qy * qz), 1 - 2 * (qx ** 2 + qy ** 2)),
-                               atol=1e-12)
-    assert (1 - 2 * (qx ** 2 + qy ** 2)).min() < -0.8           # upside down at t = 0.47 s
+    np.testing.assert_allclose(data[:, 18], np.arctan2(2 * (qw * qx + qy * qz), 1 - 2 * (qx**2 + qy**2)), atol=1e-12)
+    assert (1 - 2 * (qx**2 + qy**2)).min() < -0.8  # upside down at t = 0.47 s
     assert list(tmp_path.iterdir()) == [out]
 
 
@@ -57,20 +56,26 @@ def test_a_vehicle_file_with_a_preset_and_overrides(tmp_path):
     heavy = np.loadtxt(out, delimiter=",", skiprows=1)
     # 10 g heavier at the same speeds: it sinks at (4 kf w^2 - m g) / m, less a little induced-inflow drag
     v = Vehicle.preset("crazyflie")
-    sink = (4 * v.kf * 1788.55 ** 2 - 0.04 * v.g) / 0.04 * 0.2 ** 2 / 2
+    sink = (4 * v.kf * 1788.55**2 - 0.04 * v.g) / 0.04 * 0.2**2 / 2
     assert heavy[1, 3] == pytest.approx(sink, rel=0.02) and heavy[1, 3] > sink
 
 
 BAD = {
-    "speed_above_max": ("t,w1,w2,w3,w4\n0,1800,1800,1800,1800\n1,1800,2600,1800,1800\n",
-                        "line 3, column 'w2': rotor speed 2600 rad/s is outside the vehicle's [0, 2500]"),
-    "speed_negative": ("t,w1,w2,w3,w4\n0,1800,1800,1800,-5\n1,1800,1800,1800,1800\n",
-                       "line 2, column 'w4': rotor speed -5 rad/s is outside"),
+    "speed_above_max": (
+        "t,w1,w2,w3,w4\n0,1800,1800,1800,1800\n1,1800,2600,1800,1800\n",
+        "line 3, column 'w2': rotor speed 2600 rad/s is outside the vehicle's [0, 2500]",
+    ),
+    "speed_negative": (
+        "t,w1,w2,w3,w4\n0,1800,1800,1800,-5\n1,1800,1800,1800,1800\n",
+        "line 2, column 'w4': rotor speed -5 rad/s is outside",
+    ),
     "nan": ("t,w1,w2,w3,w4\n0,1800,1800,1800,1800\n1,1800,nan,1800,1800\n", "line 3, column 'w2': value is NaN"),
     "missing_rotor": ("t,w1,w2,w3\n0,1800,1800,1800\n1,1800,1800,1800\n", "column(s) 'w4': missing"),
     "a_fifth_rotor": ("t,w1,w2,w3,w4,w5\n0,1,1,1,1,1\n1,1,1,1,1,1\n", "column 'w5', but the vehicle has 4 rotors"),
-    "time_back": ("t,w1,w2,w3,w4\n0,1800,1800,1800,1800\n0,1800,1800,1800,1800\n",
-                  "line 3, column 't': time 0 is not after the previous row's 0"),
+    "time_back": (
+        "t,w1,w2,w3,w4\n0,1800,1800,1800,1800\n0,1800,1800,1800,1800\n",
+        "line 3, column 't': time 0 is not after the previous row's 0",
+    ),
     "duties": ("t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,0.1,0.1,0.1,0.1\n", "column(s) 'w1', 'w2', 'w3', 'w4': missing"),
 }
 
@@ -89,10 +94,13 @@ def test_bad_input_is_one_line_exit_two_no_output(tmp_path, case):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cmds.csv"]
 
 
-@pytest.mark.parametrize(("vehicle", "words"), [
-    ("crazyfly", "unknown vehicle preset 'crazyfly' (did you mean 'crazyflie'?)"),
-    ("absent.toml", "absent.toml: no such file"),
-])
+@pytest.mark.parametrize(
+    ("vehicle", "words"),
+    [
+        ("crazyfly", "unknown vehicle preset 'crazyfly' (did you mean 'crazyflie'?)"),
+        ("absent.toml", "absent.toml: no such file"),
+    ],
+)
 def test_bad_vehicle_is_one_line_exit_two(tmp_path, vehicle, words):
     out = tmp_path / "states.csv"
     result = run("replay", str(FLIP), "--vehicle", vehicle, "-o", str(out))
@@ -120,9 +128,9 @@ def test_a_crash_on_the_ground_writes_the_states_says_so_and_exits_one(tmp_path)
     assert result.exit_code == 1, result.output
     assert "the flight stopped early: crashed: hit the ground faster" in result.output
     data = np.loadtxt(out, delimiter=",", skiprows=1)
-    assert np.isfinite(data[1]).all() and np.isnan(data[2, 1:]).all()     # states until the crash, then NaN
+    assert np.isfinite(data[1]).all() and np.isnan(data[2, 1:]).all()  # states until the crash, then NaN
     free = run("replay", str(src), "--vehicle", "crazyflie", "-o", str(tmp_path / "free.csv"))
-    assert free.exit_code == 0                                             # no ground: it falls on
+    assert free.exit_code == 0  # no ground: it falls on
 
 
 def test_ground_needs_a_rotor_vehicle(tmp_path):

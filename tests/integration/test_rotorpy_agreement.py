@@ -20,9 +20,9 @@ from quadcruise.workflows.replay import SpeedSchedule, replay_rotors
 
 rotorpy_multirotor = pytest.importorskip("rotorpy.vehicles.multirotor")
 
-DURATION = 3.0     # s
-ROW = 0.1          # s between commands
-WIND = (2.0, -1.0, 0.5)     # m/s, with the aerodynamics on
+DURATION = 3.0  # s
+ROW = 0.1  # s between commands
+WIND = (2.0, -1.0, 0.5)  # m/s, with the aerodynamics on
 
 
 def schedule_for(params: dict, seed: int) -> SpeedSchedule:
@@ -38,14 +38,20 @@ def rotorpy_flight(params: dict, schedule: SpeedSchedule, aero: bool, wind) -> n
     (x, v, q as x y z w, body rates, wind, rotor speeds)."""
     vehicle = rotorpy_multirotor.Multirotor(params, aero=aero)
     s = np.zeros(20)
-    s[9] = 1.0                                  # identity quaternion, scalar last
+    s[9] = 1.0  # identity quaternion, scalar last
     s[13:16] = wind
     s[16:] = schedule.speeds[0]
     out = [s.copy()]
     for k in range(schedule.t.shape[0] - 1):
         cmd = schedule.speeds[k]
-        sol = solve_ivp(lambda _t, y, c=cmd: vehicle._s_dot_fn(_t, y, c), (schedule.t[k], schedule.t[k + 1]), s,
-                        method="DOP853", rtol=1e-12, atol=1e-12)
+        sol = solve_ivp(
+            lambda _t, y, c=cmd: vehicle._s_dot_fn(_t, y, c),
+            (schedule.t[k], schedule.t[k + 1]),
+            s,
+            method="DOP853",
+            rtol=1e-12,
+            atol=1e-12,
+        )
         assert sol.success
         s = sol.y[:, -1]
         out.append(s.copy())
@@ -70,7 +76,7 @@ def test_replay_agrees_with_rotorpy_through_a_tumble(name, aero):
     q = ours.states[0, :, 6:10]
     body_z_up = 1.0 - 2.0 * (q[:, 1] ** 2 + q[:, 2] ** 2)
     assert body_z_up.min() < -0.5
-    assert np.abs(ours.states[0, :, 10:13]).max() > 10.0       # rad/s
+    assert np.abs(ours.states[0, :, 10:13]).max() > 10.0  # rad/s
 
     position_error = np.abs(ours.states[0, :, 0:3] - theirs[:, 0:3]).max()
     q_theirs = theirs[:, [9, 6, 7, 8]] / np.linalg.norm(theirs[:, 6:10], axis=1, keepdims=True)

@@ -25,7 +25,7 @@ def test_shipped_scenarios_load_and_fly(name):
     sc = load_scenario(EXAMPLES / "scenarios" / name)
     assert sc.title
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")     # brief duty clipping is reported, not an error
+        warnings.simplefilter("ignore")  # brief duty clipping is reported, not an error
         res = sc.fly()
     assert res.ok.all()
     assert res.meta["scenario"]["source"].endswith(name)
@@ -38,7 +38,9 @@ def test_paper_scenario_equals_the_default_flight():
 
 
 def test_everything_a_scenario_sets_reaches_the_flight(tmp_path):
-    path = write(tmp_path, """
+    path = write(
+        tmp_path,
+        """
 title = "t"
 [vehicle]
 m = 2.0
@@ -56,7 +58,8 @@ corner = [1.0, -1.0]
 duration = 4.0
 dt = 0.002
 full_dynamics = true
-""")
+""",
+    )
     sc = load_scenario(path)
     assert sc.vehicle.m == 2.0
     c = sc.controller
@@ -88,7 +91,10 @@ BAD = [
     ("[vehicle]\nm = -3.0\n", "[vehicle] vehicle field 'm' (mass, kg) must be > 0"),
     ("[vehicle]\nmass = 3.0\n", "[vehicle] unknown key 'mass'"),
     ("[controller]\nname = 'pid'\n", "[controller] unknown controller name 'pid'"),
-    ("[controller]\nposition_poles = [0.7, -4.3]\n", "[controller] pd_from_poles: pole 0.7 is not in the open left half plane"),
+    (
+        "[controller]\nposition_poles = [0.7, -4.3]\n",
+        "[controller] pd_from_poles: pole 0.7 is not in the open left half plane",
+    ),
     ("[controller]\nposition = { kp = 3.0, kx = 1.0 }\n", "[controller] unknown key 'position.kx'"),
     ("[controller]\ngain = 3.0\n", "[controller] unknown key 'gain'"),
     ("vehicle = 3\n", "[vehicle] must be a table"),

@@ -39,19 +39,31 @@ def quiet(func, *args, **kwargs):
 
 FLIGHTS = {
     "everything": lambda: qc.fly(
-        "circle", "nlpd", duration=4.0, dt=2e-3, log_every=4, seed=5,
-        vehicle=with_drag(qc.Vehicle.paper().replace(m=3.8)), controller_vehicle=qc.Vehicle.paper(),
-        environment=Environment(wind=ConstantWind((1.0, 0.5, 0.0)), gust=Gust((0.0, 2.0, 0.0), 1.0, 1.0),
-                                turbulence=Turbulence(intensity="moderate"),
-                                rotor_loss=RotorLoss(rotor=1, fraction=0.2, time=2.0),
-                                force=ExternalForce(force=(0.1, 0.0, 0.0))),
-        sensors=SensorNoise(position_std=0.01, angle_std=0.002, delay=0.004)),
+        "circle",
+        "nlpd",
+        duration=4.0,
+        dt=2e-3,
+        log_every=4,
+        seed=5,
+        vehicle=with_drag(qc.Vehicle.paper().replace(m=3.8)),
+        controller_vehicle=qc.Vehicle.paper(),
+        environment=Environment(
+            wind=ConstantWind((1.0, 0.5, 0.0)),
+            gust=Gust((0.0, 2.0, 0.0), 1.0, 1.0),
+            turbulence=Turbulence(intensity="moderate"),
+            rotor_loss=RotorLoss(rotor=1, fraction=0.2, time=2.0),
+            force=ExternalForce(force=(0.1, 0.0, 0.0)),
+        ),
+        sensors=SensorNoise(position_std=0.01, angle_std=0.002, delay=0.004),
+    ),
     "waypoints": lambda: qc.fly(Waypoints(read_waypoints_csv(EXAMPLES / "waypoints.csv")), Cascade(), duration=4.0),
     "minsnap": lambda: qc.fly(MinimumSnap(read_waypoints_csv(EXAMPLES / "waypoints.csv")), "se3", duration=4.0),
-    "batch": lambda: qc.fly("step", "gonzalez", vehicle=qc.Vehicle(m=np.array([3.0, 3.5])), duration=3.0,
-                            max_track_error=5.0),
-    "start": lambda: qc.fly("hover", "nlpd", duration=2.0, x0=np.r_[0.3, -0.2, 1.2, np.zeros(9),
-                                                                     np.full(4, 3.499 * 9.81 / 4)]),
+    "batch": lambda: qc.fly(
+        "step", "gonzalez", vehicle=qc.Vehicle(m=np.array([3.0, 3.5])), duration=3.0, max_track_error=5.0
+    ),
+    "start": lambda: qc.fly(
+        "hover", "nlpd", duration=2.0, x0=np.r_[0.3, -0.2, 1.2, np.zeros(9), np.full(4, 3.499 * 9.81 / 4)]
+    ),
 }
 
 
@@ -79,15 +91,29 @@ def test_every_example_scenario_replays_from_its_output_folder(example, tmp_path
 
 
 def test_options_given_with_a_scenario_change_it_and_are_recorded(tmp_path):
-    run = RUNNER.invoke(main, ["fly", str(EXAMPLES / "scenarios" / "circle_paper.toml"), "-m", "radius=3",
-                               "-c", "max_tilt=0.5", "--duration", "2", "--out", str(tmp_path / "a")])
+    run = RUNNER.invoke(
+        main,
+        [
+            "fly",
+            str(EXAMPLES / "scenarios" / "circle_paper.toml"),
+            "-m",
+            "radius=3",
+            "-c",
+            "max_tilt=0.5",
+            "--duration",
+            "2",
+            "--out",
+            str(tmp_path / "a"),
+        ],
+    )
     assert run.exit_code == 0, run.output
     sc = load_scenario(tmp_path / "a" / "scenario.toml")
     assert sc.mission.radius == 3.0 and sc.controller.max_tilt == 0.5 and sc.duration == 2.0
     text = (tmp_path / "a" / "scenario.toml").read_text()
     assert "-m radius=3" in text and "-c max_tilt=0.5" in text
-    bad = RUNNER.invoke(main, ["fly", str(EXAMPLES / "scenarios" / "circle_paper.toml"), "-m", "foo=2",
-                               "--out", str(tmp_path / "b")])
+    bad = RUNNER.invoke(
+        main, ["fly", str(EXAMPLES / "scenarios" / "circle_paper.toml"), "-m", "foo=2", "--out", str(tmp_path / "b")]
+    )
     assert bad.exit_code == 2 and "foo" in bad.output and not (tmp_path / "b").exists()
     smooth = RUNNER.invoke(main, ["fly", "circle", "--smooth"])
     assert smooth.exit_code == 2 and "--smooth" in smooth.output
@@ -96,10 +122,10 @@ def test_options_given_with_a_scenario_change_it_and_are_recorded(tmp_path):
 def test_loading_a_scenario_runs_no_code(tmp_path):
     marker = tmp_path / "ran"
     path = tmp_path / "evil.toml"
-    path.write_text(f'[controller]\nname = "__import__(\'pathlib\').Path(\'{marker}\').touch()"\n')
+    path.write_text(f"[controller]\nname = \"__import__('pathlib').Path('{marker}').touch()\"\n")
     with pytest.raises(qc.InputError, match="unknown controller name"):
         load_scenario(path)
-    path.write_text(f'[mission]\nkind = "circle"\nradius = "__import__(\'pathlib\').Path(\'{marker}\').touch()"\n')
+    path.write_text(f"[mission]\nkind = \"circle\"\nradius = \"__import__('pathlib').Path('{marker}').touch()\"\n")
     with pytest.raises(qc.InputError):
         load_scenario(path)
     assert not marker.exists()
@@ -107,8 +133,19 @@ def test_loading_a_scenario_runs_no_code(tmp_path):
 
 def test_a_comparison_folder_replays_itself_and_compare_takes_a_scenario(tmp_path):
     a, b = tmp_path / "a", tmp_path / "b"
-    one = RUNNER.invoke(main, ["compare", str(EXAMPLES / "scenarios" / "circle_turbulence.toml"),
-                               "--controllers", "nlpd,se3", "--duration", "3", "--out", str(a)])
+    one = RUNNER.invoke(
+        main,
+        [
+            "compare",
+            str(EXAMPLES / "scenarios" / "circle_turbulence.toml"),
+            "--controllers",
+            "nlpd,se3",
+            "--duration",
+            "3",
+            "--out",
+            str(a),
+        ],
+    )
     assert one.exit_code == 0, one.output
     sc = load_scenario(a / "scenario.toml")
     assert list(sc.compare) == ["nlpd", "se3"] and sc.environment is not None and sc.sensor_noise is not None
@@ -122,21 +159,58 @@ def test_a_comparison_folder_replays_itself_and_compare_takes_a_scenario(tmp_pat
 def test_a_montecarlo_folder_replays_itself_and_takes_every_mission_source(tmp_path):
     a, b = tmp_path / "a", tmp_path / "b"
     common = ["--scheduler", "none", "--quiet"]
-    one = RUNNER.invoke(main, ["montecarlo", "--mission", "step", "--n", "5", "--seed", "3", "--duration", "3",
-                               "--mass-spread", "0.1", "--wind", "dryden:light@10", "--noise", "position=0.01",
-                               "--require", "rmse_m<=1", "--out", str(a), *common])
+    one = RUNNER.invoke(
+        main,
+        [
+            "montecarlo",
+            "--mission",
+            "step",
+            "--n",
+            "5",
+            "--seed",
+            "3",
+            "--duration",
+            "3",
+            "--mass-spread",
+            "0.1",
+            "--wind",
+            "dryden:light@10",
+            "--noise",
+            "position=0.01",
+            "--require",
+            "rmse_m<=1",
+            "--out",
+            str(a),
+            *common,
+        ],
+    )
     assert one.exit_code == 0, one.output
     two = RUNNER.invoke(main, ["montecarlo", "--scenario", str(a / "scenario.toml"), "--out", str(b), *common])
     assert two.exit_code == 0, two.output
     assert (a / "flights.csv").read_text() == (b / "flights.csv").read_text()
     import json
 
-    assert json.loads((a / "quadcruise.json").read_text())["spec_hash"] == \
-        json.loads((b / "quadcruise.json").read_text())["spec_hash"]
+    assert (
+        json.loads((a / "quadcruise.json").read_text())["spec_hash"]
+        == json.loads((b / "quadcruise.json").read_text())["spec_hash"]
+    )
     as_mission = RUNNER.invoke(main, ["montecarlo", "--mission", str(a / "scenario.toml"), *common])
     assert as_mission.exit_code == 0 and "5 flights of nlpd on step" in as_mission.output
-    csv = RUNNER.invoke(main, ["montecarlo", "--mission", str(EXAMPLES / "waypoints.csv"), "--n", "2",
-                               "--duration", "2", "--offset", "0.01", *common])
+    csv = RUNNER.invoke(
+        main,
+        [
+            "montecarlo",
+            "--mission",
+            str(EXAMPLES / "waypoints.csv"),
+            "--n",
+            "2",
+            "--duration",
+            "2",
+            "--offset",
+            "0.01",
+            *common,
+        ],
+    )
     assert csv.exit_code == 0 and "on waypoints" in csv.output, csv.output
 
 
@@ -153,12 +227,26 @@ def test_a_reproduction_folder_holds_the_scenario_that_flies_it_again(tmp_path):
 
 def test_the_vehicle_the_belief_the_world_and_the_seed_from_options_replay_from_the_folder(tmp_path):
     a, b, c = tmp_path / "a", tmp_path / "b", tmp_path / "c"
-    options = ["--vehicle", "m=3.8,Jzz=0.05", "--controller-vehicle", "paper", "--wind", "constant:1,0.5,0",
-               "--turbulence", "light", "--seed", "3", "--log-every", "5", "--duration", "3"]
+    options = [
+        "--vehicle",
+        "m=3.8,Jzz=0.05",
+        "--controller-vehicle",
+        "paper",
+        "--wind",
+        "constant:1,0.5,0",
+        "--turbulence",
+        "light",
+        "--seed",
+        "3",
+        "--log-every",
+        "5",
+        "--duration",
+        "3",
+    ]
     one = RUNNER.invoke(main, ["fly", "circle", *options, "--out", str(a)])
     assert one.exit_code in (0, 1), one.output
     sc = load_scenario(a / "scenario.toml")
-    assert sc.vehicle.m == 3.8 and sc.vehicle.Jzz == 0.05 and sc.vehicle.drag_linear == 0.3     # the default drag
+    assert sc.vehicle.m == 3.8 and sc.vehicle.Jzz == 0.05 and sc.vehicle.drag_linear == 0.3  # the default drag
     assert sc.controller_vehicle == qc.Vehicle.paper()
     assert sorted(sc.environment.parts) == ["turbulence", "wind"] and sc.environment.turbulence.intensity == "light"
     assert sc.simulation["seed"] == 3 and sc.simulation["log_every"] == 5
@@ -184,9 +272,9 @@ def test_a_vehicle_from_a_file_or_a_preset(tmp_path):
     assert vehicle_from_option(str(tmp_path / "light.toml"), "--vehicle") == qc.Vehicle.paper().replace(m=1.4, K=48.0)
     assert vehicle_from_option("paper", "--vehicle") == qc.Vehicle.paper()
     base = qc.Vehicle.paper().replace(K=100.0)
-    assert vehicle_from_option("m=2", "--vehicle", base) == base.replace(m=2.0)                # fields change the base
-    assert vehicle_from_option("paper,m=2", "--vehicle", base) == qc.Vehicle.paper().replace(m=2.0)   # a preset: not
-    (tmp_path / "scenario.toml").write_text("[vehicle]\nm = 2.5\n[mission]\nkind = \"hover\"\n")
+    assert vehicle_from_option("m=2", "--vehicle", base) == base.replace(m=2.0)  # fields change the base
+    assert vehicle_from_option("paper,m=2", "--vehicle", base) == qc.Vehicle.paper().replace(m=2.0)  # a preset: not
+    (tmp_path / "scenario.toml").write_text('[vehicle]\nm = 2.5\n[mission]\nkind = "hover"\n')
     assert vehicle_from_option(str(tmp_path / "scenario.toml"), "--vehicle").m == 2.5
     (tmp_path / "bad.toml").write_text("mass = 2.5\n")
     with pytest.raises(qc.InputError, match=r"--vehicle .*bad.toml: unknown key 'mass'"):
@@ -200,8 +288,22 @@ def test_the_controllers_belief_is_flown_the_sag_it_leaves_is_the_analytic_one(t
     m, m_hat, kp, g = 4.55, 3.499, 3.01, 9.81
     for belief, expected in ((["--controller-vehicle", "paper"], (m / m_hat - 1) * g / kp), ([], 0.0)):
         out = tmp_path / f"f{len(belief)}"
-        res = RUNNER.invoke(main, ["fly", "hover", "--vehicle", f"m={m}", *belief, "--duration", "15",
-                                   "--log-every", "100", "--out", str(out)])
+        res = RUNNER.invoke(
+            main,
+            [
+                "fly",
+                "hover",
+                "--vehicle",
+                f"m={m}",
+                *belief,
+                "--duration",
+                "15",
+                "--log-every",
+                "100",
+                "--out",
+                str(out),
+            ],
+        )
         assert res.exit_code in (0, 1), res.output
         assert ("note: the controller is told the flown vehicle (m=4.55)" in res.output) == (not belief)
         last = pd.read_csv(out / "traces.csv").iloc[-1]
@@ -210,9 +312,29 @@ def test_the_controllers_belief_is_flown_the_sag_it_leaves_is_the_analytic_one(t
 
 def test_a_population_comparison_replays_itself(tmp_path):
     a, b = tmp_path / "a", tmp_path / "b"
-    one = RUNNER.invoke(main, ["compare", "step", "--controllers", "nlpd,se3", "--duration", "3", "--population", "4",
-                               "--seed", "2", "--mass-spread", "0.05", "--wind", "constant:2,0,0",
-                               "--turbulence", "light", "--out", str(a)])
+    one = RUNNER.invoke(
+        main,
+        [
+            "compare",
+            "step",
+            "--controllers",
+            "nlpd,se3",
+            "--duration",
+            "3",
+            "--population",
+            "4",
+            "--seed",
+            "2",
+            "--mass-spread",
+            "0.05",
+            "--wind",
+            "constant:2,0,0",
+            "--turbulence",
+            "light",
+            "--out",
+            str(a),
+        ],
+    )
     assert one.exit_code == 0, one.output
     sc = load_scenario(a / "scenario.toml")
     assert sc.compare_population == {"n": 4, "seed": 2, "mass_spread": 0.05}
@@ -226,7 +348,7 @@ def test_a_population_comparison_replays_itself(tmp_path):
         assert (a / name).read_text() == (b / name).read_text()
     table = pd.read_csv(a / "population.csv", index_col=0)
     assert list(table.index) == ["nlpd", "se3"] and (table["flights"] == 4).all()
-    assert (table["rmse_m p95"] > table["rmse_m p50"]).all()          # the population was perturbed
+    assert (table["rmse_m p95"] > table["rmse_m p50"]).all()  # the population was perturbed
     # another seed beside the scenario: other vehicles, other turbulence
     three = RUNNER.invoke(main, ["compare", str(a / "scenario.toml"), "--seed", "5", "--out", str(tmp_path / "c")])
     assert three.exit_code == 0 and load_scenario(tmp_path / "c" / "scenario.toml").compare_population["seed"] == 5
@@ -236,19 +358,54 @@ def test_a_population_comparison_replays_itself(tmp_path):
 def test_a_montecarlo_folder_replays_its_vehicle_and_belief(tmp_path):
     a, b = tmp_path / "a", tmp_path / "b"
     common = ["--scheduler", "none", "--quiet", "--worst", "0"]
-    one = RUNNER.invoke(main, ["montecarlo", "--mission", "hover", "-n", "3", "--duration", "15", "--offset", "0.001",
-                               "--vehicle", "m=4", "--controller-vehicle", "paper", "--log-every", "20",
-                               "--out", str(a), *common])
+    one = RUNNER.invoke(
+        main,
+        [
+            "montecarlo",
+            "--mission",
+            "hover",
+            "-n",
+            "3",
+            "--duration",
+            "15",
+            "--offset",
+            "0.001",
+            "--vehicle",
+            "m=4",
+            "--controller-vehicle",
+            "paper",
+            "--log-every",
+            "20",
+            "--out",
+            str(a),
+            *common,
+        ],
+    )
     assert one.exit_code == 0, one.output
     sc = load_scenario(a / "scenario.toml")
     assert sc.vehicle.m == 4.0 and sc.controller_vehicle == qc.Vehicle.paper()
     assert sc.montecarlo["log_dt"] == pytest.approx(0.02)
     flights = pd.read_csv(a / "flights.csv")
-    sag = (4.0 / 3.499 - 1) * 9.81 / 3.01                       # as in the single flight above
+    sag = (4.0 / 3.499 - 1) * 9.81 / 3.01  # as in the single flight above
     assert flights["final_error_m"].to_numpy() == pytest.approx(np.full(3, sag), abs=0.01)
     two = RUNNER.invoke(main, ["montecarlo", "--scenario", str(a / "scenario.toml"), "--out", str(b), *common])
     assert two.exit_code == 0, two.output
     assert (a / "flights.csv").read_text() == (b / "flights.csv").read_text()
-    told = RUNNER.invoke(main, ["montecarlo", "--mission", "hover", "-n", "3", "--duration", "15", "--offset", "0.001",
-                                "--vehicle", "m=4", *common])
+    told = RUNNER.invoke(
+        main,
+        [
+            "montecarlo",
+            "--mission",
+            "hover",
+            "-n",
+            "3",
+            "--duration",
+            "15",
+            "--offset",
+            "0.001",
+            "--vehicle",
+            "m=4",
+            *common,
+        ],
+    )
     assert "note: the controllers are told the nominal vehicle (m=4)" in told.output

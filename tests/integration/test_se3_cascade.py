@@ -86,9 +86,13 @@ IDS = ["se3", "cascade"]
 
 
 def b3_of_eqs_5_to_7(phi, theta, psi):
-    return np.array([math.sin(phi) * math.sin(psi) + math.cos(phi) * math.sin(theta) * math.cos(psi),
-                     -math.sin(phi) * math.cos(psi) + math.cos(phi) * math.sin(theta) * math.sin(psi),
-                     math.cos(phi) * math.cos(theta)])
+    return np.array(
+        [
+            math.sin(phi) * math.sin(psi) + math.cos(phi) * math.sin(theta) * math.cos(psi),
+            -math.sin(phi) * math.cos(psi) + math.cos(phi) * math.sin(theta) * math.sin(psi),
+            math.cos(phi) * math.cos(theta),
+        ]
+    )
 
 
 def command(ctrl, dx=0.0, dy=0.0, dz=0.0, dpsi=0.0, vp=VP, state=None):
@@ -96,7 +100,7 @@ def command(ctrl, dx=0.0, dy=0.0, dz=0.0, dpsi=0.0, vp=VP, state=None):
     x = np.zeros(STATE_SIZE) if state is None else state.copy()
     if state is None:
         x[Z] = 1.0
-        x[F1:F1 + 4] = vp[P_M] * vp[P_G] / 4.0
+        x[F1 : F1 + 4] = vp[P_M] * vp[P_G] / 4.0
     ref = np.zeros(REF_SIZE)
     ref[REF_X], ref[REF_Y], ref[REF_Z], ref[REF_PSI] = dx, dy, 1.0 + dz, dpsi
     cmd = np.zeros(CMD_SIZE)
@@ -130,9 +134,9 @@ def test_desired_attitude_has_the_thrust_axis_and_the_heading(build):
         np.testing.assert_allclose(Rd.T @ Rd, np.eye(3), atol=1e-14)
         assert np.linalg.det(Rd) == pytest.approx(1.0)
         heading = math.atan2(Rd[1, 0], Rd[0, 0])
-        if build is attitude_px4:      # PX4's construction keeps the ZYX yaw exactly
+        if build is attitude_px4:  # PX4's construction keeps the ZYX yaw exactly
             assert math.remainder(heading - psi, 2 * math.pi) == pytest.approx(0.0, abs=1e-12)
-        else:                           # Lee's b1 is the projection of the heading on b3's plane
+        else:  # Lee's b1 is the projection of the heading on b3's plane
             c1 = np.array([math.cos(psi), math.sin(psi), 0.0])
             proj = c1 - (c1 @ b3) * b3
             np.testing.assert_allclose(Rd[:, 0], proj / np.linalg.norm(proj), atol=1e-12)
@@ -144,7 +148,7 @@ def test_attitude_errors_are_the_angle_differences_to_first_order():
         d[axis] = 1e-4
         Rm = rotation_zyx(*(0.02 + d))
         Rd = rotation_zyx(0.02, 0.02, 0.02)
-        assert np.array(error_lee(Rm, Rd)) == pytest.approx(d, abs=2e-6)          # current - desired
+        assert np.array(error_lee(Rm, Rd)) == pytest.approx(d, abs=2e-6)  # current - desired
         assert np.array(error_quaternion(Rm, Rd)) == pytest.approx(-d, abs=2e-6)  # desired - current
     # large errors: Lee's is sin(angle) on the axis, PX4's 2 sin(angle / 2), also near 180 deg
     for angle in (0.5, 2.0, math.pi - 1e-9):
@@ -160,9 +164,9 @@ def test_tilt_limit_and_velocity_priority():
     assert hx == pytest.approx(hy)
     assert limit_tilt(0.1, 0.0, 9.81, 0.5) == (0.1, 0.0, False)
     assert limit_tilt(1.0, 1.0, -1.0, 0.5) == (0.0, 0.0, True)
-    assert constrain_xy(1.0, 0.0, 1.0, 0.0, 5.0) == (2.0, 0.0)           # within the limit
+    assert constrain_xy(1.0, 0.0, 1.0, 0.0, 5.0) == (2.0, 0.0)  # within the limit
     assert constrain_xy(6.0, 8.0, 1.0, 0.0, 5.0) == pytest.approx((3.0, 4.0))  # position term alone too big
-    vx, vy = constrain_xy(3.0, 0.0, 0.0, 10.0, 5.0)                       # feedforward trimmed
+    vx, vy = constrain_xy(3.0, 0.0, 0.0, 10.0, 5.0)  # feedforward trimmed
     assert (vx, vy) == pytest.approx((3.0, 4.0))
 
 
@@ -170,20 +174,20 @@ def test_tilt_limit_and_velocity_priority():
 @pytest.mark.parametrize("ctrl", MODERN, ids=IDS)
 def test_signs_of_setpoints_and_torques(ctrl):
     c = command(ctrl)
-    assert np.all(np.abs(c[CMD_TAU_PHI:CMD_TAU_PSI + 1]) < 1e-12) and c[CMD_FLAGS] == 0
-    assert c[CMD_THRUST] == pytest.approx(V.m * V.g, rel=1e-12)           # hover: U1 = m g
-    c = command(ctrl, dx=0.5)          # short of +x: pitch up (x'' ~ sin theta), pitch torque up
+    assert np.all(np.abs(c[CMD_TAU_PHI : CMD_TAU_PSI + 1]) < 1e-12) and c[CMD_FLAGS] == 0
+    assert c[CMD_THRUST] == pytest.approx(V.m * V.g, rel=1e-12)  # hover: U1 = m g
+    c = command(ctrl, dx=0.5)  # short of +x: pitch up (x'' ~ sin theta), pitch torque up
     assert c[CMD_THETA_D] > 0 and abs(c[CMD_PHI_D]) < 1e-12 and c[CMD_TAU_THETA] > 0
-    assert c[0] > c[2]                                                       # U3 = F1 - F3 > 0 (eq 3)
-    c = command(ctrl, dy=0.5)          # short of +y: roll negative (y'' ~ -sin phi), roll torque down
+    assert c[0] > c[2]  # U3 = F1 - F3 > 0 (eq 3)
+    c = command(ctrl, dy=0.5)  # short of +y: roll negative (y'' ~ -sin phi), roll torque down
     assert c[CMD_PHI_D] < 0 and abs(c[CMD_THETA_D]) < 1e-12 and c[CMD_TAU_PHI] < 0
-    c = command(ctrl, dz=0.5)          # below: more thrust, level
+    c = command(ctrl, dz=0.5)  # below: more thrust, level
     assert c[CMD_THRUST] > V.m * V.g and abs(c[CMD_THETA_D]) + abs(c[CMD_PHI_D]) < 1e-12
-    c = command(ctrl, dpsi=0.3)        # yaw left: positive yaw torque (r' = k6 U4)
+    c = command(ctrl, dpsi=0.3)  # yaw left: positive yaw torque (r' = k6 U4)
     assert c[CMD_PSI_D] == pytest.approx(0.3) and c[CMD_TAU_PSI] > 0
     # the duties realise the desired inputs through eqs (1)-(4)
     U = mix(*(c[:4] * V.K), V.d)
-    assert U == pytest.approx(tuple(c[CMD_THRUST:CMD_TAU_PSI + 1]), rel=1e-12, abs=1e-12)
+    assert U == pytest.approx(tuple(c[CMD_THRUST : CMD_TAU_PSI + 1]), rel=1e-12, abs=1e-12)
 
 
 def test_se3_moments_cancel_the_gyroscopic_terms():
@@ -206,10 +210,17 @@ def rotorpy_se3(ctrl: SE3, vp=VP):
     quadrotor_control = pytest.importorskip("rotorpy.controllers.quadrotor_control")
     from rotorpy.vehicles.crazyflie_params import quad_params
 
-    params = dict(quad_params, mass=vp[P_M], Ixx=vp[P_JXX], Iyy=vp[P_JYY], Izz=vp[P_JZZ],
-                  kp_att=ctrl.attitude.kp, kd_att=ctrl.attitude.kd)
+    params = dict(
+        quad_params,
+        mass=vp[P_M],
+        Ixx=vp[P_JXX],
+        Iyy=vp[P_JYY],
+        Izz=vp[P_JZZ],
+        kp_att=ctrl.attitude.kp,
+        kd_att=ctrl.attitude.kd,
+    )
     theirs = quadrotor_control.SE3Control(params)
-    assert theirs.g == vp[P_G]                  # RotorPy's g is fixed at 9.81, the paper's
+    assert theirs.g == vp[P_G]  # RotorPy's g is fixed at 9.81, the paper's
     theirs.kp_pos = np.array([ctrl.position.kp, ctrl.position.kp, ctrl.altitude.kp])
     theirs.kd_pos = np.array([ctrl.position.kd, ctrl.position.kd, ctrl.altitude.kd])
     return theirs
@@ -226,34 +237,43 @@ def test_se3_equals_rotorpy_se3control_with_a_yaw_rate_reference():
     for _ in range(50):
         x = np.zeros(STATE_SIZE)
         x[:3], x[3:6] = rng.uniform(-1, 1, 3), rng.uniform(-1, 1, 3)
-        x[6:8], x[8] = rng.uniform(-0.3, 0.3, 2), rng.uniform(-math.pi, math.pi)   # roll, pitch, yaw
-        x[P:R + 1] = rng.uniform(-2, 2, 3)
+        x[6:8], x[8] = rng.uniform(-0.3, 0.3, 2), rng.uniform(-math.pi, math.pi)  # roll, pitch, yaw
+        x[P : R + 1] = rng.uniform(-2, 2, 3)
         ref = np.zeros(REF_SIZE)
-        ref[:9] = x[:9] + rng.uniform(-0.3, 0.3, 9)           # position, velocity, acceleration
+        ref[:9] = x[:9] + rng.uniform(-0.3, 0.3, 9)  # position, velocity, acceleration
         ref[REF_PSI], ref[REF_PSI_DOT] = rng.uniform(-math.pi, math.pi), rng.uniform(-1.0, 1.0)
         cmd = np.zeros(CMD_SIZE)
         se3(0.0, 1e-3, x, ref, VP, ctrl.gains(), np.zeros(0), cmd)
-        assert cmd[CMD_FLAGS] == 0                           # neither limit acts: Lee's law alone
-        state = {"x": x[:3], "v": x[3:6], "w": x[P:R + 1],
-                 "q": Rotation.from_euler("ZYX", [x[8], x[7], x[6]]).as_quat()}
-        flat = {"x": ref[:3], "x_dot": ref[3:6], "x_ddot": ref[6:9], "yaw": ref[REF_PSI],
-                "yaw_dot": ref[REF_PSI_DOT]}
+        assert cmd[CMD_FLAGS] == 0  # neither limit acts: Lee's law alone
+        state = {
+            "x": x[:3],
+            "v": x[3:6],
+            "w": x[P : R + 1],
+            "q": Rotation.from_euler("ZYX", [x[8], x[7], x[6]]).as_quat(),
+        }
+        flat = {"x": ref[:3], "x_dot": ref[3:6], "x_ddot": ref[6:9], "yaw": ref[REF_PSI], "yaw_dot": ref[REF_PSI_DOT]}
         out = theirs.update(0.0, state, flat)
         l = VP[P_L]
         np.testing.assert_allclose(cmd[CMD_THRUST], out["cmd_thrust"], rtol=1e-12)
-        np.testing.assert_allclose([cmd[CMD_TAU_PHI] * l, cmd[CMD_TAU_THETA] * l, cmd[CMD_TAU_PSI]],
-                                   out["cmd_moment"], rtol=0, atol=1e-10)
+        np.testing.assert_allclose(
+            [cmd[CMD_TAU_PHI] * l, cmd[CMD_TAU_THETA] * l, cmd[CMD_TAU_PSI]], out["cmd_moment"], rtol=0, atol=1e-10
+        )
         psi_d, theta_d, phi_d = Rotation.from_quat(out["cmd_q"]).as_euler("ZYX")
-        np.testing.assert_allclose([cmd[CMD_PHI_D], cmd[CMD_THETA_D], cmd[CMD_PSI_D]],
-                                   [phi_d, theta_d, psi_d], rtol=0, atol=1e-10)
+        np.testing.assert_allclose(
+            [cmd[CMD_PHI_D], cmd[CMD_THETA_D], cmd[CMD_PSI_D]], [phi_d, theta_d, psi_d], rtol=0, atol=1e-10
+        )
 
 
 def yawing_minimum_snap() -> MinimumSnap:
     """A 2 m square flown as one minimum-snap path in 16 s, the heading turning a full lap
     (psi_dot_d up to 0.83 rad/s)."""
-    return MinimumSnap(WaypointTable([[0, 0, 1], [2, 0, 1], [2, 2, 1], [0, 2, 1], [0, 0, 1]],
-                                     yaw=[0, math.pi / 2, math.pi, 1.5 * math.pi, 2 * math.pi],
-                                     t=[0, 4, 8, 12, 16]))
+    return MinimumSnap(
+        WaypointTable(
+            [[0, 0, 1], [2, 0, 1], [2, 2, 1], [0, 2, 1], [0, 0, 1]],
+            yaw=[0, math.pi / 2, math.pi, 1.5 * math.pi, 2 * math.pi],
+            t=[0, 4, 8, 12, 16],
+        )
+    )
 
 
 def yaw_error_deg(res) -> np.ndarray:
@@ -271,7 +291,7 @@ def test_se3_follows_the_yaw_rate_of_a_minimum_snap_path():
     res = qc.fly(mission, ctrl)
     assert res.ok[0]
     rate = np.max(np.abs(res.references[0, :, REF_PSI_DOT]))
-    assert math.degrees(ctrl.attitude.kd / ctrl.attitude.kp * rate) > 8.0     # the lag this path would show
+    assert math.degrees(ctrl.attitude.kd / ctrl.attitude.kp * rate) > 8.0  # the lag this path would show
     assert np.max(np.abs(yaw_error_deg(res))) < 0.6
 
 
@@ -297,7 +317,7 @@ def test_tilt_and_thrust_limits_are_applied_and_flagged(ctrl):
     c = command(weak, dz=100.0)
     assert int(c[CMD_FLAGS]) & FLAG_THRUST_LIMIT
     assert c[CMD_THRUST] == pytest.approx(0.05 * 4 * V.K if weak is not ctrl else 4 * V.K)
-    c = command(ctrl, dz=-100.0)                  # asked to fall faster than g: no negative thrust
+    c = command(ctrl, dz=-100.0)  # asked to fall faster than g: no negative thrust
     assert c[CMD_THRUST] >= 0.0 and (isinstance(ctrl, Cascade) or int(c[CMD_FLAGS]) & FLAG_THRUST_LIMIT)
 
 
@@ -310,7 +330,7 @@ def test_cascade_rate_and_attitude_loops_are_stable_with_the_rotor_lag(axis):
         assert pm > 40.0 and gm > 3.0
         assert np.all(control.feedback(loops[name], 1).poles().real < 0)
         if name == "rate":
-            assert wgc < V.omega          # the rate loop is fast but below the 15 rad/s lag
+            assert wgc < V.omega  # the rate loop is fast but below the 15 rad/s lag
     assert np.all(loops["closed"].poles().real < 0)
     assert float(loops["closed"].dcgain()) == pytest.approx(1.0)
 
@@ -328,7 +348,7 @@ def cascade_x_loop(c: Cascade, w=15.0, g=9.81):
     e = np.eye(n)
     A, B = np.zeros((n, n)), np.zeros((n, 1))
     fv, fa = 2 * math.pi * c.vel_d_cutoff, 2 * math.pi * c.rate_d_cutoff
-    ev = (-c.xy_p * e[i["x"]] - e[i["v"]], c.xy_p)                 # (state row, reference gain)
+    ev = (-c.xy_p * e[i["x"]] - e[i["v"]], c.xy_p)  # (state row, reference gain)
     acc = (c.xy_vel_p * ev[0] + e[i["vi"]] - c.xy_vel_d * e[i["vdf"]], c.xy_vel_p * ev[1])
     er = (c.roll_p * (acc[0] / g - e[i["th"]]) - e[i["q"]], c.roll_p * acc[1] / g)
     al = (c.rate.kp * er[0] + e[i["ri"]] - c.rate.kd * e[i["adf"]], c.rate.kp * er[1])
@@ -347,7 +367,7 @@ def test_small_step_follows_the_linearised_cascade(ctrl):
     for se3, design.cascade_state_space with the attitude PD as a PID without integral."""
     if isinstance(ctrl, SE3):
         full = cascade_state_space(ctrl.position, PIDGains(kp=ctrl.attitude.kp, ki=0.0, kd=ctrl.attitude.kd))
-        assert np.all(full.A[:5, 5] == 0.0)       # with ki = 0 the last state, int(e), feeds nothing
+        assert np.all(full.A[:5, 5] == 0.0)  # with ki = 0 the last state, int(e), feeds nothing
         sys = control.ss(full.A[:5, :5], full.B[:5], full.C[:, :5], 0.0)
     else:
         sys = cascade_x_loop(ctrl)
@@ -378,7 +398,7 @@ def test_steps_are_reached_with_the_right_sign(ctrl, axis, size):
     assert np.max(np.abs(res.final_state[0, :3] - goal)) < 0.02
     moved = res.state(axis)[0] - base[j]
     assert np.all(np.sign(moved[np.abs(moved) > 0.05]) == np.sign(size))  # never the wrong way
-    for o in set("xyz") - {axis}:   # se3's U1 = F . b3 dips 2 cm while the tilt lags b3_d
+    for o in set("xyz") - {axis}:  # se3's U1 = F . b3 dips 2 cm while the tilt lags b3_d
         assert np.max(np.abs(res.state(o)[0] - base["xyz".index(o)])) < 0.03
 
 
@@ -393,7 +413,7 @@ def test_x_and_y_steps_are_mirror_images(ctrl):
 @pytest.mark.parametrize("ctrl", MODERN, ids=IDS)
 def test_yaw_step_is_followed_in_place(ctrl):
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")   # se3's yaw torque briefly asks for negative rotor thrust
+        warnings.simplefilter("ignore")  # se3's yaw torque briefly asks for negative rotor thrust
         res = qc.fly(Step(axis="yaw", size=0.5), ctrl, duration=12.0)
     assert res.ok[0]
     assert res.final_state[0, PSI] == pytest.approx(0.5, abs=2e-3)
@@ -427,22 +447,25 @@ def test_registry_and_gains():
     assert SE3().function is se3 and Cascade().function is cascade
     assert Cascade().gains().shape == (CASCADE_GAINS,) and Cascade().memory().shape == (19,)
     assert SE3().memory_size == 0
-    assert rate_pid_design(30.0).kp == 30.0        # scales with the rotor bandwidth
+    assert rate_pid_design(30.0).kp == 30.0  # scales with the rotor bandwidth
     assert json.dumps(Cascade().to_dict())
 
 
-@pytest.mark.parametrize("cls,kw,field", [
-    (SE3, {"max_tilt": 2.0}, "max_tilt"),
-    (SE3, {"max_tilt": float("nan")}, "max_tilt"),
-    (SE3, {"attitude": (81.0, 14.4)}, "attitude"),
-    (Cascade, {"xy_p": 0.0}, "xy_p"),
-    (Cascade, {"xy_vel_i": -0.1}, "xy_vel_i"),
-    (Cascade, {"max_tilt": 1.6}, "max_tilt"),
-    (Cascade, {"thrust_max": 1.5}, "thrust_max"),
-    (Cascade, {"thrust_min": -0.1}, "thrust_min"),
-    (Cascade, {"rate": PDGains(kp=1.0, kd=0.1)}, "rate"),
-    (Cascade, {"rate_d_cutoff": "30"}, "rate_d_cutoff"),
-])
+@pytest.mark.parametrize(
+    "cls,kw,field",
+    [
+        (SE3, {"max_tilt": 2.0}, "max_tilt"),
+        (SE3, {"max_tilt": float("nan")}, "max_tilt"),
+        (SE3, {"attitude": (81.0, 14.4)}, "attitude"),
+        (Cascade, {"xy_p": 0.0}, "xy_p"),
+        (Cascade, {"xy_vel_i": -0.1}, "xy_vel_i"),
+        (Cascade, {"max_tilt": 1.6}, "max_tilt"),
+        (Cascade, {"thrust_max": 1.5}, "thrust_max"),
+        (Cascade, {"thrust_min": -0.1}, "thrust_min"),
+        (Cascade, {"rate": PDGains(kp=1.0, kd=0.1)}, "rate"),
+        (Cascade, {"rate_d_cutoff": "30"}, "rate_d_cutoff"),
+    ],
+)
 def test_bad_parameters_raise_input_error_naming_the_field(cls, kw, field):
     with pytest.raises(qc.InputError, match=f"'{field}'"):
         cls(**kw)
@@ -460,7 +483,7 @@ def test_comparison_on_the_circle():
     cmp = compare("circle", duration=40.0)
     table = cmp.table()
     print("\n" + cmp.text())
-    assert "did not settle" not in cmp.text()     # each converges onto its steady lag (docs/metrics.md)
+    assert "did not settle" not in cmp.text()  # each converges onto its steady lag (docs/metrics.md)
     assert table.index.tolist() == ["nlpd", "gonzalez", "se3", "cascade"]
     assert table["status"].eq("finished").all()
     for label, res in cmp.results.items():
@@ -475,8 +498,7 @@ def test_comparison_on_the_circle():
 
 
 def test_compare_table_plot_dict_and_write(tmp_path):
-    cmp = compare(Step(axis="y", size=1.0), ["nlpd", SE3(), "cascade", SE3(max_tilt=0.3)], duration=3.0,
-                  log_every=5)
+    cmp = compare(Step(axis="y", size=1.0), ["nlpd", SE3(), "cascade", SE3(max_tilt=0.3)], duration=3.0, log_every=5)
     assert isinstance(cmp, Comparison)
     assert list(cmp.results) == ["nlpd", "se3", "cascade", "se3#2"]
     table = cmp.table()
@@ -492,7 +514,12 @@ def test_compare_table_plot_dict_and_write(tmp_path):
     assert d["controllers"]["se3#2"]["max_tilt"] == 0.3
     json.dumps(d, allow_nan=False)
     out = cmp.write(tmp_path / "cmp")
-    assert sorted(p.name for p in out.iterdir()) == ["comparison.png", "metrics.csv", "quadcruise.json", "scenario.toml"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        "comparison.png",
+        "metrics.csv",
+        "quadcruise.json",
+        "scenario.toml",
+    ]
     by_label = compare("hover", {"paper": "nlpd", "px4": Cascade()}, duration=0.5)
     assert list(by_label.results) == ["paper", "px4"]
     batch = compare("hover", ("se3",), duration=0.5, vehicle=qc.Vehicle(m=np.array([3.0, 4.0])))
@@ -537,8 +564,11 @@ def test_readme_states_the_tilt_flown_at_a_square_corner_as_measured():
     from quadcruise.missions import Square
 
     text = " ".join(Path(__file__).parents[2].joinpath("README.md").read_text().split())
-    m = re.search(r"the largest tilt flown is (\d+)° for `nlpd`, (\d+)° for `gonzalez`, (\d+)° for `se3` and "
-                  r"(\d+)° for `cascade` \(asked: (\d+)°, (\d+)°, (\d+)°, (\d+)°\)", text)
+    m = re.search(
+        r"the largest tilt flown is (\d+)° for `nlpd`, (\d+)° for `gonzalez`, (\d+)° for `se3` and "
+        r"(\d+)° for `cascade` \(asked: (\d+)°, (\d+)°, (\d+)°, (\d+)°\)",
+        text,
+    )
     assert m, "README lost its flown-tilt sentence"
     stated = [int(v) for v in m.groups()]
     flown, asked = [], []
@@ -549,6 +579,6 @@ def test_readme_states_the_tilt_flown_at_a_square_corner_as_measured():
             s, c = res.states[0], res.commands[0]
             flown.append(math.degrees(np.arccos(np.min(np.cos(s[:, PHI]) * np.cos(s[:, THETA])))))
             asked.append(math.degrees(np.arccos(np.min(np.cos(c[:, CMD_PHI_D]) * np.cos(c[:, CMD_THETA_D])))))
-    assert np.all(np.abs(np.array(flown + asked) - stated) < 0.6), (flown, asked)   # README's whole degrees
-    assert flown[0] > 45.0 + 15.0 and asked[0] == pytest.approx(60.0, abs=0.1)   # per-axis limits: acos(cos^2 45)
-    assert asked[2] == pytest.approx(45.0, abs=0.1)                              # se3: the thrust axis's tilt
+    assert np.all(np.abs(np.array(flown + asked) - stated) < 0.6), (flown, asked)  # README's whole degrees
+    assert flown[0] > 45.0 + 15.0 and asked[0] == pytest.approx(60.0, abs=0.1)  # per-axis limits: acos(cos^2 45)
+    assert asked[2] == pytest.approx(45.0, abs=0.1)  # se3: the thrust axis's tilt

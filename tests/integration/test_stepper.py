@@ -20,10 +20,19 @@ pytestmark = pytest.mark.filterwarnings("ignore:the vehicle has no drag")
 
 
 def _kw(n=3, **more):
-    return dict(vehicle=with_drag(Vehicle.paper()), duration=DUR, dt=2e-3, max_step=1e-3, n=n, seed=7,
-                environment=Environment(gust=Gust(amplitude=(2.0, 0.0, 0.5), start=0.1, duration=0.2),
-                                        turbulence=Turbulence(intensity="severe")),
-                sensors=SensorNoise(position_std=0.02, angle_std=0.01, rate_std=0.05, delay=0.006), **more)
+    return dict(
+        vehicle=with_drag(Vehicle.paper()),
+        duration=DUR,
+        dt=2e-3,
+        max_step=1e-3,
+        n=n,
+        seed=7,
+        environment=Environment(
+            gust=Gust(amplitude=(2.0, 0.0, 0.5), start=0.1, duration=0.2), turbulence=Turbulence(intensity="severe")
+        ),
+        sensors=SensorNoise(position_std=0.02, angle_std=0.01, rate_std=0.05, delay=0.006),
+        **more,
+    )
 
 
 def _flown(s):
@@ -59,7 +68,7 @@ def test_fly_step_by_step_is_fly(controller):
 
 def test_steps_of_several_periods_fly_the_same():
     one = stepper("circle", "nlpd", **_kw())
-    many = stepper("circle", "nlpd", **_kw(periods=7))      # 200 periods: 28 steps of 7, then 4
+    many = stepper("circle", "nlpd", **_kw(periods=7))  # 200 periods: 28 steps of 7, then 4
     while not one.done.all():
         one.step()
     while not many.done.all():
@@ -80,7 +89,7 @@ def test_a_vehicle_reset_alone_leaves_the_others():
     for k in range(60):
         a.step()
         b.step()
-        assert np.array_equal(a.state[1], first[k])        # vehicle 1 flies its start again
+        assert np.array_equal(a.state[1], first[k])  # vehicle 1 flies its start again
     assert np.array_equal(a.state[[0, 2]], b.state[[0, 2]])  # the others never noticed
     assert not np.array_equal(a.state[1], b.state[1])
 
@@ -107,7 +116,7 @@ def test_seeds_reproduce_and_do_not_depend_on_n():
 def test_a_diverged_vehicle_stops_with_its_status_and_the_rest_fly_on():
     s = stepper("hover", "nlpd", duration=0.2, dt=2e-3, n=2, limits=qc.Limits(max_rate=4.0))
     x0 = s.state.copy()
-    x0[0, 9] = 4.5                          # vehicle 0 starts rolling faster than the bound
+    x0[0, 9] = 4.5  # vehicle 0 starts rolling faster than the bound
     s.reset(x0=x0)
     s.step()
     assert s.status.tolist() == [int(ExitStatus.RATE_BOUND), int(ExitStatus.FINISHED)]
@@ -117,7 +126,7 @@ def test_a_diverged_vehicle_stops_with_its_status_and_the_rest_fly_on():
         s.step()
     assert np.array_equal(s.state[0], stopped) and s.period.tolist() == [1, 100]
     assert s.status.tolist() == [int(ExitStatus.RATE_BOUND), int(ExitStatus.FINISHED)]
-    assert np.isnan(s.log_x[0]).all()       # a stopped vehicle logs nothing
+    assert np.isnan(s.log_x[0]).all()  # a stopped vehicle logs nothing
 
 
 def test_bad_arguments_are_one_clear_error():

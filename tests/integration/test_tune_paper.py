@@ -12,13 +12,15 @@ from quadcruise.workflows.reproduce import FITTED
 from quadcruise.workflows.scenario import load_scenario
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "examples" / "scenarios"
-FILES = {"nlpd (fitted)": SCENARIOS / "paper_fitted_nlpd.toml",
-         "gonzalez (fitted)": SCENARIOS / "paper_fitted_gonzalez.toml"}
+FILES = {
+    "nlpd (fitted)": SCENARIOS / "paper_fitted_nlpd.toml",
+    "gonzalez (fitted)": SCENARIOS / "paper_fitted_gonzalez.toml",
+}
 
 
 def regenerate_command(path: Path) -> list[str]:
     line = next(x for x in path.read_text().splitlines() if x.startswith("# regenerate: "))
-    words = shlex.split(line[len("# regenerate: "):])
+    words = shlex.split(line[len("# regenerate: ") :])
     assert words[:2] == ["quadcruise", "tune"]
     return words[1:]
 

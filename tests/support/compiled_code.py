@@ -17,7 +17,8 @@ def reference_count_calls(py_func, signature) -> list[str]:
         start = re.match(r'define [^@]*@"?([^"(]+)', line)
         if start:
             body = start.group(1)
-        elif ("@NRT_incref" in line or "@NRT_decref" in line) and "call " in line \
-                and not body.startswith("_ZN7cpython"):
+        elif (
+            ("@NRT_incref" in line or "@NRT_decref" in line) and "call " in line and not body.startswith("_ZN7cpython")
+        ):
             calls.append(body)
     return calls

@@ -15,11 +15,13 @@ def rhs(x, u, m=3.499, Jxx=0.03, Jyy=0.03, Jzz=0.04, l=0.2, K=120.0, w=15.0, d=4
     U2 = F[1] - F[3]
     U3 = F[0] - F[2]
     U4 = d * (F[0] + F[2] - F[1] - F[3])
-    acc = np.array([
-        (np.sin(phi) * np.sin(psi) + np.cos(phi) * np.sin(th) * np.cos(psi)) * U1 / m,
-        (-np.sin(phi) * np.cos(psi) + np.cos(phi) * np.sin(th) * np.sin(psi)) * U1 / m,
-        np.cos(phi) * np.cos(th) * U1 / m - g,
-    ])
+    acc = np.array(
+        [
+            (np.sin(phi) * np.sin(psi) + np.cos(phi) * np.sin(th) * np.cos(psi)) * U1 / m,
+            (-np.sin(phi) * np.cos(psi) + np.cos(phi) * np.sin(th) * np.sin(psi)) * U1 / m,
+            np.cos(phi) * np.cos(th) * U1 / m - g,
+        ]
+    )
     # Euler's equations for a rigid body (the k1..k6 form)
     pdot = ((Jyy - Jzz) * q * r + l * U2) / Jxx
     qdot = ((Jzz - Jxx) * p * r + l * U3) / Jyy
@@ -32,7 +34,7 @@ def still_air_ext():
     from quadcruise.layout import EXT_E1, EXT_SIZE
 
     ext = np.zeros(EXT_SIZE)
-    ext[EXT_E1:EXT_E1 + 4] = 1.0
+    ext[EXT_E1 : EXT_E1 + 4] = 1.0
     return ext
 
 

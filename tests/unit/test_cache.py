@@ -12,27 +12,29 @@ def test_cache_files_go_when_any_source_changes(tmp_path):
     (pkg / "engine.py").write_text("import numba\nx = 1\n")
     (pkg / "model" / "plant.py").write_text("from numba import njit\ny = 2\n")
     (pkg / "tables.py").write_text("z = 3\n")
-    cached = [pkg / "model" / "__pycache__" / "plant.derivative-1.py311.nbi",
-              pkg / "model" / "__pycache__" / "plant.derivative-1.py311.1.nbc"]
+    cached = [
+        pkg / "model" / "__pycache__" / "plant.derivative-1.py311.nbi",
+        pkg / "model" / "__pycache__" / "plant.derivative-1.py311.1.nbc",
+    ]
     for path in cached:
         path.write_bytes(b"machine code")
-    assert drop_stale_cache(pkg, "")                       # no stamp yet: dropped
+    assert drop_stale_cache(pkg, "")  # no stamp yet: dropped
     assert not any(p.exists() for p in cached)
     for path in cached:
         path.write_bytes(b"machine code")
-    assert not drop_stale_cache(pkg, "")                   # unchanged sources: kept
+    assert not drop_stale_cache(pkg, "")  # unchanged sources: kept
     assert all(p.exists() for p in cached)
     before = sources_stamp(pkg)
-    (pkg / "tables.py").write_text("z = 4\n")         # no compiled code in it: the cache stays
+    (pkg / "tables.py").write_text("z = 4\n")  # no compiled code in it: the cache stays
     assert sources_stamp(pkg) == before and not drop_stale_cache(pkg, "")
     plant = pkg / "model" / "plant.py"
     st = plant.stat()
-    os.utime(plant, ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))   # touched, not changed: stays
+    os.utime(plant, ns=(st.st_atime_ns, st.st_mtime_ns + 10**9))  # touched, not changed: stays
     assert sources_stamp(pkg) == before
-    plant.write_text("from numba import njit\ny = 3\n")          # an edit to a callee's file only
+    plant.write_text("from numba import njit\ny = 3\n")  # an edit to a callee's file only
     assert sources_stamp(pkg) != before
     assert drop_stale_cache(pkg, "") and not any(p.exists() for p in cached)
-    (pkg / "new.py").write_text("import numba\n")    # a new compiled module changes the stamp too
+    (pkg / "new.py").write_text("import numba\n")  # a new compiled module changes the stamp too
     assert drop_stale_cache(pkg, "") and not drop_stale_cache(pkg, "")
 
 

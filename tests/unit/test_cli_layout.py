@@ -31,8 +31,12 @@ def printing(source: str, name: str = "<source>") -> list[str]:
             func = node.func
             if isinstance(func, ast.Name) and func.id == "print":
                 found.append(f"{node.lineno}: print(")
-            elif isinstance(func, ast.Attribute) and func.attr in ("echo", "secho") and \
-                    isinstance(func.value, ast.Name) and func.value.id == "click":
+            elif (
+                isinstance(func, ast.Attribute)
+                and func.attr in ("echo", "secho")
+                and isinstance(func.value, ast.Name)
+                and func.value.id == "click"
+            ):
                 found.append(f"{node.lineno}: click.{func.attr}(")
     return found
 
@@ -40,7 +44,7 @@ def printing(source: str, name: str = "<source>") -> list[str]:
 def test_the_check_sees_printing():
     source = "import click\nfrom click import echo\ndef f():\n    print('x')\n    click.echo('y')\n"
     assert printing(source) == ["1: import click", "2: from click import ...", "4: print(", "5: click.echo("]
-    assert printing('def f():\n    """>>> print(1)"""\n    return "print(2)"\n') == []   # text is not a call
+    assert printing('def f():\n    """>>> print(1)"""\n    return "print(2)"\n') == []  # text is not a call
 
 
 def test_only_the_cli_prints_or_imports_click():
@@ -71,5 +75,14 @@ def test_the_entry_points_stay():
 
     module = importlib.import_module("quadcruise.cli.main")
     assert module.main is main and quadcruise.cli.main is main and quadcruise.cli.run is module.run
-    assert set(main.commands) == {"analyze", "compare", "fly", "identify", "montecarlo", "replay", "reproduce", "tune",
-                                  "vehicles"}
+    assert set(main.commands) == {
+        "analyze",
+        "compare",
+        "fly",
+        "identify",
+        "montecarlo",
+        "replay",
+        "reproduce",
+        "tune",
+        "vehicles",
+    }

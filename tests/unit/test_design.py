@@ -38,6 +38,7 @@ def _same_poles(a, b, tol=1e-7):
 
 # --- the paper's numbers (eqs 17-18) -------------------------------------------------------
 
+
 def test_paper_position_gains_eq18():
     g = pd_from_poles((-0.7, -4.3))
     assert g.kp == pytest.approx(3.01, abs=1e-12)
@@ -102,10 +103,11 @@ def test_gains_are_frozen():
 
 # --- round trips poles -> gains -> poles ---------------------------------------------------
 
+
 def _random_pole_sets(n, count, seed):
     rng = np.random.default_rng(seed)
     for i in range(count):
-        if i % 2 and n >= 2:      # one complex pair (+ a real pole for n = 3)
+        if i % 2 and n >= 2:  # one complex pair (+ a real pole for n = 3)
             re, im = -rng.uniform(0.1, 20), rng.uniform(0.01, 20)
             yield [complex(re, im), complex(re, -im)] + list(-rng.uniform(0.1, 20, n - 2))
         else:
@@ -128,7 +130,7 @@ def test_pid_round_trip(poles):
     g = pid_from_poles(poles)
     _same_poles(g.poles, poles, tol=1e-6)
     _same_poles(g.closed_loop().poles(), poles, tol=1e-6)
-    A3 = np.eye(3, k=1)                    # states (int y, y, y')
+    A3 = np.eye(3, k=1)  # states (int y, y, y')
     K = np.ravel(control.place(A3, [[0], [0], [1]], poles))
     np.testing.assert_allclose(K, [g.ki, g.kp, g.kd], rtol=1e-7)
     assert check_with_control(g)["gain_error"] < 1e-7
@@ -142,26 +144,30 @@ def test_pid_char_poly():
 
 # --- bad input -----------------------------------------------------------------------------
 
-@pytest.mark.parametrize("func, poles, match", [
-    (pd_from_poles, (0.7, 4.3), r"pole 0\.7 is not in the open left half plane \(did you mean -0\.7\?\)"),
-    (pd_from_poles, (-0.7, 4.3), r"pole 4\.3 .*did you mean -4\.3"),
-    (pd_from_poles, (0.0, -1.0), r"pole 0 is not in the open left half plane$"),
-    (pd_from_poles, (1j, -1j), r"pole \(0\+1j\) is not in the open left half plane"),
-    (pd_from_poles, (0.5 + 1j, 0.5 - 1j), r"did you mean \(-0\.5\+1j\)"),
-    (pd_from_poles, (-1 + 2j, -3.0), r"complex pole \(-1\+2j\) has no conjugate \(-1-2j\)"),
-    (pd_from_poles, (-1 + 2j, -1 + 2j), r"no conjugate"),
-    (pid_from_poles, (-1 + 2j, -1 - 2j, -1 + 2j), r"no conjugate"),
-    (pd_from_poles, (-1.0,), r"pd_from_poles needs 2 poles, got 1"),
-    (pd_from_poles, -1.0, r"needs 2 poles, got 1"),
-    (pd_from_poles, (-1, -2, -3), r"needs 2 poles, got 3"),
-    (pd_from_poles, [[-1, -2]], r"needs 2 poles"),
-    (pd_from_poles, (), r"needs 2 poles, got 0"),
-    (pid_from_poles, (-1, -2), r"pid_from_poles needs 3 poles, got 2"),
-    (pd_from_poles, (float("nan"), -1), r"pole nan is not finite"),
-    (pid_from_poles, (-1, -2, -np.inf), r"pole -inf is not finite"),
-    (pd_from_poles, ("abc", -1), r"poles must be numbers"),
-    (pd_from_poles, None, r"poles must be numbers"),
-])
+
+@pytest.mark.parametrize(
+    "func, poles, match",
+    [
+        (pd_from_poles, (0.7, 4.3), r"pole 0\.7 is not in the open left half plane \(did you mean -0\.7\?\)"),
+        (pd_from_poles, (-0.7, 4.3), r"pole 4\.3 .*did you mean -4\.3"),
+        (pd_from_poles, (0.0, -1.0), r"pole 0 is not in the open left half plane$"),
+        (pd_from_poles, (1j, -1j), r"pole \(0\+1j\) is not in the open left half plane"),
+        (pd_from_poles, (0.5 + 1j, 0.5 - 1j), r"did you mean \(-0\.5\+1j\)"),
+        (pd_from_poles, (-1 + 2j, -3.0), r"complex pole \(-1\+2j\) has no conjugate \(-1-2j\)"),
+        (pd_from_poles, (-1 + 2j, -1 + 2j), r"no conjugate"),
+        (pid_from_poles, (-1 + 2j, -1 - 2j, -1 + 2j), r"no conjugate"),
+        (pd_from_poles, (-1.0,), r"pd_from_poles needs 2 poles, got 1"),
+        (pd_from_poles, -1.0, r"needs 2 poles, got 1"),
+        (pd_from_poles, (-1, -2, -3), r"needs 2 poles, got 3"),
+        (pd_from_poles, [[-1, -2]], r"needs 2 poles"),
+        (pd_from_poles, (), r"needs 2 poles, got 0"),
+        (pid_from_poles, (-1, -2), r"pid_from_poles needs 3 poles, got 2"),
+        (pd_from_poles, (float("nan"), -1), r"pole nan is not finite"),
+        (pid_from_poles, (-1, -2, -np.inf), r"pole -inf is not finite"),
+        (pd_from_poles, ("abc", -1), r"poles must be numbers"),
+        (pd_from_poles, None, r"poles must be numbers"),
+    ],
+)
 def test_bad_poles(func, poles, match):
     with pytest.raises(InputError, match=match) as exc:
         func(poles)
@@ -169,14 +175,17 @@ def test_bad_poles(func, poles, match):
     assert isinstance(exc.value, ValueError)
 
 
-@pytest.mark.parametrize("cls, kwargs, match", [
-    (PDGains, dict(kp=0.0, kd=1.0), r"PD gain 'kp' \(proportional gain, 1/s\^2\) must be > 0, got 0.0"),
-    (PDGains, dict(kp=-1.0, kd=1.0), r"'kp'"),
-    (PDGains, dict(kp=1.0, kd=float("nan")), r"'kd' .* must be finite, got nan"),
-    (PDGains, dict(kp="x", kd=1.0), r"gain 'kp' .* must be a number, got 'x'"),
-    (PIDGains, dict(kp=1.0, ki=-1.0, kd=1.0), r"PID gain 'ki' \(integral gain, 1/s\^3\) must be >= 0, got -1.0"),
-    (PIDGains, dict(kp=1.0, ki=1.0, kd=np.inf), r"'kd' .* must be finite, got inf"),
-])
+@pytest.mark.parametrize(
+    "cls, kwargs, match",
+    [
+        (PDGains, dict(kp=0.0, kd=1.0), r"PD gain 'kp' \(proportional gain, 1/s\^2\) must be > 0, got 0.0"),
+        (PDGains, dict(kp=-1.0, kd=1.0), r"'kp'"),
+        (PDGains, dict(kp=1.0, kd=float("nan")), r"'kd' .* must be finite, got nan"),
+        (PDGains, dict(kp="x", kd=1.0), r"gain 'kp' .* must be a number, got 'x'"),
+        (PIDGains, dict(kp=1.0, ki=-1.0, kd=1.0), r"PID gain 'ki' \(integral gain, 1/s\^3\) must be >= 0, got -1.0"),
+        (PIDGains, dict(kp=1.0, ki=1.0, kd=np.inf), r"'kd' .* must be finite, got inf"),
+    ],
+)
 def test_bad_gains(cls, kwargs, match):
     with pytest.raises(InputError, match=match) as err:
         cls(**kwargs)
@@ -191,10 +200,11 @@ def test_bad_actuator_bandwidth(w):
 
 # --- attitude and altitude designs with the rotor lag -----------------------------------------
 
+
 def test_attitude_design_poles_and_gains():
     g = attitude_pid_design()
     assert (g.kp, g.ki, g.kd) == pytest.approx((88.2, 40.5, 14.9))
-    _same_poles(g.poles, [-7.2 + 5.4j, -7.2 - 5.4j, -0.5], tol=1e-6)   # wn 9, zeta 0.8
+    _same_poles(g.poles, [-7.2 + 5.4j, -7.2 - 5.4j, -0.5], tol=1e-6)  # wn 9, zeta 0.8
     r = check_with_control(g)
     assert r["gain_error"] < 1e-6
     # the dominant pair is faster than the position loop's fastest pole (4.3 rad/s)
@@ -209,12 +219,13 @@ def test_attitude_margins_with_actuator_lag_independent():
     assert pm > 20.0
     assert pm == pytest.approx(24.47, abs=0.01)
     assert wc == pytest.approx(12.49, abs=0.01)
-    assert gm == pytest.approx(0.0509, abs=1e-4)       # gain may fall to 5 %, rise without limit
+    assert gm == pytest.approx(0.0509, abs=1e-4)  # gain may fall to 5 %, rise without limit
     assert np.all(control.feedback(L, 1).poles().real < 0)
     m = loop_margins(g, 15.0)
     assert m["stable"]
-    assert (m["phase_margin"], m["gain_margin"], m["gain_crossover"], m["phase_crossover"]) == \
-        pytest.approx((pm, gm, wc, wg))
+    assert (m["phase_margin"], m["gain_margin"], m["gain_crossover"], m["phase_crossover"]) == pytest.approx(
+        (pm, gm, wc, wg)
+    )
     # too slow a gain: conditionally stable loop goes unstable below the gain margin
     weak = PIDGains(kp=g.kp * 0.05, ki=g.ki * 0.05, kd=g.kd * 0.05)
     assert not loop_margins(weak, 15.0)["stable"]

@@ -38,7 +38,7 @@ def modules() -> list[str]:
 
 
 def _home(obj) -> str | None:
-    obj = getattr(obj, "py_func", obj)                  # a numba dispatcher: its Python function
+    obj = getattr(obj, "py_func", obj)  # a numba dispatcher: its Python function
     return getattr(obj, "__module__", None)
 
 
@@ -57,7 +57,7 @@ def public_names(module: str) -> list[str]:
                 if callable(member) or isinstance(member, (property, classmethod, staticmethod)):
                     out.append(f"{module}.{name}.{attr}")
         elif inspect.isfunction(getattr(obj, "py_func", obj)) and getattr(obj, "__name__", name) == name:
-            out.append(f"{module}.{name}")          # a function defined under this name (not a constant made by one)
+            out.append(f"{module}.{name}")  # a function defined under this name (not a constant made by one)
     return out
 
 
@@ -85,14 +85,14 @@ def problems(name: str, required: bool) -> list[str]:
         return []
     obj = result["file"] and _resolve(name)
     if inspect.isclass(obj) and _home(_own_init(obj)) != _home(obj):
-        return []                                   # an Enum's or a Protocol's constructor is not ours
+        return []  # an Enum's or a Protocol's constructor is not ours
     found = [f"{code} {message}" for code, message in result["errors"] if code in CHECKED]
     return [p for p in found if not (p.startswith("PR02") and message_names(p) <= {"self", "cls"})]
 
 
 def message_names(message: str) -> set[str]:
     """The parameter names a PR01/PR02 message lists."""
-    inside = message[message.find("{") + 1:message.find("}")]
+    inside = message[message.find("{") + 1 : message.find("}")]
     return {part.strip().strip("'\"") for part in inside.split(",")}
 
 
@@ -182,12 +182,25 @@ def bare(x):
 def test_the_validator_reads_numpydoc(tmp_path, monkeypatch):
     (tmp_path / "qc_docstring_sample.py").write_text(SAMPLE)
     monkeypatch.syspath_prepend(str(tmp_path))
-    found = {name: [p[:4] for p in problems(f"qc_docstring_sample.{name}", required)]
-             for name, required in (("good", True), ("stale", False), ("no_returns", False),
-                                    ("one_line", False), ("one_line", True), ("bare", False))}
-    assert found == {"good": [], "stale": ["PR01", "PR02"], "no_returns": ["RT01"], "one_line": ["PR01", "RT01"],
-                     "bare": ["GL08"]}
-    assert problems("qc_docstring_sample.one_line", False) == []          # a helper may be one line
+    found = {
+        name: [p[:4] for p in problems(f"qc_docstring_sample.{name}", required)]
+        for name, required in (
+            ("good", True),
+            ("stale", False),
+            ("no_returns", False),
+            ("one_line", False),
+            ("one_line", True),
+            ("bare", False),
+        )
+    }
+    assert found == {
+        "good": [],
+        "stale": ["PR01", "PR02"],
+        "no_returns": ["RT01"],
+        "one_line": ["PR01", "RT01"],
+        "bare": ["GL08"],
+    }
+    assert problems("qc_docstring_sample.one_line", False) == []  # a helper may be one line
 
 
 def test_the_validator_holds_our_rules():

@@ -55,25 +55,28 @@ def refused(check, value, **kw) -> str:
 
 
 # --- each check -------------------------------------------------------------------------------
-@pytest.mark.parametrize("check, good, bad", [
-    ("real", [0, -3.5, 1e300, np.float32(2.0), np.int64(4)], [math.nan, math.inf, "1", True, None, [1.0]]),
-    ("pos", [1e-300, 2, 5.5], [0.0, -1.0, -math.inf, math.nan]),
-    ("nonneg", [0.0, 0, 3.0], [-1e-300, -2, math.nan]),
-    ("frac", [0.0, 0.5, 1.0], [-0.01, 1.01, math.inf]),
-    ("sign", [1, -1, 1.0], [0, 2, -0.5]),
-    ("whole", [0, 3, 7.0], [-1, 2.5, math.nan]),
-    ("flag", [True, False, np.bool_(True), 0, 1], [2, "yes", None, 0.5]),
-    ("pair", [(1, 2), [0.5, -1.0], np.array([1.0, 2.0])], [(1,), (1, 2, 3), "ab", 3.0, (1, math.nan), [[1, 2]]]),
-    ("vec", [(1, 2, 3)], [(1, 2), (1, 2, "3")]),
-    (between(0.0, 1.0, "[)"), [0.0, 0.999], [1.0, -0.1]),
-    (between(0.0, 1.0, "(]"), [1.0, 1e-9], [0.0, 1.1]),
-    (between(0.0, math.pi / 2, "()", text="(0, pi/2)"), [0.1, 1.5], [0.0, math.pi / 2, 2.0]),
-    (between(1, 4, whole=True), [1, 4, 2.0], [0, 5, 1.5]),
-    (one_of("light", "moderate"), ["light", np.str_("moderate")], ["Light", 1, None]),
-    (vector(4, "pos"), [(1, 2, 3, 4)], [(1, 2, 3, 0), (1, 2, 3)]),
-    (instance_of(tuple), [(1,), ()], [[1], None, "x"]),
-    (Check("even", "an even number", lambda v: isinstance(v, int) and v % 2 == 0), [2, 0], [1, "2"]),
-])
+@pytest.mark.parametrize(
+    "check, good, bad",
+    [
+        ("real", [0, -3.5, 1e300, np.float32(2.0), np.int64(4)], [math.nan, math.inf, "1", True, None, [1.0]]),
+        ("pos", [1e-300, 2, 5.5], [0.0, -1.0, -math.inf, math.nan]),
+        ("nonneg", [0.0, 0, 3.0], [-1e-300, -2, math.nan]),
+        ("frac", [0.0, 0.5, 1.0], [-0.01, 1.01, math.inf]),
+        ("sign", [1, -1, 1.0], [0, 2, -0.5]),
+        ("whole", [0, 3, 7.0], [-1, 2.5, math.nan]),
+        ("flag", [True, False, np.bool_(True), 0, 1], [2, "yes", None, 0.5]),
+        ("pair", [(1, 2), [0.5, -1.0], np.array([1.0, 2.0])], [(1,), (1, 2, 3), "ab", 3.0, (1, math.nan), [[1, 2]]]),
+        ("vec", [(1, 2, 3)], [(1, 2), (1, 2, "3")]),
+        (between(0.0, 1.0, "[)"), [0.0, 0.999], [1.0, -0.1]),
+        (between(0.0, 1.0, "(]"), [1.0, 1e-9], [0.0, 1.1]),
+        (between(0.0, math.pi / 2, "()", text="(0, pi/2)"), [0.1, 1.5], [0.0, math.pi / 2, 2.0]),
+        (between(1, 4, whole=True), [1, 4, 2.0], [0, 5, 1.5]),
+        (one_of("light", "moderate"), ["light", np.str_("moderate")], ["Light", 1, None]),
+        (vector(4, "pos"), [(1, 2, 3, 4)], [(1, 2, 3, 0), (1, 2, 3)]),
+        (instance_of(tuple), [(1,), ()], [[1], None, "x"]),
+        (Check("even", "an even number", lambda v: isinstance(v, int) and v % 2 == 0), [2, 0], [1, "2"]),
+    ],
+)
 def test_each_check_accepts_good_and_refuses_bad_in_one_line(check, good, bad):
     for value in good:
         probe(check, value)
@@ -88,7 +91,7 @@ def test_stored_forms():
     assert probe("flag", 1) is True
     assert probe("pair", np.array([1, 2])) == (1.0, 2.0)
     assert probe(one_of("x", "y"), np.str_("x")) == "x" and type(probe(one_of("x", "y"), np.str_("x"))) is str
-    assert probe("real", np.array(2.0)) == 2.0                      # a 0-d array is a number
+    assert probe("real", np.array(2.0)) == 2.0  # a 0-d array is a number
 
 
 def test_messages_say_what_was_wrong():
@@ -99,7 +102,7 @@ def test_messages_say_what_was_wrong():
     assert refused("frac", 2.0, optional=True).endswith("must be in [0, 1] or None, got 2.0")
     assert refused(instance_of(tuple), [1]).endswith("must be a tuple, got [1]")
     assert "must be a number or a 1-D array of numbers" in refused("pos", np.ones((40, 40)), batch=True)
-    assert len(refused("pos", np.ones((40, 40)), batch=True)) < 250      # a long value is cut short
+    assert len(refused("pos", np.ones((40, 40)), batch=True)) < 250  # a long value is cut short
 
 
 def test_batched_fields_hold_one_value_per_vehicle():
@@ -109,13 +112,13 @@ def test_batched_fields_hold_one_value_per_vehicle():
     source = np.array([1.0, 2.0])
     stored = probe("pos", source, batch=True)
     source[0] = -5.0
-    assert stored[0] == 1.0                                              # a copy
+    assert stored[0] == 1.0  # a copy
     assert refused("pos", [1.0, -2.0, 3.0], batch=True).endswith("got -2.0 (entry 1 of 3)")
     assert refused("pos", [1.0, math.nan], batch=True).endswith("must be finite, got nan (entry 1 of 2)")
     for bad in ([], [[1.0]], ["a"], [True, False]):
         refused("pos", bad, batch=True)
-    refused("pos", [1.0, 2.0])                                           # not batched: one number
-    x, y, z = probe("vec", np.ones((4, 3)), batch=True, default=(0.0, 0.0, 0.0))   # (N, 3) -> columns
+    refused("pos", [1.0, 2.0])  # not batched: one number
+    x, y, z = probe("vec", np.ones((4, 3)), batch=True, default=(0.0, 0.0, 0.0))  # (N, 3) -> columns
     assert x.shape == (4,) and isinstance(y, np.ndarray)
     assert probe("vec", ([1.0, 2.0], 0.0, 0), batch=True, default=(0.0, 0.0, 0.0))[1] == 0.0
 
@@ -134,8 +137,8 @@ def test_batch_lengths_must_agree():
 
 
 def test_optional_fields_and_required_fields():
-    assert probe("pos", None, default=None) is None                      # default None: optional
-    refused("pos", None)                                                 # otherwise not
+    assert probe("pos", None, default=None) is None  # default None: optional
+    refused("pos", None)  # otherwise not
 
     @dataclass(frozen=True)
     class Gains(Validated):
@@ -194,10 +197,32 @@ def package_dataclasses():
 
 def test_every_parameter_class_is_validated_and_every_field_has_unit_doc_and_check():
     classes = package_dataclasses()
-    expected = {"Vehicle", "Mission", "Hover", "Step", "Circle", "Square", "Waypoints", "MinimumSnap",
-                "ConstantWind", "Gust", "Turbulence", "RotorLoss", "ExternalForce", "SensorNoise", "Environment",
-                "CustomDisturbance", "Controller", "NLPD", "Gonzalez", "SE3", "Cascade", "PDGains", "PIDGains",
-                "RateGains"}
+    expected = {
+        "Vehicle",
+        "Mission",
+        "Hover",
+        "Step",
+        "Circle",
+        "Square",
+        "Waypoints",
+        "MinimumSnap",
+        "ConstantWind",
+        "Gust",
+        "Turbulence",
+        "RotorLoss",
+        "ExternalForce",
+        "SensorNoise",
+        "Environment",
+        "CustomDisturbance",
+        "Controller",
+        "NLPD",
+        "Gonzalez",
+        "SE3",
+        "Cascade",
+        "PDGains",
+        "PIDGains",
+        "RateGains",
+    }
     assert expected <= {c.__name__ for c in classes.values()}
     missing = []
     for qualname, cls in sorted(classes.items()):
@@ -225,21 +250,36 @@ def test_units_of_parameter_classes():
     assert Environment.units()["turbulence.altitude"] == "m" and SensorNoise.units()["delay"] == "s"
 
 
-@pytest.mark.parametrize("make, words", [
-    (lambda: quadcruise.Vehicle(m=0.0), "vehicle field 'm' (mass, kg) must be > 0, got 0.0"),
-    (lambda: __import__("quadcruise.missions", fromlist=["Circle"]).Circle(center=(1.0,)),
-     "circle field 'center' (centre (x, y), m) must be a pair of numbers"),
-    (lambda: __import__("quadcruise.disturbances", fromlist=["Gust"]).Gust(duration=-1.0),
-     "gust field 'duration' (gust duration, s) must be > 0, got -1.0"),
-    (lambda: __import__("quadcruise.disturbances", fromlist=["RotorLoss"]).RotorLoss(rotor=5),
-     "loss field 'rotor' (rotor number, -) must be a whole number in [1, 4], got 5.0"),
-    (lambda: __import__("quadcruise.control", fromlist=["SE3"]).SE3(max_tilt=2.0),
-     "se3 parameter 'max_tilt' (largest tilt of b3_d from the vertical, rad) must be in (0, pi/2), got 2.0"),
-    (lambda: __import__("quadcruise.control", fromlist=["Cascade"]).Cascade(rate=None),
-     "cascade parameter 'rate' (roll and pitch rate PID, -) must be a RateGains, got None"),
-    (lambda: __import__("quadcruise.control.design", fromlist=["PIDGains"]).PIDGains(1.0, -1.0, 0.0),
-     "PID gain 'ki' (integral gain, 1/s^3) must be >= 0, got -1.0"),
-])
+@pytest.mark.parametrize(
+    "make, words",
+    [
+        (lambda: quadcruise.Vehicle(m=0.0), "vehicle field 'm' (mass, kg) must be > 0, got 0.0"),
+        (
+            lambda: __import__("quadcruise.missions", fromlist=["Circle"]).Circle(center=(1.0,)),
+            "circle field 'center' (centre (x, y), m) must be a pair of numbers",
+        ),
+        (
+            lambda: __import__("quadcruise.disturbances", fromlist=["Gust"]).Gust(duration=-1.0),
+            "gust field 'duration' (gust duration, s) must be > 0, got -1.0",
+        ),
+        (
+            lambda: __import__("quadcruise.disturbances", fromlist=["RotorLoss"]).RotorLoss(rotor=5),
+            "loss field 'rotor' (rotor number, -) must be a whole number in [1, 4], got 5.0",
+        ),
+        (
+            lambda: __import__("quadcruise.control", fromlist=["SE3"]).SE3(max_tilt=2.0),
+            "se3 parameter 'max_tilt' (largest tilt of b3_d from the vertical, rad) must be in (0, pi/2), got 2.0",
+        ),
+        (
+            lambda: __import__("quadcruise.control", fromlist=["Cascade"]).Cascade(rate=None),
+            "cascade parameter 'rate' (roll and pitch rate PID, -) must be a RateGains, got None",
+        ),
+        (
+            lambda: __import__("quadcruise.control.design", fromlist=["PIDGains"]).PIDGains(1.0, -1.0, 0.0),
+            "PID gain 'ki' (integral gain, 1/s^3) must be >= 0, got -1.0",
+        ),
+    ],
+)
 def test_package_messages_name_owner_field_meaning_unit(make, words):
     with pytest.raises(InputError) as err:
         make()
@@ -256,17 +296,20 @@ def test_parse_assignments_values():
     assert parse_assignments("Position=0.1", "noise", keys={"position": "position_std"}) == {"position_std": 0.1}
 
 
-@pytest.mark.parametrize("items, kw, words", [
-    (["radius"], {}, "-m 'radius': expected KEY=VALUE"),
-    (("a=1", "a=2"), {}, "-m 'a=2': 'a' is given twice; give each key once"),
-    ("Position=0.1,position=0.2", {"keys": {"position": "position_std"}}, "'position_std' is given twice"),
-    (["=3"], {}, "-m '=3': expected KEY=VALUE"),
-    (["radius="], {}, "-m 'radius=': expected KEY=VALUE"),
-    ("jitter=1", {"keys": ["position", "rate"]}, "-m 'jitter=1': unknown key 'jitter'; keys: position, rate"),
-    ("postion=1", {"keys": ["position", "rate"]}, "unknown key 'postion' (did you mean 'position'?)"),
-    ("rate=fast", {"numbers": True}, "-m 'rate=fast': the value must be a number, got 'fast'"),
-    ("center=1,x", {"numbers": True}, "-m 'center=1,x': the value must be a number, got '1,x'"),
-])
+@pytest.mark.parametrize(
+    "items, kw, words",
+    [
+        (["radius"], {}, "-m 'radius': expected KEY=VALUE"),
+        (("a=1", "a=2"), {}, "-m 'a=2': 'a' is given twice; give each key once"),
+        ("Position=0.1,position=0.2", {"keys": {"position": "position_std"}}, "'position_std' is given twice"),
+        (["=3"], {}, "-m '=3': expected KEY=VALUE"),
+        (["radius="], {}, "-m 'radius=': expected KEY=VALUE"),
+        ("jitter=1", {"keys": ["position", "rate"]}, "-m 'jitter=1': unknown key 'jitter'; keys: position, rate"),
+        ("postion=1", {"keys": ["position", "rate"]}, "unknown key 'postion' (did you mean 'position'?)"),
+        ("rate=fast", {"numbers": True}, "-m 'rate=fast': the value must be a number, got 'fast'"),
+        ("center=1,x", {"numbers": True}, "-m 'center=1,x': the value must be a number, got '1,x'"),
+    ],
+)
 def test_parse_assignments_refuses_bad_items_in_one_line(items, kw, words):
     with pytest.raises(InputError) as err:
         parse_assignments(items, "-m", **kw)

@@ -18,10 +18,15 @@ PACKAGE = Path(quadcruise.__file__).parent
 
 #: bottom (0) to top: a module may import only from a lower rank or from its own subpackage
 RANKS = {
-    "quadcruise._version": 0, "quadcruise.errors": 0, "quadcruise.layout": 0, "quadcruise._cache": 0,
+    "quadcruise._version": 0,
+    "quadcruise.errors": 0,
+    "quadcruise.layout": 0,
+    "quadcruise._cache": 0,
     "quadcruise.protocols": 0,
     "quadcruise.numeric": 0,
-    "quadcruise.fields": 1, "quadcruise.checks": 1, "quadcruise.io": 1,
+    "quadcruise.fields": 1,
+    "quadcruise.checks": 1,
+    "quadcruise.io": 1,
     "quadcruise.model": 2,
     "quadcruise.metrics": 3,
     "quadcruise.plots": 4,
@@ -32,10 +37,12 @@ RANKS = {
     "quadcruise.workflows": 9,
     "quadcruise.sysid": 9,
     "quadcruise.montecarlo": 10,
-    "quadcruise.tune": 11, "quadcruise.gym": 11,
+    "quadcruise.tune": 11,
+    "quadcruise.gym": 11,
     "quadcruise.report": 12,
     "quadcruise.cli": 13,
-    "quadcruise": 14, "quadcruise.__main__": 14,
+    "quadcruise": 14,
+    "quadcruise.__main__": 14,
 }
 
 
@@ -113,7 +120,7 @@ def test_no_import_cycle():
         state[node] = "open"
         for nxt in sorted(graph[node]):
             if state.get(nxt) == "open":
-                cycles.append(" -> ".join(stack[stack.index(nxt):] + [nxt]))
+                cycles.append(" -> ".join(stack[stack.index(nxt) :] + [nxt]))
             elif nxt not in state:
                 visit(nxt, stack + [nxt])
         state[node] = "done"
@@ -125,14 +132,19 @@ def test_no_import_cycle():
 
 
 def test_no_private_name_crosses_modules():
-    crossing = [f"{MODULES[m].relative_to(PACKAGE)}:{line} imports {n} from {target}"
-                for m in MODULES for target, names, line in imports(m)
-                for n in names if n.startswith("_") and not n.startswith("__")]
+    crossing = [
+        f"{MODULES[m].relative_to(PACKAGE)}:{line} imports {n} from {target}"
+        for m in MODULES
+        for target, names, line in imports(m)
+        for n in names
+        if n.startswith("_") and not n.startswith("__")
+    ]
     assert not crossing, "\n".join(crossing)
 
 
-@pytest.mark.parametrize("low,high", [("quadcruise.sim.engine", "quadcruise.report"),
-                                      ("quadcruise.model.plant", "quadcruise.sim")])
+@pytest.mark.parametrize(
+    "low,high", [("quadcruise.sim.engine", "quadcruise.report"), ("quadcruise.model.plant", "quadcruise.sim")]
+)
 def test_the_check_sees_an_upward_import(low, high):
     """The rule itself: a low module importing a high one is upward (the check can fail)."""
     assert RANKS[group(high)] > RANKS[group(low)]

@@ -49,6 +49,7 @@ def design_loop():
 
 # --- step_info -------------------------------------------------------------------------
 
+
 def test_design_loop_agrees_with_python_control(design_loop):
     t, y = design_loop
     ours = step_info(t, y)
@@ -72,7 +73,7 @@ def test_design_loop_agrees_with_python_control(design_loop):
 
 def test_design_loop_agrees_with_closed_form(design_loop):
     t, y = design_loop
-    assert np.max(np.abs(y - design_loop_exact(t))) < 1e-9   # the simulation is exact
+    assert np.max(np.abs(y - design_loop_exact(t))) < 1e-9  # the simulation is exact
     ours = step_info(t, y, y_final=1.0)
 
     def cross(level, lo, hi):
@@ -80,7 +81,7 @@ def test_design_loop_agrees_with_closed_form(design_loop):
 
     t_peak = np.log(4.3 * 1.1944444444444444 / (0.7 * 0.19444444444444445)) / 3.6
     rise = cross(0.9, 0.0, t_peak) - cross(0.1, 0.0, t_peak)
-    settle2 = cross(1.02, t_peak, 20.0)      # last exit: falling through the upper edge
+    settle2 = cross(1.02, t_peak, 20.0)  # last exit: falling through the upper edge
     settle5 = cross(1.05, t_peak, 20.0)
     # Linear interpolation on a 1 ms grid is accurate far below a sample interval.
     assert ours.rise_time == pytest.approx(rise, abs=1e-6)
@@ -107,38 +108,37 @@ def test_downward_step_mirrors_upward():
     t = np.linspace(0.0, 15.0, 3001)
     up = second_order(t, 0.4, 2.0)
     a = step_info(t, up, y_final=1.0)
-    b = step_info(t, 5.0 - 2.0 * up, y_final=3.0)             # from 5 m down to 3 m
+    b = step_info(t, 5.0 - 2.0 * up, y_final=3.0)  # from 5 m down to 3 m
     assert (b.y_initial, b.y_final) == pytest.approx((5.0, 3.0))
-    for name in ("rise_time", "settling_time", "settling_time_5pct", "overshoot_pct",
-                 "undershoot_pct", "peak_time"):
+    for name in ("rise_time", "settling_time", "settling_time_5pct", "overshoot_pct", "undershoot_pct", "peak_time"):
         assert getattr(b, name) == pytest.approx(getattr(a, name), abs=1e-9), name
-    assert b.peak == pytest.approx(5.0 - 2.0 * a.peak)        # the lowest point
+    assert b.peak == pytest.approx(5.0 - 2.0 * a.peak)  # the lowest point
     assert b.peak < 3.0 and b.overshoot_pct > 20.0
 
 
 def test_delayed_step_from_nonzero_level():
     t = np.linspace(0.0, 20.0, 20001)
-    t_step = 2.5004                                            # between samples
+    t_step = 2.5004  # between samples
     y = 1.5 + np.where(t > t_step, -0.8 * second_order(np.maximum(t - t_step, 0.0), 0.5, 3.0), 0.0)
     delayed = step_info(t, y, y_final=0.7, t_step=t_step)
     t0 = np.linspace(0.0, 20.0 - t_step, 20001)
     plain = step_info(t0, second_order(t0, 0.5, 3.0), y_final=1.0)
-    assert delayed.y_initial == pytest.approx(1.5)            # interpolated at t_step
+    assert delayed.y_initial == pytest.approx(1.5)  # interpolated at t_step
     for name in ("rise_time", "settling_time", "settling_time_5pct", "overshoot_pct"):
         assert getattr(delayed, name) == pytest.approx(getattr(plain, name), abs=2e-6), name
-    assert delayed.peak_time == pytest.approx(plain.peak_time, abs=1e-3)   # from the step
+    assert delayed.peak_time == pytest.approx(plain.peak_time, abs=1e-3)  # from the step
     # Measured from t[0] instead, the same record is a different (wrong) step.
     assert step_info(t, y, y_final=0.7).settling_time > delayed.settling_time + 2.0
 
 
 def test_response_that_does_not_settle():
     t = np.linspace(0.0, 3.5, 3501)
-    info = step_info(t, 1.0 - np.exp(-t), y_final=1.0)      # 3 % short at the end
+    info = step_info(t, 1.0 - np.exp(-t), y_final=1.0)  # 3 % short at the end
     assert info.settling_time is None and not info.settled
     assert info.settling_time_5pct == pytest.approx(np.log(20.0), abs=1e-6)
     slow = step_info(t, 1.0 - np.exp(-t / 10.0), y_final=1.0)
     assert slow.rise_time is None and slow.settling_time_5pct is None
-    t_osc = np.linspace(0, 9.8, 981)                          # undamped, ends off the band
+    t_osc = np.linspace(0, 9.8, 981)  # undamped, ends off the band
     osc = step_info(t_osc, 1.0 - 0.5 * np.cos(t_osc), y_final=1.0)
     assert osc.settling_time is None and osc.settling_time_5pct is None
     assert osc.to_dict()["settling_time"] is None
@@ -146,7 +146,7 @@ def test_response_that_does_not_settle():
 
 def test_interpolation_coarse_vs_fine():
     fine_t = np.linspace(0.0, 20.0, 40001)
-    coarse_t = np.linspace(0.0, 20.0, 401)                     # dt = 50 ms
+    coarse_t = np.linspace(0.0, 20.0, 401)  # dt = 50 ms
     fine = step_info(fine_t, second_order(fine_t, 0.3, 3.0), y_final=1.0)
     coarse = step_info(coarse_t, second_order(coarse_t, 0.3, 3.0), y_final=1.0)
     # Snapping to samples would be off by up to dt = 0.05 s; interpolation by far less.
@@ -164,18 +164,21 @@ def test_stepinfo_is_frozen_and_dicts():
     assert d["rise_time"] == pytest.approx(0.8) and d["settled"] is True
 
 
-@pytest.mark.parametrize("t, y, kw, words", [
-    ([0.0, 1.0, 1.0], [0.0, 1.0, 2.0], {}, "strictly increasing"),
-    ([0.0, 2.0, 1.0], [0.0, 1.0, 2.0], {}, "strictly increasing"),
-    ([0.0, 1.0, 2.0], [0.0, 1.0], {}, "shape"),
-    ([0.0, 1.0, 2.0], [0.0, np.nan, 2.0], {}, "NaN"),
-    ([0.0, np.nan, 2.0], [0.0, 1.0, 2.0], {}, "NaN"),
-    ([0.0], [1.0], {}, "at least 2"),
-    ([0.0, 1.0, 2.0], [3.0, 3.0, 3.0], {}, "step size"),
-    ([0.0, 1.0, 2.0], [0.0, 1.0, 2.0], {"y_initial": 2.0}, "step size"),
-    ([0.0, 1.0, 2.0], [0.0, 1.0, 2.0], {"t_step": 2.0}, "t_step"),
-    ([0.0, 1.0, 2.0], [0.0, 1.0, 2.0], {"rise": (0.9, 0.1)}, "rise"),
-])
+@pytest.mark.parametrize(
+    "t, y, kw, words",
+    [
+        ([0.0, 1.0, 1.0], [0.0, 1.0, 2.0], {}, "strictly increasing"),
+        ([0.0, 2.0, 1.0], [0.0, 1.0, 2.0], {}, "strictly increasing"),
+        ([0.0, 1.0, 2.0], [0.0, 1.0], {}, "shape"),
+        ([0.0, 1.0, 2.0], [0.0, np.nan, 2.0], {}, "NaN"),
+        ([0.0, np.nan, 2.0], [0.0, 1.0, 2.0], {}, "NaN"),
+        ([0.0], [1.0], {}, "at least 2"),
+        ([0.0, 1.0, 2.0], [3.0, 3.0, 3.0], {}, "step size"),
+        ([0.0, 1.0, 2.0], [0.0, 1.0, 2.0], {"y_initial": 2.0}, "step size"),
+        ([0.0, 1.0, 2.0], [0.0, 1.0, 2.0], {"t_step": 2.0}, "t_step"),
+        ([0.0, 1.0, 2.0], [0.0, 1.0, 2.0], {"rise": (0.9, 0.1)}, "rise"),
+    ],
+)
 def test_step_info_bad_input(t, y, kw, words):
     with pytest.raises(InputError, match=words) as err:
         step_info(t, y, **kw)
@@ -185,9 +188,8 @@ def test_step_info_bad_input(t, y, kw, words):
 def test_step_info_batch_matches_loop_and_marks_nan():
     t = np.linspace(0.0, 6.0, 601)
     zetas = np.array([0.2, 0.5, 0.8, 1.2])
-    y = np.array([control.step_response(control.tf([4.0], [1, 4 * z, 4.0]), T=t).outputs
-                  for z in zetas])
-    y[-1] *= 0.9                                               # settles 10 % short of 1
+    y = np.array([control.step_response(control.tf([4.0], [1, 4 * z, 4.0]), T=t).outputs for z in zetas])
+    y[-1] *= 0.9  # settles 10 % short of 1
     out = step_info_batch(t, y, y_final=np.ones(4))
     for i in range(3):
         one = step_info(t, y[i], y_final=1.0).to_dict()
@@ -201,13 +203,21 @@ def test_step_info_batch_matches_loop_and_marks_nan():
 
 # --- transient_info --------------------------------------------------------------------
 
+
 def test_transient_with_constant_reference_is_the_step(design_loop):
     t, y = design_loop
     for act, ref in ((y, 1.0), (3.0 - 4.0 * y, -1.0)):
         step = step_info(t, act, y_final=ref)
         tr = transient_info(t, act, np.full_like(t, ref))
-        for name in ("rise_time", "settling_time", "settling_time_5pct", "overshoot_pct",
-                     "undershoot_pct", "peak_time", "settled"):
+        for name in (
+            "rise_time",
+            "settling_time",
+            "settling_time_5pct",
+            "overshoot_pct",
+            "undershoot_pct",
+            "peak_time",
+            "settled",
+        ):
             assert getattr(tr, name) == pytest.approx(getattr(step, name), abs=1e-9), name
         assert (tr.y_initial, tr.y_final) == (0.0, 1.0)
 
@@ -216,7 +226,7 @@ def test_transient_chasing_a_circle():
     t = np.linspace(0.0, 10.0, 10001)
     ref = np.c_[2.0 * np.cos(t), 2.0 * np.sin(t), np.full_like(t, 1.0)]
     act = ref - np.c_[2.0 * np.exp(-t), np.zeros_like(t), np.zeros_like(t)]
-    info = transient_info(t, act, ref)                    # starts 2 m away, error 2 e^-t
+    info = transient_info(t, act, ref)  # starts 2 m away, error 2 e^-t
     assert info.rise_time == pytest.approx(np.log(9.0), abs=1e-6)
     assert info.settling_time == pytest.approx(np.log(50.0), abs=1e-6)
     assert info.overshoot_pct == 0.0
@@ -233,14 +243,15 @@ def test_transient_without_initial_error_is_rejected():
 
 # --- tracking, effort, saturation --------------------------------------------------------
 
+
 def test_tracking_errors_on_nonuniform_grid():
     rng = np.random.default_rng(1)
     # Dense in the first second, sparse in the second one: a plain sample mean is biased.
     t = np.sort(np.r_[0.0, rng.uniform(0.0, 1.0, 3000), rng.uniform(1.0, 2.0, 300), 2.0])
-    out = tracking_errors(t, t + 0.5, np.full_like(t, 0.5))   # error e(t) = t
+    out = tracking_errors(t, t + 0.5, np.full_like(t, 0.5))  # error e(t) = t
     assert out["rmse"] == pytest.approx(np.sqrt(4.0 / 3.0), abs=1e-4)
     assert out["max_error"] == pytest.approx(2.0)
-    assert np.sqrt(np.mean(t**2)) < np.sqrt(4.0 / 3.0) - 0.3   # the bias we avoid
+    assert np.sqrt(np.mean(t**2)) < np.sqrt(4.0 / 3.0) - 0.3  # the bias we avoid
 
 
 def test_tracking_errors_euclidean_and_t_from():
@@ -251,7 +262,7 @@ def test_tracking_errors_euclidean_and_t_from():
     np.testing.assert_allclose(out["rmse_axes"], [3.0, 4.0, 0.0])
     e = np.array([10.0, 0.0, 0.0, 0.0])
     assert tracking_errors(t, e, 0.0, t_from=1.0)["max_error"] == 0.0
-    half = tracking_errors(t, e, 0.0, t_from=0.5)            # error 5 interpolated at 0.5 s
+    half = tracking_errors(t, e, 0.0, t_from=0.5)  # error 5 interpolated at 0.5 s
     assert half["max_error"] == pytest.approx(5.0)
     assert half["rmse"] == pytest.approx(np.sqrt(0.5 * 25.0 * 0.5 / 2.5))
     with pytest.raises(InputError, match="t_from"):
@@ -281,7 +292,7 @@ def test_batch_metrics_are_vectorised_and_match_single():
 
 def test_control_effort_closed_form():
     t = np.linspace(0.0, 2.0, 2001)
-    u = np.c_[np.full_like(t, 0.5), np.sin(np.pi * t)]       # 0.25 + sin^2: mean 0.75
+    u = np.c_[np.full_like(t, 0.5), np.sin(np.pi * t)]  # 0.25 + sin^2: mean 0.75
     out = control_effort(t, u)
     assert out["integral"] == pytest.approx(1.5, abs=1e-6)
     assert out["mean"] == pytest.approx(0.75, abs=1e-6)
@@ -291,7 +302,7 @@ def test_control_effort_closed_form():
 
 def test_time_in_saturation_sample_and_hold():
     t = np.array([0.0, 0.5, 2.0, 2.5, 4.0])
-    bits = np.array([0, 4, 4, 0, 8])                           # bit masks; the last holds 0 s
+    bits = np.array([0, 4, 4, 0, 8])  # bit masks; the last holds 0 s
     out = time_in_saturation(t, bits)
     assert out["seconds"] == pytest.approx(2.0) and out["fraction"] == pytest.approx(0.5)
     both = time_in_saturation(t, np.array([bits != 0, np.ones(5, bool)]))
@@ -307,6 +318,7 @@ def test_docstring_examples():
 
 # --- a whole flight: tracking after the transient, peak time, conventions, effort ------------
 
+
 def as_result(t, pos, ref, *, duties=None, status=None, meta=None):
     """A SimResult of N vehicles from positions and references (N, L, 3) [m]."""
     from quadcruise.layout import CMD_SIZE, CMD_U1, REF_SIZE, REF_X, STATE_SIZE, X
@@ -314,16 +326,25 @@ def as_result(t, pos, ref, *, duties=None, status=None, meta=None):
 
     n, length = pos.shape[:2]
     states = np.zeros((n, length, STATE_SIZE))
-    states[:, :, X:X + 3] = pos
+    states[:, :, X : X + 3] = pos
     refs = np.zeros((n, length, REF_SIZE))
-    refs[:, :, REF_X:REF_X + 3] = ref
+    refs[:, :, REF_X : REF_X + 3] = ref
     commands = np.zeros((n, length, CMD_SIZE))
-    commands[:, :, CMD_U1:CMD_U1 + 4] = 0.25 if duties is None else duties
+    commands[:, :, CMD_U1 : CMD_U1 + 4] = 0.25 if duties is None else duties
     status = np.zeros(n, dtype=np.int64) if status is None else np.asarray(status)
-    return SimResult(t=t, states=states, commands=commands, references=refs, final_state=states[:, -1],
-                     status=status, t_stop=np.full(n, t[-1]), memory=np.zeros((n, 0)),
-                     duty_clipped_s=np.zeros(n), controller_limited_s=np.zeros(n),
-                     meta={"vehicle": {"m": 1.0, "g": 10.0, "K": 10.0}} if meta is None else meta)
+    return SimResult(
+        t=t,
+        states=states,
+        commands=commands,
+        references=refs,
+        final_state=states[:, -1],
+        status=status,
+        t_stop=np.full(n, t[-1]),
+        memory=np.zeros((n, 0)),
+        duty_clipped_s=np.zeros(n),
+        controller_limited_s=np.zeros(n),
+        meta={"vehicle": {"m": 1.0, "g": 10.0, "K": 10.0}} if meta is None else meta,
+    )
 
 
 def step_mission(time=0.0, size=1.0):
@@ -344,18 +365,18 @@ def default_circle():
 def test_steady_tracking_of_the_default_circle(default_circle):
     res = default_circle
     row = res.metrics().iloc[0]
-    assert row["max_error_m"] == pytest.approx(2.0) and row["rmse_m"] > 0.4    # the start offset dominates
+    assert row["max_error_m"] == pytest.approx(2.0) and row["rmse_m"] > 0.4  # the start offset dominates
     # independently, written out sample by sample: the 3-D error's level over the last quarter,
     # the last exit above the 5 % line over it, the steady window the last half of the flight
     t, pos, ref = res.t, res.states[0, :, :3], res.references[0, :, :3]
     err = [float(np.sqrt(sum((pos[k, a] - ref[k, a]) ** 2 for a in range(3)))) for k in range(t.size)]
-    level = max(e for tk, e in zip(t, err) if tk >= 15.0)
+    level = max(e for tk, e in zip(t, err, strict=False) if tk >= 15.0)
     line = level + 0.05 * (err[0] - level)
     k = max(i for i, e in enumerate(err) if e > line)
     t_from = t[k] + (line - err[k]) / (err[k + 1] - err[k]) * (t[k + 1] - t[k])
     assert row["axis"] == "xyz" and row["settling_time_5pct_s"] == pytest.approx(t_from, abs=1e-9)
     tw = [tk for tk in t if tk >= 10.0]
-    ew = [e for tk, e in zip(t, err) if tk >= 10.0]
+    ew = [e for tk, e in zip(t, err, strict=False) if tk >= 10.0]
     area = sum(0.5 * (ew[i] ** 2 + ew[i + 1] ** 2) * (tw[i + 1] - tw[i]) for i in range(len(tw) - 1))
     assert row["steady_rmse_m"] == pytest.approx(np.sqrt(area / 10.0), rel=1e-9)
     assert row["steady_max_error_m"] == pytest.approx(max(ew), rel=1e-12)
@@ -370,9 +391,9 @@ def test_steady_metrics_are_undefined_when_the_transient_never_settles():
 
     t = np.linspace(0.0, 10.0, 1001)
     pos = np.zeros((3, t.size, 3))
-    pos[0, :, 0] = np.exp(-t)                           # settles
-    pos[1, :, 0] = 0.5 + 0.5 * np.exp(-t)               # halves and stays: never within 5 %
-    pos[2, :, 1] = 0.005 * np.sin(t)                    # no transient (below 1 cm): all steady
+    pos[0, :, 0] = np.exp(-t)  # settles
+    pos[1, :, 0] = 0.5 + 0.5 * np.exp(-t)  # halves and stays: never within 5 %
+    pos[2, :, 1] = 0.005 * np.sin(t)  # no transient (below 1 cm): all steady
     table = flight_metrics(as_result(t, pos, np.zeros_like(pos)))
     assert np.isnan(table["steady_rmse_m"][1]) and np.isnan(table["steady_max_error_m"][1])
     assert table["steady_rmse_m"][0] < 0.05 and table["steady_max_error_m"][0] == pytest.approx(0.05, rel=1e-9)
@@ -412,13 +433,13 @@ def test_rise_and_settling_conventions_against_python_control():
     res = as_result(t, pos, ref, meta={"mission": step_mission(0.0)})
     ours = flight_metrics(res, rise=(0.0, 1.0), settle_bands=(0.02, 0.03)).iloc[0]
     theirs = control.step_info(y, T=t, yfinal=1.0, RiseTimeLimits=(0.0, 1.0), SettlingTimeThreshold=0.03)
-    assert ours["rise_time_s"] == pytest.approx(theirs["RiseTime"], abs=1e-3)          # within a sample
+    assert ours["rise_time_s"] == pytest.approx(theirs["RiseTime"], abs=1e-3)  # within a sample
     assert ours["settling_time_3pct_s"] == pytest.approx(theirs["SettlingTime"], abs=1e-3)
     default = flight_metrics(res).iloc[0]
     theirs = control.step_info(y, T=t, yfinal=1.0, SettlingTimeThreshold=0.05)
     assert default["rise_time_s"] == pytest.approx(theirs["RiseTime"], abs=1e-3)
     assert default["settling_time_5pct_s"] == pytest.approx(theirs["SettlingTime"], abs=1e-3)
-    assert ours["rise_time_s"] > default["rise_time_s"] + 0.1                    # 0-100 % is longer
+    assert ours["rise_time_s"] > default["rise_time_s"] + 0.1  # 0-100 % is longer
     # the columns say which band they hold, and the table records its conventions
     table = flight_metrics(res, rise="0-100", settle_bands=(0.01, 0.03))
     assert "settling_time_3pct_s" in table.columns and "settling_time_5pct_s" not in table.columns
@@ -440,19 +461,23 @@ def test_effort_is_measured_about_hover():
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        hovers = {c: qc.fly("hover", c, duration=2.0, vehicle=qc.Vehicle(m=[2.5, 3.5, 4.5]))
-                  for c in ("nlpd", "gonzalez", "se3", "cascade")}
+        hovers = {
+            c: qc.fly("hover", c, duration=2.0, vehicle=qc.Vehicle(m=[2.5, 3.5, 4.5]))
+            for c in ("nlpd", "gonzalez", "se3", "cascade")
+        }
         circles = qc.compare("circle", duration=6.0, log_every=10).table()
     for name, res in hovers.items():
         effort = res.metrics()["effort"].to_numpy()
-        assert np.all(np.abs(effort) < 1e-9), name        # each vehicle about its own hover duty
+        assert np.all(np.abs(effort) < 1e-9), name  # each vehicle about its own hover duty
     # from zero duty, a hover of 2 s would read 4 (m g / 4 K)^2 2 s: about 0.04 s
     assert 4 * qc.Vehicle.paper().hover_duty ** 2 * 2.0 > 0.03
     # controllers that fly differently spend differently
     assert circles["effort"].nunique() == len(circles) and (circles["effort"] > 0).all()
     # a result that records no vehicle has no hover duty to measure about
     t = np.linspace(0.0, 1.0, 11)
-    assert np.isnan(metrics.flight_metrics(as_result(t, np.zeros((1, 11, 3)), np.zeros((1, 11, 3)), meta={}))["effort"][0])
+    assert np.isnan(
+        metrics.flight_metrics(as_result(t, np.zeros((1, 11, 3)), np.zeros((1, 11, 3)), meta={}))["effort"][0]
+    )
 
 
 def test_batch_agrees_with_flight_metrics_at_the_edges():
@@ -462,12 +487,12 @@ def test_batch_agrees_with_flight_metrics_at_the_edges():
     n = 5
     rng = np.random.default_rng(4)
     pos = np.zeros((n, t.size, 3))
-    pos[0, :, 0] = 2.0 * np.exp(-t) * np.cos(3 * t)                 # settles, with overshoot
-    pos[1, :, 1] = 0.4 + 1.6 * np.exp(-t)                             # never settles within 5 %
-    pos[2, :, 2] = 0.004 * np.sin(t)                                  # no transient
-    pos[3, :, 0] = 1.0 * np.exp(-t)                                   # stops early
+    pos[0, :, 0] = 2.0 * np.exp(-t) * np.cos(3 * t)  # settles, with overshoot
+    pos[1, :, 1] = 0.4 + 1.6 * np.exp(-t)  # never settles within 5 %
+    pos[2, :, 2] = 0.004 * np.sin(t)  # no transient
+    pos[3, :, 0] = 1.0 * np.exp(-t)  # stops early
     pos[3, 400:] = np.nan
-    pos[4, :, 0] = 1.5 * np.exp(-2 * t) + 0.01 * rng.normal(size=t.size)   # noisy, settles
+    pos[4, :, 0] = 1.5 * np.exp(-2 * t) + 0.01 * rng.normal(size=t.size)  # noisy, settles
     ref = np.zeros_like(pos)
     duties = 0.2 + 0.01 * rng.normal(size=(n, t.size, 4))
     meta = {"vehicle": {"m": [1.0, 1.2, 1.4, 1.6, 1.8], "g": 9.81, "K": 30.0}}
@@ -476,17 +501,34 @@ def test_batch_agrees_with_flight_metrics_at_the_edges():
         slow = flight_metrics(res, **kw)
         bands = kw.get("settle_bands", (0.02, 0.05))
         live = [0, 1, 2, 4]
-        fast = flight_metrics_batch(t, pos[live], ref[live], duties[live], bands=bands,
-                                    rise=kw.get("rise", (0.1, 0.9)), transient_until=kw.get("transient_until"),
-                                    hover_duty=hover_duties(meta, n)[live])
+        fast = flight_metrics_batch(
+            t,
+            pos[live],
+            ref[live],
+            duties[live],
+            bands=bands,
+            rise=kw.get("rise", (0.1, 0.9)),
+            transient_until=kw.get("transient_until"),
+            hover_duty=hover_duties(meta, n)[live],
+        )
         columns = [c for c in slow.columns if c.startswith("settling")]
-        for key in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "rise_time_s",
-                    "overshoot_pct", "peak_time_s", "effort", *columns):
+        for key in (
+            "rmse_m",
+            "max_error_m",
+            "steady_rmse_m",
+            "steady_max_error_m",
+            "rise_time_s",
+            "overshoot_pct",
+            "peak_time_s",
+            "effort",
+            *columns,
+        ):
             got = fast["settling_s"][columns.index(key)] if key in columns else fast[key]
-            np.testing.assert_allclose(got, slow[key].to_numpy(dtype=float)[live], rtol=1e-12, atol=1e-15,
-                                       err_msg=f"{kw} {key}")
+            np.testing.assert_allclose(
+                got, slow[key].to_numpy(dtype=float)[live], rtol=1e-12, atol=1e-15, err_msg=f"{kw} {key}"
+            )
         assert np.isnan(fast["steady_rmse_m"][1]) and fast["transient_axis"][2] == -1
-        assert slow[["steady_rmse_m", "peak_time_s", "effort"]].iloc[3].isna().all()   # stopped early
+        assert slow[["steady_rmse_m", "peak_time_s", "effort"]].iloc[3].isna().all()  # stopped early
 
 
 def test_window_errors_batch_matches_tracking_errors():

@@ -37,12 +37,15 @@ def central(mission, t, cols, h=1e-4):
 
 
 # --- circle -------------------------------------------------------------------------------
-@pytest.mark.parametrize("mission", [
-    Circle(),
-    Circle(radius=1.5, period=7.0, direction=-1, start_angle=0.7, center=(1.0, -2.0)),
-    Circle(ramp_time=5.0),
-    Circle(radius=3.0, period=12.0, ramp_time=2.5, direction=-1),
-])
+@pytest.mark.parametrize(
+    "mission",
+    [
+        Circle(),
+        Circle(radius=1.5, period=7.0, direction=-1, start_angle=0.7, center=(1.0, -2.0)),
+        Circle(ramp_time=5.0),
+        Circle(radius=3.0, period=12.0, ramp_time=2.5, direction=-1),
+    ],
+)
 def test_circle_derivatives(mission):
     t = np.linspace(0.01, 40.0, 997)
     ref = mission.reference(t)
@@ -60,8 +63,8 @@ def test_circle_radius_period_speed_and_start():
     np.testing.assert_allclose(c.reference(t + 16.0), ref, atol=1e-11)
     np.testing.assert_allclose(np.hypot(ref[:, REF_VX], ref[:, REF_VY]), 2 * math.pi * 2.5 / 16.0)
     np.testing.assert_allclose(np.hypot(ref[:, REF_AX], ref[:, REF_AY]), 2.5 * (2 * math.pi / 16.0) ** 2)
-    np.testing.assert_allclose(ref[0, :2], [3.0, -1.0])           # starts at centre + (R, 0)
-    quarter = c.reference(4.0)[0]                                 # counter-clockwise
+    np.testing.assert_allclose(ref[0, :2], [3.0, -1.0])  # starts at centre + (R, 0)
+    quarter = c.reference(4.0)[0]  # counter-clockwise
     np.testing.assert_allclose(quarter[:2], [0.5, 1.5], atol=1e-12)
     assert Circle().speed == pytest.approx(0.6283, abs=1e-4)
 
@@ -92,23 +95,25 @@ def test_square_corners_at_the_right_times():
     s = Square(side=4.0, speed=0.5, altitude=1.2)
     assert s.lap_time == 32.0
     corners = s.reference([0.0, 8.0, 16.0, 24.0, 32.0, 40.0, 64.0])
-    np.testing.assert_allclose(corners[:, :3], [[0, 0, 1.2], [4, 0, 1.2], [4, 4, 1.2],
-                                                [0, 4, 1.2], [0, 0, 1.2], [4, 0, 1.2],
-                                                [0, 0, 1.2]], atol=1e-12)
+    np.testing.assert_allclose(
+        corners[:, :3],
+        [[0, 0, 1.2], [4, 0, 1.2], [4, 4, 1.2], [0, 4, 1.2], [0, 0, 1.2], [4, 0, 1.2], [0, 0, 1.2]],
+        atol=1e-12,
+    )
 
 
 def test_square_legs_constant_speed_and_derivatives():
     s = Square(side=3.0, speed=0.75, corner=(-1.0, 2.0), direction=-1)
     leg = 3.0 / 0.75
     t = np.linspace(0.0, 3 * s.lap_time, 3001)
-    t = t[np.abs(t / leg - np.round(t / leg)) > 1e-3]             # off the corners
+    t = t[np.abs(t / leg - np.round(t / leg)) > 1e-3]  # off the corners
     ref = s.reference(t)
     np.testing.assert_allclose(np.hypot(ref[:, REF_VX], ref[:, REF_VY]), 0.75)
     np.testing.assert_allclose(ref[:, ACC + [REF_VZ, REF_PSI_DOT]], 0.0)
     np.testing.assert_allclose(central(s, t, POS, h=1e-5), ref[:, VEL], atol=1e-8)
-    x, y = ref[:, REF_X], ref[:, REF_Y]                          # stays on the square's edges
+    x, y = ref[:, REF_X], ref[:, REF_Y]  # stays on the square's edges
     assert x.min() >= -1.0 - 1e-12 and x.max() <= 2.0 + 1e-12
-    assert y.min() >= -1.0 - 1e-12 and y.max() <= 2.0 + 1e-12    # clockwise: y goes down first
+    assert y.min() >= -1.0 - 1e-12 and y.max() <= 2.0 + 1e-12  # clockwise: y goes down first
     on_edge = np.minimum.reduce([np.abs(x + 1), np.abs(x - 2), np.abs(y - 2), np.abs(y + 1)])
     assert on_edge.max() < 1e-9
     np.testing.assert_allclose(s.reference(leg + 1.0)[0, [REF_VX, REF_VY]], [0.0, -0.75])
@@ -163,8 +168,7 @@ def _call_batch(fn, mps, refs):
         fn(3.0, mps[i], refs[i])
 
 
-@pytest.mark.parametrize("mission", [Hover(z=2.0), Step(time=0.5), Circle(radius=1.2),
-                                     Square(dwell=0.2)])
+@pytest.mark.parametrize("mission", [Hover(z=2.0), Step(time=0.5), Circle(radius=1.2), Square(dwell=0.2)])
 def test_called_from_compiled_code(mission):
     ref = np.full(REF_SIZE, np.nan)
     _call_at_one(mission.function, mission.params(), ref)
@@ -177,19 +181,21 @@ def test_per_vehicle_rows():
     assert mps.shape == (3, 8) and mps.flags.c_contiguous
     refs = np.empty((3, REF_SIZE))
     _call_batch(Circle.function, mps, refs)
-    for m, row in zip(missions, refs):
+    for m, row in zip(missions, refs, strict=False):
         np.testing.assert_array_equal(row, m.reference(3.0)[0])
     assert stack_params(Square(), n=4).shape == (4, 8)
 
 
 def test_cache_hits_in_a_new_process():
     """The references compile on first use, not at import, and then load from the cache."""
-    code = ("import quadcruise.missions as m; "
-            "fs = (m.hover_ref, m.step_ref, m.circle_ref, m.square_ref); "
-            "lazy = all(not f.signatures for f in fs); "
-            "[M().reference(1.0) for M in (m.Hover, m.Step, m.Circle, m.Square)]; "
-            "print(lazy and all(sum(f.stats.cache_hits.values()) > 0 and not f.stats.cache_misses "
-            "for f in fs))")
+    code = (
+        "import quadcruise.missions as m; "
+        "fs = (m.hover_ref, m.step_ref, m.circle_ref, m.square_ref); "
+        "lazy = all(not f.signatures for f in fs); "
+        "[M().reference(1.0) for M in (m.Hover, m.Step, m.Circle, m.Square)]; "
+        "print(lazy and all(sum(f.stats.cache_hits.values()) > 0 and not f.stats.cache_misses "
+        "for f in fs))"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "True"
 
@@ -208,15 +214,29 @@ def test_params_layout_and_dict_round_trip():
     assert Circle().replace(radius=5.0).radius == 5.0
 
 
-@pytest.mark.parametrize("cls,field,value", [
-    (Circle, "radius", 0.0), (Circle, "radius", -1.0), (Circle, "period", 0.0),
-    (Circle, "altitude", float("nan")), (Circle, "ramp_time", -1.0), (Circle, "direction", 2),
-    (Circle, "center", (1.0,)), (Circle, "center", (0.0, float("inf"))), (Circle, "yaw", "0"),
-    (Square, "side", -4.0), (Square, "speed", 0.0), (Square, "dwell", -0.1),
-    (Square, "corner", "ab"), (Square, "altitude", True),
-    (Step, "axis", "w"), (Step, "time", -1.0), (Step, "size", float("nan")),
-    (Hover, "z", float("inf")),
-])
+@pytest.mark.parametrize(
+    "cls,field,value",
+    [
+        (Circle, "radius", 0.0),
+        (Circle, "radius", -1.0),
+        (Circle, "period", 0.0),
+        (Circle, "altitude", float("nan")),
+        (Circle, "ramp_time", -1.0),
+        (Circle, "direction", 2),
+        (Circle, "center", (1.0,)),
+        (Circle, "center", (0.0, float("inf"))),
+        (Circle, "yaw", "0"),
+        (Square, "side", -4.0),
+        (Square, "speed", 0.0),
+        (Square, "dwell", -0.1),
+        (Square, "corner", "ab"),
+        (Square, "altitude", True),
+        (Step, "axis", "w"),
+        (Step, "time", -1.0),
+        (Step, "size", float("nan")),
+        (Hover, "z", float("inf")),
+    ],
+)
 def test_bad_input_names_the_field(cls, field, value):
     with pytest.raises(InputError, match=f"'{field}'") as err:
         cls(**{field: value})

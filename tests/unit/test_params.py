@@ -12,9 +12,20 @@ def test_paper_preset_is_table_one():
     assert (v.m, v.Jxx, v.Jyy, v.Jzz, v.l, v.K, v.omega) == (3.499, 0.03, 0.03, 0.04, 0.2, 120.0, 15.0)
     assert v.d == pytest.approx(4 / 120)
     assert v.hover_duty == pytest.approx(3.499 * 9.81 / 480)
-    assert set(Vehicle.units()) == {"m", "Jxx", "Jyy", "Jzz", "l", "K", "omega", "d", "g",
-                                    "drag_linear", "drag_quadratic"}
-    assert v.drag_linear == 0.0 and v.drag_quadratic == 0.0   # the paper's model has no drag
+    assert set(Vehicle.units()) == {
+        "m",
+        "Jxx",
+        "Jyy",
+        "Jzz",
+        "l",
+        "K",
+        "omega",
+        "d",
+        "g",
+        "drag_linear",
+        "drag_quadratic",
+    }
+    assert v.drag_linear == 0.0 and v.drag_quadratic == 0.0  # the paper's model has no drag
 
 
 def test_rows_carry_k_coefficients_of_section_three():
@@ -33,13 +44,16 @@ def test_frozen():
         Vehicle().m = 2.0
 
 
-@pytest.mark.parametrize("field, value, words", [
-    ("m", 0.0, "'m' (mass, kg) must be > 0"),
-    ("Jxx", -0.01, "'Jxx'"),
-    ("K", math.nan, "'K' (thrust per unit PWM duty"),
-    ("omega", math.inf, "must be finite"),
-    ("g", -1.0, "'g'"),
-])
+@pytest.mark.parametrize(
+    "field, value, words",
+    [
+        ("m", 0.0, "'m' (mass, kg) must be > 0"),
+        ("Jxx", -0.01, "'Jxx'"),
+        ("K", math.nan, "'K' (thrust per unit PWM duty"),
+        ("omega", math.inf, "must be finite"),
+        ("g", -1.0, "'g'"),
+    ],
+)
 def test_bad_values_name_the_field(field, value, words):
     with pytest.raises(InputError, match=words.replace("(", r"\(").replace(")", r"\)")):
         Vehicle.paper().replace(**{field: value})
@@ -62,7 +76,7 @@ def test_batch_axis():
         v.rows(3)
     assert Vehicle().rows(4).shape == (4, PARAM_SIZE)
     with pytest.raises(ValueError):
-        v.m[0] = 1.0   # stored arrays are read-only
+        v.m[0] = 1.0  # stored arrays are read-only
 
 
 def test_stack():

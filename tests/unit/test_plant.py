@@ -66,7 +66,7 @@ def test_gyroscopic_terms_are_eulers_equations():
     assert dx[Q] == pytest.approx(vp[P_K3] * 1.0 * 3.0)
     assert dx[R] == pytest.approx(vp[P_K5] * 1.0 * -2.0)
     J = np.array([0.02, 0.03, 0.05])
-    assert np.dot(J * x[P:R + 1], dx[P:R + 1]) == pytest.approx(0.0, abs=1e-15)
+    assert np.dot(J * x[P : R + 1], dx[P : R + 1]) == pytest.approx(0.0, abs=1e-15)
 
 
 def test_mixer_round_trip():

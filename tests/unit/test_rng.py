@@ -9,7 +9,7 @@ from scipy import stats
 from quadcruise.sim.rng import ZIGGURAT_R, ZIGGURAT_V, gauss, next_normal, vehicle_states, ziggurat_tables
 
 
-@njit   # not cached: numba would not see a change in quadcruise.sim.rng
+@njit  # not cached: numba would not see a change in quadcruise.sim.rng
 def _draws(n, s):
     out = np.empty(n)
     for k in range(n):
@@ -19,9 +19,9 @@ def _draws(n, s):
 
 def test_ziggurat_layers_have_equal_area_and_cover_the_density():
     ki, wi, fi = ziggurat_tables()
-    x = wi * 2.0 ** 52                                    # layer edges x_i (x_0: the base's pseudo-width)
+    x = wi * 2.0**52  # layer edges x_i (x_0: the base's pseudo-width)
     assert math.isclose(x[255], ZIGGURAT_R) and fi[0] == 1.0
-    assert np.all(np.diff(x[1:]) > 0) and np.all(np.diff(fi[1:]) < 0)     # narrower going up
+    assert np.all(np.diff(x[1:]) > 0) and np.all(np.diff(fi[1:]) < 0)  # narrower going up
     # every layer i >= 1 is the rectangle [0, x_i] x [f(x_i), f(x_{i-1})] of area V
     areas = x[1:] * (fi[:-1] - fi[1:])
     areas[0] = x[1] * (fi[0] - fi[1])
@@ -31,7 +31,7 @@ def test_ziggurat_layers_have_equal_area_and_cover_the_density():
     # base: rectangle r f(r) plus the tail's mass, also V
     tail = math.sqrt(math.pi / 2.0) * math.erfc(ZIGGURAT_R / math.sqrt(2.0))
     assert math.isclose(ZIGGURAT_R * fi[255] + tail, ZIGGURAT_V, rel_tol=1e-9)
-    assert ki[1] == 0 and np.all(ki[2:] < 2 ** 52)
+    assert ki[1] == 0 and np.all(ki[2:] < 2**52)
 
 
 def test_normal_draws_follow_the_standard_normal_law():
@@ -54,5 +54,5 @@ def test_gauss_advances_the_array_state_like_next_normal():
     s = np.uint64(state[0])
     for _ in range(100):
         want, s = next_normal(s)
-        s = np.uint64(s)                 # back from Python: keep the state unsigned
+        s = np.uint64(s)  # back from Python: keep the state unsigned
         assert gauss(state) == want and state[0] == s

@@ -27,7 +27,7 @@ def test_a_vehicle_at_rest_stays_on_the_ground_and_falls_through_without_one():
     assert held.ok[0] and held.final_state[0, 2] == 0.0 and held.final_state[0, 5] == 0.0
     np.testing.assert_array_equal(held.final_state[0, 6:10], [1, 0, 0, 0])
     falling = replay_rotors(idle, CF)
-    assert falling.final_state[0, 2] < -3.0                       # 36 % of g for 2 s
+    assert falling.final_state[0, 2] < -3.0  # 36 % of g for 2 s
 
 
 def test_a_takeoff_flies_as_in_free_flight():
@@ -40,10 +40,10 @@ def test_a_takeoff_flies_as_in_free_flight():
 
 def test_a_gentle_landing_is_set_down_level():
     h = CF.hover_speed
-    rows = [(0.0, [1.05 * h] * 4), (0.3, [0.98 * h] * 4), (4.0, [0.98 * h] * 4)]    # down at 0.38 m/s at 2.3 s
+    rows = [(0.0, [1.05 * h] * 4), (0.3, [0.98 * h] * 4), (4.0, [0.98 * h] * 4)]  # down at 0.38 m/s at 2.3 s
     res = replay_rotors(schedule(rows), CF, ground=True)
     free = replay_rotors(schedule(rows), CF)
-    assert free.final_state[0, 2] < -0.2                           # without the ground it would sink through
+    assert free.final_state[0, 2] < -0.2  # without the ground it would sink through
     assert res.ok[0], res.status_text(0)
     assert res.final_state[0, 2] == 0.0
     assert np.abs(res.final_state[0, 3:6]).max() == 0.0
@@ -55,9 +55,13 @@ def test_a_hard_landing_crashes_where_free_flight_meets_the_ground():
     res = replay_rotors(schedule(rows), CF, ground=True, max_step=1e-4)
     assert ExitStatus(int(res.status[0])) is ExitStatus.CRASHED
     assert res.status_text(0).startswith("crashed: hit the ground faster than the vehicle's touchdown speed")
-    free = replay_rotors(SpeedSchedule(t=np.linspace(0.0, 3.0, 30001),
-                                       speeds=np.where(np.linspace(0.0, 3.0, 30001)[:, None] < 0.5, 1.3 * h, 0.0)
-                                       * np.ones((1, 4))), CF)
+    free = replay_rotors(
+        SpeedSchedule(
+            t=np.linspace(0.0, 3.0, 30001),
+            speeds=np.where(np.linspace(0.0, 3.0, 30001)[:, None] < 0.5, 1.3 * h, 0.0) * np.ones((1, 4)),
+        ),
+        CF,
+    )
     z = free.states[0, :, 2]
     crossing = free.t[np.flatnonzero((z[:-1] >= 0) & (z[1:] < 0))[0] + 1]
     assert res.t_stop[0] == pytest.approx(crossing, abs=1.5e-4)
@@ -68,9 +72,10 @@ def test_a_hard_landing_crashes_where_free_flight_meets_the_ground():
 
 def test_upside_down_on_the_ground_is_a_crash():
     x0 = np.zeros(ROTOR_W1 + 4)
-    x0[7] = 1.0                                                    # 180 degrees about x: upside down
-    res = replay_rotor_speeds([0.0, 1.0], np.zeros((2, 4)), x0, CF.row(), max_step=1e-4, touchdown_speed=1.0,
-                              names=state_names(4))
+    x0[7] = 1.0  # 180 degrees about x: upside down
+    res = replay_rotor_speeds(
+        [0.0, 1.0], np.zeros((2, 4)), x0, CF.row(), max_step=1e-4, touchdown_speed=1.0, names=state_names(4)
+    )
     assert ExitStatus(int(res.status[0])) is ExitStatus.CRASHED and res.t_stop[0] == pytest.approx(1e-4)
 
 
@@ -83,13 +88,22 @@ def test_an_iris_losing_sixty_percent_of_a_rotor_crashes():
     w = np.full((2, n), 1.2 * IRIS.hover_speed)
     x0[ROTOR_W1:] = w[0]
     ext = np.r_[np.zeros(9), [0.4, 1.0, 1.0, 1.0]]
-    res = replay_rotor_speeds([0.0, 10.0], w, x0, IRIS.row(), ext=ext, max_step=1e-4,
-                              touchdown_speed=IRIS.touchdown_speed, names=state_names(n))
+    res = replay_rotor_speeds(
+        [0.0, 10.0],
+        w,
+        x0,
+        IRIS.row(),
+        ext=ext,
+        max_step=1e-4,
+        touchdown_speed=IRIS.touchdown_speed,
+        names=state_names(n),
+    )
     assert ExitStatus(int(res.status[0])) is ExitStatus.CRASHED, res.status_text(0)
     assert res.t_stop[0] < 10.0
-    healthy = replay_rotor_speeds([0.0, 10.0], w, x0, IRIS.row(), max_step=1e-4,
-                                  touchdown_speed=IRIS.touchdown_speed, names=state_names(n))
-    assert healthy.ok[0] and healthy.final_state[0, 2] > 10.0     # the healthy one climbs away
+    healthy = replay_rotor_speeds(
+        [0.0, 10.0], w, x0, IRIS.row(), max_step=1e-4, touchdown_speed=IRIS.touchdown_speed, names=state_names(n)
+    )
+    assert healthy.ok[0] and healthy.final_state[0, 2] > 10.0  # the healthy one climbs away
 
 
 def test_a_touchdown_speed_must_be_positive():
@@ -98,5 +112,6 @@ def test_a_touchdown_speed_must_be_positive():
     with pytest.raises(InputError, match="touchdown_speed"):
         CF.replace(touchdown_speed=0.0)
     with pytest.raises(InputError, match="touchdown speed must be > 0"):
-        replay_rotor_speeds([0.0, 1.0], np.zeros((2, 4)), np.r_[0, 0, 0, 0, 0, 0, 1, np.zeros(10)], CF.row(),
-                            touchdown_speed=-1.0)
+        replay_rotor_speeds(
+            [0.0, 1.0], np.zeros((2, 4)), np.r_[0, 0, 0, 0, 0, 0, 1, np.zeros(10)], CF.row(), touchdown_speed=-1.0
+        )

@@ -17,9 +17,13 @@ CF = RotorVehicle.preset("crazyflie")
 def rotation(q):
     """Body-to-world rotation matrices of unit quaternions (L, 4), scalar first."""
     w, x, y, z = q.T
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]).transpose(2, 0, 1)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    ).transpose(2, 0, 1)
 
 
 def fly(vehicle, t, speeds, rates=(0.0, 0.0, 0.0), w0=None):
@@ -49,10 +53,10 @@ def test_a_free_tumble_keeps_energy_and_angular_momentum_and_falls_freely():
     states = fly(v, t, np.zeros((51, 4)), rates=(0.05, 20.0, 0.05))
     energy = 0.5 * np.sum(J * states[:, 10:13] ** 2, axis=1)
     L = momentum(states, J)
-    assert np.abs(states[:, 11]).min() < 5.0                     # it tumbled: the y rate went through 0
+    assert np.abs(states[:, 11]).min() < 5.0  # it tumbled: the y rate went through 0
     assert np.abs(energy / energy[0] - 1).max() < 1e-9
     assert np.abs(L - L[0]).max() < 1e-9 * np.linalg.norm(L[0])
-    np.testing.assert_allclose(states[:, 2], -0.5 * v.g * t ** 2, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(states[:, 2], -0.5 * v.g * t**2, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(np.linalg.norm(states[:, 6:10], axis=1), 1.0, atol=1e-14)
 
 
@@ -65,8 +69,8 @@ def test_rotor_inertia_exchanges_momentum_with_the_body_and_the_sum_is_kept():
     signs = np.array([r[3] for r in v.rotors])
     t = np.array([0.0, 0.3, 0.6, 1.0, 1.5])
     a, b = [2000.0, 800.0, 2400.0, 1500.0, 1500.0], [900.0, 2300.0, 1000.0, 1500.0, 1500.0]
-    speeds = np.column_stack([a, b, a, b])          # rotors 1, 3 (s = +1) and 2, 4 (s = -1): thrusts cancel in pairs
-    fine = np.linspace(0.0, 1.5, 151)                 # holds t's rows among its instants
+    speeds = np.column_stack([a, b, a, b])  # rotors 1, 3 (s = +1) and 2, 4 (s = -1): thrusts cancel in pairs
+    fine = np.linspace(0.0, 1.5, 151)  # holds t's rows among its instants
     fine_speeds = speeds[np.searchsorted(t, fine, side="right") - 1]
     states = fly(v, fine, fine_speeds, rates=(3.0, -2.0, 1.0))
     L = momentum(states, J, v.J_rotor, signs)
@@ -87,7 +91,7 @@ def test_gyroscopic_torque_does_no_work():
     energy = 0.5 * np.sum(J * states[:, 10:13] ** 2, axis=1)
     assert np.abs(energy / energy[0] - 1).max() < 1e-9
     still = fly(v.replace(J_rotor=0.0), t, speeds, rates=(4.0, -3.0, 0.5))
-    assert np.abs(still[:, 10:13] - states[:, 10:13]).max() > 0.1      # the rotors' momentum mattered
+    assert np.abs(still[:, 10:13] - states[:, 10:13]).max() > 0.1  # the rotors' momentum mattered
 
 
 def test_motors_follow_first_order_lags_up_and_down():
@@ -128,8 +132,7 @@ def test_a_flip_through_180_degrees_flies_on(axis):
     q = states[:, 6:10]
     R = rotation(q)
     np.testing.assert_allclose(np.linalg.norm(q, axis=1), 1.0, atol=1e-14)
-    assert R[:, 2, 2].min() < -0.99                               # upside down
-    assert R[-1, 2, 2] > 0.99                                     # and round again
+    assert R[:, 2, 2].min() < -0.99  # upside down
+    assert R[-1, 2, 2] > 0.99  # and round again
     turned = np.abs(states[:, 10 if axis == "roll" else 11]).max()
     assert turned > 30.0
-

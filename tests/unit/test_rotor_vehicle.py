@@ -29,7 +29,7 @@ def test_each_rotor_preset_hovers_within_its_speed_range_and_cites_its_source(na
     assert v.source and preset_source(name) == v.source
     assert v.w_min < v.hover_speed < v.w_max
     # the hover speed carries the weight: n kf w^2 = m g
-    assert v.n_rotors * v.kf * v.hover_speed ** 2 == pytest.approx(v.m * v.g, rel=1e-12)
+    assert v.n_rotors * v.kf * v.hover_speed**2 == pytest.approx(v.m * v.g, rel=1e-12)
     # each preset is an "x" quad whose drag moments cancel in hover
     assert sum(r[3] for r in v.rotors) == 0
 
@@ -42,8 +42,14 @@ def test_rotorpy_numbers_and_rotor_order():
     for name, params in (("crazyflie", rotorpy_params.quad_params), ("hummingbird", hb.quad_params)):
         v = RotorVehicle.preset(name)
         assert (v.m, v.Jxx, v.Jyy, v.Jzz) == (params["mass"], params["Ixx"], params["Iyy"], params["Izz"])
-        assert (v.kf, v.km, v.k_d, v.k_z, v.k_h, v.k_flap) == (params["k_eta"], params["k_m"], params["k_d"],
-                                                               params["k_z"], params["k_h"], params["k_flap"])
+        assert (v.kf, v.km, v.k_d, v.k_z, v.k_h, v.k_flap) == (
+            params["k_eta"],
+            params["k_m"],
+            params["k_d"],
+            params["k_z"],
+            params["k_h"],
+            params["k_flap"],
+        )
         assert (v.c_Dx, v.c_Dy, v.c_Dz) == (params["c_Dx"], params["c_Dy"], params["c_Dz"])
         assert v.tau_up == v.tau_down == params["tau_m"]
         assert (v.w_min, v.w_max) == (params["rotor_speed_min"], params["rotor_speed_max"])
@@ -62,21 +68,28 @@ def test_row_layout():
 CF = RotorVehicle.preset("crazyflie")
 
 
-@pytest.mark.parametrize(("changes", "message"), [
-    ({"w_max": 1000.0}, "vehicle cannot lift itself: 4 rotors x kf w_max^2 = 0.092 N, its weight m g = 0.2943 N"),
-    ({"m": 1.0}, "cannot lift itself"),
-    ({"tau_up": -0.01}, "vehicle field 'tau_up' (motor time constant speeding up, s) must be > 0, got -0.01"),
-    ({"tau_down": 0.0}, "'tau_down'"),
-    ({"w_min": 3000.0}, "'w_max' (2500 rad/s) must be above 'w_min' (3000 rad/s)"),
-    ({"rotors": [[0.05, 0.05, 0, 1], [0.05, -0.05, 0, -1], [0.02, 0.0, 0, 1], [0.03, 0.01, 0, -1]]},
-     "the rotors do not surround the centre of mass"),
-    ({"rotors": [[0.05, 0.0, 0, 1], [-0.05, 0.0, 0, -1], [0.1, 0.0, 0, 1]]},    # all on one line
-     "the rotors do not surround the centre of mass"),
-    ({"rotors": [[0.05, 0.05, 0, 2], [0.05, -0.05, 0, -1], [-0.05, 0.0, 0, 1]]}, "direction 2 for rotor 1"),
-    ({"rotors": [[0.05, 0.05, 0, 1], [0.05, -0.05, 0, -1]]}, "at least 3 rows"),
-    ({"k_d": -1e-7}, "'k_d' (rotor drag coefficient"),
-    ({"m": math.nan}, "'m' (mass, kg)"),
-])
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"w_max": 1000.0}, "vehicle cannot lift itself: 4 rotors x kf w_max^2 = 0.092 N, its weight m g = 0.2943 N"),
+        ({"m": 1.0}, "cannot lift itself"),
+        ({"tau_up": -0.01}, "vehicle field 'tau_up' (motor time constant speeding up, s) must be > 0, got -0.01"),
+        ({"tau_down": 0.0}, "'tau_down'"),
+        ({"w_min": 3000.0}, "'w_max' (2500 rad/s) must be above 'w_min' (3000 rad/s)"),
+        (
+            {"rotors": [[0.05, 0.05, 0, 1], [0.05, -0.05, 0, -1], [0.02, 0.0, 0, 1], [0.03, 0.01, 0, -1]]},
+            "the rotors do not surround the centre of mass",
+        ),
+        (
+            {"rotors": [[0.05, 0.0, 0, 1], [-0.05, 0.0, 0, -1], [0.1, 0.0, 0, 1]]},  # all on one line
+            "the rotors do not surround the centre of mass",
+        ),
+        ({"rotors": [[0.05, 0.05, 0, 2], [0.05, -0.05, 0, -1], [-0.05, 0.0, 0, 1]]}, "direction 2 for rotor 1"),
+        ({"rotors": [[0.05, 0.05, 0, 1], [0.05, -0.05, 0, -1]]}, "at least 3 rows"),
+        ({"k_d": -1e-7}, "'k_d' (rotor drag coefficient"),
+        ({"m": math.nan}, "'m' (mass, kg)"),
+    ],
+)
 def test_a_vehicle_that_cannot_fly_is_refused_in_one_line(changes, message):
     with pytest.raises(InputError) as info:
         CF.replace(**changes)
@@ -107,14 +120,16 @@ def test_unknown_presets_and_bad_files(tmp_path):
     assert (v.Jxx, v.k_d, v.m) == (0.03, 0.0, RotorVehicle.preset("iris").m)
     assert Vehicle.load(str(f)) == v
     for text, message in [
-        ('[vehicle]\npreset = "iris"\ntau_upp = 1.0\n',
-         "mine.toml: [vehicle] has no key 'tau_upp' for the rotor plant (did you mean 'tau_up'?)"),
+        (
+            '[vehicle]\npreset = "iris"\ntau_upp = 1.0\n',
+            "mine.toml: [vehicle] has no key 'tau_upp' for the rotor plant (did you mean 'tau_up'?)",
+        ),
         ('[vehicle]\npreset = "iris"\ntau_down = -1\n', "mine.toml: [vehicle] vehicle field 'tau_down'"),
         ('[vehicle]\npreset = "nope"\n', "unknown vehicle preset 'nope'"),
         ('[vehicle]\npreset = "paper"\nrotors = []\n', "has no key 'rotors' for the paper plant"),
         ('[vehicle]\npreset = "iris"\nplant = "paper"\n', "does not match preset 'iris'"),
-        ('[vehicle]\nm = 1.0\nJxx = [\n', "mine.toml: not valid TOML"),
-        ('[vehicel]\nm = 1.0\n', "mine.toml: unknown table or key 'vehicel'"),
+        ("[vehicle]\nm = 1.0\nJxx = [\n", "mine.toml: not valid TOML"),
+        ("[vehicel]\nm = 1.0\n", "mine.toml: unknown table or key 'vehicel'"),
         ('[vehicle]\nplant = "rotor"\nm = 1.0\n', "mine.toml: [vehicle] lacks 'Jxx', 'Jyy', 'Jzz', 'kf', "),
     ]:
         f.write_text(text)

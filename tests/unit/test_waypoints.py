@@ -27,8 +27,11 @@ EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "waypoints.csv"
 POS, VEL, ACC = [REF_X, REF_Y, REF_Z], [REF_VX, REF_VY, REF_VZ], [REF_AX, REF_AY, REF_AZ]
 
 # an irregular 3-D table with yaw and explicit times (and one sharp turn back)
-TIMED = WaypointTable([[0, 0, 1], [2, 1, 1.5], [3, -1, 1.2], [1, -2, 1], [1.5, 0.5, 2]],
-                      yaw=[0.0, 0.4, -0.3, 1.0, 0.2], t=[0.0, 3.0, 5.5, 9.0, 12.0])
+TIMED = WaypointTable(
+    [[0, 0, 1], [2, 1, 1.5], [3, -1, 1.2], [1, -2, 1], [1.5, 0.5, 2]],
+    yaw=[0.0, 0.4, -0.3, 1.0, 0.2],
+    t=[0.0, 3.0, 5.5, 9.0, 12.0],
+)
 
 
 def central(mission, t, cols, h=1e-5):
@@ -37,7 +40,9 @@ def central(mission, t, cols, h=1e-5):
 
 def inside(times, per_leg=50, margin=1e-3):
     """Times strictly inside each leg, away from the points."""
-    return np.concatenate([np.linspace(a + margin, b - margin, per_leg) for a, b in zip(times[:-1], times[1:])])
+    return np.concatenate(
+        [np.linspace(a + margin, b - margin, per_leg) for a, b in zip(times[:-1], times[1:], strict=False)]
+    )
 
 
 # --- the example and the table ---------------------------------------------------------------
@@ -52,49 +57,55 @@ def test_example_is_a_lawnmower_over_6_by_4_at_1_5m():
 
 def test_table_from_arrays_times_and_round_trip():
     tab = WaypointTable([[0, 0, 1], [3, 4, 1], [3, 4, 2]])
-    np.testing.assert_allclose(tab.times(), [0, 10, 12])            # 0.5 m/s by default
+    np.testing.assert_allclose(tab.times(), [0, 10, 12])  # 0.5 m/s by default
     np.testing.assert_allclose(tab.times(speed=1.0), [0, 5, 6])
     np.testing.assert_array_equal(tab.yaws(), 0.0)
     for t in (tab, TIMED, read_waypoints_csv(EXAMPLE)):
         back = WaypointTable.from_dict(json.loads(json.dumps(t.to_dict())))
         assert back == t and hash(back) == hash(t)
     with pytest.raises(ValueError):
-        tab.points[0, 0] = 5.0                                       # read-only
+        tab.points[0, 0] = 5.0  # read-only
 
 
-@pytest.mark.parametrize("kw,match", [
-    (dict(points=[[0, 0, 1]]), "at least two waypoints"),
-    (dict(points=[[0, 0], [1, 1]]), r"expected \(n, 3\)"),
-    (dict(points=[[0, 0, 1], [1, 0, 1]], yaw=[0.0]), r"yaw has shape \(1,\)"),
-    (dict(points=[[0, 0, 1], [1, 0, np.nan]]), "row 2, column 'z': value is not finite"),
-    (dict(points=[[0, 0, 1], [1, 0, 1]], t=[1.0, 2.0]), "row 1, column 't': the first arrival time must be 0"),
-    (dict(points=[[0, 0, 1], [1, 0, 1]], t=[0.0, 2.0], speed=[0, 1]), "columns 't' and 'speed'"),
-    (dict(points=[[0, 0, 1], [1, 0, 1]], speed=[0, -1.0]), "row 2, column 'speed'"),
-    (dict(points=[[0, 0, 1], [0, 0, 1]]), "row 2, column 'x'.*zero-length leg"),
-])
+@pytest.mark.parametrize(
+    "kw,match",
+    [
+        (dict(points=[[0, 0, 1]]), "at least two waypoints"),
+        (dict(points=[[0, 0], [1, 1]]), r"expected \(n, 3\)"),
+        (dict(points=[[0, 0, 1], [1, 0, 1]], yaw=[0.0]), r"yaw has shape \(1,\)"),
+        (dict(points=[[0, 0, 1], [1, 0, np.nan]]), "row 2, column 'z': value is not finite"),
+        (dict(points=[[0, 0, 1], [1, 0, 1]], t=[1.0, 2.0]), "row 1, column 't': the first arrival time must be 0"),
+        (dict(points=[[0, 0, 1], [1, 0, 1]], t=[0.0, 2.0], speed=[0, 1]), "columns 't' and 'speed'"),
+        (dict(points=[[0, 0, 1], [1, 0, 1]], speed=[0, -1.0]), "row 2, column 'speed'"),
+        (dict(points=[[0, 0, 1], [0, 0, 1]]), "row 2, column 'x'.*zero-length leg"),
+    ],
+)
 def test_table_errors(kw, match):
     with pytest.raises(InputError, match=match):
         WaypointTable(**kw)
 
 
 # --- CSV errors: one line each, naming the file, the line and the column -------------------------
-@pytest.mark.parametrize("text,line,column", [
-    ("x,y\n0,0\n1,1\n", 1, "z"),                                       # missing column
-    ("x,y,z\n0,0,1\n1,abc,1\n", 3, "y"),                               # not a number
-    ("x,y,z\n0,0,1\n1,nan,1\n", 3, "y"),                               # NaN
-    ("x,y,z\n0,0,1\n", 2, None),                                       # fewer than two points
-    ("x,y,z,t\n0,0,1,0\n1,0,1,2\n2,0,1,2\n", 4, "t"),                  # non-increasing t
-    ("x,y,z,t\n0,0,1,0.5\n1,0,1,2\n", 2, "t"),                         # t does not start at 0
-    ("x,y,z,t,speed\n0,0,1,0,\n1,0,1,2,1\n", 1, "t"),                  # both t and speed
-    ("x,y,z,speed\n0,0,1,\n1,0,1,0.5\n1,0,1,0.5\n", 4, "x"),          # zero-length leg, no dwell
-    ("x,y,z\n\n0,0,1\n\n0,0,1\n", 5, "x"),                             # ... blank lines still counted
-    ("x,y,z,speed\n0,0,1,\n1,0,1,-0.5\n", 3, "speed"),                 # negative speed
-    ("x,y,z,speed\n0,0,1,\n1,0,1,0\n", 3, "speed"),                    # zero speed
-    ("x,y,z,speed\n0,0,1,\n1,0,1,\n", 3, "speed"),                     # empty speed after the first
-    ("x,y,z,yaw\n0,0,1,0\n1,0,1,inf\n", 3, "yaw"),                     # infinite yaw
-    ("x,y,z,x\n0,0,1,0\n1,0,1,1\n", 1, "x"),                           # duplicate column
-    ("x,y,z\n0,0,1\n1,0\n", 3, None),                                  # short row
-])
+@pytest.mark.parametrize(
+    "text,line,column",
+    [
+        ("x,y\n0,0\n1,1\n", 1, "z"),  # missing column
+        ("x,y,z\n0,0,1\n1,abc,1\n", 3, "y"),  # not a number
+        ("x,y,z\n0,0,1\n1,nan,1\n", 3, "y"),  # NaN
+        ("x,y,z\n0,0,1\n", 2, None),  # fewer than two points
+        ("x,y,z,t\n0,0,1,0\n1,0,1,2\n2,0,1,2\n", 4, "t"),  # non-increasing t
+        ("x,y,z,t\n0,0,1,0.5\n1,0,1,2\n", 2, "t"),  # t does not start at 0
+        ("x,y,z,t,speed\n0,0,1,0,\n1,0,1,2,1\n", 1, "t"),  # both t and speed
+        ("x,y,z,speed\n0,0,1,\n1,0,1,0.5\n1,0,1,0.5\n", 4, "x"),  # zero-length leg, no dwell
+        ("x,y,z\n\n0,0,1\n\n0,0,1\n", 5, "x"),  # ... blank lines still counted
+        ("x,y,z,speed\n0,0,1,\n1,0,1,-0.5\n", 3, "speed"),  # negative speed
+        ("x,y,z,speed\n0,0,1,\n1,0,1,0\n", 3, "speed"),  # zero speed
+        ("x,y,z,speed\n0,0,1,\n1,0,1,\n", 3, "speed"),  # empty speed after the first
+        ("x,y,z,yaw\n0,0,1,0\n1,0,1,inf\n", 3, "yaw"),  # infinite yaw
+        ("x,y,z,x\n0,0,1,0\n1,0,1,1\n", 1, "x"),  # duplicate column
+        ("x,y,z\n0,0,1\n1,0\n", 3, None),  # short row
+    ],
+)
 def test_csv_errors_name_file_line_and_column(tmp_path, text, line, column):
     path = tmp_path / "wp.csv"
     path.write_text(text)
@@ -120,20 +131,22 @@ def test_csv_dwell_with_times_and_extra_column(tmp_path):
     with pytest.warns(UserWarning, match="ignoring column"):
         tab = read_waypoints_csv(path)
     np.testing.assert_array_equal(tab.t, [0, 2, 5])
-    ref = Waypoints(tab).reference([3.0, 3.5])                        # dwelling, turning
+    ref = Waypoints(tab).reference([3.0, 3.5])  # dwelling, turning
     np.testing.assert_allclose(ref[:, VEL], 0.0)
     np.testing.assert_allclose(ref[:, [REF_PSI, REF_PSI_DOT]], [[0.5, 0.5], [0.75, 0.5]])
 
 
 # --- straight legs ---------------------------------------------------------------------------
-@pytest.mark.parametrize("mission", [Waypoints(EXAMPLE), Waypoints(TIMED),
-                                     Waypoints(WaypointTable([[0, 0, 1], [1, 1, 1], [0, 2, 0.5]]), speed=0.3)])
+@pytest.mark.parametrize(
+    "mission",
+    [Waypoints(EXAMPLE), Waypoints(TIMED), Waypoints(WaypointTable([[0, 0, 1], [1, 1, 1], [0, 2, 0.5]]), speed=0.3)],
+)
 def test_legs_hit_the_points_at_their_times_exactly(mission):
     tab, times = mission.table, mission.times
     ref = mission.reference(times)
     np.testing.assert_array_equal(ref[:, POS], tab.points)
     np.testing.assert_array_equal(ref[:, REF_PSI], tab.yaws())
-    after = mission.reference([times[-1], times[-1] + 1.0, 1e6])     # held after the end
+    after = mission.reference([times[-1], times[-1] + 1.0, 1e6])  # held after the end
     np.testing.assert_array_equal(after[:, POS], np.tile(tab.points[-1], (3, 1)))
     np.testing.assert_array_equal(after[:, VEL + ACC + [REF_PSI_DOT]], 0.0)
     np.testing.assert_array_equal(mission.reference(-1.0)[0, POS], tab.points[0])
@@ -194,7 +207,7 @@ def segment_polys(mission):
     tk = mission.times
     out = []
     for i, dur in enumerate(np.diff(tk)):
-        scale = dur ** -np.arange(8.0)                     # s^k = (t - t_i)^k / T^k
+        scale = dur ** -np.arange(8.0)  # s^k = (t - t_i)^k / T^k
         out.append([np.polynomial.Polynomial(mission.coefficients[i, :, a] * scale) for a in range(4)])
     return tk, out
 
@@ -207,10 +220,10 @@ def test_minsnap_through_points_continuous_and_at_rest_at_the_ends(mission):
     np.testing.assert_allclose(ref[:, REF_PSI], tab.yaws(), rtol=0, atol=1e-9)
     tk, polys = segment_polys(mission)
     dur = np.diff(tk)
-    for i in range(1, len(tk) - 1):                        # left and right of interior knot i
+    for i in range(1, len(tk) - 1):  # left and right of interior knot i
         for a in range(4):
             left, right = polys[i - 1][a], polys[i][a]
-            for r in range(7):                             # C3 by constraint, C4..C6 by optimality
+            for r in range(7):  # C3 by constraint, C4..C6 by optimality
                 lv, rv = left.deriv(r)(dur[i - 1]) if r else left(dur[i - 1]), right.deriv(r)(0.0) if r else right(0.0)
                 assert lv == pytest.approx(rv, abs=1e-9), (i, a, r)
     for seg, s in ((polys[0], 0.0), (polys[-1], dur[-1])):  # rest at both ends
@@ -221,9 +234,9 @@ def test_minsnap_through_points_continuous_and_at_rest_at_the_ends(mission):
     t = inside(tk, margin=1e-4)
     seg = np.searchsorted(tk, t) - 1
     ref = mission.reference(t)
-    for a, (col, vcol, acol) in enumerate(zip(POS, VEL, ACC)):
-        p = np.array([polys[i][a](tt - tk[i]) for tt, i in zip(t, seg)])
-        v = np.array([polys[i][a].deriv()(tt - tk[i]) for tt, i in zip(t, seg)])
+    for a, (col, vcol, _acol) in enumerate(zip(POS, VEL, ACC, strict=False)):
+        p = np.array([polys[i][a](tt - tk[i]) for tt, i in zip(t, seg, strict=False)])
+        v = np.array([polys[i][a].deriv()(tt - tk[i]) for tt, i in zip(t, seg, strict=False)])
         np.testing.assert_allclose(ref[:, col], p, atol=1e-10)
         np.testing.assert_allclose(ref[:, vcol], v, atol=1e-9)
     np.testing.assert_allclose(central(mission, t, POS), ref[:, VEL], atol=1e-7)
@@ -235,8 +248,11 @@ def test_minsnap_through_points_continuous_and_at_rest_at_the_ends(mission):
     np.testing.assert_allclose(mission.reference(0.0)[0, VEL + ACC], 0.0, atol=1e-12)
 
 
-UNEVEN = WaypointTable(np.random.default_rng(3).uniform(-2, 2, (6, 3)),
-                       yaw=[0.0, 1.0, 0.5, -0.5, 0.0, 2.0], t=np.cumsum([0, 1, 50, 3, 0.5, 20]))
+UNEVEN = WaypointTable(
+    np.random.default_rng(3).uniform(-2, 2, (6, 3)),
+    yaw=[0.0, 1.0, 0.5, -0.5, 0.0, 2.0],
+    t=np.cumsum([0, 1, 50, 3, 0.5, 20]),
+)
 
 
 @pytest.mark.parametrize("tab", [TIMED, UNEVEN])
@@ -262,7 +278,7 @@ def snap_integral(coef, tk, n=2001):
         tt = np.linspace(0.0, dur, n)
         for a in range(3):
             snap = np.polynomial.Polynomial(coef[i, :, a] * dur ** -np.arange(8.0)).deriv(4)(tt)
-            total += simpson(snap ** 2, x=tt)
+            total += simpson(snap**2, x=tt)
     return total
 
 
@@ -275,19 +291,30 @@ def test_minsnap_has_less_snap_than_the_alternatives():
     assert best < 0.5 * snap_integral(naive, tk)
     # 2. any feasible change of the coefficients (same points, C3, rest at the ends) adds snap
     from quadcruise.missions.waypoints import _derivative_row
+
     m_seg = len(tk) - 1
     rows = []
     for j in range(len(tk)):
         for r in range(4):
             if j > 0:
-                rows.append(np.r_[np.zeros(8 * (j - 1)), _derivative_row(r, 1.0) / np.diff(tk)[j - 1] ** r,
-                                  np.zeros(8 * (m_seg - j))])
+                rows.append(
+                    np.r_[
+                        np.zeros(8 * (j - 1)),
+                        _derivative_row(r, 1.0) / np.diff(tk)[j - 1] ** r,
+                        np.zeros(8 * (m_seg - j)),
+                    ]
+                )
             if j < m_seg and (r == 0 or j == 0 or j == m_seg):
-                rows.append(np.r_[np.zeros(8 * j), _derivative_row(r, 0.0) / np.diff(tk)[j] ** r,
-                                  np.zeros(8 * (m_seg - j - 1))])
-            elif j < m_seg:                                # continuity: right minus left
-                rows[-1] = rows[-1] - np.r_[np.zeros(8 * j), _derivative_row(r, 0.0) / np.diff(tk)[j] ** r,
-                                            np.zeros(8 * (m_seg - j - 1))]
+                rows.append(
+                    np.r_[np.zeros(8 * j), _derivative_row(r, 0.0) / np.diff(tk)[j] ** r, np.zeros(8 * (m_seg - j - 1))]
+                )
+            elif j < m_seg:  # continuity: right minus left
+                rows[-1] = (
+                    rows[-1]
+                    - np.r_[
+                        np.zeros(8 * j), _derivative_row(r, 0.0) / np.diff(tk)[j] ** r, np.zeros(8 * (m_seg - j - 1))
+                    ]
+                )
     free = null_space(np.array(rows))
     rng = np.random.default_rng(7)
     for _ in range(5):
@@ -331,17 +358,18 @@ def test_stack_pads_tables_of_different_lengths(cls):
     long, short = cls(EXAMPLE), cls(WaypointTable([[0, 0, 1], [1, 0, 1]], t=[0, 2]))
     rows = stack_params([long, short])
     assert rows.shape == (2, long.params().size)
-    np.testing.assert_array_equal(rows[1, short.params().size:], 0.0)
+    np.testing.assert_array_equal(rows[1, short.params().size :], 0.0)
     t = np.linspace(-1, 50, 301)
-    for row, mission in zip(rows, (long, short)):
+    for row, mission in zip(rows, (long, short), strict=False):
         out = np.empty((t.size, 11))
         from quadcruise.missions.base import _evaluate
+
         _evaluate(cls.function, t, np.ascontiguousarray(row), out)
         np.testing.assert_array_equal(out, mission.reference(t))
     assert stack_params([short], n=3).shape == (3, short.params().size)
     np.testing.assert_array_equal(stack_params(long, n=2), np.vstack([long.params()] * 2))
     frozen = np.linspace(0.0, 10.0, 11)
-    frozen.flags.writeable = False              # read-only times are fine too
+    frozen.flags.writeable = False  # read-only times are fine too
     np.testing.assert_array_equal(long.reference(frozen), long.reference(frozen.copy()))
 
 
@@ -368,7 +396,7 @@ def test_yaw_through_plus_minus_pi_turns_the_short_way(kind):
     mission = (Waypoints if kind == "waypoints" else MinimumSnap)(table)
     psi = mission.reference(np.linspace(0.0, mission.duration, 2001))[:, REF_PSI]
     travel = np.abs(np.diff(psi)).sum()
-    assert travel == pytest.approx(2 * (2 * np.pi - 6.0), rel=0.05)          # 0.57 rad, not 12
+    assert travel == pytest.approx(2 * (2 * np.pi - 6.0), rel=0.05)  # 0.57 rad, not 12
     assert np.allclose(np.cos(psi[[0, -1]]), np.cos(3.0)) and np.allclose(np.sin(psi[[0, -1]]), np.sin(3.0))
 
 
@@ -383,13 +411,13 @@ def kkt_minimum_snap(values, times, stops):
     n, m = w.shape[0], w.shape[0] - 1
     stop = np.asarray(stops, bool).copy()
     stop[[0, -1]] = True
-    g = (dur / dur[0]) ** 3.5                       # unknowns b_i = a_i / g_i: every block weighs H alone
+    g = (dur / dur[0]) ** 3.5  # unknowns b_i = a_i / g_i: every block weighs H alone
     rows, rhs = [], []
 
     def constrain(value, *terms):
         row = np.zeros(8 * m)
         for seg, d in terms:
-            row[8 * seg:8 * seg + 8] += d * g[seg]
+            row[8 * seg : 8 * seg + 8] += d * g[seg]
         scale = np.abs(row).max()
         rows.append(row / scale)
         rhs.append(np.broadcast_to(value, (w.shape[1],)) / scale)
@@ -406,8 +434,9 @@ def kkt_minimum_snap(values, times, stops):
                 if j < m:
                     constrain(0.0, (j, _derivative_row(r, 0.0)))
             else:
-                constrain(0.0, (j - 1, _derivative_row(r, 1.0) / dur[j - 1] ** r),
-                          (j, -_derivative_row(r, 0.0) / dur[j] ** r))
+                constrain(
+                    0.0, (j - 1, _derivative_row(r, 1.0) / dur[j - 1] ** r), (j, -_derivative_row(r, 0.0) / dur[j] ** r)
+                )
     k = np.arange(4, 8)
     fall = np.array([math.perm(int(i), 4) for i in k], dtype=float)
     h = np.zeros((8, 8))
@@ -415,7 +444,7 @@ def kkt_minimum_snap(values, times, stops):
     a_eq = np.array(rows)
     kkt = np.block([[np.kron(np.eye(m), h), a_eq.T], [a_eq, np.zeros((len(rows), len(rows)))]])
     sol = np.linalg.solve(kkt, np.vstack([np.zeros((8 * m, w.shape[1])), np.array(rhs)]))
-    return g[:, None, None] * sol[:8 * m].reshape(m, 8, -1)
+    return g[:, None, None] * sol[: 8 * m].reshape(m, 8, -1)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])

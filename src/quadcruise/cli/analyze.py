@@ -13,11 +13,19 @@ __all__ = ["analyze"]
 
 @click.command("analyze")
 @click.option("--controller", default="nlpd", show_default=True, help="Controller name.")
-@click.option("-c", "--controller-param", "controller_params", multiple=True, metavar="KEY=VALUE",
-              help="Controller parameter (repeatable).")
+@click.option(
+    "-c",
+    "--controller-param",
+    "controller_params",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Controller parameter (repeatable).",
+)
 @click.option("--poles", "position_poles", metavar="P1,P2", help="Closed-loop poles of the x/y loops [rad/s].")
 @click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
-@click.option("--out", type=click.Path(file_okay=False), callback=writable, help="Folder for analysis.json and Bode plots.")
+@click.option(
+    "--out", type=click.Path(file_okay=False), callback=writable, help="Folder for analysis.json and Bode plots."
+)
 @FORCE_OPTION
 @friendly
 def analyze(controller, controller_params, position_poles, dt, out, force):
@@ -41,7 +49,7 @@ def analyze(controller, controller_params, position_poles, dt, out, force):
         ``--force``: replace a non-empty ``out`` folder that quadcruise did not write.
     """
     linearising = Bar("linearising about hover")
-    linearising(0, 3)                       # python-control takes a few seconds to load
+    linearising(0, 3)  # python-control takes a few seconds to load
     from quadcruise.workflows.analysis import linearize
 
     the_controller = controller_from_options(controller, controller_params, position_poles)

@@ -8,7 +8,7 @@ from __future__ import annotations
 import functools
 import sys
 import warnings
-from typing import Callable
+from collections.abc import Callable
 
 import click
 
@@ -17,24 +17,46 @@ from quadcruise.cli.feedback import Bar, close_bars, compile_notice
 from quadcruise.cli.objects import controller_from_options, mission_from_options
 from quadcruise.errors import InputError
 
-__all__ = ["FORCE_OPTION", "FORMAT_OPTION", "REPORT_OPTION", "RISE_OPTION", "SETTLE_BAND_OPTION", "Bar", "friendly",
-           "needs_out", "writable_with",
-           "metric_options", "writable", "controller_from_options", "mission_from_options"]
+__all__ = [
+    "FORCE_OPTION",
+    "FORMAT_OPTION",
+    "REPORT_OPTION",
+    "RISE_OPTION",
+    "SETTLE_BAND_OPTION",
+    "Bar",
+    "friendly",
+    "needs_out",
+    "writable_with",
+    "metric_options",
+    "writable",
+    "controller_from_options",
+    "mission_from_options",
+]
+
 
 # options several commands share
 def _table_format(ctx: click.Context, param: click.Parameter, value: str) -> str:
     from quadcruise.io.files import check_table_format
 
     try:
-        check_table_format(value)           # Parquet needs pyarrow: said before anything flies
+        check_table_format(value)  # Parquet needs pyarrow: said before anything flies
     except InputError as exc:
         raise click.BadParameter(str(exc), ctx=ctx, param=param) from None
     return value
 
 
-FORMAT_OPTION = click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv",
-                             show_default=True, callback=_table_format, help="Format of the traces.")
+FORMAT_OPTION = click.option(
+    "--format",
+    "fmt",
+    type=click.Choice(["csv", "parquet"]),
+    default="csv",
+    show_default=True,
+    callback=_table_format,
+    help="Format of the traces.",
+)
 FORCE_OPTION = click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
+
+
 def writable(ctx: click.Context, param: click.Parameter, value):
     """A click callback: refuse an output path that could not be written, before any work.
 
@@ -94,25 +116,42 @@ def writable_with(*suffixes: str):
     callable
         The callback.
     """
+
     def check(ctx: click.Context, param: click.Parameter, value):
         if value is not None and str(value).strip() and not str(value).lower().endswith(suffixes):
-            raise click.BadParameter(f"{value}: the file is written as {' or '.join(suffixes)}; name it so",
-                                     ctx=ctx, param=param)
+            raise click.BadParameter(
+                f"{value}: the file is written as {' or '.join(suffixes)}; name it so", ctx=ctx, param=param
+            )
         return writable(ctx, param, value)
+
     return check
 
 
-REPORT_OPTION = click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html",
-                             callback=writable_with(".html", ".htm"),
-                             help="Also write a self-contained HTML report (tables, figures, interactive 3-D "
-                                  "view, configuration).")
+REPORT_OPTION = click.option(
+    "--report",
+    type=click.Path(dir_okay=False),
+    metavar="PATH.html",
+    callback=writable_with(".html", ".htm"),
+    help="Also write a self-contained HTML report (tables, figures, interactive 3-D view, configuration).",
+)
 
-RISE_OPTION = click.option("--rise", type=click.Choice(["10-90", "0-100"]), default="10-90", show_default=True,
-                           help="Rise time between these percents of the step.")
-SETTLE_BAND_OPTION = click.option("--settle-band", "settle_bands", type=float, multiple=True, metavar="FRACTION",
-                                  help="Settling band, a fraction of the step (default 0.02, then 0.05): the first "
-                                       "gives settling_time_s, a second (0.05 if left out; 0.02 beside a first "
-                                       "0.05) a column named after it.")
+RISE_OPTION = click.option(
+    "--rise",
+    type=click.Choice(["10-90", "0-100"]),
+    default="10-90",
+    show_default=True,
+    help="Rise time between these percents of the step.",
+)
+SETTLE_BAND_OPTION = click.option(
+    "--settle-band",
+    "settle_bands",
+    type=float,
+    multiple=True,
+    metavar="FRACTION",
+    help="Settling band, a fraction of the step (default 0.02, then 0.05): the first "
+    "gives settling_time_s, a second (0.05 if left out; 0.02 beside a first "
+    "0.05) a column named after it.",
+)
 
 
 def metric_options(rise: str = "10-90", settle_bands: tuple[float, ...] = ()) -> dict:
@@ -174,7 +213,7 @@ def friendly(func: Callable) -> Callable:
             except KeyboardInterrupt as exc:
                 close_bars()
                 text, status = interrupt_text(exc)
-                click.echo(("\n" if sys.stderr.isatty() else "") + f"error: {text}", err=True)   # after a ^C
+                click.echo(("\n" if sys.stderr.isatty() else "") + f"error: {text}", err=True)  # after a ^C
                 sys.exit(status)
             finally:
                 close_bars()

@@ -32,28 +32,66 @@ __all__ = ["compare"]
 
 @click.command("compare")
 @click.argument("mission", metavar="MISSION")
-@click.option("--controllers", help="Comma-separated controller names (default nlpd,gonzalez,se3,cascade, "
-              "or the scenario's).")
+@click.option(
+    "--controllers", help="Comma-separated controller names (default nlpd,gonzalez,se3,cascade, or the scenario's)."
+)
 @click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
 @click.option("--dt", type=float, help="Control period [s] (default 0.001, or the scenario's).")
-@click.option("-m", "--mission-param", "mission_params", multiple=True, metavar="KEY=VALUE",
-              help="Mission parameter (repeatable).")
-@click.option("--out", type=click.Path(file_okay=False), callback=writable, help="Folder for metrics.csv and comparison.png.")
+@click.option(
+    "-m",
+    "--mission-param",
+    "mission_params",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Mission parameter (repeatable).",
+)
+@click.option(
+    "--out", type=click.Path(file_okay=False), callback=writable, help="Folder for metrics.csv and comparison.png."
+)
 @FORCE_OPTION
-@click.option("--population", type=int, metavar="N",
-              help="Also fly every controller on the same Monte Carlo population of N vehicles.")
-@click.option("--seed", type=int, help="Seed of every random draw: the population's, and the turbulence and "
-              "sensor noise of every flight (default 0, or the scenario's).")
+@click.option(
+    "--population",
+    type=int,
+    metavar="N",
+    help="Also fly every controller on the same Monte Carlo population of N vehicles.",
+)
+@click.option(
+    "--seed",
+    type=int,
+    help="Seed of every random draw: the population's, and the turbulence and "
+    "sensor noise of every flight (default 0, or the scenario's).",
+)
 @click.option("--mass-spread", type=float, help="Relative std of the population's mass (default 0.1).")
-@world_options(wind_help="Wind of every flight (and of the population): constant:WX,WY,WZ | "
-               "gust:AX,AY,AZ@START+DURATION | dryden:light|moderate|severe@ALTITUDE | loss:ROTOR,FRACTION@TIME "
-               "(comma-separable; none: still air).", seed=False)
+@world_options(
+    wind_help="Wind of every flight (and of the population): constant:WX,WY,WZ | "
+    "gust:AX,AY,AZ@START+DURATION | dryden:light|moderate|severe@ALTITUDE | loss:ROTOR,FRACTION@TIME "
+    "(comma-separable; none: still air).",
+    seed=False,
+)
 @REPORT_OPTION
 @RISE_OPTION
 @SETTLE_BAND_OPTION
 @friendly
-def compare(mission, controllers, duration, dt, mission_params, out, force, population, seed, mass_spread,
-            vehicle, controller_vehicle, wind, turbulence, log_every, report, rise, settle_bands):
+def compare(
+    mission,
+    controllers,
+    duration,
+    dt,
+    mission_params,
+    out,
+    force,
+    population,
+    seed,
+    mass_spread,
+    vehicle,
+    controller_vehicle,
+    wind,
+    turbulence,
+    log_every,
+    report,
+    rise,
+    settle_bands,
+):
     """Fly MISSION (a name or a waypoint CSV) with several controllers; one table, one figure.
 
     \f
@@ -112,14 +150,18 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
     if out is not None:
         check_output_dir(out, force)
     cmp_mission, chosen, kwargs, scenario = compared_from_options(mission, controllers, mission_params)
-    world, notes = flight_world(vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind,
-                                turbulence=turbulence, scenario=scenario)
-    kwargs = {**{k: v for k, v in kwargs.items() if k not in world},
-              **{k: v for k, v in world.items() if v is not None}}
+    world, notes = flight_world(
+        vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind, turbulence=turbulence, scenario=scenario
+    )
+    kwargs = {
+        **{k: v for k, v in kwargs.items() if k not in world},
+        **{k: v for k, v in world.items() if v is not None},
+    }
     kwargs.update({k: v for k, v in (("duration", duration), ("dt", dt), ("log_every", log_every)) if v is not None})
-    count, pop_seed, pop = population_from_options(population, seed, mass_spread, scenario,
-                                                   kwargs.get("environment"), kwargs.get("sensors"))
-    if seed is not None or "seed" not in kwargs:           # the flights' seed: given, the scenario's, the population's
+    count, pop_seed, pop = population_from_options(
+        population, seed, mass_spread, scenario, kwargs.get("environment"), kwargs.get("sensors")
+    )
+    if seed is not None or "seed" not in kwargs:  # the flights' seed: given, the scenario's, the population's
         kwargs["seed"] = pop_seed if seed is None else seed
     if count is not None:
         from quadcruise.montecarlo.sweep import check_sweep_size
@@ -143,4 +185,4 @@ def compare(mission, controllers, duration, dt, mission_params, out, force, popu
         write_html_report(report, **comparison_report(cmp, **conventions))
         click.echo(f"wrote report {report}")
     if cmp.failed:
-        sys.exit(1)             # a controller's flight did not finish: diverged, lost track, out of bounds
+        sys.exit(1)  # a controller's flight did not finish: diverged, lost track, out of bounds

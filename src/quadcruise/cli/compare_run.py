@@ -11,12 +11,18 @@ from quadcruise.cli.objects import mission_from_options
 from quadcruise.cli.vehicle import refuse_vehicle_fields
 from quadcruise.errors import InputError
 
-__all__ = ["DEFAULT_COMPARED", "compared_from_options", "echo_population_comparison", "population_from_options",
-           "population_record"]
+__all__ = [
+    "DEFAULT_COMPARED",
+    "compared_from_options",
+    "echo_population_comparison",
+    "population_from_options",
+    "population_record",
+]
 
 
-def population_from_options(n: int | None, seed: int | None, mass_spread: float | None, scenario=None,
-                            environment=None, sensors=None):
+def population_from_options(
+    n: int | None, seed: int | None, mass_spread: float | None, scenario=None, environment=None, sensors=None
+):
     """The population that ``--population``, ``--seed`` and ``--mass-spread`` describe, a
     scenario's ``[compare] population`` changed by them; checked before anything flies.
 
@@ -57,15 +63,20 @@ def population_from_options(n: int | None, seed: int | None, mass_spread: float 
         table["mass_spread"] = mass_spread
     if "n" not in table:
         if mass_spread is not None:
-            raise InputError("--mass-spread describes the population that --population N flies; without it, "
-                             "it would change nothing")
+            raise InputError(
+                "--mass-spread describes the population that --population N flies; without it, it would change nothing"
+            )
         return None, table.get("seed", 0), None
     count, pop_seed = table.pop("n"), table.pop("seed", 0)
     table.setdefault("mass_spread", 0.1)
-    pop = Population(**table, environment=environment if environment is not None and environment.parts else None,
-                     noise=sensors)
-    pop.check_perturbs(count, hint="a --mass-spread > 0, turbulence (--turbulence "
-                       "moderate) or a scenario's sensor noise or spreads ([compare] population)")
+    pop = Population(
+        **table, environment=environment if environment is not None and environment.parts else None, noise=sensors
+    )
+    pop.check_perturbs(
+        count,
+        hint="a --mass-spread > 0, turbulence (--turbulence "
+        "moderate) or a scenario's sensor noise or spreads ([compare] population)",
+    )
     return count, pop_seed, pop
 
 
@@ -121,14 +132,29 @@ def echo_population_comparison(mission, controllers, n: int, seed: int, pop, fli
     """
     from quadcruise.montecarlo.compare import compare_population
 
-    same = {k: flight[k] for k in ("vehicle", "controller_vehicle", "max_step", "full_dynamics")
-            if flight.get(k) is not None}
-    table = compare_population(mission, controllers, pop, n, seed, duration=flight.get("duration"),
-                               dt=flight.get("dt", 1e-3), scheduler="none",
-                               progress=Bar("flying the population", unit="flight"), **same)
+    same = {
+        k: flight[k]
+        for k in ("vehicle", "controller_vehicle", "max_step", "full_dynamics")
+        if flight.get(k) is not None
+    }
+    table = compare_population(
+        mission,
+        controllers,
+        pop,
+        n,
+        seed,
+        duration=flight.get("duration"),
+        dt=flight.get("dt", 1e-3),
+        scheduler="none",
+        progress=Bar("flying the population", unit="flight"),
+        **same,
+    )
     world = ", ".join(pop.environment.parts) if pop.environment is not None else ""
-    click.echo(f"\nthe same {n} perturbed vehicles (seed {seed}, mass spread {pop.mass_spread:g}"
-               + (f", {world}" if world else "") + "):")
+    click.echo(
+        f"\nthe same {n} perturbed vehicles (seed {seed}, mass spread {pop.mass_spread:g}"
+        + (f", {world}" if world else "")
+        + "):"
+    )
     click.echo(table.to_string(float_format=lambda v: f"{v:.4g}"))
     return table
 
@@ -170,6 +196,10 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
         changes = parse_assignments(mission_params, "--mission-param")
         refuse_vehicle_fields(changes, type(the_mission))
         the_mission = the_mission.replace(**changes)
-    chosen = controllers if controllers is not None else scenario.compare or (
-        {scenario.controller.name: scenario.controller} if scenario.controller is not None else DEFAULT_COMPARED)
+    chosen = (
+        controllers
+        if controllers is not None
+        else scenario.compare
+        or ({scenario.controller.name: scenario.controller} if scenario.controller is not None else DEFAULT_COMPARED)
+    )
     return the_mission, chosen, scenario.fly_kwargs(drag=False), scenario

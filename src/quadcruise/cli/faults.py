@@ -27,8 +27,17 @@ import sys
 
 from quadcruise.errors import WriteError
 
-__all__ = ["EXIT_FAULT", "EXIT_INTERRUPTED", "EXIT_TERMINATED", "GuardedStdout", "Terminated", "fault_text",
-           "guard_stdout", "interrupt_text", "stop_on_sigterm"]
+__all__ = [
+    "EXIT_FAULT",
+    "EXIT_INTERRUPTED",
+    "EXIT_TERMINATED",
+    "GuardedStdout",
+    "Terminated",
+    "fault_text",
+    "guard_stdout",
+    "interrupt_text",
+    "stop_on_sigterm",
+]
 
 EXIT_FAULT = 74
 """Exit status when the machine failed the command: a file it could not write."""
@@ -139,7 +148,7 @@ class GuardedStdout:
         if exc.errno == errno.EPIPE:
             self.reader_gone = True
             return
-        self.fault = WriteError("standard output", exc)     # said again by every later write
+        self.fault = WriteError("standard output", exc)  # said again by every later write
         raise self.fault from None
 
     def write(self, text: str) -> int:
@@ -160,7 +169,7 @@ class GuardedStdout:
             If standard output could not be written, now or before.
         """
         if not isinstance(text, str):
-            return self._stream.write(text)     # a TypeError, as from the stream itself
+            return self._stream.write(text)  # a TypeError, as from the stream itself
         if self.fault is not None:
             raise self.fault
         if text and not self.reader_gone:

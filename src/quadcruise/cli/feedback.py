@@ -39,13 +39,12 @@ __all__ = ["COMPILE_LINE", "ENV", "Bar", "close_bars", "compile_notice", "feedba
 ENV = "QUADCRUISE_PROGRESS"
 """The environment variable that turns the feedback on (``1``) or off (``0``) anywhere."""
 
-COMPILE_LINE = ("compiling the engine and controllers for this machine, once (numba caches them on disk): "
-                "about 5-15 s")
+COMPILE_LINE = "compiling the engine and controllers for this machine, once (numba caches them on disk): about 5-15 s"
 """What :func:`compile_notice` says. Measured with an empty ``NUMBA_CACHE_DIR``, less the warm
 run, on two shared cores: ``fly hover`` 6-8 s, ``analyze`` 7 s, ``montecarlo`` 10 s, ``compare``
 (four controllers) 11-13 s."""
 
-_OPEN: weakref.WeakSet = weakref.WeakSet()     # the bars drawn and not closed yet
+_OPEN: weakref.WeakSet = weakref.WeakSet()  # the bars drawn and not closed yet
 
 
 def feedback_on() -> bool:
@@ -63,7 +62,7 @@ def feedback_on() -> bool:
         return False
     try:
         return bool(sys.stderr.isatty())
-    except (AttributeError, ValueError):      # no stderr, or a closed one
+    except (AttributeError, ValueError):  # no stderr, or a closed one
         return False
 
 
@@ -72,7 +71,7 @@ def _size() -> dict:
     reports no size (0 x 0, as a bare pseudo-terminal) gets 80 x 24, on which tqdm draws."""
     try:
         columns, lines = os.get_terminal_size(sys.stderr.fileno())
-    except (AttributeError, OSError, ValueError):      # not a terminal: tqdm's defaults
+    except (AttributeError, OSError, ValueError):  # not a terminal: tqdm's defaults
         return {}
     return {"dynamic_ncols": True} if columns and lines else {"ncols": 80, "nrows": 24}
 
@@ -125,8 +124,16 @@ class Bar:
         if self.closed:
             return
         if self._bar is None:
-            self._bar = _Tqdm(total=total, initial=done, desc=self.label, unit=self.unit, file=sys.stderr,
-                              leave=False, disable=not feedback_on(), **_size())
+            self._bar = _Tqdm(
+                total=total,
+                initial=done,
+                desc=self.label,
+                unit=self.unit,
+                file=sys.stderr,
+                leave=False,
+                disable=not feedback_on(),
+                **_size(),
+            )
             _OPEN.add(self)
         bar = self._bar
         if bar.disable:
@@ -137,9 +144,9 @@ class Bar:
         if done >= total:
             self.close()
             return
-        bar.update(done - bar.n)             # drawn at most every 0.1 s
+        bar.update(done - bar.n)  # drawn at most every 0.1 s
         if text is not None:
-            bar.set_postfix_str(text)        # drawn now
+            bar.set_postfix_str(text)  # drawn now
 
     def close(self) -> None:
         """Remove the bar (nothing happens if it is closed already)."""
@@ -187,7 +194,7 @@ def compile_notice() -> Iterator[None]:
         def on_start(self, ev) -> None:
             if not said:
                 said.append(True)
-                tqdm.write(COMPILE_LINE, file=sys.stderr)     # above any bar being drawn
+                tqdm.write(COMPILE_LINE, file=sys.stderr)  # above any bar being drawn
 
         def on_end(self, ev) -> None:
             pass

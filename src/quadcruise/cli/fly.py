@@ -31,26 +31,70 @@ __all__ = ["fly"]
 @click.option("--duration", type=float, help="Flight time [s] (default: one lap, or 10 s after a step).")
 @click.option("--dt", type=float, help="Control period [s] (default 0.001).")
 @click.option("--max-step", type=float, help="Longest RK4 substep [s] (default: dt).")
-@click.option("-m", "--mission-param", "mission_params", multiple=True, metavar="KEY=VALUE",
-              help="Mission parameter, e.g. -m radius=3 -m period=30 (repeatable).")
-@click.option("-c", "--controller-param", "controller_params", multiple=True, metavar="KEY=VALUE",
-              help="Controller parameter, e.g. -c max_tilt=0.5 (repeatable).")
-@click.option("--poles", "position_poles", metavar="P1,P2",
-              help="Closed-loop poles of the x/y loops [rad/s], e.g. -0.7,-4.3 (the paper's).")
-@click.option("--out", "out", type=click.Path(file_okay=False), callback=writable, help="Folder for traces, figure and metrics.")
+@click.option(
+    "-m",
+    "--mission-param",
+    "mission_params",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Mission parameter, e.g. -m radius=3 -m period=30 (repeatable).",
+)
+@click.option(
+    "-c",
+    "--controller-param",
+    "controller_params",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Controller parameter, e.g. -c max_tilt=0.5 (repeatable).",
+)
+@click.option(
+    "--poles",
+    "position_poles",
+    metavar="P1,P2",
+    help="Closed-loop poles of the x/y loops [rad/s], e.g. -0.7,-4.3 (the paper's).",
+)
+@click.option(
+    "--out", "out", type=click.Path(file_okay=False), callback=writable, help="Folder for traces, figure and metrics."
+)
 @FORMAT_OPTION
 @FORCE_OPTION
 @click.option("--smooth", is_flag=True, help="Fly a waypoint file as a minimum-snap path instead of legs.")
 @REPORT_OPTION
-@click.option("--animate", type=click.Path(dir_okay=False), metavar="PATH.gif", callback=writable,
-              help="Also write an animation of the flight (.gif; .mp4 needs ffmpeg).")
+@click.option(
+    "--animate",
+    type=click.Path(dir_okay=False),
+    metavar="PATH.gif",
+    callback=writable,
+    help="Also write an animation of the flight (.gif; .mp4 needs ffmpeg).",
+)
 @WORLD_OPTIONS
 @RISE_OPTION
 @SETTLE_BAND_OPTION
 @friendly
-def fly(mission, controller, duration, dt, max_step, mission_params, controller_params, position_poles,
-        out, fmt, force, smooth, report, animate, vehicle, controller_vehicle, wind, turbulence, log_every, seed,
-        rise, settle_bands):
+def fly(
+    mission,
+    controller,
+    duration,
+    dt,
+    max_step,
+    mission_params,
+    controller_params,
+    position_poles,
+    out,
+    fmt,
+    force,
+    smooth,
+    report,
+    animate,
+    vehicle,
+    controller_vehicle,
+    wind,
+    turbulence,
+    log_every,
+    seed,
+    rise,
+    settle_bands,
+):
     """Fly a MISSION with a controller on the paper's vehicle (or --vehicle) and print its metrics.
 
     MISSION is circle, square, step, hover, a waypoint CSV (columns x,y,z and optional yaw
@@ -123,19 +167,36 @@ def fly(mission, controller, duration, dt, max_step, mission_params, controller_
         whole_number(seed, "--seed")
     if log_every is not None:
         whole_number(log_every, "--log-every", minimum=1)
-    overrides = {k: v for k, v in (("duration", duration), ("dt", dt), ("max_step", max_step), ("seed", seed),
-                                   ("log_every", log_every)) if v is not None}
+    overrides = {
+        k: v
+        for k, v in (
+            ("duration", duration),
+            ("dt", dt),
+            ("max_step", max_step),
+            ("seed", seed),
+            ("log_every", log_every),
+        )
+        if v is not None
+    }
     world = {"vehicle": vehicle, "controller_vehicle": controller_vehicle, "wind": wind, "turbulence": turbulence}
-    given = [f"--{k.replace('_', '-')} {v}" for k, v in {**overrides, **world}.items() if v is not None] \
-        + [f"-m {p}" for p in mission_params] + [f"-c {p}" for p in controller_params] \
-        + ([f"--controller {controller}"] if controller else []) \
+    given = (
+        [f"--{k.replace('_', '-')} {v}" for k, v in {**overrides, **world}.items() if v is not None]
+        + [f"-m {p}" for p in mission_params]
+        + [f"-c {p}" for p in controller_params]
+        + ([f"--controller {controller}"] if controller else [])
         + ([f"--poles {position_poles}"] if position_poles else [])
+    )
     the_mission, the_controller, kwargs, scenario = flight_from_options(
-        mission, controller, mission_params, controller_params, position_poles, smooth)
+        mission, controller, mission_params, controller_params, position_poles, smooth
+    )
     flown, notes = flight_world(**world, scenario=scenario)
-    kwargs = {**{k: v for k, v in kwargs.items() if k not in flown}, **overrides,
-              **{k: v for k, v in flown.items() if v is not None}}
-    result = fly_and_report(the_mission, the_controller, kwargs, out, fmt, force, report, animate, given, scenario,
-                             conventions, notes)
+    kwargs = {
+        **{k: v for k, v in kwargs.items() if k not in flown},
+        **overrides,
+        **{k: v for k, v in flown.items() if v is not None},
+    }
+    result = fly_and_report(
+        the_mission, the_controller, kwargs, out, fmt, force, report, animate, given, scenario, conventions, notes
+    )
     if not result.ok.all():
-        sys.exit(1)             # a vehicle did not fly its mission: diverged, lost track, out of bounds
+        sys.exit(1)  # a vehicle did not fly its mission: diverged, lost track, out of bounds

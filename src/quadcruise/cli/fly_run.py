@@ -14,8 +14,20 @@ from quadcruise.io.files import check_output_dir
 __all__ = ["fly_and_report"]
 
 
-def fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=None, animate=None, given=(),
-                    scenario=None, conventions=None, notes=()):
+def fly_and_report(
+    mission,
+    controller,
+    kwargs: dict,
+    out,
+    fmt,
+    force,
+    report=None,
+    animate=None,
+    given=(),
+    scenario=None,
+    conventions=None,
+    notes=(),
+):
     """Fly, print the metrics and each unfinished vehicle's reason, and write what was asked for.
 
     Parameters
@@ -55,7 +67,7 @@ def fly_and_report(mission, controller, kwargs: dict, out, fmt, force, report=No
     if animate is not None:
         from quadcruise.plots.animate import check_animation_path
 
-        check_animation_path(animate)       # suffix, and ffmpeg for .mp4: before anything flies
+        check_animation_path(animate)  # suffix, and ffmpeg for .mp4: before anything flies
     if out is not None:
         check_output_dir(out, force)
     for line in notes:

@@ -47,25 +47,70 @@ def base_vehicle(text: str):
 
 @click.command("identify")
 @click.argument("log", metavar="LOG")
-@click.option("--vehicle", "vehicle", default="paper", show_default=True, metavar="BASE",
-              help="Base vehicle: 'paper' or a TOML file with a [vehicle] table (geometry when the log has none, "
-                   "starting values, values for what the log cannot identify).")
-@click.option("--mass", type=float, default=None, metavar="KG",
-              help="The vehicle's mass [kg]; without it K and the inertias are per unit mass.")
-@click.option("--frame", type=click.Choice(["enu", "ned"]), default=None,
-              help="A CSV's frames (default enu: ENU world, FLU body); a ULog is always PX4's NED/FRD.")
-@click.option("--commands", default="duty", show_default=True, metavar="duty|pwm:MIN:MAX",
-              help="Rotor commands: normalised duties, or PWM [us] with their range.")
-@click.option("--holdout", type=float, default=0.3, show_default=True,
-              help="Fraction of the airborne time, at its end, kept out of the fit and predicted.")
-@click.option("--out", "out", required=True, type=click.Path(file_okay=False), callback=writable,
-              help="Folder for identify.json, vehicle.toml, report.md and the figure.")
-@click.option("--report", type=click.Path(dir_okay=False), metavar="PATH.html", callback=writable_with(".html", ".htm"),
-              help="Also write a self-contained HTML report (parameters, validation, figure, configuration).")
+@click.option(
+    "--vehicle",
+    "vehicle",
+    default="paper",
+    show_default=True,
+    metavar="BASE",
+    help="Base vehicle: 'paper' or a TOML file with a [vehicle] table (geometry when the log has none, "
+    "starting values, values for what the log cannot identify).",
+)
+@click.option(
+    "--mass",
+    type=float,
+    default=None,
+    metavar="KG",
+    help="The vehicle's mass [kg]; without it K and the inertias are per unit mass.",
+)
+@click.option(
+    "--frame",
+    type=click.Choice(["enu", "ned"]),
+    default=None,
+    help="A CSV's frames (default enu: ENU world, FLU body); a ULog is always PX4's NED/FRD.",
+)
+@click.option(
+    "--commands",
+    default="duty",
+    show_default=True,
+    metavar="duty|pwm:MIN:MAX",
+    help="Rotor commands: normalised duties, or PWM [us] with their range.",
+)
+@click.option(
+    "--holdout",
+    type=float,
+    default=0.3,
+    show_default=True,
+    help="Fraction of the airborne time, at its end, kept out of the fit and predicted.",
+)
+@click.option(
+    "--out",
+    "out",
+    required=True,
+    type=click.Path(file_okay=False),
+    callback=writable,
+    help="Folder for identify.json, vehicle.toml, report.md and the figure.",
+)
+@click.option(
+    "--report",
+    type=click.Path(dir_okay=False),
+    metavar="PATH.html",
+    callback=writable_with(".html", ".htm"),
+    help="Also write a self-contained HTML report (parameters, validation, figure, configuration).",
+)
 @click.option("--force", is_flag=True, help="Replace a non-empty --out folder that quadcruise did not write.")
 @friendly
-def identify(log: str, vehicle: str, mass: float | None, frame: str | None, commands: str, holdout: float,
-             out: str, report: str | None, force: bool) -> None:
+def identify(
+    log: str,
+    vehicle: str,
+    mass: float | None,
+    frame: str | None,
+    commands: str,
+    holdout: float,
+    out: str,
+    report: str | None,
+    force: bool,
+) -> None:
     """Identify the vehicle that flew LOG (a PX4 .ulg or a CSV) and check it on held-out data.
 
     Fits thrust, inertias, yaw moment and rotor lag by equation error, with 95 % intervals;
@@ -103,12 +148,34 @@ def identify(log: str, vehicle: str, mass: float | None, frame: str | None, comm
     base = base_vehicle(vehicle)
     parse_commands(commands)
     check_output_dir(out, force)
-    words = ["quadcruise", "identify", log, "--vehicle", vehicle, "--commands", commands, "--holdout", f"{holdout:g}",
-             "--out", out] + (["--mass", f"{mass:g}"] if mass is not None else []) \
-        + (["--frame", frame] if frame else []) + (["--report", report] if report else [])
+    words = (
+        [
+            "quadcruise",
+            "identify",
+            log,
+            "--vehicle",
+            vehicle,
+            "--commands",
+            commands,
+            "--holdout",
+            f"{holdout:g}",
+            "--out",
+            out,
+        ]
+        + (["--mass", f"{mass:g}"] if mass is not None else [])
+        + (["--frame", frame] if frame else [])
+        + (["--report", report] if report else [])
+    )
     bar = Bar("identifying", unit="stage")
-    result = run_identify(log, base, mass=mass, frame=frame, commands=commands, holdout=holdout,
-                          progress=lambda done, total, stage="": bar(done, total, stage))
+    result = run_identify(
+        log,
+        base,
+        mass=mass,
+        frame=frame,
+        commands=commands,
+        holdout=holdout,
+        progress=lambda done, total, stage="": bar(done, total, stage),
+    )
     bar.close()
     result = dataclasses.replace(result, command=shlex.join(words))
     click.echo(str(result.summary()))

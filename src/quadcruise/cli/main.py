@@ -71,17 +71,17 @@ def run() -> None:
     guard_stdout()
     stop_on_sigterm()
     try:
-        if len(sys.argv) <= 1:              # bare `quadcruise`: the usage, as --help gives it
+        if len(sys.argv) <= 1:  # bare `quadcruise`: the usage, as --help gives it
             with click.Context(main, info_name="quadcruise") as ctx:
                 click.echo(main.get_help(ctx))
             code = 0
         else:
             code = main(standalone_mode=False)
-        sys.stdout.flush()                  # a fault of standard output is said here, not at exit
+        sys.stdout.flush()  # a fault of standard output is said here, not at exit
     except click.exceptions.UsageError as exc:
         click.echo(f"error: {exc.format_message()}", err=True)
         sys.exit(2)
-    except OSError as exc:                  # outside a command: --help, --version
+    except OSError as exc:  # outside a command: --help, --version
         click.echo(f"error: {fault_text(exc)}", err=True)
         sys.exit(EXIT_FAULT)
     except (click.exceptions.Abort, KeyboardInterrupt) as exc:

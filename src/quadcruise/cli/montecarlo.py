@@ -15,47 +15,75 @@ __all__ = ["montecarlo", "montecarlo_command", "parse_noise"]
 
 
 @click.command("montecarlo")
-@click.option("--mission", help="Mission: a name, a waypoint CSV or a scenario file (as --scenario); "
-              "default: the scenario's, else circle.")
+@click.option(
+    "--mission",
+    help="Mission: a name, a waypoint CSV or a scenario file (as --scenario); default: the scenario's, else circle.",
+)
 @click.option("--controller", help="Controller name (default: the scenario's, else nlpd).")
 @click.option("-n", "--n", "n", type=int, show_default="1000", help="Number of flights.")
 @click.option("--seed", type=int, show_default="0", help="Seed of every random draw.")
 @click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
 @click.option("--dt", type=float, help="Control period [s] (default 0.001, or the scenario's).")
-@world_options(wind_help="Wind of every flight: constant:WX,WY,WZ | gust:AX,AY,AZ@START+DURATION | "
-               "dryden:light|moderate|severe@ALTITUDE | loss:ROTOR,FRACTION@TIME (comma-separable).", seed=False)
-@click.option("--wind-spread", type=float, show_default="0",
-              help="Std of a random steady horizontal wind per flight [m/s].")
+@world_options(
+    wind_help="Wind of every flight: constant:WX,WY,WZ | gust:AX,AY,AZ@START+DURATION | "
+    "dryden:light|moderate|severe@ALTITUDE | loss:ROTOR,FRACTION@TIME (comma-separable).",
+    seed=False,
+)
+@click.option(
+    "--wind-spread", type=float, show_default="0", help="Std of a random steady horizontal wind per flight [m/s]."
+)
 @click.option("--mass-spread", type=float, show_default="0", help="Relative std of the mass.")
 @click.option("--inertia-spread", type=float, show_default="0", help="Relative std of each inertia.")
 @click.option("--thrust-spread", type=float, show_default="0", help="Relative std of K.")
-@click.option("--bandwidth-spread", type=float, show_default="0",
-              help="Relative std of the actuator bandwidth.")
+@click.option("--bandwidth-spread", type=float, show_default="0", help="Relative std of the actuator bandwidth.")
 @click.option("--yaw-arm-spread", type=float, show_default="0", help="Relative std of d.")
 @click.option("--distribution", type=click.Choice(["normal", "uniform"]), show_default="normal")
 @click.option("--offset", type=float, show_default="0", help="Std of the start position [m].")
-@click.option("--noise", metavar="position=STD,velocity=STD,angle=STD,rate=STD,delay=S",
-              help="Sensor noise and delay.")
-@click.option("--model-error/--no-model-error", default=None, show_default="model-error",
-              help="The controller flies with the nominal model, not each vehicle's own.")
+@click.option("--noise", metavar="position=STD,velocity=STD,angle=STD,rate=STD,delay=S", help="Sensor noise and delay.")
+@click.option(
+    "--model-error/--no-model-error",
+    default=None,
+    show_default="model-error",
+    help="The controller flies with the nominal model, not each vehicle's own.",
+)
 @click.option("--chunk-size", default="auto", show_default=True, help="Flights per task.")
-@click.option("--scheduler", default="local", show_default=True,
-              help="local (a Dask cluster of processes here), none (in this process) or a Dask address.")
+@click.option(
+    "--scheduler",
+    default="local",
+    show_default=True,
+    help="local (a Dask cluster of processes here), none (in this process) or a Dask address.",
+)
 @click.option("--workers", type=int, help="Workers of the local cluster.")
 @click.option("--connect-timeout", type=float, default=10.0, show_default=True, help="[s] for --scheduler ADDRESS.")
-@click.option("--out", type=click.Path(file_okay=False), callback=writable, help="Folder: chunks stream here, so a rerun resumes.")
+@click.option(
+    "--out", type=click.Path(file_okay=False), callback=writable, help="Folder: chunks stream here, so a rerun resumes."
+)
 @click.option("--force", is_flag=True, help="Replace a folder holding something else.")
 @click.option("--resume/--no-resume", default=True, show_default=True)
 @click.option("--format", "fmt", type=click.Choice(["csv", "parquet"]), default="csv", show_default=True)
-@click.option("--require", "requirements", multiple=True, metavar="METRIC<=VALUE",
-              help='Your own pass criterion, e.g. "steady_max_error_m<=0.2" (or <, >=, >; repeatable).')
-@click.option("--max-track-error", "max_track_error_m", type=float, metavar="M",
-              help="Error after the transient [m] beyond which a flight lost track (default: max(1, extent/4)).")
+@click.option(
+    "--require",
+    "requirements",
+    multiple=True,
+    metavar="METRIC<=VALUE",
+    help='Your own pass criterion, e.g. "steady_max_error_m<=0.2" (or <, >=, >; repeatable).',
+)
+@click.option(
+    "--max-track-error",
+    "max_track_error_m",
+    type=float,
+    metavar="M",
+    help="Error after the transient [m] beyond which a flight lost track (default: max(1, extent/4)).",
+)
 @click.option("--case", type=int, help="Fly flight I alone (replays a worst case exactly).")
 @click.option("--worst", type=int, default=5, show_default=True, help="How many worst cases to list.")
 @click.option("--quiet", is_flag=True, help="No progress bar.")
-@click.option("--scenario", type=click.Path(dir_okay=False), metavar="FILE.toml",
-              help="Mission, controller, vehicle, disturbances and a [montecarlo] table from a scenario file.")
+@click.option(
+    "--scenario",
+    type=click.Path(dir_okay=False),
+    metavar="FILE.toml",
+    help="Mission, controller, vehicle, disturbances and a [montecarlo] table from a scenario file.",
+)
 @friendly
 def montecarlo(**options):
     """Fly a population of perturbed vehicles and report the distribution of every metric.

@@ -6,7 +6,8 @@ in :mod:`quadcruise.cli.montecarlo`, which re-exports these."""
 from __future__ import annotations
 
 import warnings
-from typing import TYPE_CHECKING, Callable
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import click
 
@@ -47,32 +48,62 @@ def parse_noise(text: str | None):
     >>> parse_noise("jitter=1")
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: noise spec 'jitter=1': unknown key 'jitter'; keys: position, velocity, angle, rate, delay
+    quadcruise.errors.InputError: noise spec 'jitter=1': unknown key 'jitter'; keys: position, velocity, angle, ...
     """
     if text is None or str(text).strip().lower() in ("", "none"):
         return None
     from quadcruise.disturbances import SensorNoise
     from quadcruise.fields import parse_assignments
 
-    names = {"position": "position_std", "velocity": "velocity_std", "angle": "angle_std",
-             "rate": "rate_std", "delay": "delay"}
+    names = {
+        "position": "position_std",
+        "velocity": "velocity_std",
+        "angle": "angle_std",
+        "rate": "rate_std",
+        "delay": "delay",
+    }
     return SensorNoise(**parse_assignments(text, "noise spec", keys=names, numbers=True))
 
 
-def montecarlo_command(*, mission: str | None = None, controller: str | None = None, n: int | None = None,
-                       seed: int | None = None, duration: float | None = None, dt: float | None = None,
-                       wind: str | None = None, wind_spread: float | None = None, offset: float | None = None,
-                       mass_spread: float | None = None, inertia_spread: float | None = None, noise: str | None = None,
-                       thrust_spread: float | None = None, bandwidth_spread: float | None = None,
-                       yaw_arm_spread: float | None = None, distribution: str | None = None,
-                       model_error: bool | None = None, chunk_size: str | int = "auto", scheduler: str = "local",
-                       workers: int | None = None, connect_timeout: float = 10.0, out: str | None = None,
-                       force: bool = False, resume: bool = True, fmt: str = "csv", case: int | None = None,
-                       worst: int = 5, quiet: bool = False, scenario: str | None = None,
-                       requirements: tuple[str, ...] = (), max_track_error_m: float | None = None,
-                       vehicle: str | None = None, controller_vehicle: str | None = None,
-                       turbulence: str | None = None, log_every: int | None = None,
-                       echo: Callable[[str], None] = click.echo) -> MonteCarloResult | Case:
+def montecarlo_command(
+    *,
+    mission: str | None = None,
+    controller: str | None = None,
+    n: int | None = None,
+    seed: int | None = None,
+    duration: float | None = None,
+    dt: float | None = None,
+    wind: str | None = None,
+    wind_spread: float | None = None,
+    offset: float | None = None,
+    mass_spread: float | None = None,
+    inertia_spread: float | None = None,
+    noise: str | None = None,
+    thrust_spread: float | None = None,
+    bandwidth_spread: float | None = None,
+    yaw_arm_spread: float | None = None,
+    distribution: str | None = None,
+    model_error: bool | None = None,
+    chunk_size: str | int = "auto",
+    scheduler: str = "local",
+    workers: int | None = None,
+    connect_timeout: float = 10.0,
+    out: str | None = None,
+    force: bool = False,
+    resume: bool = True,
+    fmt: str = "csv",
+    case: int | None = None,
+    worst: int = 5,
+    quiet: bool = False,
+    scenario: str | None = None,
+    requirements: tuple[str, ...] = (),
+    max_track_error_m: float | None = None,
+    vehicle: str | None = None,
+    controller_vehicle: str | None = None,
+    turbulence: str | None = None,
+    log_every: int | None = None,
+    echo: Callable[[str], None] = click.echo,
+) -> MonteCarloResult | Case:
     """What ``quadcruise montecarlo`` runs: build the population, fly it (or one case), print
     the summary and the worst flights, write ``out``.
 
@@ -125,7 +156,7 @@ offset, distribution, model_error : optional
     from quadcruise.montecarlo.sweep import run_sweep
 
     whole_number(worst, "--worst")
-    if mission is not None and str(mission).lower().endswith(".toml"):   # a scenario as the mission: as --scenario
+    if mission is not None and str(mission).lower().endswith(".toml"):  # a scenario as the mission: as --scenario
         if scenario is not None:
             raise InputError(f"--mission {mission} and --scenario {scenario}: give the scenario once")
         mission, scenario = None, mission
@@ -148,27 +179,54 @@ offset, distribution, model_error : optional
     sc = load_scenario(scenario) if scenario is not None else None
 
     nominal = vehicle_from_option(vehicle, "--vehicle", sc.vehicle if sc is not None else None)
-    believed = vehicle_from_option(controller_vehicle, "--controller-vehicle",
-                                   sc.controller_vehicle if sc is not None and sc.controller_vehicle else None)
+    believed = vehicle_from_option(
+        controller_vehicle,
+        "--controller-vehicle",
+        sc.controller_vehicle if sc is not None and sc.controller_vehicle else None,
+    )
     environment = None
     if wind is not None or turbulence is not None:
         environment = environment_from_options(wind, turbulence, sc.environment if sc is not None else None)
-        environment = environment if environment is not None else parse_wind("none")    # given as still air
-    with warnings.catch_warnings(record=True) as caught:       # the default drag, said before flying
+        environment = environment if environment is not None else parse_wind("none")  # given as still air
+    with warnings.catch_warnings(record=True) as caught:  # the default drag, said before flying
         warnings.simplefilter("always")
-        spec, n = sweep_spec(mission=mission, controller=controller, n=n, seed=seed, duration=duration, dt=dt,
-                             environment=environment, noise=parse_noise(noise),
-                             scenario=scenario, mass_spread=mass_spread, inertia_spread=inertia_spread,
-                             thrust_spread=thrust_spread, bandwidth_spread=bandwidth_spread, offset=offset,
-                             yaw_arm_spread=yaw_arm_spread, wind_spread=wind_spread, distribution=distribution,
-                             model_error=model_error, requirements=requirements,
-                             max_track_error_m=max_track_error_m, vehicle=nominal, controller_vehicle=believed,
-                             log_every=log_every)
+        spec, n = sweep_spec(
+            mission=mission,
+            controller=controller,
+            n=n,
+            seed=seed,
+            duration=duration,
+            dt=dt,
+            environment=environment,
+            noise=parse_noise(noise),
+            scenario=scenario,
+            mass_spread=mass_spread,
+            inertia_spread=inertia_spread,
+            thrust_spread=thrust_spread,
+            bandwidth_spread=bandwidth_spread,
+            offset=offset,
+            yaw_arm_spread=yaw_arm_spread,
+            wind_spread=wind_spread,
+            distribution=distribution,
+            model_error=model_error,
+            requirements=requirements,
+            max_track_error_m=max_track_error_m,
+            vehicle=nominal,
+            controller_vehicle=believed,
+            log_every=log_every,
+        )
     notes = [str(w.message) for w in caught]
-    if nominal is not None and spec.controller_vehicle is None and spec.population.model_error \
-            and nominal != Vehicle.paper():
-        notes.insert(0, f"the controllers are told the nominal vehicle ({vehicle}): their only model error is the "
-                        "spreads'; --controller-vehicle paper (or KEY=VALUE,...) gives them another belief")
+    if (
+        nominal is not None
+        and spec.controller_vehicle is None
+        and spec.population.model_error
+        and nominal != Vehicle.paper()
+    ):
+        notes.insert(
+            0,
+            f"the controllers are told the nominal vehicle ({vehicle}): their only model error is the "
+            "spreads'; --controller-vehicle paper (or KEY=VALUE,...) gives them another belief",
+        )
     if case is None:
         spec.population.check_perturbs(n)
     else:
@@ -187,13 +245,26 @@ offset, distribution, model_error : optional
         note(line)
     bar = None if quiet else Bar("flying", unit="flight")
     try:
-        res = run_sweep(spec, n, chunk_size=chunk_size, scheduler=scheduler, workers=workers, out=out,
-                        resume=resume, force=force, fmt=fmt, progress=bar, connect_timeout=connect_timeout)
+        res = run_sweep(
+            spec,
+            n,
+            chunk_size=chunk_size,
+            scheduler=scheduler,
+            workers=workers,
+            out=out,
+            resume=resume,
+            force=force,
+            fmt=fmt,
+            progress=bar,
+            connect_timeout=connect_timeout,
+        )
     finally:
         if bar is not None:
             bar.close()
     echo(res.summary_text(worst=worst))
     info = res.info
-    echo(f"{info.get('flown', 0):,} flights flown ({info.get('resumed', 0):,} resumed) in {info.get('wall_s', 0):.1f} s "
-         f"on {info.get('scheduler')}" + (f"; wrote {out}" if out is not None else ""))
+    echo(
+        f"{info.get('flown', 0):,} flights flown ({info.get('resumed', 0):,} resumed) in {info.get('wall_s', 0):.1f} s "
+        f"on {info.get('scheduler')}" + (f"; wrote {out}" if out is not None else "")
+    )
     return res

@@ -124,8 +124,14 @@ def mission_from_options(text: str, params: tuple[str, ...], smooth: bool):
     return mission_from_name(text, **mparams)
 
 
-def flight_from_options(mission: str, controller: str | None, mission_params: tuple[str, ...],
-                        controller_params: tuple[str, ...], poles_text: str | None, smooth: bool):
+def flight_from_options(
+    mission: str,
+    controller: str | None,
+    mission_params: tuple[str, ...],
+    controller_params: tuple[str, ...],
+    poles_text: str | None,
+    smooth: bool,
+):
     """What ``quadcruise fly MISSION ...`` flies: from a mission name, a waypoint CSV or a scenario
     file, with the options applied to it.
 
@@ -153,13 +159,19 @@ def flight_from_options(mission: str, controller: str | None, mission_params: tu
     if not mission.lower().endswith(".toml"):
         if smooth and not mission.lower().endswith(".csv"):
             raise InputError(f"--smooth turns a waypoint CSV into a minimum-snap path; {mission!r} is not one")
-        return (mission_from_options(mission, mission_params, smooth),
-                controller_from_options(controller, controller_params, poles_text), {}, None)
+        return (
+            mission_from_options(mission, mission_params, smooth),
+            controller_from_options(controller, controller_params, poles_text),
+            {},
+            None,
+        )
     from quadcruise.workflows.scenario import load_scenario
 
     if smooth:
-        raise InputError("--smooth turns a waypoint CSV into a minimum-snap path; a scenario file "
-                         "says its mission kind itself (kind = \"minsnap\")")
+        raise InputError(
+            "--smooth turns a waypoint CSV into a minimum-snap path; a scenario file "
+            'says its mission kind itself (kind = "minsnap")'
+        )
     scenario = load_scenario(mission)
     the_mission = scenario.mission or mission_from_name("circle")
     if mission_params:

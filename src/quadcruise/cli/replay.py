@@ -12,18 +12,37 @@ __all__ = ["replay"]
 
 @click.command("replay")
 @click.argument("pwm_csv", metavar="CMDS.csv")
-@click.option("-o", "--out", "out", required=True, metavar="STATES.csv", callback=writable_with(".csv"),
-              type=click.Path(dir_okay=False),
-              help="Where to write the states: t,x,y,z,vx,vy,vz,phi,theta,psi,p,q,r,F1..F4 for the paper's plant; "
-                   "t,x,y,z,vx,vy,vz,qw,qx,qy,qz,p,q,r,w1..wn,phi,theta,psi for a rotor-plant vehicle.")
-@click.option("--vehicle", "vehicle_name", default=None, metavar="NAME|FILE.toml",
-              help="The vehicle: a preset (paper, crazyflie, hummingbird, iris) or a vehicle file "
-                   "([vehicle] preset = \"iris\" and the fields to change). Default: the paper's Table I.")
-@click.option("--ground", is_flag=True,
-              help="A ground at z = 0 (rotor-plant vehicles): the vehicle starts and rests on it; meeting it faster "
-                   "than the vehicle's touchdown_speed, or upside down, ends the flight 'crashed'.")
-@click.option("--max-step", default=None, type=float,
-              help="Longest RK4 substep [s]. Default: 1e-3 for the paper's plant, 1e-4 for a rotor-plant vehicle.")
+@click.option(
+    "-o",
+    "--out",
+    "out",
+    required=True,
+    metavar="STATES.csv",
+    callback=writable_with(".csv"),
+    type=click.Path(dir_okay=False),
+    help="Where to write the states: t,x,y,z,vx,vy,vz,phi,theta,psi,p,q,r,F1..F4 for the paper's plant; "
+    "t,x,y,z,vx,vy,vz,qw,qx,qy,qz,p,q,r,w1..wn,phi,theta,psi for a rotor-plant vehicle.",
+)
+@click.option(
+    "--vehicle",
+    "vehicle_name",
+    default=None,
+    metavar="NAME|FILE.toml",
+    help="The vehicle: a preset (paper, crazyflie, hummingbird, iris) or a vehicle file "
+    '([vehicle] preset = "iris" and the fields to change). Default: the paper\'s Table I.',
+)
+@click.option(
+    "--ground",
+    is_flag=True,
+    help="A ground at z = 0 (rotor-plant vehicles): the vehicle starts and rests on it; meeting it faster "
+    "than the vehicle's touchdown_speed, or upside down, ends the flight 'crashed'.",
+)
+@click.option(
+    "--max-step",
+    default=None,
+    type=float,
+    help="Longest RK4 substep [s]. Default: 1e-3 for the paper's plant, 1e-4 for a rotor-plant vehicle.",
+)
 @friendly
 def replay(pwm_csv: str, out: str, vehicle_name: str | None, ground: bool, max_step: float | None) -> None:
     """Replay commands open loop and write the states.
@@ -63,24 +82,35 @@ def replay(pwm_csv: str, out: str, vehicle_name: str | None, ground: bool, max_s
         raise click.BadParameter(f"{out} is the input file: write the states elsewhere", param_hint="'-o'")
     vehicle = Vehicle.paper() if vehicle_name is None else Vehicle.load(vehicle_name)
     if getattr(vehicle, "batch_size", None) is not None:
-        raise InputError(f"{vehicle_name}: replay flies one vehicle and writes its states: give one value per field, "
-                         f"not a list")
+        raise InputError(
+            f"{vehicle_name}: replay flies one vehicle and writes its states: give one value per field, not a list"
+        )
     if ground and not isinstance(vehicle, RotorVehicle):
-        raise InputError("option '--ground': the paper's plant has no ground: give a rotor-plant --vehicle "
-                         "(crazyflie, hummingbird, iris or a file)")
+        raise InputError(
+            "option '--ground': the paper's plant has no ground: give a rotor-plant --vehicle "
+            "(crazyflie, hummingbird, iris or a file)"
+        )
 
     if isinstance(vehicle, RotorVehicle):
         schedule = workflow.read_speed_csv(pwm_csv, vehicle.n_rotors, progress=Bar(f"reading {pwm_csv}", unit="row"))
-        result = workflow.replay_rotors(schedule, vehicle, max_step=workflow.ROTOR_MAX_STEP if max_step is None
-                                        else max_step, ground=ground, progress=Bar("flying", unit="row"))
+        result = workflow.replay_rotors(
+            schedule,
+            vehicle,
+            max_step=workflow.ROTOR_MAX_STEP if max_step is None else max_step,
+            ground=ground,
+            progress=Bar("flying", unit="row"),
+        )
         workflow.write_rotor_states_csv(result, out)
     else:
         schedule = workflow.read_duty_csv(pwm_csv, progress=Bar(f"reading {pwm_csv}", unit="row"))
-        result = workflow.replay(schedule, vehicle, max_step=1e-3 if max_step is None else max_step,
-                                 progress=Bar("flying", unit="row"))
+        result = workflow.replay(
+            schedule, vehicle, max_step=1e-3 if max_step is None else max_step, progress=Bar("flying", unit="row")
+        )
         workflow.write_states_csv(result, out, progress=Bar(f"writing {out}", unit="row"))
-    click.echo(f"wrote {len(result.t)} states to {out} "
-               f"(t = {result.t[0]:g} .. {result.t[-1]:g} s, final z = {result.final_state[0, 2]:.4f} m)")
+    click.echo(
+        f"wrote {len(result.t)} states to {out} "
+        f"(t = {result.t[0]:g} .. {result.t[-1]:g} s, final z = {result.final_state[0, 2]:.4f} m)"
+    )
     if not result.ok[0]:
         click.echo(f"the flight stopped early: {result.status_text(0)}", err=True)
-        sys.exit(1)             # diverged or crashed: the states up to then are written
+        sys.exit(1)  # diverged or crashed: the states up to then are written

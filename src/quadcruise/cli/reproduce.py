@@ -13,14 +13,24 @@ __all__ = ["reproduce"]
 
 
 @click.command("reproduce")
-@click.option("--out", "out", default="quadcruise-out", show_default=True, type=click.Path(file_okay=False),
-              callback=writable,
-              help="Folder for metrics.json, figures, traces and report.md.")
+@click.option(
+    "--out",
+    "out",
+    default="quadcruise-out",
+    show_default=True,
+    type=click.Path(file_okay=False),
+    callback=writable,
+    help="Folder for metrics.json, figures, traces and report.md.",
+)
 @FORMAT_OPTION
 @FORCE_OPTION
 @REPORT_OPTION
-@click.option("--scenario", type=click.Path(dir_okay=False), metavar="FILE.toml",
-              help="Reproduce with a scenario's vehicle and control period (e.g. the 1.4 kg Qball-X4).")
+@click.option(
+    "--scenario",
+    type=click.Path(dir_okay=False),
+    metavar="FILE.toml",
+    help="Reproduce with a scenario's vehicle and control period (e.g. the 1.4 kg Qball-X4).",
+)
 @friendly
 def reproduce(out, fmt, force, report, scenario):
     """Reproduce the paper: both controllers on the circle, square and step, beside its numbers;
@@ -57,13 +67,23 @@ def reproduce(out, fmt, force, report, scenario):
 
         sc = load_scenario(scenario)
         settings = {"vehicle": sc.vehicle, "dt": sc.dt}
-        unused = [name for name, part in (("[mission]", sc.mission), ("[controller]", sc.controller),
-                                          ("[disturbances]", sc.environment or sc.sensor_noise),
-                                          ("[compare]", sc.compare), ("[montecarlo]", sc.montecarlo))
-                  if part] + [f"[simulation] {k}" for k in sc.simulation if k != "dt"]
+        unused = [
+            name
+            for name, part in (
+                ("[mission]", sc.mission),
+                ("[controller]", sc.controller),
+                ("[disturbances]", sc.environment or sc.sensor_noise),
+                ("[compare]", sc.compare),
+                ("[montecarlo]", sc.montecarlo),
+            )
+            if part
+        ] + [f"[simulation] {k}" for k in sc.simulation if k != "dt"]
         if unused:
-            click.echo(f"warning: {scenario}: reproduce flies the paper's missions and controllers with the "
-                       f"scenario's vehicle and dt only; not used: {', '.join(unused)}", err=True)
+            click.echo(
+                f"warning: {scenario}: reproduce flies the paper's missions and controllers with the "
+                f"scenario's vehicle and dt only; not used: {', '.join(unused)}",
+                err=True,
+            )
     with Bar("flying", unit="flight") as flown:
         rep = run_reproduce(progress=flown, **settings)
     click.echo(results_table(rep))
@@ -77,6 +97,5 @@ def reproduce(out, fmt, force, report, scenario):
         write_html_report(report, **reproduction_report(rep, written_figures(out)))
         click.echo(f"wrote report {report}")
     click.echo(f"wrote {out}/report.md, metrics.json, figures and traces in {time.perf_counter() - start:.1f} s")
-    if rep.failed:                          # each one's warning names it: "circle with nlpd: vehicle 0 lost track ..."
-        sys.exit(1)             # a flight did not finish (e.g. a --scenario vehicle the paper's gains cannot fly)
-
+    if rep.failed:  # each one's warning names it: "circle with nlpd: vehicle 0 lost track ..."
+        sys.exit(1)  # a flight did not finish (e.g. a --scenario vehicle the paper's gains cannot fly)

@@ -17,38 +17,85 @@ __all__ = ["tune"]
 
 @click.command("tune")
 @click.argument("mission", metavar="MISSION")
-@click.option("-m", "--mission-param", "mission_params", multiple=True, metavar="KEY=VALUE",
-              help="Mission parameter, e.g. -m size=2 (repeatable).")
+@click.option(
+    "-m",
+    "--mission-param",
+    "mission_params",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Mission parameter, e.g. -m size=2 (repeatable).",
+)
 @click.option("--controller", help="Controller name (default: the scenario's, else nlpd).")
-@click.option("-c", "--controller-param", "controller_params", multiple=True, metavar="KEY=VALUE",
-              help="Controller parameter kept during the search, e.g. -c derivative=error (repeatable).")
-@click.option("--gains", metavar="NAMES", help="Gains to search, comma-separated: position.kp,position.kd "
-              "(the default), or a PD pair by its poles: position.wn,position.zeta.")
-@click.option("--bounds", multiple=True, metavar="NAME=LOW:HIGH",
-              help="Bounds of a gain (repeatable); default: a decade either side of its value.")
-@click.option("--target", "targets", multiple=True, metavar="METRIC=VALUE[+-TOL]",
-              help="A value to reach, e.g. rise_time_s=1 or overshoot_pct=4+-1.5 (repeatable).")
-@click.option("--require", "require", multiple=True, metavar="METRIC<=VALUE",
-              help="A bound every candidate must keep, e.g. 'overshoot_pct<=5' (<, >=, > too; repeatable).")
+@click.option(
+    "-c",
+    "--controller-param",
+    "controller_params",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Controller parameter kept during the search, e.g. -c derivative=error (repeatable).",
+)
+@click.option(
+    "--gains",
+    metavar="NAMES",
+    help="Gains to search, comma-separated: position.kp,position.kd "
+    "(the default), or a PD pair by its poles: position.wn,position.zeta.",
+)
+@click.option(
+    "--bounds",
+    multiple=True,
+    metavar="NAME=LOW:HIGH",
+    help="Bounds of a gain (repeatable); default: a decade either side of its value.",
+)
+@click.option(
+    "--target",
+    "targets",
+    multiple=True,
+    metavar="METRIC=VALUE[+-TOL]",
+    help="A value to reach, e.g. rise_time_s=1 or overshoot_pct=4+-1.5 (repeatable).",
+)
+@click.option(
+    "--require",
+    "require",
+    multiple=True,
+    metavar="METRIC<=VALUE",
+    help="A bound every candidate must keep, e.g. 'overshoot_pct<=5' (<, >=, > too; repeatable).",
+)
 @click.option("--minimize", multiple=True, metavar="METRIC", help="A metric to make small (repeatable).")
-@click.option("--samples", type=int, default=1, show_default=True,
-              help="Perturbed vehicles each candidate flies (a robust tune with the spreads below).")
-@click.option("--objective", default="worst", show_default=True,
-              help="Over a candidate's vehicles: worst, median, or a quantile such as q90.")
+@click.option(
+    "--samples",
+    type=int,
+    default=1,
+    show_default=True,
+    help="Perturbed vehicles each candidate flies (a robust tune with the spreads below).",
+)
+@click.option(
+    "--objective",
+    default="worst",
+    show_default=True,
+    help="Over a candidate's vehicles: worst, median, or a quantile such as q90.",
+)
 @click.option("--mass-spread", type=float, default=0.0, show_default=True, help="Relative std of the mass.")
 @click.option("--inertia-spread", type=float, default=0.0, show_default=True, help="Relative std of each inertia.")
-@world_options(wind_help="Wind of every flight (as quadcruise montecarlo --wind), e.g. dryden:moderate@10.",
-               seed=False)
-@click.option("--wind-spread", type=float, default=0.0, show_default=True,
-              help="Std of a random steady horizontal wind per vehicle [m/s].")
+@world_options(wind_help="Wind of every flight (as quadcruise montecarlo --wind), e.g. dryden:moderate@10.", seed=False)
+@click.option(
+    "--wind-spread",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="Std of a random steady horizontal wind per vehicle [m/s].",
+)
 @click.option("--noise", metavar="position=STD,...,delay=S", help="Sensor noise and delay.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the search and the population.")
 @click.option("--budget", type=int, default=100, show_default=True, help="At most this many generations.")
 @click.option("--popsize", type=int, help="Candidates per generation (default: 15 per gain).")
 @click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
 @click.option("--dt", type=float, help="Control period [s] (default 0.001).")
-@click.option("--out", type=click.Path(file_okay=False), callback=writable, help="Folder: scenario.toml with the tuned gains, "
-              "tune.json, history, flights, figure.")
+@click.option(
+    "--out",
+    type=click.Path(file_okay=False),
+    callback=writable,
+    help="Folder: scenario.toml with the tuned gains, tune.json, history, flights, figure.",
+)
 @click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
 @click.option("--quiet", is_flag=True, help="No progress lines.")
 @friendly
@@ -116,4 +163,4 @@ def tune(**options):
             ``--force``: replace a folder quadcruise did not write; ``--quiet``: no progress.
     """
     if not tune_command(**options, echo=click.echo).met:
-        sys.exit(1)             # the tuned gains miss a target or a requirement (the summary says which)
+        sys.exit(1)  # the tuned gains miss a target or a requirement (the summary says which)

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import contextlib
 import shlex
-from typing import Callable
+from collections.abc import Callable
 
 import click
 
@@ -44,20 +44,51 @@ def command_line(mission: str, options: dict) -> str:
     return " ".join(shlex.quote(w) for w in words)
 
 
-DEFAULTS = {"controller": None, "samples": 1, "objective": "worst", "mass_spread": 0.0, "inertia_spread": 0.0,
-            "wind_spread": 0.0, "seed": 0, "budget": 100}
+DEFAULTS = {
+    "controller": None,
+    "samples": 1,
+    "objective": "worst",
+    "mass_spread": 0.0,
+    "inertia_spread": 0.0,
+    "wind_spread": 0.0,
+    "seed": 0,
+    "budget": 100,
+}
 """Options left out of the recorded command line when they have these values."""
 
 
-def tune_command(*, mission: str, mission_params: tuple = (), controller: str | None = None,
-                 controller_params: tuple = (), gains: str | None = None,
-                 bounds: tuple = (), targets: tuple = (), require: tuple = (), minimize: tuple = (),
-                 samples: int = 1, objective: str = "worst", mass_spread: float = 0.0, inertia_spread: float = 0.0,
-                 wind: str | None = None, wind_spread: float = 0.0, noise: str | None = None, seed: int = 0,
-                 budget: int = 100, popsize: int | None = None, duration: float | None = None,
-                 dt: float | None = None, out: str | None = None, force: bool = False, quiet: bool = False,
-                 vehicle: str | None = None, controller_vehicle: str | None = None, turbulence: str | None = None,
-                 log_every: int | None = None, echo: Callable[..., None] = click.echo):
+def tune_command(
+    *,
+    mission: str,
+    mission_params: tuple = (),
+    controller: str | None = None,
+    controller_params: tuple = (),
+    gains: str | None = None,
+    bounds: tuple = (),
+    targets: tuple = (),
+    require: tuple = (),
+    minimize: tuple = (),
+    samples: int = 1,
+    objective: str = "worst",
+    mass_spread: float = 0.0,
+    inertia_spread: float = 0.0,
+    wind: str | None = None,
+    wind_spread: float = 0.0,
+    noise: str | None = None,
+    seed: int = 0,
+    budget: int = 100,
+    popsize: int | None = None,
+    duration: float | None = None,
+    dt: float | None = None,
+    out: str | None = None,
+    force: bool = False,
+    quiet: bool = False,
+    vehicle: str | None = None,
+    controller_vehicle: str | None = None,
+    turbulence: str | None = None,
+    log_every: int | None = None,
+    echo: Callable[..., None] = click.echo,
+):
     """What ``quadcruise tune`` runs: build the tune, run it, print its progress and summary,
     write ``out``.
 
@@ -108,15 +139,36 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str | 
     from quadcruise.montecarlo.population import Population
     from quadcruise.tune import tune
 
-    given = {k: v for k, v in dict(mission_params=mission_params, controller=controller,
-                                   controller_params=controller_params, gains=gains,
-                                   bounds=bounds, targets=targets, require=require, minimize=minimize,
-                                   samples=samples, objective=objective, mass_spread=mass_spread,
-                                   inertia_spread=inertia_spread, wind=wind, wind_spread=wind_spread, noise=noise,
-                                   seed=seed, budget=budget, popsize=popsize, duration=duration, dt=dt,
-                                   vehicle=vehicle, controller_vehicle=controller_vehicle, turbulence=turbulence,
-                                   log_every=log_every).items()
-             if DEFAULTS.get(k, object()) != v}
+    given = {
+        k: v
+        for k, v in dict(
+            mission_params=mission_params,
+            controller=controller,
+            controller_params=controller_params,
+            gains=gains,
+            bounds=bounds,
+            targets=targets,
+            require=require,
+            minimize=minimize,
+            samples=samples,
+            objective=objective,
+            mass_spread=mass_spread,
+            inertia_spread=inertia_spread,
+            wind=wind,
+            wind_spread=wind_spread,
+            noise=noise,
+            seed=seed,
+            budget=budget,
+            popsize=popsize,
+            duration=duration,
+            dt=dt,
+            vehicle=vehicle,
+            controller_vehicle=controller_vehicle,
+            turbulence=turbulence,
+            log_every=log_every,
+        ).items()
+        if DEFAULTS.get(k, object()) != v
+    }
     from quadcruise.cli.world import flight_world
     from quadcruise.errors import InputError, whole_number
 
@@ -140,8 +192,9 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str | 
     else:
         the_mission = mission_from_options(mission, mission_params, False)
         the_controller = controller_from_options(controller, controller_params, None)
-    world, notes = flight_world(vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind,
-                                turbulence=turbulence, scenario=sc)
+    world, notes = flight_world(
+        vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind, turbulence=turbulence, scenario=sc
+    )
     environment = world["environment"]
     if wind_spread > 0 and not any("wind acts only through drag" in line for line in notes):
         from quadcruise.disturbances.environment import default_drag_text, with_drag
@@ -152,17 +205,35 @@ def tune_command(*, mission: str, mission_params: tuple = (), controller: str | 
     kwargs.update(vehicle=world["vehicle"], controller_vehicle=world["controller_vehicle"])
     if log_every is not None:
         kwargs["log_dt"] = log_every * kwargs["dt"]
-    population = Population(mass_spread=mass_spread, inertia_spread=inertia_spread, wind_spread=wind_spread,
-                            environment=environment if environment is not None and environment.parts else None,
-                            noise=sensors)
+    population = Population(
+        mass_spread=mass_spread,
+        inertia_spread=inertia_spread,
+        wind_spread=wind_spread,
+        environment=environment if environment is not None and environment.parts else None,
+        noise=sensors,
+    )
     from quadcruise.cli.feedback import Bar
 
     with contextlib.nullcontext() if quiet else Bar("tuning", unit="generation") as progress:
-        result = tune(the_mission, the_controller, gains=gains, bounds=bounds, targets=targets, require=require,
-                      minimize=minimize, population=population, samples=samples, objective=objective, seed=seed,
-                      budget=budget, popsize=popsize, progress=progress, command=command_line(mission, given),
-                      **kwargs)
-    for line in notes:                  # after tune() has checked its own input: an error stays one line
+        result = tune(
+            the_mission,
+            the_controller,
+            gains=gains,
+            bounds=bounds,
+            targets=targets,
+            require=require,
+            minimize=minimize,
+            population=population,
+            samples=samples,
+            objective=objective,
+            seed=seed,
+            budget=budget,
+            popsize=popsize,
+            progress=progress,
+            command=command_line(mission, given),
+            **kwargs,
+        )
+    for line in notes:  # after tune() has checked its own input: an error stays one line
         echo(f"note: {line}", err=True)
     echo(result.summary_text())
     if out is not None:

@@ -76,8 +76,11 @@ or give the vehicle's fields, KEY=VALUE,..., or a FILE.toml
         message = str(exc)
         if message.startswith(option):
             raise
-        hint = ("; or give the vehicle's fields, KEY=VALUE,..., or a FILE.toml"
-                if message.startswith("unknown vehicle preset") else "")
+        hint = (
+            "; or give the vehicle's fields, KEY=VALUE,..., or a FILE.toml"
+            if message.startswith("unknown vehicle preset")
+            else ""
+        )
         raise InputError(f"{option} {text!r}: {message}{hint}") from None
 
 
@@ -106,5 +109,7 @@ def refuse_vehicle_fields(mission_params: dict, mission_cls, option: str = "-m")
     for key, value in mission_params.items():
         if key in {f.name for f in dataclasses.fields(Vehicle)} and key not in own:
             shown = ",".join(f"{v:g}" for v in value) if isinstance(value, tuple) else f"{value}"
-            raise InputError(f"{option} {key}={shown}: {key} is a field of the vehicle, not of the mission: "
-                             f"give it as --vehicle {key}={shown}")
+            raise InputError(
+                f"{option} {key}={shown}: {key} is a field of the vehicle, not of the mission: "
+                f"give it as --vehicle {key}={shown}"
+            )

@@ -37,8 +37,12 @@ from quadcruise.protocols import ControllerLike
 class _Registry(Mapping):
     """Controller name -> class, importing each module on first use."""
 
-    _where = {"nlpd": ("quadcruise.control.position", "NLPD"), "gonzalez": ("quadcruise.control.baselines", "Gonzalez"),
-              "se3": ("quadcruise.control.se3", "SE3"), "cascade": ("quadcruise.control.cascade", "Cascade")}
+    _where = {
+        "nlpd": ("quadcruise.control.position", "NLPD"),
+        "gonzalez": ("quadcruise.control.baselines", "Gonzalez"),
+        "se3": ("quadcruise.control.se3", "SE3"),
+        "cascade": ("quadcruise.control.cascade", "Cascade"),
+    }
 
     def __getitem__(self, name: str) -> type[Controller]:
         module, attr = self._where[name]
@@ -128,18 +132,28 @@ def as_controller(obj: Any, where: str = "fly()") -> ControllerLike:
     >>> as_controller(3.0)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.ArgumentTypeError: fly() argument controller must be a name (nlpd, gonzalez, se3, cascade) or an object with name, function, gains() and memory() (quadcruise.protocols.ControllerLike), got float 3.0
+    quadcruise.errors.ArgumentTypeError: fly() argument controller must be a name (nlpd, gonzalez, se3, ...
     """
     if isinstance(obj, str):
         return controller_from_name(obj)
     if inspect.isclass(obj) or not isinstance(obj, ControllerLike) or not callable(getattr(obj, "function", None)):
-        checks.fail(where, "controller", obj, f"a name ({', '.join(CONTROLLERS)}) or an object with name, function, "
-                    "gains() and memory() (quadcruise.protocols.ControllerLike)")
+        checks.fail(
+            where,
+            "controller",
+            obj,
+            f"a name ({', '.join(CONTROLLERS)}) or an object with name, function, "
+            "gains() and memory() (quadcruise.protocols.ControllerLike)",
+        )
     if not compiled_for_engine(obj.function):
-        checks.fail(where, "controller", obj, "an object whose function is compiled with CONTROLLER_SIG",
-                    hint=f"its function {getattr(obj.function, '__name__', '?')!r} is {_compiled_how(obj.function)}: "
-                    "compile it with `from numba import njit; from quadcruise.layout import CONTROLLER_SIG` "
-                    "and `@njit(CONTROLLER_SIG, cache=True)` above its def")
+        checks.fail(
+            where,
+            "controller",
+            obj,
+            "an object whose function is compiled with CONTROLLER_SIG",
+            hint=f"its function {getattr(obj.function, '__name__', '?')!r} is {_compiled_how(obj.function)}: "
+            "compile it with `from numba import njit; from quadcruise.layout import CONTROLLER_SIG` "
+            "and `@njit(CONTROLLER_SIG, cache=True)` above its def",
+        )
     return obj
 
 
@@ -169,18 +183,20 @@ def compiled_for_engine(function: Any) -> bool:
     if signatures is not None and hasattr(function, "py_func"):
         if tuple(CONTROLLER_SIG.args) in [tuple(sig) for sig in signatures]:
             return True
-        try:                            # an @njit without a signature compiles on first use: do it now
+        try:  # an @njit without a signature compiles on first use: do it now
             function.compile(CONTROLLER_SIG)
-        except Exception:               # noqa: BLE001 - numba's typing errors: it cannot take the signature
+        except Exception:  # noqa: BLE001 - numba's typing errors: it cannot take the signature
             return False
         return True
-    return hasattr(function, "_numba_type_") or hasattr(function, "address")    # a cfunc or a wrapped pointer
+    return hasattr(function, "_numba_type_") or hasattr(function, "address")  # a cfunc or a wrapped pointer
 
 
 def _compiled_how(function: Any) -> str:
     if hasattr(function, "py_func"):
-        return "compiled by numba without CONTROLLER_SIG (its signatures: " \
+        return (
+            "compiled by numba without CONTROLLER_SIG (its signatures: "
             f"{', '.join(str(s) for s in function.signatures) or 'none yet'})"
+        )
     plain = inspect.isfunction(function) or inspect.ismethod(function)
     return "a plain Python function" if plain else f"a {type(function).__name__}"
 
@@ -201,8 +217,11 @@ def controller_record(controller: ControllerLike) -> dict:
     to_dict = getattr(controller, "to_dict", None)
     if callable(to_dict):
         return to_dict()
-    return {"name": str(controller.name), "gains": [float(g) for g in np.asarray(controller.gains()).ravel()],
-            "memory_size": int(np.asarray(controller.memory()).size)}
+    return {
+        "name": str(controller.name),
+        "gains": [float(g) for g in np.asarray(controller.gains()).ravel()],
+        "memory_size": int(np.asarray(controller.memory()).size),
+    }
 
 
 def __getattr__(name: str):
@@ -213,6 +232,16 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-__all__ = ["CONTROLLERS", "NLPD", "Gonzalez", "SE3", "Cascade", "Controller", "ControllerLike", "as_controller",
-           "compiled_for_engine",
-           "controller_from_name", "controller_record"]
+__all__ = [
+    "CONTROLLERS",
+    "NLPD",
+    "Gonzalez",
+    "SE3",
+    "Cascade",
+    "Controller",
+    "ControllerLike",
+    "as_controller",
+    "compiled_for_engine",
+    "controller_from_name",
+    "controller_record",
+]

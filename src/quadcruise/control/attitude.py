@@ -124,9 +124,9 @@ def attitude_law(phi_d, theta_d, psi_d, phi, theta, psi, p, q, r, k, g, integral
     u2s, i_phi, h1 = pid_axis(phi_d - phi, p, i_phi, g[ATT_KP], g[ATT_KI], g[ATT_KD], lim, dt)
     u3s, i_theta, h2 = pid_axis(theta_d - theta, q, i_theta, g[ATT_KP], g[ATT_KI], g[ATT_KD], lim, dt)
     u4s, i_psi, h3 = pid_axis(wrap_angle(psi_d - psi), r, i_psi, g[YAW_KP], g[YAW_KI], g[YAW_KD], lim, dt)
-    U2 = (u2s - k1 * q * r) / k2                                             # (13)
-    U3 = (u3s - k3 * p * r) / k4                                             # (13)
-    U4 = (u4s - k5 * p * q) / k6                                             # (13)
+    U2 = (u2s - k1 * q * r) / k2  # (13)
+    U3 = (u3s - k3 * p * r) / k4  # (13)
+    U4 = (u4s - k5 * p * q) / k6  # (13)
     flags = FLAG_INTEGRATOR_HOLD if (h1 or h2 or h3) else 0
     return (U2, U3, U4), (i_phi, i_theta, i_psi), flags
 
@@ -164,8 +164,15 @@ def attitude_gains(gains):
         The attitude gains, ATT_GAINS entries laid out as ``ATT_*``/``YAW_*``: kp [1/s^2],
         ki [1/s^3], kd [1/s] of roll and pitch, the same of yaw, and i_limit [rad/s^2].
     """
-    return (gains[ATT_KP], gains[ATT_KI], gains[ATT_KD], gains[YAW_KP], gains[YAW_KI],
-            gains[YAW_KD], gains[ATT_I_LIMIT])
+    return (
+        gains[ATT_KP],
+        gains[ATT_KI],
+        gains[ATT_KD],
+        gains[YAW_KP],
+        gains[YAW_KI],
+        gains[YAW_KD],
+        gains[ATT_I_LIMIT],
+    )
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -203,7 +210,19 @@ def decoupled_attitude(x, phi_d, theta_d, psi_d, vp, g, mem, dt):
         FLAG_INTEGRATOR_HOLD if anti-windup held any integral, else 0.
     """
     U, integrals, flags = attitude_law(
-        phi_d, theta_d, psi_d, x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R],
-        decoupling_constants(vp), attitude_gains(g), (mem[0], mem[1], mem[2]), dt)
+        phi_d,
+        theta_d,
+        psi_d,
+        x[PHI],
+        x[THETA],
+        x[PSI],
+        x[P],
+        x[Q],
+        x[R],
+        decoupling_constants(vp),
+        attitude_gains(g),
+        (mem[0], mem[1], mem[2]),
+        dt,
+    )
     mem[0], mem[1], mem[2] = integrals
     return U[0], U[1], U[2], flags

@@ -23,7 +23,8 @@ the SMALL-ANGLE relation of eqs (5)-(6) in the yaw frame at U1 ~ m g,
 i.e. without the paper's inverse model (eqs 16, 19): at large tilt the vehicle gets
 g tan(u/g) > u. Working in the yaw frame makes the law the same at any held yaw (at yaw 0,
 f = x and l = y: theta_d = u_x / g, phi_d = -u_y / g); mapped in the earth frame instead, the
-axes would mix at yaw away from 0 (146 % overshoot on a 1 m step at 45 degrees). Setpoints are limited to ``max_tilt`` (FLAG_TILT_LIMIT). Altitude
+axes would mix at yaw away from 0 (146 % overshoot on a 1 m step at 45 degrees). Setpoints are limited to
+``max_tilt`` (FLAG_TILT_LIMIT). Altitude
 is the same linear PD with tilt-compensated thrust as ``nlpd``, yaw holds the mission's yaw,
 and the attitude loop is the same decoupled PID (eqs 13-15).
 
@@ -183,14 +184,13 @@ def gonzalez(t, dt, x, ref, vp, gains, mem, cmd):
     kp, kd, ap, ad, tilt = gains[KP_XY], gains[KD_XY], gains[SAT_P], gains[SAT_D], gains[MAX_TILT]
     spsi, cpsi = math.sin(x[PSI]), math.cos(x[PSI])
     ex, ey, evx, evy = ref[REF_X] - x[X], ref[REF_Y] - x[Y], ref[REF_VX] - x[VX], ref[REF_VY] - x[VY]
-    uf = saturated_pd(cpsi * ex + spsi * ey, cpsi * evx + spsi * evy, kp, kd, ap, ad)       # forward
-    ul = saturated_pd(cpsi * ey - spsi * ex, cpsi * evy - spsi * evx, kp, kd, ap, ad)       # left
+    uf = saturated_pd(cpsi * ex + spsi * ey, cpsi * evx + spsi * evy, kp, kd, ap, ad)  # forward
+    ul = saturated_pd(cpsi * ey - spsi * ex, cpsi * evy - spsi * evx, kp, kd, ap, ad)  # left
     uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ])
     g = vp[P_G]
-    U1, flags = thrust_for_tilt(uz, math.cos(x[PHI]) * math.cos(x[THETA]), vp[P_M], g, vp[P_K],
-                                gains[COS_MAX_TILT])
-    theta_d, flags = tilt_setpoint(uf / g, False, tilt, flags)           # eq (5), small angle, yaw frame
-    phi_d, flags = tilt_setpoint(-ul / g, False, tilt, flags)            # eq (6), small angle, yaw frame
+    U1, flags = thrust_for_tilt(uz, math.cos(x[PHI]) * math.cos(x[THETA]), vp[P_M], g, vp[P_K], gains[COS_MAX_TILT])
+    theta_d, flags = tilt_setpoint(uf / g, False, tilt, flags)  # eq (5), small angle, yaw frame
+    phi_d, flags = tilt_setpoint(-ul / g, False, tilt, flags)  # eq (6), small angle, yaw frame
     finish(U1, phi_d, theta_d, ref[REF_PSI], flags, dt, x, vp, gains, mem, cmd)
 
 
@@ -226,19 +226,21 @@ class Gonzalez(Controller):
     >>> Gonzalez(accel_d=-1.0)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: gonzalez parameter 'accel_d' (saturation level of the D term (None: k_d x 1 m/s), m/s^2) must be > 0 or None, got -1.0
+    quadcruise.errors.InputError: gonzalez parameter 'accel_d' (saturation level of the D term (None: k_d x 1 ...
     """
 
     name = "gonzalez"
     memory_size = ATT_MEMORY
 
-    position: PDGains = _f(unit="-", doc="small-signal PD of x and y", check=instance_of(PDGains),
-                           factory=position_pd_design)
+    position: PDGains = _f(
+        unit="-", doc="small-signal PD of x and y", check=instance_of(PDGains), factory=position_pd_design
+    )
     accel_p: float | None = _f(None, "m/s^2", "saturation level of the P term (None: k_p x 1 m)", "pos")
     accel_d: float | None = _f(None, "m/s^2", "saturation level of the D term (None: k_d x 1 m/s)", "pos")
     altitude: PDGains = _f(unit="-", doc="z PD loop", check=instance_of(PDGains), factory=altitude_pd_design)
-    attitude: PIDGains = _f(unit="-", doc="roll and pitch PID loops", check=instance_of(PIDGains),
-                            factory=attitude_pid_design)
+    attitude: PIDGains = _f(
+        unit="-", doc="roll and pitch PID loops", check=instance_of(PIDGains), factory=attitude_pid_design
+    )
     yaw: PIDGains = _f(unit="-", doc="yaw PID loop", check=instance_of(PIDGains), factory=attitude_pid_design)
     max_tilt: float = _f(math.radians(45.0), "rad", "roll and pitch setpoint limit", TILT)
     i_limit: float = _f(5.0, "rad/s^2", "anti-windup bound on the attitude integral term", "pos")
@@ -267,6 +269,14 @@ class Gonzalez(Controller):
             [1/s] of x and y, a_p and a_d [m/s^2], Kp [1/s^2] and Kd [1/s] of z, max_tilt
             [rad] and cos(max_tilt).
         """
-        tail = [self.position.kp, self.position.kd, self.accel_p, self.accel_d,
-                self.altitude.kp, self.altitude.kd, self.max_tilt, math.cos(self.max_tilt)]
+        tail = [
+            self.position.kp,
+            self.position.kd,
+            self.accel_p,
+            self.accel_d,
+            self.altitude.kp,
+            self.altitude.kd,
+            self.max_tilt,
+            math.cos(self.max_tilt),
+        ]
         return np.array(attitude_block(self.attitude, self.yaw, self.i_limit) + tail)

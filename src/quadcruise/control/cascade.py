@@ -94,10 +94,35 @@ from quadcruise.layout import (
 from quadcruise.numeric import clamp
 
 # gains layout
-(C_POS_XY, C_POS_Z, C_VEL_P_XY, C_VEL_I_XY, C_VEL_D_XY, C_VEL_P_Z, C_VEL_I_Z, C_VEL_D_Z,
- C_VMAX_XY, C_VMAX_UP, C_VMAX_DOWN, C_MAX_TILT, C_THR_MIN, C_THR_MAX, C_ATT_RP, C_ATT_YAW,
- C_RMAX_RP, C_RMAX_YAW, C_RATE_P, C_RATE_I, C_RATE_D, C_YRATE_P, C_YRATE_I, C_YRATE_D,
- C_RATE_I_LIM, C_VEL_D_LP, C_RATE_D_LP) = range(27)
+(
+    C_POS_XY,
+    C_POS_Z,
+    C_VEL_P_XY,
+    C_VEL_I_XY,
+    C_VEL_D_XY,
+    C_VEL_P_Z,
+    C_VEL_I_Z,
+    C_VEL_D_Z,
+    C_VMAX_XY,
+    C_VMAX_UP,
+    C_VMAX_DOWN,
+    C_MAX_TILT,
+    C_THR_MIN,
+    C_THR_MAX,
+    C_ATT_RP,
+    C_ATT_YAW,
+    C_RMAX_RP,
+    C_RMAX_YAW,
+    C_RATE_P,
+    C_RATE_I,
+    C_RATE_D,
+    C_YRATE_P,
+    C_YRATE_I,
+    C_YRATE_D,
+    C_RATE_I_LIM,
+    C_VEL_D_LP,
+    C_RATE_D_LP,
+) = range(27)
 CASCADE_GAINS = 27
 # memory: velocity integral [m/s^2], rate integral [rad/s^2], last velocity and rate, their
 # low-passed derivatives (6 slots after the last values), and a flag set after period one
@@ -239,19 +264,35 @@ def cascade(t, dt, x, ref, vp, G, mem, cmd):
     dw_1, dw_2, dw_3 = mem[M_WD], mem[M_WD + 1], mem[M_WD + 2]
     first = mem[M_INIT] == 0.0
     k_pos_xy, k_pos_z = G[C_POS_XY], G[C_POS_Z]
-    kv_p_xy, kv_i_xy, kv_d_xy, kv_p_z, kv_i_z, kv_d_z = G[C_VEL_P_XY], G[C_VEL_I_XY], G[C_VEL_D_XY], G[C_VEL_P_Z], G[C_VEL_I_Z], G[C_VEL_D_Z]
+    kv_p_xy, kv_i_xy, kv_d_xy, kv_p_z, kv_i_z, kv_d_z = (
+        G[C_VEL_P_XY],
+        G[C_VEL_I_XY],
+        G[C_VEL_D_XY],
+        G[C_VEL_P_Z],
+        G[C_VEL_I_Z],
+        G[C_VEL_D_Z],
+    )
     vmax_xy, vmax_up, vmax_down = G[C_VMAX_XY], G[C_VMAX_UP], G[C_VMAX_DOWN]
     max_tilt, thr_min, thr_max = G[C_MAX_TILT], G[C_THR_MIN], G[C_THR_MAX]
     k_att_rp, k_att_yaw, rmax_rp, rmax_yaw = G[C_ATT_RP], G[C_ATT_YAW], G[C_RMAX_RP], G[C_RMAX_YAW]
-    kr_p, kr_i, kr_d, ky_p, ky_i, ky_d, rate_i_lim = G[C_RATE_P], G[C_RATE_I], G[C_RATE_D], G[C_YRATE_P], G[C_YRATE_I], G[C_YRATE_D], G[C_RATE_I_LIM]
+    kr_p, kr_i, kr_d, ky_p, ky_i, ky_d, rate_i_lim = (
+        G[C_RATE_P],
+        G[C_RATE_I],
+        G[C_RATE_D],
+        G[C_YRATE_P],
+        G[C_YRATE_I],
+        G[C_YRATE_D],
+        G[C_RATE_I_LIM],
+    )
     vel_d_lp, rate_d_lp = G[C_VEL_D_LP], G[C_RATE_D_LP]
     psi_d, yr = ref[REF_PSI], ref[REF_PSI_DOT]
     av = dt / (dt + 1.0 / (2.0 * math.pi * vel_d_lp))
     aw = dt / (dt + 1.0 / (2.0 * math.pi * rate_d_lp))
     flags = 0
     # 1. position P -> velocity setpoint
-    vsx, vsy = constrain_xy(k_pos_xy * (ref[REF_X] - x[X]), k_pos_xy * (ref[REF_Y] - x[Y]),
-                            ref[REF_VX], ref[REF_VY], vmax_xy)
+    vsx, vsy = constrain_xy(
+        k_pos_xy * (ref[REF_X] - x[X]), k_pos_xy * (ref[REF_Y] - x[Y]), ref[REF_VX], ref[REF_VY], vmax_xy
+    )
     vsz, _ = clamp(k_pos_z * (ref[REF_Z] - x[Z]) + ref[REF_VZ], -vmax_down, vmax_up)
     # 2. velocity PID -> acceleration -> thrust vector
     ex, ey, ez = vsx - vx, vsy - vy, vsz - vz
@@ -271,10 +312,10 @@ def cascade(t, dt, x, ref, vp, G, mem, cmd):
     if limited:
         flags |= FLAG_THRUST_LIMIT
         if (U1 == u_min and ez <= 0.0) or (U1 == u_max and ez >= 0.0):
-            ez = 0.0                                      # vertical anti-windup
+            ez = 0.0  # vertical anti-windup
             flags |= FLAG_INTEGRATOR_HOLD
-    px, py = U1 * b3x / m, U1 * b3y / m                   # horizontal acceleration produced
-    if ax * ax + ay * ay > px * px + py * py:             # tracking anti-windup
+    px, py = U1 * b3x / m, U1 * b3y / m  # horizontal acceleration produced
+    if ax * ax + ay * ay > px * px + py * py:  # tracking anti-windup
         ex -= 2.0 / kv_p_xy * (ax - px)
         ey -= 2.0 / kv_p_xy * (ay - py)
     vi_x += kv_i_xy * ex * dt
@@ -288,13 +329,12 @@ def cascade(t, dt, x, ref, vp, G, mem, cmd):
     sp2, _ = clamp(k_att_rp * e2 + Rm[2][1] * yr, -rmax_rp, rmax_rp)
     sp3, _ = clamp(k_att_yaw * e3 + Rm[2][2] * yr, -rmax_yaw, rmax_yaw)
     # 4. rate PID -> torques
-    full = l * K                                          # full roll/pitch torque [N m]
-    a1, ri_1, dw_1, h1 = _rate_axis(sp1, p, ri_1, lw_1, dw_1, dt, aw, first, kr_p, kr_i,
-                                    kr_d, rate_i_lim * full / jx)
-    a2, ri_2, dw_2, h2 = _rate_axis(sp2, q, ri_2, lw_2, dw_2, dt, aw, first, kr_p, kr_i,
-                                    kr_d, rate_i_lim * full / jy)
-    a3, ri_3, dw_3, h3 = _rate_axis(sp3, r, ri_3, lw_3, dw_3, dt, aw, first, ky_p, ky_i,
-                                    ky_d, rate_i_lim * 2.0 * d * K / jz)
+    full = l * K  # full roll/pitch torque [N m]
+    a1, ri_1, dw_1, h1 = _rate_axis(sp1, p, ri_1, lw_1, dw_1, dt, aw, first, kr_p, kr_i, kr_d, rate_i_lim * full / jx)
+    a2, ri_2, dw_2, h2 = _rate_axis(sp2, q, ri_2, lw_2, dw_2, dt, aw, first, kr_p, kr_i, kr_d, rate_i_lim * full / jy)
+    a3, ri_3, dw_3, h3 = _rate_axis(
+        sp3, r, ri_3, lw_3, dw_3, dt, aw, first, ky_p, ky_i, ky_d, rate_i_lim * 2.0 * d * K / jz
+    )
     if h1 or h2 or h3:
         flags |= FLAG_INTEGRATOR_HOLD
     mem[M_VI], mem[M_VI + 1], mem[M_VI + 2] = vi_x, vi_y, vi_z
@@ -384,8 +424,9 @@ def rate_pid_design(actuator_bandwidth: float = 15.0, yaw: bool = False) -> Rate
     >>> round(g.kp, 3), round(g.ki, 3), g.kd
     (5.859, 2.93, 0.0)
     """
-    w = check_value("rate_pid_design argument 'actuator_bandwidth' (rotor lag bandwidth, rad/s)",
-                    actuator_bandwidth, "pos")
+    w = check_value(
+        "rate_pid_design argument 'actuator_bandwidth' (rotor lag bandwidth, rad/s)", actuator_bandwidth, "pos"
+    )
     if yaw:
         kp = w / (4.0 * RATE_ZETA**2)
         return RateGains(kp=kp, ki=PX4_YAW_RATE_I_RATIO * kp, kd=0.0)
@@ -484,7 +525,7 @@ class Cascade(Controller):
     >>> Cascade(thrust_min=1.5)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: cascade parameter 'thrust_min' (least thrust over the weight m g, -) must be in [0, 1), got 1.5
+    quadcruise.errors.InputError: cascade parameter 'thrust_min' (least thrust over the weight m g, -) must be ...
     """
 
     name = "cascade"
@@ -509,8 +550,9 @@ class Cascade(Controller):
     max_rate_rp: float = _f(math.radians(220.0), "rad/s", "roll and pitch rate limit", "pos")
     max_rate_yaw: float = _f(math.radians(200.0), "rad/s", "yaw rate limit", "pos")
     rate: RateGains = _f(unit="-", doc="roll and pitch rate PID", check=instance_of(RateGains), factory=rate_pid_design)
-    yaw_rate: RateGains = _f(unit="-", doc="yaw rate PID", check=instance_of(RateGains),
-                             factory=lambda: rate_pid_design(yaw=True))
+    yaw_rate: RateGains = _f(
+        unit="-", doc="yaw rate PID", check=instance_of(RateGains), factory=lambda: rate_pid_design(yaw=True)
+    )
     rate_i_limit: float = _f(0.3, "-", "rate integral bound over the axis' full torque", "pos")
     vel_d_cutoff: float = _f(5.0, "Hz", "low-pass cutoff of the differenced velocity", "pos")
     rate_d_cutoff: float = _f(30.0, "Hz", "low-pass cutoff of the differenced rate", "pos")
@@ -534,17 +576,34 @@ class Cascade(Controller):
             velocity and rate derivative cutoffs [Hz].
         """
         g = np.zeros(CASCADE_GAINS)
-        for col, value in ((C_POS_XY, self.xy_p), (C_POS_Z, self.z_p), (C_VEL_P_XY, self.xy_vel_p),
-                           (C_VEL_I_XY, self.xy_vel_i), (C_VEL_D_XY, self.xy_vel_d),
-                           (C_VEL_P_Z, self.z_vel_p), (C_VEL_I_Z, self.z_vel_i), (C_VEL_D_Z, self.z_vel_d),
-                           (C_VMAX_XY, self.max_speed_xy), (C_VMAX_UP, self.max_speed_up),
-                           (C_VMAX_DOWN, self.max_speed_down), (C_MAX_TILT, self.max_tilt),
-                           (C_THR_MIN, self.thrust_min), (C_THR_MAX, self.thrust_max),
-                           (C_ATT_RP, self.roll_p), (C_ATT_YAW, self.yaw_p),
-                           (C_RMAX_RP, self.max_rate_rp), (C_RMAX_YAW, self.max_rate_yaw),
-                           (C_RATE_P, self.rate.kp), (C_RATE_I, self.rate.ki), (C_RATE_D, self.rate.kd),
-                           (C_YRATE_P, self.yaw_rate.kp), (C_YRATE_I, self.yaw_rate.ki),
-                           (C_YRATE_D, self.yaw_rate.kd), (C_RATE_I_LIM, self.rate_i_limit),
-                           (C_VEL_D_LP, self.vel_d_cutoff), (C_RATE_D_LP, self.rate_d_cutoff)):
+        for col, value in (
+            (C_POS_XY, self.xy_p),
+            (C_POS_Z, self.z_p),
+            (C_VEL_P_XY, self.xy_vel_p),
+            (C_VEL_I_XY, self.xy_vel_i),
+            (C_VEL_D_XY, self.xy_vel_d),
+            (C_VEL_P_Z, self.z_vel_p),
+            (C_VEL_I_Z, self.z_vel_i),
+            (C_VEL_D_Z, self.z_vel_d),
+            (C_VMAX_XY, self.max_speed_xy),
+            (C_VMAX_UP, self.max_speed_up),
+            (C_VMAX_DOWN, self.max_speed_down),
+            (C_MAX_TILT, self.max_tilt),
+            (C_THR_MIN, self.thrust_min),
+            (C_THR_MAX, self.thrust_max),
+            (C_ATT_RP, self.roll_p),
+            (C_ATT_YAW, self.yaw_p),
+            (C_RMAX_RP, self.max_rate_rp),
+            (C_RMAX_YAW, self.max_rate_yaw),
+            (C_RATE_P, self.rate.kp),
+            (C_RATE_I, self.rate.ki),
+            (C_RATE_D, self.rate.kd),
+            (C_YRATE_P, self.yaw_rate.kp),
+            (C_YRATE_I, self.yaw_rate.ki),
+            (C_YRATE_D, self.yaw_rate.kd),
+            (C_RATE_I_LIM, self.rate_i_limit),
+            (C_VEL_D_LP, self.vel_d_cutoff),
+            (C_RATE_D_LP, self.rate_d_cutoff),
+        ):
             g[col] = value
         return g

@@ -37,9 +37,22 @@ def python_control():
 
     return control
 
-__all__ = ["PAPER_POSITION_POLES", "PDGains", "PIDGains", "parse_pole", "pd_from_poles", "pid_from_poles",
-           "position_pd_design", "altitude_pd_design", "attitude_pid_design",
-           "loop_transfer", "loop_margins", "check_with_control", "cascade_state_space"]
+
+__all__ = [
+    "PAPER_POSITION_POLES",
+    "PDGains",
+    "PIDGains",
+    "parse_pole",
+    "pd_from_poles",
+    "pid_from_poles",
+    "position_pd_design",
+    "altitude_pd_design",
+    "attitude_pid_design",
+    "loop_transfer",
+    "loop_margins",
+    "check_with_control",
+    "cascade_state_space",
+]
 
 PAPER_POSITION_POLES = (-0.7, -4.3)
 """Closed-loop poles of the paper's x/y PD loops [rad/s] (section III.B, eq 18)."""
@@ -372,15 +385,15 @@ def attitude_pid_design(actuator_bandwidth: float = 15.0) -> PIDGains:
     >>> round(loop_margins(g, 15.0)["phase_margin"], 1)
     24.5
     """
-    w = check_value("attitude_pid_design argument 'actuator_bandwidth' (rotor lag bandwidth, rad/s)",
-                    actuator_bandwidth, "pos")
+    w = check_value(
+        "attitude_pid_design argument 'actuator_bandwidth' (rotor lag bandwidth, rad/s)", actuator_bandwidth, "pos"
+    )
     wn, zeta = ATTITUDE_WN_RATIO * w, ATTITUDE_ZETA
     pair = complex(-zeta * wn, wn * np.sqrt(1.0 - zeta**2))
     return pid_from_poles([pair, pair.conjugate(), -ATTITUDE_INTEGRATOR_RATIO * w])
 
 
-def cascade_state_space(position: PDGains, attitude: PIDGains, actuator_bandwidth: float = 15.0,
-                        g: float = 9.81):
+def cascade_state_space(position: PDGains, attitude: PIDGains, actuator_bandwidth: float = 15.0, g: float = 9.81):
     """The x loop of the paper's controller linearised about hover, from x_r to x.
 
     States (x, x', theta, q, theta'' (the lagged attitude input), int(theta_d - theta)):
@@ -414,7 +427,7 @@ def cascade_state_space(position: PDGains, attitude: PIDGains, actuator_bandwidt
     w = float(actuator_bandwidth)
     kp, kd = position.kp, position.kd
     kpa, kia, kda = attitude.kp, attitude.ki, attitude.kd
-    theta_d = np.array([-kp, -kd, 0.0, 0.0, 0.0, 0.0]) / g          # theta_d as a row over the states
+    theta_d = np.array([-kp, -kd, 0.0, 0.0, 0.0, 0.0]) / g  # theta_d as a row over the states
     e = np.eye(6)
     u_star = kpa * (theta_d - e[2]) + kia * e[5] - kda * e[3]
     A = np.zeros((6, 6))
@@ -481,8 +494,13 @@ def loop_margins(gains: PDGains | PIDGains, actuator_bandwidth: float | None = 1
     L = loop_transfer(gains, actuator_bandwidth)
     gm, pm, _, wpc, wgc, _ = python_control().stability_margins(L)
     stable = bool(np.all(python_control().feedback(L, 1).poles().real < 0))
-    return {"gain_margin": float(gm), "phase_margin": float(pm), "phase_crossover": float(wpc),
-            "gain_crossover": float(wgc), "stable": stable}
+    return {
+        "gain_margin": float(gm),
+        "phase_margin": float(pm),
+        "phase_crossover": float(wpc),
+        "gain_crossover": float(wgc),
+        "stable": stable,
+    }
 
 
 def check_with_control(gains: PDGains | PIDGains) -> dict:
@@ -525,6 +543,10 @@ def check_with_control(gains: PDGains | PIDGains) -> dict:
     want = gains._char[:0:-1]
     cl = np.linalg.eigvals(sys.A - sys.B @ K[None, :])
     dist = np.abs(cl[:, None] - poles[None, :])
-    return {"place_gain": K, "gain_error": float(np.max(np.abs(K - want)) / np.max(np.abs(want))),
-            "closed_loop_poles": cl, "pole_error": float(max(dist.min(0).max(), dist.min(1).max())),
-            "step_info": python_control().step_info(gains.closed_loop())}
+    return {
+        "place_gain": K,
+        "gain_error": float(np.max(np.abs(K - want)) / np.max(np.abs(want))),
+        "closed_loop_poles": cl,
+        "pole_error": float(max(dist.min(0).max(), dist.min(1).max())),
+        "step_info": python_control().step_info(gains.closed_loop()),
+    }

@@ -13,7 +13,7 @@ from numba import njit
 from quadcruise.layout import CMD_FLAGS
 
 
-@njit(cache=True)     # compiled (as CONTROLLER_SIG) on first use, not at import
+@njit(cache=True)  # compiled (as CONTROLLER_SIG) on first use, not at import
 def duty_schedule(t, dt, x, ref, vp, gains, mem, cmd):
     """Hold the duties of the last schedule row whose time is <= t (the first row before it).
 
@@ -59,7 +59,7 @@ def duty_schedule(t, dt, x, ref, vp, gains, mem, cmd):
     base = 1 + n + 4 * row
     for j in range(4):
         cmd[j] = gains[base + j]
-    for j in range(4, CMD_FLAGS):      # no generalized inputs or setpoints: open loop
+    for j in range(4, CMD_FLAGS):  # no generalized inputs or setpoints: open loop
         cmd[j] = np.nan
 
 

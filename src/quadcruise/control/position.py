@@ -120,8 +120,9 @@ from quadcruise.numeric import clamp, wrap_angle
 # (INVERSION: 0 joint, 1 the paper's sequential eqs 16 then 19)
 # (DERIVATIVE: 0 on the measurement with the reference's velocity, 1 on the whole error through
 #  the filter N [1/s] of FILTER_N)
-KP_XY, KD_XY, KP_Z, KD_Z, MAX_TILT, ACCEL_FF, COS_MAX_TILT, SIN_MAX_TILT, INVERSION, DERIVATIVE, FILTER_N = \
-    range(ATT_GAINS, ATT_GAINS + 11)
+KP_XY, KD_XY, KP_Z, KD_Z, MAX_TILT, ACCEL_FF, COS_MAX_TILT, SIN_MAX_TILT, INVERSION, DERIVATIVE, FILTER_N = range(
+    ATT_GAINS, ATT_GAINS + 11
+)
 NLPD_GAINS = ATT_GAINS + 11
 INVERSIONS = ("joint", "sequential")
 DERIVATIVES = ("measurement", "error")
@@ -161,11 +162,11 @@ def tilt_joint(ux, uy, spsi, cpsi, a, max_tilt, flags):
     >>> round(phi, 6), round(theta, 6) + 0.0, flags
     (0.100167, 0.0, 0)
     """
-    if a < 1e-9:                                     # no thrust: no tilt can help
+    if a < 1e-9:  # no thrust: no tilt can help
         return 0.0, 0.0, flags | FLAG_ASIN_CLIP
-    sphi, clipped = clamp((ux * spsi - uy * cpsi) / a, -1.0, 1.0)            # (6) in the yaw frame
+    sphi, clipped = clamp((ux * spsi - uy * cpsi) / a, -1.0, 1.0)  # (6) in the yaw frame
     phi_d, flags = tilt_setpoint(math.asin(sphi), clipped, max_tilt, flags)
-    stheta, clipped = clamp((ux * cpsi + uy * spsi) / (a * math.cos(phi_d)), -1.0, 1.0)   # (5), (16)
+    stheta, clipped = clamp((ux * cpsi + uy * spsi) / (a * math.cos(phi_d)), -1.0, 1.0)  # (5), (16)
     theta_d, flags = tilt_setpoint(math.asin(stheta), clipped, max_tilt, flags)
     return phi_d, theta_d, flags
 
@@ -232,7 +233,7 @@ def roll_eq19(uy, stheta, spsi, cpsi, a):
     """
     A = cpsi
     B = stheta * spsi
-    R = math.sqrt(A * A + B * B)         # |A|, |B| <= 1: no overflow to guard against
+    R = math.sqrt(A * A + B * B)  # |A|, |B| <= 1: no overflow to guard against
     if R * a < 1e-9:
         return 0.0, True
     s, clipped = clamp(uy / (a * R), -1.0, 1.0)
@@ -516,10 +517,10 @@ def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
     0.0307
     """
     ff, tilt = gains[ACCEL_FF], gains[MAX_TILT]
-    if gains[DERIVATIVE] == 0.0:                     # on the measurement, with the reference's velocity
+    if gains[DERIVATIVE] == 0.0:  # on the measurement, with the reference's velocity
         ux = gains[KP_XY] * (ref[REF_X] - x[X]) + gains[KD_XY] * (ref[REF_VX] - x[VX]) + ff * ref[REF_AX]
         uy = gains[KP_XY] * (ref[REF_Y] - x[Y]) + gains[KD_XY] * (ref[REF_VY] - x[VY]) + ff * ref[REF_AY]
-    else:                                            # eq (17): on the whole error, filtered by N
+    else:  # eq (17): on the whole error, filtered by N
         ex, ey, n = ref[REF_X] - x[X], ref[REF_Y] - x[Y], gains[FILTER_N]
         decay = math.exp(-n * dt)
         dx, fx = filtered_derivative(ex, mem[FILTER_X], gains[KD_XY], n, decay)
@@ -530,18 +531,18 @@ def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
     uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ]) + ff * ref[REF_AZ]
     phi, theta, psi, psi_d = x[PHI], x[THETA], x[PSI], ref[REF_PSI]
     m, g, K = vp[P_M], vp[P_G], vp[P_K]
-    sphi, cphi = math.sin(phi), math.cos(phi)           # each computed once, shared
+    sphi, cphi = math.sin(phi), math.cos(phi)  # each computed once, shared
     spsi, cpsi = math.sin(psi), math.cos(psi)
     U1, flags = thrust_for_tilt(uz, cphi * math.cos(theta), m, g, K, gains[COS_MAX_TILT])
     a = U1 / m
-    if gains[INVERSION] == 0.0:                      # (5) and (6) together, at any yaw
+    if gains[INVERSION] == 0.0:  # (5) and (6) together, at any yaw
         phi_d, theta_d, flags = tilt_joint(ux, uy, spsi, cpsi, a, tilt, flags)
-    else:                                            # the paper's: (16) with the current roll, then (19)
-        pitch, stheta_d, clipped = pitch_eq16(ux, sphi, cphi, spsi, cpsi, a)      # (16)
+    else:  # the paper's: (16) with the current roll, then (19)
+        pitch, stheta_d, clipped = pitch_eq16(ux, sphi, cphi, spsi, cpsi, a)  # (16)
         theta_d, flags = tilt_setpoint(pitch, clipped, tilt, flags)
-        if theta_d != pitch:              # limited: sin theta_d is no longer asin's argument
+        if theta_d != pitch:  # limited: sin theta_d is no longer asin's argument
             stheta_d = math.copysign(gains[SIN_MAX_TILT], theta_d)
-        phi_d, clipped = roll_eq19(uy, stheta_d, spsi, cpsi, a)                    # (19), sign kept
+        phi_d, clipped = roll_eq19(uy, stheta_d, spsi, cpsi, a)  # (19), sign kept
         phi_d, flags = tilt_setpoint(phi_d, clipped, tilt, flags)
     finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd)
 
@@ -631,8 +632,9 @@ class NLPD(Controller):
 
     position: PDGains = _f(unit="-", doc="x and y PD loops", check=instance_of(PDGains), factory=position_pd_design)
     altitude: PDGains = _f(unit="-", doc="z PD loop", check=instance_of(PDGains), factory=altitude_pd_design)
-    attitude: PIDGains = _f(unit="-", doc="roll and pitch PID loops", check=instance_of(PIDGains),
-                            factory=attitude_pid_design)
+    attitude: PIDGains = _f(
+        unit="-", doc="roll and pitch PID loops", check=instance_of(PIDGains), factory=attitude_pid_design
+    )
     yaw: PIDGains = _f(unit="-", doc="yaw PID loop", check=instance_of(PIDGains), factory=attitude_pid_design)
     max_tilt: float = _f(math.radians(45.0), "rad", "roll and pitch setpoint limit", TILT)
     i_limit: float = _f(5.0, "rad/s^2", "anti-windup bound on the attitude integral term", "pos")
@@ -671,8 +673,17 @@ class NLPD(Controller):
             (index in ``INVERSIONS``), the derivative form (index in ``DERIVATIVES``) and
             derivative_filter N [1/s].
         """
-        tail = [self.position.kp, self.position.kd, self.altitude.kp, self.altitude.kd,
-                self.max_tilt, 1.0 if self.accel_feedforward else 0.0,
-                math.cos(self.max_tilt), math.sin(self.max_tilt), float(INVERSIONS.index(self.inversion)),
-                float(DERIVATIVES.index(self.derivative)), self.derivative_filter]
+        tail = [
+            self.position.kp,
+            self.position.kd,
+            self.altitude.kp,
+            self.altitude.kd,
+            self.max_tilt,
+            1.0 if self.accel_feedforward else 0.0,
+            math.cos(self.max_tilt),
+            math.sin(self.max_tilt),
+            float(INVERSIONS.index(self.inversion)),
+            float(DERIVATIVES.index(self.derivative)),
+            self.derivative_filter,
+        ]
         return np.array(attitude_block(self.attitude, self.yaw, self.i_limit) + tail)

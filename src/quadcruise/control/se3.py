@@ -167,13 +167,13 @@ def se3(t, dt, x, ref, vp, gains, mem, cmd):
     n = math.sqrt(fx * fx + fy * fy + fz * fz) if fz > 0.0 else 0.0
     if n > 0.0:
         Rd = attitude_lee(fx / n, fy / n, fz / n, psi_d)
-    else:                                                  # F points down: b3_d = e3, U1 -> 0
+    else:  # F points down: b3_d = e3, U1 -> 0
         Rd = attitude_lee(0.0, 0.0, 1.0, psi_d)
     U1, limited = clamp(fx * Rm[0][2] + fy * Rm[1][2] + fz * Rm[2][2], 0.0, 4.0 * K)
     if limited:
         flags |= FLAG_THRUST_LIMIT
     ex, ey, ez = error_lee(Rm, Rd)
-    mx = -jx * (kr * ex + kw * p) + (jz - jy) * q * r          # + (w x J w)_x
+    mx = -jx * (kr * ex + kw * p) + (jz - jy) * q * r  # + (w x J w)_x
     my = -jy * (kr * ey + kw * q) + (jx - jz) * p * r
     mz = -jz * (kr * ez + kw * (r - yaw_rate_d)) + (jy - jx) * p * q
     command_from_rotation(U1, mx / l, my / l, mz, Rd, flags, d, K, cmd)
@@ -201,7 +201,8 @@ def se3_attitude_design(actuator_bandwidth: float = 15.0) -> PDGains:
     (81.0, 14.4, 26.1)
     """
     actuator_bandwidth = check_value(
-        "se3_attitude_design argument 'actuator_bandwidth' (rotor lag bandwidth, rad/s)", actuator_bandwidth, "pos")
+        "se3_attitude_design argument 'actuator_bandwidth' (rotor lag bandwidth, rad/s)", actuator_bandwidth, "pos"
+    )
     wn = ATTITUDE_WN_RATIO * actuator_bandwidth
     return PDGains(kp=wn * wn, kd=2.0 * ATTITUDE_ZETA * wn)
 
@@ -229,18 +230,24 @@ class SE3(Controller):
     >>> SE3(max_tilt=-1.0)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: se3 parameter 'max_tilt' (largest tilt of b3_d from the vertical, rad) must be in (0, pi/2), got -1.0
+    quadcruise.errors.InputError: se3 parameter 'max_tilt' (largest tilt of b3_d from the vertical, rad) must ...
     """
 
     name = "se3"
     memory_size = 0
 
-    position: PDGains = _f(unit="-", doc="kx (kp) and kv (kd) of x and y, per unit mass", check=instance_of(PDGains),
-                           factory=position_pd_design)
-    altitude: PDGains = _f(unit="-", doc="kx and kv of z, per unit mass", check=instance_of(PDGains),
-                           factory=altitude_pd_design)
-    attitude: PDGains = _f(unit="-", doc="kR (kp) and kw (kd) per unit inertia", check=instance_of(PDGains),
-                           factory=se3_attitude_design)
+    position: PDGains = _f(
+        unit="-",
+        doc="kx (kp) and kv (kd) of x and y, per unit mass",
+        check=instance_of(PDGains),
+        factory=position_pd_design,
+    )
+    altitude: PDGains = _f(
+        unit="-", doc="kx and kv of z, per unit mass", check=instance_of(PDGains), factory=altitude_pd_design
+    )
+    attitude: PDGains = _f(
+        unit="-", doc="kR (kp) and kw (kd) per unit inertia", check=instance_of(PDGains), factory=se3_attitude_design
+    )
     max_tilt: float = _f(math.radians(45.0), "rad", "largest tilt of b3_d from the vertical", TILT)
 
     @property
@@ -257,5 +264,14 @@ class SE3(Controller):
             7 float64 entries: kx [1/s^2] and kv [1/s] of x and y (``position``), the same
             of z (``altitude``), kR [1/s^2] and kw [1/s] (``attitude``), max_tilt [rad].
         """
-        return np.array([self.position.kp, self.position.kd, self.altitude.kp, self.altitude.kd,
-                         self.attitude.kp, self.attitude.kd, self.max_tilt])
+        return np.array(
+            [
+                self.position.kp,
+                self.position.kd,
+                self.altitude.kp,
+                self.altitude.kd,
+                self.attitude.kp,
+                self.attitude.kd,
+                self.max_tilt,
+            ]
+        )

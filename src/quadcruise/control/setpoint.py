@@ -65,22 +65,23 @@ from quadcruise.layout import (
 from quadcruise.model.actuators import mix
 
 # offsets into the gains row after the 4 setpoint entries
-(S_RATE_RP, S_RATE_YAW, S_TILT, S_SPEED_XY, S_SPEED_Z, S_KP_RATE_RP, S_KP_RATE_YAW, S_K_ATT,
- S_K_ATT_YAW, S_K_VEL) = range(4, 14)
+(S_RATE_RP, S_RATE_YAW, S_TILT, S_SPEED_XY, S_SPEED_Z, S_KP_RATE_RP, S_KP_RATE_YAW, S_K_ATT, S_K_ATT_YAW, S_K_VEL) = (
+    range(4, 14)
+)
 SETPOINT_GAINS = 14
 """Length of an action-mode controller's gains row: 4 setpoint entries, then 10 scales and gains."""
 
 DEFAULT_SCALES = {
-    "max_rate_rp": 3.0,       # rad/s: the largest roll and pitch rate asked
-    "max_rate_yaw": 1.5,      # rad/s
-    "max_tilt": 0.5,          # rad
-    "max_speed_xy": 3.0,      # m/s
-    "max_speed_z": 2.0,       # m/s
-    "kp_rate_rp": 15.0,       # 1/s: rate_pid_design()'s kp at the paper's 15 rad/s actuator bandwidth
-    "kp_rate_yaw": 5.86,      # 1/s: rate_pid_design(yaw=True)'s kp
-    "k_att": 5.0,             # 1/s: a third of the rate loop's gain, so the loops stay apart
-    "k_att_yaw": 2.0,         # 1/s
-    "k_vel": 2.0,             # 1/s
+    "max_rate_rp": 3.0,  # rad/s: the largest roll and pitch rate asked
+    "max_rate_yaw": 1.5,  # rad/s
+    "max_tilt": 0.5,  # rad
+    "max_speed_xy": 3.0,  # m/s
+    "max_speed_z": 2.0,  # m/s
+    "kp_rate_rp": 15.0,  # 1/s: rate_pid_design()'s kp at the paper's 15 rad/s actuator bandwidth
+    "kp_rate_yaw": 5.86,  # 1/s: rate_pid_design(yaw=True)'s kp
+    "k_att": 5.0,  # 1/s: a third of the rate loop's gain, so the loops stay apart
+    "k_att_yaw": 2.0,  # 1/s
+    "k_vel": 2.0,  # 1/s
 }
 """Scales and loop gains of the action modes, in the order of the ``S_*`` offsets."""
 
@@ -270,9 +271,21 @@ def velocity_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags, d, K)
 
 
-ACTION_CONTROLLERS = {"rotors": rotor_setpoint, "rates": rate_setpoint, "attitude": attitude_setpoint,
-                      "velocity": velocity_setpoint}
+ACTION_CONTROLLERS = {
+    "rotors": rotor_setpoint,
+    "rates": rate_setpoint,
+    "attitude": attitude_setpoint,
+    "velocity": velocity_setpoint,
+}
 """The action modes and their compiled controllers."""
 
-__all__ = ["ACTION_CONTROLLERS", "DEFAULT_SCALES", "SETPOINT_GAINS", "attitude_setpoint", "rate_setpoint",
-           "rotor_setpoint", "setpoint_gains", "velocity_setpoint"]
+__all__ = [
+    "ACTION_CONTROLLERS",
+    "DEFAULT_SCALES",
+    "SETPOINT_GAINS",
+    "attitude_setpoint",
+    "rate_setpoint",
+    "rotor_setpoint",
+    "setpoint_gains",
+    "velocity_setpoint",
+]

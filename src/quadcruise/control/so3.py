@@ -57,9 +57,11 @@ def rotation_zyx(phi, theta, psi):
     sf, cf = math.sin(phi), math.cos(phi)
     st, ct = math.sin(theta), math.cos(theta)
     sp, cp = math.sin(psi), math.cos(psi)
-    return ((cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf),
-            (sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf),
-            (-st, ct * sf, ct * cf))
+    return (
+        (cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf),
+        (sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf),
+        (-st, ct * sf, ct * cf),
+    )
 
 
 @njit(cache=True, error_model="numpy")
@@ -156,11 +158,10 @@ def attitude_lee(b3x, b3y, b3z, psi):
     [0.0, 0.0, 0.3]
     """
     cx, cy = math.cos(psi), math.sin(psi)
-    b2x, b2y, b2z = -b3z * cy, b3z * cx, b3x * cy - b3y * cx        # b3 x c1, c1z = 0
+    b2x, b2y, b2z = -b3z * cy, b3z * cx, b3x * cy - b3y * cx  # b3 x c1, c1z = 0
     n = math.sqrt(b2x * b2x + b2y * b2y + b2z * b2z)
     b2x, b2y, b2z = b2x / n, b2y / n, b2z / n
-    return _columns(b2y * b3z - b2z * b3y, b2z * b3x - b2x * b3z, b2x * b3y - b2y * b3x,
-                    b2x, b2y, b2z, b3x, b3y, b3z)
+    return _columns(b2y * b3z - b2z * b3y, b2z * b3x - b2x * b3z, b2x * b3y - b2y * b3x, b2x, b2y, b2z, b3x, b3y, b3z)
 
 
 @njit(cache=True, error_model="numpy")
@@ -190,11 +191,10 @@ def attitude_px4(b3x, b3y, b3z, psi):
     0.5
     """
     cx, cy = -math.sin(psi), math.cos(psi)
-    b1x, b1y, b1z = cy * b3z, -cx * b3z, cx * b3y - cy * b3x        # c2 x b3, c2z = 0
+    b1x, b1y, b1z = cy * b3z, -cx * b3z, cx * b3y - cy * b3x  # c2 x b3, c2z = 0
     n = math.sqrt(b1x * b1x + b1y * b1y + b1z * b1z)
     b1x, b1y, b1z = b1x / n, b1y / n, b1z / n
-    return _columns(b1x, b1y, b1z, b3y * b1z - b3z * b1y, b3z * b1x - b3x * b1z, b3x * b1y - b3y * b1x,
-                    b3x, b3y, b3z)
+    return _columns(b1x, b1y, b1z, b3y * b1z - b3z * b1y, b3z * b1x - b3x * b1z, b3x * b1y - b3y * b1x, b3x, b3y, b3z)
 
 
 @njit(cache=True, inline="always")
@@ -233,9 +233,11 @@ def error_lee(Rm, Rd):
     >>> [round(v, 6) + 0.0 for v in e]                      # sin 0.1 about body x
     [0.099833, 0.0, 0.0]
     """
-    return (0.5 * (_tn(Rd, Rm, 2, 1) - _tn(Rd, Rm, 1, 2)),
-            0.5 * (_tn(Rd, Rm, 0, 2) - _tn(Rd, Rm, 2, 0)),
-            0.5 * (_tn(Rd, Rm, 1, 0) - _tn(Rd, Rm, 0, 1)))
+    return (
+        0.5 * (_tn(Rd, Rm, 2, 1) - _tn(Rd, Rm, 1, 2)),
+        0.5 * (_tn(Rd, Rm, 0, 2) - _tn(Rd, Rm, 2, 0)),
+        0.5 * (_tn(Rd, Rm, 1, 0) - _tn(Rd, Rm, 0, 1)),
+    )
 
 
 @njit(cache=True, error_model="numpy")
@@ -265,10 +267,16 @@ def error_quaternion(Rm, Rd):
     [-0.099958, 0.0, 0.0]
     """
     m00, m11, m22 = _tn(Rm, Rd, 0, 0), _tn(Rm, Rd, 1, 1), _tn(Rm, Rd, 2, 2)
-    d21, d02, d10 = _tn(Rm, Rd, 2, 1) - _tn(Rm, Rd, 1, 2), _tn(Rm, Rd, 0, 2) - _tn(Rm, Rd, 2, 0), \
-        _tn(Rm, Rd, 1, 0) - _tn(Rm, Rd, 0, 1)
-    s01, s02, s12 = _tn(Rm, Rd, 0, 1) + _tn(Rm, Rd, 1, 0), _tn(Rm, Rd, 0, 2) + _tn(Rm, Rd, 2, 0), \
-        _tn(Rm, Rd, 1, 2) + _tn(Rm, Rd, 2, 1)
+    d21, d02, d10 = (
+        _tn(Rm, Rd, 2, 1) - _tn(Rm, Rd, 1, 2),
+        _tn(Rm, Rd, 0, 2) - _tn(Rm, Rd, 2, 0),
+        _tn(Rm, Rd, 1, 0) - _tn(Rm, Rd, 0, 1),
+    )
+    s01, s02, s12 = (
+        _tn(Rm, Rd, 0, 1) + _tn(Rm, Rd, 1, 0),
+        _tn(Rm, Rd, 0, 2) + _tn(Rm, Rd, 2, 0),
+        _tn(Rm, Rd, 1, 2) + _tn(Rm, Rd, 2, 1),
+    )
     tr = m00 + m11 + m22
     if tr > 0.0:
         S = 2.0 * math.sqrt(tr + 1.0)

@@ -19,6 +19,20 @@ from quadcruise.disturbances.environment import (
     with_drag,
 )
 
-__all__ = ["AIRSPEED_FLOOR", "DEFAULT_DRAG", "INTENSITIES", "ConstantWind", "CustomDisturbance", "Environment", "ExternalForce",
-           "Gust", "RotorLoss", "SensorNoise", "Turbulence", "environment_disturbance", "parse_wind",
-           "wind_from_name", "with_drag"]
+__all__ = [
+    "AIRSPEED_FLOOR",
+    "DEFAULT_DRAG",
+    "INTENSITIES",
+    "ConstantWind",
+    "CustomDisturbance",
+    "Environment",
+    "ExternalForce",
+    "Gust",
+    "RotorLoss",
+    "SensorNoise",
+    "Turbulence",
+    "environment_disturbance",
+    "parse_wind",
+    "wind_from_name",
+    "with_drag",
+]

@@ -55,7 +55,7 @@ class CustomDisturbance(Validated):
     >>> CustomDisturbance(print)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: custom disturbance field 'function' (the compiled disturbance, -) must be a numba-compiled function with DISTURBANCE_SIG, got <built-in function print>
+    quadcruise.errors.InputError: custom disturbance field 'function' (the compiled disturbance, -) must be a ...
     """
 
     function: Any = unit_field(unit="-", doc="the compiled disturbance", check=_COMPILED)

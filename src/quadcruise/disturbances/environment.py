@@ -66,14 +66,28 @@ from quadcruise.layout import DISTURBANCE_SIG, EXT_E1, EXT_FX, EXT_WX, PHI, STAT
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.fastmath import five_normals, same_period
 
-__all__ = ["ConstantWind", "Gust", "Turbulence", "RotorLoss", "ExternalForce", "Environment",
-           "SensorNoise", "DEFAULT_DRAG", "default_drag_text", "with_drag", "wind_from_name", "parse_wind",
-           "environment_disturbance", "PARAMS_SIZE", "MEMORY_SIZE"]
+__all__ = [
+    "ConstantWind",
+    "Gust",
+    "Turbulence",
+    "RotorLoss",
+    "ExternalForce",
+    "Environment",
+    "SensorNoise",
+    "DEFAULT_DRAG",
+    "default_drag_text",
+    "with_drag",
+    "wind_from_name",
+    "parse_wind",
+    "environment_disturbance",
+    "PARAMS_SIZE",
+    "MEMORY_SIZE",
+]
 
-KNOT = 0.514444                      # m/s
-FOOT = 0.3048                        # m
+KNOT = 0.514444  # m/s
+FOOT = 0.3048  # m
 INTENSITIES = {"light": 15.0 * KNOT, "moderate": 30.0 * KNOT, "severe": 45.0 * KNOT}
-AIRSPEED_FLOOR = 0.5                 # m/s
+AIRSPEED_FLOOR = 0.5  # m/s
 
 #: Drag estimates for a Qball-X4-sized vehicle (assumptions, not measurements): quadratic
 #: 0.5 rho Cd A with rho = 1.225 kg/m^3, Cd ~ 1 (bluff frame and cage), A ~ 0.1 m^2 frontal
@@ -104,9 +118,9 @@ def _lateral_coefficients(a):
     """Exact discretisation of (1 + sqrt3 T s)/(1 + T s)^2 over a = dt/T, states scaled to the
     stationary covariance [[1/2, 1/4], [1/4, 1/4]]: Phi = e^-a [[1, 0], [a, 1]] and noise of
     covariance Q = int_0^a e^-2u [[1, u], [u, u^2]] du. Returns (e^-a, a, Cholesky of Q)."""
-    if a < 1.0:                       # series: no cancellation for small a
+    if a < 1.0:  # series: no cancellation for small a
         i0 = i1 = i2 = 0.0
-        term = 1.0                    # (-2a)^n / n!
+        term = 1.0  # (-2a)^n / n!
         for n in range(60):
             i0 += term * a / (n + 1)
             i1 += term * a * a / (n + 2)
@@ -180,14 +194,14 @@ def environment_disturbance(t, dt, x, dp, dmem, rng, ext):
             k = 0.5 * (1.0 - math.cos(2.0 * math.pi * s / dp[_GUST + 5]))
             for j in range(3):
                 ext[EXT_WX + j] += k * dp[_GUST + 1 + j]
-    if dp[_TURB] != 0.0:              # Dryden: output at t, then advance the filters to t + dt
-        if started == 0.0:            # first period: draw the stationary start
+    if dp[_TURB] != 0.0:  # Dryden: output at t, then advance the filters to t + dt
+        if started == 0.0:  # first period: draw the stationary start
             n0, n1, n2, n3, n4, state = five_normals(state)
             started, dmem[1] = 1.0, n0
             dmem[2], dmem[3] = n1 / math.sqrt(2.0), math.sqrt(2.0) / 4.0 * n1 + n2 / math.sqrt(8.0)
             dmem[4], dmem[5] = n3 / math.sqrt(2.0), math.sqrt(2.0) / 4.0 * n3 + n4 / math.sqrt(8.0)
         n0, n1, n2, n3, n4, state = five_normals(state)
-        if not same_period(dmem[_MDT], dt):             # coefficients, cached per period
+        if not same_period(dmem[_MDT], dt):  # coefficients, cached per period
             a = dt / dp[_TURB + 4]
             dmem[_MDT], dmem[_CU], dmem[_CU + 1] = dt, math.exp(-a), math.sqrt(-math.expm1(-2.0 * a))
             dmem[_CV], dmem[_CV + 1], dmem[_CV + 2], dmem[_CV + 3], dmem[_CV + 4] = _lateral_coefficients(a)
@@ -195,7 +209,7 @@ def environment_disturbance(t, dt, x, dp, dmem, rng, ext):
             dmem[_CW], dmem[_CW + 1], dmem[_CW + 2], dmem[_CW + 3], dmem[_CW + 4] = _lateral_coefficients(a)
         ext[EXT_WX] += dp[_TURB + 1] * dmem[1]
         dmem[1] = dmem[_CU] * dmem[1] + dmem[_CU + 1] * n0
-        for k in range(2):            # v (states 2, 3), w (4, 5)
+        for k in range(2):  # v (states 2, 3), w (4, 5)
             j, c = 2 + 2 * k, _CV + 5 * k
             na, nb = (n1, n2) if k == 0 else (n3, n4)
             s1, s2, e = dmem[j], dmem[j + 1], dmem[c]
@@ -238,6 +252,7 @@ class _Part(Validated):
     def to_dict(self) -> dict:
         def plain(v):
             return [plain(u) for u in v] if isinstance(v, tuple) else v.tolist() if isinstance(v, np.ndarray) else v
+
         return {"model": self.name, **{f.name: plain(getattr(self, f.name)) for f in dataclasses.fields(self)}}
 
 
@@ -311,7 +326,7 @@ class Turbulence(_Part):
     name = "dryden"
 
     def _h(self) -> Any:
-        return np.maximum(self.altitude, 10 * FOOT) / FOOT          # ft, 10 ft floor
+        return np.maximum(self.altitude, 10 * FOOT) / FOOT  # ft, 10 ft floor
 
     def scales(self) -> tuple:
         """(L_u, L_v, L_w) [m].
@@ -406,8 +421,7 @@ class ExternalForce(_Part):
     name = "force"
 
 
-_SLOTS = {"wind": ConstantWind, "gust": Gust, "turbulence": Turbulence, "rotor_loss": RotorLoss,
-          "force": ExternalForce}
+_SLOTS = {"wind": ConstantWind, "gust": Gust, "turbulence": Turbulence, "rotor_loss": RotorLoss, "force": ExternalForce}
 
 
 def _columns(n: int, *values: Any) -> np.ndarray:
@@ -445,7 +459,7 @@ class Environment(Validated):
     name = "environment"
 
     @classmethod
-    def from_parts(cls, *parts: _Part) -> "Environment":
+    def from_parts(cls, *parts: _Part) -> Environment:
         """Each part into its slot (one of each kind).
 
         Parameters
@@ -477,7 +491,7 @@ class Environment(Validated):
         return cls(**slots)
 
     @classmethod
-    def from_dict(cls, d: dict) -> "Environment":
+    def from_dict(cls, d: dict) -> Environment:
         """Inverse of :meth:`to_dict`.
 
         Parameters
@@ -557,12 +571,12 @@ class Environment(Validated):
         if self.wind is not None:
             out[:, 6:9] = _columns(n, *self.wind.velocity)
         if (g := self.gust) is not None:
-            out[:, _GUST:_GUST + 6] = _columns(n, 1.0, *g.amplitude, g.start, g.duration)
+            out[:, _GUST : _GUST + 6] = _columns(n, 1.0, *g.amplitude, g.start, g.duration)
         if (tb := self.turbulence) is not None:
             tu, _, tw = tb.time_constants()
-            out[:, _TURB:_TURB + 6] = _columns(n, 1.0, *tb.sigmas(), tu, tw)
+            out[:, _TURB : _TURB + 6] = _columns(n, 1.0, *tb.sigmas(), tu, tw)
         if (r := self.rotor_loss) is not None:
-            out[:, _LOSS:_LOSS + 4] = _columns(n, 1.0, np.subtract(r.rotor, 1), np.subtract(1, r.fraction), r.time)
+            out[:, _LOSS : _LOSS + 4] = _columns(n, 1.0, np.subtract(r.rotor, 1), np.subtract(1, r.fraction), r.time)
         return out
 
     def memory(self, n: int | None = None) -> np.ndarray:
@@ -600,8 +614,11 @@ class Environment(Validated):
         """
         one = n is None and self.batch_size is None
         dp, dm = self.params(n), self.memory(n)
-        return {"disturbance": self.function, "disturbance_params": dp[0] if one else dp,
-                "disturbance_memory": dm[0] if one else dm}
+        return {
+            "disturbance": self.function,
+            "disturbance_params": dp[0] if one else dp,
+            "disturbance_memory": dm[0] if one else dm,
+        }
 
 
 @dataclass(frozen=True)
@@ -647,7 +664,7 @@ class SensorNoise(_Part):
         size = self.one_size(self.sizes(), "sensor")
         out = np.zeros((size or 1, STATE_SIZE))
         for name, j in (("position_std", X), ("velocity_std", VX), ("angle_std", PHI), ("rate_std", P)):
-            out[:, j:j + 3] = np.asarray(getattr(self, name))[..., None]
+            out[:, j : j + 3] = np.asarray(getattr(self, name))[..., None]
         return out if size else out[0]
 
     def delay_periods(self, dt: float) -> int:
@@ -701,8 +718,9 @@ class SensorNoise(_Part):
         quadcruise.errors.InputError: sensor field 'delay' (30 s) is longer than the flight (20 s)
         """
         if np.max(self.delay) > duration:
-            raise InputError(f"sensor field 'delay' ({np.max(self.delay):g} s) is longer than the flight "
-                             f"({float(duration):g} s)")
+            raise InputError(
+                f"sensor field 'delay' ({np.max(self.delay):g} s) is longer than the flight ({float(duration):g} s)"
+            )
 
     def kwargs(self, dt: float) -> dict:
         """``sensor_std`` and ``sensor_delay`` for simulate/fly.
@@ -756,7 +774,7 @@ def with_drag(vehicle: Vehicle, *, warn: bool = False) -> Vehicle:
         return vehicle
     if warn:
         warnings.warn(default_drag_text(int(np.count_nonzero(bare)), int(bare.size)), stacklevel=2)
-    new = {k: np.where(bare, v, c) for (k, v), c in zip(DEFAULT_DRAG.items(), (c1, c2))}
+    new = {k: np.where(bare, v, c) for (k, v), c in zip(DEFAULT_DRAG.items(), (c1, c2), strict=False)}
     return vehicle.replace(**{k: float(v) if v.ndim == 0 else v for k, v in new.items()})
 
 
@@ -779,14 +797,24 @@ def default_drag_text(count: int = 1, total: int = 1) -> str:
 and drag_quadratic 0.06125 N s^2/m^2 (estimates; give the vehicle's own drag_linear and drag_quadratic to choose)
     """
     which = "the vehicle has no drag" if total == 1 else f"{count:,} of {total:,} vehicles have no drag"
-    return (f"{which}, and wind acts only through drag: {'it flies' if count == 1 else 'they fly'} with "
-            f"DEFAULT_DRAG, drag_linear {DEFAULT_DRAG['drag_linear']:g} N s/m and drag_quadratic "
-            f"{DEFAULT_DRAG['drag_quadratic']:.4g} N s^2/m^2 (estimates; give the vehicle's own drag_linear and "
-            "drag_quadratic to choose)")
+    return (
+        f"{which}, and wind acts only through drag: {'it flies' if count == 1 else 'they fly'} with "
+        f"DEFAULT_DRAG, drag_linear {DEFAULT_DRAG['drag_linear']:g} N s/m and drag_quadratic "
+        f"{DEFAULT_DRAG['drag_quadratic']:.4g} N s^2/m^2 (estimates; give the vehicle's own drag_linear and "
+        "drag_quadratic to choose)"
+    )
 
 
-_NAMES = {"constant": ConstantWind, "wind": ConstantWind, "gust": Gust, "dryden": Turbulence,
-          "turbulence": Turbulence, "loss": RotorLoss, "rotor_loss": RotorLoss, "force": ExternalForce}
+_NAMES = {
+    "constant": ConstantWind,
+    "wind": ConstantWind,
+    "gust": Gust,
+    "dryden": Turbulence,
+    "turbulence": Turbulence,
+    "loss": RotorLoss,
+    "rotor_loss": RotorLoss,
+    "force": ExternalForce,
+}
 
 
 def wind_from_name(name: str, **kw: Any) -> _Part:
@@ -842,8 +870,11 @@ def _part(text: str) -> _Part:
         return Gust(_floats(first, 3, "AX,AY,AZ"), _floats(start, 1, "START")[0], _floats(dur, 1, "DURATION")[0])
     if cls is Turbulence:
         alt, _, speed = rest.partition("/")
-        kw: dict = {"intensity": first.lower()} if first.lower() in INTENSITIES else {
-            "w20": _floats(first, 1, "LEVEL (light, moderate, severe or w20 m/s)")[0]}
+        kw: dict = (
+            {"intensity": first.lower()}
+            if first.lower() in INTENSITIES
+            else {"w20": _floats(first, 1, "LEVEL (light, moderate, severe or w20 m/s)")[0]}
+        )
         return Turbulence(**kw, **{k: _floats(v, 1, k)[0] for k, v in (("altitude", alt), ("airspeed", speed)) if v})
     if cls is RotorLoss:
         if not at:

@@ -27,7 +27,11 @@ ENVIRONMENTS = {
 
 for _id, _kwargs in ENVIRONMENTS.items():
     if _id not in gymnasium.registry:
-        gymnasium.register(id=_id, entry_point="quadcruise.gym.env:QuadEnv",
-                           vector_entry_point="quadcruise.gym.env:QuadVectorEnv", kwargs=_kwargs)
+        gymnasium.register(
+            id=_id,
+            entry_point="quadcruise.gym.env:QuadEnv",
+            vector_entry_point="quadcruise.gym.env:QuadVectorEnv",
+            kwargs=_kwargs,
+        )
 
 __all__ = ["ENVIRONMENTS", "HOVER_POPULATION", "QuadEnv", "QuadVectorEnv"]

@@ -27,7 +27,7 @@ from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.stepper import Stepper
 from quadcruise.workflows.fly import check_can_hover
 
-EPISODE_STRIDE = 2 ** 32
+EPISODE_STRIDE = 2**32
 """Episode e of vehicle i draws from the stream ``(seed, i * EPISODE_STRIDE + e)``: it depends on
 (seed, i, e) only, never on the number of vehicles."""
 RANDOM_MISSION_KEY = 2
@@ -55,8 +55,12 @@ def random_circle(seed: int, episode_id: int) -> Circle:
         At 1 m altitude, around the origin.
     """
     u = np.random.default_rng(np.random.SeedSequence([seed, episode_id], spawn_key=(RANDOM_MISSION_KEY,))).random(4)
-    return Circle(radius=0.5 + 2.5 * u[0], period=8.0 + 12.0 * u[1], direction=1 if u[2] < 0.5 else -1,
-                  start_angle=2.0 * math.pi * u[3])
+    return Circle(
+        radius=0.5 + 2.5 * u[0],
+        period=8.0 + 12.0 * u[1],
+        direction=1 if u[2] < 0.5 else -1,
+        start_angle=2.0 * math.pi * u[3],
+    )
 
 
 class QuadVectorEnv(VectorEnv):
@@ -95,11 +99,22 @@ class QuadVectorEnv(VectorEnv):
 
     metadata: ClassVar[dict] = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
 
-    def __init__(self, num_envs: int = 1, *, mission: Mission | str = "hover", action: str = "attitude",
-                 controller: Any = None, vehicle: Vehicle | None = None, dt: float = 0.01,
-                 max_step: float | None = None, duration: float | None = None,
-                 population: Population | None = None, max_track_error: float = 2.0,
-                 limits: Limits | None = None, scales: dict | None = None) -> None:
+    def __init__(
+        self,
+        num_envs: int = 1,
+        *,
+        mission: Mission | str = "hover",
+        action: str = "attitude",
+        controller: Any = None,
+        vehicle: Vehicle | None = None,
+        dt: float = 0.01,
+        max_step: float | None = None,
+        duration: float | None = None,
+        population: Population | None = None,
+        max_track_error: float = 2.0,
+        limits: Limits | None = None,
+        scales: dict | None = None,
+    ) -> None:
         if not (isinstance(num_envs, (int, np.integer)) and num_envs >= 1):
             raise InputError(f"num_envs must be a whole number >= 1, got {num_envs!r}")
         if action not in ACTION_CONTROLLERS:
@@ -110,8 +125,11 @@ class QuadVectorEnv(VectorEnv):
             raise InputError(f"max_track_error must be a positive number [m], got {max_track_error!r}")
         n = self.num_envs = int(num_envs)
         self.random_mission = isinstance(mission, str) and mission.strip().lower() == "random"
-        self.mission = random_circle(0, 0) if self.random_mission else (
-            mission_from_name(mission) if isinstance(mission, str) else mission)
+        self.mission = (
+            random_circle(0, 0)
+            if self.random_mission
+            else (mission_from_name(mission) if isinstance(mission, str) else mission)
+        )
         if not isinstance(self.mission, Mission):
             raise InputError(f"mission must be a Mission or a name, got {type(mission).__name__}")
         self.nominal = vehicle or Vehicle.paper()
@@ -130,15 +148,27 @@ class QuadVectorEnv(VectorEnv):
         draw = self._draw(0, np.arange(n) * EPISODE_STRIDE, n)
         self.sensors = None if population is None else population.noise
         if self.baseline is not None:
-            function, gains, memory, width = (self.baseline.function, self.baseline.gains(), self.baseline.memory(),
-                                              0)
+            function, gains, memory, width = (self.baseline.function, self.baseline.gains(), self.baseline.memory(), 0)
         else:
             function, memory, width = ACTION_CONTROLLERS[action], None, 4
         env_kw = {} if draw["environment"] is None else draw["environment"].kwargs(n)
         sens_kw = {} if self.sensors is None else self.sensors.kwargs(float(dt))
-        self.stepper = Stepper(grid, draw["x0"], draw["vp"], function, gains, self.mission.function, draw["mp"],
-                               memory=memory, vp_ctrl=draw["vp_ctrl"], max_step=max_step or dt,
-                               limits=limits or DEFAULT_LIMITS, setpoint_width=width, **env_kw, **sens_kw)
+        self.stepper = Stepper(
+            grid,
+            draw["x0"],
+            draw["vp"],
+            function,
+            gains,
+            self.mission.function,
+            draw["mp"],
+            memory=memory,
+            vp_ctrl=draw["vp_ctrl"],
+            max_step=max_step or dt,
+            limits=limits or DEFAULT_LIMITS,
+            setpoint_width=width,
+            **env_kw,
+            **sens_kw,
+        )
         self.dt = float(dt)
         self.single_action_space = spaces.Box(-1.0, 1.0, (4,), dtype=np.float32)
         self.single_observation_space = spaces.Box(-np.inf, np.inf, (OBS_SIZE,), dtype=np.float32)
@@ -164,17 +194,16 @@ class QuadVectorEnv(VectorEnv):
         missions = [random_circle(seed, int(i)) for i in ids] if self.random_mission else [self.mission]
         if self.random_mission:
             start = np.concatenate([m.reference(0.0) for m in missions])
-        else:                                                 # computed once: a reset is on the hot path
+        else:  # computed once: a reset is on the hot path
             start = self._start_ref if hasattr(self, "_start_ref") else self.mission.reference(0.0)
             self._start_ref = start
         vp = vehicle.rows(k)
-        x0 = np.zeros((k, STATE_SIZE))                        # level, still, rotors at the hover thrust
-        x0[:, X:X + 3] = start[:, REF_X:REF_X + 3] + offsets  # on the reference, plus the drawn offset
+        x0 = np.zeros((k, STATE_SIZE))  # level, still, rotors at the hover thrust
+        x0[:, X : X + 3] = start[:, REF_X : REF_X + 3] + offsets  # on the reference, plus the drawn offset
         x0[:, PSI] = start[:, REF_PSI]
-        x0[:, F1:F1 + 4] = (vp[:, P_M] * vp[:, P_G] / 4.0)[:, None]
+        x0[:, F1 : F1 + 4] = (vp[:, P_M] * vp[:, P_G] / 4.0)[:, None]
         vp_ctrl = self.nominal.rows(k) if pop is None or pop.model_error else vp
-        return {"vp": vp, "vp_ctrl": vp_ctrl, "x0": x0, "mp": stack_params(missions, n=k),
-                "environment": environment}
+        return {"vp": vp, "vp_ctrl": vp_ctrl, "x0": x0, "mp": stack_params(missions, n=k), "environment": environment}
 
     def _start(self, rows: np.ndarray) -> None:
         """Start new episodes of the vehicles ``rows``, each from its own (seed, vehicle, episode) stream."""
@@ -188,8 +217,12 @@ class QuadVectorEnv(VectorEnv):
         env = draw["environment"]
         if env is not None:
             s.disturbance_params[rows] = env.params(k)
-        s.reset(self._mask(rows), x0=draw["x0"], rng=vehicle_states(self._seed, k, ids) if s.drawn else None,
-                disturbance_memory=None if env is None else env.memory(k))
+        s.reset(
+            self._mask(rows),
+            x0=draw["x0"],
+            rng=vehicle_states(self._seed, k, ids) if s.drawn else None,
+            disturbance_memory=None if env is None else env.memory(k),
+        )
         self._episode[rows] += 1
         self.returns[rows] = 0.0
 
@@ -221,7 +254,7 @@ class QuadVectorEnv(VectorEnv):
         """
         mask = None if not options else options.get("reset_mask")
         if seed is not None or not hasattr(self, "_seeded"):
-            self._seed = int(np.random.SeedSequence().entropy % (2 ** 63)) if seed is None else int(seed)
+            self._seed = int(np.random.SeedSequence().entropy % (2**63)) if seed is None else int(seed)
             if self._seed < 0:
                 raise InputError(f"seed must be >= 0, got {seed}")
             self._seeded = True
@@ -256,8 +289,9 @@ class QuadVectorEnv(VectorEnv):
         try:
             a = np.asarray(actions, dtype=float)
         except (TypeError, ValueError):
-            raise InputError(f"action: expected numbers of shape ({self.num_envs}, 4), got {type(actions).__name__}"
-                             ) from None
+            raise InputError(
+                f"action: expected numbers of shape ({self.num_envs}, 4), got {type(actions).__name__}"
+            ) from None
         if a.shape != (self.num_envs, 4):
             raise InputError(f"action: expected shape ({self.num_envs}, 4), got {a.shape}")
         bad = ~np.isfinite(a)
@@ -267,8 +301,10 @@ class QuadVectorEnv(VectorEnv):
         out = np.abs(a) > 1.0
         if out.any():
             i, j = np.argwhere(out)[0]
-            raise InputError(f"action: vehicle {i}, entry {j} is {a[i, j]:.6g}, outside the action space [-1, 1] "
-                             f"(mode '{self.action_mode}')")
+            raise InputError(
+                f"action: vehicle {i}, entry {j} is {a[i, j]:.6g}, outside the action space [-1, 1] "
+                f"(mode '{self.action_mode}')"
+            )
         return a
 
     def step(self, actions):
@@ -362,7 +398,7 @@ class QuadEnv(gymnasium.Env):
         a = None if action is None else np.asarray(action)
         if a is not None and a.shape != (4,):
             raise InputError(f"action: expected shape (4,), got {a.shape}")
-        self.vec._pending[:] = False        # no autoreset: the user resets
+        self.vec._pending[:] = False  # no autoreset: the user resets
         obs, r, term, trunc, info = self.vec.step(None if a is None else a[None, :])
         return obs[0], float(r[0]), bool(term[0]), bool(trunc[0]), {k: v[0] for k, v in info.items()}
 

@@ -69,21 +69,37 @@ def rollout(env: QuadVectorEnv, policy: Callable | None = None, *, seed: int = 0
         commands[alive, k] = s.log_cmd[alive, 0]
         refs[alive, k] = s.log_ref[alive, 0]
         states[alive, k + 1] = s.state[alive]
-        if k == length - 2:                         # the last instant's reference and command
+        if k == length - 2:  # the last instant's reference and command
             commands[alive, k + 1] = s.log_cmd[alive, 1]
             refs[alive, k + 1] = s.log_ref[alive, 1]
-        ended = alive & (terminated | truncated)          # as they ended: the next step restarts them
+        ended = alive & (terminated | truncated)  # as they ended: the next step restarts them
         status[ended], final[ended] = info["status"][ended], s.state[ended]
         t_stop[ended & terminated] = s.t_stop[ended & terminated]
         alive &= ~ended
         if not alive.any():
             break
-    meta = {"workflow": "gym", "mission": env.mission.to_dict(), "dt_s": env.dt, "seed": seed, "n": n,
-            "controller": {"name": env.baseline.name} if env.baseline is not None else {"name": "policy"}}
-    result = SimResult(t=s.t_grid.copy(), states=states, commands=commands, references=refs,
-                       final_state=final, status=status, t_stop=t_stop, memory=s.memory.copy(),
-                       duty_clipped_s=s.saturated[:, 0].copy(), controller_limited_s=s.saturated[:, 1].copy(),
-                       meta=meta, disturbance_memory=s.disturbance_memory.copy())
+    meta = {
+        "workflow": "gym",
+        "mission": env.mission.to_dict(),
+        "dt_s": env.dt,
+        "seed": seed,
+        "n": n,
+        "controller": {"name": env.baseline.name} if env.baseline is not None else {"name": "policy"},
+    }
+    result = SimResult(
+        t=s.t_grid.copy(),
+        states=states,
+        commands=commands,
+        references=refs,
+        final_state=final,
+        status=status,
+        t_stop=t_stop,
+        memory=s.memory.copy(),
+        duty_clipped_s=s.saturated[:, 0].copy(),
+        controller_limited_s=s.saturated[:, 1].copy(),
+        meta=meta,
+        disturbance_memory=s.disturbance_memory.copy(),
+    )
     return returns, result
 
 
@@ -116,8 +132,12 @@ def baselines(controllers=BASELINES, *, num_envs: int = 8, seed: int = 0, **env_
         returns, flights = rollout(env, seed=seed)
         table = flights.metrics()
         periods = env.stepper.t_grid.shape[0] - 1
-        row = {"controller": env.baseline.name, "mean_return": float(returns.mean()),
-               "mean_reward": float(returns.mean() / periods), "finished": float(np.mean(flights.status == 0))}
+        row = {
+            "controller": env.baseline.name,
+            "mean_return": float(returns.mean()),
+            "mean_reward": float(returns.mean() / periods),
+            "finished": float(np.mean(flights.status == 0)),
+        }
         row.update(table.select_dtypes("number").drop(columns=["vehicle"], errors="ignore").mean().to_dict())
         rows.append(row)
     return pd.DataFrame(rows).set_index("controller")

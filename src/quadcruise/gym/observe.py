@@ -26,8 +26,29 @@ from numba import njit
 from quadcruise.control.so3 import rotation_zyx
 from quadcruise.layout import F1, P_G, P_M, PHI, PSI, REF_AX, REF_PSI, REF_SIZE, REF_VX, REF_X, THETA, VX, P, X
 
-OBS_NAMES = ("ex_b", "ey_b", "ez_b", "evx_b", "evy_b", "evz_b", "up_x", "up_y", "up_z", "sin_epsi", "cos_epsi",
-             "p", "q", "r", "ax_ref_b", "ay_ref_b", "az_ref_b", "f1_rel", "f2_rel", "f3_rel", "f4_rel")
+OBS_NAMES = (
+    "ex_b",
+    "ey_b",
+    "ez_b",
+    "evx_b",
+    "evy_b",
+    "evz_b",
+    "up_x",
+    "up_y",
+    "up_z",
+    "sin_epsi",
+    "cos_epsi",
+    "p",
+    "q",
+    "r",
+    "ax_ref_b",
+    "ay_ref_b",
+    "az_ref_b",
+    "f1_rel",
+    "f2_rel",
+    "f3_rel",
+    "f4_rel",
+)
 OBS_SIZE = len(OBS_NAMES)
 REWARD_DISTANCE = 0.5
 """[m]: the reward falls by 1/e per this distance from the reference."""
@@ -77,8 +98,7 @@ def observe(x, ref, vp, bound, obs, reward, lost):
     for i in range(x.shape[0]):
         Rm = rotation_zyx(x[i, PHI], x[i, THETA], x[i, PSI])
         ex, ey, ez = x[i, X] - ref[i, REF_X], x[i, X + 1] - ref[i, REF_X + 1], x[i, X + 2] - ref[i, REF_X + 2]
-        ux, uy, uz = (x[i, VX] - ref[i, REF_VX], x[i, VX + 1] - ref[i, REF_VX + 1],
-                      x[i, VX + 2] - ref[i, REF_VX + 2])
+        ux, uy, uz = (x[i, VX] - ref[i, REF_VX], x[i, VX + 1] - ref[i, REF_VX + 1], x[i, VX + 2] - ref[i, REF_VX + 2])
         ax, ay, az = ref[i, REF_AX], ref[i, REF_AX + 1], ref[i, REF_AX + 2]
         for j in range(3):
             obs[i, j] = Rm[0][j] * ex + Rm[1][j] * ey + Rm[2][j] * ez

@@ -13,5 +13,16 @@ from quadcruise.io.files import (
 )
 from quadcruise.io.plainjson import dumps, plain
 
-__all__ = ["MARKER", "atomic_dir", "atomic_path", "check_output_dir", "check_table_format", "check_writable_place", "dumps",
-           "plain", "read_marker", "read_numeric_csv", "write_table"]
+__all__ = [
+    "MARKER",
+    "atomic_dir",
+    "atomic_path",
+    "check_output_dir",
+    "check_table_format",
+    "check_writable_place",
+    "dumps",
+    "plain",
+    "read_marker",
+    "read_numeric_csv",
+    "write_table",
+]

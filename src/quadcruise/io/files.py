@@ -55,7 +55,7 @@ def atomic_path(path: str | os.PathLike):
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
         os.close(fd)
-        os.chmod(tmp, 0o666 & ~_umask())     # mkstemp makes 0600; a result file is an ordinary file
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; a result file is an ordinary file
         yield Path(tmp)
         os.replace(tmp, path)
     except BaseException as exc:
@@ -109,7 +109,7 @@ def atomic_dir(path: str | os.PathLike):
             try:
                 os.replace(tmp, path)
             except BaseException:
-                os.replace(old, path)       # the old folder back where it was
+                os.replace(old, path)  # the old folder back where it was
                 raise
             _remove(old)
         else:
@@ -160,7 +160,7 @@ def check_writable_place(path: str | os.PathLike) -> None:
         parent = parent.parent
     if not parent.is_dir():
         raise InputError(f"{path}: cannot write there ({parent} is not a folder)")
-    try:                                    # the only sure test: make something there, and remove it
+    try:  # the only sure test: make something there, and remove it
         os.rmdir(tempfile.mkdtemp(prefix=".quadcruise-probe.", dir=parent))
     except OSError as exc:
         raise InputError(f"{path}: cannot write there ({exc.strerror.lower()} in {parent})") from None
@@ -213,12 +213,19 @@ def read_marker(folder: str | os.PathLike) -> dict | None:
     except UnicodeDecodeError:
         why = "not UTF-8 text"
     except json.JSONDecodeError as exc:
-        why = ("empty" if not text.strip() else "NUL bytes" if "\0" in text
-               else f"not JSON: {exc.msg.lower()} at line {exc.lineno}, column {exc.colno}")
+        why = (
+            "empty"
+            if not text.strip()
+            else "NUL bytes"
+            if "\0" in text
+            else f"not JSON: {exc.msg.lower()} at line {exc.lineno}, column {exc.colno}"
+        )
     if why is None:
         return doc
-    raise InputError(f"{path}: damaged ({why}), so what {folder} holds (a Monte Carlo sweep's chunks, perhaps) "
-                     "is unknown: use --force to replace the folder, or delete it")
+    raise InputError(
+        f"{path}: damaged ({why}), so what {folder} holds (a Monte Carlo sweep's chunks, perhaps) "
+        "is unknown: use --force to replace the folder, or delete it"
+    )
 
 
 def check_output_dir(path: str | os.PathLike, force: bool = False, *, workflow: str | None = None) -> Path:
@@ -258,14 +265,17 @@ def check_output_dir(path: str | os.PathLike, force: bool = False, *, workflow: 
         return path
     held = read_marker(path)
     if held is None and any(path.iterdir()):
-        raise InputError(f"{path}: folder is not empty and was not written by quadcruise "
-                         "(use --force to replace it)")
+        raise InputError(f"{path}: folder is not empty and was not written by quadcruise (use --force to replace it)")
     if workflow != "montecarlo" and held is not None and held.get("workflow") == "montecarlo":
-        raise InputError(f"{path}: holds a Monte Carlo sweep (hours of flights, resumable); use --force to "
-                         "replace it or choose another --out")
+        raise InputError(
+            f"{path}: holds a Monte Carlo sweep (hours of flights, resumable); use --force to "
+            "replace it or choose another --out"
+        )
     if workflow == "reproduce" and held is not None and held.get("workflow") != "reproduce":
-        raise InputError(f"{path}: holds the output of quadcruise {held.get('workflow') or 'another command'}, not of "
-                         "reproduce; use --force to replace it or choose another --out")
+        raise InputError(
+            f"{path}: holds the output of quadcruise {held.get('workflow') or 'another command'}, not of "
+            "reproduce; use --force to replace it or choose another --out"
+        )
     return path
 
 
@@ -331,8 +341,14 @@ def write_table(frame, path: Path, fmt: str) -> Path:
             import numpy as np
 
             # numpy's savetxt formats an all-numeric table faster than pandas' to_csv
-            np.savetxt(tmp, frame.to_numpy(dtype=float), delimiter=",", fmt="%.10g",
-                       header=",".join(map(str, frame.columns)), comments="")
+            np.savetxt(
+                tmp,
+                frame.to_numpy(dtype=float),
+                delimiter=",",
+                fmt="%.10g",
+                header=",".join(map(str, frame.columns)),
+                comments="",
+            )
         else:
             frame.to_csv(tmp, index=False, float_format="%.10g")
     return out
@@ -352,23 +368,36 @@ def _read_at_once(path: Path, required, optional, blank_ok):
         raw = raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw
         text = raw.rstrip(b"\r\n")
         if b'"' in text:
-            return None                                        # quoted cells: the csv module's
+            return None  # quoted cells: the csv module's
         header = [h.strip() for h in text.split(b"\n", 1)[0].decode().rstrip("\r").split(",")]
         rows = text.count(b"\n")
-        if (len(set(header)) != len(header) or not set(required) <= set(header)
-                or not set(header) <= set(required) | set(optional) or text.count(b",") != (rows + 1) * (len(header) - 1)):
+        if (
+            len(set(header)) != len(header)
+            or not set(required) <= set(header)
+            or not set(header) <= set(required) | set(optional)
+            or text.count(b",") != (rows + 1) * (len(header) - 1)
+        ):
             return None
         if b"nan" in text.lower():
-            return None                                        # a NaN cell: refused, by line
+            return None  # a NaN cell: refused, by line
         used = [c for c in required + tuple(optional) if c in header]
-        table = pd.read_csv(io.BytesIO(text), header=0, names=header, usecols=used, dtype=float,
-                            na_values=[""], keep_default_na=False, skipinitialspace=True, engine="c")
+        table = pd.read_csv(
+            io.BytesIO(text),
+            header=0,
+            names=header,
+            usecols=used,
+            dtype=float,
+            na_values=[""],
+            keep_default_na=False,
+            skipinitialspace=True,
+            engine="c",
+        )
         if len(table) != rows:
-            return None                                        # a blank line (pandas skips it): lines to count
+            return None  # a blank line (pandas skips it): lines to count
         columns = []
         for name in used:
             column = table[name].to_numpy(dtype=float)
-            blank = np.flatnonzero(np.isnan(column))            # only a blank cell reads as NaN here
+            blank = np.flatnonzero(np.isnan(column))  # only a blank cell reads as NaN here
             if blank.size and (blank_ok is None or not all(blank_ok(name, int(k)) for k in blank)):
                 return None
             columns.append(column)
@@ -378,8 +407,9 @@ def _read_at_once(path: Path, required, optional, blank_ok):
     return 1, used, data, list(range(2, rows + 2))
 
 
-def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optional: tuple[str, ...] = (), *,
-                     blank_ok=None, progress=None):
+def read_numeric_csv(
+    path: str | os.PathLike, required: tuple[str, ...], optional: tuple[str, ...] = (), *, blank_ok=None, progress=None
+):
     """Read a CSV of numbers with a header; any problem is one InputError naming the file,
     the line and the column.
 
@@ -441,7 +471,7 @@ def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optiona
             progress(fast[2].shape[0], fast[2].shape[0])
         return fast
     try:
-        with path.open(newline="", encoding="utf-8-sig") as f:       # a byte-order mark (Excel's) is dropped
+        with path.open(newline="", encoding="utf-8-sig") as f:  # a byte-order mark (Excel's) is dropped
             rows = [(n, r) for n, r in enumerate(csv.reader(f), start=1) if any(c.strip() for c in r)]
     except (OSError, UnicodeDecodeError, csv.Error) as exc:
         raise InputError(f"{path}: cannot be read ({exc.__class__.__name__}: {exc})") from None
@@ -451,8 +481,9 @@ def read_numeric_csv(path: str | os.PathLike, required: tuple[str, ...], optiona
     head, header = rows[0][0], [h.strip() for h in rows[0][1]]
     missing = [c for c in required if c not in header]
     if missing:
-        raise InputError(f"{path}, line {head}, column(s) {', '.join(map(repr, missing))}: missing "
-                         f"(the header must name {names})")
+        raise InputError(
+            f"{path}, line {head}, column(s) {', '.join(map(repr, missing))}: missing (the header must name {names})"
+        )
     dupes = sorted({h for h in header if header.count(h) > 1})
     if dupes:
         raise InputError(f"{path}, line {head}, column(s) {', '.join(map(repr, dupes))}: appear more than once")

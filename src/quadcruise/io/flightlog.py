@@ -58,8 +58,7 @@ FRD_TO_FLU = np.diag([1.0, -1.0, -1.0])
 """``B``: FRD body vectors to FLU (its own inverse)."""
 ARMED = 2
 """``vehicle_status.arming_state`` of an armed vehicle (PX4's ARMING_STATE_ARMED)."""
-MULTICOPTER_TYPES = {2: "quadrotor", 3: "coaxial", 4: "helicopter", 13: "hexarotor", 14: "octorotor",
-                     15: "tricopter"}
+MULTICOPTER_TYPES = {2: "quadrotor", 3: "coaxial", 4: "helicopter", 13: "hexarotor", 14: "octorotor", 15: "tricopter"}
 """MAVLink MAV_TYPE values of the multicopters this reader accepts."""
 MIN_SEGMENT_S = 1.0
 """Shortest airborne segment kept [s]: shorter ones are left out (a bounce, not a flight)."""
@@ -68,9 +67,17 @@ MIN_HEIGHT = 0.3
 sample is left out: touching the ground, or in its strongest effect on the rotors' thrust."""
 CSV_COLUMNS = ("t", "vx", "vy", "vz", "qw", "qx", "qy", "qz", "p", "q", "r")
 """The columns a CSV log must have, besides its commands ``u1..un``."""
-ULOG_TOPICS = ("vehicle_status", "vehicle_land_detected", "vehicle_attitude", "vehicle_angular_velocity",
-               "sensor_combined", "vehicle_local_position", "actuator_motors", "actuator_outputs",
-               "hover_thrust_estimate")
+ULOG_TOPICS = (
+    "vehicle_status",
+    "vehicle_land_detected",
+    "vehicle_attitude",
+    "vehicle_angular_velocity",
+    "sensor_combined",
+    "vehicle_local_position",
+    "actuator_motors",
+    "actuator_outputs",
+    "hover_thrust_estimate",
+)
 """The topics read from a ULog (others are skipped)."""
 
 
@@ -241,13 +248,15 @@ def read_flight_log(path: str | os.PathLike, *, frame: str | None = None, comman
     spec = parse_commands(commands)
     if kind == ".ulg":
         if frame_name == "enu":
-            raise InputError(f"{path}: a PX4 log is always in PX4's frames (NED world, FRD body); "
-                             "frame 'enu' is for CSV logs")
+            raise InputError(
+                f"{path}: a PX4 log is always in PX4's frames (NED world, FRD body); frame 'enu' is for CSV logs"
+            )
         return _read_ulog(path, spec)
     return _read_csv(path, frame_name or "enu", spec)
 
 
 # --- ULog ---------------------------------------------------------------------------------
+
 
 def check_ulog_framing(path: Path) -> None:
     """Refuse a file that is not a ULog, or whose last message runs past its end (truncated).
@@ -269,8 +278,10 @@ def check_ulog_framing(path: Path) -> None:
     while pos + 3 <= size:
         (length,) = struct.unpack_from("<H", data, pos)
         if pos + 3 + length > size:
-            raise InputError(f"{path}: truncated PX4 log: the message at byte {pos} needs {length} bytes, "
-                             f"the file ends after {size - pos - 3}")
+            raise InputError(
+                f"{path}: truncated PX4 log: the message at byte {pos} needs {length} bytes, "
+                f"the file ends after {size - pos - 3}"
+            )
         pos += 3 + length
     if pos != size:
         raise InputError(f"{path}: truncated PX4 log: {size - pos} stray byte(s) at its end")
@@ -339,7 +350,7 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
     cmd = topics[cmd_topic]
     prefix = "control" if cmd_topic == "actuator_motors" else "output"
     channels = list(range(n_rot))
-    if cmd_topic == "actuator_outputs":             # PX4 >= 1.13: PWM_MAIN_FUNCi = 101 + k puts motor k on output i
+    if cmd_topic == "actuator_outputs":  # PX4 >= 1.13: PWM_MAIN_FUNCi = 101 + k puts motor k on output i
         funcs = {int(params[f"PWM_MAIN_FUNC{i + 1}"]): i for i in range(16) if f"PWM_MAIN_FUNC{i + 1}" in params}
         if all(101 + k in funcs for k in range(n_rot)):
             channels = [funcs[101 + k] for k in range(n_rot)]
@@ -364,8 +375,9 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
     t_status = times("vehicle_status")
     land = topics.get("vehicle_land_detected")
     rate_topic = "vehicle_angular_velocity"
-    if "sensor_combined" in topics and (rate_topic not in topics or _median_rate(times("sensor_combined"))
-                                        > 1.01 * _median_rate(times(rate_topic))):
+    if "sensor_combined" in topics and (
+        rate_topic not in topics or _median_rate(times("sensor_combined")) > 1.01 * _median_rate(times(rate_topic))
+    ):
         rate_topic = "sensor_combined"
     t_rate = times(rate_topic)
     step = 1.0 / _median_rate(t_rate)
@@ -383,14 +395,15 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
             if flag in land:
                 landed |= _held(times("vehicle_land_detected"), land[flag].astype(bool), grid, True)
     lp = topics["vehicle_local_position"]
-    if "dist_bottom" in lp:        # PX4's estimate, also while its own valid flag is down (no range sensor)
+    if "dist_bottom" in lp:  # PX4's estimate, also while its own valid flag is down (no range sensor)
         height = _interp(times("vehicle_local_position"), lp["dist_bottom"][:, None], grid)[:, 0]
         landed |= np.isfinite(height) & (height < MIN_HEIGHT)
     air = armed & ~landed & np.all(np.isfinite(_interp(times(cmd_topic), u_raw, grid)), axis=1)
     segment = _segments(air, grid, step)
     if not np.any(segment >= 0):
-        raise InputError(f"{path}: nothing to identify: the vehicle was armed but never airborne "
-                         f"for {MIN_SEGMENT_S:g} s")
+        raise InputError(
+            f"{path}: nothing to identify: the vehicle was armed but never airborne for {MIN_SEGMENT_S:g} s"
+        )
     keep = segment >= 0
     t = grid[keep]
 
@@ -398,8 +411,11 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
     q_ned = np.column_stack([att[f"q[{i}]"] for i in range(4)]).astype(np.float64)
     r_ned = Rotation.from_quat(q_ned[:, [1, 2, 3, 0]])
     t_att, first = np.unique(times("vehicle_attitude"), return_index=True)
-    r_enu = Rotation.from_matrix(NED_TO_ENU) * Slerp(t_att, r_ned[first])(np.clip(t, t_att[0], t_att[-1])) \
+    r_enu = (
+        Rotation.from_matrix(NED_TO_ENU)
+        * Slerp(t_att, r_ned[first])(np.clip(t, t_att[0], t_att[-1]))
         * Rotation.from_matrix(FRD_TO_FLU)
+    )
     xyzw = r_enu.as_quat()
     quat = np.column_stack([xyzw[:, 3], xyzw[:, :3]])
 
@@ -407,14 +423,19 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
     vel = _interp(t_lp, np.column_stack([lp["vx"], lp["vy"], lp["vz"]]), t) @ NED_TO_ENU.T
     pos = _interp(t_lp, np.column_stack([lp["x"], lp["y"], lp["z"]]), t) @ NED_TO_ENU.T
     rt = topics[rate_topic]
-    keys = [f"xyz[{i}]" for i in range(3)] if rate_topic == "vehicle_angular_velocity" else \
-        [f"gyro_rad[{i}]" for i in range(3)]
+    keys = (
+        [f"xyz[{i}]" for i in range(3)]
+        if rate_topic == "vehicle_angular_velocity"
+        else [f"gyro_rad[{i}]" for i in range(3)]
+    )
     rates = _interp(t_rate, np.column_stack([rt[k] for k in keys]), t) @ FRD_TO_FLU.T
     force = None
     if accel_topic:
         sc = topics[accel_topic]
-        force = _interp(times(accel_topic), np.column_stack([sc[f"accelerometer_m_s2[{i}]"] for i in range(3)]),
-                        t) @ FRD_TO_FLU.T
+        force = (
+            _interp(times(accel_topic), np.column_stack([sc[f"accelerometer_m_s2[{i}]"] for i in range(3)]), t)
+            @ FRD_TO_FLU.T
+        )
     u = _interp(times(cmd_topic), u_raw, t)
 
     rotors, km = _rotors(params, n_rot)
@@ -431,14 +452,32 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
         if np.any(inside):
             hover = (th[inside], h["hover_thrust"][inside].astype(np.float64))
     rates_hz = {n: round(_median_rate(times(n)), 1) for n in topics}
-    resampling = (f"uniform grid at the rate of {rate_topic} ({1 / step:.0f} Hz) over each airborne segment "
-                  f"(armed, not landed or touching the ground, "
-                  f"and >= {MIN_HEIGHT:g} m above the ground by dist_bottom, for >= {MIN_SEGMENT_S:g} s); vectors and commands interpolated linearly, "
-                  "attitude by slerp, arming and landed states held from their last message")
+    resampling = (
+        f"uniform grid at the rate of {rate_topic} ({1 / step:.0f} Hz) over each airborne segment "
+        f"(armed, not landed or touching the ground, "
+        f"and >= {MIN_HEIGHT:g} m above the ground by dist_bottom, for >= {MIN_SEGMENT_S:g} s); "
+        "vectors and commands interpolated linearly, "
+        "attitude by slerp, arming and landed states held from their last message"
+    )
     kept = {k: params[k] for k in ("MAV_TYPE", "THR_MDL_FAC", "CA_ROTOR_COUNT", "SYS_AUTOSTART") if k in params}
-    return FlightLog(source=str(path), t=t, segment=segment[keep], u=u, velocity=vel, quaternion=quat,
-                     rates=rates, specific_force=force, position=pos, rotors=rotors, yaw_per_thrust=km,
-                     parameters=kept, hover_thrust=hover, rates_hz=rates_hz, commands=how, resampling=resampling)
+    return FlightLog(
+        source=str(path),
+        t=t,
+        segment=segment[keep],
+        u=u,
+        velocity=vel,
+        quaternion=quat,
+        rates=rates,
+        specific_force=force,
+        position=pos,
+        rotors=rotors,
+        yaw_per_thrust=km,
+        parameters=kept,
+        hover_thrust=hover,
+        rates_hz=rates_hz,
+        commands=how,
+        resampling=resampling,
+    )
 
 
 def _pwm_param(params: dict, which: str, i: int, default: float) -> float:
@@ -460,7 +499,7 @@ def _segments(air: np.ndarray, t: np.ndarray, step: float) -> np.ndarray:
     out = np.full(air.shape, -1)
     edges = np.flatnonzero(np.diff(np.r_[0, air.astype(np.int8), 0]))
     k = 0
-    for a, b in zip(edges[::2], edges[1::2]):
+    for a, b in zip(edges[::2], edges[1::2], strict=False):
         if (b - a) * step >= MIN_SEGMENT_S:
             out[a:b] = k
             k += 1
@@ -471,12 +510,19 @@ def _rotors(params: dict, n: int) -> tuple[np.ndarray | None, float | None]:
     keys = [f"CA_ROTOR{i}_{w}" for i in range(n) for w in ("PX", "PY", "KM")]
     if not all(k in params for k in keys):
         return None, None
-    rows = [(float(params[f"CA_ROTOR{i}_PX"]), -float(params[f"CA_ROTOR{i}_PY"]),
-             -float(np.sign(params[f"CA_ROTOR{i}_KM"]))) for i in range(n)]
+    rows = [
+        (
+            float(params[f"CA_ROTOR{i}_PX"]),
+            -float(params[f"CA_ROTOR{i}_PY"]),
+            -float(np.sign(params[f"CA_ROTOR{i}_KM"])),
+        )
+        for i in range(n)
+    ]
     return np.array(rows), abs(float(params["CA_ROTOR0_KM"]))
 
 
 # --- CSV ----------------------------------------------------------------------------------
+
 
 def _read_csv(path: Path, frame: str, spec: tuple[str, float, float]) -> FlightLog:
     import pandas as pd
@@ -500,14 +546,17 @@ def _read_csv(path: Path, frame: str, spec: tuple[str, float, float]) -> FlightL
         col = pd.to_numeric(table[name], errors="coerce").to_numpy(np.float64)
         bad = np.flatnonzero(~np.isfinite(col))
         if bad.size:
-            raise InputError(f"{path}: row {bad[0] + 2}, column {name}: not a finite number "
-                             f"({table[name].iloc[bad[0]]!r})")
+            raise InputError(
+                f"{path}: row {bad[0] + 2}, column {name}: not a finite number ({table[name].iloc[bad[0]]!r})"
+            )
         table[name] = col
     t = table["t"].to_numpy(np.float64)
     back = np.flatnonzero(np.diff(t) <= 0)
     if back.size:
-        raise InputError(f"{path}: row {back[0] + 3}: time t={t[back[0] + 1]:g} does not increase "
-                         f"(previous {t[back[0]]:g}); the rows must be sorted by time")
+        raise InputError(
+            f"{path}: row {back[0] + 3}: time t={t[back[0] + 1]:g} does not increase "
+            f"(previous {t[back[0]]:g}); the rows must be sorted by time"
+        )
     for group in (("x", "y", "z"), ("ax", "ay", "az")):
         if 0 < sum(c in table.columns for c in group) < 3:
             raise InputError(f"{path}: give all of {', '.join(group)} or none of them")
@@ -516,8 +565,9 @@ def _read_csv(path: Path, frame: str, spec: tuple[str, float, float]) -> FlightL
     segment = _segments(~landed, t, step)
     keep = segment >= 0
     if not np.any(keep):
-        raise InputError(f"{path}: nothing to identify: no airborne stretch of {MIN_SEGMENT_S:g} s "
-                         "(landed column, or too few rows)")
+        raise InputError(
+            f"{path}: nothing to identify: no airborne stretch of {MIN_SEGMENT_S:g} s (landed column, or too few rows)"
+        )
     kind, lo, hi = spec
     u = table[[f"u{i + 1}" for i in range(n_rot)]].to_numpy()
     if kind == "pwm":
@@ -537,11 +587,23 @@ def _read_csv(path: Path, frame: str, spec: tuple[str, float, float]) -> FlightL
     rot = Rotation.from_matrix(world) * Rotation.from_quat(q[:, [1, 2, 3, 0]]) * Rotation.from_matrix(body)
     xyzw = rot.as_quat()
     quat = np.column_stack([xyzw[:, 3], xyzw[:, :3]])
-    pick = (lambda cols: table[list(cols)].to_numpy()[keep])
+
+    def pick(cols):
+        return table[list(cols)].to_numpy()[keep]
+
     position = pick(("x", "y", "z")) @ world.T if "x" in table.columns else None
     force = pick(("ax", "ay", "az")) @ body.T if "ax" in table.columns else None
-    return FlightLog(source=str(path), t=t[keep], segment=segment[keep], u=u[keep],
-                     velocity=pick(("vx", "vy", "vz")) @ world.T, quaternion=quat[keep],
-                     rates=pick(("p", "q", "r")) @ body.T, specific_force=force, position=position,
-                     rates_hz={"csv": round(1.0 / step, 1)}, commands=how,
-                     resampling=f"the CSV's own rows ({frame.upper()} frames), landed rows left out")
+    return FlightLog(
+        source=str(path),
+        t=t[keep],
+        segment=segment[keep],
+        u=u[keep],
+        velocity=pick(("vx", "vy", "vz")) @ world.T,
+        quaternion=quat[keep],
+        rates=pick(("p", "q", "r")) @ body.T,
+        specific_force=force,
+        position=position,
+        rates_hz={"csv": round(1.0 / step, 1)},
+        commands=how,
+        resampling=f"the CSV's own rows ({frame.upper()} frames), landed rows left out",
+    )

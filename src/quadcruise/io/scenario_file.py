@@ -15,15 +15,32 @@ from typing import Any
 
 __all__ = ["comparison_document", "montecarlo_document", "scenario_document", "scenario_text"]
 
-SPEC_KEYS = ("requirements", "max_track_error_m", "max_altitude_error_m", "settle_band", "max_clipped_s",
-             "transient_until", "log_dt", "trace_dt", "max_traces", "max_failure_traces")
+SPEC_KEYS = (
+    "requirements",
+    "max_track_error_m",
+    "max_altitude_error_m",
+    "settle_band",
+    "max_clipped_s",
+    "transient_until",
+    "log_dt",
+    "trace_dt",
+    "max_traces",
+    "max_failure_traces",
+)
 """The Monte Carlo spec's settings a scenario's [montecarlo] table holds beside n, seed and the
 population's spreads."""
 
-SIMULATION_FROM_META = {"duration_s": "duration", "dt_s": "dt", "max_step_s": "max_step",
-                        "full_dynamics": "full_dynamics", "seed": "seed", "log_every": "log_every",
-                        "max_track_error": "max_track_error", "max_steady_error": "max_steady_error",
-                        "initial_state": "initial_state"}
+SIMULATION_FROM_META = {
+    "duration_s": "duration",
+    "dt_s": "dt",
+    "max_step_s": "max_step",
+    "full_dynamics": "full_dynamics",
+    "seed": "seed",
+    "log_every": "log_every",
+    "max_track_error": "max_track_error",
+    "max_steady_error": "max_steady_error",
+    "initial_state": "initial_state",
+}
 """Keys of a flight's meta and the [simulation] keys they become."""
 
 
@@ -114,11 +131,18 @@ def montecarlo_document(spec: dict, n: int, *, title: str = "") -> dict:
         ``seed``, the population's fields and the spec's settings (:data:`SPEC_KEYS`).
     """
     population = spec["population"]
-    meta = {"mission": spec["mission"], "controller": spec["controller"], "vehicle": spec["vehicle"],
-            "controller_vehicle": spec.get("controller_vehicle"),
-            "environment": population.get("environment"), "sensors": population.get("noise"),
-            "duration_s": spec.get("duration"), "dt_s": spec.get("dt"), "max_step_s": spec.get("max_step"),
-            "full_dynamics": spec.get("full_dynamics")}
+    meta = {
+        "mission": spec["mission"],
+        "controller": spec["controller"],
+        "vehicle": spec["vehicle"],
+        "controller_vehicle": spec.get("controller_vehicle"),
+        "environment": population.get("environment"),
+        "sensors": population.get("noise"),
+        "duration_s": spec.get("duration"),
+        "dt_s": spec.get("dt"),
+        "max_step_s": spec.get("max_step"),
+        "full_dynamics": spec.get("full_dynamics"),
+    }
     doc = scenario_document(meta, title=title)
     table = {"n": int(n), "seed": spec["seed"]}
     table.update({k: v for k, v in population.items() if k not in ("environment", "noise")})

@@ -38,9 +38,18 @@ MAGIC = b"ULog\x01\x12\x35"
 """The first seven bytes of every ULog file."""
 
 NUMPY_TYPES = {
-    "int8_t": "i1", "uint8_t": "u1", "bool": "u1", "char": "S1",
-    "int16_t": "<i2", "uint16_t": "<u2", "int32_t": "<i4", "uint32_t": "<u4",
-    "int64_t": "<i8", "uint64_t": "<u8", "float": "<f4", "double": "<f8",
+    "int8_t": "i1",
+    "uint8_t": "u1",
+    "bool": "u1",
+    "char": "S1",
+    "int16_t": "<i2",
+    "uint16_t": "<u2",
+    "int32_t": "<i4",
+    "uint32_t": "<u4",
+    "int64_t": "<i8",
+    "uint64_t": "<u8",
+    "float": "<f4",
+    "double": "<f8",
 }
 """ULog's field types and the little-endian numpy types they are packed as."""
 
@@ -80,7 +89,7 @@ class Topic:
         """
         if not self.fields or self.fields[0][2] != "timestamp":
             raise ValueError(f"topic {self.name!r}: the first field must be the timestamp")
-        packed = self.fields[:-1] if self.fields[-1][2].startswith("_padding") else self.fields   # as PX4 does
+        packed = self.fields[:-1] if self.fields[-1][2].startswith("_padding") else self.fields  # as PX4 does
         fields = [(name, NUMPY_TYPES[kind], (length,) if length else ()) for kind, length, name in packed]
         dtype = np.dtype([("size", "<u2"), ("type", "u1"), ("msg_id", "<u2"), *fields])
         n = len(self.values["timestamp"])
@@ -101,8 +110,9 @@ class Topic:
         -------
         bytes
         """
-        text = "".join(f"{kind}[{length}] {name};" if length else f"{kind} {name};"
-                       for kind, length, name in self.fields)
+        text = "".join(
+            f"{kind}[{length}] {name};" if length else f"{kind} {name};" for kind, length, name in self.fields
+        )
         return f"{self.name}:{text}".encode()
 
 
@@ -121,8 +131,13 @@ def _key_value(kind: str, name: str, value) -> bytes:
     return _message(kind, struct.pack("<B", len(key)) + key + data)
 
 
-def ulog_bytes(topics: Sequence[Topic], *, info: Mapping[str, object] | None = None,
-               parameters: Mapping[str, float | int] | None = None, start_us: int = 0) -> bytes:
+def ulog_bytes(
+    topics: Sequence[Topic],
+    *,
+    info: Mapping[str, object] | None = None,
+    parameters: Mapping[str, float | int] | None = None,
+    start_us: int = 0,
+) -> bytes:
     """A whole ULog file's bytes.
 
     Parameters
@@ -140,8 +155,7 @@ def ulog_bytes(topics: Sequence[Topic], *, info: Mapping[str, object] | None = N
     -------
     bytes
     """
-    head = [MAGIC + b"\x01" + struct.pack("<Q", start_us),
-            _message("B", bytes(16) + struct.pack("<QQQ", 0, 0, 0))]
+    head = [MAGIC + b"\x01" + struct.pack("<Q", start_us), _message("B", bytes(16) + struct.pack("<QQQ", 0, 0, 0))]
     head += [_message("F", topic.format_message()) for topic in topics]
     head += [_key_value("I", name, value) for name, value in (info or {}).items()]
     head += [_key_value("P", name, value) for name, value in (parameters or {}).items()]
@@ -150,14 +164,14 @@ def ulog_bytes(topics: Sequence[Topic], *, info: Mapping[str, object] | None = N
     records = [topic.records(msg_id) for msg_id, topic in enumerate(topics)]
     stamps = np.concatenate([r["timestamp"] for r in records])
     sizes = np.concatenate([np.full(len(r), r.dtype.itemsize) for r in records])
-    order = np.argsort(stamps, kind="stable")                  # time order; ties keep the topic order
+    order = np.argsort(stamps, kind="stable")  # time order; ties keep the topic order
     offsets = np.empty(len(order), np.int64)
     offsets[order] = np.concatenate([[0], np.cumsum(sizes[order])[:-1]]) if len(order) else []
     body = np.empty(int(sizes.sum()), np.uint8)
     first = 0
     for r in records:
         rows = r.view(np.uint8).reshape(len(r), r.dtype.itemsize)
-        where = offsets[first:first + len(r), None] + np.arange(r.dtype.itemsize)
+        where = offsets[first : first + len(r), None] + np.arange(r.dtype.itemsize)
         body[where] = rows
         first += len(r)
     return b"".join(head) + body.tobytes()

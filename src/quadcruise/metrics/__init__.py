@@ -18,6 +18,18 @@ from quadcruise.metrics.flight import (
     transient_info,
 )
 
-__all__ = ["STEADY_BAND", "TRANSIENT_MIN_ERROR", "StepInfo", "control_effort", "flight_metrics",
-           "flight_metrics_batch", "hover_duties", "metric_conventions", "step_info", "step_info_batch",
-           "time_in_saturation", "tracking_errors", "transient_info"]
+__all__ = [
+    "STEADY_BAND",
+    "TRANSIENT_MIN_ERROR",
+    "StepInfo",
+    "control_effort",
+    "flight_metrics",
+    "flight_metrics_batch",
+    "hover_duties",
+    "metric_conventions",
+    "step_info",
+    "step_info_batch",
+    "time_in_saturation",
+    "tracking_errors",
+    "transient_info",
+]

@@ -21,15 +21,21 @@ Examples
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
 from quadcruise.metrics.flight import STEADY_BAND, TRANSIENT_MIN_ERROR, control_effort, tracking_errors
 from quadcruise.metrics.tracking import TRACKING_AXIS, first_crossing_batch, moving_reference, tracking_transient_batch
 
-__all__ = ["first_crossing_batch", "settling_time_batch", "transient_batch", "window_errors_batch",
-           "flight_metrics_batch"]
+__all__ = [
+    "first_crossing_batch",
+    "settling_time_batch",
+    "transient_batch",
+    "window_errors_batch",
+    "flight_metrics_batch",
+]
+
 
 def settling_time_batch(t: np.ndarray, z: np.ndarray, band: float) -> np.ndarray:
     """Time from ``t[0]`` after which each row of ``z`` stays within ``band`` of 1.
@@ -70,8 +76,15 @@ def settling_time_batch(t: np.ndarray, z: np.ndarray, band: float) -> np.ndarray
     return out
 
 
-def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: dict, bands: Sequence[float],
-                    rise: Sequence[float] = (0.1, 0.9), err: np.ndarray | None = None) -> dict:
+def transient_batch(
+    t: np.ndarray,
+    pos: np.ndarray,
+    ref: np.ndarray,
+    mission: dict,
+    bands: Sequence[float],
+    rise: Sequence[float] = (0.1, 0.9),
+    err: np.ndarray | None = None,
+) -> dict:
     """The transient of each vehicle, measured as :func:`quadcruise.metrics.flight_metrics` does.
 
     A moving reference (:func:`moving_reference`: circle, square, waypoints, ...) on the
@@ -119,10 +132,16 @@ def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: di
     """
     n = pos.shape[0]
     bands = [float(b) for b in bands]
-    out = {"axis": np.full(n, -1, dtype=np.int64), "t_step": np.full(n, np.nan),
-           "rise_time_s": np.full(n, np.nan), "settling_s": [np.full(n, np.nan) for _ in bands],
-           "overshoot_pct": np.full(n, np.nan), "peak_time_s": np.full(n, np.nan),
-           "settled_at": np.full(n, np.nan), "steady_from": np.full(n, np.nan)}
+    out = {
+        "axis": np.full(n, -1, dtype=np.int64),
+        "t_step": np.full(n, np.nan),
+        "rise_time_s": np.full(n, np.nan),
+        "settling_s": [np.full(n, np.nan) for _ in bands],
+        "overshoot_pct": np.full(n, np.nan),
+        "peak_time_s": np.full(n, np.nan),
+        "settled_at": np.full(n, np.nan),
+        "steady_from": np.full(n, np.nan),
+    }
     if moving_reference(t, ref, mission):
         if err is None:
             d = pos - ref
@@ -133,7 +152,7 @@ def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: di
         out["t_step"][sel] = t[0]
         for key in ("rise_time_s", "overshoot_pct", "peak_time_s", "settled_at", "steady_from"):
             out[key][sel] = got[key][sel]
-        for full, got_band in zip(out["settling_s"], got["settling_s"]):
+        for full, got_band in zip(out["settling_s"], got["settling_s"], strict=False):
             full[sel] = got_band[sel]
         return out
     if mission.get("kind") == "step" and mission.get("axis") in ("x", "y", "z"):
@@ -165,7 +184,7 @@ def transient_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, mission: di
         ts = t
     out["t_step"][sel] = ts[0]
     out["rise_time_s"][sel] = first_crossing_batch(ts, z, float(rise[1])) - first_crossing_batch(ts, z, float(rise[0]))
-    for full, band in zip(out["settling_s"], bands):
+    for full, band in zip(out["settling_s"], bands, strict=False):
         full[sel] = settling_time_batch(ts, z, band)
     out["settled_at"][sel] = out["steady_from"][sel] = ts[0] + settling_time_batch(ts, z, STEADY_BAND)
     out["overshoot_pct"][sel] = np.maximum(0.0, 100.0 * (z.max(axis=1) - 1.0))
@@ -206,10 +225,10 @@ def window_errors_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, t_from:
     n, length = pos.shape[:2]
     rows = np.arange(n)
     d = pos - ref
-    e2 = (d**2).sum(axis=-1)                                             # (N, L)
-    seg = 0.5 * (e2[:, 1:] + e2[:, :-1]) * np.diff(t)                    # (N, L - 1)
+    e2 = (d**2).sum(axis=-1)  # (N, L)
+    seg = 0.5 * (e2[:, 1:] + e2[:, :-1]) * np.diff(t)  # (N, L - 1)
     tail = np.zeros((n, length))
-    tail[:, :-1] = np.cumsum(seg[:, ::-1], axis=1)[:, ::-1]              # integral from t[k] to the end
+    tail[:, :-1] = np.cumsum(seg[:, ::-1], axis=1)[:, ::-1]  # integral from t[k] to the end
     peak = np.maximum.accumulate(np.sqrt(e2)[:, ::-1], axis=1)[:, ::-1]  # max from t[k] on
     start = np.where(np.isfinite(t_from), t_from, t[0])
     k = np.clip(np.searchsorted(t, start, side="right"), 1, length - 1)  # t[k - 1] <= start < t[k]
@@ -226,10 +245,18 @@ def window_errors_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, t_from:
     return {"rmse": rmse, "max_error": max_error}
 
 
-def flight_metrics_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, duties: np.ndarray, *,
-                         mission: dict | None = None, bands: Sequence[float] = (0.02, 0.05),
-                         transient_until: float | None = None, rise: Sequence[float] = (0.1, 0.9),
-                         hover_duty=None) -> dict:
+def flight_metrics_batch(
+    t: np.ndarray,
+    pos: np.ndarray,
+    ref: np.ndarray,
+    duties: np.ndarray,
+    *,
+    mission: dict | None = None,
+    bands: Sequence[float] = (0.02, 0.05),
+    transient_until: float | None = None,
+    rise: Sequence[float] = (0.1, 0.9),
+    hover_duty=None,
+) -> dict:
     """Tracking error, effort and transient of N vehicles that flew the whole record.
 
     The numbers of :func:`quadcruise.metrics.flight_metrics` for vehicles that did not
@@ -287,18 +314,32 @@ def flight_metrics_batch(t: np.ndarray, pos: np.ndarray, ref: np.ndarray, duties
     else:
         trim = np.broadcast_to(np.asarray(hover_duty, dtype=float), (n,))
         effort = control_effort(t, duties - trim[:, None, None])["integral"]
-    out = {"rmse_m": err["rmse"], "max_error_m": err["max_error"],
-           "steady_rmse_m": err["rmse"].copy(), "steady_max_error_m": err["max_error"].copy(),
-           "final_error_m": np.linalg.norm(pos[:, -1] - ref[:, -1], axis=1), "effort": effort,
-           "transient_axis": np.full(n, -1, dtype=np.int64), "rise_time_s": np.full(n, np.nan),
-           "settling_s": [np.full(n, np.nan) for _ in bands], "overshoot_pct": np.full(n, np.nan),
-           "peak_time_s": np.full(n, np.nan), "settled_at": np.full(n, np.nan)}
+    out = {
+        "rmse_m": err["rmse"],
+        "max_error_m": err["max_error"],
+        "steady_rmse_m": err["rmse"].copy(),
+        "steady_max_error_m": err["max_error"].copy(),
+        "final_error_m": np.linalg.norm(pos[:, -1] - ref[:, -1], axis=1),
+        "effort": effort,
+        "transient_axis": np.full(n, -1, dtype=np.int64),
+        "rise_time_s": np.full(n, np.nan),
+        "settling_s": [np.full(n, np.nan) for _ in bands],
+        "overshoot_pct": np.full(n, np.nan),
+        "peak_time_s": np.full(n, np.nan),
+        "settled_at": np.full(n, np.nan),
+    }
     keep = slice(None) if transient_until is None else t <= transient_until
     tk = t[keep]
     if tk.size >= 2:
         got = transient_batch(tk, pos[:, keep], ref[:, keep], mission or {}, bands, rise)
-        out.update(transient_axis=got["axis"], rise_time_s=got["rise_time_s"], settling_s=got["settling_s"],
-                   overshoot_pct=got["overshoot_pct"], peak_time_s=got["peak_time_s"], settled_at=got["settled_at"])
+        out.update(
+            transient_axis=got["axis"],
+            rise_time_s=got["rise_time_s"],
+            settling_s=got["settling_s"],
+            overshoot_pct=got["overshoot_pct"],
+            peak_time_s=got["peak_time_s"],
+            settled_at=got["settled_at"],
+        )
         measured = np.flatnonzero(got["axis"] >= 0)
         if measured.size:
             steady = window_errors_batch(t, pos[measured], ref[measured], got["steady_from"][measured])

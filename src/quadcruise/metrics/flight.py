@@ -26,10 +26,22 @@ import numpy as np
 from quadcruise.errors import InputError
 from quadcruise.metrics.tracking import STEADY_BAND, TRANSIENT_MIN_ERROR, moving_reference, tracking_transient_batch
 
-__all__ = ["StepInfo", "step_info", "step_info_batch", "transient_info",
-           "tracking_errors", "control_effort", "time_in_saturation", "flight_metrics",
-           "metric_conventions", "settling_column", "hover_duties", "STEADY_BAND", "EFFORT_DEFINITION",
-           "RISE_CONVENTIONS"]
+__all__ = [
+    "StepInfo",
+    "step_info",
+    "step_info_batch",
+    "transient_info",
+    "tracking_errors",
+    "control_effort",
+    "time_in_saturation",
+    "flight_metrics",
+    "metric_conventions",
+    "settling_column",
+    "hover_duties",
+    "STEADY_BAND",
+    "EFFORT_DEFINITION",
+    "RISE_CONVENTIONS",
+]
 
 
 @dataclass(frozen=True)
@@ -126,14 +138,15 @@ def _settling_time(t: np.ndarray, z: np.ndarray, band: float) -> float | None:
         return None
     if not outside.any():
         return 0.0
-    k = np.flatnonzero(outside)[-1]              # z[k] outside, z[k + 1] inside
+    k = np.flatnonzero(outside)[-1]  # z[k] outside, z[k + 1] inside
     edge = 1.0 + band if z[k] > 1.0 else 1.0 - band
     frac = (edge - z[k]) / (z[k + 1] - z[k])
     return float(t[k] + frac * (t[k + 1] - t[k]) - t[0])
 
 
-def step_info(t, y, *, y_initial=None, y_final=None, t_step=None,
-              rise=(0.1, 0.9), settle_bands=(0.02, 0.05)) -> StepInfo:
+def step_info(
+    t, y, *, y_initial=None, y_final=None, t_step=None, rise=(0.1, 0.9), settle_bands=(0.02, 0.05)
+) -> StepInfo:
     """Rise time, settling times, overshoot, undershoot and peak of one step response.
 
     Parameters
@@ -208,7 +221,7 @@ def step_info(t, y, *, y_initial=None, y_final=None, t_step=None,
     if len(bands) != 2 or not all(0.0 < b < 1.0 for b in bands):
         raise InputError(f"settle_bands must be two fractions in (0, 1), got {settle_bands}")
 
-    after = t > t_step                           # the record from the step on
+    after = t > t_step  # the record from the step on
     ts = np.concatenate(([t_step], t[after]))
     ys = np.concatenate(([np.interp(t_step, t, y)], y[after]))
     y0 = float(ys[0]) if y_initial is None else float(y_initial)
@@ -274,13 +287,15 @@ def step_info_batch(t, y, *, y_initial=None, y_final=None, **kw) -> dict[str, np
     out = {}
     for f in dataclasses.fields(StepInfo):
         vals = [r[f.name] for r in rows]
-        out[f.name] = (np.array(vals, dtype=bool) if f.name == "settled" else
-                       np.array([np.nan if v is None else v for v in vals], dtype=float))
+        out[f.name] = (
+            np.array(vals, dtype=bool)
+            if f.name == "settled"
+            else np.array([np.nan if v is None else v for v in vals], dtype=float)
+        )
     return out
 
 
-def transient_info(t, actual, reference, *, t_step=None, rise=(0.1, 0.9),
-                   settle_bands=(0.02, 0.05)) -> StepInfo:
+def transient_info(t, actual, reference, *, t_step=None, rise=(0.1, 0.9), settle_bands=(0.02, 0.05)) -> StepInfo:
     """Step metrics of a tracking transient in which the reference itself moves.
 
     The progress ``y(t) = 1 - e(t) / e(t_step)`` with ``e = reference - actual`` goes
@@ -333,8 +348,7 @@ def transient_info(t, actual, reference, *, t_step=None, rise=(0.1, 0.9),
     scale = max(np.abs(actual).max(), np.abs(reference).max())
     if e0 == 0.0 or abs(e0) <= 1e-9 * scale:
         raise InputError(f"tracking error at t = {t_step:g} s is ~0: no transient to measure")
-    return step_info(t, 1.0 - e / e0, y_initial=0.0, y_final=1.0, t_step=t_step,
-                     rise=rise, settle_bands=settle_bands)
+    return step_info(t, 1.0 - e / e0, y_initial=0.0, y_final=1.0, t_step=t_step, rise=rise, settle_bands=settle_bands)
 
 
 def _trapezoid(t: np.ndarray, f: np.ndarray) -> np.ndarray:
@@ -395,9 +409,8 @@ def tracking_errors(t, actual, reference, *, t_from=None) -> dict[str, np.ndarra
     (1.0, 1.0, array([1., 0.]))
     """
     t = _check_time(t)
-    d = _difference(_time_major("actual", actual, t.size),
-                    _time_major("reference", reference, t.size))
-    d = np.moveaxis(d, -2, -1)                        # (..., n_axes, L)
+    d = _difference(_time_major("actual", actual, t.size), _time_major("reference", reference, t.size))
+    d = np.moveaxis(d, -2, -1)  # (..., n_axes, L)
     if t_from is not None:
         if not t[0] <= t_from < t[-1]:
             raise InputError(f"t_from = {t_from:g} s is outside [{t[0]:g}, {t[-1]:g}) s")
@@ -408,9 +421,11 @@ def tracking_errors(t, actual, reference, *, t_from=None) -> dict[str, np.ndarra
         t = np.concatenate(([t_from], t[k:]))
     duration = t[-1] - t[0]
     ms_axes = _trapezoid(t, d**2) / duration
-    return {"rmse": np.sqrt(ms_axes.sum(axis=-1)),
-            "max_error": np.sqrt((d**2).sum(axis=-2)).max(axis=-1),
-            "rmse_axes": np.sqrt(ms_axes)}
+    return {
+        "rmse": np.sqrt(ms_axes.sum(axis=-1)),
+        "max_error": np.sqrt((d**2).sum(axis=-2)).max(axis=-1),
+        "rmse_axes": np.sqrt(ms_axes),
+    }
 
 
 def control_effort(t, u) -> dict[str, np.ndarray]:
@@ -478,8 +493,14 @@ def time_in_saturation(t, flags) -> dict[str, np.ndarray]:
 
 # --- a whole flight --------------------------------------------------------------------
 _AXIS_NAMES = ("x", "y", "z")
-FAILED_FLIGHT_METRICS = ("rise_time_s", "settling_time_s", "overshoot_pct", "peak_time_s", "steady_rmse_m",
-                         "steady_max_error_m")
+FAILED_FLIGHT_METRICS = (
+    "rise_time_s",
+    "settling_time_s",
+    "overshoot_pct",
+    "peak_time_s",
+    "steady_rmse_m",
+    "steady_max_error_m",
+)
 """The metrics (besides the second settling column) that are NaN for a flight that did not finish:
 a vehicle that lost its track has no transient or steady state to measure."""
 TRACKING_AXIS_NAME = "xyz"
@@ -555,7 +576,7 @@ def metric_conventions(rise=(0.1, 0.9), settle_bands=(0.02, 0.05)) -> dict:
         bands = tuple(float(b) for b in np.atleast_1d(np.asarray(settle_bands, dtype=float)))
     except (TypeError, ValueError):
         raise InputError(f"rise levels and settle_bands must be numbers, got {rise!r}, {settle_bands!r}") from None
-    if len(bands) == 1:                          # the second column: 5 %, or 2 % beside a first 5 %
+    if len(bands) == 1:  # the second column: 5 %, or 2 % beside a first 5 %
         bands = bands + ((0.02,) if bands[0] == STEADY_BAND else (STEADY_BAND,))
     if len(bands) == 2 and bands[0] == bands[1]:
         raise InputError(f"settle_bands: the two bands are the same ({bands[0]:g}): give two different bands, or one")
@@ -563,9 +584,13 @@ def metric_conventions(rise=(0.1, 0.9), settle_bands=(0.02, 0.05)) -> dict:
         raise InputError(f"rise levels must satisfy 0 <= low < high <= 1, got {rise}")
     if len(bands) != 2 or not all(0.0 < b < 1.0 for b in bands):
         raise InputError(f"settle_bands must be one or two fractions in (0, 1), got {settle_bands}")
-    return {"rise": list(levels), "settle_bands": list(bands),
-            "settling_columns": {"settling_time_s": bands[0], settling_column(bands[1]): bands[1]},
-            "steady_band": STEADY_BAND, "effort": EFFORT_DEFINITION}
+    return {
+        "rise": list(levels),
+        "settle_bands": list(bands),
+        "settling_columns": {"settling_time_s": bands[0], settling_column(bands[1]): bands[1]},
+        "steady_band": STEADY_BAND,
+        "effort": EFFORT_DEFINITION,
+    }
 
 
 def hover_duties(meta, n: int) -> np.ndarray | None:
@@ -600,8 +625,14 @@ def hover_duties(meta, n: int) -> np.ndarray | None:
     return m * g / (4.0 * k)
 
 
-def flight_metrics(result, *, transient_axis: str | None = None, transient_until: float | None = None,
-                   rise=(0.1, 0.9), settle_bands=(0.02, 0.05)):
+def flight_metrics(
+    result,
+    *,
+    transient_axis: str | None = None,
+    transient_until: float | None = None,
+    rise=(0.1, 0.9),
+    settle_bands=(0.02, 0.05),
+):
     """Per-vehicle metrics of a :class:`~quadcruise.sim.result.SimResult`, as a DataFrame.
 
     The transient is measured on ``transient_axis``, or else on the stepped axis of a
@@ -675,33 +706,49 @@ def flight_metrics(result, *, transient_axis: str | None = None, transient_until
     hover = hover_duties(result.meta, result.n)
     rows = []
     for i in range(result.n):
-        row = {"vehicle": i, "status": result.status_text(i), "rmse_m": np.nan, "max_error_m": np.nan,
-               "steady_rmse_m": np.nan, "steady_max_error_m": np.nan,
-               "axis": None, "rise_time_s": np.nan, "settling_time_s": np.nan,
-               second: np.nan, "overshoot_pct": np.nan, "peak_time_s": np.nan, "effort": np.nan,
-               "duty_clipped_s": float(result.duty_clipped_s[i]),
-               "controller_limited_s": float(result.controller_limited_s[i])}
+        row = {
+            "vehicle": i,
+            "status": result.status_text(i),
+            "rmse_m": np.nan,
+            "max_error_m": np.nan,
+            "steady_rmse_m": np.nan,
+            "steady_max_error_m": np.nan,
+            "axis": None,
+            "rise_time_s": np.nan,
+            "settling_time_s": np.nan,
+            second: np.nan,
+            "overshoot_pct": np.nan,
+            "peak_time_s": np.nan,
+            "effort": np.nan,
+            "duty_clipped_s": float(result.duty_clipped_s[i]),
+            "controller_limited_s": float(result.controller_limited_s[i]),
+        }
         rows.append(row)
-        if result.stopped[i]:                    # the engine stopped it: its later rows are NaN
+        if result.stopped[i]:  # the engine stopped it: its later rows are NaN
             continue
-        pos, ref = result.states[i, :, X:X + 3], result.references[i, :, REF_X:REF_X + 3]
+        pos, ref = result.states[i, :, X : X + 3], result.references[i, :, REF_X : REF_X + 3]
         if np.all(np.isfinite(ref)):
             err = tracking_errors(t, pos, ref)
             row["rmse_m"], row["max_error_m"] = float(err["rmse"]), float(err["max_error"])
             keep = slice(None) if transient_until is None else t <= transient_until
             transient = _flight_transient(t[keep], pos[keep], ref[keep], mission, transient_axis, levels, bands)
-            steady = (row["rmse_m"], row["max_error_m"])          # no transient: the whole flight
+            steady = (row["rmse_m"], row["max_error_m"])  # no transient: the whole flight
             if transient is not None:
                 info, axis, t_step, settled = transient
-                row.update(axis=axis, rise_time_s=_nan(info.rise_time), settling_time_s=_nan(info.settling_time),
-                           overshoot_pct=info.overshoot_pct, peak_time_s=info.peak_time)
+                row.update(
+                    axis=axis,
+                    rise_time_s=_nan(info.rise_time),
+                    settling_time_s=_nan(info.settling_time),
+                    overshoot_pct=info.overshoot_pct,
+                    peak_time_s=info.peak_time,
+                )
                 row[second] = _nan(info.settling_time_5pct)
                 steady = (np.nan, np.nan) if settled is None else _steady_errors(t, pos, ref, t_step + settled)
             row["steady_rmse_m"], row["steady_max_error_m"] = steady
-            if not result.ok[i]:                 # lost or off track: no transient or steady state to speak of
+            if not result.ok[i]:  # lost or off track: no transient or steady state to speak of
                 row.update({key: np.nan for key in FAILED_FLIGHT_METRICS + (second,)})
         if hover is not None:
-            duties = result.commands[i, :, CMD_U1:CMD_U1 + 4]
+            duties = result.commands[i, :, CMD_U1 : CMD_U1 + 4]
             row["effort"] = float(control_effort(t, duties - hover[i])["integral"])
     frame = pd.DataFrame(rows)
     frame.attrs["conventions"] = conventions
@@ -725,11 +772,18 @@ def _flight_transient(t, pos, ref, mission: dict, axis: str | None, rise: tuple,
         if not got["measured"][0]:
             return None
         settle = [None if np.isnan(s[0]) else float(s[0]) for s in got["settling_s"]]
-        info = StepInfo(rise_time=None if np.isnan(got["rise_time_s"][0]) else float(got["rise_time_s"][0]),
-                        settling_time=settle[0], settling_time_5pct=settle[1],
-                        overshoot_pct=float(got["overshoot_pct"][0]), undershoot_pct=np.nan, peak=np.nan,
-                        peak_time=float(got["peak_time_s"][0]), y_initial=0.0, y_final=1.0,
-                        settled=settle[0] is not None)
+        info = StepInfo(
+            rise_time=None if np.isnan(got["rise_time_s"][0]) else float(got["rise_time_s"][0]),
+            settling_time=settle[0],
+            settling_time_5pct=settle[1],
+            overshoot_pct=float(got["overshoot_pct"][0]),
+            undershoot_pct=np.nan,
+            peak=np.nan,
+            peak_time=float(got["peak_time_s"][0]),
+            y_initial=0.0,
+            y_final=1.0,
+            settled=settle[0] is not None,
+        )
         steady_from = float(got["steady_from"][0])
         return info, TRACKING_AXIS_NAME, float(t[0]), None if np.isnan(steady_from) else steady_from - float(t[0])
     if axis is None and mission.get("kind") == "step" and mission.get("axis") in _AXIS_NAMES:
@@ -737,11 +791,19 @@ def _flight_transient(t, pos, ref, mission: dict, axis: str | None, rise: tuple,
         t_step = float(mission["time"])
         if not t[0] <= t_step < t[-1]:
             return None
-        before = float(mission[mission["axis"]])   # the hover point the step leaves
+        before = float(mission[mission["axis"]])  # the hover point the step leaves
 
         def measure(levels, settle):
-            return step_info(t, pos[:, j], y_initial=before, y_final=before + float(mission["size"]),
-                             t_step=t_step, rise=levels, settle_bands=settle)
+            return step_info(
+                t,
+                pos[:, j],
+                y_initial=before,
+                y_final=before + float(mission["size"]),
+                t_step=t_step,
+                rise=levels,
+                settle_bands=settle,
+            )
+
         name = mission["axis"]
     else:
         e0 = np.abs(ref[0] - pos[0])
@@ -752,6 +814,7 @@ def _flight_transient(t, pos, ref, mission: dict, axis: str | None, rise: tuple,
 
         def measure(levels, settle):
             return transient_info(t, pos[:, j], ref[:, j], rise=levels, settle_bands=settle)
+
         name = _AXIS_NAMES[j]
     info = measure(rise, bands)
     if bands[1] == STEADY_BAND:

@@ -73,8 +73,10 @@ def margins(L) -> dict:
     r = control.frequency_response(L, w).complex.ravel()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        gms, pms, sms, wpcs, wgcs, wsms = (np.atleast_1d(a) for a in control.stability_margins(
-            (np.abs(r), np.degrees(np.unwrap(np.angle(r))), w), returnall=True))
+        gms, pms, sms, wpcs, wgcs, wsms = (
+            np.atleast_1d(a)
+            for a in control.stability_margins((np.abs(r), np.degrees(np.unwrap(np.angle(r))), w), returnall=True)
+        )
     with np.errstate(divide="ignore"):
         g = int(np.argmin(np.abs(np.log(gms)))) if gms.size and not np.isinf(gms).all() else None
     p, s = (int(np.argmin(np.abs(pms))) if pms.size else None), (int(np.argmin(sms)) if sms.size else None)
@@ -82,19 +84,21 @@ def margins(L) -> dict:
     up = up[np.argmin(gms[up])] if up.size else None
     down = down[np.argmax(gms[down])] if down.size else None
     increase, decrease = (math.inf if up is None else float(gms[up])), (0.0 if down is None else float(gms[down]))
-    return {"phase_margin": math.inf if p is None else float(pms[p]),
-            "gain_crossover": math.nan if p is None else float(wgcs[p]),
-            "gain_margin": math.inf if g is None else float(gms[g]),
-            "phase_crossover": math.nan if g is None else float(wpcs[g]),
-            "gain_increase": increase,
-            "gain_increase_frequency": math.nan if up is None else float(wpcs[up]),
-            "gain_increase_db": db(increase),
-            "gain_decrease": decrease,
-            "gain_decrease_frequency": math.nan if down is None else float(wpcs[down]),
-            "gain_decrease_db": db(decrease),
-            "stability_margin": math.nan if s is None else float(sms[s]),
-            "stability_margin_frequency": math.nan if s is None else float(wsms[s]),
-            "open_loop_unstable_poles": int(np.sum(np.abs(np.linalg.eigvals(L.A)) > 1.0 + 1e-9))}
+    return {
+        "phase_margin": math.inf if p is None else float(pms[p]),
+        "gain_crossover": math.nan if p is None else float(wgcs[p]),
+        "gain_margin": math.inf if g is None else float(gms[g]),
+        "phase_crossover": math.nan if g is None else float(wpcs[g]),
+        "gain_increase": increase,
+        "gain_increase_frequency": math.nan if up is None else float(wpcs[up]),
+        "gain_increase_db": db(increase),
+        "gain_decrease": decrease,
+        "gain_decrease_frequency": math.nan if down is None else float(wpcs[down]),
+        "gain_decrease_db": db(decrease),
+        "stability_margin": math.nan if s is None else float(sms[s]),
+        "stability_margin_frequency": math.nan if s is None else float(wsms[s]),
+        "open_loop_unstable_poles": int(np.sum(np.abs(np.linalg.eigvals(L.A)) > 1.0 + 1e-9)),
+    }
 
 
 def low_margins(m: dict) -> list[str]:

@@ -23,8 +23,17 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["cell", "metric_cell", "metrics_text", "vehicle_metrics_text", "conventions_text", "DID_NOT_SETTLE",
-           "FAILED_FLIGHT", "NO_TRANSIENT", "NO_OVERSHOOT"]
+__all__ = [
+    "cell",
+    "metric_cell",
+    "metrics_text",
+    "vehicle_metrics_text",
+    "conventions_text",
+    "DID_NOT_SETTLE",
+    "FAILED_FLIGHT",
+    "NO_TRANSIENT",
+    "NO_OVERSHOOT",
+]
 
 DID_NOT_SETTLE = "did not settle"
 FAILED_FLIGHT = "failed flight"
@@ -152,12 +161,15 @@ def metrics_text(frame, labels) -> str:
     """
     import pandas as pd
 
-    axes = ([a if isinstance(a, str) else "" for a in frame["axis"]] if "axis" in frame.columns
-            else [None] * len(frame))
+    axes = [a if isinstance(a, str) else "" for a in frame["axis"]] if "axis" in frame.columns else [None] * len(frame)
     statuses = frame["status"].tolist() if "status" in frame.columns else [None] * len(frame)
-    shown = pd.DataFrame({label: [metric_cell(v, col, axis, status=status)[0] for col, v in row.items()]
-                          for label, axis, status, (_, row) in zip(labels, axes, statuses, frame.iterrows())},
-                         index=list(frame.columns))
+    shown = pd.DataFrame(
+        {
+            label: [metric_cell(v, col, axis, status=status)[0] for col, v in row.items()]
+            for label, axis, status, (_, row) in zip(labels, axes, statuses, frame.iterrows(), strict=False)
+        },
+        index=list(frame.columns),
+    )
     return shown.to_string()
 
 
@@ -206,19 +218,24 @@ def conventions_text(conventions: dict | None) -> str:
     --------
     >>> from quadcruise.metrics.flight import metric_conventions
     >>> print(conventions_text(metric_conventions(rise=(0.0, 1.0))))
-    rise_time_s: 0-100 % of the step (axis xyz: of the error's way to its steady level); settling_time_s: 2 % band; settling_time_5pct_s: 5 % band
-    steady_*: 3-D position error from the 5 % settling time on (axis xyz, a moving reference: over the last half of the flight, once converged; the whole flight without a transient)
+    rise_time_s: 0-100 % of the step (axis xyz: of the error's way to its steady level); settling_time_s: 2 % ...
+    steady_*: 3-D position error from the 5 % settling time on (axis xyz, a moving reference: over the last ...
     effort: integral of sum_i (u_i - u_hover)^2 dt over the four rotor duties, u_hover = m g / (4 K) [s]
     """
     if not conventions:
         return ""
     lo, hi = (format(100.0 * float(v), ".6g") for v in conventions["rise"])
     parts = [f"rise_time_s: {lo}-{hi} % of the step (axis xyz: of the error's way to its steady level)"]
-    parts += [f"{name}: {format(100.0 * float(band), '.6g')} % band"
-              for name, band in conventions["settling_columns"].items()]
+    parts += [
+        f"{name}: {format(100.0 * float(band), '.6g')} % band" for name, band in conventions["settling_columns"].items()
+    ]
     steady = format(100.0 * float(conventions["steady_band"]), ".6g")
-    return "\n".join(["; ".join(parts),
-                      f"steady_*: 3-D position error from the {steady} % settling time on (axis xyz, a moving "
-                      "reference: over the last half of the flight, once converged; the whole flight without a "
-                      "transient)",
-                      f"effort: {conventions['effort']}"])
+    return "\n".join(
+        [
+            "; ".join(parts),
+            f"steady_*: 3-D position error from the {steady} % settling time on (axis xyz, a moving "
+            "reference: over the last half of the flight, once converged; the whole flight without a "
+            "transient)",
+            f"effort: {conventions['effort']}",
+        ]
+    )

@@ -6,12 +6,19 @@ docs/metrics.md gives each definition with its reason, beside python-control's.
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["STEADY_BAND", "TRANSIENT_MIN_ERROR", "TRACKING_AXIS", "FINAL_FRACTION", "first_crossing_batch",
-           "moving_reference", "tracking_transient_batch"]
+__all__ = [
+    "STEADY_BAND",
+    "TRANSIENT_MIN_ERROR",
+    "TRACKING_AXIS",
+    "FINAL_FRACTION",
+    "first_crossing_batch",
+    "moving_reference",
+    "tracking_transient_batch",
+]
 
 TRANSIENT_MIN_ERROR = 0.01
 """An initial tracking error below this [m] is no transient to measure."""
@@ -56,17 +63,18 @@ def moving_reference(t: np.ndarray, ref: np.ndarray, mission: dict) -> bool:
     """
     if mission.get("kind") == "step":
         return False
-    for k in range(ref.shape[-1]):                 # axis by axis: the log's strided rows, without copies of (N, L, 3)
+    for k in range(ref.shape[-1]):  # axis by axis: the log's strided rows, without copies of (N, L, 3)
         axis = ref[..., k]
         with np.errstate(invalid="ignore"):
-            moved = np.fmax.reduce(np.abs(axis - axis[:, :1]), axis=None, initial=0.0)   # NaN (stopped) ignored
+            moved = np.fmax.reduce(np.abs(axis - axis[:, :1]), axis=None, initial=0.0)  # NaN (stopped) ignored
         if moved >= TRANSIENT_MIN_ERROR:
             return True
     return False
 
 
-def tracking_transient_batch(t: np.ndarray, err: np.ndarray, bands: Sequence[float],
-                             rise: Sequence[float] = (0.1, 0.9)) -> dict:
+def tracking_transient_batch(
+    t: np.ndarray, err: np.ndarray, bands: Sequence[float], rise: Sequence[float] = (0.1, 0.9)
+) -> dict:
     """The entry transient of a moving reference, on the size of the tracking error.
 
     The error ``e(t)`` (3-D, [m]) of a vehicle that starts off its path falls from ``e0``
@@ -117,9 +125,16 @@ def tracking_transient_batch(t: np.ndarray, err: np.ndarray, bands: Sequence[flo
     (array([2.996,   nan]), array([0.1  , 0.446]))
     """
     n = err.shape[0]
-    out = {"measured": np.zeros(n, dtype=bool), "level": np.full(n, np.nan), "rise_time_s": np.full(n, np.nan),
-           "settling_s": [np.full(n, np.nan) for _ in bands], "overshoot_pct": np.full(n, np.nan),
-           "peak_time_s": np.full(n, np.nan), "settled_at": np.full(n, np.nan), "steady_from": np.full(n, np.nan)}
+    out = {
+        "measured": np.zeros(n, dtype=bool),
+        "level": np.full(n, np.nan),
+        "rise_time_s": np.full(n, np.nan),
+        "settling_s": [np.full(n, np.nan) for _ in bands],
+        "overshoot_pct": np.full(n, np.nan),
+        "peak_time_s": np.full(n, np.nan),
+        "settled_at": np.full(n, np.nan),
+        "steady_from": np.full(n, np.nan),
+    }
     span = t[-1] - t[0]
     final = t >= t[-1] - FINAL_FRACTION * span
     if final.sum() < 2:
@@ -136,11 +151,11 @@ def tracking_transient_batch(t: np.ndarray, err: np.ndarray, bands: Sequence[flo
     scale = (e0 - level)[:, None]
     z = (e0[:, None] - e) / scale
     out["rise_time_s"][sel] = first_crossing_batch(t, z, float(rise[1])) - first_crossing_batch(t, z, float(rise[0]))
-    held = t[-1] - 2.0 * FINAL_FRACTION * span            # converged: within the band from here on
+    held = t[-1] - 2.0 * FINAL_FRACTION * span  # converged: within the band from here on
     steady_k = None
-    for full, band in zip(out["settling_s"] + [None], list(bands) + [STEADY_BAND]):
+    for full, band in zip(out["settling_s"] + [None], list(bands) + [STEADY_BAND], strict=False):
         above = z < 1.0 - band
-        last = z.shape[1] - 1 - above[:, ::-1].argmax(axis=1)        # last sample above the line
+        last = z.shape[1] - 1 - above[:, ::-1].argmax(axis=1)  # last sample above the line
         k = np.minimum(last, z.shape[1] - 2)
         rows = np.arange(sel.size)
         zk, zk1 = z[rows, k], z[rows, k + 1]
@@ -153,18 +168,17 @@ def tracking_transient_batch(t: np.ndarray, err: np.ndarray, bands: Sequence[flo
         else:
             full[sel] = settle
     floor = err[sel][:, final].min(axis=1)
-    entry_end = np.minimum(t[0] + 2.0 * steady_k, held)             # twice the settling time: the dip of
-    entry = t[None, :] <= np.where(np.isnan(steady_k), -np.inf, entry_end)[:, None]   # an underdamped entry
+    entry_end = np.minimum(t[0] + 2.0 * steady_k, held)  # twice the settling time: the dip of
+    entry = t[None, :] <= np.where(np.isnan(steady_k), -np.inf, entry_end)[:, None]  # an underdamped entry
     low = np.where(entry, e, np.inf)
     k_low = low.argmin(axis=1)
     dip = floor - low[np.arange(sel.size), k_low]
     over = np.where(np.isnan(steady_k), np.nan, np.maximum(0.0, 100.0 * dip / (e0 - level)))
     out["overshoot_pct"][sel] = over
-    out["peak_time_s"][sel] = np.where(over > 0.0, t[k_low] - t[0], np.nan)   # NaN > 0 is False
+    out["peak_time_s"][sel] = np.where(over > 0.0, t[k_low] - t[0], np.nan)  # NaN > 0 is False
     out["settled_at"][sel] = t[0] + steady_k
     out["steady_from"][sel] = np.where(np.isnan(steady_k), np.nan, held)
     return out
-
 
 
 def first_crossing_batch(t: np.ndarray, z: np.ndarray, level: float) -> np.ndarray:

@@ -6,6 +6,23 @@ from quadcruise.missions.registry import MISSIONS, as_mission, mission_from_dict
 from quadcruise.missions.shapes import Circle, Hover, Square, Step, circle_ref, hover_ref, square_ref, step_ref
 from quadcruise.missions.waypoints import MinimumSnap, Waypoints, WaypointTable, read_waypoints_csv
 
-__all__ = ["MISSIONS", "Circle", "as_mission", "Hover", "MinimumSnap", "Mission", "Square", "Step", "WaypointTable",
-           "Waypoints", "circle_ref", "hover_ref", "mission_from_dict", "mission_from_name", "read_waypoints_csv", "square_ref",
-           "stack_params", "step_ref"]
+__all__ = [
+    "MISSIONS",
+    "Circle",
+    "as_mission",
+    "Hover",
+    "MinimumSnap",
+    "Mission",
+    "Square",
+    "Step",
+    "WaypointTable",
+    "Waypoints",
+    "circle_ref",
+    "hover_ref",
+    "mission_from_dict",
+    "mission_from_name",
+    "read_waypoints_csv",
+    "square_ref",
+    "stack_params",
+    "step_ref",
+]

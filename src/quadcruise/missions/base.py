@@ -8,8 +8,9 @@ reference with ``MISSION_SIG``, as a staticmethod) and ``_row()`` (the mp entrie
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, ClassVar, Sequence
+from typing import Any, ClassVar
 
 import numpy as np
 from numba import njit, types
@@ -21,12 +22,10 @@ from quadcruise.layout import REF_SIZE, MissionType
 __all__ = ["Mission", "check_names", "stack_params"]
 
 
-@njit(types.void(MissionType, types.float64[::1], types.float64[::1], types.float64[:, ::1]),
-      cache=True)
+@njit(types.void(MissionType, types.float64[::1], types.float64[::1], types.float64[:, ::1]), cache=True)
 def _evaluate(fn, ts, mp, out):
     for i in range(ts.shape[0]):
         fn(ts[i], mp, out[i])
-
 
 
 @dataclass(frozen=True)
@@ -92,14 +91,14 @@ class Mission(Validated):
         InputError
             ``t`` is not a scalar or 1-D array of finite numbers.
         """
-        ts = np.array(np.atleast_1d(t), dtype=np.float64)    # a writable C-ordered copy
+        ts = np.array(np.atleast_1d(t), dtype=np.float64)  # a writable C-ordered copy
         if ts.ndim != 1 or not np.all(np.isfinite(ts)):
             raise InputError("mission reference times must be a 1-D array of finite numbers")
         out = np.empty((ts.shape[0], REF_SIZE))
         _evaluate(self.function, ts, self.params(), out)
         return out
 
-    def replace(self, **changes: Any) -> "Mission":
+    def replace(self, **changes: Any) -> Mission:
         """A copy with some fields changed (validated again).
 
         Parameters
@@ -133,7 +132,6 @@ class Mission(Validated):
         return {"kind": self.name, **{k: list(v) if isinstance(v, tuple) else v for k, v in values.items()}}
 
 
-
 def check_names(cls: type, kw: dict) -> None:
     """Refuse keys that are not fields of a mission kind.
 
@@ -161,7 +159,6 @@ def check_names(cls: type, kw: dict) -> None:
     unknown = set(kw) - {f.name for f in dataclasses.fields(cls)}
     if unknown:
         raise InputError(f"unknown {cls.name} field(s): {', '.join(sorted(unknown))}")
-
 
 
 def stack_params(missions: Mission | Sequence[Mission], n: int | None = None) -> np.ndarray:
@@ -204,10 +201,10 @@ def stack_params(missions: Mission | Sequence[Mission], n: int | None = None) ->
     if len(kinds) > 1:
         raise InputError(f"a batch flies one mission kind, got {', '.join(kinds)}")
     params = [m.params() for m in missions]
-    width = max(p.shape[0] for p in params)      # tables of waypoints differ in length:
-    rows = np.zeros((len(params), width))        # pad; each function reads its own count
+    width = max(p.shape[0] for p in params)  # tables of waypoints differ in length:
+    rows = np.zeros((len(params), width))  # pad; each function reads its own count
     for i, p in enumerate(params):
-        rows[i, :p.shape[0]] = p
+        rows[i, : p.shape[0]] = p
     if n is not None:
         if len(missions) == 1:
             rows = np.repeat(rows, n, axis=0)

@@ -53,8 +53,10 @@ def mission_from_name(name: str, **kw: Any) -> Mission:
         raise InputError(f"unknown mission {name!r}; valid missions: {', '.join(MISSIONS)}")
     check_names(cls, kw)
     if cls in (Waypoints, MinimumSnap) and kw.get("table") is None:
-        raise InputError(f"the {cls.name} mission flies a waypoint table: give its CSV file as the mission "
-                         f"(quadcruise fly path.csv{' --smooth' if cls is MinimumSnap else ''}) or table=PATH")
+        raise InputError(
+            f"the {cls.name} mission flies a waypoint table: give its CSV file as the mission "
+            f"(quadcruise fly path.csv{' --smooth' if cls is MinimumSnap else ''}) or table=PATH"
+        )
     return cls(**kw) if kw else shared_default(cls)
 
 
@@ -110,9 +112,10 @@ def as_mission(value: Any, where: str = "fly()", name: str = "mission") -> Missi
     >>> as_mission(Circle)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.ArgumentTypeError: fly() argument mission must be a mission name (hover, step, circle, square, waypoints, minsnap) or a Mission, got the class Circle; give an object, e.g. Circle()
+    quadcruise.errors.ArgumentTypeError: fly() argument mission must be a mission name (hover, step, circle, ...
     """
     if isinstance(value, str):
         return mission_from_name(value)
-    return checks.instance(where, name, value, Mission, optional=False,
-                           want=f"a mission name ({', '.join(MISSIONS)}) or a Mission")
+    return checks.instance(
+        where, name, value, Mission, optional=False, want=f"a mission name ({', '.join(MISSIONS)}) or a Mission"
+    )

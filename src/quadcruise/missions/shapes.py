@@ -144,12 +144,12 @@ def circle_ref(t, mp, ref):
         [m/s^2], yaw [rad] and yaw rate [rad/s] at ``t`` (overwritten).
     """
     radius, omega, ramp = mp[0], mp[1], mp[7]
-    s, rate, drate = t, 1.0, 0.0          # phase time s(t) and its derivatives
+    s, rate, drate = t, 1.0, 0.0  # phase time s(t) and its derivatives
     if ramp > 0.0:
         u = t / ramp
         if u <= 0.0:
             s, rate = 0.0, 0.0
-        elif u < 1.0:                      # rate = smoothstep(u), s = its integral
+        elif u < 1.0:  # rate = smoothstep(u), s = its integral
             s = ramp * u * u * u * (1.0 - 0.5 * u)
             rate = u * u * (3.0 - 2.0 * u)
             drate = 6.0 * u * (1.0 - u) / ramp
@@ -189,7 +189,7 @@ def square_ref(t, mp, ref):
         [m/s^2], yaw [rad] and yaw rate [rad/s] at ``t`` (overwritten).
     """
     side, speed, sgn, dwell = mp[0], mp[1], mp[5], mp[6]
-    seg = dwell + side / speed            # one corner's dwell plus one leg
+    seg = dwell + side / speed  # one corner's dwell plus one leg
     lap = 4.0 * seg
     tau = t - lap * math.floor(t / lap)
     k = min(int(tau / seg), 3)
@@ -198,7 +198,7 @@ def square_ref(t, mp, ref):
     cx, cy = side * (0.0, 1.0, 1.0, 0.0)[k], side * (0.0, 0.0, 1.0, 1.0)[k]
     dx, dy = (1.0, 0.0, -1.0, 0.0)[k], (0.0, 1.0, 0.0, -1.0)[k]
     _clear(ref)
-    moved = s - dwell                     # the leg is [departure, arrival): v jumps at corners
+    moved = s - dwell  # the leg is [departure, arrival): v jumps at corners
     if moved >= 0.0:
         ref[REF_VX], ref[REF_VY] = dx * speed, sgn * dy * speed
     else:
@@ -270,7 +270,7 @@ class Step(Mission):
     """
 
     axis: str = _f("x", "-", "stepped axis", "choice", tuple(_AXES))
-    size: float = _f(1.0, "m or rad", "step size", "nonzero")    # a step of 0 is a hover: no step to measure
+    size: float = _f(1.0, "m or rad", "step size", "nonzero")  # a step of 0 is a hover: no step to measure
     time: float = _f(1.0, "s", "step time", "nonneg")
     x: float = _f(0.0, "m", "base x")
     y: float = _f(0.0, "m", "base y")
@@ -336,8 +336,7 @@ class Circle(Mission):
     ramp_time: float = _f(0.0, "s", "smooth ramp-up of the speed", "nonneg")
 
     name: ClassVar[str] = "circle"
-    columns: ClassVar[tuple] = ("radius", "omega", "altitude", "start_angle", "cx", "cy",
-                                "yaw", "ramp_time")
+    columns: ClassVar[tuple] = ("radius", "omega", "altitude", "start_angle", "cx", "cy", "yaw", "ramp_time")
     function = staticmethod(circle_ref)
 
     @property
@@ -351,8 +350,15 @@ class Circle(Mission):
         return self.period
 
     def _row(self) -> tuple:
-        return (self.radius, self.direction * 2.0 * math.pi / self.period, self.altitude,
-                self.start_angle, *self.center, self.yaw, self.ramp_time)
+        return (
+            self.radius,
+            self.direction * 2.0 * math.pi / self.period,
+            self.altitude,
+            self.start_angle,
+            *self.center,
+            self.yaw,
+            self.ramp_time,
+        )
 
 
 MIN_LEG_S = 1e-6
@@ -401,16 +407,17 @@ class Square(Mission):
     yaw: float = _f(0.0, "rad", "yaw")
 
     name: ClassVar[str] = "square"
-    columns: ClassVar[tuple] = ("side", "speed", "altitude", "x0", "y0", "direction",
-                                "dwell", "yaw")
+    columns: ClassVar[tuple] = ("side", "speed", "altitude", "x0", "y0", "direction", "dwell", "yaw")
     function = staticmethod(square_ref)
 
     def __post_init__(self) -> None:
         super().__post_init__()
         leg = float(self.side) / float(self.speed)
         if not leg >= MIN_LEG_S:
-            raise InputError(f"square: a side of {self.side:g} m at {self.speed:g} m/s takes {leg:g} s, "
-                             f"under {MIN_LEG_S:g} s: too short a leg to fly")
+            raise InputError(
+                f"square: a side of {self.side:g} m at {self.speed:g} m/s takes {leg:g} s, "
+                f"under {MIN_LEG_S:g} s: too short a leg to fly"
+            )
 
     @property
     def lap_time(self) -> float:
@@ -423,5 +430,4 @@ class Square(Mission):
         return self.lap_time
 
     def _row(self) -> tuple:
-        return (self.side, self.speed, self.altitude, *self.corner, self.direction,
-                self.dwell, self.yaw)
+        return (self.side, self.speed, self.altitude, *self.corner, self.direction, self.dwell, self.yaw)

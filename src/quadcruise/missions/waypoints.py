@@ -63,24 +63,31 @@ from quadcruise.io.files import read_numeric_csv
 from quadcruise.layout import REF_AX, REF_PSI, REF_PSI_DOT, REF_SIZE, REF_VX, REF_X
 from quadcruise.missions.base import Mission
 
-__all__ = ["WaypointTable", "read_waypoints_csv", "Waypoints", "MinimumSnap",
-           "minimum_snap_coefficients", "SETTLE_S", "DEFAULT_SPEED"]
+__all__ = [
+    "WaypointTable",
+    "read_waypoints_csv",
+    "Waypoints",
+    "MinimumSnap",
+    "minimum_snap_coefficients",
+    "SETTLE_S",
+    "DEFAULT_SPEED",
+]
 
 COLUMNS = ("x", "y", "z", "yaw", "t", "speed")
-DEFAULT_SPEED = 0.5   # m/s, the square mission's default speed, for tables that give no timing
-SETTLE_S = 5.0        # s flown after the last point by default
-_ORDER = 7            # polynomial degree of the minimum-snap segments
+DEFAULT_SPEED = 0.5  # m/s, the square mission's default speed, for tables that give no timing
+SETTLE_S = 5.0  # s flown after the last point by default
+_ORDER = 7  # polynomial degree of the minimum-snap segments
 _NC = _ORDER + 1
 
 # offsets into the packed parameter vectors (mp) that the compiled references read
 # Waypoints: [n, hold_yaw, (x, y, z, yaw, t) per point]
-WP_N, WP_HOLD_YAW, WP_POINTS = 0, 1, 2      # count, yaw mode, first point
-WP_STRIDE = 5                               # entries per point: ...
-PT_X, PT_YAW, PT_T = 0, 3, 4                # ... x, y, z from PT_X, then yaw, arrival time
+WP_N, WP_HOLD_YAW, WP_POINTS = 0, 1, 2  # count, yaw mode, first point
+WP_STRIDE = 5  # entries per point: ...
+PT_X, PT_YAW, PT_T = 0, 3, 4  # ... x, y, z from PT_X, then yaw, arrival time
 # MinimumSnap: [m, x, y, z, yaw at the end, t at the end, (t_i, T_i, 4 x 8 coefficients) per segment]
-MS_M, MS_END, MS_T_END, MS_SEGMENTS = 0, 1, 5, 6   # segments, end point (x, y, z, yaw), end time, first segment
-MS_STRIDE = 2 + 4 * _NC                     # entries per segment: ...
-SEG_T0, SEG_DUR, SEG_COEF = 0, 1, 2         # ... start, duration, coefficients of s^0..s^7 per axis
+MS_M, MS_END, MS_T_END, MS_SEGMENTS = 0, 1, 5, 6  # segments, end point (x, y, z, yaw), end time, first segment
+MS_STRIDE = 2 + 4 * _NC  # entries per segment: ...
+SEG_T0, SEG_DUR, SEG_COEF = 0, 1, 2  # ... start, duration, coefficients of s^0..s^7 per axis
 
 
 # --- the table -----------------------------------------------------------------------------
@@ -124,7 +131,7 @@ class WaypointTable:
     t: Any = None
     speed: Any = None
     source: str = "waypoints"
-    lines: Any = field(default=None, repr=False)   # file line of each point, for messages
+    lines: Any = field(default=None, repr=False)  # file line of each point, for messages
 
     def __post_init__(self) -> None:
         src, lines = str(self.source), self.lines
@@ -150,7 +157,7 @@ class WaypointTable:
         named = [("x", pts[:, 0]), ("y", pts[:, 1]), ("z", pts[:, 2])]
         named += [(c, cols[c]) for c in ("yaw", "t") if cols[c] is not None]
         bad = np.argwhere(~np.isfinite(np.column_stack([c for _, c in named])))
-        if bad.size:                                   # the first bad cell, row by row
+        if bad.size:  # the first bad cell, row by row
             k, j = bad[0]
             raise InputError(f"{where(k, named[j][0])}: value is not finite ({named[j][1][k]!r})")
         if t is not None and t[0] != 0.0:
@@ -165,8 +172,10 @@ class WaypointTable:
             raise InputError(f"{where(k, 'speed')}: the leg speed must be a positive number, got {v[k]:g}")
         k = None if t is not None else _after_first(np.all(pts[1:] == pts[:-1], axis=1))
         if k is not None:
-            raise InputError(f"{where(k, 'x')} (and 'y', 'z'): the same point as the one before, "
-                             "a zero-length leg with no dwell time (give arrival times 't')")
+            raise InputError(
+                f"{where(k, 'x')} (and 'y', 'z'): the same point as the one before, "
+                "a zero-length leg with no dwell time (give arrival times 't')"
+            )
         for name, arr in (("points", pts), *cols.items()):
             if arr is not None:
                 arr.setflags(write=False)
@@ -182,8 +191,7 @@ class WaypointTable:
         return all(_same(getattr(self, n), getattr(other, n)) for n in ("points", "yaw", "t", "speed"))
 
     def __hash__(self) -> int:
-        return hash(tuple(None if a is None else a.tobytes() for a in
-                          (self.points, self.yaw, self.t, self.speed)))
+        return hash(tuple(None if a is None else a.tobytes() for a in (self.points, self.yaw, self.t, self.speed)))
 
     def times(self, speed: float = DEFAULT_SPEED) -> np.ndarray:
         """Arrival time at each point: ``t``, or cumulated leg length / leg speed.
@@ -246,7 +254,7 @@ class WaypointTable:
         return {**out, "source": self.source}
 
     @classmethod
-    def from_dict(cls, d: dict) -> "WaypointTable":
+    def from_dict(cls, d: dict) -> WaypointTable:
         """Inverse of :meth:`to_dict`.
 
         Parameters
@@ -273,8 +281,10 @@ class WaypointTable:
         """
         try:
             pts = np.column_stack([np.asarray(d[c], dtype=float) for c in "xyz"])
-            opt = {c: None if d.get(c) is None else np.array([np.nan if v is None else v for v in d[c]], dtype=float)
-                   for c in ("yaw", "t", "speed")}
+            opt = {
+                c: None if d.get(c) is None else np.array([np.nan if v is None else v for v in d[c]], dtype=float)
+                for c in ("yaw", "t", "speed")
+            }
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"waypoint table: bad dict ({exc.__class__.__name__}: {exc})") from None
         return cls(pts, **opt, source=str(d.get("source", "waypoints")))
@@ -321,16 +331,28 @@ def read_waypoints_csv(path: str | os.PathLike) -> WaypointTable:
         ``speed``, fewer than two waypoints, or a table :class:`WaypointTable` refuses.
     """
     head_line, used, data, lines = read_numeric_csv(
-        path, ("x", "y", "z"), tuple(c for c in COLUMNS if c not in "xyz"),
-        blank_ok=lambda name, k: name == "speed" and k == 0)       # the first point ends no leg
+        path,
+        ("x", "y", "z"),
+        tuple(c for c in COLUMNS if c not in "xyz"),
+        blank_ok=lambda name, k: name == "speed" and k == 0,
+    )  # the first point ends no leg
     if "t" in used and "speed" in used:
-        raise InputError(f"{path}, line {head_line}, columns 't' and 'speed': give arrival times or leg speeds, not both")
+        raise InputError(
+            f"{path}, line {head_line}, columns 't' and 'speed': give arrival times or leg speeds, not both"
+        )
     if data.shape[0] < 2:
-        raise InputError(f"{path}, line {lines[-1] if lines else head_line}: needs at least two waypoints, found {data.shape[0]}")
+        raise InputError(
+            f"{path}, line {lines[-1] if lines else head_line}: needs at least two waypoints, found {data.shape[0]}"
+        )
     col = {name: data[:, j] for j, name in enumerate(used)}
-    return WaypointTable(np.column_stack([col["x"], col["y"], col["z"]]), yaw=col.get("yaw"),
-                         t=col.get("t"), speed=col.get("speed"), source=str(path),
-                         lines=tuple(lines))
+    return WaypointTable(
+        np.column_stack([col["x"], col["y"], col["z"]]),
+        yaw=col.get("yaw"),
+        t=col.get("t"),
+        speed=col.get("speed"),
+        source=str(path),
+        lines=tuple(lines),
+    )
 
 
 # --- compiled references ---------------------------------------------------------------------
@@ -372,7 +394,7 @@ def waypoints_ref(t, mp, ref):
         ref[i] = 0.0
     n = int(mp[WP_N])
     last = WP_POINTS + WP_STRIDE * (n - 1)
-    if t >= mp[last + PT_T] or t < 0.0:            # hold the last (first) point
+    if t >= mp[last + PT_T] or t < 0.0:  # hold the last (first) point
         at = last if t >= 0.0 else WP_POINTS
         for j in range(3):
             ref[REF_X + j] = mp[at + PT_X + j]
@@ -383,7 +405,7 @@ def waypoints_ref(t, mp, ref):
     b = a + WP_STRIDE
     dur = mp[b + PT_T] - mp[a + PT_T]
     s = (t - mp[a + PT_T]) / dur
-    for j in range(3):                             # REF_X.. and REF_VX.. are x, y, z in order
+    for j in range(3):  # REF_X.. and REF_VX.. are x, y, z in order
         ref[REF_X + j] = mp[a + PT_X + j] + s * (mp[b + PT_X + j] - mp[a + PT_X + j])
         ref[REF_VX + j] = (mp[b + PT_X + j] - mp[a + PT_X + j]) / dur
     if mp[WP_HOLD_YAW] != 0.0:
@@ -423,9 +445,9 @@ def minsnap_ref(t, mp, ref):
         return
     off = MS_SEGMENTS + MS_STRIDE * _last_start(t, mp, MS_SEGMENTS + SEG_T0, MS_STRIDE, int(mp[MS_M]))
     dur = mp[off + SEG_DUR]
-    s = max(t - mp[off + SEG_T0], 0.0) / dur      # before t = 0: the first point, at rest
-    for j in range(4):                            # Horner for p, p' and p'' / 2 (in s)
-        c = off + SEG_COEF + _NC * j              # x, y, z, yaw: coefficients of s^0..s^7
+    s = max(t - mp[off + SEG_T0], 0.0) / dur  # before t = 0: the first point, at rest
+    for j in range(4):  # Horner for p, p' and p'' / 2 (in s)
+        c = off + SEG_COEF + _NC * j  # x, y, z, yaw: coefficients of s^0..s^7
         p, dp, ddp = mp[c + _ORDER], 0.0, 0.0
         for k in range(_ORDER - 1, -1, -1):
             ddp = ddp * s + dp
@@ -453,13 +475,18 @@ def _hermite_matrices() -> tuple[np.ndarray, np.ndarray]:
     every cubic: rounded in floating point term by term, it would lose seven digits.)"""
     rows = np.array([_derivative_row(r, s) for s in (0.0, 1.0) for r in range(4)])
     exact = np.vectorize(lambda x: Fraction(x).limit_denominator(10_000), otypes=[object])
-    minv = exact(np.linalg.inv(rows))                      # small rationals (halves, sixths, ...)
+    minv = exact(np.linalg.inv(rows))  # small rationals (halves, sixths, ...)
     if not np.all(exact(rows) @ minv == np.eye(_NC, dtype=int)):
         raise ArithmeticError("the Hermite inverse is not a matrix of small rationals")
     k = np.arange(_NC)
     fall = np.array([math.perm(int(i), 4) for i in k], dtype=object)
-    hess = np.array([[Fraction(int(fall[i] * fall[j]), int(i + j - 7)) if i >= 4 and j >= 4 else Fraction(0)
-                      for j in k] for i in k], dtype=object)
+    hess = np.array(
+        [
+            [Fraction(int(fall[i] * fall[j]), int(i + j - 7)) if i >= 4 and j >= 4 else Fraction(0) for j in k]
+            for i in k
+        ],
+        dtype=object,
+    )
     return minv.astype(float), (minv.T @ hess @ minv).astype(float)
 
 
@@ -505,7 +532,7 @@ def minimum_snap_coefficients(values: Any, times: Any, stops: Any = None) -> np.
     n, m, axes = w.shape[0], w.shape[0] - 1, w.shape[1]
     fixed = np.zeros(n, bool) if stops is None else np.asarray(stops, bool).copy()
     fixed[[0, -1]] = True
-    minv, k_s = _hermite_matrices()                # a segment's cost y^T K y, y: value and s-derivatives at both ends
+    minv, k_s = _hermite_matrices()  # a segment's cost y^T K y, y: value and s-derivatives at both ends
     # with time derivatives instead (y_a = T^r_a times them) a segment of duration T costs
     # T^-7 sum K[a, b] T^(r_a + r_b) y_a y_b; entry (a, b) over all segments as one vector:
     order, log_t = np.array([0, 1, 2, 3, 0, 1, 2, 3]), np.log(dur)
@@ -513,29 +540,29 @@ def minimum_snap_coefficients(values: Any, times: Any, stops: Any = None) -> np.
     def q(a: int, b: int) -> np.ndarray:
         return k_s[a, b] * np.exp((order[a] + order[b] - 7) * log_t)
 
-    size = 3 * n                                   # unknowns: velocity, acceleration, jerk at each knot
-    band = np.zeros((6, size))                     # upper band storage: band[5 + row - col, col]
+    size = 3 * n  # unknowns: velocity, acceleration, jerk at each knot
+    band = np.zeros((6, size))  # upper band storage: band[5 + row - col, col]
     rhs = np.zeros((size, axes))
-    start = 3 * np.arange(m)                       # a segment's first unknown at its start knot; + 3 at its end
+    start = 3 * np.arange(m)  # a segment's first unknown at its start knot; + 3 at its end
     for ra in range(3):
         for rb in range(3):
-            if rb >= ra:                           # start-start and end-end blocks (upper triangle)
+            if rb >= ra:  # start-start and end-end blocks (upper triangle)
                 band[5 - (rb - ra), start + rb] += q(1 + ra, 1 + rb)
                 band[5 - (rb - ra), start + 3 + rb] += q(5 + ra, 5 + rb)
-            band[5 - (3 + rb - ra), start + 3 + rb] += q(1 + ra, 5 + rb)      # start-end block
-        for local, row in ((1 + ra, start + ra), (5 + ra, start + 3 + ra)):      # the values' pull
+            band[5 - (3 + rb - ra), start + 3 + rb] += q(1 + ra, 5 + rb)  # start-end block
+        for local, row in ((1 + ra, start + ra), (5 + ra, start + 3 + ra)):  # the values' pull
             rhs[row] -= q(local, 0)[:, None] * w[:-1] + q(local, 4)[:, None] * w[1:]
-    fixed = np.repeat(fixed, 3)                    # a stop's derivatives are 0: an identity row
+    fixed = np.repeat(fixed, 3)  # a stop's derivatives are 0: an identity row
     for o in range(1, 6):
         band[5 - o, o:][fixed[o:] | fixed[:-o]] = 0.0
     band[5, fixed] = 1.0
     rhs[fixed] = 0.0
-    scale = 1.0 / np.sqrt(band[5])                 # unit diagonal, whatever the spread of durations
+    scale = 1.0 / np.sqrt(band[5])  # unit diagonal, whatever the spread of durations
     for o in range(6):
-        band[5 - o, o:] *= scale[o:] * scale[:size - o]
+        band[5 - o, o:] *= scale[o:] * scale[: size - o]
     deriv = scipy.linalg.solveh_banded(band, rhs * scale[:, None], check_finite=False) * scale[:, None]
     d = deriv.reshape(n, 3, axes)
-    powers = (dur[:, None] ** np.arange(1, 4))[:, :, None]     # a time derivative times T^r: the s-derivative
+    powers = (dur[:, None] ** np.arange(1, 4))[:, :, None]  # a time derivative times T^r: the s-derivative
     y = np.empty((m, 8, axes))
     y[:, 0], y[:, 4] = w[:-1], w[1:]
     y[:, 1:4], y[:, 5:8] = d[:-1] * powers, d[1:] * powers
@@ -572,8 +599,10 @@ class _WaypointMission(Mission):
         with np.errstate(over="ignore", invalid="ignore"):
             last = float(self.times[-1])
         if not (math.isfinite(last) and last <= MAX_PATH_S):
-            raise InputError(f"{self.table.source}: flying the path takes {last:g} s at its speeds, more than "
-                             f"{MAX_PATH_S:g} s (a coordinate too large, or a speed too small?)")
+            raise InputError(
+                f"{self.table.source}: flying the path takes {last:g} s at its speeds, more than "
+                f"{MAX_PATH_S:g} s (a coordinate too large, or a speed too small?)"
+            )
 
     @property
     def times(self) -> np.ndarray:
@@ -623,7 +652,7 @@ class Waypoints(_WaypointMission):
     columns: ClassVar[tuple] = ("n", "hold_yaw", "x[k]", "y[k]", "z[k]", "yaw[k]", "t[k]")
     function = staticmethod(waypoints_ref)
 
-    def _row(self) -> np.ndarray:                   # an array, not a tuple: 10^6 points stay quick
+    def _row(self) -> np.ndarray:  # an array, not a tuple: 10^6 points stay quick
         per_point = np.column_stack([self.table.points, self.table.yaws(), self.times])
         return np.concatenate([[len(self.table), float(self.yaw_mode == "hold")], per_point.ravel()])
 
@@ -651,15 +680,27 @@ class MinimumSnap(_WaypointMission):
     """
 
     name: ClassVar[str] = "minsnap"
-    columns: ClassVar[tuple] = ("m", "x_end", "y_end", "z_end", "yaw_end", "t_end", "t[i]", "T[i]",
-                                "x[i, 0..7]", "y[i, 0..7]", "z[i, 0..7]", "yaw[i, 0..7]")
+    columns: ClassVar[tuple] = (
+        "m",
+        "x_end",
+        "y_end",
+        "z_end",
+        "yaw_end",
+        "t_end",
+        "t[i]",
+        "T[i]",
+        "x[i, 0..7]",
+        "y[i, 0..7]",
+        "z[i, 0..7]",
+        "yaw[i, 0..7]",
+    )
     function = staticmethod(minsnap_ref)
 
     @cached_property
     def coefficients(self) -> np.ndarray:
         """(m, 8, 4) coefficients of s^0..s^7 per segment, for x, y, z, yaw."""
         pts = self.table.points
-        still = np.all(pts[1:] == pts[:-1], axis=1)             # dwells: rest at both ends
+        still = np.all(pts[1:] == pts[:-1], axis=1)  # dwells: rest at both ends
         stops = np.zeros(len(pts), bool)
         stops[:-1] |= still
         stops[1:] |= still
@@ -667,7 +708,7 @@ class MinimumSnap(_WaypointMission):
         coef.setflags(write=False)
         return coef
 
-    def _row(self) -> np.ndarray:                   # an array, not a tuple: 10^6 points stay quick
+    def _row(self) -> np.ndarray:  # an array, not a tuple: 10^6 points stay quick
         tk, end = self.times, np.append(self.table.points[-1], self.table.yaws()[-1])
         segs = np.column_stack([tk[:-1], np.diff(tk), self.coefficients.transpose(0, 2, 1).reshape(len(tk) - 1, -1)])
         return np.concatenate([[len(tk) - 1], end, [tk[-1]], segs.ravel()])

@@ -48,8 +48,7 @@ def allocation_matrix(vehicle: RotorVehicle) -> np.ndarray:
         Shape (4, n): rows T [N], Mx, My, Mz [N m] per newton of each rotor's thrust.
     """
     rotors = np.asarray(vehicle.rotors, dtype=float)
-    return np.vstack([np.ones(vehicle.n_rotors), rotors[:, 1], -rotors[:, 0],
-                      rotors[:, 3] * vehicle.km / vehicle.kf])
+    return np.vstack([np.ones(vehicle.n_rotors), rotors[:, 1], -rotors[:, 0], rotors[:, 3] * vehicle.km / vehicle.kf])
 
 
 def mixer(vehicle: RotorVehicle) -> np.ndarray:
@@ -74,8 +73,10 @@ def mixer(vehicle: RotorVehicle) -> np.ndarray:
     B = allocation_matrix(vehicle)
     rank = np.linalg.matrix_rank(B)
     if rank < 4:
-        raise InputError(f"vehicle field 'rotors': the rotors cannot make thrust, roll, pitch and yaw moments "
-                         f"independently (the allocation matrix has rank {rank} of 4: check the directions and km)")
+        raise InputError(
+            f"vehicle field 'rotors': the rotors cannot make thrust, roll, pitch and yaw moments "
+            f"independently (the allocation matrix has rank {rank} of 4: check the directions and km)"
+        )
     return np.linalg.pinv(B)
 
 

@@ -101,6 +101,7 @@ EULER_PITCH_LIMIT = math.radians(85.0)
 """|pitch| [rad] beyond which a flight of the full plant stops: there 1/cos theta = 11.5, and
 the ZYX Euler-angle rates go singular at 90 degrees."""
 
+
 @njit(cache=True, error_model="numpy")
 def derivative(x, u, vp, ext, full, dx):
     """Write dx/dt of one vehicle into ``dx``.
@@ -120,8 +121,20 @@ def derivative(x, u, vp, ext, full, dx):
     dx : ndarray, shape (16,)
         Output: the state's time derivative [unit/s].
     """
-    derivative_at(x, math.sin(x[PHI]), math.cos(x[PHI]), math.sin(x[THETA]), math.cos(x[THETA]),
-                  math.sin(x[PSI]), math.cos(x[PSI]), u, vp, ext, full, dx)
+    derivative_at(
+        x,
+        math.sin(x[PHI]),
+        math.cos(x[PHI]),
+        math.sin(x[THETA]),
+        math.cos(x[THETA]),
+        math.sin(x[PSI]),
+        math.cos(x[PSI]),
+        u,
+        vp,
+        ext,
+        full,
+        dx,
+    )
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -154,12 +167,12 @@ def derivative_at(x, sphi, cphi, sth, cth, spsi, cpsi, u, vp, ext, full, dx):
     """
     m = vp[P_M]
     p, q, r = x[P], x[Q], x[R]
-    U1, U2, U3, U4 = mix(x[F1], x[F2], x[F3], x[F4], vp[P_D])             # (1)-(4)
+    U1, U2, U3, U4 = mix(x[F1], x[F2], x[F3], x[F4], vp[P_D])  # (1)-(4)
     a = U1 / m
 
     fx, fy, fz = ext[EXT_FX], ext[EXT_FY], ext[EXT_FZ]
     c1, c2 = vp[P_CD1], vp[P_CD2]
-    if c1 != 0.0 or c2 != 0.0:                                              # drag, air-relative
+    if c1 != 0.0 or c2 != 0.0:  # drag, air-relative
         rx, ry, rz = x[VX] - ext[EXT_WX], x[VY] - ext[EXT_WY], x[VZ] - ext[EXT_WZ]
         c = c1 + c2 * math.sqrt(rx * rx + ry * ry + rz * rz)
         fx -= c * rx
@@ -169,23 +182,23 @@ def derivative_at(x, sphi, cphi, sth, cth, spsi, cpsi, u, vp, ext, full, dx):
     dx[X] = x[VX]
     dx[Y] = x[VY]
     dx[Z] = x[VZ]
-    dx[VX] = (sphi * spsi + cphi * sth * cpsi) * a + fx / m                 # (5)
-    dx[VY] = (-sphi * cpsi + cphi * sth * spsi) * a + fy / m                # (6)
-    dx[VZ] = cphi * cth * a - vp[P_G] + fz / m                              # (7)
+    dx[VX] = (sphi * spsi + cphi * sth * cpsi) * a + fx / m  # (5)
+    dx[VY] = (-sphi * cpsi + cphi * sth * spsi) * a + fy / m  # (6)
+    dx[VZ] = cphi * cth * a - vp[P_G] + fz / m  # (7)
     if full:
         s = q * sphi + r * cphi
         dx[PHI] = p + s * sth / cth
         dx[THETA] = q * cphi - r * sphi
         dx[PSI] = s / cth
-    else:                                                                   # the paper's
+    else:  # the paper's
         dx[PHI] = p
         dx[THETA] = q
         dx[PSI] = r
-    dx[P] = vp[P_K1] * q * r + vp[P_K2] * U2 + ext[EXT_TX] / vp[P_JXX]      # (11) roll
-    dx[Q] = vp[P_K3] * p * r + vp[P_K4] * U3 + ext[EXT_TY] / vp[P_JYY]      # (11) pitch
-    dx[R] = vp[P_K5] * p * q + vp[P_K6] * U4 + ext[EXT_TZ] / vp[P_JZZ]      # (11) yaw
+    dx[P] = vp[P_K1] * q * r + vp[P_K2] * U2 + ext[EXT_TX] / vp[P_JXX]  # (11) roll
+    dx[Q] = vp[P_K3] * p * r + vp[P_K4] * U3 + ext[EXT_TY] / vp[P_JYY]  # (11) pitch
+    dx[R] = vp[P_K5] * p * q + vp[P_K6] * U4 + ext[EXT_TZ] / vp[P_JZZ]  # (11) yaw
     w, K = vp[P_OMEGA], vp[P_K]
-    dx[F1] = w * (ext[EXT_E1] * K * u[0] - x[F1])                           # rotor lag
+    dx[F1] = w * (ext[EXT_E1] * K * u[0] - x[F1])  # rotor lag
     dx[F2] = w * (ext[EXT_E2] * K * u[1] - x[F2])
     dx[F3] = w * (ext[EXT_E3] * K * u[2] - x[F3])
     dx[F4] = w * (ext[EXT_E4] * K * u[3] - x[F4])

@@ -56,8 +56,28 @@ ROTOR_BODY_NAMES = ("x", "y", "z", "vx", "vy", "vz", "qw", "qx", "qy", "qz", "p"
 ROTOR_BODY_UNITS = ("m", "m", "m", "m/s", "m/s", "m/s", "-", "-", "-", "-", "rad/s", "rad/s", "rad/s")
 
 # --- parameter row ----------------------------------------------------------------------------
-(RP_M, RP_JXX, RP_JYY, RP_JZZ, RP_KF, RP_KM, RP_TAU_UP, RP_TAU_DOWN, RP_W_MIN, RP_W_MAX, RP_G,
- RP_CDX, RP_CDY, RP_CDZ, RP_KD, RP_KZ, RP_KH, RP_KFLAP, RP_J_ROTOR, RP_N_ROTORS) = range(20)
+(
+    RP_M,
+    RP_JXX,
+    RP_JYY,
+    RP_JZZ,
+    RP_KF,
+    RP_KM,
+    RP_TAU_UP,
+    RP_TAU_DOWN,
+    RP_W_MIN,
+    RP_W_MAX,
+    RP_G,
+    RP_CDX,
+    RP_CDY,
+    RP_CDZ,
+    RP_KD,
+    RP_KZ,
+    RP_KH,
+    RP_KFLAP,
+    RP_J_ROTOR,
+    RP_N_ROTORS,
+) = range(20)
 RP_ROTORS = 20
 """First column of the rotors: rotor i's x, y, z [m] and direction s at ``RP_ROTORS + 4 i`` on."""
 
@@ -107,32 +127,32 @@ def rotor_derivative(x, w_cmd, rp, ext, dx):
     tau_up, tau_down, j_rotor = rp[RP_TAU_UP], rp[RP_TAU_DOWN], rp[RP_J_ROTOR]
     qw, qx, qy, qz = x[QW], x[QX], x[QY], x[QZ]
     p, q, r = x[RP], x[RQ], x[RR]
-    s = 2.0 / (qw * qw + qx * qx + qy * qy + qz * qz)      # R of q / |q|
+    s = 2.0 / (qw * qw + qx * qx + qy * qy + qz * qz)  # R of q / |q|
     r00, r01, r02 = 1.0 - s * (qy * qy + qz * qz), s * (qx * qy - qw * qz), s * (qx * qz + qw * qy)
     r10, r11, r12 = s * (qx * qy + qw * qz), 1.0 - s * (qx * qx + qz * qz), s * (qy * qz - qw * qx)
     r20, r21, r22 = s * (qx * qz - qw * qy), s * (qy * qz + qw * qx), 1.0 - s * (qx * qx + qy * qy)
     ax, ay, az = x[RVX] - ext[EXT_WX], x[RVY] - ext[EXT_WY], x[RVZ] - ext[EXT_WZ]
-    ub = r00 * ax + r10 * ay + r20 * az                    # airspeed, body frame: R^T (v - w)
+    ub = r00 * ax + r10 * ay + r20 * az  # airspeed, body frame: R^T (v - w)
     vb = r01 * ax + r11 * ay + r21 * az
     wb = r02 * ax + r12 * ay + r22 * az
-    fx = fy = fz = 0.0                                     # body force [N]
-    mx = my = mz = 0.0                                     # body moment [N m]
-    h = h_dot = 0.0                                        # rotors' angular momentum about body z
+    fx = fy = fz = 0.0  # body force [N]
+    mx = my = mz = 0.0  # body moment [N m]
+    h = h_dot = 0.0  # rotors' angular momentum about body z
     for i in range(n):
         base = RP_ROTORS + 4 * i
         px, py, pz, sign = rp[base], rp[base + 1], rp[base + 2], rp[base + 3]
         w = x[ROTOR_W1 + i]
         e = ext[EXT_E1 + i]
-        lx = ub + q * pz - r * py                          # airspeed at the hub: v_b + Omega x r_i
+        lx = ub + q * pz - r * py  # airspeed at the hub: v_b + Omega x r_i
         ly = vb + r * px - p * pz
         lz = wb + p * py - q * px
-        f_x = -w * kd * lx                                 # rotor drag (H force) ...
+        f_x = -w * kd * lx  # rotor drag (H force) ...
         f_y = -w * kd * ly
-        f_z = e * kf * w * w + kh * (lx * lx + ly * ly) - w * kz * lz    # ... thrust, lift, inflow
+        f_z = e * kf * w * w + kh * (lx * lx + ly * ly) - w * kz * lz  # ... thrust, lift, inflow
         fx += f_x
         fy += f_y
         fz += f_z
-        mx += py * f_z - pz * f_y - kflap * w * ly         # r_i x F_i, and flapping
+        mx += py * f_z - pz * f_y - kflap * w * ly  # r_i x F_i, and flapping
         my += pz * f_x - px * f_z + kflap * w * lx
         mz += px * f_y - py * f_x + sign * e * km * w * w  # and the rotor's drag moment
         c = w_cmd[i]
@@ -140,7 +160,7 @@ def rotor_derivative(x, w_cmd, rp, ext, dx):
         dx[ROTOR_W1 + i] = w_dot
         h -= sign * j_rotor * w
         h_dot -= sign * j_rotor * w_dot
-    speed = math.sqrt(ub * ub + vb * vb + wb * wb)          # parasitic drag
+    speed = math.sqrt(ub * ub + vb * vb + wb * wb)  # parasitic drag
     fx -= speed * rp[RP_CDX] * ub
     fy -= speed * rp[RP_CDY] * vb
     fz -= speed * rp[RP_CDZ] * wb
@@ -151,12 +171,12 @@ def rotor_derivative(x, w_cmd, rp, ext, dx):
     dx[RVX] = (r00 * fx + r01 * fy + r02 * fz + ext[EXT_FX]) * inv_m
     dx[RVY] = (r10 * fx + r11 * fy + r12 * fz + ext[EXT_FY]) * inv_m
     dx[RVZ] = (r20 * fx + r21 * fy + r22 * fz + ext[EXT_FZ]) * inv_m - rp[RP_G]
-    dx[QW] = -0.5 * (qx * p + qy * q + qz * r)             # q (x) (0, Omega) / 2
+    dx[QW] = -0.5 * (qx * p + qy * q + qz * r)  # q (x) (0, Omega) / 2
     dx[QX] = 0.5 * (qw * p + qy * r - qz * q)
     dx[QY] = 0.5 * (qw * q + qz * p - qx * r)
     dx[QZ] = 0.5 * (qw * r + qx * q - qy * p)
     jxx, jyy, jzz = rp[RP_JXX], rp[RP_JYY], rp[RP_JZZ]
-    lx_, ly_, lz_ = jxx * p, jyy * q, jzz * r + h          # body and rotors' angular momentum
+    lx_, ly_, lz_ = jxx * p, jyy * q, jzz * r + h  # body and rotors' angular momentum
     dx[RP] = (mx + ext[EXT_TX] - (q * lz_ - r * ly_)) / jxx
     dx[RQ] = (my + ext[EXT_TY] - (r * lx_ - p * lz_)) / jyy
     dx[RR] = (mz + ext[EXT_TZ] - (p * ly_ - q * lx_) - h_dot) / jzz

@@ -156,18 +156,25 @@ class RotorVehicle(Validated):
     def __post_init__(self) -> None:
         super().__post_init__()
         if not self.w_max > self.w_min:
-            raise InputError(f"vehicle field 'w_max' ({self.w_max:g} rad/s) must be above 'w_min' "
-                             f"({self.w_min:g} rad/s)")
-        lift, weight = self.n_rotors * self.kf * self.w_max ** 2, self.m * self.g
+            raise InputError(
+                f"vehicle field 'w_max' ({self.w_max:g} rad/s) must be above 'w_min' ({self.w_min:g} rad/s)"
+            )
+        lift, weight = self.n_rotors * self.kf * self.w_max**2, self.m * self.g
         if not lift > weight:
-            raise InputError(f"vehicle cannot lift itself: {self.n_rotors} rotors x kf w_max^2 = {lift:.4g} N, "
-                             f"its weight m g = {weight:.4g} N")
+            raise InputError(
+                f"vehicle cannot lift itself: {self.n_rotors} rotors x kf w_max^2 = {lift:.4g} N, "
+                f"its weight m g = {weight:.4g} N"
+            )
         angles = sorted(math.atan2(y, x) for x, y, _, _ in self.rotors if math.hypot(x, y) > 0.0)
-        gaps = [b - a for a, b in zip(angles, angles[1:] + [angles[0] + 2.0 * math.pi])] if angles else [7.0]
+        gaps = (
+            [b - a for a, b in zip(angles, angles[1:] + [angles[0] + 2.0 * math.pi], strict=False)] if angles else [7.0]
+        )
         if max(gaps) >= math.pi - 1e-9:
-            raise InputError("vehicle field 'rotors': the rotors do not surround the centre of mass (seen from "
-                             "above they all lie on one side of a line through it), so some tilt cannot be "
-                             "commanded")
+            raise InputError(
+                "vehicle field 'rotors': the rotors do not surround the centre of mass (seen from "
+                "above they all lie on one side of a line through it), so some tilt cannot be "
+                "commanded"
+            )
 
     # --- constructors ---------------------------------------------------------------------
     @classmethod
@@ -243,11 +250,27 @@ class RotorVehicle(Validated):
             rotor's x, y, z [m] and direction.
         """
         out = np.zeros(RP_ROTORS + 4 * self.n_rotors)
-        for col, name in ((RP_M, "m"), (RP_JXX, "Jxx"), (RP_JYY, "Jyy"), (RP_JZZ, "Jzz"), (RP_KF, "kf"),
-                          (RP_KM, "km"), (RP_TAU_UP, "tau_up"), (RP_TAU_DOWN, "tau_down"), (RP_W_MIN, "w_min"),
-                          (RP_W_MAX, "w_max"), (RP_G, "g"), (RP_CDX, "c_Dx"), (RP_CDY, "c_Dy"), (RP_CDZ, "c_Dz"),
-                          (RP_KD, "k_d"), (RP_KZ, "k_z"), (RP_KH, "k_h"), (RP_KFLAP, "k_flap"),
-                          (RP_J_ROTOR, "J_rotor")):
+        for col, name in (
+            (RP_M, "m"),
+            (RP_JXX, "Jxx"),
+            (RP_JYY, "Jyy"),
+            (RP_JZZ, "Jzz"),
+            (RP_KF, "kf"),
+            (RP_KM, "km"),
+            (RP_TAU_UP, "tau_up"),
+            (RP_TAU_DOWN, "tau_down"),
+            (RP_W_MIN, "w_min"),
+            (RP_W_MAX, "w_max"),
+            (RP_G, "g"),
+            (RP_CDX, "c_Dx"),
+            (RP_CDY, "c_Dy"),
+            (RP_CDZ, "c_Dz"),
+            (RP_KD, "k_d"),
+            (RP_KZ, "k_z"),
+            (RP_KH, "k_h"),
+            (RP_KFLAP, "k_flap"),
+            (RP_J_ROTOR, "J_rotor"),
+        ):
             out[col] = getattr(self, name)
         out[RP_N_ROTORS] = self.n_rotors
         out[RP_ROTORS:] = np.asarray(self.rotors, dtype=float).ravel()

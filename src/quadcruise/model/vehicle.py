@@ -101,7 +101,7 @@ class Vehicle(Validated):
     >>> Vehicle(K=[120, -1])
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: vehicle field 'K' (thrust per unit PWM duty (Table I's K), N) must be > 0, got -1.0 (entry 1 of 2)
+    quadcruise.errors.InputError: vehicle field 'K' (thrust per unit PWM duty (Table I's K), N) must be > 0, ...
     """
 
     m: Any = _f(3.499, "kg", "mass", "pos", batch=True)
@@ -120,7 +120,7 @@ class Vehicle(Validated):
 
     # --- constructors -------------------------------------------------------------------
     @classmethod
-    def paper(cls) -> "Vehicle":
+    def paper(cls) -> Vehicle:
         """The paper's Table I (Qball-X4) with d = 4/120 m.
 
         Returns
@@ -186,7 +186,7 @@ class Vehicle(Validated):
 
         return load_vehicle(name_or_path, {"paper": cls, "rotor": RotorVehicle})
 
-    def replace(self, **changes: Any) -> "Vehicle":
+    def replace(self, **changes: Any) -> Vehicle:
         """A copy with some fields changed (validated again).
 
         Parameters
@@ -210,7 +210,7 @@ class Vehicle(Validated):
         return dataclasses.replace(self, **changes)
 
     @classmethod
-    def stack(cls, vehicles: "list[Vehicle]") -> "Vehicle":
+    def stack(cls, vehicles: list[Vehicle]) -> Vehicle:
         """One batched Vehicle from a list of vehicles, in order.
 
         Parameters
@@ -236,8 +236,10 @@ class Vehicle(Validated):
         """
         if not vehicles:
             raise InputError("cannot stack an empty list of vehicles")
-        cols = {f.name: np.concatenate([np.atleast_1d(getattr(v, f.name)) * np.ones(v.batch_size or 1)
-                                        for v in vehicles]) for f in dataclasses.fields(cls)}
+        cols = {
+            f.name: np.concatenate([np.atleast_1d(getattr(v, f.name)) * np.ones(v.batch_size or 1) for v in vehicles])
+            for f in dataclasses.fields(cls)
+        }
         return cls(**cols)
 
     # --- views --------------------------------------------------------------------------
@@ -259,9 +261,12 @@ class Vehicle(Validated):
     def k(self) -> tuple:
         """(k1, ..., k6) of the paper's Section III, eq (11)."""
         return (
-            (self.Jyy - self.Jzz) / self.Jxx, self.l / self.Jxx,
-            (self.Jzz - self.Jxx) / self.Jyy, self.l / self.Jyy,
-            (self.Jxx - self.Jyy) / self.Jzz, 1.0 / self.Jzz,
+            (self.Jyy - self.Jzz) / self.Jxx,
+            self.l / self.Jxx,
+            (self.Jzz - self.Jxx) / self.Jyy,
+            self.l / self.Jyy,
+            (self.Jxx - self.Jyy) / self.Jzz,
+            1.0 / self.Jzz,
         )
 
     def rows(self, n: int | None = None) -> np.ndarray:
@@ -292,10 +297,19 @@ class Vehicle(Validated):
         if size is not None and size != n:
             raise InputError(f"vehicle batch has {size} entries but {n} vehicles were asked for")
         out = np.empty((n, PARAM_SIZE))
-        for col, name in ((P_M, "m"), (P_JXX, "Jxx"), (P_JYY, "Jyy"), (P_JZZ, "Jzz"),
-                          (P_L, "l"), (P_K, "K"), (P_OMEGA, "omega"), (P_D, "d"), (P_G, "g")):
+        for col, name in (
+            (P_M, "m"),
+            (P_JXX, "Jxx"),
+            (P_JYY, "Jyy"),
+            (P_JZZ, "Jzz"),
+            (P_L, "l"),
+            (P_K, "K"),
+            (P_OMEGA, "omega"),
+            (P_D, "d"),
+            (P_G, "g"),
+        ):
             out[:, col] = getattr(self, name)
-        for col, value in zip((P_K1, P_K2, P_K3, P_K4, P_K5, P_K6), self.k):
+        for col, value in zip((P_K1, P_K2, P_K3, P_K4, P_K5, P_K6), self.k, strict=False):
             out[:, col] = value
         out[:, P_CD1] = self.drag_linear
         out[:, P_CD2] = self.drag_quadratic
@@ -311,9 +325,14 @@ class Vehicle(Validated):
         dict
             Field name -> float, or list of floats for a batched field (SI units).
         """
-        return {f.name: (getattr(self, f.name).tolist() if isinstance(getattr(self, f.name), np.ndarray)
-                         else getattr(self, f.name)) for f in dataclasses.fields(self)}
-
+        return {
+            f.name: (
+                getattr(self, f.name).tolist()
+                if isinstance(getattr(self, f.name), np.ndarray)
+                else getattr(self, f.name)
+            )
+            for f in dataclasses.fields(self)
+        }
 
 
 @functools.cache

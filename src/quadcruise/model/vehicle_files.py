@@ -28,7 +28,7 @@ Examples
 >>> preset_path("irs")
 Traceback (most recent call last):
     ...
-quadcruise.errors.InputError: unknown vehicle preset 'irs' (did you mean 'iris'?); presets: crazyflie, hummingbird, iris, paper
+quadcruise.errors.InputError: unknown vehicle preset 'irs' (did you mean 'iris'?); presets: crazyflie, ...
 """
 
 from __future__ import annotations
@@ -126,9 +126,16 @@ def preset_table() -> list[dict]:
     rows = []
     for name in sorted(PRESETS):
         table = _preset_table(name)
-        rows.append({"name": name, "plant": table["plant"], "m": float(table["m"]),
-                     "rotors": len(table.get("rotors", ())) or 4, "source": str(table.get("source", "")),
-                     "file": str(PRESETS[name])})
+        rows.append(
+            {
+                "name": name,
+                "plant": table["plant"],
+                "m": float(table["m"]),
+                "rotors": len(table.get("rotors", ())) or 4,
+                "source": str(table.get("source", "")),
+                "file": str(PRESETS[name]),
+            }
+        )
     return rows
 
 
@@ -218,28 +225,36 @@ def vehicle_from_table(table: dict, plants: Mapping[str, type], where: str = "ve
             raise InputError(f"{where}: [vehicle] 'preset' must be a preset's name, got {name!r}")
         base = dict(_preset_table(name))
         if table.get("plant", base["plant"]) != base["plant"]:
-            raise InputError(f"{where}: [vehicle] 'plant' = {table['plant']!r} does not match preset '{name}', "
-                             f"which the {base['plant']} plant flies")
+            raise InputError(
+                f"{where}: [vehicle] 'plant' = {table['plant']!r} does not match preset '{name}', "
+                f"which the {base['plant']} plant flies"
+            )
         base.update(table)
         table = base
     plant = table.pop("plant", "rotor" if "rotors" in table else "paper")
     if plant not in plants:
-        raise InputError(f"{where}: [vehicle] 'plant' = {plant!r}: here the vehicle must be for the "
-                         f"{' or '.join(plants)} plant")
+        raise InputError(
+            f"{where}: [vehicle] 'plant' = {plant!r}: here the vehicle must be for the {' or '.join(plants)} plant"
+        )
     cls = plants[plant]
     fields = {f.name for f in dataclasses.fields(cls)}
     if "source" not in fields:
-        table.pop("source", None)            # a class that keeps no source (the paper's Vehicle)
+        table.pop("source", None)  # a class that keeps no source (the paper's Vehicle)
     for key in table:
         if key not in fields:
             close = difflib.get_close_matches(key, sorted(fields), n=1)
             hint = f" (did you mean '{close[0]}'?)" if close else ""
             raise InputError(f"{where}: [vehicle] has no key '{key}' for the {plant} plant{hint}")
-    missing = [f.name for f in dataclasses.fields(cls)
-               if f.name not in table and f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING]
+    missing = [
+        f.name
+        for f in dataclasses.fields(cls)
+        if f.name not in table and f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+    ]
     if missing:
-        raise InputError(f"{where}: [vehicle] lacks {', '.join(repr(k) for k in missing)}, which the {plant} plant "
-                         f"needs (or start from a preset: preset = \"{min(PRESETS)}\")")
+        raise InputError(
+            f"{where}: [vehicle] lacks {', '.join(repr(k) for k in missing)}, which the {plant} plant "
+            f'needs (or start from a preset: preset = "{min(PRESETS)}")'
+        )
     try:
         return cls(**_plain(table))
     except InputError as exc:
@@ -248,5 +263,6 @@ def vehicle_from_table(table: dict, plants: Mapping[str, type], where: str = "ve
 
 def _plain(table: dict) -> dict[str, Any]:
     """TOML integers as floats for the number fields (``k_d = 0``), the rest as they are."""
-    return {k: float(v) if isinstance(v, int) and not isinstance(v, bool) and k != "source" else v
-            for k, v in table.items()}
+    return {
+        k: float(v) if isinstance(v, int) and not isinstance(v, bool) and k != "source" else v for k, v in table.items()
+    }

@@ -8,5 +8,14 @@ from quadcruise.montecarlo.requirements import Requirement
 from quadcruise.montecarlo.result import MonteCarloResult
 from quadcruise.montecarlo.spec import MonteCarloSpec
 
-__all__ = ["Case", "Draw", "MonteCarloResult", "MonteCarloSpec", "Population", "Requirement", "montecarlo",
-           "montecarlo_case", "replay_case"]
+__all__ = [
+    "Case",
+    "Draw",
+    "MonteCarloResult",
+    "MonteCarloSpec",
+    "Population",
+    "Requirement",
+    "montecarlo",
+    "montecarlo_case",
+    "replay_case",
+]

@@ -42,8 +42,9 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from quadcruise import checks
 from quadcruise.control import Controller, as_controller
@@ -61,13 +62,26 @@ __all__ = ["Case", "montecarlo", "montecarlo_case", "replay_case"]
 
 
 # --- the whole population ---------------------------------------------------------------
-def montecarlo(mission: Mission | str = "circle", controller: Controller | str = "nlpd",
-               population: Population | None = None, n: int = 100, seed: int = 0, *,
-               environment: Environment | None = None, sensors: SensorNoise | None = None,
-               chunk_size: int | str = "auto", scheduler: str | None = None, workers: int | None = None,
-               out: str | Path | None = None, resume: bool = True, force: bool = False, fmt: str = "csv",
-               progress: Callable[[int, int], None] | None = None, connect_timeout: float = 10.0,
-               **spec_options: Any) -> MonteCarloResult:
+def montecarlo(
+    mission: Mission | str = "circle",
+    controller: Controller | str = "nlpd",
+    population: Population | None = None,
+    n: int = 100,
+    seed: int = 0,
+    *,
+    environment: Environment | None = None,
+    sensors: SensorNoise | None = None,
+    chunk_size: int | str = "auto",
+    scheduler: str | None = None,
+    workers: int | None = None,
+    out: str | Path | None = None,
+    resume: bool = True,
+    force: bool = False,
+    fmt: str = "csv",
+    progress: Callable[[int, int], None] | None = None,
+    connect_timeout: float = 10.0,
+    **spec_options: Any,
+) -> MonteCarloResult:
     """Fly a population of n vehicles and collect one row of metrics per flight.
 
     Parameters
@@ -123,28 +137,87 @@ def montecarlo(mission: Mission | str = "circle", controller: Controller | str =
         One table row per flight, the kept paths, the summary and how it ran.
     """
     spec_fields = [f.name for f in dataclasses.fields(MonteCarloSpec) if f.init]
-    reject_unknown("montecarlo()", {k: v for k, v in spec_options.items() if k not in spec_fields},
-                   ["chunk_size", "environment", "force", "fmt", "out", "progress", "resume", "scheduler", "sensors",
-                    "workers", "connect_timeout", *(f for f in spec_fields if f not in ("mission", "controller"))])
-    check_montecarlo_arguments(mission, controller, population, n, seed, environment, sensors, chunk_size,
-                               scheduler, workers, out, resume, force, progress, connect_timeout, spec_options)
+    reject_unknown(
+        "montecarlo()",
+        {k: v for k, v in spec_options.items() if k not in spec_fields},
+        [
+            "chunk_size",
+            "environment",
+            "force",
+            "fmt",
+            "out",
+            "progress",
+            "resume",
+            "scheduler",
+            "sensors",
+            "workers",
+            "connect_timeout",
+            *(f for f in spec_fields if f not in ("mission", "controller")),
+        ],
+    )
+    check_montecarlo_arguments(
+        mission,
+        controller,
+        population,
+        n,
+        seed,
+        environment,
+        sensors,
+        chunk_size,
+        scheduler,
+        workers,
+        out,
+        resume,
+        force,
+        progress,
+        connect_timeout,
+        spec_options,
+    )
     population = population or Population()
     if environment is not None or sensors is not None:
-        if (environment is not None and population.environment is not None) or \
-                (sensors is not None and population.noise is not None):
+        if (environment is not None and population.environment is not None) or (
+            sensors is not None and population.noise is not None
+        ):
             raise InputError("give the environment and sensors either to montecarlo() or to the Population, not both")
         population = dataclasses.replace(
-            population, environment=population.environment if environment is None else environment,
-            noise=population.noise if sensors is None else sensors)
-    spec = MonteCarloSpec(mission=mission, controller=controller, population=population,
-                          seed=seed, **spec_options)
-    return run_sweep(spec, n, chunk_size=chunk_size, scheduler=scheduler, workers=workers, out=out,
-                     resume=resume, force=force, fmt=fmt, progress=progress, connect_timeout=connect_timeout)
+            population,
+            environment=population.environment if environment is None else environment,
+            noise=population.noise if sensors is None else sensors,
+        )
+    spec = MonteCarloSpec(mission=mission, controller=controller, population=population, seed=seed, **spec_options)
+    return run_sweep(
+        spec,
+        n,
+        chunk_size=chunk_size,
+        scheduler=scheduler,
+        workers=workers,
+        out=out,
+        resume=resume,
+        force=force,
+        fmt=fmt,
+        progress=progress,
+        connect_timeout=connect_timeout,
+    )
 
 
-def check_montecarlo_arguments(mission, controller, population, n, seed, environment, sensors, chunk_size,
-                               scheduler, workers, out, resume, force, progress, connect_timeout,
-                               spec_options: dict) -> None:
+def check_montecarlo_arguments(
+    mission,
+    controller,
+    population,
+    n,
+    seed,
+    environment,
+    sensors,
+    chunk_size,
+    scheduler,
+    workers,
+    out,
+    resume,
+    force,
+    progress,
+    connect_timeout,
+    spec_options: dict,
+) -> None:
     """:func:`montecarlo`'s arguments checked, before any work, in the API's one message form
     (:mod:`quadcruise.checks`): a wrong type is an ArgumentTypeError, a bad value an InputError.
 
@@ -166,7 +239,7 @@ resume, force, progress, connect_timeout
     checks.instance(w, "sensors", sensors, SensorNoise)
     if not (isinstance(chunk_size, str) and chunk_size == "auto"):
         checks.whole(w, "chunk_size", chunk_size, 1)
-    checks.instance(w, "scheduler", scheduler, str, want="\"none\", \"local\" or a scheduler address")
+    checks.instance(w, "scheduler", scheduler, str, want='"none", "local" or a scheduler address')
     checks.whole(w, "workers", workers, 1, optional=True)
     checks.instance(w, "out", out, (str, os.PathLike), want="a folder path")
     checks.flag(w, "resume", resume)

@@ -57,16 +57,26 @@ def fly_chunk(spec: MonteCarloSpec, first, count: int, log_every: int | None = N
 
     draw = spec.population.draw(spec.seed, first, count, spec.vehicle, spec.dt)
     x0 = hover_state(draw.vehicle, count, spec.mission)
-    x0[:, X:X + 3] += draw.offsets
+    x0[:, X : X + 3] += draw.offsets
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = fly(spec.mission, spec.controller if controller is None else controller, vehicle=draw.vehicle,
-                  controller_vehicle=spec.model_vehicle,
-                  duration=spec.duration, dt=spec.dt, max_step=spec.max_step, x0=x0,
-                  log_every=spec.log_every if log_every is None else log_every,
-                  full_dynamics=spec.full_dynamics, seed=spec.seed, first_vehicle=first,
-                  environment=draw.environment, sensors=draw.sensors,
-                  max_steady_error=np.inf)        # sweep_metrics judges it, by the spec's bound
+        res = fly(
+            spec.mission,
+            spec.controller if controller is None else controller,
+            vehicle=draw.vehicle,
+            controller_vehicle=spec.model_vehicle,
+            duration=spec.duration,
+            dt=spec.dt,
+            max_step=spec.max_step,
+            x0=x0,
+            log_every=spec.log_every if log_every is None else log_every,
+            full_dynamics=spec.full_dynamics,
+            seed=spec.seed,
+            first_vehicle=first,
+            environment=draw.environment,
+            sensors=draw.sensors,
+            max_steady_error=np.inf,
+        )  # sweep_metrics judges it, by the spec's bound
     return res, draw
 
 
@@ -136,14 +146,14 @@ def reduce_chunk(spec: MonteCarloSpec, first: int, res, draw: Draw) -> dict:
     out.update({k: np.asarray(cols[k], dtype=t) for k, t in COLUMNS.items()})
     # paths: the random sample (the first max_traces vehicles) and the chunk's first failures
     sample = cols["vehicle"] < spec.max_traces
-    failed = np.flatnonzero((cols["failure"] != 0) & ~sample)[:spec.max_failure_traces]
+    failed = np.flatnonzero((cols["failure"] != 0) & ~sample)[: spec.max_failure_traces]
     keep = np.union1d(np.flatnonzero(sample), failed).astype(np.int64)
     step = spec.trace_every
     out["trace_vehicle"] = cols["vehicle"][keep]
     out["trace_sample"] = sample[keep]
     out["trace_t"] = res.t[::step].copy()
-    out["trace_pos"] = np.ascontiguousarray(res.states[keep, ::step, X:X + 3])
-    out["trace_ref"] = np.ascontiguousarray(res.references[keep, ::step, REF_X:REF_X + 3])
+    out["trace_pos"] = np.ascontiguousarray(res.states[keep, ::step, X : X + 3])
+    out["trace_ref"] = np.ascontiguousarray(res.references[keep, ::step, REF_X : REF_X + 3])
     return out
 
 
@@ -189,45 +199,73 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
     out["transient_axis"] = np.full(n, -1, dtype=np.int64)
     out["status"] = status
     out["stop_time_s"] = np.asarray(result.t_stop, dtype=float).copy()
-    refs = result.references[:, :, REF_X:REF_X + 3]
-    stopped = np.asarray(result.stopped, dtype=bool)           # by the engine: later rows NaN
+    refs = result.references[:, :, REF_X : REF_X + 3]
+    stopped = np.asarray(result.stopped, dtype=bool)  # by the engine: later rows NaN
     live = np.flatnonzero(~stopped & np.isfinite(refs).all(axis=(1, 2)))
     not_settled = np.zeros(n, dtype=bool)
     if live.size:
         mission = result.meta.get("mission") if isinstance(result.meta.get("mission"), dict) else {}
         hover = hover_duties(result.meta, n)
-        got = flight_metrics_batch(t, result.states[live, :, X:X + 3], refs[live],
-                                   result.commands[live, :, CMD_U1:CMD_U1 + 4], mission=mission,
-                                   bands=(0.02, 0.05, spec.settle_band), transient_until=spec.transient_until,
-                                   hover_duty=None if hover is None else hover[live])
-        for key in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "final_error_m", "effort",
-                    "transient_axis", "rise_time_s", "overshoot_pct", "peak_time_s"):
+        got = flight_metrics_batch(
+            t,
+            result.states[live, :, X : X + 3],
+            refs[live],
+            result.commands[live, :, CMD_U1 : CMD_U1 + 4],
+            mission=mission,
+            bands=(0.02, 0.05, spec.settle_band),
+            transient_until=spec.transient_until,
+            hover_duty=None if hover is None else hover[live],
+        )
+        for key in (
+            "rmse_m",
+            "max_error_m",
+            "steady_rmse_m",
+            "steady_max_error_m",
+            "final_error_m",
+            "effort",
+            "transient_axis",
+            "rise_time_s",
+            "overshoot_pct",
+            "peak_time_s",
+        ):
             out[key][live] = got[key]
         out["settling_time_s"][live], out["settling_time_5pct_s"][live] = got["settling_s"][:2]
         not_settled[live] = (got["transient_axis"] >= 0) & np.isnan(got["settling_s"][2])
     diverged = stopped
     off = np.zeros(n, dtype=bool)
-    if live.size:                  # fly's rule (off_track_since), by the spec's bounds, on the sweep's log
+    if live.size:  # fly's rule (off_track_since), by the spec's bounds, on the sweep's log
         from quadcruise.workflows.fly import off_track_since
 
-        d = result.states[live, :, X:X + 3] - refs[live]
-        first = off_track_since(t, np.sqrt((d * d).sum(axis=-1)), d[:, :, 2], got["transient_axis"] >= 0,
-                                got["settled_at"], np.full(live.size, spec.max_track_error_m),
-                                np.full(live.size, spec.max_altitude_error_m))
+        d = result.states[live, :, X : X + 3] - refs[live]
+        first = off_track_since(
+            t,
+            np.sqrt((d * d).sum(axis=-1)),
+            d[:, :, 2],
+            got["transient_axis"] >= 0,
+            got["settled_at"],
+            np.full(live.size, spec.max_track_error_m),
+            np.full(live.size, spec.max_altitude_error_m),
+        )
         off[live] = np.isfinite(first)
     # lost track: fly's own status (the error left 1 m + the mission's size at some instant), or
     # off track after the transient by the spec's bounds
     lost_track = ~diverged & ((status == int(ExitStatus.LOST_TRACK)) | off)
-    for key in FAILED_FLIGHT_METRICS + ("settling_time_5pct_s",):   # no transient or steady state to speak of
+    for key in FAILED_FLIGHT_METRICS + ("settling_time_5pct_s",):  # no transient or steady state to speak of
         out[key][lost_track] = np.nan
     saturated = out["duty_clipped_s"] > spec.max_clipped_s
     failed_requirement = np.zeros(n, dtype=bool)
     for req in spec.parsed_requirements:
         failed_requirement |= ~req.met(out[req.metric])
-    out.update(diverged=diverged, lost_track=lost_track, saturated=saturated,
-               failed_requirement=failed_requirement, not_settled=not_settled)
-    out["failure"] = np.select([diverged, lost_track, saturated, failed_requirement],
-                               [FAILURES.index(r) for r in FAILURES[1:]], 0).astype(np.int64)
+    out.update(
+        diverged=diverged,
+        lost_track=lost_track,
+        saturated=saturated,
+        failed_requirement=failed_requirement,
+        not_settled=not_settled,
+    )
+    out["failure"] = np.select(
+        [diverged, lost_track, saturated, failed_requirement], [FAILURES.index(r) for r in FAILURES[1:]], 0
+    ).astype(np.int64)
     return out
 
 

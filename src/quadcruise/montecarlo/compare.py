@@ -12,8 +12,16 @@ from quadcruise.workflows.compare import labelled
 __all__ = ["compare_population"]
 
 
-def compare_population(mission, controllers, population, n: int, seed: int, *,
-                       progress: Callable[[int, int], None] | None = None, **montecarlo_kw):
+def compare_population(
+    mission,
+    controllers,
+    population,
+    n: int,
+    seed: int,
+    *,
+    progress: Callable[[int, int], None] | None = None,
+    **montecarlo_kw,
+):
     """The controllers on the *same* Monte Carlo population.
 
     Every controller flies the same n perturbed vehicles (same seed, so the same draws,

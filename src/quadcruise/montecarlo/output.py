@@ -70,11 +70,16 @@ def write_outputs(result, out, *, fmt: str = "csv", force: bool = False) -> Path
     with atomic_path(path / "report.md") as tmp:
         tmp.write_text(report_markdown(result, summary, worst, name))
     with atomic_path(path / "scenario.toml") as tmp:
-        tmp.write_text(scenario_text(montecarlo_document(result.spec.to_dict(), result.n), header=(
-            "written by quadcruise from a Monte Carlo sweep; `quadcruise montecarlo --scenario THIS_FILE` "
-            "flies the same flights")))
-    write_marker(path, result.spec, result.n, complete=True, table=name,
-                 chunk_size=result.info.get("chunk_size"))
+        tmp.write_text(
+            scenario_text(
+                montecarlo_document(result.spec.to_dict(), result.n),
+                header=(
+                    "written by quadcruise from a Monte Carlo sweep; `quadcruise montecarlo --scenario THIS_FILE` "
+                    "flies the same flights"
+                ),
+            )
+        )
+    write_marker(path, result.spec, result.n, complete=True, table=name, chunk_size=result.info.get("chunk_size"))
     return path
 
 
@@ -108,8 +113,9 @@ def write_case(case, out, *, fmt: str = "csv", force: bool = False) -> Path:
         write_table(case.result.to_pandas(), tmp / "traces", fmt)
         (tmp / "case.json").write_text(dumps(case.row, indent=2) + "\n")
         save_figure(plot_flight(case.result), tmp / "flight.png")
-        (tmp / MARKER).write_text(dumps({"workflow": "montecarlo-case", "vehicle": case.vehicle,
-                                          **case.result.meta}, indent=2) + "\n")
+        (tmp / MARKER).write_text(
+            dumps({"workflow": "montecarlo-case", "vehicle": case.vehicle, **case.result.meta}, indent=2) + "\n"
+        )
     return path
 
 
@@ -132,7 +138,8 @@ def case_text(case, seed: int) -> str:
     """
     keys = ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "settling_time_5pct_s", "m")
     return f"flight {case.vehicle} of seed {seed}: {case.row['reason']}, " + ", ".join(
-        f"{k} = {case.row[k]:.4g}" for k in keys)
+        f"{k} = {case.row[k]:.4g}" for k in keys
+    )
 
 
 def case_folder(out, spec, case: int, *, force: bool = False) -> Path | None:
@@ -166,10 +173,12 @@ def case_folder(out, spec, case: int, *, force: bool = False) -> Path | None:
         return None
     target = Path(out)
     meta, same = holds_sweep(target, spec, force=force)
-    if meta and meta.get("workflow") == "montecarlo":      # a sweep's folder: the case goes inside
+    if meta and meta.get("workflow") == "montecarlo":  # a sweep's folder: the case goes inside
         if not same:
-            raise InputError(f"{out}: holds a sweep flown with other options or code (spec {meta.get('spec_hash')}, "
-                             f"these give {spec.hash()}); give the sweep's options to replay its flight")
+            raise InputError(
+                f"{out}: holds a sweep flown with other options or code (spec {meta.get('spec_hash')}, "
+                f"these give {spec.hash()}); give the sweep's options to replay its flight"
+            )
         target = target / f"case-{case:06d}"
     check_output_dir(target, force)
     return target
@@ -197,59 +206,93 @@ def report_markdown(result, summary: dict, worst, table_name: str) -> str:
     spec = result.spec
     pop = {k: v for k, v in spec.population.to_dict().items() if v not in (0.0, None)}
     f = summary["failures"]
-    lines = [f"# Monte Carlo: {spec.controller.name} on {spec.mission.name}, {summary['flights']:,} flights\n",
-             f"quadcruise {__version__}, seed {spec.seed}, {spec.duration:g} s at dt = {spec.dt:g} s, "
-             f"metrics on a {spec.dt * spec.log_every:g} s log; spec hash `{spec.hash()}`.\n",
-             "Population: " + (", ".join(f"{k} = {v}" for k, v in pop.items()) or "nominal") + ".\n",
-             f"## Failures: {f['count']:,} of {summary['flights']:,} ({100 * f['rate']:.2f} %)\n",
-             "Each flight counts once, under the first that applies: diverged (the engine stopped it), "
-             f"lost track (its position error after the transient, or at the end if the transient never "
-             f"settled into 5 %, above {spec.max_track_error_m:g} m, or its altitude error above "
-             f"{spec.max_altitude_error_m:g} m), saturated (rotor duties clipped for "
-             f"more than {spec.max_clipped_s:g} s), failed a requirement (missed one of the requirements "
-             "below).\n",
-             "| reason | flights | rate |", "|---|---|---|"]
+    lines = [
+        f"# Monte Carlo: {spec.controller.name} on {spec.mission.name}, {summary['flights']:,} flights\n",
+        f"quadcruise {__version__}, seed {spec.seed}, {spec.duration:g} s at dt = {spec.dt:g} s, "
+        f"metrics on a {spec.dt * spec.log_every:g} s log; spec hash `{spec.hash()}`.\n",
+        "Population: " + (", ".join(f"{k} = {v}" for k, v in pop.items()) or "nominal") + ".\n",
+        f"## Failures: {f['count']:,} of {summary['flights']:,} ({100 * f['rate']:.2f} %)\n",
+        "Each flight counts once, under the first that applies: diverged (the engine stopped it), "
+        f"lost track (its position error after the transient, or at the end if the transient never "
+        f"settled into 5 %, above {spec.max_track_error_m:g} m, or its altitude error above "
+        f"{spec.max_altitude_error_m:g} m), saturated (rotor duties clipped for "
+        f"more than {spec.max_clipped_s:g} s), failed a requirement (missed one of the requirements "
+        "below).\n",
+        "| reason | flights | rate |",
+        "|---|---|---|",
+    ]
     for reason, v in f["by_reason"].items():
         lines.append(f"| {reason} | {v['count']:,} | {100 * v['rate']:.2f} % |")
     lines.append("\n### Requirements\n")
     if summary["requirements"]:
-        lines += ["Flights that miss a requirement, whatever else they failed (an undefined value, such as "
-                  "the error after a transient that never settled, misses it).\n",
-                  "| requirement | flights that missed it | rate |", "|---|---|---|"]
-        lines += [f"| `{r['requirement']}` | {r['failed']:,} | {100 * r['rate']:.2f} % |"
-                  for r in summary["requirements"]]
+        lines += [
+            "Flights that miss a requirement, whatever else they failed (an undefined value, such as "
+            "the error after a transient that never settled, misses it).\n",
+            "| requirement | flights that missed it | rate |",
+            "|---|---|---|",
+        ]
+        lines += [
+            f"| `{r['requirement']}` | {r['failed']:,} | {100 * r['rate']:.2f} % |" for r in summary["requirements"]
+        ]
     else:
-        lines.append("None given (`--require \"steady_max_error_m<=0.2\"`, or `requirements=` in Python).")
+        lines.append('None given (`--require "steady_max_error_m<=0.2"`, or `requirements=` in Python).')
     ns = summary["not_settled"]
-    lines.append(f"\nNot settled within {100 * ns['band']:g} % at the end (a metric, not a failure): "
-                 f"{ns['count']:,} flights ({100 * ns['rate']:.2f} %).")
+    lines.append(
+        f"\nNot settled within {100 * ns['band']:g} % at the end (a metric, not a failure): "
+        f"{ns['count']:,} flights ({100 * ns['rate']:.2f} %)."
+    )
     if summary["stopped"]:
-        lines.append("\nWhy the engine stopped flights: " + "; ".join(f"{k}: {v:,}" for k, v in summary["stopped"].items()) + ".")
+        lines.append(
+            "\nWhy the engine stopped flights: " + "; ".join(f"{k}: {v:,}" for k, v in summary["stopped"].items()) + "."
+        )
     left_out = summary["flights"] - summary["metrics_over"]
-    lines += ["\n## Metrics\n", f"Over the {summary['metrics_over']:,} flights that kept track"
-              + (f": the {left_out:,} that diverged or lost track are left out, so that their numbers do not pass "
-                 "for a good flight's." if left_out else ".") + "\n",
-              "| metric | flights | p5 | p50 | p95 | max |", "|---|---|---|---|---|---|"]
+    lines += [
+        "\n## Metrics\n",
+        f"Over the {summary['metrics_over']:,} flights that kept track"
+        + (
+            f": the {left_out:,} that diverged or lost track are left out, so that their numbers do not pass "
+            "for a good flight's."
+            if left_out
+            else "."
+        )
+        + "\n",
+        "| metric | flights | p5 | p50 | p95 | max |",
+        "|---|---|---|---|---|---|",
+    ]
     for name, m in summary["metrics"].items():
         cells = " | ".join("-" if m[k] is None else f"{m[k]:.4g}" for k in ("p5", "p50", "p95", "max"))
         lines.append(f"| {name} | {m['count']:,} | {cells} |")
-    lines += ["\n## Worst flights\n",
-              "Fly one alone again: `quadcruise montecarlo <the same options> --case VEHICLE`, or in Python "
-              "`quadcruise.montecarlo.montecarlo_case(spec, VEHICLE)`; it gives the same row.\n",
-              "| vehicle | reason | rmse [m] | max error [m] | steady rmse [m] | steady max error [m] "
-              "| settling 5 % [s] | stop [s] | m [kg] |",
-              "|---|---|---|---|---|---|---|---|---|"]
+    lines += [
+        "\n## Worst flights\n",
+        "Fly one alone again: `quadcruise montecarlo <the same options> --case VEHICLE`, or in Python "
+        "`quadcruise.montecarlo.montecarlo_case(spec, VEHICLE)`; it gives the same row.\n",
+        "| vehicle | reason | rmse [m] | max error [m] | steady rmse [m] | steady max error [m] "
+        "| settling 5 % [s] | stop [s] | m [kg] |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
     for _, r in worst.head(10).iterrows():
         unsettled = "did not settle" if r["transient_axis"] >= 0 else "-"
-        cells = " | ".join((unsettled if k.startswith(("steady", "settling")) else "-")
-                           if not np.isfinite(r[k]) else f"{r[k]:.4g}"
-                           for k in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m",
-                                     "settling_time_5pct_s", "stop_time_s", "m"))
+        cells = " | ".join(
+            (unsettled if k.startswith(("steady", "settling")) else "-") if not np.isfinite(r[k]) else f"{r[k]:.4g}"
+            for k in (
+                "rmse_m",
+                "max_error_m",
+                "steady_rmse_m",
+                "steady_max_error_m",
+                "settling_time_5pct_s",
+                "stop_time_s",
+                "m",
+            )
+        )
         lines.append(f"| {int(r['vehicle'])} | {r['reason']} | {cells} |")
     info = result.info
-    lines += ["\n## Figures\n", "![histograms](histograms.png)\n", "![envelope](envelope.png)\n",
-              "\n## How it ran\n",
-              f"{info.get('flown', 0):,} flights flown and {info.get('resumed', 0):,} resumed from disk on "
-              f"{info.get('scheduler')}, chunks of {info.get('chunk_size')} vehicles, "
-              f"{info.get('wall_s', 0):.1f} s. One row per flight: `{table_name}`; the chunks: `chunks/`.\n"]
+    lines += [
+        "\n## Figures\n",
+        "![histograms](histograms.png)\n",
+        "![envelope](envelope.png)\n",
+        "\n## How it ran\n",
+        f"{info.get('flown', 0):,} flights flown and {info.get('resumed', 0):,} resumed from disk on "
+        f"{info.get('scheduler')}, chunks of {info.get('chunk_size')} vehicles, "
+        f"{info.get('wall_s', 0):.1f} s. One row per flight: `{table_name}`; the chunks: `chunks/`.\n",
+    ]
     return "\n".join(lines)

@@ -29,11 +29,28 @@ __all__ = ["Population", "Draw", "DRAW_KEY", "N_DRAWS", "SLOTS", "SPREADS", "CLI
 DRAW_KEY = 1
 """spawn_key of the population's draws (the engine's own streams have none)."""
 N_DRAWS = 16
-SLOTS = {"m": 0, "Jxx": 1, "Jyy": 2, "Jzz": 3, "K": 4, "omega": 5, "d": 6,
-         "dx0": 7, "dy0": 8, "dz0": 9, "wind_x": 10, "wind_y": 11}
+SLOTS = {
+    "m": 0,
+    "Jxx": 1,
+    "Jyy": 2,
+    "Jzz": 3,
+    "K": 4,
+    "omega": 5,
+    "d": 6,
+    "dx0": 7,
+    "dy0": 8,
+    "dz0": 9,
+    "wind_x": 10,
+    "wind_y": 11,
+}
 """Which of the 16 unit draws of a vehicle feeds which quantity (12..15 are spare)."""
-SPREADS = {"mass_spread": ("m",), "inertia_spread": ("Jxx", "Jyy", "Jzz"), "thrust_spread": ("K",),
-           "bandwidth_spread": ("omega",), "yaw_arm_spread": ("d",)}
+SPREADS = {
+    "mass_spread": ("m",),
+    "inertia_spread": ("Jxx", "Jyy", "Jzz"),
+    "thrust_spread": ("K",),
+    "bandwidth_spread": ("omega",),
+    "yaw_arm_spread": ("d",),
+}
 CLIP = {"normal": 3.0, "uniform": math.sqrt(3.0)}
 """Largest |unit draw|: normal draws are clipped at 3 sigma, uniform ones span +-sqrt(3)
 (unit standard deviation)."""
@@ -107,20 +124,25 @@ class Population:
             wrong_type = isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating))
             if wrong_type or not math.isfinite(value) or value < 0:
                 raise (ArgumentTypeError if wrong_type else InputError)(
-                    f"population field '{name}' must be a number >= 0, got {value!r}")
+                    f"population field '{name}' must be a number >= 0, got {value!r}"
+                )
             object.__setattr__(self, name, float(value))
             limit = 1.0 / CLIP[self.distribution]
             if name in SPREADS and value >= limit:
-                raise InputError(f"population field '{name}' = {value:g} is too large: with {self.distribution} "
-                                 f"draws it must be < {limit:.4f} so that every value stays positive")
+                raise InputError(
+                    f"population field '{name}' = {value:g} is too large: with {self.distribution} "
+                    f"draws it must be < {limit:.4f} so that every value stays positive"
+                )
         from quadcruise.disturbances.environment import Environment, SensorNoise
 
         if self.environment is not None:
             if not isinstance(self.environment, Environment):
                 raise InputError("population field 'environment' must be an Environment or None")
             if self.environment.batch_size is not None:
-                raise InputError("the population's environment must be the same for every vehicle "
-                                 "(per-vehicle values come from the spreads)")
+                raise InputError(
+                    "the population's environment must be the same for every vehicle "
+                    "(per-vehicle values come from the spreads)"
+                )
         if self.noise is not None:
             if not isinstance(self.noise, SensorNoise):
                 raise InputError("population field 'noise' must be a SensorNoise or None")
@@ -173,11 +195,15 @@ class Population:
         ...     print(str(exc).split(";")[0])
         the population perturbs nothing: its 3 vehicles would fly the same flight
         """
-        hint = hint or ("a spread (--mass-spread 0.1, --inertia-spread, --thrust-spread, --bandwidth-spread, "
-                        "--yaw-arm-spread), a start --offset, a --wind-spread, turbulence (--turbulence moderate) "
-                        "or sensor --noise")
+        hint = hint or (
+            "a spread (--mass-spread 0.1, --inertia-spread, --thrust-spread, --bandwidth-spread, "
+            "--yaw-arm-spread), a start --offset, a --wind-spread, turbulence (--turbulence moderate) "
+            "or sensor --noise"
+        )
         if n > 1 and not self.perturbs:
-            raise InputError(f"the population perturbs nothing: its {n:,} vehicles would fly the same flight; give {hint}")
+            raise InputError(
+                f"the population perturbs nothing: its {n:,} vehicles would fly the same flight; give {hint}"
+            )
 
     def unit_draws(self, seed: int, first, count: int) -> np.ndarray:
         """The unit draws of vehicles first .. first + count - 1 (see the module).
@@ -209,7 +235,7 @@ class Population:
         clip = CLIP[self.distribution]
         return np.clip(out, -clip, clip) if normal else clip * (2.0 * out - 1.0)
 
-    def draw(self, seed: int, first, count: int, nominal: Vehicle, dt: float = 1e-3) -> "Draw":
+    def draw(self, seed: int, first, count: int, nominal: Vehicle, dt: float = 1e-3) -> Draw:
         """The vehicles first .. first + count - 1: parameters, offsets and environment.
 
         Parameters
@@ -242,9 +268,13 @@ class Population:
         cols.update(dx0=offsets[:, 0], dy0=offsets[:, 1], dz0=offsets[:, 2])
         env = self.environment
         base = (0.0, 0.0, 0.0) if env is None or env.wind is None else tuple(map(float, env.wind.velocity))
-        wind = np.column_stack([base[0] + self.wind_spread * z[:, SLOTS["wind_x"]],
-                                base[1] + self.wind_spread * z[:, SLOTS["wind_y"]],
-                                np.full(count, base[2])])
+        wind = np.column_stack(
+            [
+                base[0] + self.wind_spread * z[:, SLOTS["wind_x"]],
+                base[1] + self.wind_spread * z[:, SLOTS["wind_y"]],
+                np.full(count, base[2]),
+            ]
+        )
         cols.update(wind_x=wind[:, 0], wind_y=wind[:, 1])
         if self.wind_spread > 0:
             from quadcruise.disturbances.environment import ConstantWind, Environment
@@ -295,4 +325,3 @@ class Draw:
     environment: Any
     sensors: Any
     columns: dict
-

@@ -14,7 +14,7 @@ Examples
 >>> Requirement.parse("steady_max_error <= 0.2")      # doctest: +ELLIPSIS
 Traceback (most recent call last):
     ...
-quadcruise.errors.InputError: requirement 'steady_max_error <= 0.2': unknown metric 'steady_max_error'; choose one of rmse_m, ...
+quadcruise.errors.InputError: requirement 'steady_max_error <= 0.2': unknown metric 'steady_max_error'; choose ...
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ from __future__ import annotations
 import math
 import operator
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Iterable
 
 import numpy as np
 
@@ -55,7 +55,7 @@ class Requirement:
     value: float
 
     @classmethod
-    def parse(cls, text: str) -> "Requirement":
+    def parse(cls, text: str) -> Requirement:
         """A requirement from its text, ``"metric<=value"`` (spaces allowed).
 
         Parameters
@@ -77,8 +77,10 @@ class Requirement:
             raise InputError(f"a requirement is text such as 'steady_max_error_m<=0.2', got {text!r}")
         match = _PATTERN.match(text)
         if match is None:
-            raise InputError(f"requirement {text!r}: expected METRIC<=VALUE (or <, >=, >), e.g. "
-                             f"steady_max_error_m<=0.2, with METRIC one of {', '.join(METRICS)}")
+            raise InputError(
+                f"requirement {text!r}: expected METRIC<=VALUE (or <, >=, >), e.g. "
+                f"steady_max_error_m<=0.2, with METRIC one of {', '.join(METRICS)}"
+            )
         metric, op, number = match.groups()
         if metric not in METRICS:
             raise InputError(f"requirement {text!r}: unknown metric {metric!r}; choose one of {', '.join(METRICS)}")

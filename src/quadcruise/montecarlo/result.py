@@ -23,6 +23,7 @@ from quadcruise.montecarlo.spec import MonteCarloSpec
 
 __all__ = ["MonteCarloResult", "Traces", "FAILURES", "COLUMNS", "METRICS"]
 
+
 @dataclass
 class Traces:
     """The kept paths of a sweep.
@@ -148,31 +149,47 @@ class MonteCarloResult:
         n = len(tab)
         failure = tab["failure"].to_numpy()
         counts = np.bincount(failure, minlength=len(FAILURES))
-        by_reason = {FAILURES[c]: {"count": int(counts[c]), "rate": float(counts[c] / n)}
-                     for c in range(1, len(FAILURES))}
+        by_reason = {
+            FAILURES[c]: {"count": int(counts[c]), "rate": float(counts[c] / n)} for c in range(1, len(FAILURES))
+        }
         requirements = []
         for req in self.spec.parsed_requirements:
             missed = int(np.count_nonzero(~req.met(tab[req.metric].to_numpy(dtype=float))))
             requirements.append({"requirement": req.text, "failed": missed, "rate": missed / n})
         unsettled = int(np.count_nonzero(tab["not_settled"].to_numpy()))
-        stops = {STATUS_REASONS[c]: int(k) for c, k in zip(*np.unique(tab["status"], return_counts=True)) if c}
+        stops = {
+            STATUS_REASONS[c]: int(k) for c, k in zip(*np.unique(tab["status"], return_counts=True), strict=False) if c
+        }
         metrics = {}
         kept = ~(tab["diverged"].to_numpy(dtype=bool) | tab["lost_track"].to_numpy(dtype=bool))
         for name in METRICS:
             v = tab[name].to_numpy(dtype=float)[kept]
             v = v[np.isfinite(v)]
             q = np.percentile(v, [5, 50, 95]) if v.size else [np.nan] * 3
-            metrics[name] = {"count": int(v.size), "p5": _num(q[0]), "p50": _num(q[1]), "p95": _num(q[2]),
-                             "max": _num(v.max() if v.size else np.nan), "mean": _num(v.mean() if v.size else np.nan)}
+            metrics[name] = {
+                "count": int(v.size),
+                "p5": _num(q[0]),
+                "p50": _num(q[1]),
+                "p95": _num(q[2]),
+                "max": _num(v.max() if v.size else np.nan),
+                "mean": _num(v.mean() if v.size else np.nan),
+            }
         fails = int(np.count_nonzero(failure))
-        return {"flights": n, "seed": self.spec.seed,
-                "failures": {"count": fails, "rate": fails / n, "by_reason": by_reason},
-                "criteria": {"max_track_error_m": self.spec.max_track_error_m,
-                             "max_altitude_error_m": self.spec.max_altitude_error_m,
-                             "max_clipped_s": self.spec.max_clipped_s},
-                "requirements": requirements,
-                "not_settled": {"count": unsettled, "rate": unsettled / n, "band": self.spec.settle_band},
-                "stopped": stops, "metrics": metrics, "metrics_over": int(np.count_nonzero(kept))}
+        return {
+            "flights": n,
+            "seed": self.spec.seed,
+            "failures": {"count": fails, "rate": fails / n, "by_reason": by_reason},
+            "criteria": {
+                "max_track_error_m": self.spec.max_track_error_m,
+                "max_altitude_error_m": self.spec.max_altitude_error_m,
+                "max_clipped_s": self.spec.max_clipped_s,
+            },
+            "requirements": requirements,
+            "not_settled": {"count": unsettled, "rate": unsettled / n, "band": self.spec.settle_band},
+            "stopped": stops,
+            "metrics": metrics,
+            "metrics_over": int(np.count_nonzero(kept)),
+        }
 
     def summary_text(self, worst: int = 0) -> str:
         """The summary as aligned text (for the terminal).
@@ -192,27 +209,38 @@ class MonteCarloResult:
         """
         s = self.summary_data()
         f = s["failures"]
-        lines = [f"{s['flights']:,} flights of {self.spec.controller.name} on {self.spec.mission.name}, "
-                 f"seed {s['seed']}: {f['count']:,} failed ({100 * f['rate']:.2f} %)"]
-        bounds = {"lost track": f"error after the transient > {s['criteria']['max_track_error_m']:g} m "
-                                f"or altitude error > {s['criteria']['max_altitude_error_m']:g} m",
-                  "saturated": f"duties clipped > {s['criteria']['max_clipped_s']:g} s",
-                  "failed a requirement": "see below" if s["requirements"] else "none given"}
+        lines = [
+            f"{s['flights']:,} flights of {self.spec.controller.name} on {self.spec.mission.name}, "
+            f"seed {s['seed']}: {f['count']:,} failed ({100 * f['rate']:.2f} %)"
+        ]
+        bounds = {
+            "lost track": f"error after the transient > {s['criteria']['max_track_error_m']:g} m "
+            f"or altitude error > {s['criteria']['max_altitude_error_m']:g} m",
+            "saturated": f"duties clipped > {s['criteria']['max_clipped_s']:g} s",
+            "failed a requirement": "see below" if s["requirements"] else "none given",
+        }
         for reason, v in f["by_reason"].items():
             why = f"  [{bounds[reason]}]" if reason in bounds else ""
             lines.append(f"  {reason:<22} {v['count']:>8,}  ({100 * v['rate']:.2f} %){why}")
         for r in s["requirements"]:
             lines.append(f"  requirement {r['requirement']}: missed by {r['failed']:,} ({100 * r['rate']:.2f} %)")
         ns = s["not_settled"]
-        lines.append(f"  not settled within {100 * ns['band']:g} % (a metric, not a failure): "
-                     f"{ns['count']:,} ({100 * ns['rate']:.2f} %)")
+        lines.append(
+            f"  not settled within {100 * ns['band']:g} % (a metric, not a failure): "
+            f"{ns['count']:,} ({100 * ns['rate']:.2f} %)"
+        )
         left_out = s["flights"] - s["metrics_over"]
-        lines.append(f"  metrics over the {s['metrics_over']:,} flights that kept track"
-                     + (f" ({left_out:,} that diverged or lost track left out)" if left_out else "") + ":")
+        lines.append(
+            f"  metrics over the {s['metrics_over']:,} flights that kept track"
+            + (f" ({left_out:,} that diverged or lost track left out)" if left_out else "")
+            + ":"
+        )
         lines.append(f"  {'metric':<22}{'count':>8}{'p5':>11}{'p50':>11}{'p95':>11}{'max':>11}")
         for name, m in s["metrics"].items():
-            lines.append(f"  {name:<22}{m['count']:>8,}" + "".join(
-                f"{'-' if m[k] is None else format(m[k], '.4g'):>11}" for k in ("p5", "p50", "p95", "max")))
+            lines.append(
+                f"  {name:<22}{m['count']:>8,}"
+                + "".join(f"{'-' if m[k] is None else format(m[k], '.4g'):>11}" for k in ("p5", "p50", "p95", "max"))
+            )
         if worst:
             lines += [f"worst {worst} (fly one alone again with --case VEHICLE):", self.worst_text(worst)]
         return "\n".join(lines)
@@ -271,8 +299,18 @@ class MonteCarloResult:
             maximum error after the transient, 5 % settling time, stop time and mass,
             numbers to 4 significant digits.
         """
-        cols = ["vehicle", "seed", "reason", "rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m",
-                "settling_time_5pct_s", "stop_time_s", "m"]
+        cols = [
+            "vehicle",
+            "seed",
+            "reason",
+            "rmse_m",
+            "max_error_m",
+            "steady_rmse_m",
+            "steady_max_error_m",
+            "settling_time_5pct_s",
+            "stop_time_s",
+            "m",
+        ]
         return self.worst(k, by)[cols].to_string(index=False, float_format=lambda v: f"{v:.4g}")
 
     def case(self, i: int, **kw):

@@ -43,18 +43,33 @@ def merge_scenario(path, given: dict) -> tuple[Scenario, dict]:
     known = ({f.name for f in dataclasses.fields(Population)} - {"environment", "noise"}) | set(SPEC_KEYS)
     unknown = set(table) - known - {"n", "seed"}
     if unknown:
-        raise InputError(f"{path}: [montecarlo] unknown key(s) {', '.join(sorted(unknown))} "
-                         f"(known: n, seed, {', '.join(sorted(known))})")
+        raise InputError(
+            f"{path}: [montecarlo] unknown key(s) {', '.join(sorted(unknown))} "
+            f"(known: n, seed, {', '.join(sorted(known))})"
+        )
     if "seed" in sc.simulation:
         table.setdefault("seed", sc.simulation["seed"])
     return sc, {**table, **given}
 
 
-def sweep_spec(*, mission=None, controller=None, n: int | None = None, seed: int | None = None,
-               duration: float | None = None, dt: float | None = None, environment=None, noise=None,
-               scenario=None, requirements=(), max_track_error_m: float | None = None, vehicle=None,
-               controller_vehicle=None, log_every: int | None = None,
-               **population) -> tuple[MonteCarloSpec, int]:
+def sweep_spec(
+    *,
+    mission=None,
+    controller=None,
+    n: int | None = None,
+    seed: int | None = None,
+    duration: float | None = None,
+    dt: float | None = None,
+    environment=None,
+    noise=None,
+    scenario=None,
+    requirements=(),
+    max_track_error_m: float | None = None,
+    vehicle=None,
+    controller_vehicle=None,
+    log_every: int | None = None,
+    **population,
+) -> tuple[MonteCarloSpec, int]:
     """The spec of a sweep and its number of flights; None means "not given".
 
     Parameters
@@ -99,19 +114,25 @@ def sweep_spec(*, mission=None, controller=None, n: int | None = None, seed: int
         An unknown or bad option, or a bad scenario.
     """
     given = {key: value for key, value in {**population, "n": n, "seed": seed}.items() if value is not None}
-    options: dict = dict(duration=duration, dt=1e-3 if dt is None else dt, requirements=requirements,
-                         max_track_error_m=max_track_error_m)
+    options: dict = dict(
+        duration=duration, dt=1e-3 if dt is None else dt, requirements=requirements, max_track_error_m=max_track_error_m
+    )
     if scenario is not None:
         sc, given = merge_scenario(scenario, given)
         mission = sc.mission if mission is None else mission
         controller = sc.controller if controller is None else controller
         environment = environment if environment is not None else sc.environment
         noise = noise if noise is not None else sc.sensor_noise
-        options.update(vehicle=sc.vehicle, controller_vehicle=sc.controller_vehicle, duration=duration or sc.duration,
-                       dt=sc.dt if dt is None else dt, max_step=sc.simulation.get("max_step"),
-                       full_dynamics=sc.simulation.get("full_dynamics", False))
+        options.update(
+            vehicle=sc.vehicle,
+            controller_vehicle=sc.controller_vehicle,
+            duration=duration or sc.duration,
+            dt=sc.dt if dt is None else dt,
+            max_step=sc.simulation.get("max_step"),
+            full_dynamics=sc.simulation.get("full_dynamics", False),
+        )
     n, seed = given.pop("n", 1000), given.pop("seed", 0)
-    for key in SPEC_KEYS:                      # the scenario's settings; options given win
+    for key in SPEC_KEYS:  # the scenario's settings; options given win
         if key in given:
             value = given.pop(key)
             if key == "requirements" and requirements:
@@ -127,6 +148,7 @@ def sweep_spec(*, mission=None, controller=None, n: int | None = None, seed: int
         options["log_dt"] = log_every * options["dt"]
     mission = "circle" if mission is None else mission
     controller = "nlpd" if controller is None else controller
-    pop = Population(**given, environment=environment if environment is not None and environment.parts else None,
-                     noise=noise)
+    pop = Population(
+        **given, environment=environment if environment is not None and environment.parts else None, noise=noise
+    )
     return MonteCarloSpec(mission=mission, controller=controller, population=pop, seed=seed, **options), n

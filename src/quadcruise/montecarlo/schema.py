@@ -15,14 +15,33 @@ stopped the flight; its error after the transient exceeded the spec's ``max_trac
 its rotor duties were clipped for longer than ``max_clipped_s``; it missed one of the
 spec's ``requirements``. A transient that did not settle is a metric (``not_settled``),
 not a failure."""
-METRICS = ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "final_error_m", "rise_time_s",
-           "settling_time_s", "settling_time_5pct_s", "overshoot_pct", "peak_time_s", "effort",
-           "duty_clipped_s", "controller_limited_s")
+METRICS = (
+    "rmse_m",
+    "max_error_m",
+    "steady_rmse_m",
+    "steady_max_error_m",
+    "final_error_m",
+    "rise_time_s",
+    "settling_time_s",
+    "settling_time_5pct_s",
+    "overshoot_pct",
+    "peak_time_s",
+    "effort",
+    "duty_clipped_s",
+    "controller_limited_s",
+)
 """The metrics summarised by quantiles (NaN where not applicable is left out), and those a
 requirement may name."""
 COLUMNS = {
-    "vehicle": np.int64, "status": np.int64, "stop_time_s": float, "failure": np.int64,
-    "diverged": bool, "lost_track": bool, "saturated": bool, "failed_requirement": bool, "not_settled": bool,
+    "vehicle": np.int64,
+    "status": np.int64,
+    "stop_time_s": float,
+    "failure": np.int64,
+    "diverged": bool,
+    "lost_track": bool,
+    "saturated": bool,
+    "failed_requirement": bool,
+    "not_settled": bool,
     "transient_axis": np.int64,
     **{m: float for m in METRICS},
     **{k: float for k in SLOTS},

@@ -154,18 +154,20 @@ class MonteCarloSpec:
             raise InputError("population must be a Population")
         if not isinstance(self.vehicle, Vehicle) or self.vehicle.batch_size is not None:
             raise InputError("the nominal vehicle must be one (unbatched) Vehicle")
-        with warnings.catch_warnings():            # fly() warns of a vehicle with little left for control
+        with warnings.catch_warnings():  # fly() warns of a vehicle with little left for control
             warnings.simplefilter("ignore")
-            check_can_hover(self.vehicle)              # before any chunk flies: a nominal that cannot lift
+            check_can_hover(self.vehicle)  # before any chunk flies: a nominal that cannot lift
         if self.controller_vehicle is not None:
             if not isinstance(self.controller_vehicle, Vehicle) or self.controller_vehicle.batch_size is not None:
                 raise InputError("the controller's vehicle must be one (unbatched) Vehicle")
             if not self.population.model_error:
-                raise InputError("a controller_vehicle (the model every controller flies with) contradicts the "
-                                 "population's model_error=False (each controller knows its own vehicle)")
+                raise InputError(
+                    "a controller_vehicle (the model every controller flies with) contradicts the "
+                    "population's model_error=False (each controller knows its own vehicle)"
+                )
         object.__setattr__(self, "seed", whole_number(self.seed, "seed"))
         duration = default_duration(self.mission) if self.duration is None else self.duration
-        time_grid(float(duration), float(self.dt))          # validates duration and dt
+        time_grid(float(duration), float(self.dt))  # validates duration and dt
         object.__setattr__(self, "duration", float(duration))
         if self.population.noise is not None:
             self.population.noise.check_fits(self.duration)
@@ -182,8 +184,7 @@ class MonteCarloSpec:
             if int(getattr(self, name)) != getattr(self, name) or getattr(self, name) < 0:
                 raise InputError(f"{name} must be a whole number >= 0, got {getattr(self, name)!r}")
         object.__setattr__(self, "requirements", tuple(r.text for r in parse_requirements(self.requirements)))
-        bound = steady_bound(self.mission, self.duration) if self.max_track_error_m is None \
-            else self.max_track_error_m
+        bound = steady_bound(self.mission, self.duration) if self.max_track_error_m is None else self.max_track_error_m
         if isinstance(bound, bool) or not (isinstance(bound, (int, float)) and math.isfinite(bound) and bound > 0):
             raise InputError(f"max_track_error_m must be a positive number [m], got {bound!r}")
         zbound = self.max_altitude_error_m
@@ -247,9 +248,13 @@ class MonteCarloSpec:
             Every field (mission, controller, population and vehicle as their
             ``to_dict()``), and ``log_every`` and ``trace_every``.
         """
-        out = {"mission": self.mission.to_dict(), "controller": controller_record(self.controller),
-               "population": self.population.to_dict(), "vehicle": self.vehicle.to_dict(),
-               "controller_vehicle": None if self.controller_vehicle is None else self.controller_vehicle.to_dict()}
+        out = {
+            "mission": self.mission.to_dict(),
+            "controller": controller_record(self.controller),
+            "population": self.population.to_dict(),
+            "vehicle": self.vehicle.to_dict(),
+            "controller_vehicle": None if self.controller_vehicle is None else self.controller_vehicle.to_dict(),
+        }
         for f in dataclasses.fields(self):
             if f.name not in out:
                 out[f.name] = getattr(self, f.name)
@@ -268,5 +273,3 @@ class MonteCarloSpec:
         """
         text = dumps({"spec": self.to_dict(), "version": __version__, "code": code_digest()}, sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-

@@ -21,8 +21,9 @@ from __future__ import annotations
 
 import shutil
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 import numpy as np
 
@@ -55,7 +56,7 @@ TRACES = ("trace_vehicle", "trace_sample", "trace_t", "trace_pos", "trace_ref")
 
 def _load_chunk(path: Path) -> dict:
     """The arrays of one chunk file; ValueError or OSError if it is not a whole .npz archive."""
-    with open(path, "rb") as f:              # closed whatever np.load makes of it
+    with open(path, "rb") as f:  # closed whatever np.load makes of it
         if f.read(4) not in (b"PK\x03\x04", b"PK\x05\x06"):
             raise ValueError("not an .npz archive")
         f.seek(0)
@@ -76,8 +77,12 @@ def _chunk_problem(chunk: dict, first: int) -> str | None:
     if not np.array_equal(chunk["vehicle"], np.arange(first, first + count)):
         return "its vehicles are not numbered in order"
     kept, samples = chunk["trace_vehicle"].shape, chunk["trace_t"].shape
-    if (len(kept) != 1 or chunk["trace_sample"].shape != kept or len(samples) != 1
-            or any(chunk[k].shape != (*kept, *samples, 3) for k in ("trace_pos", "trace_ref"))):
+    if (
+        len(kept) != 1
+        or chunk["trace_sample"].shape != kept
+        or len(samples) != 1
+        or any(chunk[k].shape != (*kept, *samples, 3) for k in ("trace_pos", "trace_ref"))
+    ):
         return "its paths do not fit together"
     return None
 
@@ -88,9 +93,12 @@ def _read_chunks(folder: Path, spec_hash: str) -> Iterator[dict]:
         try:
             first = int(path.stem.split("-")[1])
             chunk = _load_chunk(path)
-        except Exception as exc:              # a foreign or damaged file: fly it again
-            warnings.warn(f"{path}: damaged or unreadable ({' '.join(str(exc).split()) or type(exc).__name__}); "
-                          "its flights are flown again", stacklevel=3)
+        except Exception as exc:  # a foreign or damaged file: fly it again
+            warnings.warn(
+                f"{path}: damaged or unreadable ({' '.join(str(exc).split()) or type(exc).__name__}); "
+                "its flights are flown again",
+                stacklevel=3,
+            )
             continue
         if str(chunk.get("hash")) != spec_hash:
             warnings.warn(f"{path}: belongs to another sweep; its flights are flown again", stacklevel=3)
@@ -169,8 +177,11 @@ class SweepFolder:
         self.spec = spec
         meta, same = holds_sweep(self.path, spec, force=force)
         if meta is not None and not same and not force:
-            what = (f"a different sweep (spec {meta.get('spec_hash')})" if meta.get("workflow") == "montecarlo"
-                    else f"a quadcruise {meta.get('workflow', 'result')} result")
+            what = (
+                f"a different sweep (spec {meta.get('spec_hash')})"
+                if meta.get("workflow") == "montecarlo"
+                else f"a quadcruise {meta.get('workflow', 'result')} result"
+            )
             raise InputError(f"{self.path}: holds {what}; use --force to replace it or choose another --out")
         self.resume = same and resume
         self.clear = self.path.is_dir() and any(self.path.iterdir()) and not self.resume
@@ -258,7 +269,15 @@ def write_marker(path: Path, spec: MonteCarloSpec, n: int, **extra: Any) -> None
     **extra : Any
         More entries, e.g. ``complete``, ``chunk_size``, ``table``.
     """
-    doc = {"workflow": "montecarlo", "version": __version__, "code": code_digest()[:16], "spec_hash": spec.hash(),
-           "n": n, "seed": spec.seed, **extra, "spec": spec.to_dict()}
+    doc = {
+        "workflow": "montecarlo",
+        "version": __version__,
+        "code": code_digest()[:16],
+        "spec_hash": spec.hash(),
+        "n": n,
+        "seed": spec.seed,
+        **extra,
+        "spec": spec.to_dict(),
+    }
     with atomic_path(path / MARKER) as tmp:
         tmp.write_text(dumps(doc, indent=2) + "\n")

@@ -33,7 +33,7 @@ import os
 import time
 import uuid
 import warnings
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -46,8 +46,16 @@ from quadcruise.montecarlo.schema import COLUMNS, FAILURES
 from quadcruise.montecarlo.spec import MonteCarloSpec
 from quadcruise.montecarlo.store import SweepFolder
 
-__all__ = ["run_chunk", "fly_chunk", "reduce_chunk", "sweep_metrics", "run_sweep", "check_sweep_size",
-           "auto_chunk_size", "CHUNK_BUDGET"]
+__all__ = [
+    "run_chunk",
+    "fly_chunk",
+    "reduce_chunk",
+    "sweep_metrics",
+    "run_sweep",
+    "check_sweep_size",
+    "auto_chunk_size",
+    "CHUNK_BUDGET",
+]
 
 CHUNK_BUDGET = 64 * 2**20
 """Bytes of engine log per chunk that ``chunk_size="auto"`` aims at."""
@@ -76,16 +84,17 @@ class _Collector:
         self.parts: dict[int, dict] = {}
         self.covered: list[tuple[int, int]] = []
         self.trace_t: np.ndarray | None = None
-        self.tr = {"vehicle": np.zeros(0, np.int64), "sample": np.zeros(0, bool),
-                   "pos": None, "ref": None}
+        self.tr = {"vehicle": np.zeros(0, np.int64), "sample": np.zeros(0, bool), "pos": None, "ref": None}
 
     def add(self, chunk: dict) -> int:
         """Take a chunk (cut at n; a chunk overlapping one already taken is an error)."""
         first = int(chunk["first"])
         if str(chunk["hash"]) != self.hash:
-            raise SimulationError(f"the chunk of vehicles from {first} was flown with other options or other "
-                                  f"quadcruise code (spec {chunk['hash']}, this sweep's {self.hash}): "
-                                  "every worker must run the same version")
+            raise SimulationError(
+                f"the chunk of vehicles from {first} was flown with other options or other "
+                f"quadcruise code (spec {chunk['hash']}, this sweep's {self.hash}): "
+                "every worker must run the same version"
+            )
         count = min(int(chunk["count"]), self.n - first)
         if count <= 0:
             return 0
@@ -101,12 +110,16 @@ class _Collector:
             self.trace_t = chunk["trace_t"]
             shape = (0, chunk["trace_t"].size, 3)
             self.tr["pos"], self.tr["ref"] = np.zeros(shape), np.zeros(shape)
-        for key, name in (("vehicle", "trace_vehicle"), ("sample", "trace_sample"),
-                          ("pos", "trace_pos"), ("ref", "trace_ref")):
+        for key, name in (
+            ("vehicle", "trace_vehicle"),
+            ("sample", "trace_sample"),
+            ("pos", "trace_pos"),
+            ("ref", "trace_ref"),
+        ):
             self.tr[key] = np.concatenate([self.tr[key], chunk[name][keep]])
         extra = np.flatnonzero(~self.tr["sample"])
-        if extra.size > self.spec.max_failure_traces:      # keep the first failures by index
-            drop = extra[np.argsort(self.tr["vehicle"][extra], kind="stable")[self.spec.max_failure_traces:]]
+        if extra.size > self.spec.max_failure_traces:  # keep the first failures by index
+            drop = extra[np.argsort(self.tr["vehicle"][extra], kind="stable")[self.spec.max_failure_traces :]]
             for key in self.tr:
                 self.tr[key] = np.delete(self.tr[key], drop, axis=0)
         return count
@@ -128,14 +141,20 @@ class _Collector:
         import pandas as pd
 
         order = sorted(self.parts)
-        table = pd.DataFrame({k: np.concatenate([self.parts[f][k] for f in order]).astype(t)
-                              for k, t in COLUMNS.items()})
+        table = pd.DataFrame(
+            {k: np.concatenate([self.parts[f][k] for f in order]).astype(t) for k, t in COLUMNS.items()}
+        )
         if not np.array_equal(table["vehicle"].to_numpy(), np.arange(self.n)):
             raise SimulationError("the sweep's chunks do not cover every flight exactly once")
         table["reason"] = np.asarray(FAILURES, dtype=object)[table["failure"].to_numpy()]
         o = np.argsort(self.tr["vehicle"], kind="stable")
-        traces = Traces(vehicle=self.tr["vehicle"][o], t=self.trace_t, pos=self.tr["pos"][o],
-                        ref=self.tr["ref"][o], sample=self.tr["sample"][o])
+        traces = Traces(
+            vehicle=self.tr["vehicle"][o],
+            t=self.trace_t,
+            pos=self.tr["pos"][o],
+            ref=self.tr["ref"][o],
+            sample=self.tr["sample"][o],
+        )
         return MonteCarloResult(spec=self.spec, table=table, traces=traces, info=info)
 
 
@@ -173,11 +192,16 @@ class _Dask:
             n_workers = workers or os.cpu_count() or 1
             try:
                 with dask.config.set(LOCAL_CLUSTER_SETTINGS), _ctrl_c_for_this_process_only():
-                    self.cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                                                dashboard_address=":0", silence_logs=logging.CRITICAL,
-                                                env={"NUMBA_NUM_THREADS": "1"})
+                    self.cluster = LocalCluster(
+                        n_workers=n_workers,
+                        threads_per_worker=1,
+                        processes=True,
+                        dashboard_address=":0",
+                        silence_logs=logging.CRITICAL,
+                        env={"NUMBA_NUM_THREADS": "1"},
+                    )
                     self.client = Client(self.cluster, set_as_default=False)
-            except BaseException:           # Ctrl-C while the workers started (it arrives at the end)
+            except BaseException:  # Ctrl-C while the workers started (it arrives at the end)
                 self.close()
                 raise
             self.name = f"a local Dask cluster of {n_workers} processes"
@@ -189,19 +213,20 @@ class _Dask:
                 raise InputError(f"cannot reach the Dask scheduler at {scheduler}: {reason}") from None
             self.name = f"the Dask cluster at {scheduler}"
         self.parallel = max(1, sum(self.client.nthreads().values()))
-        self.threads = 1                    # each task runs numba on one thread
+        self.threads = 1  # each task runs numba on one thread
 
     def run(self, spec, ranges):
         from distributed import as_completed
 
         todo = iter(ranges)
-        key = f"{spec.hash()}-{uuid.uuid4().hex[:8]}"     # unique per run: no clash with a cancelled one
+        key = f"{spec.hash()}-{uuid.uuid4().hex[:8]}"  # unique per run: no clash with a cancelled one
         pending = set()
 
         def submit():
             for first, count in todo:
-                fut = self.client.submit(run_chunk, spec, first, count, threads=1,
-                                         key=f"quadcruise-chunk-{key}-{first}-{count}")
+                fut = self.client.submit(
+                    run_chunk, spec, first, count, threads=1, key=f"quadcruise-chunk-{key}-{first}-{count}"
+                )
                 pending.add(fut)
                 return fut
             return None
@@ -332,13 +357,26 @@ def check_sweep_size(n: int, periods: int) -> None:
         Saying how many vehicle-steps that is, and what to change.
     """
     if n * periods > MAX_SWEEP_STEPS:
-        raise InputError(f"{n:,} flights x {periods:,} control periods is {n * periods:.2g} vehicle-steps, "
-                         "days of computing even on a cluster: fewer flights or a shorter duration")
+        raise InputError(
+            f"{n:,} flights x {periods:,} control periods is {n * periods:.2g} vehicle-steps, "
+            "days of computing even on a cluster: fewer flights or a shorter duration"
+        )
 
 
-def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", scheduler: str | None = None,
-              workers: int | None = None, out=None, resume: bool = True, force: bool = False, fmt: str = "csv",
-              progress: Callable[[int, int], None] | None = None, connect_timeout: float = 10.0) -> MonteCarloResult:
+def run_sweep(
+    spec: MonteCarloSpec,
+    n: int,
+    *,
+    chunk_size: int | str = "auto",
+    scheduler: str | None = None,
+    workers: int | None = None,
+    out=None,
+    resume: bool = True,
+    force: bool = False,
+    fmt: str = "csv",
+    progress: Callable[[int, int], None] | None = None,
+    connect_timeout: float = 10.0,
+) -> MonteCarloResult:
     """Fly vehicles 0 .. n-1 of ``spec``: see :func:`quadcruise.montecarlo.montecarlo`.
 
     Every input is checked (and a scheduler address reached) before anything is written.
@@ -390,8 +428,9 @@ def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", s
     """
     n = whole_number(n, "the number of flights", 1)
     check_sweep_size(n, spec.periods)
-    if chunk_size != "auto" and (isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer))
-                                 or chunk_size < 1):
+    if chunk_size != "auto" and (
+        isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1
+    ):
         raise InputError(f"chunk size must be a whole number >= 1 or 'auto', got {chunk_size!r}")
     workers = None if workers is None else whole_number(workers, "workers", 1)
     if not (isinstance(connect_timeout, (int, float)) and math.isfinite(connect_timeout) and connect_timeout > 0):
@@ -425,16 +464,24 @@ def run_sweep(spec: MonteCarloSpec, n: int, *, chunk_size: int | str = "auto", s
                 if progress:
                     progress(collector.done, n)
         finally:
-            chunks.close()                  # cancels the tasks still out (an interruption)
+            chunks.close()  # cancels the tasks still out (an interruption)
     except WriteError as exc:
         raise _saying_what_is_kept(exc, folder, collector.done, n) from None
     finally:
         runner.close()
     wall = time.perf_counter() - start
-    info = {"scheduler": runner.name, "parallel": runner.parallel, "chunk_size": size, "chunks_flown": len(todo),
-            "flown": flown, "resumed": resumed, "wall_s": wall, "flights_per_s": flown / wall if wall > 0 else None,
-            "vehicle_steps_per_s": flown * spec.periods / wall if wall > 0 else None,
-            "out": None if out is None else str(out)}
+    info = {
+        "scheduler": runner.name,
+        "parallel": runner.parallel,
+        "chunk_size": size,
+        "chunks_flown": len(todo),
+        "flown": flown,
+        "resumed": resumed,
+        "wall_s": wall,
+        "flights_per_s": flown / wall if wall > 0 else None,
+        "vehicle_steps_per_s": flown * spec.periods / wall if wall > 0 else None,
+        "out": None if out is None else str(out),
+    }
     result = collector.result(info)
     if folder is not None:
         try:
@@ -451,6 +498,9 @@ def _saying_what_is_kept(exc: WriteError, folder, done: int, n: int) -> WriteErr
     if folder is None or done == 0:
         return exc
     where = folder.path / "chunks"
-    kept = (f"all {n:,} flights are kept in {where}: the same command writes the results without flying them again"
-            if done == n else f"the {done:,} flights done are kept in {where}: the same command resumes from them")
+    kept = (
+        f"all {n:,} flights are kept in {where}: the same command writes the results without flying them again"
+        if done == n
+        else f"the {done:,} flights done are kept in {where}: the same command resumes from them"
+    )
     return WriteError(exc.filename, exc, kept=kept)

@@ -73,8 +73,9 @@ def check_animation_path(path) -> None:
     if kind not in (".gif", ".mp4"):
         raise InputError(f"{path}: an animation is written as .gif or .mp4, not {path.suffix or 'no suffix'!r}")
     if kind == ".mp4" and _ffmpeg() is None:
-        raise InputError(f"{path}: writing .mp4 needs ffmpeg, which is not installed; "
-                         "write a .gif instead (e.g. flight.gif)")
+        raise InputError(
+            f"{path}: writing .mp4 needs ffmpeg, which is not installed; write a .gif instead (e.g. flight.gif)"
+        )
 
 
 def _frame_indices(t: np.ndarray, end: int, fps: float, duration_s, every) -> np.ndarray:
@@ -97,9 +98,18 @@ def _thin(i0: int, i1: int) -> np.ndarray:
     return thinned(i0, i1, (i1 - i0) // MAX_LINE_POINTS + 1)
 
 
-def animate_flight(result, path, *, vehicle: int = 0, fps: float = 15, duration_s: float | None = None,
-                   every: int | None = None, trail_s: float | None = None, dpi: int = 80,
-                   progress: Callable[[int, int], None] | None = None) -> Path:
+def animate_flight(
+    result,
+    path,
+    *,
+    vehicle: int = 0,
+    fps: float = 15,
+    duration_s: float | None = None,
+    every: int | None = None,
+    trail_s: float | None = None,
+    dpi: int = 80,
+    progress: Callable[[int, int], None] | None = None,
+) -> Path:
     """Write an animation of one vehicle's flight, whole or not at all.
 
     Parameters
@@ -172,12 +182,12 @@ def animate_flight(result, path, *, vehicle: int = 0, fps: float = 15, duration_
     stopped = int(result.status[vehicle]) != 0
     if stopped:
         top.plot(*pos[end - 1, :2], "X", color="tab:red", ms=8, label=f"stopped, t = {t[end - 1]:.2f} s")
-    trail, = top.plot([], [], color="tab:blue", lw=2.2, label="trail")
-    heading, = top.plot([], [], color="k", lw=1.5)
-    ref_dot, = top.plot([], [], "o", mfc="none", mec="k", ms=7)
-    dot, = top.plot([], [], "o", color="tab:blue", mec="white", ms=8)
-    z_line, = alt.plot([], [], color="tab:blue", lw=1.6, label="z")
-    z_dot, = alt.plot([], [], "o", color="tab:blue", mec="white", ms=7)
+    (trail,) = top.plot([], [], color="tab:blue", lw=2.2, label="trail")
+    (heading,) = top.plot([], [], color="k", lw=1.5)
+    (ref_dot,) = top.plot([], [], "o", mfc="none", mec="k", ms=7)
+    (dot,) = top.plot([], [], "o", color="tab:blue", mec="white", ms=8)
+    (z_line,) = alt.plot([], [], color="tab:blue", lw=1.6, label="z")
+    (z_dot,) = alt.plot([], [], "o", color="tab:blue", mec="white", ms=7)
     cursor = alt.axvline(t[0], color="0.4", lw=0.8)
     top.set_aspect("equal", adjustable="datalim")
     top.set(xlabel="x [m]", ylabel="y [m]", title="top view")
@@ -191,8 +201,8 @@ def animate_flight(result, path, *, vehicle: int = 0, fps: float = 15, duration_
     label = describe(result, vehicle)
     title = fig.suptitle(f"{label} — t = {t[end - 1]:.{decimals}f} s", fontsize="medium")
     moving = (trail, heading, ref_dot, dot, z_line, z_dot, cursor, title)
-    canvas.draw()                       # lay out once, with a full-length title
-    fig.set_layout_engine("none")       # then freeze it: the frames only blit
+    canvas.draw()  # lay out once, with a full-length title
+    fig.set_layout_engine("none")  # then freeze it: the frames only blit
     for artist in moving:
         artist.set_animated(True)
     canvas.draw()
@@ -236,24 +246,52 @@ def _write_gif(tmp: Path, rgba_frames, fps: float, Image) -> None:
     images, palette = [], None
     for rgba in rgba_frames:
         img = Image.fromarray(rgba[:, :, :3])
-        if palette is None:       # one palette for all frames, from the first
+        if palette is None:  # one palette for all frames, from the first
             palette = img.quantize(colors=128, method=Image.Quantize.MEDIANCUT)
         images.append(img.quantize(palette=palette, dither=Image.Dither.NONE))
-    images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:],
-                   duration=max(20, int(round(1000 / fps))), loop=0, optimize=False)
+    images[0].save(
+        tmp,
+        format="GIF",
+        save_all=True,
+        append_images=images[1:],
+        duration=max(20, int(round(1000 / fps))),
+        loop=0,
+        optimize=False,
+    )
 
 
 def _write_mp4(tmp: Path, rgba_frames, fps: float, ffmpeg: str, size) -> None:
     w, h = size
-    cmd = [ffmpeg, "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgba", "-s", f"{w}x{h}",
-           "-r", f"{fps:g}", "-i", "-", "-an", "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p",
-           "-f", "mp4", str(tmp)]
+    cmd = [
+        ffmpeg,
+        "-y",
+        "-loglevel",
+        "error",
+        "-f",
+        "rawvideo",
+        "-pix_fmt",
+        "rgba",
+        "-s",
+        f"{w}x{h}",
+        "-r",
+        f"{fps:g}",
+        "-i",
+        "-",
+        "-an",
+        "-vf",
+        "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+        "-pix_fmt",
+        "yuv420p",
+        "-f",
+        "mp4",
+        str(tmp),
+    ]
     proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
         for rgba in rgba_frames:
             proc.stdin.write(rgba.tobytes())
     except BrokenPipeError:
-        pass                # ffmpeg quit early; its message follows
+        pass  # ffmpeg quit early; its message follows
     except BaseException:
         proc.kill()
         proc.wait()

@@ -56,13 +56,23 @@ def _draw(axes, system, w, start, label, style):
     r = control.frequency_response(system, w).complex.ravel()
     # handed over as data (no dt): for a discrete system bode_plot adds a line at the Nyquist
     # frequency, beyond the 0.9 pi / dt drawn, and stretches the axis to it
-    plot = control.bode_plot(control.frd(r, w), ax=axes, dB=True, deg=True, wrap_phase=False,
-                             initial_phase=start, label=label, legend_loc=False, **style)
+    plot = control.bode_plot(
+        control.frd(r, w),
+        ax=axes,
+        dB=True,
+        deg=True,
+        wrap_phase=False,
+        initial_phase=start,
+        label=label,
+        legend_loc=False,
+        **style,
+    )
     return plot.lines[1, 0][0]
 
 
-def plot_bode(lin, *, loops: bool = False, omega=None, at: str = "input",
-              progress: Callable[[int, int], None] | None = None):
+def plot_bode(
+    lin, *, loops: bool = False, omega=None, at: str = "input", progress: Callable[[int, int], None] | None = None
+):
     """Bode plots of the closed loop and, optionally, of the loop transfers with their margins.
 
     Parameters
@@ -110,23 +120,24 @@ def plot_bode(lin, *, loops: bool = False, omega=None, at: str = "input",
     names = list(lin.loops)
     if progress is not None:
         progress(0, len(names))
-    for k, (loop, color) in enumerate(zip(names, ("C0", "C1", "C2", "C3"))):
+    for k, (loop, color) in enumerate(zip(names, ("C0", "C1", "C2", "C3"), strict=False)):
         style = {"color": color, "linestyle": "--" if loop == "y" else "-"}
         closed = lin.closed_loop(loop)
         state = closed.output_labels[0]
         _draw(axes[:, [0]], closed, w, 0.0, f"{state}_r -> {state}", style)
         if loops:
             m = lin.margins(loop, at)
-            phase_line = _draw(axes[:, [1]], lin.loop_transfer(loop, at), w, -180.0,
-                               f"L {loop}: {margin_label(m)}", style)
+            phase_line = _draw(
+                axes[:, [1]], lin.loop_transfer(loop, at), w, -180.0, f"L {loop}: {margin_label(m)}", style
+            )
             key = {q: round(m[q], 9) for q in ("phase_margin", "gain_crossover", "gain_increase", "gain_decrease")}
-            if key not in marked:                       # y's margins are x's: marked once
+            if key not in marked:  # y's margins are x's: marked once
                 marked.append(key)
                 _mark_margins(axes[:, 1], m, phase_line, loop, color)
         if progress is not None:
             progress(k + 1, len(names))
     axes[0, 0].set_ylim(bottom=max(axes[0, 0].get_ylim()[0], -150.0))
-    for col, title in enumerate([f"closed loop (discrete, dt = {lin.dt:g} s)", "loop transfers"][:axes.shape[1]]):
+    for col, title in enumerate([f"closed loop (discrete, dt = {lin.dt:g} s)", "loop transfers"][: axes.shape[1]]):
         axes[0, col].set(ylabel="magnitude [dB]", title=title)
         axes[1, col].set(ylabel="phase [deg]", xlabel="frequency [rad/s]")
         low, high = axes[1, col].get_ylim()
@@ -137,8 +148,10 @@ def plot_bode(lin, *, loops: bool = False, omega=None, at: str = "input",
             axes[1, col].axhline(-180.0 + 360.0 * k, color="0.6", lw=0.6)
         axes[1, col].set_ylim(low, high)
         handles, labels = axes[0, col].get_legend_handles_labels()
-        keep = [(h, lb) for h, lb in zip(handles, labels) if not lb.startswith(("PM ", "GM "))]
-        axes[0, col].legend(*zip(*keep), fontsize=7 if col else 8, loc="upper right" if col else "lower left")
+        keep = [(h, lb) for h, lb in zip(handles, labels, strict=False) if not lb.startswith(("PM ", "GM "))]
+        axes[0, col].legend(
+            *zip(*keep, strict=False), fontsize=7 if col else 8, loc="upper right" if col else "lower left"
+        )
         for ax in axes[:, col]:
             ax.grid(True, which="both", alpha=0.3)
     fig.suptitle(f"{getattr(lin.controller, 'name', 'controller')}: linearised about hover")
@@ -151,10 +164,11 @@ def _mark_margins(axes, m, phase_line, loop, color):
     w, phase = np.asarray(phase_line.get_xdata(), float), np.asarray(phase_line.get_ydata(), float)
     wgc = m["gain_crossover"]
     if math.isfinite(m["phase_margin"]) and math.isfinite(wgc):
-        p = float(np.interp(np.log(wgc), np.log(w), phase))          # the phase at the crossover
+        p = float(np.interp(np.log(wgc), np.log(w), phase))  # the phase at the crossover
         base = _nearest_minus_180(p - m["phase_margin"])
-        axes[1].plot([wgc, wgc], [base, base + m["phase_margin"]], color=color, lw=2.5,
-                     solid_capstyle="butt", label=f"PM {loop}")
+        axes[1].plot(
+            [wgc, wgc], [base, base + m["phase_margin"]], color=color, lw=2.5, solid_capstyle="butt", label=f"PM {loop}"
+        )
         axes[1].plot([wgc], [base + m["phase_margin"]], "o", color=color, ms=5)
         axes[0].plot([wgc], [0.0], "o", color=color, ms=5)
     for way in ("down", "up"):
@@ -162,8 +176,9 @@ def _mark_margins(axes, m, phase_line, loop, color):
         wpc = m["gain_decrease_frequency" if way == "down" else "gain_increase_frequency"]
         if not (0.0 < factor < math.inf and math.isfinite(wpc)):
             continue
-        g = -db(factor)                                   # the magnitude at the phase crossover
+        g = -db(factor)  # the magnitude at the phase crossover
         axes[0].plot([wpc, wpc], [0.0, g], color=color, lw=2.5, solid_capstyle="butt", label=f"GM {way} {loop}")
         axes[0].plot([wpc], [g], "s", color=color, ms=5)
-        axes[1].plot([wpc], [_nearest_minus_180(float(np.interp(np.log(wpc), np.log(w), phase)))], "s",
-                     color=color, ms=5)
+        axes[1].plot(
+            [wpc], [_nearest_minus_180(float(np.interp(np.log(wpc), np.log(w), phase)))], "s", color=color, ms=5
+        )

@@ -76,8 +76,10 @@ def _names(result, vehicle: int = 0) -> tuple[str | None, str | None]:
     if isinstance(mission, list):
         mission = mission[min(vehicle, len(mission) - 1)] if mission else None
     ctrl = meta.get("controller")
-    return (ctrl.get("name") if isinstance(ctrl, dict) else ctrl,
-            mission.get("kind") if isinstance(mission, dict) else None)
+    return (
+        ctrl.get("name") if isinstance(ctrl, dict) else ctrl,
+        mission.get("kind") if isinstance(mission, dict) else None,
+    )
 
 
 def describe(result, vehicle: int = 0) -> str:
@@ -130,8 +132,9 @@ def _path3d(ax, result, vehicle: int) -> None:
         pts.append(ref)
     live = pos[np.all(np.isfinite(pos), axis=1)]
     if live.size:
-        ax.scatter(*live[0], facecolor="none", edgecolor="tab:green", s=90, lw=2, marker="o",
-                   label="start", depthshade=False)
+        ax.scatter(
+            *live[0], facecolor="none", edgecolor="tab:green", s=90, lw=2, marker="o", label="start", depthshade=False
+        )
         ax.scatter(*live[-1], color="tab:red", s=45, marker="X", label="end", depthshade=False)
     # one scale on all three axes (box aspect = spans), each span at least 3/4 of the
     # largest, so a level flight is not drawn as a flat sliver
@@ -141,7 +144,7 @@ def _path3d(ax, result, vehicle: int) -> None:
     half = np.maximum((hi - lo) / 2 * 1.1, 0.25)
     half = np.maximum(half, 0.75 * half.max())
     mid = (lo + hi) / 2
-    for setter, m, h in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), mid, half):
+    for setter, m, h in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), mid, half, strict=False):
         setter(m - h, m + h)
     ax.set_box_aspect(tuple(half), zoom=0.8)
     # x ends and y starts at the front corner in the default view: prune both there
@@ -153,8 +156,9 @@ def _path3d(ax, result, vehicle: int) -> None:
     _legend(ax, loc="upper center", ncols=4, title="3-D path", bbox_to_anchor=(0.5, 0.98))
 
 
-def _time_panel(ax, t, y, ref, ylabel: str, color: str, label: str, min_span: float,
-                ref_label: str = "reference") -> None:
+def _time_panel(
+    ax, t, y, ref, ylabel: str, color: str, label: str, min_span: float, ref_label: str = "reference"
+) -> None:
     """A trace against time with its reference (dashed, where finite) on a y range at
     least ``min_span`` tall, so numerical noise on a held value is not blown up."""
     ax.plot(t, y, color=color, lw=1.3, label=label)
@@ -209,21 +213,44 @@ def plot_flight(result, vehicle: int = 0, *, title: str | None = None) -> Figure
     fig = Figure(figsize=(16, 12))
     # row 3 and column 1 are gaps: for the time axes' labels above the error panel, and
     # between the 3-D path's labels and the position panels' own
-    gs = fig.add_gridspec(6, 4, width_ratios=(1.3, 0.02, 1, 1), height_ratios=(1, 1, 1, 0.06, 0.9, 1.0),
-                          **FLIGHT_MARGINS)
+    gs = fig.add_gridspec(
+        6, 4, width_ratios=(1.3, 0.02, 1, 1), height_ratios=(1, 1, 1, 0.06, 0.9, 1.0), **FLIGHT_MARGINS
+    )
     _path3d(fig.add_subplot(gs[0:3, 0], projection="3d"), result, vehicle)
     pos_axes = [fig.add_subplot(gs[0, 2])]
     pos_axes += [fig.add_subplot(gs[i, 2], sharex=pos_axes[0]) for i in (1, 2)]
     att_axes = [fig.add_subplot(gs[i, 3], sharex=pos_axes[0]) for i in range(3)]
     closed_loop = any(_has(result.state(f"{n}_ref")[vehicle]) for n in "xyz")
-    for ax, name, c in zip(pos_axes, "xyz", ("tab:blue", "tab:orange", "tab:green")):
-        _time_panel(ax, t, result.state(name)[vehicle], result.state(f"{name}_ref")[vehicle],
-                    f"{name} [m]", c, name, min_span=0.02)
-    for ax, name, label, c in zip(att_axes, ("phi", "theta", "psi"), ("roll φ", "pitch θ", "yaw ψ"),
-                                  ("tab:blue", "tab:orange", "tab:green")):
+    for ax, name, c in zip(pos_axes, "xyz", ("tab:blue", "tab:orange", "tab:green"), strict=False):
+        _time_panel(
+            ax,
+            t,
+            result.state(name)[vehicle],
+            result.state(f"{name}_ref")[vehicle],
+            f"{name} [m]",
+            c,
+            name,
+            min_span=0.02,
+        )
+    for ax, name, label, c in zip(
+        att_axes,
+        ("phi", "theta", "psi"),
+        ("roll φ", "pitch θ", "yaw ψ"),
+        ("tab:blue", "tab:orange", "tab:green"),
+        strict=False,
+    ):
         sp = np.degrees(result.state(f"{name}_d")[vehicle]) if closed_loop else None
-        _time_panel(ax, t, np.degrees(result.state(name)[vehicle]), sp, f"{label} [deg]", c,
-                    label, min_span=2.0, ref_label="setpoint")
+        _time_panel(
+            ax,
+            t,
+            np.degrees(result.state(name)[vehicle]),
+            sp,
+            f"{label} [deg]",
+            c,
+            label,
+            min_span=2.0,
+            ref_label="setpoint",
+        )
     ax_e = fig.add_subplot(gs[4, :], sharex=pos_axes[0])
     error_axes(ax_e, [(t, position_error(result, vehicle), dict(color="k", label="|p - p_ref|"))])
     ax_u = fig.add_subplot(gs[5, :], sharex=pos_axes[0])
@@ -264,8 +291,9 @@ def _duties(ax, result, vehicle: int, spans: dict, min_width: float) -> None:
     t = result.t
     duties = result.commands[vehicle, :, :4]
     for j in range(4):
-        ax.plot(t, duties[:, j], color=("tab:blue", "tab:orange", "tab:green", "tab:purple")[j],
-                lw=1.0, label=f"u{j + 1}")
+        ax.plot(
+            t, duties[:, j], color=("tab:blue", "tab:orange", "tab:green", "tab:purple")[j], lw=1.0, label=f"u{j + 1}"
+        )
     for kind in ("flagged", "clipped"):
         shade(ax, spans[kind], min_width=min_width, **SATURATION_STYLE[kind])
     live = duties[np.isfinite(duties)]
@@ -277,9 +305,10 @@ def _duties(ax, result, vehicle: int, spans: dict, min_width: float) -> None:
     # rather than the duties being squashed to the bottom of a [0, 1] scale
     off = " (1 off scale)" if hi + pad < 1.0 else ""
     for limit in (0.0, 1.0):
-        ax.axhline(limit, color="0.3", lw=1.2, ls="-.", zorder=1.5,
-                   label=f"duty limits 0, 1{off}" if limit == 0.0 else None)
-    for a, b in ((lo - 10 * pad - 1.0, 0.0), (1.0, hi + 10 * pad + 1.0)):   # beyond the limits
+        ax.axhline(
+            limit, color="0.3", lw=1.2, ls="-.", zorder=1.5, label=f"duty limits 0, 1{off}" if limit == 0.0 else None
+        )
+    for a, b in ((lo - 10 * pad - 1.0, 0.0), (1.0, hi + 10 * pad + 1.0)):  # beyond the limits
         ax.axhspan(a, b, color="0.5", alpha=0.12, lw=0)
     ax.set_ylabel("rotor duty [-]")
     ax.grid(True, alpha=0.3)
@@ -304,9 +333,11 @@ def _saturation_strips(ax, spans: list[dict], min_width: float) -> list:
         for kind, alpha in (("flagged", 0.35), ("clipped", 1.0)):
             if shade(ax, flight[kind], min_width=min_width, yrange=y, color=f"C{k}", alpha=alpha) is not None:
                 drawn.add(kind)
-    return [Patch(color="0.35", alpha=alpha, lw=0, label=f"{what} (strip in the flight's colour)")
-            for kind, alpha, what in (("flagged", 0.35, "limit flagged"), ("clipped", 1.0, "duty clipped"))
-            if kind in drawn]
+    return [
+        Patch(color="0.35", alpha=alpha, lw=0, label=f"{what} (strip in the flight's colour)")
+        for kind, alpha, what in (("flagged", 0.35, "limit flagged"), ("clipped", 1.0, "duty clipped"))
+        if kind in drawn
+    ]
 
 
 def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None, axes: str = "xy") -> Figure:
@@ -357,7 +388,7 @@ def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None, axe
     ref = _reference_xy([(r, vehicle) for r in results.values()])
     if ref is not None:
         top.plot(ref[1], ref[2], **REF_STYLE)
-    for ax, name in zip(time_axes, axes):
+    for ax, name in zip(time_axes, axes, strict=False):
         for res in results.values():
             if _has(res.state(f"{name}_ref")[vehicle]):
                 ax.plot(res.t, res.state(f"{name}_ref")[vehicle], **REF_STYLE)
@@ -370,7 +401,7 @@ def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None, axe
         if stopped:
             label = f"{label} (stopped at {res.t_stop[vehicle]:.2f} s)"
         top.plot(x, y, color=c, lw=1.4, label=label)
-        for ax, name in zip(time_axes, axes):
+        for ax, name in zip(time_axes, axes, strict=False):
             trace = res.state(name)[vehicle]
             ax.plot(res.t, trace, color=c, lw=1.4, label=label)
             live = np.flatnonzero(np.isfinite(trace))
@@ -386,14 +417,14 @@ def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None, axe
     if error_axes(ax_e, curves):
         for t, err, _ in curves:
             live = np.flatnonzero(np.isfinite(err))
-            if live.size and live[-1] < err.size - 1:          # it stopped: cross its last error
+            if live.size and live[-1] < err.size - 1:  # it stopped: cross its last error
                 ax_e.plot(t[live[-1]], max(err[live[-1]], ERROR_FLOOR), "X", color="tab:red", ms=9)
     strips = _saturation_strips(ax_e, spans, (t_hi - t_lo) / 1500)
     for ax in time_axes:
         mark_events(ax, events, (t_lo, t_hi), label=ax is ax_e)
     top.set_aspect("equal", adjustable="datalim")
     top.set(xlabel="x [m]", ylabel="y [m]", title="top view")
-    for ax, name in zip(time_axes, axes):
+    for ax, name in zip(time_axes, axes, strict=False):
         ax.set_ylabel(f"{name} [m]")
         ax.tick_params(labelbottom=False)
     ax_e.set_xlabel("time [s]")
@@ -401,7 +432,7 @@ def plot_paths(results: dict, *, vehicle: int = 0, title: str | None = None, axe
         ax.grid(True, alpha=0.3)
     # one legend, in the top view's spare room: the flights, then what else is drawn
     handles, labels = top.get_legend_handles_labels()
-    for h, lb in zip(*ax_e.get_legend_handles_labels()):
+    for h, lb in zip(*ax_e.get_legend_handles_labels(), strict=False):
         if lb not in labels:
             handles.append(h)
             labels.append(lb)
@@ -462,7 +493,7 @@ def plot_envelope(result, *, title: str | None = None, max_paths: int = 50) -> F
         top.plot(x[i], y[i], color="tab:blue", lw=1.0, alpha=alpha, zorder=2.2)
     for ok, c, what in ((True, "tab:blue", "finished"), (False, "tab:red", "stopped early")):
         total = int(np.count_nonzero(result.ok == ok))
-        if total:   # legend proxies: how many of each kind are drawn
+        if total:  # legend proxies: how many of each kind are drawn
             drawn = int(np.count_nonzero(result.ok[picks] == ok))
             top.plot([], [], color=c, lw=1, label=f"{what} ({drawn} drawn of {total})")
     ref = _reference_xy([(result, 0)])
@@ -475,17 +506,23 @@ def plot_envelope(result, *, title: str | None = None, max_paths: int = 50) -> F
     err = np.linalg.norm(pos - result.references[:, :, :3], axis=2)
     if _has(err):
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)   # all-NaN instants after stops
+            warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN instants after stops
             p5, p50, p95 = np.nanpercentile(err, [5, 50, 95], axis=0)
         ax_e.fill_between(result.t, p5, p95, color="tab:blue", alpha=0.25, lw=0, label="5-95 %")
         ax_e.plot(result.t, p50, color="tab:blue", lw=1.5, label="median")
         ax_e.set_ylim(bottom=0)
         _legend(ax_e, loc="best")
     else:
-        ax_e.text(0.5, 0.5, "no reference: the position error is undefined", ha="center",
-                  va="center", transform=ax_e.transAxes, color="0.4")
-    ax_e.set(xlabel="time [s]", ylabel="position error |p - p_ref| [m]",
-             title=f"position error over {n} vehicles")
+        ax_e.text(
+            0.5,
+            0.5,
+            "no reference: the position error is undefined",
+            ha="center",
+            va="center",
+            transform=ax_e.transAxes,
+            color="0.4",
+        )
+    ax_e.set(xlabel="time [s]", ylabel="position error |p - p_ref| [m]", title=f"position error over {n} vehicles")
     ax_e.set_xlim(result.t[0], result.t[-1])
     for ax in (top, ax_e):
         ax.grid(True, alpha=0.3)

@@ -20,8 +20,19 @@ from matplotlib.ticker import FuncFormatter, NullFormatter
 
 from quadcruise.layout import CMD_FLAGS, CMD_U1
 
-__all__ = ["Event", "flight_events", "intervals", "saturation", "position_error", "mark_events",
-           "shade", "error_axes", "ERROR_FLOOR", "EVENT_COLORS", "SATURATION_STYLE"]
+__all__ = [
+    "Event",
+    "flight_events",
+    "intervals",
+    "saturation",
+    "position_error",
+    "mark_events",
+    "shade",
+    "error_axes",
+    "ERROR_FLOOR",
+    "EVENT_COLORS",
+    "SATURATION_STYLE",
+]
 
 ERROR_FLOOR = 1e-4
 """The smallest position error [m] the error panels show (0.1 mm): an error below it, an
@@ -167,11 +178,10 @@ def saturation(result, vehicle: int = 0) -> dict[str, np.ndarray]:
     """
     cmd = result.commands[vehicle]
     flags = cmd[:, CMD_FLAGS]
-    duties = cmd[:, CMD_U1:CMD_U1 + 4]
+    duties = cmd[:, CMD_U1 : CMD_U1 + 4]
     with np.errstate(invalid="ignore"):
-        clipped = np.any((duties < 0.0) | (duties > 1.0), axis=1)     # NaN after a stop: False
-    return {"flagged": intervals(result.t, np.isfinite(flags) & (flags != 0)),
-            "clipped": intervals(result.t, clipped)}
+        clipped = np.any((duties < 0.0) | (duties > 1.0), axis=1)  # NaN after a stop: False
+    return {"flagged": intervals(result.t, np.isfinite(flags) & (flags != 0)), "clipped": intervals(result.t, clipped)}
 
 
 def position_error(result, vehicle: int = 0) -> np.ndarray:
@@ -296,8 +306,15 @@ def error_axes(ax, curves) -> bool:
     values = np.concatenate(finite) if finite else np.zeros(0)
     ax.set_ylabel("position error [m]")
     if not values.size:
-        ax.text(0.5, 0.5, "no reference: the position error is undefined", ha="center", va="center",
-                transform=ax.transAxes, color="0.4")
+        ax.text(
+            0.5,
+            0.5,
+            "no reference: the position error is undefined",
+            ha="center",
+            va="center",
+            transform=ax.transAxes,
+            color="0.4",
+        )
         ax.set_yticks([])
         return False
     for t, e, style in curves:
@@ -305,10 +322,11 @@ def error_axes(ax, curves) -> bool:
     ax.set_yscale("log")
     top = max(float(values.max()), 10 * ERROR_FLOOR)
     low = max(float(values.min()), ERROR_FLOOR)
-    ax.set_ylim(10.0 ** math.floor(math.log10(min(low, top / 10) / 1.5)), top * 1.6)   # two decades at least
+    ax.set_ylim(10.0 ** math.floor(math.log10(min(low, top / 10) / 1.5)), top * 1.6)  # two decades at least
     if values.min() < ERROR_FLOOR:
-        ax.axhline(ERROR_FLOOR, color="0.55", lw=0.8, ls=":", zorder=1.2,
-                   label=f"≤ {ERROR_FLOOR * 1e3:g} mm (drawn here)")
+        ax.axhline(
+            ERROR_FLOOR, color="0.55", lw=0.8, ls=":", zorder=1.2, label=f"≤ {ERROR_FLOOR * 1e3:g} mm (drawn here)"
+        )
     ax.yaxis.set_major_formatter(FuncFormatter(_tick))
     ax.yaxis.set_minor_formatter(NullFormatter())
     ax.grid(True, which="major", alpha=0.3)

@@ -18,17 +18,37 @@ from matplotlib.ticker import MaxNLocator
 __all__ = ["plot_histograms", "plot_envelope", "metric_label", "degenerate", "METRIC_LABELS"]
 
 
-HISTOGRAM_METRICS = ("rmse_m", "max_error_m", "final_error_m", "rise_time_s", "settling_time_5pct_s",
-                     "overshoot_pct", "effort", "duty_clipped_s")
+HISTOGRAM_METRICS = (
+    "rmse_m",
+    "max_error_m",
+    "final_error_m",
+    "rise_time_s",
+    "settling_time_5pct_s",
+    "overshoot_pct",
+    "effort",
+    "duty_clipped_s",
+)
 """The metrics :func:`plot_histograms` draws by default."""
 
-METRIC_LABELS = {"rmse_m": "RMSE [m]", "max_error_m": "max error [m]", "final_error_m": "final error [m]",
-                 "rise_time_s": "rise time [s]", "settling_time_s": "settling time 2 % [s]",
-                 "settling_time_5pct_s": "settling time 5 % [s]", "overshoot_pct": "overshoot [%]",
-                 "effort": "effort [s]", "duty_clipped_s": "duty clipped [s]",
-                 "controller_limited_s": "controller limited [s]", "stop_time_s": "stop time [s]",
-                 "m": "mass [kg]", "dx0": "start offset x [m]", "dy0": "start offset y [m]",
-                 "dz0": "start offset z [m]", "wind_x": "wind x [m/s]", "wind_y": "wind y [m/s]"}
+METRIC_LABELS = {
+    "rmse_m": "RMSE [m]",
+    "max_error_m": "max error [m]",
+    "final_error_m": "final error [m]",
+    "rise_time_s": "rise time [s]",
+    "settling_time_s": "settling time 2 % [s]",
+    "settling_time_5pct_s": "settling time 5 % [s]",
+    "overshoot_pct": "overshoot [%]",
+    "effort": "effort [s]",
+    "duty_clipped_s": "duty clipped [s]",
+    "controller_limited_s": "controller limited [s]",
+    "stop_time_s": "stop time [s]",
+    "m": "mass [kg]",
+    "dx0": "start offset x [m]",
+    "dy0": "start offset y [m]",
+    "dz0": "start offset z [m]",
+    "wind_x": "wind x [m/s]",
+    "wind_y": "wind y [m/s]",
+}
 """Axis labels, with units, of the sweep table's columns."""
 
 
@@ -55,7 +75,7 @@ def metric_label(name: str) -> str:
         return METRIC_LABELS[name]
     for suffix, unit in (("_s", "s"), ("_m", "m"), ("_pct", "%"), ("_deg", "deg")):
         if name.endswith(suffix) and len(name) > len(suffix):
-            return f"{name[:-len(suffix)].replace('_', ' ')} [{unit}]"
+            return f"{name[: -len(suffix)].replace('_', ' ')} [{unit}]"
     return name.replace("_", " ")
 
 
@@ -116,12 +136,15 @@ def plot_histograms(result, metrics=None):
     rows = math.ceil(len(panels) / cols)
     fig = Figure(figsize=(4.3 * max(cols, 2), 3.2 * rows + (0.4 if skipped else 0.0)), layout="constrained")
     axes = fig.subplots(rows, cols, squeeze=False).ravel()
-    for ax, name in zip(axes, panels):
+    for ax, name in zip(axes, panels, strict=False):
         if name == "failures":
-            outcomes = result.failure_names          # the outcome codes 0..4 of the table's 'failure' column
+            outcomes = result.failure_names  # the outcome codes 0..4 of the table's 'failure' column
             counts = [int(np.count_nonzero(result.table["failure"] == c)) for c in range(len(outcomes))]
-            ax.bar(range(len(outcomes)), counts,
-                   color=["tab:green", "tab:red", "tab:orange", "tab:brown", "tab:purple"][:len(outcomes)])
+            ax.bar(
+                range(len(outcomes)),
+                counts,
+                color=["tab:green", "tab:red", "tab:orange", "tab:brown", "tab:purple"][: len(outcomes)],
+            )
             ax.set_xticks(range(len(outcomes)), [n.replace(" ", "\n", 1) for n in outcomes], fontsize="small")
             for x, c in enumerate(counts):
                 ax.annotate(f"{c:,}", (x, c), ha="center", va="bottom", fontsize="small")
@@ -132,21 +155,26 @@ def plot_histograms(result, metrics=None):
         v = columns[name]
         v = v[np.isfinite(v)]
         ax.hist(v, bins=40, color="tab:blue", alpha=0.8)
-        for q, style in zip(np.percentile(v, [5, 50, 95]), (":", "-", ":")):
+        for q, style in zip(np.percentile(v, [5, 50, 95]), (":", "-", ":"), strict=False):
             ax.axvline(q, color="k", ls=style, lw=1.0)
         missing = result.n - v.size
         ax.set_title(f"{name}  (n = {v.size:,}" + (f", {missing:,} n/a)" if missing else ")"), fontsize="medium")
         ax.set(xlabel=metric_label(name), ylabel="flights")
         ax.yaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(True, alpha=0.3)
-    for ax in axes[len(panels):]:
+    for ax in axes[len(panels) :]:
         ax.set_visible(False)
     if skipped:
         note = "not drawn: " + ", ".join(f"{k} ({why})".replace(" ", "\u00a0") for k, why in skipped.items())
-        fig.supxlabel(textwrap.fill(note, width=int(15 * fig.get_figwidth()), break_on_hyphens=False),
-                      fontsize="small", color="0.3")
-    fig.suptitle(f"{result.spec.controller.name} on {result.spec.mission.name}: {result.n:,} flights, seed "
-                 f"{result.spec.seed} (lines: 5 %, median, 95 %)")
+        fig.supxlabel(
+            textwrap.fill(note, width=int(15 * fig.get_figwidth()), break_on_hyphens=False),
+            fontsize="small",
+            color="0.3",
+        )
+    fig.suptitle(
+        f"{result.spec.controller.name} on {result.spec.mission.name}: {result.n:,} flights, seed "
+        f"{result.spec.seed} (lines: 5 %, median, 95 %)"
+    )
     return fig
 
 
@@ -208,11 +236,16 @@ def plot_envelope(result):
         ax_e.plot(tr.t, p50, color="tab:blue", lw=1.5, label="median")
         ax_e.set_ylim(bottom=0)
         ax_e.legend(fontsize="small", loc="best")
-    ax_e.set(xlabel="time [s]", ylabel="position error |p - p_ref| [m]",
-             title=f"position error of the first {n_sample:,} flights")
+    ax_e.set(
+        xlabel="time [s]",
+        ylabel="position error |p - p_ref| [m]",
+        title=f"position error of the first {n_sample:,} flights",
+    )
     if tr.t.size > 1:
         ax_e.set_xlim(tr.t[0], tr.t[-1])
     for ax in (top, ax_e):
         ax.grid(True, alpha=0.3)
-    fig.suptitle(f"{result.spec.controller.name} on {result.spec.mission.name}: {result.n:,} flights, seed {result.spec.seed}")
+    fig.suptitle(
+        f"{result.spec.controller.name} on {result.spec.mission.name}: {result.n:,} flights, seed {result.spec.seed}"
+    )
     return fig

@@ -78,14 +78,21 @@ def plot_tune(result, *, title: str | None = None) -> Figure:
             level = final + size * target.value / 100.0
             ax_resp.axhline(level, color="tab:red", ls=":", lw=1.0, label=f"overshoot target {target.value:g} %")
         elif target.metric == "rise_time_s":
-            ax_resp.axvline(t_step + target.value, color="tab:green", ls=":", lw=1.0,
-                            label=f"rise target {target.value:g} s")
+            ax_resp.axvline(
+                t_step + target.value, color="tab:green", ls=":", lw=1.0, label=f"rise target {target.value:g} s"
+            )
         elif target.metric in ("settling_time_s", "settling_time_5pct_s"):
             band = 0.02 if target.metric == "settling_time_s" else 0.05
             t_set = t_step + target.value
             ax_resp.axvline(t_set, color="tab:purple", ls=":", lw=1.0, label=f"settling target {target.value:g} s")
-            ax_resp.fill_between([t_set, tuned.t[-1]], final - band * abs(size), final + band * abs(size),
-                                 color="tab:purple", alpha=0.12, lw=0)
+            ax_resp.fill_between(
+                [t_set, tuned.t[-1]],
+                final - band * abs(size),
+                final + band * abs(size),
+                color="tab:purple",
+                alpha=0.12,
+                lw=0,
+            )
     ax_resp.set_xlabel("t [s]")
     ax_resp.set_ylabel(f"{name} [m]")
     ax_resp.grid(True, alpha=0.3)

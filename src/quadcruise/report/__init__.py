@@ -9,5 +9,11 @@ from quadcruise.report.html import (
     write_html_report,
 )
 
-__all__ = ["comparison_report", "flight_report", "html_report", "markdown_html", "reproduction_report",
-           "write_html_report"]
+__all__ = [
+    "comparison_report",
+    "flight_report",
+    "html_report",
+    "markdown_html",
+    "reproduction_report",
+    "write_html_report",
+]

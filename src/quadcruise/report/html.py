@@ -38,19 +38,42 @@ from quadcruise.io.plainjson import dumps
 from quadcruise.metrics.tables import DID_NOT_SETTLE, FAILED_FLIGHT, NO_OVERSHOOT, NO_TRANSIENT, metric_cell
 from quadcruise.plots.thin import thinned
 
-__all__ = ["html_report", "write_html_report", "flight_report", "comparison_report",
-           "reproduction_report", "markdown_html", "table_html"]
+__all__ = [
+    "html_report",
+    "write_html_report",
+    "flight_report",
+    "comparison_report",
+    "reproduction_report",
+    "markdown_html",
+    "table_html",
+]
 
 MAX_POINTS = 2000
 """Most logged instants of one path embedded for the 3-D view."""
 MAX_VEHICLES = 8
 """Most vehicles of one batched result shown in the 3-D view (stopped ones first)."""
-COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
-          "#7f7f7f", "#bcbd22", "#17becf")   # matplotlib's tab10, the C0..C9 of the figures
-LABELS = {"rmse_m": "RMSE [m]", "settling_time_s": "settling time 2 % [s]",
-          "settling_time_5pct_s": "settling time 5 % [s]", "overshoot_pct": "overshoot [%]",
-          "steady_rmse_m": "RMSE after the transient [m]", "steady_max_error_m": "max error after the transient [m]",
-          "effort": "effort about hover [s]", "axis": "transient axis"}
+COLORS = (
+    "#1f77b4",
+    "#ff7f0e",
+    "#2ca02c",
+    "#d62728",
+    "#9467bd",
+    "#8c564b",
+    "#e377c2",
+    "#7f7f7f",
+    "#bcbd22",
+    "#17becf",
+)  # matplotlib's tab10, the C0..C9 of the figures
+LABELS = {
+    "rmse_m": "RMSE [m]",
+    "settling_time_s": "settling time 2 % [s]",
+    "settling_time_5pct_s": "settling time 5 % [s]",
+    "overshoot_pct": "overshoot [%]",
+    "steady_rmse_m": "RMSE after the transient [m]",
+    "steady_max_error_m": "max error after the transient [m]",
+    "effort": "effort about hover [s]",
+    "axis": "transient axis",
+}
 MISSING = "—"
 
 
@@ -66,7 +89,7 @@ def _label(name, conventions: dict | None = None) -> str:
         return LABELS[name]
     for suffix, unit in (("_s", "s"), ("_m", "m"), ("_pct", "%"), ("_deg", "deg"), ("_rad", "rad")):
         if name.endswith(suffix) and len(name) > len(suffix):
-            return f"{name[:-len(suffix)].replace('_', ' ')} [{unit}]"
+            return f"{name[: -len(suffix)].replace('_', ' ')} [{unit}]"
     return name.replace("_", " ")
 
 
@@ -101,20 +124,18 @@ def table_html(frame) -> str:
     """
     import pandas as pd
 
-    def _axes(values):                                   # "" where the table measured no transient
+    def _axes(values):  # "" where the table measured no transient
         return None if values is None else values.map(lambda a: a if isinstance(a, str) else "")
 
     rows_axis = _axes(frame["axis"] if "axis" in frame.columns else None)
     cols_axis = _axes(frame.loc["axis"] if rows_axis is None and "axis" in frame.index else None)
     rows_status = frame["status"] if "status" in frame.columns else None
     cols_status = frame.loc["status"] if rows_status is None and "status" in frame.index else None
-    shown_index = not (isinstance(frame.index, pd.RangeIndex) and frame.index.start == 0
-                       and frame.index.step == 1)
+    shown_index = not (isinstance(frame.index, pd.RangeIndex) and frame.index.start == 0 and frame.index.step == 1)
     idx_names = [n for n in frame.index.names] if shown_index else []
     conventions = frame.attrs.get("conventions")
     head = [_label(n) if n is not None else "" for n in idx_names] + [_label(c, conventions) for c in frame.columns]
-    out = ["<table>", "<thead><tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in head) + "</tr></thead>",
-           "<tbody>"]
+    out = ["<table>", "<thead><tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in head) + "</tr></thead>", "<tbody>"]
     for r, (key, row) in enumerate(frame.iterrows()):
         keys = key if isinstance(key, tuple) else (key,)
         cells = [f'<th scope="row">{html.escape(_label(k, conventions))}</th>' for k in keys] if shown_index else []
@@ -122,7 +143,7 @@ def table_html(frame) -> str:
             axis = rows_axis.iloc[r] if rows_axis is not None else None
             status = rows_status.iloc[r] if rows_status is not None else None
             metric = col
-            if cols_axis is not None or cols_status is not None:    # a transposed table: metrics down
+            if cols_axis is not None or cols_status is not None:  # a transposed table: metrics down
                 metric = key
                 axis = cols_axis.iloc[c] if cols_axis is not None else None
                 status = cols_status.iloc[c] if cols_status is not None else None
@@ -150,8 +171,9 @@ def _png_b64(fig) -> str:
         fig.savefig(buf, format="png", dpi=100)
         data = buf.getvalue()
     else:
-        raise InputError(f"a report figure must be a matplotlib Figure, PNG bytes or a PNG file, "
-                         f"got {type(fig).__name__}")
+        raise InputError(
+            f"a report figure must be a matplotlib Figure, PNG bytes or a PNG file, got {type(fig).__name__}"
+        )
     if not data.startswith(b"\x89PNG\r\n\x1a\n"):
         raise InputError("a report figure is not a PNG image")
     return base64.b64encode(data).decode("ascii")
@@ -179,9 +201,14 @@ def _view_data(flights: dict) -> dict:
             end = int(live[-1]) + 1 if live.size else 1
             step = max(1, math.ceil(end / MAX_POINTS))
             keep = thinned(0, end - 1, step)
-            entry = {"label": label if res.n == 1 else f"{label} · vehicle {v}",
-                     "color": COLORS[len(entries) % len(COLORS)], "ok": bool(res.ok[v]),
-                     "status": res.status_text(v), "ref": None, **_series(res.t, pos, keep)}
+            entry = {
+                "label": label if res.n == 1 else f"{label} · vehicle {v}",
+                "color": COLORS[len(entries) % len(COLORS)],
+                "ok": bool(res.ok[v]),
+                "status": res.status_text(v),
+                "ref": None,
+                **_series(res.t, pos, keep),
+            }
             if np.any(np.all(np.isfinite(ref), axis=1)):
                 rkeep = thinned(0, ref.shape[0] - 1, step)
                 rdata = _series(res.t, ref, rkeep)
@@ -291,11 +318,18 @@ ERROR_HOOK = """<script>
 })();
 </script>"""
 
-CSP = ("default-src 'none'; img-src data:; style-src 'unsafe-inline'; script-src 'unsafe-inline'")
+CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'; script-src 'unsafe-inline'"
 
 
-def html_report(*, title: str, tables: dict | None = None, figures: dict | None = None,
-                flights: dict | None = None, config: dict | None = None, notes: str = "") -> str:
+def html_report(
+    *,
+    title: str,
+    tables: dict | None = None,
+    figures: dict | None = None,
+    flights: dict | None = None,
+    config: dict | None = None,
+    notes: str = "",
+) -> str:
     """The report as one self-contained HTML page.
 
     Parameters
@@ -326,43 +360,58 @@ def html_report(*, title: str, tables: dict | None = None, figures: dict | None 
     views = _views(flights or {})
     sections = []
     if tables:
-        body = "".join(f'<div class="qc-table"><h3>{html.escape(name)}</h3>{table_html(frame)}</div>'
-                       for name, frame in tables.items())
+        body = "".join(
+            f'<div class="qc-table"><h3>{html.escape(name)}</h3>{table_html(frame)}</div>'
+            for name, frame in tables.items()
+        )
         sections.append(("tables", "Metrics", f'<div class="qc-tables">{body}</div>'))
     if views:
         body = []
         for i, (vtitle, group) in enumerate(views):
             head = f"<h3>{html.escape(vtitle)}</h3>" if vtitle else ""
-            body.append(f'<div class="qc-view" id="qc-view-{i}">{head}'
-                        f'<div class="qc-viewbox"><div class="qc-stage"><canvas class="qc-canvas" '
-                        f'aria-label="{html.escape(vtitle or "flight")}: 3-D view">A 3-D view of the flight '
-                        f'(needs JavaScript).</canvas><div class="qc-hint">drag: orbit · shift-drag: '
-                        f'pan · wheel: zoom · double-click: reset</div></div><div class="qc-side">'
-                        f'</div></div>{_json_script(_view_data(group), "qc-data")}</div>')
+            body.append(
+                f'<div class="qc-view" id="qc-view-{i}">{head}'
+                f'<div class="qc-viewbox"><div class="qc-stage"><canvas class="qc-canvas" '
+                f'aria-label="{html.escape(vtitle or "flight")}: 3-D view">A 3-D view of the flight '
+                f'(needs JavaScript).</canvas><div class="qc-hint">drag: orbit · shift-drag: '
+                f'pan · wheel: zoom · double-click: reset</div></div><div class="qc-side">'
+                f"</div></div>{_json_script(_view_data(group), 'qc-data')}</div>"
+            )
         sections.append(("view", "3-D view", "".join(body)))
     if figures:
-        body = "".join(f'<figure><img src="data:image/png;base64,{_png_b64(fig)}" alt="{html.escape(cap)}">'
-                       f'<figcaption>{html.escape(cap)}</figcaption></figure>' for cap, fig in figures.items())
+        body = "".join(
+            f'<figure><img src="data:image/png;base64,{_png_b64(fig)}" alt="{html.escape(cap)}">'
+            f"<figcaption>{html.escape(cap)}</figcaption></figure>"
+            for cap, fig in figures.items()
+        )
         sections.append(("figures", "Figures", body))
     if notes:
         sections.append(("notes", "Notes", f'<div class="qc-notes">{notes}</div>'))
     text = dumps(config, indent=2)
     link = base64.b64encode(text.encode()).decode("ascii")
-    sections.append(("config", "Scenario", f'<details open><summary>configuration that produced this report '
-                     f'(JSON)</summary><pre class="qc-config">{html.escape(text)}</pre></details><p>'
-                     f'<a download="quadcruise-config.json" href="data:application/json;base64,{link}">'
-                     f'save as quadcruise-config.json</a></p>'))
+    sections.append(
+        (
+            "config",
+            "Scenario",
+            f"<details open><summary>configuration that produced this report "
+            f'(JSON)</summary><pre class="qc-config">{html.escape(text)}</pre></details><p>'
+            f'<a download="quadcruise-config.json" href="data:application/json;base64,{link}">'
+            f"save as quadcruise-config.json</a></p>",
+        )
+    )
     nav = " ".join(f'<a href="#{key}">{name}</a>' for key, name, _ in sections)
     main = "\n".join(f'<section id="{key}"><h2>{name}</h2>{body}</section>' for key, name, body in sections)
-    return (f'<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n{ERROR_HOOK}\n'
-            f'<meta http-equiv="Content-Security-Policy" content="{CSP}">\n'
-            f'<meta name="viewport" content="width=device-width, initial-scale=1">\n'
-            f'<meta name="generator" content="quadcruise {html.escape(__version__)}">\n'
-            f'<title>{html.escape(title)}</title>\n<style>\n{CSS}</style>\n</head>\n<body>\n'
-            f'<pre id="qc-errors" hidden></pre>\n<header><h1>{html.escape(title)}</h1>'
-            f'<p class="qc-sub">quadcruise {html.escape(__version__)} · self-contained report</p>'
-            f'<nav>{nav}</nav></header>\n<main>\n{main}\n</main>\n'
-            f'<script>\n{_asset("viewer.js")}</script>\n</body>\n</html>\n')
+    return (
+        f'<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n{ERROR_HOOK}\n'
+        f'<meta http-equiv="Content-Security-Policy" content="{CSP}">\n'
+        f'<meta name="viewport" content="width=device-width, initial-scale=1">\n'
+        f'<meta name="generator" content="quadcruise {html.escape(__version__)}">\n'
+        f"<title>{html.escape(title)}</title>\n<style>\n{CSS}</style>\n</head>\n<body>\n"
+        f'<pre id="qc-errors" hidden></pre>\n<header><h1>{html.escape(title)}</h1>'
+        f'<p class="qc-sub">quadcruise {html.escape(__version__)} · self-contained report</p>'
+        f"<nav>{nav}</nav></header>\n<main>\n{main}\n</main>\n"
+        f"<script>\n{_asset('viewer.js')}</script>\n</body>\n</html>\n"
+    )
 
 
 def write_html_report(path, **kwargs) -> Path:
@@ -405,13 +454,18 @@ def _conventions_table(frame) -> dict:
     conv = frame.attrs.get("conventions")
     if not conv:
         return {}
-    values = {"rise_time_s": "{:g}-{:g} % of the step (axis xyz: of the error's way to its steady level)".format(
-        *(100.0 * v for v in conv["rise"]))}
+    values = {
+        "rise_time_s": "{:g}-{:g} % of the step (axis xyz: of the error's way to its steady level)".format(
+            *(100.0 * v for v in conv["rise"])
+        )
+    }
     values.update({name: f"{100.0 * band:g} % band" for name, band in conv["settling_columns"].items()})
-    values["steady_rmse_m, steady_max_error_m"] = (f"3-D position error from the {100.0 * conv['steady_band']:g} % "
-                                                   "settling time on (axis xyz, a moving reference: over the last "
-                                                   "half of the flight, once converged; the whole flight without a "
-                                                   "transient)")
+    values["steady_rmse_m, steady_max_error_m"] = (
+        f"3-D position error from the {100.0 * conv['steady_band']:g} % "
+        "settling time on (axis xyz, a moving reference: over the last "
+        "half of the flight, once converged; the whole flight without a "
+        "transient)"
+    )
     values["effort"] = conv["effort"]
     return {"Metric conventions": pd.DataFrame({"meaning": values})}
 
@@ -443,21 +497,29 @@ def flight_report(result, *, title: str | None = None, metrics=None) -> dict:
     meta = result.meta or {}
     ctrl, mission = meta.get("controller"), meta.get("mission")
     mission = mission[0] if isinstance(mission, list) and mission else mission
-    run = {"controller": ctrl.get("name") if isinstance(ctrl, dict) else ctrl,
-           "mission": mission.get("kind") if isinstance(mission, dict) else mission,
-           "duration_s": float(result.t[-1] - result.t[0]), "dt_s": meta.get("dt_s"),
-           "vehicles": result.n, "finished": f"{int(result.ok.sum())} of {result.n}",
-           "seed": meta.get("seed"), "version": meta.get("version")}
+    run = {
+        "controller": ctrl.get("name") if isinstance(ctrl, dict) else ctrl,
+        "mission": mission.get("kind") if isinstance(mission, dict) else mission,
+        "duration_s": float(result.t[-1] - result.t[0]),
+        "dt_s": meta.get("dt_s"),
+        "vehicles": result.n,
+        "finished": f"{int(result.ok.sum())} of {result.n}",
+        "seed": meta.get("seed"),
+        "version": meta.get("version"),
+    }
     run_table = pd.DataFrame({"value": {k: v for k, v in run.items() if v is not None}})
     label = describe(result)
     figures = {(f"Flight of vehicle 0: {label}" if result.n > 1 else f"Flight: {label}"): plot_flight(result)}
     if result.n > 1:
         figures[f"All {result.n} vehicles"] = plot_envelope(result)
     metrics = result.metrics() if metrics is None else metrics
-    return {"title": title or f"quadcruise: {label}",
-            "tables": {"Flight metrics": _metrics_table(metrics, label), **_conventions_table(metrics),
-                       "Run": run_table},
-            "figures": figures, "flights": {label: result}, "config": meta}
+    return {
+        "title": title or f"quadcruise: {label}",
+        "tables": {"Flight metrics": _metrics_table(metrics, label), **_conventions_table(metrics), "Run": run_table},
+        "figures": figures,
+        "flights": {label: result},
+        "config": meta,
+    }
 
 
 def comparison_report(cmp, *, title: str | None = None, **metric_kw) -> dict:
@@ -481,13 +543,16 @@ def comparison_report(cmp, *, title: str | None = None, **metric_kw) -> dict:
     """
     table = cmp.table(**metric_kw)
     if all(r.n == 1 for r in cmp.results.values()):
-        table = table.T   # metrics down, controllers across
+        table = table.T  # metrics down, controllers across
     config = {k: v for k, v in cmp.to_dict(**metric_kw).items() if k != "metrics"}
     name = getattr(cmp.mission, "name", "mission")
-    return {"title": title or f"quadcruise: {' vs '.join(cmp.results)} on {name}",
-            "tables": {"Metrics by controller": table, **_conventions_table(table)},
-            "figures": {f"Paths on {name}": cmp.plot()},
-            "flights": dict(cmp.results), "config": config}
+    return {
+        "title": title or f"quadcruise: {' vs '.join(cmp.results)} on {name}",
+        "tables": {"Metrics by controller": table, **_conventions_table(table)},
+        "figures": {f"Paths on {name}": cmp.plot()},
+        "flights": dict(cmp.results),
+        "config": config,
+    }
 
 
 def reproduction_report(rep, figures: dict | None = None, *, title: str | None = None) -> dict:
@@ -527,25 +592,41 @@ def reproduction_report(rep, figures: dict | None = None, *, title: str | None =
     rows = []
     for r in rep.runs:
         paper = paper_numbers(r)
-        rows.append({"scenario": r["scenario"], "controller": r["controller"], "axis": r["axis"],
-                     "rise_time_s": r["rise_time_s"], "paper: rise_time_s": paper.get("rise_time_s"),
-                     "settling_time_s": r["settling_time_s"],
-                     "paper: settling_time_s": paper.get("settling_time_s"),
-                     "settling_time_5pct_s": r["settling_time_5pct_s"], "overshoot_pct": r["overshoot_pct"],
-                     "paper: overshoot_pct": paper.get("overshoot_pct"), "rmse_m": r["rmse_m"],
-                     "max_error_m": r["max_error_m"], "status": r["status"]})
-    table = pd.DataFrame(rows).astype({c: float for c in rows[0] if c.endswith(("_s", "_pct", "_m"))}) \
-        if rows else pd.DataFrame()
+        rows.append(
+            {
+                "scenario": r["scenario"],
+                "controller": r["controller"],
+                "axis": r["axis"],
+                "rise_time_s": r["rise_time_s"],
+                "paper: rise_time_s": paper.get("rise_time_s"),
+                "settling_time_s": r["settling_time_s"],
+                "paper: settling_time_s": paper.get("settling_time_s"),
+                "settling_time_5pct_s": r["settling_time_5pct_s"],
+                "overshoot_pct": r["overshoot_pct"],
+                "paper: overshoot_pct": paper.get("overshoot_pct"),
+                "rmse_m": r["rmse_m"],
+                "max_error_m": r["max_error_m"],
+                "status": r["status"],
+            }
+        )
+    table = (
+        pd.DataFrame(rows).astype({c: float for c in rows[0] if c.endswith(("_s", "_pct", "_m"))})
+        if rows
+        else pd.DataFrame()
+    )
     if figures is None:
         light = {key: res.decimate(TRACE_EVERY) for key, res in rep.results.items()}
-        figures = {cap: fig for name, cap in FIGURES.items()
-                   if (fig := paper_figure(name, cap, light)) is not None}
+        figures = {cap: fig for name, cap in FIGURES.items() if (fig := paper_figure(name, cap, light)) is not None}
     flights = {scen: {c: res for (s, c), res in rep.results.items() if s == scen} for scen in ("circle", "square")}
     notes = markdown_html(INTRO + "\n" + differences() + baseline_comparison(rep))
-    return {"title": title or f"quadcruise {__version__}: reproduction of the paper",
-            "tables": {"Results against the paper": table}, "figures": figures,
-            "flights": {k: v for k, v in flights.items() if v},
-            "config": {"workflow": "reproduce", **rep.config, "version": __version__}, "notes": notes}
+    return {
+        "title": title or f"quadcruise {__version__}: reproduction of the paper",
+        "tables": {"Results against the paper": table},
+        "figures": figures,
+        "flights": {k: v for k, v in flights.items() if v},
+        "config": {"workflow": "reproduce", **rep.config, "version": __version__},
+        "notes": notes,
+    }
 
 
 def _inline(text: str) -> str:

@@ -65,8 +65,18 @@ from quadcruise.sim.status import STATUS_REASONS, ExitStatus
 
 # exit status codes as plain ints, which the kernel compiles as constants (see sim/status.py)
 FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, TILT_BOUND, BAD_COMMAND, PITCH_SINGULAR = (
-    int(ExitStatus[name]) for name in ("FINISHED", "NONFINITE", "POSITION_BOUND", "SPEED_BOUND", "RATE_BOUND",
-                                       "TILT_BOUND", "BAD_COMMAND", "PITCH_SINGULAR"))
+    int(ExitStatus[name])
+    for name in (
+        "FINISHED",
+        "NONFINITE",
+        "POSITION_BOUND",
+        "SPEED_BOUND",
+        "RATE_BOUND",
+        "TILT_BOUND",
+        "BAD_COMMAND",
+        "PITCH_SINGULAR",
+    )
+)
 
 
 @dataclass(frozen=True)
@@ -114,7 +124,7 @@ class Limits:
 # and cosines of the state's phi, theta and psi carried from one step to the next
 K1, K2, K3, K4, XT, TRIG = range(6)
 WORK_ROWS = 6
-TRIG_WIDTH = 6      # the entries of row TRIG in use, carried from one call of the kernel to the next
+TRIG_WIDTH = 6  # the entries of row TRIG in use, carried from one call of the kernel to the next
 
 
 def carry_width(sensor_delay: int) -> int:
@@ -217,7 +227,7 @@ def rk4_step(x, u, vp, ext, full, h, work, fresh):
         derivative_at(xt, s1, c1, s2, c2, s3, c3, u, vp, ext, full, work[stage])
     c = h / 6.0
     for j in range(STATE_SIZE):
-        xt[j] = c * (work[K1, j] + 2.0 * (work[K2, j] + work[K3, j]) + work[K4, j])   # the increment
+        xt[j] = c * (work[K1, j] + 2.0 * (work[K2, j] + work[K3, j]) + work[K4, j])  # the increment
         x[j] += xt[j]
     trig[0], trig[1] = turned(x[PHI], sa, ca, xt[PHI])
     trig[2], trig[3] = turned(x[THETA], sb, cb, xt[THETA])
@@ -248,6 +258,7 @@ def still_air(t, dt, x, dp, dmem, rng, ext):
 
 
 # The per-period helpers below follow the scalar-only rule of quadcruise.sim.fastmath.
+
 
 @njit(cache=True, inline="always")
 def beyond(a, b, c, bound):
@@ -354,18 +365,76 @@ _i8m = types.int64[:, ::1]
 _u8m = types.uint64[:, ::1]
 
 KERNEL_SIG = types.void(
-    types.int64, types.int64, _f8v, _f8m, _f8m, _f8m, ControllerType, _f8m, _f8m, MissionType, _f8m,
-    DisturbanceType, types.boolean, _f8m, _f8m, _u8m, _f8m, types.int64, types.boolean,
-    types.float64, types.int64, _f8v, types.int64, _i8m, _f8m,
-    _f8c, _f8c, _f8c, _f8m, _i8v, _f8v, _f8m,
+    types.int64,
+    types.int64,
+    _f8v,
+    _f8m,
+    _f8m,
+    _f8m,
+    ControllerType,
+    _f8m,
+    _f8m,
+    MissionType,
+    _f8m,
+    DisturbanceType,
+    types.boolean,
+    _f8m,
+    _f8m,
+    _u8m,
+    _f8m,
+    types.int64,
+    types.boolean,
+    types.float64,
+    types.int64,
+    _f8v,
+    types.int64,
+    _i8m,
+    _f8m,
+    _f8c,
+    _f8c,
+    _f8c,
+    _f8m,
+    _i8v,
+    _f8v,
+    _f8m,
 )
 
 
 @njit(KERNEL_SIG, cache=True, nogil=True, error_model="numpy")
-def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
-            disturbance, disturbed, dp, dmem, rng, sensor_std, sensor_delay, full,
-            max_step, log_every, limits, n_step, clock, carry,
-            log_x, log_cmd, log_ref, x_final, status, t_stop, saturated):
+def _kernel(
+    first,
+    stop,
+    t_grid,
+    x0,
+    vp,
+    vp_ctrl,
+    controller,
+    gains,
+    mem,
+    mission,
+    mp,
+    disturbance,
+    disturbed,
+    dp,
+    dmem,
+    rng,
+    sensor_std,
+    sensor_delay,
+    full,
+    max_step,
+    log_every,
+    limits,
+    n_step,
+    clock,
+    carry,
+    log_x,
+    log_cmd,
+    log_ref,
+    x_final,
+    status,
+    t_stop,
+    saturated,
+):
     """Fly vehicles first .. stop - 1 of the batch. The arguments, by role (their meaning:
     :func:`simulate`'s parameters; one row per vehicle):
 
@@ -401,7 +470,7 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
     # more on allocating it than on flying); every entry is set for each vehicle before use
     x = np.empty(STATE_SIZE)
     seen = np.empty(STATE_SIZE)
-    history = np.empty((sensor_delay + 1, STATE_SIZE))   # ring buffer of past states
+    history = np.empty((sensor_delay + 1, STATE_SIZE))  # ring buffer of past states
     ref = np.empty(REF_SIZE)
     cmd = np.empty(CMD_SIZE)
     u = np.empty(4)
@@ -410,7 +479,7 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
     mi, dmi, rngi = np.empty(mem.shape[1]), np.empty(dmem.shape[1]), np.empty(rng.shape[1], dtype=np.uint64)
     for i in range(first, stop):
         k0 = clock[i, 0]
-        if status[i] != FINISHED or k0 >= n_periods:      # stopped, or its grid flown
+        if status[i] != FINISHED or k0 >= n_periods:  # stopped, or its grid flown
             blank_rows(log_x, i, 0)
             blank_rows(log_cmd, i, 0)
             blank_rows(log_ref, i, 0)
@@ -444,15 +513,15 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
         code = FINISHED
         t_end = t_grid[n_periods]
         rows_x = rows = 0
-        steps = clock[i, 1]            # RK4 steps flown
-        if not disturbed:              # set once (a kept trick: quadcruise.sim.fastmath)
+        steps = clock[i, 1]  # RK4 steps flown
+        if not disturbed:  # set once (a kept trick: quadcruise.sim.fastmath)
             still_air(0.0, 0.0, x, dpi, dmi, rngi, ext)
         for k in range(k0, k1 + 1 if k1 == n_periods else k1):
             t = t_grid[k]
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
             mission(t, mpi, ref)
             # what the controller sees: the state sensor_delay periods ago, plus noise
-            newest = k % (sensor_delay + 1)                     # in the ring buffer
+            newest = k % (sensor_delay + 1)  # in the ring buffer
             oldest = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
             for j in range(STATE_SIZE):
                 history[newest, j] = x[j]
@@ -507,16 +576,16 @@ def _kernel(first, stop, t_grid, x0, vp, vp_ctrl, controller, gains, mem, missio
                 code = RATE_BOUND
             elif beyond(x[PHI], x[THETA], 0.0, max_tilt):
                 code = TILT_BOUND
-            elif full and abs(x[THETA]) > EULER_PITCH_LIMIT:      # the full plant's 1/cos theta
+            elif full and abs(x[THETA]) > EULER_PITCH_LIMIT:  # the full plant's 1/cos theta
                 code = PITCH_SINGULAR
             if code != FINISHED:
                 t_end = t_grid[k + 1]
                 k_reached = k + 1
-                if (k + 1) % log_every == 0:    # keep the state that broke the bound
+                if (k + 1) % log_every == 0:  # keep the state that broke the bound
                     log_row(log_x, i, rows, x)
                     rows_x += 1
                 break
-        blank_rows(log_x, i, rows_x)               # rows after a stop: NaN
+        blank_rows(log_x, i, rows_x)  # rows after a stop: NaN
         blank_rows(log_cmd, i, rows)
         blank_rows(log_ref, i, rows)
         put_row(x_final, i, x)
@@ -562,14 +631,14 @@ def fly_vehicles(n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD
         _kernel(0, n, *args)
         return
     bounds = np.linspace(0, n, min(n, pieces_per_thread * threads) + 1).round().astype(np.int64)
-    pieces = itertools.count()                  # next() on it is atomic under the GIL
+    pieces = itertools.count()  # next() on it is atomic under the GIL
 
     def work() -> None:
         while (k := next(pieces)) < bounds.shape[0] - 1:
             _kernel(int(bounds[k]), int(bounds[k + 1]), *args)
-    if _pool is None:                            # numba's threads can never exceed this
-        _pool = ThreadPoolExecutor(max_workers=max(1, config.NUMBA_NUM_THREADS - 1),
-                                   thread_name_prefix="quadcruise")
+
+    if _pool is None:  # numba's threads can never exceed this
+        _pool = ThreadPoolExecutor(max_workers=max(1, config.NUMBA_NUM_THREADS - 1), thread_name_prefix="quadcruise")
     helpers = [_pool.submit(work) for _ in range(threads - 1)]
     work()
     for h in helpers:
@@ -613,8 +682,10 @@ def time_grid(duration: float, dt: float, t0: float = 0.0) -> np.ndarray:
     if dt > duration:
         raise InputError(f"dt ({dt:g} s) is larger than the duration ({duration:g} s)")
     if duration / dt > MAX_STEPS:
-        raise InputError(f"{duration:g} s at dt = {dt:g} s is {duration / dt:.3g} control periods, more than "
-                         f"{MAX_STEPS:.0e}: shorten the duration or lengthen dt")
+        raise InputError(
+            f"{duration:g} s at dt = {dt:g} s is {duration / dt:.3g} control periods, more than "
+            f"{MAX_STEPS:.0e}: shorten the duration or lengthen dt"
+        )
     n = round(duration / dt)
     if abs(n * dt - duration) > 1e-9 * max(1.0, duration):
         raise InputError(f"duration ({duration:g} s) is not a whole number of dt ({dt:g} s) periods")
@@ -632,9 +703,25 @@ def _batch(name: str, a, n: int, width: int | None) -> np.ndarray:
     return np.array(arr, dtype=float, order="C")  # a writable copy, never a broadcast view
 
 
-def batch_inputs(t_grid, x0, vp, gains, mp, *, memory=None, vp_ctrl=None, disturbance=None,
-                 disturbance_params=None, disturbance_memory=None, seed: int = 0, first_vehicle=0,
-                 sensor_std=None, sensor_delay: int = 0, max_step: float = 1e-3, log_every: int = 1) -> dict:
+def batch_inputs(
+    t_grid,
+    x0,
+    vp,
+    gains,
+    mp,
+    *,
+    memory=None,
+    vp_ctrl=None,
+    disturbance=None,
+    disturbance_params=None,
+    disturbance_memory=None,
+    seed: int = 0,
+    first_vehicle=0,
+    sensor_std=None,
+    sensor_delay: int = 0,
+    max_step: float = 1e-3,
+    log_every: int = 1,
+) -> dict:
     """The kernel's batch arrays, checked and made C-contiguous writable copies: what
     :func:`simulate` and :class:`quadcruise.sim.stepper.Stepper` hand to the kernel.
 
@@ -686,17 +773,48 @@ def batch_inputs(t_grid, x0, vp, gains, mp, *, memory=None, vp_ctrl=None, distur
     disturbed = disturbance is not None
     drawn = disturbed or bool(np.any(std))
     rng = vehicle_states(seed, n, first_vehicle) if drawn else np.zeros((n, 1), dtype=np.uint64)
-    return {"t_grid": t_grid, "x0": x0, "vp": vp, "n": n, "gains": gains, "mp": mp, "memory": mem,
-            "vp_ctrl": vp_ctrl, "disturbance_params": dp, "disturbance_memory": dmem, "sensor_std": std,
-            "rng": rng, "disturbed": disturbed, "drawn": drawn}
+    return {
+        "t_grid": t_grid,
+        "x0": x0,
+        "vp": vp,
+        "n": n,
+        "gains": gains,
+        "mp": mp,
+        "memory": mem,
+        "vp_ctrl": vp_ctrl,
+        "disturbance_params": dp,
+        "disturbance_memory": dmem,
+        "sensor_std": std,
+        "rng": rng,
+        "disturbed": disturbed,
+        "drawn": drawn,
+    }
 
 
-def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
-             vp_ctrl=None, disturbance=None, disturbance_params=None, disturbance_memory=None,
-             seed: int = 0, first_vehicle: int = 0, sensor_std=None, sensor_delay: int = 0,
-             full_dynamics: bool = False,
-             max_step: float = 1e-3, log_every: int = 1, limits: Limits | None = None,
-             meta: dict | None = None) -> SimResult:
+def simulate(
+    t_grid,
+    x0,
+    vp,
+    controller,
+    gains,
+    mission,
+    mp,
+    *,
+    memory=None,
+    vp_ctrl=None,
+    disturbance=None,
+    disturbance_params=None,
+    disturbance_memory=None,
+    seed: int = 0,
+    first_vehicle: int = 0,
+    sensor_std=None,
+    sensor_delay: int = 0,
+    full_dynamics: bool = False,
+    max_step: float = 1e-3,
+    log_every: int = 1,
+    limits: Limits | None = None,
+    meta: dict | None = None,
+) -> SimResult:
     """Fly N vehicles over the control instants ``t_grid`` and return a :class:`SimResult`.
 
     This is the array-level entry point that :func:`quadcruise.fly` and
@@ -750,10 +868,24 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
     SimResult
         The logged flight of every vehicle, its exit status and saturation times.
     """
-    inp = batch_inputs(t_grid, x0, vp, gains, mp, memory=memory, vp_ctrl=vp_ctrl,
-                       disturbance=disturbance, disturbance_params=disturbance_params,
-                       disturbance_memory=disturbance_memory, seed=seed, first_vehicle=first_vehicle,
-                       sensor_std=sensor_std, sensor_delay=sensor_delay, max_step=max_step, log_every=log_every)
+    inp = batch_inputs(
+        t_grid,
+        x0,
+        vp,
+        gains,
+        mp,
+        memory=memory,
+        vp_ctrl=vp_ctrl,
+        disturbance=disturbance,
+        disturbance_params=disturbance_params,
+        disturbance_memory=disturbance_memory,
+        seed=seed,
+        first_vehicle=first_vehicle,
+        sensor_std=sensor_std,
+        sensor_delay=sensor_delay,
+        max_step=max_step,
+        log_every=log_every,
+    )
     t_grid, x0, vp, n = inp["t_grid"], inp["x0"], inp["vp"], inp["n"]
     mem, dmem, rng, disturbed = inp["memory"], inp["disturbance_memory"], inp["rng"], inp["disturbed"]
     vp_ctrl, gains, mp, dp = inp["vp_ctrl"], inp["gains"], inp["mp"], inp["disturbance_params"]
@@ -761,25 +893,71 @@ def simulate(t_grid, x0, vp, controller, gains, mission, mp, *, memory=None,
     limits = limits or Limits()
     n_periods = t_grid.shape[0] - 1
     n_log = n_periods // log_every + 1
-    log_x = np.empty((n, n_log, STATE_SIZE))      # every row is written by the kernel:
-    log_cmd = np.empty((n, n_log, CMD_SIZE))      # logged, or NaN after a stop
+    log_x = np.empty((n, n_log, STATE_SIZE))  # every row is written by the kernel:
+    log_cmd = np.empty((n, n_log, CMD_SIZE))  # logged, or NaN after a stop
     log_ref = np.empty((n, n_log, REF_SIZE))
     x_final = np.empty((n, STATE_SIZE))
     status = np.zeros(n, dtype=np.int64)
     t_stop = np.empty(n)
     saturated = np.zeros((n, 2))
-    fly_vehicles(n, (t_grid, x0, vp, vp_ctrl, controller, gains, mem, mission, mp,
-                     disturbance or still_air, disturbed, dp, dmem, rng, std, int(sensor_delay),
-                     bool(full_dynamics), float(max_step), int(log_every), limits.array(),
-                     n_periods, np.zeros((n, 2), dtype=np.int64), fresh_carry(x0, int(sensor_delay)),
-                     log_x, log_cmd, log_ref, x_final, status, t_stop, saturated))
+    fly_vehicles(
+        n,
+        (
+            t_grid,
+            x0,
+            vp,
+            vp_ctrl,
+            controller,
+            gains,
+            mem,
+            mission,
+            mp,
+            disturbance or still_air,
+            disturbed,
+            dp,
+            dmem,
+            rng,
+            std,
+            int(sensor_delay),
+            bool(full_dynamics),
+            float(max_step),
+            int(log_every),
+            limits.array(),
+            n_periods,
+            np.zeros((n, 2), dtype=np.int64),
+            fresh_carry(x0, int(sensor_delay)),
+            log_x,
+            log_cmd,
+            log_ref,
+            x_final,
+            status,
+            t_stop,
+            saturated,
+        ),
+    )
     return SimResult(
-        t=t_grid[::log_every][:n_log].copy(), states=log_x, commands=log_cmd, references=log_ref,
-        final_state=x_final, status=status, t_stop=t_stop, memory=mem, disturbance_memory=dmem,
-        duty_clipped_s=saturated[:, 0].copy(), controller_limited_s=saturated[:, 1].copy(),
+        t=t_grid[::log_every][:n_log].copy(),
+        states=log_x,
+        commands=log_cmd,
+        references=log_ref,
+        final_state=x_final,
+        status=status,
+        t_stop=t_stop,
+        memory=mem,
+        disturbance_memory=dmem,
+        duty_clipped_s=saturated[:, 0].copy(),
+        controller_limited_s=saturated[:, 1].copy(),
         meta=dict(meta or {}),
     )
 
 
-__all__ = ["Limits", "simulate", "time_grid", "rk4_step", "STATUS_REASONS", "batch_inputs", "carry_width",
-           "fresh_carry"]
+__all__ = [
+    "Limits",
+    "simulate",
+    "time_grid",
+    "rk4_step",
+    "STATUS_REASONS",
+    "batch_inputs",
+    "carry_width",
+    "fresh_carry",
+]

@@ -106,7 +106,6 @@ TRIG_REFRESH = 256
 carries them by :func:`turned` in between (each turn adds a rounding, about 1e-16)."""
 
 
-
 @njit(cache=True, inline="always")
 def five_normals(s):
     """Five standard normals from a SplitMix64 state s (:mod:`quadcruise.sim.rng`'s ziggurat

@@ -26,7 +26,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from quadcruise.io.ulog import Topic
-from quadcruise.layout import CMD_U1, PHI, PSI, THETA, VX, X, P
+from quadcruise.layout import CMD_U1, PHI, PSI, THETA, VX, P, X
 
 ENU_TO_NED = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
 """``A``: ENU (or FLU) vectors to NED."""
@@ -34,50 +34,121 @@ FLU_TO_FRD = np.diag([1.0, -1.0, -1.0])
 """``B``: FLU body vectors to FRD."""
 NOISE_STREAM = 0x554C4F47
 """The third word of the noise generator's seed, ``[seed, vehicle, NOISE_STREAM]`` ("ULOG")."""
-RATES_HZ = {"vehicle_local_position": 50.0, "vehicle_attitude": 250.0, "vehicle_angular_velocity": 250.0,
-            "actuator_motors": 250.0, "sensor_combined": 250.0, "vehicle_status": 1.0,
-            "vehicle_land_detected": 1.0}
+RATES_HZ = {
+    "vehicle_local_position": 50.0,
+    "vehicle_attitude": 250.0,
+    "vehicle_angular_velocity": 250.0,
+    "actuator_motors": 250.0,
+    "sensor_combined": 250.0,
+    "vehicle_status": 1.0,
+    "vehicle_land_detected": 1.0,
+}
 """Each topic's rate at most [Hz]: PX4's default logging profile's order of magnitude, capped
 by the flight's own log interval (a topic is written every k-th logged instant)."""
 
 # PX4's formats (uORB, as PX4 v1.15 logs them), field for field.
 VEHICLE_LOCAL_POSITION = (
-    ("uint64_t", 0, "timestamp"), ("uint64_t", 0, "timestamp_sample"), ("uint64_t", 0, "ref_timestamp"),
-    ("double", 0, "ref_lat"), ("double", 0, "ref_lon"), ("float", 0, "x"), ("float", 0, "y"), ("float", 0, "z"),
-    ("float", 2, "delta_xy"), ("float", 0, "delta_z"), ("float", 0, "vx"), ("float", 0, "vy"), ("float", 0, "vz"),
-    ("float", 0, "z_deriv"), ("float", 2, "delta_vxy"), ("float", 0, "delta_vz"), ("float", 0, "ax"),
-    ("float", 0, "ay"), ("float", 0, "az"), ("float", 0, "heading"), ("float", 0, "heading_var"),
-    ("float", 0, "unaided_heading"), ("float", 0, "delta_heading"), ("float", 0, "tilt_var"),
-    ("float", 0, "ref_alt"), ("float", 0, "dist_bottom"), ("float", 0, "eph"), ("float", 0, "epv"),
-    ("float", 0, "evh"), ("float", 0, "evv"), ("float", 0, "vxy_max"), ("float", 0, "vz_max"),
-    ("float", 0, "hagl_min"), ("float", 0, "hagl_max"), ("bool", 0, "xy_valid"), ("bool", 0, "z_valid"),
-    ("bool", 0, "v_xy_valid"), ("bool", 0, "v_z_valid"), ("uint8_t", 0, "xy_reset_counter"),
-    ("uint8_t", 0, "z_reset_counter"), ("uint8_t", 0, "vxy_reset_counter"), ("uint8_t", 0, "vz_reset_counter"),
-    ("uint8_t", 0, "heading_reset_counter"), ("bool", 0, "heading_good_for_control"), ("bool", 0, "xy_global"),
-    ("bool", 0, "z_global"), ("bool", 0, "dist_bottom_valid"), ("uint8_t", 0, "dist_bottom_sensor_bitfield"),
-    ("bool", 0, "dead_reckoning"), ("uint8_t", 5, "_padding0"))
+    ("uint64_t", 0, "timestamp"),
+    ("uint64_t", 0, "timestamp_sample"),
+    ("uint64_t", 0, "ref_timestamp"),
+    ("double", 0, "ref_lat"),
+    ("double", 0, "ref_lon"),
+    ("float", 0, "x"),
+    ("float", 0, "y"),
+    ("float", 0, "z"),
+    ("float", 2, "delta_xy"),
+    ("float", 0, "delta_z"),
+    ("float", 0, "vx"),
+    ("float", 0, "vy"),
+    ("float", 0, "vz"),
+    ("float", 0, "z_deriv"),
+    ("float", 2, "delta_vxy"),
+    ("float", 0, "delta_vz"),
+    ("float", 0, "ax"),
+    ("float", 0, "ay"),
+    ("float", 0, "az"),
+    ("float", 0, "heading"),
+    ("float", 0, "heading_var"),
+    ("float", 0, "unaided_heading"),
+    ("float", 0, "delta_heading"),
+    ("float", 0, "tilt_var"),
+    ("float", 0, "ref_alt"),
+    ("float", 0, "dist_bottom"),
+    ("float", 0, "eph"),
+    ("float", 0, "epv"),
+    ("float", 0, "evh"),
+    ("float", 0, "evv"),
+    ("float", 0, "vxy_max"),
+    ("float", 0, "vz_max"),
+    ("float", 0, "hagl_min"),
+    ("float", 0, "hagl_max"),
+    ("bool", 0, "xy_valid"),
+    ("bool", 0, "z_valid"),
+    ("bool", 0, "v_xy_valid"),
+    ("bool", 0, "v_z_valid"),
+    ("uint8_t", 0, "xy_reset_counter"),
+    ("uint8_t", 0, "z_reset_counter"),
+    ("uint8_t", 0, "vxy_reset_counter"),
+    ("uint8_t", 0, "vz_reset_counter"),
+    ("uint8_t", 0, "heading_reset_counter"),
+    ("bool", 0, "heading_good_for_control"),
+    ("bool", 0, "xy_global"),
+    ("bool", 0, "z_global"),
+    ("bool", 0, "dist_bottom_valid"),
+    ("uint8_t", 0, "dist_bottom_sensor_bitfield"),
+    ("bool", 0, "dead_reckoning"),
+    ("uint8_t", 5, "_padding0"),
+)
 VEHICLE_ATTITUDE = (
-    ("uint64_t", 0, "timestamp"), ("uint64_t", 0, "timestamp_sample"), ("float", 4, "q"),
-    ("float", 4, "delta_q_reset"), ("uint8_t", 0, "quat_reset_counter"), ("uint8_t", 7, "_padding0"))
+    ("uint64_t", 0, "timestamp"),
+    ("uint64_t", 0, "timestamp_sample"),
+    ("float", 4, "q"),
+    ("float", 4, "delta_q_reset"),
+    ("uint8_t", 0, "quat_reset_counter"),
+    ("uint8_t", 7, "_padding0"),
+)
 VEHICLE_ANGULAR_VELOCITY = (
-    ("uint64_t", 0, "timestamp"), ("uint64_t", 0, "timestamp_sample"), ("float", 3, "xyz"),
-    ("float", 3, "xyz_derivative"))
+    ("uint64_t", 0, "timestamp"),
+    ("uint64_t", 0, "timestamp_sample"),
+    ("float", 3, "xyz"),
+    ("float", 3, "xyz_derivative"),
+)
 ACTUATOR_MOTORS = (
-    ("uint64_t", 0, "timestamp"), ("uint64_t", 0, "timestamp_sample"), ("float", 12, "control"),
-    ("uint16_t", 0, "reversible_flags"), ("uint8_t", 6, "_padding0"))
+    ("uint64_t", 0, "timestamp"),
+    ("uint64_t", 0, "timestamp_sample"),
+    ("float", 12, "control"),
+    ("uint16_t", 0, "reversible_flags"),
+    ("uint8_t", 6, "_padding0"),
+)
 SENSOR_COMBINED = (
-    ("uint64_t", 0, "timestamp"), ("float", 3, "gyro_rad"), ("uint32_t", 0, "gyro_integral_dt"),
-    ("int32_t", 0, "accelerometer_timestamp_relative"), ("float", 3, "accelerometer_m_s2"),
-    ("uint32_t", 0, "accelerometer_integral_dt"), ("uint8_t", 0, "accelerometer_clipping"),
-    ("uint8_t", 0, "gyro_clipping"), ("uint8_t", 0, "accel_calibration_count"),
-    ("uint8_t", 0, "gyro_calibration_count"))
+    ("uint64_t", 0, "timestamp"),
+    ("float", 3, "gyro_rad"),
+    ("uint32_t", 0, "gyro_integral_dt"),
+    ("int32_t", 0, "accelerometer_timestamp_relative"),
+    ("float", 3, "accelerometer_m_s2"),
+    ("uint32_t", 0, "accelerometer_integral_dt"),
+    ("uint8_t", 0, "accelerometer_clipping"),
+    ("uint8_t", 0, "gyro_clipping"),
+    ("uint8_t", 0, "accel_calibration_count"),
+    ("uint8_t", 0, "gyro_calibration_count"),
+)
 VEHICLE_STATUS = (
-    ("uint64_t", 0, "timestamp"), ("uint64_t", 0, "armed_time"), ("uint64_t", 0, "takeoff_time"),
-    ("uint8_t", 0, "arming_state"), ("uint8_t", 0, "nav_state"), ("uint8_t", 0, "vehicle_type"),
-    ("bool", 0, "is_vtol"), ("uint8_t", 0, "system_type"))
+    ("uint64_t", 0, "timestamp"),
+    ("uint64_t", 0, "armed_time"),
+    ("uint64_t", 0, "takeoff_time"),
+    ("uint8_t", 0, "arming_state"),
+    ("uint8_t", 0, "nav_state"),
+    ("uint8_t", 0, "vehicle_type"),
+    ("bool", 0, "is_vtol"),
+    ("uint8_t", 0, "system_type"),
+)
 VEHICLE_LAND_DETECTED = (
-    ("uint64_t", 0, "timestamp"), ("bool", 0, "freefall"), ("bool", 0, "ground_contact"),
-    ("bool", 0, "maybe_landed"), ("bool", 0, "landed"))
+    ("uint64_t", 0, "timestamp"),
+    ("bool", 0, "freefall"),
+    ("bool", 0, "ground_contact"),
+    ("bool", 0, "maybe_landed"),
+    ("bool", 0, "landed"),
+)
 ARMING_STATE_ARMED = 2
 """``vehicle_status.arming_state`` of an armed vehicle (PX4's ARMING_STATE_ARMED)."""
 MAV_TYPE_QUADROTOR = 2
@@ -110,7 +181,7 @@ def attitude_ned_frd(phi: np.ndarray, theta: np.ndarray, psi: np.ndarray) -> np.
     q = np.column_stack([xyzw[:, 3], xyzw[:, :3]])
     if len(q) and q[0, 0] < 0.0:
         q = -q
-    if len(q) > 1:                                                     # keep the hemisphere
+    if len(q) > 1:  # keep the hemisphere
         flips = np.cumprod(np.where(np.einsum("ij,ij->i", q[1:], q[:-1]) < 0.0, -1.0, 1.0))
         q[1:] *= flips[:, None]
     return q
@@ -155,11 +226,18 @@ def rotor_parameters(arm: float, yaw_per_thrust: float, max_thrust: float) -> di
         ``CA_ROTOR_COUNT`` and ``CA_ROTORi_{PX,PY,PZ,KM,CT}`` for i = 0..3 (rotor i + 1),
         ``MAV_TYPE``.
     """
-    flu = [(-arm, 0.0, -1.0), (0.0, arm, 1.0), (arm, 0.0, -1.0), (0.0, -arm, 1.0)]   # x, y, +1 = CCW
+    flu = [(-arm, 0.0, -1.0), (0.0, arm, 1.0), (arm, 0.0, -1.0), (0.0, -arm, 1.0)]  # x, y, +1 = CCW
     out: dict[str, float | int] = {"CA_ROTOR_COUNT": 4, "MAV_TYPE": MAV_TYPE_QUADROTOR}
     for i, (x, y, ccw) in enumerate(flu):
-        out.update({f"CA_ROTOR{i}_PX": x, f"CA_ROTOR{i}_PY": -y, f"CA_ROTOR{i}_PZ": 0.0,
-                    f"CA_ROTOR{i}_KM": ccw * yaw_per_thrust, f"CA_ROTOR{i}_CT": max_thrust})
+        out.update(
+            {
+                f"CA_ROTOR{i}_PX": x,
+                f"CA_ROTOR{i}_PY": -y,
+                f"CA_ROTOR{i}_PZ": 0.0,
+                f"CA_ROTOR{i}_KM": ccw * yaw_per_thrust,
+                f"CA_ROTOR{i}_CT": max_thrust,
+            }
+        )
     return out
 
 
@@ -169,8 +247,15 @@ def _every(t: np.ndarray, rate_hz: float) -> np.ndarray:
     return np.arange(0, len(t), k)
 
 
-def px4_topics(t: np.ndarray, states: np.ndarray, duties: np.ndarray, *, g: float,
-               noise_std: np.ndarray | None = None, rng: np.random.Generator | None = None) -> list[Topic]:
+def px4_topics(
+    t: np.ndarray,
+    states: np.ndarray,
+    duties: np.ndarray,
+    *,
+    g: float,
+    noise_std: np.ndarray | None = None,
+    rng: np.random.Generator | None = None,
+) -> list[Topic]:
     """One vehicle's flight as PX4 topics.
 
     Parameters
@@ -196,15 +281,15 @@ def px4_topics(t: np.ndarray, states: np.ndarray, duties: np.ndarray, *, g: floa
         ``vehicle_land_detected`` (airborne), at :data:`RATES_HZ`.
     """
     us = np.round(t * 1e6).astype(np.uint64)
-    accel = np.gradient(states[:, VX:VX + 3], t, axis=0, edge_order=2) if len(t) > 2 else np.zeros((len(t), 3))
-    rate_dot = np.gradient(states[:, P:P + 3], t, axis=0, edge_order=2) if len(t) > 2 else np.zeros((len(t), 3))
+    accel = np.gradient(states[:, VX : VX + 3], t, axis=0, edge_order=2) if len(t) > 2 else np.zeros((len(t), 3))
+    rate_dot = np.gradient(states[:, P : P + 3], t, axis=0, edge_order=2) if len(t) > 2 else np.zeros((len(t), 3))
     force = specific_force_frd(states, accel, g)
     seen = states.copy()
     if noise_std is not None and np.any(noise_std > 0.0):
         seen += rng.standard_normal(seen.shape) * noise_std
     q = attitude_ned_frd(seen[:, PHI], seen[:, THETA], seen[:, PSI])
-    pos, vel, acc = (seen[:, X:X + 3] @ ENU_TO_NED.T, seen[:, VX:VX + 3] @ ENU_TO_NED.T, accel @ ENU_TO_NED.T)
-    gyro = seen[:, P:P + 3] @ FLU_TO_FRD.T
+    pos, vel, acc = (seen[:, X : X + 3] @ ENU_TO_NED.T, seen[:, VX : VX + 3] @ ENU_TO_NED.T, accel @ ENU_TO_NED.T)
+    gyro = seen[:, P : P + 3] @ FLU_TO_FRD.T
     heading = np.arctan2(2.0 * (q[:, 0] * q[:, 3] + q[:, 1] * q[:, 2]), 1.0 - 2.0 * (q[:, 2] ** 2 + q[:, 3] ** 2))
     control = np.full((len(t), 12), np.nan)
     control[:, :4] = duties
@@ -216,21 +301,53 @@ def px4_topics(t: np.ndarray, states: np.ndarray, duties: np.ndarray, *, g: floa
 
     ones = np.ones(len(t), bool)
     return [
-        topic("vehicle_local_position", VEHICLE_LOCAL_POSITION, timestamp_sample=us, x=pos[:, 0], y=pos[:, 1],
-              z=pos[:, 2], vx=vel[:, 0], vy=vel[:, 1], vz=vel[:, 2], z_deriv=vel[:, 2], ax=acc[:, 0], ay=acc[:, 1],
-              az=acc[:, 2], heading=heading, xy_valid=ones, z_valid=ones, v_xy_valid=ones, v_z_valid=ones,
-              heading_good_for_control=ones, dist_bottom=-pos[:, 2]),
+        topic(
+            "vehicle_local_position",
+            VEHICLE_LOCAL_POSITION,
+            timestamp_sample=us,
+            x=pos[:, 0],
+            y=pos[:, 1],
+            z=pos[:, 2],
+            vx=vel[:, 0],
+            vy=vel[:, 1],
+            vz=vel[:, 2],
+            z_deriv=vel[:, 2],
+            ax=acc[:, 0],
+            ay=acc[:, 1],
+            az=acc[:, 2],
+            heading=heading,
+            xy_valid=ones,
+            z_valid=ones,
+            v_xy_valid=ones,
+            v_z_valid=ones,
+            heading_good_for_control=ones,
+            dist_bottom=-pos[:, 2],
+        ),
         topic("vehicle_attitude", VEHICLE_ATTITUDE, timestamp_sample=us, q=q),
-        topic("vehicle_angular_velocity", VEHICLE_ANGULAR_VELOCITY, timestamp_sample=us, xyz=gyro,
-              xyz_derivative=rate_dot @ FLU_TO_FRD.T),
+        topic(
+            "vehicle_angular_velocity",
+            VEHICLE_ANGULAR_VELOCITY,
+            timestamp_sample=us,
+            xyz=gyro,
+            xyz_derivative=rate_dot @ FLU_TO_FRD.T,
+        ),
         topic("actuator_motors", ACTUATOR_MOTORS, timestamp_sample=us, control=control),
-        topic("sensor_combined", SENSOR_COMBINED, gyro_rad=gyro, accelerometer_m_s2=force,
-              gyro_integral_dt=np.full(len(t), int(round(1e6 / RATES_HZ["sensor_combined"])))),
-        topic("vehicle_status", VEHICLE_STATUS, armed_time=np.zeros(len(t), np.uint64),
-              arming_state=np.full(len(t), ARMING_STATE_ARMED), system_type=np.full(len(t), MAV_TYPE_QUADROTOR),
-              vehicle_type=np.ones(len(t))),
-        topic("vehicle_land_detected", VEHICLE_LAND_DETECTED, landed=~ones, maybe_landed=~ones,
-              ground_contact=~ones),
+        topic(
+            "sensor_combined",
+            SENSOR_COMBINED,
+            gyro_rad=gyro,
+            accelerometer_m_s2=force,
+            gyro_integral_dt=np.full(len(t), int(round(1e6 / RATES_HZ["sensor_combined"]))),
+        ),
+        topic(
+            "vehicle_status",
+            VEHICLE_STATUS,
+            armed_time=np.zeros(len(t), np.uint64),
+            arming_state=np.full(len(t), ARMING_STATE_ARMED),
+            system_type=np.full(len(t), MAV_TYPE_QUADROTOR),
+            vehicle_type=np.ones(len(t)),
+        ),
+        topic("vehicle_land_detected", VEHICLE_LAND_DETECTED, landed=~ones, maybe_landed=~ones, ground_contact=~ones),
     ]
 
 
@@ -246,4 +363,4 @@ def duties_of(commands: np.ndarray) -> np.ndarray:
     -------
     ndarray, shape (L, 4)
     """
-    return np.clip(commands[:, CMD_U1:CMD_U1 + 4], 0.0, 1.0)
+    return np.clip(commands[:, CMD_U1 : CMD_U1 + 4], 0.0, 1.0)

@@ -146,8 +146,7 @@ class SimResult:
         ndarray, shape (N, L)
             The column, in its SI unit (a view, not a copy).
         """
-        for names, arr in ((STATE_NAMES, self.states), (REF_NAMES, self.references),
-                           (CMD_NAMES, self.commands)):
+        for names, arr in ((STATE_NAMES, self.states), (REF_NAMES, self.references), (CMD_NAMES, self.commands)):
             if name in names:
                 return arr[:, :, names.index(name)]
         raise InputError(f"unknown trace name {name!r}; known: {', '.join(STATE_NAMES + REF_NAMES + CMD_NAMES)}")
@@ -188,7 +187,7 @@ class SimResult:
         frame.insert(0, "vehicle", np.repeat(np.asarray(list(picks)), n_log))
         return frame
 
-    def decimate(self, every: int) -> "SimResult":
+    def decimate(self, every: int) -> SimResult:
         """A result holding every ``every``-th logged instant (the end state stays exact).
 
         Parameters
@@ -204,8 +203,13 @@ class SimResult:
         if int(every) != every or every < 1:
             raise InputError(f"decimation step must be a positive integer, got {every!r}")
         keep = slice(None, None, int(every))
-        return dataclasses.replace(self, t=self.t[keep], states=self.states[:, keep],
-                                   commands=self.commands[:, keep], references=self.references[:, keep])
+        return dataclasses.replace(
+            self,
+            t=self.t[keep],
+            states=self.states[:, keep],
+            commands=self.commands[:, keep],
+            references=self.references[:, keep],
+        )
 
     def metrics(self, **kwargs):
         """Per-vehicle metrics as a DataFrame.
@@ -303,14 +307,19 @@ class SimResult:
         std = np.zeros(states.shape[1])
         for key, first in (("position_std", 0), ("velocity_std", 3), ("angle_std", 6), ("rate_std", 9)):
             value = sensors.get(key, 0.0)
-            std[first:first + 3] = value[vehicle] if isinstance(value, (list, tuple)) else value
+            std[first : first + 3] = value[vehicle] if isinstance(value, (list, tuple)) else value
         seed = self.meta.get("seed") or 0
         rng = np.random.default_rng([int(seed), int(vehicle), NOISE_STREAM])
-        topics = px4_topics(t, states, duties_of(self.commands[vehicle][rows]), g=field_of("g", 9.81),
-                            noise_std=std, rng=rng)
+        topics = px4_topics(
+            t, states, duties_of(self.commands[vehicle][rows]), g=field_of("g", 9.81), noise_std=std, rng=rng
+        )
         params = rotor_parameters(field_of("l", 0.2), field_of("d", 0.0), field_of("K", 0.0))
-        write_ulog(path, topics, info={"sys_name": "quadcruise", "ver_sw": __version__, "ver_hw": "SIMULATION"},
-                   parameters=params)
+        write_ulog(
+            path,
+            topics,
+            info={"sys_name": "quadcruise", "ver_sw": __version__, "ver_hw": "SIMULATION"},
+            parameters=params,
+        )
         return Path(path)
 
     def summary(self) -> Summary:
@@ -341,8 +350,10 @@ class SimResult:
         }
         lines = [f"{self.n:,} vehicle(s) over {float(self.t[-1]) if self.t.size else 0.0:g} s"]
         lines += [f"  {count:>8,}  {reason}" for reason, count in reasons.items()]
-        lines.append(f"  rotor duties clipped for up to {data['duty_clipped_s']:.3f} s; "
-                     f"controller limits active for up to {data['controller_limited_s']:.3f} s")
+        lines.append(
+            f"  rotor duties clipped for up to {data['duty_clipped_s']:.3f} s; "
+            f"controller limits active for up to {data['controller_limited_s']:.3f} s"
+        )
         return Summary(data, "\n".join(lines))
 
     def write(self, out: str | os.PathLike, *, fmt: str = "csv", force: bool = False, metrics=None) -> Path:
@@ -405,8 +416,10 @@ class SimResult:
         scenario = self.meta.get("scenario") or {}
         doc = scenario_document(self.meta, title=scenario.get("title", ""))
         what = f"{self.meta.get('controller', {}).get('name', '?')} on {self.meta.get('mission', {}).get('kind', '?')}"
-        header = (f"written by quadcruise {self.meta.get('version', '')} from a flight of {what}; "
-                  f"`quadcruise fly THIS_FILE` flies it again")
+        header = (
+            f"written by quadcruise {self.meta.get('version', '')} from a flight of {what}; "
+            f"`quadcruise fly THIS_FILE` flies it again"
+        )
         if self.meta.get("command_line"):
             header += "\nthe command line changed: " + " ".join(self.meta["command_line"])
         return scenario_text(doc, header=header)
@@ -427,5 +440,3 @@ class SimResult:
         from quadcruise.io.plainjson import dumps
 
         return dumps({**self.meta, **{k: v for k, v in extra.items() if v is not None}}, indent=2, sort_keys=True)
-
-

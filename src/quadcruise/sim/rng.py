@@ -173,7 +173,7 @@ def ziggurat_tables(n: int = 256, r: float = ZIGGURAT_R, v: float = ZIGGURAT_V, 
     >>> ki.dtype, wi.shape, float(fi[0])
     (dtype('uint64'), (256,), 1.0)
     """
-    scale = 2.0 ** bits
+    scale = 2.0**bits
     ki, wi, fi = np.zeros(n, np.uint64), np.zeros(n), np.zeros(n)
     dn = tn = r
     fr = math.exp(-0.5 * r * r)
@@ -188,7 +188,7 @@ def ziggurat_tables(n: int = 256, r: float = ZIGGURAT_R, v: float = ZIGGURAT_V, 
     return ki, wi, fi
 
 
-_KI, _WI, _FI = ziggurat_tables()       # frozen into the compiled code as constants
+_KI, _WI, _FI = ziggurat_tables()  # frozen into the compiled code as constants
 _BYTE = uint64(0xFF)
 _MANTISSA = uint64(0x000FFFFFFFFFFFFF)
 
@@ -254,16 +254,16 @@ def ziggurat(s):
         x = float(rabs) * _WI[layer]
         if bits & uint64(1):
             x = -x
-        if rabs < _KI[layer]:              # inside the layer's rectangle: ~99 %
+        if rabs < _KI[layer]:  # inside the layer's rectangle: ~99 %
             return x, s
-        if layer == 0:                     # the tail beyond r (Marsaglia, 1964)
+        if layer == 0:  # the tail beyond r (Marsaglia, 1964)
             while True:
                 u1, s = next_unit(s)
                 u2, s = next_unit(s)
                 xx = -math.log1p(-u1) / ZIGGURAT_R
                 if -2.0 * math.log1p(-u2) > xx * xx:
                     return (-(ZIGGURAT_R + xx) if (rabs >> uint64(8)) & uint64(1) else ZIGGURAT_R + xx), s
-        u, s = next_unit(s)                 # the wedge: under the density?
+        u, s = next_unit(s)  # the wedge: under the density?
         if (_FI[layer - 1] - _FI[layer]) * u + _FI[layer] < math.exp(-0.5 * x * x):
             return x, s
 

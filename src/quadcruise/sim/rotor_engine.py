@@ -47,8 +47,9 @@ from quadcruise.sim.rotor_result import RotorResult
 from quadcruise.sim.status import ExitStatus
 
 FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, CRASHED = (
-    int(ExitStatus[name]) for name in ("FINISHED", "NONFINITE", "POSITION_BOUND", "SPEED_BOUND", "RATE_BOUND",
-                                       "CRASHED"))
+    int(ExitStatus[name])
+    for name in ("FINISHED", "NONFINITE", "POSITION_BOUND", "SPEED_BOUND", "RATE_BOUND", "CRASHED")
+)
 
 ROTOR_WORK_ROWS = 5
 """Rows of the RK4 workspace: the four stage derivatives and the stage state."""
@@ -156,7 +157,7 @@ def _replay_kernel(t, w_cmd, x0, rp, ext, max_step, limits, ground, touchdown, l
                     code = CRASHED
                     t_end = t[k] + (sub + 1) * h
                     break
-            if code == CRASHED:        # mid-interval: its state is x_final at t_stop, not row k + 1's
+            if code == CRASHED:  # mid-interval: its state is x_final at t_stop, not row k + 1's
                 break
             finite = True
             for j in range(size):
@@ -184,8 +185,19 @@ def _replay_kernel(t, w_cmd, x0, rp, ext, max_step, limits, ground, touchdown, l
         t_stop[i] = t_end
 
 
-def replay_rotor_speeds(t, w_cmd, x0, rp, *, ext=None, max_step: float = 1e-3, limits: Limits | None = None,
-                        touchdown_speed=None, names: tuple[str, ...] = (), meta: dict | None = None) -> RotorResult:
+def replay_rotor_speeds(
+    t,
+    w_cmd,
+    x0,
+    rp,
+    *,
+    ext=None,
+    max_step: float = 1e-3,
+    limits: Limits | None = None,
+    touchdown_speed=None,
+    names: tuple[str, ...] = (),
+    meta: dict | None = None,
+) -> RotorResult:
     """Fly N rotor-plant vehicles open loop through a schedule of rotor speeds.
 
     The array-level entry point that :func:`quadcruise.workflows.replay.replay_rotors` builds on.
@@ -252,11 +264,20 @@ def replay_rotor_speeds(t, w_cmd, x0, rp, *, ext=None, max_step: float = 1e-3, l
     status = np.zeros(N, dtype=np.int64)
     t_stop = np.empty(N)
     ground = touchdown_speed is not None
-    touchdown = np.ascontiguousarray(np.broadcast_to(np.inf if touchdown_speed is None else touchdown_speed, (N,)),
-                                     dtype=float)
+    touchdown = np.ascontiguousarray(
+        np.broadcast_to(np.inf if touchdown_speed is None else touchdown_speed, (N,)), dtype=float
+    )
     if ground and not np.all(touchdown > 0):
         raise InputError(f"touchdown speed must be > 0 m/s, got {touchdown_speed!r}")
-    _replay_kernel(t, w_cmd, x0, rp, ext, float(max_step), limits.array(), ground, touchdown, log_x, x_final,
-                   status, t_stop)
-    return RotorResult(t=t.copy(), states=log_x, final_state=x_final, status=status, t_stop=t_stop,
-                       names=tuple(names), meta=dict(meta or {}))
+    _replay_kernel(
+        t, w_cmd, x0, rp, ext, float(max_step), limits.array(), ground, touchdown, log_x, x_final, status, t_stop
+    )
+    return RotorResult(
+        t=t.copy(),
+        states=log_x,
+        final_state=x_final,
+        status=status,
+        t_stop=t_stop,
+        names=tuple(names),
+        meta=dict(meta or {}),
+    )

@@ -70,7 +70,7 @@ _REASONS = {
     ExitStatus.LOST_TRACK: "lost track: the position error left the tracking bound",
     ExitStatus.PITCH_SINGULAR: "stopped: pitch beyond 85 degrees, near the full plant's Euler-angle singularity",
     ExitStatus.OFF_TRACK: "off track: the position or altitude error after the transient (at the end, if it never "
-                          "settled) exceeded the steady bound",
+    "settled) exceeded the steady bound",
     ExitStatus.CRASHED: "crashed: hit the ground faster than the vehicle's touchdown speed, or upside down",
 }
 

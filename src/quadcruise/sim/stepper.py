@@ -101,28 +101,65 @@ class Stepper:
         flies alone, and ``step`` takes no commands).
     """
 
-    def __init__(self, t_grid, x0, vp, controller, gains, mission, mp, *, memory=None, vp_ctrl=None,
-                 disturbance=None, disturbance_params=None, disturbance_memory=None, seed: int = 0,
-                 first_vehicle=0, sensor_std=None, sensor_delay: int = 0, full_dynamics: bool = False,
-                 max_step: float = 1e-3, limits: Limits | None = None, periods: int = 1,
-                 setpoint_width: int = 0) -> None:
-        inp = batch_inputs(t_grid, x0, vp, gains, mp, memory=memory, vp_ctrl=vp_ctrl, disturbance=disturbance,
-                           disturbance_params=disturbance_params, disturbance_memory=disturbance_memory,
-                           seed=seed, first_vehicle=first_vehicle, sensor_std=sensor_std,
-                           sensor_delay=sensor_delay, max_step=max_step)
+    def __init__(
+        self,
+        t_grid,
+        x0,
+        vp,
+        controller,
+        gains,
+        mission,
+        mp,
+        *,
+        memory=None,
+        vp_ctrl=None,
+        disturbance=None,
+        disturbance_params=None,
+        disturbance_memory=None,
+        seed: int = 0,
+        first_vehicle=0,
+        sensor_std=None,
+        sensor_delay: int = 0,
+        full_dynamics: bool = False,
+        max_step: float = 1e-3,
+        limits: Limits | None = None,
+        periods: int = 1,
+        setpoint_width: int = 0,
+    ) -> None:
+        inp = batch_inputs(
+            t_grid,
+            x0,
+            vp,
+            gains,
+            mp,
+            memory=memory,
+            vp_ctrl=vp_ctrl,
+            disturbance=disturbance,
+            disturbance_params=disturbance_params,
+            disturbance_memory=disturbance_memory,
+            seed=seed,
+            first_vehicle=first_vehicle,
+            sensor_std=sensor_std,
+            sensor_delay=sensor_delay,
+            max_step=max_step,
+        )
         if int(periods) != periods or periods < 1:
             raise InputError(f"periods must be a whole number >= 1, got {periods!r}")
         self.n = n = inp["n"]
         if not (0 <= int(setpoint_width) <= inp["gains"].shape[1]):
-            raise InputError(f"setpoint_width must be in 0..{inp['gains'].shape[1]} (the gains' width), "
-                             f"got {setpoint_width!r}")
+            raise InputError(
+                f"setpoint_width must be in 0..{inp['gains'].shape[1]} (the gains' width), got {setpoint_width!r}"
+            )
         self.t_grid = inp["t_grid"]
         self.periods, self.setpoint_width = int(periods), int(setpoint_width)
         self.sensor_delay = int(sensor_delay)
         self.drawn = inp["drawn"]
         self.seed = int(seed)
-        self.first_vehicle = (np.arange(n) + int(first_vehicle) if np.ndim(first_vehicle) == 0
-                              else np.asarray(first_vehicle, dtype=np.int64).ravel().copy())
+        self.first_vehicle = (
+            np.arange(n) + int(first_vehicle)
+            if np.ndim(first_vehicle) == 0
+            else np.asarray(first_vehicle, dtype=np.int64).ravel().copy()
+        )
         self.vp, self.vp_ctrl, self.mp = inp["vp"], inp["vp_ctrl"], inp["mp"]
         self.gains = inp["gains"]
         self.disturbance_params = inp["disturbance_params"]
@@ -141,7 +178,10 @@ class Stepper:
         self.log_x = np.empty((n, rows, STATE_SIZE))
         self.log_cmd = np.empty((n, rows, CMD_SIZE))
         self.log_ref = np.empty((n, rows, REF_SIZE))
-        self.controller, self.mission = compiled_address(controller, CONTROLLER_SIG), compiled_address(mission, MISSION_SIG)
+        self.controller, self.mission = (
+            compiled_address(controller, CONTROLLER_SIG),
+            compiled_address(mission, MISSION_SIG),
+        )
         self.disturbance = compiled_address(disturbance or still_air, DISTURBANCE_SIG)
         self.disturbed = disturbance is not None
         self.full_dynamics, self.max_step = bool(full_dynamics), float(max_step)
@@ -192,15 +232,17 @@ class Stepper:
             start = self._x0[rows]
         else:
             start = np.asarray(x0, dtype=float)
-            start = np.broadcast_to(start, (k, STATE_SIZE)) if start.shape in ((STATE_SIZE,), (1, STATE_SIZE)) \
-                else start
+            start = (
+                np.broadcast_to(start, (k, STATE_SIZE)) if start.shape in ((STATE_SIZE,), (1, STATE_SIZE)) else start
+            )
             if start.shape != (k, STATE_SIZE) or not np.isfinite(start).all():
                 raise InputError(f"reset: x0 must be finite and of shape (16,) or ({k}, 16), got {np.shape(x0)}")
         if disturbance_memory is not None:
             dmem = np.asarray(disturbance_memory, dtype=float)
             if dmem.shape != (k, self._dmem0.shape[1]):
-                raise InputError(f"reset: disturbance_memory must have shape ({k}, {self._dmem0.shape[1]}), "
-                                 f"got {dmem.shape}")
+                raise InputError(
+                    f"reset: disturbance_memory must have shape ({k}, {self._dmem0.shape[1]}), got {dmem.shape}"
+                )
             self._dmem0[rows] = dmem
         self.state[rows] = start
         self.memory[rows] = self._mem0[rows]
@@ -267,15 +309,46 @@ class Stepper:
             if c.shape != (self.n, self.setpoint_width):
                 raise InputError(f"step: commands must have shape ({self.n}, {self.setpoint_width}), got {c.shape}")
             if not np.isfinite(c).all():
-                raise InputError("step: commands must be finite (row "
-                                 f"{int(np.flatnonzero(~np.isfinite(c).all(axis=1))[0])} is not)")
-            self.gains[:, :self.setpoint_width] = c
-        fly_vehicles(self.n, (self.t_grid, self.state, self.vp, self.vp_ctrl, self.controller, self.gains,
-                              self.memory, self.mission, self.mp, self.disturbance, self.disturbed,
-                              self.disturbance_params, self.disturbance_memory, self.rng, self.sensor_std,
-                              self.sensor_delay, self.full_dynamics, self.max_step, 1, self.limits,
-                              self.periods, self.clock, self.carry, self.log_x, self.log_cmd, self.log_ref,
-                              self.state, self.status, self.t_stop, self.saturated), STEP_PIECES_PER_THREAD)
+                raise InputError(
+                    f"step: commands must be finite (row {int(np.flatnonzero(~np.isfinite(c).all(axis=1))[0])} is not)"
+                )
+            self.gains[:, : self.setpoint_width] = c
+        fly_vehicles(
+            self.n,
+            (
+                self.t_grid,
+                self.state,
+                self.vp,
+                self.vp_ctrl,
+                self.controller,
+                self.gains,
+                self.memory,
+                self.mission,
+                self.mp,
+                self.disturbance,
+                self.disturbed,
+                self.disturbance_params,
+                self.disturbance_memory,
+                self.rng,
+                self.sensor_std,
+                self.sensor_delay,
+                self.full_dynamics,
+                self.max_step,
+                1,
+                self.limits,
+                self.periods,
+                self.clock,
+                self.carry,
+                self.log_x,
+                self.log_cmd,
+                self.log_ref,
+                self.state,
+                self.status,
+                self.t_stop,
+                self.saturated,
+            ),
+            STEP_PIECES_PER_THREAD,
+        )
 
 
 __all__ = ["Stepper"]

@@ -53,15 +53,33 @@ must pass (omega up to ~40 rad/s), and long enough to average gyro noise."""
 SHAPE_SPAN = 0.25
 """The least spread (5th to 95th percentile) of the rotor commands over which the thrust
 curve's shape f is fitted; over a narrower span u and u^2 cannot be told apart."""
-UNITS = {"K": "N", "Jxx": "kg m^2", "Jyy": "kg m^2", "Jzz": "kg m^2", "d": "m", "omega": "rad/s",
-         "hover_duty": "-", "thrust_curve_f": "-", "K_per_m": "N/kg", "Jxx_per_m": "m^2", "Jyy_per_m": "m^2",
-         "Jzz_per_m": "m^2"}
+UNITS = {
+    "K": "N",
+    "Jxx": "kg m^2",
+    "Jyy": "kg m^2",
+    "Jzz": "kg m^2",
+    "d": "m",
+    "omega": "rad/s",
+    "hover_duty": "-",
+    "thrust_curve_f": "-",
+    "K_per_m": "N/kg",
+    "Jxx_per_m": "m^2",
+    "Jyy_per_m": "m^2",
+    "Jzz_per_m": "m^2",
+}
 """Each parameter's unit."""
 
 
-def identify(log: str | os.PathLike | FlightLog, vehicle: Vehicle | None = None, *, mass: float | None = None,
-             frame: str | None = None, commands: str = "duty", holdout: float = 0.3,
-             progress: Callable[[int, int], None] | None = None) -> IdentifyResult:
+def identify(
+    log: str | os.PathLike | FlightLog,
+    vehicle: Vehicle | None = None,
+    *,
+    mass: float | None = None,
+    frame: str | None = None,
+    commands: str = "duty",
+    holdout: float = 0.3,
+    progress: Callable[[int, int], None] | None = None,
+) -> IdentifyResult:
     """Identify the paper's plant from a flight log by equation error; validate on a held-out tail.
 
     Parameters
@@ -102,8 +120,9 @@ def identify(log: str | os.PathLike | FlightLog, vehicle: Vehicle | None = None,
     """
     if isinstance(holdout, bool) or not isinstance(holdout, (int, float)) or not 0.05 <= holdout <= 0.6:
         raise InputError(f"holdout must be a fraction in [0.05, 0.6], got {holdout!r}")
-    if mass is not None and (isinstance(mass, bool) or not isinstance(mass, (int, float))
-                             or not math.isfinite(mass) or mass <= 0):
+    if mass is not None and (
+        isinstance(mass, bool) or not isinstance(mass, (int, float)) or not math.isfinite(mass) or mass <= 0
+    ):
         raise InputError(f"mass must be a positive number of kg, got {mass!r}")
     if vehicle is not None and not isinstance(vehicle, Vehicle):
         raise InputError(f"vehicle must be a quadcruise Vehicle, got {type(vehicle).__name__}")
@@ -118,8 +137,10 @@ def identify(log: str | os.PathLike | FlightLog, vehicle: Vehicle | None = None,
     rotors = flight.rotors
     if rotors is None:
         if flight.n_rotors != 4:
-            raise InputError(f"{flight.source}: {flight.n_rotors} rotor commands and no CA_ROTOR* geometry: "
-                             "the base vehicle has the paper's four '+' rotors")
+            raise InputError(
+                f"{flight.source}: {flight.n_rotors} rotor commands and no CA_ROTOR* geometry: "
+                "the base vehicle has the paper's four '+' rotors"
+            )
         arm = float(base.l)
         rotors = np.array([[-arm, 0.0, 1.0], [0.0, arm, -1.0], [arm, 0.0, 1.0], [0.0, -arm, -1.0]])
     g = float(base.g)
@@ -130,10 +151,11 @@ def identify(log: str | os.PathLike | FlightLog, vehicle: Vehicle | None = None,
     omega0 = float(base.omega)
     fit_rows, held = _split(flight, sig.window, omega0, holdout)
     if fit_rows.sum() * sig.dt < MIN_FIT_S or held.sum() * sig.dt < MIN_HELD_S:
-        raise InputError(f"{flight.source}: {flight.duration:.1f} s airborne is too short to fit and hold out "
-                         f"{holdout:g} of it")
+        raise InputError(
+            f"{flight.source}: {flight.duration:.1f} s airborne is too short to fit and hold out {holdout:g} of it"
+        )
     cmd_hz = _command_rate(flight)
-    lag_seen = cmd_hz >= 2.0 * omega0                         # a sample at least every tau/2
+    lag_seen = cmd_hz >= 2.0 * omega0  # a sample at least every tau/2
     u_fit = sig.u[fit_rows]
     span = float(np.percentile(u_fit, 95) - np.percentile(u_fit, 5))
     fit_shape = span >= SHAPE_SPAN
@@ -145,67 +167,111 @@ def identify(log: str | os.PathLike | FlightLog, vehicle: Vehicle | None = None,
     signal_share = _coupling_signal(flight, sig, fit_rows)
     signal_share.update(_command_signal(sig, fit_rows, rotors, result.omega))
     coupling = (signal_share["qr"] >= MIN_SIGNAL_SHARE, signal_share["pr"] >= MIN_SIGNAL_SHARE)
-    found = parameters(result, mass, flight.n_rotors, g,
-                       systematic=_sensitivity(flight, force_z, fit_rows, rotors, result, mass, g, cmd_hz, bounds,
-                                               coupling),
-                       coupling=coupling)
+    found = parameters(
+        result,
+        mass,
+        flight.n_rotors,
+        g,
+        systematic=_sensitivity(flight, force_z, fit_rows, rotors, result, mass, g, cmd_hz, bounds, coupling),
+        coupling=coupling,
+    )
     notes: dict[str, str] = {}
     cautions = []
     jittery = [a for a in ("roll", "pitch", "yaw") if signal_share[a] < CAUTION_SHARE]
     if jittery:
-        cautions.append("the " + ", ".join(f"{a} ({100 * (1 - signal_share[a]):.1f} %)" for a in jittery)
-                        + " commands carry sample-to-sample jitter: commands that change faster than they are "
-                          "logged bias Jzz and d low (errors in variables) beyond their intervals; see docs/identify.md")
+        cautions.append(
+            "the "
+            + ", ".join(f"{a} ({100 * (1 - signal_share[a]):.1f} %)" for a in jittery)
+            + " commands carry sample-to-sample jitter: commands that change faster than they are "
+            "logged bias Jzz and d low (errors in variables) beyond their intervals; see docs/identify.md"
+        )
     jitter_axes = {"roll": ("Jxx",), "pitch": ("Jyy",), "yaw": ("d",)}
     for axis, names in jitter_axes.items():
         if signal_share[axis] < MIN_SIGNAL_SHARE:
             for name in names:
                 key = name if mass is not None or name == "d" else f"{name}_per_m"
-                notes[key] = (f"the {axis} commands are {100 * (1 - signal_share[axis]):.0f} % sample-to-sample "
-                              "jitter (commands logged slower than they change): their effect is underestimated")
+                notes[key] = (
+                    f"the {axis} commands are {100 * (1 - signal_share[axis]):.0f} % sample-to-sample "
+                    "jitter (commands logged slower than they change): their effect is underestimated"
+                )
     jzz_key = "Jzz" if mass is not None else "Jzz_per_m"
     if signal_share["roll"] < MIN_SIGNAL_SHARE or signal_share["pitch"] < MIN_SIGNAL_SHARE:
         coupling = (False, False)
-        notes[jzz_key] = notes["d"] = ("Jzz and d come through the roll and pitch equations, whose commands are "
-                                       "jitter-dominated here (see Jxx, Jyy)")
+        notes[jzz_key] = notes["d"] = (
+            "Jzz and d come through the roll and pitch equations, whose commands are "
+            "jitter-dominated here (see Jxx, Jyy)"
+        )
     elif not any(coupling):
-        why = ("the gyroscopic terms that separate Jzz from d (q r, p r) are too noisy here: signal "
-               f"{100 * signal_share['qr']:.0f} % and {100 * signal_share['pr']:.0f} % of their variance, under "
-               f"{100 * MIN_SIGNAL_SHARE:.0f} % (roll or pitch while yawing to see them)")
+        why = (
+            "the gyroscopic terms that separate Jzz from d (q r, p r) are too noisy here: signal "
+            f"{100 * signal_share['qr']:.0f} % and {100 * signal_share['pr']:.0f} % of their variance, under "
+            f"{100 * MIN_SIGNAL_SHARE:.0f} % (roll or pitch while yawing to see them)"
+        )
         notes[jzz_key] = why
         notes["d"] = why
     excited = _excitation(sig.u[fit_rows], rotors)
-    needs = {"Jxx": ("roll",), "Jyy": ("pitch",), "Jzz": ("roll", "pitch"), "d": ("roll", "pitch", "yaw"),
-             "omega": ("thrust", "roll", "pitch", "yaw")}
+    needs = {
+        "Jxx": ("roll",),
+        "Jyy": ("pitch",),
+        "Jzz": ("roll", "pitch"),
+        "d": ("roll", "pitch", "yaw"),
+        "omega": ("thrust", "roll", "pitch", "yaw"),
+    }
     for name, axes in needs.items():
         key = name if name in found or name == "omega" else f"{name}_per_m"
         flat = [a for a in axes if excited[a] < MIN_EXCITATION]
         if (name == "omega" and len(flat) == len(axes)) or (name != "omega" and flat):
-            notes[key] = ("no variation on the " + " and ".join(flat) + " axis: the commands there vary by "
-                          + ", ".join(f"{100 * excited[a]:.2g} %" for a in flat) + " of their mean")
+            notes[key] = (
+                "no variation on the "
+                + " and ".join(flat)
+                + " axis: the commands there vary by "
+                + ", ".join(f"{100 * excited[a]:.2g} %" for a in flat)
+                + " of their mean"
+            )
     if not lag_seen:
-        notes["omega"] = (f"commands logged at {cmd_hz:g} Hz: too slow to see a rotor lag of {1 / omega0:.3g} s "
-                          "(a sample every half time constant at least)")
+        notes["omega"] = (
+            f"commands logged at {cmd_hz:g} Hz: too slow to see a rotor lag of {1 / omega0:.3g} s "
+            "(a sample every half time constant at least)"
+        )
     elif result.omega <= bounds[0] * 1.01 or result.omega >= bounds[1] * 0.99:
         found["omega"]["identifiable"] = False
         notes["omega"] = f"the fit ran to the end of its search interval {bounds[0]:g}..{bounds[1]:g} rad/s"
     if not fit_shape:
-        notes["thrust_curve_f"] = (f"the commands span only {span:.2f} (5th to 95th percentile): the thrust curve's "
-                                   f"shape is not seen; f fixed at {f0:g} (the log's THR_MDL_FAC, else 0)")
+        notes["thrust_curve_f"] = (
+            f"the commands span only {span:.2f} (5th to 95th percentile): the thrust curve's "
+            f"shape is not seen; f fixed at {f0:g} (the log's THR_MDL_FAC, else 0)"
+        )
     f0_source = "the log's THR_MDL_FAC" if "THR_MDL_FAC" in flight.parameters else "linear thrust, f = 0"
     table = _table(found, base, notes, f0, f0_source)
     report(4, len(STAGES), STAGES[3])
 
     validation, traces = validate(sig, held, result, rotors, flight, g)
     report(5, len(STAGES), STAGES[4])
-    return IdentifyResult(parameters=table, validation=validation, traces=traces, log=_log_info(flight, sig),
-                          fit={"rows": result.rows, "held_out_rows": int(held.sum()), "holdout": float(holdout),
-                               "window_samples": sig.window, "window_s": sig.window * sig.dt, "excitation": excited, "signal_share": signal_share, "cautions": cautions,
-                               "newey_west_bandwidth": result.bandwidth, "omega_fitted": result.omega_fitted,
-                               "omega_used": result.omega, "thrust_curve_fitted": fit_shape,
-                               "residual_std": result.sigma, "coefficients": dict(zip(result.names,
-                                                                                      result.values.tolist()))},
-                          base=base, mass=mass, rotors=rotors)
+    return IdentifyResult(
+        parameters=table,
+        validation=validation,
+        traces=traces,
+        log=_log_info(flight, sig),
+        fit={
+            "rows": result.rows,
+            "held_out_rows": int(held.sum()),
+            "holdout": float(holdout),
+            "window_samples": sig.window,
+            "window_s": sig.window * sig.dt,
+            "excitation": excited,
+            "signal_share": signal_share,
+            "cautions": cautions,
+            "newey_west_bandwidth": result.bandwidth,
+            "omega_fitted": result.omega_fitted,
+            "omega_used": result.omega,
+            "thrust_curve_fitted": fit_shape,
+            "residual_std": result.sigma,
+            "coefficients": dict(zip(result.names, result.values.tolist(), strict=False)),
+        },
+        base=base,
+        mass=mass,
+        rotors=rotors,
+    )
 
 
 def _excitation(u: np.ndarray, rotors: np.ndarray) -> dict[str, float]:
@@ -213,10 +279,12 @@ def _excitation(u: np.ndarray, rotors: np.ndarray) -> dict[str, float]:
     of each moment's command combination, relative to the mean rotor command (times the arm)."""
     mean = max(float(np.mean(u)), 1e-12)
     arm = max(float(np.mean(np.hypot(rotors[:, 0], rotors[:, 1]))), 1e-12)
-    return {"thrust": float(np.std(u.sum(1))) / (u.shape[1] * mean),
-            "roll": float(np.std(u @ rotors[:, 1])) / (arm * mean),
-            "pitch": float(np.std(u @ -rotors[:, 0])) / (arm * mean),
-            "yaw": float(np.std(u @ rotors[:, 2])) / mean}
+    return {
+        "thrust": float(np.std(u.sum(1))) / (u.shape[1] * mean),
+        "roll": float(np.std(u @ rotors[:, 1])) / (arm * mean),
+        "pitch": float(np.std(u @ -rotors[:, 0])) / (arm * mean),
+        "yaw": float(np.std(u @ rotors[:, 2])) / mean,
+    }
 
 
 def _coupling_signal(flight: FlightLog, sig, rows: np.ndarray) -> dict[str, float]:
@@ -232,8 +300,11 @@ def _coupling_signal(flight: FlightLog, sig, rows: np.ndarray) -> dict[str, floa
     raw = flight.rates[rows]
     out = {}
     for name, (a, b), col in (("qr", (1, 2), 0), ("pr", (0, 2), 1)):
-        noise_var = gain * (np.mean(raw[:, a] ** 2) * noise[b] ** 2 + np.mean(raw[:, b] ** 2) * noise[a] ** 2
-                            + noise[a] ** 2 * noise[b] ** 2)
+        noise_var = gain * (
+            np.mean(raw[:, a] ** 2) * noise[b] ** 2
+            + np.mean(raw[:, b] ** 2) * noise[a] ** 2
+            + noise[a] ** 2 * noise[b] ** 2
+        )
         total = float(np.var(sig.products[rows, col]))
         out[name] = max(0.0, 1.0 - noise_var / total) if total > 0 else 0.0
     return out
@@ -259,9 +330,10 @@ def _command_signal(sig, rows: np.ndarray, rotors: np.ndarray, omega: float) -> 
     impulse = np.zeros((2 * n, 1))
     impulse[n // 2, 0] = 1.0
     seg = np.zeros(2 * n, int)
-    response = smooth(lagged(impulse, seg, omega, sig.dt) - lagged(np.zeros_like(impulse), seg, omega, sig.dt),
-                      seg, sig.window)
-    gain = float(np.nansum(response ** 2))
+    response = smooth(
+        lagged(impulse, seg, omega, sig.dt) - lagged(np.zeros_like(impulse), seg, omega, sig.dt), seg, sig.window
+    )
+    gain = float(np.nansum(response**2))
     combos = {"roll": rotors[:, 1], "pitch": -rotors[:, 0], "yaw": rotors[:, 2]}
     out = {}
     for axis, weights in combos.items():
@@ -273,17 +345,27 @@ def _command_signal(sig, rows: np.ndarray, rotors: np.ndarray, omega: float) -> 
     return out
 
 
-def _sensitivity(flight, force_z, rows, rotors, result, mass, g, cmd_hz, bounds,
-                 coupling=(True, True)) -> dict[str, float]:
+def _sensitivity(
+    flight, force_z, rows, rotors, result, mass, g, cmd_hz, bounds, coupling=(True, True)
+) -> dict[str, float]:
     """Systematic half-ranges: each parameter refitted (1) with the commands shifted by half
     their logging interval either way (a log that samples its commands says when they changed
     to that much) and (2) with the filter window halved and doubled (the model holds at every
     time scale, or the estimate moves: commands that change faster than they are logged, unmodelled
     dynamics). The two half-ranges are combined in quadrature."""
+
     def refit(u, window_s):
         sig = signals(flight.t, flight.segment, u, flight.rates, force_z, window_s)
-        again = fit(sig, rows, rotors, result.omega, result.shape_f, fit_omega=result.omega_fitted,
-                    fit_shape="KQ" in result.names, omega_bounds=bounds)
+        again = fit(
+            sig,
+            rows,
+            rotors,
+            result.omega,
+            result.shape_f,
+            fit_omega=result.omega_fitted,
+            fit_shape="KQ" in result.names,
+            omega_bounds=bounds,
+        )
         return {k: v["value"] for k, v in parameters(again, mass, flight.n_rotors, g, coupling=coupling).items()}
 
     shift = 0.5 / cmd_hz
@@ -325,11 +407,11 @@ def _split(flight: FlightLog, window: int, omega0: float, holdout: float) -> tup
     usable = np.zeros(n, bool)
     for k in np.unique(flight.segment):
         idx = np.flatnonzero(flight.segment == k)
-        usable[idx[settle: len(idx) - window]] = True        # room for the doubled window too
+        usable[idx[settle : len(idx) - window]] = True  # room for the doubled window too
     cut = round(n * (1.0 - holdout))
     fit_rows, held = usable.copy(), usable.copy()
     fit_rows[cut:] = False
-    held[:cut + window] = False                          # a window's gap: no filtered sample in both
+    held[: cut + window] = False  # a window's gap: no filtered sample in both
     return fit_rows, held
 
 
@@ -341,8 +423,16 @@ def _command_rate(flight: FlightLog) -> float:
 
 
 def _table(found: dict, base: Vehicle, notes: dict, f0: float, f0_source: str) -> dict[str, dict]:
-    prior = {"K": base.K, "Jxx": base.Jxx, "Jyy": base.Jyy, "Jzz": base.Jzz, "d": base.d, "omega": base.omega,
-             "thrust_curve_f": f0, "hover_duty": base.hover_duty}
+    prior = {
+        "K": base.K,
+        "Jxx": base.Jxx,
+        "Jyy": base.Jyy,
+        "Jzz": base.Jzz,
+        "d": base.d,
+        "omega": base.omega,
+        "thrust_curve_f": f0,
+        "hover_duty": base.hover_duty,
+    }
     out: dict[str, dict[str, Any]] = {}
     order = list(found) + [n for n in ("omega", "thrust_curve_f") if n not in found]
     for name in order:
@@ -356,13 +446,16 @@ def _table(found: dict, base: Vehicle, notes: dict, f0: float, f0_source: str) -
             why = notes.get(name) or (entry or {}).get("inconsistent")
             if why is None and entry is not None:
                 half = Z95 * entry["se"] / abs(entry["value"]) if entry["value"] else float("inf")
-                why = (f"the log does not excite it enough: estimate {entry['value']:.4g} with a 95 % half-width of "
-                       f"{100 * half:.0f} %" if np.isfinite(half) else "no excitation")
+                why = (
+                    f"the log does not excite it enough: estimate {entry['value']:.4g} with a 95 % half-width of "
+                    f"{100 * half:.0f} %"
+                    if np.isfinite(half)
+                    else "no excitation"
+                )
             source = "base vehicle"
             if name == "thrust_curve_f":
                 source = f0_source
-            row.update(value=base_value, ci95=[None, None], identifiable=False,
-                       source=source, note=why or "not fitted")
+            row.update(value=base_value, ci95=[None, None], identifiable=False, source=source, note=why or "not fitted")
             if entry is not None:
                 row["estimate"] = entry["value"]
         out[name] = row
@@ -370,11 +463,19 @@ def _table(found: dict, base: Vehicle, notes: dict, f0: float, f0_source: str) -
 
 
 def _log_info(flight: FlightLog, sig) -> dict:
-    info = {"source": flight.source, "airborne_s": flight.duration, "segments": len(np.unique(flight.segment)),
-            "samples": len(flight.t), "grid_hz": 1.0 / sig.dt, "commands": flight.commands,
-            "resampling": flight.resampling, "topic_rates_hz": flight.rates_hz, "rotors": flight.n_rotors,
-            "rotor_geometry": "log (CA_ROTOR*)" if flight.rotors is not None else "base vehicle ('+', arm l)",
-            "parameters": flight.parameters}
+    info = {
+        "source": flight.source,
+        "airborne_s": flight.duration,
+        "segments": len(np.unique(flight.segment)),
+        "samples": len(flight.t),
+        "grid_hz": 1.0 / sig.dt,
+        "commands": flight.commands,
+        "resampling": flight.resampling,
+        "topic_rates_hz": flight.rates_hz,
+        "rotors": flight.n_rotors,
+        "rotor_geometry": "log (CA_ROTOR*)" if flight.rotors is not None else "base vehicle ('+', arm l)",
+        "parameters": flight.parameters,
+    }
     if flight.hover_thrust is not None:
         info["px4_hover_thrust_estimate"] = float(np.median(flight.hover_thrust[1]))
     return info

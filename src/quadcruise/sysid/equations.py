@@ -32,8 +32,11 @@ from scipy.signal import lfilter, savgol_coeffs
 
 CHANNELS = ("thrust", "roll", "pitch", "yaw")
 """The four regressions, in order."""
-ROTATION_TERMS = {"roll": ("k1", "b_roll", "c_roll"), "pitch": ("k3", "b_pitch", "c_pitch"),
-                  "yaw": ("k5", "b_yaw", "c_yaw")}
+ROTATION_TERMS = {
+    "roll": ("k1", "b_roll", "c_roll"),
+    "pitch": ("k3", "b_pitch", "c_pitch"),
+    "yaw": ("k5", "b_yaw", "c_yaw"),
+}
 """Each rotational regression's coefficients: coupling, effectiveness, trim."""
 
 
@@ -170,9 +173,17 @@ def signals(t, segment, u, rates, force_z, window_s: float) -> Signals:
     dt = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
     window = max(5, round(window_s / dt) | 1)
     p, q, r = rates.T
-    return Signals(t=t, segment=segment, u=np.clip(u, 0.0, 1.0), rates=smooth(rates, segment, window),
-                   rate_dot=smooth(rates, segment, window, deriv=1, dt=dt), force_z=smooth(force_z, segment, window),
-                   products=smooth(np.column_stack([q * r, p * r, p * q]), segment, window), window=window, dt=dt)
+    return Signals(
+        t=t,
+        segment=segment,
+        u=np.clip(u, 0.0, 1.0),
+        rates=smooth(rates, segment, window),
+        rate_dot=smooth(rates, segment, window, deriv=1, dt=dt),
+        force_z=smooth(force_z, segment, window),
+        products=smooth(np.column_stack([q * r, p * r, p * q]), segment, window),
+        window=window,
+        dt=dt,
+    )
 
 
 def lagged(u: np.ndarray, segment: np.ndarray, omega: float, dt: float) -> np.ndarray:
@@ -208,13 +219,14 @@ def lagged(u: np.ndarray, segment: np.ndarray, omega: float, dt: float) -> np.nd
     for k in np.unique(segment):
         rows = segment == k
         x = u[rows]
-        zi = (x[0] * (1.0 - a) - b * x[0])[None, :]             # steady state: y[-1] = x[0]
+        zi = (x[0] * (1.0 - a) - b * x[0])[None, :]  # steady state: y[-1] = x[0]
         out[rows] = lfilter([b, b], [1.0, -a], x, axis=0, zi=zi)[0]
     return out
 
 
-def regressions(sig: Signals, omega: float, shape_f: float | None, rotors: np.ndarray,
-                fit_shape: bool = False) -> dict[str, tuple[np.ndarray, np.ndarray, tuple[str, ...]]]:
+def regressions(
+    sig: Signals, omega: float, shape_f: float | None, rotors: np.ndarray, fit_shape: bool = False
+) -> dict[str, tuple[np.ndarray, np.ndarray, tuple[str, ...]]]:
     """The four regressions' data at a given rotor bandwidth.
 
     Parameters

@@ -86,7 +86,7 @@ class Fit:
         """
         out, k = {}, 0
         for c, width in self.widths:
-            out[c] = self.values[k:k + width]
+            out[c] = self.values[k : k + width]
             k += width
         return out
 
@@ -102,8 +102,9 @@ def _solve(y: np.ndarray, X: np.ndarray) -> np.ndarray:
     return beta
 
 
-def weighted_ssr(sig: Signals, rows: np.ndarray, omega: float, shape_f: float, rotors: np.ndarray,
-                 fit_shape: bool, sigma: dict) -> float:
+def weighted_ssr(
+    sig: Signals, rows: np.ndarray, omega: float, shape_f: float, rotors: np.ndarray, fit_shape: bool, sigma: dict
+) -> float:
     """The profile objective: sum over channels of SSR / sigma^2 at this omega.
 
     Parameters
@@ -134,8 +135,17 @@ def weighted_ssr(sig: Signals, rows: np.ndarray, omega: float, shape_f: float, r
     return total
 
 
-def fit(sig: Signals, rows: np.ndarray, rotors: np.ndarray, omega0: float, shape_f: float, *,
-        fit_omega: bool, fit_shape: bool, omega_bounds: tuple[float, float]) -> Fit:
+def fit(
+    sig: Signals,
+    rows: np.ndarray,
+    rotors: np.ndarray,
+    omega0: float,
+    shape_f: float,
+    *,
+    fit_omega: bool,
+    fit_shape: bool,
+    omega_bounds: tuple[float, float],
+) -> Fit:
     """Fit the four regressions (and omega), with the Newey-West covariance.
 
     Parameters
@@ -159,6 +169,7 @@ def fit(sig: Signals, rows: np.ndarray, rotors: np.ndarray, omega0: float, shape
     -------
     Fit
     """
+
     def residual_sigma(omega, f):
         out = {}
         for c, (y, X, _) in regressions(sig, omega, f, rotors, fit_shape).items():
@@ -171,9 +182,12 @@ def fit(sig: Signals, rows: np.ndarray, rotors: np.ndarray, omega0: float, shape
         sigma = residual_sigma(omega, f)
         if fit_omega:
             lo, hi = np.log(omega_bounds[0]), np.log(omega_bounds[1])
-            best = minimize_scalar(lambda lw, f=f, sigma=sigma: weighted_ssr(sig, rows, float(np.exp(lw)), f, rotors,
-                                                                              fit_shape, sigma),
-                                   bounds=(lo, hi), method="bounded", options={"xatol": 1e-4})
+            best = minimize_scalar(
+                lambda lw, f=f, sigma=sigma: weighted_ssr(sig, rows, float(np.exp(lw)), f, rotors, fit_shape, sigma),
+                bounds=(lo, hi),
+                method="bounded",
+                options={"xatol": 1e-4},
+            )
             omega = float(np.exp(best.x))
         if fit_shape:
             y, X, _ = regressions(sig, omega, f, rotors, True)["thrust"]
@@ -191,7 +205,7 @@ def fit(sig: Signals, rows: np.ndarray, rotors: np.ndarray, omega0: float, shape
     k = 0
     for c in CHANNELS:
         width = data[c][1].shape[1]
-        jac[c][:, k:k + width] = data[c][1][rows]
+        jac[c][:, k : k + width] = data[c][1][rows]
         k += width
     if fit_omega:
         h = 1e-3 * omega
@@ -209,8 +223,17 @@ def fit(sig: Signals, rows: np.ndarray, rotors: np.ndarray, omega0: float, shape
         gamma = (score[j:] * same).T @ score[:-j]
         meat += (1.0 - j / (lag + 1.0)) * (gamma + gamma.T)
     cov = sandwich(bread, meat)
-    return Fit(names=tuple(names), values=values, cov=cov, omega=omega, omega_fitted=fit_omega, shape_f=f,
-               sigma=sigma, bandwidth=lag, rows=n)
+    return Fit(
+        names=tuple(names),
+        values=values,
+        cov=cov,
+        omega=omega,
+        omega_fitted=fit_omega,
+        shape_f=f,
+        sigma=sigma,
+        bandwidth=lag,
+        rows=n,
+    )
 
 
 def sandwich(bread: np.ndarray, meat: np.ndarray, tol: float = 1e-10) -> np.ndarray:

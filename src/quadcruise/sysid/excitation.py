@@ -69,8 +69,17 @@ class ScheduleController:
         return np.zeros(1)
 
 
-def doublets(vehicle: Vehicle, *, rate: float = 1.0, spin: float = 1.5, accel: float = 1.0, pulse: float = 0.25,
-             rest: float = 0.75, dt: float = 1e-3, repeats: int = 2) -> tuple[np.ndarray, np.ndarray]:
+def doublets(
+    vehicle: Vehicle,
+    *,
+    rate: float = 1.0,
+    spin: float = 1.5,
+    accel: float = 1.0,
+    pulse: float = 0.25,
+    rest: float = 0.75,
+    dt: float = 1e-3,
+    repeats: int = 2,
+) -> tuple[np.ndarray, np.ndarray]:
     """The duty schedule of a doublet excitation around hover.
 
     Parameters
@@ -101,13 +110,17 @@ def doublets(vehicle: Vehicle, *, rate: float = 1.0, spin: float = 1.5, accel: f
     """
     u0 = float(vehicle.hover_duty)
     K, l, d = float(vehicle.K), float(vehicle.l), float(vehicle.d)
-    roll = rate / pulse * float(vehicle.Jxx) / (2 * l * K)          # duty step: p' = 2 l K a / Jxx
+    roll = rate / pulse * float(vehicle.Jxx) / (2 * l * K)  # duty step: p' = 2 l K a / Jxx
     pitch = rate / pulse * float(vehicle.Jyy) / (2 * l * K)
-    yaw_rate = rate / pulse * float(vehicle.Jzz) / (4 * d * K)     # r' = 4 d K b / Jzz
+    yaw_rate = rate / pulse * float(vehicle.Jzz) / (4 * d * K)  # r' = 4 d K b / Jzz
     spin_step = spin / (2 * pulse) * float(vehicle.Jzz) / (4 * d * K)
     lift = accel * float(vehicle.m) / (4 * K)
-    axes = {"roll": np.array([0.0, 1.0, 0.0, -1.0]) * roll, "pitch": np.array([1.0, 0.0, -1.0, 0.0]) * pitch,
-            "yaw": np.array([1.0, -1.0, 1.0, -1.0]), "thrust": np.ones(4) * lift}
+    axes = {
+        "roll": np.array([0.0, 1.0, 0.0, -1.0]) * roll,
+        "pitch": np.array([1.0, 0.0, -1.0, 0.0]) * pitch,
+        "yaw": np.array([1.0, -1.0, 1.0, -1.0]),
+        "thrust": np.ones(4) * lift,
+    }
     steps: list[tuple[float, np.ndarray]] = [(1.0, np.zeros(4))]
 
     def doublet(delta):
@@ -118,10 +131,10 @@ def doublets(vehicle: Vehicle, *, rate: float = 1.0, spin: float = 1.5, accel: f
         for name in ("roll", "pitch", "thrust"):
             doublet(axes[name])
         doublet(axes["yaw"] * yaw_rate)
-        steps.extend([(2 * pulse, sign * axes["yaw"] * spin_step), (rest, np.zeros(4))])      # spin up, hold
+        steps.extend([(2 * pulse, sign * axes["yaw"] * spin_step), (rest, np.zeros(4))])  # spin up, hold
         for name in ("roll", "pitch", "roll", "pitch"):
             doublet(axes[name])
-        steps.extend([(2 * pulse, -sign * axes["yaw"] * spin_step), (rest, np.zeros(4))])     # spin down
+        steps.extend([(2 * pulse, -sign * axes["yaw"] * spin_step), (rest, np.zeros(4))])  # spin down
     times = np.cumsum([0.0] + [s for s, _ in steps])
     t = np.arange(0.0, times[-1], dt)
     which = np.searchsorted(times, t, side="right") - 1

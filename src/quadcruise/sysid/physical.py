@@ -14,7 +14,8 @@ every rotor with ``n K s(u) = m g`` (level hover).
 
 The covariance of the coefficients carries over by the delta method (the mapping's Jacobian by
 central differences). A parameter is identifiable when its 95 % interval is finite and within
-:data:`RELATIVE_HALF_WIDTH` of its value (f: within :data:`SHAPE_HALF_WIDTH`); otherwise it is reported as not identifiable, with the
+:data:`RELATIVE_HALF_WIDTH` of its value (f: within :data:`SHAPE_HALF_WIDTH`); otherwise it is reported as not
+identifiable, with the
 base vehicle's value and no interval.
 """
 
@@ -101,9 +102,14 @@ def mapping(fit: Fit, mass: float | None, n_rotors: int, g: float, jzz_weights: 
         km = kl + kq
         jxx, jyy = km / v[idx["b_roll"]], km / v[idx["b_pitch"]]
         jzz = w1 * (jyy - v[idx["k1"]] * jxx) + w2 * (jxx + v[idx["k3"]] * jyy)
-        out = {f"K{suffix}": km * scale, f"Jxx{suffix}": jxx * scale, f"Jyy{suffix}": jyy * scale,
-               f"Jzz{suffix}": jzz * scale, "d": v[idx["b_yaw"]] * jzz / km,
-               "hover_duty": hover_command(kl, kq, n_rotors, g)}
+        out = {
+            f"K{suffix}": km * scale,
+            f"Jxx{suffix}": jxx * scale,
+            f"Jyy{suffix}": jyy * scale,
+            f"Jzz{suffix}": jzz * scale,
+            "d": v[idx["b_yaw"]] * jzz / km,
+            "hover_duty": hover_command(kl, kq, n_rotors, g),
+        }
         if "KQ" in idx:
             out["thrust_curve_f"] = kq / km
         if "omega" in idx:
@@ -147,9 +153,14 @@ def _jacobian(func, v):
     return names, np.array([base[n] for n in names]), jac
 
 
-def parameters(fit: Fit, mass: float | None, n_rotors: int, g: float,
-               systematic: dict[str, float] | None = None,
-               coupling: tuple[bool, bool] = (True, True)) -> dict[str, dict]:
+def parameters(
+    fit: Fit,
+    mass: float | None,
+    n_rotors: int,
+    g: float,
+    systematic: dict[str, float] | None = None,
+    coupling: tuple[bool, bool] = (True, True),
+) -> dict[str, dict]:
     """The physical parameters with 95 % intervals and identifiability.
 
     Parameters
@@ -190,9 +201,13 @@ def parameters(fit: Fit, mass: float | None, n_rotors: int, g: float,
     # the two estimates of Jzz must agree: if not, the gyroscopic terms do not fit the model (a
     # test of the over-determined part of the model, with their covariance)
     diff_var = float((rows[0] - rows[1]) @ finite @ (rows[0] - rows[1]))
-    consistent = not (all(np.isfinite(est)) and all(coupling) and diff_var > 0
-                      and abs(jzz[0] - jzz[1]) > CONSISTENCY_SIGMAS * np.sqrt(diff_var))
-    inv = [1.0 / v if v > 0 and np.isfinite(v) and ok else 0.0 for v, ok in zip(est, coupling)]
+    consistent = not (
+        all(np.isfinite(est))
+        and all(coupling)
+        and diff_var > 0
+        and abs(jzz[0] - jzz[1]) > CONSISTENCY_SIGMAS * np.sqrt(diff_var)
+    )
+    inv = [1.0 / v if v > 0 and np.isfinite(v) and ok else 0.0 for v, ok in zip(est, coupling, strict=False)]
     weights = (0.5, 0.5) if sum(inv) == 0 else (inv[0] / sum(inv), inv[1] / sum(inv))
     names, values, jac = jacobian(mapping(fit, mass, n_rotors, g, weights), fit.values)
     blind = ~np.isfinite(np.diag(fit.cov))
@@ -210,11 +225,14 @@ def parameters(fit: Fit, mass: float | None, n_rotors: int, g: float,
         se = float(np.sqrt(max(cov[i, i], 0.0) + extra * extra / 3.0))
         value = float(values[i])
         bound = SHAPE_HALF_WIDTH if name == "thrust_curve_f" else RELATIVE_HALF_WIDTH * abs(value)
-        ok = bool(np.isfinite(value) and np.isfinite(se) and (value != 0.0 or name == "thrust_curve_f")
-                  and Z95 * se <= bound)
+        ok = bool(
+            np.isfinite(value) and np.isfinite(se) and (value != 0.0 or name == "thrust_curve_f") and Z95 * se <= bound
+        )
         out[name] = {"value": value, "se": se, "ci95": [value - Z95 * se, value + Z95 * se], "identifiable": ok}
         if not consistent and (name.startswith("Jzz") or name == "d"):
-            out[name]["inconsistent"] = (f"roll's and pitch's gyroscopic terms give Jzz {jzz[0]:.4g} and {jzz[1]:.4g} "
-                                         f"(more than {CONSISTENCY_SIGMAS:g} standard errors apart): the log does not "
-                                         "fit the model there (commands changing faster than logged, a missing term)")
+            out[name]["inconsistent"] = (
+                f"roll's and pitch's gyroscopic terms give Jzz {jzz[0]:.4g} and {jzz[1]:.4g} "
+                f"(more than {CONSISTENCY_SIGMAS:g} standard errors apart): the log does not "
+                "fit the model there (commands changing faster than logged, a missing term)"
+            )
     return out

@@ -19,8 +19,14 @@ import numpy as np
 from quadcruise.metrics.summary import Summary
 from quadcruise.model.vehicle import Vehicle
 
-CHANNEL_LABELS = {"ax": "a_x world [m/s^2]", "ay": "a_y world [m/s^2]", "az": "a_z world [m/s^2]",
-                  "p_dot": "p' [rad/s^2]", "q_dot": "q' [rad/s^2]", "r_dot": "r' [rad/s^2]"}
+CHANNEL_LABELS = {
+    "ax": "a_x world [m/s^2]",
+    "ay": "a_y world [m/s^2]",
+    "az": "a_z world [m/s^2]",
+    "p_dot": "p' [rad/s^2]",
+    "q_dot": "q' [rad/s^2]",
+    "r_dot": "r' [rad/s^2]",
+}
 """The validated channels and how figures label them."""
 
 
@@ -102,9 +108,18 @@ class IdentifyResult:
         """
         import pandas as pd
 
-        rows = [{"parameter": k, "value": v["value"], "ci95_low": v["ci95"][0], "ci95_high": v["ci95"][1],
-                 "unit": v["unit"], "identifiable": v["identifiable"], "source": v["source"]}
-                for k, v in self.parameters.items()]
+        rows = [
+            {
+                "parameter": k,
+                "value": v["value"],
+                "ci95_low": v["ci95"][0],
+                "ci95_high": v["ci95"][1],
+                "unit": v["unit"],
+                "identifiable": v["identifiable"],
+                "source": v["source"],
+            }
+            for k, v in self.parameters.items()
+        ]
         return pd.DataFrame(rows)
 
     def summary(self) -> Summary:
@@ -116,8 +131,12 @@ class IdentifyResult:
             Keys ``parameters`` (name -> value), ``identifiable`` (names), ``hover_duty``,
             ``validation_r2`` (channel -> R^2); prints as a table.
         """
-        lines = [(f"{self.log['source']}: {self.log['airborne_s']:.1f} s airborne, "
-                 f"{'mass ' + format(self.mass, 'g') + ' kg' if self.mass is not None else 'no mass given'}")]
+        lines = [
+            (
+                f"{self.log['source']}: {self.log['airborne_s']:.1f} s airborne, "
+                f"{'mass ' + format(self.mass, 'g') + ' kg' if self.mass is not None else 'no mass given'}"
+            )
+        ]
         if self.mass is None:
             lines.append("  no mass: K and the inertias are per unit mass (_per_m)")
         for name, p in self.parameters.items():
@@ -129,9 +148,12 @@ class IdentifyResult:
         lines += [f"  caution: {c}" for c in self.fit.get("cautions", [])]
         r2 = {k: v["r2"] for k, v in self.validation.items() if k in CHANNEL_LABELS}
         lines.append("  held-out R^2: " + ", ".join(f"{k} {v:.3f}" for k, v in r2.items()))
-        data = {"parameters": {k: v["value"] for k, v in self.parameters.items()},
-                "identifiable": [k for k, v in self.parameters.items() if v["identifiable"]],
-                "hover_duty": self.hover_duty, "validation_r2": r2}
+        data = {
+            "parameters": {k: v["value"] for k, v in self.parameters.items()},
+            "identifiable": [k for k, v in self.parameters.items() if v["identifiable"]],
+            "hover_duty": self.hover_duty,
+            "validation_r2": r2,
+        }
         return Summary(data, "\n".join(lines))
 
     def plot(self):
@@ -146,7 +168,7 @@ class IdentifyResult:
         fig = Figure(figsize=(11, 6.5), layout="constrained")
         axes = fig.subplots(2, 3, sharex=True)
         t = self.traces["t"]
-        for ax, name in zip(axes.ravel(), CHANNEL_LABELS):
+        for ax, name in zip(axes.ravel(), CHANNEL_LABELS, strict=False):
             measured, predicted = self.traces[name]
             ax.plot(t, measured, lw=0.8, color="0.3", label="measured")
             ax.plot(t, predicted, lw=0.8, color="tab:red", label="predicted")
@@ -168,10 +190,19 @@ class IdentifyResult:
         """
         from quadcruise.io.plainjson import plain
 
-        return plain({"parameters": {k: {kk: vv for kk, vv in v.items()} for k, v in self.parameters.items()},
-                      "hover_duty": self.hover_duty, "mass_kg": self.mass, "per_unit_mass": self.mass is None,
-                      "validation": self.validation, "log": self.log, "fit": self.fit, "command": self.command,
-                      "base_vehicle": self.base.to_dict()})
+        return plain(
+            {
+                "parameters": {k: {kk: vv for kk, vv in v.items()} for k, v in self.parameters.items()},
+                "hover_duty": self.hover_duty,
+                "mass_kg": self.mass,
+                "per_unit_mass": self.mass is None,
+                "validation": self.validation,
+                "log": self.log,
+                "fit": self.fit,
+                "command": self.command,
+                "base_vehicle": self.base.to_dict(),
+            }
+        )
 
     def vehicle_toml(self) -> str:
         """The identified vehicle as a ``[vehicle]`` table.
@@ -188,13 +219,19 @@ class IdentifyResult:
         for name in ("K", "Jxx", "Jyy", "Jzz", "d", "omega"):
             key = name if self.mass is not None or name in ("d", "omega") else f"{name}_per_m"
             origin[name] = "identified" if self.parameters[key]["identifiable"] else "base vehicle"
-        head = [f"# identified from {self.log['source']} by quadcruise identify",
-                "# " + ", ".join(f"{k}: {s}" for k, s in origin.items()),
-                (f"# m: {'given' if self.mass is not None else 'base vehicle (no mass given: K, J scaled by it)'}"
-                f"; l: mean rotor distance of the {self.log['rotor_geometry']}")]
+        head = [
+            f"# identified from {self.log['source']} by quadcruise identify",
+            "# " + ", ".join(f"{k}: {s}" for k, s in origin.items()),
+            (
+                f"# m: {'given' if self.mass is not None else 'base vehicle (no mass given: K, J scaled by it)'}"
+                f"; l: mean rotor distance of the {self.log['rotor_geometry']}"
+            ),
+        ]
         if len(self.rotors) != 4:
-            head.append(f"# the log's vehicle has {len(self.rotors)} rotors, the paper's plant 4: K scaled by "
-                        f"{len(self.rotors)}/4 (same total thrust and hover; moments approximate)")
+            head.append(
+                f"# the log's vehicle has {len(self.rotors)} rotors, the paper's plant 4: K scaled by "
+                f"{len(self.rotors)}/4 (same total thrust and hover; moments approximate)"
+            )
         body = tomli_w.dumps({"vehicle": {"preset": "paper", **{k: float(x) for k, x in v.to_dict().items()}}})
         return "\n".join(head) + "\n" + body
 
@@ -205,38 +242,67 @@ class IdentifyResult:
         -------
         str
         """
-        lines = [f"# Identified vehicle: {Path(self.log['source']).name}", "",
-                 (f"- log: `{self.log['source']}`, {self.log['airborne_s']:.1f} s airborne in "
-                 f"{self.log['segments']} segment(s), on a {self.log['grid_hz']:.0f} Hz grid"),
-                 f"- resampling: {self.log['resampling']}", f"- commands: {self.log['commands']}",
-                 f"- rotor geometry: {self.log['rotor_geometry']}",
-                 f"- mass: {self.mass} kg" if self.mass is not None
-                 else "- mass: not given; K and the inertias are **per unit mass** (`_per_m`)",
-                 (f"- fit: first {1 - self.fit['holdout']:.0%} of the airborne samples ({self.fit['rows']}), "
-                 f"Savitzky-Golay window {self.fit['window_s']:.3f} s, Newey-West bandwidth "
-                 f"{self.fit['newey_west_bandwidth']} samples"), "",
-                 "| parameter | value | 95 % interval | unit | identifiable | note |", "|---|---|---|---|---|---|"]
+        lines = [
+            f"# Identified vehicle: {Path(self.log['source']).name}",
+            "",
+            (
+                f"- log: `{self.log['source']}`, {self.log['airborne_s']:.1f} s airborne in "
+                f"{self.log['segments']} segment(s), on a {self.log['grid_hz']:.0f} Hz grid"
+            ),
+            f"- resampling: {self.log['resampling']}",
+            f"- commands: {self.log['commands']}",
+            f"- rotor geometry: {self.log['rotor_geometry']}",
+            f"- mass: {self.mass} kg"
+            if self.mass is not None
+            else "- mass: not given; K and the inertias are **per unit mass** (`_per_m`)",
+            (
+                f"- fit: first {1 - self.fit['holdout']:.0%} of the airborne samples ({self.fit['rows']}), "
+                f"Savitzky-Golay window {self.fit['window_s']:.3f} s, Newey-West bandwidth "
+                f"{self.fit['newey_west_bandwidth']} samples"
+            ),
+            "",
+            "| parameter | value | 95 % interval | unit | identifiable | note |",
+            "|---|---|---|---|---|---|",
+        ]
         for name, p in self.parameters.items():
             ci = f"[{p['ci95'][0]:.4g}, {p['ci95'][1]:.4g}]" if p["identifiable"] else "-"
             value = f"{p['value']:.5g}" + ("" if p["identifiable"] else f" ({p['source']})")
-            lines.append(f"| {name} | {value} | {ci} | {p['unit']} | {'yes' if p['identifiable'] else 'no'} "
-                         f"| {p.get('note', '')} |")
+            lines.append(
+                f"| {name} | {value} | {ci} | {p['unit']} | {'yes' if p['identifiable'] else 'no'} "
+                f"| {p.get('note', '')} |"
+            )
         if self.fit.get("cautions"):
             lines += [""] + [f"**Caution**: {c}" for c in self.fit["cautions"]]
         if "px4_hover_thrust_estimate" in self.log:
-            lines += ["", (f"PX4's own hover_thrust_estimate in this log (median): "
-                          f"{self.log['px4_hover_thrust_estimate']:.4f}")]
-        lines += ["", f"## Held-out validation (last {self.fit['holdout']:.0%})", "",
-                  "| channel | R² | RMSE | unit |", "|---|---|---|---|"]
+            lines += [
+                "",
+                (f"PX4's own hover_thrust_estimate in this log (median): {self.log['px4_hover_thrust_estimate']:.4f}"),
+            ]
+        lines += [
+            "",
+            f"## Held-out validation (last {self.fit['holdout']:.0%})",
+            "",
+            "| channel | R² | RMSE | unit |",
+            "|---|---|---|---|",
+        ]
         for name in CHANNEL_LABELS:
             v = self.validation[name]
             lines.append(f"| {name} | {v['r2']:.4f} | {v['rmse']:.4g} | {v['unit']} |")
         low = [name for name in CHANNEL_LABELS if not self.validation[name]["r2"] >= 0.5]
         if low:
-            lines += ["", (f"R² below 0.5 on {', '.join(low)}: the held-out tail moves little there (or the model "
-                           "misses something); read the RMSE against the sensors' noise before trusting either.")]
+            lines += [
+                "",
+                (
+                    f"R² below 0.5 on {', '.join(low)}: the held-out tail moves little there (or the model "
+                    "misses something); read the RMSE against the sensors' noise before trusting either."
+                ),
+            ]
         ol = self.validation["open_loop"]
-        lines += ["", f"Open loop over {ol['windows']} windows of {ol['window_s']:.3f} s (rates at the window's end):", ""]
+        lines += [
+            "",
+            f"Open loop over {ol['windows']} windows of {ol['window_s']:.3f} s (rates at the window's end):",
+            "",
+        ]
         for name in "pqr":
             if name in ol:
                 lines.append(f"- {name}: R² {ol[name]['r2']:.4f}, RMSE {ol[name]['rmse']:.4g} rad/s")
@@ -271,9 +337,15 @@ class IdentifyResult:
             (tmp / "vehicle.toml").write_text(self.vehicle_toml())
             (tmp / "report.md").write_text(self.report_md())
             self.plot().savefig(tmp / "fit.png", dpi=110)
-            marker: dict[str, Any] = {"workflow": "identify", "version": __version__, "command": self.command,
-                                      "log": self.log["source"], "mass_kg": self.mass,
-                                      "holdout": self.fit["holdout"], "commands": self.log["commands"],
-                                      "base_vehicle": self.base.to_dict()}
+            marker: dict[str, Any] = {
+                "workflow": "identify",
+                "version": __version__,
+                "command": self.command,
+                "log": self.log["source"],
+                "mass_kg": self.mass,
+                "holdout": self.fit["holdout"],
+                "commands": self.log["commands"],
+                "base_vehicle": self.base.to_dict(),
+            }
             (tmp / MARKER).write_text(json.dumps(marker, indent=2) + "\n")
         return out

@@ -82,7 +82,7 @@ def validate(sig, held: np.ndarray, fit: Fit, rotors: np.ndarray, flight, g: flo
     for j, name in enumerate(("ax", "ay", "az")):
         out[name] = {**scores(accel[held, j], world[held, j]), "unit": "m/s^2"}
         traces[name] = (accel[held, j], world[held, j])
-    for j, (name, c) in enumerate((("p_dot", "roll"), ("q_dot", "pitch"), ("r_dot", "yaw"))):
+    for name, c in (("p_dot", "roll"), ("q_dot", "pitch"), ("r_dot", "yaw")):
         out[name] = {**scores(data[c][0][held], pred[c][held]), "unit": "rad/s^2"}
         traces[name] = (data[c][0][held], pred[c][held])
     out["open_loop"] = open_loop(sig, held, data, beta)
@@ -111,8 +111,11 @@ def open_loop(sig, held: np.ndarray, data: dict, beta: dict) -> dict:
     """
     steps = max(1, round(WINDOW_S / sig.dt))
     idx = np.flatnonzero(held)
-    starts = [i for i in idx[::steps] if i + steps < len(sig.t) and held[i + steps]
-              and sig.segment[i + steps] == sig.segment[i]]
+    starts = [
+        i
+        for i in idx[::steps]
+        if i + steps < len(sig.t) and held[i + steps] and sig.segment[i + steps] == sig.segment[i]
+    ]
     effect = {c: data[c][1][:, 1] * beta[c][1] + beta[c][2] for c in ("roll", "pitch", "yaw")}
     k = (beta["roll"][0], beta["pitch"][0], beta["yaw"][0])
     ends, truth = [], []
@@ -120,8 +123,9 @@ def open_loop(sig, held: np.ndarray, data: dict, beta: dict) -> dict:
         w = sig.rates[i].copy()
         for s in range(i, i + steps):
             p, q, r = w
-            w = w + sig.dt * np.array([k[0] * q * r + effect["roll"][s], k[1] * p * r + effect["pitch"][s],
-                                       k[2] * p * q + effect["yaw"][s]])
+            w = w + sig.dt * np.array(
+                [k[0] * q * r + effect["roll"][s], k[1] * p * r + effect["pitch"][s], k[2] * p * q + effect["yaw"][s]]
+            )
         ends.append(w)
         truth.append(sig.rates[i + steps])
     out: dict = {"window_s": steps * sig.dt, "windows": len(starts)}

@@ -197,8 +197,13 @@ class Objective:
         for key in ("status", "failure", "diverged", "lost_track"):
             metrics[key] = np.asarray(cols[key]).reshape(p, m)
         flight_cost = self.flight_cost(metrics)
-        ev = Evaluation(values=values, cost=self.reduce(flight_cost), flight_cost=flight_cost, metrics=metrics,
-                        wall_s=time.perf_counter() - start)
+        ev = Evaluation(
+            values=values,
+            cost=self.reduce(flight_cost),
+            flight_cost=flight_cost,
+            metrics=metrics,
+            wall_s=time.perf_counter() - start,
+        )
         self.evaluations.append(ev)
         return ev
 

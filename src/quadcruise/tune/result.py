@@ -86,7 +86,7 @@ class TuneResult:
     info: dict = field(default_factory=dict)
 
     @classmethod
-    def from_search(cls, obj, *, budget: int, popsize: int, command: str = "") -> "TuneResult":
+    def from_search(cls, obj, *, budget: int, popsize: int, command: str = "") -> TuneResult:
         """The result of a search from its objective, which kept every generation flown.
 
         Parameters
@@ -113,34 +113,69 @@ class TuneResult:
         k_gen = int(np.argmin([e.cost.min() for e in evs]))
         ev = evs[k_gen]
         k = int(np.argmin(ev.cost))
-        controller = obj.space.controllers(ev.values[k:k + 1])[0]
+        controller = obj.space.controllers(ev.values[k : k + 1])[0]
         rows = []
         for g, e in enumerate(evs):
             for i in range(e.values.shape[0]):
-                rows.append({"generation": g, "candidate": i, **dict(zip(obj.space.names, e.values[i])),
-                             "cost": float(e.cost[i])})
-        flights = pd.DataFrame({"sample": np.arange(obj.samples),
-                                **{m: ev.metrics[m][k] for m in METRICS},
-                                "status": ev.metrics["status"][k], "cost": ev.flight_cost[k]})
+                rows.append(
+                    {
+                        "generation": g,
+                        "candidate": i,
+                        **dict(zip(obj.space.names, e.values[i], strict=False)),
+                        "cost": float(e.cost[i]),
+                    }
+                )
+        flights = pd.DataFrame(
+            {
+                "sample": np.arange(obj.samples),
+                **{m: ev.metrics[m][k] for m in METRICS},
+                "status": ev.metrics["status"][k],
+                "cost": ev.flight_cost[k],
+            }
+        )
         spec = obj.spec
-        kw = dict(vehicle=spec.vehicle, controller_vehicle=spec.controller_vehicle, duration=spec.duration,
-                  dt=spec.dt, seed=spec.seed,
-                  environment=spec.population.environment, sensors=spec.population.noise)
+        kw = dict(
+            vehicle=spec.vehicle,
+            controller_vehicle=spec.controller_vehicle,
+            duration=spec.duration,
+            dt=spec.dt,
+            seed=spec.seed,
+            environment=spec.population.environment,
+            sensors=spec.population.noise,
+        )
         import warnings
 
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             response = fly(spec.mission, controller, **kw)
             start_response = fly(spec.mission, obj.space.base, **kw)
-        info = {"samples": obj.samples, "popsize": popsize, "budget": budget, "generations": len(evs) - 1,
-                "flights": int(sum(e.values.shape[0] for e in evs) * obj.samples),
-                "wall_s": float(sum(e.wall_s for e in evs)), "command": command}
-        return cls(controller=controller, start=obj.space.base, gains=obj.space.describe(controller),
-                   start_gains=obj.space.describe(obj.space.base),
-                   bounds={g.name: (g.low, g.high, "log" if g.log else "linear") for g in obj.space.gains},
-                   targets=obj.targets, requirements=obj.requirements, minimize=obj.minimize,
-                   statistic=obj.statistic, cost=float(ev.cost[k]), flights=flights, history=pd.DataFrame(rows),
-                   response=response, start_response=start_response, spec=spec, info=info)
+        info = {
+            "samples": obj.samples,
+            "popsize": popsize,
+            "budget": budget,
+            "generations": len(evs) - 1,
+            "flights": int(sum(e.values.shape[0] for e in evs) * obj.samples),
+            "wall_s": float(sum(e.wall_s for e in evs)),
+            "command": command,
+        }
+        return cls(
+            controller=controller,
+            start=obj.space.base,
+            gains=obj.space.describe(controller),
+            start_gains=obj.space.describe(obj.space.base),
+            bounds={g.name: (g.low, g.high, "log" if g.log else "linear") for g in obj.space.gains},
+            targets=obj.targets,
+            requirements=obj.requirements,
+            minimize=obj.minimize,
+            statistic=obj.statistic,
+            cost=float(ev.cost[k]),
+            flights=flights,
+            history=pd.DataFrame(rows),
+            response=response,
+            start_response=start_response,
+            spec=spec,
+            info=info,
+        )
 
     # --- what was reached --------------------------------------------------------------
     @property
@@ -178,14 +213,30 @@ class TuneResult:
         out = []
         for t in self.targets:
             value = self.reached(t.metric)
-            out.append({"kind": "target", "metric": t.metric, "text": f"{t.value:g} +- {t.tolerance:g}",
-                        "target": t.value, "tolerance": t.tolerance, "reached": value,
-                        "met": value is not None and bool(t.met(value))})
+            out.append(
+                {
+                    "kind": "target",
+                    "metric": t.metric,
+                    "text": f"{t.value:g} +- {t.tolerance:g}",
+                    "target": t.value,
+                    "tolerance": t.tolerance,
+                    "reached": value,
+                    "met": value is not None and bool(t.met(value)),
+                }
+            )
         for r in self.requirements:
             value = self.reached(r.metric)
-            out.append({"kind": "requirement", "metric": r.metric, "text": f"{r.op} {r.value:g}",
-                        "bound": r.value, "op": r.op, "reached": value,
-                        "met": value is not None and bool(r.met(value))})
+            out.append(
+                {
+                    "kind": "requirement",
+                    "metric": r.metric,
+                    "text": f"{r.op} {r.value:g}",
+                    "bound": r.value,
+                    "op": r.op,
+                    "reached": value,
+                    "met": value is not None and bool(r.met(value)),
+                }
+            )
         for m in self.minimize:
             out.append({"kind": "minimize", "metric": m, "text": "minimize", "reached": self.reached(m), "met": True})
         return out
@@ -211,12 +262,26 @@ class TuneResult:
             ``checks`` (each target, requirement and minimised metric: reached, met), ``met``,
             ``cost``, ``objective``, ``seed`` and the run's ``info``.
         """
-        data = {"controller": self.controller.name, "mission": self.spec.mission.name,
-                "gains": {n: {"start": self.start_gains[n], "tuned": v, "low": self.bounds[n][0],
-                              "high": self.bounds[n][1], "scale": self.bounds[n][2]} for n, v in self.gains.items()},
-                "checks": self._checks(), "met": self.met, "cost": self.cost,
-                "objective": self.statistic if self.statistic == "worst" else f"quantile {self.statistic:g}",
-                "seed": self.spec.seed, "info": dict(self.info)}
+        data = {
+            "controller": self.controller.name,
+            "mission": self.spec.mission.name,
+            "gains": {
+                n: {
+                    "start": self.start_gains[n],
+                    "tuned": v,
+                    "low": self.bounds[n][0],
+                    "high": self.bounds[n][1],
+                    "scale": self.bounds[n][2],
+                }
+                for n, v in self.gains.items()
+            },
+            "checks": self._checks(),
+            "met": self.met,
+            "cost": self.cost,
+            "objective": self.statistic if self.statistic == "worst" else f"quantile {self.statistic:g}",
+            "seed": self.spec.seed,
+            "info": dict(self.info),
+        }
         return Summary(data, self.summary_text(data))
 
     def summary_text(self, data: dict | None = None) -> str:
@@ -234,18 +299,26 @@ class TuneResult:
         data = data or self.summary().to_dict()
         info = data["info"]
         over = f"; the {data['objective']} of {info['samples']} vehicles" if info["samples"] > 1 else ""
-        lines = [f"tuned {data['controller']} on {data['mission']}: {info['generations']} generations, "
-                 f"{info['flights']:,} flights in {info['wall_s']:.1f} s (seed {data['seed']}){over}",
-                 f"{'gain':<22}{'start':>10}{'tuned':>12}  bounds"]
+        lines = [
+            f"tuned {data['controller']} on {data['mission']}: {info['generations']} generations, "
+            f"{info['flights']:,} flights in {info['wall_s']:.1f} s (seed {data['seed']}){over}",
+            f"{'gain':<22}{'start':>10}{'tuned':>12}  bounds",
+        ]
         for name, g in data["gains"].items():
-            lines.append(f"{name:<22}{_fmt(g['start']):>10}{_fmt(g['tuned'], '.5g'):>12}  "
-                         f"[{g['low']:.4g}, {g['high']:.4g}] {g['scale']}")
+            lines.append(
+                f"{name:<22}{_fmt(g['start']):>10}{_fmt(g['tuned'], '.5g'):>12}  "
+                f"[{g['low']:.4g}, {g['high']:.4g}] {g['scale']}"
+            )
         lines.append(f"{'metric':<22}{'wanted':>16}{'reached':>10}  met")
         for c in data["checks"]:
-            lines.append(f"{c['metric']:<22}{c['text']:>16}{_fmt(c['reached']):>10}  "
-                         f"{'-' if c['kind'] == 'minimize' else ('yes' if c['met'] else 'NO')}")
-        lines.append(f"cost {data['cost']:.4g}; " + ("every target and requirement met" if data["met"]
-                                                     else "not every target or requirement met"))
+            lines.append(
+                f"{c['metric']:<22}{c['text']:>16}{_fmt(c['reached']):>10}  "
+                f"{'-' if c['kind'] == 'minimize' else ('yes' if c['met'] else 'NO')}"
+            )
+        lines.append(
+            f"cost {data['cost']:.4g}; "
+            + ("every target and requirement met" if data["met"] else "not every target or requirement met")
+        )
         return "\n".join(lines)
 
     def plot(self):
@@ -275,13 +348,23 @@ class TuneResult:
         pop = self.spec.population
         spreads = {k: getattr(pop, k) for k in (*SPREADS, "offset", "wind_spread") if getattr(pop, k)}
         if spreads or self.info["samples"] > 1:
-            doc["montecarlo"] = {**spreads, "distribution": pop.distribution, "model_error": pop.model_error,
-                                 "n": self.info["samples"], "seed": self.spec.seed}
-        wanted = ", ".join([t.text for t in self.targets] + [r.text for r in self.requirements]
-                           + [f"minimize {m}" for m in self.minimize])
-        header = (f"tuned by quadcruise {__version__} for {wanted}\n"
-                  + (f"regenerate: {self.info['command']}\n" if self.info.get("command") else "")
-                  + "`quadcruise fly THIS_FILE` flies the tuned gains")
+            doc["montecarlo"] = {
+                **spreads,
+                "distribution": pop.distribution,
+                "model_error": pop.model_error,
+                "n": self.info["samples"],
+                "seed": self.spec.seed,
+            }
+        wanted = ", ".join(
+            [t.text for t in self.targets]
+            + [r.text for r in self.requirements]
+            + [f"minimize {m}" for m in self.minimize]
+        )
+        header = (
+            f"tuned by quadcruise {__version__} for {wanted}\n"
+            + (f"regenerate: {self.info['command']}\n" if self.info.get("command") else "")
+            + "`quadcruise fly THIS_FILE` flies the tuned gains"
+        )
         return scenario_text(doc, header=header)
 
     def to_json(self) -> dict:
@@ -324,8 +407,16 @@ class TuneResult:
             self.history.to_csv(tmp / "history.csv", index=False)
             self.flights.to_csv(tmp / "flights.csv", index=False)
             save_figure(self.plot(), tmp / "tune.png")
-            (tmp / MARKER).write_text(dumps({"workflow": "tune", "version": __version__,
-                                             "command": self.info.get("command", ""),
-                                             "spec": self.spec.to_dict() if hasattr(self.spec, "to_dict") else {}},
-                                            indent=2) + "\n")
+            (tmp / MARKER).write_text(
+                dumps(
+                    {
+                        "workflow": "tune",
+                        "version": __version__,
+                        "command": self.info.get("command", ""),
+                        "spec": self.spec.to_dict() if hasattr(self.spec, "to_dict") else {},
+                    },
+                    indent=2,
+                )
+                + "\n"
+            )
         return out

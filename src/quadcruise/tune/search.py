@@ -22,7 +22,8 @@ from __future__ import annotations
 import inspect
 import time
 import warnings
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -44,20 +45,57 @@ ABS_TOL = 1e-3
 ``atol``): a cost of 1e-3 is a miss of 3 % of a target's tolerance, and targets that can all be
 met exactly would otherwise never stop a relative test."""
 
-TUNE_OPTIONS = ("gains", "bounds", "targets", "require", "minimize", "population", "samples", "objective",
-                "seed", "budget", "popsize", "tol", "duration", "dt", "vehicle", "controller_vehicle", "log_dt",
-                "transient_until",
-                "progress", "command")
+TUNE_OPTIONS = (
+    "gains",
+    "bounds",
+    "targets",
+    "require",
+    "minimize",
+    "population",
+    "samples",
+    "objective",
+    "seed",
+    "budget",
+    "popsize",
+    "tol",
+    "duration",
+    "dt",
+    "vehicle",
+    "controller_vehicle",
+    "log_dt",
+    "transient_until",
+    "progress",
+    "command",
+)
 """The keywords :func:`tune` takes besides the mission and the controller."""
 
 
-def tune(mission: Mission | str = "step", controller: Any = "nlpd", *, gains=None, bounds=None, targets=(),
-         require=(), minimize=(), population: Population | None = None, samples: int = 1,
-         objective: str | float = "worst", seed: int = 0, budget: int = 100, popsize: int | None = None,
-         tol: float = 0.01, duration: float | None = None, dt: float = 1e-3, vehicle: Vehicle | None = None,
-         controller_vehicle: Vehicle | None = None, log_dt: float = 0.01, transient_until: float | None = None,
-         progress: Callable[[int, int, str], None] | None = None, command: str = "",
-         **unknown: Any) -> TuneResult:
+def tune(
+    mission: Mission | str = "step",
+    controller: Any = "nlpd",
+    *,
+    gains=None,
+    bounds=None,
+    targets=(),
+    require=(),
+    minimize=(),
+    population: Population | None = None,
+    samples: int = 1,
+    objective: str | float = "worst",
+    seed: int = 0,
+    budget: int = 100,
+    popsize: int | None = None,
+    tol: float = 0.01,
+    duration: float | None = None,
+    dt: float = 1e-3,
+    vehicle: Vehicle | None = None,
+    controller_vehicle: Vehicle | None = None,
+    log_dt: float = 0.01,
+    transient_until: float | None = None,
+    progress: Callable[[int, int, str], None] | None = None,
+    command: str = "",
+    **unknown: Any,
+) -> TuneResult:
     """Tune a controller's gains, within bounds, towards targets on its metrics.
 
     Parameters
@@ -134,7 +172,7 @@ def tune(mission: Mission | str = "step", controller: Any = "nlpd", *, gains=Non
     targets, requirements, minimize = parse_targets(targets), parse_requirements(require), parse_minimize(minimize)
     if not targets and not minimize:
         raise InputError("nothing to tune for: give a target (METRIC=VALUE) or a metric to minimize")
-    w = "tune()"                                    # every argument checked before any flight
+    w = "tune()"  # every argument checked before any flight
     checks.number(w, "tol", tol, "nonneg")
     mission = as_mission(mission, w)
     checks.instance(w, "population", population, Population)
@@ -147,14 +185,25 @@ def tune(mission: Mission | str = "step", controller: Any = "nlpd", *, gains=Non
     checks.instance(w, "command", command, str, optional=False)
     base = as_controller(controller, w)
     space = GainSpace.build(base, gains, bounds)
-    popsize = 15 * len(space.gains) if popsize is None else whole_number(popsize, "popsize (candidates per generation)", 5)
+    popsize = (
+        15 * len(space.gains) if popsize is None else whole_number(popsize, "popsize (candidates per generation)", 5)
+    )
     population = population or Population()
-    spec = MonteCarloSpec(mission, base, population, seed=seed, duration=duration, dt=dt,
-                          vehicle=vehicle or Vehicle.paper(), controller_vehicle=controller_vehicle, log_dt=log_dt,
-                          transient_until=transient_until)
+    spec = MonteCarloSpec(
+        mission,
+        base,
+        population,
+        seed=seed,
+        duration=duration,
+        dt=dt,
+        vehicle=vehicle or Vehicle.paper(),
+        controller_vehicle=controller_vehicle,
+        log_dt=log_dt,
+        transient_until=transient_until,
+    )
     from quadcruise.workflows.fly import check_run_size
 
-    check_run_size(popsize * samples, spec.periods, spec.log_every)   # one generation is one batch: size it first
+    check_run_size(popsize * samples, spec.periods, spec.log_every)  # one generation is one batch: size it first
     obj = Objective(spec, space, targets, requirements, minimize, samples, statistic)
     _search(obj, budget, popsize, tol, seed, progress)
     return TuneResult.from_search(obj, budget=budget, popsize=popsize, command=command)
@@ -178,16 +227,30 @@ def _search(obj: Objective, budget: int, popsize: int, tol: float, seed: int, pr
         ev = obj.evaluations[-1]
         best = min(float(e.cost.min()) for e in obj.evaluations)
         values = obj.space.values(xk)[0]
-        gains = ", ".join(f"{n} {v:.4g}" for n, v in zip(obj.space.names, values))
+        gains = ", ".join(f"{n} {v:.4g}" for n, v in zip(obj.space.names, values, strict=False))
         if progress is not None:
-            progress(done, budget, f"best cost {best:.4g} ({gains}); {ev.values.shape[0] * obj.samples} flights "
-                     f"in {ev.wall_s:.2f} s, {time.perf_counter() - t0:.1f} s in all")
+            progress(
+                done,
+                budget,
+                f"best cost {best:.4g} ({gains}); {ev.values.shape[0] * obj.samples} flights "
+                f"in {ev.wall_s:.2f} s, {time.perf_counter() - t0:.1f} s in all",
+            )
         return False
 
     seeding = {"rng": rng} if "rng" in inspect.signature(differential_evolution).parameters else {"seed": rng}
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UserWarning)          # scipy: "differential_evolution: the 'workers' ..."
-        out = differential_evolution(obj, [(0.0, 1.0)] * g, maxiter=budget, init=init, tol=tol, atol=ABS_TOL,
-                                     polish=False,
-                                     updating="deferred", vectorized=True, callback=callback, **seeding)
+        warnings.simplefilter("ignore", UserWarning)  # scipy: "differential_evolution: the 'workers' ..."
+        out = differential_evolution(
+            obj,
+            [(0.0, 1.0)] * g,
+            maxiter=budget,
+            init=init,
+            tol=tol,
+            atol=ABS_TOL,
+            polish=False,
+            updating="deferred",
+            vectorized=True,
+            callback=callback,
+            **seeding,
+        )
     return obj.space.values(out.x)[0]

@@ -8,7 +8,8 @@ any flight.
   :mod:`quadcruise.control.design` (s^2 + kd s + kp = s^2 + 2 zeta wn s + wn^2):
   ``position.wn`` [rad/s] and ``position.zeta`` [-].
 - **Bounds** ``NAME=LOW:HIGH``; by default a decade either side of the controller's value, cut
-  to the range the field allows (``max_tilt`` stays below pi/2; the damping ratio: [0.1, 2]). A gain whose bounds are positive and a decade or more apart
+  to the range the field allows (``max_tilt`` stays below pi/2; the damping ratio: [0.1, 2]). A gain whose bounds are
+  positive and a decade or more apart
   is searched on a log scale.
 - A **target** ``METRIC=VALUE`` or ``METRIC=VALUE+-TOLERANCE``: the cost counts the miss in
   tolerances, squared; without a tolerance, 10 % of the value (1 in the metric's unit for a
@@ -41,8 +42,9 @@ import dataclasses
 import difflib
 import math
 import re
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, Iterable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -51,8 +53,18 @@ from quadcruise.errors import InputError
 from quadcruise.montecarlo.requirements import Requirement, parse_requirements
 from quadcruise.montecarlo.schema import METRICS
 
-__all__ = ["Gain", "GainSpace", "Requirement", "Target", "check_metric", "parse_bounds", "parse_minimize",
-           "parse_requirements", "parse_targets", "violation"]
+__all__ = [
+    "Gain",
+    "GainSpace",
+    "Requirement",
+    "Target",
+    "check_metric",
+    "parse_bounds",
+    "parse_minimize",
+    "parse_requirements",
+    "parse_targets",
+    "violation",
+]
 
 POLE_NAMES = ("wn", "zeta")
 """The pole-pair parameters of a PD gains field: natural frequency [rad/s], damping ratio [-]."""
@@ -87,7 +99,7 @@ def check_metric(name: str, what: str) -> str:
     >>> check_metric("rise_time", "target 'rise_time=1'")          # doctest: +ELLIPSIS
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: target 'rise_time=1': unknown metric 'rise_time' (did you mean 'rise_time_s'?); metrics: rmse_m, ...
+    quadcruise.errors.InputError: target 'rise_time=1': unknown metric 'rise_time' (did you mean ...
     """
     if name not in METRICS:
         close = difflib.get_close_matches(name, METRICS, n=1)
@@ -129,7 +141,7 @@ class Target:
     tolerance: float
 
     @classmethod
-    def parse(cls, text: str) -> "Target":
+    def parse(cls, text: str) -> Target:
         """A target from ``METRIC=VALUE`` or ``METRIC=VALUE+-TOLERANCE``.
 
         Parameters
@@ -444,7 +456,7 @@ def parse_bounds(items: str | Iterable[str] | Mapping | None) -> dict[str, tuple
         pairs = [(str(k), v) for k, v in items.items()]
     else:
         pairs = []
-        for text in ([items] if isinstance(items, str) else list(items)):
+        for text in [items] if isinstance(items, str) else list(items):
             pieces = [piece for piece in str(text).split(",") if piece.strip()]
             if not pieces:
                 raise InputError(f"bounds {str(text)!r}: expected NAME=LOW:HIGH, e.g. position.kp=0.5:10")
@@ -496,8 +508,9 @@ class GainSpace:
     derived: tuple = ()
 
     @classmethod
-    def build(cls, base: Any, names: Sequence[str] | str | None = None,
-              bounds: Mapping | str | Iterable[str] | None = None) -> "GainSpace":
+    def build(
+        cls, base: Any, names: Sequence[str] | str | None = None, bounds: Mapping | str | Iterable[str] | None = None
+    ) -> GainSpace:
         """The space of ``names`` around ``base``, each within its bounds.
 
         Parameters
@@ -529,8 +542,10 @@ class GainSpace:
         if isinstance(names, str):
             text, names = names, [n.strip() for n in names.split(",") if n.strip()]
             if not names:
-                raise InputError(f"gains {text!r}: expected gain names, e.g. position.kp,position.kd; "
-                                 f"gains of {base.name}: {', '.join(values)}")
+                raise InputError(
+                    f"gains {text!r}: expected gain names, e.g. position.kp,position.kd; "
+                    f"gains of {base.name}: {', '.join(values)}"
+                )
         if not names:
             if "position.kp" not in values:
                 raise InputError(f"name the gains of {base.name} to tune (gains: {', '.join(values)})")
@@ -562,11 +577,15 @@ class GainSpace:
             else:
                 raise InputError(f"{name} is {value:g}: give its bounds (NAME=LOW:HIGH)")
             gains.append(Gain(name, low, high, bool(low > 0 and high / low >= 10.0), unit))
-        derived = tuple(f.name for f in dataclasses.fields(base) if f.default is None
-                        and getattr(dataclasses.replace(base, **{f.name: None}), f.name) == getattr(base, f.name))
+        derived = tuple(
+            f.name
+            for f in dataclasses.fields(base)
+            if f.default is None
+            and getattr(dataclasses.replace(base, **{f.name: None}), f.name) == getattr(base, f.name)
+        )
         space = cls(base, tuple(gains), derived)
         corners = np.array([[g.low for g in gains], [g.high for g in gains]])
-        space.controllers(corners)          # the controller validates its gains: bad bounds fail here
+        space.controllers(corners)  # the controller validates its gains: bad bounds fail here
         return space
 
     @property
@@ -617,7 +636,7 @@ class GainSpace:
         for row in np.atleast_2d(np.asarray(values, dtype=float)):
             top: dict[str, Any] = {f: None for f in self.derived}
             nested: dict[str, dict[str, float]] = {}
-            for g, v in zip(self.gains, row):
+            for g, v in zip(self.gains, row, strict=False):
                 owner, _, leaf = g.name.rpartition(".")
                 if owner:
                     nested.setdefault(owner, {})[leaf] = float(v)

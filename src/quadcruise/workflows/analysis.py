@@ -84,7 +84,7 @@ def _period(x, u, vp, dt, n_sub):
     from quadcruise.sim.engine import WORK_ROWS, rk4_step
 
     ext = np.zeros(EXT_SIZE)
-    ext[EXT_E1:EXT_E1 + 4] = 1.0
+    ext[EXT_E1 : EXT_E1 + 4] = 1.0
     x, u = np.array(x, dtype=float), np.ascontiguousarray(u, dtype=float)
     work = np.empty((WORK_ROWS, STATE_SIZE))
     for _ in range(n_sub):
@@ -95,7 +95,9 @@ def _period(x, u, vp, dt, n_sub):
 def _jacobian(f, v0, eps):
     """Central differences of f at v0, step eps * max(1, |v_i|)."""
     steps = eps * np.maximum(1.0, np.abs(v0))
-    return np.array([(f(v0 + h * e) - f(v0 - h * e)) / (2.0 * h) for h, e in zip(steps, np.eye(v0.size))]).T
+    return np.array(
+        [(f(v0 + h * e) - f(v0 - h * e)) / (2.0 * h) for h, e in zip(steps, np.eye(v0.size), strict=False)]
+    ).T
 
 
 def _s_plane(z, dt):
@@ -227,7 +229,7 @@ class Linearization:
         b = (S @ self.sys.B)[idx, INPUTS.index(f"{state}_ref")]
         c = (self.sys.C @ Si)[OUTPUTS.index(state), idx]
         order, s = _s_plane(z, self.dt)
-        with np.errstate(divide="ignore", invalid="ignore"):      # inf for a marginal mode
+        with np.errstate(divide="ignore", invalid="ignore"):  # inf for a marginal mode
             weight = np.abs((c @ V) * np.linalg.solve(V, b) / (1.0 - z)) / np.abs(s.real)
         return s[order], weight[order]
 
@@ -250,11 +252,20 @@ class Linearization:
         n, m = self.sys.B.shape
         z = self.poles()
         if np.any((np.abs(z.imag) < 1e-12) & (z.real <= 1e-12)):
-            raise InputError("the loop has purely discrete modes (poles at z = 0 or on the negative real "
-                             "axis, e.g. a one-period memory): it has no continuous equivalent")
+            raise InputError(
+                "the loop has purely discrete modes (poles at z = 0 or on the negative real "
+                "axis, e.g. a one-period memory): it has no continuous equivalent"
+            )
         L = scipy.linalg.logm(np.block([[self.sys.A, self.sys.B], [np.zeros((m, n)), np.eye(m)]])).real / self.dt
-        return control.ss(L[:n, :n], L[:n, n:], self.sys.C, self.sys.D, inputs=INPUTS, outputs=OUTPUTS,
-                          states=list(self.sys.state_labels))
+        return control.ss(
+            L[:n, :n],
+            L[:n, n:],
+            self.sys.C,
+            self.sys.D,
+            inputs=INPUTS,
+            outputs=OUTPUTS,
+            states=list(self.sys.state_labels),
+        )
 
     def closed_loop(self, loop: str) -> control.StateSpace:
         """One loop's closed loop, from its set-point to its output (``x_ref`` to ``x``, ...).
@@ -292,13 +303,13 @@ class Linearization:
         u_idx, state = LOOPS[_check_loop(loop)]
         Ap, Bp, Kx, Km, Hx, Hm = self.plant_A, self.plant_B, self.K_state, self.K_memory, self.H_state, self.H_memory
         C = Hm.shape[0]
-        if at == "input":                # w replaces the controller's U_j at the plant input
+        if at == "input":  # w replaces the controller's U_j at the plant input
             Bu, KU, KmU = Bp @ np.linalg.inv(self.mixer), self.mixer @ Kx, self.mixer @ Km
             e = np.eye(4)[:, [u_idx]]
             keep = np.eye(4) - e @ e.T
             A = np.block([[Ap + Bu @ keep @ KU, Bu @ keep @ KmU], [Hx, Hm]])
             B, Cl = np.vstack([Bu @ e, np.zeros((C, 1))]), -np.hstack([KU[u_idx], KmU[u_idx]])[None, :]
-        elif at == "output":             # w replaces the measured output the controller sees
+        elif at == "output":  # w replaces the measured output the controller sees
             e = np.eye(STATE_SIZE)[:, [STATE_NAMES.index(state)]]
             keep = np.eye(STATE_SIZE) - e @ e.T
             A = np.block([[Ap + Bp @ Kx @ keep, Bp @ Km], [Hx @ keep, Hm]])
@@ -352,14 +363,30 @@ class Linearization:
             at_cols = {}
             for at in ("input", "output"):
                 m = e["margins_" + at]
-                at_cols.update({f"{at}_phase_margin_deg": m["phase_margin"],
-                                f"{at}_gain_crossover_rad_s": m["gain_crossover"],
-                                f"{at}_gain_decrease_db": m["gain_decrease_db"],
-                                f"{at}_gain_increase_db": m["gain_increase_db"]})
-            for p, wn, zeta, weight in zip(e["poles"], e["natural_frequency"], e["damping"], e["step_weight"]):
-                rows.append({"loop": loop, "real": p[0], "imag": p[1], "natural_frequency": wn, "damping": zeta,
-                             "step_weight": weight, "dominant": p == e["dominant"], "slowest": p == e["slowest"],
-                             **at_cols})
+                at_cols.update(
+                    {
+                        f"{at}_phase_margin_deg": m["phase_margin"],
+                        f"{at}_gain_crossover_rad_s": m["gain_crossover"],
+                        f"{at}_gain_decrease_db": m["gain_decrease_db"],
+                        f"{at}_gain_increase_db": m["gain_increase_db"],
+                    }
+                )
+            for p, wn, zeta, weight in zip(
+                e["poles"], e["natural_frequency"], e["damping"], e["step_weight"], strict=False
+            ):
+                rows.append(
+                    {
+                        "loop": loop,
+                        "real": p[0],
+                        "imag": p[1],
+                        "natural_frequency": wn,
+                        "damping": zeta,
+                        "step_weight": weight,
+                        "dominant": p == e["dominant"],
+                        "slowest": p == e["slowest"],
+                        **at_cols,
+                    }
+                )
         return pd.DataFrame(rows)
 
     def summary(self, progress: Callable[[int, int], None] | None = None) -> Summary:
@@ -394,8 +421,9 @@ class Linearization:
         data = summary_data(self, progress)
         return Summary(data, summary_text(data))
 
-    def plot(self, *, loops: bool = True, at: str = "input", omega=None,
-             progress: Callable[[int, int], None] | None = None):
+    def plot(
+        self, *, loops: bool = True, at: str = "input", omega=None, progress: Callable[[int, int], None] | None = None
+    ):
         """Bode plots: the closed loops and the loop transfers with their margins marked.
 
         Parameters
@@ -462,8 +490,10 @@ class Linearization:
                 save_figure(self.plot(at=at, progress=part), tmp / name)
                 if progress is not None:
                     progress(5 * k + 5, 10)
-            (tmp / MARKER).write_text(dumps({"workflow": "analyze", "controller": self.controller,
-                                             "dt_s": self.dt, "version": __version__}) + "\n")
+            (tmp / MARKER).write_text(
+                dumps({"workflow": "analyze", "controller": self.controller, "dt_s": self.dt, "version": __version__})
+                + "\n"
+            )
         return out
 
 
@@ -476,13 +506,16 @@ def _check_loop(loop: str) -> str:
 def _as_controller(controller):
     if isinstance(controller, str):
         from quadcruise.control import controller_from_name
+
         return controller_from_name(controller)
     if isinstance(controller, type):
         checks.fail("linearize()", "controller", controller, "a controller name or object")
     missing = [m for m in ("function", "gains", "memory") if not hasattr(controller, m)]
     if missing:
-        raise InputError(f"controller must be a name or have .function, .gains() and .memory(); "
-                         f"{type(controller).__name__} lacks {', '.join(missing)}")
+        raise InputError(
+            f"controller must be a name or have .function, .gains() and .memory(); "
+            f"{type(controller).__name__} lacks {', '.join(missing)}"
+        )
     return controller
 
 
@@ -491,9 +524,19 @@ MIN_DT = 1e-9
 within rounding of 1, and the s-plane poles computed from them are noise."""
 
 
-def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 1e-3, hover_z: float = 1.0,
-              eps: float = 1e-6, max_step: float | None = None, memory=None, settle: int = 1,
-              tol: float = 1e-6, progress: Callable[[int, int], None] | None = None) -> Linearization:
+def linearize(
+    controller="nlpd",
+    vehicle: Vehicle | None = None,
+    *,
+    dt: float = 1e-3,
+    hover_z: float = 1.0,
+    eps: float = 1e-6,
+    max_step: float | None = None,
+    memory=None,
+    settle: int = 1,
+    tol: float = 1e-6,
+    progress: Callable[[int, int], None] | None = None,
+) -> Linearization:
     """Linearise plant + controller over one control period ``dt`` about hover at ``hover_z``.
 
     Parameters
@@ -540,8 +583,8 @@ def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 
     >>> bool(lin.residual < 1e-9), lin.sys.state_labels[-3:]
     (True, ['mem0', 'mem1', 'mem2'])
     """
-    w = "linearize()"                                # every argument checked before any work
-    controller = _as_controller(controller)          # (its function may be plain Python: it is called here)
+    w = "linearize()"  # every argument checked before any work
+    controller = _as_controller(controller)  # (its function may be plain Python: it is called here)
     vehicle = checks.instance(w, "vehicle", vehicle, Vehicle) or Vehicle.paper()
     dt = checks.number(w, "dt", dt, "pos", unit="s")
     hover_z = checks.number(w, "hover_z", hover_z, unit="m")
@@ -555,45 +598,51 @@ def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 
     if not (math.isfinite(dt) and dt > 0):
         raise InputError(f"dt must be a positive number of seconds, got {dt!r}")
     if dt < MIN_DT:
-        raise InputError(f"dt = {dt:g} s is below {MIN_DT:g} s: the discrete poles would lie within rounding of 1 "
-                         "and read as unstable; linearise at a real control period")
+        raise InputError(
+            f"dt = {dt:g} s is below {MIN_DT:g} s: the discrete poles would lie within rounding of 1 "
+            "and read as unstable; linearise at a real control period"
+        )
     vp = np.ascontiguousarray(vehicle.rows()[0])
     gains = np.ascontiguousarray(controller.gains(), dtype=float)
     mem0 = np.array(controller.memory() if memory is None else memory, dtype=float).ravel()
     n, C = STATE_SIZE + mem0.size, mem0.size
     n_sub = max(1, math.ceil(dt / (max_step or dt) - 1e-9))
     x0, ref0 = np.zeros(STATE_SIZE), np.zeros(len(REF_NAMES))
-    x0[Z], x0[F1:F1 + 4], ref0[REF_Z] = hover_z, vp[P_M] * vp[P_G] / 4.0, hover_z
+    x0[Z], x0[F1 : F1 + 4], ref0[REF_Z] = hover_z, vp[P_M] * vp[P_G] / 4.0, hover_z
     cols = [REF_NAMES.index(name) for name in INPUTS]
     step = _steps(progress, 3)
 
-    def ctrl(v):                      # (x, memory, set-points) -> (duties, next memory, flags)
+    def ctrl(v):  # (x, memory, set-points) -> (duties, next memory, flags)
         ref, mem, cmd = ref0.copy(), v[STATE_SIZE:n].copy(), np.zeros(CMD_SIZE)
         ref[cols] = v[n:]
         controller.function(0.0, dt, np.ascontiguousarray(v[:STATE_SIZE]), ref, vp, gains, mem, cmd)
-        return np.concatenate([cmd[:4], mem, cmd[CMD_FLAGS:CMD_FLAGS + 1]])
+        return np.concatenate([cmd[:4], mem, cmd[CMD_FLAGS : CMD_FLAGS + 1]])
 
     for _ in range(settle):
-        mem0 = ctrl(np.concatenate([x0, mem0, ref0[cols]]))[4:4 + C]
+        mem0 = ctrl(np.concatenate([x0, mem0, ref0[cols]]))[4 : 4 + C]
     v0 = np.concatenate([x0, mem0, ref0[cols]])
     out0 = ctrl(v0)
     u0 = out0[:4]
-    drift = np.concatenate([_period(x0, np.clip(u0, 0.0, 1.0), vp, dt, n_sub) - x0, out0[4:4 + C] - mem0]) / dt
+    drift = np.concatenate([_period(x0, np.clip(u0, 0.0, 1.0), vp, dt, n_sub) - x0, out0[4 : 4 + C] - mem0]) / dt
     names = list(STATE_NAMES) + [f"mem{i}" for i in range(C)]
     if not np.all(np.abs(drift) <= tol):
         i = int(np.argmax(np.where(np.isfinite(drift), np.abs(drift), np.inf)))
         who = getattr(controller, "name", "the controller")
-        raise HoverError(f"{who} does not hold hover at z = {hover_z:g} m: '{names[i]}' moves at {drift[i]:.3g} "
-                         f"per second (tolerance {tol:g}), so there is no equilibrium to linearise about")
+        raise HoverError(
+            f"{who} does not hold hover at z = {hover_z:g} m: '{names[i]}' moves at {drift[i]:.3g} "
+            f"per second (tolerance {tol:g}), so there is no equilibrium to linearise about"
+        )
     if np.any(u0 <= 0.0) or np.any(u0 >= 1.0):
-        raise HoverError(f"a hover duty sits on its clip to [0, 1] ({np.round(u0, 4).tolist()}): "
-                         f"the loop is not differentiable there")
+        raise HoverError(
+            f"a hover duty sits on its clip to [0, 1] ({np.round(u0, 4).tolist()}): "
+            f"the loop is not differentiable there"
+        )
     if out0[-1] != 0.0:
         warnings.warn(f"the controller flags a limit at hover (flags {out0[-1]:g})", stacklevel=2)
     step()
 
     # the period map's Jacobian by the chain rule: controller, then plant (a duty clip is inactive)
-    G = _jacobian(lambda v: ctrl(v)[:4 + C], v0, eps)
+    G = _jacobian(lambda v: ctrl(v)[: 4 + C], v0, eps)
     step()
     P = _jacobian(lambda v: _period(v[:STATE_SIZE], v[STATE_SIZE:], vp, dt, n_sub), np.r_[x0, u0], eps)
     step()
@@ -603,14 +652,15 @@ def linearize(controller="nlpd", vehicle: Vehicle | None = None, *, dt: float = 
     Cy = np.eye(n)[[STATE_NAMES.index(name) for name in OUTPUTS]]
     sys = control.ss(A, np.vstack([Bp @ Kr, Hr]), Cy, 0.0, dt, inputs=INPUTS, outputs=OUTPUTS, states=names)
     mixer = vp[P_K] * np.array([mix(*row, vp[P_D]) for row in np.eye(4)]).T
-    return Linearization(sys, float(dt), controller, Ap, Bp, Kx, Km, Hx, Hm, mixer, _loops(A, mixer),
-                         float(np.max(np.abs(drift))))
+    return Linearization(
+        sys, float(dt), controller, Ap, Bp, Kx, Km, Hx, Hm, mixer, _loops(A, mixer), float(np.max(np.abs(drift)))
+    )
 
 
 def _to_generalized(n, mixer):
     """The change of state that replaces the rotor thrusts F1..F4 by U1..U4 (up to scale)."""
     S = np.eye(n)
-    S[F1:F1 + 4, F1:F1 + 4] = mixer / mixer[0, 0]
+    S[F1 : F1 + 4, F1 : F1 + 4] = mixer / mixer[0, 0]
     return S
 
 

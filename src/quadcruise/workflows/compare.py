@@ -64,7 +64,7 @@ class Comparison:
     results: dict
     population: dict = field(default_factory=dict)
     population_table: Any = None
-    _tables: dict = field(default_factory=dict, init=False, repr=False)   # table() per keywords
+    _tables: dict = field(default_factory=dict, init=False, repr=False)  # table() per keywords
 
     @property
     def ok(self) -> dict:
@@ -259,8 +259,9 @@ class Comparison:
         doc = comparison_document(first.meta, records)
         if self.population:
             doc["compare"]["population"] = plain(self.population)
-        return scenario_text(doc, header=(
-            "written by quadcruise from a comparison; `quadcruise compare THIS_FILE` flies it again"))
+        return scenario_text(
+            doc, header=("written by quadcruise from a comparison; `quadcruise compare THIS_FILE` flies it again")
+        )
 
     @staticmethod
     def _rows(table) -> dict:
@@ -306,10 +307,16 @@ class Comparison:
         return out
 
 
-def compare(mission: Mission | str = "circle",
-            controllers: Sequence[Controller | str] | Mapping[str, Controller | str] = DEFAULT_CONTROLLERS,
-            *, vehicle=None, duration: float | None = None, dt: float = 1e-3,
-            progress: Callable[[int, int], None] | None = None, **fly_kw: Any) -> Comparison:
+def compare(
+    mission: Mission | str = "circle",
+    controllers: Sequence[Controller | str] | Mapping[str, Controller | str] = DEFAULT_CONTROLLERS,
+    *,
+    vehicle=None,
+    duration: float | None = None,
+    dt: float = 1e-3,
+    progress: Callable[[int, int], None] | None = None,
+    **fly_kw: Any,
+) -> Comparison:
     """Fly ``mission`` with each controller on the same vehicle; see :class:`Comparison`.
 
     Parameters
@@ -339,9 +346,12 @@ def compare(mission: Mission | str = "circle",
     for bad in ("missions", "controller", "mission"):
         if bad in fly_kw:
             raise InputError(f"compare() flies one mission with each controller; '{bad}' is not an option")
-    reject_unknown("compare()", {k: v for k, v in fly_kw.items() if k not in FLY_OPTIONS},
-                   ["controllers", "progress", *(k for k in FLY_OPTIONS if k != "missions")])
-    w = "compare()"                                 # its own arguments checked before any flight
+    reject_unknown(
+        "compare()",
+        {k: v for k, v in fly_kw.items() if k not in FLY_OPTIONS},
+        ["controllers", "progress", *(k for k in FLY_OPTIONS if k != "missions")],
+    )
+    w = "compare()"  # its own arguments checked before any flight
     mission = as_mission(mission, w)
     checks.instance(w, "vehicle", vehicle, Vehicle)
     checks.number(w, "duration", duration, "pos", unit="s", optional=True)
@@ -389,8 +399,12 @@ def labelled(controllers) -> dict:
         if any(not c for c in controllers):
             raise InputError(f"controllers {text!r}: an empty name; give comma-separated names such as nlpd,se3")
     if not isinstance(controllers, (Mapping, list, tuple)):
-        checks.fail("compare()", "controllers", controllers, "comma-separated names, a list of controllers "
-                    "(names or objects) or a mapping label -> controller")
+        checks.fail(
+            "compare()",
+            "controllers",
+            controllers,
+            "comma-separated names, a list of controllers (names or objects) or a mapping label -> controller",
+        )
     items = list(controllers.items()) if isinstance(controllers, Mapping) else [(None, c) for c in controllers]
     if not items:
         raise InputError("compare() needs at least one controller")

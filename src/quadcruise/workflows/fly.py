@@ -81,18 +81,33 @@ def hover_state(vehicle: Vehicle, n: int, mission: Mission) -> np.ndarray:
     x0 = np.zeros((n, STATE_SIZE))
     x0[:, Z] = ref0[REF_Z]
     x0[:, PSI] = ref0[REF_PSI]
-    x0[:, F1:F1 + 4] = (vp[:, P_M] * vp[:, P_G] / 4.0)[:, None]
+    x0[:, F1 : F1 + 4] = (vp[:, P_M] * vp[:, P_G] / 4.0)[:, None]
     return x0
 
 
-def fly(mission: Mission | str = "circle", controller: ControllerLike | str | list = "nlpd", *,
-        vehicle: Vehicle | None = None, duration: float | None = None, dt: float = 1e-3,
-        max_step: float | None = None, n: int | None = None, x0: Any = None,
-        log_every: int = 1, limits: Limits | None = None, missions: list[Mission] | None = None,
-        controller_vehicle: Vehicle | None = None, full_dynamics: bool = False,
-        environment: Environment | None = None, sensors: SensorNoise | None = None,
-        seed: int = 0, first_vehicle: int | np.ndarray = 0, max_track_error: float | None = None,
-        max_steady_error: float | None = None, **unknown: Any) -> SimResult:
+def fly(
+    mission: Mission | str = "circle",
+    controller: ControllerLike | str | list = "nlpd",
+    *,
+    vehicle: Vehicle | None = None,
+    duration: float | None = None,
+    dt: float = 1e-3,
+    max_step: float | None = None,
+    n: int | None = None,
+    x0: Any = None,
+    log_every: int = 1,
+    limits: Limits | None = None,
+    missions: list[Mission] | None = None,
+    controller_vehicle: Vehicle | None = None,
+    full_dynamics: bool = False,
+    environment: Environment | None = None,
+    sensors: SensorNoise | None = None,
+    seed: int = 0,
+    first_vehicle: int | np.ndarray = 0,
+    max_track_error: float | None = None,
+    max_steady_error: float | None = None,
+    **unknown: Any,
+) -> SimResult:
     """Fly a mission with a controller and return the logged flight.
 
     Parameters
@@ -181,7 +196,7 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
         that does not divide the flight's control periods, a flight too large to log.
     """
     reject_unknown("fly()", unknown, FLY_OPTIONS)
-    w = "fly()"                                       # every argument checked before any work
+    w = "fly()"  # every argument checked before any work
     mission = as_mission(mission, w)
     missions = fly_missions(missions)
     controllers = per_vehicle_controllers(controller)
@@ -202,10 +217,18 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
     for name, value in (("max_track_error", max_track_error), ("max_steady_error", max_steady_error)):
         checks.number(w, name, value, "pos", unit="m", optional=True, infinite=True)
     x0 = initial_states(x0)
-    sizes = {s for s in (vehicle.batch_size, None if x0 is None or np.ndim(x0) < 2 else np.shape(x0)[0],
-                         None if missions is None else len(missions), n,
-                         len(controllers) if len(controllers) > 1 else None,
-                         None if np.ndim(first_vehicle) == 0 else np.size(first_vehicle)) if s is not None}
+    sizes = {
+        s
+        for s in (
+            vehicle.batch_size,
+            None if x0 is None or np.ndim(x0) < 2 else np.shape(x0)[0],
+            None if missions is None else len(missions),
+            n,
+            len(controllers) if len(controllers) > 1 else None,
+            None if np.ndim(first_vehicle) == 0 else np.size(first_vehicle),
+        )
+        if s is not None
+    }
     if len(sizes) > 1:
         raise InputError(f"the number of vehicles is ambiguous: {sorted(sizes)}")
     n = sizes.pop() if sizes else 1
@@ -215,7 +238,7 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
     first = missions[0] if missions else mission
     duration = default_duration(first) if duration is None else duration
     d, h = duration, dt
-    if 0 < h <= d < math.inf:                               # sized before the grid is allocated
+    if 0 < h <= d < math.inf:  # sized before the grid is allocated
         check_run_size(n, round(d / h), int(log_every), max(1, math.ceil(h / float(max_step or h) - 1e-9)))
     grid = time_grid(float(duration), float(dt))
     check_log_every(log_every, grid.size - 1)
@@ -231,39 +254,80 @@ def fly(mission: Mission | str = "circle", controller: ControllerLike | str | li
         "controller": controller_record(controller),
         **({"controllers": [controller_record(c) for c in controllers]} if len(controllers) > 1 else {}),
         "vehicle": vehicle.to_dict(),
-        "duration_s": float(duration), "dt_s": float(dt),
-        "max_step_s": float(max_step or dt), "n": n, "version": __version__,
-        "full_dynamics": bool(full_dynamics), "seed": seed, "log_every": int(log_every),
+        "duration_s": float(duration),
+        "dt_s": float(dt),
+        "max_step_s": float(max_step or dt),
+        "n": n,
+        "version": __version__,
+        "full_dynamics": bool(full_dynamics),
+        "seed": seed,
+        "log_every": int(log_every),
         "max_track_error": None if max_track_error is None else float(max_track_error),
         "max_steady_error": None if max_steady_error is None else float(max_steady_error),
         "initial_state": given_x0,
     }
     if environment is not None:
-        meta["environment"] = (environment.to_dict() if isinstance(environment, Environment)
-                               else {"custom": getattr(environment.function, "__name__", "disturbance")})
+        meta["environment"] = (
+            environment.to_dict()
+            if isinstance(environment, Environment)
+            else {"custom": getattr(environment.function, "__name__", "disturbance")}
+        )
     if sensors is not None:
         meta["sensors"] = sensors.to_dict()
     if controller_vehicle is not None:
         meta["controller_vehicle"] = controller_vehicle.to_dict()
     vp_ctrl = None if controller_vehicle is None else controller_vehicle.rows(n)
-    gains, memory = ((controller.gains(), controller.memory()) if len(controllers) == 1 else
-                     (np.stack([c.gains() for c in controllers]), np.stack([c.memory() for c in controllers])))
-    result = simulate(grid, x0, vehicle.rows(n), controller.function, gains,
-                      first.function, mp, memory=memory, max_step=max_step or dt,
-                      log_every=log_every, limits=limits, meta=meta, vp_ctrl=vp_ctrl,
-                      full_dynamics=full_dynamics, seed=seed, first_vehicle=first_vehicle,
-                      **engine_inputs(environment, sensors, n, dt))
-    bound = (track_bound(missions or [first], np.broadcast_to(x0, (n, STATE_SIZE)), n)
-             if max_track_error is None else np.full(n, float(max_track_error)))
+    gains, memory = (
+        (controller.gains(), controller.memory())
+        if len(controllers) == 1
+        else (np.stack([c.gains() for c in controllers]), np.stack([c.memory() for c in controllers]))
+    )
+    result = simulate(
+        grid,
+        x0,
+        vehicle.rows(n),
+        controller.function,
+        gains,
+        first.function,
+        mp,
+        memory=memory,
+        max_step=max_step or dt,
+        log_every=log_every,
+        limits=limits,
+        meta=meta,
+        vp_ctrl=vp_ctrl,
+        full_dynamics=full_dynamics,
+        seed=seed,
+        first_vehicle=first_vehicle,
+        **engine_inputs(environment, sensors, n, dt),
+    )
+    bound = (
+        track_bound(missions or [first], np.broadcast_to(x0, (n, STATE_SIZE)), n)
+        if max_track_error is None
+        else np.full(n, float(max_track_error))
+    )
     result.meta["max_track_error_m"] = bound.tolist() if n > 1 else float(bound[0])
     err = position_error(result)
     result = mark_lost_track(result, bound, err)
-    steady = (np.array([steady_bound(m, duration) for m in missions]) if missions else
-              np.full(n, steady_bound(first, duration))) if max_steady_error is None else \
-        np.full(n, float(max_steady_error))
+    steady = (
+        (
+            np.array([steady_bound(m, duration) for m in missions])
+            if missions
+            else np.full(n, steady_bound(first, duration))
+        )
+        if max_steady_error is None
+        else np.full(n, float(max_steady_error))
+    )
     result.meta["max_steady_error_m"] = steady.tolist() if n > 1 else float(steady[0])
-    vertical = (np.array([altitude_bound(m, duration) for m in missions]) if missions else
-                np.full(n, altitude_bound(first, duration))) if max_steady_error is None else steady
+    vertical = (
+        (
+            np.array([altitude_bound(m, duration) for m in missions])
+            if missions
+            else np.full(n, altitude_bound(first, duration))
+        )
+        if max_steady_error is None
+        else steady
+    )
     result.meta["max_altitude_error_m"] = vertical.tolist() if n > 1 else float(vertical[0])
     result = mark_off_track(result, steady, err, vertical)
     _warn_about(result)
@@ -298,7 +362,7 @@ def per_vehicle_controllers(controller: Any) -> list:
     >>> per_vehicle_controllers([NLPD(), Gonzalez()])
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: the controllers of one flight must be of one kind: vehicle 1 flies a Gonzalez (gonzalez), vehicle 0 a NLPD (nlpd)
+    quadcruise.errors.InputError: the controllers of one flight must be of one kind: vehicle 1 flies a Gonzalez ...
     """
     if not isinstance(controller, (list, tuple)):
         return [as_controller(controller)]
@@ -309,12 +373,16 @@ def per_vehicle_controllers(controller: Any) -> list:
     shape = (np.shape(first.gains()), np.shape(first.memory()))
     for i, c in enumerate(out[1:], start=1):
         if type(c) is not type(first) or c.function is not first.function:
-            raise InputError(f"the controllers of one flight must be of one kind: vehicle {i} flies a "
-                             f"{type(c).__name__} ({c.name}), vehicle 0 a {type(first).__name__} ({first.name})")
+            raise InputError(
+                f"the controllers of one flight must be of one kind: vehicle {i} flies a "
+                f"{type(c).__name__} ({c.name}), vehicle 0 a {type(first).__name__} ({first.name})"
+            )
         if (np.shape(c.gains()), np.shape(c.memory())) != shape:
-            raise InputError(f"the controllers of one flight must have the same gains and memory sizes: "
-                             f"vehicle {i} has {np.size(c.gains())} gains and memory {np.size(c.memory())}, "
-                             f"vehicle 0 {np.size(first.gains())} and {np.size(first.memory())}")
+            raise InputError(
+                f"the controllers of one flight must have the same gains and memory sizes: "
+                f"vehicle {i} has {np.size(c.gains())} gains and memory {np.size(c.memory())}, "
+                f"vehicle 0 {np.size(first.gains())} and {np.size(first.memory())}"
+            )
     return out
 
 
@@ -374,8 +442,7 @@ def vehicle_indices(first_vehicle: Any) -> int | np.ndarray:
     if arr.ndim != 1 or arr.size == 0 or arr.dtype.kind not in "iu":
         checks.fail("fly()", "first_vehicle", first_vehicle, "a whole number >= 0 or a 1-D array of them")
     if arr.min() < 0:
-        checks.fail("fly()", "first_vehicle", first_vehicle, "a whole number >= 0 or a 1-D array of them",
-                    kind=False)
+        checks.fail("fly()", "first_vehicle", first_vehicle, "a whole number >= 0 or a 1-D array of them", kind=False)
     return arr.astype(np.int64)
 
 
@@ -413,9 +480,25 @@ def initial_states(x0: Any) -> np.ndarray | None:
     return arr
 
 
-FLY_OPTIONS = ("vehicle", "duration", "dt", "max_step", "n", "x0", "log_every", "limits", "missions",
-               "controller_vehicle", "full_dynamics", "environment", "sensors", "seed", "first_vehicle",
-               "max_track_error", "max_steady_error")
+FLY_OPTIONS = (
+    "vehicle",
+    "duration",
+    "dt",
+    "max_step",
+    "n",
+    "x0",
+    "log_every",
+    "limits",
+    "missions",
+    "controller_vehicle",
+    "full_dynamics",
+    "environment",
+    "sensors",
+    "seed",
+    "first_vehicle",
+    "max_track_error",
+    "max_steady_error",
+)
 """The keywords :func:`fly` takes besides the mission and the controller."""
 
 MAX_LOG_FRACTION = 0.5
@@ -451,34 +534,41 @@ def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1) -> Non
     >>> check_run_size(10_000, 3_600_000, 1)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: 10,000 vehicles x 3,600,000 control periods is 3.6e+10 vehicle-steps, hours of computing: fly fewer vehicles or a shorter duration
+    quadcruise.errors.InputError: 10,000 vehicles x 3,600,000 control periods is 3.6e+10 vehicle-steps, hours ...
     """
     from quadcruise.layout import CMD_SIZE, REF_SIZE
 
     if log_every < 1:
         raise InputError(f"log_every must be a whole number >= 1, got {log_every!r}")
-    def many(k: int) -> str:                       # a count as a message writes it: short, whatever its size
+
+    def many(k: int) -> str:  # a count as a message writes it: short, whatever its size
         return f"{k:,}" if k < 10**12 else f"{float(k):.3g}"
 
     if n * steps > MAX_VEHICLE_STEPS:
-        raise InputError(f"{many(n)} vehicles x {many(steps)} control periods is {n * steps:.2g} vehicle-steps, "
-                         f"hours of computing: fly fewer vehicles or a shorter duration")
+        raise InputError(
+            f"{many(n)} vehicles x {many(steps)} control periods is {n * steps:.2g} vehicle-steps, "
+            f"hours of computing: fly fewer vehicles or a shorter duration"
+        )
     if n * steps * substeps > MAX_VEHICLE_STEPS:
-        raise InputError(f"{many(n)} vehicles x {many(steps)} control periods x {many(substeps)} RK4 substeps each is "
-                         f"{n * steps * substeps:.2g} substeps, hours of computing: a larger max_step, fewer "
-                         "vehicles or a shorter duration")
+        raise InputError(
+            f"{many(n)} vehicles x {many(steps)} control periods x {many(substeps)} RK4 substeps each is "
+            f"{n * steps * substeps:.2g} substeps, hours of computing: a larger max_step, fewer "
+            "vehicles or a shorter duration"
+        )
     row = 8 * (STATE_SIZE + CMD_SIZE + REF_SIZE)
     need = n * (steps // log_every + 2) * row
     try:
         memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):      # not a POSIX system: assume 8 GiB
+    except (ValueError, OSError, AttributeError):  # not a POSIX system: assume 8 GiB
         memory = 8 * 2**30
     if need > MAX_LOG_FRACTION * memory:
         every = int(math.ceil(n * (steps + 2) * row / (0.1 * memory)))
-        raise InputError(f"the flight's log would take {need / 2**30:.1f} GiB ({n:,} vehicle(s) x "
-                         f"{steps // log_every + 1:,} logged instants), more than half of this machine's "
-                         f"{memory / 2**30:.0f} GiB: log less often (log_every={every:,}: in Python, or a scenario's "
-                         "[simulation]) or fly shorter")
+        raise InputError(
+            f"the flight's log would take {need / 2**30:.1f} GiB ({n:,} vehicle(s) x "
+            f"{steps // log_every + 1:,} logged instants), more than half of this machine's "
+            f"{memory / 2**30:.0f} GiB: log less often (log_every={every:,}: in Python, or a scenario's "
+            "[simulation]) or fly shorter"
+        )
 
 
 def check_log_every(log_every: int, periods: int) -> None:
@@ -504,14 +594,20 @@ def check_log_every(log_every: int, periods: int) -> None:
     >>> check_log_every(1500, 2000)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: fly() argument log_every must be a divisor of the flight's 2,000 control periods (so that the log ends where the flight does), got int 1500; the nearest: 1,000, 2,000
+    quadcruise.errors.InputError: fly() argument log_every must be a divisor of the flight's 2,000 control ...
     """
     if periods % log_every == 0:
         return
     below, above = nearest_divisors(log_every, periods)
     hint = f"at most {periods:,}" if log_every > periods else f"the nearest: {below:,}, {above:,}"
-    checks.fail("fly()", "log_every", log_every, f"a divisor of the flight's {periods:,} control periods (so that "
-                "the log ends where the flight does)", kind=False, hint=hint)
+    checks.fail(
+        "fly()",
+        "log_every",
+        log_every,
+        f"a divisor of the flight's {periods:,} control periods (so that the log ends where the flight does)",
+        kind=False,
+        hint=hint,
+    )
 
 
 def nearest_divisors(k: int, n: int) -> tuple[int, int]:
@@ -565,7 +661,7 @@ def check_can_hover(vehicle: Vehicle) -> None:
     >>> check_can_hover(qc.Vehicle.paper().replace(m=60.0))
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: the vehicle of mass 60 kg cannot lift itself: hovering needs 588.6 N, its four rotors give at most 480 N (K = 120 N each)
+    quadcruise.errors.InputError: the vehicle of mass 60 kg cannot lift itself: hovering needs 588.6 N, its ...
     """
     duty = np.atleast_1d(np.asarray(vehicle.hover_duty, dtype=float))
     m = np.broadcast_to(np.asarray(vehicle.m, dtype=float), duty.shape)
@@ -575,13 +671,18 @@ def check_can_hover(vehicle: Vehicle) -> None:
     if bad.size:
         i = int(bad[0])
         which = f"vehicle {i} (mass {m[i]:g} kg)" if duty.size > 1 else f"the vehicle of mass {m[i]:g} kg"
-        raise InputError(f"{which} cannot lift itself: hovering needs {m[i] * g[i]:.4g} N, its four rotors "
-                         f"give at most {4 * k[i]:g} N (K = {k[i]:g} N each)")
+        raise InputError(
+            f"{which} cannot lift itself: hovering needs {m[i] * g[i]:.4g} N, its four rotors "
+            f"give at most {4 * k[i]:g} N (K = {k[i]:g} N each)"
+        )
     close = np.flatnonzero(duty > HOVER_DUTY_WARNING)
     if close.size:
         i = int(close[0])
-        warnings.warn(f"the vehicle{'' if duty.size == 1 else f' {i}'} hovers at {100 * duty[i]:.0f} % duty, "
-                      f"leaving {100 * (1 - duty[i]):.0f} % of its thrust for control", stacklevel=3)
+        warnings.warn(
+            f"the vehicle{'' if duty.size == 1 else f' {i}'} hovers at {100 * duty[i]:.0f} % duty, "
+            f"leaving {100 * (1 - duty[i]):.0f} % of its thrust for control",
+            stacklevel=3,
+        )
 
 
 def check_reference_fits(missions: list[Mission], duration: float, limits: Limits) -> None:
@@ -609,16 +710,18 @@ def check_reference_fits(missions: list[Mission], duration: float, limits: Limit
     >>> check_reference_fits([mission_from_name("circle", radius=1e200)], 20.0, Limits())
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: the circle's reference goes 1e+200 m from the origin, beyond the position bound of 1e+04 m (Limits.max_position)
+    quadcruise.errors.InputError: the circle's reference goes 1e+200 m from the origin, beyond the position ...
     """
     for mission in missions:
         with np.errstate(all="ignore"):
-            ref = mission.reference(np.linspace(0.0, duration, 1001))[:, REF_X:REF_X + 3]
+            ref = mission.reference(np.linspace(0.0, duration, 1001))[:, REF_X : REF_X + 3]
             reach = float(np.max(np.abs(ref))) if np.isfinite(ref).all() else math.inf
-        if reach > max(limits.max_position, Limits().max_position):   # a tighter bound given: the engine stops it
+        if reach > max(limits.max_position, Limits().max_position):  # a tighter bound given: the engine stops it
             kind = mission.to_dict().get("kind", type(mission).__name__.lower())
-            raise InputError(f"the {kind}'s reference goes {reach:.3g} m from the origin, beyond the position bound "
-                             f"of {limits.max_position:.3g} m (Limits.max_position)")
+            raise InputError(
+                f"the {kind}'s reference goes {reach:.3g} m from the origin, beyond the position bound "
+                f"of {limits.max_position:.3g} m (Limits.max_position)"
+            )
 
 
 def track_bound(missions: list[Mission], x0: np.ndarray, n: int) -> np.ndarray:
@@ -650,12 +753,12 @@ def track_bound(missions: list[Mission], x0: np.ndarray, n: int) -> np.ndarray:
     sizes, starts = [], []
     for mission in missions:
         ref = mission.reference(np.linspace(0.0, float(mission.duration), 1001))
-        path = ref[:, REF_X:REF_X + 3]
+        path = ref[:, REF_X : REF_X + 3]
         sizes.append(float(np.linalg.norm(path.max(axis=0) - path.min(axis=0))))
         starts.append(path[0])
     size = np.broadcast_to(np.asarray(sizes), (n,))
     start = np.broadcast_to(np.asarray(starts), (n, 3))
-    offset = np.linalg.norm(np.asarray(x0, dtype=float).reshape(n, -1)[:, X:X + 3] - start, axis=1)
+    offset = np.linalg.norm(np.asarray(x0, dtype=float).reshape(n, -1)[:, X : X + 3] - start, axis=1)
     return 1.0 + size + offset
 
 
@@ -685,7 +788,7 @@ def steady_bound(mission: Mission, duration: float) -> float:
     >>> steady_bound(mission_from_name("circle", radius=10.0), 20.0)
     5.0
     """
-    ref = mission.reference(np.linspace(0.0, float(duration), 1001))[:, REF_X:REF_X + 3]
+    ref = mission.reference(np.linspace(0.0, float(duration), 1001))[:, REF_X : REF_X + 3]
     extent = float(np.max(ref.max(axis=0) - ref.min(axis=0)))
     return max(1.0, 0.25 * extent)
 
@@ -727,8 +830,15 @@ def altitude_bound(mission: Mission, duration: float) -> float:
     return min(steady_bound(mission, duration), max(MIN_ALTITUDE_BOUND, ALTITUDE_FRACTION * float(z.min())))
 
 
-def off_track_since(t: np.ndarray, err: np.ndarray, dz: np.ndarray, measured: np.ndarray, settled_at: np.ndarray,
-                    bound: np.ndarray, zbound: np.ndarray) -> np.ndarray:
+def off_track_since(
+    t: np.ndarray,
+    err: np.ndarray,
+    dz: np.ndarray,
+    measured: np.ndarray,
+    settled_at: np.ndarray,
+    bound: np.ndarray,
+    zbound: np.ndarray,
+) -> np.ndarray:
     """The first instant after the transient at which each vehicle was off track: the one rule
     of ``fly`` (:func:`mark_off_track`) and of a Monte Carlo sweep.
 
@@ -769,8 +879,9 @@ def off_track_since(t: np.ndarray, err: np.ndarray, dz: np.ndarray, measured: np
     return np.where(beyond.any(axis=1), t[np.argmax(beyond, axis=1)], np.nan)
 
 
-def mark_off_track(result: SimResult, bound: np.ndarray, err: np.ndarray | None = None,
-                   zbound: np.ndarray | None = None) -> SimResult:
+def mark_off_track(
+    result: SimResult, bound: np.ndarray, err: np.ndarray | None = None, zbound: np.ndarray | None = None
+) -> SimResult:
     """The result, with ``off track`` as the status of each finished vehicle whose position
     error after the transient exceeded the bound, or whose altitude error exceeded the
     vertical bound, and the first instant it did as its ``t_stop`` (:func:`off_track_since`,
@@ -801,11 +912,12 @@ def mark_off_track(result: SimResult, bound: np.ndarray, err: np.ndarray | None 
     err = (position_error(result) if err is None else err)[live]
     if not np.isfinite(err).all():
         return result
-    pos, ref = result.states[live, :, X:X + 3], result.references[live, :, REF_X:REF_X + 3]
+    pos, ref = result.states[live, :, X : X + 3], result.references[live, :, REF_X : REF_X + 3]
     mission = result.meta.get("mission")
     got = transient_batch(t, pos, ref, mission if isinstance(mission, dict) else {}, [], err=err)
-    first = off_track_since(t, err, pos[:, :, 2] - ref[:, :, 2], got["axis"] >= 0, got["settled_at"],
-                            bound[live], zbound[live])
+    first = off_track_since(
+        t, err, pos[:, :, 2] - ref[:, :, 2], got["axis"] >= 0, got["settled_at"], bound[live], zbound[live]
+    )
     off = np.isfinite(first)
     if not off.any():
         return result
@@ -888,8 +1000,9 @@ def engine_inputs(environment: Environment | None, sensors: SensorNoise | None, 
     out: dict = {}
     if environment is not None:
         if not isinstance(environment, (Environment, CustomDisturbance)):
-            raise InputError(f"environment must be an Environment or a CustomDisturbance, "
-                             f"got {type(environment).__name__}")
+            raise InputError(
+                f"environment must be an Environment or a CustomDisturbance, got {type(environment).__name__}"
+            )
         if environment.parts:
             out.update(environment.kwargs(n))
     if sensors is not None:
@@ -947,9 +1060,22 @@ def _warn_about(result: SimResult) -> None:
         warnings.warn(f"vehicle {first} {result.status_text(first)}{more}", FlightWarning, stacklevel=3)
     clipped = result.duty_clipped_s
     if np.any(clipped > 0):
-        warnings.warn(f"rotor duties were clipped to [0, 1] for up to {clipped.max():.3f} s "
-                      f"({np.count_nonzero(clipped)} of {result.n} vehicles)", FlightWarning, stacklevel=3)
+        warnings.warn(
+            f"rotor duties were clipped to [0, 1] for up to {clipped.max():.3f} s "
+            f"({np.count_nonzero(clipped)} of {result.n} vehicles)",
+            FlightWarning,
+            stacklevel=3,
+        )
 
 
-__all__ = ["fly", "default_duration", "flight_warnings_named", "hover_state", "per_vehicle_controllers", "steady_bound",
-           "altitude_bound", "off_track_since", "write_flight"]
+__all__ = [
+    "fly",
+    "default_duration",
+    "flight_warnings_named",
+    "hover_state",
+    "per_vehicle_controllers",
+    "steady_bound",
+    "altitude_bound",
+    "off_track_since",
+    "write_flight",
+]

@@ -46,7 +46,7 @@ INPUT_COLUMNS = ("t", "u1", "u2", "u3", "u4")
 OUTPUT_COLUMNS = ("t",) + STATE_NAMES
 
 
-@njit(cache=True)     # compiled (as MISSION_SIG) on first use, not at import
+@njit(cache=True)  # compiled (as MISSION_SIG) on first use, not at import
 def no_reference(t, mp, ref):
     """An open-loop flight has no reference: NaN throughout (a mission, ``MISSION_SIG``).
 
@@ -100,7 +100,7 @@ def _validated(t, duties, source: str, lines: list[int] | None = None):
         raise InputError(f"{source}: needs at least two rows (a start and an end time)")
     if u.shape != (t.shape[0], 4):
         raise InputError(f"{source}: duties have shape {u.shape}, expected ({t.shape[0]}, 4)")
-    with np.errstate(invalid="ignore"):      # the rows at fault, at array speed; the first one named below
+    with np.errstate(invalid="ignore"):  # the rows at fault, at array speed; the first one named below
         bad = ~np.isfinite(t) | np.r_[False, ~(t[1:] > t[:-1])] | ~np.all((u >= 0.0) & (u <= 1.0), axis=1)
     for k in range(int(np.argmax(bad)) if bad.any() else t.shape[0], t.shape[0]):
         where = f"{source}, line {lines[k]}" if lines else f"{source}, row {k + 1}"
@@ -143,9 +143,15 @@ MAX_SUBSTEPS = 2.0e10
 """The most RK4 substeps a replay may take (at about ten million a second, half an hour or more)."""
 
 
-def replay(schedule: DutySchedule | str | os.PathLike, vehicle: Vehicle | None = None, *, max_step: float = 1e-3,
-           limits: Limits | None = None, full_dynamics: bool = False,
-           progress: Callable[[int, int], None] | None = None) -> SimResult:
+def replay(
+    schedule: DutySchedule | str | os.PathLike,
+    vehicle: Vehicle | None = None,
+    *,
+    max_step: float = 1e-3,
+    limits: Limits | None = None,
+    full_dynamics: bool = False,
+    progress: Callable[[int, int], None] | None = None,
+) -> SimResult:
     """Fly the duty schedule open loop and log the state at every schedule row.
 
     Parameters
@@ -172,9 +178,15 @@ def replay(schedule: DutySchedule | str | os.PathLike, vehicle: Vehicle | None =
         One logged instant per schedule row (the first is the initial state); the
         references are NaN.
     """
-    w = "replay()"                                  # every argument checked before any work
-    checks.instance(w, "schedule", schedule, (DutySchedule, str, os.PathLike), optional=False,
-                    want="a DutySchedule or the path of a t,u1,u2,u3,u4 CSV file")
+    w = "replay()"  # every argument checked before any work
+    checks.instance(
+        w,
+        "schedule",
+        schedule,
+        (DutySchedule, str, os.PathLike),
+        optional=False,
+        want="a DutySchedule or the path of a t,u1,u2,u3,u4 CSV file",
+    )
     vehicle = checks.instance(w, "vehicle", vehicle, Vehicle) or Vehicle.paper()
     max_step = checks.number(w, "max_step", max_step, "pos", unit="s")
     checks.instance(w, "limits", limits, Limits)
@@ -184,7 +196,7 @@ def replay(schedule: DutySchedule | str | os.PathLike, vehicle: Vehicle | None =
         schedule = read_duty_csv(schedule)
     vp = vehicle.rows()
     x0 = np.zeros((vp.shape[0], STATE_SIZE))
-    x0[:, F1:F1 + 4] = vp[:, [P_K]] * schedule.duties[0]   # thrust K * u of the first row
+    x0[:, F1 : F1 + 4] = vp[:, [P_K]] * schedule.duties[0]  # thrust K * u of the first row
     meta = {
         "workflow": "replay",
         "source": schedule.source,
@@ -196,22 +208,35 @@ def replay(schedule: DutySchedule | str | os.PathLike, vehicle: Vehicle | None =
     rows = schedule.t.shape[0]
     substeps = float(np.sum(np.ceil(np.diff(schedule.t) / max_step - 1e-9)))
     if substeps > MAX_SUBSTEPS:
-        raise InputError(f"{schedule.source}: {schedule.t[-1] - schedule.t[0]:g} s of duties at max_step "
-                         f"{max_step:g} s is {substeps:.3g} RK4 substeps, hours of computing: a larger "
-                         "--max-step or a shorter table")
+        raise InputError(
+            f"{schedule.source}: {schedule.t[-1] - schedule.t[0]:g} s of duties at max_step "
+            f"{max_step:g} s is {substeps:.3g} RK4 substeps, hours of computing: a larger "
+            "--max-step or a shorter table"
+        )
     if progress is not None:
         progress(0, rows)
-    result = simulate(schedule.t, x0, vp, duty_schedule, pack_schedule(schedule.t, schedule.duties),
-                      no_reference, np.zeros(1), memory=np.zeros(1), max_step=max_step,
-                      limits=Limits(max_tilt=math.inf) if limits is None else limits, meta=meta,
-                      full_dynamics=full_dynamics)
+    result = simulate(
+        schedule.t,
+        x0,
+        vp,
+        duty_schedule,
+        pack_schedule(schedule.t, schedule.duties),
+        no_reference,
+        np.zeros(1),
+        memory=np.zeros(1),
+        max_step=max_step,
+        limits=Limits(max_tilt=math.inf) if limits is None else limits,
+        meta=meta,
+        full_dynamics=full_dynamics,
+    )
     if progress is not None:
         progress(rows, rows)
     return result
 
 
-def write_states_csv(result: SimResult, path: str | os.PathLike, vehicle: int = 0,
-                     progress: Callable[[int, int], None] | None = None) -> None:
+def write_states_csv(
+    result: SimResult, path: str | os.PathLike, vehicle: int = 0, progress: Callable[[int, int], None] | None = None
+) -> None:
     """Write one vehicle's states as ``t,x,...,F4`` (SI units, radians), atomically.
 
     Parameters
@@ -232,8 +257,14 @@ def write_states_csv(result: SimResult, path: str | os.PathLike, vehicle: int = 
         for start in range(0, rows, block):
             if progress is not None:
                 progress(start, rows)
-            np.savetxt(f, table[start:start + block], delimiter=",", fmt="%.15g", comments="",
-                       header=",".join(OUTPUT_COLUMNS) if start == 0 else "")
+            np.savetxt(
+                f,
+                table[start : start + block],
+                delimiter=",",
+                fmt="%.15g",
+                comments="",
+                header=",".join(OUTPUT_COLUMNS) if start == 0 else "",
+            )
         if progress is not None:
             progress(rows, rows)
 
@@ -322,8 +353,9 @@ class SpeedSchedule:
         return f"{self.source}, line {self.lines[k]}" if self.lines else f"{self.source}, row {k + 1}"
 
 
-def read_speed_csv(path: str | os.PathLike, n_rotors: int,
-                   progress: Callable[[int, int], None] | None = None) -> SpeedSchedule:
+def read_speed_csv(
+    path: str | os.PathLike, n_rotors: int, progress: Callable[[int, int], None] | None = None
+) -> SpeedSchedule:
     """Read a ``t,w1,..,wn`` CSV of commanded rotor speeds; errors name the file, line and column.
 
     Parameters
@@ -345,8 +377,10 @@ def read_speed_csv(path: str | os.PathLike, n_rotors: int,
     columns = speed_columns(n_rotors)
     _, used, data, lines = read_numeric_csv(path, columns, (f"w{n_rotors + 1}",), progress=progress)
     if len(used) > len(columns):
-        raise InputError(f"{path}: column '{used[len(columns)]}', but the vehicle has {n_rotors} rotors "
-                         f"(columns {', '.join(columns)})")
+        raise InputError(
+            f"{path}: column '{used[len(columns)]}', but the vehicle has {n_rotors} rotors "
+            f"(columns {', '.join(columns)})"
+        )
     if data.shape[0] < 2:
         raise InputError(f"{path}: needs at least two data rows (a start and an end time), found {data.shape[0]}")
     return SpeedSchedule(t=data[:, 0], speeds=data[:, 1:], source=str(path), lines=tuple(lines))
@@ -358,9 +392,16 @@ motors) tumbling at up to 290 rad/s ends 3 s with its quaternion 3e-3 off at 1e-
 at 1e-4 s (tests/integration/test_rotorpy_agreement.py); 3 s cost 30,000 steps, milliseconds."""
 
 
-def replay_rotors(schedule: SpeedSchedule, vehicle: RotorVehicle, *, max_step: float = ROTOR_MAX_STEP,
-                  limits: Limits | None = None, wind=(0.0, 0.0, 0.0), ground: bool = False,
-                  progress: Callable[[int, int], None] | None = None) -> RotorResult:
+def replay_rotors(
+    schedule: SpeedSchedule,
+    vehicle: RotorVehicle,
+    *,
+    max_step: float = ROTOR_MAX_STEP,
+    limits: Limits | None = None,
+    wind=(0.0, 0.0, 0.0),
+    ground: bool = False,
+    progress: Callable[[int, int], None] | None = None,
+) -> RotorResult:
     """Fly the commanded rotor speeds open loop on the rotor-speed plant and log every row.
 
     The vehicle starts at rest at the origin, level (the identity quaternion), each rotor at
@@ -403,34 +444,56 @@ def replay_rotors(schedule: SpeedSchedule, vehicle: RotorVehicle, *, max_step: f
         raise InputError(f"replay_rotors needs a rotor-plant vehicle (RotorVehicle), got {type(vehicle).__name__}")
     n = vehicle.n_rotors
     if schedule.speeds.shape[1] != n:
-        raise InputError(f"{schedule.source}: {schedule.speeds.shape[1]} rotor speed columns, but the vehicle has "
-                         f"{n} rotors")
+        raise InputError(
+            f"{schedule.source}: {schedule.speeds.shape[1]} rotor speed columns, but the vehicle has {n} rotors"
+        )
     outside = (schedule.speeds < vehicle.w_min) | (schedule.speeds > vehicle.w_max)
     if outside.any():
         k, j = (int(a[0]) for a in np.nonzero(outside))
-        raise InputError(f"{schedule.where(k)}, column 'w{j + 1}': rotor speed {schedule.speeds[k, j]:g} rad/s is "
-                         f"outside the vehicle's [{vehicle.w_min:g}, {vehicle.w_max:g}]")
+        raise InputError(
+            f"{schedule.where(k)}, column 'w{j + 1}': rotor speed {schedule.speeds[k, j]:g} rad/s is "
+            f"outside the vehicle's [{vehicle.w_min:g}, {vehicle.w_max:g}]"
+        )
     wind = np.asarray(wind, dtype=float)
     if wind.shape != (3,) or not np.all(np.isfinite(wind)):
         raise InputError(f"wind must be 3 finite numbers [m/s], got {wind.tolist()!r}")
     if isinstance(max_step, (int, float)) and max_step > 0:
         substeps = float(np.sum(np.ceil(np.diff(schedule.t) / max_step - 1e-9)))
         if substeps > MAX_SUBSTEPS:
-            raise InputError(f"{schedule.source}: {schedule.t[-1] - schedule.t[0]:g} s of rotor speeds at max_step "
-                             f"{max_step:g} s is {substeps:.3g} RK4 substeps, hours of computing: a larger "
-                             "--max-step or a shorter table")
+            raise InputError(
+                f"{schedule.source}: {schedule.t[-1] - schedule.t[0]:g} s of rotor speeds at max_step "
+                f"{max_step:g} s is {substeps:.3g} RK4 substeps, hours of computing: a larger "
+                "--max-step or a shorter table"
+            )
     x0 = np.zeros(ROTOR_W1 + n)
     x0[QW] = 1.0
     x0[ROTOR_W1:] = schedule.speeds[0]
     ext = np.r_[np.zeros(6), wind, np.ones(n)]
-    meta = {"workflow": "replay", "plant": "rotor", "source": schedule.source, "vehicle": vehicle.to_dict(),
-            "max_step_s": max_step, "wind": wind.tolist(), "ground": bool(ground), "version": __version__}
+    meta = {
+        "workflow": "replay",
+        "plant": "rotor",
+        "source": schedule.source,
+        "vehicle": vehicle.to_dict(),
+        "max_step_s": max_step,
+        "wind": wind.tolist(),
+        "ground": bool(ground),
+        "version": __version__,
+    }
     rows = schedule.t.shape[0]
     if progress is not None:
         progress(0, rows)
-    result = replay_rotor_speeds(schedule.t, schedule.speeds, x0, vehicle.row(), ext=ext, max_step=max_step,
-                                 limits=limits, touchdown_speed=vehicle.touchdown_speed if ground else None,
-                                 names=state_names(n), meta=meta)
+    result = replay_rotor_speeds(
+        schedule.t,
+        schedule.speeds,
+        x0,
+        vehicle.row(),
+        ext=ext,
+        max_step=max_step,
+        limits=limits,
+        touchdown_speed=vehicle.touchdown_speed if ground else None,
+        names=state_names(n),
+        meta=meta,
+    )
     if progress is not None:
         progress(rows, rows)
     return result

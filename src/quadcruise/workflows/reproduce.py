@@ -38,9 +38,9 @@ import functools
 import math
 import re
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -118,8 +118,18 @@ TRACE_EVERY = 10
 """Traces are written, and figures drawn, at every 10th control period (100 Hz at the
 default 1 kHz); the metrics are computed on the full-rate log."""
 
-METRIC_KEYS = ("rise_time_s", "settling_time_s", "settling_time_5pct_s", "overshoot_pct", "rmse_m",
-               "max_error_m", "steady_rmse_m", "steady_max_error_m", "duty_clipped_s", "controller_limited_s")
+METRIC_KEYS = (
+    "rise_time_s",
+    "settling_time_s",
+    "settling_time_5pct_s",
+    "overshoot_pct",
+    "rmse_m",
+    "max_error_m",
+    "steady_rmse_m",
+    "steady_max_error_m",
+    "duty_clipped_s",
+    "controller_limited_s",
+)
 
 
 def paper_numbers(run: dict) -> dict:
@@ -177,8 +187,9 @@ class Reproduction:
         dict of str to str
             Empty when every flight finished.
         """
-        return {f"{scen} with {ctrl}": res.status_text(0)
-                for (scen, ctrl), res in self.results.items() if not res.ok[0]}
+        return {
+            f"{scen} with {ctrl}": res.status_text(0) for (scen, ctrl), res in self.results.items() if not res.ok[0]
+        }
 
     def to_json(self) -> dict:
         """The ``metrics.json`` document.
@@ -228,9 +239,15 @@ class Reproduction:
         raise KeyError((scenario, controller))
 
 
-def reproduce(*, scenarios=tuple(SCENARIOS), controllers=tuple(CONTROLLERS), dt: float = 1e-3,
-              vehicle: Vehicle | None = None, fitted: bool = True,
-              progress: Callable[[int, int, str], None] | None = None) -> Reproduction:
+def reproduce(
+    *,
+    scenarios=tuple(SCENARIOS),
+    controllers=tuple(CONTROLLERS),
+    dt: float = 1e-3,
+    vehicle: Vehicle | None = None,
+    fitted: bool = True,
+    progress: Callable[[int, int, str], None] | None = None,
+) -> Reproduction:
     """Fly every scenario with every controller and measure the transients and tracking.
 
     Parameters
@@ -279,8 +296,14 @@ def reproduce(*, scenarios=tuple(SCENARIOS), controllers=tuple(CONTROLLERS), dt:
         with flight_warnings_named(f"{scen} with {ctrl_name}"):
             result = fly(mission, factory(), vehicle=vehicle, duration=duration, dt=dt)
         row = result.metrics().iloc[0].to_dict()
-        run = {"scenario": scen, "controller": ctrl_name, "axis": row["axis"], "status": row["status"],
-               **{k: _json_number(row[k]) for k in METRIC_KEYS}, "fitted": ctrl_name in FITTED}
+        run = {
+            "scenario": scen,
+            "controller": ctrl_name,
+            "axis": row["axis"],
+            "status": row["status"],
+            **{k: _json_number(row[k]) for k in METRIC_KEYS},
+            "fitted": ctrl_name in FITTED,
+        }
         if scen == fit_name:
             run["rise_0_100_s"] = _json_number(_rise_0_100(result, mission))
         runs.append(run)
@@ -289,7 +312,9 @@ def reproduce(*, scenarios=tuple(SCENARIOS), controllers=tuple(CONTROLLERS), dt:
         if progress:
             progress(len(runs), len(flights), f"{scen} with {ctrl_name}")
     config = {
-        "vehicle": vehicle.to_dict(), "dt_s": dt, "seed": None,
+        "vehicle": vehicle.to_dict(),
+        "dt_s": dt,
+        "seed": None,
         "scenarios": {s: {"mission": SCENARIOS[s][0].to_dict(), "duration_s": SCENARIOS[s][1]} for s in scenarios},
         "controllers": {c: CONTROLLERS[c]().to_dict() for c in controllers},
     }
@@ -305,8 +330,9 @@ def _rise_0_100(result: SimResult, mission: Step) -> float:
 
     j = "xyz".index(mission.axis)
     y0 = getattr(mission, mission.axis)
-    info = step_info(result.t, result.states[0, :, j], y_initial=y0, y_final=y0 + mission.size,
-                     t_step=mission.time, rise=(0.0, 1.0))
+    info = step_info(
+        result.t, result.states[0, :, j], y_initial=y0, y_final=y0 + mission.size, t_step=mission.time, rise=(0.0, 1.0)
+    )
     return math.nan if info.rise_time is None else info.rise_time
 
 
@@ -318,8 +344,14 @@ def _json_number(value) -> float | None:
     return None if not np.isfinite(value) else value
 
 
-def write_reproduction(rep: Reproduction, out: str | Path, *, force: bool = False, fmt: str = "csv",
-                       progress: Callable[[int, int, str], None] | None = None) -> Path:
+def write_reproduction(
+    rep: Reproduction,
+    out: str | Path,
+    *,
+    force: bool = False,
+    fmt: str = "csv",
+    progress: Callable[[int, int, str], None] | None = None,
+) -> Path:
     """Write metrics.json, the figures, the traces and report.md into ``out``, atomically.
 
     The folder also holds ``quadcruise.json`` (the configuration); traces and figures are
@@ -350,11 +382,16 @@ def write_reproduction(rep: Reproduction, out: str | Path, *, force: bool = Fals
     with atomic_dir(out) as tmp:
         tmp = Path(tmp)
         (tmp / "metrics.json").write_text(dumps(rep.to_json(), indent=2) + "\n")
-        (tmp / MARKER).write_text(dumps({"workflow": "reproduce", **rep.config, "version": __version__}, indent=2) + "\n")
-        (tmp / "scenario.toml").write_text(scenario_text(
-            scenario_document({"vehicle": rep.config["vehicle"], "dt_s": rep.config["dt_s"]}),
-            header="written by quadcruise reproduce; `quadcruise reproduce --scenario THIS_FILE` flies the same "
-                   "reproduction (the paper's scenarios and controllers, this vehicle and control period)"))
+        (tmp / MARKER).write_text(
+            dumps({"workflow": "reproduce", **rep.config, "version": __version__}, indent=2) + "\n"
+        )
+        (tmp / "scenario.toml").write_text(
+            scenario_text(
+                scenario_document({"vehicle": rep.config["vehicle"], "dt_s": rep.config["dt_s"]}),
+                header="written by quadcruise reproduce; `quadcruise reproduce --scenario THIS_FILE` flies the same "
+                "reproduction (the paper's scenarios and controllers, this vehicle and control period)",
+            )
+        )
         traces = tmp / "traces"
         traces.mkdir()
         light = {key: result.decimate(TRACE_EVERY) for key, result in rep.results.items()}
@@ -455,9 +492,11 @@ def results_table(rep: Reproduction) -> str:
         says so in bold after its controller, and a line under the table counts them: its
         metrics describe a failed flight.
     """
-    lines = ["| scenario | controller | rise 10-90 % [s] (paper) | settling 2 % [s] (paper) | settling 5 % [s] "
-             "| overshoot [%] (paper) | RMSE [m] | max error [m] |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| scenario | controller | rise 10-90 % [s] (paper) | settling 2 % [s] (paper) | settling 5 % [s] "
+        "| overshoot [%] (paper) | RMSE [m] | max error [m] |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for r in rep.runs:
         paper = paper_numbers(r)
         p = {k: (f" ({paper[k]:g})" if k in paper else "") for k in ("rise_time_s", "settling_time_s", "overshoot_pct")}
@@ -466,11 +505,14 @@ def results_table(rep: Reproduction) -> str:
             f"| {r['scenario']} | {who} | {_cell(r['rise_time_s'])}{p['rise_time_s']} "
             f"| {_cell(r['settling_time_s'], 'did not settle')}{p['settling_time_s']} "
             f"| {_cell(r['settling_time_5pct_s'], 'did not settle')} "
-            f"| {_cell(r['overshoot_pct'])}{p['overshoot_pct']} | {_cell(r['rmse_m'])} | {_cell(r['max_error_m'])} |")
+            f"| {_cell(r['overshoot_pct'])}{p['overshoot_pct']} | {_cell(r['rmse_m'])} | {_cell(r['max_error_m'])} |"
+        )
     failed = sum(r["status"] != "finished" for r in rep.runs)
     if failed:
-        lines.append(f"\n**{failed} of {len(rep.runs)} flights did not finish**: their metrics describe a failed "
-                     "flight, not the controller's design.")
+        lines.append(
+            f"\n**{failed} of {len(rep.runs)} flights did not finish**: their metrics describe a failed "
+            "flight, not the controller's design."
+        )
     return "\n".join(lines)
 
 
@@ -497,16 +539,24 @@ def fitted_table(rep: Reproduction) -> str:
     if not rows:
         return ""
     factories = {**CONTROLLERS, **FITTED}
-    lines = ["| controller | gains | rise 10-90 % [s] | rise 0-100 % [s] | settling 2 % [s] | overshoot [%] "
-             "| paper: rise, settling, overshoot |", "|---|---|---|---|---|---|---|"]
+    lines = [
+        "| controller | gains | rise 10-90 % [s] | rise 0-100 % [s] | settling 2 % [s] | overshoot [%] "
+        "| paper: rise, settling, overshoot |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
         paper = paper_numbers(r)
-        label = r["controller"] + (" **(fitted)**" if r["fitted"] and "fitted" not in r["controller"] else "") \
+        label = (
+            r["controller"]
+            + (" **(fitted)**" if r["fitted"] and "fitted" not in r["controller"] else "")
             + ("" if r["status"] == "finished" else f" **({r['status']})**")
-        lines.append(f"| {label} | {_gains_text(factories[r['controller']]())} | {_cell(r['rise_time_s'])} "
-                     f"| {_cell(r.get('rise_0_100_s'))} | {_cell(r['settling_time_s'], 'did not settle')} "
-                     f"| {_cell(r['overshoot_pct'])} | {paper['rise_time_s']:g} s, {paper['settling_time_s']:g} s, "
-                     f"{paper['overshoot_pct']:g} % |")
+        )
+        lines.append(
+            f"| {label} | {_gains_text(factories[r['controller']]())} | {_cell(r['rise_time_s'])} "
+            f"| {_cell(r.get('rise_0_100_s'))} | {_cell(r['settling_time_s'], 'did not settle')} "
+            f"| {_cell(r['overshoot_pct'])} | {paper['rise_time_s']:g} s, {paper['settling_time_s']:g} s, "
+            f"{paper['overshoot_pct']:g} % |"
+        )
     return "\n".join(lines)
 
 
@@ -521,10 +571,12 @@ the rise time are given; the paper does not say which it used.
 """
 
 
-INTRO = ("Our value first, the paper's in brackets. Transients are measured on x from hover; the rise is "
-         "10-90 % (python-control's convention) in this table, while the paper does not say which convention "
-         "its rise follows: the fitted table below gives both. Settling uses the 2 % band (5 % beside it); RMSE "
-         "is the 3-D position error over the whole flight, transient included.")
+INTRO = (
+    "Our value first, the paper's in brackets. Transients are measured on x from hover; the rise is "
+    "10-90 % (python-control's convention) in this table, while the paper does not say which convention "
+    "its rise follows: the fitted table below gives both. Settling uses the 2 % band (5 % beside it); RMSE "
+    "is the 3-D position error over the whole flight, transient included."
+)
 """The sentences above the results table: what each column measures."""
 
 
@@ -543,8 +595,7 @@ def report_markdown(rep: Reproduction, figures: list[str]) -> str:
     str
         The Markdown text.
     """
-    text = [f"# quadcruise {__version__}: reproduction of the paper\n",
-            INTRO + "\n", results_table(rep)]
+    text = [f"# quadcruise {__version__}: reproduction of the paper\n", INTRO + "\n", results_table(rep)]
     fits = fitted_table(rep)
     if fits:
         text += [FITTED_NOTE, fits]
@@ -579,12 +630,19 @@ def baseline_comparison(rep: Reproduction) -> str:
         except KeyError:
             continue
         if ours["settling_time_5pct_s"] is not None and r["settling_time_5pct_s"] is not None:
-            pairs.append((r["scenario"], r["settling_time_5pct_s"] - ours["settling_time_5pct_s"],
-                          (r["overshoot_pct"] or 0.0) - (ours["overshoot_pct"] or 0.0)))
+            pairs.append(
+                (
+                    r["scenario"],
+                    r["settling_time_5pct_s"] - ours["settling_time_5pct_s"],
+                    (r["overshoot_pct"] or 0.0) - (ours["overshoot_pct"] or 0.0),
+                )
+            )
     if not pairs:
         return ""
-    lines = [f"- {s}: the baseline settles (5 % band) {d:+.2f} s and overshoots {o:+.2f} points "
-             "relative to nlpd" for s, d, o in pairs]
+    lines = [
+        f"- {s}: the baseline settles (5 % band) {d:+.2f} s and overshoots {o:+.2f} points relative to nlpd"
+        for s, d, o in pairs
+    ]
     return "\n**In this run.**\n\n" + "\n".join(lines) + "\n"
 
 
@@ -626,10 +684,20 @@ def _fitted_nlpd_loop() -> tuple:
     t = np.arange(0.0, 20.0 + lin.dt / 2, lin.dt)
     info = control.step_info(x, T=t, SettlingTimeThreshold=0.02, RiseTimeLimits=(0.1, 0.9))
     full = control.step_info(x, T=t, RiseTimeLimits=(0.0, 1.0))
-    return (("kp", c.position.kp), ("kd", c.position.kd), ("pd_pole", pd), ("pd_zeta", c.position.damping),
-            ("pd_wn", c.position.natural_frequency), ("dom_pole", dom), ("dom_zeta", -dom.real / abs(dom)),
-            ("dom_wn", abs(dom)), ("lin_rise", info["RiseTime"]), ("lin_rise_0_100", full["RiseTime"]),
-            ("lin_settling", info["SettlingTime"]), ("lin_overshoot", info["Overshoot"]))
+    return (
+        ("kp", c.position.kp),
+        ("kd", c.position.kd),
+        ("pd_pole", pd),
+        ("pd_zeta", c.position.damping),
+        ("pd_wn", c.position.natural_frequency),
+        ("dom_pole", dom),
+        ("dom_zeta", -dom.real / abs(dom)),
+        ("dom_wn", abs(dom)),
+        ("lin_rise", info["RiseTime"]),
+        ("lin_rise_0_100", full["RiseTime"]),
+        ("lin_settling", info["SettlingTime"]),
+        ("lin_overshoot", info["Overshoot"]),
+    )
 
 
 def _pole_text(p: complex) -> str:
@@ -714,4 +782,3 @@ the transient is over; the paper's design numbers (Kp = 3.01, tau_d = 1.66, Kd =
 reproduced exactly by `quadcruise.control.design.pd_from_poles`.
 """
 """The text of :func:`differences`, with its computed numbers as ``str.format`` fields."""
-

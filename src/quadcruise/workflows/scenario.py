@@ -78,15 +78,43 @@ from quadcruise.model.vehicle import Vehicle
 
 VEHICLE_PRESETS = {"paper": Vehicle.paper}
 """Vehicles by name: ``preset = "paper"`` in a ``[vehicle]`` table, ``--vehicle paper`` on the command line."""
-COMPARE_POPULATION_KEYS = ("n", "seed", "mass_spread", "inertia_spread", "thrust_spread", "bandwidth_spread",
-                           "yaw_arm_spread", "offset", "wind_spread", "distribution", "model_error")
+COMPARE_POPULATION_KEYS = (
+    "n",
+    "seed",
+    "mass_spread",
+    "inertia_spread",
+    "thrust_spread",
+    "bandwidth_spread",
+    "yaw_arm_spread",
+    "offset",
+    "wind_spread",
+    "distribution",
+    "model_error",
+)
 """Keys of ``[compare] population``: the number of vehicles, the seed and the
 :class:`~quadcruise.montecarlo.Population` fields (its disturbances are the scenario's)."""
-TABLES = ("vehicle", "controller", "mission", "disturbances", "simulation", "montecarlo", "controller_vehicle",
-          "compare")
-SIMULATION_KEYS = {"duration": float, "dt": float, "max_step": float, "full_dynamics": bool,
-                   "seed": int, "log_every": int, "n": int, "max_track_error": float,
-                   "max_steady_error": float, "initial_state": list}
+TABLES = (
+    "vehicle",
+    "controller",
+    "mission",
+    "disturbances",
+    "simulation",
+    "montecarlo",
+    "controller_vehicle",
+    "compare",
+)
+SIMULATION_KEYS = {
+    "duration": float,
+    "dt": float,
+    "max_step": float,
+    "full_dynamics": bool,
+    "seed": int,
+    "log_every": int,
+    "n": int,
+    "max_track_error": float,
+    "max_steady_error": float,
+    "initial_state": list,
+}
 DISTURBANCE_KEYS = ("wind", "gust", "turbulence", "rotor_loss", "force", "sensor_noise")
 
 
@@ -238,7 +266,7 @@ def load_scenario(path: str | Path) -> Scenario:
     if not path.is_file():
         raise InputError(f"{path}: no such file")
     try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8-sig"))     # a byte-order mark is dropped
+        doc = tomllib.loads(path.read_text(encoding="utf-8-sig"))  # a byte-order mark is dropped
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: not valid TOML ({exc})") from None
     return scenario_from_dict(doc, source=str(path), base=path.parent)
@@ -288,14 +316,25 @@ def scenario_from_dict(doc: dict, *, source: str = "scenario", base: Path | None
     environment, noise = _disturbances(where.at("disturbances"), doc.get("disturbances", {}))
     simulation = _simulation(where.at("simulation"), doc.get("simulation", {}))
     _consistent(where, doc, vehicle, model, mission, simulation)
-    return Scenario(vehicle=vehicle, controller_vehicle=model, controller=controller, mission=mission, environment=environment,
-                    sensor_noise=noise, simulation=simulation, montecarlo=dict(doc.get("montecarlo", {})),
-                    compare=compared, compare_population=dict(doc.get("compare", {}).get("population", {})),
-                    title=title, source=source)
+    return Scenario(
+        vehicle=vehicle,
+        controller_vehicle=model,
+        controller=controller,
+        mission=mission,
+        environment=environment,
+        sensor_noise=noise,
+        simulation=simulation,
+        montecarlo=dict(doc.get("montecarlo", {})),
+        compare=compared,
+        compare_population=dict(doc.get("compare", {}).get("population", {})),
+        title=title,
+        source=source,
+    )
 
 
-def _consistent(where: _Where, doc: dict, vehicle: Vehicle, model: Vehicle | None, mission: Mission | None,
-                simulation: dict) -> None:
+def _consistent(
+    where: _Where, doc: dict, vehicle: Vehicle, model: Vehicle | None, mission: Mission | None, simulation: dict
+) -> None:
     """Refuse a scenario whose tables contradict each other (one hand-edited after the tool wrote
     it), naming the file and the keys: the number of vehicles given by per-vehicle values, ``n``
     and ``initial_state``; and, when the file gives both ``duration`` and ``dt``, a ``dt`` that
@@ -314,10 +353,10 @@ def _consistent(where: _Where, doc: dict, vehicle: Vehicle, model: Vehicle | Non
     if len(set(counts.values())) > 1:
         told = ", ".join(f"{k} gives {v}" for k, v in counts.items())
         raise InputError(f"{where.source}: the number of vehicles contradicts itself: {told}")
-    if "duration" not in simulation or "dt" not in simulation:   # else the command line may give them
+    if "duration" not in simulation or "dt" not in simulation:  # else the command line may give them
         return
     sim, duration, dt = where.at("simulation"), simulation["duration"], simulation["dt"]
-    periods = round(duration / dt)                # as sim.engine.time_grid counts them, without the grid
+    periods = round(duration / dt)  # as sim.engine.time_grid counts them, without the grid
     if dt > duration or abs(periods * dt - duration) > 1e-9 * max(1.0, duration):
         raise sim.error(f"'dt' = {dt:g} s does not divide 'duration' = {duration:g} s into whole control periods")
     every = simulation.get("log_every", 1)
@@ -325,9 +364,11 @@ def _consistent(where: _Where, doc: dict, vehicle: Vehicle, model: Vehicle | Non
         from quadcruise.workflows.fly import nearest_divisors
 
         near = nearest_divisors(every, periods)
-        raise sim.error(f"'log_every' = {every} does not divide the flight's {periods:,} control periods "
-                        f"('duration' / 'dt'): the log would end before the flight does; the nearest that do: "
-                        f"{near[0]}, {near[1]}")
+        raise sim.error(
+            f"'log_every' = {every} does not divide the flight's {periods:,} control periods "
+            f"('duration' / 'dt'): the log would end before the flight does; the nearest that do: "
+            f"{near[0]}, {near[1]}"
+        )
 
 
 class _Where:
@@ -336,7 +377,7 @@ class _Where:
     def __init__(self, source: str, table: str = "") -> None:
         self.source, self.table = source, table
 
-    def at(self, table: str) -> "_Where":
+    def at(self, table: str) -> _Where:
         return _Where(self.source, table)
 
     def error(self, message: str) -> InputError:
@@ -442,8 +483,11 @@ def _vehicle(where: _Where, table: dict) -> Vehicle:
     fields = {f.name for f in dataclasses.fields(Vehicle)}
     _known(where, "", table, fields | {"preset"})
     base = where.wrap(vehicle_preset, table.get("preset", "paper"))
-    values = {k: _numbers(where, k, v) if isinstance(v, list) else _number(where, k, v)
-              for k, v in table.items() if k != "preset"}
+    values = {
+        k: _numbers(where, k, v) if isinstance(v, list) else _number(where, k, v)
+        for k, v in table.items()
+        if k != "preset"
+    }
     return where.wrap(base.replace, **values)
 
 
@@ -498,8 +542,13 @@ def _controller(where: _Where, table: dict) -> Controller:
                 cls_gains = PIDGains if "ki" in value else PDGains
             else:
                 cls_gains = type(default)
-            _known(where, f"{key}.", value, {f.name for f in dataclasses.fields(cls_gains)}
-                   | ({"kp", "kd", "ki"} if cls_gains in (PDGains, PIDGains) else set()))
+            _known(
+                where,
+                f"{key}.",
+                value,
+                {f.name for f in dataclasses.fields(cls_gains)}
+                | ({"kp", "kd", "ki"} if cls_gains in (PDGains, PIDGains) else set()),
+            )
             params[key] = where.wrap(cls_gains, **{k: _number(where, f"{key}.{k}", v) for k, v in value.items()})
         elif isinstance(value, bool) or isinstance(value, str):
             params[key] = value
@@ -553,13 +602,14 @@ def _mission(where: _Where, table: dict, base: Path | None) -> Mission:
     fields = {f.name for f in dataclasses.fields(cls)}
     _known(where, "", table, fields | {"kind"})
     params = {k: v for k, v in table.items() if k != "kind"}
-    if isinstance(params.get("table"), dict):                  # a waypoint table written inline
+    if isinstance(params.get("table"), dict):  # a waypoint table written inline
         from quadcruise.missions import WaypointTable
 
         params["table"] = where.wrap(WaypointTable.from_dict, params["table"])
     if "table" in params and isinstance(params["table"], str) and base is not None:
-        params["table"] = str((base / params["table"]).resolve()) if not Path(params["table"]).is_absolute() \
-            else params["table"]
+        params["table"] = (
+            str((base / params["table"]).resolve()) if not Path(params["table"]).is_absolute() else params["table"]
+        )
     for k, v in params.items():
         if isinstance(v, list):
             params[k] = tuple(v)
@@ -575,10 +625,17 @@ def _disturbances(where: _Where, table: dict):
     parts: dict[str, Any] = {}
     if "wind" in table:
         wind = table["wind"]
-        parts["wind"] = where.wrap(d.ConstantWind, velocity=tuple(wind)) if isinstance(wind, list) \
+        parts["wind"] = (
+            where.wrap(d.ConstantWind, velocity=tuple(wind))
+            if isinstance(wind, list)
             else where.wrap(d.ConstantWind, **_table(where, "wind", wind, d.ConstantWind))
-    for key, cls in (("gust", d.Gust), ("turbulence", d.Turbulence), ("rotor_loss", d.RotorLoss),
-                     ("force", d.ExternalForce)):
+        )
+    for key, cls in (
+        ("gust", d.Gust),
+        ("turbulence", d.Turbulence),
+        ("rotor_loss", d.RotorLoss),
+        ("force", d.ExternalForce),
+    ):
         if key in table:
             values = {k: tuple(v) if isinstance(v, list) else v for k, v in _table(where, key, table[key], cls).items()}
             parts[key] = where.wrap(cls, **values)
@@ -604,10 +661,16 @@ OFF_WHEN_INFINITE = ("max_track_error", "max_steady_error")
 
 def _simulation(where: _Where, table: dict) -> dict:
     _known(where, "", table, set(SIMULATION_KEYS))
-    out = {k: _numbers(where, k, v) if SIMULATION_KEYS[k] is list else
-           (math.inf if k in OFF_WHEN_INFINITE and isinstance(v, float) and v == math.inf
-            else _number(where, k, v, SIMULATION_KEYS[k]))
-           for k, v in table.items()}
+    out = {
+        k: _numbers(where, k, v)
+        if SIMULATION_KEYS[k] is list
+        else (
+            math.inf
+            if k in OFF_WHEN_INFINITE and isinstance(v, float) and v == math.inf
+            else _number(where, k, v, SIMULATION_KEYS[k])
+        )
+        for k, v in table.items()
+    }
     for key in ("duration", "dt", "max_step"):
         if key in out and out[key] <= 0:
             raise where.error(f"'{key}' must be > 0 seconds, got {out[key]!r}")

@@ -26,12 +26,26 @@ from quadcruise.workflows.fly import (
 )
 
 
-def stepper(mission: Mission | str = "circle", controller: ControllerLike | str = "nlpd", *,
-            vehicle: Vehicle | None = None, duration: float | None = None, dt: float = 1e-3,
-            max_step: float | None = None, n: int | None = None, x0: Any = None, limits: Limits | None = None,
-            controller_vehicle: Vehicle | None = None, full_dynamics: bool = False, environment=None,
-            sensors=None, seed: int = 0, first_vehicle: int | np.ndarray = 0, periods: int = 1,
-            setpoint_width: int = 0) -> Stepper:
+def stepper(
+    mission: Mission | str = "circle",
+    controller: ControllerLike | str = "nlpd",
+    *,
+    vehicle: Vehicle | None = None,
+    duration: float | None = None,
+    dt: float = 1e-3,
+    max_step: float | None = None,
+    n: int | None = None,
+    x0: Any = None,
+    limits: Limits | None = None,
+    controller_vehicle: Vehicle | None = None,
+    full_dynamics: bool = False,
+    environment=None,
+    sensors=None,
+    seed: int = 0,
+    first_vehicle: int | np.ndarray = 0,
+    periods: int = 1,
+    setpoint_width: int = 0,
+) -> Stepper:
     """A :class:`~quadcruise.sim.stepper.Stepper` of the flight ``fly`` would fly with these arguments.
 
     Parameters
@@ -78,11 +92,25 @@ def stepper(mission: Mission | str = "circle", controller: ControllerLike | str 
     check_can_hover(vehicle)
     x0 = hover_state(vehicle, n, mission) if x0 is None else x0
     vp_ctrl = None if controller_vehicle is None else controller_vehicle.rows(n)
-    return Stepper(grid, x0, vehicle.rows(n), controller.function, controller.gains(), mission.function,
-                   stack_params(mission, n=n), memory=controller.memory(), vp_ctrl=vp_ctrl,
-                   full_dynamics=full_dynamics, seed=seed, first_vehicle=first_vehicle,
-                   max_step=max_step or dt, limits=limits, periods=periods, setpoint_width=setpoint_width,
-                   **engine_inputs(environment, sensors, n, dt))
+    return Stepper(
+        grid,
+        x0,
+        vehicle.rows(n),
+        controller.function,
+        controller.gains(),
+        mission.function,
+        stack_params(mission, n=n),
+        memory=controller.memory(),
+        vp_ctrl=vp_ctrl,
+        full_dynamics=full_dynamics,
+        seed=seed,
+        first_vehicle=first_vehicle,
+        max_step=max_step or dt,
+        limits=limits,
+        periods=periods,
+        setpoint_width=setpoint_width,
+        **engine_inputs(environment, sensors, n, dt),
+    )
 
 
 __all__ = ["stepper"]
