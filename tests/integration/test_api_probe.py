@@ -243,8 +243,9 @@ def test_a_compiled_controller_of_ones_own_passes_the_check():
 
     assert compiled_for_engine(Mine().function) and not compiled_for_engine(PlainController().function)
     assert as_controller(Mine()).name == "plain"
-    lazily = njit(PlainController.function)  # compiled by numba, but not for the engine
-    assert not compiled_for_engine(lazily)
+    lazily = njit(PlainController.function)  # an @njit without a signature: the check compiles it for the engine
+    assert compiled_for_engine(lazily) and tuple(CONTROLLER_SIG.args) in [tuple(s) for s in lazily.signatures]
+    assert not compiled_for_engine(njit(lambda t, dt: t + dt))  # one that cannot take the engine's arguments
 
 
 def test_seed_given_to_fly_is_written_so_that_the_scenario_flies_again(tmp_path):
