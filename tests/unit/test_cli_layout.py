@@ -15,7 +15,7 @@ from quadcruise.cli.main import main
 PACKAGE = Path(quadcruise.__file__).parent
 CLI = PACKAGE / "cli"
 LIBRARY = sorted(p for p in PACKAGE.rglob("*.py") if CLI not in p.parents)
-MAX_LINES = 280   # as ruff formats them
+MAX_LINES = 280  # as ruff formats them
 
 
 def printing(source: str, name: str = "<source>") -> list[str]:
