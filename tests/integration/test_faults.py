@@ -331,8 +331,8 @@ def test_a_stopped_sweep_ends_its_workers_says_one_line_and_resumes_to_the_same_
     tmp_path, sig, to_group, status, word
 ):
     psutil = pytest.importorskip("psutil")
-    n = 2000
-    options = ["--mission", "circle", "-n", n, "--seed", 5, "--mass-spread", 0.1, "--duration", 1, "--chunk-size", 10]
+    n = 4000  # 2e7 vehicle-steps: seconds of flying once the workers run, so the signal lands mid-sweep
+    options = ["--mission", "circle", "-n", n, "--seed", 5, "--mass-spread", 0.1, "--duration", 5, "--chunk-size", 10]
     args = ["montecarlo", *options, "--scheduler", "local", "--workers", 2, "--out", "mc", "--quiet"]
     env = {**os.environ, "PYTHONPATH": SRC, "QUADCRUISE_PROGRESS": "0"}
     proc = subprocess.Popen(
@@ -373,7 +373,7 @@ def test_a_stopped_sweep_ends_its_workers_says_one_line_and_resumes_to_the_same_
         n=n,
         seed=5,
         mass_spread=0.1,
-        duration=1.0,
+        duration=5.0,
         chunk_size=10,
         scheduler="none",
         out=str(tmp_path / "ref"),
