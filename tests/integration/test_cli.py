@@ -74,7 +74,7 @@ def test_fly_controller_options_reach_the_controller(tmp_path):
     "args, words",
     [
         (["fly", "loop"], "unknown mission 'loop'"),
-        (["fly", "circle", "--duration", "-1"], "duration must be a positive number"),
+        (["fly", "circle", "--duration", "-1"], "'--duration': -1.0 is not in the range x>0"),
         (["fly", "circle", "--dt", "30"], "dt (30 s) is larger than the duration (20 s)"),
         (["fly", "circle", "--poles", "0.7,-4.3"], "pole 0.7 is not in the open left half plane"),
         (["fly", "circle", "--poles", "fast"], "--poles 'fast': expected comma-separated poles"),

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import click
 
-from quadcruise.cli.common import FORCE_OPTION, Bar, controller_from_options, friendly, writable
+from quadcruise.cli.common import FORCE_OPTION, SECONDS, Bar, controller_from_options, friendly, writable
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["analyze"]
@@ -22,7 +22,7 @@ __all__ = ["analyze"]
     help="Controller parameter (repeatable).",
 )
 @click.option("--poles", "position_poles", metavar="P1,P2", help="Closed-loop poles of the x/y loops [rad/s].")
-@click.option("--dt", type=float, default=1e-3, show_default=True, help="Control period [s].")
+@click.option("--dt", type=SECONDS, default=1e-3, show_default=True, help="Control period [s].")
 @click.option(
     "--out", type=click.Path(file_okay=False), callback=writable, help="Folder for analysis.json and Bode plots."
 )

@@ -54,6 +54,9 @@ FORMAT_OPTION = click.option(
     callback=_table_format,
     help="Format of the traces.",
 )
+SECONDS = click.FloatRange(min=0.0, min_open=True)
+"""A time option's type (--duration, --dt, --max-step): a positive number of seconds, said by the option's name."""
+
 FORCE_OPTION = click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
 
 

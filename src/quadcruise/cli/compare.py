@@ -11,6 +11,7 @@ from quadcruise.cli.common import (
     FORCE_OPTION,
     REPORT_OPTION,
     RISE_OPTION,
+    SECONDS,
     SETTLE_BAND_OPTION,
     Bar,
     friendly,
@@ -35,8 +36,8 @@ __all__ = ["compare"]
 @click.option(
     "--controllers", help="Comma-separated controller names (default nlpd,gonzalez,se3,cascade, or the scenario's)."
 )
-@click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
-@click.option("--dt", type=float, help="Control period [s] (default 0.001, or the scenario's).")
+@click.option("--duration", type=SECONDS, help="Flight time [s] (default: the mission's).")
+@click.option("--dt", type=SECONDS, help="Control period [s] (default 0.001, or the scenario's).")
 @click.option(
     "-m",
     "--mission-param",

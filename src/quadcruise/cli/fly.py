@@ -12,6 +12,7 @@ from quadcruise.cli.common import (
     FORMAT_OPTION,
     REPORT_OPTION,
     RISE_OPTION,
+    SECONDS,
     SETTLE_BAND_OPTION,
     friendly,
     metric_options,
@@ -28,9 +29,9 @@ __all__ = ["fly"]
 @click.command("fly")
 @click.argument("mission", metavar="MISSION")
 @click.option("--controller", help="Controller name (default nlpd, or the scenario's).")
-@click.option("--duration", type=float, help="Flight time [s] (default: one lap, or 10 s after a step).")
-@click.option("--dt", type=float, help="Control period [s] (default 0.001).")
-@click.option("--max-step", type=float, help="Longest RK4 substep [s] (default: dt).")
+@click.option("--duration", type=SECONDS, help="Flight time [s] (default: one lap, or 10 s after a step).")
+@click.option("--dt", type=SECONDS, help="Control period [s] (default 0.001).")
+@click.option("--max-step", type=SECONDS, help="Longest RK4 substep [s] (default: dt).")
 @click.option(
     "-m",
     "--mission-param",

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import click
 
-from quadcruise.cli.common import friendly, writable
+from quadcruise.cli.common import SECONDS, friendly, writable
 from quadcruise.cli.montecarlo_run import montecarlo_command, parse_noise
 from quadcruise.cli.world import world_options
 
@@ -22,8 +22,8 @@ __all__ = ["montecarlo", "montecarlo_command", "parse_noise"]
 @click.option("--controller", help="Controller name (default: the scenario's, else nlpd).")
 @click.option("-n", "--n", "n", type=int, show_default="1000", help="Number of flights.")
 @click.option("--seed", type=int, show_default="0", help="Seed of every random draw.")
-@click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
-@click.option("--dt", type=float, help="Control period [s] (default 0.001, or the scenario's).")
+@click.option("--duration", type=SECONDS, help="Flight time [s] (default: the mission's).")
+@click.option("--dt", type=SECONDS, help="Control period [s] (default 0.001, or the scenario's).")
 @world_options(
     wind_help="Wind of every flight: constant:WX,WY,WZ | gust:AX,AY,AZ@START+DURATION | "
     "dryden:light|moderate|severe@ALTITUDE | loss:ROTOR,FRACTION@TIME (comma-separable).",

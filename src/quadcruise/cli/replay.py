@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import click
 
-from quadcruise.cli.common import Bar, friendly, writable_with
+from quadcruise.cli.common import SECONDS, Bar, friendly, writable_with
 
 __all__ = ["replay"]
 
@@ -40,7 +40,7 @@ __all__ = ["replay"]
 @click.option(
     "--max-step",
     default=None,
-    type=float,
+    type=SECONDS,
     help="Longest RK4 substep [s]. Default: 1e-3 for the paper's plant, 1e-4 for a rotor-plant vehicle.",
 )
 @friendly

@@ -8,7 +8,7 @@ import sys
 
 import click
 
-from quadcruise.cli.common import friendly, writable
+from quadcruise.cli.common import SECONDS, friendly, writable
 from quadcruise.cli.tune_run import tune_command
 from quadcruise.cli.world import world_options
 
@@ -88,8 +88,8 @@ __all__ = ["tune"]
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the search and the population.")
 @click.option("--budget", type=int, default=100, show_default=True, help="At most this many generations.")
 @click.option("--popsize", type=int, help="Candidates per generation (default: 15 per gain).")
-@click.option("--duration", type=float, help="Flight time [s] (default: the mission's).")
-@click.option("--dt", type=float, help="Control period [s] (default 0.001).")
+@click.option("--duration", type=SECONDS, help="Flight time [s] (default: the mission's).")
+@click.option("--dt", type=SECONDS, help="Control period [s] (default 0.001).")
 @click.option(
     "--out",
     type=click.Path(file_okay=False),
