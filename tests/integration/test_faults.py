@@ -343,6 +343,7 @@ def test_a_stopped_sweep_ends_its_workers_says_one_line_and_resumes_to_the_same_
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,
+        preexec_fn=as_from_a_terminal,
     )
     try:
         deadline = time.monotonic() + 300
@@ -381,6 +382,14 @@ def test_a_stopped_sweep_ends_its_workers_says_one_line_and_resumes_to_the_same_
         echo=lambda text: None,
     )  # untroubled, in one go
     same_sweep(tmp_path / "mc", tmp_path / "ref")
+
+
+def as_from_a_terminal():
+    """In the child before it runs: Ctrl-C and SIGTERM act as they do for a command typed at a terminal, even when
+    these tests run in the background (a shell starts a background job with SIGINT ignored, and a child keeps that)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
 
 
 # --- damaged sweep files --------------------------------------------------------------------------
