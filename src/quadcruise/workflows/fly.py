@@ -788,9 +788,20 @@ def steady_bound(mission: Mission, duration: float) -> float:
     >>> steady_bound(mission_from_name("circle", radius=10.0), 20.0)
     5.0
     """
-    ref = mission.reference(np.linspace(0.0, float(duration), 1001))[:, REF_X : REF_X + 3]
-    extent = float(np.max(ref.max(axis=0) - ref.min(axis=0)))
+    return _steady_from(reference_span(mission, duration)[0])
+
+
+def _steady_from(extent: float) -> float:
     return max(1.0, 0.25 * extent)
+
+
+def reference_span(mission: Mission, duration: float) -> tuple[float, float]:
+    """The longest side [m] of the box holding the mission's reference position, and its lowest
+    altitude [m], from the reference at 1,001 instants over the flight (one evaluation for both
+    bounds)."""
+    ref = mission.reference(np.linspace(0.0, float(duration), 1001))
+    position = ref[:, REF_X : REF_X + 3]
+    return float(np.max(position.max(axis=0) - position.min(axis=0))), float(ref[:, REF_Z].min())
 
 
 ALTITUDE_FRACTION = 0.5
@@ -826,8 +837,8 @@ def altitude_bound(mission: Mission, duration: float) -> float:
     >>> altitude_bound(mission_from_name("circle", altitude=30.0), 20.0)  # capped by the 3-D bound
     1.0
     """
-    z = mission.reference(np.linspace(0.0, float(duration), 1001))[:, REF_Z]
-    return min(steady_bound(mission, duration), max(MIN_ALTITUDE_BOUND, ALTITUDE_FRACTION * float(z.min())))
+    extent, lowest = reference_span(mission, duration)
+    return min(_steady_from(extent), max(MIN_ALTITUDE_BOUND, ALTITUDE_FRACTION * lowest))
 
 
 def off_track_since(
