@@ -705,10 +705,10 @@ def _pole_text(p: complex) -> str:
 
 
 def differences() -> str:
-    """The report's section on where our numbers differ from the paper's, and why.
+    """The report's section on where our numbers differ from the paper's, and why, in short.
 
-    The fitted nlpd's poles and its linear step response in it are computed
-    (:func:`fitted_nlpd_loop`), not typed in.
+    The reasoning in full is in docs/paper.md (the section of the same title); the fitted nlpd's
+    poles and its linear step response here are computed (:func:`fitted_nlpd_loop`), not typed in.
 
     Returns
     -------
@@ -723,62 +723,32 @@ def differences() -> str:
 DIFFERENCES_TEMPLATE = """
 ## Where our numbers differ from the paper's, and why
 
-**Rise time (ours about 3 s, the paper's 1 s).** The paper's poles, -0.7 and -4.3 rad/s, put a
-slow pole at 0.7 rad/s. Eq (17) hides it behind a zero at -1/tau_d = -0.60 because its
-derivative acts on the whole error, including the derivative of the reference. At the start
-of a cruise the reference *position* jumps (the vehicle hovers 2 m from the circle's start
-point), and no finite controller differentiates that jump, so the realised loop is
-Kp / (s^2 + Kd s + Kp): its rise time is 3.2 s and it does not overshoot. Eq (17) itself, with
-the zero and an ideal attitude loop, would rise in 0.34 s and overshoot 8 %. Flown with the
-derivative on the whole error as eq (17) writes it (`NLPD(derivative="error")`, filter N = 100
-with its state at rest), the jump kicks u_x by Kd N per metre, but the asin clip and the tilt
-limit cut the kick to 45 degrees for a few hundredths of a second, and the 1 m step rises in
-3.3 s without overshoot, as slowly as the default. Neither derivative form reaches the
-paper's 1 s and 4 %. The `step` row isolates the design case.
+The reasoning in full, with the derivative forms tried: docs/paper.md, the section of this title.
 
-**What gives the paper's numbers (the fitted rows).** `quadcruise tune` finds position gains
-Kp {kp:.2f}, Kd {kd:.2f} for rise 1 s, settling 2 s, overshoot 4 % (within 0.3 s, 0.5 s, 1.5 points).
-The PD alone would place the pair {pd_pole} (damping {pd_zeta:.2f}, natural frequency
-{pd_wn:.2f} rad/s), but it flies through the attitude PID and the rotor lag: the closed loop
-that `quadcruise analyze` linearises about hover has its dominant pair at {dom_pole}
-(damping {dom_zeta:.2f}, natural frequency {dom_wn:.2f} rad/s), and that linear loop's own
-step rises in {lin_rise:.2f} s (10-90 %; {lin_rise_0_100:.2f} s 0-100 %), settles in
-{lin_settling:.2f} s (2 %) and overshoots {lin_overshoot:.1f} %. The paper's reported transient
-is that of this loop, not of its stated poles -0.7 and -4.3. Its 1 s is met by the 10-90 %
-rise and missed by the 0-100 % one; the paper does not say which it measured.
+**Rise time and settling time (ours about 3 s and 3-6 s, the paper's 1 s and 2 s).** The poles
+-0.7 and -4.3 leave a slow pole at 0.7 rad/s, which eq (17) hides behind its zero only by
+differentiating a jump of the reference. No finite controller does, so the realised loop is
+Kp / (s^2 + Kd s + Kp): it rises in 3.2 s without overshoot (with the derivative on the whole
+error as eq (17) writes it, `NLPD(derivative="error")`, in 3.3 s). The `step` row isolates it.
 
-**Settling time (ours 3-6 s at 5 %, the paper's 2 s).** Same cause: the 0.7 rad/s pole sets
-a time constant of 1.4 s. On the circle and the square the entry is measured on the size of
-the tracking error, settling onto its own steady level (docs/metrics.md): the PD law of eq (16)
-has no acceleration feedforward, so it tracks the circle with a steady lag of about 6 cm, which
-is the steady error (`steady_rmse_m`), not a transient that never ends. With the reference
-acceleration fed forward (`nlpd+ff`, beyond the paper) the lag nearly vanishes.
+**The fitted rows.** `quadcruise tune` finds Kp {kp:.2f}, Kd {kd:.2f} for the paper's transient.
+The PD alone would place the pair {pd_pole} (damping {pd_zeta:.2f}), but the closed loop that
+`quadcruise analyze` linearises about hover has its dominant pair at {dom_pole} (damping
+{dom_zeta:.2f}, natural frequency {dom_wn:.2f} rad/s); its step rises in {lin_rise:.2f} s (10-90 %;
+{lin_rise_0_100:.2f} s 0-100 %), settles in {lin_settling:.2f} s (2 %) and overshoots
+{lin_overshoot:.1f} %. The paper's reported transient is that of this loop, not of its stated poles.
 
-**The baseline (the paper's 6 s, 12 s, 11 %).** The paper's reference [5] could not be
-found, so `gonzalez` is a reconstruction (see `quadcruise.control.baselines`), with gains
-fixed by a rule before any simulation and never fitted to these numbers. It has the paper's
-small-signal poles, so the two laws differ only in the tanh saturation (the literal
-k tanh(e) form: 1 m and 1 m/s widths) and in the small-angle attitude mapping, which matter
-only for large errors. The ranking of the paper holds in direction (the baseline settles
-later, and never overshoots less) but not in size: the paper's baseline was evidently tuned
-differently, and its gains are not recoverable from the paper. With saturation levels from
-the tilt budget instead (`Gonzalez(accel_p=..., accel_d=...)`, see its docstring) the two
-controllers become nearly indistinguishable: the comparison hinges on this unknown. Fitted
-instead (the `gonzalez (fitted)` row), the literal form k_p tanh(e) + k_d tanh(e') with
-k_p 0.29, k_d 0.54 meets the 12 s settling and 11 % overshoot exactly; its rise, in the fitted
-table in both conventions, is near the paper's 6 s only measured 0-100 % (from the step to the
-first reaching of the target). That the paper's 6 s is a 0-100 % rise is a hypothesis, not a
-finding: it rests on a reconstruction of a baseline whose reference could not be found, and it
-does not fit the nlpd row, whose 1 s is met only 10-90 %. No one rise convention makes both fits
-match the paper. Those gains are an order of magnitude below the
-paper's design (Kp 3.01, Kd 5.0) and below the fitted nlpd's (Kp 3.47): a PD pair of natural
-frequency 0.54 rad/s and damping 0.50, three and a half times slower than the fitted nlpd's
-PD pair (1.86 rad/s).
-The paper's baseline was evidently a much slower loop, not the same design saturated.
+**The circle's steady error is a lag** of about 6 cm (`steady_rmse_m`): eq (16) has no
+acceleration feedforward; `nlpd+ff` (beyond the paper) removes it.
 
-**What agrees.** The inverse-model controller flies both cruises with the decoupled
-attitude loops, holds altitude through the tilt, and tracks the circle and the square once
-the transient is over; the paper's design numbers (Kp = 3.01, tau_d = 1.66, Kd = 5.0) are
-reproduced exactly by `quadcruise.control.design.pd_from_poles`.
+**The baseline** is a reconstruction (the paper's reference [5] could not be found), its gains
+fixed by a rule: the paper's ranking holds in direction, not in size. Fitted (k_p 0.29, k_d 0.54,
+an order of magnitude below the paper's design) it meets 12 s and 11 % exactly, and 6 s only
+measured 0-100 %. That the paper's 6 s is a 0-100 % rise is a hypothesis, not a finding: no one
+rise convention makes both fits match the paper.
+
+**What agrees.** The inverse-model controller flies both cruises and holds altitude through the
+tilt; the paper's design numbers (Kp = 3.01, tau_d = 1.66, Kd = 5.0) are reproduced exactly by
+`quadcruise.control.design.pd_from_poles`.
 """
 """The text of :func:`differences`, with its computed numbers as ``str.format`` fields."""
