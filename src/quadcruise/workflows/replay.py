@@ -48,17 +48,7 @@ OUTPUT_COLUMNS = ("t",) + STATE_NAMES
 
 @njit(cache=True)  # compiled (as MISSION_SIG) on first use, not at import
 def no_reference(t, mp, ref):
-    """An open-loop flight has no reference: NaN throughout (a mission, ``MISSION_SIG``).
-
-    Parameters
-    ----------
-    t : float
-        Time [s] (unused).
-    mp : ndarray
-        Mission parameters (unused).
-    ref : ndarray, shape (11,)
-        Output: the reference, set to NaN.
-    """
+    """An open-loop flight's reference (a mission, ``MISSION_SIG``): NaN throughout."""
     for j in range(ref.shape[0]):
         ref[j] = math.nan
 
@@ -272,15 +262,6 @@ def write_states_csv(
 # --- rotor-plant vehicles: commanded rotor speeds ---------------------------------------------
 def speed_columns(n_rotors: int) -> tuple[str, ...]:
     """The input columns of a rotor-speed schedule: ``t, w1 .. wn``.
-
-    Parameters
-    ----------
-    n_rotors : int
-        Number of rotors.
-
-    Returns
-    -------
-    tuple of str
 
     Examples
     --------

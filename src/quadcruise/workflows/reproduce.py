@@ -1,27 +1,12 @@
 """Reproduce the paper: both controllers on its scenarios, our numbers beside its numbers.
 
-The paper reports, for its inverse-model nonlinear PD ("nlpd"), rise time 1 s, settling time
-2 s and overshoot 4 % for the transient from hover into the cruise, and 6 s, 12 s and 11 %
-for the baseline built on Gonzalez's paper [5] ("gonzalez", reconstructed here). It shows
-the circle cruise (Figs 4, 5a, 5b) and the square cruise (Figs 6a, 6b).
-
-Scenarios (each starts hovering at the origin at 1 m; transients are measured on x):
-
-- ``circle``: the default :class:`~quadcruise.missions.Circle` (R = 2 m, 20 s a lap), one lap;
-  the start point (2, 0) makes a 2 m step in x at t = 0;
-- ``square``: a 4 m square at 0.5 m/s centred on the origin, first corner (-2, -2), one lap;
-  the vehicle starts 2 m from it in x and in y;
-- ``step``: a 1 m step in x at t = 1 s, the pure design case of eqs (17)-(18).
-
-Beyond the paper, ``nlpd+ff`` is the paper's controller with the reference acceleration fed
-forward, which removes most of the steady tracking lag on the circle.
-
-Fitted, and labelled so: ``nlpd (fitted)`` and ``gonzalez (fitted)`` fly the gains that
-``quadcruise tune`` finds for the paper's reported transients (:data:`FITTED`; the scenario
-files ``examples/scenarios/paper_fitted_*.toml`` hold them with the command that regenerates
-them), beside the paper's own gains, on ``entry``: the 2 m step in x that the circle and the
-square start with, without their motion (:data:`FIT_SCENARIO`). They explain the paper's
-numbers; they are not the paper's design.
+Scenarios, each from hover at the origin at 1 m, transients measured on x: ``circle`` (the
+default :class:`~quadcruise.missions.Circle`, one lap: a 2 m step in x at t = 0), ``square`` (4 m
+at 0.5 m/s, first corner (-2, -2), one lap) and ``step`` (1 m in x at t = 1 s, the design case of
+eqs (17)-(18)). Controllers: the paper's ``nlpd`` and ``gonzalez``, ``nlpd+ff`` (beyond the
+paper: the reference acceleration fed forward) and, labelled *fitted*, the gains ``quadcruise
+tune`` finds for the paper's reported transients (:data:`FITTED`) on ``entry``
+(:data:`FIT_SCENARIO`). The results and their reading: docs/paper.md.
 
 Examples
 --------
@@ -133,20 +118,7 @@ METRIC_KEYS = (
 
 
 def paper_numbers(run: dict) -> dict:
-    """The paper's reported transient that a run is set beside.
-
-    Parameters
-    ----------
-    run : dict
-        An entry of :attr:`Reproduction.runs`.
-
-    Returns
-    -------
-    dict
-        ``rise_time_s``, ``settling_time_s``, ``overshoot_pct`` of :data:`PAPER` for the
-        circle, the square and the fit scenario; empty for the ``step`` scenario and for
-        controllers the paper has no numbers for.
-    """
+    """The paper's reported transient (:data:`PAPER`) that a run is set beside; empty for ``step``."""
     if run["scenario"] == FIT_SCENARIO[0]:
         return PAPER.get(FIT_PAPER.get(run["controller"], ""), {})
     return PAPER.get(run["controller"], {}) if run["scenario"] != "step" else {}
@@ -154,23 +126,10 @@ def paper_numbers(run: dict) -> dict:
 
 @dataclass
 class Reproduction:
-    """The runs of a reproduction: one dict of metrics per (scenario, controller).
-
-    :func:`reproduce` builds it.
-
-    Parameters
-    ----------
-    runs : list of dict
-        One per flight, in the order flown: ``scenario``, ``controller``, ``axis``,
-        ``status`` and the metrics of :data:`METRIC_KEYS` (times [s], overshoot [%],
-        errors [m]; None where not applicable or not settled).
-    results : dict of (str, str) to SimResult
-        (scenario, controller) -> the flight, logged at every control period.
-    config : dict
-        The vehicle, control period, scenarios and controllers, as ``metrics.json`` and
-        ``quadcruise.json`` record them.
-    timings : dict of str to float
-        ``"scenario/controller"`` -> wall time of the flight and its metrics [s].
+    """The flights of a reproduction (:func:`reproduce`): ``runs``, one dict per flight in the order
+    flown (``scenario``, ``controller``, ``axis``, ``status`` and the metrics of :data:`METRIC_KEYS`;
+    None where not applicable or not settled); ``results``, (scenario, controller) -> its
+    :class:`SimResult`; ``config``, as ``metrics.json`` records it; ``timings`` [s] per flight.
     """
 
     runs: list[dict]
@@ -180,59 +139,23 @@ class Reproduction:
 
     @property
     def failed(self) -> dict:
-        """``"scenario with controller"`` -> why it stopped, for each flight that did not finish.
-
-        Returns
-        -------
-        dict of str to str
-            Empty when every flight finished.
-        """
+        """``"scenario with controller"`` -> why it stopped, for each flight that did not finish."""
         return {
             f"{scen} with {ctrl}": res.status_text(0) for (scen, ctrl), res in self.results.items() if not res.ok[0]
         }
 
     def to_json(self) -> dict:
-        """The ``metrics.json`` document.
-
-        Returns
-        -------
-        dict
-            ``runs``, ``paper`` (:data:`PAPER`), ``config`` and ``version``.
-        """
+        """The ``metrics.json`` document: ``runs``, ``paper`` (:data:`PAPER`), ``config``, ``version``."""
         return {"runs": self.runs, "paper": PAPER, "config": self.config, "version": __version__}
 
     def to_pandas(self):
-        """The runs as a DataFrame.
-
-        Returns
-        -------
-        pandas.DataFrame
-            One row per run, the keys of :attr:`runs` as columns.
-        """
+        """One row per flight (scenario and controller), the keys of :attr:`runs` as columns."""
         import pandas as pd
 
         return pd.DataFrame(self.runs)
 
     def run(self, scenario: str, controller: str) -> dict:
-        """The metrics of one run.
-
-        Parameters
-        ----------
-        scenario : str
-            A name of :data:`SCENARIOS`.
-        controller : str
-            A label of :data:`CONTROLLERS`.
-
-        Returns
-        -------
-        dict
-            The run's entry of :attr:`runs`.
-
-        Raises
-        ------
-        KeyError
-            If that pair was not flown.
-        """
+        """The metrics of one flight, ``runs``' entry for (scenario, controller); KeyError if not flown."""
         for r in self.runs:
             if r["scenario"] == scenario and r["controller"] == controller:
                 return r
@@ -410,54 +333,17 @@ def write_reproduction(
 
 
 def trace_name(label: str) -> str:
-    """A controller label as a file name: ``nlpd+ff`` -> ``nlpd_ff``, ``nlpd (fitted)`` -> ``nlpd_fitted``.
-
-    Parameters
-    ----------
-    label : str
-        A controller label of :data:`CONTROLLERS` or :data:`FITTED`.
-
-    Returns
-    -------
-    str
-    """
+    """A controller label as a file name: ``nlpd+ff`` -> ``nlpd_ff``, ``nlpd (fitted)`` -> ``nlpd_fitted``."""
     return re.sub(r"[^A-Za-z0-9]+", "_", label).strip("_")
 
 
 def written_figures(out: str | Path) -> dict[str, Path]:
-    """The figures that :func:`write_reproduction` wrote into ``out``, by caption.
-
-    Parameters
-    ----------
-    out : str or path-like
-        The reproduction's folder.
-
-    Returns
-    -------
-    dict of str to pathlib.Path
-        Caption -> PNG file, in the order of :data:`FIGURES`, for those present (the
-        ``figures`` of :func:`quadcruise.report.html.reproduction_report`).
-    """
+    """Caption -> PNG file of the figures :func:`write_reproduction` wrote into ``out``."""
     return {caption: Path(out) / name for name, caption in FIGURES.items() if (Path(out) / name).is_file()}
 
 
 def paper_figure(name: str, caption: str, results: dict):
-    """The figure ``name`` of :data:`FIGURES` drawn from the flights.
-
-    Parameters
-    ----------
-    name : str
-        A file name of :data:`FIGURES`.
-    caption : str
-        The figure's title.
-    results : dict of (str, str) to SimResult
-        (scenario, controller) -> flight, as :attr:`Reproduction.results`.
-
-    Returns
-    -------
-    matplotlib.figure.Figure or None
-        None if the flights it needs are missing.
-    """
+    """The figure ``name`` of :data:`FIGURES` drawn from the flights, or None if those it needs are missing."""
     from quadcruise.plots.flight import plot_paths, plot_reference
 
     scen = "circle" if "circle" in name else "square"
@@ -477,20 +363,8 @@ def _cell(value, missing: str = "-") -> str:
 
 
 def results_table(rep: Reproduction) -> str:
-    """Markdown table: each run's transient and tracking metrics beside the paper's.
-
-    Parameters
-    ----------
-    rep : Reproduction
-        The runs.
-
-    Returns
-    -------
-    str
-        One row per run; the paper's value in brackets after ours where it reports one
-        (:func:`paper_numbers`: not for the ``step`` scenario). A flight that did not finish
-        says so in bold after its controller, and a line under the table counts them: its
-        metrics describe a failed flight.
+    """Markdown table: each flight's metrics, the paper's in brackets where it reports one
+    (:func:`paper_numbers`); a flight that did not finish says so in bold, and a line counts them.
     """
     lines = [
         "| scenario | controller | rise 10-90 % [s] (paper) | settling 2 % [s] (paper) | settling 5 % [s] "
@@ -522,18 +396,8 @@ def _gains_text(controller) -> str:
 
 
 def fitted_table(rep: Reproduction) -> str:
-    """Markdown table of the fit scenario: the paper's gains and the fitted ones (labelled),
-    each with both rise conventions, beside the paper's numbers.
-
-    Parameters
-    ----------
-    rep : Reproduction
-        The runs.
-
-    Returns
-    -------
-    str
-        Empty if the fit scenario was not flown.
+    """Markdown table of the fit scenario, the paper's gains and the fitted ones, both rise
+    conventions, beside the paper's numbers; empty if it was not flown.
     """
     rows = [r for r in rep.runs if r["scenario"] == FIT_SCENARIO[0]]
     if not rows:
@@ -581,20 +445,7 @@ INTRO = (
 
 
 def report_markdown(rep: Reproduction, figures: list[str]) -> str:
-    """report.md: the table, the figures, and what differs from the paper and why.
-
-    Parameters
-    ----------
-    rep : Reproduction
-        The runs.
-    figures : list of str
-        The file names of the figures written (keys of :data:`FIGURES`).
-
-    Returns
-    -------
-    str
-        The Markdown text.
-    """
+    """report.md: the tables, the figures, and what differs from the paper and why."""
     text = [f"# quadcruise {__version__}: reproduction of the paper\n", INTRO + "\n", results_table(rep)]
     fits = fitted_table(rep)
     if fits:
@@ -608,18 +459,8 @@ def report_markdown(rep: Reproduction, figures: list[str]) -> str:
 
 
 def baseline_comparison(rep: Reproduction) -> str:
-    """A sentence, from the numbers, on how the baseline compares with nlpd here.
-
-    Parameters
-    ----------
-    rep : Reproduction
-        The runs.
-
-    Returns
-    -------
-    str
-        One line per scenario flown by both ``gonzalez`` and ``nlpd`` where both settled:
-        the differences in 5 % settling time [s] and overshoot [points]; empty if none.
+    """One line per scenario where both ``gonzalez`` and ``nlpd`` settled: the baseline's 5 % settling
+    and overshoot relative to nlpd's; empty if none.
     """
     pairs = []
     for r in rep.runs:
@@ -647,19 +488,12 @@ def baseline_comparison(rep: Reproduction) -> str:
 
 
 def fitted_nlpd_loop() -> dict:
-    """The fitted nlpd's x loop as ``quadcruise analyze`` sees it: linearised about hover
-    (:func:`~quadcruise.workflows.analysis.linearize`: the PD, the attitude PID, the rotor lag, the
-    1 ms sampling), beside the PD's own pair.
+    """The fitted nlpd's x loop as ``quadcruise analyze`` linearises it about hover, beside the PD's own pair.
 
-    Returns
-    -------
-    dict
-        ``kp`` [1/s^2], ``kd`` [1/s]; ``pd_pole`` [rad/s] (complex, Im >= 0), ``pd_zeta``,
-        ``pd_wn`` [rad/s]: the pair of s^2 + Kd s + Kp alone; ``dom_pole`` [rad/s], ``dom_zeta``,
-        ``dom_wn`` [rad/s]: the linearised closed loop's dominant pole
-        (:meth:`~quadcruise.workflows.analysis.Linearization.summary`); ``lin_rise`` (10-90 %),
-        ``lin_rise_0_100``, ``lin_settling`` (2 %) [s] and ``lin_overshoot`` [%]: that linear
-        loop's step response by ``control.step_info``.
+    Keys: ``kp``, ``kd``; ``pd_pole``, ``pd_zeta``, ``pd_wn`` (s^2 + Kd s + Kp alone); ``dom_pole``,
+    ``dom_zeta``, ``dom_wn`` (the linearised closed loop's dominant pole); ``lin_rise`` (10-90 %),
+    ``lin_rise_0_100``, ``lin_settling`` (2 %) [s] and ``lin_overshoot`` [%] of that loop's step
+    (``control.step_info``). Poles in rad/s, complex, Im >= 0.
 
     Examples
     --------
