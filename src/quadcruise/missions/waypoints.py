@@ -371,24 +371,18 @@ def _last_start(t, mp, first, stride, count):
 
 @njit(cache=True, error_model="numpy")
 def waypoints_ref(t, mp, ref):
-    """Waypoint reference: straight constant-speed legs, C0 at the points.
+    """Waypoint reference: straight constant-speed legs, yaw linear or held.
 
-    On the leg [t_k, t_k+1) the position moves linearly from point k to point k+1, the
-    velocity is constant and the acceleration zero; yaw moves linearly with its rate, or is
-    held at point k's yaw when ``hold_yaw`` is not 0. Before t = 0 the reference is the first
-    point, from the last arrival on the last point, at rest.
+    Before t = 0, the first point; after the last arrival, the last point, at rest.
 
     Parameters
     ----------
     t : float
         Time [s].
     mp : numpy.ndarray
-        The mission's parameter vector (float64, 1-D): [n, hold_yaw, then per point
-        x [m], y [m], z [m], yaw [rad], t [s]], length 2 + 5 n (entries after it are not
-        read).
+        [n, hold_yaw, then per point x, y, z [m], yaw [rad], t [s]].
     ref : numpy.ndarray
-        Output, REF_SIZE float64 entries: position [m], velocity [m/s], acceleration
-        [m/s^2], yaw [rad] and yaw rate [rad/s] at ``t`` (overwritten).
+        Output: the reference at ``t`` (``REF_SIZE`` entries, overwritten).
     """
     for i in range(REF_SIZE):
         ref[i] = 0.0
@@ -419,22 +413,17 @@ def waypoints_ref(t, mp, ref):
 def minsnap_ref(t, mp, ref):
     """Minimum-snap reference: the polynomial segments of :func:`minimum_snap_coefficients`.
 
-    In segment i, s = (t - t_i) / T_i and each of x, y, z, yaw is sum_k c_k s^k; velocity,
-    acceleration and yaw rate are its time derivatives. Before t = 0 the reference is the
-    first point (s = 0), from the end time on the last point, at rest.
+    Before t = 0, the first point; after the end, the last point, at rest.
 
     Parameters
     ----------
     t : float
         Time [s].
     mp : numpy.ndarray
-        The mission's parameter vector (float64, 1-D): [m, x [m], y [m], z [m], yaw [rad]
-        and t [s] of the end, then per segment t_i [s], T_i [s] and 8 coefficients of
-        s^0..s^7 for each of x [m], y [m], z [m], yaw [rad]], length 6 + 34 m (entries after
-        it are not read).
+        [m, the end's x, y, z [m], yaw [rad], t [s], then per segment t_i, T_i [s] and the 8
+        coefficients of s^0..s^7, s = (t - t_i) / T_i, for each of x, y, z, yaw].
     ref : numpy.ndarray
-        Output, REF_SIZE float64 entries: position [m], velocity [m/s], acceleration
-        [m/s^2], yaw [rad] and yaw rate [rad/s] at ``t`` (overwritten).
+        Output: the reference at ``t`` (``REF_SIZE`` entries, overwritten).
     """
     for i in range(REF_SIZE):
         ref[i] = 0.0
