@@ -1,29 +1,9 @@
 """Waypoint missions: a table of points flown as straight legs or as one minimum-snap path.
 
-A :class:`WaypointTable` holds points (x, y, z [m]), optionally a yaw at each [rad], and the
-timing: EITHER arrival times ``t`` [s] (first 0, strictly increasing; a point repeated then
-means a dwell there) OR ``speed`` [m/s], the cruise speed on the leg that ENDS at each point
-(the first row's is unused and may be left empty), or neither: the mission's ``speed``
-(0.5 m/s by default) on every leg. :func:`read_waypoints_csv` reads ``x,y,z[,yaw][,t|speed]``.
-
-Kinds (both hold the last point after the end, and the first before t = 0):
-
-- :class:`Waypoints` ('waypoints'): constant-speed straight legs with explicit corners, like the
-  paper's square: C0 at the points (the velocity jumps, each leg being [departure, arrival)),
-  zero acceleration on the legs, yaw linear per leg (or held).
-  mp = [n, hold_yaw, then per point: x, y, z, yaw, t], length 2 + 5 n.
-- :class:`MinimumSnap` ('minsnap'): Mellinger & Kumar's (2011) minimum-snap path, one
-  7th-order polynomial per segment and axis (x, y, z, yaw) through every point at its time,
-  at rest (zero velocity, acceleration, jerk) at both ends and at every dwell, C3 by
-  constraint and C6 elsewhere by optimality: the equality-constrained QP
-  min sum_i int |p_i''''|^2 dt, solved through its KKT system in each segment's local time
-  s = (t - t_i) / T_i. mp = [m, x, y, z, yaw and t of the end, then per segment: t_i, T_i,
-  8 coefficients of s^0..s^7 for each of x, y, z, yaw], length 6 + 34 m, m = n - 1.
-
-A batch flies one kind but its tables may differ in length:
-:func:`~quadcruise.missions.base.stack_params` pads shorter rows with zeros, which the
-compiled functions never read (the count is mp[0]). ``duration`` is the last
-arrival + ``SETTLE_S``, rounded up to a whole second (so any usual dt divides it).
+A :class:`WaypointTable` holds the points and their timing (arrival times, or the speed of the
+leg ending at each, or one cruise speed); :class:`Waypoints` flies it as constant-speed legs,
+:class:`MinimumSnap` as Mellinger and Kumar's (2011) minimum-snap path. Their parameter
+layouts and continuity: docs/missions.md.
 
 Examples
 --------
