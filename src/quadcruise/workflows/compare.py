@@ -133,7 +133,7 @@ class Comparison:
         return table.set_index(["controller", "vehicle"])
 
     def to_pandas(self):
-        """Every flight's traces, long-form, with a ``controller`` column first.
+        """The traces, long-form: one row per controller, vehicle and logged instant (per-flight: :meth:`table`).
 
         Returns
         -------
