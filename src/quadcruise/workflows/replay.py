@@ -368,9 +368,7 @@ def read_speed_csv(
 
 
 ROTOR_MAX_STEP = 1e-4
-"""Default longest RK4 substep [s] of a rotor-plant replay: against RotorPy, a hummingbird (5 ms
-motors) tumbling at up to 290 rad/s ends 3 s with its quaternion 3e-3 off at 1e-3 s, 2.5e-7
-at 1e-4 s (tests/integration/test_rotorpy_agreement.py); 3 s cost 30,000 steps, milliseconds."""
+"""Default longest RK4 substep [s] of a rotor-plant replay (why: docs/vehicles.md, "Step")."""
 
 
 def replay_rotors(

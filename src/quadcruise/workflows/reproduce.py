@@ -73,18 +73,8 @@ FITTED = {
     "gonzalez (fitted)": lambda: Gonzalez(position=PDGains(kp=0.2894724746913224, kd=0.5427710673470861)),
 }
 """Label -> factory of the controllers fitted to the paper's transients by ``quadcruise tune``
-(examples/scenarios/paper_fitted_nlpd.toml and paper_fitted_gonzalez.toml, with the commands):
-
-- nlpd: position Kp, Kd for rise 1 +- 0.3 s (10-90 %), 2 % settling 2 +- 0.5 s, overshoot
-  4 +- 1.5 % (the tolerances weight the three misses; two gains cannot meet three targets
-  exactly): the PD's own pair has zeta 0.70, wn 1.86 rad/s; flown with the attitude loop and
-  the rotor lag the dominant pair is that of :func:`fitted_nlpd_loop`, not the paper's poles
-  -0.7 and -4.3;
-- gonzalez: the literal tanh form (a_p = k_p x 1 m, a_d = k_d x 1 m/s) with k_p, k_d for 2 %
-  settling 12 s and overshoot 11 % (met exactly); its rise then comes out at 6.3 s measured
-  0-100 % (4.2 s 10-90 %), close to the paper's 6 s if that is a 0-100 % rise, which the
-  paper does not say (a hypothesis, not a finding). zeta 0.50, wn 0.54 rad/s.
-"""
+(``examples/scenarios/paper_fitted_*.toml``, with the commands). The targets, what the fits
+reach and what they explain: docs/paper.md, "The paper's table, explained"."""
 FIT_PAPER = {"nlpd": "nlpd", "gonzalez": "gonzalez", "nlpd (fitted)": "nlpd", "gonzalez (fitted)": "gonzalez"}
 """Controller label on the fit scenario -> whose reported numbers it is set beside."""
 
