@@ -3,8 +3,9 @@
 With the mass m given: ``K = m Km`` (or ``m (KL + KQ)``, ``f = KQ / (KL + KQ)``),
 ``Jxx = K / b_roll``, ``Jyy = K / b_pitch``, ``Jzz`` from roll's and pitch's gyroscopic terms
 (inverse-variance weights), ``d = b_yaw Jzz / K``; without it, the same per unit mass
-(``_per_m``). A parameter whose interval is infinite or wider than :data:`RELATIVE_HALF_WIDTH`
-(f: :data:`SHAPE_HALF_WIDTH`) is reported not identifiable. docs/identify.md explains.
+(``_per_m``). A parameter is identifiable when its 95 % interval is finite and within
+:data:`RELATIVE_HALF_WIDTH` of its value (f: :data:`SHAPE_HALF_WIDTH`); otherwise it is reported
+with the base vehicle's value and no interval. docs/identify.md explains.
 """
 
 from __future__ import annotations

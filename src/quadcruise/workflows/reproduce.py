@@ -108,7 +108,7 @@ METRIC_KEYS = (
 
 
 def paper_numbers(run: dict) -> dict:
-    """The paper's reported transient (:data:`PAPER`) that a run is set beside; empty for ``step``."""
+    """The paper's reported transient (:data:`PAPER`) a run is set beside; empty for ``step`` and ``nlpd+ff``."""
     if run["scenario"] == FIT_SCENARIO[0]:
         return PAPER.get(FIT_PAPER.get(run["controller"], ""), {})
     return PAPER.get(run["controller"], {}) if run["scenario"] != "step" else {}
