@@ -278,9 +278,9 @@ def step_info_batch(t, y, *, y_initial=None, y_final=None, **kw) -> dict[str, np
 def transient_info(t, actual, reference, *, t_step=None, rise=(0.1, 0.9), settle_bands=(0.02, 0.05)) -> StepInfo:
     """Step metrics of a tracking transient in which the reference itself moves.
 
-    :func:`step_info` of the progress ``y = 1 - |e(t)| / |e(t_step)|``, ``e = reference - actual``
-    (the Euclidean norm over several axes, whose overshoot is then always 0), with
-    ``y_initial=0, y_final=1``; for a constant reference, the ordinary step response.
+    :func:`step_info` of the progress ``y = 1 - e(t) / e(t_step)``, ``e = reference - actual``, with
+    ``y_initial=0, y_final=1``: for a constant reference, the ordinary step response. Over several
+    axes ``e`` is the error's Euclidean norm, and the overshoot is then always 0.
 
     Parameters
     ----------
