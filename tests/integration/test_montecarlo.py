@@ -252,6 +252,10 @@ def test_requirements_are_objects_kept_as_text_in_the_record():
     spec = MonteCarloSpec("circle", requirements={"rmse_m": ("<", 0.5), "overshoot_pct": (">=", 1)})
     assert spec.requirements == (Requirement("rmse_m", "<", 0.5), Requirement("overshoot_pct", ">=", 1.0))
     assert spec.to_dict()["requirements"] == ["rmse_m<0.5", "overshoot_pct>=1"]
+    from quadcruise.montecarlo.scenario import parse_requirement
+
+    odd = Requirement("rmse_m", "<=", 0.1 + 0.2)  # the text a scenario.toml keeps reads back to the same float
+    assert odd.text == "rmse_m<=0.30000000000000004" and parse_requirement(odd.text) == odd
     one = MonteCarloSpec("circle", requirements=Requirement("rmse_m", "<", 0.5))
     assert one == MonteCarloSpec("circle", requirements=[Requirement("rmse_m", "<", 0.5)]) and one.hash() != spec.hash()
     with pytest.raises(TypeError, match=r"^MonteCarloSpec\(\) argument requirements must be Requirement objects"):
