@@ -181,6 +181,10 @@ def test_targets_requirements_and_bounds_are_objects_and_the_cli_texts_read_into
     assert as_bounds(parse_bounds(["position.kp=0.5:10,position.kd=1:8"]), "tune()") == bounds
     assert as_minimize("rmse_m", "tune()") == parse_minimize(["rmse_m"]) == ("rmse_m",)
     assert parse_objective("q90") == 0.9 and parse_objective("max") == "worst"
+    # numbers of any numeric type pass, as everywhere in the API
+    assert as_targets({"rise_time_s": np.float32(1.0)}, "tune()") == (Target("rise_time_s", 1.0, 0.1),)
+    assert Requirement("rmse_m", "<=", np.int64(1)) == Requirement("rmse_m", "<=", 1.0)
+    assert as_bounds({"position.kp": np.array([0.5, 10.0])}, "tune()") == {"position.kp": bounds["position.kp"]}
     with pytest.raises(AttributeError):  # frozen: a target is a value
         targets[0].value = 3.0
 
@@ -203,6 +207,8 @@ def no_flight(*args, **kwargs):
         (dict(require=["overshoot_pct<=5"]), TypeError, ["tune() argument require[0] must be a Requirement"]),
         (dict(require={"overshoot_pct": ("=<", 5)}), ValueError, ["require['overshoot_pct'][0] must be one of"]),
         (dict(require={"overshoot_pct": 5}), TypeError, ["require['overshoot_pct'] must be a pair (op, value)"]),
+        (dict(require={"overshoot_pct": (["<="], 5)}), TypeError, ["require['overshoot_pct'][0] must be one of"]),
+        (dict(bounds={"position.kp": "1:10"}), TypeError, ["bounds['position.kp'] must be a pair", "str '1:10'"]),
         (dict(bounds="position.kp=0.5:10"), TypeError, ["tune() argument bounds must be Bounds objects or a mapping"]),
         (dict(bounds={"position.kp": (10, 1)}), ValueError, ["bounds['position.kp'] must be a pair", "reversed"]),
         (dict(bounds={"position.kp": (1, "10")}), TypeError, ["tune() argument bounds['position.kp'][1]", "str '10'"]),

@@ -226,9 +226,8 @@ def as_requirements(value: Any, where: str, name: str = "requirements") -> tuple
         for metric, pair in value.items():
             item = f"{name}[{metric!r}]"
             check_metric(where, f"{name} key", metric)
-            if isinstance(pair, str) or not isinstance(pair, (tuple, list)) or len(pair) != 2:
-                checks.fail(where, item, pair, "a pair (op, value), e.g. ('<=', 0.5)")
-            if pair[0] not in _OPERATORS:
+            pair = checks.pair(where, item, pair, "a pair (op, value), e.g. ('<=', 0.5)")
+            if not isinstance(pair[0], str) or pair[0] not in _OPERATORS:
                 checks.fail(
                     where, f"{item}[0]", pair[0], "one of '<=', '<', '>=', '>'", kind=not isinstance(pair[0], str)
                 )

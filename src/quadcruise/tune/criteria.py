@@ -162,9 +162,8 @@ def as_targets(value: Any, where: str, name: str = "targets") -> tuple[Target, .
         for metric, given in value.items():
             item = f"{name}[{metric!r}]"
             check_metric(where, f"{name} key", metric)
-            if isinstance(given, (tuple, list)):
-                if len(given) != 2:
-                    checks.fail(where, item, given, "a value or a pair (value, tolerance)")
+            if isinstance(given, (tuple, list, np.ndarray)):
+                given = checks.pair(where, item, given, "a value or a pair (value, tolerance)")
                 x = _value(where, f"{item}[0]", given[0])
                 tol = _tolerance(where, f"{item}[1]", x, given[1])
             else:

@@ -22,7 +22,7 @@ from __future__ import annotations
 import inspect
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -34,10 +34,10 @@ from quadcruise.missions import Mission, as_mission
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
 from quadcruise.montecarlo.spec import MonteCarloSpec
-from quadcruise.tune.criteria import as_minimize, as_requirements, as_targets
+from quadcruise.tune.criteria import Requirement, Target, as_minimize, as_requirements, as_targets
 from quadcruise.tune.objective import Objective, check_statistic
 from quadcruise.tune.result import TuneResult
-from quadcruise.tune.space import GainSpace
+from quadcruise.tune.space import Bounds, GainSpace
 
 __all__ = ["tune", "ABS_TOL", "TUNE_OPTIONS"]
 
@@ -75,11 +75,11 @@ def tune(
     mission: Mission | str = "step",
     controller: Any = "nlpd",
     *,
-    gains=None,
-    bounds=None,
-    targets=(),
-    require=(),
-    minimize=(),
+    gains: str | Sequence[str] | None = None,
+    bounds: Mapping[str, tuple[float, float]] | Bounds | Sequence[Bounds] | None = None,
+    targets: Mapping[str, float | tuple[float, float]] | Target | Sequence[Target] = (),
+    require: Mapping[str, tuple[str, float]] | Requirement | Sequence[Requirement] = (),
+    minimize: str | Sequence[str] = (),
     population: Population | None = None,
     samples: int = 1,
     objective: str | float = "worst",

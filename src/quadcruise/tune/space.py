@@ -269,8 +269,7 @@ got tuple (10, 0.5); bounds reversed or empty
             item = f"{name}[{gain!r}]"
             if not isinstance(gain, str) or not gain:
                 checks.fail(where, f"{name} key", gain, "a gain's name, e.g. 'position.kp'")
-            if isinstance(pair, str) or not isinstance(pair, (tuple, list)) or len(pair) != 2:
-                checks.fail(where, item, pair, "a pair (low, high)", hint=hint)
+            pair = checks.pair(where, item, pair, "a pair (low, high)", hint=hint)
             low, high = checks.number(where, f"{item}[0]", pair[0]), checks.number(where, f"{item}[1]", pair[1])
             if not low < high:
                 checks.fail(
