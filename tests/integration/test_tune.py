@@ -271,7 +271,10 @@ RISE = ["--target", "rise_time_s=1"]
         (["--target", "overshoot_pct=4+-0"], "target 'overshoot_pct=4+-0': the tolerance must be > 0"),
         ([*RISE, "--target", "rise_time_s=2"], "target: rise_time_s is given twice"),
         (["--bounds", "position.kp=a:3", *RISE], "bounds 'position.kp=a:3': 'a' is not a finite number"),
-        (["--gains", ",", *RISE], "gains ',': expected gain names"),
+        (
+            ["--gains", ",", *RISE],
+            "gains ',': expected gain names, e.g. position.kp,position.kd; gains of nlpd: position.kp",
+        ),
         ([], "nothing to tune for"),
     ],
 )

@@ -27,7 +27,7 @@ from quadcruise.montecarlo.requirements import metric_hint
 from quadcruise.montecarlo.scenario import parse_requirements
 from quadcruise.montecarlo.schema import METRICS
 from quadcruise.tune.criteria import Target
-from quadcruise.tune.space import Bounds
+from quadcruise.tune.space import Bounds, tunable_values
 
 __all__ = ["parse_bounds", "parse_gains", "parse_minimize", "parse_objective", "parse_requirements", "parse_targets"]
 
@@ -120,13 +120,15 @@ def parse_minimize(texts: Iterable[str]) -> tuple[str, ...]:
     return tuple(out)
 
 
-def parse_gains(text: str | None) -> list[str] | None:
+def parse_gains(text: str | None, controller=None) -> list[str] | None:
     """The gains' names from ``--gains``, comma-separated (checked against the controller by the tune).
 
     Parameters
     ----------
     text : str or None
         E.g. ``"position.kp,position.kd"``; None: the tune's default.
+    controller : Controller, optional
+        The controller tuned, whose gains a message lists.
 
     Returns
     -------
@@ -141,7 +143,8 @@ def parse_gains(text: str | None) -> list[str] | None:
         return None
     names = [n.strip() for n in text.split(",") if n.strip()]
     if not names:
-        raise InputError(f"gains {text!r}: expected gain names, e.g. position.kp,position.kd")
+        known = f"; gains of {controller.name}: {', '.join(tunable_values(controller))}" if controller else ""
+        raise InputError(f"gains {text!r}: expected gain names, e.g. position.kp,position.kd{known}")
     return names
 
 

@@ -190,7 +190,6 @@ def tune_command(
         require=parse_requirements(require),
         minimize=parse_minimize(minimize),
         objective=parse_objective(objective),
-        gains=parse_gains(gains),
         bounds=parse_bounds(bounds),
     )
     if not wanted["targets"] and not wanted["minimize"]:
@@ -213,6 +212,7 @@ def tune_command(
     else:
         the_mission = mission_from_options(mission, mission_params, False)
         the_controller = controller_from_options(controller, controller_params, None)
+    wanted["gains"] = parse_gains(gains, the_controller)
     world, notes = flight_world(
         vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind, turbulence=turbulence, scenario=sc
     )
