@@ -32,7 +32,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from machine import end_of_run, machine  # noqa: E402
 
-TARGETS = ["rise_time_s=1", "settling_time_s=2", "overshoot_pct=4"]
+TARGETS = {"rise_time_s": 1.0, "settling_time_s": 2.0, "overshoot_pct": 4.0}
 LIMITS = {"nominal": 60.0, "robust": 300.0}
 
 

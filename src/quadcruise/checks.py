@@ -31,7 +31,7 @@ import numpy as np
 
 from quadcruise.errors import ArgumentTypeError, InputError
 
-__all__ = ["callback", "describe", "fail", "flag", "instance", "number", "short_number", "whole"]
+__all__ = ["callback", "describe", "fail", "flag", "instance", "number", "pair", "short_number", "whole"]
 
 _UNITS = {"s": " of seconds", "m": " of metres"}
 
@@ -309,3 +309,39 @@ def callback(where: str, name: str, value: Any) -> Any:
     if value is not None and not callable(value):
         fail(where, name, value, "a callable or None")
     return value
+
+
+def pair(where: str, name: str, value: Any, want: str, *, hint: str = "") -> tuple:
+    """Two items (a tuple, a list or a 1-D array of two), as a tuple; their values are checked
+    by the caller.
+
+    Parameters
+    ----------
+    where, name : str
+        The function and the argument, for the message.
+    value : Any
+        The value given.
+    want : str
+        What is expected, e.g. ``"a pair (low, high)"``.
+    hint : str
+        What to do, for the message.
+
+    Returns
+    -------
+    tuple
+        The two items.
+
+    Examples
+    --------
+    >>> pair("tune()", "bounds['kp']", np.array([0.5, 10.0]), "a pair (low, high)")
+    (0.5, 10.0)
+    >>> pair("tune()", "bounds['kp']", "0.5:10", "a pair (low, high)")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.ArgumentTypeError: tune() argument bounds['kp'] must be a pair (low, high), got str '0.5:10'
+    """
+    if isinstance(value, np.ndarray) and value.shape == (2,):
+        return tuple(value.tolist())
+    if not isinstance(value, (tuple, list)) or len(value) != 2:
+        fail(where, name, value, want, hint=hint)
+    return tuple(value)

@@ -22,11 +22,12 @@ from quadcruise.errors import ArgumentTypeError, InputError
 from quadcruise.missions import Circle, Step
 from quadcruise.montecarlo import Population, montecarlo
 from quadcruise.sim.engine import Limits
-from quadcruise.tune import tune
+from quadcruise.tune import Bounds, Requirement, Target, tune
 from quadcruise.workflows.analysis import linearize
 
 EXAMPLES = Path(__file__).parents[2] / "examples"
 WRONG, BAD = TypeError, ValueError
+RISE = {"rise_time_s": 1.0}
 
 
 class PlainController:
@@ -134,13 +135,32 @@ CASES = {
     "montecarlo controller class": (lambda: montecarlo("step", NLPD, n=2), WRONG, ["montecarlo()", "NLPD()"]),
     "montecarlo mission class": (lambda: montecarlo(Circle, n=2), WRONG, ["montecarlo()", "mission"]),
     # tune
-    "tune seed 1.5": (lambda: tune("step", targets=["rise_time_s=1"], seed=1.5), WRONG, ["seed", "1.5"]),
-    "tune budget 0": (lambda: tune("step", targets=["rise_time_s=1"], budget=0), BAD, ["budget", ">= 1"]),
-    "tune mission class": (lambda: tune(Step, targets=["rise_time_s=1"]), WRONG, ["tune()", "mission"]),
-    "tune dt str": (lambda: tune("step", targets=["rise_time_s=1"], dt="1e-3"), WRONG, ["tune()", "dt"]),
-    "tune vehicle": (lambda: tune("step", targets=["rise_time_s=1"], vehicle=2), WRONG, ["tune()", "vehicle"]),
-    "tune tol -1": (lambda: tune("step", targets=["rise_time_s=1"], tol=-1.0), BAD, ["tol", ">= 0"]),
-    "tune controller class": (lambda: tune("step", NLPD, targets=["rise_time_s=1"]), WRONG, ["tune()", "NLPD()"]),
+    "tune seed 1.5": (lambda: tune("step", targets=RISE, seed=1.5), WRONG, ["seed", "1.5"]),
+    "tune budget 0": (lambda: tune("step", targets=RISE, budget=0), BAD, ["budget", ">= 1"]),
+    "tune mission class": (lambda: tune(Step, targets=RISE), WRONG, ["tune()", "mission"]),
+    "tune dt str": (lambda: tune("step", targets=RISE, dt="1e-3"), WRONG, ["tune()", "dt"]),
+    "tune vehicle": (lambda: tune("step", targets=RISE, vehicle=2), WRONG, ["tune()", "vehicle"]),
+    "tune tol -1": (lambda: tune("step", targets=RISE, tol=-1.0), BAD, ["tol", ">= 0"]),
+    "tune controller class": (lambda: tune("step", NLPD, targets=RISE), WRONG, ["tune()", "NLPD()"]),
+    "tune targets text": (lambda: tune("step", targets=["rise_time_s=1"]), WRONG, ["tune()", "targets[0]", "Target"]),
+    "tune require text": (lambda: tune("step", targets=RISE, require="rmse_m<1"), WRONG, ["tune()", "require"]),
+    "tune bounds text": (lambda: tune("step", targets=RISE, bounds="position.kp=1:9"), WRONG, ["tune()", "bounds"]),
+    "tune bounds reversed": (
+        lambda: tune("step", targets=RISE, bounds={"position.kp": (9, 1)}),
+        BAD,
+        ["tune()", "bounds['position.kp']", "low < high"],
+    ),
+    "tune target negative": (lambda: tune("step", targets={"rmse_m": -1}), BAD, ["tune()", "targets['rmse_m']"]),
+    "montecarlo requirements text": (
+        lambda: montecarlo("step", n=2, requirements="rmse_m<1"),
+        WRONG,
+        ["montecarlo()", "requirements", "Requirement"],
+    ),
+    "montecarlo requirement metric": (
+        lambda: montecarlo("step", n=2, requirements={"rmse": ("<", 1)}),
+        BAD,
+        ["montecarlo()", "requirements key", "did you mean 'rmse_m'?"],
+    ),
     # replay
     "replay int": (lambda: qc.replay(3), WRONG, ["schedule", "DutySchedule", "path"]),
     "replay max_step 0": (lambda: qc.replay(EXAMPLES / "pwm_step.csv", max_step=0.0), BAD, ["max_step"]),
@@ -172,6 +192,12 @@ CASES = {
     "Limits str": (lambda: Limits(max_tilt="1"), WRONG, ["Limits()", "max_tilt"]),
     "Limits 0": (lambda: Limits(max_position=0.0), BAD, ["max_position", "positive"]),
     "Population str": (lambda: Population(mass_spread="0.1"), WRONG, ["mass_spread"]),
+    "Target value str": (lambda: Target("rmse_m", "0.1"), WRONG, ["Target()", "value", "str '0.1'"]),
+    "Target metric": (lambda: Target("rmse", 0.1), BAD, ["Target()", "metric", "did you mean 'rmse_m'?"]),
+    "Requirement op": (lambda: Requirement("rmse_m", "==", 0.1), BAD, ["Requirement()", "op", "'<='"]),
+    "Requirement value nan": (lambda: Requirement("rmse_m", "<", math.nan), BAD, ["Requirement()", "value"]),
+    "Bounds reversed": (lambda: Bounds("position.kp", 2, 1), BAD, ["Bounds()", "high", "low = 2"]),
+    "Bounds str": (lambda: Bounds("position.kp", "1", 2), WRONG, ["Bounds()", "low", "str '1'"]),
 }
 
 
@@ -256,7 +282,7 @@ def test_seed_given_to_fly_is_written_so_that_the_scenario_flies_again(tmp_path)
 
 
 def test_default_tuning_bounds_stay_within_the_fields_range():
-    from quadcruise.tune.spec import GainSpace
+    from quadcruise.tune.space import GainSpace
 
     for name in ("nlpd", "gonzalez", "se3", "cascade"):
         gain = GainSpace.build(qc_controller(name), "max_tilt").gains[0]

@@ -17,7 +17,7 @@ from quadcruise.disturbances import ConstantWind, Environment, SensorNoise, Turb
 from quadcruise.errors import InputError, SimulationError
 from quadcruise.metrics import flight_metrics
 from quadcruise.model.vehicle import Vehicle
-from quadcruise.montecarlo import MonteCarloSpec, Population, montecarlo, montecarlo_case, replay_case
+from quadcruise.montecarlo import MonteCarloSpec, Population, Requirement, montecarlo, montecarlo_case, replay_case
 from quadcruise.montecarlo.chunk import fly_chunk, sweep_metrics
 from quadcruise.montecarlo.schema import COLUMNS
 
@@ -124,7 +124,7 @@ def test_table_does_not_depend_on_chunking(reference):
     assert not sweep(seed=2).table["m"].equals(res.table["m"])
     # memory stays bounded: paths of the first max_traces vehicles and of the first
     # max_failure_traces failed ones (3 s is mostly too short to settle into 2 %)
-    small = sweep(max_traces=5, max_failure_traces=3, requirements=("settling_time_s<=2.5",))
+    small = sweep(max_traces=5, max_failure_traces=3, requirements={"settling_time_s": ("<=", 2.5)})
     failed = small.table.query("failure > 0 and vehicle >= 5")["vehicle"].tolist()
     assert len(failed) > 3
     assert small.traces.vehicle.tolist() == [0, 1, 2, 3, 4] + failed[:3]
@@ -217,7 +217,7 @@ def test_a_requirement_that_fails_is_counted_and_shown(tmp_path):
         24,
         seed=1,
         scheduler="none",
-        requirements=[req],
+        requirements=[Requirement("steady_max_error_m", "<=", 0.2)],
         out=tmp_path / "mc",
     )
     tab = res.table
@@ -243,10 +243,25 @@ def test_a_requirement_that_fails_is_counted_and_shown(tmp_path):
             24,
             seed=1,
             scheduler="none",
-            requirements=["steady_max_error_m<=0.3"],
+            requirements={"steady_max_error_m": ("<=", 0.3)},
             out=tmp_path / "mc",
         )
-    assert MonteCarloSpec("circle", requirements="rmse_m < 0.5").requirements == ("rmse_m<0.5",)
+
+
+def test_requirements_are_objects_kept_as_text_in_the_record():
+    spec = MonteCarloSpec("circle", requirements={"rmse_m": ("<", 0.5), "overshoot_pct": (">=", 1)})
+    assert spec.requirements == (Requirement("rmse_m", "<", 0.5), Requirement("overshoot_pct", ">=", 1.0))
+    assert spec.to_dict()["requirements"] == ["rmse_m<0.5", "overshoot_pct>=1"]
+    from quadcruise.montecarlo.scenario import parse_requirement
+
+    odd = Requirement("rmse_m", "<=", 0.1 + 0.2)  # the text a scenario.toml keeps reads back to the same float
+    assert odd.text == "rmse_m<=0.30000000000000004" and parse_requirement(odd.text) == odd
+    one = MonteCarloSpec("circle", requirements=Requirement("rmse_m", "<", 0.5))
+    assert one == MonteCarloSpec("circle", requirements=[Requirement("rmse_m", "<", 0.5)]) and one.hash() != spec.hash()
+    with pytest.raises(TypeError, match=r"^MonteCarloSpec\(\) argument requirements must be Requirement objects"):
+        MonteCarloSpec("circle", requirements="rmse_m < 0.5")  # text is the command line's and the scenario's
+    with pytest.raises(TypeError, match=r"^montecarlo\(\) argument requirements\[0\] must be a Requirement"):
+        montecarlo("hover", n=2, duration=0.5, scheduler="none", requirements=["rmse_m<0.5"])
 
 
 @pytest.mark.parametrize(
@@ -287,8 +302,14 @@ def test_a_bad_requirement_is_refused_before_any_flight(tmp_path, text, words):
     assert res.exit_code == 2, res.output
     assert words in res.output and f"requirement {text!r}" in res.output and len(res.output.strip().splitlines()) == 1
     assert not out.exists()
-    with pytest.raises(InputError, match="requirement"):
-        montecarlo("hover", n=2, duration=0.5, scheduler="none", requirements=[text])
+    scenario = tmp_path / "s.toml"  # the same text in a scenario's [montecarlo] table
+    scenario.write_text(f'[mission]\nkind = "hover"\n[montecarlo]\nn = 4\nrequirements = ["rmse_m<1", "{text}"]\n')
+    res = CliRunner().invoke(
+        main, ["montecarlo", "--scenario", str(scenario), "--scheduler", "none", "--out", str(out)]
+    )
+    assert res.exit_code == 2 and len(res.output.strip().splitlines()) == 1, res.output
+    assert f"{scenario}: [montecarlo] requirements: requirement {text!r}: " in res.output and words in res.output
+    assert not out.exists()
 
 
 def test_metrics_on_the_decimated_log_are_close_to_full_rate():

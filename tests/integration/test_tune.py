@@ -15,9 +15,8 @@ from quadcruise.control.design import attitude_pid_design
 from quadcruise.errors import InputError
 from quadcruise.missions import Step
 from quadcruise.montecarlo import Population
-from quadcruise.tune import GainSpace, TuneResult, tune
+from quadcruise.tune import Bounds, GainSpace, Requirement, Target, TuneResult, tune
 from quadcruise.tune.objective import FAILURE_COST, REQUIREMENT_COST, Objective
-from quadcruise.tune.spec import parse_requirements, parse_targets
 from quadcruise.workflows.scenario import load_scenario
 
 SMALL = dict(duration=6.0, budget=4, popsize=6)
@@ -34,8 +33,8 @@ def small():
         Step(size=1.0, time=0.5),
         "nlpd",
         gains="position.kp",
-        targets=["rise_time_s=1.2"],
-        require=["overshoot_pct<=20"],
+        targets=[Target("rise_time_s", 1.2)],
+        require=[Requirement("overshoot_pct", "<=", 20)],
         seed=2,
         **SMALL,
     )
@@ -48,11 +47,11 @@ def test_reaches_the_gains_of_a_designed_linear_response():
     ctrl = pytest.importorskip("control")
     kp, kd = 4.0, 2.4  # wn 2 rad/s, zeta 0.6
     info = ctrl.step_info(ctrl.tf([kp], [1.0, kd, kp]))
-    targets = [
-        f"rise_time_s={info['RiseTime']}",
-        f"settling_time_s={info['SettlingTime']}",
-        f"overshoot_pct={info['Overshoot']}",
-    ]
+    targets = {
+        "rise_time_s": info["RiseTime"],
+        "settling_time_s": info["SettlingTime"],
+        "overshoot_pct": info["Overshoot"],
+    }
     fast = attitude_pid_design(300.0)
     res = tune(
         Step(size=0.01, time=0.5),
@@ -68,12 +67,12 @@ def test_reaches_the_gains_of_a_designed_linear_response():
 
 
 def test_the_same_seed_gives_the_same_gains(small):
-    again = tune(
+    again = tune(  # the same targets and requirement as mappings: the same tune
         Step(size=1.0, time=0.5),
         "nlpd",
-        gains="position.kp",
-        targets=["rise_time_s=1.2"],
-        require=["overshoot_pct<=20"],
+        gains=["position.kp"],
+        targets={"rise_time_s": 1.2},
+        require={"overshoot_pct": ("<=", 20)},
         seed=2,
         **SMALL,
     )
@@ -111,7 +110,7 @@ def test_robust_tune_flies_each_candidate_on_the_same_perturbed_vehicles():
         Step(size=1.0, time=0.5),
         "nlpd",
         gains="position.kp",
-        targets=["settling_time_s=3"],
+        targets={"settling_time_s": 3},
         population=pop,
         samples=5,
         objective="worst",
@@ -126,7 +125,7 @@ def test_robust_tune_flies_each_candidate_on_the_same_perturbed_vehicles():
         Step(size=1.0, time=0.5),
         "nlpd",
         gains="position.kp",
-        targets=["settling_time_s=3"],
+        targets={"settling_time_s": 3},
         population=pop,
         samples=5,
         objective="median",
@@ -137,7 +136,7 @@ def test_robust_tune_flies_each_candidate_on_the_same_perturbed_vehicles():
 
 
 def test_requirements_rank_before_targets_and_failures_last(small):
-    obj = Objective(None, None, parse_targets(["rise_time_s=1"]), parse_requirements(["overshoot_pct<=5"]))
+    obj = Objective(None, None, (Target("rise_time_s", 1),), (Requirement("overshoot_pct", "<=", 5),))
     metrics = {
         "status": np.array([[0, 0, 0, 0, 3]]),
         "rise_time_s": np.array([[1.0, 1.5, 1.0, np.nan, 1.0]]),
@@ -153,7 +152,7 @@ def test_requirements_rank_before_targets_and_failures_last(small):
 
 
 def test_gains_by_pole_pair_and_derived_saturation_levels():
-    space = GainSpace.build(NLPD(), "position.wn,position.zeta", {"position.zeta": (0.3, 1.2)})
+    space = GainSpace.build(NLPD(), ["position.wn", "position.zeta"], [Bounds("position.zeta", 0.3, 1.2)])
     c = space.controllers([[2.0, 0.5]])[0]
     assert (c.position.kp, c.position.kd) == pytest.approx((4.0, 2.0))
     assert space.gains[1].log is False and space.gains[0].log is True
@@ -161,6 +160,95 @@ def test_gains_by_pole_pair_and_derived_saturation_levels():
     assert base.accel_p == pytest.approx(0.5)
     fixed = GainSpace.build(Gonzalez(accel_p=3.85), "position.kp").controllers([[0.5]])[0]
     assert fixed.accel_p == 3.85
+
+
+def test_targets_requirements_and_bounds_are_objects_and_the_cli_texts_read_into_the_same():
+    from quadcruise.cli.criteria import parse_bounds, parse_minimize, parse_objective, parse_targets
+    from quadcruise.montecarlo.scenario import parse_requirements
+    from quadcruise.tune.criteria import as_minimize, as_requirements, as_targets
+    from quadcruise.tune.space import as_bounds
+
+    targets = (Target("overshoot_pct", 4, 1.5), Target("rise_time_s", 1.0))
+    assert targets[1].tolerance == pytest.approx(0.1) and Target("overshoot_pct", 0).tolerance == 1.0
+    assert as_targets({"overshoot_pct": (4, 1.5), "rise_time_s": 1}, "tune()") == targets
+    assert parse_targets(["overshoot_pct=4+-1.5", "rise_time_s = 1"]) == targets
+    required = (Requirement("overshoot_pct", "<=", 5), Requirement("rmse_m", ">", 0.25))
+    assert as_requirements({"overshoot_pct": ("<=", 5), "rmse_m": (">", 0.25)}, "tune()") == required
+    assert parse_requirements(["overshoot_pct<=5", "rmse_m > 0.25"]) == required
+    assert [r.text for r in required] == ["overshoot_pct<=5", "rmse_m>0.25"]
+    bounds = {"position.kp": Bounds("position.kp", 0.5, 10), "position.kd": Bounds("position.kd", 1, 8)}
+    assert as_bounds({"position.kp": (0.5, 10), "position.kd": [1, 8]}, "tune()") == bounds
+    assert as_bounds(parse_bounds(["position.kp=0.5:10,position.kd=1:8"]), "tune()") == bounds
+    assert as_minimize("rmse_m", "tune()") == parse_minimize(["rmse_m"]) == ("rmse_m",)
+    assert parse_objective("q90") == 0.9 and parse_objective("max") == "worst"
+    # numbers of any numeric type pass, as everywhere in the API
+    assert as_targets({"rise_time_s": np.float32(1.0)}, "tune()") == (Target("rise_time_s", 1.0, 0.1),)
+    assert Requirement("rmse_m", "<=", np.int64(1)) == Requirement("rmse_m", "<=", 1.0)
+    assert as_bounds({"position.kp": np.array([0.5, 10.0])}, "tune()") == {"position.kp": bounds["position.kp"]}
+    with pytest.raises(AttributeError):  # frozen: a target is a value
+        targets[0].value = 3.0
+
+
+def no_flight(*args, **kwargs):
+    raise AssertionError("flew before refusing bad input")
+
+
+@pytest.mark.parametrize(
+    "kwargs, error, words",
+    [
+        (dict(targets=["rise_time_s=1"]), TypeError, ["tune() argument targets[0] must be a Target", "str 'rise_"]),
+        (dict(targets="rise_time_s=1"), TypeError, ["tune() argument targets must be Target objects or a mapping"]),
+        (dict(targets={"rise_time": 1}), ValueError, ["tune() argument targets key", "did you mean 'rise_time_s'?"]),
+        (dict(targets={"overshoot_pct": -4}), ValueError, ["targets['overshoot_pct'] must be a number >= 0"]),
+        (dict(targets={"overshoot_pct": "4"}), TypeError, ["targets['overshoot_pct'] must be", "str '4'"]),
+        (dict(targets={"overshoot_pct": (4, 0)}), ValueError, ["targets['overshoot_pct'][1] must be a positive"]),
+        (dict(targets={"overshoot_pct": (4, 1, 2)}), TypeError, ["targets['overshoot_pct'] must be a value or a pair"]),
+        (dict(targets=[Target("rmse_m", 1), Target("rmse_m", 2)]), ValueError, ["targets gives rmse_m twice"]),
+        (dict(require=["overshoot_pct<=5"]), TypeError, ["tune() argument require[0] must be a Requirement"]),
+        (dict(require={"overshoot_pct": ("=<", 5)}), ValueError, ["require['overshoot_pct'][0] must be one of"]),
+        (dict(require={"overshoot_pct": 5}), TypeError, ["require['overshoot_pct'] must be a pair (op, value)"]),
+        (dict(require={"overshoot_pct": (["<="], 5)}), TypeError, ["require['overshoot_pct'][0] must be one of"]),
+        (dict(bounds={"position.kp": "1:10"}), TypeError, ["bounds['position.kp'] must be a pair", "str '1:10'"]),
+        (dict(bounds="position.kp=0.5:10"), TypeError, ["tune() argument bounds must be Bounds objects or a mapping"]),
+        (dict(bounds={"position.kp": (10, 1)}), ValueError, ["bounds['position.kp'] must be a pair", "reversed"]),
+        (dict(bounds={"position.kp": (1, "10")}), TypeError, ["tune() argument bounds['position.kp'][1]", "str '10'"]),
+        (dict(bounds={"max_tilt": (0.1, 0.5)}), ValueError, ["bounds of 'max_tilt', which is not searched"]),
+        (dict(gains="position.kp,position.kd"), ValueError, ["several gains are a list", "['position.kp', 'position"]),
+        (dict(gains=3), TypeError, ["tune() argument gains must be a gain's name or a list"]),
+        (dict(minimize="rmse_m,effort"), ValueError, ["tune() argument minimize must be a metric of the flights"]),
+        (dict(minimize=["rmse"]), ValueError, ["minimize[0]", "did you mean 'rmse_m'?"]),
+        (dict(objective="q90"), ValueError, ["tune() argument objective must be 'worst', 'median' or a quantile"]),
+        (dict(objective=True), TypeError, ["tune() argument objective"]),
+    ],
+)
+def test_bad_criteria_in_python_are_one_line_naming_the_argument_before_any_flight(monkeypatch, kwargs, error, words):
+    monkeypatch.setattr("quadcruise.tune.objective.fly_chunk", no_flight)
+    with pytest.raises(error) as caught:
+        tune("step", **{"targets": {"rise_time_s": 1}, **kwargs})
+    assert isinstance(caught.value, InputError)  # the command line would say it in one line, exit 2
+    text = str(caught.value)
+    assert "\n" not in text and all(w in text for w in words), text
+
+
+@pytest.mark.parametrize(
+    "make, error, words",
+    [
+        (lambda: Target("rise_time", 1), ValueError, ["Target() argument metric", "did you mean 'rise_time_s'?"]),
+        (lambda: Target(3, 1), TypeError, ["Target() argument metric must be a metric's name (str), got int 3"]),
+        (lambda: Target("overshoot_pct", float("nan")), ValueError, ["Target() argument value", "nan"]),
+        (lambda: Target("overshoot_pct", 4, -1), ValueError, ["Target() argument tolerance must be a positive"]),
+        (lambda: Requirement("rmse_m", "=<", 1), ValueError, ["Requirement() argument op must be one of"]),
+        (lambda: Requirement("rmse_m", "<=", "1"), TypeError, ["Requirement() argument value", "str '1'"]),
+        (lambda: Requirement("rmse_m", "<=", float("inf")), ValueError, ["Requirement() argument value", "inf"]),
+        (lambda: Bounds("position.kp", 10, 1), ValueError, ["Bounds() argument high must be above low = 10"]),
+        (lambda: Bounds("position.kp", "1", 10), TypeError, ["Bounds() argument low", "str '1'"]),
+        (lambda: Bounds("", 1, 10), TypeError, ["Bounds() argument gain"]),
+    ],
+)
+def test_the_objects_check_their_fields_on_construction(make, error, words):
+    with pytest.raises(error) as caught:
+        make()
+    assert isinstance(caught.value, InputError) and all(w in str(caught.value) for w in words), str(caught.value)
 
 
 RISE = ["--target", "rise_time_s=1"]
@@ -180,13 +268,17 @@ RISE = ["--target", "rise_time_s=1"]
         (["--budget", "0", *RISE], "budget (generations) must be a whole number >= 1"),
         (["--require", "overshoot_pct=<5", *RISE], "expected METRIC<=VALUE"),
         (["--objective", "best", *RISE], "expected worst, median or a quantile"),
+        (["--target", "overshoot_pct=4+-0"], "target 'overshoot_pct=4+-0': the tolerance must be > 0"),
+        ([*RISE, "--target", "rise_time_s=2"], "target: rise_time_s is given twice"),
+        (["--bounds", "position.kp=a:3", *RISE], "bounds 'position.kp=a:3': 'a' is not a finite number"),
+        (
+            ["--gains", ",", *RISE],
+            "gains ',': expected gain names, e.g. position.kp,position.kd; gains of nlpd: position.kp",
+        ),
         ([], "nothing to tune for"),
     ],
 )
 def test_bad_input_is_one_line_exit_2_before_any_flight(tmp_path, monkeypatch, args, message):
-    def no_flight(*a, **k):
-        raise AssertionError("flew before refusing bad input")
-
     monkeypatch.setattr("quadcruise.tune.objective.fly_chunk", no_flight)
     out = tmp_path / "out"
     res = run("tune", "step", *args, "--out", out)
@@ -264,4 +356,4 @@ def test_qc_tune_is_the_package():
 
 def test_library_refuses_unknown_options():
     with pytest.raises(InputError, match="tune\\(\\) has no option 'sede'"):
-        tune("step", targets=["rise_time_s=1"], sede=1)
+        tune("step", targets={"rise_time_s": 1}, sede=1)

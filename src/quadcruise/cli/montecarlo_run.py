@@ -109,9 +109,12 @@ def montecarlo_command(
 
     Parameters
     ----------
-    mission, controller, n, seed, duration, dt, scenario, requirements, max_track_error_m
+    mission, controller, n, seed, duration, dt, scenario, max_track_error_m
         As :func:`quadcruise.montecarlo.scenario.sweep_spec`: None means "not given" (a
         ``scenario`` file's value, else the default).
+    requirements : tuple of str
+        ``--require`` texts, ``METRIC<=VALUE`` each
+        (:func:`quadcruise.montecarlo.scenario.parse_requirement`).
     wind, noise : str, optional
         A :func:`~quadcruise.disturbances.parse_wind` spec and a :func:`parse_noise` one.
     turbulence : str, optional
@@ -152,10 +155,11 @@ offset, distribution, model_error : optional
     from quadcruise.errors import whole_number
     from quadcruise.montecarlo import montecarlo_case
     from quadcruise.montecarlo.output import case_folder, case_text, write_case
-    from quadcruise.montecarlo.scenario import sweep_spec
+    from quadcruise.montecarlo.scenario import parse_requirements, sweep_spec
     from quadcruise.montecarlo.sweep import run_sweep
 
     whole_number(worst, "--worst")
+    requirements = parse_requirements(requirements)  # --require texts, read before any work
     if mission is not None and str(mission).lower().endswith(".toml"):  # a scenario as the mission: as --scenario
         if scenario is not None:
             raise InputError(f"--mission {mission} and --scenario {scenario}: give the scenario once")

@@ -103,8 +103,11 @@ def tune_command(
         change it), else ``nlpd``.
     controller_params : tuple of str
         ``KEY=VALUE`` parameters of the controller.
-    gains, bounds, targets, require, minimize, samples, objective, seed, budget, popsize
-        As :func:`quadcruise.tune.tune` (text as on the command line).
+    gains, bounds, targets, require, minimize, objective : str or tuple of str
+        As on the command line, read by :mod:`quadcruise.cli.criteria` into
+        :func:`quadcruise.tune.tune`'s objects.
+    samples, seed, budget, popsize : int
+        As :func:`quadcruise.tune.tune`.
     mass_spread, inertia_spread, wind_spread : float
         :class:`~quadcruise.montecarlo.Population` fields.
     wind, noise : str, optional
@@ -169,11 +172,28 @@ def tune_command(
         ).items()
         if DEFAULTS.get(k, object()) != v
     }
+    from quadcruise.cli.criteria import (
+        parse_bounds,
+        parse_gains,
+        parse_minimize,
+        parse_objective,
+        parse_requirements,
+        parse_targets,
+    )
     from quadcruise.cli.world import flight_world
     from quadcruise.errors import InputError, whole_number
 
     if log_every is not None:
         whole_number(log_every, "--log-every", minimum=1)
+    wanted = dict(  # the texts read into the library's objects, before any work
+        targets=parse_targets(targets),
+        require=parse_requirements(require),
+        minimize=parse_minimize(minimize),
+        objective=parse_objective(objective),
+        bounds=parse_bounds(bounds),
+    )
+    if not wanted["targets"] and not wanted["minimize"]:
+        raise InputError("nothing to tune for: give a target (--target METRIC=VALUE) or a metric to --minimize")
     if out is not None:
         check_output_dir(out, force)
     kwargs: dict = {"duration": duration, "dt": 1e-3 if dt is None else dt}
@@ -192,6 +212,7 @@ def tune_command(
     else:
         the_mission = mission_from_options(mission, mission_params, False)
         the_controller = controller_from_options(controller, controller_params, None)
+    wanted["gains"] = parse_gains(gains, the_controller)
     world, notes = flight_world(
         vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind, turbulence=turbulence, scenario=sc
     )
@@ -218,14 +239,9 @@ def tune_command(
         result = tune(
             the_mission,
             the_controller,
-            gains=gains,
-            bounds=bounds,
-            targets=targets,
-            require=require,
-            minimize=minimize,
+            **wanted,
             population=population,
             samples=samples,
-            objective=objective,
             seed=seed,
             budget=budget,
             popsize=popsize,

@@ -33,8 +33,9 @@ Examples
 >>> s = res.summary()                           # 0.5 s is too short to settle: a metric, not a failure
 >>> s["failures"]["count"], s["not_settled"]["count"]
 (0, 4)
+>>> from quadcruise.montecarlo import Requirement
 >>> montecarlo("hover", "nlpd", Population(offset=0.1), n=4, seed=1, duration=0.5, scheduler="none",
-...            requirements=["steady_max_error_m<=0.05"]).summary()["requirements"][0]["failed"]
+...            requirements=[Requirement("steady_max_error_m", "<=", 0.05)]).summary()["requirements"][0]["failed"]
 4
 """
 
@@ -54,6 +55,7 @@ from quadcruise.missions import Mission, as_mission
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.chunk import Case, montecarlo_case, replay_case
 from quadcruise.montecarlo.population import Population
+from quadcruise.montecarlo.requirements import as_requirements
 from quadcruise.montecarlo.result import MonteCarloResult
 from quadcruise.montecarlo.spec import MonteCarloSpec
 from quadcruise.montecarlo.sweep import run_sweep
@@ -128,7 +130,8 @@ def montecarlo(
     **spec_options
         More :class:`MonteCarloSpec` fields: duration [s], dt [s], vehicle, log_dt [s],
         settle_band, ``requirements`` (your own pass criteria, e.g.
-        ``["steady_max_error_m<=0.2"]``), ``max_track_error_m`` [m] (the "lost track"
+        ``[Requirement("steady_max_error_m", "<=", 0.2)]`` or
+        ``{"steady_max_error_m": ("<=", 0.2)}``), ``max_track_error_m`` [m] (the "lost track"
         bound), ...
 
     Returns
@@ -251,6 +254,8 @@ resume, force, progress, connect_timeout
             checks.number(w, name, spec_options[name], "pos", unit="s", optional=name == "duration")
     if "vehicle" in spec_options:
         checks.instance(w, "vehicle", spec_options["vehicle"], Vehicle, optional=False)
+    if "requirements" in spec_options:
+        as_requirements(spec_options["requirements"], w)
 
 
 # --- command line -----------------------------------------------------------------------

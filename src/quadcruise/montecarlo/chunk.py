@@ -254,7 +254,7 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
         out[key][lost_track] = np.nan
     saturated = out["duty_clipped_s"] > spec.max_clipped_s
     failed_requirement = np.zeros(n, dtype=bool)
-    for req in spec.parsed_requirements:
+    for req in spec.requirements:
         failed_requirement |= ~req.met(out[req.metric])
     out.update(
         diverged=diverged,

@@ -1,4 +1,4 @@
-"""A user's own pass criteria for a Monte Carlo sweep: ``"metric<=value"`` and the like.
+"""A user's own pass criteria for a Monte Carlo sweep (and a tune): ``Requirement("rmse_m", "<=", 0.5)``.
 
 A requirement names one metric of the sweep's table (:data:`~quadcruise.montecarlo.schema.METRICS`),
 a comparison (``<=``, ``<``, ``>=``, ``>``) and a number in the metric's unit. A flight meets
@@ -6,39 +6,109 @@ it if its value satisfies the comparison; an undefined value (NaN: a flight that
 early, a transient that never settled) does not meet it. A flight that misses any
 requirement (and no earlier failure reason) fails as "failed a requirement".
 
+The library takes the objects, or a mapping ``{metric: (op, value)}``
+(:func:`as_requirements`); the text form ``"rmse_m<=0.5"`` of the command line and of a
+scenario's ``[montecarlo]`` table is read by
+:func:`quadcruise.montecarlo.scenario.parse_requirement`.
+
 Examples
 --------
->>> req = Requirement.parse("steady_max_error_m <= 0.2")
+>>> req = Requirement("steady_max_error_m", "<=", 0.2)
 >>> req.text, req.met(np.array([0.1, 0.3, np.nan])).tolist()
 ('steady_max_error_m<=0.2', [True, False, False])
->>> Requirement.parse("steady_max_error <= 0.2")      # doctest: +ELLIPSIS
+>>> as_requirements({"overshoot_pct": ("<=", 5)}, "montecarlo()")
+(Requirement(metric='overshoot_pct', op='<=', value=5.0),)
+>>> Requirement("steady_max_error", "<=", 0.2)      # doctest: +ELLIPSIS
 Traceback (most recent call last):
     ...
-quadcruise.errors.InputError: requirement 'steady_max_error <= 0.2': unknown metric 'steady_max_error'; choose ...
+quadcruise.errors.InputError: Requirement() argument metric must be a metric of the flights table, got str \
+'steady_max_error'; did you mean 'steady_max_error_m'? metrics: rmse_m, ...
 """
 
 from __future__ import annotations
 
-import math
+import difflib
 import operator
-import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from quadcruise.errors import InputError
+from quadcruise import checks
 from quadcruise.montecarlo.schema import METRICS
 
-__all__ = ["Requirement", "parse_requirements"]
+__all__ = ["OPERATORS", "Requirement", "as_requirements", "check_metric", "metric_hint"]
 
 _OPERATORS = {"<=": operator.le, "<": operator.lt, ">=": operator.ge, ">": operator.gt}
-_PATTERN = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|<|>)\s*([^<>=\s]+)\s*$")
+OPERATORS = tuple(_OPERATORS)
+"""The comparisons a requirement may make."""
+
+
+def metric_hint(name: str) -> str:
+    """The closest metric's name, for a message: ``" (did you mean 'rmse_m'?)"`` or ``""``.
+
+    Parameters
+    ----------
+    name : str
+        A name that is not a metric.
+
+    Returns
+    -------
+    str
+    """
+    close = _closest(name)
+    return f" (did you mean '{close}'?)" if close else ""
+
+
+def _closest(name: str) -> str | None:
+    close = difflib.get_close_matches(str(name), METRICS, n=1)
+    return close[0] if close else None
+
+
+def check_metric(where: str, name: str, value: Any) -> str:
+    """A metric's name, checked against the table's metrics, in the API's message form.
+
+    Parameters
+    ----------
+    where, name : str
+        The function and the argument, for the message (``"tune()"``, ``"minimize"``).
+    value : Any
+        The value given.
+
+    Returns
+    -------
+    str
+        ``value``.
+
+    Raises
+    ------
+    ArgumentTypeError
+        Not a string.
+    InputError
+        Not a metric of :data:`~quadcruise.montecarlo.schema.METRICS` (the closest is named).
+
+    Examples
+    --------
+    >>> check_metric("tune()", "minimize", "rmse")          # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: tune() argument minimize must be a metric of the flights table, got str 'rmse'; \
+did you mean 'rmse_m'? metrics: rmse_m, ...
+    """
+    metrics = f"metrics: {', '.join(METRICS)}"
+    if not isinstance(value, str):
+        checks.fail(where, name, value, "a metric's name (str)", hint=metrics)
+    if value not in METRICS:
+        close = _closest(value)
+        hint = f"did you mean '{close}'? {metrics}" if close else metrics
+        checks.fail(where, name, value, "a metric of the flights table", kind=False, hint=hint)
+    return value
 
 
 @dataclass(frozen=True)
 class Requirement:
-    """One pass criterion: ``metric op value``.
+    """One pass criterion: ``metric op value``, checked on construction.
 
     Parameters
     ----------
@@ -47,54 +117,33 @@ class Requirement:
     op : {"<=", "<", ">=", ">"}
         The comparison.
     value : float
-        The bound, in the metric's unit.
+        The bound, in the metric's unit (a finite number).
+
+    Raises
+    ------
+    ArgumentTypeError
+        A field of the wrong type (a metric that is not a string, a bound given as text).
+    InputError
+        An unknown metric, comparison or a bound that is not finite.
     """
 
     metric: str
     op: str
     value: float
 
-    @classmethod
-    def parse(cls, text: str) -> Requirement:
-        """A requirement from its text, ``"metric<=value"`` (spaces allowed).
-
-        Parameters
-        ----------
-        text : str
-            The requirement, e.g. ``"steady_max_error_m<=0.2"`` or ``"rmse_m < 0.5"``.
-
-        Returns
-        -------
-        Requirement
-            Checked: a known metric, one of the four comparisons, a finite number.
-
-        Raises
-        ------
-        InputError
-            One line naming the text and, for an unknown metric, the metrics available.
-        """
-        if not isinstance(text, str):
-            raise InputError(f"a requirement is text such as 'steady_max_error_m<=0.2', got {text!r}")
-        match = _PATTERN.match(text)
-        if match is None:
-            raise InputError(
-                f"requirement {text!r}: expected METRIC<=VALUE (or <, >=, >), e.g. "
-                f"steady_max_error_m<=0.2, with METRIC one of {', '.join(METRICS)}"
-            )
-        metric, op, number = match.groups()
-        if metric not in METRICS:
-            raise InputError(f"requirement {text!r}: unknown metric {metric!r}; choose one of {', '.join(METRICS)}")
-        try:
-            value = float(number)
-        except ValueError:
-            value = math.nan
-        if not math.isfinite(value):
-            raise InputError(f"requirement {text!r}: {number!r} is not a finite number")
-        return cls(metric, op, value)
+    def __post_init__(self) -> None:
+        where = "Requirement()"
+        check_metric(where, "metric", self.metric)
+        if not isinstance(self.op, str):
+            checks.fail(where, "op", self.op, "one of '<=', '<', '>=', '>'")
+        if self.op not in _OPERATORS:
+            checks.fail(where, "op", self.op, "one of '<=', '<', '>=', '>'", kind=False)
+        object.__setattr__(self, "value", checks.number(where, "value", self.value))
 
     @property
     def text(self) -> str:
-        """The requirement as text, without spaces: ``"steady_max_error_m<=0.2"``."""
+        """The requirement as text, without spaces: ``"steady_max_error_m<=0.2"`` (the value
+        written so that it reads back to the same float)."""
         number = repr(self.value)
         return f"{self.metric}{self.op}{number[:-2] if number.endswith('.0') else number}"
 
@@ -115,14 +164,42 @@ class Requirement:
         with np.errstate(invalid="ignore"):
             return np.asarray(_OPERATORS[self.op](v, self.value), dtype=bool) & np.isfinite(v)
 
+    def violation(self, values) -> np.ndarray:
+        """How far each value is on the wrong side of the bound, in the metric's unit.
 
-def parse_requirements(texts: str | Iterable[str] | None) -> tuple[Requirement, ...]:
-    """Requirements from their texts, each checked.
+        Parameters
+        ----------
+        values : array_like
+            Values of :attr:`metric`.
+
+        Returns
+        -------
+        ndarray
+            0 where the value is on the right side (and at the bound of a strict comparison).
+
+        Examples
+        --------
+        >>> Requirement("overshoot_pct", "<=", 5).violation([3.0, 7.5]).tolist()
+        [0.0, 2.5]
+        """
+        v = np.asarray(values, dtype=float)
+        gap = v - self.value if self.op in ("<=", "<") else self.value - v
+        return np.maximum(gap, 0.0)
+
+
+_WANT = "Requirement objects or a mapping {metric: (op, value)}"
+
+
+def as_requirements(value: Any, where: str, name: str = "requirements") -> tuple[Requirement, ...]:
+    """A function's requirements argument as a tuple of :class:`Requirement`.
 
     Parameters
     ----------
-    texts : str, Requirement, iterable of them, or None
-        One requirement, several, or none.
+    value : Requirement, iterable of Requirement, mapping, or None
+        One requirement, several, or none; or a mapping of a metric to its ``(op, value)``
+        pair, ``{"overshoot_pct": ("<=", 5)}`` (two bounds on one metric: two objects in a list).
+    where, name : str
+        The function and the argument, for the message.
 
     Returns
     -------
@@ -131,16 +208,35 @@ def parse_requirements(texts: str | Iterable[str] | None) -> tuple[Requirement, 
 
     Raises
     ------
+    ArgumentTypeError
+        Text (``"rmse_m<=0.5"``: the command line and scenario files read text; Python takes
+        objects), or anything else that is not of these forms.
     InputError
-        For the first text that is not a requirement (see :meth:`Requirement.parse`).
-
-    Examples
-    --------
-    >>> [r.text for r in parse_requirements(["rmse_m<0.5", "overshoot_pct <= 10"])]
-    ['rmse_m<0.5', 'overshoot_pct<=10']
+        A bad metric, comparison or bound.
     """
-    if texts is None:
+    if value is None:
         return ()
-    if isinstance(texts, (str, Requirement)):
-        texts = [texts]
-    return tuple(t if isinstance(t, Requirement) else Requirement.parse(t) for t in texts)
+    if isinstance(value, Requirement):
+        return (value,)
+    hint = "write Requirement('rmse_m', '<=', 0.5) or {'rmse_m': ('<=', 0.5)}"
+    if isinstance(value, str):
+        checks.fail(where, name, value, _WANT, hint=hint + "; text is read by the command line and scenario files")
+    if isinstance(value, Mapping):
+        out = []
+        for metric, pair in value.items():
+            item = f"{name}[{metric!r}]"
+            check_metric(where, f"{name} key", metric)
+            pair = checks.pair(where, item, pair, "a pair (op, value), e.g. ('<=', 0.5)")
+            if not isinstance(pair[0], str) or pair[0] not in _OPERATORS:
+                checks.fail(
+                    where, f"{item}[0]", pair[0], "one of '<=', '<', '>=', '>'", kind=not isinstance(pair[0], str)
+                )
+            out.append(Requirement(metric, pair[0], checks.number(where, f"{item}[1]", pair[1])))
+        return tuple(out)
+    if not isinstance(value, Iterable):
+        checks.fail(where, name, value, _WANT)
+    out = list(value)
+    for k, item in enumerate(out):
+        if not isinstance(item, Requirement):
+            checks.fail(where, f"{name}[{k}]", item, "a Requirement", hint=hint)
+    return tuple(out)

@@ -153,7 +153,7 @@ class MonteCarloResult:
             FAILURES[c]: {"count": int(counts[c]), "rate": float(counts[c] / n)} for c in range(1, len(FAILURES))
         }
         requirements = []
-        for req in self.spec.parsed_requirements:
+        for req in self.spec.requirements:
             missed = int(np.count_nonzero(~req.met(tab[req.metric].to_numpy(dtype=float))))
             requirements.append({"requirement": req.text, "failed": missed, "rate": missed / n})
         unsettled = int(np.count_nonzero(tab["not_settled"].to_numpy()))

@@ -1,18 +1,109 @@
 """A sweep from options and a scenario file: its :class:`MonteCarloSpec` and its number of
 flights, the options given explicitly winning over the scenario's ``[montecarlo]`` table,
-``[simulation]`` and disturbances, which win over the defaults."""
+``[simulation]`` and disturbances, which win over the defaults.
+
+This is the scenario reader of the ``[montecarlo]`` table, so it also reads the text form of a
+requirement, ``"steady_max_error_m<=0.2"`` (:func:`parse_requirement`), which the table holds
+and the command line's ``--require`` takes; the library itself takes
+:class:`~quadcruise.montecarlo.requirements.Requirement` objects.
+"""
 
 from __future__ import annotations
 
 import dataclasses
+import math
+import re
+from collections.abc import Iterable
 
 from quadcruise.errors import InputError
 from quadcruise.io.scenario_file import SPEC_KEYS
 from quadcruise.montecarlo.population import Population
+from quadcruise.montecarlo.requirements import Requirement
+from quadcruise.montecarlo.schema import METRICS
 from quadcruise.montecarlo.spec import MonteCarloSpec
 from quadcruise.workflows.scenario import Scenario, load_scenario
 
-__all__ = ["merge_scenario", "sweep_spec"]
+__all__ = ["merge_scenario", "parse_requirement", "parse_requirements", "sweep_spec"]
+
+_REQUIREMENT = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|<|>)\s*([^<>=\s]+)\s*$")
+
+
+def parse_requirement(text: str, where: str = "") -> Requirement:
+    """A requirement from its text, ``"metric<=value"`` (``<``, ``>=``, ``>`` too; spaces allowed).
+
+    Parameters
+    ----------
+    text : str
+        The requirement, e.g. ``"steady_max_error_m<=0.2"`` or ``"rmse_m < 0.5"``.
+    where : str
+        Where the text was written, put before the message (``"s.toml: [montecarlo] requirements"``).
+
+    Returns
+    -------
+    Requirement
+
+    Raises
+    ------
+    InputError
+        One line naming the text and, for an unknown metric, the metrics available.
+
+    Examples
+    --------
+    >>> parse_requirement("overshoot_pct <= 5")
+    Requirement(metric='overshoot_pct', op='<=', value=5.0)
+    >>> parse_requirement("steady_max_error <= 0.2")      # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: requirement 'steady_max_error <= 0.2': unknown metric 'steady_max_error'; choose ...
+    """
+    what = (f"{where}: " if where else "") + f"requirement {text!r}"
+    if not isinstance(text, str):
+        raise InputError(f"{what}: a requirement is text such as 'steady_max_error_m<=0.2'")
+    match = _REQUIREMENT.match(text)
+    if match is None:
+        raise InputError(
+            f"{what}: expected METRIC<=VALUE (or <, >=, >), e.g. "
+            f"steady_max_error_m<=0.2, with METRIC one of {', '.join(METRICS)}"
+        )
+    metric, op, number = match.groups()
+    if metric not in METRICS:
+        raise InputError(f"{what}: unknown metric {metric!r}; choose one of {', '.join(METRICS)}")
+    try:
+        value = float(number)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise InputError(f"{what}: {number!r} is not a finite number")
+    return Requirement(metric, op, value)
+
+
+def parse_requirements(texts: str | Iterable[str] | None, where: str = "") -> tuple[Requirement, ...]:
+    """Requirements from their texts, each read by :func:`parse_requirement`.
+
+    Parameters
+    ----------
+    texts : str, iterable of str, or None
+        One requirement, several, or none.
+    where : str
+        Where they were written, for the message.
+
+    Returns
+    -------
+    tuple of Requirement
+        In the order given.
+
+    Examples
+    --------
+    >>> [r.text for r in parse_requirements(["rmse_m<0.5", "overshoot_pct <= 10"])]
+    ['rmse_m<0.5', 'overshoot_pct<=10']
+    """
+    if texts is None:
+        return ()
+    if isinstance(texts, str):
+        texts = [texts]
+    elif not isinstance(texts, Iterable):
+        raise InputError(f"{where + ': ' if where else ''}requirements must be a list of texts, got {texts!r}")
+    return tuple(parse_requirement(t, where) for t in texts)
 
 
 def merge_scenario(path, given: dict) -> tuple[Scenario, dict]:
@@ -89,8 +180,9 @@ def sweep_spec(
     scenario : str or path-like, optional
         A TOML scenario file: mission, controller, nominal vehicle, disturbances, sensor
         noise, simulation settings, and a ``[montecarlo]`` table (:func:`merge_scenario`).
-    requirements : sequence of str
-        The user's pass criteria (:class:`MonteCarloSpec`'s ``requirements``).
+    requirements : sequence of Requirement
+        The user's pass criteria (:class:`MonteCarloSpec`'s ``requirements``); a scenario's
+        ``[montecarlo] requirements`` texts are read by :func:`parse_requirements`.
     max_track_error_m : float, optional
         The "lost track" bound [m]; the spec's default if None.
     vehicle, controller_vehicle : Vehicle, optional
@@ -135,11 +227,13 @@ def sweep_spec(
     for key in SPEC_KEYS:  # the scenario's settings; options given win
         if key in given:
             value = given.pop(key)
-            if key == "requirements" and requirements:
-                continue
+            if key == "requirements":
+                value = parse_requirements(value, f"{scenario}: [montecarlo] requirements")
+                if requirements:
+                    continue
             if key == "max_track_error_m" and max_track_error_m is not None:
                 continue
-            options[key] = tuple(value) if key == "requirements" else value
+            options[key] = value
     if vehicle is not None:
         options["vehicle"] = vehicle
     if controller_vehicle is not None:

@@ -31,7 +31,7 @@ from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from quadcruise.missions import Mission, mission_from_name
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
-from quadcruise.montecarlo.requirements import Requirement, parse_requirements
+from quadcruise.montecarlo.requirements import Requirement, as_requirements
 
 __all__ = ["MonteCarloSpec"]
 
@@ -101,11 +101,12 @@ class MonteCarloSpec:
         transient exceeds this [m]. By default (None) :func:`quadcruise.workflows.fly.altitude_bound`
         (half the mission's lowest altitude: 0.5 m for the built-in missions), or
         ``max_track_error_m`` where that is given, as ``fly``'s ``max_steady_error`` bounds both.
-    requirements : str or sequence of str
-        The user's own pass criteria, e.g. ``("steady_max_error_m<=0.2",)``: a metric of
+    requirements : Requirement, sequence of Requirement, or mapping
+        The user's own pass criteria, e.g. ``[Requirement("steady_max_error_m", "<=", 0.2)]``
+        or ``{"steady_max_error_m": ("<=", 0.2)}``: a metric of
         :data:`~quadcruise.montecarlo.schema.METRICS`, ``<=``, ``<``, ``>=`` or ``>``, and a
-        number (:class:`~quadcruise.montecarlo.requirements.Requirement`). A flight that
-        misses one "failed a requirement"; an undefined value misses it.
+        number (:class:`~quadcruise.montecarlo.requirements.Requirement`); kept as a tuple of
+        Requirement. A flight that misses one "failed a requirement"; an undefined value misses it.
 
     Raises
     ------
@@ -138,7 +139,7 @@ class MonteCarloSpec:
     transient_until: float | None = None
     full_dynamics: bool = False
     max_track_error_m: float | None = None
-    requirements: Any = ()
+    requirements: tuple[Requirement, ...] = ()
     max_altitude_error_m: float | None = None
 
     def __post_init__(self) -> None:
@@ -183,7 +184,7 @@ class MonteCarloSpec:
         for name in ("max_traces", "max_failure_traces"):
             if int(getattr(self, name)) != getattr(self, name) or getattr(self, name) < 0:
                 raise InputError(f"{name} must be a whole number >= 0, got {getattr(self, name)!r}")
-        object.__setattr__(self, "requirements", tuple(r.text for r in parse_requirements(self.requirements)))
+        object.__setattr__(self, "requirements", as_requirements(self.requirements, "MonteCarloSpec()"))
         bound = steady_bound(self.mission, self.duration) if self.max_track_error_m is None else self.max_track_error_m
         if isinstance(bound, bool) or not (isinstance(bound, (int, float)) and math.isfinite(bound) and bound > 0):
             raise InputError(f"max_track_error_m must be a positive number [m], got {bound!r}")
@@ -207,11 +208,6 @@ class MonteCarloSpec:
         if self.controller_vehicle is not None:
             return self.controller_vehicle
         return self.vehicle if self.population.model_error else None
-
-    @property
-    def parsed_requirements(self) -> tuple[Requirement, ...]:
-        """The :attr:`requirements` as :class:`~quadcruise.montecarlo.requirements.Requirement` objects."""
-        return parse_requirements(self.requirements)
 
     @property
     def periods(self) -> int:
@@ -246,7 +242,8 @@ class MonteCarloSpec:
         -------
         dict
             Every field (mission, controller, population and vehicle as their
-            ``to_dict()``), and ``log_every`` and ``trace_every``.
+            ``to_dict()``, the requirements as their text, ``"rmse_m<=0.5"``), and
+            ``log_every`` and ``trace_every``.
         """
         out = {
             "mission": self.mission.to_dict(),
@@ -256,7 +253,9 @@ class MonteCarloSpec:
             "controller_vehicle": None if self.controller_vehicle is None else self.controller_vehicle.to_dict(),
         }
         for f in dataclasses.fields(self):
-            if f.name not in out:
+            if f.name == "requirements":
+                out[f.name] = [r.text for r in self.requirements]
+            elif f.name not in out:
                 out[f.name] = getattr(self, f.name)
         out["log_every"], out["trace_every"] = self.log_every, self.trace_every
         return out

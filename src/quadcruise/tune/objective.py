@@ -29,11 +29,11 @@ from typing import Any
 
 import numpy as np
 
-from quadcruise.errors import InputError
+from quadcruise import checks
 from quadcruise.montecarlo.chunk import fly_chunk, sweep_metrics
 from quadcruise.montecarlo.schema import METRICS
 from quadcruise.montecarlo.spec import MonteCarloSpec
-from quadcruise.tune.spec import GainSpace, violation
+from quadcruise.tune.space import GainSpace
 
 __all__ = ["FAILURE_COST", "REQUIREMENT_COST", "Evaluation", "Objective", "check_statistic"]
 
@@ -44,14 +44,16 @@ REQUIREMENT_COST = 1e6
 """Added to the cost of a flight that misses a requirement."""
 
 
-def check_statistic(statistic: Any) -> str | float:
+def check_statistic(statistic: Any, where: str = "tune()", name: str = "objective") -> str | float:
     """The statistic over a candidate's flights: ``"worst"`` or a quantile in (0, 1).
 
     Parameters
     ----------
     statistic : str or float
-        ``"worst"`` (also ``"max"``), ``"median"``, a quantile such as 0.9, or its text
-        (``"0.9"``, ``"q0.9"``, ``"q90"``).
+        ``"worst"``, ``"median"`` (the quantile 0.5) or a quantile such as 0.9. The command
+        line's forms (``q90``, ``max``) are read by :func:`quadcruise.cli.criteria.parse_objective`.
+    where, name : str
+        The function and the argument, for the message.
 
     Returns
     -------
@@ -60,33 +62,29 @@ def check_statistic(statistic: Any) -> str | float:
 
     Raises
     ------
+    ArgumentTypeError
+        Neither one of those names nor a number.
     InputError
-        Anything else.
+        Another name, or a number outside (0, 1).
 
     Examples
     --------
-    >>> check_statistic("q90"), check_statistic("median"), check_statistic("max")
-    (0.9, 0.5, 'worst')
+    >>> check_statistic("worst"), check_statistic("median"), check_statistic(0.9)
+    ('worst', 0.5, 0.9)
+    >>> check_statistic("q90")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: tune() argument objective must be 'worst', 'median' or a quantile in (0, 1), \
+got str 'q90'
     """
+    want = "'worst', 'median' or a quantile in (0, 1)"
     if isinstance(statistic, str):
-        text = statistic.strip().lower()
-        if text in ("worst", "max"):
-            return "worst"
-        if text == "median":
-            return 0.5
-        body = text[1:] if text.startswith("q") else text
-        try:
-            q = float(body)
-        except ValueError:
-            q = -1.0
-        if text.startswith("q") and q > 1:
-            q /= 100.0
-    elif isinstance(statistic, (int, float)) and not isinstance(statistic, bool):
-        q = float(statistic)
-    else:
-        q = -1.0
+        if statistic in ("worst", "median"):
+            return "worst" if statistic == "worst" else 0.5
+        checks.fail(where, name, statistic, want, kind=False)
+    q = checks.number(where, name, statistic)
     if not 0.0 < q < 1.0:
-        raise InputError(f"objective {statistic!r}: expected worst, median or a quantile such as 0.9 (or q90)")
+        checks.fail(where, name, statistic, want, kind=False)
     return q
 
 
@@ -128,7 +126,8 @@ class Objective:
     space : GainSpace
         The searched gains.
     targets, requirements : tuple
-        :class:`~quadcruise.tune.spec.Target` and :class:`~quadcruise.tune.spec.Requirement`.
+        :class:`~quadcruise.tune.criteria.Target` and
+        :class:`~quadcruise.montecarlo.requirements.Requirement`.
     minimize : tuple of str
         Metrics whose values are added to the cost.
     samples : int
@@ -232,7 +231,7 @@ class Objective:
         for r in self.requirements:
             values = metrics[r.metric]
             failed |= np.isnan(values)
-            missed += np.where(r.met(values), 0.0, violation(r, values) / (abs(r.value) or 1.0))
+            missed += np.where(r.met(values), 0.0, r.violation(values) / (abs(r.value) or 1.0))
         cost = np.where(missed > 0, cost + REQUIREMENT_COST * (1.0 + missed), cost)
         failed |= ~np.isfinite(cost)
         rmse = metrics.get("rmse_m", np.zeros(status.shape))

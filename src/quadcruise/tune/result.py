@@ -47,7 +47,8 @@ class TuneResult:
     bounds : dict of str to (float, float, str)
         Each gain's bounds and scale ("log" or "linear").
     targets, requirements : tuple
-        :class:`~quadcruise.tune.spec.Target` and :class:`~quadcruise.tune.spec.Requirement`.
+        :class:`~quadcruise.tune.criteria.Target` and
+        :class:`~quadcruise.montecarlo.requirements.Requirement`.
     minimize : tuple of str
         The minimised metrics.
     statistic : str or float

@@ -11,7 +11,7 @@ Everything random comes from ``seed``: the same call gives the same gains.
 
 Examples
 --------
->>> res = tune("step", "nlpd", targets=["rise_time_s=1.5"], gains=["position.kp"],
+>>> res = tune("step", "nlpd", targets={"rise_time_s": 1.5}, gains="position.kp",
 ...            bounds={"position.kp": (1.0, 10.0)}, duration=6.0, budget=3, popsize=6, seed=1)
 >>> res.generations, len(res.to_pandas()) == 6 * (res.generations + 1)
 (3, True)
@@ -22,7 +22,7 @@ from __future__ import annotations
 import inspect
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -34,9 +34,10 @@ from quadcruise.missions import Mission, as_mission
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
 from quadcruise.montecarlo.spec import MonteCarloSpec
+from quadcruise.tune.criteria import Requirement, Target, as_minimize, as_requirements, as_targets
 from quadcruise.tune.objective import Objective, check_statistic
 from quadcruise.tune.result import TuneResult
-from quadcruise.tune.spec import GainSpace, parse_minimize, parse_requirements, parse_targets
+from quadcruise.tune.space import Bounds, GainSpace
 
 __all__ = ["tune", "ABS_TOL", "TUNE_OPTIONS"]
 
@@ -74,11 +75,11 @@ def tune(
     mission: Mission | str = "step",
     controller: Any = "nlpd",
     *,
-    gains=None,
-    bounds=None,
-    targets=(),
-    require=(),
-    minimize=(),
+    gains: str | Sequence[str] | None = None,
+    bounds: Mapping[str, tuple[float, float]] | Bounds | Sequence[Bounds] | None = None,
+    targets: Mapping[str, float | tuple[float, float]] | Target | Sequence[Target] = (),
+    require: Mapping[str, tuple[str, float]] | Requirement | Sequence[Requirement] = (),
+    minimize: str | Sequence[str] = (),
     population: Population | None = None,
     samples: int = 1,
     objective: str | float = "worst",
@@ -104,18 +105,20 @@ def tune(
         The mission flown (a name for its defaults); ``"step"``: 1 m in x at t = 1 s.
     controller : Controller or str
         The controller whose gains are searched (its other gains stay as they are).
-    gains : sequence of str or str, optional
-        The gains by name (``"position.kp,position.kd"``, ``"position.wn,position.zeta"``, see
-        :mod:`quadcruise.tune.spec`); the position PD pair by default.
-    bounds : mapping or str or sequence of str, optional
-        ``{"position.kp": (0.5, 10)}`` or ``"position.kp=0.5:10"``; a decade either side of
-        each value by default.
-    targets : sequence of str or Target
-        ``"rise_time_s=1"``, ``"overshoot_pct=4+-1.5"``: values to reach.
-    require : sequence of str or Requirement
-        ``"overshoot_pct<=5"``: bounds every candidate must keep.
-    minimize : sequence of str
-        Metrics to make small.
+    gains : str or sequence of str, optional
+        The gains by name, ``"position.kp"`` or ``["position.wn", "position.zeta"]`` (see
+        :mod:`quadcruise.tune.space`); the position PD pair by default.
+    bounds : mapping, Bounds or sequence of Bounds, optional
+        ``{"position.kp": (0.5, 10)}`` or ``[Bounds("position.kp", 0.5, 10)]``; a decade
+        either side of each value by default.
+    targets : mapping, Target or sequence of Target
+        Values to reach: ``{"rise_time_s": 1, "overshoot_pct": (4, 1.5)}`` (a value, or a pair
+        value, tolerance) or ``[Target("overshoot_pct", 4, 1.5)]`` (:mod:`quadcruise.tune.criteria`).
+    require : mapping, Requirement or sequence of Requirement
+        Bounds every candidate must keep: ``{"overshoot_pct": ("<=", 5)}`` or
+        ``[Requirement("overshoot_pct", "<=", 5)]``.
+    minimize : str or sequence of str
+        Metrics to make small, ``"rmse_m"`` or a list.
     population : Population, optional
         How the vehicles differ from the nominal one (mass and inertia spreads, wind, an
         environment, sensor noise; see :class:`~quadcruise.montecarlo.Population`); none by
@@ -124,7 +127,8 @@ def tune(
         Vehicles of the population each candidate flies (M): a generation is popsize x M
         vehicles in one batch.
     objective : str or float
-        Over a candidate's M flights: ``"worst"`` (the largest cost) or a quantile (0.9).
+        Over a candidate's M flights: ``"worst"`` (the largest cost), ``"median"`` or a
+        quantile (0.9).
     seed : int
         Seed of the search and of the population: the same seed gives the same gains.
     budget : int
@@ -160,19 +164,23 @@ def tune(
 
     Raises
     ------
+    ArgumentTypeError
+        An argument of the wrong type, before any flight: text targets, requirements or
+        bounds (the command line's forms; Python takes the objects or mappings), ...
     InputError
-        Bad input, before any flight: an unknown metric or gain, a target no metric has,
+        Bad input, before any flight: an unknown metric or gain, a negative target,
         bounds reversed or empty, a budget of 0, nothing to tune for, ...
     """
     reject_unknown("tune()", unknown, TUNE_OPTIONS)
     budget = whole_number(budget, "budget (generations)", 1)
     samples = whole_number(samples, "samples (vehicles per candidate)", 1)
     seed = whole_number(seed, "seed")
-    statistic = check_statistic(objective)
-    targets, requirements, minimize = parse_targets(targets), parse_requirements(require), parse_minimize(minimize)
-    if not targets and not minimize:
-        raise InputError("nothing to tune for: give a target (METRIC=VALUE) or a metric to minimize")
     w = "tune()"  # every argument checked before any flight
+    statistic = check_statistic(objective, w)
+    targets, requirements = as_targets(targets, w), as_requirements(require, w, "require")
+    minimize = as_minimize(minimize, w)
+    if not targets and not minimize:
+        raise InputError("nothing to tune for: give a target or a metric to minimize")
     checks.number(w, "tol", tol, "nonneg")
     mission = as_mission(mission, w)
     checks.instance(w, "population", population, Population)
@@ -184,7 +192,7 @@ def tune(
     checks.callback(w, "progress", progress)
     checks.instance(w, "command", command, str, optional=False)
     base = as_controller(controller, w)
-    space = GainSpace.build(base, gains, bounds)
+    space = GainSpace.build(base, gains, bounds, where=w)
     popsize = (
         15 * len(space.gains) if popsize is None else whole_number(popsize, "popsize (candidates per generation)", 5)
     )

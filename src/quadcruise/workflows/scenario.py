@@ -36,9 +36,10 @@ A scenario has up to seven tables; every one is optional::
     full_dynamics = false
     seed = 1                  # also: max_step, log_every, n, max_track_error, max_steady_error, initial_state
 
-    [montecarlo]              # read by `quadcruise montecarlo`
+    [montecarlo]              # read by `quadcruise montecarlo` (quadcruise.montecarlo.scenario)
     n = 1000
     mass_spread = 0.1
+    requirements = ["steady_max_error_m<=0.2"]   # each METRIC<=VALUE (<, >=, > too)
 
     [compare]                 # read by `quadcruise compare`
     controllers = ["nlpd", "se3"]

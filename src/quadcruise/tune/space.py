@@ -1,35 +1,23 @@
-"""What a tuner is told: the gains to search and their bounds, the targets to reach, the
-requirements to meet and the metrics to minimise, each parsed from text and checked before
-any flight.
+"""What a tuner searches: the gains, by name, and their bounds, and how a row of values
+becomes a controller.
 
 - A **gain** is named as ``quadcruise.fields.units()`` names it, ``position.kp`` or
   ``max_tilt``: any numeric field of the controller or of its nested gains. A PD gains field
   can also be searched by its pole pair through the design rule of
   :mod:`quadcruise.control.design` (s^2 + kd s + kp = s^2 + 2 zeta wn s + wn^2):
-  ``position.wn`` [rad/s] and ``position.zeta`` [-].
-- **Bounds** ``NAME=LOW:HIGH``; by default a decade either side of the controller's value, cut
-  to the range the field allows (``max_tilt`` stays below pi/2; the damping ratio: [0.1, 2]). A gain whose bounds are
-  positive and a decade or more apart
-  is searched on a log scale.
-- A **target** ``METRIC=VALUE`` or ``METRIC=VALUE+-TOLERANCE``: the cost counts the miss in
-  tolerances, squared; without a tolerance, 10 % of the value (1 in the metric's unit for a
-  target of 0). A target is *met* within its tolerance.
-- A **requirement** ``METRIC<=VALUE`` (``<``, ``>=``, ``>``), the Monte Carlo sweep's own
-  (:mod:`quadcruise.montecarlo.requirements`): a candidate that misses it ranks behind every
-  candidate that meets all of them.
-- **minimize** ``METRIC``: the metric's value, in its unit, is added to the cost.
+  ``position.wn`` [rad/s] and ``position.zeta`` [-]. Several gains are a list of names.
+- **Bounds** ``Bounds("position.kp", 0.5, 10)``, or a mapping ``{"position.kp": (0.5, 10)}``;
+  by default a decade either side of the controller's value, cut to the range the field
+  allows (``max_tilt`` stays below pi/2; the damping ratio: [0.1, 2]). A gain whose bounds are
+  positive and a decade or more apart is searched on a log scale.
 
-The metrics are the columns of a Monte Carlo table
-(:data:`quadcruise.montecarlo.schema.METRICS`), measured the same way.
+The text forms of the command line (``--gains position.kp,position.kd``, ``--bounds
+position.kp=0.5:10``) are read in :mod:`quadcruise.cli.criteria`.
 
 Examples
 --------
->>> Target.parse("overshoot_pct=4+-1.5")
-Target(metric='overshoot_pct', value=4.0, tolerance=1.5)
->>> Requirement.parse("overshoot_pct <= 5").text
-'overshoot_pct<=5'
 >>> from quadcruise.control import NLPD
->>> space = GainSpace.build(NLPD(), ["position.kp", "position.kd"], {"position.kp": "1:10"})
+>>> space = GainSpace.build(NLPD(), ["position.kp", "position.kd"], {"position.kp": (1, 10)})
 >>> [(g.name, g.low, g.high, g.log) for g in space.gains]
 [('position.kp', 1.0, 10.0, True), ('position.kd', 0.5, 50.0, True)]
 >>> round(space.controllers([[2.0, 3.0]])[0].position.kd, 3)
@@ -41,30 +29,17 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import math
-import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from quadcruise import checks
 from quadcruise.control.design import PDGains
 from quadcruise.errors import InputError
-from quadcruise.montecarlo.requirements import Requirement, parse_requirements
-from quadcruise.montecarlo.schema import METRICS
 
-__all__ = [
-    "Gain",
-    "GainSpace",
-    "Requirement",
-    "Target",
-    "check_metric",
-    "parse_bounds",
-    "parse_minimize",
-    "parse_requirements",
-    "parse_targets",
-    "violation",
-]
+__all__ = ["Bounds", "Gain", "GainSpace", "as_bounds", "as_gain_names", "tunable_values"]
 
 POLE_NAMES = ("wn", "zeta")
 """The pole-pair parameters of a PD gains field: natural frequency [rad/s], damping ratio [-]."""
@@ -72,229 +47,6 @@ DEFAULT_SPAN = 10.0
 """Default bounds: the controller's value divided and multiplied by this."""
 ZETA_BOUNDS = (0.1, 2.0)
 """Default bounds of a damping ratio."""
-
-
-def check_metric(name: str, what: str) -> str:
-    """A metric's name, checked against the table's metrics.
-
-    Parameters
-    ----------
-    name : str
-        The metric, e.g. ``"rise_time_s"``.
-    what : str
-        Where it was given, for the message (``"target 'rise=1'"``).
-
-    Returns
-    -------
-    str
-        ``name``.
-
-    Raises
-    ------
-    InputError
-        One line naming the closest metric and the choices.
-
-    Examples
-    --------
-    >>> check_metric("rise_time", "target 'rise_time=1'")          # doctest: +ELLIPSIS
-    Traceback (most recent call last):
-        ...
-    quadcruise.errors.InputError: target 'rise_time=1': unknown metric 'rise_time' (did you mean ...
-    """
-    if name not in METRICS:
-        close = difflib.get_close_matches(name, METRICS, n=1)
-        hint = f" (did you mean '{close[0]}'?)" if close else ""
-        raise InputError(f"{what}: unknown metric {name!r}{hint}; metrics: {', '.join(METRICS)}")
-    return name
-
-
-def _number(text: str, what: str) -> float:
-    try:
-        value = float(text)
-    except (TypeError, ValueError):
-        value = math.nan
-    if not math.isfinite(value):
-        raise InputError(f"{what}: {str(text).strip()!r} is not a finite number")
-    return value
-
-
-# --- targets, requirements, minimised metrics -------------------------------------------------
-_TARGET = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*=\s*([^=]+?)\s*(?:(?:\+-|±|\+/-)\s*([^=]+?))?\s*$")
-
-
-@dataclass(frozen=True)
-class Target:
-    """A value a metric should reach: the cost counts the miss in tolerances, squared.
-
-    Parameters
-    ----------
-    metric : str
-        A metric of :data:`~quadcruise.montecarlo.schema.METRICS`.
-    value : float
-        The value wanted, in the metric's unit (>= 0: every metric is).
-    tolerance : float
-        How far from ``value`` still meets the target (> 0).
-    """
-
-    metric: str
-    value: float
-    tolerance: float
-
-    @classmethod
-    def parse(cls, text: str) -> Target:
-        """A target from ``METRIC=VALUE`` or ``METRIC=VALUE+-TOLERANCE``.
-
-        Parameters
-        ----------
-        text : str
-            E.g. ``"rise_time_s=1"``, ``"overshoot_pct=4+-1.5"``.
-
-        Returns
-        -------
-        Target
-            The tolerance 10 % of the value if not given (1 for a value of 0).
-
-        Raises
-        ------
-        InputError
-            Not of that form, an unknown metric, a value no metric has (negative), a
-            tolerance that is not positive.
-        """
-        if isinstance(text, Target):
-            return text
-        match = _TARGET.match(str(text))
-        what = f"target {str(text).strip()!r}"
-        if match is None:
-            raise InputError(f"{what}: expected METRIC=VALUE or METRIC=VALUE+-TOLERANCE, e.g. rise_time_s=1")
-        metric = check_metric(match.group(1), what)
-        value = _number(match.group(2), what)
-        if value < 0:
-            raise InputError(f"{what}: no metric is negative; {metric} is >= 0")
-        tol = _number(match.group(3), what) if match.group(3) else (0.1 * value if value > 0 else 1.0)
-        if tol <= 0:
-            raise InputError(f"{what}: the tolerance must be > 0")
-        return cls(metric, value, tol)
-
-    @property
-    def text(self) -> str:
-        """``METRIC=VALUE+-TOLERANCE``."""
-        return f"{self.metric}={self.value:g}+-{self.tolerance:g}"
-
-    def cost(self, values: np.ndarray) -> np.ndarray:
-        """The miss in tolerances, squared.
-
-        Parameters
-        ----------
-        values : ndarray
-            Values of the metric.
-
-        Returns
-        -------
-        ndarray
-            ((values - value) / tolerance)^2, NaN where a value is NaN.
-        """
-        return ((np.asarray(values, dtype=float) - self.value) / self.tolerance) ** 2
-
-    def met(self, values) -> np.ndarray:
-        """Which values are within the tolerance.
-
-        Parameters
-        ----------
-        values : array_like
-            Values of the metric.
-
-        Returns
-        -------
-        ndarray of bool
-            False where a value is NaN.
-        """
-        v = np.asarray(values, dtype=float)
-        with np.errstate(invalid="ignore"):
-            return np.abs(v - self.value) <= self.tolerance * (1 + 1e-12)
-
-
-def violation(requirement: Requirement, values) -> np.ndarray:
-    """How far each value is on the wrong side of a requirement's bound, in the metric's unit.
-
-    Parameters
-    ----------
-    requirement : Requirement
-        A Monte Carlo requirement (:class:`quadcruise.montecarlo.requirements.Requirement`).
-    values : array_like
-        Values of its metric.
-
-    Returns
-    -------
-    ndarray
-        0 where the value is on the right side (and at the bound of a strict comparison).
-
-    Examples
-    --------
-    >>> violation(Requirement.parse("overshoot_pct<=5"), [3.0, 7.5]).tolist()
-    [0.0, 2.5]
-    """
-    v = np.asarray(values, dtype=float)
-    gap = v - requirement.value if requirement.op in ("<=", "<") else requirement.value - v
-    return np.maximum(gap, 0.0)
-
-
-def parse_targets(texts: str | Iterable | None) -> tuple[Target, ...]:
-    """Targets from their texts (see :meth:`Target.parse`); a metric at most once.
-
-    Parameters
-    ----------
-    texts : str, Target, or an iterable of them, or None
-
-    Returns
-    -------
-    tuple of Target
-
-    Raises
-    ------
-    InputError
-        A bad target, or two targets on one metric.
-    """
-    out = tuple(Target.parse(t) for t in _items(texts))
-    _once([t.metric for t in out], "target")
-    return out
-
-
-def parse_minimize(names: str | Iterable[str] | None) -> tuple[str, ...]:
-    """The metrics to minimise, each checked; a metric at most once.
-
-    Parameters
-    ----------
-    names : str or iterable of str or None
-        Metric names (a string may hold several, comma-separated).
-
-    Returns
-    -------
-    tuple of str
-    """
-    out = []
-    for item in _items(names):
-        found = [check_metric(n.strip(), f"minimize {n.strip()!r}") for n in str(item).split(",") if n.strip()]
-        if not found:
-            raise InputError(f"minimize {str(item)!r}: expected a metric, e.g. rmse_m; metrics: {', '.join(METRICS)}")
-        out += found
-    _once(out, "minimize")
-    return tuple(out)
-
-
-def _items(texts) -> list:
-    if texts is None:
-        return []
-    if isinstance(texts, (str, Target)):
-        return [texts]
-    return list(texts)
-
-
-def _once(metrics: list[str], what: str) -> None:
-    seen = set()
-    for m in metrics:
-        if m in seen:
-            raise InputError(f"{what}: {m} is given twice")
-        seen.add(m)
 
 
 # --- gains ---------------------------------------------------------------------------------
@@ -424,67 +176,149 @@ def _within_range(base: Any, name: str, low: float, high: float) -> tuple[float,
     return low, high
 
 
-def parse_bounds(items: str | Iterable[str] | Mapping | None) -> dict[str, tuple[float, float]]:
-    """Bounds from ``NAME=LOW:HIGH`` texts (or a mapping of name to a pair or such a text).
+@dataclass(frozen=True)
+class Bounds:
+    """The bounds of one searched gain, checked on construction.
 
     Parameters
     ----------
-    items : str, iterable of str, mapping, or None
-        ``"position.kp=0.5:10"``; several comma-separated or as a list.
-
-    Returns
-    -------
-    dict of str to (float, float)
+    gain : str
+        The gain's name, ``position.kp``, ``max_tilt``, ``position.wn``, ...
+    low, high : float
+        Finite, low < high. Whether the controller accepts them is checked when the
+        search is built (:meth:`GainSpace.build` builds a candidate at each corner).
 
     Raises
     ------
+    ArgumentTypeError
+        A field of the wrong type (a bound given as text).
     InputError
-        Not of that form, not numbers, or bounds reversed or empty (LOW >= HIGH).
+        A bound that is not finite, or bounds reversed or empty (low >= high).
 
     Examples
     --------
-    >>> parse_bounds("position.kp=0.5:10,position.kd=1:8")
-    {'position.kp': (0.5, 10.0), 'position.kd': (1.0, 8.0)}
-    >>> parse_bounds("position.kp=10:0.5")
+    >>> Bounds("position.kp", 10, 0.5)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: bounds 'position.kp=10:0.5' are reversed or empty: LOW must be below HIGH
+    quadcruise.errors.InputError: Bounds() argument high must be above low = 10, got float 0.5; bounds reversed or empty
     """
-    if items is None:
-        return {}
-    if isinstance(items, Mapping):
-        pairs = [(str(k), v) for k, v in items.items()]
-    else:
-        pairs = []
-        for text in [items] if isinstance(items, str) else list(items):
-            pieces = [piece for piece in str(text).split(",") if piece.strip()]
-            if not pieces:
-                raise InputError(f"bounds {str(text)!r}: expected NAME=LOW:HIGH, e.g. position.kp=0.5:10")
-            for piece in pieces:
-                name, sep, span = piece.partition("=")
-                if not sep or not name.strip():
-                    raise InputError(f"bounds {piece.strip()!r}: expected NAME=LOW:HIGH, e.g. position.kp=0.5:10")
-                pairs.append((name.strip(), span.strip()))
-    out: dict[str, tuple[float, float]] = {}
-    for name, span in pairs:
-        what = f"bounds '{name}={span}'" if isinstance(span, str) else f"bounds of {name}"
-        if isinstance(span, str):
-            low_text, sep, high_text = span.partition(":")
-            if not sep:
-                raise InputError(f"{what}: expected NAME=LOW:HIGH, e.g. position.kp=0.5:10")
-            low, high = _number(low_text, what), _number(high_text, what)
-        else:
-            try:
-                low, high = (float(v) for v in span)
-            except (TypeError, ValueError):
-                raise InputError(f"{what}: expected a pair (low, high)") from None
-            _number(low, what), _number(high, what)
+
+    gain: str
+    low: float
+    high: float
+
+    def __post_init__(self) -> None:
+        where = "Bounds()"
+        if not isinstance(self.gain, str) or not self.gain:
+            checks.fail(where, "gain", self.gain, "a gain's name, e.g. 'position.kp'")
+        low = checks.number(where, "low", self.low)
+        high = checks.number(where, "high", self.high)
         if not low < high:
-            raise InputError(f"{what} are reversed or empty: LOW must be below HIGH")
-        if name.strip() in out:
-            raise InputError(f"{what}: {name.strip()} is bounded twice; give its bounds once")
-        out[name.strip()] = (low, high)
+            checks.fail(
+                where, "high", self.high, f"above low = {self.low}", kind=False, hint="bounds reversed or empty"
+            )
+        object.__setattr__(self, "low", low)
+        object.__setattr__(self, "high", high)
+
+
+_BOUNDS = "Bounds objects or a mapping {gain: (low, high)}"
+
+
+def as_bounds(value: Any, where: str, name: str = "bounds") -> dict[str, Bounds]:
+    """A function's bounds argument as :class:`Bounds` by gain, a gain at most once.
+
+    Parameters
+    ----------
+    value : Bounds, iterable of Bounds, mapping, or None
+        ``{"position.kp": (0.5, 10)}`` or ``[Bounds("position.kp", 0.5, 10)]``.
+    where, name : str
+        The function and the argument, for the message.
+
+    Returns
+    -------
+    dict of str to Bounds
+
+    Raises
+    ------
+    ArgumentTypeError
+        Text (``"position.kp=0.5:10"``: the command line reads text; Python takes objects),
+        or anything else that is not of these forms.
+    InputError
+        Bounds not finite, reversed or empty, or a gain bounded twice.
+
+    Examples
+    --------
+    >>> as_bounds({"position.kp": (0.5, 10)}, "tune()")
+    {'position.kp': Bounds(gain='position.kp', low=0.5, high=10.0)}
+    >>> as_bounds({"position.kp": (10, 0.5)}, "tune()")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: tune() argument bounds['position.kp'] must be a pair (low, high) with low < high, \
+got tuple (10, 0.5); bounds reversed or empty
+    """
+    if value is None:
+        return {}
+    if isinstance(value, Bounds):
+        return {value.gain: value}
+    hint = "write {'position.kp': (0.5, 10)} or [Bounds('position.kp', 0.5, 10)]"
+    if isinstance(value, str):
+        checks.fail(where, name, value, _BOUNDS, hint=hint + "; text is read by the command line")
+    if isinstance(value, Mapping):
+        out = {}
+        for gain, pair in value.items():
+            item = f"{name}[{gain!r}]"
+            if not isinstance(gain, str) or not gain:
+                checks.fail(where, f"{name} key", gain, "a gain's name, e.g. 'position.kp'")
+            pair = checks.pair(where, item, pair, "a pair (low, high)", hint=hint)
+            low, high = checks.number(where, f"{item}[0]", pair[0]), checks.number(where, f"{item}[1]", pair[1])
+            if not low < high:
+                checks.fail(
+                    where,
+                    item,
+                    tuple(pair),
+                    "a pair (low, high) with low < high",
+                    kind=False,
+                    hint="bounds reversed or empty",
+                )
+            out[gain] = Bounds(gain, low, high)
+        return out
+    if not isinstance(value, Iterable):
+        checks.fail(where, name, value, _BOUNDS)
+    out = {}
+    for k, item in enumerate(value):
+        if not isinstance(item, Bounds):
+            checks.fail(where, f"{name}[{k}]", item, "a Bounds", hint=hint)
+        if item.gain in out:
+            raise InputError(f"{where} argument {name} bounds {item.gain} twice; give its bounds once")
+        out[item.gain] = item
     return out
+
+
+def as_gain_names(value: Any, where: str, name: str = "gains") -> list[str]:
+    """A function's gains argument as a list of names (not yet checked against a controller).
+
+    Parameters
+    ----------
+    value : str, iterable of str, or None
+        One gain's name or a list of them.
+    where, name : str
+        The function and the argument, for the message.
+
+    Returns
+    -------
+    list of str
+        Empty for None.
+    """
+    if value is None:
+        return []
+    items = [value] if isinstance(value, str) else value
+    if not isinstance(items, Iterable):
+        checks.fail(where, name, value, "a gain's name or a list of them, e.g. ['position.kp', 'position.kd']")
+    items = list(items)
+    for k, item in enumerate(items):
+        if not isinstance(item, str):
+            checks.fail(where, f"{name}[{k}]", item, "a gain's name (str)")
+    return items
 
 
 @dataclass(frozen=True)
@@ -509,7 +343,12 @@ class GainSpace:
 
     @classmethod
     def build(
-        cls, base: Any, names: Sequence[str] | str | None = None, bounds: Mapping | str | Iterable[str] | None = None
+        cls,
+        base: Any,
+        names: Sequence[str] | str | None = None,
+        bounds: Mapping | Bounds | Iterable[Bounds] | None = None,
+        *,
+        where: str = "GainSpace.build()",
     ) -> GainSpace:
         """The space of ``names`` around ``base``, each within its bounds.
 
@@ -518,11 +357,13 @@ class GainSpace:
         base : Controller
             A built-in controller (a frozen dataclass of validated fields).
         names : sequence of str or str, optional
-            The gains (comma-separated in a string); ``position.kp, position.kd`` by default
-            where the controller has them.
-        bounds : mapping or str or iterable of str, optional
-            :func:`parse_bounds` input; by default a decade either side of each value, cut to
-            the range its field allows (``max_tilt``: below pi/2).
+            The gains (one name, or a list); ``position.kp, position.kd`` by default where the
+            controller has them.
+        bounds : mapping, Bounds or iterable of Bounds, optional
+            :func:`as_bounds` input, ``{"position.kp": (0.5, 10)}``; by default a decade either
+            side of each value, cut to the range its field allows (``max_tilt``: below pi/2).
+        where : str
+            The function the arguments were given to, for the messages.
 
         Returns
         -------
@@ -530,6 +371,8 @@ class GainSpace:
 
         Raises
         ------
+        ArgumentTypeError
+            Names or bounds of the wrong type (text bounds, ``"position.kp=0.5:10"``, included).
         InputError
             An unknown gain (the message lists the tunable ones), a gain given twice, a gain
             both by its value and by its pole pair, bounds of a gain not searched, bounds
@@ -539,29 +382,26 @@ class GainSpace:
         if not dataclasses.is_dataclass(base) or not hasattr(type(base), "units"):
             raise InputError(f"a tuner needs a built-in controller (a dataclass of gains), got {type(base).__name__}")
         values = tunable_values(base)
-        if isinstance(names, str):
-            text, names = names, [n.strip() for n in names.split(",") if n.strip()]
-            if not names:
-                raise InputError(
-                    f"gains {text!r}: expected gain names, e.g. position.kp,position.kd; "
-                    f"gains of {base.name}: {', '.join(values)}"
-                )
+        names = as_gain_names(names, where)
+        given = as_bounds(bounds, where)
         if not names:
             if "position.kp" not in values:
                 raise InputError(f"name the gains of {base.name} to tune (gains: {', '.join(values)})")
             names = ["position.kp", "position.kd"]
-        names = list(names)
         for name in names:
             if name not in values:
                 close = difflib.get_close_matches(name, list(values), n=1)
                 hint = f" (did you mean '{close[0]}'?)" if close else ""
+                if "," in name:
+                    hint += f"; several gains are a list, e.g. {[n.strip() for n in name.split(',')]}"
                 raise InputError(f"unknown gain {name!r} of {base.name}{hint}; gains: {', '.join(values)}")
-        _once(names, "gains")
+        for k, name in enumerate(names):
+            if name in names[:k]:
+                raise InputError(f"gains: {name} is given twice")
         for name in names:
             owner, _, leaf = name.rpartition(".")
             if owner and leaf in POLE_NAMES and {f"{owner}.kp", f"{owner}.kd"} & set(names):
                 raise InputError(f"gains: {owner} is searched both by its gains and by its poles ({name}); choose one")
-        given = parse_bounds(bounds)
         for name in given:
             if name not in names:
                 raise InputError(f"bounds of {name!r}, which is not searched (gains: {', '.join(names)})")
@@ -569,13 +409,13 @@ class GainSpace:
         for name in names:
             value, unit = values[name]
             if name in given:
-                low, high = given[name]
+                low, high = given[name].low, given[name].high
             elif name.endswith(".zeta"):
                 low, high = ZETA_BOUNDS
             elif value > 0:
                 low, high = _within_range(base, name, value / DEFAULT_SPAN, value * DEFAULT_SPAN)
             else:
-                raise InputError(f"{name} is {value:g}: give its bounds (NAME=LOW:HIGH)")
+                raise InputError(f"{name} is {value:g}: give its bounds")
             gains.append(Gain(name, low, high, bool(low > 0 and high / low >= 10.0), unit))
         derived = tuple(
             f.name
