@@ -91,3 +91,15 @@ def test_each_controller_packs_its_declared_row(name):
     assert controller.gains().shape == (row.size,) == (len(row.names),)
     assert np.all(np.isfinite(controller.gains()))
 
+
+def test_the_kernel_takes_its_declared_arguments_flat_and_in_order():
+    """KernelArgs declares the kernel's arguments once; the kernel stays a flat list (faster
+    than tuples: docs/performance.md), and its parameters are those fields, in order."""
+    import inspect
+
+    from quadcruise.sim import engine
+    from quadcruise.sim.kernel_args import KERNEL_SIG, KernelArgs
+
+    parameters = tuple(inspect.signature(engine._kernel.py_func).parameters)
+    assert parameters == ("first", "stop") + KernelArgs._fields
+    assert len(KERNEL_SIG.args) == len(parameters) and engine._kernel.signatures == [KERNEL_SIG.args]
