@@ -11,7 +11,8 @@ import quadcruise as qc
 from quadcruise.control import NLPD, controller_from_name
 from quadcruise.control.attitude import ATT_MEMORY, decoupled_attitude
 from quadcruise.control.design import PIDGains, attitude_pid_design, cascade_state_space, pd_from_poles
-from quadcruise.control.position import nlpd, phi_from_eq6, theta_from_eq5
+from quadcruise.control.inversion import phi_from_eq6, theta_from_eq5
+from quadcruise.control.position import nlpd
 from quadcruise.layout import (
     CMD_FLAGS,
     CMD_PHI_D,

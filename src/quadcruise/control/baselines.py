@@ -62,7 +62,8 @@ from numba import njit
 from quadcruise.control.attitude import ATTITUDE_GAINS, ATTITUDE_MEMORY, attitude_fields
 from quadcruise.control.base import TILT, Controller
 from quadcruise.control.design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
-from quadcruise.control.position import finish, thrust_for_tilt, tilt_setpoint
+from quadcruise.control.inversion import thrust_for_tilt, tilt_setpoint
+from quadcruise.control.position import finish
 from quadcruise.fields import instance_of
 from quadcruise.fields import unit_field as _f
 from quadcruise.layout import (
