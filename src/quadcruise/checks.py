@@ -1,21 +1,10 @@
 """The Python API's argument checks: one message form for every public function.
 
-Every public entry (``fly``, ``compare``, ``montecarlo``, ``tune``, ``replay``, ``analyze``)
-checks its arguments here, before any work, and a bad one raises one line::
-
-    fly() argument dt must be a positive number of seconds, got str '0.001'
-
-naming the function, the argument, what is expected and what was given (its type and a
-short form of its value). A value of the wrong kind raises
-:class:`~quadcruise.errors.ArgumentTypeError` (a ``TypeError``); a value of the right kind
-out of its range raises :class:`~quadcruise.errors.InputError` (a ``ValueError``). Both are
-InputErrors, so the command line turns either into ``error: ...`` and exit status 2.
-
-The library takes objects, not strings: a number given as text (``duration="10"``) is
-refused, as is a bool where a number is wanted, a float where a whole number is wanted
-(``seed=1.5``), and anything but ``True``/``False`` for a switch (``full_dynamics="no"``).
-The parameter objects themselves (``Vehicle``, missions, disturbances, controllers) check
-their fields with :mod:`quadcruise.fields`, in the same words.
+A bad argument raises one line, before any work, naming the function, the argument, what is
+expected and what was given: :class:`~quadcruise.errors.ArgumentTypeError` for a value of the
+wrong kind (text for a number, a bool for a number, a float for a whole number, anything but a
+bool for a switch), :class:`~quadcruise.errors.InputError` for one out of range. The rule and
+its reasons: docs/architecture.md, "Arguments".
 
 Examples
 --------

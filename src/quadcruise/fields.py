@@ -102,24 +102,7 @@ class Check:
         return f"<check {self.name}: {self.want}>"
 
     def __call__(self, label: str, value: Any, *, batch: bool = False, optional: bool = False) -> Any:
-        """``value`` as stored (None passes if ``optional``); InputError naming ``label`` if it is bad.
-
-        Parameters
-        ----------
-        label : str
-            How the message names the field: ``"<owner> field '<name>' (<meaning>, <unit>)"``.
-        value : Any
-            The value given.
-        batch : bool
-            Whether a number may be a 1-D array, one value per vehicle.
-        optional : bool
-            Whether None is allowed (and kept).
-
-        Returns
-        -------
-        Any
-            The value in its stored form.
-        """
+        """``value`` as stored (None passes if ``optional``); InputError naming ``label`` if it is bad."""
         if value is None and optional:
             return None
         return self.convert(_Site(label, batch, optional), value)
@@ -507,17 +490,7 @@ def unit_field(
 
 
 def owner_name(cls: type) -> str:
-    """How messages name an object of ``cls``.
-
-    Parameters
-    ----------
-    cls : type
-
-    Returns
-    -------
-    str
-        Its ``name`` attribute, else the class name.
-    """
+    """How messages name an object of ``cls``: its ``name`` attribute, else the class name."""
     name = getattr(cls, "name", "")
     return name if isinstance(name, str) and name else cls.__name__
 

@@ -1,20 +1,9 @@
 """The compiled per-step work of the environments: references, observations, rewards and
 the tracking check of N vehicles in one call (no Python loop over vehicles).
 
-Observation of a vehicle (:data:`OBS_NAMES`, float32), body frame = the paper's ZYX Euler
-rotation R (z up); ``R^T v`` is an earth-frame vector v seen in the body frame:
-
-- 0-2: position error R^T (p - p_ref) [m];
-- 3-5: velocity error R^T (v - v_ref) [m/s];
-- 6-8: the earth's up axis in the body frame, R^T e_z (roll and pitch) [-];
-- 9-10: sin and cos of the yaw error psi - psi_ref [-];
-- 11-13: body rates p, q, r [rad/s];
-- 14-16: the reference acceleration R^T a_ref [m/s^2];
-- 17-20: rotor thrusts over the hover thrust, minus 1: F_i / (m g / 4) - 1 [-].
-
-Reward of a period: ``exp(-|p - p_ref| / 0.5 m - 0.05 |omega| / (1 rad/s))``, in (0, 1]: 1 on
-the reference without rotating, 1/e at 0.5 m off; so a vehicle earns more by flying on
-(a terminated episode earns nothing after its end).
+The observation (:data:`OBS_NAMES`, float32: errors, attitude and rates in the body frame, the
+rotor thrusts about hover) and the reward ``exp(-|p - p_ref| / 0.5 m - 0.05 |omega| / (1 rad/s))``
+are tabled, with their reasons, in docs/gym.md.
 """
 
 from __future__ import annotations

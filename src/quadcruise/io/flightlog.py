@@ -1,42 +1,12 @@
 """A flight log (PX4 ULog or CSV) read into one typed record in quadcruise's frames.
 
-:func:`read_flight_log` reads a PX4 log (``.ulg``, with pyulog) or a CSV into a
-:class:`FlightLog`: ENU world, FLU body, quaternions w first (body to world), seconds, the
-rotor commands normalised to [0, 1], only the armed, airborne stretches of the flight, all on
-one time grid.
-
-The grid (a ULog)
-    Uniform, at the rate of the body-rate topic (the faster of ``vehicle_angular_velocity``
-    and ``sensor_combined``'s gyro, the former on a tie), over each airborne segment where
-    every topic it needs has samples on both sides. Vectors (velocity, position, rates,
-    specific force) and commands are interpolated linearly between their samples (PX4 logs
-    a topic by sampling it, so a straight line between two samples is the best guess of what
-    happened between them); the attitude by spherical linear interpolation (scipy ``Slerp``);
-    arming and landed states are held from their last message. Airborne: armed
-    (``vehicle_status.arming_state == 2``), neither landed, maybe landed nor touching the
-    ground (``vehicle_land_detected``: PX4 clears ``landed`` when it starts a take-off, seconds
-    before the rotors lift the vehicle) and, where the log has a distance to the ground,
-    at least :data:`MIN_HEIGHT` above it (``vehicle_local_position.dist_bottom``, PX4's own
-    estimate of it); all at once for at least :data:`MIN_SEGMENT_S`.
-
-Commands (a ULog)
-    ``actuator_motors.control`` (already normalised to [0, 1]) when the log has it, else
-    ``actuator_outputs.output`` (PWM [us]; motor k on the output whose ``PWM_MAIN_FUNCi`` is
-    101 + k where the log says, else outputs 1..n) mapped with the log's own ``PWM_MAIN_MINi`` /
-    ``PWM_MAIN_MAXi`` (older logs: ``PWM_MIN`` / ``PWM_MAX``; PX4's defaults 1000 / 2000 us),
-    or with ``commands="pwm:MIN:MAX"`` given by the user.
-
-A CSV
-    Columns ``t,u1..un,vx,vy,vz,qw,qx,qy,qz,p,q,r`` and optionally ``x,y,z``, ``ax,ay,az``
-    (accelerometer: specific force in the body frame) and ``landed`` (1 on the ground). Its
-    rows are the grid; a row with ``landed`` = 1 is left out. ``frame="ned"`` reads PX4's NED
-    world and FRD body instead of ENU and FLU.
+:func:`read_flight_log` gives a :class:`FlightLog`: ENU world, FLU body, quaternions w first
+(body to world), seconds, rotor commands in [0, 1], only the armed, airborne stretches, on one
+uniform grid (a ULog's body-rate topic's, a CSV's own rows). What is read, which samples count
+as airborne, how commands are scaled and what is refused: docs/identify.md, "What is read".
 
 Frames: with ``A`` the NED/ENU axis swap and ``B = diag(1, -1, -1)`` (FRD/FLU),
 ``v_enu = A v_ned``, ``w_flu = B w_frd``, ``R_enu_flu = A R_ned_frd B``.
-
-Every check runs before anything is computed, and a bad file is refused with one line that
-names the file and what is wrong (:class:`quadcruise.errors.InputError`).
 """
 
 from __future__ import annotations
@@ -85,42 +55,13 @@ ULOG_TOPICS = (
 class FlightLog:
     """A flight's airborne stretches on one time grid, in quadcruise's frames.
 
-    Parameters
-    ----------
-    source : str
-        The file it was read from.
-    t : ndarray, shape (L,)
-        Time [s] from the log's start; uniform within each segment.
-    segment : ndarray, shape (L,)
-        The airborne segment each sample belongs to (0, 1, ...).
-    u : ndarray, shape (L, n)
-        Rotor commands, normalised [-] (0 idle, 1 full).
-    velocity : ndarray, shape (L, 3)
-        Velocity in the world frame (ENU) [m/s].
-    quaternion : ndarray, shape (L, 4)
-        Attitude, body (FLU) to world (ENU), w first.
-    rates : ndarray, shape (L, 3)
-        Body rates p, q, r (FLU) [rad/s].
-    specific_force : ndarray or None, shape (L, 3)
-        Accelerometer, FLU [m/s^2] ((0, 0, g) at rest, level); None if the log has none.
-    position : ndarray or None, shape (L, 3)
-        Position in the world frame (ENU) [m].
-    rotors : ndarray or None, shape (n, 3)
-        Each rotor's x, y (FLU, [m]) and yaw sign (+1 when its drag torque is positive about
-        body z up), from the log's ``CA_ROTOR*`` parameters; None when the log has none.
-    yaw_per_thrust : float or None
-        ``|CA_ROTOR0_KM|`` [m], the log's own value (a starting point, not a measurement).
-    parameters : dict
-        The log's parameters that matter here (``THR_MDL_FAC``, ``MAV_TYPE``, ...).
-    hover_thrust : tuple of ndarray or None
-        PX4's own ``hover_thrust_estimate`` (time [s], value [-]) inside the airborne
-        segments, when the log has it.
-    rates_hz : dict
-        Each topic's median rate in the log [Hz].
-    commands : str
-        Where the commands came from (topic and scaling).
-    resampling : str
-        How the samples were put on the grid, in words.
+    Per sample: ``t`` [s] (uniform within each ``segment``), rotor commands ``u`` (L, n) in [0, 1],
+    ``velocity`` and ``position`` (or None) [m/s, m] in ENU, ``quaternion`` (FLU to ENU, w first),
+    body ``rates`` [rad/s] and ``specific_force`` (or None) [m/s^2] in FLU. Per log: ``source``,
+    ``rotors`` (n, 3: x, y [m] FLU and yaw sign, from ``CA_ROTOR*``; or None), ``yaw_per_thrust``
+    (``|CA_ROTOR0_KM|`` [m], or None), ``parameters`` (``THR_MDL_FAC``, ``MAV_TYPE``, ...),
+    ``hover_thrust`` (PX4's own estimate: time, value; or None), ``rates_hz`` (each topic's median
+    rate), and in words where the ``commands`` came from and the ``resampling``.
     """
 
     source: str
@@ -155,32 +96,12 @@ class FlightLog:
         return total
 
     def rotation(self) -> Rotation:
-        """The attitudes as a scipy Rotation (body FLU to world ENU).
-
-        Returns
-        -------
-        scipy.spatial.transform.Rotation
-        """
+        """The attitudes as a scipy Rotation (body FLU to world ENU)."""
         return Rotation.from_quat(self.quaternion[:, [1, 2, 3, 0]])
 
 
 def parse_commands(commands: str) -> tuple[str, float, float]:
-    """``"duty"`` or ``"pwm:MIN:MAX"`` as (kind, min, max).
-
-    Parameters
-    ----------
-    commands : str
-        ``duty`` (already in [0, 1]) or ``pwm:MIN:MAX`` (PWM [us], MIN idle, MAX full).
-
-    Returns
-    -------
-    tuple
-        ``("duty", 0.0, 1.0)`` or ``("pwm", MIN, MAX)``.
-
-    Raises
-    ------
-    InputError
-        Anything else, or MIN >= MAX.
+    """``"duty"`` or ``"pwm:MIN:MAX"`` as ``(kind, min, max)``; InputError for anything else or MIN >= MAX.
 
     Examples
     --------
@@ -215,8 +136,7 @@ def read_flight_log(path: str | os.PathLike, *, frame: str | None = None, comman
         PX4's: "ned" or None.
     commands : str
         ``duty`` (default: ``actuator_motors``, or a CSV's ``u`` columns in [0, 1]) or
-        ``pwm:MIN:MAX`` (PWM [us]: a ULog's ``actuator_outputs``, a CSV's ``u`` columns).
-        A ULog without ``actuator_motors`` uses ``actuator_outputs`` with its own PWM limits.
+        ``pwm:MIN:MAX`` (PWM [us]).
 
     Returns
     -------
@@ -225,9 +145,7 @@ def read_flight_log(path: str | os.PathLike, *, frame: str | None = None, comman
     Raises
     ------
     InputError
-        One line naming the file and what is wrong: not a ULog, a truncated one, a topic or
-        column missing, time not increasing, never armed or never airborne, not a
-        multicopter.
+        One line naming the file and what is wrong, before any work.
 
     Examples
     --------
@@ -259,18 +177,7 @@ def read_flight_log(path: str | os.PathLike, *, frame: str | None = None, comman
 
 
 def check_ulog_framing(path: Path) -> None:
-    """Refuse a file that is not a ULog, or whose last message runs past its end (truncated).
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The file.
-
-    Raises
-    ------
-    InputError
-        Not a ULog (no ULog magic), or a message cut off by the end of the file.
-    """
+    """Refuse a file that is not a ULog, or whose last message runs past its end (truncated)."""
     data = path.read_bytes()
     if len(data) < 16 or data[:7] != b"ULog\x01\x12\x35":
         raise InputError(f"{path}: not a PX4 log (ULog): its first bytes are not ULog's header")

@@ -1,12 +1,8 @@
 """PX4's ULog file format, written: the definitions, then every topic's samples in time order.
 
-The format (PX4's ``dev/log/ulog_file_format``): a 16-byte header (magic, version 1, start
-time in microseconds), a flag-bits message, one format message per topic (``name:type
-field;...``), information and parameter messages, one subscription per topic, then the data
-messages, each a 3-byte header (payload size, ``'D'``) followed by the topic's id and its
-fields packed little-endian (a format's trailing ``_padding`` field is declared but, as PX4
-writes it, not sent). A topic's samples are one numpy structured
-array, so a flight of any length is written without a Python loop over its samples.
+The layout follows PX4's ``dev/log/ulog_file_format``; a topic's samples are one numpy structured
+array, so a flight of any length is written without a Python loop over its samples (a format's
+trailing ``_padding`` field is declared but, as PX4 writes it, not sent).
 
 Examples
 --------
@@ -56,18 +52,8 @@ NUMPY_TYPES = {
 
 @dataclass(frozen=True)
 class Topic:
-    """One topic's format and samples.
-
-    Parameters
-    ----------
-    name : str
-        The topic's name, e.g. ``"vehicle_attitude"``.
-    fields : sequence of (type, length, name)
-        The format in PX4's order: a ULog type (:data:`NUMPY_TYPES`), the array length (0 for a
-        scalar) and the field's name. The first field is ``uint64_t timestamp`` [us].
-    values : mapping of str to array
-        Each field's samples: shape (L,) for a scalar, (L, length) for an array. A field not
-        given is written as zeros (PX4's default for a field a module does not fill).
+    """One topic: its ``name``, its ``fields`` as PX4 orders them (ULog type, array length or 0, name;
+    ``uint64_t timestamp`` [us] first) and each field's ``values`` (a field not given is zeros).
     """
 
     name: str
@@ -75,18 +61,7 @@ class Topic:
     values: Mapping[str, np.ndarray]
 
     def records(self, msg_id: int) -> np.ndarray:
-        """The topic's data messages, header included, as one packed structured array.
-
-        Parameters
-        ----------
-        msg_id : int
-            The id its subscription gave the topic.
-
-        Returns
-        -------
-        numpy.ndarray
-            Structured, shape (L,): ``size``, ``type``, ``msg_id``, then the fields.
-        """
+        """The topic's data messages under ``msg_id``, headers included, as one packed structured array."""
         if not self.fields or self.fields[0][2] != "timestamp":
             raise ValueError(f"topic {self.name!r}: the first field must be the timestamp")
         packed = self.fields[:-1] if self.fields[-1][2].startswith("_padding") else self.fields  # as PX4 does
@@ -104,12 +79,7 @@ class Topic:
         return out
 
     def format_message(self) -> bytes:
-        """The topic's format message payload, ``name:type field;...``.
-
-        Returns
-        -------
-        bytes
-        """
+        """The topic's format message payload, ``name:type field;...``."""
         text = "".join(
             f"{kind}[{length}] {name};" if length else f"{kind} {name};" for kind, length, name in self.fields
         )
@@ -138,22 +108,8 @@ def ulog_bytes(
     parameters: Mapping[str, float | int] | None = None,
     start_us: int = 0,
 ) -> bytes:
-    """A whole ULog file's bytes.
-
-    Parameters
-    ----------
-    topics : sequence of Topic
-        The topics, each written under its own id (0, 1, ...), instance 0.
-    info : mapping, optional
-        Information messages (``sys_name``, ``ver_hw``, ...): str, int (int32) or float.
-    parameters : mapping, optional
-        Parameters: int (int32_t) or float.
-    start_us : int
-        The header's start time [us].
-
-    Returns
-    -------
-    bytes
+    """A whole ULog file's bytes: each topic under its own id, ``info`` and ``parameters`` messages
+    (str, int32 or float), the header's ``start_us`` [us].
     """
     head = [MAGIC + b"\x01" + struct.pack("<Q", start_us), _message("B", bytes(16) + struct.pack("<QQQ", 0, 0, 0))]
     head += [_message("F", topic.format_message()) for topic in topics]
@@ -178,17 +134,7 @@ def ulog_bytes(
 
 
 def write_ulog(path: str | os.PathLike, topics: Sequence[Topic], **kwargs) -> None:
-    """Write a ULog file whole or not at all (:func:`ulog_bytes`).
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The file.
-    topics : sequence of Topic
-        The topics.
-    **kwargs
-        ``info``, ``parameters``, ``start_us`` of :func:`ulog_bytes`.
-    """
+    """Write a ULog file whole or not at all (``**kwargs``: those of :func:`ulog_bytes`)."""
     data = ulog_bytes(topics, **kwargs)
     with atomic_path(path) as tmp:
         tmp.write_bytes(data)

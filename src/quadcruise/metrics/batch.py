@@ -87,14 +87,6 @@ def transient_batch(
 ) -> dict:
     """The transient of each vehicle, measured as :func:`quadcruise.metrics.flight_metrics` does.
 
-    A moving reference (:func:`moving_reference`: circle, square, waypoints, ...) on the
-    size of the 3-D tracking error, :func:`tracking_transient_batch`. Otherwise on the
-    stepped axis of a step mission, as a step response from the hover point the step
-    leaves to the one it commands (from the step time on); or, for a reference that holds
-    still, on the axis with the largest initial error, as the progress ``1 - e(t) / e(t[0])``
-    of that axis's error, if that error is at least
-    :data:`~quadcruise.metrics.TRANSIENT_MIN_ERROR`.
-
     Parameters
     ----------
     t : ndarray, shape (L,)
@@ -102,33 +94,23 @@ def transient_batch(
     pos, ref : ndarray, shape (N, L, 3)
         Positions and references [m], finite.
     mission : dict
-        The mission as its ``to_dict()`` records it (``kind``; for a step ``axis``,
-        ``time``, ``size`` and the hover point); ``{}`` for none.
+        The mission's ``to_dict()`` (``{}`` for none).
     bands : sequence of float
         Settling bands (0.02 for 2 %).
     rise : (float, float)
         Rise-time levels, fractions of the step (0.1 and 0.9 for 10-90 %).
     err : ndarray, shape (N, L), optional
-        The 3-D position errors [m], if already computed (a moving reference reads them).
+        The 3-D position errors [m], if already computed.
 
     Returns
     -------
     dict
-        ``axis`` (int64: 0, 1, 2 for x, y, z, :data:`TRACKING_AXIS` for a moving
-        reference's error, -1 where none is measured), ``t_step`` (start of the transient
-        [s]), ``rise_time_s`` [s], ``settling_s`` (a list of one array per band: settling
-        time [s] from the start of the transient), ``overshoot_pct`` [%] and ``peak_time_s``
-        (from the start of the transient [s]), ``settled_at`` (the end of the transient [s]:
-        its settling into :data:`~quadcruise.metrics.STEADY_BAND`) and ``steady_from``
-        (the start of the steady window [s]: ``settled_at``, or for a moving reference the
-        last half of the flight, over which it was shown to have converged); arrays of
-        shape (N,).
-
-    Notes
-    -----
-    Every value of a vehicle without a measured transient is NaN, and so is every value
-    of a step whose time lies outside ``[t[0], t[-1])``; ``settled_at`` and ``steady_from``
-    are NaN for one that did not settle.
+        Arrays of shape (N,): ``axis`` (0, 1, 2 for x, y, z, :data:`TRACKING_AXIS` for a moving
+        reference's error, -1 for none), ``t_step`` [s], ``rise_time_s``, ``settling_s`` (one
+        array per band), ``overshoot_pct``, ``peak_time_s`` (from ``t_step`` [s]), ``settled_at``
+        and ``steady_from`` (the end of the transient and the start of the steady window [s]).
+        NaN where no transient is measured, for a step outside ``[t[0], t[-1])``, and (the last
+        two) for one that did not settle.
     """
     n = pos.shape[0]
     bands = [float(b) for b in bands]
@@ -259,9 +241,8 @@ def flight_metrics_batch(
 ) -> dict:
     """Tracking error, effort and transient of N vehicles that flew the whole record.
 
-    The numbers of :func:`quadcruise.metrics.flight_metrics` for vehicles that did not
-    stop early and have a finite reference (leave the others out: their metrics are NaN
-    there), and the position error at the end.
+    The numbers of :func:`quadcruise.metrics.flight_metrics` (for vehicles that did not stop early
+    and have a finite reference), and the position error at the end.
 
     Parameters
     ----------
@@ -272,8 +253,7 @@ def flight_metrics_batch(
     duties : ndarray, shape (N, L, 4)
         Rotor duties commanded [-].
     mission : dict, optional
-        The mission's ``to_dict()``, which says how the transient is measured
-        (:func:`transient_batch`).
+        The mission's ``to_dict()``: how the transient is measured (:func:`transient_batch`).
     bands : sequence of float
         Settling bands (fractions).
     transient_until : float, optional
@@ -281,20 +261,16 @@ def flight_metrics_batch(
     rise : (float, float)
         Rise-time levels (fractions of the step).
     hover_duty : float or ndarray of shape (N,), optional
-        Each vehicle's hover duty m g / (4 K) [-], about which the effort is measured
-        (:func:`quadcruise.metrics.hover_duties`); without it the effort is NaN.
+        Each vehicle's hover duty [-], about which the effort is measured; without it, NaN.
 
     Returns
     -------
     dict of ndarray, shape (N,)
-        ``rmse_m`` and ``max_error_m`` (3-D position error over the record),
-        ``steady_rmse_m`` and ``steady_max_error_m`` (the same from the settling time into
-        :data:`~quadcruise.metrics.flight.STEADY_BAND` on; the whole record without a
-        transient; NaN if it never settles into that band), ``final_error_m`` (at the last
-        sample), ``effort`` (:data:`~quadcruise.metrics.flight.EFFORT_DEFINITION` [s]),
-        ``transient_axis`` (-1: none), ``rise_time_s``, ``overshoot_pct``, ``peak_time_s``,
-        and ``settling_s``: a list of one array per band. The transient is NaN (axis -1)
-        when the window holds fewer than 2 samples.
+        ``rmse_m``, ``max_error_m`` (over the record), ``steady_rmse_m``, ``steady_max_error_m``
+        (over the steady window, :func:`transient_batch`'s ``steady_from``; the whole record
+        without a transient; NaN if it never settles), ``final_error_m``, ``effort`` [s],
+        ``transient_axis`` (-1: none; also when the window holds fewer than 2 samples),
+        ``rise_time_s``, ``overshoot_pct``, ``peak_time_s``, and ``settling_s`` (one array per band).
 
     Examples
     --------

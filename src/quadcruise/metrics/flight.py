@@ -149,6 +149,11 @@ def step_info(
 ) -> StepInfo:
     """Rise time, settling times, overshoot, undershoot and peak of one step response.
 
+    The response is normalised as ``z = (y - y_initial) / (y_final - y_initial)``: rise between the
+    first crossings of the two ``rise`` levels, settling at the last exit from each band around 1
+    (None if outside at the last sample), crossings interpolated between samples. How this differs
+    from ``control.step_info``: docs/metrics.md.
+
     Parameters
     ----------
     t : array_like, shape (L,)
@@ -158,13 +163,10 @@ def step_info(
     y_initial : float, optional
         Value before the step; default: ``y`` at ``t_step`` (interpolated).
     y_final : float, optional
-        Value the response should settle to; default: the **last sample** ``y[-1]``.
-        With the default the response is, by construction, inside every band at the end,
-        so pass ``y_final`` (e.g. the commanded value) to detect a response that did not
-        settle or settles somewhere else.
+        Value the response should settle to; default: the last sample, inside every band by
+        construction: pass the commanded value to detect a response that did not settle.
     t_step : float, optional
-        Time of the step, ``t[0] <= t_step < t[-1]``; default ``t[0]``. Samples before it
-        are ignored and all reported times are measured from it.
+        Time of the step, ``t[0] <= t_step < t[-1]``; default ``t[0]``. Times are from it.
     rise : (float, float)
         Rise-time levels as fractions of the step (10 % and 90 %).
     settle_bands : (float, float)
@@ -174,28 +176,6 @@ def step_info(
     -------
     StepInfo
         Times [s] from ``t_step``, percentages of the step, peak in the unit of ``y``.
-
-    Notes
-    -----
-    The response is normalised as ``z = (y - y_initial) / (y_final - y_initial)``, so a
-    downward step is the mirror image of an upward one.
-
-    * rise time: from the first time z reaches ``rise[0]`` to the first time it reaches
-      ``rise[1]``, each crossing interpolated linearly between samples;
-    * settling time: ``t - t_step`` at the last exit from ``|z - 1| <= band``,
-      interpolated; None if the last sample is outside the band. Only the record is
-      seen: a settling time near the end of it means little;
-    * overshoot: ``100 * (max z - 1)`` if positive, else 0; undershoot: ``-100 * min z``
-      (excursion against the step direction) if positive, else 0;
-    * peak: the value of ``y`` at the largest excursion in the step direction (the
-      sample maximum of z), peak_time its first time.
-
-    Against ``control.step_info`` (python-control 0.10): its crossings and settling time
-    are the first samples past each threshold (not interpolated: they differ from ours
-    by less than one sample interval); its levels, bands and percentages are fractions
-    of the final value measured from 0 (ours: of the step, measured from
-    ``y_initial``; the same when ``y_initial == 0``); its times are absolute (ours: from
-    ``t_step``); its ``Peak`` is ``max |y|`` (ours: signed ``y`` at the peak).
 
     Examples
     --------
@@ -298,23 +278,16 @@ def step_info_batch(t, y, *, y_initial=None, y_final=None, **kw) -> dict[str, np
 def transient_info(t, actual, reference, *, t_step=None, rise=(0.1, 0.9), settle_bands=(0.02, 0.05)) -> StepInfo:
     """Step metrics of a tracking transient in which the reference itself moves.
 
-    The progress ``y(t) = 1 - e(t) / e(t_step)`` with ``e = reference - actual`` goes
-    from 0 to 1 as the error dies out; :func:`step_info` is applied to it with
-    ``y_initial=0, y_final=1``. For a constant reference this is exactly the ordinary
-    step response scaled to the step, so times and percentages are the ordinary ones;
-    ``peak``, ``y_initial`` and ``y_final`` are in progress units.
-
-    With several axes the error is its Euclidean norm, ``y = 1 - |e(t)| / |e(t_step)|``:
-    rise and settling are then about the error size in any direction and the overshoot
-    is always 0 (an error that grows beyond the initial one shows as undershoot).
+    :func:`step_info` of the progress ``y = 1 - e(t) / e(t_step)``, ``e = reference - actual``, with
+    ``y_initial=0, y_final=1``: for a constant reference, the ordinary step response. Over several
+    axes ``e`` is the error's Euclidean norm, and the overshoot is then always 0.
 
     Parameters
     ----------
     t : array_like, shape (L,)
         Sample times [s], strictly increasing.
     actual, reference : array_like, shape (L,) or (L, n_axes)
-        The response and what it tracks [m, or any unit, the same for both], broadcast
-        against each other.
+        The response and what it tracks (one unit), broadcast against each other.
     t_step : float, optional
         Start of the transient [s]; default ``t[0]``. The error there must not be ~0.
     rise : (float, float)
@@ -635,54 +608,41 @@ def flight_metrics(
 ):
     """Per-vehicle metrics of a :class:`~quadcruise.sim.result.SimResult`, as a DataFrame.
 
-    The transient is measured on ``transient_axis``, or else on the stepped axis of a
-    step mission (as a step response from the reference before the step to the one
-    after, so a response that never arrives reads "did not settle"), or else on the
-    axis with the largest initial tracking error (the circle's start offset, say), if it
-    reaches :data:`TRANSIENT_MIN_ERROR`; otherwise those columns are empty. A settling
-    time that does not exist (still outside the band at the end) is NaN, and so is every
-    metric of a vehicle that stopped early.
-
-    The tracking after the transient: ``steady_rmse_m`` and ``steady_max_error_m`` are the
-    3-D position error (as ``rmse_m``) from the start of the transient plus its settling
-    time into :data:`STEADY_BAND` (5 %) to the end of the flight. Without a transient to
-    measure, the whole flight is steady (they equal ``rmse_m`` and ``max_error_m``); a
-    transient that never settles into 5 % leaves them undefined (NaN: the tables read
-    "did not settle"), not zero.
+    The transient is measured on ``transient_axis`` if given; else, for a moving reference, on the
+    size of the 3-D error against its own steady level (``axis`` ``xyz``); for a step mission, on
+    its stepped axis as a step response; else on the axis of the largest initial error if it
+    reaches :data:`TRANSIENT_MIN_ERROR`; otherwise not at all. The steady metrics cover the steady
+    window of that definition (the whole flight without a transient). NaN: a settling time that
+    does not exist, the steady metrics of a transient that never settles, every metric of a
+    vehicle that stopped early, and the transient and steady metrics of one that did not finish
+    (:data:`FAILED_FLIGHT_METRICS`). Each definition and its reason: docs/metrics.md.
 
     Parameters
     ----------
     result : SimResult
-        The flight (duck-typed: ``t``, ``states``, ``references``, ``commands``,
-        ``status``, ``meta`` and the saturation times are read; ``meta["vehicle"]`` gives
-        the hover duty of the effort, see :func:`hover_duties`).
+        The flight (duck-typed: ``t``, ``states``, ``references``, ``commands``, ``status``,
+        ``meta`` and the saturation times; ``meta["vehicle"]`` gives the hover duty of the
+        effort, :func:`hover_duties`).
     transient_axis : {"x", "y", "z"}, optional
         The axis whose transient is measured, instead of the one chosen as above.
     transient_until : float, optional
-        End [s] of the window in which the transient is measured (e.g. the first corner
-        of a square, after which the reference turns and the error grows again).
+        End [s] of the window in which the transient is measured.
     rise : (float, float) or str
-        Rise-time levels as fractions of the step: ``(0.1, 0.9)`` (10-90 %, default) or
-        ``(0.0, 1.0)`` (0-100 %, also ``"0-100"``), or any ``0 <= low < high <= 1``.
+        Rise-time levels as fractions of the step: ``(0.1, 0.9)`` (default), ``(0.0, 1.0)``
+        (also ``"0-100"``), or any ``0 <= low < high <= 1``.
     settle_bands : (float, float) or float
-        Settling bands as fractions of the step: the first gives ``settling_time_s``, the
-        second (5 % if only one is given) the column named after it
-        (:func:`settling_column`: ``settling_time_5pct_s`` for the default 5 %).
+        Settling bands as fractions of the step: ``settling_time_s`` and the column
+        :func:`settling_column` names (5 % if only one is given).
 
     Returns
     -------
     pandas.DataFrame
-        One row per vehicle. Columns: ``vehicle``, ``status``, ``rmse_m`` and
-        ``max_error_m`` (3-D position error over the whole flight [m]),
-        ``steady_rmse_m`` and ``steady_max_error_m`` (the same after the transient [m]),
-        the transient of one axis (``axis``, ``rise_time_s``, ``settling_time_s`` (first
-        band), ``settling_time_<band>pct_s`` (second band), ``overshoot_pct``,
-        ``peak_time_s`` (time of the peak from the start of the transient [s])),
-        ``effort`` (:data:`EFFORT_DEFINITION`: the rotor duties' squared deviation from
-        hover, integrated over the flight [s], about 0 for a hover; NaN if the result
-        records no vehicle), ``duty_clipped_s`` and ``controller_limited_s`` [s].
-        ``attrs["conventions"]`` records the rise levels, the bands, the steady band and
-        the effort's definition (:func:`metric_conventions`).
+        One row per vehicle: ``vehicle``, ``status``, ``rmse_m``, ``max_error_m`` (3-D position
+        error over the flight [m]), ``steady_rmse_m``, ``steady_max_error_m``, ``axis``,
+        ``rise_time_s``, ``settling_time_s``, ``settling_time_<band>pct_s``, ``overshoot_pct``,
+        ``peak_time_s``, ``effort`` (:data:`EFFORT_DEFINITION` [s]; NaN without a vehicle),
+        ``duty_clipped_s``, ``controller_limited_s`` [s]; ``attrs["conventions"]`` records the
+        conventions (:func:`metric_conventions`).
 
     Examples
     --------

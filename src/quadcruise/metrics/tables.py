@@ -1,11 +1,9 @@
 """How a metric reads in a table: one rule for the terminal (``fly``, ``compare``) and the
 HTML report.
 
-Numbers show 4 significant digits (scientific notation when very large or small), a
-missing value a dash, and a missing settling time or steady error (``steady_rmse_m``,
-``steady_max_error_m``) of a response that did have a transient (its ``axis`` is named)
-reads "did not settle": the response never stayed in the band, which is not the same as
-"no step to measure". :func:`conventions_text` says in words what the columns measure.
+Numbers show 4 significant digits (scientific notation when very large or small), a missing
+value a dash, or why it is missing (:func:`metric_cell`): "did not settle" is not "no transient",
+and neither is "failed flight". :func:`conventions_text` says in words what the columns measure.
 
 >>> import pandas as pd
 >>> frame = pd.DataFrame({"axis": ["x", None], "settling_time_s": [float("nan")] * 2, "rmse_m": [0.01234, 2e-5]})
@@ -115,7 +113,7 @@ def metric_cell(value: Any, metric: Any, axis: Any, missing: str = "-", status: 
     Returns
     -------
     text : str
-        As :func:`cell` writes it, or :data:`DID_NOT_SETTLE`.
+        As :func:`cell` writes it, or for a missing value the words above.
     is_number : bool
         True if ``text`` is a number.
 

@@ -75,24 +75,11 @@ def moving_reference(t: np.ndarray, ref: np.ndarray, mission: dict) -> bool:
 def tracking_transient_batch(
     t: np.ndarray, err: np.ndarray, bands: Sequence[float], rise: Sequence[float] = (0.1, 0.9)
 ) -> dict:
-    """The entry transient of a moving reference, on the size of the tracking error.
+    """The entry transient of a moving reference, on the size of the tracking error ``e`` (3-D, [m]).
 
-    The error ``e(t)`` (3-D, [m]) of a vehicle that starts off its path falls from ``e0``
-    to a steady level ``E``: its largest value over the last :data:`FINAL_FRACTION` of the
-    flight (largest, so that a periodic steady error, such as a circle's in a steady wind
-    or a square's at each corner, lies under it). The response measured is the progress
-    ``z = (e0 - e) / (e0 - E)``, from 0 to 1, with python-control's conventions:
-
-    * rise: between the first times z reaches ``rise[0]`` and ``rise[1]``;
-    * settling into band b: the last time ``e > E + b (e0 - E)``, from ``t[0]``, if the
-      error stayed under that line over at least the last half of the flight (a level
-      measured on the last quarter is a steady level only if the quarter before agrees);
-      otherwise NaN: it had not converged;
-    * overshoot: the error going below anything it does in steady state during the entry
-      (up to twice its settling time into :data:`~quadcruise.metrics.STEADY_BAND`, and not
-      into the last half): ``100 (min e over the last quarter - min e over the entry) /
-      (e0 - E)``, 0 if none; its peak time is that lowest error's time (NaN without an
-      overshoot). A peak at the last sample is never one.
+    The progress ``z = (e0 - e) / (e0 - E)``, ``E`` the steady level (the largest error over the last
+    :data:`FINAL_FRACTION`), with python-control's conventions; settled only if the error stayed
+    under the band over the last half of the flight. Each rule and its reason: docs/metrics.md.
 
     Parameters
     ----------
@@ -108,13 +95,11 @@ def tracking_transient_batch(
     Returns
     -------
     dict
-        ``measured`` (bool: ``e0`` at least :data:`~quadcruise.metrics.TRANSIENT_MIN_ERROR`
-        and ``E < e0``), ``level`` (E [m]), ``rise_time_s``, ``settling_s`` (a list, one
-        array per band), ``overshoot_pct``, ``peak_time_s``, ``settled_at`` (the end of
-        the entry: ``t[0]`` + its settling into :data:`~quadcruise.metrics.STEADY_BAND` [s])
-        and ``steady_from`` (the start of the steady window: the last half of the flight,
-        over which the error was shown to have converged [s]); arrays of shape (N,), NaN
-        where not measured or not converged.
+        Arrays of shape (N,), NaN where not measured or not converged: ``measured`` (bool),
+        ``level`` (E [m]), ``rise_time_s``, ``settling_s`` (one array per band), ``overshoot_pct``,
+        ``peak_time_s``, ``settled_at`` (``t[0]`` + the settling into
+        :data:`~quadcruise.metrics.STEADY_BAND` [s]) and ``steady_from`` (start of the steady
+        window, the last half of the flight [s]).
 
     Examples
     --------

@@ -1,32 +1,9 @@
-"""Missions: the reference a vehicle is asked to follow, as a function of time.
+"""Missions: the reference a vehicle is asked to follow, as a compiled function of time.
 
-At time t a mission writes position, velocity and acceleration (earth frame, z up), yaw and
-yaw rate into a ``REF_SIZE`` vector laid out as in :mod:`quadcruise.layout`. Each kind is one
-compiled function with the signature ``MISSION_SIG`` (``mission(t, mp, ref)``), so the engine
-takes it as a first-class ``MissionType`` and its cache serves every kind, a user's own too.
-``mp`` is the mission's flat parameter vector (one row per vehicle in a batch); its columns
-are listed in each class's ``columns``. Missions are meant for t >= 0.
-
-Kinds and defaults (the paper, Section IV, gives no numbers for its Figs 4-6, so the defaults
-are sized for the Qball-X4 of Table I in an indoor arena: a few metres, tens of seconds):
-
-- :class:`Hover` at (0, 0, 1 m): 1 m is a usual indoor flight height for the Qball-X4.
-- :class:`Step` of 1 m in x at t = 1 s from hover at (0, 0, 1 m): a unit step gives rise time,
-  settling time and overshoot directly; the 1 s of hover before it shows the initial state.
-- :class:`Circle` of radius 2 m, period 20 s, at 1 m, centred on the origin, starting at
-  (R, 0), counter-clockwise: the paper's search-and-rescue pattern (Fig 4). Cruise speed
-  2 pi R / T = 0.63 m/s and centripetal acceleration 0.20 m/s^2 (about 1.2 deg of tilt) keep it
-  a gentle cruise. A vehicle at rest at the origin sees a step of R in x at t = 0: that
-  transient is what the paper's rise/settling/overshoot numbers measure. ``ramp_time`` > 0
-  ramps the angular rate smoothly (C2 reference) from 0; afterwards the phase lags the
-  unramped circle by omega * ramp_time / 2.
-- :class:`Square` of side 4 m at 0.5 m/s (8 s per leg, 32 s per lap) at 1 m: the paper's
-  mapping pattern (Fig 6), of the same size and speed as the circle. The first corner is at
-  ``corner`` (default the origin, where the vehicle starts, so there is no position step) and
-  the legs run +x, +y, -x, -y (``direction=-1`` mirrors y: +x, -y, -x, +y), dwelling ``dwell``
-  seconds at each corner before leaving it. The reference is only C0 at the corners: the
-  velocity jumps and the acceleration is zero on the legs (the corner impulses are left out).
-  It repeats every lap.
+Each kind writes position, velocity, acceleration, yaw and yaw rate into a ``REF_SIZE`` vector
+(``mission(t, mp, ref)``, ``MISSION_SIG``) from its flat parameter row ``mp`` (the class's
+``columns``). The kinds here, :class:`Hover`, :class:`Step`, :class:`Circle` and :class:`Square`,
+and why their defaults: docs/missions.md.
 
 Examples
 --------

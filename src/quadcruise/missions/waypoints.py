@@ -1,29 +1,9 @@
 """Waypoint missions: a table of points flown as straight legs or as one minimum-snap path.
 
-A :class:`WaypointTable` holds points (x, y, z [m]), optionally a yaw at each [rad], and the
-timing: EITHER arrival times ``t`` [s] (first 0, strictly increasing; a point repeated then
-means a dwell there) OR ``speed`` [m/s], the cruise speed on the leg that ENDS at each point
-(the first row's is unused and may be left empty), or neither: the mission's ``speed``
-(0.5 m/s by default) on every leg. :func:`read_waypoints_csv` reads ``x,y,z[,yaw][,t|speed]``.
-
-Kinds (both hold the last point after the end, and the first before t = 0):
-
-- :class:`Waypoints` ('waypoints'): constant-speed straight legs with explicit corners, like the
-  paper's square: C0 at the points (the velocity jumps, each leg being [departure, arrival)),
-  zero acceleration on the legs, yaw linear per leg (or held).
-  mp = [n, hold_yaw, then per point: x, y, z, yaw, t], length 2 + 5 n.
-- :class:`MinimumSnap` ('minsnap'): Mellinger & Kumar's (2011) minimum-snap path, one
-  7th-order polynomial per segment and axis (x, y, z, yaw) through every point at its time,
-  at rest (zero velocity, acceleration, jerk) at both ends and at every dwell, C3 by
-  constraint and C6 elsewhere by optimality: the equality-constrained QP
-  min sum_i int |p_i''''|^2 dt, solved through its KKT system in each segment's local time
-  s = (t - t_i) / T_i. mp = [m, x, y, z, yaw and t of the end, then per segment: t_i, T_i,
-  8 coefficients of s^0..s^7 for each of x, y, z, yaw], length 6 + 34 m, m = n - 1.
-
-A batch flies one kind but its tables may differ in length:
-:func:`~quadcruise.missions.base.stack_params` pads shorter rows with zeros, which the
-compiled functions never read (the count is mp[0]). ``duration`` is the last
-arrival + ``SETTLE_S``, rounded up to a whole second (so any usual dt divides it).
+A :class:`WaypointTable` holds the points and their timing (arrival times, or the speed of the
+leg ending at each, or one cruise speed); :class:`Waypoints` flies it as constant-speed legs,
+:class:`MinimumSnap` as Mellinger and Kumar's (2011) minimum-snap path. Their parameter
+layouts and continuity: docs/missions.md.
 
 Examples
 --------
@@ -371,24 +351,18 @@ def _last_start(t, mp, first, stride, count):
 
 @njit(cache=True, error_model="numpy")
 def waypoints_ref(t, mp, ref):
-    """Waypoint reference: straight constant-speed legs, C0 at the points.
+    """Waypoint reference: straight constant-speed legs, yaw linear or held.
 
-    On the leg [t_k, t_k+1) the position moves linearly from point k to point k+1, the
-    velocity is constant and the acceleration zero; yaw moves linearly with its rate, or is
-    held at point k's yaw when ``hold_yaw`` is not 0. Before t = 0 the reference is the first
-    point, from the last arrival on the last point, at rest.
+    Before t = 0, the first point; after the last arrival, the last point, at rest.
 
     Parameters
     ----------
     t : float
         Time [s].
     mp : numpy.ndarray
-        The mission's parameter vector (float64, 1-D): [n, hold_yaw, then per point
-        x [m], y [m], z [m], yaw [rad], t [s]], length 2 + 5 n (entries after it are not
-        read).
+        [n, hold_yaw, then per point x, y, z [m], yaw [rad], t [s]].
     ref : numpy.ndarray
-        Output, REF_SIZE float64 entries: position [m], velocity [m/s], acceleration
-        [m/s^2], yaw [rad] and yaw rate [rad/s] at ``t`` (overwritten).
+        Output: the reference at ``t`` (``REF_SIZE`` entries, overwritten).
     """
     for i in range(REF_SIZE):
         ref[i] = 0.0
@@ -419,22 +393,17 @@ def waypoints_ref(t, mp, ref):
 def minsnap_ref(t, mp, ref):
     """Minimum-snap reference: the polynomial segments of :func:`minimum_snap_coefficients`.
 
-    In segment i, s = (t - t_i) / T_i and each of x, y, z, yaw is sum_k c_k s^k; velocity,
-    acceleration and yaw rate are its time derivatives. Before t = 0 the reference is the
-    first point (s = 0), from the end time on the last point, at rest.
+    Before t = 0, the first point; after the end, the last point, at rest.
 
     Parameters
     ----------
     t : float
         Time [s].
     mp : numpy.ndarray
-        The mission's parameter vector (float64, 1-D): [m, x [m], y [m], z [m], yaw [rad]
-        and t [s] of the end, then per segment t_i [s], T_i [s] and 8 coefficients of
-        s^0..s^7 for each of x [m], y [m], z [m], yaw [rad]], length 6 + 34 m (entries after
-        it are not read).
+        [m, the end's x, y, z [m], yaw [rad], t [s], then per segment t_i, T_i [s] and the 8
+        coefficients of s^0..s^7, s = (t - t_i) / T_i, for each of x, y, z, yaw].
     ref : numpy.ndarray
-        Output, REF_SIZE float64 entries: position [m], velocity [m/s], acceleration
-        [m/s^2], yaw [rad] and yaw rate [rad/s] at ``t`` (overwritten).
+        Output: the reference at ``t`` (``REF_SIZE`` entries, overwritten).
     """
     for i in range(REF_SIZE):
         ref[i] = 0.0

@@ -82,16 +82,11 @@ def plot_bode(
         ``closed_loop(loop)`` (set-point to output), ``loop_transfer(loop, at)`` and
         ``margins(loop, at)`` (:class:`quadcruise.workflows.analysis.Linearization`).
     loops : bool
-        Add a second column of the loop transfers (broken ``at``), with their margins
-        marked and named: the phase margin as a segment from the -180 deg line up to the
-        phase at the gain crossover (a dot there on the 0 dB line too), each gain margin (down
-        and up) as a segment from the 0 dB line to the magnitude at its phase crossover (a
-        square there on the -180 deg line too), all with units and frequencies in the legend
-        (:func:`margin_label`: "PM 18.1° @ 10.8 rad/s (< 30°), GM down -3.98 dB @ 7.07 rad/s
-        (> -6 dB), up +38.2 dB @ 300 rad/s": the loop is stable and stays so while its gain
-        falls by less than 3.98 dB or rises by less than 38.2 dB; a margin short of 30 deg or
-        6 dB is marked). y's margins are x's for a symmetric vehicle and are then not marked
-        twice.
+        Add a second column of the loop transfers (broken ``at``), each margin drawn as a
+        segment from its reference line to the curve at its crossover and named in the legend
+        (:func:`margin_label`; short margins flagged). y's margins are x's for a symmetric
+        vehicle and are then not marked twice. How to read them: docs/paper.md, "Linear
+        analysis of the full loop".
     omega : array_like, optional
         Frequencies [rad/s]; by default 800 from 0.01 rad/s to 0.9 of the Nyquist frequency
         pi / dt (closer to it the sampling zeros near z = -1 turn the phase by half a turn

@@ -48,19 +48,7 @@ more are invisible at screen resolution and only slow the drawing down."""
 
 
 def drawable(result):
-    """The result, decimated to at most :data:`MAX_DRAWN` logged instants for drawing.
-
-    Parameters
-    ----------
-    result : SimResult
-        A flight.
-
-    Returns
-    -------
-    SimResult
-        ``result`` itself if it is short enough, else ``result.decimate(k)`` with the
-        smallest step ``k`` that fits.
-    """
+    """The result, decimated by the smallest step that leaves at most :data:`MAX_DRAWN` instants."""
     every = -(-len(result.t) // MAX_DRAWN)
     return result if every <= 1 else result.decimate(every)
 
@@ -83,20 +71,8 @@ def _names(result, vehicle: int = 0) -> tuple[str | None, str | None]:
 
 
 def describe(result, vehicle: int = 0) -> str:
-    """What a flight was, in a few words, for a title.
-
-    Parameters
-    ----------
-    result : SimResult
-        A flight; its ``meta`` is read.
-    vehicle : int
-        The vehicle whose mission is named, when each vehicle flew its own.
-
-    Returns
-    -------
-    str
-        ``"<controller> on <mission>"``, ``"open-loop replay of <file>"``, or whichever of
-        the controller, the mission and the workflow is recorded (``"flight"`` if none).
+    """What a flight was, for a title: ``"<controller> on <mission>"``, ``"open-loop replay of <file>"``,
+    or what its ``meta`` records (``"flight"`` if nothing).
 
     Examples
     --------

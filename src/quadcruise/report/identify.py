@@ -6,21 +6,8 @@ from pathlib import Path
 
 
 def identification_report(result, *, title: str | None = None) -> dict:
-    """Keywords of :func:`quadcruise.report.html.html_report` for an identified vehicle.
-
-    Parameters
-    ----------
-    result : IdentifyResult
-        What :func:`quadcruise.identify` returned (duck-typed: ``to_pandas``, ``plot``,
-        ``validation``, ``report_md``, ``to_json``, ``log``).
-    title : str, optional
-        The page's title; by default "quadcruise identify: " and the log's name.
-
-    Returns
-    -------
-    dict
-        ``title``, ``tables`` (parameters; held-out validation), ``figures`` (measured against
-        predicted), ``notes`` (the Markdown report) and ``config`` (``identify.json``'s content).
+    """Keywords of :func:`quadcruise.report.html.html_report` for an identified vehicle: its
+    parameters and held-out validation as tables, measured against predicted, the Markdown report.
     """
     import pandas as pd
 

@@ -1,23 +1,16 @@
 """A flight in PX4's conventions, as the topics of a PX4 log (:meth:`SimResult.to_ulog`).
 
-quadcruise's world frame is ENU (x east, y north, z up) and its body frame FLU (x forward, y
-left, z up); PX4's are NED and FRD. With ``A`` the ENU-to-NED swap and ``B = diag(1, -1, -1)``
-(FLU to FRD)::
+With ``A`` the ENU-to-NED swap and ``B = diag(1, -1, -1)`` (FLU to FRD)::
 
     p_ned = A p_enu = (y, x, -z)                      position, velocity, acceleration
     R_ned_frd = A R_enu_flu B                          attitude, quaternion (w, x, y, z)
     w_frd = B w_flu = (p, -q, -r)                      body rates
     f_frd = B R_enu_flu^T (a_enu + g e_z)              accelerometer: specific force
 
-The paper's rotors sit on the body axes ("+", eqs 1-4): rotor 1 at -x, 2 at +y, 3 at +x and 4
-at -y (FLU), 1 and 3 turning clockwise seen from above (their drag torque U4 > 0 about z up).
-They are written as PX4's ``CA_ROTOR*`` parameters (FRD positions ``PX``, ``PY``; ``KM``, the
-yaw moment per unit thrust, positive for a counter-clockwise rotor; ``CT``, the thrust at full
-command), so that a reader of the log can rebuild eqs (1)-(4).
-
-Sensor noise: the topics carry the noise the flight's controller saw (its ``SensorNoise``),
-drawn again from the flight's seed and the vehicle's index, a stream of its own
-(:data:`NOISE_STREAM`). The accelerometer has no noise of its own (``SensorNoise`` has none).
+The paper's "+" rotors (1 at -x, 2 at +y, 3 at +x, 4 at -y in FLU; 1 and 3 clockwise seen from
+above) are written as PX4's ``CA_ROTOR*`` parameters, so that a reader of the log can rebuild
+eqs (1)-(4). The topics carry the sensor noise the controller saw, drawn again
+from the flight's seed (:data:`NOISE_STREAM`); the accelerometer has none of its own.
 """
 
 from __future__ import annotations
@@ -156,18 +149,8 @@ MAV_TYPE_QUADROTOR = 2
 
 
 def attitude_ned_frd(phi: np.ndarray, theta: np.ndarray, psi: np.ndarray) -> np.ndarray:
-    """PX4's attitude quaternions (w, x, y, z), FRD body to NED, from the paper's ZYX angles.
-
-    Parameters
-    ----------
-    phi, theta, psi : ndarray, shape (L,)
-        Roll, pitch, yaw [rad]: ``R_enu_flu = Rz(psi) Ry(theta) Rx(phi)``.
-
-    Returns
-    -------
-    ndarray, shape (L, 4)
-        Unit quaternions, w first, the first with w >= 0 and each on the side of the previous
-        one (no sign jumps).
+    """PX4's attitude quaternions (w, x, y, z), FRD body to NED, from the paper's ZYX angles, with no
+    sign jumps from one to the next.
 
     Examples
     --------
@@ -188,43 +171,14 @@ def attitude_ned_frd(phi: np.ndarray, theta: np.ndarray, psi: np.ndarray) -> np.
 
 
 def specific_force_frd(states: np.ndarray, accel_enu: np.ndarray, g: float) -> np.ndarray:
-    """What an accelerometer reads: the specific force in the FRD body frame [m/s^2].
-
-    Parameters
-    ----------
-    states : ndarray, shape (L, 16)
-        The logged states (their angles give the attitude).
-    accel_enu : ndarray, shape (L, 3)
-        The acceleration in the world frame (ENU) [m/s^2].
-    g : float
-        Gravity [m/s^2].
-
-    Returns
-    -------
-    ndarray, shape (L, 3)
-        ``B R^T (a + g e_z)``: (0, 0, -g) at rest, level.
-    """
+    """What an accelerometer reads, ``B R^T (a + g e_z)`` [m/s^2] in FRD: (0, 0, -g) at rest, level."""
     rot = Rotation.from_euler("ZYX", states[:, [PSI, THETA, PHI]])
     return rot.inv().apply(accel_enu + np.array([0.0, 0.0, g])) @ FLU_TO_FRD.T
 
 
 def rotor_parameters(arm: float, yaw_per_thrust: float, max_thrust: float) -> dict[str, float | int]:
-    """The paper's "+" rotors as PX4's control-allocation parameters.
-
-    Parameters
-    ----------
-    arm : float
-        l, the rotors' distance from the centre [m].
-    yaw_per_thrust : float
-        d, the drag torque per unit thrust [m].
-    max_thrust : float
-        K, a rotor's thrust at full duty [N].
-
-    Returns
-    -------
-    dict
-        ``CA_ROTOR_COUNT`` and ``CA_ROTORi_{PX,PY,PZ,KM,CT}`` for i = 0..3 (rotor i + 1),
-        ``MAV_TYPE``.
+    """The paper's "+" rotors as PX4's ``CA_ROTOR*`` parameters (FRD positions, ``KM`` the yaw moment
+    per unit thrust, positive counter-clockwise, ``CT`` the thrust at full command) and ``MAV_TYPE``.
     """
     flu = [(-arm, 0.0, -1.0), (0.0, arm, 1.0), (arm, 0.0, -1.0), (0.0, -arm, 1.0)]  # x, y, +1 = CCW
     out: dict[str, float | int] = {"CA_ROTOR_COUNT": 4, "MAV_TYPE": MAV_TYPE_QUADROTOR}
@@ -256,29 +210,8 @@ def px4_topics(
     noise_std: np.ndarray | None = None,
     rng: np.random.Generator | None = None,
 ) -> list[Topic]:
-    """One vehicle's flight as PX4 topics.
-
-    Parameters
-    ----------
-    t : ndarray, shape (L,)
-        Logged instants [s], evenly spaced, from 0.
-    states : ndarray, shape (L, 16)
-        The vehicle's states (finite rows only).
-    duties : ndarray, shape (L, 4)
-        The rotor duties in [0, 1] (``actuator_motors.control``).
-    g : float
-        Gravity [m/s^2].
-    noise_std : ndarray, shape (16,), optional
-        Standard deviations of the noise on each state (``SensorNoise.std_vector``).
-    rng : numpy.random.Generator, optional
-        Its source; required with ``noise_std``.
-
-    Returns
-    -------
-    list of Topic
-        ``vehicle_local_position``, ``vehicle_attitude``, ``vehicle_angular_velocity``,
-        ``actuator_motors``, ``sensor_combined``, ``vehicle_status`` (armed),
-        ``vehicle_land_detected`` (airborne), at :data:`RATES_HZ`.
+    """One vehicle's flight as PX4 topics at :data:`RATES_HZ`, from its logged ``t``, ``states`` and
+    ``duties``, with the sensor noise ``noise_std`` (``SensorNoise.std_vector``) drawn from ``rng``.
     """
     us = np.round(t * 1e6).astype(np.uint64)
     accel = np.gradient(states[:, VX : VX + 3], t, axis=0, edge_order=2) if len(t) > 2 else np.zeros((len(t), 3))
@@ -352,15 +285,5 @@ def px4_topics(
 
 
 def duties_of(commands: np.ndarray) -> np.ndarray:
-    """The rotor duties, clipped to [0, 1] as the engine applies them.
-
-    Parameters
-    ----------
-    commands : ndarray, shape (L, 12)
-        The logged commands.
-
-    Returns
-    -------
-    ndarray, shape (L, 4)
-    """
+    """The rotor duties of the logged commands, clipped to [0, 1] as the engine applies them."""
     return np.clip(commands[:, CMD_U1 : CMD_U1 + 4], 0.0, 1.0)

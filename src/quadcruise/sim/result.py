@@ -152,7 +152,7 @@ class SimResult:
         raise InputError(f"unknown trace name {name!r}; known: {', '.join(STATE_NAMES + REF_NAMES + CMD_NAMES)}")
 
     def to_pandas(self, vehicle: int | None = None, *, references: bool = True, commands: bool = True):
-        """Long-form DataFrame: one row per vehicle and logged instant.
+        """The traces, long-form: one row per vehicle and logged instant (per-flight metrics: :meth:`metrics`).
 
         Parameters
         ----------
@@ -258,14 +258,10 @@ class SimResult:
         return plot_flight(self, vehicle=vehicle, **kwargs)
 
     def to_ulog(self, path: str | os.PathLike, vehicle: int = 0) -> Path:
-        """Write one vehicle's flight as a PX4 log (ULog), in PX4's conventions.
+        """Write one vehicle's flight as a PX4 log (ULog), in PX4's conventions (:mod:`quadcruise.sim.px4`).
 
-        NED world, FRD body, quaternions w first, microsecond timestamps; the topics
-        ``vehicle_local_position``, ``vehicle_attitude``, ``vehicle_angular_velocity``,
-        ``actuator_motors``, ``sensor_combined`` (a simulated IMU), ``vehicle_status`` and
-        ``vehicle_land_detected``, at the rates of :data:`quadcruise.sim.px4.RATES_HZ` (at most
-        the flight's log rate), the rotors as ``CA_ROTOR*`` parameters. pyulog, PX4 Flight Review
-        and PlotJuggler read it. See :mod:`quadcruise.sim.px4`.
+        The topics and rates are :func:`quadcruise.sim.px4.px4_topics`' (at most the flight's log
+        rate); pyulog, PX4 Flight Review and PlotJuggler read it.
 
         Parameters
         ----------

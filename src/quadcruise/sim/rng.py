@@ -1,16 +1,9 @@
 """Per-vehicle random numbers inside compiled code, reproducible whatever the batching.
 
-Each vehicle owns a 64-bit generator state (one uint64) advanced by SplitMix64 (Steele,
-Lea and Flood, 2014), a small, fast generator that passes BigCrush. The state of vehicle i
-of a run with seed s is drawn from ``numpy.random.SeedSequence([s, i])``, so a vehicle's
-random stream depends only on (seed, i): splitting a population into chunks, or flying one
-vehicle alone, gives the same draws.
-
-Normal draws (sensor noise, turbulence) use the 256-layer ziggurat of Marsaglia and Tsang
-(2000), in the form of numpy's ``Generator.standard_normal``: one 64-bit word gives the
-layer (8 bits), the sign (1 bit) and a 52-bit abscissa, accepted at once about 99 % of the
-time; the wedges and the tail (beyond r = 3.654) are sampled exactly. It is faster than the
-polar method and Box-Muller (see docs/performance.md).
+Each vehicle owns one uint64 state advanced by SplitMix64 (Steele, Lea and Flood, 2014), seeded
+from ``numpy.random.SeedSequence([seed, i])``: a vehicle's stream depends on (seed, i) only, so
+chunks, or one vehicle flown alone, draw the same numbers. Normal draws use numpy's 256-layer
+ziggurat (Marsaglia and Tsang, 2000); its speed against the polar method: docs/performance.md.
 
 Examples
 --------
@@ -49,23 +42,7 @@ def _mix(z):
 
 @njit(cache=True, inline="always")
 def next_unit(s):
-    """On a scalar state s: (a float in [0, 1) with 53 random bits, the advanced state).
-
-    For compiled code that keeps the state in a local variable and stores it once.
-
-    Parameters
-    ----------
-    s : numpy.uint64 or int
-        A SplitMix64 generator state (an entry of :func:`vehicle_states`, or the state a
-        previous draw returned).
-
-    Returns
-    -------
-    u : float
-        A uniform draw in [0, 1), a multiple of 2^-53.
-    s : int
-        The advanced state (a uint64 value; numba returns it as a Python int), to pass to
-        the next draw.
+    """On a scalar state s: (a uniform float in [0, 1) with 53 random bits, the advanced state).
 
     Examples
     --------
@@ -80,18 +57,7 @@ def next_unit(s):
 
 @njit(cache=True)
 def next_u64(state):
-    """Advance ``state`` (uint64 array, entry 0) and return the next 64 random bits.
-
-    Parameters
-    ----------
-    state : numpy.ndarray
-        A vehicle's generator state, uint64, at least one entry (entry 0 is advanced in
-        place; a row of :func:`vehicle_states`).
-
-    Returns
-    -------
-    int
-        64 random bits (SplitMix64's output, a uint64 value returned as a Python int).
+    """Advance ``state[0]`` (a row of :func:`vehicle_states`) in place and return 64 random bits.
 
     Examples
     --------
@@ -108,19 +74,7 @@ def next_u64(state):
 
 @njit(cache=True)
 def uniform(state):
-    """A float in [0, 1) with 53 random bits.
-
-    Parameters
-    ----------
-    state : numpy.ndarray
-        A vehicle's generator state, uint64, at least one entry (entry 0 is advanced in
-        place; a row of :func:`vehicle_states`).
-
-    Returns
-    -------
-    float
-        A uniform draw in [0, 1), a multiple of 2^-53 (the first value of
-        :func:`next_unit` on ``state[0]``).
+    """A float in [0, 1) with 53 random bits, advancing ``state[0]`` in place.
 
     Examples
     --------
@@ -141,31 +95,9 @@ ZIGGURAT_V = 0.00492867323399
 
 
 def ziggurat_tables(n: int = 256, r: float = ZIGGURAT_R, v: float = ZIGGURAT_V, bits: int = 52):
-    """Marsaglia and Tsang's tables for the normal density f(x) = exp(-x^2/2):
-    ``(ki, wi, fi)``: the acceptance thresholds (uint64, scaled to ``bits``), the layer
-    widths per unit of the abscissa and f at each layer's edge.
-
-    Parameters
-    ----------
-    n : int
-        Number of layers (256: one byte of a draw picks the layer).
-    r : float
-        Where the tail begins, the base layer's right edge [-] (standard normal units);
-        it must match ``v`` and ``n``.
-    v : float
-        The area of each layer [-].
-    bits : int
-        Bits of the abscissa drawn per sample (52).
-
-    Returns
-    -------
-    ki : numpy.ndarray
-        (n,) uint64: for each layer, the largest abscissa (scaled to 2^bits) that is
-        inside the layer below at any height, i.e. accepted at once.
-    wi : numpy.ndarray
-        (n,) float64: each layer's right edge [-] per unit of the scaled abscissa.
-    fi : numpy.ndarray
-        (n,) float64: f at each layer's right edge [-] (1 for the top layer).
+    """Marsaglia and Tsang's tables ``(ki, wi, fi)`` for f(x) = exp(-x^2/2): each layer's threshold
+    of immediate acceptance (uint64, scaled to 2^bits), its width per unit of the abscissa, and f
+    at its right edge.
 
     Examples
     --------
@@ -197,20 +129,6 @@ _MANTISSA = uint64(0x000FFFFFFFFFFFFF)
 def next_normal(s):
     """On a scalar state s: (a standard normal draw, the advanced state).
 
-    Parameters
-    ----------
-    s : numpy.uint64 or int
-        A SplitMix64 generator state (an entry of :func:`vehicle_states`, or the state a
-        previous draw returned).
-
-    Returns
-    -------
-    x : float
-        A standard normal draw [-] (the ziggurat).
-    s : int
-        The advanced state (a uint64 value, returned as a Python int; one or more steps:
-        the wedges and the tail draw again).
-
     Examples
     --------
     >>> s = vehicle_states(seed=1, n=1)[0, 0]
@@ -222,22 +140,8 @@ def next_normal(s):
 
 @njit(cache=True, inline="always")
 def ziggurat(s):
-    """:func:`next_normal`'s body, for compiled code that inlines it once (a loop of
-    draws): every inlined copy adds to the first compile of the function holding it, so
-    the turbulence inlines one copy in a loop rather than five
-    (:func:`quadcruise.sim.fastmath.five_normals`; see docs/performance.md).
-
-    Parameters
-    ----------
-    s : numpy.uint64 or int
-        A SplitMix64 generator state.
-
-    Returns
-    -------
-    x : float
-        A standard normal draw [-].
-    s : int
-        The advanced state (a uint64 value, returned as a Python int).
+    """:func:`next_normal`'s body, inlined once into a loop of draws (each inlined copy lengthens
+    the first compile; docs/performance.md).
 
     Examples
     --------
@@ -270,18 +174,7 @@ def ziggurat(s):
 
 @njit(cache=True)
 def gauss(state):
-    """A standard normal draw (the ziggurat, :func:`next_normal`).
-
-    Parameters
-    ----------
-    state : numpy.ndarray
-        A vehicle's generator state, uint64, at least one entry (entry 0 is advanced in
-        place; a row of :func:`vehicle_states`).
-
-    Returns
-    -------
-    float
-        A standard normal draw [-].
+    """A standard normal draw (:func:`next_normal`), advancing ``state[0]`` in place.
 
     Examples
     --------
@@ -294,32 +187,11 @@ def gauss(state):
 
 
 def vehicle_states(seed: int, n: int, first=0) -> np.ndarray:
-    """(n, 1) uint64 generator states of vehicles first .. first + n - 1 of a run.
+    """(n, 1) uint64 generator states of vehicles ``first`` .. ``first + n - 1`` of a run.
 
-    ``first`` may also be an (n,) array of whole numbers: the index of each vehicle in the
-    run, so that vehicles flown side by side can share a stream (a tuner flies each
-    candidate on the same perturbed vehicles, noise included).
-
-    Parameters
-    ----------
-    seed : int
-        The run's seed, >= 0.
-    n : int
-        Number of vehicles.
-    first : int or array_like of int
-        The index of the first vehicle in the run (the rest follow it), or the (n,) indices
-        of the vehicles, each >= 0 (repeats allowed).
-
-    Returns
-    -------
-    numpy.ndarray
-        (n, 1) uint64: row k is the state of vehicle i, drawn from
-        ``numpy.random.SeedSequence([seed, i])``, so it depends on (seed, i) only.
-
-    Raises
-    ------
-    ValueError
-        A negative seed, or indices that are not n whole numbers >= 0.
+    ``first`` may also be the (n,) indices of the vehicles (repeats allowed), so that vehicles
+    flown side by side share a stream. Row k is drawn from ``SeedSequence([seed, i])``; a negative
+    seed or indices that are not n whole numbers >= 0 raise ValueError.
 
     Examples
     --------

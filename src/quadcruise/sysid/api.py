@@ -32,15 +32,11 @@ deviation, relative to the mean command) for its parameters to be identifiable a
 whatever interval the residuals give reflects the absence of noise, not information."""
 MIN_SIGNAL_SHARE = 0.99
 """The least share of a regressor's variance that must be signal, not noise, for its coefficient
-to be identifiable: a gyroscopic product's (q r, p r) against the rates' sensor noise, a moment
-command's against its sample-to-sample jitter. Noise in a regressor biases its coefficient
-toward zero (errors in variables), which the intervals do not cover; on a closed-loop circle a
-jitter share of 1.3 % (as estimated) came with a 3.8 % bias on Jyy, so the bound is tight."""
+to be identifiable (noise biases it toward zero, which the intervals do not cover; the bias
+measured: docs/identify.md, "Known limitation")."""
 SETTLE_TAUS = 6.0
-"""Rotor time constants (of the base vehicle) left out at each segment's start: the lag's state
-there is taken as settled on the first command, which it may not be (a flight that starts with a
-jump of the commands). After 3 of them 5 % of a wrong start is left, enough to bias a log whose
-excitation is mostly that start by 10 % (measured on a closed-loop circle); after 6, 0.25 %."""
+"""Rotor time constants (of the base vehicle) left out at each segment's start, where the lag's
+state is taken as settled on the first command (why 6: docs/identify.md, "Known limitation")."""
 CAUTION_SHARE = 0.99
 """Below this share of signal (not jitter) in a moment command, the result carries a caution."""
 MIN_FIT_S, MIN_HELD_S = 2.0, 0.5

@@ -1,26 +1,15 @@
 """The equations identified, as linear regressions: regressors and regressands from a flight log.
 
-The paper's plant (:mod:`quadcruise.model.plant`) with any rotor positions (the log's
-``CA_ROTOR*``): rotor i makes thrust ``K s(u_i)`` through a first-order lag of bandwidth
-``omega``, with PX4's thrust-curve shape ``s(u) = (1 - f) u + f u^2`` (``THR_MDL_FAC``).
-With ``F_i = lag_omega(s(u_i))`` (thrust in units of K), in the body frame (FLU)::
+Rotor i makes thrust ``K s(u_i)``, ``s(u) = (1 - f) u + f u^2`` (PX4's ``THR_MDL_FAC``), through
+a first-order lag of bandwidth ``omega``; with ``F_i`` that lagged thrust in units of K, body FLU::
 
-    a_z   = (K/m) sum_i F_i                                   specific force along body z
-    p'    = k1 q r + (K/Jxx) sum_i  y_i F_i + c_x             roll,  k1 = (Jyy - Jzz)/Jxx
-    q'    = k3 p r + (K/Jyy) sum_i -x_i F_i + c_y             pitch, k3 = (Jzz - Jxx)/Jyy
-    r'    = k5 p q + (K d/Jzz) sum_i s_i F_i + c_z            yaw,   k5 = (Jxx - Jyy)/Jzz
+    a_z   = (K/m) sum_i F_i
+    p'    = k1 q r + (K/Jxx) sum_i  y_i F_i + c_x             k1 = (Jyy - Jzz)/Jxx
+    q'    = k3 p r + (K/Jyy) sum_i -x_i F_i + c_y             k3 = (Jzz - Jxx)/Jyy
+    r'    = k5 p q + (K d/Jzz) sum_i s_i F_i + c_z            k5 = (Jxx - Jyy)/Jzz
 
-with ``(x_i, y_i)`` rotor i's position [m] and ``s_i`` its yaw sign (+1 when its drag torque is
-positive about body z up; eq (4): rotors 1 and 3). ``c_x, c_y, c_z`` are constant trim
-accelerations (a centre of mass off the rotors' centre, unequal motors): left free so that a
-trim does not bias the effectiveness. For a given ``omega`` (and ``f``) each line is linear in
-its parameters.
-
-Every signal, regressor and regressand alike, goes through the same filter: the angular
-accelerations are the Savitzky-Golay first derivative (scipy.signal.savgol_coeffs) of the
-logged rates, and every other signal is filtered by the same derivative filter applied to its
-integral (:func:`kernels`), so the filter's delay and attenuation are exactly the same on both
-sides of each equation and do not bias the fit.
+each linear in its parameters for a given ``omega``; both sides of each go through the same
+filter (:func:`kernels`). The symbols and why: docs/identify.md.
 """
 
 from __future__ import annotations
@@ -42,28 +31,9 @@ ROTATION_TERMS = {
 
 @dataclass(frozen=True)
 class Signals:
-    """A log's samples, filtered and split into what the regressions need.
-
-    Parameters
-    ----------
-    t : ndarray, shape (L,)
-        Time [s].
-    segment : ndarray, shape (L,)
-        Segment index of each sample.
-    u : ndarray, shape (L, n)
-        Rotor commands in [0, 1].
-    rates : ndarray, shape (L, 3)
-        Body rates (FLU), filtered [rad/s].
-    rate_dot : ndarray, shape (L, 3)
-        Their derivative, by the same filter [rad/s^2].
-    force_z : ndarray, shape (L,)
-        Specific force along body z, filtered [m/s^2].
-    products : ndarray, shape (L, 3)
-        q r, p r, p q, each filtered after the product [rad^2/s^2].
-    window : int
-        The filter's window [samples].
-    dt : float
-        The grid's step [s].
+    """A log's samples through the matched filters: ``t`` [s], ``segment``, commands ``u`` (L, n),
+    body ``rates`` [rad/s] (FLU), ``rate_dot`` [rad/s^2], ``force_z`` [m/s^2], ``products`` (q r, p r,
+    p q, filtered after the product), the filter's ``window`` [samples] and the grid's ``dt`` [s].
     """
 
     t: np.ndarray
@@ -78,24 +48,10 @@ class Signals:
 
 
 def kernels(window: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """The derivative filter and the smoothing filter matched to it.
+    """The Savitzky-Golay derivative filter ``h`` (order 2) and ``c``, ``h`` applied to the integral.
 
-    ``h`` is the Savitzky-Golay first-derivative filter (order 2). ``c`` is ``h`` applied to
-    the integral of a signal (trapezoids between samples): ``h * p`` equals ``c * p'`` for any
-    ``p'`` linear between samples, so a rate's filtered derivative and its filtered
-    right-hand side see exactly the same filter, and the fit no bias from the filtering.
-
-    Parameters
-    ----------
-    window : int
-        Length [samples], odd, >= 5.
-    dt : float
-        Sample spacing [s].
-
-    Returns
-    -------
-    h, c : ndarray, shape (window,)
-        Convolution kernels (``numpy.convolve(x, k, "same")``); ``c`` sums to 1.
+    ``h * p`` equals ``c * p'`` for ``p'`` linear between samples, so a rate's filtered derivative
+    and its filtered right-hand side see the same filter (no bias from the filtering).
 
     Examples
     --------
@@ -110,26 +66,7 @@ def kernels(window: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def smooth(x: np.ndarray, segment: np.ndarray, window: int, deriv: int = 0, dt: float = 1.0) -> np.ndarray:
-    """The matched filters of :func:`kernels` along axis 0, within each segment.
-
-    Parameters
-    ----------
-    x : ndarray, shape (L,) or (L, k)
-        The signal(s).
-    segment : ndarray, shape (L,)
-        Segment index of each sample: the filter does not reach across segments (the first
-        and last half window of each segment are not valid: the fit leaves them out).
-    window : int
-        Window length [samples], odd, >= 5.
-    deriv : int
-        0 to smooth (``c``), 1 for the first derivative (``h``).
-    dt : float
-        Sample spacing [s].
-
-    Returns
-    -------
-    ndarray
-        Same shape as ``x``.
+    """:func:`kernels`' ``c`` (``deriv=0``) or ``h`` (``deriv=1``) along axis 0, within each segment.
 
     Examples
     --------
@@ -151,25 +88,7 @@ def smooth(x: np.ndarray, segment: np.ndarray, window: int, deriv: int = 0, dt: 
 
 
 def signals(t, segment, u, rates, force_z, window_s: float) -> Signals:
-    """Filter a log's samples for the regressions.
-
-    Parameters
-    ----------
-    t, segment : ndarray, shape (L,)
-        Time [s] and segment index.
-    u : ndarray, shape (L, n)
-        Rotor commands [-].
-    rates : ndarray, shape (L, 3)
-        Body rates, FLU [rad/s].
-    force_z : ndarray, shape (L,)
-        Specific force along body z [m/s^2].
-    window_s : float
-        Filter window [s]; at least 5 samples, odd.
-
-    Returns
-    -------
-    Signals
-    """
+    """Filter a log's samples for the regressions (a window of ``window_s``, at least 5 samples, odd)."""
     dt = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
     window = max(5, round(window_s / dt) | 1)
     p, q, r = rates.T
@@ -187,25 +106,7 @@ def signals(t, segment, u, rates, force_z, window_s: float) -> Signals:
 
 
 def lagged(u: np.ndarray, segment: np.ndarray, omega: float, dt: float) -> np.ndarray:
-    """First-order lag ``F' = omega (u - F)`` of each column, within each segment.
-
-    The bilinear (trapezoidal) discretisation, exact for an input linear between samples (as
-    the log's interpolation makes it), each segment starting in steady state.
-
-    Parameters
-    ----------
-    u : ndarray, shape (L, n)
-        Inputs.
-    segment : ndarray, shape (L,)
-        Segment index of each sample.
-    omega : float
-        Bandwidth [rad/s].
-    dt : float
-        Sample spacing [s].
-
-    Returns
-    -------
-    ndarray, shape (L, n)
+    """The first-order lag ``F' = omega (u - F)`` of each column, bilinear, each segment from steady state.
 
     Examples
     --------
@@ -227,26 +128,10 @@ def lagged(u: np.ndarray, segment: np.ndarray, omega: float, dt: float) -> np.nd
 def regressions(
     sig: Signals, omega: float, shape_f: float | None, rotors: np.ndarray, fit_shape: bool = False
 ) -> dict[str, tuple[np.ndarray, np.ndarray, tuple[str, ...]]]:
-    """The four regressions' data at a given rotor bandwidth.
+    """The four regressions' data at a given rotor bandwidth: channel -> (y, X, parameter names).
 
-    Parameters
-    ----------
-    sig : Signals
-        The filtered log.
-    omega : float
-        Rotor bandwidth [rad/s].
-    shape_f : float or None
-        The thrust-curve factor f the moments' regressors are built with (0 for None).
-    rotors : ndarray, shape (n, 3)
-        x, y [m] (FLU) and yaw sign of each rotor.
-    fit_shape : bool
-        Fit f: the thrust regression gets two columns, ``sum u`` and ``sum u^2`` (lagged).
-
-    Returns
-    -------
-    dict
-        Channel name -> (y, X, parameter names); the names of the thrust regression are
-        ``KL`` (K (1 - f) / m) and ``KQ`` (K f / m) when ``fit_shape``, else ``Km`` (K / m).
+    The thrust regression's names are ``KL`` (K (1 - f) / m) and ``KQ`` (K f / m) when
+    ``fit_shape``, else ``Km`` (K / m).
     """
     u = sig.u
     f = 0.0 if shape_f is None else shape_f

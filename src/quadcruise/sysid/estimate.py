@@ -1,18 +1,7 @@
-"""Equation-error least squares with intervals that hold under autocorrelated residuals.
+"""Equation-error least squares, ``omega`` by variable projection, intervals by a Newey-West sandwich.
 
-The four regressions of :mod:`quadcruise.sysid.equations` are linear in their coefficients
-for a given rotor bandwidth ``omega``. ``omega`` is found by variable projection: for each
-trial value the coefficients are the least-squares solution, and ``omega`` minimises the sum
-of the four residual sums of squares, each weighted by its channel's residual variance
-(scipy's bounded Brent search on log omega).
-
-Intervals: the filtered signals make the residuals strongly correlated from one sample to the
-next (over the filter window at least), so the ordinary least-squares covariance would be
-several times too small. The covariance of all coefficients together, ``omega`` included
-(through the regressors' derivative with respect to it), is the sandwich
-``A^-1 S A^-1`` with ``S`` the Newey-West (Bartlett) long-run covariance of the score; its
-bandwidth is the larger of twice the filter window and the lag at which the residuals'
-autocorrelation has fallen below 0.05 (at most a fifth of the samples).
+The filtered residuals are autocorrelated over the filter window at least, so the ordinary
+covariance would be several times too small; docs/identify.md gives the estimator and its reasons.
 """
 
 from __future__ import annotations
@@ -27,29 +16,9 @@ from quadcruise.sysid.equations import CHANNELS, Signals, regressions
 
 @dataclass(frozen=True)
 class Fit:
-    """The fitted coefficients and their joint covariance.
-
-    Parameters
-    ----------
-    names : tuple of str
-        Coefficient names (the regressions' in :data:`CHANNELS` order, then ``omega`` when
-        fitted).
-    values : ndarray
-        Their values.
-    cov : ndarray
-        Their covariance (Newey-West sandwich).
-    omega : float
-        The rotor bandwidth the regressors were built with [rad/s].
-    omega_fitted : bool
-        Whether ``omega`` was fitted (else fixed, and not in ``names``).
-    shape_f : float
-        The thrust-curve factor the moments' regressors were built with.
-    sigma : dict
-        Channel -> residual standard deviation on the fitted rows.
-    bandwidth : int
-        The Newey-West bandwidth [samples].
-    rows : int
-        Samples fitted.
+    """The fitted coefficients (``names``, ``values``; ``omega`` last when ``omega_fitted``), their
+    Newey-West covariance ``cov``, the ``omega`` [rad/s] and ``shape_f`` used, each channel's
+    residual ``sigma``, the HAC ``bandwidth`` and the ``rows`` [samples] fitted.
     """
 
     names: tuple
@@ -63,27 +32,11 @@ class Fit:
     rows: int
 
     def value(self, name: str) -> float:
-        """One coefficient's value.
-
-        Parameters
-        ----------
-        name : str
-            A name of :attr:`names`.
-
-        Returns
-        -------
-        float
-        """
+        """One coefficient's value, by name."""
         return float(self.values[self.names.index(name)])
 
     def coefficients(self) -> dict[str, np.ndarray]:
-        """Each channel's coefficient vector.
-
-        Returns
-        -------
-        dict
-            Channel -> its coefficients, in the regression's column order.
-        """
+        """Channel -> its coefficients, in the regression's column order."""
         out, k = {}, 0
         for c, width in self.widths:
             out[c] = self.values[k : k + width]
@@ -105,29 +58,7 @@ def _solve(y: np.ndarray, X: np.ndarray) -> np.ndarray:
 def weighted_ssr(
     sig: Signals, rows: np.ndarray, omega: float, shape_f: float, rotors: np.ndarray, fit_shape: bool, sigma: dict
 ) -> float:
-    """The profile objective: sum over channels of SSR / sigma^2 at this omega.
-
-    Parameters
-    ----------
-    sig : Signals
-        The filtered log.
-    rows : ndarray of bool
-        The samples fitted.
-    omega : float
-        Rotor bandwidth [rad/s].
-    shape_f : float
-        Thrust-curve factor.
-    rotors : ndarray, shape (n, 3)
-        Rotor geometry.
-    fit_shape : bool
-        Two thrust columns.
-    sigma : dict
-        Channel -> weight's standard deviation.
-
-    Returns
-    -------
-    float
-    """
+    """The profile objective at this omega: the sum over channels of SSR / sigma^2."""
     total = 0.0
     for c, (y, X, _) in regressions(sig, omega, shape_f, rotors, fit_shape).items():
         e = y[rows] - X[rows] @ _solve(y[rows], X[rows])
@@ -146,29 +77,7 @@ def fit(
     fit_shape: bool,
     omega_bounds: tuple[float, float],
 ) -> Fit:
-    """Fit the four regressions (and omega), with the Newey-West covariance.
-
-    Parameters
-    ----------
-    sig : Signals
-        The filtered log.
-    rows : ndarray of bool
-        The samples fitted.
-    rotors : ndarray, shape (n, 3)
-        Rotor geometry.
-    omega0 : float
-        Starting (or fixed) rotor bandwidth [rad/s].
-    shape_f : float
-        Starting (or fixed) thrust-curve factor.
-    fit_omega, fit_shape : bool
-        Whether to fit omega, and the thrust curve's shape.
-    omega_bounds : tuple of float
-        The search interval for omega [rad/s].
-
-    Returns
-    -------
-    Fit
-    """
+    """Fit the four regressions (and ``omega``, the thrust curve's shape), with the Newey-West covariance."""
 
     def residual_sigma(omega, f):
         out = {}
@@ -237,24 +146,9 @@ def fit(
 
 
 def sandwich(bread: np.ndarray, meat: np.ndarray, tol: float = 1e-10) -> np.ndarray:
-    """``A^-1 S A^-1``, with infinite variance for what the data do not determine.
-
-    A direction of the (scaled) bread with an eigenvalue below ``tol`` times the largest is
-    one the regressors do not excite; every coefficient with a share in it gets an infinite
-    variance (a pseudo-inverse would give it zero: a tight interval on nothing).
-
-    Parameters
-    ----------
-    bread : ndarray, shape (p, p)
-        ``A``, the weighted sum of the Jacobians' outer products.
-    meat : ndarray, shape (p, p)
-        ``S``, the long-run covariance of the score.
-    tol : float
-        Relative eigenvalue below which a direction counts as not excited.
-
-    Returns
-    -------
-    ndarray, shape (p, p)
+    """``A^-1 S A^-1``, with infinite variance for a coefficient in a direction the data do not excite
+    (an eigenvalue of the scaled ``A`` below ``tol`` times the largest): a pseudo-inverse would give
+    it zero, a tight interval on nothing.
 
     Examples
     --------
@@ -276,21 +170,8 @@ def sandwich(bread: np.ndarray, meat: np.ndarray, tol: float = 1e-10) -> np.ndar
 
 
 def hac_bandwidth(resid: dict, segment: np.ndarray, window: int) -> int:
-    """Newey-West bandwidth: max(2 window, the lag where every channel's residual
-    autocorrelation is below 0.05), at most a fifth of the samples.
-
-    Parameters
-    ----------
-    resid : dict
-        Channel -> residuals.
-    segment : ndarray
-        Segment of each residual.
-    window : int
-        The filter window [samples].
-
-    Returns
-    -------
-    int
+    """Newey-West bandwidth: max(2 window, the lag where every channel's residual autocorrelation is
+    below 0.05), at most a fifth of the samples.
 
     Examples
     --------

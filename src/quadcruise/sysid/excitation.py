@@ -1,17 +1,9 @@
-"""An open-loop excitation for identification: hover with doublets on every axis.
+"""An open-loop excitation for identification: hover with 1-2-1 doublets on every axis.
 
-PX4-style system identification injects doublets (a step up, a step down twice as long, a step
-back) on roll, pitch, yaw and thrust on top of hover. Flown open loop on the paper's plant
-(``quadcruise.replay``), a "1-2-1" doublet of torque brings the rate up, down through zero and
-back to zero, and the angle back to where it was, so the vehicle stays near hover. Part of the
-roll and pitch doublets are flown while the vehicle spins about z (a yaw step, held, undone
-later): the gyroscopic terms ``k1 q r`` and ``k3 p r`` then carry the information on ``Jzz``
-that the yaw axis alone cannot separate from ``d`` (the yaw equation sees only ``K d / Jzz``).
-
-Open loop, nothing holds the altitude: the tilts of the doublets cost some lift, and the
-vehicle sinks (tens of metres over the pattern), so fly it from high up (the paper's plant has
-no ground). :class:`ScheduleController` flies the schedule in ``quadcruise.fly``, so that the
-flight carries the sensor noise its PX4 log (``SimResult.to_ulog``) is written with.
+Part of the roll and pitch doublets fly while the vehicle spins about z, so that the gyroscopic
+terms carry the information on ``Jzz``. Open loop, the vehicle sinks (tens of metres over the
+pattern): fly it from high up. :class:`ScheduleController` flies the schedule in
+``quadcruise.fly``, with the sensor noise its PX4 log is written with. docs/identify.md.
 
 Examples
 --------
@@ -34,15 +26,7 @@ from quadcruise.model.vehicle import Vehicle
 
 
 class ScheduleController:
-    """A duty schedule as a controller (``ControllerLike``): open loop, the state ignored.
-
-    Parameters
-    ----------
-    t : ndarray, shape (L,)
-        Times [s], increasing.
-    duties : ndarray, shape (L, 4)
-        Rotor duties [-], each held until the next time.
-    """
+    """A duty schedule ``(t, duties)``, each row held until the next time, as an open-loop controller."""
 
     name = "schedule"
 
@@ -51,21 +35,11 @@ class ScheduleController:
         self.function = duty_schedule
 
     def gains(self) -> np.ndarray:
-        """The packed schedule (:func:`quadcruise.control.openloop.pack_schedule`).
-
-        Returns
-        -------
-        ndarray
-        """
+        """The packed schedule (:func:`quadcruise.control.openloop.pack_schedule`)."""
         return pack_schedule(self.t, self.duties)
 
     def memory(self) -> np.ndarray:
-        """The controller's memory: the current row.
-
-        Returns
-        -------
-        ndarray, shape (1,)
-        """
+        """The controller's memory: the current row."""
         return np.zeros(1)
 
 
@@ -80,33 +54,12 @@ def doublets(
     dt: float = 1e-3,
     repeats: int = 2,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The duty schedule of a doublet excitation around hover.
+    """``(t, duties)``: the duty schedule of a doublet excitation around ``vehicle``'s hover.
 
-    Parameters
-    ----------
-    vehicle : Vehicle
-        The vehicle flown (its hover duty and gains size the doublets).
-    rate : float
-        Peak body rate of a roll or pitch doublet [rad/s].
-    spin : float
-        Yaw rate held during the spinning part [rad/s].
-    accel : float
-        Vertical acceleration of a thrust doublet [m/s^2].
-    pulse : float
-        The doublet's unit step length [s] (1-2-1: four of them).
-    rest : float
-        Hover between doublets [s].
-    dt : float
-        Schedule step [s].
-    repeats : int
-        How many times the whole pattern is flown (spinning the other way each time).
-
-    Returns
-    -------
-    t : ndarray, shape (L,)
-        Times [s].
-    duties : ndarray, shape (L, 4)
-        Rotor duties [-].
+    ``rate`` [rad/s] and ``accel`` [m/s^2] size the roll/pitch and thrust doublets, ``spin`` [rad/s]
+    the yaw rate held meanwhile; ``pulse`` [s] is the doublet's unit step, ``rest`` [s] the hover
+    between doublets, ``dt`` [s] the step; the pattern is flown ``repeats`` times, spinning each
+    way in turn.
     """
     u0 = float(vehicle.hover_duty)
     K, l, d = float(vehicle.K), float(vehicle.l), float(vehicle.d)

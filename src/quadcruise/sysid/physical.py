@@ -1,22 +1,11 @@
-"""From regression coefficients to the vehicle's parameters, with intervals (delta method).
+"""From regression coefficients to the vehicle's parameters, with 95 % intervals (delta method).
 
-With the mass m given::
-
-    K   = m Km                    (or m (KL + KQ), f = KQ / (KL + KQ) with the curve's shape)
-    Jxx = K / b_roll,  Jyy = K / b_pitch
-    Jzz = Jyy - k1 Jxx   (roll's gyroscopic term)   and   Jzz = Jxx + k3 Jyy   (pitch's),
-          the two combined with inverse-variance weights
-    d   = b_yaw Jzz / K
-
-Without the mass, ``K``, ``Jxx``, ``Jyy`` and ``Jzz`` are the same numbers per unit mass (``_per_m``);
-``d``, ``omega`` and ``hover_duty`` do not depend on the mass. ``hover_duty``: the command u of
-every rotor with ``n K s(u) = m g`` (level hover).
-
-The covariance of the coefficients carries over by the delta method (the mapping's Jacobian by
-central differences). A parameter is identifiable when its 95 % interval is finite and within
-:data:`RELATIVE_HALF_WIDTH` of its value (f: within :data:`SHAPE_HALF_WIDTH`); otherwise it is reported as not
-identifiable, with the
-base vehicle's value and no interval.
+With the mass m given: ``K = m Km`` (or ``m (KL + KQ)``, ``f = KQ / (KL + KQ)``),
+``Jxx = K / b_roll``, ``Jyy = K / b_pitch``, ``Jzz`` from roll's and pitch's gyroscopic terms
+(inverse-variance weights), ``d = b_yaw Jzz / K``; without it, the same per unit mass
+(``_per_m``). A parameter is identifiable when its 95 % interval is finite and within
+:data:`RELATIVE_HALF_WIDTH` of its value (f: :data:`SHAPE_HALF_WIDTH`); otherwise it is reported
+with the base vehicle's value and no interval. docs/identify.md explains.
 """
 
 from __future__ import annotations
@@ -38,23 +27,7 @@ Z95 = 1.959963984540054
 
 
 def hover_command(km: float, kq: float, n: int, g: float) -> float:
-    """The per-rotor command that holds level hover: ``n (Km u + KQ u^2) = g``.
-
-    Parameters
-    ----------
-    km : float
-        The linear thrust coefficient per unit mass, K (1 - f) / m [N/kg].
-    kq : float
-        The quadratic one, K f / m [N/kg].
-    n : int
-        Number of rotors.
-    g : float
-        Gravity [m/s^2].
-
-    Returns
-    -------
-    float
-        u [-] (NaN when no positive root).
+    """The per-rotor command ``u`` of level hover, ``n (km u + kq u^2) = g`` (NaN when no positive root).
 
     Examples
     --------
@@ -69,26 +42,7 @@ def hover_command(km: float, kq: float, n: int, g: float) -> float:
 
 
 def mapping(fit: Fit, mass: float | None, n_rotors: int, g: float, jzz_weights: tuple[float, float]):
-    """The function from the coefficient vector to the physical parameters.
-
-    Parameters
-    ----------
-    fit : Fit
-        The fit (for the names).
-    mass : float or None
-        m [kg]; None for per-unit-mass values.
-    n_rotors : int
-        Number of rotors.
-    g : float
-        Gravity [m/s^2].
-    jzz_weights : tuple of float
-        Weights of Jzz from roll's and pitch's gyroscopic terms (sum 1).
-
-    Returns
-    -------
-    callable
-        ``values -> dict`` of parameter name -> value.
-    """
+    """The function ``values -> {parameter: value}`` from the coefficient vector."""
     idx = {name: i for i, name in enumerate(fit.names)}
     scale = 1.0 if mass is None else float(mass)
     suffix = "_per_m" if mass is None else ""
@@ -120,21 +74,7 @@ def mapping(fit: Fit, mass: float | None, n_rotors: int, g: float, jzz_weights: 
 
 
 def jacobian(func, v: np.ndarray) -> tuple[list[str], np.ndarray, np.ndarray]:
-    """Values and Jacobian of a dict-valued function, by central differences.
-
-    Parameters
-    ----------
-    func : callable
-        ``ndarray -> dict`` of name -> float.
-    v : ndarray
-        Where.
-
-    Returns
-    -------
-    names : list of str
-    values : ndarray
-    jac : ndarray, shape (len(names), len(v))
-    """
+    """``(names, values, jac)`` of a dict-valued function at ``v``, by central differences."""
     with np.errstate(all="ignore"):
         return _jacobian(func, v)
 
@@ -161,30 +101,11 @@ def parameters(
     systematic: dict[str, float] | None = None,
     coupling: tuple[bool, bool] = (True, True),
 ) -> dict[str, dict]:
-    """The physical parameters with 95 % intervals and identifiability.
+    """The physical parameters: name -> ``{"value", "se", "ci95": [lo, hi], "identifiable"}``.
 
-    Parameters
-    ----------
-    fit : Fit
-        The coefficients and their covariance.
-    mass : float or None
-        m [kg], or None (per unit mass).
-    n_rotors : int
-        Number of rotors.
-    g : float
-        Gravity [m/s^2].
-    systematic : dict, optional
-        Name -> half-range of a systematic error (uniformly distributed: its variance,
-        half^2 / 3, is added to the statistical one).
-    coupling : tuple of bool
-        Whether roll's (``k1 q r``) and pitch's (``k3 p r``) gyroscopic terms may give Jzz; one
-        whose regressor is mostly sensor noise is biased toward zero (errors in variables) and
-        must not.
-
-    Returns
-    -------
-    dict
-        Name -> ``{"value", "se", "ci95": [lo, hi], "identifiable"}``.
+    ``systematic`` adds a uniform error's variance (half-range^2 / 3) per name; ``coupling`` says
+    whether roll's and pitch's gyroscopic terms may give Jzz (one whose regressor is mostly sensor
+    noise is biased toward zero and must not).
     """
     # Jzz's two estimates, weighted by their inverse variances
     est, jzz, rows = [], [], []

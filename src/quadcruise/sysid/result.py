@@ -99,7 +99,7 @@ class IdentifyResult:
         return self.base.replace(**values)
 
     def to_pandas(self):
-        """The parameters as a table.
+        """One row per identified parameter (not per sample: the held-out samples are in :attr:`traces`).
 
         Returns
         -------

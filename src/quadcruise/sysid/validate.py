@@ -1,14 +1,8 @@
-"""The identified model against the held-out tail of the log.
+"""The identified model against the held-out tail of the log: R^2 and RMSE per channel.
 
-Per channel, R^2 and RMSE of the model's prediction against the measurement:
-
-- linear accelerations in the world frame (ENU): measured, the derivative of the logged
-  velocity (the fit's filter); predicted, ``R (0, 0, T/m) - g e_z`` from the held-out commands
-  and the logged attitude;
-- angular accelerations p', q', r': the fitted equations on the held-out samples;
-- rates over short windows (:data:`WINDOW_S`): from the logged rates at each window's start,
-  the model alone (its own gyroscopic terms, the logged commands through the fitted lag)
-  integrated to the window's end, against the logged rates there: the open-loop check.
+Linear accelerations (ENU, the logged velocity's derivative against ``R (0, 0, T/m) - g e_z``),
+angular accelerations (the fitted equations), and rates over short windows (:data:`WINDOW_S`)
+predicted open loop from each window's start. docs/identify.md says what each shows.
 """
 
 from __future__ import annotations
@@ -23,17 +17,7 @@ WINDOW_S = 0.25
 
 
 def scores(measured: np.ndarray, predicted: np.ndarray) -> dict[str, float]:
-    """R^2 and RMSE of a prediction.
-
-    Parameters
-    ----------
-    measured, predicted : ndarray, shape (L,)
-        The two series.
-
-    Returns
-    -------
-    dict
-        ``r2`` (1 - SSE/SST; NaN when the measurement does not vary) and ``rmse``.
+    """``r2`` (1 - SSE/SST; NaN when the measurement does not vary) and ``rmse`` of a prediction.
 
     Examples
     --------
@@ -47,29 +31,10 @@ def scores(measured: np.ndarray, predicted: np.ndarray) -> dict[str, float]:
 
 
 def validate(sig, held: np.ndarray, fit: Fit, rotors: np.ndarray, flight, g: float) -> tuple[dict, dict]:
-    """Score the fitted model on the held-out samples.
+    """Score the fitted model on the held-out samples: ``(validation, traces)``.
 
-    Parameters
-    ----------
-    sig : Signals
-        The filtered log.
-    held : ndarray of bool
-        The held-out samples.
-    fit : Fit
-        The fitted coefficients.
-    rotors : ndarray, shape (n, 3)
-        Rotor geometry.
-    flight : FlightLog
-        The log (attitude, velocity).
-    g : float
-        Gravity [m/s^2].
-
-    Returns
-    -------
-    validation : dict
-        Channel -> ``{"r2", "rmse", "unit"}``, and ``open_loop`` (rates over windows).
-    traces : dict
-        ``t`` and, per channel, ``measured`` and ``predicted`` arrays on the held-out samples.
+    ``validation``: channel -> ``{"r2", "rmse", "unit"}`` and ``open_loop``; ``traces``: ``t`` and
+    each channel's ``measured`` and ``predicted`` on the held-out samples.
     """
     data = regressions(sig, fit.omega, fit.shape_f, rotors, "KQ" in fit.names)
     beta = fit.coefficients()
@@ -90,25 +55,7 @@ def validate(sig, held: np.ndarray, fit: Fit, rotors: np.ndarray, flight, g: flo
 
 
 def open_loop(sig, held: np.ndarray, data: dict, beta: dict) -> dict:
-    """Rates predicted open loop over short windows of the held-out samples.
-
-    Parameters
-    ----------
-    sig : Signals
-        The filtered log.
-    held : ndarray of bool
-        The held-out samples.
-    data : dict
-        The regressions at the fitted omega.
-    beta : dict
-        The fitted coefficients per channel.
-
-    Returns
-    -------
-    dict
-        ``window_s``, ``windows``, and per rate (``p``, ``q``, ``r``) its R^2 and RMSE at
-        the windows' ends [rad/s].
-    """
+    """Rates predicted open loop over short windows: ``window_s``, ``windows``, each rate's R^2 and RMSE."""
     steps = max(1, round(WINDOW_S / sig.dt))
     idx = np.flatnonzero(held)
     starts = [

@@ -133,7 +133,7 @@ class Comparison:
         return table.set_index(["controller", "vehicle"])
 
     def to_pandas(self):
-        """Every flight's traces, long-form, with a ``controller`` column first.
+        """The traces, long-form: one row per controller, vehicle and logged instant (per-flight: :meth:`table`).
 
         Returns
         -------
@@ -370,24 +370,10 @@ def compare(
 
 
 def labelled(controllers) -> dict:
-    """Controllers by label, as :func:`compare` flies them.
+    """Label -> controller, in the order given, as :func:`compare` flies them.
 
-    Parameters
-    ----------
-    controllers : str, sequence or mapping
-        Comma-separated names; a sequence of names or Controller objects, each labelled by
-        its name (a repeated name gets '#2', '#3', ...); or a mapping label -> name or
-        Controller.
-
-    Returns
-    -------
-    dict of str to Controller
-        Label -> controller, in the order given.
-
-    Raises
-    ------
-    InputError
-        For no controller, or one that is neither a name nor a Controller.
+    Comma-separated names, a sequence of names or Controller objects (a repeated name gets '#2',
+    '#3', ...), or a mapping label -> name or Controller; InputError for none or a bad one.
 
     Examples
     --------

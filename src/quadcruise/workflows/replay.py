@@ -48,17 +48,7 @@ OUTPUT_COLUMNS = ("t",) + STATE_NAMES
 
 @njit(cache=True)  # compiled (as MISSION_SIG) on first use, not at import
 def no_reference(t, mp, ref):
-    """An open-loop flight has no reference: NaN throughout (a mission, ``MISSION_SIG``).
-
-    Parameters
-    ----------
-    t : float
-        Time [s] (unused).
-    mp : ndarray
-        Mission parameters (unused).
-    ref : ndarray, shape (11,)
-        Output: the reference, set to NaN.
-    """
+    """An open-loop flight's reference (a mission, ``MISSION_SIG``): NaN throughout."""
     for j in range(ref.shape[0]):
         ref[j] = math.nan
 
@@ -273,15 +263,6 @@ def write_states_csv(
 def speed_columns(n_rotors: int) -> tuple[str, ...]:
     """The input columns of a rotor-speed schedule: ``t, w1 .. wn``.
 
-    Parameters
-    ----------
-    n_rotors : int
-        Number of rotors.
-
-    Returns
-    -------
-    tuple of str
-
     Examples
     --------
     >>> speed_columns(4)
@@ -387,9 +368,7 @@ def read_speed_csv(
 
 
 ROTOR_MAX_STEP = 1e-4
-"""Default longest RK4 substep [s] of a rotor-plant replay: against RotorPy, a hummingbird (5 ms
-motors) tumbling at up to 290 rad/s ends 3 s with its quaternion 3e-3 off at 1e-3 s, 2.5e-7
-at 1e-4 s (tests/integration/test_rotorpy_agreement.py); 3 s cost 30,000 steps, milliseconds."""
+"""Default longest RK4 substep [s] of a rotor-plant replay (why: docs/vehicles.md, "Step")."""
 
 
 def replay_rotors(

@@ -1,27 +1,12 @@
 """Reproduce the paper: both controllers on its scenarios, our numbers beside its numbers.
 
-The paper reports, for its inverse-model nonlinear PD ("nlpd"), rise time 1 s, settling time
-2 s and overshoot 4 % for the transient from hover into the cruise, and 6 s, 12 s and 11 %
-for the baseline built on Gonzalez's paper [5] ("gonzalez", reconstructed here). It shows
-the circle cruise (Figs 4, 5a, 5b) and the square cruise (Figs 6a, 6b).
-
-Scenarios (each starts hovering at the origin at 1 m; transients are measured on x):
-
-- ``circle``: the default :class:`~quadcruise.missions.Circle` (R = 2 m, 20 s a lap), one lap;
-  the start point (2, 0) makes a 2 m step in x at t = 0;
-- ``square``: a 4 m square at 0.5 m/s centred on the origin, first corner (-2, -2), one lap;
-  the vehicle starts 2 m from it in x and in y;
-- ``step``: a 1 m step in x at t = 1 s, the pure design case of eqs (17)-(18).
-
-Beyond the paper, ``nlpd+ff`` is the paper's controller with the reference acceleration fed
-forward, which removes most of the steady tracking lag on the circle.
-
-Fitted, and labelled so: ``nlpd (fitted)`` and ``gonzalez (fitted)`` fly the gains that
-``quadcruise tune`` finds for the paper's reported transients (:data:`FITTED`; the scenario
-files ``examples/scenarios/paper_fitted_*.toml`` hold them with the command that regenerates
-them), beside the paper's own gains, on ``entry``: the 2 m step in x that the circle and the
-square start with, without their motion (:data:`FIT_SCENARIO`). They explain the paper's
-numbers; they are not the paper's design.
+Scenarios, each from hover at the origin at 1 m, transients measured on x: ``circle`` (the
+default :class:`~quadcruise.missions.Circle`, one lap: a 2 m step in x at t = 0), ``square`` (4 m
+at 0.5 m/s, first corner (-2, -2), one lap) and ``step`` (1 m in x at t = 1 s, the design case of
+eqs (17)-(18)). Controllers: the paper's ``nlpd`` and ``gonzalez``, ``nlpd+ff`` (beyond the
+paper: the reference acceleration fed forward) and, labelled *fitted*, the gains ``quadcruise
+tune`` finds for the paper's reported transients (:data:`FITTED`) on ``entry``
+(:data:`FIT_SCENARIO`). The results and their reading: docs/paper.md.
 
 Examples
 --------
@@ -88,18 +73,8 @@ FITTED = {
     "gonzalez (fitted)": lambda: Gonzalez(position=PDGains(kp=0.2894724746913224, kd=0.5427710673470861)),
 }
 """Label -> factory of the controllers fitted to the paper's transients by ``quadcruise tune``
-(examples/scenarios/paper_fitted_nlpd.toml and paper_fitted_gonzalez.toml, with the commands):
-
-- nlpd: position Kp, Kd for rise 1 +- 0.3 s (10-90 %), 2 % settling 2 +- 0.5 s, overshoot
-  4 +- 1.5 % (the tolerances weight the three misses; two gains cannot meet three targets
-  exactly): the PD's own pair has zeta 0.70, wn 1.86 rad/s; flown with the attitude loop and
-  the rotor lag the dominant pair is that of :func:`fitted_nlpd_loop`, not the paper's poles
-  -0.7 and -4.3;
-- gonzalez: the literal tanh form (a_p = k_p x 1 m, a_d = k_d x 1 m/s) with k_p, k_d for 2 %
-  settling 12 s and overshoot 11 % (met exactly); its rise then comes out at 6.3 s measured
-  0-100 % (4.2 s 10-90 %), close to the paper's 6 s if that is a 0-100 % rise, which the
-  paper does not say (a hypothesis, not a finding). zeta 0.50, wn 0.54 rad/s.
-"""
+(``examples/scenarios/paper_fitted_*.toml``, with the commands). The targets, what the fits
+reach and what they explain: docs/paper.md, "The paper's table, explained"."""
 FIT_PAPER = {"nlpd": "nlpd", "gonzalez": "gonzalez", "nlpd (fitted)": "nlpd", "gonzalez (fitted)": "gonzalez"}
 """Controller label on the fit scenario -> whose reported numbers it is set beside."""
 
@@ -133,20 +108,7 @@ METRIC_KEYS = (
 
 
 def paper_numbers(run: dict) -> dict:
-    """The paper's reported transient that a run is set beside.
-
-    Parameters
-    ----------
-    run : dict
-        An entry of :attr:`Reproduction.runs`.
-
-    Returns
-    -------
-    dict
-        ``rise_time_s``, ``settling_time_s``, ``overshoot_pct`` of :data:`PAPER` for the
-        circle, the square and the fit scenario; empty for the ``step`` scenario and for
-        controllers the paper has no numbers for.
-    """
+    """The paper's reported transient (:data:`PAPER`) a run is set beside; empty for ``step`` and ``nlpd+ff``."""
     if run["scenario"] == FIT_SCENARIO[0]:
         return PAPER.get(FIT_PAPER.get(run["controller"], ""), {})
     return PAPER.get(run["controller"], {}) if run["scenario"] != "step" else {}
@@ -154,23 +116,10 @@ def paper_numbers(run: dict) -> dict:
 
 @dataclass
 class Reproduction:
-    """The runs of a reproduction: one dict of metrics per (scenario, controller).
-
-    :func:`reproduce` builds it.
-
-    Parameters
-    ----------
-    runs : list of dict
-        One per flight, in the order flown: ``scenario``, ``controller``, ``axis``,
-        ``status`` and the metrics of :data:`METRIC_KEYS` (times [s], overshoot [%],
-        errors [m]; None where not applicable or not settled).
-    results : dict of (str, str) to SimResult
-        (scenario, controller) -> the flight, logged at every control period.
-    config : dict
-        The vehicle, control period, scenarios and controllers, as ``metrics.json`` and
-        ``quadcruise.json`` record them.
-    timings : dict of str to float
-        ``"scenario/controller"`` -> wall time of the flight and its metrics [s].
+    """The flights of a reproduction (:func:`reproduce`): ``runs``, one dict per flight in the order
+    flown (``scenario``, ``controller``, ``axis``, ``status`` and the metrics of :data:`METRIC_KEYS`;
+    None where not applicable or not settled); ``results``, (scenario, controller) -> its
+    :class:`SimResult`; ``config``, as ``metrics.json`` records it; ``timings`` [s] per flight.
     """
 
     runs: list[dict]
@@ -180,59 +129,23 @@ class Reproduction:
 
     @property
     def failed(self) -> dict:
-        """``"scenario with controller"`` -> why it stopped, for each flight that did not finish.
-
-        Returns
-        -------
-        dict of str to str
-            Empty when every flight finished.
-        """
+        """``"scenario with controller"`` -> why it stopped, for each flight that did not finish."""
         return {
             f"{scen} with {ctrl}": res.status_text(0) for (scen, ctrl), res in self.results.items() if not res.ok[0]
         }
 
     def to_json(self) -> dict:
-        """The ``metrics.json`` document.
-
-        Returns
-        -------
-        dict
-            ``runs``, ``paper`` (:data:`PAPER`), ``config`` and ``version``.
-        """
+        """The ``metrics.json`` document: ``runs``, ``paper`` (:data:`PAPER`), ``config``, ``version``."""
         return {"runs": self.runs, "paper": PAPER, "config": self.config, "version": __version__}
 
     def to_pandas(self):
-        """The runs as a DataFrame.
-
-        Returns
-        -------
-        pandas.DataFrame
-            One row per run, the keys of :attr:`runs` as columns.
-        """
+        """One row per flight (scenario and controller), the keys of :attr:`runs` as columns."""
         import pandas as pd
 
         return pd.DataFrame(self.runs)
 
     def run(self, scenario: str, controller: str) -> dict:
-        """The metrics of one run.
-
-        Parameters
-        ----------
-        scenario : str
-            A name of :data:`SCENARIOS`.
-        controller : str
-            A label of :data:`CONTROLLERS`.
-
-        Returns
-        -------
-        dict
-            The run's entry of :attr:`runs`.
-
-        Raises
-        ------
-        KeyError
-            If that pair was not flown.
-        """
+        """The metrics of one flight, ``runs``' entry for (scenario, controller); KeyError if not flown."""
         for r in self.runs:
             if r["scenario"] == scenario and r["controller"] == controller:
                 return r
@@ -410,54 +323,17 @@ def write_reproduction(
 
 
 def trace_name(label: str) -> str:
-    """A controller label as a file name: ``nlpd+ff`` -> ``nlpd_ff``, ``nlpd (fitted)`` -> ``nlpd_fitted``.
-
-    Parameters
-    ----------
-    label : str
-        A controller label of :data:`CONTROLLERS` or :data:`FITTED`.
-
-    Returns
-    -------
-    str
-    """
+    """A controller label as a file name: ``nlpd+ff`` -> ``nlpd_ff``, ``nlpd (fitted)`` -> ``nlpd_fitted``."""
     return re.sub(r"[^A-Za-z0-9]+", "_", label).strip("_")
 
 
 def written_figures(out: str | Path) -> dict[str, Path]:
-    """The figures that :func:`write_reproduction` wrote into ``out``, by caption.
-
-    Parameters
-    ----------
-    out : str or path-like
-        The reproduction's folder.
-
-    Returns
-    -------
-    dict of str to pathlib.Path
-        Caption -> PNG file, in the order of :data:`FIGURES`, for those present (the
-        ``figures`` of :func:`quadcruise.report.html.reproduction_report`).
-    """
+    """Caption -> PNG file of the figures :func:`write_reproduction` wrote into ``out``."""
     return {caption: Path(out) / name for name, caption in FIGURES.items() if (Path(out) / name).is_file()}
 
 
 def paper_figure(name: str, caption: str, results: dict):
-    """The figure ``name`` of :data:`FIGURES` drawn from the flights.
-
-    Parameters
-    ----------
-    name : str
-        A file name of :data:`FIGURES`.
-    caption : str
-        The figure's title.
-    results : dict of (str, str) to SimResult
-        (scenario, controller) -> flight, as :attr:`Reproduction.results`.
-
-    Returns
-    -------
-    matplotlib.figure.Figure or None
-        None if the flights it needs are missing.
-    """
+    """The figure ``name`` of :data:`FIGURES` drawn from the flights, or None if those it needs are missing."""
     from quadcruise.plots.flight import plot_paths, plot_reference
 
     scen = "circle" if "circle" in name else "square"
@@ -477,20 +353,8 @@ def _cell(value, missing: str = "-") -> str:
 
 
 def results_table(rep: Reproduction) -> str:
-    """Markdown table: each run's transient and tracking metrics beside the paper's.
-
-    Parameters
-    ----------
-    rep : Reproduction
-        The runs.
-
-    Returns
-    -------
-    str
-        One row per run; the paper's value in brackets after ours where it reports one
-        (:func:`paper_numbers`: not for the ``step`` scenario). A flight that did not finish
-        says so in bold after its controller, and a line under the table counts them: its
-        metrics describe a failed flight.
+    """Markdown table: each flight's metrics, the paper's in brackets where it reports one
+    (:func:`paper_numbers`); a flight that did not finish says so in bold, and a line counts them.
     """
     lines = [
         "| scenario | controller | rise 10-90 % [s] (paper) | settling 2 % [s] (paper) | settling 5 % [s] "
@@ -522,18 +386,8 @@ def _gains_text(controller) -> str:
 
 
 def fitted_table(rep: Reproduction) -> str:
-    """Markdown table of the fit scenario: the paper's gains and the fitted ones (labelled),
-    each with both rise conventions, beside the paper's numbers.
-
-    Parameters
-    ----------
-    rep : Reproduction
-        The runs.
-
-    Returns
-    -------
-    str
-        Empty if the fit scenario was not flown.
+    """Markdown table of the fit scenario, the paper's gains and the fitted ones, both rise
+    conventions, beside the paper's numbers; empty if it was not flown.
     """
     rows = [r for r in rep.runs if r["scenario"] == FIT_SCENARIO[0]]
     if not rows:
@@ -581,20 +435,7 @@ INTRO = (
 
 
 def report_markdown(rep: Reproduction, figures: list[str]) -> str:
-    """report.md: the table, the figures, and what differs from the paper and why.
-
-    Parameters
-    ----------
-    rep : Reproduction
-        The runs.
-    figures : list of str
-        The file names of the figures written (keys of :data:`FIGURES`).
-
-    Returns
-    -------
-    str
-        The Markdown text.
-    """
+    """report.md: the tables, the figures, and what differs from the paper and why."""
     text = [f"# quadcruise {__version__}: reproduction of the paper\n", INTRO + "\n", results_table(rep)]
     fits = fitted_table(rep)
     if fits:
@@ -608,18 +449,8 @@ def report_markdown(rep: Reproduction, figures: list[str]) -> str:
 
 
 def baseline_comparison(rep: Reproduction) -> str:
-    """A sentence, from the numbers, on how the baseline compares with nlpd here.
-
-    Parameters
-    ----------
-    rep : Reproduction
-        The runs.
-
-    Returns
-    -------
-    str
-        One line per scenario flown by both ``gonzalez`` and ``nlpd`` where both settled:
-        the differences in 5 % settling time [s] and overshoot [points]; empty if none.
+    """One line per scenario where both ``gonzalez`` and ``nlpd`` settled: the baseline's 5 % settling
+    and overshoot relative to nlpd's; empty if none.
     """
     pairs = []
     for r in rep.runs:
@@ -647,19 +478,12 @@ def baseline_comparison(rep: Reproduction) -> str:
 
 
 def fitted_nlpd_loop() -> dict:
-    """The fitted nlpd's x loop as ``quadcruise analyze`` sees it: linearised about hover
-    (:func:`~quadcruise.workflows.analysis.linearize`: the PD, the attitude PID, the rotor lag, the
-    1 ms sampling), beside the PD's own pair.
+    """The fitted nlpd's x loop as ``quadcruise analyze`` linearises it about hover, beside the PD's own pair.
 
-    Returns
-    -------
-    dict
-        ``kp`` [1/s^2], ``kd`` [1/s]; ``pd_pole`` [rad/s] (complex, Im >= 0), ``pd_zeta``,
-        ``pd_wn`` [rad/s]: the pair of s^2 + Kd s + Kp alone; ``dom_pole`` [rad/s], ``dom_zeta``,
-        ``dom_wn`` [rad/s]: the linearised closed loop's dominant pole
-        (:meth:`~quadcruise.workflows.analysis.Linearization.summary`); ``lin_rise`` (10-90 %),
-        ``lin_rise_0_100``, ``lin_settling`` (2 %) [s] and ``lin_overshoot`` [%]: that linear
-        loop's step response by ``control.step_info``.
+    Keys: ``kp``, ``kd``; ``pd_pole``, ``pd_zeta``, ``pd_wn`` (s^2 + Kd s + Kp alone); ``dom_pole``,
+    ``dom_zeta``, ``dom_wn`` (the linearised closed loop's dominant pole); ``lin_rise`` (10-90 %),
+    ``lin_rise_0_100``, ``lin_settling`` (2 %) [s] and ``lin_overshoot`` [%] of that loop's step
+    (``control.step_info``). Poles in rad/s, complex, Im >= 0.
 
     Examples
     --------
@@ -705,10 +529,10 @@ def _pole_text(p: complex) -> str:
 
 
 def differences() -> str:
-    """The report's section on where our numbers differ from the paper's, and why.
+    """The report's section on where our numbers differ from the paper's, and why, in short.
 
-    The fitted nlpd's poles and its linear step response in it are computed
-    (:func:`fitted_nlpd_loop`), not typed in.
+    The reasoning in full is in docs/paper.md (the section of the same title); the fitted nlpd's
+    poles and its linear step response here are computed (:func:`fitted_nlpd_loop`), not typed in.
 
     Returns
     -------
@@ -723,62 +547,32 @@ def differences() -> str:
 DIFFERENCES_TEMPLATE = """
 ## Where our numbers differ from the paper's, and why
 
-**Rise time (ours about 3 s, the paper's 1 s).** The paper's poles, -0.7 and -4.3 rad/s, put a
-slow pole at 0.7 rad/s. Eq (17) hides it behind a zero at -1/tau_d = -0.60 because its
-derivative acts on the whole error, including the derivative of the reference. At the start
-of a cruise the reference *position* jumps (the vehicle hovers 2 m from the circle's start
-point), and no finite controller differentiates that jump, so the realised loop is
-Kp / (s^2 + Kd s + Kp): its rise time is 3.2 s and it does not overshoot. Eq (17) itself, with
-the zero and an ideal attitude loop, would rise in 0.34 s and overshoot 8 %. Flown with the
-derivative on the whole error as eq (17) writes it (`NLPD(derivative="error")`, filter N = 100
-with its state at rest), the jump kicks u_x by Kd N per metre, but the asin clip and the tilt
-limit cut the kick to 45 degrees for a few hundredths of a second, and the 1 m step rises in
-3.3 s without overshoot, as slowly as the default. Neither derivative form reaches the
-paper's 1 s and 4 %. The `step` row isolates the design case.
+The reasoning in full, with the derivative forms tried: docs/paper.md, the section of this title.
 
-**What gives the paper's numbers (the fitted rows).** `quadcruise tune` finds position gains
-Kp {kp:.2f}, Kd {kd:.2f} for rise 1 s, settling 2 s, overshoot 4 % (within 0.3 s, 0.5 s, 1.5 points).
-The PD alone would place the pair {pd_pole} (damping {pd_zeta:.2f}, natural frequency
-{pd_wn:.2f} rad/s), but it flies through the attitude PID and the rotor lag: the closed loop
-that `quadcruise analyze` linearises about hover has its dominant pair at {dom_pole}
-(damping {dom_zeta:.2f}, natural frequency {dom_wn:.2f} rad/s), and that linear loop's own
-step rises in {lin_rise:.2f} s (10-90 %; {lin_rise_0_100:.2f} s 0-100 %), settles in
-{lin_settling:.2f} s (2 %) and overshoots {lin_overshoot:.1f} %. The paper's reported transient
-is that of this loop, not of its stated poles -0.7 and -4.3. Its 1 s is met by the 10-90 %
-rise and missed by the 0-100 % one; the paper does not say which it measured.
+**Rise time and settling time (ours about 3 s and 3-6 s, the paper's 1 s and 2 s).** The poles
+-0.7 and -4.3 leave a slow pole at 0.7 rad/s, which eq (17) hides behind its zero only by
+differentiating a jump of the reference. No finite controller does, so the realised loop is
+Kp / (s^2 + Kd s + Kp): it rises in 3.2 s without overshoot (with the derivative on the whole
+error as eq (17) writes it, `NLPD(derivative="error")`, in 3.3 s). The `step` row isolates it.
 
-**Settling time (ours 3-6 s at 5 %, the paper's 2 s).** Same cause: the 0.7 rad/s pole sets
-a time constant of 1.4 s. On the circle and the square the entry is measured on the size of
-the tracking error, settling onto its own steady level (docs/metrics.md): the PD law of eq (16)
-has no acceleration feedforward, so it tracks the circle with a steady lag of about 6 cm, which
-is the steady error (`steady_rmse_m`), not a transient that never ends. With the reference
-acceleration fed forward (`nlpd+ff`, beyond the paper) the lag nearly vanishes.
+**The fitted rows.** `quadcruise tune` finds Kp {kp:.2f}, Kd {kd:.2f} for the paper's transient.
+The PD alone would place the pair {pd_pole} (damping {pd_zeta:.2f}), but the closed loop that
+`quadcruise analyze` linearises about hover has its dominant pair at {dom_pole} (damping
+{dom_zeta:.2f}, natural frequency {dom_wn:.2f} rad/s); its step rises in {lin_rise:.2f} s (10-90 %;
+{lin_rise_0_100:.2f} s 0-100 %), settles in {lin_settling:.2f} s (2 %) and overshoots
+{lin_overshoot:.1f} %. The paper's reported transient is that of this loop, not of its stated poles.
 
-**The baseline (the paper's 6 s, 12 s, 11 %).** The paper's reference [5] could not be
-found, so `gonzalez` is a reconstruction (see `quadcruise.control.baselines`), with gains
-fixed by a rule before any simulation and never fitted to these numbers. It has the paper's
-small-signal poles, so the two laws differ only in the tanh saturation (the literal
-k tanh(e) form: 1 m and 1 m/s widths) and in the small-angle attitude mapping, which matter
-only for large errors. The ranking of the paper holds in direction (the baseline settles
-later, and never overshoots less) but not in size: the paper's baseline was evidently tuned
-differently, and its gains are not recoverable from the paper. With saturation levels from
-the tilt budget instead (`Gonzalez(accel_p=..., accel_d=...)`, see its docstring) the two
-controllers become nearly indistinguishable: the comparison hinges on this unknown. Fitted
-instead (the `gonzalez (fitted)` row), the literal form k_p tanh(e) + k_d tanh(e') with
-k_p 0.29, k_d 0.54 meets the 12 s settling and 11 % overshoot exactly; its rise, in the fitted
-table in both conventions, is near the paper's 6 s only measured 0-100 % (from the step to the
-first reaching of the target). That the paper's 6 s is a 0-100 % rise is a hypothesis, not a
-finding: it rests on a reconstruction of a baseline whose reference could not be found, and it
-does not fit the nlpd row, whose 1 s is met only 10-90 %. No one rise convention makes both fits
-match the paper. Those gains are an order of magnitude below the
-paper's design (Kp 3.01, Kd 5.0) and below the fitted nlpd's (Kp 3.47): a PD pair of natural
-frequency 0.54 rad/s and damping 0.50, three and a half times slower than the fitted nlpd's
-PD pair (1.86 rad/s).
-The paper's baseline was evidently a much slower loop, not the same design saturated.
+**The circle's steady error is a lag** of about 6 cm (`steady_rmse_m`): eq (16) has no
+acceleration feedforward; `nlpd+ff` (beyond the paper) removes it.
 
-**What agrees.** The inverse-model controller flies both cruises with the decoupled
-attitude loops, holds altitude through the tilt, and tracks the circle and the square once
-the transient is over; the paper's design numbers (Kp = 3.01, tau_d = 1.66, Kd = 5.0) are
-reproduced exactly by `quadcruise.control.design.pd_from_poles`.
+**The baseline** is a reconstruction (the paper's reference [5] could not be found), its gains
+fixed by a rule: the paper's ranking holds in direction, not in size. Fitted (k_p 0.29, k_d 0.54,
+an order of magnitude below the paper's design) it meets 12 s and 11 % exactly, and 6 s only
+measured 0-100 %. That the paper's 6 s is a 0-100 % rise is a hypothesis, not a finding: no one
+rise convention makes both fits match the paper.
+
+**What agrees.** The inverse-model controller flies both cruises and holds altitude through the
+tilt; the paper's design numbers (Kp = 3.01, tau_d = 1.66, Kd = 5.0) are reproduced exactly by
+`quadcruise.control.design.pd_from_poles`.
 """
 """The text of :func:`differences`, with its computed numbers as ``str.format`` fields."""
