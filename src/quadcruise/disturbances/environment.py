@@ -96,7 +96,7 @@ MEMORY_SIZE = DRYDEN_MEMORY.size
 
 @njit(DISTURBANCE_SIG, cache=True, error_model="numpy")
 def environment_disturbance(t, dt, x, dp, dmem, rng, ext):
-    """The composite disturbance of :class:`Environment` (see the module's formulas).
+    """The composite disturbance of :class:`Environment` (the formulas: each part's module).
 
     Compiled with :data:`quadcruise.layout.DISTURBANCE_SIG`; the engine calls it once per
     control period and holds ``ext`` over the period.
