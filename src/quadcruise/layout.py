@@ -1,5 +1,7 @@
 """The engine's data layout: named columns of the state, reference and command vectors,
-and the compiled signatures that controllers and missions must have.
+the compiled signatures that controllers and missions must have, and :class:`Row`, the one
+declaration of every packed row (a controller's gains and memory, a disturbance's parameters
+and memory).
 
 Everything the compiled engine touches is a flat ``float64`` vector (one vehicle) or a
 2-D array with a leading batch axis (N vehicles). The names below are the column indices;
@@ -20,7 +22,154 @@ Units are SI throughout: metres, seconds, radians, newtons.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
 from numba import types
+
+
+@dataclass(frozen=True)
+class Row:
+    """One packed float64 row, declared once: an ordered list of named fields that yields the
+    offsets, the packing and the column names.
+
+    The compiled code reads a row through module-level int constants, which numba folds into
+    the machine code: unpack them from :attr:`offsets` where the row is declared, named
+    ``prefix + FIELD.upper()`` (``tests/unit/test_rows.py`` checks the names and the order)::
+
+        PD = Row.of("pd gains", "kp", "kd", prefix="PD_")
+        PD_KP, PD_KD = PD.offsets
+
+    Parameters
+    ----------
+    name : str
+        What the row is, for messages (``"nlpd gains"``).
+    fields : tuple of (str, int)
+        Each field's name and width (a vector field is wider than 1), in order.
+    parent : Row, optional
+        A row this one continues (a shared block first): its fields come first.
+    prefix : str
+        The prefix of the constants' names.
+
+    Examples
+    --------
+    >>> pd = Row.of("pd gains", "kp", "kd", ("bias", 2), prefix="PD_")
+    >>> pd.offsets, pd.size, pd.names
+    ((0, 1, 2), 4, ('kp', 'kd', 'bias[0]', 'bias[1]'))
+    >>> pd.pack({"kp": 3.0, "kd": 5.0, "bias": (1.0, 2.0)}).tolist()
+    [3.0, 5.0, 1.0, 2.0]
+    >>> pd.pack({"kp": 3.0, "kd": [5.0, 6.0]}, n=2, default=0.0).tolist()     # one value per vehicle
+    [[3.0, 5.0, 0.0, 0.0], [3.0, 6.0, 0.0, 0.0]]
+    >>> Row.of("more", "ki", parent=pd).offsets
+    (4,)
+    """
+
+    name: str
+    fields: tuple[tuple[str, int], ...]
+    parent: Row | None = None
+    prefix: str = ""
+
+    @classmethod
+    def of(cls, name: str, *fields: str | tuple[str, int], parent: Row | None = None, prefix: str = "") -> Row:
+        """A row from its fields: a name, or (name, width) for a vector field.
+
+        Parameters
+        ----------
+        name : str
+            What the row is.
+        *fields : str or (str, int)
+            The fields in order.
+        parent : Row, optional
+            The row this one continues.
+        prefix : str
+            The prefix of the constants' names.
+
+        Returns
+        -------
+        Row
+        """
+        spec = tuple((f, 1) if isinstance(f, str) else (f[0], int(f[1])) for f in fields)
+        names = [f for f, _ in spec] + ([f for f, _ in parent.all_fields] if parent else [])
+        if len(set(names)) != len(names) or any(w < 1 for _, w in spec):
+            raise ValueError(f"{name}: field names must be unique and widths >= 1, got {fields}")
+        return cls(name, spec, parent, prefix)
+
+    @property
+    def start(self) -> int:
+        """Offset of this row's first own field (the parent's size, else 0)."""
+        return self.parent.size if self.parent else 0
+
+    @property
+    def all_fields(self) -> tuple[tuple[str, int], ...]:
+        """(name, width) of every field, the parent's first."""
+        return (self.parent.all_fields if self.parent else ()) + self.fields
+
+    @property
+    def offsets(self) -> tuple[int, ...]:
+        """Offset of each of this row's own fields (a vector field: its first entry)."""
+        out, at = [], self.start
+        for _, width in self.fields:
+            out.append(at)
+            at += width
+        return tuple(out)
+
+    @property
+    def size(self) -> int:
+        """Number of float64 entries of the whole row."""
+        return self.start + sum(w for _, w in self.fields)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """One name per entry of the whole row, for tables and JSON (``name[i]`` in a vector)."""
+        return tuple(f if w == 1 else f"{f}[{i}]" for f, w in self.all_fields for i in range(w))
+
+    def pack(self, values: Mapping[str, Any], n: int | None = None, default: float | None = None) -> np.ndarray:
+        """The row (or rows) holding ``values``.
+
+        Parameters
+        ----------
+        values : mapping
+            Field name -> a number (or, with ``n``, one per vehicle); a vector field takes a
+            sequence of its width of such, or an (n, width) array.
+        n : int, optional
+            Number of vehicles: (n, size) rows; None: one (size,) row.
+        default : float, optional
+            The value of a field not in ``values``; None: every field must be given.
+
+        Returns
+        -------
+        numpy.ndarray
+            (size,) or (n, size) float64.
+
+        Raises
+        ------
+        ValueError
+            A field unknown, or missing without a default.
+        """
+        widths = dict(self.all_fields)
+        unknown, missing = set(values) - set(widths), set(widths) - set(values)
+        if unknown or (missing and default is None):
+            raise ValueError(f"{self.name}: unknown fields {sorted(unknown)}, missing {sorted(missing)}")
+        rows = 1 if n is None else n
+        out = np.full((rows, self.size), np.nan if default is None else float(default))
+        at = 0
+        for field, width in self.all_fields:
+            if field in values:
+                value = values[field]
+                columns = (
+                    [value]
+                    if width == 1
+                    else list(value.T if isinstance(value, np.ndarray) and value.ndim == 2 else value)
+                )
+                if len(columns) != width:
+                    raise ValueError(f"{self.name}: field {field!r} takes {width} values, got {len(columns)}")
+                for j, column in enumerate(columns):
+                    out[:, at + j] = np.broadcast_to(column, (rows,))
+            at += width
+        return out[0] if n is None else out
+
 
 # --- state: 16 columns -------------------------------------------------------------
 # position and velocity in the earth frame (z up), the paper's Euler angles and body

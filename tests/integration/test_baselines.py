@@ -11,7 +11,7 @@ import pytest
 import quadcruise as qc
 from quadcruise.control import CONTROLLERS, Gonzalez, controller_from_name
 from quadcruise.control.attitude import ATT_GAINS
-from quadcruise.control.baselines import COS_MAX_TILT, GONZALEZ_GAINS, MAX_TILT, gonzalez, saturated_pd
+from quadcruise.control.baselines import GONZALEZ_GAINS, GZ_COS_MAX_TILT, GZ_MAX_TILT, gonzalez, saturated_pd
 from quadcruise.control.position import NLPD, nlpd
 from quadcruise.errors import InputError
 from quadcruise.layout import (
@@ -134,8 +134,8 @@ def test_registry_and_gains_layout():
     c = controller_from_name("gonzalez", max_tilt=0.3)
     assert isinstance(c, Gonzalez) and c.accel_p == pytest.approx(3.01)
     g = c.gains()
-    assert g.shape == (GONZALEZ_GAINS,) == (ATT_GAINS + 8,) and np.all(np.isfinite(g))
-    assert g[MAX_TILT] == 0.3 and g[COS_MAX_TILT] == math.cos(0.3)
+    assert g.shape == (GONZALEZ_GAINS.size,) == (ATT_GAINS + 8,) and np.all(np.isfinite(g))
+    assert g[GZ_MAX_TILT] == 0.3 and g[GZ_COS_MAX_TILT] == math.cos(0.3)
     np.testing.assert_array_equal(g[:ATT_GAINS], NLPD().gains()[:ATT_GAINS])  # same attitude loop
     assert c.to_dict()["name"] == "gonzalez" and c.function is gonzalez
 

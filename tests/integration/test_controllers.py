@@ -11,7 +11,8 @@ import quadcruise as qc
 from quadcruise.control import NLPD, controller_from_name
 from quadcruise.control.attitude import ATT_MEMORY, decoupled_attitude
 from quadcruise.control.design import PIDGains, attitude_pid_design, cascade_state_space, pd_from_poles
-from quadcruise.control.position import nlpd, phi_from_eq6, theta_from_eq5
+from quadcruise.control.inversion import phi_from_eq6, theta_from_eq5
+from quadcruise.control.position import nlpd
 from quadcruise.layout import (
     CMD_FLAGS,
     CMD_PHI_D,
@@ -244,3 +245,21 @@ def test_compiled_controller_makes_no_reference_count_calls(name):
 
     calls = reference_count_calls(controller_from_name(name).function.py_func, CONTROLLER_SIG)
     assert calls == []
+
+
+@pytest.mark.parametrize(
+    "name, gains, memory",
+    [("nlpd", "gains", 5), ("gonzalez", "gains", 3), ("se3", "gains", 0), ("cascade", "G", 19)],
+)
+def test_compiled_controller_reads_its_rows_at_constant_offsets(name, gains, memory):
+    """The offsets unpacked from each controller's declared rows (quadcruise.layout.Row) are
+    module-level ints, which numba folds: every entry of the gains and memory rows is reached
+    at a constant offset in the compiled body, none through an index computed at run time
+    (which a row read through a tuple or an object's attribute could need)."""
+    from quadcruise.layout import CONTROLLER_SIG
+    from support.compiled_code import row_offsets
+
+    function = controller_from_name(name).function.py_func
+    size = controller_from_name(name).gains().size
+    assert row_offsets(function, CONTROLLER_SIG, gains) == (set(range(1, size)), 0)
+    assert row_offsets(function, CONTROLLER_SIG, "mem") == (set(range(1, memory)), 0)

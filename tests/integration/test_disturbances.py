@@ -11,11 +11,10 @@ from numba import njit
 from scipy.integrate import quad
 
 import quadcruise as qc
+from quadcruise.cli.wind import parse_wind, wind_from_name
 from quadcruise.control.openloop import duty_schedule, pack_schedule
-from quadcruise.disturbances.environment import (
+from quadcruise.disturbances import (
     DEFAULT_DRAG,
-    MEMORY_SIZE,
-    PARAMS_SIZE,
     ConstantWind,
     Environment,
     ExternalForce,
@@ -23,11 +22,10 @@ from quadcruise.disturbances.environment import (
     RotorLoss,
     SensorNoise,
     Turbulence,
-    _lateral_coefficients,
-    parse_wind,
-    wind_from_name,
     with_drag,
 )
+from quadcruise.disturbances.environment import MEMORY_SIZE, PARAMS_SIZE
+from quadcruise.disturbances.turbulence import lateral_coefficients
 from quadcruise.layout import EXT_E1, EXT_FX, EXT_SIZE, EXT_TX, EXT_WX, F1, PHI, PSI, STATE_SIZE, THETA, VX, VY, X, Y, Z
 from quadcruise.missions import Circle, Hover
 from quadcruise.sim.rng import vehicle_states
@@ -162,7 +160,7 @@ def test_dryden_intensities_and_scales_follow_mil_f_8785c():
 @pytest.mark.parametrize("a", [1e-8, 1e-5, 1e-3, 0.1, 0.999, 1.0, 1.001, 3.0, 40.0])
 def test_lateral_filter_discretisation_is_exact(a):
     """Phi P Phi^T + L L^T = P (the stationary covariance), for any a = dt / T."""
-    e, a_back, l11, l21, l22 = _lateral_coefficients(a)
+    e, a_back, l11, l21, l22 = lateral_coefficients(a)
     assert a_back == a and e == pytest.approx(math.exp(-a), rel=1e-15)
     phi = e * np.array([[1.0, 0.0], [a, 1.0]])
     low = np.array([[l11, 0.0], [l21, l22]])
@@ -414,7 +412,7 @@ def test_turbulence_draws_come_from_the_vehicles_splitmix_stream():
 def test_dryden_coefficients_follow_the_period_but_not_its_rounding():
     """Cached per period: a grid's rounding (1e-12 relative) keeps them, a new period
     (2 ms after 1 ms) recomputes them, as the exact discretisation of the new a = dt / T."""
-    from quadcruise.disturbances.environment import _CU, _CV, _MDT
+    from quadcruise.disturbances.turbulence import DRY_COEF_DT, DRY_U_COEF, DRY_V_COEF
     from quadcruise.sim.fastmath import DT_TOLERANCE
 
     tb = Turbulence(intensity="moderate", altitude=10.0, airspeed=5.0)
@@ -424,11 +422,11 @@ def test_dryden_coefficients_follow_the_period_but_not_its_rounding():
     env.function(0.0, 1e-3, x, dp, dm, rng, ext)
     first = dm.copy()
     env.function(1e-3, 1e-3 * (1 + 1e-12), x, dp, dm, rng, ext)
-    assert dm[_MDT] == 1e-3 and np.array_equal(dm[_CU:], first[_CU:])
+    assert dm[DRY_COEF_DT] == 1e-3 and np.array_equal(dm[DRY_U_COEF:], first[DRY_U_COEF:])
     env.function(2e-3, 2e-3, x, dp, dm, rng, ext)
     T_u, T_v = tb.time_constants()[:2]
-    assert dm[_MDT] == 2e-3 and dm[_CU] == pytest.approx(math.exp(-2e-3 / T_u), rel=1e-15)
-    np.testing.assert_allclose(dm[_CV : _CV + 5], _lateral_coefficients(2e-3 / T_v), rtol=1e-15)
+    assert dm[DRY_COEF_DT] == 2e-3 and dm[DRY_U_COEF] == pytest.approx(math.exp(-2e-3 / T_u), rel=1e-15)
+    np.testing.assert_allclose(dm[DRY_V_COEF : DRY_V_COEF + 5], lateral_coefficients(2e-3 / T_v), rtol=1e-15)
     assert 1e-11 < DT_TOLERANCE < 1e-3
 
 
@@ -442,3 +440,16 @@ def test_compiled_disturbance_makes_no_reference_count_calls():
 
     calls = reference_count_calls(environment_disturbance.py_func, DISTURBANCE_SIG)
     assert calls == []
+
+
+def test_compiled_disturbance_reads_its_rows_at_constant_offsets():
+    """The parameter and memory rows are read through the offsets of their declarations
+    (ENVIRONMENT_PARAMS, DRYDEN_MEMORY), module-level ints that numba folds: every entry is
+    reached at a constant offset, none through an index computed at run time."""
+    from quadcruise.disturbances import environment_disturbance
+    from quadcruise.layout import DISTURBANCE_SIG
+    from support.compiled_code import row_offsets
+
+    function = environment_disturbance.py_func
+    assert row_offsets(function, DISTURBANCE_SIG, "dp") == (set(range(1, PARAMS_SIZE)), 0)
+    assert row_offsets(function, DISTURBANCE_SIG, "dmem") == (set(range(1, MEMORY_SIZE)), 0)

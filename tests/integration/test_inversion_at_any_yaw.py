@@ -11,7 +11,7 @@ import pytest
 
 import quadcruise as qc
 from quadcruise.control import NLPD
-from quadcruise.control.position import phi_from_eq6, theta_from_eq5, tilt_joint
+from quadcruise.control.inversion import phi_from_eq6, theta_from_eq5, tilt_joint
 from quadcruise.missions import Circle, MinimumSnap, Step, WaypointTable
 
 

@@ -445,7 +445,7 @@ def test_registry_and_gains():
     assert CONTROLLERS["se3"] is SE3 and CONTROLLERS["cascade"] is Cascade
     assert controller_from_name("se3") == SE3() and controller_from_name("cascade") == Cascade()
     assert SE3().function is se3 and Cascade().function is cascade
-    assert Cascade().gains().shape == (CASCADE_GAINS,) and Cascade().memory().shape == (19,)
+    assert Cascade().gains().shape == (CASCADE_GAINS.size,) == (27,) and Cascade().memory().shape == (19,)
     assert SE3().memory_size == 0
     assert rate_pid_design(30.0).kp == 30.0  # scales with the rotor bandwidth
     assert json.dumps(Cascade().to_dict())

@@ -128,7 +128,7 @@ def compare(
         controllers' model of it (:func:`~quadcruise.cli.objects.vehicle_from_option`).
     wind, turbulence : str or None
         ``--wind``: the flights' (and the population's) disturbances, a
-        :func:`~quadcruise.disturbances.environment.parse_wind` spec such as
+        :func:`~quadcruise.cli.wind.parse_wind` spec such as
         ``dryden:moderate@10``, replacing a scenario's; ``--turbulence``: Dryden turbulence added.
     log_every : int or None
         ``--log-every``: log every this many control periods.

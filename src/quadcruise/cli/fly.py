@@ -148,7 +148,7 @@ def fly(
         it (:func:`~quadcruise.cli.objects.vehicle_from_option`); None: the scenario's, else
         Table I and the flown vehicle.
     wind, turbulence : str or None
-        ``--wind``: a :func:`~quadcruise.disturbances.parse_wind` spec replacing the scenario's
+        ``--wind``: a :func:`~quadcruise.cli.wind.parse_wind` spec replacing the scenario's
         disturbances; ``--turbulence``: Dryden turbulence added
         (:func:`~quadcruise.cli.objects.environment_from_options`).
     log_every : int or None

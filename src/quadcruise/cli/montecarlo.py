@@ -116,7 +116,7 @@ def montecarlo(**options):
             default the nominal one). See :func:`~quadcruise.cli.objects.vehicle_from_option`.
         wind : str or None
             ``--wind``: wind, gust and turbulence of every flight, a
-            :func:`~quadcruise.disturbances.parse_wind` spec; None: the scenario's, else none.
+            :func:`~quadcruise.cli.wind.parse_wind` spec; None: the scenario's, else none.
         turbulence : str or None
             ``--turbulence``: Dryden turbulence added (its random stream differs by vehicle).
         log_every : int or None

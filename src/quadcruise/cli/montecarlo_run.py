@@ -116,7 +116,7 @@ def montecarlo_command(
         ``--require`` texts, ``METRIC<=VALUE`` each
         (:func:`quadcruise.montecarlo.scenario.parse_requirement`).
     wind, noise : str, optional
-        A :func:`~quadcruise.disturbances.parse_wind` spec and a :func:`parse_noise` one.
+        A :func:`~quadcruise.cli.wind.parse_wind` spec and a :func:`parse_noise` one.
     turbulence : str, optional
         Dryden turbulence added (:func:`~quadcruise.cli.objects.environment_from_options`).
     vehicle, controller_vehicle : str, optional
@@ -151,7 +151,7 @@ offset, distribution, model_error : optional
     """
     import numpy as np
 
-    from quadcruise.disturbances import parse_wind
+    from quadcruise.cli.wind import parse_wind
     from quadcruise.errors import whole_number
     from quadcruise.montecarlo import montecarlo_case
     from quadcruise.montecarlo.output import case_folder, case_text, write_case

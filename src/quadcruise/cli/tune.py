@@ -141,7 +141,7 @@ def tune(**options):
             ``--mass-spread``, ``--inertia-spread``: relative standard deviations;
             ``--wind-spread``: standard deviation of a steady wind per vehicle [m/s].
         wind, noise : str or None
-            ``--wind``: a :func:`~quadcruise.disturbances.parse_wind` spec; ``--noise``: a
+            ``--wind``: a :func:`~quadcruise.cli.wind.parse_wind` spec; ``--noise``: a
             :func:`~quadcruise.cli.montecarlo_run.parse_noise` spec.
         turbulence : str or None
             ``--turbulence``: Dryden turbulence added.

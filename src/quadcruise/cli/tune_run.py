@@ -111,7 +111,7 @@ def tune_command(
     mass_spread, inertia_spread, wind_spread : float
         :class:`~quadcruise.montecarlo.Population` fields.
     wind, noise : str, optional
-        A :func:`~quadcruise.disturbances.parse_wind` spec and a
+        A :func:`~quadcruise.cli.wind.parse_wind` spec and a
         :func:`~quadcruise.cli.montecarlo_run.parse_noise` one.
     vehicle, controller_vehicle, turbulence : str, optional
         ``--vehicle``, ``--controller-vehicle``, ``--turbulence``
@@ -218,7 +218,7 @@ def tune_command(
     )
     environment = world["environment"]
     if wind_spread > 0 and not any("wind acts only through drag" in line for line in notes):
-        from quadcruise.disturbances.environment import default_drag_text, with_drag
+        from quadcruise.disturbances import default_drag_text, with_drag
 
         if world["vehicle"].drag_linear == 0 and world["vehicle"].drag_quadratic == 0:
             world["vehicle"] = with_drag(world["vehicle"])

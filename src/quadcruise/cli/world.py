@@ -103,7 +103,7 @@ def environment_from_options(wind: str | None, turbulence: str | None, base=None
     Parameters
     ----------
     wind : str or None
-        A :func:`~quadcruise.disturbances.parse_wind` spec: it replaces ``base`` (``none``: still air).
+        A :func:`~quadcruise.cli.wind.parse_wind` spec: it replaces ``base`` (``none``: still air).
     turbulence : str or None
         ``LEVEL[@ALTITUDE[/AIRSPEED]]``, LEVEL light, moderate or severe (or w20 [m/s]), as
         the wind spec's ``dryden:`` part: it adds Dryden turbulence or replaces the base's.
@@ -127,7 +127,8 @@ def environment_from_options(wind: str | None, turbulence: str | None, base=None
     """
     import dataclasses
 
-    from quadcruise.disturbances import INTENSITIES, Environment, parse_wind
+    from quadcruise.cli.wind import parse_wind
+    from quadcruise.disturbances import INTENSITIES, Environment
 
     env = parse_wind(wind) if wind is not None else base
     if turbulence is not None:
@@ -182,7 +183,7 @@ def flight_world(
         One line each: the default drag given, or a changed vehicle whose controller is told
         the truth.
     """
-    from quadcruise.disturbances.environment import default_drag_text, with_drag
+    from quadcruise.disturbances import default_drag_text, with_drag
     from quadcruise.model.vehicle import Vehicle
 
     base = scenario.vehicle if scenario is not None else Vehicle.paper()

@@ -23,14 +23,51 @@ from __future__ import annotations
 
 from numba import njit
 
-from quadcruise.layout import FLAG_INTEGRATOR_HOLD, P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, PHI, PSI, THETA, P, Q, R
+from quadcruise.layout import FLAG_INTEGRATOR_HOLD, P_K1, P_K2, P_K3, P_K4, P_K5, P_K6, PHI, PSI, THETA, P, Q, R, Row
 from quadcruise.numeric import clamp, wrap_angle
 
-# gains layout shared by every controller built on this loop (offsets into ``gains``)
-ATT_KP, ATT_KI, ATT_KD, YAW_KP, YAW_KI, YAW_KD, ATT_I_LIMIT = range(7)
-ATT_GAINS = 7
-# memory: the integral of the roll, pitch and yaw errors [rad s]
-ATT_MEMORY = 3
+ATTITUDE_GAINS = Row.of("attitude gains", "att_kp", "att_ki", "att_kd", "yaw_kp", "yaw_ki", "yaw_kd", "att_i_limit")
+"""The block that starts the gains of every controller built on this loop: kp [1/s^2], ki
+[1/s^3], kd [1/s] of roll and pitch, the same of yaw, and i_limit [rad/s^2]."""
+ATT_KP, ATT_KI, ATT_KD, YAW_KP, YAW_KI, YAW_KD, ATT_I_LIMIT = ATTITUDE_GAINS.offsets
+ATT_GAINS = ATTITUDE_GAINS.size
+ATTITUDE_MEMORY = Row.of("attitude memory", ("att_integral", 3))
+"""The block that starts their memory: the integrals of the roll, pitch and yaw errors [rad s]."""
+(ATT_INTEGRAL,) = ATTITUDE_MEMORY.offsets
+ATT_MEMORY = ATTITUDE_MEMORY.size
+
+
+def attitude_fields(attitude, yaw, i_limit: float) -> dict[str, float]:
+    """The fields of :data:`ATTITUDE_GAINS`, for :meth:`Row.pack <quadcruise.layout.Row.pack>`.
+
+    Parameters
+    ----------
+    attitude, yaw : PIDGains
+        Roll and pitch PID, yaw PID: kp [1/s^2], ki [1/s^3], kd [1/s].
+    i_limit : float
+        Anti-windup bound on the integral term [rad/s^2].
+
+    Returns
+    -------
+    dict
+        Field name -> value.
+
+    Examples
+    --------
+    >>> from quadcruise.control.design import PIDGains
+    >>> fields = attitude_fields(PIDGains(kp=1.0, ki=2.0, kd=3.0), PIDGains(kp=4.0, ki=5.0, kd=6.0), 7.0)
+    >>> ATTITUDE_GAINS.pack(fields).tolist()
+    [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]
+    """
+    return {
+        "att_kp": attitude.kp,
+        "att_ki": attitude.ki,
+        "att_kd": attitude.kd,
+        "yaw_kp": yaw.kp,
+        "yaw_ki": yaw.ki,
+        "yaw_kd": yaw.kd,
+        "att_i_limit": i_limit,
+    }
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -193,7 +230,7 @@ def decoupled_attitude(x, phi_d, theta_d, psi_d, vp, g, mem, dt):
     vp : numpy.ndarray
         The vehicle parameter row, PARAM_SIZE entries (k1..k6 are read).
     g : numpy.ndarray
-        The controller's gains vector, starting with the attitude block (:func:`attitude_gains`).
+        The controller's gains vector, starting with the attitude block (:data:`ATTITUDE_GAINS`).
     mem : numpy.ndarray
         The controller's memory: its first ATT_MEMORY entries are the roll, pitch and yaw
         error integrals [rad s], updated in place.
@@ -221,8 +258,8 @@ def decoupled_attitude(x, phi_d, theta_d, psi_d, vp, g, mem, dt):
         x[R],
         decoupling_constants(vp),
         attitude_gains(g),
-        (mem[0], mem[1], mem[2]),
+        (mem[ATT_INTEGRAL], mem[ATT_INTEGRAL + 1], mem[ATT_INTEGRAL + 2]),
         dt,
     )
-    mem[0], mem[1], mem[2] = integrals
+    mem[ATT_INTEGRAL], mem[ATT_INTEGRAL + 1], mem[ATT_INTEGRAL + 2] = integrals
     return U[0], U[1], U[2], flags

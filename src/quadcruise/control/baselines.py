@@ -59,10 +59,11 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from quadcruise.control.attitude import ATT_GAINS, ATT_MEMORY
+from quadcruise.control.attitude import ATTITUDE_GAINS, ATTITUDE_MEMORY, attitude_fields
 from quadcruise.control.base import TILT, Controller
 from quadcruise.control.design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
-from quadcruise.control.position import attitude_block, finish, thrust_for_tilt, tilt_setpoint
+from quadcruise.control.inversion import thrust_for_tilt, tilt_setpoint
+from quadcruise.control.position import finish
 from quadcruise.fields import instance_of
 from quadcruise.fields import unit_field as _f
 from quadcruise.layout import (
@@ -83,14 +84,29 @@ from quadcruise.layout import (
     VX,
     VY,
     VZ,
+    Row,
     X,
     Y,
     Z,
 )
 
-# gains layout after the attitude block
-KP_XY, KD_XY, SAT_P, SAT_D, KP_Z, KD_Z, MAX_TILT, COS_MAX_TILT = range(ATT_GAINS, ATT_GAINS + 8)
-GONZALEZ_GAINS = ATT_GAINS + 8
+GONZALEZ_GAINS = Row.of(
+    "gonzalez gains",
+    "kp_xy",
+    "kd_xy",
+    "sat_p",
+    "sat_d",
+    "kp_z",
+    "kd_z",
+    "max_tilt",
+    "cos_max_tilt",
+    parent=ATTITUDE_GAINS,
+    prefix="GZ_",
+)
+"""The gains of :func:`gonzalez`: the attitude block, then k_p [1/s^2], k_d [1/s] of x and y,
+the saturation levels a_p, a_d [m/s^2], the z PD gains [1/s^2], [1/s], max_tilt [rad] and its
+cosine."""
+GZ_KP_XY, GZ_KD_XY, GZ_SAT_P, GZ_SAT_D, GZ_KP_Z, GZ_KD_Z, GZ_MAX_TILT, GZ_COS_MAX_TILT = GONZALEZ_GAINS.offsets
 G0 = 9.81
 """Gravity [m/s^2] of the tilt-budget rule a_p = a_d = G0 max_tilt / 2 (not the default)."""
 UNIT_ERROR = 1.0
@@ -158,11 +174,11 @@ def gonzalez(t, dt, x, ref, vp, gains, mem, cmd):
         :meth:`quadcruise.model.vehicle.Vehicle.rows`): m [kg], g [m/s^2], K [N], d [m] and
         k1..k6 are read.
     gains : numpy.ndarray
-        :meth:`Gonzalez.gains`, GONZALEZ_GAINS (15) float64 entries: the attitude block
-        (:func:`~quadcruise.control.position.attitude_block`), then k_p [1/s^2], k_d [1/s],
+        :meth:`Gonzalez.gains`, :data:`GONZALEZ_GAINS` (15 float64 entries): the attitude
+        block (``ATTITUDE_GAINS``), then k_p [1/s^2], k_d [1/s],
         a_p, a_d [m/s^2], the z PD gains [1/s^2], [1/s], max_tilt [rad] and its cosine.
     mem : numpy.ndarray
-        The controller's memory, ATT_MEMORY (3) float64 entries, zeros at the start of a
+        The controller's memory, ``ATTITUDE_MEMORY`` (3 float64 entries), zeros at the start of a
         flight: the roll, pitch and yaw error integrals [rad s], updated in place.
     cmd : numpy.ndarray
         Output, CMD_SIZE (12) float64 entries, all written: the four duties [-] (not
@@ -181,14 +197,14 @@ def gonzalez(t, dt, x, ref, vp, gains, mem, cmd):
     >>> round(float(cmd[CMD_THETA_D]), 4)                  # a_p tanh(k_p e / a_p) / g, no asin
     0.0306
     """
-    kp, kd, ap, ad, tilt = gains[KP_XY], gains[KD_XY], gains[SAT_P], gains[SAT_D], gains[MAX_TILT]
+    kp, kd, ap, ad, tilt = gains[GZ_KP_XY], gains[GZ_KD_XY], gains[GZ_SAT_P], gains[GZ_SAT_D], gains[GZ_MAX_TILT]
     spsi, cpsi = math.sin(x[PSI]), math.cos(x[PSI])
     ex, ey, evx, evy = ref[REF_X] - x[X], ref[REF_Y] - x[Y], ref[REF_VX] - x[VX], ref[REF_VY] - x[VY]
     uf = saturated_pd(cpsi * ex + spsi * ey, cpsi * evx + spsi * evy, kp, kd, ap, ad)  # forward
     ul = saturated_pd(cpsi * ey - spsi * ex, cpsi * evy - spsi * evx, kp, kd, ap, ad)  # left
-    uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ])
+    uz = gains[GZ_KP_Z] * (ref[REF_Z] - x[Z]) + gains[GZ_KD_Z] * (ref[REF_VZ] - x[VZ])
     g = vp[P_G]
-    U1, flags = thrust_for_tilt(uz, math.cos(x[PHI]) * math.cos(x[THETA]), vp[P_M], g, vp[P_K], gains[COS_MAX_TILT])
+    U1, flags = thrust_for_tilt(uz, math.cos(x[PHI]) * math.cos(x[THETA]), vp[P_M], g, vp[P_K], gains[GZ_COS_MAX_TILT])
     theta_d, flags = tilt_setpoint(uf / g, False, tilt, flags)  # eq (5), small angle, yaw frame
     phi_d, flags = tilt_setpoint(-ul / g, False, tilt, flags)  # eq (6), small angle, yaw frame
     finish(U1, phi_d, theta_d, ref[REF_PSI], flags, dt, x, vp, gains, mem, cmd)
@@ -230,7 +246,7 @@ class Gonzalez(Controller):
     """
 
     name = "gonzalez"
-    memory_size = ATT_MEMORY
+    memory_size = ATTITUDE_MEMORY.size
 
     position: PDGains = _f(
         unit="-", doc="small-signal PD of x and y", check=instance_of(PDGains), factory=position_pd_design
@@ -263,20 +279,22 @@ class Gonzalez(Controller):
         Returns
         -------
         numpy.ndarray
-            GONZALEZ_GAINS (15) float64 entries: the attitude block
-            (:func:`~quadcruise.control.position.attitude_block`: roll/pitch and yaw kp
+            :data:`GONZALEZ_GAINS`, 15 float64 entries: the attitude block
+            (:data:`~quadcruise.control.attitude.ATTITUDE_GAINS`: roll/pitch and yaw kp
             [1/s^2], ki [1/s^3], kd [1/s], i_limit [rad/s^2]), then k_p [1/s^2] and k_d
             [1/s] of x and y, a_p and a_d [m/s^2], Kp [1/s^2] and Kd [1/s] of z, max_tilt
             [rad] and cos(max_tilt).
         """
-        tail = [
-            self.position.kp,
-            self.position.kd,
-            self.accel_p,
-            self.accel_d,
-            self.altitude.kp,
-            self.altitude.kd,
-            self.max_tilt,
-            math.cos(self.max_tilt),
-        ]
-        return np.array(attitude_block(self.attitude, self.yaw, self.i_limit) + tail)
+        return GONZALEZ_GAINS.pack(
+            {
+                **attitude_fields(self.attitude, self.yaw, self.i_limit),
+                "kp_xy": self.position.kp,
+                "kd_xy": self.position.kd,
+                "sat_p": self.accel_p,
+                "sat_d": self.accel_d,
+                "kp_z": self.altitude.kp,
+                "kd_z": self.altitude.kd,
+                "max_tilt": self.max_tilt,
+                "cos_max_tilt": math.cos(self.max_tilt),
+            }
+        )

@@ -87,13 +87,45 @@ from quadcruise.layout import (
     P,
     Q,
     R,
+    Row,
     X,
     Y,
     Z,
 )
 from quadcruise.numeric import clamp
 
-# gains layout
+CASCADE_GAINS = Row.of(
+    "cascade gains",
+    "pos_xy",
+    "pos_z",
+    "vel_p_xy",
+    "vel_i_xy",
+    "vel_d_xy",
+    "vel_p_z",
+    "vel_i_z",
+    "vel_d_z",
+    "vmax_xy",
+    "vmax_up",
+    "vmax_down",
+    "max_tilt",
+    "thr_min",
+    "thr_max",
+    "att_rp",
+    "att_yaw",
+    "rmax_rp",
+    "rmax_yaw",
+    "rate_p",
+    "rate_i",
+    "rate_d",
+    "yrate_p",
+    "yrate_i",
+    "yrate_d",
+    "rate_i_lim",
+    "vel_d_lp",
+    "rate_d_lp",
+    prefix="C_",
+)
+"""The gains of :func:`cascade`, in :class:`Cascade`'s order and units."""
 (
     C_POS_XY,
     C_POS_Z,
@@ -122,12 +154,13 @@ from quadcruise.numeric import clamp
     C_RATE_I_LIM,
     C_VEL_D_LP,
     C_RATE_D_LP,
-) = range(27)
-CASCADE_GAINS = 27
-# memory: velocity integral [m/s^2], rate integral [rad/s^2], last velocity and rate, their
-# low-passed derivatives (6 slots after the last values), and a flag set after period one
-M_VI, M_RI, M_V, M_W, M_VD, M_WD, M_INIT = 0, 3, 6, 9, 12, 15, 18
-CASCADE_MEMORY = 19
+) = CASCADE_GAINS.offsets
+CASCADE_MEMORY = Row.of(
+    "cascade memory", ("vi", 3), ("ri", 3), ("v", 3), ("w", 3), ("vd", 3), ("wd", 3), "init", prefix="M_"
+)
+"""The memory of :func:`cascade`: velocity integral [m/s^2], rate integral [rad/s^2], last
+velocity and rate, their low-passed derivatives, and a flag set after period one."""
+M_VI, M_RI, M_V, M_W, M_VD, M_WD, M_INIT = CASCADE_MEMORY.offsets
 I_FACTOR_RATE = math.radians(400.0)
 """PX4's rate error at which the rate integral stops growing [rad/s]."""
 
@@ -224,10 +257,10 @@ def cascade(t, dt, x, ref, vp, G, mem, cmd):
         :meth:`quadcruise.model.vehicle.Vehicle.rows`): m [kg], g [m/s^2], Jxx, Jyy, Jzz
         [kg m^2], l [m], K [N] and d [m] are read.
     G : numpy.ndarray
-        The gains, CASCADE_GAINS (27) float64 entries laid out as the ``C_*`` offsets
+        The gains, :data:`CASCADE_GAINS` (27 float64 entries) laid out as the ``C_*`` offsets
         (:meth:`Cascade.gains`, in that class's order and units).
     mem : numpy.ndarray
-        The controller's memory, CASCADE_MEMORY (19) float64 entries, zeros at the start of
+        The controller's memory, :data:`CASCADE_MEMORY` (19 float64 entries), zeros at the start of
         a flight (:meth:`Cascade.memory`), updated in place: the velocity integral (x, y, z)
         [m/s^2] from ``M_VI``, the body-rate integral (roll, pitch, yaw) [rad/s^2] from
         ``M_RI``, the last velocity [m/s] (``M_V``) and body rates [rad/s] (``M_W``), their
@@ -529,7 +562,7 @@ class Cascade(Controller):
     """
 
     name = "cascade"
-    memory_size = CASCADE_MEMORY
+    memory_size = CASCADE_MEMORY.size
 
     xy_p: float = _f(0.95, "1/s", "horizontal position P", "pos")
     z_p: float = _f(1.0, "1/s", "vertical position P", "pos")
@@ -575,35 +608,34 @@ class Cascade(Controller):
             P [1/s], I [1/s^2], D [-] of roll/pitch, then of yaw; rate_i_limit [-]; the
             velocity and rate derivative cutoffs [Hz].
         """
-        g = np.zeros(CASCADE_GAINS)
-        for col, value in (
-            (C_POS_XY, self.xy_p),
-            (C_POS_Z, self.z_p),
-            (C_VEL_P_XY, self.xy_vel_p),
-            (C_VEL_I_XY, self.xy_vel_i),
-            (C_VEL_D_XY, self.xy_vel_d),
-            (C_VEL_P_Z, self.z_vel_p),
-            (C_VEL_I_Z, self.z_vel_i),
-            (C_VEL_D_Z, self.z_vel_d),
-            (C_VMAX_XY, self.max_speed_xy),
-            (C_VMAX_UP, self.max_speed_up),
-            (C_VMAX_DOWN, self.max_speed_down),
-            (C_MAX_TILT, self.max_tilt),
-            (C_THR_MIN, self.thrust_min),
-            (C_THR_MAX, self.thrust_max),
-            (C_ATT_RP, self.roll_p),
-            (C_ATT_YAW, self.yaw_p),
-            (C_RMAX_RP, self.max_rate_rp),
-            (C_RMAX_YAW, self.max_rate_yaw),
-            (C_RATE_P, self.rate.kp),
-            (C_RATE_I, self.rate.ki),
-            (C_RATE_D, self.rate.kd),
-            (C_YRATE_P, self.yaw_rate.kp),
-            (C_YRATE_I, self.yaw_rate.ki),
-            (C_YRATE_D, self.yaw_rate.kd),
-            (C_RATE_I_LIM, self.rate_i_limit),
-            (C_VEL_D_LP, self.vel_d_cutoff),
-            (C_RATE_D_LP, self.rate_d_cutoff),
-        ):
-            g[col] = value
-        return g
+        return CASCADE_GAINS.pack(
+            {
+                "pos_xy": self.xy_p,
+                "pos_z": self.z_p,
+                "vel_p_xy": self.xy_vel_p,
+                "vel_i_xy": self.xy_vel_i,
+                "vel_d_xy": self.xy_vel_d,
+                "vel_p_z": self.z_vel_p,
+                "vel_i_z": self.z_vel_i,
+                "vel_d_z": self.z_vel_d,
+                "vmax_xy": self.max_speed_xy,
+                "vmax_up": self.max_speed_up,
+                "vmax_down": self.max_speed_down,
+                "max_tilt": self.max_tilt,
+                "thr_min": self.thrust_min,
+                "thr_max": self.thrust_max,
+                "att_rp": self.roll_p,
+                "att_yaw": self.yaw_p,
+                "rmax_rp": self.max_rate_rp,
+                "rmax_yaw": self.max_rate_yaw,
+                "rate_p": self.rate.kp,
+                "rate_i": self.rate.ki,
+                "rate_d": self.rate.kd,
+                "yrate_p": self.yaw_rate.kp,
+                "yrate_i": self.yaw_rate.ki,
+                "yrate_d": self.yaw_rate.kd,
+                "rate_i_lim": self.rate_i_limit,
+                "vel_d_lp": self.vel_d_cutoff,
+                "rate_d_lp": self.rate_d_cutoff,
+            }
+        )

@@ -67,27 +67,14 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from quadcruise.control.attitude import (
-    ATT_GAINS,
-    ATT_I_LIMIT,
-    ATT_KD,
-    ATT_KI,
-    ATT_KP,
-    ATT_MEMORY,
-    YAW_KD,
-    YAW_KI,
-    YAW_KP,
-    decoupled_attitude,
-)
+from quadcruise.control.attitude import ATTITUDE_GAINS, ATTITUDE_MEMORY, attitude_fields, decoupled_attitude
 from quadcruise.control.base import TILT, Controller, write_command
 from quadcruise.control.design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
+from quadcruise.control.inversion import pitch_eq16, roll_eq19, thrust_for_tilt, tilt_joint, tilt_setpoint
 from quadcruise.fields import instance_of
 from quadcruise.fields import unit_field as _f
 from quadcruise.layout import (
     CONTROLLER_SIG,
-    FLAG_ASIN_CLIP,
-    FLAG_THRUST_LIMIT,
-    FLAG_TILT_LIMIT,
     P_D,
     P_G,
     P_K,
@@ -108,282 +95,52 @@ from quadcruise.layout import (
     VX,
     VY,
     VZ,
+    Row,
     X,
     Y,
     Z,
 )
-from quadcruise.numeric import clamp, wrap_angle
 
-# gains layout after the attitude block
-# (COS_MAX_TILT and SIN_MAX_TILT are cos and sin of MAX_TILT, so the step calls neither: a
-# kept trick, see quadcruise.sim.fastmath)
-# (INVERSION: 0 joint, 1 the paper's sequential eqs 16 then 19)
-# (DERIVATIVE: 0 on the measurement with the reference's velocity, 1 on the whole error through
-#  the filter N [1/s] of FILTER_N)
-KP_XY, KD_XY, KP_Z, KD_Z, MAX_TILT, ACCEL_FF, COS_MAX_TILT, SIN_MAX_TILT, INVERSION, DERIVATIVE, FILTER_N = range(
-    ATT_GAINS, ATT_GAINS + 11
+NLPD_GAINS = Row.of(
+    "nlpd gains",
+    "kp_xy",
+    "kd_xy",
+    "kp_z",
+    "kd_z",
+    "max_tilt",
+    "accel_ff",
+    "cos_max_tilt",
+    "sin_max_tilt",
+    "inversion",
+    "derivative",
+    "filter_n",
+    parent=ATTITUDE_GAINS,
+    prefix="NL_",
 )
-NLPD_GAINS = ATT_GAINS + 11
+"""The gains of :func:`nlpd`: the attitude block, then the x/y and z PD gains, max_tilt, the
+feedforward switch, cos and sin of max_tilt (so that the step calls neither: a kept trick, see
+quadcruise.sim.fastmath), the inversion (0 joint, 1 the paper's sequential eqs 16 then 19), the
+derivative form (0 on the measurement with the reference's velocity, 1 on the whole error
+through the filter N [1/s] of ``filter_n``)."""
+(
+    NL_KP_XY,
+    NL_KD_XY,
+    NL_KP_Z,
+    NL_KD_Z,
+    NL_MAX_TILT,
+    NL_ACCEL_FF,
+    NL_COS_MAX_TILT,
+    NL_SIN_MAX_TILT,
+    NL_INVERSION,
+    NL_DERIVATIVE,
+    NL_FILTER_N,
+) = NLPD_GAINS.offsets
 INVERSIONS = ("joint", "sequential")
 DERIVATIVES = ("measurement", "error")
-FILTER_X, FILTER_Y = ATT_MEMORY, ATT_MEMORY + 1
-"""Memory slots of the derivative filter's states (the filtered x and y errors [m]), there
-only with ``derivative="error"``: the default memory is the attitude loop's alone."""
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def tilt_joint(ux, uy, spsi, cpsi, a, max_tilt, flags):
-    """Eqs (5) and (6) solved together for the roll and pitch setpoints, each limited to max_tilt.
-
-    Parameters
-    ----------
-    ux, uy : float
-        Wanted x and y accelerations [m/s^2].
-    spsi, cpsi : float
-        sin and cos of yaw.
-    a : float
-        U1 / m [m/s^2].
-    max_tilt : float
-        Roll and pitch setpoint limit [rad].
-    flags : int
-        The flags so far.
-
-    Returns
-    -------
-    (float, float, int)
-        phi_d [rad], theta_d [rad] and the flags (FLAG_ASIN_CLIP, FLAG_TILT_LIMIT added as they apply).
-
-    Examples
-    --------
-    >>> phi, theta, flags = tilt_joint(0.981, 0.0, 0.0, 1.0, 9.81, 0.7, 0)    # yaw 0: x'' from pitch alone
-    >>> round(phi, 6), round(theta, 6), flags
-    (0.0, 0.100167, 0)
-    >>> phi, theta, flags = tilt_joint(0.981, 0.0, 1.0, 0.0, 9.81, 0.7, 0)    # yaw 90 deg: from roll alone
-    >>> round(phi, 6), round(theta, 6) + 0.0, flags
-    (0.100167, 0.0, 0)
-    """
-    if a < 1e-9:  # no thrust: no tilt can help
-        return 0.0, 0.0, flags | FLAG_ASIN_CLIP
-    sphi, clipped = clamp((ux * spsi - uy * cpsi) / a, -1.0, 1.0)  # (6) in the yaw frame
-    phi_d, flags = tilt_setpoint(math.asin(sphi), clipped, max_tilt, flags)
-    stheta, clipped = clamp((ux * cpsi + uy * spsi) / (a * math.cos(phi_d)), -1.0, 1.0)  # (5), (16)
-    theta_d, flags = tilt_setpoint(math.asin(stheta), clipped, max_tilt, flags)
-    return phi_d, theta_d, flags
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def pitch_eq16(ux, sphi, cphi, spsi, cpsi, a):
-    """Eq (16) from the sines and cosines of roll and yaw (see :func:`theta_from_eq5`).
-
-    Parameters
-    ----------
-    ux : float
-        Wanted x acceleration [m/s^2].
-    sphi, cphi, spsi, cpsi : float
-        sin and cos of roll and yaw.
-    a : float
-        U1 / m [m/s^2].
-
-    Returns
-    -------
-    (float, float, bool)
-        theta_d [rad], its sine (asin's argument, clamped to [-1, 1]) and whether it was clamped.
-
-    Examples
-    --------
-    >>> theta, s, clipped = pitch_eq16(0.981, 0.0, 1.0, 0.0, 1.0, 9.81)
-    >>> round(theta, 6), round(s, 6), clipped
-    (0.100167, 0.1, False)
-    >>> pitch_eq16(20.0, 0.0, 1.0, 0.0, 1.0, 9.81)[1:]
-    (1.0, True)
-    """
-    den = cphi * cpsi * a
-    if abs(den) < 1e-9:
-        return 0.0, 0.0, True
-    s, clipped = clamp((ux - sphi * spsi * a) / den, -1.0, 1.0)
-    return math.asin(s), s, clipped
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def roll_eq19(uy, stheta, spsi, cpsi, a):
-    """Eq (19), sign kept, from sin(theta) and the yaw's sine and cosine (see :func:`phi_from_eq6`).
-
-    Parameters
-    ----------
-    uy : float
-        Wanted y acceleration [m/s^2].
-    stheta : float
-        sin theta_d.
-    spsi, cpsi : float
-        sin and cos of yaw.
-    a : float
-        U1 / m [m/s^2].
-
-    Returns
-    -------
-    (float, bool)
-        phi_d [rad] (the root nearest level, wrapped by :func:`quadcruise.numeric.wrap_angle`
-        when cos psi <= 0) and whether asin's argument was clamped.
-
-    Examples
-    --------
-    >>> phi, clipped = roll_eq19(0.981, 0.0, 0.0, 1.0, 9.81)
-    >>> round(phi, 6), clipped
-    (-0.100167, False)
-    """
-    A = cpsi
-    B = stheta * spsi
-    R = math.sqrt(A * A + B * B)  # |A|, |B| <= 1: no overflow to guard against
-    if R * a < 1e-9:
-        return 0.0, True
-    s, clipped = clamp(uy / (a * R), -1.0, 1.0)
-    r1 = math.asin(s)
-    if A > 0.0:
-        # |gamma| < pi/2 and |r1| <= pi/2: gamma - r1 lies in (-pi, pi) and, cos phi1 -
-        # cos phi2 = 2 A sqrt(1 - s^2) / R >= 0, it is the root nearest level (a kept trick,
-        # see quadcruise.sim.fastmath; plain: the general case below)
-        return math.atan(B / A) - r1, clipped
-    gamma = math.atan2(B, A)
-    phi1 = gamma - r1
-    phi2 = gamma + math.pi + r1
-    phi1, phi2 = wrap_angle(phi1), wrap_angle(phi2)
-    return (phi1 if abs(phi1) <= abs(phi2) else phi2), clipped
-
-
-@njit(cache=True, error_model="numpy")
-def theta_from_eq5(ux, phi, psi, a):
-    """Eq (16): the pitch that gives x'' = ux at roll phi, yaw psi and a = U1/m [m/s^2].
-
-    The angle form of :func:`pitch_eq16` (the paper's sequential inversion, step 3').
-
-    Parameters
-    ----------
-    ux : float
-        Wanted x acceleration [m/s^2].
-    phi : float
-        Roll [rad] (the current one in the paper's reading).
-    psi : float
-        Yaw [rad].
-    a : float
-        U1 / m [m/s^2].
-
-    Returns
-    -------
-    theta : float
-        The pitch setpoint theta_d [rad], not limited to a tilt.
-    clipped : bool
-        Whether asin's argument left [-1, 1] and was clamped.
-
-    Examples
-    --------
-    >>> theta, clipped = theta_from_eq5(0.981, 0.0, 0.0, 9.81)
-    >>> round(theta, 6), clipped
-    (0.100167, False)
-    """
-    theta, _, clipped = pitch_eq16(ux, math.sin(phi), math.cos(phi), math.sin(psi), math.cos(psi), a)
-    return theta, clipped
-
-
-@njit(cache=True, error_model="numpy")
-def phi_from_eq6(uy, theta, psi, a):
-    """Eq (19), sign-preserving: the roll that gives y'' = uy at pitch theta, yaw psi.
-
-    The angle form of :func:`roll_eq19` (the paper's sequential inversion, step 4').
-
-    Parameters
-    ----------
-    uy : float
-        Wanted y acceleration [m/s^2].
-    theta : float
-        Pitch [rad] (the pitch setpoint theta_d in the sequential inversion).
-    psi : float
-        Yaw [rad].
-    a : float
-        U1 / m [m/s^2].
-
-    Returns
-    -------
-    phi : float
-        The roll setpoint phi_d [rad], the root nearest level, not limited to a tilt.
-    clipped : bool
-        Whether asin's argument left [-1, 1] and was clamped.
-
-    Examples
-    --------
-    >>> phi, clipped = phi_from_eq6(0.981, 0.0, 0.0, 9.81)     # y'' > 0 needs a negative roll
-    >>> round(phi, 6), clipped
-    (-0.100167, False)
-    """
-    return roll_eq19(uy, math.sin(theta), math.sin(psi), math.cos(psi), a)
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def thrust_for_tilt(uz, cos_tilt, m, g, K, cos_max_tilt):
-    """Altitude law: U1 = m (g + u_z) / (cos phi cos theta), limited to [0, 4 K] [N], and its
-    flag. ``cos_tilt`` is cos phi cos theta; the compensation uses at most 1/cos(max_tilt) so
-    that it cannot blow up.
-
-    Parameters
-    ----------
-    uz : float
-        Wanted z acceleration [m/s^2].
-    cos_tilt : float
-        cos phi cos theta.
-    m, g, K : float
-        Mass [kg], gravity [m/s^2], thrust per unit duty [N].
-    cos_max_tilt : float
-        cos of the tilt limit.
-
-    Returns
-    -------
-    (float, int)
-        U1 [N] and FLAG_THRUST_LIMIT if it was limited, else 0.
-
-    Examples
-    --------
-    >>> U1, flag = thrust_for_tilt(0.0, 1.0, 3.499, 9.81, 120.0, 0.7)
-    >>> round(U1, 6), flag
-    (34.32519, 0)
-    >>> thrust_for_tilt(-20.0, 1.0, 3.499, 9.81, 120.0, 0.7)
-    (0.0, 4)
-    """
-    c = max(cos_tilt, cos_max_tilt)
-    U1, limited = clamp(m * (g + uz) / c, 0.0, 4.0 * K)
-    return U1, FLAG_THRUST_LIMIT if limited else 0
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def tilt_setpoint(angle, clipped, max_tilt, flags):
-    """Limit a roll/pitch setpoint to max_tilt and add the flags that apply.
-
-    Parameters
-    ----------
-    angle : float
-        The setpoint [rad].
-    clipped : bool
-        Whether its asin argument was clamped (adds FLAG_ASIN_CLIP).
-    max_tilt : float
-        The limit [rad] (adds FLAG_TILT_LIMIT when it acts).
-    flags : int
-        The flags so far.
-
-    Returns
-    -------
-    (float, int)
-
-    Examples
-    --------
-    >>> tilt_setpoint(1.0, False, 0.5, 0)
-    (0.5, 1)
-    >>> tilt_setpoint(-0.2, True, 0.5, 0)
-    (-0.2, 2)
-    """
-    if clipped:
-        flags |= FLAG_ASIN_CLIP
-    angle, limited = clamp(angle, -max_tilt, max_tilt)
-    if limited:
-        flags |= FLAG_TILT_LIMIT
-    return angle, flags
+NLPD_MEMORY = Row.of("nlpd memory", "filter_x", "filter_y", parent=ATTITUDE_MEMORY, prefix="NL_")
+NL_FILTER_X, NL_FILTER_Y = NLPD_MEMORY.offsets
+"""The memory of :func:`nlpd`: the attitude loop's, then the derivative filter's states (the
+filtered x and y errors [m]), there only with ``derivative="error"``."""
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -397,7 +154,7 @@ def finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd):
     Parameters
     ----------
     U1 : float
-        Collective thrust [N], already limited (:func:`thrust_for_tilt`).
+        Collective thrust [N], already limited (:func:`~quadcruise.control.inversion.thrust_for_tilt`).
     phi_d, theta_d, psi_d : float
         Roll, pitch and yaw setpoints [rad].
     flags : int
@@ -413,9 +170,9 @@ def finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd):
         read).
     gains : numpy.ndarray
         The controller's gains vector, starting with the attitude block
-        (:func:`attitude_block`).
+        (:data:`~quadcruise.control.attitude.ATTITUDE_GAINS`).
     mem : numpy.ndarray
-        The controller's memory: its first ATT_MEMORY (3) entries, the roll, pitch and yaw
+        The controller's memory: its first 3 entries (``ATTITUDE_MEMORY``), the roll, pitch and yaw
         error integrals [rad s], are updated in place.
     cmd : numpy.ndarray
         Output, CMD_SIZE (12) float64 entries, all written
@@ -489,15 +246,16 @@ def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
         :meth:`quadcruise.model.vehicle.Vehicle.rows`): m [kg], g [m/s^2], K [N], d [m] and
         k1..k6 are read.
     gains : numpy.ndarray
-        :meth:`NLPD.gains`, NLPD_GAINS (18) float64 entries: the attitude block
-        (:func:`attitude_block`), then at the offsets ``KP_XY`` .. ``FILTER_N`` the x/y and
+        :meth:`NLPD.gains`, :data:`NLPD_GAINS` (18 float64 entries): the attitude block
+        (``ATTITUDE_GAINS``), then at the offsets ``NL_KP_XY`` .. ``NL_FILTER_N`` the x/y and
         z PD gains [1/s^2], [1/s], max_tilt [rad], the feedforward switch (0 or 1), cos and
         sin of max_tilt, the inversion (0 joint, 1 sequential), the derivative form (0 on
         the measurement, 1 on the error) and the filter bandwidth N [1/s].
     mem : numpy.ndarray
         The controller's memory (:meth:`NLPD.memory`), zeros at the start of a flight,
-        updated in place: the roll, pitch and yaw error integrals [rad s], and with
-        ``derivative="error"`` the filtered x and y errors [m] at ``FILTER_X``, ``FILTER_Y``.
+        updated in place (:data:`NLPD_MEMORY`): the roll, pitch and yaw error integrals
+        [rad s], and with ``derivative="error"`` the filtered x and y errors [m] at
+        ``NL_FILTER_X``, ``NL_FILTER_Y``.
     cmd : numpy.ndarray
         Output, CMD_SIZE (12) float64 entries, all written (:func:`finish`): the four
         duties [-] (not clipped), U1 [N], U2 [N], U3 [N], U4 [N m], the attitude setpoints
@@ -516,66 +274,35 @@ def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
     >>> round(float(cmd[CMD_THETA_D]), 4)
     0.0307
     """
-    ff, tilt = gains[ACCEL_FF], gains[MAX_TILT]
-    if gains[DERIVATIVE] == 0.0:  # on the measurement, with the reference's velocity
-        ux = gains[KP_XY] * (ref[REF_X] - x[X]) + gains[KD_XY] * (ref[REF_VX] - x[VX]) + ff * ref[REF_AX]
-        uy = gains[KP_XY] * (ref[REF_Y] - x[Y]) + gains[KD_XY] * (ref[REF_VY] - x[VY]) + ff * ref[REF_AY]
+    ff, tilt = gains[NL_ACCEL_FF], gains[NL_MAX_TILT]
+    if gains[NL_DERIVATIVE] == 0.0:  # on the measurement, with the reference's velocity
+        ux = gains[NL_KP_XY] * (ref[REF_X] - x[X]) + gains[NL_KD_XY] * (ref[REF_VX] - x[VX]) + ff * ref[REF_AX]
+        uy = gains[NL_KP_XY] * (ref[REF_Y] - x[Y]) + gains[NL_KD_XY] * (ref[REF_VY] - x[VY]) + ff * ref[REF_AY]
     else:  # eq (17): on the whole error, filtered by N
-        ex, ey, n = ref[REF_X] - x[X], ref[REF_Y] - x[Y], gains[FILTER_N]
+        ex, ey, n = ref[REF_X] - x[X], ref[REF_Y] - x[Y], gains[NL_FILTER_N]
         decay = math.exp(-n * dt)
-        dx, fx = filtered_derivative(ex, mem[FILTER_X], gains[KD_XY], n, decay)
-        dy, fy = filtered_derivative(ey, mem[FILTER_Y], gains[KD_XY], n, decay)
-        ux = gains[KP_XY] * ex + dx + ff * ref[REF_AX]
-        uy = gains[KP_XY] * ey + dy + ff * ref[REF_AY]
-        mem[FILTER_X], mem[FILTER_Y] = fx, fy
-    uz = gains[KP_Z] * (ref[REF_Z] - x[Z]) + gains[KD_Z] * (ref[REF_VZ] - x[VZ]) + ff * ref[REF_AZ]
+        dx, fx = filtered_derivative(ex, mem[NL_FILTER_X], gains[NL_KD_XY], n, decay)
+        dy, fy = filtered_derivative(ey, mem[NL_FILTER_Y], gains[NL_KD_XY], n, decay)
+        ux = gains[NL_KP_XY] * ex + dx + ff * ref[REF_AX]
+        uy = gains[NL_KP_XY] * ey + dy + ff * ref[REF_AY]
+        mem[NL_FILTER_X], mem[NL_FILTER_Y] = fx, fy
+    uz = gains[NL_KP_Z] * (ref[REF_Z] - x[Z]) + gains[NL_KD_Z] * (ref[REF_VZ] - x[VZ]) + ff * ref[REF_AZ]
     phi, theta, psi, psi_d = x[PHI], x[THETA], x[PSI], ref[REF_PSI]
     m, g, K = vp[P_M], vp[P_G], vp[P_K]
     sphi, cphi = math.sin(phi), math.cos(phi)  # each computed once, shared
     spsi, cpsi = math.sin(psi), math.cos(psi)
-    U1, flags = thrust_for_tilt(uz, cphi * math.cos(theta), m, g, K, gains[COS_MAX_TILT])
+    U1, flags = thrust_for_tilt(uz, cphi * math.cos(theta), m, g, K, gains[NL_COS_MAX_TILT])
     a = U1 / m
-    if gains[INVERSION] == 0.0:  # (5) and (6) together, at any yaw
+    if gains[NL_INVERSION] == 0.0:  # (5) and (6) together, at any yaw
         phi_d, theta_d, flags = tilt_joint(ux, uy, spsi, cpsi, a, tilt, flags)
     else:  # the paper's: (16) with the current roll, then (19)
         pitch, stheta_d, clipped = pitch_eq16(ux, sphi, cphi, spsi, cpsi, a)  # (16)
         theta_d, flags = tilt_setpoint(pitch, clipped, tilt, flags)
         if theta_d != pitch:  # limited: sin theta_d is no longer asin's argument
-            stheta_d = math.copysign(gains[SIN_MAX_TILT], theta_d)
+            stheta_d = math.copysign(gains[NL_SIN_MAX_TILT], theta_d)
         phi_d, clipped = roll_eq19(uy, stheta_d, spsi, cpsi, a)  # (19), sign kept
         phi_d, flags = tilt_setpoint(phi_d, clipped, tilt, flags)
     finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd)
-
-
-def attitude_block(attitude: PIDGains, yaw: PIDGains, i_limit: float) -> list[float]:
-    """The first ATT_GAINS entries of a controller's gains vector.
-
-    Parameters
-    ----------
-    attitude : PIDGains
-        Roll and pitch PID: kp [1/s^2], ki [1/s^3], kd [1/s].
-    yaw : PIDGains
-        Yaw PID, the same units.
-    i_limit : float
-        Anti-windup bound on the integral term [rad/s^2].
-
-    Returns
-    -------
-    list of float
-        ATT_GAINS (7) entries laid out as the ``ATT_*``/``YAW_*`` offsets of
-        :mod:`quadcruise.control.attitude`.
-
-    Examples
-    --------
-    >>> from quadcruise.control.design import PIDGains
-    >>> attitude_block(PIDGains(kp=1.0, ki=2.0, kd=3.0), PIDGains(kp=4.0, ki=5.0, kd=6.0), 7.0)
-    [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]
-    """
-    block = [0.0] * ATT_GAINS
-    block[ATT_KP], block[ATT_KI], block[ATT_KD] = attitude.kp, attitude.ki, attitude.kd
-    block[YAW_KP], block[YAW_KI], block[YAW_KD] = yaw.kp, yaw.ki, yaw.kd
-    block[ATT_I_LIMIT] = i_limit
-    return block
 
 
 @dataclass(frozen=True)
@@ -628,7 +355,7 @@ class NLPD(Controller):
     """
 
     name = "nlpd"
-    memory_size = ATT_MEMORY
+    memory_size = ATTITUDE_MEMORY.size
 
     position: PDGains = _f(unit="-", doc="x and y PD loops", check=instance_of(PDGains), factory=position_pd_design)
     altitude: PDGains = _f(unit="-", doc="z PD loop", check=instance_of(PDGains), factory=altitude_pd_design)
@@ -655,10 +382,10 @@ class NLPD(Controller):
         Returns
         -------
         numpy.ndarray
-            Zeros: ATT_MEMORY (3) float64 entries (the roll, pitch and yaw error integrals
+            Zeros: 3 float64 entries (the roll, pitch and yaw error integrals
             [rad s]), 5 with ``derivative="error"`` (and the filtered x and y errors [m]).
         """
-        return np.zeros(ATT_MEMORY + (2 if self.derivative == "error" else 0))
+        return np.zeros((NLPD_MEMORY if self.derivative == "error" else ATTITUDE_MEMORY).size)
 
     def gains(self) -> np.ndarray:
         """The parameter vector :func:`nlpd` reads.
@@ -666,24 +393,26 @@ class NLPD(Controller):
         Returns
         -------
         numpy.ndarray
-            NLPD_GAINS (18) float64 entries: the attitude block (:func:`attitude_block`:
+            :data:`NLPD_GAINS`, 18 float64 entries: the attitude block (``ATTITUDE_GAINS``:
             roll/pitch and yaw kp [1/s^2], ki [1/s^3], kd [1/s], i_limit [rad/s^2]), then
             Kp [1/s^2] and Kd [1/s] of x and y, the same of z, max_tilt [rad], the
             feedforward switch (1.0 on, 0.0 off), cos and sin of max_tilt, the inversion
             (index in ``INVERSIONS``), the derivative form (index in ``DERIVATIVES``) and
             derivative_filter N [1/s].
         """
-        tail = [
-            self.position.kp,
-            self.position.kd,
-            self.altitude.kp,
-            self.altitude.kd,
-            self.max_tilt,
-            1.0 if self.accel_feedforward else 0.0,
-            math.cos(self.max_tilt),
-            math.sin(self.max_tilt),
-            float(INVERSIONS.index(self.inversion)),
-            float(DERIVATIVES.index(self.derivative)),
-            self.derivative_filter,
-        ]
-        return np.array(attitude_block(self.attitude, self.yaw, self.i_limit) + tail)
+        return NLPD_GAINS.pack(
+            {
+                **attitude_fields(self.attitude, self.yaw, self.i_limit),
+                "kp_xy": self.position.kp,
+                "kd_xy": self.position.kd,
+                "kp_z": self.altitude.kp,
+                "kd_z": self.altitude.kd,
+                "max_tilt": self.max_tilt,
+                "accel_ff": 1.0 if self.accel_feedforward else 0.0,
+                "cos_max_tilt": math.cos(self.max_tilt),
+                "sin_max_tilt": math.sin(self.max_tilt),
+                "inversion": float(INVERSIONS.index(self.inversion)),
+                "derivative": float(DERIVATIVES.index(self.derivative)),
+                "filter_n": self.derivative_filter,
+            }
+        )

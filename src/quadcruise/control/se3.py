@@ -91,6 +91,7 @@ from quadcruise.layout import (
     P,
     Q,
     R,
+    Row,
     X,
     Y,
     Z,
@@ -99,8 +100,10 @@ from quadcruise.numeric import clamp
 
 __all__ = ["SE3", "se3", "se3_attitude_design"]
 
-# gains layout of se3
-KX, KV, KX_Z, KV_Z, K_R, K_W, SE3_MAX_TILT = range(7)
+SE3_GAINS = Row.of("se3 gains", "kx", "kv", "kx_z", "kv_z", "k_r", "k_w", "max_tilt", prefix="SE3_")
+"""The gains of :func:`se3`: kx [1/s^2], kv [1/s] of x and y, the same of z, kR [1/s^2], kw
+[1/s], max_tilt [rad]."""
+SE3_KX, SE3_KV, SE3_KX_Z, SE3_KV_Z, SE3_K_R, SE3_K_W, SE3_MAX_TILT = SE3_GAINS.offsets
 
 
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
@@ -155,8 +158,8 @@ def se3(t, dt, x, ref, vp, gains, mem, cmd):
     phi, theta, psi, p, q, r = x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R]
     m, g, K, l, d = vp[P_M], vp[P_G], vp[P_K], vp[P_L], vp[P_D]
     jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
-    kx, kv, kx_z, kv_z = gains[KX], gains[KV], gains[KX_Z], gains[KV_Z]
-    kr, kw, max_tilt = gains[K_R], gains[K_W], gains[SE3_MAX_TILT]
+    kx, kv, kx_z, kv_z = gains[SE3_KX], gains[SE3_KV], gains[SE3_KX_Z], gains[SE3_KV_Z]
+    kr, kw, max_tilt = gains[SE3_K_R], gains[SE3_K_W], gains[SE3_MAX_TILT]
     psi_d, yaw_rate_d = ref[REF_PSI], ref[REF_PSI_DOT]
     fx = m * (kx * (ref[REF_X] - x[X]) + kv * (ref[REF_VX] - x[VX]) + ref[REF_AX])
     fy = m * (kx * (ref[REF_Y] - x[Y]) + kv * (ref[REF_VY] - x[VY]) + ref[REF_AY])
@@ -264,14 +267,14 @@ class SE3(Controller):
             7 float64 entries: kx [1/s^2] and kv [1/s] of x and y (``position``), the same
             of z (``altitude``), kR [1/s^2] and kw [1/s] (``attitude``), max_tilt [rad].
         """
-        return np.array(
-            [
-                self.position.kp,
-                self.position.kd,
-                self.altitude.kp,
-                self.altitude.kd,
-                self.attitude.kp,
-                self.attitude.kd,
-                self.max_tilt,
-            ]
+        return SE3_GAINS.pack(
+            {
+                "kx": self.position.kp,
+                "kv": self.position.kd,
+                "kx_z": self.altitude.kp,
+                "kv_z": self.altitude.kd,
+                "k_r": self.attitude.kp,
+                "k_w": self.attitude.kd,
+                "max_tilt": self.max_tilt,
+            }
         )

@@ -3,8 +3,8 @@
 
 Each is compiled with ``CONTROLLER_SIG`` and reads its setpoint, four numbers normalised to
 [-1, 1], from ``gains[0:4]`` (what :meth:`quadcruise.sim.stepper.Stepper.step` writes), its
-scales and loop gains from ``gains[4:]`` (:data:`SETPOINT_GAINS` entries, laid out as the
-``S_*`` offsets). So a policy's action flies through the engine's kernel like any controller.
+scales and loop gains from ``gains[4:]`` (the row :data:`SETPOINT_GAINS`, read at the ``S_*``
+offsets). So a policy's action flies through the engine's kernel like any controller.
 
 Modes (a = the four normalised numbers; T_h = m g, the hover thrust of the vehicle the
 controller believes in):
@@ -61,15 +61,9 @@ from quadcruise.layout import (
     P,
     Q,
     R,
+    Row,
 )
 from quadcruise.model.actuators import mix
-
-# offsets into the gains row after the 4 setpoint entries
-(S_RATE_RP, S_RATE_YAW, S_TILT, S_SPEED_XY, S_SPEED_Z, S_KP_RATE_RP, S_KP_RATE_YAW, S_K_ATT, S_K_ATT_YAW, S_K_VEL) = (
-    range(4, 14)
-)
-SETPOINT_GAINS = 14
-"""Length of an action-mode controller's gains row: 4 setpoint entries, then 10 scales and gains."""
 
 DEFAULT_SCALES = {
     "max_rate_rp": 3.0,  # rad/s: the largest roll and pitch rate asked
@@ -86,6 +80,29 @@ DEFAULT_SCALES = {
 """Scales and loop gains of the action modes, in the order of the ``S_*`` offsets."""
 
 
+ACTION = ("a0", "a1", "a2", "a3")
+"""The four normalised numbers of an action, the first entries of the gains row."""
+SETPOINT_GAINS = Row.of("setpoint gains", *ACTION, *DEFAULT_SCALES, prefix="S_")
+"""An action-mode controller's gains row: the action, then the scales and gains of
+:data:`DEFAULT_SCALES`."""
+(
+    S_A0,
+    S_A1,
+    S_A2,
+    S_A3,
+    S_MAX_RATE_RP,
+    S_MAX_RATE_YAW,
+    S_MAX_TILT,
+    S_MAX_SPEED_XY,
+    S_MAX_SPEED_Z,
+    S_KP_RATE_RP,
+    S_KP_RATE_YAW,
+    S_K_ATT,
+    S_K_ATT_YAW,
+    S_K_VEL,
+) = SETPOINT_GAINS.offsets
+
+
 def setpoint_gains(**scales: float) -> np.ndarray:
     """A gains row for an action-mode controller: zero setpoint (hover thrust, level, still),
     then :data:`DEFAULT_SCALES` with ``scales`` replacing some.
@@ -98,7 +115,7 @@ def setpoint_gains(**scales: float) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        (SETPOINT_GAINS,) float64.
+        (SETPOINT_GAINS.size,) float64.
 
     Raises
     ------
@@ -107,7 +124,7 @@ def setpoint_gains(**scales: float) -> np.ndarray:
 
     Examples
     --------
-    >>> setpoint_gains(max_tilt=0.3)[[0, S_TILT]].tolist()
+    >>> setpoint_gains(max_tilt=0.3)[[0, S_MAX_TILT]].tolist()
     [0.0, 0.3]
     """
     unknown = set(scales) - set(DEFAULT_SCALES)
@@ -117,7 +134,7 @@ def setpoint_gains(**scales: float) -> np.ndarray:
     for key, value in values.items():
         if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
             raise ValueError(f"action scale {key!r} must be a number > 0, got {value!r}")
-    return np.array([0.0] * 4 + [float(values[k]) for k in DEFAULT_SCALES])
+    return SETPOINT_GAINS.pack({**dict.fromkeys(ACTION, 0.0), **{k: float(v) for k, v in values.items()}})
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -145,7 +162,7 @@ def rotor_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     vp : numpy.ndarray
         The vehicle parameter row: m, g, K, d are read.
     G : numpy.ndarray
-        (SETPOINT_GAINS,) the normalised setpoint, then the scales.
+        (SETPOINT_GAINS.size,) the normalised setpoint, then the scales.
     mem : numpy.ndarray
         Memory (none used).
     cmd : numpy.ndarray
@@ -153,7 +170,7 @@ def rotor_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     """
     K, d = vp[P_K], vp[P_D]
     hover = vp[P_M] * vp[P_G] / (4.0 * K)
-    u1, u2, u3, u4 = hover * (1.0 + G[0]), hover * (1.0 + G[1]), hover * (1.0 + G[2]), hover * (1.0 + G[3])
+    u1, u2, u3, u4 = hover * (1.0 + G[S_A0]), hover * (1.0 + G[S_A1]), hover * (1.0 + G[S_A2]), hover * (1.0 + G[S_A3])
     U1, U2, U3, U4 = mix(K * u1, K * u2, K * u3, K * u4, d)
     cmd[0], cmd[1], cmd[2], cmd[3] = u1, u2, u3, u4
     cmd[CMD_THRUST], cmd[CMD_TAU_PHI], cmd[CMD_TAU_THETA], cmd[CMD_TAU_PSI] = U1, U2, U3, U4
@@ -176,7 +193,7 @@ def rate_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     vp : numpy.ndarray
         The vehicle parameter row.
     G : numpy.ndarray
-        (SETPOINT_GAINS,) the normalised setpoint, then the scales.
+        (SETPOINT_GAINS.size,) the normalised setpoint, then the scales.
     mem : numpy.ndarray
         Memory (none used).
     cmd : numpy.ndarray
@@ -185,8 +202,8 @@ def rate_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     m, g, K, d, l = vp[P_M], vp[P_G], vp[P_K], vp[P_D], vp[P_L]
     jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
     p, q, r = x[P], x[Q], x[R]
-    U1 = m * g * (1.0 + G[0])
-    sp1, sp2, sp3 = G[1] * G[S_RATE_RP], G[2] * G[S_RATE_RP], G[3] * G[S_RATE_YAW]
+    U1 = m * g * (1.0 + G[S_A0])
+    sp1, sp2, sp3 = G[S_A1] * G[S_MAX_RATE_RP], G[S_A2] * G[S_MAX_RATE_RP], G[S_A3] * G[S_MAX_RATE_YAW]
     U2, U3, U4 = _rate_loop(sp1, sp2, sp3, p, q, r, G[S_KP_RATE_RP], G[S_KP_RATE_YAW], jx, jy, jz, l)
     write_command(cmd, U1, U2, U3, U4, 0.0, 0.0, 0.0, 0, d, K)
 
@@ -207,7 +224,7 @@ def attitude_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     vp : numpy.ndarray
         The vehicle parameter row.
     G : numpy.ndarray
-        (SETPOINT_GAINS,) the normalised setpoint, then the scales.
+        (SETPOINT_GAINS.size,) the normalised setpoint, then the scales.
     mem : numpy.ndarray
         Memory (none used).
     cmd : numpy.ndarray
@@ -216,8 +233,8 @@ def attitude_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     m, g, K, d, l = vp[P_M], vp[P_G], vp[P_K], vp[P_D], vp[P_L]
     jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
     phi, theta, psi, p, q, r = x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R]
-    U1 = m * g * (1.0 + G[0])
-    phi_d, theta_d, psi_d = G[1] * G[S_TILT], G[2] * G[S_TILT], G[3] * math.pi
+    U1 = m * g * (1.0 + G[S_A0])
+    phi_d, theta_d, psi_d = G[S_A1] * G[S_MAX_TILT], G[S_A2] * G[S_MAX_TILT], G[S_A3] * math.pi
     k_att, k_yaw = G[S_K_ATT], G[S_K_ATT_YAW]
     sp1, sp2, sp3 = k_att * (phi_d - phi), k_att * (theta_d - theta), k_yaw * _wrapped(psi_d - psi)
     U2, U3, U4 = _rate_loop(sp1, sp2, sp3, p, q, r, G[S_KP_RATE_RP], G[S_KP_RATE_YAW], jx, jy, jz, l)
@@ -241,7 +258,7 @@ def velocity_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     vp : numpy.ndarray
         The vehicle parameter row.
     G : numpy.ndarray
-        (SETPOINT_GAINS,) the normalised setpoint, then the scales.
+        (SETPOINT_GAINS.size,) the normalised setpoint, then the scales.
     mem : numpy.ndarray
         Memory (none used).
     cmd : numpy.ndarray
@@ -251,11 +268,11 @@ def velocity_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
     vx, vy, vz = x[VX], x[VY], x[VZ]
     phi, theta, psi, p, q, r = x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R]
-    k_vel, tilt = G[S_K_VEL], G[S_TILT]
-    ax = k_vel * (G[0] * G[S_SPEED_XY] - vx)
-    ay = k_vel * (G[1] * G[S_SPEED_XY] - vy)
-    az = max(k_vel * (G[2] * G[S_SPEED_Z] - vz), -0.9 * g)
-    psi_d = G[3] * math.pi
+    k_vel, tilt = G[S_K_VEL], G[S_MAX_TILT]
+    ax = k_vel * (G[S_A0] * G[S_MAX_SPEED_XY] - vx)
+    ay = k_vel * (G[S_A1] * G[S_MAX_SPEED_XY] - vy)
+    az = max(k_vel * (G[S_A2] * G[S_MAX_SPEED_Z] - vz), -0.9 * g)
+    psi_d = G[S_A3] * math.pi
     c, s = math.cos(psi), math.sin(psi)
     # eqs (5), (6) at small roll: x'' = (cos psi theta + sin psi phi) a, y'' = (sin psi theta - cos psi phi) a
     theta_d = math.atan((c * ax + s * ay) / (g + az))

@@ -133,7 +133,7 @@ class Population:
                     f"population field '{name}' = {value:g} is too large: with {self.distribution} "
                     f"draws it must be < {limit:.4f} so that every value stays positive"
                 )
-        from quadcruise.disturbances.environment import Environment, SensorNoise
+        from quadcruise.disturbances import Environment, SensorNoise
 
         if self.environment is not None:
             if not isinstance(self.environment, Environment):
@@ -277,7 +277,7 @@ class Population:
         )
         cols.update(wind_x=wind[:, 0], wind_y=wind[:, 1])
         if self.wind_spread > 0:
-            from quadcruise.disturbances.environment import ConstantWind, Environment
+            from quadcruise.disturbances import ConstantWind, Environment
 
             env = dataclasses.replace(env or Environment(), wind=ConstantWind(velocity=wind))
         if env is not None and not env.parts:

@@ -196,7 +196,7 @@ class MonteCarloSpec:
         object.__setattr__(self, "max_track_error_m", float(bound))
         object.__setattr__(self, "max_altitude_error_m", float(zbound))
         if self.population.needs_drag:
-            from quadcruise.disturbances.environment import with_drag
+            from quadcruise.disturbances import with_drag
 
             object.__setattr__(self, "vehicle", with_drag(self.vehicle, warn=True))
 

@@ -29,7 +29,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
-from numba import config, get_num_threads, njit, types
+from numba import config, get_num_threads, njit
 
 from quadcruise import checks
 from quadcruise.errors import InputError
@@ -47,9 +47,6 @@ from quadcruise.layout import (
     VX,
     VY,
     VZ,
-    ControllerType,
-    DisturbanceType,
-    MissionType,
     P,
     Q,
     R,
@@ -59,6 +56,7 @@ from quadcruise.layout import (
 )
 from quadcruise.model.plant import EULER_PITCH_LIMIT, derivative_at
 from quadcruise.sim.fastmath import TRIG_REFRESH, turned
+from quadcruise.sim.kernel_args import KERNEL_SIG, KernelArgs
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rng import next_normal, vehicle_states
 from quadcruise.sim.status import STATUS_REASONS, ExitStatus
@@ -357,49 +355,6 @@ def blank_rows(log, i, first):
             log[i, row, j] = np.nan
 
 
-_f8v = types.float64[::1]
-_f8m = types.float64[:, ::1]
-_f8c = types.float64[:, :, ::1]
-_i8v = types.int64[::1]
-_i8m = types.int64[:, ::1]
-_u8m = types.uint64[:, ::1]
-
-KERNEL_SIG = types.void(
-    types.int64,
-    types.int64,
-    _f8v,
-    _f8m,
-    _f8m,
-    _f8m,
-    ControllerType,
-    _f8m,
-    _f8m,
-    MissionType,
-    _f8m,
-    DisturbanceType,
-    types.boolean,
-    _f8m,
-    _f8m,
-    _u8m,
-    _f8m,
-    types.int64,
-    types.boolean,
-    types.float64,
-    types.int64,
-    _f8v,
-    types.int64,
-    _i8m,
-    _f8m,
-    _f8c,
-    _f8c,
-    _f8c,
-    _f8m,
-    _i8v,
-    _f8v,
-    _f8m,
-)
-
-
 @njit(KERNEL_SIG, cache=True, nogil=True, error_model="numpy")
 def _kernel(
     first,
@@ -435,20 +390,8 @@ def _kernel(
     t_stop,
     saturated,
 ):
-    """Fly vehicles first .. stop - 1 of the batch. The arguments, by role (their meaning:
-    :func:`simulate`'s parameters; one row per vehicle):
-
-    - time: ``t_grid``;
-    - plant: ``x0``, ``vp``;
-    - controller: ``vp_ctrl``, the function ``controller``, ``gains``, ``mem``;
-    - mission: the function ``mission``, ``mp``;
-    - disturbance: the function ``disturbance``, ``disturbed`` (False: still air), ``dp``,
-      ``dmem``, ``rng``;
-    - sensors: ``sensor_std``, ``sensor_delay``;
-    - options: ``full``, ``max_step``, ``log_every``, ``limits``;
-    - resuming: ``n_step``, ``clock``, ``carry`` (below);
-    - outputs: ``log_x``, ``log_cmd``, ``log_ref``, ``x_final``, ``status``, ``t_stop``,
-      ``saturated`` (and ``mem``, ``dmem``, ``rng`` written back).
+    """Fly vehicles first .. stop - 1 of the batch; the other arguments are
+    :class:`~quadcruise.sim.kernel_args.KernelArgs`, by role.
 
     Each vehicle flies on from its period ``clock[i, 0]`` for at most ``n_step`` periods,
     then stops at the next instant without asking for its command there, unless that
@@ -620,7 +563,7 @@ def fly_vehicles(n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD
     ----------
     n : int
         Number of vehicles.
-    args : tuple
+    args : KernelArgs
         The kernel's arguments after the vehicle range (its batch arrays, by role).
     pieces_per_thread : int
         Ranges per thread: fewer for short calls (a step), where each call's fixed cost counts.
@@ -902,37 +845,37 @@ def simulate(
     saturated = np.zeros((n, 2))
     fly_vehicles(
         n,
-        (
-            t_grid,
-            x0,
-            vp,
-            vp_ctrl,
-            controller,
-            gains,
-            mem,
-            mission,
-            mp,
-            disturbance or still_air,
-            disturbed,
-            dp,
-            dmem,
-            rng,
-            std,
-            int(sensor_delay),
-            bool(full_dynamics),
-            float(max_step),
-            int(log_every),
-            limits.array(),
-            n_periods,
-            np.zeros((n, 2), dtype=np.int64),
-            fresh_carry(x0, int(sensor_delay)),
-            log_x,
-            log_cmd,
-            log_ref,
-            x_final,
-            status,
-            t_stop,
-            saturated,
+        KernelArgs(
+            t_grid=t_grid,
+            x0=x0,
+            vp=vp,
+            vp_ctrl=vp_ctrl,
+            controller=controller,
+            gains=gains,
+            mem=mem,
+            mission=mission,
+            mp=mp,
+            disturbance=disturbance or still_air,
+            disturbed=disturbed,
+            dp=dp,
+            dmem=dmem,
+            rng=rng,
+            sensor_std=std,
+            sensor_delay=int(sensor_delay),
+            full=bool(full_dynamics),
+            max_step=float(max_step),
+            log_every=int(log_every),
+            limits=limits.array(),
+            n_step=n_periods,
+            clock=np.zeros((n, 2), dtype=np.int64),
+            carry=fresh_carry(x0, int(sensor_delay)),
+            log_x=log_x,
+            log_cmd=log_cmd,
+            log_ref=log_ref,
+            x_final=x_final,
+            status=status,
+            t_stop=t_stop,
+            saturated=saturated,
         ),
     )
     return SimResult(

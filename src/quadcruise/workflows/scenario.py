@@ -220,7 +220,7 @@ class Scenario:
         vehicle = self.vehicle
         if self.environment is not None:
             if drag and self.environment.needs_drag:
-                from quadcruise.disturbances.environment import with_drag
+                from quadcruise.disturbances import with_drag
 
                 vehicle = with_drag(vehicle, warn=True)
             kw["environment"] = self.environment
@@ -621,7 +621,7 @@ def _disturbances(where: _Where, table: dict):
     _known(where, "", table, set(DISTURBANCE_KEYS))
     if not table:
         return None, None
-    from quadcruise.disturbances import environment as d
+    import quadcruise.disturbances as d
 
     parts: dict[str, Any] = {}
     if "wind" in table:
