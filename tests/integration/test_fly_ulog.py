@@ -154,3 +154,15 @@ def test_a_write_that_fails_is_one_line_exit_74_and_leaves_no_log(tmp_path, monk
     enospc = "cannot write (no space left on device)"
     assert result.stderr.strip().splitlines() == [f"error: {tmp_path / 'c-1.ulg'}: {enospc}"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["batch.toml"]
+
+
+def test_compare_writes_one_log_per_controller(tmp_path):
+    """``compare --ulog``: each controller's log, the same bytes as ``fly`` writes for that
+    controller on the same mission, and the two controllers' logs differ."""
+    result = run("compare", "step", "--controllers", "nlpd,se3", "--duration", "2", "--ulog", tmp_path / "c.ulg")
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in tmp_path.glob("*.ulg")) == ["c-nlpd.ulg", "c-se3.ulg"]
+    flown = run("fly", "step", "--controller", "se3", "--duration", "2", "--ulog", tmp_path / "fly-se3.ulg")
+    assert flown.exit_code == 0, flown.output
+    assert (tmp_path / "c-se3.ulg").read_bytes() == (tmp_path / "fly-se3.ulg").read_bytes()
+    assert (tmp_path / "c-nlpd.ulg").read_bytes() != (tmp_path / "c-se3.ulg").read_bytes()
