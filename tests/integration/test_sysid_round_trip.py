@@ -45,7 +45,7 @@ def check_identified(parameters: dict, vehicle) -> None:
 def test_sysid_flight_identifies_the_vehicle(name, tmp_path):
     fields, controller = FLIGHTS[name]
     vehicle = qc.Vehicle.paper().replace(**fields)
-    flight = qc.fly(Sysid(), controller, vehicle=vehicle, sensors=NOISE, seed=11)
+    flight = qc.fly(Sysid(repeats=1), controller, vehicle=vehicle, sensors=NOISE, seed=11)  # 30 s, one spin
     assert flight.ok[0], flight.status_text(0)
     result = qc.identify(flight.to_ulog(tmp_path / "sysid.ulg"), mass=float(vehicle.m))
     assert result.fit["command_hold"] == "zero"  # the log holds every command: each acts until the next
