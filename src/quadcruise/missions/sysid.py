@@ -1,29 +1,7 @@
-"""The ``sysid`` mission: hover with doublets on roll, pitch, thrust and yaw, flown closed loop,
-for a log worth identifying (``quadcruise identify``).
-
-PX4's system identification flies doublets (a step up, a step down twice as long, a step back:
-"1-2-1") on each axis in turn on top of hover. A position controller cannot be handed torques,
-so this mission asks for them through its reference: each doublet is one of the *acceleration*
-reference (``+A`` for ``pulse``, ``-A`` for 2 ``pulse``, ``+A`` for ``pulse``) with the velocity
-and position that integrate it exactly, so the controllers' feed-forward turns it into
-commands without waiting for a tracking error, and the reference comes back to where it
-started (a doublet's position and velocity end at zero).
-
-- an acceleration doublet in y (``accel``) asks for steps of roll (tilt arctan(A/g)): the
-  attitude loop answers each with a roll-rate pulse, which excites Jxx;
-- one in x, the same for pitch (Jyy);
-- one in z (``climb``): steps of the collective thrust (K, the thrust line, the hover command);
-- one of the yaw acceleration (``yaw_accel``; the yaw and yaw-rate references integrate it):
-  a doublet of the yaw torque (K d / Jzz);
-- then the vehicle is spun up to ``spin`` about z (over 2 ``pulse``), flies the roll and pitch
-  doublets again while spinning, and is spun down: the gyroscopic terms (q r, p r) are what
-  separates Jzz from d, which the yaw axis alone sees only as K d / Jzz. Each repeat spins the
-  other way, so an even number of repeats ends at the yaw it started from.
-
-Everything is flown ``repeats`` times after ``settle`` seconds of hover, with ``rest`` seconds of
-hover after each doublet. The defaults (tilt steps of 8.7 degrees, +-1 m/s^2 of climb, a yaw rate
-of 1 rad/s, 0.5 s pulses: 58 s in all, a reference that stays within 0.4 m of the hover point)
-are sized for the paper's Qball-X4 and vehicles of its size, gentle enough for an indoor arena.
+"""The ``sysid`` mission: hover with 1-2-1 doublets of the acceleration reference on roll, pitch,
+thrust and yaw, then roll and pitch doublets while spinning, flown closed loop for a log worth
+identifying. What each doublet excites and why its defaults: docs/missions.md and
+docs/identify.md.
 
 Examples
 --------
