@@ -127,6 +127,7 @@ def resize(point: Path, kib: int) -> None:
         (["fly", "hover", "--duration", "1", "--out", "{disk}/flight"], "{disk}/flight"),
         (["replay", str(PWM), "-o", "{disk}/states.csv"], "{disk}/states.csv"),
         (["fly", "hover", "--duration", "1", "--report", "{disk}/r.html"], "{disk}/r.html"),
+        (["fly", "hover", "--duration", "1", "--ulog", "{disk}/f.ulg"], "{disk}/f.ulg"),
     ],
 )
 def test_a_full_disk_is_one_line_exit_74_and_leaves_nothing(small_disk, tmp_path, args, target):

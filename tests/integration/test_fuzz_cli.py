@@ -154,7 +154,7 @@ def scenario_keys() -> list[tuple[str, str, str]]:
     from quadcruise.workflows.scenario import OFF_WHEN_INFINITE, SIMULATION_KEYS
 
     keys = [("vehicle", f.name, "number") for f in dataclasses.fields(Vehicle)]
-    for name in ("hover", "step", "circle", "square"):
+    for name in ("hover", "step", "circle", "square", "sysid"):
         for f in dataclasses.fields(MISSIONS[name]):
             keys.append((f"mission:{name}", f.name, "text" if f.name == "axis" else "number"))
     for name in CONTROLLERS:

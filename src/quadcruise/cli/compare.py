@@ -18,12 +18,14 @@ from quadcruise.cli.common import (
     metric_options,
     needs_out,
     writable,
+    writable_with,
 )
 from quadcruise.cli.compare_run import (
     compared_from_options,
     echo_population_comparison,
     population_from_options,
     population_record,
+    write_comparison_ulogs,
 )
 from quadcruise.cli.world import flight_world, note, world_options
 from quadcruise.io.files import check_output_dir
@@ -70,6 +72,13 @@ __all__ = ["compare"]
     seed=False,
 )
 @REPORT_OPTION
+@click.option(
+    "--ulog",
+    type=click.Path(dir_okay=False),
+    metavar="PATH.ulg",
+    callback=writable_with(".ulg"),
+    help="Also write each controller's flight as a PX4 log: PATH-nlpd.ulg, PATH-se3.ulg, ...",
+)
 @RISE_OPTION
 @SETTLE_BAND_OPTION
 @friendly
@@ -90,6 +99,7 @@ def compare(
     turbulence,
     log_every,
     report,
+    ulog,
     rise,
     settle_bands,
 ):
@@ -134,6 +144,9 @@ def compare(
         ``--log-every``: log every this many control periods.
     report : str or None
         ``--report``: path of a self-contained HTML report to write as well; None: no report.
+    ulog : str or None
+        ``--ulog``: each controller's flight as a PX4 log, the controller's label before the
+        suffix (:func:`~quadcruise.cli.compare_run.write_comparison_ulogs`); None: none.
     rise : str
         ``--rise``: the rise-time convention, ``10-90`` or ``0-100`` (% of the step).
     settle_bands : tuple of float
@@ -177,6 +190,8 @@ def compare(
     if count is not None:
         table = echo_population_comparison(cmp_mission, cmp.controllers, count, pop_seed, pop, kwargs)
         cmp = dataclasses.replace(cmp, population=population_record(count, pop_seed, pop), population_table=table)
+    if ulog is not None:
+        click.echo("wrote PX4 logs " + ", ".join(map(str, write_comparison_ulogs(cmp, ulog))))
     if out is not None:
         cmp.write(out, force=force, **conventions)
         click.echo(f"wrote metrics.csv and comparison.png to {out}")

@@ -4,6 +4,9 @@ options and its help are in :mod:`quadcruise.cli.compare`."""
 
 from __future__ import annotations
 
+import re
+from pathlib import Path
+
 import click
 
 from quadcruise.cli.common import Bar
@@ -17,6 +20,7 @@ __all__ = [
     "echo_population_comparison",
     "population_from_options",
     "population_record",
+    "write_comparison_ulogs",
 ]
 
 
@@ -203,3 +207,41 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
         or ({scenario.controller.name: scenario.controller} if scenario.controller is not None else DEFAULT_COMPARED)
     )
     return the_mission, chosen, scenario.fly_kwargs(drag=False), scenario
+
+
+def write_comparison_ulogs(cmp, path) -> list[Path]:
+    """Write each controller's flight as a PX4 log, all or none.
+
+    ``PATH.ulg`` becomes ``PATH-LABEL.ulg`` for each controller's label (characters other than
+    letters, digits, ``.``, ``_`` and ``-`` made ``_``); a flight of several vehicles is one file
+    per vehicle after that (:func:`~quadcruise.cli.fly_run.ulog_paths`).
+
+    Parameters
+    ----------
+    cmp : Comparison
+        The flights.
+    path : str or os.PathLike
+        The path given (``.ulg``).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+
+    Raises
+    ------
+    WriteError
+        A file that could not be written (named); none of the files is left.
+    """
+    from quadcruise.cli.fly_run import write_ulogs
+
+    path, written = Path(path), []
+    try:
+        for label, result in cmp.results.items():
+            safe = re.sub(r"[^A-Za-z0-9._-]", "_", str(label))
+            written += write_ulogs(result, path.with_name(f"{path.stem}-{safe}{path.suffix}"))
+    except BaseException:
+        for done in written:
+            done.unlink(missing_ok=True)
+        raise
+    return written

@@ -18,6 +18,7 @@ from quadcruise.cli.common import (
     metric_options,
     needs_out,
     writable,
+    writable_with,
 )
 from quadcruise.cli.fly_run import fly_and_report
 from quadcruise.cli.objects import flight_from_options
@@ -68,6 +69,13 @@ __all__ = ["fly"]
     callback=writable,
     help="Also write an animation of the flight (.gif; .mp4 needs ffmpeg).",
 )
+@click.option(
+    "--ulog",
+    type=click.Path(dir_okay=False),
+    metavar="PATH.ulg",
+    callback=writable_with(".ulg"),
+    help="Also write the flight as a PX4 log (ULog); a batch as PATH-0.ulg, PATH-1.ulg, ...",
+)
 @WORLD_OPTIONS
 @RISE_OPTION
 @SETTLE_BAND_OPTION
@@ -87,6 +95,7 @@ def fly(
     smooth,
     report,
     animate,
+    ulog,
     vehicle,
     controller_vehicle,
     wind,
@@ -143,6 +152,10 @@ def fly(
     animate : str or None
         ``--animate``: path of an animation of the flight to write as well (``.gif``, or
         ``.mp4`` with ffmpeg); None: no animation.
+    ulog : str or None
+        ``--ulog``: path of a PX4 log (``.ulg``) of the flight to write as well
+        (:meth:`~quadcruise.SimResult.to_ulog`); a batch of N vehicles is written as N files,
+        ``PATH-0.ulg`` ... (:func:`~quadcruise.cli.fly_run.ulog_paths`). None: no log.
     vehicle, controller_vehicle : str or None
         ``--vehicle``, ``--controller-vehicle``: the flown vehicle and the controller's model of
         it (:func:`~quadcruise.cli.objects.vehicle_from_option`); None: the scenario's, else
@@ -197,7 +210,7 @@ def fly(
         **{k: v for k, v in flown.items() if v is not None},
     }
     result = fly_and_report(
-        the_mission, the_controller, kwargs, out, fmt, force, report, animate, given, scenario, conventions, notes
+        the_mission, the_controller, kwargs, out, fmt, force, report, animate, given, scenario, conventions, notes, ulog
     )
     if not result.ok.all():
         sys.exit(1)  # a vehicle did not fly its mission: diverged, lost track, out of bounds

@@ -4,6 +4,8 @@ folder, report and animation written. The command, its options and its help are 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import click
 import numpy as np
 
@@ -11,7 +13,7 @@ from quadcruise.cli.feedback import Bar
 from quadcruise.cli.world import note
 from quadcruise.io.files import check_output_dir
 
-__all__ = ["fly_and_report"]
+__all__ = ["fly_and_report", "ulog_paths", "write_ulogs"]
 
 
 def fly_and_report(
@@ -27,6 +29,7 @@ def fly_and_report(
     scenario=None,
     conventions=None,
     notes=(),
+    ulog=None,
 ):
     """Fly, print the metrics and each unfinished vehicle's reason, and write what was asked for.
 
@@ -54,6 +57,8 @@ def fly_and_report(
         ``rise`` and ``settle_bands`` of the metrics (:func:`~quadcruise.cli.common.metric_options`).
     notes : sequence of str
         Lines printed on stderr (``note: ...``) once the options are checked, before flying.
+    ulog : str, optional
+        Path of a PX4 log of the flight (one file per vehicle for a batch: :func:`ulog_paths`).
 
     Returns
     -------
@@ -74,6 +79,8 @@ def fly_and_report(
         note(line)
     result = run_fly(mission, controller, **kwargs)
     result.meta["command_line"] = list(given)
+    if ulog is not None:
+        result.meta["ulog"] = {"path": str(ulog), "files": [str(p) for p in ulog_paths(ulog, result.n)]}
     if scenario is not None:
         result.meta["scenario"] = {"source": scenario.source, "title": scenario.title}
     metrics = result.metrics(**(conventions or {}))
@@ -82,6 +89,9 @@ def fly_and_report(
     click.echo(conventions_text(metrics.attrs.get("conventions")))
     for i in np.flatnonzero(~result.ok):
         click.echo(f"vehicle {i} did not fly its mission: {result.status_text(int(i))}")
+    if ulog is not None:
+        written = write_ulogs(result, ulog)
+        click.echo(f"wrote PX4 log{'s' if len(written) > 1 else ''} " + ", ".join(map(str, written)))
     if out is not None:
         write_flight(result, out, fmt, metrics=metrics)
         click.echo(f"wrote traces, figure and metrics to {out}")
@@ -96,3 +106,62 @@ def fly_and_report(
         animate_flight(result, animate, progress=Bar("drawing the animation", unit="frame"))
         click.echo(f"wrote animation {animate}")
     return result
+
+
+def ulog_paths(path, n: int) -> list[Path]:
+    """The PX4 logs ``--ulog PATH`` writes for a flight of ``n`` vehicles.
+
+    A PX4 log holds one vehicle, so a batch is written one file per vehicle, its index (from 0,
+    as :meth:`~quadcruise.SimResult.to_ulog` counts) before the suffix.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The path given (``.ulg``).
+    n : int
+        The number of vehicles flown.
+
+    Returns
+    -------
+    list of pathlib.Path
+
+    Examples
+    --------
+    >>> [p.name for p in ulog_paths("out/flight.ulg", 1)], [p.name for p in ulog_paths("flight.ulg", 2)]
+    (['flight.ulg'], ['flight-0.ulg', 'flight-1.ulg'])
+    """
+    path = Path(path)
+    if n == 1:
+        return [path]
+    return [path.with_name(f"{path.stem}-{i}{path.suffix}") for i in range(n)]
+
+
+def write_ulogs(result, path) -> list[Path]:
+    """Write each vehicle's PX4 log, all or none: a fault on one removes those already written.
+
+    Parameters
+    ----------
+    result : SimResult
+        The flight.
+    path : str or os.PathLike
+        The path given (``.ulg``); see :func:`ulog_paths`.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+
+    Raises
+    ------
+    WriteError
+        A file that could not be written (named); none of the files is left.
+    """
+    written: list[Path] = []
+    try:
+        for i, each in enumerate(ulog_paths(path, result.n)):
+            written.append(result.to_ulog(each, vehicle=i))
+    except BaseException:
+        for done in written:
+            done.unlink(missing_ok=True)
+        raise
+    return written

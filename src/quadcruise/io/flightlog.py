@@ -366,7 +366,8 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
         "vectors and commands interpolated linearly, "
         "attitude by slerp, arming and landed states held from their last message"
     )
-    kept = {k: params[k] for k in ("MAV_TYPE", "THR_MDL_FAC", "CA_ROTOR_COUNT", "SYS_AUTOSTART") if k in params}
+    names = ("MAV_TYPE", "THR_MDL_FAC", "CA_ROTOR_COUNT", "SYS_AUTOSTART", "SDLOG_PROFILE")
+    kept = {k: params[k] for k in names if k in params}
     return FlightLog(
         source=str(path),
         t=t,

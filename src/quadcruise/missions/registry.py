@@ -8,12 +8,13 @@ from quadcruise import checks
 from quadcruise.errors import InputError
 from quadcruise.missions.base import Mission, check_names
 from quadcruise.missions.shapes import Circle, Hover, Square, Step
+from quadcruise.missions.sysid import Sysid
 from quadcruise.missions.waypoints import MinimumSnap, Waypoints
 from quadcruise.model.vehicle import shared_default
 
 __all__ = ["MISSIONS", "as_mission", "mission_from_dict", "mission_from_name"]
 
-MISSIONS = {cls.name: cls for cls in (Hover, Step, Circle, Square, Waypoints, MinimumSnap)}
+MISSIONS = {cls.name: cls for cls in (Hover, Step, Circle, Square, Waypoints, MinimumSnap, Sysid)}
 """Mission kind name -> class."""
 
 
@@ -23,8 +24,8 @@ def mission_from_name(name: str, **kw: Any) -> Mission:
     Parameters
     ----------
     name : str
-        A key of :data:`MISSIONS`: 'hover', 'step', 'circle', 'square', 'waypoints' or
-        'minsnap' (case and surrounding blanks ignored).
+        A key of :data:`MISSIONS`: 'hover', 'step', 'circle', 'square', 'waypoints',
+        'minsnap' or 'sysid' (case and surrounding blanks ignored).
     **kw : Any
         Fields of that kind, in their units (e.g. ``radius`` [m], ``period`` [s]); the
         waypoint kinds need ``table`` (a :class:`~quadcruise.missions.WaypointTable`, a CSV

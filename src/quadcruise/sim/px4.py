@@ -38,6 +38,14 @@ RATES_HZ = {
 }
 """Each topic's rate at most [Hz]: PX4's default logging profile's order of magnitude, capped
 by the flight's own log interval (a topic is written every k-th logged instant)."""
+SYSID_TOPICS = ("vehicle_attitude", "vehicle_angular_velocity", "actuator_motors", "sensor_combined")
+"""The topics PX4's system-identification logging profile writes at their full rate."""
+PROFILES = {
+    "default": (RATES_HZ, 1),
+    "sysid": ({**RATES_HZ, **dict.fromkeys(SYSID_TOPICS, float("inf"))}, 1 | 8),
+}
+"""Logging profiles: each topic's rate at most [Hz] and the ``SDLOG_PROFILE`` bits PX4 writes
+for it (1 default, 8 system identification: every logged instant; why, docs/identify.md)."""
 
 # PX4's formats (uORB, as PX4 v1.15 logs them), field for field.
 VEHICLE_LOCAL_POSITION = (
@@ -197,7 +205,7 @@ def rotor_parameters(arm: float, yaw_per_thrust: float, max_thrust: float) -> di
 
 def _every(t: np.ndarray, rate_hz: float) -> np.ndarray:
     step = float(t[1] - t[0]) if len(t) > 1 else 1.0
-    k = max(1, int(round(1.0 / (rate_hz * step))))
+    k = max(1, int(round(1.0 / (rate_hz * step)))) if np.isfinite(rate_hz) else 1
     return np.arange(0, len(t), k)
 
 
@@ -209,9 +217,11 @@ def px4_topics(
     g: float,
     noise_std: np.ndarray | None = None,
     rng: np.random.Generator | None = None,
+    rates_hz: dict[str, float] | None = None,
 ) -> list[Topic]:
-    """One vehicle's flight as PX4 topics at :data:`RATES_HZ`, from its logged ``t``, ``states`` and
-    ``duties``, with the sensor noise ``noise_std`` (``SensorNoise.std_vector``) drawn from ``rng``.
+    """One vehicle's flight as PX4 topics at ``rates_hz`` (a profile of :data:`PROFILES`;
+    :data:`RATES_HZ` by default), from its logged ``t``, ``states`` and ``duties``, with the sensor
+    noise ``noise_std`` (``SensorNoise.std_vector``) drawn from ``rng``.
     """
     us = np.round(t * 1e6).astype(np.uint64)
     accel = np.gradient(states[:, VX : VX + 3], t, axis=0, edge_order=2) if len(t) > 2 else np.zeros((len(t), 3))
@@ -227,8 +237,10 @@ def px4_topics(
     control = np.full((len(t), 12), np.nan)
     control[:, :4] = duties
 
+    rates_hz = RATES_HZ if rates_hz is None else rates_hz
+
     def topic(name, fields, **values):
-        rows = _every(t, RATES_HZ[name])
+        rows = _every(t, rates_hz[name])
         values = {k: np.asarray(v)[rows] for k, v in values.items()}
         return Topic(name, fields, {"timestamp": us[rows], **values})
 
@@ -270,7 +282,7 @@ def px4_topics(
             SENSOR_COMBINED,
             gyro_rad=gyro,
             accelerometer_m_s2=force,
-            gyro_integral_dt=np.full(len(t), int(round(1e6 / RATES_HZ["sensor_combined"]))),
+            gyro_integral_dt=np.full(len(t), int(np.diff(us[_every(t, rates_hz["sensor_combined"])][:2]).sum())),
         ),
         topic(
             "vehicle_status",

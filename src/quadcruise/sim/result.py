@@ -257,11 +257,11 @@ class SimResult:
 
         return plot_flight(self, vehicle=vehicle, **kwargs)
 
-    def to_ulog(self, path: str | os.PathLike, vehicle: int = 0) -> Path:
+    def to_ulog(self, path: str | os.PathLike, vehicle: int = 0, *, profile: str | None = None) -> Path:
         """Write one vehicle's flight as a PX4 log (ULog), in PX4's conventions (:mod:`quadcruise.sim.px4`).
 
-        The topics and rates are :func:`quadcruise.sim.px4.px4_topics`' (at most the flight's log
-        rate); pyulog, PX4 Flight Review and PlotJuggler read it.
+        The topics are :func:`quadcruise.sim.px4.px4_topics`', at the rates of ``profile`` (at most
+        the flight's log rate); pyulog, PX4 Flight Review and PlotJuggler read it.
 
         Parameters
         ----------
@@ -269,6 +269,11 @@ class SimResult:
             The ``.ulg`` file, written whole or not at all.
         vehicle : int
             The vehicle's index.
+        profile : {"default", "sysid"}, optional
+            PX4's logging profile (:data:`quadcruise.sim.px4.PROFILES`): ``sysid`` writes the
+            commands, rates, attitude and IMU at every logged instant, as a log to identify from
+            needs (``quadcruise identify``); ``default`` at most at PX4's default rates. None:
+            ``sysid`` for a flight of the ``sysid`` mission, else ``default``.
 
         Returns
         -------
@@ -286,8 +291,13 @@ class SimResult:
         """
         from quadcruise._version import __version__
         from quadcruise.io.ulog import write_ulog
-        from quadcruise.sim.px4 import NOISE_STREAM, duties_of, px4_topics, rotor_parameters
+        from quadcruise.sim.px4 import NOISE_STREAM, PROFILES, duties_of, px4_topics, rotor_parameters
 
+        if profile is None:
+            profile = "sysid" if (self.meta.get("mission") or {}).get("kind") == "sysid" else "default"
+        if profile not in PROFILES:
+            raise InputError(f"to_ulog: profile must be one of {', '.join(PROFILES)}, got {profile!r}")
+        rates_hz, profile_bits = PROFILES[profile]
         if isinstance(vehicle, bool) or not isinstance(vehicle, (int, np.integer)) or not 0 <= vehicle < self.n:
             raise InputError(f"to_ulog: vehicle must be an index in [0, {self.n}), got {vehicle!r}")
         if not str(path).endswith(".ulg"):
@@ -307,9 +317,16 @@ class SimResult:
         seed = self.meta.get("seed") or 0
         rng = np.random.default_rng([int(seed), int(vehicle), NOISE_STREAM])
         topics = px4_topics(
-            t, states, duties_of(self.commands[vehicle][rows]), g=field_of("g", 9.81), noise_std=std, rng=rng
+            t,
+            states,
+            duties_of(self.commands[vehicle][rows]),
+            g=field_of("g", 9.81),
+            noise_std=std,
+            rng=rng,
+            rates_hz=rates_hz,
         )
         params = rotor_parameters(field_of("l", 0.2), field_of("d", 0.0), field_of("K", 0.0))
+        params["SDLOG_PROFILE"] = profile_bits
         write_ulog(
             path,
             topics,
@@ -418,6 +435,12 @@ class SimResult:
         )
         if self.meta.get("command_line"):
             header += "\nthe command line changed: " + " ".join(self.meta["command_line"])
+        if self.meta.get("ulog"):
+            logs = self.meta["ulog"]
+            header += (
+                f"\nwritten as a PX4 log too ({', '.join(logs['files'])}): "
+                f"`quadcruise fly THIS_FILE --ulog {logs['path']}` writes the same bytes again"
+            )
         return scenario_text(doc, header=header)
 
     def meta_json(self, **extra) -> str:

@@ -41,6 +41,8 @@ CAUTION_SHARE = 0.99
 """Below this share of signal (not jitter) in a moment command, the result carries a caution."""
 MIN_FIT_S, MIN_HELD_S = 2.0, 0.5
 """The least airborne time fitted and held out [s] (after each segment's settling)."""
+SYSID_PROFILE_BIT = 8
+"""``SDLOG_PROFILE``'s bit for PX4's system-identification logging profile."""
 STAGES = ("reading the log", "filtering", "fitting", "intervals", "validating")
 """The stages ``progress`` counts."""
 WINDOW_S = 0.08
@@ -141,7 +143,9 @@ def identify(
         rotors = np.array([[-arm, 0.0, 1.0], [0.0, arm, -1.0], [arm, 0.0, 1.0], [0.0, -arm, -1.0]])
     g = float(base.g)
     force_z = _specific_force_z(flight, g)
-    sig = signals(flight.t, flight.segment, flight.u, flight.rates, force_z, WINDOW_S)
+    cmd_hz = _command_rate(flight)
+    hold = command_hold(flight, cmd_hz)
+    sig = signals(flight.t, flight.segment, flight.u, flight.rates, force_z, WINDOW_S, hold)
     report(2, len(STAGES), STAGES[1])
 
     omega0 = float(base.omega)
@@ -150,7 +154,6 @@ def identify(
         raise InputError(
             f"{flight.source}: {flight.duration:.1f} s airborne is too short to fit and hold out {holdout:g} of it"
         )
-    cmd_hz = _command_rate(flight)
     lag_seen = cmd_hz >= 2.0 * omega0  # a sample at least every tau/2
     u_fit = sig.u[fit_rows]
     span = float(np.percentile(u_fit, 95) - np.percentile(u_fit, 5))
@@ -168,7 +171,7 @@ def identify(
         mass,
         flight.n_rotors,
         g,
-        systematic=_sensitivity(flight, force_z, fit_rows, rotors, result, mass, g, cmd_hz, bounds, coupling),
+        systematic=_sensitivity(flight, force_z, fit_rows, rotors, result, mass, g, cmd_hz, bounds, coupling, hold),
         coupling=coupling,
     )
     notes: dict[str, str] = {}
@@ -260,6 +263,7 @@ def identify(
             "newey_west_bandwidth": result.bandwidth,
             "omega_fitted": result.omega_fitted,
             "omega_used": result.omega,
+            "command_hold": hold,
             "thrust_curve_fitted": fit_shape,
             "residual_std": result.sigma,
             "coefficients": dict(zip(result.names, result.values.tolist(), strict=False)),
@@ -327,7 +331,9 @@ def _command_signal(sig, rows: np.ndarray, rotors: np.ndarray, omega: float) -> 
     impulse[n // 2, 0] = 1.0
     seg = np.zeros(2 * n, int)
     response = smooth(
-        lagged(impulse, seg, omega, sig.dt) - lagged(np.zeros_like(impulse), seg, omega, sig.dt), seg, sig.window
+        lagged(impulse, seg, omega, sig.dt, sig.hold) - lagged(np.zeros_like(impulse), seg, omega, sig.dt, sig.hold),
+        seg,
+        sig.window,
     )
     gain = float(np.nansum(response**2))
     combos = {"roll": rotors[:, 1], "pitch": -rotors[:, 0], "yaw": rotors[:, 2]}
@@ -335,14 +341,15 @@ def _command_signal(sig, rows: np.ndarray, rotors: np.ndarray, omega: float) -> 
     for axis, weights in combos.items():
         command = sig.u @ weights
         noise_var = gain * _noise_level(command, sig.segment) ** 2
-        regressor = smooth(lagged(command[:, None], sig.segment, omega, sig.dt), sig.segment, sig.window)[rows, 0]
+        lag = lagged(command[:, None], sig.segment, omega, sig.dt, sig.hold)
+        regressor = smooth(lag, sig.segment, sig.window)[rows, 0]
         total = float(np.var(regressor))
         out[axis] = max(0.0, 1.0 - noise_var / total) if total > 0 else 0.0
     return out
 
 
 def _sensitivity(
-    flight, force_z, rows, rotors, result, mass, g, cmd_hz, bounds, coupling=(True, True)
+    flight, force_z, rows, rotors, result, mass, g, cmd_hz, bounds, coupling=(True, True), hold="linear"
 ) -> dict[str, float]:
     """Systematic half-ranges: each parameter refitted (1) with the commands shifted by half
     their logging interval either way (a log that samples its commands says when they changed
@@ -351,7 +358,7 @@ def _sensitivity(
     dynamics). The two half-ranges are combined in quadrature."""
 
     def refit(u, window_s):
-        sig = signals(flight.t, flight.segment, u, flight.rates, force_z, window_s)
+        sig = signals(flight.t, flight.segment, u, flight.rates, force_z, window_s, hold)
         again = fit(
             sig,
             rows,
@@ -409,6 +416,40 @@ def _split(flight: FlightLog, window: int, omega0: float, holdout: float) -> tup
     fit_rows[cut:] = False
     held[: cut + window] = False  # a window's gap: no filtered sample in both
     return fit_rows, held
+
+
+def command_hold(flight: FlightLog, cmd_hz: float) -> str:
+    """How the logged commands act between samples: ``"zero"`` (each held until the next) when
+    the log holds every command its controller computed, else ``"linear"``.
+
+    Every command is in the log when PX4's system-identification logging profile wrote it
+    (``SDLOG_PROFILE`` bit :data:`SYSID_PROFILE_BIT`: the actuator commands at the rate the rate
+    controller publishes them) and the commands come at the rate of the grid (the body rates').
+    A log that samples its commands more slowly (PX4's default profile) says only where they
+    passed, and a line between the samples is the better guess.
+
+    Parameters
+    ----------
+    flight : FlightLog
+        The log read.
+    cmd_hz : float
+        The rate of its command topic [Hz].
+
+    Returns
+    -------
+    {"zero", "linear"}
+
+    Examples
+    --------
+    >>> log = FlightLog(source="x.ulg", t=np.arange(0.0, 1.0, 1e-3), segment=np.zeros(1000, int),
+    ...                 u=np.zeros((1000, 4)), velocity=np.zeros((1000, 3)), quaternion=np.zeros((1000, 4)),
+    ...                 rates=np.zeros((1000, 3)), parameters={"SDLOG_PROFILE": 9})
+    >>> command_hold(log, 1000.0), command_hold(log, 250.0)
+    ('zero', 'linear')
+    """
+    profile = int(flight.parameters.get("SDLOG_PROFILE", 0) or 0)
+    grid_hz = 1.0 / float(np.median(np.diff(flight.t))) if len(flight.t) > 1 else 0.0
+    return "zero" if profile & SYSID_PROFILE_BIT and cmd_hz >= 0.9 * grid_hz else "linear"
 
 
 def _command_rate(flight: FlightLog) -> float:

@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import lfilter, savgol_coeffs
+from scipy.signal import lfilter, lfilter_zi, savgol_coeffs
 
 CHANNELS = ("thrust", "roll", "pitch", "yaw")
 """The four regressions, in order."""
@@ -33,7 +33,8 @@ ROTATION_TERMS = {
 class Signals:
     """A log's samples through the matched filters: ``t`` [s], ``segment``, commands ``u`` (L, n),
     body ``rates`` [rad/s] (FLU), ``rate_dot`` [rad/s^2], ``force_z`` [m/s^2], ``products`` (q r, p r,
-    p q, filtered after the product), the filter's ``window`` [samples] and the grid's ``dt`` [s].
+    p q, filtered after the product), the filter's ``window`` [samples], the grid's ``dt`` [s] and
+    ``hold``, how the commands act between samples (:func:`lagged`).
     """
 
     t: np.ndarray
@@ -45,6 +46,7 @@ class Signals:
     products: np.ndarray
     window: int
     dt: float
+    hold: str = "linear"
 
 
 def kernels(window: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -87,8 +89,9 @@ def smooth(x: np.ndarray, segment: np.ndarray, window: int, deriv: int = 0, dt: 
     return out.reshape(x.shape)
 
 
-def signals(t, segment, u, rates, force_z, window_s: float) -> Signals:
-    """Filter a log's samples for the regressions (a window of ``window_s``, at least 5 samples, odd)."""
+def signals(t, segment, u, rates, force_z, window_s: float, hold: str = "linear") -> Signals:
+    """Filter a log's samples for the regressions (a window of ``window_s``, at least 5 samples, odd;
+    ``hold`` as :func:`lagged`)."""
     dt = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
     window = max(5, round(window_s / dt) | 1)
     p, q, r = rates.T
@@ -102,26 +105,39 @@ def signals(t, segment, u, rates, force_z, window_s: float) -> Signals:
         products=smooth(np.column_stack([q * r, p * r, p * q]), segment, window),
         window=window,
         dt=dt,
+        hold=hold,
     )
 
 
-def lagged(u: np.ndarray, segment: np.ndarray, omega: float, dt: float) -> np.ndarray:
-    """The first-order lag ``F' = omega (u - F)`` of each column, bilinear, each segment from steady state.
+def lagged(u: np.ndarray, segment: np.ndarray, omega: float, dt: float, hold: str = "linear") -> np.ndarray:
+    """The first-order lag ``F' = omega (u - F)`` of each column, each segment from steady state:
+    bilinear for ``hold="linear"`` (commands a line between samples), exact for ``hold="zero"``
+    (each command held until the next; why it matters: docs/identify.md, "Held commands").
 
     Examples
     --------
     >>> y = lagged(np.r_[np.zeros(1), np.ones(999)][:, None], np.zeros(1000, int), 10.0, 1e-3)
     >>> round(float(y[101, 0]), 2)           # 1 - exp(-1) after 1/omega
     0.63
+    >>> held = lagged(np.r_[np.zeros(1), np.ones(999)][:, None], np.zeros(1000, int), 10.0, 1e-3, hold="zero")
+    >>> float(held[1, 0]), round(float(held[101, 0]), 2)   # a sample late: 1 - exp(-1) at 101
+    (0.0, 0.63)
     """
-    h = 0.5 * omega * dt
-    a, b = (1.0 - h) / (1.0 + h), h / (1.0 + h)
+    if hold == "zero":
+        a = float(np.exp(-omega * dt))
+        num, den = [0.0, 1.0 - a], [1.0, -a]
+    elif hold == "linear":
+        h = 0.5 * omega * dt
+        a, b = (1.0 - h) / (1.0 + h), h / (1.0 + h)
+        num, den = [b, b], [1.0, -a]
+    else:
+        raise ValueError(f"hold must be 'linear' or 'zero', got {hold!r}")
+    steady = lfilter_zi(num, den)
     out = np.empty_like(u, dtype=np.float64)
     for k in np.unique(segment):
         rows = segment == k
         x = u[rows]
-        zi = (x[0] * (1.0 - a) - b * x[0])[None, :]  # steady state: y[-1] = x[0]
-        out[rows] = lfilter([b, b], [1.0, -a], x, axis=0, zi=zi)[0]
+        out[rows] = lfilter(num, den, x, axis=0, zi=steady[:, None] * x[0][None, :])[0]  # y[-1] = x[0]
     return out
 
 
@@ -136,12 +152,12 @@ def regressions(
     u = sig.u
     f = 0.0 if shape_f is None else shape_f
     if fit_shape:
-        lin = smooth(lagged(u, sig.segment, omega, sig.dt), sig.segment, sig.window)
-        quad = smooth(lagged(u * u, sig.segment, omega, sig.dt), sig.segment, sig.window)
+        lin = smooth(lagged(u, sig.segment, omega, sig.dt, sig.hold), sig.segment, sig.window)
+        quad = smooth(lagged(u * u, sig.segment, omega, sig.dt, sig.hold), sig.segment, sig.window)
         shape = (1.0 - f) * lin + f * quad
         thrust = (sig.force_z, np.column_stack([lin.sum(1), quad.sum(1)]), ("KL", "KQ"))
     else:
-        shape = smooth(lagged((1.0 - f) * u + f * u * u, sig.segment, omega, sig.dt), sig.segment, sig.window)
+        shape = smooth(lagged((1.0 - f) * u + f * u * u, sig.segment, omega, sig.dt, sig.hold), sig.segment, sig.window)
         thrust = (sig.force_z, shape.sum(1)[:, None], ("Km",))
     ones = np.ones(len(u))
     out = {"thrust": thrust}

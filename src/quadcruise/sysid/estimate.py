@@ -121,7 +121,12 @@ def fit(
         up = regressions(sig, omega + h, f, rotors, fit_shape)
         down = regressions(sig, omega - h, f, rotors, fit_shape)
         for c in CHANNELS:
-            jac[c][:, -1] = (up[c][1][rows] - down[c][1][rows]) @ betas[c] / (2 * h)
+            change = up[c][1][rows] - down[c][1][rows]
+            # rounding is no dependence on omega (constant commands: the lag's output is the
+            # command at every omega); left in, it is collinear with the gains' columns and
+            # takes their identifiability with it
+            change[np.abs(change) <= 64 * np.finfo(float).eps * np.max(np.abs(data[c][1][rows]), initial=0.0)] = 0.0
+            jac[c][:, -1] = change @ betas[c] / (2 * h)
     bread = sum(jac[c].T @ jac[c] / sigma[c] ** 2 for c in CHANNELS)
     score = sum(jac[c] * (resid[c] / sigma[c] ** 2)[:, None] for c in CHANNELS)
     seg = sig.segment[rows]

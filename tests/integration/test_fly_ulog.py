@@ -1,0 +1,168 @@
+"""``quadcruise fly ... --ulog OUT.ulg``: the flight as a PX4 log, read back by pyulog alone.
+
+Checked against the flight's own traces (``--out``), converted here to PX4's frames by the
+textbook formulas (NED = (y, x, -z), FRD rates (p, -q, -r), heading pi/2 - psi, microsecond
+timestamps); the hover command against m g / (4 K); the replay of the recorded
+``scenario.toml`` must give the same bytes; a batch is one file per vehicle; a wrong name is
+refused before flying and a write that fails leaves no file.
+"""
+
+from __future__ import annotations
+
+import errno
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+from pyulog import ULog
+
+import quadcruise
+from quadcruise.cli.main import main
+
+SRC = str(Path(quadcruise.__file__).resolve().parents[1])  # this tree's code, in the subprocess
+
+
+def run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def data(path: Path) -> tuple[ULog, dict]:
+    log = ULog(str(path))
+    assert not log.file_corruption
+    return log, {d.name: d.data for d in log.data_list}
+
+
+@pytest.fixture(scope="module")
+def step_flight(tmp_path_factory):
+    """A yawed step flown with noise-free sensors, with its traces and its PX4 log."""
+    folder = tmp_path_factory.mktemp("fly-ulog")
+    result = run(
+        "fly", "step", "--duration", "3", "-m", "yaw=0.7", "--seed", "3",
+        "--ulog", folder / "step.ulg", "--out", folder / "out",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert f"wrote PX4 log {folder / 'step.ulg'}" in result.output
+    return folder, pd.read_csv(folder / "out" / "traces.csv")
+
+
+def test_the_log_reads_back_in_px4_conventions(step_flight):
+    folder, traces = step_flight
+    log, topics = data(folder / "step.ulg")
+    t_us = np.round(traces["t"].to_numpy() * 1e6).astype(np.uint64)
+
+    pos = topics["vehicle_local_position"]
+    rows = np.searchsorted(t_us, pos["timestamp"])
+    assert np.array_equal(t_us[rows], pos["timestamp"])  # microseconds of the flight's own instants
+    assert np.median(np.diff(pos["timestamp"])) == pytest.approx(20_000)  # 50 Hz
+    for ned, enu, sign in (("x", "y", 1), ("y", "x", 1), ("z", "z", -1)):
+        assert np.allclose(pos[ned], sign * traces[enu].to_numpy()[rows], atol=1e-5), ned
+    heading = math.pi / 2 - traces["psi"].to_numpy()[rows]
+    assert np.allclose(np.angle(np.exp(1j * (pos["heading"] - heading))), 0.0, atol=1e-5)
+
+    rates = topics["vehicle_angular_velocity"]
+    rows = np.searchsorted(t_us, rates["timestamp"])
+    assert np.median(np.diff(rates["timestamp"])) == pytest.approx(4_000)  # 250 Hz: the default profile
+    for i, (name, sign) in enumerate((("p", 1), ("q", -1), ("r", -1))):
+        assert np.allclose(rates[f"xyz[{i}]"], sign * traces[name].to_numpy()[rows], atol=1e-6), name
+
+    motors = topics["actuator_motors"]
+    rows = np.searchsorted(t_us, motors["timestamp"])
+    for i in range(4):
+        assert np.allclose(motors[f"control[{i}]"], traces[f"u{i + 1}"].to_numpy()[rows], atol=1e-7)
+
+    q = np.column_stack([topics["vehicle_attitude"][f"q[{i}]"] for i in range(4)])
+    assert np.allclose(np.linalg.norm(q, axis=1), 1.0, atol=1e-6)  # w first: unit quaternions
+    assert q[0, 0] == pytest.approx(math.cos((math.pi / 2 - 0.7) / 2), abs=1e-6)  # level, heading 90 - 40 deg
+    assert log.initial_parameters["SDLOG_PROFILE"] == 1
+    assert log.initial_parameters["CA_ROTOR_COUNT"] == 4
+
+
+def test_the_recorded_scenario_writes_the_same_bytes_again(step_flight, tmp_path):
+    folder, _ = step_flight
+    scenario = folder / "out" / "scenario.toml"
+    assert f"--ulog {folder / 'step.ulg'}` writes the same bytes again" in scenario.read_text()
+    result = run("fly", scenario, "--ulog", tmp_path / "again.ulg")
+    assert result.exit_code == 0, result.output
+    assert (tmp_path / "again.ulg").read_bytes() == (folder / "step.ulg").read_bytes()
+
+
+def test_a_batch_is_one_log_per_vehicle(tmp_path):
+    """Two vehicles of 1.0 and 1.5 kg hover: c-0.ulg and c-1.ulg, each at its own hover
+    command m g / (4 K) (Table I's K = 120 N)."""
+    (tmp_path / "batch.toml").write_text(
+        '[mission]\nkind = "hover"\n[simulation]\nduration = 1.0\n[vehicle]\nm = [1.0, 1.5]\n'
+    )
+    result = run("fly", tmp_path / "batch.toml", "--ulog", tmp_path / "c.ulg")
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in tmp_path.glob("*.ulg")) == ["c-0.ulg", "c-1.ulg"]
+    for i, mass in enumerate((1.0, 1.5)):
+        _, topics = data(tmp_path / f"c-{i}.ulg")
+        assert np.allclose(topics["actuator_motors"]["control[0]"], mass * 9.81 / (4 * 120.0), rtol=1e-6)
+
+
+def test_a_sysid_flight_is_logged_at_the_rate_of_its_commands(tmp_path):
+    """The sysid mission is written with PX4's system-identification profile: every command
+    of a 1 kHz controller is in the log (the default profile would keep one in four)."""
+    result = run("fly", "sysid", "--duration", "1", "--ulog", tmp_path / "s.ulg")
+    assert result.exit_code == 0, result.output
+    log, topics = data(tmp_path / "s.ulg")
+    assert log.initial_parameters["SDLOG_PROFILE"] == 9  # default | system identification
+    for name in ("actuator_motors", "vehicle_angular_velocity", "sensor_combined", "vehicle_attitude"):
+        assert np.all(np.diff(topics[name]["timestamp"]) == 1_000), name
+    assert np.median(np.diff(topics["vehicle_local_position"]["timestamp"])) == 20_000
+
+
+@pytest.mark.parametrize("name", ["flight.csv", "flight"])
+def test_a_wrong_name_is_refused_before_flying(tmp_path, name):
+    env = {**os.environ, "PYTHONPATH": SRC, "QUADCRUISE_PROGRESS": "0"}
+    proc = subprocess.run(
+        [sys.executable, "-m", "quadcruise", "fly", "circle", "--ulog", str(tmp_path / name)],
+        capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300, check=False,
+    )  # fmt: skip
+    assert proc.returncode == 2
+    assert proc.stdout == ""
+    assert proc.stderr.splitlines() == [
+        f"error: Invalid value for '--ulog': {tmp_path / name}: the file is written as .ulg; name it so"
+    ]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_write_that_fails_is_one_line_exit_74_and_leaves_no_log(tmp_path, monkeypatch):
+    """The second vehicle's log cannot be written: one line naming it, exit 74, and the first
+    vehicle's log is removed too (all or none)."""
+    (tmp_path / "batch.toml").write_text(
+        '[mission]\nkind = "hover"\n[simulation]\nduration = 0.5\n[vehicle]\nm = [1.0, 1.5]\n'
+    )
+    write_bytes, calls = Path.write_bytes, []
+
+    def second_fails(self, content):
+        calls.append(self)
+        if len(calls) == 2:
+            write_bytes(self, content[:100])
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return write_bytes(self, content)
+
+    monkeypatch.setattr(Path, "write_bytes", second_fails)
+    result = run("fly", tmp_path / "batch.toml", "--ulog", tmp_path / "c.ulg")
+    assert result.exit_code == 74, result.output
+    enospc = "cannot write (no space left on device)"
+    assert result.stderr.strip().splitlines() == [f"error: {tmp_path / 'c-1.ulg'}: {enospc}"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["batch.toml"]
+
+
+def test_compare_writes_one_log_per_controller(tmp_path):
+    """``compare --ulog``: each controller's log, the same bytes as ``fly`` writes for that
+    controller on the same mission, and the two controllers' logs differ."""
+    result = run("compare", "step", "--controllers", "nlpd,se3", "--duration", "2", "--ulog", tmp_path / "c.ulg")
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in tmp_path.glob("*.ulg")) == ["c-nlpd.ulg", "c-se3.ulg"]
+    flown = run("fly", "step", "--controller", "se3", "--duration", "2", "--ulog", tmp_path / "fly-se3.ulg")
+    assert flown.exit_code == 0, flown.output
+    assert (tmp_path / "c-se3.ulg").read_bytes() == (tmp_path / "fly-se3.ulg").read_bytes()
+    assert (tmp_path / "c-nlpd.ulg").read_bytes() != (tmp_path / "c-se3.ulg").read_bytes()
