@@ -107,9 +107,9 @@ def fly(
 ):
     """Fly a MISSION with a controller on the paper's vehicle (or --vehicle) and print its metrics.
 
-    MISSION is circle, square, step, hover, a waypoint CSV (columns x,y,z and optional yaw
-    and t or speed), flown as constant-speed legs or, with --smooth, a minimum-snap path, or
-    a TOML scenario file describing the whole run (options given here override it).
+    MISSION is circle, square, step, hover, sysid (doublets for `identify`), a waypoint CSV
+    (columns x,y,z and optional yaw and t or speed), flown as constant-speed legs or, with
+    --smooth, a minimum-snap path, or a TOML scenario file describing the whole run (options given here override it).
     With --out, also write the traces, a figure of the flight, the metrics and the
     configuration (quadcruise.json) to that folder, atomically.
 

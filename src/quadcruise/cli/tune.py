@@ -102,7 +102,7 @@ __all__ = ["tune"]
 def tune(**options):
     """Tune a controller's gains on a MISSION towards targets on its metrics.
 
-    MISSION is circle, square, step, hover, a waypoint CSV, or a TOML scenario file (its
+    MISSION is circle, square, step, hover, sysid, a waypoint CSV, or a TOML scenario file (its
     vehicle, controller, disturbances and simulation settings). Each generation of candidates
     is one batched flight; with --samples M each candidate flies the same M perturbed vehicles
     and its cost is the worst (or --objective quantile) of theirs. Bad input is refused
