@@ -28,11 +28,14 @@ from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import FlightWarning, InputError, reject_unknown
 from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, REF_Z, STATE_SIZE, X, Z
 from quadcruise.missions import Mission, as_mission, stack_params
+from quadcruise.model.equivalent import paper_equivalent
+from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
 from quadcruise.sim.engine import Limits, simulate, time_grid
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.status import ExitStatus
+from quadcruise.workflows.rotor_fly import as_vehicle, fly_rotor, rotor_flight_setup
 
 
 def default_duration(mission: Mission) -> float:
@@ -199,10 +202,13 @@ def fly(
     w = "fly()"  # every argument checked before any work
     mission = as_mission(mission, w)
     missions = fly_missions(missions)
+    vehicle = checks.instance(w, "vehicle", as_vehicle(vehicle), (Vehicle, RotorVehicle)) or Vehicle.paper()
+    controller_vehicle = checks.instance(
+        w, "controller_vehicle", as_vehicle(controller_vehicle), (Vehicle, RotorVehicle)
+    )
+    rotor, controller = rotor_flight_setup(vehicle, controller_vehicle, controller)  # rotor_fly.py
     controllers = per_vehicle_controllers(controller)
     controller = controllers[0]
-    vehicle = checks.instance(w, "vehicle", vehicle, Vehicle) or Vehicle.paper()
-    checks.instance(w, "controller_vehicle", controller_vehicle, Vehicle)
     duration = checks.number(w, "duration", duration, "pos", unit="s", optional=True)
     dt = checks.number(w, "dt", dt, "pos", unit="s")
     max_step = checks.number(w, "max_step", max_step, "pos", unit="s", optional=True)
@@ -217,10 +223,15 @@ def fly(
     for name, value in (("max_track_error", max_track_error), ("max_steady_error", max_steady_error)):
         checks.number(w, name, value, "pos", unit="m", optional=True, infinite=True)
     x0 = initial_states(x0)
+    if rotor and (x0 is not None or full_dynamics):
+        raise InputError(
+            f"fly() argument {'x0' if x0 is not None else 'full_dynamics'}: not for a rotor-plant vehicle "
+            "(it starts hovering at the mission's start; its plant has no Euler-angle kinematics to choose)"
+        )
     sizes = {
         s
         for s in (
-            vehicle.batch_size,
+            getattr(vehicle, "batch_size", None),
             None if x0 is None or np.ndim(x0) < 2 else np.shape(x0)[0],
             None if missions is None else len(missions),
             n,
@@ -244,16 +255,17 @@ def fly(
     check_log_every(log_every, grid.size - 1)
     if sensors is not None:
         sensors.check_fits(duration)
-    check_can_hover(vehicle)
+    if not rotor:  # a RotorVehicle that cannot lift itself cannot be made
+        check_can_hover(vehicle)
     check_reference_fits(missions or [first], float(duration), limits or Limits())
     given_x0 = None if x0 is None else np.asarray(x0, dtype=float).tolist()
-    x0 = hover_state(vehicle, n, first) if x0 is None else x0
+    x0 = hover_state(paper_equivalent(vehicle) if rotor else vehicle, n, first) if x0 is None else x0
     meta = {
         "workflow": "fly",
         "mission": [m.to_dict() for m in missions] if missions else mission.to_dict(),
         "controller": controller_record(controller),
         **({"controllers": [controller_record(c) for c in controllers]} if len(controllers) > 1 else {}),
-        "vehicle": vehicle.to_dict(),
+        "vehicle": {"plant": "rotor", **vehicle.to_dict()} if rotor else vehicle.to_dict(),
         "duration_s": float(duration),
         "dt_s": float(dt),
         "max_step_s": float(max_step or dt),
@@ -275,32 +287,32 @@ def fly(
     if sensors is not None:
         meta["sensors"] = sensors.to_dict()
     if controller_vehicle is not None:
-        meta["controller_vehicle"] = controller_vehicle.to_dict()
-    vp_ctrl = None if controller_vehicle is None else controller_vehicle.rows(n)
+        meta["controller_vehicle"] = (
+            {"plant": "rotor", **controller_vehicle.to_dict()} if rotor else controller_vehicle.to_dict()
+        )
+    vp_ctrl = None if controller_vehicle is None or rotor else controller_vehicle.rows(n)
     gains, memory = (
         (controller.gains(), controller.memory())
         if len(controllers) == 1
         else (np.stack([c.gains() for c in controllers]), np.stack([c.memory() for c in controllers]))
     )
-    result = simulate(
-        grid,
-        x0,
-        vehicle.rows(n),
-        controller.function,
-        gains,
-        first.function,
-        mp,
-        memory=memory,
-        max_step=max_step or dt,
-        log_every=log_every,
-        limits=limits,
-        meta=meta,
-        vp_ctrl=vp_ctrl,
-        full_dynamics=full_dynamics,
-        seed=seed,
-        first_vehicle=first_vehicle,
-        **engine_inputs(environment, sensors, n, dt),
-    )
+    common = {"memory": memory, "max_step": max_step or dt, "log_every": log_every, "limits": limits, "meta": meta}
+    common.update(seed=seed, first_vehicle=first_vehicle, **engine_inputs(environment, sensors, n, dt))
+    if rotor:
+        result = fly_rotor(grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, **common)
+    else:
+        result = simulate(
+            grid,
+            x0,
+            vehicle.rows(n),
+            controller.function,
+            gains,
+            first.function,
+            mp,
+            vp_ctrl=vp_ctrl,
+            full_dynamics=full_dynamics,
+            **common,
+        )
     bound = (
         track_bound(missions or [first], np.broadcast_to(x0, (n, STATE_SIZE)), n)
         if max_track_error is None

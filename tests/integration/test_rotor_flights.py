@@ -1,0 +1,86 @@
+"""Closed-loop flights of rotor-plant vehicles: every preset flies the circle with se3, cascade and
+nlpd; the paper-layout state the controllers see is the rotor state's (scipy's Euler angles);
+an Iris losing 60 % of a rotor over the ground crashes, a healthy one does not; bad input is one line."""
+
+import warnings
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import quadcruise as qc
+from quadcruise.disturbances import Environment, RotorLoss
+from quadcruise.errors import FlightWarning, InputError
+from quadcruise.model.equivalent import duty_to_thrust, paper_equivalent
+from quadcruise.model.rotor_vehicle import RotorVehicle
+from quadcruise.sim.status import ExitStatus
+
+PRESETS = ("paper", "qball-x4", "crazyflie", "hummingbird", "iris")
+
+
+@pytest.mark.parametrize("preset", PRESETS)
+@pytest.mark.parametrize("controller", ("se3", "cascade", "nlpd"))
+def test_each_preset_flies_the_circle(preset, controller):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the start's 2 m offset saturates some rotors briefly
+        res = qc.fly("circle", controller, vehicle=preset)
+    assert res.status_text(0) == "finished"
+    err = np.linalg.norm(res.states[0, :, :3] - res.references[0, :, :3], axis=1)
+    assert err[res.t > 10.0].max() < 1.0  # on its circle after the start, not just inside the bounds
+    if preset not in ("paper", "qball-x4"):
+        assert res.rotor_states is not None and res.meta["vehicle"]["plant"] == "rotor"
+
+
+def test_the_controller_sees_the_rotor_state_in_the_paper_layout():
+    v = RotorVehicle.preset("crazyflie")
+    res = qc.fly("circle", "se3", vehicle=v, duration=3.0)
+    q = res.rotor_states[0, :, 6:10]
+    zyx = Rotation.from_quat(q, scalar_first=True).as_euler("ZYX")[:, ::-1]
+    np.testing.assert_allclose(res.states[0, :, 6:9], zyx, atol=1e-12)
+    np.testing.assert_array_equal(res.states[0, :, :6], res.rotor_states[0, :, :6])
+    np.testing.assert_allclose(res.states[0, :, 12:16], v.kf * res.rotor_states[0, :, 13:17] ** 2, rtol=1e-12)
+    frame = res.to_pandas()
+    assert {"qw", "w4", "phi", "F1"} <= set(frame.columns)
+
+
+def test_the_plus_equivalent_duties_make_the_wrench_they_mean():
+    v = RotorVehicle.preset("iris")
+    eq = paper_equivalent(v)
+    u = np.array([0.6, 0.5, 0.4, 0.55])
+    f = duty_to_thrust(v) @ u
+    F = eq.K * u  # the "+" vehicle's thrusts, eqs (1)-(4)
+    rotors = np.asarray(v.rotors)
+    wrench = [f.sum(), rotors[:, 1] @ f, -rotors[:, 0] @ f, (rotors[:, 3] * v.km / v.kf) @ f]
+    want = [F.sum(), eq.l * (F[1] - F[3]), eq.l * (F[0] - F[2]), eq.d * (F[0] + F[2] - F[1] - F[3])]
+    np.testing.assert_allclose(wrench, want, rtol=1e-12, atol=1e-12)
+    assert eq.omega == 1.0 / max(v.tau_up, v.tau_down) and eq.m == v.m and eq.drag_linear == 0.0
+
+
+def test_an_iris_losing_60_percent_of_a_rotor_crashes_and_a_healthy_one_does_not():
+    loss = Environment(rotor_loss=RotorLoss(rotor=1, fraction=0.6, time=1.0))
+    with pytest.warns(FlightWarning, match="crashed"):
+        res = qc.fly("hover", "se3", vehicle="iris", environment=loss, duration=5.0)
+    assert res.exit_status(0) == ExitStatus.CRASHED and 1.0 < res.t_stop[0] < 5.0
+    assert res.rotor_final_state[0, 2] < 0.0  # it met the ground
+    healthy = qc.fly("hover", "se3", vehicle="iris", duration=5.0)
+    assert healthy.status_text(0) == "finished"
+    assert abs(healthy.final_state[0, 2] - 1.0) < 0.01
+
+
+def test_batches_reproduce_single_flights():
+    one = qc.fly("circle", "cascade", vehicle="iris", duration=2.0)
+    three = qc.fly("circle", "cascade", vehicle="iris", duration=2.0, n=3)
+    for i in range(3):
+        np.testing.assert_array_equal(three.rotor_states[i], one.rotor_states[0])
+
+
+def test_a_rotor_vehicle_it_cannot_fly_is_one_line():
+    tri = RotorVehicle.preset("iris").replace(rotors=[[0.2, 0.0, 0.0, 1], [-0.1, 0.17, 0.0, -1], [-0.1, -0.17, 0.0, 1]])
+    with pytest.raises(InputError, match="rank 3 of 4"):
+        qc.fly("hover", "se3", vehicle=tri, duration=1.0)
+    with pytest.raises(InputError, match="one plant"):
+        qc.fly("hover", "se3", vehicle="iris", controller_vehicle=qc.Vehicle.paper(), duration=1.0)
+    with pytest.raises(InputError, match="full_dynamics"):
+        qc.fly("hover", "se3", vehicle="iris", full_dynamics=True, duration=1.0)
+    with pytest.raises(InputError, match="unknown vehicle preset 'irs'"):
+        qc.fly("hover", "se3", vehicle="irs", duration=1.0)
