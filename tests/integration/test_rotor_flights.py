@@ -2,9 +2,12 @@
 nlpd; the paper-layout state the controllers see is the rotor state's (scipy's Euler angles);
 an Iris losing 60 % of a rotor over the ground crashes, a healthy one does not; bad input is one line."""
 
+import subprocess
+import sys
 import warnings
 
 import numpy as np
+import pandas as pd
 import pytest
 from scipy.spatial.transform import Rotation
 
@@ -84,3 +87,40 @@ def test_a_rotor_vehicle_it_cannot_fly_is_one_line():
         qc.fly("hover", "se3", vehicle="iris", full_dynamics=True, duration=1.0)
     with pytest.raises(InputError, match="unknown vehicle preset 'irs'"):
         qc.fly("hover", "se3", vehicle="irs", duration=1.0)
+
+
+def quadcruise(*args, cwd):
+    return subprocess.run(
+        [sys.executable, "-m", "quadcruise", *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=300
+    )
+
+
+def test_the_command_line_flies_a_preset_and_its_scenario_flies_it_again(tmp_path):
+    first = quadcruise(
+        "fly", "circle", "--vehicle", "iris", "--controller", "se3", "--duration", "4", "--out", "a", cwd=tmp_path
+    )
+    assert first.returncode == 0, first.stderr
+    again = quadcruise("fly", "a/scenario.toml", "--out", "b", cwd=tmp_path)
+    assert again.returncode == 0, again.stderr
+    a, b = (pd.read_csv(tmp_path / d / "traces.csv") for d in "ab")
+    assert {"qw", "w4"} <= set(a.columns)
+    pd.testing.assert_frame_equal(a, b)
+
+
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (
+            ["montecarlo", "--mission", "hover", "-n", "2", "--duration", "1", "--scheduler", "none"],
+            "fly and compare only",
+        ),
+        (["fly", "hover", "--wind", "constant:2,0,0", "--duration", "1"], "has none"),
+        (["fly", "hover", "--controller-vehicle", "paper", "--duration", "1"], "of one plant"),
+    ],
+)
+def test_what_the_rotor_plant_cannot_do_is_one_line_exit_2(tmp_path, args, words):
+    vehicle = "iris,k_d=0" if "--wind" in args else "iris"
+    proc = quadcruise(*args, "--vehicle", vehicle, cwd=tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    errors = [ln for ln in proc.stderr.splitlines() if ln.startswith("error: ")]
+    assert len(errors) == 1 and words in errors[0] and "Traceback" not in proc.stderr

@@ -35,7 +35,7 @@ from quadcruise.protocols import ControllerLike
 from quadcruise.sim.engine import Limits, simulate, time_grid
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.status import ExitStatus
-from quadcruise.workflows.rotor_fly import as_vehicle, fly_rotor, rotor_flight_setup
+from quadcruise.workflows.rotor_fly import as_vehicle, check_wind_acts, fly_rotor, rotor_flight_setup
 
 
 def default_duration(mission: Mission) -> float:
@@ -218,6 +218,7 @@ def fly(
     full_dynamics = checks.flag(w, "full_dynamics", full_dynamics)
     checks.instance(w, "environment", environment, (Environment, CustomDisturbance))
     checks.instance(w, "sensors", sensors, SensorNoise)
+    check_wind_acts(vehicle, environment)  # rotor_fly.py
     seed = checks.whole(w, "seed", seed)
     first_vehicle = vehicle_indices(first_vehicle)
     for name, value in (("max_track_error", max_track_error), ("max_steady_error", max_steady_error)):
@@ -1083,9 +1084,11 @@ def _warn_about(result: SimResult) -> None:
         warnings.warn(f"vehicle {first} {result.status_text(first)}{more}", FlightWarning, stacklevel=3)
     clipped = result.duty_clipped_s
     if np.any(clipped > 0):
+        what = "rotor duties were clipped to [0, 1]"
+        if result.rotor_states is not None:  # a rotor-plant flight: its speeds, not duties (rotor_flight.py)
+            what = "rotor speed commands were held in [w_min, w_max]"
         warnings.warn(
-            f"rotor duties were clipped to [0, 1] for up to {clipped.max():.3f} s "
-            f"({np.count_nonzero(clipped)} of {result.n} vehicles)",
+            f"{what} for up to {clipped.max():.3f} s ({np.count_nonzero(clipped)} of {result.n} vehicles)",
             FlightWarning,
             stacklevel=3,
         )

@@ -34,7 +34,7 @@ from quadcruise.layout import REF_PSI, REF_Z
 from quadcruise.missions import Mission
 from quadcruise.model.equivalent import duty_to_thrust, paper_equivalent
 from quadcruise.model.rotor_plant import QW, QZ, ROTOR_W1, RZ, state_names
-from quadcruise.model.rotor_vehicle import RotorVehicle
+from quadcruise.model.rotor_vehicle import AERO_FIELDS, RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rotor_flight import fly_rotor_vehicles
@@ -139,6 +139,30 @@ def rotor_flight_setup(vehicle: Any, controller_vehicle: Any, controller: Any) -
     return True, controller
 
 
+def check_wind_acts(vehicle: Any, environment: Any) -> None:
+    """Refuse wind on a rotor-plant vehicle without aerodynamics: it would blow through it unfelt.
+
+    Parameters
+    ----------
+    vehicle : Vehicle or RotorVehicle
+        The flown vehicle (a paper Vehicle is the paper plant's business: it is given drag).
+    environment : Environment, CustomDisturbance or None
+        The disturbances.
+
+    Raises
+    ------
+    InputError
+        Wind, gusts or turbulence, and every aerodynamic coefficient of the RotorVehicle zero.
+    """
+    if not isinstance(vehicle, RotorVehicle) or not getattr(environment, "needs_drag", False):
+        return
+    if all(getattr(vehicle, name) == 0.0 for name in AERO_FIELDS):
+        raise InputError(
+            "fly(): wind acts on a rotor-plant vehicle through its aerodynamics, and this one has none "
+            f"({', '.join(AERO_FIELDS)} all 0): give it some, or fly without wind"
+        )
+
+
 def rotor_hover_state(vehicle: RotorVehicle, mission: Mission) -> np.ndarray:
     """The rotor state hovering level at x = y = 0, at the mission's start altitude and yaw.
 
@@ -225,4 +249,11 @@ def fly_rotor(
     )
 
 
-__all__ = ["as_vehicle", "designed_controller", "fly_rotor", "rotor_flight_setup", "rotor_hover_state"]
+__all__ = [
+    "as_vehicle",
+    "check_wind_acts",
+    "designed_controller",
+    "fly_rotor",
+    "rotor_flight_setup",
+    "rotor_hover_state",
+]
