@@ -121,8 +121,12 @@ def fly(
         A controller object, or a name ('nlpd', ...) for its defaults; or one controller per
         vehicle, all of one kind (the same class, the same memory size and gains layout),
         so that each vehicle flies its own gains in the one batch (a tuner's generation).
-    vehicle : Vehicle, optional
-        Table I by default; a batched Vehicle gives each of the N vehicles its own values.
+    vehicle : Vehicle, RotorVehicle or str, optional
+        Table I by default; a batched Vehicle gives each of the N vehicles its own values. A
+        :class:`~quadcruise.model.rotor_vehicle.RotorVehicle` or a preset's name (``"iris"``)
+        flies the rotor-speed plant (:mod:`quadcruise.workflows.rotor_fly`; docs/vehicles.md):
+        the controller believes its paper equivalent, and a controller given by name gets
+        gains designed for it.
     duration : float, optional
         Flight time [s]; one lap (circle, square), step time + 10 s, or 5 s by default.
     dt : float
@@ -140,8 +144,9 @@ def fly(
         Divergence bounds.
     missions : list of Mission, optional
         One mission of the same kind per vehicle (instead of ``mission``).
-    controller_vehicle : Vehicle, optional
-        The vehicle the controller believes it flies (its model); ``vehicle`` by default.
+    controller_vehicle : Vehicle or RotorVehicle, optional
+        The vehicle the controller believes it flies (its model); ``vehicle`` by default; of
+        the flown vehicle's plant.
         Give the nominal vehicle here and a perturbed one as ``vehicle`` to fly with model error.
     full_dynamics : bool
         Fly the higher-fidelity plant (exact Euler-angle kinematics) instead of the paper's.
@@ -203,9 +208,7 @@ def fly(
     mission = as_mission(mission, w)
     missions = fly_missions(missions)
     vehicle = checks.instance(w, "vehicle", as_vehicle(vehicle), (Vehicle, RotorVehicle)) or Vehicle.paper()
-    controller_vehicle = checks.instance(
-        w, "controller_vehicle", as_vehicle(controller_vehicle), (Vehicle, RotorVehicle)
-    )
+    controller_vehicle = checks.instance(w, "controller_vehicle", controller_vehicle, (Vehicle, RotorVehicle))
     rotor, controller = rotor_flight_setup(vehicle, controller_vehicle, controller)  # rotor_fly.py
     controllers = per_vehicle_controllers(controller)
     controller = controllers[0]
