@@ -12,7 +12,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import quadcruise as qc
-from quadcruise.disturbances import Environment, RotorLoss
+from quadcruise.disturbances import ConstantWind, Environment, RotorLoss, SensorNoise
 from quadcruise.errors import FlightWarning, InputError
 from quadcruise.model.equivalent import duty_to_thrust, paper_equivalent
 from quadcruise.model.rotor_vehicle import RotorVehicle
@@ -124,3 +124,38 @@ def test_what_the_rotor_plant_cannot_do_is_one_line_exit_2(tmp_path, args, words
     assert proc.returncode == 2, proc.stderr
     errors = [ln for ln in proc.stderr.splitlines() if ln.startswith("error: ")]
     assert len(errors) == 1 and words in errors[0] and "Traceback" not in proc.stderr
+
+
+def test_a_hexarotor_flies_through_the_least_squares_mixer():
+    iris = RotorVehicle.preset("iris")
+    a = np.radians(np.arange(6) * 60.0 + 30.0)
+    rotors = [[0.25 * np.cos(t), 0.25 * np.sin(t), 0.02, (-1) ** k] for k, t in enumerate(a)]
+    hexa = iris.replace(rotors=rotors, m=2.0)
+    res = qc.fly("circle", "se3", vehicle=hexa)
+    assert res.status_text(0) == "finished" and res.rotor_states.shape[2] == 13 + 6
+    err = np.linalg.norm(res.states[0, :, :3] - res.references[0, :, :3], axis=1)
+    assert err[res.t > 10.0].max() < 1.0
+    w = res.rotor_states[0, -1, 13:]
+    assert np.allclose(w, w.mean(), rtol=0.05)  # B+: the least thrusts share the load
+
+
+def test_sensor_noise_and_delay_reach_the_controller_and_repeat_with_the_seed():
+    sensors = SensorNoise(position_std=0.01, delay=0.01)
+    clean = qc.fly("hover", "se3", vehicle="crazyflie", duration=3.0)
+    a = qc.fly("hover", "se3", vehicle="crazyflie", duration=3.0, sensors=sensors, seed=3)
+    b = qc.fly("hover", "se3", vehicle="crazyflie", duration=3.0, sensors=sensors, seed=3)
+    c = qc.fly("hover", "se3", vehicle="crazyflie", duration=3.0, sensors=sensors, seed=4)
+    np.testing.assert_array_equal(a.rotor_states, b.rotor_states)
+    assert not np.array_equal(a.rotor_states, c.rotor_states)
+    assert 0.0 < np.abs(a.states[0, :, :3] - clean.states[0, :, :3]).max() < 0.05
+    assert a.status_text(0) == "finished"
+
+
+def test_wind_pushes_a_vehicle_with_rotor_drag_and_it_leans_into_it():
+    calm = qc.fly("hover", "se3", vehicle="iris", duration=5.0)
+    windy = qc.fly(
+        "hover", "se3", vehicle="iris", duration=5.0, environment=Environment(wind=ConstantWind((3.0, 0, 0)))
+    )
+    assert calm.states[0, -1, 7] == pytest.approx(0.0, abs=1e-9)
+    assert windy.states[0, -1, 7] < -0.02  # pitched against the wind (+theta accelerates +x)
+    assert windy.final_state[0, 0] > 0.05  # se3 has no integrator: blown downwind

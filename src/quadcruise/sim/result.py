@@ -56,7 +56,8 @@ class SimResult:
     memory : ndarray, shape (N, C)
         The controllers' memory at the end.
     duty_clipped_s : ndarray, shape (N,)
-        Time [s] during which a commanded duty was clipped to [0, 1].
+        Time [s] during which a commanded duty was clipped to [0, 1] (a rotor-plant vehicle:
+        a commanded rotor speed held in [w_min, w_max]).
     controller_limited_s : ndarray, shape (N,)
         Time [s] during which the controller flagged a limit.
     meta : dict
@@ -369,7 +370,8 @@ class SimResult:
         lines = [f"{self.n:,} vehicle(s) over {float(self.t[-1]) if self.t.size else 0.0:g} s"]
         lines += [f"  {count:>8,}  {reason}" for reason, count in reasons.items()]
         lines.append(
-            f"  rotor duties clipped for up to {data['duty_clipped_s']:.3f} s; "
+            f"  {'rotor duties clipped' if self.rotor_states is None else 'rotor speed commands held'} for up to "
+            f"{data['duty_clipped_s']:.3f} s; "
             f"controller limits active for up to {data['controller_limited_s']:.3f} s"
         )
         return Summary(data, "\n".join(lines))
