@@ -319,7 +319,7 @@ class SimResult:
         t, states = self.t[rows], self.states[vehicle][rows]
 
         def field_of(name, default):
-            value = (self.meta.get("vehicle") or {}).get(name, default)
+            value = (self.meta.get("paper_equivalent") or self.meta.get("vehicle") or {}).get(name, default)
             return float(value[vehicle] if isinstance(value, (list, tuple, np.ndarray)) else value)
 
         sensors = self.meta.get("sensors") or {}

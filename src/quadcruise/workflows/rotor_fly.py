@@ -231,6 +231,9 @@ def fly_rotor(
     """
     believed = controller_vehicle or vehicle
     alloc = np.r_[duty_to_thrust(believed).ravel(), believed.kf]
+    meta = engine.get("meta")
+    if meta is not None:  # the flown vehicle's "+" equivalent: its hover duty (effort), a log's K, l, d
+        meta["paper_equivalent"] = paper_equivalent(vehicle).to_dict()
     return fly_rotor_vehicles(
         grid,
         rotor_hover_state(vehicle, mission),
