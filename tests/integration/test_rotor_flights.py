@@ -14,6 +14,7 @@ from scipy.spatial.transform import Rotation
 import quadcruise as qc
 from quadcruise.disturbances import ConstantWind, Environment, RotorLoss, SensorNoise
 from quadcruise.errors import FlightWarning, InputError
+from quadcruise.missions import Hover
 from quadcruise.model.equivalent import duty_to_thrust, paper_equivalent
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.sim.status import ExitStatus
@@ -44,6 +45,13 @@ def test_the_controller_sees_the_rotor_state_in_the_paper_layout():
     np.testing.assert_allclose(res.states[0, :, 12:16], v.kf * res.rotor_states[0, :, 13:17] ** 2, rtol=1e-12)
     frame = res.to_pandas()
     assert {"qw", "w4", "phi", "F1"} <= set(frame.columns)
+    assert np.isfinite(res.metrics()["effort"][0])  # the hover duty of its paper equivalent
+
+
+def test_the_yaw_is_continuous_beyond_pi():
+    res = qc.fly(Hover(yaw=4.0), "se3", vehicle="iris", duration=2.0)  # 4 rad: the quaternion's is 4 - 2 pi
+    assert res.status_text(0) == "finished"
+    np.testing.assert_allclose(res.states[0, :, 8], 4.0, atol=1e-6)
 
 
 def test_the_plus_equivalent_duties_make_the_wrench_they_mean():
