@@ -32,10 +32,12 @@ the rotor state beside them. This path shares no code with the paper kernel's ho
 
 from __future__ import annotations
 
+import itertools
 import math
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
-from numba import njit, types
+from numba import config, get_num_threads, njit, types
 
 from quadcruise.errors import InputError
 from quadcruise.layout import (
@@ -58,7 +60,16 @@ from quadcruise.layout import (
     X,
 )
 from quadcruise.model.rotor_plant import QW, QX, QY, QZ, ROTOR_W1, RP, RP_KF, RP_N_ROTORS, RP_W_MAX, RP_W_MIN, RX, RZ
-from quadcruise.sim.engine import Limits, batch_inputs, beyond, blank_rows, log_row, put_row, still_air
+from quadcruise.sim.engine import (
+    PIECES_PER_THREAD,
+    Limits,
+    batch_inputs,
+    beyond,
+    blank_rows,
+    log_row,
+    put_row,
+    still_air,
+)
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rng import next_normal
 from quadcruise.sim.rotor_engine import ROTOR_WORK_ROWS, ground_contact, rotor_rk4_step
@@ -131,6 +142,8 @@ _u8m = types.uint64[:, ::1]
 _i8v = types.int64[::1]
 
 ROTOR_FLIGHT_SIG = types.void(
+    types.int64,  # first
+    types.int64,  # stop
     _f8v,  # t_grid
     _f8m,  # x0 (rotor states)
     _f8v,  # psi0
@@ -168,6 +181,8 @@ ROTOR_FLIGHT_SIG = types.void(
 
 @njit(ROTOR_FLIGHT_SIG, cache=True, nogil=True, error_model="numpy")
 def _rotor_flight_kernel(
+    first,
+    stop,
     t_grid,
     x0,
     psi0,
@@ -201,9 +216,9 @@ def _rotor_flight_kernel(
     t_stop,
     saturated,
 ):
-    """Fly every vehicle of the batch (the module's steps; arguments: :func:`fly_rotor_vehicles`'s,
-    one row per vehicle, ``alloc`` the n x 4 duty-to-thrust matrix row by row and the
-    controller vehicle's kf)."""
+    """Fly vehicles first .. stop - 1 of the batch (the module's steps; arguments:
+    :func:`fly_rotor_vehicles`'s, one row per vehicle, ``alloc`` the n x 4 duty-to-thrust matrix
+    row by row and the controller vehicle's kf)."""
     n_periods = t_grid.shape[0] - 1
     size = x0.shape[1]
     n = size - ROTOR_W1
@@ -220,7 +235,7 @@ def _rotor_flight_kernel(
     mi, dmi, rngi = np.empty(mem.shape[1]), np.empty(dmem.shape[1]), np.empty(rng.shape[1], dtype=np.uint64)
     max_position, max_speed, max_rate = limits[0], limits[1], limits[2]
     cos_tilt = math.cos(limits[3])
-    for i in range(x0.shape[0]):
+    for i in range(first, stop):
         for j in range(size):
             x[j] = x0[i, j]
         rpi, ai, vci, gi, mpi, dpi, stdi = rp[i], alloc[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
@@ -335,6 +350,33 @@ def _rotor_flight_kernel(
         saturated[i, 0], saturated[i, 1] = clipped_s, limited_s
         status[i] = code
         t_stop[i] = t_end
+
+
+_pool: ThreadPoolExecutor | None = None
+
+
+def _in_pieces(n: int, *args) -> None:
+    """The kernel over vehicles 0..n-1 on numba's number of threads, in ranges handed out in turn
+    (as :func:`quadcruise.sim.engine.fly_vehicles` does for the paper's kernel); each vehicle's
+    arithmetic does not depend on its range, so a batch reproduces single flights bit for bit."""
+    global _pool
+    threads = min(n, get_num_threads())
+    if threads <= 1:
+        _rotor_flight_kernel(0, n, *args)
+        return
+    bounds = np.linspace(0, n, min(n, PIECES_PER_THREAD * threads) + 1).round().astype(np.int64)
+    pieces = itertools.count()  # next() on it is atomic under the GIL
+
+    def work() -> None:
+        while (k := next(pieces)) < bounds.shape[0] - 1:
+            _rotor_flight_kernel(int(bounds[k]), int(bounds[k + 1]), *args)
+
+    if _pool is None:
+        _pool = ThreadPoolExecutor(max_workers=max(1, config.NUMBA_NUM_THREADS - 1), thread_name_prefix="rotors")
+    helpers = [_pool.submit(work) for _ in range(threads - 1)]
+    work()
+    for h in helpers:
+        h.result()
 
 
 def fly_rotor_vehicles(
@@ -457,7 +499,8 @@ def fly_rotor_vehicles(
     t_stop = np.empty(n_vehicles)
     saturated = np.zeros((n_vehicles, 2))
     mem, dmem, rng = inp["memory"], inp["disturbance_memory"], inp["rng"]
-    _rotor_flight_kernel(
+    _in_pieces(
+        n_vehicles,
         t_grid,
         x0,
         psi0,
