@@ -6,7 +6,9 @@ paper-layout vehicle row. For a :class:`~quadcruise.model.rotor_vehicle.RotorVeh
 given its *equivalent paper vehicle* (:func:`paper_equivalent`):
 
 - m, Jxx, Jyy, Jzz, g: the rotor vehicle's own;
-- K = kf w_max^2: one rotor's thrust at full speed, so duty 1 is full speed;
+- K = (n / 4) kf w_max^2: a quarter of all n rotors' thrust at full speed, so that four duties
+  of 1 are every rotor at full speed (for a quadrotor, one rotor's full thrust; a hexarotor's
+  controller would otherwise cap its collective thrust, 4 K, at two thirds of what it has);
 - omega = 1 / max(tau_up, tau_down): the motor lag's bandwidth. Thrust kf w^2 linearised about
   a speed w0 is 2 kf w0 dw, and dw lags the command by tau, so the thrust lags by the same tau.
   A moment is made by speeding some rotors up and slowing the others down, so the slower of
@@ -57,7 +59,7 @@ def paper_equivalent(vehicle: RotorVehicle) -> Vehicle:
     Returns
     -------
     Vehicle
-        Same m, J and g; K = kf w_max^2 [N], omega = ``control_bandwidth`` or else
+        Same m, J and g; K = (n / 4) kf w_max^2 [N], omega = ``control_bandwidth`` or else
         1 / max(tau_up, tau_down) [rad/s], d = km / kf [m],
         l = the mean hub distance from the z axis [m], no drag.
 
@@ -73,7 +75,7 @@ def paper_equivalent(vehicle: RotorVehicle) -> Vehicle:
         Jyy=vehicle.Jyy,
         Jzz=vehicle.Jzz,
         l=arm,
-        K=vehicle.kf * vehicle.w_max**2,
+        K=vehicle.n_rotors / 4.0 * vehicle.kf * vehicle.w_max**2,
         omega=vehicle.control_bandwidth or 1.0 / max(vehicle.tau_up, vehicle.tau_down),
         d=vehicle.km / vehicle.kf,
         g=vehicle.g,
