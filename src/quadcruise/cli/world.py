@@ -212,7 +212,8 @@ def flight_world(
             + (
                 "--controller-vehicle paper (or KEY=VALUE,...) gives it another belief"
                 if isinstance(flown, Vehicle)
-                else f"--controller-vehicle {vehicle.split(',')[0]},KEY=VALUE,... gives it another belief"
+                else "--controller-vehicle KEY=VALUE,... (the flown vehicle changed), PRESET,KEY=VALUE,... or "
+                "FILE.toml gives it another belief"
             )
         )
     if (
