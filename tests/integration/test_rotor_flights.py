@@ -167,3 +167,18 @@ def test_wind_pushes_a_vehicle_with_rotor_drag_and_it_leans_into_it():
     assert calm.states[0, -1, 7] == pytest.approx(0.0, abs=1e-9)
     assert windy.states[0, -1, 7] < -0.02  # pitched against the wind (+theta accelerates +x)
     assert windy.final_state[0, 0] > 0.05  # se3 has no integrator: blown downwind
+
+
+def test_model_error_the_controller_believes_another_rotor_vehicle():
+    iris = RotorVehicle.preset("iris")
+    heavier = qc.fly("hover", "se3", vehicle=iris.replace(m=1.05 * iris.m), controller_vehicle=iris, duration=12.0)
+    assert heavier.status_text(0) == "finished"
+    assert heavier.meta["controller_vehicle"]["m"] == iris.m and heavier.meta["vehicle"]["m"] == 1.05 * iris.m
+    # se3 has no integrator: m (kz e + g) = 1.05 m g holds it e = 0.05 g / kz below its reference
+    kz = qc.control.SE3().altitude.kp
+    assert 1.0 - heavier.final_state[0, 2] == pytest.approx(0.05 * iris.g / kz, rel=0.02)
+    hexa = iris.replace(
+        rotors=[[0.25 * np.cos(a), 0.25 * np.sin(a), 0.0, (-1) ** k] for k, a in enumerate(np.arange(6))]
+    )
+    with pytest.raises(InputError, match="6 rotors, the flown vehicle 4"):
+        qc.fly("hover", "se3", vehicle=iris, controller_vehicle=hexa, duration=1.0)
