@@ -124,6 +124,7 @@ def test_the_command_line_flies_a_preset_and_its_scenario_flies_it_again(tmp_pat
         ),
         (["fly", "hover", "--wind", "constant:2,0,0", "--duration", "1"], "has none"),
         (["fly", "hover", "--controller-vehicle", "paper", "--duration", "1"], "of one plant"),
+        (["compare", "circle", "--population", "3", "--mass-spread", "0.1", "--duration", "1"], "a population flies"),
     ],
 )
 def test_what_the_rotor_plant_cannot_do_is_one_line_exit_2(tmp_path, args, words):
@@ -132,6 +133,7 @@ def test_what_the_rotor_plant_cannot_do_is_one_line_exit_2(tmp_path, args, words
     assert proc.returncode == 2, proc.stderr
     errors = [ln for ln in proc.stderr.splitlines() if ln.startswith("error: ")]
     assert len(errors) == 1 and words in errors[0] and "Traceback" not in proc.stderr
+    assert not proc.stdout.strip()  # refused before anything flew
 
 
 def test_a_hexarotor_flies_through_the_least_squares_mixer():
