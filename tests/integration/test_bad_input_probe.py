@@ -242,7 +242,7 @@ BASES = {
 @pytest.mark.parametrize(
     "args, words",
     [
-        (["--vehicle", "jumbo"], "--vehicle 'jumbo': unknown vehicle preset 'jumbo' (known: paper)"),
+        (["--vehicle", "jumbo"], "--vehicle 'jumbo': unknown vehicle preset 'jumbo' (known: paper, "),
         (["--vehicle", "m=-1"], "--vehicle 'm=-1': vehicle field 'm' (mass, kg) must be > 0"),
         (["--vehicle", "mass=1.4"], "--vehicle 'mass=1.4': unknown key 'mass'"),
         (["--vehicle", "m=1,2"], "m must be one number"),

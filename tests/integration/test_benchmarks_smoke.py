@@ -61,3 +61,16 @@ def test_quick_gym_benchmark_writes_positive_figures(tmp_path):
     assert positive(data["fly_rate"])
     assert set(data["modes"]) == {"rotors", "rates", "attitude", "velocity"}
     assert all(positive(m["rate"]) and positive(m["ratio_to_fly"]) for m in data["modes"].values())
+
+
+def test_quick_rotor_benchmark_flies_both_plants(tmp_path):
+    out = tmp_path / "rotor.json"
+    script = SCRIPT.with_name("rotor.py")
+    proc = subprocess.run(
+        [sys.executable, str(script), "--quick", "--json", str(out)], capture_output=True, text=True, timeout=600
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    data = json.loads(out.read_text())
+    for side in ("paper", "iris"):
+        assert positive(data["results"][side]["rate"]) and len(data["results"][side]["runs_s"]) == 3
+    assert positive(data["ratio"]) and "rotor plant / paper plant" in proc.stdout

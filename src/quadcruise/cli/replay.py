@@ -28,7 +28,7 @@ __all__ = ["replay"]
     "vehicle_name",
     default=None,
     metavar="NAME|FILE.toml",
-    help="The vehicle: a preset (paper, crazyflie, hummingbird, iris) or a vehicle file "
+    help="The vehicle: a preset (paper, qball-x4, crazyflie, hummingbird, iris) or a vehicle file "
     '([vehicle] preset = "iris" and the fields to change). Default: the paper\'s Table I.',
 )
 @click.option(

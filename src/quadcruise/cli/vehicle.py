@@ -42,8 +42,8 @@ def vehicle_from_option(text: str | None, option: str, base=None):
     >>> vehicle_from_option("jumbo", "--vehicle")
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: --vehicle 'jumbo': unknown vehicle preset 'jumbo' (known: paper); \
-or give the vehicle's fields, KEY=VALUE,..., or a FILE.toml
+    quadcruise.errors.InputError: --vehicle 'jumbo': unknown vehicle preset 'jumbo' (known: paper, crazyflie, \
+hummingbird, iris, qball-x4); or give the vehicle's fields, KEY=VALUE,..., or a FILE.toml
     """
     if text is None:
         return None
@@ -66,7 +66,7 @@ or give the vehicle's fields, KEY=VALUE,..., or a FILE.toml
             vehicle, text = vehicle_preset(head.strip()), rest
             if not text.strip():
                 return vehicle
-        fields = [f.name for f in dataclasses.fields(Vehicle)]
+        fields = [f.name for f in dataclasses.fields(type(vehicle))]
         values = parse_assignments(text, option, keys=fields, numbers=True)
         many = [k for k, v in values.items() if isinstance(v, tuple)]
         if many:

@@ -190,11 +190,15 @@ def flight_world(
     flown = vehicle_from_option(vehicle, "--vehicle", base) or base
     believed_base = scenario.controller_vehicle if scenario is not None else None
     believed = (
-        vehicle_from_option(controller_vehicle, "--controller-vehicle", believed_base or Vehicle.paper())
+        vehicle_from_option(
+            controller_vehicle,
+            "--controller-vehicle",
+            believed_base or (Vehicle.paper() if isinstance(flown, Vehicle) else flown),  # bare fields change it
+        )
         or believed_base
     )
     env = environment_from_options(wind, turbulence, scenario.environment if scenario is not None else None)
-    if vehicle is not None:
+    if vehicle is not None and isinstance(flown, Vehicle):  # a RotorVehicle that cannot lift cannot be made
         import warnings
 
         from quadcruise.workflows.fly import check_can_hover
@@ -206,9 +210,19 @@ def flight_world(
     if vehicle is not None and believed is None and flown != Vehicle.paper():
         notes.append(
             f"the controller is told the flown vehicle ({vehicle}), so it flies without model error; "
-            "--controller-vehicle paper (or KEY=VALUE,...) gives it another belief"
+            + (
+                "--controller-vehicle paper (or KEY=VALUE,...) gives it another belief"
+                if isinstance(flown, Vehicle)
+                else "--controller-vehicle KEY=VALUE,... (the flown vehicle changed), PRESET,KEY=VALUE,... or "
+                "FILE.toml gives it another belief"
+            )
         )
-    if env is not None and env.needs_drag and flown.drag_linear == 0 and flown.drag_quadratic == 0:
+    if (
+        env is not None
+        and env.needs_drag
+        and isinstance(flown, Vehicle)
+        and flown.drag_linear == flown.drag_quadratic == 0
+    ):
         flown = with_drag(flown)
         notes.append(default_drag_text())
     return {"vehicle": flown, "controller_vehicle": believed, "environment": env}, notes

@@ -573,7 +573,8 @@ def hover_duties(meta, n: int) -> np.ndarray | None:
     ----------
     meta : dict
         A result's ``meta``: its ``vehicle`` entry (the flown vehicle's ``to_dict()``: ``m``
-        [kg], ``g`` [m/s^2] and ``K`` [N], each a number or one per vehicle) is read.
+        [kg], ``g`` [m/s^2] and ``K`` [N], each a number or one per vehicle) is read; for a
+        rotor-plant vehicle its ``paper_equivalent`` (the "+" vehicle whose duties were flown).
     n : int
         Number of vehicles.
 
@@ -588,7 +589,7 @@ def hover_duties(meta, n: int) -> np.ndarray | None:
     >>> hover_duties({"vehicle": {"m": [3.0, 6.0], "g": 10.0, "K": 100.0}}, 2)
     array([0.075, 0.15 ])
     """
-    vehicle = meta.get("vehicle") if isinstance(meta, dict) else None
+    vehicle = (meta.get("paper_equivalent") or meta.get("vehicle")) if isinstance(meta, dict) else None
     if not isinstance(vehicle, dict) or not all(k in vehicle for k in ("m", "g", "K")):
         return None
     try:

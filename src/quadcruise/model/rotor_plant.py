@@ -103,7 +103,7 @@ def state_names(n_rotors: int) -> tuple[str, ...]:
     return ROTOR_BODY_NAMES + tuple(f"w{i + 1}" for i in range(n_rotors))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def rotor_derivative(x, w_cmd, rp, ext, dx):
     """Write dx/dt of one rotor-speed vehicle into ``dx`` (the equations of this module).
 

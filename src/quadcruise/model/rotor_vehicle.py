@@ -121,6 +121,11 @@ class RotorVehicle(Validated):
         Flapping moment coefficient [N m/(rad/s m/s)], >= 0.
     J_rotor : float
         One rotor's (with its motor's rotating part) inertia about its axis [kg m^2], >= 0.
+    control_bandwidth : float
+        The actuator bandwidth [rad/s] that the controllers' gains are designed for
+        (:mod:`quadcruise.model.equivalent`); 0, the default: the motors' own,
+        1 / max(tau_up, tau_down). A preset sets it where gains designed for the motors' lag
+        do not fly (the Hummingbird's 5 ms motors).
     touchdown_speed : float
         The fastest vertical speed [m/s] at which it may meet the ground (when a flight has
         one); faster is a crash. 1 m/s by default: PX4 lands at 0.7 m/s (``MPC_LAND_SPEED``).
@@ -148,6 +153,7 @@ class RotorVehicle(Validated):
     k_h: float = _f(0.0, "N/(m/s)^2", "translational lift coefficient", "nonneg")
     k_flap: float = _f(0.0, "N m/(rad/s m/s)", "flapping moment coefficient", "nonneg")
     J_rotor: float = _f(0.0, "kg m^2", "a rotor's inertia about its axis", "nonneg")
+    control_bandwidth: float = _f(0.0, "rad/s", "bandwidth the controllers are designed for (0: the motors')", "nonneg")
     touchdown_speed: float = _f(1.0, "m/s", "fastest descent its landing gear survives", "pos")
     source: str = _f("", "-", "where the numbers come from", _TEXT)
 

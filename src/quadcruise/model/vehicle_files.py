@@ -22,7 +22,7 @@ This module reads tables and imports no vehicle class: the classes come in as ``
 Examples
 --------
 >>> sorted(PRESETS)
-['crazyflie', 'hummingbird', 'iris', 'paper']
+['crazyflie', 'hummingbird', 'iris', 'paper', 'qball-x4']
 >>> preset_source("iris")[:23]
 'PX4-SITL_gazebo-classic'
 >>> preset_path("irs")

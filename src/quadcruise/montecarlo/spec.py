@@ -29,6 +29,7 @@ from quadcruise.errors import InputError, whole_number
 from quadcruise.io.plainjson import dumps
 from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from quadcruise.missions import Mission, mission_from_name
+from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
 from quadcruise.montecarlo.requirements import Requirement, as_requirements
@@ -153,6 +154,11 @@ class MonteCarloSpec:
             raise InputError(f"mission must be a name or a Mission, got {type(self.mission).__name__}")
         if not isinstance(self.population, Population):
             raise InputError("population must be a Population")
+        if isinstance(self.vehicle, RotorVehicle) or isinstance(self.controller_vehicle, RotorVehicle):
+            raise InputError(
+                "a rotor-plant vehicle (RotorVehicle) is flown by fly and compare only: a Monte Carlo sweep and "
+                "tune fly the paper's plant, whose Population perturbs the paper vehicle's m, J, K and omega"
+            )
         if not isinstance(self.vehicle, Vehicle) or self.vehicle.batch_size is not None:
             raise InputError("the nominal vehicle must be one (unbatched) Vehicle")
         with warnings.catch_warnings():  # fly() warns of a vehicle with little left for control

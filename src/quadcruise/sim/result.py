@@ -56,13 +56,23 @@ class SimResult:
     memory : ndarray, shape (N, C)
         The controllers' memory at the end.
     duty_clipped_s : ndarray, shape (N,)
-        Time [s] during which a commanded duty was clipped to [0, 1].
+        Time [s] during which a commanded duty was clipped to [0, 1] (a rotor-plant vehicle:
+        a commanded rotor speed held in [w_min, w_max]).
     controller_limited_s : ndarray, shape (N,)
         Time [s] during which the controller flagged a limit.
     meta : dict
         The configuration, seed and version that produced the result.
     disturbance_memory : ndarray, shape (N, D), optional
         The disturbance models' state at the end.
+    rotor_states : ndarray, shape (N, L, 13 + n), optional
+        A rotor-plant vehicle's own state at each instant (:mod:`quadcruise.model.rotor_plant`:
+        position, velocity, quaternion, body rates, rotor speeds), beside ``states``, which
+        hold it in the paper's layout (Euler angles, F1..F4 the thrusts of rotors 1..4);
+        None for the paper's plant.
+    rotor_final_state : ndarray, shape (N, 13 + n), optional
+        The rotor state when each vehicle finished or stopped.
+    rotor_names : tuple of str
+        The columns of ``rotor_states``.
     """
 
     t: np.ndarray
@@ -77,6 +87,9 @@ class SimResult:
     controller_limited_s: np.ndarray
     meta: dict = field(default_factory=dict)
     disturbance_memory: np.ndarray | None = None
+    rotor_states: np.ndarray | None = None
+    rotor_final_state: np.ndarray | None = None
+    rotor_names: tuple = ()
 
     @property
     def n(self) -> int:
@@ -167,7 +180,8 @@ class SimResult:
         -------
         pandas.DataFrame
             Columns ``vehicle``, ``t`` [s], the 16 state names, then (optionally) the
-            reference and the command names.
+            reference and the command names; for a rotor-plant vehicle then its quaternion
+            ``qw, qx, qy, qz`` and rotor speeds ``w1..wn`` [rad/s].
         """
         import pandas as pd
 
@@ -180,6 +194,10 @@ class SimResult:
         if commands:
             blocks.append(self.commands)
             names += CMD_NAMES
+        if self.rotor_states is not None:
+            extra = [j for j, name in enumerate(self.rotor_names) if name not in STATE_NAMES]
+            blocks.append(self.rotor_states[:, :, extra])
+            names += [self.rotor_names[j] for j in extra]
         data = np.concatenate(blocks, axis=2)[list(picks)]
         n_sel, n_log, _ = data.shape
         frame = pd.DataFrame(data.reshape(n_sel * n_log, -1), columns=names)
@@ -209,6 +227,7 @@ class SimResult:
             states=self.states[:, keep],
             commands=self.commands[:, keep],
             references=self.references[:, keep],
+            rotor_states=None if self.rotor_states is None else self.rotor_states[:, keep],
         )
 
     def metrics(self, **kwargs):
@@ -306,7 +325,7 @@ class SimResult:
         t, states = self.t[rows], self.states[vehicle][rows]
 
         def field_of(name, default):
-            value = (self.meta.get("vehicle") or {}).get(name, default)
+            value = (self.meta.get("paper_equivalent") or self.meta.get("vehicle") or {}).get(name, default)
             return float(value[vehicle] if isinstance(value, (list, tuple, np.ndarray)) else value)
 
         sensors = self.meta.get("sensors") or {}
@@ -364,7 +383,8 @@ class SimResult:
         lines = [f"{self.n:,} vehicle(s) over {float(self.t[-1]) if self.t.size else 0.0:g} s"]
         lines += [f"  {count:>8,}  {reason}" for reason, count in reasons.items()]
         lines.append(
-            f"  rotor duties clipped for up to {data['duty_clipped_s']:.3f} s; "
+            f"  {'rotor duties clipped' if self.rotor_states is None else 'rotor speed commands held'} for up to "
+            f"{data['duty_clipped_s']:.3f} s; "
             f"controller limits active for up to {data['controller_limited_s']:.3f} s"
         )
         return Summary(data, "\n".join(lines))

@@ -55,7 +55,7 @@ ROTOR_WORK_ROWS = 5
 """Rows of the RK4 workspace: the four stage derivatives and the stage state."""
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, inline="always", error_model="numpy")
 def rotor_rk4_step(x, w_cmd, rp, ext, h, work):
     """One classical Runge-Kutta step of length h [s] of the rotor plant, in place on x,
     then the quaternion scaled to unit length.

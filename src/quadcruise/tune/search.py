@@ -31,6 +31,7 @@ from quadcruise import checks
 from quadcruise.control import as_controller
 from quadcruise.errors import InputError, reject_unknown, whole_number
 from quadcruise.missions import Mission, as_mission
+from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
 from quadcruise.montecarlo.spec import MonteCarloSpec
@@ -184,6 +185,11 @@ def tune(
     checks.number(w, "tol", tol, "nonneg")
     mission = as_mission(mission, w)
     checks.instance(w, "population", population, Population)
+    if isinstance(vehicle, RotorVehicle):
+        raise InputError(
+            "a rotor-plant vehicle (RotorVehicle) is flown by fly and compare only: a Monte Carlo sweep and "
+            "tune fly the paper's plant, whose Population perturbs the paper vehicle's m, J, K and omega"
+        )
     checks.instance(w, "vehicle", vehicle, Vehicle)
     checks.number(w, "duration", duration, "pos", unit="s", optional=True)
     checks.number(w, "dt", dt, "pos", unit="s")

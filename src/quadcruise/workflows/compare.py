@@ -29,8 +29,10 @@ from quadcruise.errors import InputError, reject_unknown
 from quadcruise.io.plainjson import dumps, plain
 from quadcruise.metrics.summary import Summary
 from quadcruise.missions import Mission, as_mission
+from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.workflows.fly import FLY_OPTIONS, flight_warnings_named, fly
+from quadcruise.workflows.rotor_fly import as_vehicle
 
 __all__ = ["compare", "Comparison", "DEFAULT_CONTROLLERS"]
 
@@ -353,7 +355,7 @@ def compare(
     )
     w = "compare()"  # its own arguments checked before any flight
     mission = as_mission(mission, w)
-    checks.instance(w, "vehicle", vehicle, Vehicle)
+    vehicle = checks.instance(w, "vehicle", as_vehicle(vehicle), (Vehicle, RotorVehicle))  # a preset's name too
     checks.number(w, "duration", duration, "pos", unit="s", optional=True)
     checks.number(w, "dt", dt, "pos", unit="s")
     checks.callback(w, "progress", progress)

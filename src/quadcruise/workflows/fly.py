@@ -28,11 +28,14 @@ from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import FlightWarning, InputError, reject_unknown
 from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, REF_Z, STATE_SIZE, X, Z
 from quadcruise.missions import Mission, as_mission, stack_params
+from quadcruise.model.equivalent import paper_equivalent
+from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
 from quadcruise.sim.engine import Limits, simulate, time_grid
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.status import ExitStatus
+from quadcruise.workflows.rotor_fly import as_vehicle, check_wind_acts, fly_rotor, rotor_flight_setup
 
 
 def default_duration(mission: Mission) -> float:
@@ -118,8 +121,12 @@ def fly(
         A controller object, or a name ('nlpd', ...) for its defaults; or one controller per
         vehicle, all of one kind (the same class, the same memory size and gains layout),
         so that each vehicle flies its own gains in the one batch (a tuner's generation).
-    vehicle : Vehicle, optional
-        Table I by default; a batched Vehicle gives each of the N vehicles its own values.
+    vehicle : Vehicle, RotorVehicle or str, optional
+        Table I by default; a batched Vehicle gives each of the N vehicles its own values. A
+        :class:`~quadcruise.model.rotor_vehicle.RotorVehicle` or a preset's name (``"iris"``)
+        flies the rotor-speed plant (:mod:`quadcruise.workflows.rotor_fly`; docs/vehicles.md):
+        the controller believes its paper equivalent, and a controller given by name gets
+        gains designed for it.
     duration : float, optional
         Flight time [s]; one lap (circle, square), step time + 10 s, or 5 s by default.
     dt : float
@@ -137,8 +144,9 @@ def fly(
         Divergence bounds.
     missions : list of Mission, optional
         One mission of the same kind per vehicle (instead of ``mission``).
-    controller_vehicle : Vehicle, optional
-        The vehicle the controller believes it flies (its model); ``vehicle`` by default.
+    controller_vehicle : Vehicle or RotorVehicle, optional
+        The vehicle the controller believes it flies (its model); ``vehicle`` by default; of
+        the flown vehicle's plant.
         Give the nominal vehicle here and a perturbed one as ``vehicle`` to fly with model error.
     full_dynamics : bool
         Fly the higher-fidelity plant (exact Euler-angle kinematics) instead of the paper's.
@@ -199,10 +207,11 @@ def fly(
     w = "fly()"  # every argument checked before any work
     mission = as_mission(mission, w)
     missions = fly_missions(missions)
+    vehicle = checks.instance(w, "vehicle", as_vehicle(vehicle), (Vehicle, RotorVehicle)) or Vehicle.paper()
+    controller_vehicle = checks.instance(w, "controller_vehicle", controller_vehicle, (Vehicle, RotorVehicle))
+    rotor, controller = rotor_flight_setup(vehicle, controller_vehicle, controller)  # rotor_fly.py
     controllers = per_vehicle_controllers(controller)
     controller = controllers[0]
-    vehicle = checks.instance(w, "vehicle", vehicle, Vehicle) or Vehicle.paper()
-    checks.instance(w, "controller_vehicle", controller_vehicle, Vehicle)
     duration = checks.number(w, "duration", duration, "pos", unit="s", optional=True)
     dt = checks.number(w, "dt", dt, "pos", unit="s")
     max_step = checks.number(w, "max_step", max_step, "pos", unit="s", optional=True)
@@ -212,15 +221,21 @@ def fly(
     full_dynamics = checks.flag(w, "full_dynamics", full_dynamics)
     checks.instance(w, "environment", environment, (Environment, CustomDisturbance))
     checks.instance(w, "sensors", sensors, SensorNoise)
+    check_wind_acts(vehicle, environment)  # rotor_fly.py
     seed = checks.whole(w, "seed", seed)
     first_vehicle = vehicle_indices(first_vehicle)
     for name, value in (("max_track_error", max_track_error), ("max_steady_error", max_steady_error)):
         checks.number(w, name, value, "pos", unit="m", optional=True, infinite=True)
     x0 = initial_states(x0)
+    if rotor and (x0 is not None or full_dynamics):
+        raise InputError(
+            f"fly() argument {'x0' if x0 is not None else 'full_dynamics'}: not for a rotor-plant vehicle "
+            "(it starts hovering at the mission's start; its plant has no Euler-angle kinematics to choose)"
+        )
     sizes = {
         s
         for s in (
-            vehicle.batch_size,
+            getattr(vehicle, "batch_size", None),
             None if x0 is None or np.ndim(x0) < 2 else np.shape(x0)[0],
             None if missions is None else len(missions),
             n,
@@ -244,16 +259,17 @@ def fly(
     check_log_every(log_every, grid.size - 1)
     if sensors is not None:
         sensors.check_fits(duration)
-    check_can_hover(vehicle)
+    if not rotor:  # a RotorVehicle that cannot lift itself cannot be made
+        check_can_hover(vehicle)
     check_reference_fits(missions or [first], float(duration), limits or Limits())
     given_x0 = None if x0 is None else np.asarray(x0, dtype=float).tolist()
-    x0 = hover_state(vehicle, n, first) if x0 is None else x0
+    x0 = hover_state(paper_equivalent(vehicle) if rotor else vehicle, n, first) if x0 is None else x0
     meta = {
         "workflow": "fly",
         "mission": [m.to_dict() for m in missions] if missions else mission.to_dict(),
         "controller": controller_record(controller),
         **({"controllers": [controller_record(c) for c in controllers]} if len(controllers) > 1 else {}),
-        "vehicle": vehicle.to_dict(),
+        "vehicle": {"plant": "rotor", **vehicle.to_dict()} if rotor else vehicle.to_dict(),
         "duration_s": float(duration),
         "dt_s": float(dt),
         "max_step_s": float(max_step or dt),
@@ -275,32 +291,32 @@ def fly(
     if sensors is not None:
         meta["sensors"] = sensors.to_dict()
     if controller_vehicle is not None:
-        meta["controller_vehicle"] = controller_vehicle.to_dict()
-    vp_ctrl = None if controller_vehicle is None else controller_vehicle.rows(n)
+        meta["controller_vehicle"] = (
+            {"plant": "rotor", **controller_vehicle.to_dict()} if rotor else controller_vehicle.to_dict()
+        )
+    vp_ctrl = None if controller_vehicle is None or rotor else controller_vehicle.rows(n)
     gains, memory = (
         (controller.gains(), controller.memory())
         if len(controllers) == 1
         else (np.stack([c.gains() for c in controllers]), np.stack([c.memory() for c in controllers]))
     )
-    result = simulate(
-        grid,
-        x0,
-        vehicle.rows(n),
-        controller.function,
-        gains,
-        first.function,
-        mp,
-        memory=memory,
-        max_step=max_step or dt,
-        log_every=log_every,
-        limits=limits,
-        meta=meta,
-        vp_ctrl=vp_ctrl,
-        full_dynamics=full_dynamics,
-        seed=seed,
-        first_vehicle=first_vehicle,
-        **engine_inputs(environment, sensors, n, dt),
-    )
+    common = {"memory": memory, "max_step": max_step or dt, "log_every": log_every, "limits": limits, "meta": meta}
+    common.update(seed=seed, first_vehicle=first_vehicle, **engine_inputs(environment, sensors, n, dt))
+    if rotor:
+        result = fly_rotor(grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, **common)
+    else:
+        result = simulate(
+            grid,
+            x0,
+            vehicle.rows(n),
+            controller.function,
+            gains,
+            first.function,
+            mp,
+            vp_ctrl=vp_ctrl,
+            full_dynamics=full_dynamics,
+            **common,
+        )
     bound = (
         track_bound(missions or [first], np.broadcast_to(x0, (n, STATE_SIZE)), n)
         if max_track_error is None
@@ -1071,9 +1087,11 @@ def _warn_about(result: SimResult) -> None:
         warnings.warn(f"vehicle {first} {result.status_text(first)}{more}", FlightWarning, stacklevel=3)
     clipped = result.duty_clipped_s
     if np.any(clipped > 0):
+        what = "rotor duties were clipped to [0, 1]"
+        if result.rotor_states is not None:  # a rotor-plant flight: its speeds, not duties (rotor_flight.py)
+            what = "rotor speed commands were held in [w_min, w_max]"
         warnings.warn(
-            f"rotor duties were clipped to [0, 1] for up to {clipped.max():.3f} s "
-            f"({np.count_nonzero(clipped)} of {result.n} vehicles)",
+            f"{what} for up to {clipped.max():.3f} s ({np.count_nonzero(clipped)} of {result.n} vehicles)",
             FlightWarning,
             stacklevel=3,
         )

@@ -75,7 +75,9 @@ from quadcruise.control import CONTROLLERS, Controller
 from quadcruise.control.design import PDGains, PIDGains, parse_pole, pd_from_poles, pid_from_poles
 from quadcruise.errors import InputError
 from quadcruise.missions import MISSIONS, Mission
+from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
+from quadcruise.model.vehicle_files import PRESETS, vehicle_from_table
 
 VEHICLE_PRESETS = {"paper": Vehicle.paper}
 """Vehicles by name: ``preset = "paper"`` in a ``[vehicle]`` table, ``--vehicle paper`` on the command line."""
@@ -343,7 +345,7 @@ def _consistent(
     periods (as :func:`~quadcruise.workflows.fly.check_log_every`)."""
     counts: dict[str, int] = {}
     for table, v in (("vehicle", vehicle), ("controller_vehicle", model)):
-        if v is not None and v.batch_size is not None:
+        if v is not None and getattr(v, "batch_size", None) is not None:
             key = next((k for k, x in doc.get(table, {}).items() if isinstance(x, list)), "?")
             counts[f"[{table}] {key}"] = v.batch_size
     if "n" in simulation:
@@ -436,9 +438,12 @@ def vehicle_preset(name: str) -> Vehicle:
     >>> vehicle_preset("paper").m
     3.499
     """
-    if not isinstance(name, str) or name not in VEHICLE_PRESETS:
-        raise InputError(f"unknown vehicle preset {name!r} (known: {', '.join(VEHICLE_PRESETS)})")
-    return VEHICLE_PRESETS[name]()
+    if isinstance(name, str) and name in VEHICLE_PRESETS:
+        return VEHICLE_PRESETS[name]()
+    if isinstance(name, str) and name in PRESETS:  # the other presets: a file each
+        return Vehicle.preset(name)
+    known = ", ".join([*VEHICLE_PRESETS, *sorted(set(PRESETS) - set(VEHICLE_PRESETS))])
+    raise InputError(f"unknown vehicle preset {name!r} (known: {known})")
 
 
 def read_vehicle_file(path: str | Path) -> Vehicle:
@@ -480,7 +485,11 @@ def read_vehicle_file(path: str | Path) -> Vehicle:
     return _vehicle(_Where(str(path)), doc)
 
 
-def _vehicle(where: _Where, table: dict) -> Vehicle:
+def _vehicle(where: _Where, table: dict) -> Vehicle | RotorVehicle:
+    preset = table.get("preset", "paper")
+    if "plant" in table or "rotors" in table or (isinstance(preset, str) and preset in set(PRESETS) - {"paper"}):
+        # a rotor-plant vehicle, or a preset file's: the vehicle file's reader (one vehicle, not a batch)
+        return vehicle_from_table(table, {"paper": Vehicle, "rotor": RotorVehicle}, where.source)
     fields = {f.name for f in dataclasses.fields(Vehicle)}
     _known(where, "", table, fields | {"preset"})
     base = where.wrap(vehicle_preset, table.get("preset", "paper"))

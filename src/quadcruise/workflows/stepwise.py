@@ -80,6 +80,11 @@ def stepper(
         raise InputError("stepper: give one controller (its gains rows may be written between steps)")
     controller = controllers[0]
     vehicle = vehicle or Vehicle.paper()
+    if not isinstance(vehicle, Vehicle) or not isinstance(controller_vehicle, (Vehicle, type(None))):
+        raise InputError(
+            "stepper: the step-wise engine flies the paper's plant: give a paper Vehicle, got "
+            f"{type(vehicle).__name__} (a rotor-plant vehicle flies with fly and compare)"
+        )
     n = n or vehicle.batch_size or (np.shape(x0)[0] if x0 is not None and np.ndim(x0) == 2 else 1)
     if vehicle.batch_size not in (None, n):
         raise InputError(f"the number of vehicles is ambiguous: n = {n}, vehicle has {vehicle.batch_size}")

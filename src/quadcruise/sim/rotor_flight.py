@@ -1,0 +1,556 @@
+"""Closed-loop flights of rotor-plant vehicles: the engine's controllers, missions, disturbances
+and sensors around :func:`quadcruise.model.rotor_plant.rotor_derivative`, one vehicle or N, in
+one compiled function.
+
+Each control period t_k, for each vehicle:
+
+1. the mission gives the reference;
+2. the rotor state becomes the paper-layout state (:func:`paper_state`): position, velocity,
+   the ZYX Euler angles of the quaternion (the rotation R = Rz(psi) Ry(theta) Rx(phi) of eqs
+   (5)-(7); yaw unwrapped, continuous from period to period), the body rates, and F1..F4 the
+   thrusts e_i kf w_i^2 of rotors 1..4 (rotors beyond the fourth are in the rotor log only);
+   the controller sees it ``sensor_delay`` periods late, with noise, exactly as in the paper's
+   kernel (the same ring buffer and random stream);
+3. the controller computes the duties of its "+" equivalent vehicle
+   (:mod:`quadcruise.model.equivalent`); they are not clipped: the matrix of
+   :func:`~quadcruise.model.equivalent.duty_to_thrust` turns them into the controller vehicle's
+   rotor thrusts, and each thrust into a speed sqrt(f / kf) held in the flown vehicle's
+   [w_min, w_max] (the time any speed is held is counted, as the paper's clipped duties are);
+   a non-finite duty stops the vehicle (``BAD_COMMAND``);
+4. the disturbance function (``DISTURBANCE_SIG``, read with the paper-layout true state) gives
+   force, torque, wind and the effectiveness of rotors 1..4 (rotors beyond stay at 1);
+5. RK4 substeps no longer than ``max_step`` fly the commanded speeds on the true vehicle, the
+   quaternion renormalised after each, and with a ground each step that ends below z = 0 meets
+   it (:func:`quadcruise.sim.rotor_engine.ground_contact`): held, or ``CRASHED``;
+6. the state is checked against :class:`~quadcruise.sim.engine.Limits`: non-finite, position,
+   speed, body rate, and tilt: the angle between body z and world z above ``max_tilt``.
+
+The paper-layout states, commands and references are logged as the paper kernel logs them, and
+the rotor state beside them. This path shares no code with the paper kernel's hot loop
+(:func:`quadcruise.sim.engine._kernel`), whose flights and speed stay as they are.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+from numba import config, get_num_threads, njit, types
+
+from quadcruise.errors import InputError
+from quadcruise.layout import (
+    CMD_FLAGS,
+    CMD_SIZE,
+    EXT_E1,
+    EXT_SIZE,
+    F1,
+    PHI,
+    PSI,
+    REF_SIZE,
+    STATE_SIZE,
+    THETA,
+    ControllerType,
+    DisturbanceType,
+    MissionType,
+    P,
+    Q,
+    R,
+    X,
+)
+from quadcruise.model.rotor_plant import QW, QX, QY, QZ, ROTOR_W1, RP, RP_KF, RP_N_ROTORS, RP_W_MAX, RP_W_MIN, RX, RZ
+from quadcruise.sim.engine import (
+    PIECES_PER_THREAD,
+    Limits,
+    batch_inputs,
+    beyond,
+    blank_rows,
+    log_row,
+    put_row,
+    still_air,
+)
+from quadcruise.sim.result import SimResult
+from quadcruise.sim.rng import next_normal
+from quadcruise.sim.rotor_engine import ROTOR_WORK_ROWS, ground_contact, rotor_rk4_step
+from quadcruise.sim.status import ExitStatus
+
+FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, TILT_BOUND, BAD_COMMAND, CRASHED = (
+    int(ExitStatus[name])
+    for name in (
+        "FINISHED",
+        "NONFINITE",
+        "POSITION_BOUND",
+        "SPEED_BOUND",
+        "RATE_BOUND",
+        "TILT_BOUND",
+        "BAD_COMMAND",
+        "CRASHED",
+    )
+)
+
+
+@njit(cache=True, inline="always")
+def paper_state(xr, rp, ext, psi_last, out):
+    """The paper-layout state (:data:`quadcruise.layout.STATE_NAMES`) of a rotor-plant state.
+
+    Parameters
+    ----------
+    xr : numpy.ndarray
+        (13 + n,) the rotor state, its quaternion of unit length.
+    rp : numpy.ndarray
+        The vehicle's parameter row (its kf and rotor count).
+    ext : numpy.ndarray
+        (EXT_SIZE,) the external inputs held over the last period (its rotor effectiveness).
+    psi_last : float
+        The yaw [rad] of the previous call: the new yaw is the one within pi of it.
+    out : numpy.ndarray
+        (STATE_SIZE,) output: x, y, z, vx, vy, vz, phi, theta, psi (ZYX), p, q, r, and
+        F1..F4 = e_i kf w_i^2 [N] of rotors 1..4 (0 for a rotor that does not exist).
+
+    Returns
+    -------
+    float
+        The yaw written [rad].
+    """
+    qw, qx, qy, qz = xr[QW], xr[QX], xr[QY], xr[QZ]
+    for j in range(6):
+        out[X + j] = xr[RX + j]
+    out[PHI] = math.atan2(2.0 * (qw * qx + qy * qz), 1.0 - 2.0 * (qx * qx + qy * qy))
+    s = 2.0 * (qw * qy - qx * qz)
+    out[THETA] = math.asin(max(-1.0, min(1.0, s)))
+    raw = math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+    turn = raw - psi_last
+    psi = psi_last + turn - 2.0 * math.pi * math.floor(turn / (2.0 * math.pi) + 0.5)
+    out[PSI] = psi
+    out[P], out[Q], out[R] = xr[RP], xr[RP + 1], xr[RP + 2]
+    n = int(rp[RP_N_ROTORS])
+    kf = rp[RP_KF]
+    for i in range(4):
+        if i < n:
+            w = xr[ROTOR_W1 + i]
+            out[F1 + i] = ext[EXT_E1 + i] * kf * w * w
+        else:
+            out[F1 + i] = 0.0
+    return psi
+
+
+_f8v = types.float64[::1]
+_f8m = types.float64[:, ::1]
+_f8c = types.float64[:, :, ::1]
+_u8m = types.uint64[:, ::1]
+_i8v = types.int64[::1]
+
+ROTOR_FLIGHT_SIG = types.void(
+    types.int64,  # first
+    types.int64,  # stop
+    _f8v,  # t_grid
+    _f8m,  # x0 (rotor states)
+    _f8v,  # psi0
+    _f8m,  # rp
+    _f8m,  # alloc: duty -> thrust matrix (n x 4, row-major), then the controller's kf
+    _f8m,  # vp_ctrl
+    ControllerType,
+    _f8m,  # gains
+    _f8m,  # mem
+    MissionType,
+    _f8m,  # mp
+    DisturbanceType,
+    types.boolean,  # disturbed
+    _f8m,  # dp
+    _f8m,  # dmem
+    _u8m,  # rng
+    _f8m,  # sensor_std
+    types.int64,  # sensor_delay
+    types.float64,  # max_step
+    types.int64,  # log_every
+    _f8v,  # limits
+    types.boolean,  # ground
+    _f8v,  # touchdown
+    _f8c,  # log_x
+    _f8c,  # log_rotor
+    _f8c,  # log_cmd
+    _f8c,  # log_ref
+    _f8m,  # x_final (rotor)
+    _f8m,  # seen_final (paper layout)
+    _i8v,  # status
+    _f8v,  # t_stop
+    _f8m,  # saturated
+)
+
+
+@njit(ROTOR_FLIGHT_SIG, cache=True, nogil=True, error_model="numpy")
+def _rotor_flight_kernel(
+    first,
+    stop,
+    t_grid,
+    x0,
+    psi0,
+    rp,
+    alloc,
+    vp_ctrl,
+    controller,
+    gains,
+    mem,
+    mission,
+    mp,
+    disturbance,
+    disturbed,
+    dp,
+    dmem,
+    rng,
+    sensor_std,
+    sensor_delay,
+    max_step,
+    log_every,
+    limits,
+    ground,
+    touchdown,
+    log_x,
+    log_rotor,
+    log_cmd,
+    log_ref,
+    x_final,
+    seen_final,
+    status,
+    t_stop,
+    saturated,
+):
+    """Fly vehicles first .. stop - 1 of the batch (the module's steps; arguments:
+    :func:`fly_rotor_vehicles`'s, one row per vehicle, ``alloc`` the n x 4 duty-to-thrust matrix
+    row by row and the controller vehicle's kf)."""
+    n_periods = t_grid.shape[0] - 1
+    size = x0.shape[1]
+    n = size - ROTOR_W1
+    x = np.empty(size)
+    true = np.empty(STATE_SIZE)
+    seen = np.empty(STATE_SIZE)
+    history = np.empty((sensor_delay + 1, STATE_SIZE))
+    ref = np.empty(REF_SIZE)
+    cmd = np.empty(CMD_SIZE)
+    ext = np.empty(EXT_SIZE)
+    ext_r = np.empty(9 + n)
+    w_cmd = np.empty(n)
+    work = np.empty((ROTOR_WORK_ROWS, size))
+    mi, dmi, rngi = np.empty(mem.shape[1]), np.empty(dmem.shape[1]), np.empty(rng.shape[1], dtype=np.uint64)
+    max_position, max_speed, max_rate = limits[0], limits[1], limits[2]
+    cos_tilt = math.cos(limits[3])
+    for i in range(first, stop):
+        for j in range(size):
+            x[j] = x0[i, j]
+        rpi, ai, vci, gi, mpi, dpi, stdi = rp[i], alloc[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
+        for j in range(mi.shape[0]):
+            mi[j] = mem[i, j]
+        for j in range(dmi.shape[0]):
+            dmi[j] = dmem[i, j]
+        for j in range(rngi.shape[0]):
+            rngi[j] = rng[i, j]
+        kf_ctrl = ai[4 * n]
+        w_min, w_max = rpi[RP_W_MIN], rpi[RP_W_MAX]
+        still_air(0.0, 0.0, true, dpi, dmi, rngi, ext)
+        psi = paper_state(x, rpi, ext, psi0[i], true)
+        for d in range(sensor_delay + 1):
+            for j in range(STATE_SIZE):
+                history[d, j] = true[j]
+        clipped_s = limited_s = 0.0
+        code = FINISHED
+        t_end = t_grid[n_periods]
+        rows_x = rows = 0
+        for k in range(n_periods + 1):
+            t = t_grid[k]
+            dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
+            mission(t, mpi, ref)
+            newest = k % (sensor_delay + 1)
+            oldest = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
+            for j in range(STATE_SIZE):
+                history[newest, j] = true[j]
+            state = rngi[0]
+            for j in range(STATE_SIZE):
+                seen[j] = history[oldest, j]
+                if stdi[j] != 0.0:
+                    draw, state = next_normal(state)
+                    seen[j] += stdi[j] * draw
+            rngi[0] = state
+            for j in range(CMD_SIZE):
+                cmd[j] = 0.0
+            controller(t, dt, seen, ref, vci, gi, mi, cmd)
+            if k % log_every == 0:
+                log_row(log_x, i, rows, true)
+                log_row(log_rotor, i, rows, x)
+                log_row(log_cmd, i, rows, cmd)
+                log_row(log_ref, i, rows, ref)
+                rows += 1
+                rows_x = rows
+            if k == n_periods:
+                break
+            u0, u1, u2, u3 = cmd[0], cmd[1], cmd[2], cmd[3]
+            if not (math.isfinite(u0) and math.isfinite(u1) and math.isfinite(u2) and math.isfinite(u3)):
+                code = BAD_COMMAND
+                t_end = t
+                break
+            held = False
+            for r in range(n):
+                f = ai[4 * r] * u0 + ai[4 * r + 1] * u1 + ai[4 * r + 2] * u2 + ai[4 * r + 3] * u3
+                w = math.sqrt(f / kf_ctrl) if f > 0.0 else 0.0
+                if f < 0.0 or w < w_min or w > w_max:
+                    held = True
+                    w = min(max(w, w_min), w_max)
+                w_cmd[r] = w
+            if held:
+                clipped_s += dt
+            if cmd[CMD_FLAGS] != 0.0:
+                limited_s += dt
+            if disturbed:
+                disturbance(t, dt, true, dpi, dmi, rngi, ext)
+            for j in range(9):
+                ext_r[j] = ext[j]
+            for r in range(n):
+                ext_r[9 + r] = ext[EXT_E1 + r] if r < 4 else 1.0
+            n_sub = max(1, int(math.ceil(dt / max_step - 1e-9)))
+            h = dt / n_sub
+            for sub in range(n_sub):
+                rotor_rk4_step(x, w_cmd, rpi, ext_r, h, work)
+                if ground and x[RZ] < 0.0 and ground_contact(x, touchdown[i]):
+                    code = CRASHED
+                    t_end = t + (sub + 1) * h
+                    break
+            if code == CRASHED:  # mid-period: its state is the final one, at t_stop
+                psi = paper_state(x, rpi, ext, psi, true)
+                break
+            psi = paper_state(x, rpi, ext, psi, true)
+            finite = True
+            for j in range(size):
+                finite = finite and math.isfinite(x[j])
+            if not finite:
+                code = NONFINITE
+            elif beyond(x[RX], x[RX + 1], x[RX + 2], max_position):
+                code = POSITION_BOUND
+            elif beyond(x[RX + 3], x[RX + 4], x[RX + 5], max_speed):
+                code = SPEED_BOUND
+            elif beyond(x[RP], x[RP + 1], x[RP + 2], max_rate):
+                code = RATE_BOUND
+            elif 1.0 - 2.0 * (x[QX] * x[QX] + x[QY] * x[QY]) < cos_tilt:
+                code = TILT_BOUND
+            if code != FINISHED:
+                t_end = t_grid[k + 1]
+                if (k + 1) % log_every == 0:  # keep the state that broke the bound
+                    log_row(log_x, i, rows, true)
+                    log_row(log_rotor, i, rows, x)
+                    rows_x += 1
+                break
+        blank_rows(log_x, i, rows_x)
+        blank_rows(log_rotor, i, rows_x)
+        blank_rows(log_cmd, i, rows)
+        blank_rows(log_ref, i, rows)
+        put_row(x_final, i, x)
+        put_row(seen_final, i, true)
+        put_row(mem, i, mi)
+        put_row(dmem, i, dmi)
+        put_row(rng, i, rngi)
+        saturated[i, 0], saturated[i, 1] = clipped_s, limited_s
+        status[i] = code
+        t_stop[i] = t_end
+
+
+_pool: ThreadPoolExecutor | None = None
+
+
+def _in_pieces(n: int, *args) -> None:
+    """The kernel over vehicles 0..n-1 on numba's number of threads, in ranges handed out in turn
+    (as :func:`quadcruise.sim.engine.fly_vehicles` does for the paper's kernel); each vehicle's
+    arithmetic does not depend on its range, so a batch reproduces single flights bit for bit."""
+    global _pool
+    threads = min(n, get_num_threads())
+    if threads <= 1:
+        _rotor_flight_kernel(0, n, *args)
+        return
+    bounds = np.linspace(0, n, min(n, PIECES_PER_THREAD * threads) + 1).round().astype(np.int64)
+    pieces = itertools.count()  # next() on it is atomic under the GIL
+
+    def work() -> None:
+        while (k := next(pieces)) < bounds.shape[0] - 1:
+            _rotor_flight_kernel(int(bounds[k]), int(bounds[k + 1]), *args)
+
+    if _pool is None:
+        _pool = ThreadPoolExecutor(max_workers=max(1, config.NUMBA_NUM_THREADS - 1), thread_name_prefix="rotors")
+    helpers = [_pool.submit(work) for _ in range(threads - 1)]
+    work()
+    for h in helpers:
+        h.result()
+
+
+def fly_rotor_vehicles(
+    t_grid,
+    x0,
+    rp,
+    alloc,
+    vp_ctrl,
+    controller,
+    gains,
+    mission,
+    mp,
+    *,
+    psi0=0.0,
+    memory=None,
+    disturbance=None,
+    disturbance_params=None,
+    disturbance_memory=None,
+    seed: int = 0,
+    first_vehicle=0,
+    sensor_std=None,
+    sensor_delay: int = 0,
+    max_step: float = 1e-3,
+    log_every: int = 1,
+    limits: Limits | None = None,
+    touchdown_speed=None,
+    rotor_names: tuple[str, ...] = (),
+    meta: dict | None = None,
+) -> SimResult:
+    """Fly N rotor-plant vehicles closed loop and return a :class:`SimResult` in the paper layout.
+
+    The array-level entry point that :func:`quadcruise.fly` builds on for a
+    :class:`~quadcruise.model.rotor_vehicle.RotorVehicle`.
+
+    Parameters
+    ----------
+    t_grid : (M+1,) array
+        Strictly increasing control instants [s].
+    x0 : (13 + n,) or (N, 13 + n) array
+        Initial rotor states (:mod:`quadcruise.model.rotor_plant`), quaternions of unit length.
+    rp : (P,) or (N, P) array
+        The flown vehicles' parameter rows (:meth:`~quadcruise.model.rotor_vehicle.RotorVehicle.row`).
+    alloc : (4 n + 1,) or (N, 4 n + 1) array
+        The controller vehicle's duty-to-thrust matrix (:func:`quadcruise.model.equivalent.duty_to_thrust`)
+        row by row, then its kf [N/(rad/s)^2].
+    vp_ctrl : (PARAM_SIZE,) or (N, PARAM_SIZE) array
+        The paper-layout row the controller reads (its equivalent vehicle's).
+    controller : compiled function with ``CONTROLLER_SIG``
+    gains : (G,) or (N, G) array
+    mission : compiled function with ``MISSION_SIG``
+    mp : (Mp,) or (N, Mp) array
+    psi0 : float or (N,) array
+        The yaw [rad] the initial quaternion's is read near (a mission's initial yaw may lie
+        beyond pi).
+    memory, disturbance, disturbance_params, disturbance_memory, seed, first_vehicle : optional
+        As in :func:`quadcruise.simulate`.
+    sensor_std, sensor_delay, max_step, log_every, limits : optional
+        As in :func:`quadcruise.simulate` (``limits.max_tilt`` bounds the angle between body z
+        and world z).
+    touchdown_speed : float or (N,) array, optional
+        With it, a ground at z = 0 (:func:`quadcruise.sim.rotor_engine.ground_contact`).
+    rotor_names : tuple of str
+        The rotor state's column names (:func:`quadcruise.model.rotor_plant.state_names`).
+    meta : dict, optional
+        Recorded in the result.
+
+    Returns
+    -------
+    SimResult
+        Paper-layout states, commands and references, with ``rotor_states`` and ``rotor_names``.
+
+    Raises
+    ------
+    InputError
+        Arrays whose shapes do not fit, a bad grid, step or touchdown speed.
+    """
+    rp = np.array(np.atleast_2d(np.asarray(rp, dtype=float)), order="C")
+    n_vehicles = rp.shape[0]
+    n = int(rp[0, RP_N_ROTORS])
+    if np.any(rp[:, RP_N_ROTORS] != n):
+        raise InputError("the vehicles of one flight must have the same number of rotors")
+    x0 = np.array(np.broadcast_to(np.atleast_2d(np.asarray(x0, dtype=float)), (n_vehicles, ROTOR_W1 + n)), order="C")
+    if not np.all(np.isfinite(x0)):
+        raise InputError("the initial state must be finite")
+    alloc = np.array(np.broadcast_to(np.atleast_2d(np.asarray(alloc, dtype=float)), (n_vehicles, 4 * n + 1)), order="C")
+    psi0 = np.array(np.broadcast_to(np.asarray(psi0, dtype=float), (n_vehicles,)), order="C")
+    seen0 = np.zeros((n_vehicles, STATE_SIZE))  # only its shape is checked
+    inp = batch_inputs(
+        t_grid,
+        seen0,
+        np.array(np.broadcast_to(np.atleast_2d(np.asarray(vp_ctrl, dtype=float)), (n_vehicles, np.shape(vp_ctrl)[-1]))),
+        gains,
+        mp,
+        memory=memory,
+        disturbance=disturbance,
+        disturbance_params=disturbance_params,
+        disturbance_memory=disturbance_memory,
+        seed=seed,
+        first_vehicle=first_vehicle,
+        sensor_std=sensor_std,
+        sensor_delay=sensor_delay,
+        max_step=max_step,
+        log_every=log_every,
+    )
+    t_grid = inp["t_grid"]
+    ground = touchdown_speed is not None
+    touchdown = np.array(np.broadcast_to(np.inf if touchdown_speed is None else touchdown_speed, (n_vehicles,)), float)
+    if ground and not np.all(touchdown > 0):
+        raise InputError(f"touchdown speed must be > 0 m/s, got {touchdown_speed!r}")
+    limits = limits or Limits()
+    n_periods = t_grid.shape[0] - 1
+    n_log = n_periods // log_every + 1
+    log_x = np.empty((n_vehicles, n_log, STATE_SIZE))
+    log_rotor = np.empty((n_vehicles, n_log, ROTOR_W1 + n))
+    log_cmd = np.empty((n_vehicles, n_log, CMD_SIZE))
+    log_ref = np.empty((n_vehicles, n_log, REF_SIZE))
+    x_final = np.empty((n_vehicles, ROTOR_W1 + n))
+    seen_final = np.empty((n_vehicles, STATE_SIZE))
+    status = np.zeros(n_vehicles, dtype=np.int64)
+    t_stop = np.empty(n_vehicles)
+    saturated = np.zeros((n_vehicles, 2))
+    mem, dmem, rng = inp["memory"], inp["disturbance_memory"], inp["rng"]
+    _in_pieces(
+        n_vehicles,
+        t_grid,
+        x0,
+        psi0,
+        rp,
+        alloc,
+        inp["vp"],
+        controller,
+        inp["gains"],
+        mem,
+        mission,
+        inp["mp"],
+        disturbance or still_air,
+        inp["disturbed"],
+        inp["disturbance_params"],
+        dmem,
+        rng,
+        inp["sensor_std"],
+        int(sensor_delay),
+        float(max_step),
+        int(log_every),
+        limits.array(),
+        ground,
+        touchdown,
+        log_x,
+        log_rotor,
+        log_cmd,
+        log_ref,
+        x_final,
+        seen_final,
+        status,
+        t_stop,
+        saturated,
+    )
+    return SimResult(
+        t=t_grid[::log_every][:n_log].copy(),
+        states=log_x,
+        commands=log_cmd,
+        references=log_ref,
+        final_state=seen_final,
+        status=status,
+        t_stop=t_stop,
+        memory=mem,
+        disturbance_memory=dmem,
+        duty_clipped_s=saturated[:, 0].copy(),
+        controller_limited_s=saturated[:, 1].copy(),
+        meta=dict(meta or {}),
+        rotor_states=log_rotor,
+        rotor_final_state=x_final,
+        rotor_names=tuple(rotor_names),
+    )
+
+
+__all__ = ["fly_rotor_vehicles", "paper_state"]

@@ -1,0 +1,262 @@
+"""What :func:`quadcruise.fly` does differently for a rotor-plant vehicle
+(:class:`~quadcruise.model.rotor_vehicle.RotorVehicle`): the vehicle by preset name, the
+controller's gains designed for the vehicle it believes, the initial hover, and the flight
+through :func:`quadcruise.sim.rotor_flight.fly_rotor_vehicles`.
+
+Gains: a controller given by name (``"se3"``) is designed for the controller vehicle's motor
+bandwidth, the ``omega`` = 1 / tau_up of its equivalent paper vehicle
+(:func:`quadcruise.model.equivalent.paper_equivalent`), by the same rules that give the
+paper's vehicle its default gains at 15 rad/s (:func:`designed_controller`). The attitude
+gains of every built-in controller are per unit inertia, so the bandwidth is the only vehicle
+parameter they need; the position gains place the paper's poles for any mass. A controller
+object is flown with the gains it has.
+
+Examples
+--------
+>>> designed_controller("se3", 80.0).attitude.kp      # (0.6 x 80 rad/s)^2
+2304.0
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+import numpy as np
+
+from quadcruise.control import CONTROLLERS, controller_from_name
+from quadcruise.control.cascade import rate_pid_design
+from quadcruise.control.design import attitude_pid_design
+from quadcruise.control.se3 import se3_attitude_design
+from quadcruise.errors import InputError
+from quadcruise.layout import REF_PSI, REF_Z
+from quadcruise.missions import Mission
+from quadcruise.model.equivalent import duty_to_thrust, paper_equivalent
+from quadcruise.model.rotor_plant import QW, QZ, ROTOR_W1, RZ, state_names
+from quadcruise.model.rotor_vehicle import AERO_FIELDS, RotorVehicle
+from quadcruise.model.vehicle import Vehicle
+from quadcruise.sim.result import SimResult
+from quadcruise.sim.rotor_flight import fly_rotor_vehicles
+
+# the controller fields designed for an actuator bandwidth w [rad/s], by controller name
+_DESIGNS = {
+    "nlpd": {"attitude": attitude_pid_design, "yaw": attitude_pid_design},
+    "gonzalez": {"attitude": attitude_pid_design, "yaw": attitude_pid_design},
+    "se3": {"attitude": se3_attitude_design},
+    "cascade": {"rate": rate_pid_design, "yaw_rate": lambda w: rate_pid_design(w, yaw=True)},
+}
+
+
+def designed_controller(name: str, bandwidth: float) -> Any:
+    """A built-in controller with the gains its design rules give for a motor bandwidth.
+
+    Parameters
+    ----------
+    name : str
+        A built-in controller's name (``nlpd``, ``gonzalez``, ``se3``, ``cascade``).
+    bandwidth : float
+        The rotor lag's bandwidth w [rad/s] (15 for the paper's vehicle: the defaults).
+
+    Returns
+    -------
+    Controller
+        nlpd and gonzalez: attitude and yaw PID by
+        :func:`~quadcruise.control.design.attitude_pid_design`; se3: kR, kw by
+        :func:`~quadcruise.control.se3.se3_attitude_design`; cascade: the rate PIDs by
+        :func:`~quadcruise.control.cascade.rate_pid_design`; the rest their defaults.
+
+    Raises
+    ------
+    InputError
+        An unknown name.
+    """
+    base = controller_from_name(name)
+    return dataclasses.replace(base, **{field: design(bandwidth) for field, design in _DESIGNS[name].items()})
+
+
+def as_vehicle(vehicle: Any) -> Any:
+    """``fly``'s vehicle: a preset's name read (:meth:`quadcruise.Vehicle.preset`), any other value as given.
+
+    Parameters
+    ----------
+    vehicle : Vehicle, RotorVehicle, str or None
+        The vehicle, or a preset's name.
+
+    Returns
+    -------
+    Vehicle, RotorVehicle or None
+
+    Raises
+    ------
+    InputError
+        An unknown preset.
+    """
+    return Vehicle.preset(vehicle) if isinstance(vehicle, str) else vehicle
+
+
+def rotor_flight_setup(vehicle: Any, controller_vehicle: Any, controller: Any) -> tuple[bool, Any]:
+    """Whether a flight is of a rotor-plant vehicle, and its controller (designed when named).
+
+    Parameters
+    ----------
+    vehicle, controller_vehicle : Vehicle or RotorVehicle or None
+        The flown vehicle and the one the controller believes.
+    controller : str, Controller or list
+        ``fly``'s controller argument.
+
+    Returns
+    -------
+    rotor : bool
+        The flown vehicle is a RotorVehicle.
+    controller : str, Controller or list
+        A built-in name turned into that controller with gains for the controller vehicle's
+        bandwidth (:func:`designed_controller`); anything else as given.
+
+    Raises
+    ------
+    InputError
+        A rotor vehicle believed as a paper vehicle or the other way round, or a controller
+        vehicle with another number of rotors: the controller's rotor commands would not fit.
+    """
+    rotor = isinstance(vehicle, RotorVehicle)
+    if controller_vehicle is not None and isinstance(controller_vehicle, RotorVehicle) != rotor:
+        raise InputError(
+            "fly(): vehicle and controller_vehicle must be of one plant: a RotorVehicle flown with a "
+            "RotorVehicle as the controller's model, or a paper Vehicle with a paper Vehicle"
+        )
+    if not rotor:
+        return False, controller
+    believed = controller_vehicle or vehicle
+    if believed.n_rotors != vehicle.n_rotors:
+        raise InputError(
+            f"fly(): the controller vehicle has {believed.n_rotors} rotors, the flown vehicle "
+            f"{vehicle.n_rotors}: the controller's rotor commands would not fit"
+        )
+    duty_to_thrust(believed)  # a layout the mixer cannot serve: one line, before any work
+    if isinstance(controller, str) and controller in CONTROLLERS:
+        controller = designed_controller(controller, paper_equivalent(believed).omega)
+    return True, controller
+
+
+def check_wind_acts(vehicle: Any, environment: Any) -> None:
+    """Refuse wind on a rotor-plant vehicle without aerodynamics: it would blow through it unfelt.
+
+    Parameters
+    ----------
+    vehicle : Vehicle or RotorVehicle
+        The flown vehicle (a paper Vehicle is the paper plant's business: it is given drag).
+    environment : Environment, CustomDisturbance or None
+        The disturbances.
+
+    Raises
+    ------
+    InputError
+        Wind, gusts or turbulence, and every aerodynamic coefficient of the RotorVehicle zero.
+    """
+    if not isinstance(vehicle, RotorVehicle) or not getattr(environment, "needs_drag", False):
+        return
+    if all(getattr(vehicle, name) == 0.0 for name in AERO_FIELDS):
+        raise InputError(
+            "fly(): wind acts on a rotor-plant vehicle through its aerodynamics, and this one has none "
+            f"({', '.join(AERO_FIELDS)} all 0): give it some, or fly without wind"
+        )
+
+
+def rotor_hover_state(vehicle: RotorVehicle, mission: Mission) -> np.ndarray:
+    """The rotor state hovering level at x = y = 0, at the mission's start altitude and yaw.
+
+    Parameters
+    ----------
+    vehicle : RotorVehicle
+        The vehicle: each rotor at its hover speed sqrt(m g / (n kf)).
+    mission : Mission
+        Its reference at t = 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        (13 + n,) position, zero velocity, the yaw's quaternion, zero rates, rotor speeds.
+    """
+    ref0 = mission.reference(0.0)[0]
+    x0 = np.zeros(ROTOR_W1 + vehicle.n_rotors)
+    x0[RZ] = ref0[REF_Z]
+    x0[QW], x0[QZ] = math.cos(0.5 * ref0[REF_PSI]), math.sin(0.5 * ref0[REF_PSI])
+    x0[ROTOR_W1:] = vehicle.hover_speed
+    return x0
+
+
+def fly_rotor(
+    grid: np.ndarray,
+    vehicle: RotorVehicle,
+    controller_vehicle: RotorVehicle | None,
+    controller_function: Any,
+    gains: np.ndarray,
+    mission: Mission,
+    mp: np.ndarray,
+    n: int,
+    *,
+    limits: Any = None,
+    **engine: Any,
+) -> SimResult:
+    """The closed-loop flight of ``n`` copies of a rotor-plant vehicle, for :func:`quadcruise.fly`.
+
+    Parameters
+    ----------
+    grid : numpy.ndarray
+        The control instants [s].
+    vehicle : RotorVehicle
+        The flown vehicle, with a ground at z = 0 (its ``touchdown_speed``).
+    controller_vehicle : RotorVehicle or None
+        The vehicle the controller believes; ``vehicle`` by default.
+    controller_function : compiled function
+        The controller's law (``CONTROLLER_SIG``).
+    gains : numpy.ndarray
+        Its gains, one row or one per vehicle.
+    mission : Mission
+        The (first) mission: its start gives the initial hover.
+    mp : numpy.ndarray
+        Mission parameter rows.
+    n : int
+        Number of vehicles.
+    limits : Limits, optional
+        Divergence bounds.
+    **engine : Any
+        :func:`quadcruise.sim.rotor_flight.fly_rotor_vehicles`'s other keywords (memory,
+        disturbance, sensors, seed, first_vehicle, max_step, log_every, meta).
+
+    Returns
+    -------
+    SimResult
+    """
+    believed = controller_vehicle or vehicle
+    alloc = np.r_[duty_to_thrust(believed).ravel(), believed.kf]
+    meta = engine.get("meta")
+    if meta is not None:  # the flown vehicle's "+" equivalent: its hover duty (effort), a log's K, l, d
+        meta["paper_equivalent"] = paper_equivalent(vehicle).to_dict()
+    return fly_rotor_vehicles(
+        grid,
+        rotor_hover_state(vehicle, mission),
+        np.broadcast_to(vehicle.row(), (n, vehicle.row().size)),
+        alloc,
+        paper_equivalent(believed).rows(1)[0],
+        controller_function,
+        gains,
+        mission.function,
+        mp,
+        psi0=float(mission.reference(0.0)[0][REF_PSI]),
+        limits=limits,
+        touchdown_speed=vehicle.touchdown_speed,
+        rotor_names=state_names(vehicle.n_rotors),
+        **engine,
+    )
+
+
+__all__ = [
+    "as_vehicle",
+    "check_wind_acts",
+    "designed_controller",
+    "fly_rotor",
+    "rotor_flight_setup",
+    "rotor_hover_state",
+]
