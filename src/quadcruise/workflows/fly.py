@@ -25,14 +25,16 @@ from quadcruise import checks
 from quadcruise._version import __version__
 from quadcruise.control import as_controller, controller_record
 from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
-from quadcruise.errors import FlightWarning, InputError, reject_unknown
+from quadcruise.errors import FlightWarning, InputError, LogWarning, reject_unknown
 from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, REF_Z, STATE_SIZE, X, Z
 from quadcruise.missions import Mission, as_mission, stack_params
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
+from quadcruise.sim.chunked import simulate_watched
 from quadcruise.sim.engine import Limits, simulate, time_grid
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.status import ExitStatus
+from quadcruise.workflows.track_watch import TrackWatch
 
 
 def default_duration(mission: Mission) -> float:
@@ -95,7 +97,7 @@ def fly(
     max_step: float | None = None,
     n: int | None = None,
     x0: Any = None,
-    log_every: int = 1,
+    log_every: int | None = None,
     limits: Limits | None = None,
     missions: list[Mission] | None = None,
     controller_vehicle: Vehicle | None = None,
@@ -131,8 +133,13 @@ def fly(
     x0 : (16,) or (N, 16) array, optional
         Initial states; by default each vehicle hovers at x = y = 0 at the mission's
         starting altitude and yaw.
-    log_every : int
-        Log every this many control periods.
+    log_every : int, optional
+        Log every this many control periods (a divisor of them). By default every period,
+        unless a batch's log would exceed :data:`LOG_BUDGET` (1 GiB): then the smallest divisor
+        that fits, said in a :class:`~quadcruise.errors.LogWarning`, and the track checks
+        (``lost track``, ``off track``) are made at every period as the flight goes, so the
+        statuses and times are those of the full log. A ``log_every`` given is kept, and the
+        checks read its log (a log over half the memory is refused).
     limits : Limits, optional
         Divergence bounds.
     missions : list of Mission, optional
@@ -207,7 +214,7 @@ def fly(
     dt = checks.number(w, "dt", dt, "pos", unit="s")
     max_step = checks.number(w, "max_step", max_step, "pos", unit="s", optional=True)
     n = checks.whole(w, "n", n, 1, optional=True)
-    log_every = checks.whole(w, "log_every", log_every, 1)
+    log_every = checks.whole(w, "log_every", log_every, 1, optional=True)
     checks.instance(w, "limits", limits, Limits)
     full_dynamics = checks.flag(w, "full_dynamics", full_dynamics)
     checks.instance(w, "environment", environment, (Environment, CustomDisturbance))
@@ -238,6 +245,17 @@ def fly(
     first = missions[0] if missions else mission
     duration = default_duration(first) if duration is None else duration
     d, h = duration, dt
+    watched = log_every is None and n > 1 and 0 < h <= d < math.inf and batch_log_every(n, round(d / h)) > 1
+    if watched:  # a batch whose full log would not fit in LOG_BUDGET: a coarser log, checked at every period
+        log_every = batch_log_every(n, round(d / h))
+        warnings.warn(
+            f"fly(): {n:,} vehicles x {round(d / h) + 1:,} instants would log {log_bytes(n, round(d / h), 1) / 2**30:.1f}"
+            f" GiB: logging every {log_every} periods ({log_bytes(n, round(d / h), log_every) / 2**30:.2f} GiB;"
+            " the track checks still see every period); give log_every to choose",
+            LogWarning,
+            stacklevel=2,
+        )
+    log_every = 1 if log_every is None else log_every
     if 0 < h <= d < math.inf:  # sized before the grid is allocated
         check_run_size(n, round(d / h), int(log_every), max(1, math.ceil(h / float(max_step or h) - 1e-9)))
     grid = time_grid(float(duration), float(dt))
@@ -282,14 +300,31 @@ def fly(
         if len(controllers) == 1
         else (np.stack([c.gains() for c in controllers]), np.stack([c.memory() for c in controllers]))
     )
-    result = simulate(
-        grid,
-        x0,
-        vehicle.rows(n),
-        controller.function,
-        gains,
-        first.function,
-        mp,
+    bound = (
+        track_bound(missions or [first], np.broadcast_to(x0, (n, STATE_SIZE)), n)
+        if max_track_error is None
+        else np.full(n, float(max_track_error))
+    )
+    steady = (
+        (
+            np.array([steady_bound(m, duration) for m in missions])
+            if missions
+            else np.full(n, steady_bound(first, duration))
+        )
+        if max_steady_error is None
+        else np.full(n, float(max_steady_error))
+    )
+    vertical = (
+        (
+            np.array([altitude_bound(m, duration) for m in missions])
+            if missions
+            else np.full(n, altitude_bound(first, duration))
+        )
+        if max_steady_error is None
+        else steady
+    )
+    args = (grid, x0, vehicle.rows(n), controller.function, gains, first.function, mp)
+    options = dict(
         memory=memory,
         max_step=max_step or dt,
         log_every=log_every,
@@ -301,35 +336,21 @@ def fly(
         first_vehicle=first_vehicle,
         **engine_inputs(environment, sensors, n, dt),
     )
-    bound = (
-        track_bound(missions or [first], np.broadcast_to(x0, (n, STATE_SIZE)), n)
-        if max_track_error is None
-        else np.full(n, float(max_track_error))
-    )
+    if watched:  # the log keeps every log_every-th period; the checks see every one
+        mission_record = meta["mission"] if isinstance(meta["mission"], dict) else {}
+        watch = TrackWatch(grid, mission_record, bound, steady, vertical)
+        result = simulate_watched(*args, watch=watch.feed, **options)
+        status, t_stop = watch.verdict(result.status, result.t_stop)
+        result = dataclasses.replace(result, status=status, t_stop=t_stop)
+    else:
+        result = simulate(*args, **options)
     result.meta["max_track_error_m"] = bound.tolist() if n > 1 else float(bound[0])
-    err = position_error(result)
-    result = mark_lost_track(result, bound, err)
-    steady = (
-        (
-            np.array([steady_bound(m, duration) for m in missions])
-            if missions
-            else np.full(n, steady_bound(first, duration))
-        )
-        if max_steady_error is None
-        else np.full(n, float(max_steady_error))
-    )
     result.meta["max_steady_error_m"] = steady.tolist() if n > 1 else float(steady[0])
-    vertical = (
-        (
-            np.array([altitude_bound(m, duration) for m in missions])
-            if missions
-            else np.full(n, altitude_bound(first, duration))
-        )
-        if max_steady_error is None
-        else steady
-    )
     result.meta["max_altitude_error_m"] = vertical.tolist() if n > 1 else float(vertical[0])
-    result = mark_off_track(result, steady, err, vertical)
+    if not watched:
+        err = position_error(result)
+        result = mark_lost_track(result, bound, err)
+        result = mark_off_track(result, steady, err, vertical)
     _warn_about(result)
     return result
 
@@ -506,6 +527,59 @@ MAX_LOG_FRACTION = 0.5
 MAX_VEHICLE_STEPS = 2.0e10
 """Most vehicle-steps (vehicles x control periods) a flight may have: at the engine's few million
 vehicle-steps per second on two cores, about two hours or more."""
+
+
+LOG_BUDGET = 2**30
+"""Largest log [bytes] a batch keeps when ``fly`` chooses ``log_every`` itself (docs/performance.md)."""
+
+
+def log_bytes(n: int, periods: int, log_every: int) -> int:
+    """Bytes of a flight's log: states, commands and references at every ``log_every``-th period.
+
+    Parameters
+    ----------
+    n : int
+        Number of vehicles.
+    periods : int
+        Control periods of the flight.
+    log_every : int
+        Log every this many periods.
+
+    Returns
+    -------
+    int
+        312 bytes per vehicle and logged instant.
+    """
+    from quadcruise.layout import CMD_SIZE, REF_SIZE
+
+    return n * (periods // log_every + 1) * 8 * (STATE_SIZE + CMD_SIZE + REF_SIZE)
+
+
+def batch_log_every(n: int, periods: int) -> int:
+    """The ``log_every`` a flight gets by default: 1 (every period) for one vehicle or a log within
+    :data:`LOG_BUDGET`, else the smallest divisor of the periods that keeps the log within it.
+
+    Parameters
+    ----------
+    n : int
+        Number of vehicles.
+    periods : int
+        Control periods of the flight.
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> batch_log_every(1, 10**6), batch_log_every(2000, 1000), batch_log_every(2000, 10_000)
+    (1, 1, 8)
+    """
+    if n <= 1 or log_bytes(n, periods, 1) <= LOG_BUDGET:
+        return 1
+    small = [d for d in range(1, math.isqrt(periods) + 1) if periods % d == 0]
+    divisors = sorted(set(small + [periods // d for d in small]))
+    return next((d for d in divisors if log_bytes(n, periods, d) <= LOG_BUDGET), periods)
 
 
 def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1) -> None:
