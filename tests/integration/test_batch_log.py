@@ -13,7 +13,7 @@ import pytest
 import quadcruise as qc
 from quadcruise.control import NLPD
 from quadcruise.control.design import PDGains, pd_from_poles
-from quadcruise.disturbances import Environment, RotorLoss
+from quadcruise.disturbances import Environment, RotorLoss, SensorNoise, Turbulence, with_drag
 from quadcruise.errors import LogWarning
 from quadcruise.missions import Circle, Step
 from quadcruise.sim.chunked import simulate_watched
@@ -47,6 +47,9 @@ def full_and_watched(monkeypatch, *args, **kwargs):
         assert np.array_equal(getattr(full, name)[:, ::every], getattr(watched, name), equal_nan=True), name
     assert np.array_equal(full.t[::every], watched.t)
     assert np.array_equal(full.final_state, watched.final_state) and np.array_equal(full.memory, watched.memory)
+    assert watched.meta["log_every_chosen"]
+    if isinstance(watched.meta["mission"], dict):  # (a list of missions has no scenario file)
+        assert "log_every" not in watched.scenario_toml()  # a scenario file flown again chooses it again
     return full, watched
 
 
@@ -108,6 +111,16 @@ def test_a_fast_circle_and_a_square_with_a_mass_spread(monkeypatch):
     same_verdict(*full_and_watched(monkeypatch, "square", "gonzalez", vehicle=qc.Vehicle(m=masses), duration=8.0))
 
 
+def test_one_mission_per_vehicle_and_a_turbulent_noisy_flight(monkeypatch):
+    steps = [Step(size=s) for s in (0.5, 1.0, 20.0)]  # judged as fly judges a list: not as one step
+    same_verdict(*full_and_watched(monkeypatch, "step", missions=steps, duration=6.0))
+    env = Environment(turbulence=Turbulence(intensity="severe"))
+    vehicle = with_drag(qc.Vehicle(m=qc.Vehicle.paper().m * np.linspace(0.8, 1.6, 4)))
+    sensors = SensorNoise(position_std=0.05, delay=0.004)
+    world = dict(vehicle=vehicle, environment=env, sensors=sensors, seed=3)
+    same_verdict(*full_and_watched(monkeypatch, "circle", duration=4.0, **world))
+
+
 def test_the_chunked_flight_is_the_whole_flight_bit_for_bit_with_vehicles_stopping_mid_chunk():
     # vehicles started ever closer to a tight position bound stop at different periods; chunks of
     # 7 periods and a log of every 5th put stops on and next to the chunks' edges
@@ -150,3 +163,10 @@ def test_an_explicit_log_every_is_kept_and_one_too_large_is_refused(monkeypatch)
     assert res.meta["log_every"] == 1 and res.t.size == 501
     with pytest.raises(qc.InputError, match="log_every=.*: in Python"):
         qc.fly("hover", n=20_000, duration=60.0, log_every=1)  # 374 GB: refused before flying
+
+
+def test_a_batch_whose_checks_would_not_fit_is_refused_before_flying():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", LogWarning)  # refused before it says what it would log
+        with pytest.raises(qc.InputError, match="track checks at every period would keep 75.4 GiB"):
+            qc.fly("circle", n=200_000, duration=90.0)  # (refused on a machine of less than 150 GiB)

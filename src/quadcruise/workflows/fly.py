@@ -246,8 +246,12 @@ def fly(
     duration = default_duration(first) if duration is None else duration
     d, h = duration, dt
     watched = log_every is None and n > 1 and 0 < h <= d < math.inf and batch_log_every(n, round(d / h)) > 1
-    if watched:  # a batch whose full log would not fit in LOG_BUDGET: a coarser log, checked at every period
-        log_every = batch_log_every(n, round(d / h))
+    # a batch whose full log would not fit in LOG_BUDGET: a coarser log, checked at every period
+    log_every = batch_log_every(n, round(d / h)) if watched else 1 if log_every is None else log_every
+    if 0 < h <= d < math.inf:  # sized before the grid is allocated
+        substeps = max(1, math.ceil(h / float(max_step or h) - 1e-9))
+        check_run_size(n, round(d / h), int(log_every), substeps, watched)
+    if watched:
         full, kept = log_bytes(n, round(d / h), 1) / 2**30, log_bytes(n, round(d / h), log_every) / 2**30
         warnings.warn(
             f"fly(): the log of {n:,} vehicles x {round(d / h) + 1:,} instants would take {full:.1f} GiB: logging "
@@ -256,9 +260,6 @@ def fly(
             LogWarning,
             stacklevel=2,
         )
-    log_every = 1 if log_every is None else log_every
-    if 0 < h <= d < math.inf:  # sized before the grid is allocated
-        check_run_size(n, round(d / h), int(log_every), max(1, math.ceil(h / float(max_step or h) - 1e-9)))
     grid = time_grid(float(duration), float(dt))
     check_log_every(log_every, grid.size - 1)
     if sensors is not None:
@@ -281,6 +282,7 @@ def fly(
         "full_dynamics": bool(full_dynamics),
         "seed": seed,
         "log_every": int(log_every),
+        **({"log_every_chosen": True} if watched else {}),
         "max_track_error": None if max_track_error is None else float(max_track_error),
         "max_steady_error": None if max_steady_error is None else float(max_steady_error),
         "initial_state": given_x0,
@@ -585,7 +587,12 @@ def batch_log_every(n: int, periods: int) -> int:
     return next((d for d in divisors if log_bytes(n, periods, d) <= LOG_BUDGET), periods)
 
 
-def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1) -> None:
+WATCH_BYTES = 9
+"""Bytes per vehicle-period that the track checks at every period keep over the first half of a
+batch's flight (a moving reference's error and beyond-the-bounds flag: :mod:`~quadcruise.workflows.track_watch`)."""
+
+
+def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1, watched: bool = False) -> None:
     """Refuse, before anything is allocated, a flight whose log would not fit in memory or that
     would run for hours; the message says what to change.
 
@@ -599,12 +606,14 @@ def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1) -> Non
         Log every this many periods.
     substeps : int
         RK4 substeps per control period (``ceil(dt / max_step)``).
+    watched : bool
+        The track checks are made at every period as the flight goes (:data:`WATCH_BYTES`).
 
     Raises
     ------
     InputError
-        The log would take more than :data:`MAX_LOG_FRACTION` of the memory, or the flight more
-        than :data:`MAX_VEHICLE_STEPS` vehicle-steps.
+        The log (and what the checks keep) would take more than :data:`MAX_LOG_FRACTION` of the
+        memory, or the flight more than :data:`MAX_VEHICLE_STEPS` vehicle-steps.
 
     Examples
     --------
@@ -645,6 +654,14 @@ def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1) -> Non
             f"{steps // log_every + 1:,} logged instants), more than half of this machine's "
             f"{memory / 2**30:.0f} GiB: log less often (log_every={every:,}: in Python, or a scenario's "
             "[simulation]) or fly shorter"
+        )
+    watching = n * (steps // 2 + 2) * WATCH_BYTES if watched else 0
+    if watched and need + watching > MAX_LOG_FRACTION * memory:
+        raise InputError(
+            f"the flight's track checks at every period would keep {watching / 2**30:.1f} GiB ({n:,} vehicles x "
+            f"{steps // 2 + 1:,} periods of the first half x {WATCH_BYTES} bytes) beside its "
+            f"{need / 2**30:.2f} GiB log, more than half of this machine's {memory / 2**30:.0f} GiB: fly fewer "
+            "vehicles or shorter, or give log_every (the checks then read the log)"
         )
 
 

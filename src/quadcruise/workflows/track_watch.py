@@ -37,7 +37,18 @@ TOLERANCE = 1e-12
 :func:`~quadcruise.workflows.fly.off_track_since`)."""
 
 
-# columns of the per-vehicle rows the compiled pass keeps (ints, floats, flags)
+# columns of the per-vehicle rows the compiled pass keeps (periods as grid indices, -1: none yet).
+# ints: the first period beyond the tracking bound (LOST), beyond the steady bounds (FIRST_OFF), beyond
+# them at or after the last excursion's anchor and after it (SINCE, SINCE_AFTER), beyond them in the
+# second half (TAIL_FIRST); the anchor (EV_ANCHOR: the first period at or after the excursion's
+# sample); a still reference's axis (HOLD_AXIS).
+# floats: the reference's largest move (MOVED); the largest error over the last quarter (LEVEL) and
+# over the second half (TAIL_MAX); the last excursion's time and response, and the next sample's
+# (EV_TAU, EV_Z, EV_TAU1, EV_Z1); a still reference's initial error on its axis (HOLD_E0); the step
+# axis's position at the previous period (PREV_POS); the reference at the start (REF0, 3 columns).
+# flags: the error finite throughout (FINITE); beyond the bounds at the last period (OFF_AT_END); the
+# response out of the band there (OUT_AT_END); the next sample still to come (PENDING); beyond at
+# the previous period (PREV_BEYOND); a still reference's transient measured (HOLD_MEASURED).
 LOST, FIRST_OFF, SINCE, SINCE_AFTER, TAIL_FIRST, EV_ANCHOR, HOLD_AXIS = range(7)
 MOVED, LEVEL, TAIL_MAX, EV_TAU, EV_TAU1, EV_Z, EV_Z1, HOLD_E0, PREV_POS, REF0 = range(10)  # REF0: 3 columns
 FINITE, OFF_AT_END, OUT_AT_END, PENDING, PREV_BEYOND, HOLD_MEASURED = range(6)
