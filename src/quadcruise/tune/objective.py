@@ -54,7 +54,8 @@ def check_statistic(statistic: Any, where: str = "tune()", name: str = "objectiv
     >>> check_statistic("q90")
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: tune() argument objective must be 'worst', 'median' or a quantile in (0, 1), got str 'q90'
+    quadcruise.errors.InputError: tune() argument objective must be 'worst', 'median' or a quantile in (0, 1), got \
+str 'q90'
     """
     want = "'worst', 'median' or a quantile in (0, 1)"
     if isinstance(statistic, str):

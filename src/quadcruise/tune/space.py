@@ -190,7 +190,8 @@ def as_bounds(value: Any, where: str, name: str = "bounds") -> dict[str, Bounds]
     >>> as_bounds({"position.kp": (10, 0.5)}, "tune()")
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: tune() argument bounds['position.kp'] must be a pair (low, high) with low < high, got tuple (10, 0.5); bounds reversed or empty
+    quadcruise.errors.InputError: tune() argument bounds['position.kp'] must be a pair (low, high) with low < high, \
+got tuple (10, 0.5); bounds reversed or empty
     """
     if value is None:
         return {}
