@@ -82,6 +82,7 @@ def montecarlo_command(
     thrust_spread: float | None = None,
     bandwidth_spread: float | None = None,
     yaw_arm_spread: float | None = None,
+    aero_spread: float | None = None,
     distribution: str | None = None,
     model_error: bool | None = None,
     chunk_size: str | int = "auto",
@@ -125,7 +126,7 @@ def montecarlo_command(
         scenario's.
     log_every : int, optional
         Control periods between the logged instants the metrics are measured on.
-    mass_spread, inertia_spread, thrust_spread, bandwidth_spread, yaw_arm_spread, wind_spread, \
+    mass_spread, inertia_spread, thrust_spread, bandwidth_spread, yaw_arm_spread, aero_spread, wind_spread, \
 offset, distribution, model_error : optional
         :class:`~quadcruise.montecarlo.Population` fields.
     chunk_size : int or str
@@ -210,6 +211,7 @@ offset, distribution, model_error : optional
             bandwidth_spread=bandwidth_spread,
             offset=offset,
             yaw_arm_spread=yaw_arm_spread,
+            aero_spread=aero_spread,
             wind_spread=wind_spread,
             distribution=distribution,
             model_error=model_error,
@@ -229,7 +231,9 @@ offset, distribution, model_error : optional
         notes.insert(
             0,
             f"the controllers are told the nominal vehicle ({vehicle}): their only model error is the "
-            "spreads'; --controller-vehicle paper (or KEY=VALUE,...) gives them another belief",
+            "spreads'; --controller-vehicle "
+            + (f"{vehicle.split(',')[0]},m=..." if spec.rotor else "paper")
+            + " (or KEY=VALUE,...) gives them another belief",
         )
     if case is None:
         spec.population.check_perturbs(n)

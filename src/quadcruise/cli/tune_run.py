@@ -182,6 +182,7 @@ def tune_command(
     )
     from quadcruise.cli.world import flight_world
     from quadcruise.errors import InputError, whole_number
+    from quadcruise.model.rotor_vehicle import RotorVehicle
 
     if log_every is not None:
         whole_number(log_every, "--log-every", minimum=1)
@@ -212,12 +213,18 @@ def tune_command(
     else:
         the_mission = mission_from_options(mission, mission_params, False)
         the_controller = controller_from_options(controller, controller_params, None)
-    wanted["gains"] = parse_gains(gains, the_controller)
     world, notes = flight_world(
         vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind, turbulence=turbulence, scenario=sc
     )
+    rotor = isinstance(world["vehicle"], RotorVehicle)
+    if rotor and sc is None:  # a controller named starts from the gains designed for the vehicle, as fly's
+        from quadcruise.workflows.rotor_fly import rotor_flight_setup
+
+        designed = rotor_flight_setup(world["vehicle"], world["controller_vehicle"], controller or "nlpd")[1]
+        the_controller = controller_from_options(None, controller_params, None, base=designed)
+    wanted["gains"] = parse_gains(gains, the_controller)
     environment = world["environment"]
-    if wind_spread > 0 and not any("wind acts only through drag" in line for line in notes):
+    if wind_spread > 0 and not rotor and not any("wind acts only through drag" in line for line in notes):
         from quadcruise.disturbances import default_drag_text, with_drag
 
         if world["vehicle"].drag_linear == 0 and world["vehicle"].drag_quadratic == 0:
