@@ -20,7 +20,7 @@ from quadcruise.disturbances import Environment, RotorLoss
 from quadcruise.errors import InputError
 from quadcruise.metrics import flight_metrics
 from quadcruise.model.rotor_vehicle import RotorVehicle
-from quadcruise.montecarlo import MonteCarloSpec, Population, montecarlo
+from quadcruise.montecarlo import MonteCarloSpec, Population, montecarlo, montecarlo_case
 from quadcruise.sim.status import ExitStatus
 
 
@@ -55,6 +55,7 @@ def test_a_sweep_flies_each_perturbed_crazyflie_as_fly_flies_it_alone():
         v = perturbed(cf, 5, i, 0.05, 0.1, 0.03)
         alone = qc.fly("step", "se3", vehicle=v, controller_vehicle=cf, duration=8.0, log_every=res.spec.log_every)
         m = flight_metrics(alone).iloc[0]
+        np.testing.assert_array_equal(montecarlo_case(res.spec, i).result.rotor_states[0], alone.rotor_states[0])
         row = table.loc[i]
         assert row["m"] == pytest.approx(v.m, rel=1e-15) and row["Jyy"] == pytest.approx(v.Jyy, rel=1e-15)
         assert row["K"] == pytest.approx(v.kf * v.w_max**2, rel=1e-15)  # the "+" equivalent's K
@@ -167,6 +168,16 @@ def test_the_command_line_sweeps_iris_on_dask_and_its_scenario_replays_it(tmp_pa
     pd.testing.assert_frame_equal(a, b)
     assert len(a) == 4 and a["omega"].nunique() == 4  # the motors' bandwidths were drawn
     assert "rotor-speed plant" in (tmp_path / "a" / "report.md").read_text()
+
+
+def test_the_command_line_compares_controllers_on_a_population_of_iris(tmp_path):
+    proc = quadcruise(
+        "compare", "hover", "--vehicle", "iris", "--controllers", "se3,cascade", "--population", "3",
+        "--mass-spread", "0.05", "--duration", "2", cwd=tmp_path,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    table = proc.stdout.split("the same 3 perturbed vehicles")[1].splitlines()
+    assert [ln.split()[:2] for ln in table[2:4]] == [["se3", "3"], ["cascade", "3"]]
 
 
 @pytest.mark.parametrize(
