@@ -122,6 +122,18 @@ def test_a_rotor_fault_crashes_the_heavy_vehicles_and_the_sweep_says_so():
     assert alone.status_text(0).startswith("crashed") and alone.t_stop[0] == faulty.table.loc[k, "stop_time_s"]
 
 
+def test_a_drawn_vehicle_that_cannot_lift_itself_flies_and_falls_instead_of_stopping_the_sweep():
+    pop = Population(mass_spread=0.5, thrust_spread=0.55, distribution="uniform")
+    res = montecarlo("hover", "se3", pop, 12, seed=0, duration=3.0, vehicle="crazyflie", scheduler="none")
+    t = res.table
+    lift = 4.0 * t["K"] / (t["m"] * 9.81)  # K = (n/4) kf w_max^2: all rotors at full speed over the weight
+    weak = lift < 1.0
+    assert weak.sum() >= 2 and (t.loc[weak, "status"] == int(ExitStatus.CRASHED)).all()
+    assert (t.loc[lift > 1.1, "status"] != int(ExitStatus.CRASHED)).all()
+    with pytest.raises(InputError, match="cannot lift itself"):  # a vehicle of one's own is still checked
+        RotorVehicle.preset("crazyflie").replace(m=1.0)
+
+
 def test_a_tune_on_a_rotor_vehicle_improves_its_flight():
     from quadcruise.tune import tune
 

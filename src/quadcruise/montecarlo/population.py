@@ -23,6 +23,7 @@ noise and turbulence come from the engine's stream of ``(seed, i)``
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 from dataclasses import dataclass
@@ -352,7 +353,7 @@ class Population:
                 if f[k] != 1.0:  # a field not spread keeps its very value
                     base = getattr(nominal, name)
                     changes[name] = float(base / f[k] if name.startswith("tau") else base * f[k])
-            vehicles.append(nominal.replace(**changes) if changes else nominal)
+            vehicles.append(_drawn(nominal, changes))
         # the table's columns: the drawn vehicles' "+" equivalents (K, d) and motor bandwidth (omega)
         cols = {name: np.array([getattr(v, name) for v in vehicles]) for name in ("m", "Jxx", "Jyy", "Jzz")}
         cols["K"] = np.array([v.n_rotors / 4.0 * v.kf * v.w_max**2 for v in vehicles])
@@ -372,6 +373,23 @@ class Population:
         for key in ("environment", "noise"):
             out[key] = None if out[key] is None else out[key].to_dict()
         return out
+
+
+def _drawn(nominal: RotorVehicle, changes: dict) -> RotorVehicle:
+    """``nominal`` with the drawn ``changes``. A draw that cannot lift itself (n kf w_max^2 <= m g,
+    which RotorVehicle refuses to make) is made anyway and flown: a heavy, weak vehicle of a
+    population is a result (it sinks, or lands hard: ``lost track``, ``crashed``), not bad input.
+    Every other check holds for any draw: the spreads keep each value positive, and the rotors,
+    w_min and w_max are not drawn."""
+    if not changes:
+        return nominal
+    kf, m = changes.get("kf", nominal.kf), changes.get("m", nominal.m)
+    if nominal.n_rotors * kf * nominal.w_max**2 > m * nominal.g:
+        return nominal.replace(**changes)
+    weak = copy.copy(nominal)
+    for name, value in changes.items():
+        object.__setattr__(weak, name, value)
+    return weak
 
 
 @dataclass(frozen=True)
