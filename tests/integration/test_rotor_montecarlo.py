@@ -16,6 +16,7 @@ import pandas as pd
 import pytest
 
 import quadcruise as qc
+from quadcruise.control import SE3
 from quadcruise.disturbances import Environment, RotorLoss
 from quadcruise.errors import InputError
 from quadcruise.metrics import flight_metrics
@@ -140,7 +141,7 @@ def test_a_tune_on_a_rotor_vehicle_improves_its_flight():
     result = tune("step", "se3", vehicle="crazyflie", minimize="rmse_m", budget=4, popsize=8, duration=3.0, seed=2)
     start = qc.fly("step", result.start, vehicle="crazyflie", duration=3.0)
     tuned = qc.fly("step", result.controller, vehicle="crazyflie", duration=3.0, log_every=result.spec.log_every)
-    assert result.start.attitude.kp == start.meta["controller"]["attitude"]["kp"] != qc.control.SE3().attitude.kp
+    assert result.start.attitude.kp == start.meta["controller"]["attitude"]["kp"] != SE3().attitude.kp
     before, after = flight_metrics(start)["rmse_m"].iloc[0], flight_metrics(tuned)["rmse_m"].iloc[0]
     assert after < 0.95 * before
     assert result.cost == pytest.approx(after, rel=1e-6)
@@ -190,6 +191,16 @@ def test_the_command_line_compares_controllers_on_a_population_of_iris(tmp_path)
     assert proc.returncode == 0, proc.stderr
     table = proc.stdout.split("the same 3 perturbed vehicles")[1].splitlines()
     assert [ln.split()[:2] for ln in table[2:4]] == [["se3", "3"], ["cascade", "3"]]
+
+
+def test_every_command_gives_a_named_controller_the_gains_fly_designs_for_the_rotor_vehicle(tmp_path):
+    designed = qc.fly("hover", "se3", vehicle="iris", duration=0.1).meta["controller"]["attitude"]
+    assert designed["kp"] != SE3().attitude.kp  # not the paper's defaults
+    proc = quadcruise("fly", "hover", "--vehicle", "iris", "--controller", "se3", "--duration", "0.1", "--out", "f",
+                      cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    text = (tmp_path / "f" / "scenario.toml").read_text()
+    assert f"[controller.attitude]\nkp = {designed['kp']}\n" in text
 
 
 @pytest.mark.parametrize(

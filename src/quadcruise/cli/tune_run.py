@@ -138,6 +138,7 @@ def tune_command(
     """
     from quadcruise.cli.common import controller_from_options, mission_from_options
     from quadcruise.cli.montecarlo_run import parse_noise
+    from quadcruise.cli.objects import controller_for_vehicle
     from quadcruise.io.files import check_output_dir
     from quadcruise.montecarlo.population import Population
     from quadcruise.tune import tune
@@ -217,11 +218,7 @@ def tune_command(
         vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind, turbulence=turbulence, scenario=sc
     )
     rotor = isinstance(world["vehicle"], RotorVehicle)
-    if rotor and sc is None:  # a controller named starts from the gains designed for the vehicle, as fly's
-        from quadcruise.workflows.rotor_fly import rotor_flight_setup
-
-        designed = rotor_flight_setup(world["vehicle"], world["controller_vehicle"], controller or "nlpd")[1]
-        the_controller = controller_from_options(None, controller_params, None, base=designed)
+    the_controller = controller_for_vehicle(the_controller, controller, controller_params, None, world, sc)
     wanted["gains"] = parse_gains(gains, the_controller)
     environment = world["environment"]
     if wind_spread > 0 and not rotor and not any("wind acts only through drag" in line for line in notes):
