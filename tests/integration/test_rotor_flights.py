@@ -119,16 +119,16 @@ def test_the_command_line_flies_a_preset_and_its_scenario_flies_it_again(tmp_pat
     "args, words",
     [
         (
-            ["montecarlo", "--mission", "hover", "-n", "2", "--duration", "1", "--scheduler", "none"],
-            "fly and compare only",
+            ["montecarlo", "--mission", "hover", "-n", "2", "--offset", "0.1", "--duration", "1"],
+            "'offset': not for a rotor-plant vehicle",
         ),
         (["fly", "hover", "--wind", "constant:2,0,0", "--duration", "1"], "has none"),
         (["fly", "hover", "--controller-vehicle", "paper", "--duration", "1"], "of one plant"),
-        (["compare", "circle", "--population", "3", "--mass-spread", "0.1", "--duration", "1"], "a population flies"),
+        (["tune", "step", "--minimize", "rmse_m", "--wind-spread", "1", "--duration", "1"], "has none"),
     ],
 )
 def test_what_the_rotor_plant_cannot_do_is_one_line_exit_2(tmp_path, args, words):
-    vehicle = "iris,k_d=0" if "--wind" in args else "iris"
+    vehicle = "iris,k_d=0" if any(a.startswith("--wind") for a in args) else "iris"
     proc = quadcruise(*args, "--vehicle", vehicle, cwd=tmp_path)
     assert proc.returncode == 2, proc.stderr
     errors = [ln for ln in proc.stderr.splitlines() if ln.startswith("error: ")]

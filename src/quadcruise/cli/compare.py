@@ -154,8 +154,7 @@ def compare(
     """
     import dataclasses
 
-    from quadcruise.errors import InputError, whole_number
-    from quadcruise.model.vehicle import Vehicle
+    from quadcruise.errors import whole_number
     from quadcruise.workflows.compare import compare as run_compare
 
     needs_out(out, force=force)
@@ -178,11 +177,6 @@ def compare(
     )
     if seed is not None or "seed" not in kwargs:  # the flights' seed: given, the scenario's, the population's
         kwargs["seed"] = pop_seed if seed is None else seed
-    if count is not None and not isinstance(kwargs.get("vehicle") or Vehicle.paper(), Vehicle):
-        raise InputError(
-            "--population: a population flies the paper's plant (it perturbs the paper vehicle's m, J, K and "
-            "omega); a rotor-plant --vehicle is compared without one"
-        )
     if count is not None:
         from quadcruise.montecarlo.sweep import check_sweep_size
         from quadcruise.workflows.fly import default_duration

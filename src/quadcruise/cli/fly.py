@@ -21,7 +21,7 @@ from quadcruise.cli.common import (
     writable_with,
 )
 from quadcruise.cli.fly_run import fly_and_report
-from quadcruise.cli.objects import flight_from_options
+from quadcruise.cli.objects import controller_for_vehicle, flight_from_options
 from quadcruise.cli.world import WORLD_OPTIONS, flight_world
 
 __all__ = ["fly"]
@@ -204,6 +204,9 @@ def fly(
         mission, controller, mission_params, controller_params, position_poles, smooth
     )
     flown, notes = flight_world(**world, scenario=scenario)
+    the_controller = controller_for_vehicle(
+        the_controller, controller, controller_params, position_poles, flown, scenario
+    )
     kwargs = {
         **{k: v for k, v in kwargs.items() if k not in flown},
         **overrides,

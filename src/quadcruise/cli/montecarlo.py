@@ -34,9 +34,12 @@ __all__ = ["montecarlo", "montecarlo_command", "parse_noise"]
 )
 @click.option("--mass-spread", type=float, show_default="0", help="Relative std of the mass.")
 @click.option("--inertia-spread", type=float, show_default="0", help="Relative std of each inertia.")
-@click.option("--thrust-spread", type=float, show_default="0", help="Relative std of K.")
+@click.option("--thrust-spread", type=float, show_default="0", help="Relative std of K (kf on a rotor vehicle).")
 @click.option("--bandwidth-spread", type=float, show_default="0", help="Relative std of the actuator bandwidth.")
-@click.option("--yaw-arm-spread", type=float, show_default="0", help="Relative std of d.")
+@click.option("--yaw-arm-spread", type=float, show_default="0", help="Relative std of d (km on a rotor vehicle).")
+@click.option(
+    "--aero-spread", type=float, show_default="0", help="Relative std of a rotor vehicle's aerodynamic coefficients."
+)
 @click.option("--distribution", type=click.Choice(["normal", "uniform"]), show_default="normal")
 @click.option("--offset", type=float, show_default="0", help="Std of the start position [m].")
 @click.option("--noise", metavar="position=STD,velocity=STD,angle=STD,rate=STD,delay=S", help="Sensor noise and delay.")
@@ -125,10 +128,11 @@ def montecarlo(**options):
         wind_spread : float or None
             ``--wind-spread``: standard deviation of a random steady horizontal wind drawn per
             flight [m/s].
-        mass_spread, inertia_spread, thrust_spread, bandwidth_spread, yaw_arm_spread : float or None
-            ``--mass-spread`` .. ``--yaw-arm-spread``: relative standard deviations of the
-            mass m, of each inertia, of the thrust gain K, of the actuator bandwidth and of the
-            yaw moment arm d.
+        mass_spread, inertia_spread, thrust_spread, bandwidth_spread, yaw_arm_spread, aero_spread : float or None
+            ``--mass-spread`` .. ``--aero-spread``: relative standard deviations of the
+            mass m, of each inertia, of the thrust gain K, of the actuator bandwidth, of the
+            yaw moment arm d, and of a rotor-plant vehicle's aerodynamic coefficients (on a
+            rotor-plant vehicle: kf, 1 / tau_up and 1 / tau_down, km; :mod:`quadcruise.montecarlo.population`).
         distribution : {"normal", "uniform"} or None
             ``--distribution``: distribution of the random draws.
         offset : float or None

@@ -64,6 +64,7 @@ def montecarlo_command(
     thrust_spread: float | None = None,
     bandwidth_spread: float | None = None,
     yaw_arm_spread: float | None = None,
+    aero_spread: float | None = None,
     distribution: str | None = None,
     model_error: bool | None = None,
     chunk_size: str | int = "auto",
@@ -149,6 +150,7 @@ def montecarlo_command(
             bandwidth_spread=bandwidth_spread,
             offset=offset,
             yaw_arm_spread=yaw_arm_spread,
+            aero_spread=aero_spread,
             wind_spread=wind_spread,
             distribution=distribution,
             model_error=model_error,
@@ -168,7 +170,9 @@ def montecarlo_command(
         notes.insert(
             0,
             f"the controllers are told the nominal vehicle ({vehicle}): their only model error is the "
-            "spreads'; --controller-vehicle paper (or KEY=VALUE,...) gives them another belief",
+            "spreads'; --controller-vehicle "
+            + (f"{vehicle.split(',')[0]},m=..." if spec.rotor else "paper")
+            + " (or KEY=VALUE,...) gives them another belief",
         )
     if case is None:
         spec.population.check_perturbs(n)

@@ -6,7 +6,13 @@ from __future__ import annotations
 from quadcruise.cli.vehicle import refuse_vehicle_fields
 from quadcruise.errors import InputError
 
-__all__ = ["controller_from_options", "controller_params", "flight_from_options", "mission_from_options"]
+__all__ = [
+    "controller_for_vehicle",
+    "controller_from_options",
+    "controller_params",
+    "flight_from_options",
+    "mission_from_options",
+]
 
 
 def _poles(text: str | None, option: str):
@@ -47,6 +53,42 @@ def controller_from_options(name: str | None, params: tuple[str, ...], poles_tex
     if unknown:
         raise InputError(f"{base.name} has no parameter {unknown[0]!r}; its parameters: {', '.join(known)}")
     return dataclasses.replace(base, **given) if given else base
+
+
+def controller_for_vehicle(
+    controller, name: str | None, params: tuple[str, ...], poles_text: str | None, world, scenario
+):
+    """The controller of a flight on a rotor-plant vehicle: a name's gains designed for it, as ``fly`` designs them.
+
+    Parameters
+    ----------
+    controller : Controller
+        The controller the options made (:func:`controller_from_options`).
+    name : str or None
+        ``--controller``: None with a scenario keeps the scenario's controller and its gains.
+    params : tuple of str
+        ``-c KEY=VALUE`` parameters, applied over the designed gains.
+    poles_text : str or None
+        ``--poles`` of the x/y loops.
+    world : dict
+        :func:`quadcruise.cli.world.flight_world`'s: its ``vehicle`` and ``controller_vehicle``.
+    scenario : Scenario or None
+        The scenario read, if any.
+
+    Returns
+    -------
+    Controller
+        ``controller`` for the paper's plant or a scenario's controller; else the named controller
+        (nlpd by default) with the gains :func:`quadcruise.workflows.rotor_fly.rotor_flight_setup`
+        designs for the vehicle the controller believes, changed by ``params`` and ``poles_text``.
+    """
+    from quadcruise.model.rotor_vehicle import RotorVehicle
+    from quadcruise.workflows.rotor_fly import rotor_flight_setup
+
+    if not isinstance(world.get("vehicle"), RotorVehicle) or (scenario is not None and name is None):
+        return controller
+    designed = rotor_flight_setup(world["vehicle"], world.get("controller_vehicle"), name or controller.name)[1]
+    return controller_from_options(None, params, poles_text, base=designed)
 
 
 def mission_from_options(text: str, params: tuple[str, ...], smooth: bool):

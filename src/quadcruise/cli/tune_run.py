@@ -81,6 +81,7 @@ def tune_command(
     """What ``quadcruise tune`` runs: build the tune, run it, print its progress and summary, write ``out``."""
     from quadcruise.cli.common import controller_from_options, mission_from_options
     from quadcruise.cli.montecarlo_run import parse_noise
+    from quadcruise.cli.objects import controller_for_vehicle
     from quadcruise.io.files import check_output_dir
     from quadcruise.montecarlo.population import Population
     from quadcruise.tune import tune
@@ -125,6 +126,7 @@ def tune_command(
     )
     from quadcruise.cli.world import flight_world
     from quadcruise.errors import InputError, whole_number
+    from quadcruise.model.rotor_vehicle import RotorVehicle
 
     if log_every is not None:
         whole_number(log_every, "--log-every", minimum=1)
@@ -155,12 +157,14 @@ def tune_command(
     else:
         the_mission = mission_from_options(mission, mission_params, False)
         the_controller = controller_from_options(controller, controller_params, None)
-    wanted["gains"] = parse_gains(gains, the_controller)
     world, notes = flight_world(
         vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind, turbulence=turbulence, scenario=sc
     )
+    rotor = isinstance(world["vehicle"], RotorVehicle)
+    the_controller = controller_for_vehicle(the_controller, controller, controller_params, None, world, sc)
+    wanted["gains"] = parse_gains(gains, the_controller)
     environment = world["environment"]
-    if wind_spread > 0 and not any("wind acts only through drag" in line for line in notes):
+    if wind_spread > 0 and not rotor and not any("wind acts only through drag" in line for line in notes):
         from quadcruise.disturbances import default_drag_text, with_drag
 
         if world["vehicle"].drag_linear == 0 and world["vehicle"].drag_quadratic == 0:

@@ -52,6 +52,7 @@ from quadcruise.control import Controller, as_controller
 from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import InputError, reject_unknown
 from quadcruise.missions import Mission, as_mission
+from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.chunk import Case, montecarlo_case, replay_case
 from quadcruise.montecarlo.population import Population
@@ -128,7 +129,8 @@ def montecarlo(
     connect_timeout : float
         Time to wait for a scheduler given by address [s].
     **spec_options
-        More :class:`MonteCarloSpec` fields: duration [s], dt [s], vehicle, log_dt [s],
+        More :class:`MonteCarloSpec` fields: duration [s], dt [s], vehicle (a paper
+        Vehicle, a RotorVehicle or a preset's name), log_dt [s],
         settle_band, ``requirements`` (your own pass criteria, e.g.
         ``[Requirement("steady_max_error_m", "<=", 0.2)]`` or
         ``{"steady_max_error_m": ("<=", 0.2)}``), ``max_track_error_m`` [m] (the "lost track"
@@ -244,7 +246,7 @@ def check_montecarlo_arguments(
         if name in spec_options:
             checks.number(w, name, spec_options[name], "pos", unit="s", optional=name == "duration")
     if "vehicle" in spec_options:
-        checks.instance(w, "vehicle", spec_options["vehicle"], Vehicle, optional=False)
+        checks.instance(w, "vehicle", spec_options["vehicle"], (Vehicle, RotorVehicle, str), optional=False)
     if "requirements" in spec_options:
         as_requirements(spec_options["requirements"], w)
 

@@ -28,14 +28,16 @@ def fly_chunk(spec: MonteCarloSpec, first, count: int, log_every: int | None = N
     from quadcruise.workflows.fly import fly, hover_state
 
     draw = spec.population.draw(spec.seed, first, count, spec.vehicle, spec.dt)
-    x0 = hover_state(draw.vehicle, count, spec.mission)
-    x0[:, X : X + 3] += draw.offsets
+    x0 = None  # a rotor-plant vehicle starts hovering at the mission's start (the spec refuses an offset)
+    if not spec.rotor:
+        x0 = hover_state(draw.vehicle, count, spec.mission)
+        x0[:, X : X + 3] += draw.offsets
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = fly(
             spec.mission,
             spec.controller if controller is None else controller,
-            vehicle=draw.vehicle,
+            vehicle=list(draw.vehicle) if spec.rotor else draw.vehicle,
             controller_vehicle=spec.model_vehicle,
             duration=spec.duration,
             dt=spec.dt,

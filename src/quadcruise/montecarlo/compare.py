@@ -7,7 +7,7 @@ import functools
 from collections.abc import Callable
 
 from quadcruise.montecarlo.api import montecarlo
-from quadcruise.workflows.compare import labelled
+from quadcruise.workflows.compare import labelled, named_entries
 
 __all__ = ["compare_population"]
 
@@ -36,9 +36,10 @@ def compare_population(
 
     rows = {}
     chosen = labelled(controllers)
+    named = named_entries(controllers)  # a name: the spec designs its gains for a rotor-plant vehicle
     for k, (label, ctrl) in enumerate(chosen.items()):
         part = None if progress is None else functools.partial(_overall, progress, k * n, len(chosen) * n)
-        res = montecarlo(mission, ctrl, population, n, seed, progress=part, **montecarlo_kw)
+        res = montecarlo(mission, ctrl.name if named[k] else ctrl, population, n, seed, progress=part, **montecarlo_kw)
         s = res.summary()
         row = {"flights": s["flights"], "failure_rate": s["failures"]["rate"]}
         for metric in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "settling_time_5pct_s"):

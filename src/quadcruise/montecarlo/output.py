@@ -16,6 +16,7 @@ from quadcruise.errors import InputError, WriteError
 from quadcruise.io.files import MARKER, atomic_dir, atomic_path, check_output_dir, write_table
 from quadcruise.io.plainjson import dumps
 from quadcruise.io.scenario_file import montecarlo_document, scenario_text
+from quadcruise.montecarlo.schema import engine_stops
 from quadcruise.montecarlo.store import holds_sweep, write_marker
 
 __all__ = ["write_outputs", "write_case", "case_folder", "case_text", "report_markdown"]
@@ -116,6 +117,11 @@ def report_markdown(result, summary: dict, worst, table_name: str) -> str:
         f"quadcruise {__version__}, seed {spec.seed}, {spec.duration:g} s at dt = {spec.dt:g} s, "
         f"metrics on a {spec.dt * spec.log_every:g} s log; spec hash `{spec.hash()}`.\n",
         "Population: " + (", ".join(f"{k} = {v}" for k, v in pop.items()) or "nominal") + ".\n",
+        *(
+            [f"Vehicle: the rotor-speed plant, {spec.vehicle.n_rotors} rotors ({spec.vehicle.source or 'user'}).\n"]
+            if spec.rotor
+            else []
+        ),
         f"## Failures: {f['count']:,} of {summary['flights']:,} ({100 * f['rate']:.2f} %)\n",
         "Each flight counts once, under the first that applies: diverged (the engine stopped it), "
         f"lost track (its position error after the transient, or at the end if the transient never "
@@ -128,6 +134,10 @@ def report_markdown(result, summary: dict, worst, table_name: str) -> str:
     ]
     for reason, v in f["by_reason"].items():
         lines.append(f"| {reason} | {v['count']:,} | {100 * v['rate']:.2f} % |")
+    stops = engine_stops(summary)
+    if stops:
+        lines.append("\nHow the engine stopped the flights that diverged:\n")
+        lines += [f"- {count:,}: {why}" for why, count in stops.items()]
     lines.append("\n### Requirements\n")
     if summary["requirements"]:
         lines += [

@@ -5,6 +5,15 @@ offset, a random steady wind, an :class:`~quadcruise.disturbances.Environment` a
 :class:`~quadcruise.disturbances.SensorNoise`; :meth:`Population.draw` turns them into a
 :class:`Draw`: the batched vehicles of one chunk.
 
+A rotor-plant nominal vehicle (:class:`~quadcruise.model.rotor_vehicle.RotorVehicle`) is
+perturbed field by field with the same draws (:data:`ROTOR_SPREADS`): the mass, each inertia,
+``kf`` (the thrust spread), ``km`` (the yaw-arm spread: the paper's d is km / kf), the motor
+time constants (the bandwidth spread: ``tau_up`` and ``tau_down`` are divided by one drawn
+factor, so the bandwidth 1 / tau is spread as the paper's omega is, and the motor keeps the
+ratio of its two lags), and with ``aero_spread`` its aerodynamic coefficients (one factor for
+the body's parasitic drag, another for the rotor terms). The draws of vehicle i are the same
+on both plants.
+
 Randomness. Vehicle i's drawn parameters come only from
 ``numpy.random.SeedSequence([seed, i], spawn_key=(1,))`` (16 unit draws, always all of
 them, in a fixed order, so changing one spread never moves another's draws); its sensor
@@ -14,6 +23,7 @@ noise and turbulence come from the engine's stream of ``(seed, i)``
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 from dataclasses import dataclass
@@ -22,9 +32,10 @@ from typing import Any
 import numpy as np
 
 from quadcruise.errors import ArgumentTypeError, InputError
+from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 
-__all__ = ["Population", "Draw", "DRAW_KEY", "N_DRAWS", "SLOTS", "SPREADS", "CLIP"]
+__all__ = ["Population", "Draw", "DRAW_KEY", "N_DRAWS", "SLOTS", "SPREADS", "ROTOR_SPREADS", "ROTOR_SLOTS", "CLIP"]
 
 DRAW_KEY = 1
 """spawn_key of the population's draws (the engine's own streams have none)."""
@@ -43,7 +54,7 @@ SLOTS = {
     "wind_x": 10,
     "wind_y": 11,
 }
-"""Which of the 16 unit draws of a vehicle feeds which quantity (12..15 are spare)."""
+"""Which of the 16 unit draws of a vehicle feeds which quantity (:data:`ROTOR_SLOTS`: 12, 13; 14, 15 are spare)."""
 SPREADS = {
     "mass_spread": ("m",),
     "inertia_spread": ("Jxx", "Jyy", "Jzz"),
@@ -51,6 +62,35 @@ SPREADS = {
     "bandwidth_spread": ("omega",),
     "yaw_arm_spread": ("d",),
 }
+"""The paper vehicle's fields each spread perturbs."""
+ROTOR_SPREADS = {
+    "mass_spread": ("m",),
+    "inertia_spread": ("Jxx", "Jyy", "Jzz"),
+    "thrust_spread": ("kf",),
+    "bandwidth_spread": ("tau_up", "tau_down"),
+    "yaw_arm_spread": ("km",),
+    "aero_spread": ("c_Dx", "c_Dy", "c_Dz", "k_d", "k_z", "k_h", "k_flap"),
+}
+"""A rotor-plant vehicle's fields each spread perturbs (the module says how)."""
+ROTOR_SLOTS = {
+    "m": 0,
+    "Jxx": 1,
+    "Jyy": 2,
+    "Jzz": 3,
+    "kf": 4,
+    "km": 6,
+    "tau_up": 5,
+    "tau_down": 5,
+    "c_Dx": 12,
+    "c_Dy": 12,
+    "c_Dz": 12,
+    "k_d": 13,
+    "k_z": 13,
+    "k_h": 13,
+    "k_flap": 13,
+}
+"""The unit draw that perturbs each field of a rotor-plant vehicle: the paper slot of the same
+quantity (kf: K's, tau: omega's, km: d's); one draw for the body drag, one for the rotor terms."""
 CLIP = {"normal": 3.0, "uniform": math.sqrt(3.0)}
 """Largest |unit draw|: normal draws are clipped at 3 sigma, uniform ones span +-sqrt(3)
 (unit standard deviation)."""
@@ -85,6 +125,10 @@ class Population:
     model_error : bool
         The controller computes with the nominal vehicle (True) or knows each vehicle's
         drawn parameters (False).
+    aero_spread : float
+        Relative standard deviation of a rotor-plant vehicle's aerodynamic coefficients: one
+        factor for c_Dx, c_Dy, c_Dz, another for k_d, k_z, k_h, k_flap. The paper's vehicle
+        has none to spread (a sweep of it refuses a value > 0).
 
     Raises
     ------
@@ -115,11 +159,12 @@ class Population:
     environment: Any = None
     noise: Any = None
     model_error: bool = True
+    aero_spread: float = 0.0
 
     def __post_init__(self) -> None:
         if self.distribution not in CLIP:
             raise InputError(f"population field 'distribution' must be normal or uniform, got {self.distribution!r}")
-        for name in (*SPREADS, "offset", "wind_spread"):
+        for name in (*ROTOR_SPREADS, "offset", "wind_spread"):
             value = getattr(self, name)
             wrong_type = isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating))
             if wrong_type or not math.isfinite(value) or value < 0:
@@ -128,7 +173,7 @@ class Population:
                 )
             object.__setattr__(self, name, float(value))
             limit = 1.0 / CLIP[self.distribution]
-            if name in SPREADS and value >= limit:
+            if name in ROTOR_SPREADS and value >= limit:
                 raise InputError(
                     f"population field '{name}' = {value:g} is too large: with {self.distribution} "
                     f"draws it must be < {limit:.4f} so that every value stays positive"
@@ -165,7 +210,7 @@ class Population:
         >>> Population().perturbs, Population(offset=0.1).perturbs
         (False, True)
         """
-        if any(getattr(self, name) > 0 for name in (*SPREADS, "offset", "wind_spread")):
+        if any(getattr(self, name) > 0 for name in (*ROTOR_SPREADS, "offset", "wind_spread")):
             return True
         if self.environment is not None and self.environment.turbulence is not None:
             return True
@@ -197,7 +242,7 @@ class Population:
         """
         hint = hint or (
             "a spread (--mass-spread 0.1, --inertia-spread, --thrust-spread, --bandwidth-spread, "
-            "--yaw-arm-spread), a start --offset, a --wind-spread, turbulence (--turbulence moderate) "
+            "--yaw-arm-spread, --aero-spread), a start --offset, a --wind-spread, turbulence (--turbulence moderate) "
             "or sensor --noise"
         )
         if n > 1 and not self.perturbs:
@@ -235,7 +280,7 @@ class Population:
         clip = CLIP[self.distribution]
         return np.clip(out, -clip, clip) if normal else clip * (2.0 * out - 1.0)
 
-    def draw(self, seed: int, first, count: int, nominal: Vehicle, dt: float = 1e-3) -> Draw:
+    def draw(self, seed: int, first, count: int, nominal: Vehicle | RotorVehicle, dt: float = 1e-3) -> Draw:
         """The vehicles first .. first + count - 1: parameters, offsets and environment.
 
         Parameters
@@ -247,7 +292,7 @@ class Population:
             :meth:`unit_draws`).
         count : int
             Number of vehicles.
-        nominal : Vehicle
+        nominal : Vehicle or RotorVehicle
             The nominal vehicle (not batched).
         dt : float
             Control period [s] (unused: the draws do not depend on it).
@@ -257,13 +302,22 @@ class Population:
         Draw
             The batched vehicles and what was drawn for them.
         """
-        if nominal.batch_size is not None:
+        rotor = isinstance(nominal, RotorVehicle)
+        if not rotor and nominal.batch_size is not None:
             raise InputError("the nominal vehicle of a population must not be batched")
+        if not rotor and self.aero_spread > 0:
+            raise InputError(
+                "population field 'aero_spread' perturbs a rotor-plant vehicle's aerodynamic coefficients; "
+                "the paper's vehicle has none (its drag comes with the wind)"
+            )
         z = self.unit_draws(seed, first, count)
         cols: dict[str, np.ndarray] = {}
-        for spread, names in SPREADS.items():
-            for name in names:
-                cols[name] = getattr(nominal, name) * (1.0 + getattr(self, spread) * z[:, SLOTS[name]])
+        if rotor:
+            vehicles, cols = self._rotor_vehicles(nominal, z)
+        else:
+            for spread, names in SPREADS.items():
+                for name in names:
+                    cols[name] = getattr(nominal, name) * (1.0 + getattr(self, spread) * z[:, SLOTS[name]])
         offsets = self.offset * z[:, [SLOTS["dx0"], SLOTS["dy0"], SLOTS["dz0"]]]
         cols.update(dx0=offsets[:, 0], dy0=offsets[:, 1], dz0=offsets[:, 2])
         env = self.environment
@@ -282,8 +336,30 @@ class Population:
             env = dataclasses.replace(env or Environment(), wind=ConstantWind(velocity=wind))
         if env is not None and not env.parts:
             env = None
-        vehicle = nominal.replace(**{k: cols[k] for names in SPREADS.values() for k in names})
-        return Draw(vehicle=vehicle, offsets=offsets, environment=env, sensors=self.noise, columns=cols)
+        if not rotor:
+            vehicles = nominal.replace(**{k: cols[k] for names in SPREADS.values() for k in names})
+        return Draw(vehicle=vehicles, offsets=offsets, environment=env, sensors=self.noise, columns=cols)
+
+    def _rotor_vehicles(self, nominal: RotorVehicle, z: np.ndarray) -> tuple[tuple, dict]:
+        """The drawn rotor-plant vehicles (one per row of unit draws ``z``) and their table columns."""
+        factors = {}
+        for spread, names in ROTOR_SPREADS.items():
+            for name in names:
+                factors[name] = 1.0 + getattr(self, spread) * z[:, ROTOR_SLOTS[name]]
+        vehicles = []
+        for k in range(z.shape[0]):
+            changes = {}
+            for name, f in factors.items():
+                if f[k] != 1.0:  # a field not spread keeps its very value
+                    base = getattr(nominal, name)
+                    changes[name] = float(base / f[k] if name.startswith("tau") else base * f[k])
+            vehicles.append(_drawn(nominal, changes))
+        # the table's columns: the drawn vehicles' "+" equivalents (K, d) and motor bandwidth (omega)
+        cols = {name: np.array([getattr(v, name) for v in vehicles]) for name in ("m", "Jxx", "Jyy", "Jzz")}
+        cols["K"] = np.array([v.n_rotors / 4.0 * v.kf * v.w_max**2 for v in vehicles])
+        cols["omega"] = np.array([1.0 / max(v.tau_up, v.tau_down) for v in vehicles])
+        cols["d"] = np.array([v.km / v.kf for v in vehicles])
+        return tuple(vehicles), cols
 
     def to_dict(self) -> dict:
         """Plain values, for the result folder.
@@ -299,14 +375,32 @@ class Population:
         return out
 
 
+def _drawn(nominal: RotorVehicle, changes: dict) -> RotorVehicle:
+    """``nominal`` with the drawn ``changes``. A draw that cannot lift itself (n kf w_max^2 <= m g,
+    which RotorVehicle refuses to make) is made anyway and flown: a heavy, weak vehicle of a
+    population is a result (it sinks, or lands hard: ``lost track``, ``crashed``), not bad input.
+    Every other check holds for any draw: the spreads keep each value positive, and the rotors,
+    w_min and w_max are not drawn."""
+    if not changes:
+        return nominal
+    kf, m = changes.get("kf", nominal.kf), changes.get("m", nominal.m)
+    if nominal.n_rotors * kf * nominal.w_max**2 > m * nominal.g:
+        return nominal.replace(**changes)
+    weak = copy.copy(nominal)
+    for name, value in changes.items():
+        object.__setattr__(weak, name, value)
+    return weak
+
+
 @dataclass(frozen=True)
 class Draw:
     """A chunk's drawn vehicles and what was drawn for them (:meth:`Population.draw`).
 
     Parameters
     ----------
-    vehicle : Vehicle
-        The vehicles, batched (one value per vehicle of each drawn parameter).
+    vehicle : Vehicle or tuple of RotorVehicle
+        The vehicles: a batched Vehicle (one value per vehicle of each drawn parameter), or
+        one RotorVehicle per vehicle for a rotor-plant nominal.
     offsets : ndarray, shape (count, 3)
         Initial position offsets [m] on x, y, z.
     environment : Environment or None
@@ -317,7 +411,8 @@ class Draw:
     columns : dict of str to ndarray
         The drawn values as table columns: ``m`` [kg], ``Jxx``, ``Jyy``, ``Jzz``
         [kg m^2], ``K`` [N], ``omega`` [rad/s], ``d`` [m], ``dx0``, ``dy0``, ``dz0`` [m],
-        ``wind_x``, ``wind_y`` [m/s].
+        ``wind_x``, ``wind_y`` [m/s]. For rotor-plant vehicles K = (n / 4) kf w_max^2 and
+        d = km / kf (their "+" equivalent's), omega = 1 / max(tau_up, tau_down) (the motors').
     """
 
     vehicle: Vehicle

@@ -18,7 +18,7 @@ import numpy as np
 
 from quadcruise.errors import InputError
 from quadcruise.metrics.summary import Summary
-from quadcruise.montecarlo.schema import COLUMNS, FAILURES, METRICS
+from quadcruise.montecarlo.schema import COLUMNS, FAILURES, METRICS, engine_stops
 from quadcruise.montecarlo.spec import MonteCarloSpec
 
 __all__ = ["MonteCarloResult", "Traces", "FAILURES", "COLUMNS", "METRICS"]
@@ -208,6 +208,8 @@ class MonteCarloResult:
         for reason, v in f["by_reason"].items():
             why = f"  [{bounds[reason]}]" if reason in bounds else ""
             lines.append(f"  {reason:<22} {v['count']:>8,}  ({100 * v['rate']:.2f} %){why}")
+            if reason == "diverged":  # how the engine stopped them: a crash on the ground is one way
+                lines += [f"    {count:>8,}  {why_stopped}" for why_stopped, count in engine_stops(s).items()]
         for r in s["requirements"]:
             lines.append(f"  requirement {r['requirement']}: missed by {r['failed']:,} ({100 * r['rate']:.2f} %)")
         ns = s["not_settled"]

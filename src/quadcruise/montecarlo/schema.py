@@ -6,7 +6,7 @@ import numpy as np
 
 from quadcruise.montecarlo.population import SLOTS
 
-__all__ = ["COLUMNS", "FAILURES", "METRICS"]
+__all__ = ["COLUMNS", "FAILURES", "METRICS", "engine_stops"]
 
 FAILURES = ("ok", "diverged", "lost track", "saturated", "failed a requirement")
 """Failure codes 0..4 of the table's ``failure`` column, in order of precedence: the engine
@@ -52,3 +52,27 @@ failure reason (a flight may have several; ``failure`` names the first), ``not_s
 (the transient still outside the spec's ``settle_band`` at the end),
 ``transient_axis`` (0, 1, 2 for x, y, z; -1 if none), the metrics and the drawn values
 (``dx0``..: initial offset [m]; ``wind_x``, ``wind_y``: steady wind [m/s])."""
+
+
+def engine_stops(summary: dict) -> dict[str, int]:
+    """The flights the engine stopped (the "diverged" failures), by the reason it gave.
+
+    Parameters
+    ----------
+    summary : dict
+        :meth:`quadcruise.montecarlo.MonteCarloResult.summary_data`.
+
+    Returns
+    -------
+    dict of str to int
+        Status reason (:data:`quadcruise.sim.status.STATUS_REASONS`: ``"crashed: hit the
+        ground ..."``, ``"diverged: tilt left the bound"``, ...) -> flights; the statuses of
+        flights that flew on (lost track, off track) left out.
+
+    Examples
+    --------
+    >>> engine_stops({"stopped": {"crashed: hit the ground": 2, "lost track: ...": 1}})
+    {'crashed: hit the ground': 2}
+    """
+    flew_on = ("lost track", "off track")
+    return {k: v for k, v in summary["stopped"].items() if not k.startswith(flew_on)}

@@ -24,7 +24,7 @@ from typing import Any
 
 from quadcruise._cache import code_digest
 from quadcruise._version import __version__
-from quadcruise.control import as_controller, controller_record
+from quadcruise.control import CONTROLLERS, as_controller, controller_record
 from quadcruise.errors import InputError, whole_number
 from quadcruise.io.plainjson import dumps
 from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
@@ -54,7 +54,8 @@ class MonteCarloSpec:
     mission : Mission or str
         The mission, or its name for the defaults.
     controller : Controller or str
-        The controller, or its name for the defaults.
+        The controller, or its name for the defaults (for a rotor-plant vehicle: the gains its
+        design rules give for the vehicle the controller believes, as :func:`quadcruise.fly` does).
     population : Population
         How the vehicles differ from the nominal one; none by default.
     seed : int
@@ -63,11 +64,15 @@ class MonteCarloSpec:
         Flight time [s]; the mission's default (one lap, ...) if None.
     dt : float
         Control period [s].
-    vehicle : Vehicle
-        The nominal vehicle (Table I); given drag if the population meets wind.
-    controller_vehicle : Vehicle, optional
-        The vehicle every controller believes it flies (its model); None: the nominal
-        ``vehicle`` (or, with the population's ``model_error`` False, each vehicle's own).
+    vehicle : Vehicle, RotorVehicle or str
+        The nominal vehicle (Table I), or a preset's name (``"iris"``); given drag if the population meets wind. A
+        :class:`~quadcruise.model.rotor_vehicle.RotorVehicle` flies the rotor-speed plant (its
+        fields perturbed as :mod:`quadcruise.montecarlo.population` says; no start ``offset``,
+        no ``full_dynamics``; wind only on a vehicle with aerodynamics).
+    controller_vehicle : Vehicle, RotorVehicle or str, optional
+        The vehicle every controller believes it flies (its model), of the nominal's plant;
+        None: the nominal ``vehicle`` (or, with the population's ``model_error`` False, each
+        vehicle's own).
     max_step : float, optional
         Longest RK4 substep [s]; dt by default.
     log_dt : float
@@ -149,23 +154,31 @@ class MonteCarloSpec:
 
         if isinstance(self.mission, str):
             object.__setattr__(self, "mission", mission_from_name(self.mission))
+        for name in ("vehicle", "controller_vehicle"):  # a preset's name (Vehicle.preset)
+            if isinstance(getattr(self, name), str):
+                object.__setattr__(self, name, Vehicle.preset(getattr(self, name)))
+        named = self.controller if isinstance(self.controller, str) else None
         object.__setattr__(self, "controller", as_controller(self.controller))
         if not isinstance(self.mission, Mission):
             raise InputError(f"mission must be a name or a Mission, got {type(self.mission).__name__}")
         if not isinstance(self.population, Population):
             raise InputError("population must be a Population")
         if isinstance(self.vehicle, RotorVehicle) or isinstance(self.controller_vehicle, RotorVehicle):
-            raise InputError(
-                "a rotor-plant vehicle (RotorVehicle) is flown by fly and compare only: a Monte Carlo sweep and "
-                "tune fly the paper's plant, whose Population perturbs the paper vehicle's m, J, K and omega"
-            )
-        if not isinstance(self.vehicle, Vehicle) or self.vehicle.batch_size is not None:
+            self._check_rotor(named)
+        elif not isinstance(self.vehicle, Vehicle) or self.vehicle.batch_size is not None:
             raise InputError("the nominal vehicle must be one (unbatched) Vehicle")
-        with warnings.catch_warnings():  # fly() warns of a vehicle with little left for control
-            warnings.simplefilter("ignore")
-            check_can_hover(self.vehicle)  # before any chunk flies: a nominal that cannot lift
+        elif self.population.aero_spread > 0:
+            raise InputError(
+                "population field 'aero_spread' perturbs a rotor-plant vehicle's aerodynamic coefficients; "
+                "the paper's vehicle has none to spread (give a rotor-plant vehicle: iris, crazyflie, ...)"
+            )
+        else:
+            with warnings.catch_warnings():  # fly() warns of a vehicle with little left for control
+                warnings.simplefilter("ignore")
+                check_can_hover(self.vehicle)  # before any chunk flies: a nominal that cannot lift
         if self.controller_vehicle is not None:
-            if not isinstance(self.controller_vehicle, Vehicle) or self.controller_vehicle.batch_size is not None:
+            plant = RotorVehicle if self.rotor else Vehicle
+            if not isinstance(self.controller_vehicle, plant) or getattr(self.controller_vehicle, "batch_size", None):
                 raise InputError("the controller's vehicle must be one (unbatched) Vehicle")
             if not self.population.model_error:
                 raise InputError(
@@ -201,12 +214,53 @@ class MonteCarloSpec:
             raise InputError(f"max_altitude_error_m must be a positive number [m], got {zbound!r}")
         object.__setattr__(self, "max_track_error_m", float(bound))
         object.__setattr__(self, "max_altitude_error_m", float(zbound))
-        if self.population.needs_drag:
+        if self.population.needs_drag and not self.rotor:
             from quadcruise.disturbances import with_drag
 
             object.__setattr__(self, "vehicle", with_drag(self.vehicle, warn=True))
 
+    def _check_rotor(self, named: str | None) -> None:
+        """A rotor-plant sweep's own checks, before any work; a controller named gets gains
+        designed for the vehicle it believes (as :func:`quadcruise.fly` gives them)."""
+        from quadcruise.model.equivalent import duty_to_thrust, paper_equivalent
+        from quadcruise.workflows.rotor_fly import check_wind_acts, designed_controller
+
+        if not isinstance(self.vehicle, RotorVehicle) or not isinstance(
+            self.controller_vehicle, (RotorVehicle, type(None))
+        ):
+            raise InputError(
+                "vehicle and controller_vehicle must be of one plant: a RotorVehicle flown with a "
+                "RotorVehicle as the controller's model, or a paper Vehicle with a paper Vehicle"
+            )
+        for name, bad in (("offset", self.population.offset > 0), ("full_dynamics", self.full_dynamics)):
+            if bad:
+                raise InputError(
+                    f"{'population field' if name == 'offset' else 'MonteCarloSpec field'} '{name}': not for a "
+                    "rotor-plant vehicle (it starts hovering at the mission's start; its plant has no "
+                    "Euler-angle kinematics to choose)"
+                )
+        believed = self.controller_vehicle or self.vehicle
+        if believed.n_rotors != self.vehicle.n_rotors:
+            raise InputError(
+                f"the controller vehicle has {believed.n_rotors} rotors, the flown vehicle "
+                f"{self.vehicle.n_rotors}: the controller's rotor commands would not fit"
+            )
+        duty_to_thrust(believed)
+        env = self.population.environment
+        if self.population.wind_spread > 0 and env is None:
+            from quadcruise.disturbances import ConstantWind, Environment
+
+            env = Environment(wind=ConstantWind())
+        check_wind_acts(self.vehicle, env)
+        if named in CONTROLLERS:
+            object.__setattr__(self, "controller", designed_controller(named, paper_equivalent(believed).omega))
+
     # --- derived ------------------------------------------------------------------------
+    @property
+    def rotor(self) -> bool:
+        """True for a rotor-plant sweep (a :class:`~quadcruise.model.rotor_vehicle.RotorVehicle` nominal)."""
+        return isinstance(self.vehicle, RotorVehicle)
+
     @property
     def model_vehicle(self) -> Vehicle | None:
         """The vehicle the controllers compute with: ``controller_vehicle``, else the nominal one,
@@ -239,7 +293,8 @@ class MonteCarloSpec:
         int
             Logged instants times (16 + 12 + 11) float64 values of 8 bytes.
         """
-        return (self.periods // self.log_every + 1) * (STATE_SIZE + CMD_SIZE + REF_SIZE) * 8
+        rotor = self.vehicle.n_rotors + 13 if self.rotor else 0  # a rotor flight logs its rotor state too
+        return (self.periods // self.log_every + 1) * (STATE_SIZE + CMD_SIZE + REF_SIZE + rotor) * 8
 
     def to_dict(self) -> dict:
         """Plain values (for quadcruise.json and the hash).

@@ -39,6 +39,7 @@ from quadcruise.tune.criteria import Requirement, Target, as_minimize, as_requir
 from quadcruise.tune.objective import Objective, check_statistic
 from quadcruise.tune.result import TuneResult
 from quadcruise.tune.space import Bounds, GainSpace
+from quadcruise.workflows.rotor_fly import as_vehicle, rotor_flight_setup
 
 __all__ = ["tune", "ABS_TOL", "TUNE_OPTIONS"]
 
@@ -90,8 +91,8 @@ def tune(
     tol: float = 0.01,
     duration: float | None = None,
     dt: float = 1e-3,
-    vehicle: Vehicle | None = None,
-    controller_vehicle: Vehicle | None = None,
+    vehicle: Vehicle | RotorVehicle | str | None = None,
+    controller_vehicle: Vehicle | RotorVehicle | str | None = None,
     log_dt: float = 0.01,
     transient_until: float | None = None,
     progress: Callable[[int, int, str], None] | None = None,
@@ -143,10 +144,14 @@ def tune(
         Flight time [s]; the mission's default by default.
     dt : float
         Control period [s].
-    vehicle : Vehicle, optional
-        The nominal vehicle; Table I by default.
-    controller_vehicle : Vehicle, optional
-        The vehicle the controller believes it flies (its model); the nominal ``vehicle`` by default.
+    vehicle : Vehicle, RotorVehicle or str, optional
+        The nominal vehicle, or a preset's name; Table I by default. A rotor-plant vehicle
+        (:class:`~quadcruise.model.rotor_vehicle.RotorVehicle`) flies the rotor-speed plant,
+        each generation one batch of its perturbed copies; a controller given by name starts
+        from the gains designed for it (as :func:`quadcruise.fly` gives them).
+    controller_vehicle : Vehicle, RotorVehicle or str, optional
+        The vehicle the controller believes it flies (its model), of the nominal's plant; the
+        nominal ``vehicle`` by default.
     log_dt : float
         Sampling of the log the metrics are measured on [s].
     transient_until : float, optional
@@ -185,18 +190,18 @@ def tune(
     checks.number(w, "tol", tol, "nonneg")
     mission = as_mission(mission, w)
     checks.instance(w, "population", population, Population)
-    if isinstance(vehicle, RotorVehicle):
-        raise InputError(
-            "a rotor-plant vehicle (RotorVehicle) is flown by fly and compare only: a Monte Carlo sweep and "
-            "tune fly the paper's plant, whose Population perturbs the paper vehicle's m, J, K and omega"
-        )
-    checks.instance(w, "vehicle", vehicle, Vehicle)
+    vehicle = as_vehicle(checks.instance(w, "vehicle", vehicle, (Vehicle, RotorVehicle, str)))
+    controller_vehicle = as_vehicle(
+        checks.instance(w, "controller_vehicle", controller_vehicle, (Vehicle, RotorVehicle, str))
+    )
     checks.number(w, "duration", duration, "pos", unit="s", optional=True)
     checks.number(w, "dt", dt, "pos", unit="s")
     checks.number(w, "log_dt", log_dt, "pos", unit="s")
     checks.number(w, "transient_until", transient_until, "pos", unit="s", optional=True)
     checks.callback(w, "progress", progress)
     checks.instance(w, "command", command, str, optional=False)
+    if isinstance(vehicle, RotorVehicle) and isinstance(controller, str):  # designed for it, as fly does
+        controller = rotor_flight_setup(vehicle, controller_vehicle, controller)[1]
     base = as_controller(controller, w)
     space = GainSpace.build(base, gains, bounds, where=w)
     popsize = (

@@ -32,7 +32,7 @@ from quadcruise.missions import Mission, as_mission
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.workflows.fly import FLY_OPTIONS, flight_warnings_named, fly
-from quadcruise.workflows.rotor_fly import as_vehicle
+from quadcruise.workflows.rotor_fly import as_vehicle, rotor_flight_setup
 
 __all__ = ["compare", "Comparison", "DEFAULT_CONTROLLERS"]
 
@@ -360,6 +360,12 @@ def compare(
     checks.number(w, "dt", dt, "pos", unit="s")
     checks.callback(w, "progress", progress)
     chosen = labelled(controllers)
+    if isinstance(vehicle, RotorVehicle):  # a controller named gets gains designed for it, as fly gives them
+        believed = fly_kw.get("controller_vehicle")
+        chosen = {
+            label: rotor_flight_setup(vehicle, believed, ctrl.name)[1] if named else ctrl
+            for (label, ctrl), named in zip(chosen.items(), named_entries(controllers), strict=True)
+        }
     results = {}
     for label, ctrl in chosen.items():
         if progress is not None:
@@ -369,6 +375,31 @@ def compare(
     if progress is not None:
         progress(len(results), len(chosen))
     return Comparison(mission=mission, controllers=chosen, results=results)
+
+
+def named_entries(controllers) -> list[bool]:
+    """Which of the controllers :func:`labelled` reads were given by name (in its order).
+
+    Parameters
+    ----------
+    controllers : str, sequence or mapping
+        As :func:`labelled` takes them.
+
+    Returns
+    -------
+    list of bool
+        True for an entry given as a name (a rotor-plant vehicle gives it designed gains).
+
+    Examples
+    --------
+    >>> from quadcruise.control import SE3
+    >>> named_entries("nlpd, se3"), named_entries(["nlpd", SE3()])
+    ([True, True], [True, False])
+    """
+    if isinstance(controllers, str):
+        return [True] * len(controllers.split(","))
+    entries = controllers.values() if isinstance(controllers, Mapping) else controllers
+    return [isinstance(c, str) for c in entries]
 
 
 def labelled(controllers) -> dict:

@@ -28,7 +28,6 @@ from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import FlightWarning, InputError, LogWarning, reject_unknown
 from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, REF_Z, STATE_SIZE, X, Z
 from quadcruise.missions import Mission, as_mission, stack_params
-from quadcruise.model.equivalent import paper_equivalent
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
@@ -36,7 +35,15 @@ from quadcruise.sim.chunked import simulate_watched
 from quadcruise.sim.engine import Limits, simulate, time_grid
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.status import ExitStatus
-from quadcruise.workflows.rotor_fly import as_vehicle, check_wind_acts, fly_rotor, rotor_flight_setup
+from quadcruise.workflows.rotor_fly import (
+    as_vehicle,
+    batch_equivalent,
+    check_wind_acts,
+    fly_rotor,
+    rotor_batch,
+    rotor_flight_setup,
+    vehicle_record,
+)
 from quadcruise.workflows.track_watch import TrackWatch
 
 
@@ -123,12 +130,12 @@ def fly(
         A controller object, or a name ('nlpd', ...) for its defaults; or one controller per
         vehicle, all of one kind (the same class, the same memory size and gains layout),
         so that each vehicle flies its own gains in the one batch (a tuner's generation).
-    vehicle : Vehicle, RotorVehicle or str, optional
+    vehicle : Vehicle, RotorVehicle, list of RotorVehicle or str, optional
         Table I by default; a batched Vehicle gives each of the N vehicles its own values. A
         :class:`~quadcruise.model.rotor_vehicle.RotorVehicle` or a preset's name (``"iris"``)
         flies the rotor-speed plant (:mod:`quadcruise.workflows.rotor_fly`; docs/vehicles.md):
         the controller believes its paper equivalent, and a controller given by name gets
-        gains designed for it.
+        gains designed for it; a list of RotorVehicle (one rotor count) flies one per vehicle.
     duration : float, optional
         Flight time [s]; one lap (circle, square), step time + 10 s, or 5 s by default.
     dt : float
@@ -214,7 +221,7 @@ def fly(
     w = "fly()"  # every argument checked before any work
     mission = as_mission(mission, w)
     missions = fly_missions(missions)
-    vehicle = checks.instance(w, "vehicle", as_vehicle(vehicle), (Vehicle, RotorVehicle)) or Vehicle.paper()
+    vehicle = checks.instance(w, "vehicle", as_vehicle(vehicle), (Vehicle, RotorVehicle, tuple)) or Vehicle.paper()
     controller_vehicle = checks.instance(w, "controller_vehicle", controller_vehicle, (Vehicle, RotorVehicle))
     rotor, controller = rotor_flight_setup(vehicle, controller_vehicle, controller)  # rotor_fly.py
     controllers = per_vehicle_controllers(controller)
@@ -242,7 +249,7 @@ def fly(
     sizes = {
         s
         for s in (
-            getattr(vehicle, "batch_size", None),
+            len(vehicle) if isinstance(vehicle, tuple) else getattr(vehicle, "batch_size", None),
             None if x0 is None or np.ndim(x0) < 2 else np.shape(x0)[0],
             None if missions is None else len(missions),
             n,
@@ -284,13 +291,13 @@ def fly(
         check_can_hover(vehicle)
     check_reference_fits(missions or [first], float(duration), limits or Limits())
     given_x0 = None if x0 is None else np.asarray(x0, dtype=float).tolist()
-    x0 = hover_state(paper_equivalent(vehicle) if rotor else vehicle, n, first) if x0 is None else x0
+    x0 = hover_state(batch_equivalent(rotor_batch(vehicle)[:1]) if rotor else vehicle, n, first) if x0 is None else x0
     meta = {
         "workflow": "fly",
         "mission": [m.to_dict() for m in missions] if missions else mission.to_dict(),
         "controller": controller_record(controller),
         **({"controllers": [controller_record(c) for c in controllers]} if len(controllers) > 1 else {}),
-        "vehicle": {"plant": "rotor", **vehicle.to_dict()} if rotor else vehicle.to_dict(),
+        "vehicle": vehicle_record(rotor_batch(vehicle)) if rotor else vehicle.to_dict(),
         "duration_s": float(duration),
         "dt_s": float(dt),
         "max_step_s": float(max_step or dt),

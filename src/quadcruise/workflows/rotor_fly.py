@@ -76,23 +76,100 @@ def designed_controller(name: str, bandwidth: float) -> Any:
 
 
 def as_vehicle(vehicle: Any) -> Any:
-    """``fly``'s vehicle: a preset's name read (:meth:`quadcruise.Vehicle.preset`), any other value as given.
+    """``fly``'s vehicle: a preset's name read (:meth:`quadcruise.Vehicle.preset`), a list of
+    rotor-plant vehicles as a tuple (one per flown vehicle: a Monte Carlo chunk), any other value as given.
 
     Parameters
     ----------
-    vehicle : Vehicle, RotorVehicle, str or None
-        The vehicle, or a preset's name.
+    vehicle : Vehicle, RotorVehicle, str, list of RotorVehicle or None
+        The vehicle, a preset's name, or one RotorVehicle per vehicle of the batch (all with
+        the same number of rotors).
 
     Returns
     -------
-    Vehicle, RotorVehicle or None
+    Vehicle, RotorVehicle, tuple of RotorVehicle or None
 
     Raises
     ------
     InputError
-        An unknown preset.
+        An unknown preset; an empty list, an entry that is not a RotorVehicle, or rotor counts
+        that differ.
     """
-    return Vehicle.preset(vehicle) if isinstance(vehicle, str) else vehicle
+    if isinstance(vehicle, str):
+        return Vehicle.preset(vehicle)
+    if not isinstance(vehicle, (list, tuple)):
+        return vehicle
+    if not vehicle:
+        raise InputError("fly() argument 'vehicle': the list of vehicles is empty")
+    for i, v in enumerate(vehicle):
+        if not isinstance(v, RotorVehicle):
+            raise InputError(
+                f"fly() argument 'vehicle': entry {i} is a {type(v).__name__}; a list holds one RotorVehicle "
+                "per vehicle (a batch of paper vehicles is one Vehicle with a value per vehicle)"
+            )
+        if v.n_rotors != vehicle[0].n_rotors:
+            raise InputError(
+                f"fly() argument 'vehicle': entry {i} has {v.n_rotors} rotors, entry 0 {vehicle[0].n_rotors}: "
+                "the vehicles of one flight must have the same number of rotors"
+            )
+    return tuple(vehicle)
+
+
+def rotor_batch(vehicle: Any) -> tuple[RotorVehicle, ...] | None:
+    """The flown rotor-plant vehicles as a tuple (one entry for one vehicle), or None for the paper plant.
+
+    Parameters
+    ----------
+    vehicle : Vehicle, RotorVehicle or tuple of RotorVehicle
+        ``fly``'s vehicle after :func:`as_vehicle`.
+
+    Returns
+    -------
+    tuple of RotorVehicle or None
+    """
+    if isinstance(vehicle, RotorVehicle):
+        return (vehicle,)
+    return vehicle if isinstance(vehicle, tuple) else None
+
+
+def batch_equivalent(vehicles: tuple[RotorVehicle, ...]) -> Vehicle:
+    """The paper equivalents (:func:`~quadcruise.model.equivalent.paper_equivalent`) of rotor vehicles.
+
+    Parameters
+    ----------
+    vehicles : tuple of RotorVehicle
+        One or more vehicles.
+
+    Returns
+    -------
+    Vehicle
+        One Vehicle for one vehicle, else a batched Vehicle (one value per vehicle).
+    """
+    if len(vehicles) == 1:
+        return paper_equivalent(vehicles[0])
+    return Vehicle.stack([paper_equivalent(v) for v in vehicles])
+
+
+def vehicle_record(vehicles: tuple[RotorVehicle, ...]) -> dict:
+    """The flown rotor vehicles as a result records them: ``plant`` and each field, one value
+    where all vehicles share it, else a list of one value per vehicle.
+
+    Parameters
+    ----------
+    vehicles : tuple of RotorVehicle
+        One or more vehicles.
+
+    Returns
+    -------
+    dict
+        ``{"plant": "rotor", field: value or list}``.
+    """
+    dicts = [v.to_dict() for v in vehicles]
+    out: dict = {"plant": "rotor"}
+    for key, value in dicts[0].items():
+        values = [d[key] for d in dicts]
+        out[key] = value if all(v == value for v in values) else values
+    return out
 
 
 def rotor_flight_setup(vehicle: Any, controller_vehicle: Any, controller: Any) -> tuple[bool, Any]:
@@ -119,7 +196,8 @@ def rotor_flight_setup(vehicle: Any, controller_vehicle: Any, controller: Any) -
         A rotor vehicle believed as a paper vehicle or the other way round, or a controller
         vehicle with another number of rotors: the controller's rotor commands would not fit.
     """
-    rotor = isinstance(vehicle, RotorVehicle)
+    flown = rotor_batch(vehicle)
+    rotor = flown is not None
     if controller_vehicle is not None and isinstance(controller_vehicle, RotorVehicle) != rotor:
         raise InputError(
             "fly(): vehicle and controller_vehicle must be of one plant: a RotorVehicle flown with a "
@@ -127,15 +205,18 @@ def rotor_flight_setup(vehicle: Any, controller_vehicle: Any, controller: Any) -
         )
     if not rotor:
         return False, controller
-    believed = controller_vehicle or vehicle
-    if believed.n_rotors != vehicle.n_rotors:
+    believed = (controller_vehicle,) if controller_vehicle is not None else flown
+    if believed[0].n_rotors != flown[0].n_rotors:
         raise InputError(
-            f"fly(): the controller vehicle has {believed.n_rotors} rotors, the flown vehicle "
-            f"{vehicle.n_rotors}: the controller's rotor commands would not fit"
+            f"fly(): the controller vehicle has {believed[0].n_rotors} rotors, the flown vehicle "
+            f"{flown[0].n_rotors}: the controller's rotor commands would not fit"
         )
-    duty_to_thrust(believed)  # a layout the mixer cannot serve: one line, before any work
+    for b in dict.fromkeys(believed):  # a layout the mixer cannot serve: one line, before any work
+        duty_to_thrust(b)
     if isinstance(controller, str) and controller in CONTROLLERS:
-        controller = designed_controller(controller, paper_equivalent(believed).omega)
+        bandwidths = [paper_equivalent(b).omega for b in believed]
+        designs = {w: designed_controller(controller, w) for w in dict.fromkeys(bandwidths)}
+        controller = designs[bandwidths[0]] if len(designs) == 1 else [designs[w] for w in bandwidths]
     return True, controller
 
 
@@ -144,19 +225,20 @@ def check_wind_acts(vehicle: Any, environment: Any) -> None:
 
     Parameters
     ----------
-    vehicle : Vehicle or RotorVehicle
-        The flown vehicle (a paper Vehicle is the paper plant's business: it is given drag).
+    vehicle : Vehicle, RotorVehicle or tuple of RotorVehicle
+        The flown vehicle(s) (a paper Vehicle is the paper plant's business: it is given drag).
     environment : Environment, CustomDisturbance or None
         The disturbances.
 
     Raises
     ------
     InputError
-        Wind, gusts or turbulence, and every aerodynamic coefficient of the RotorVehicle zero.
+        Wind, gusts or turbulence, and every aerodynamic coefficient of a RotorVehicle zero.
     """
-    if not isinstance(vehicle, RotorVehicle) or not getattr(environment, "needs_drag", False):
+    flown = rotor_batch(vehicle)
+    if flown is None or not getattr(environment, "needs_drag", False):
         return
-    if all(getattr(vehicle, name) == 0.0 for name in AERO_FIELDS):
+    if any(all(getattr(v, name) == 0.0 for name in AERO_FIELDS) for v in flown):
         raise InputError(
             "fly(): wind acts on a rotor-plant vehicle through its aerodynamics, and this one has none "
             f"({', '.join(AERO_FIELDS)} all 0): give it some, or fly without wind"
@@ -205,10 +287,11 @@ def fly_rotor(
     ----------
     grid : numpy.ndarray
         The control instants [s].
-    vehicle : RotorVehicle
-        The flown vehicle, with a ground at z = 0 (its ``touchdown_speed``).
+    vehicle : RotorVehicle or tuple of RotorVehicle
+        The flown vehicle, or one per vehicle (``n`` of them), with a ground at z = 0 (its
+        ``touchdown_speed``).
     controller_vehicle : RotorVehicle or None
-        The vehicle the controller believes; ``vehicle`` by default.
+        The vehicle the controller believes; each flown vehicle its own by default.
     controller_function : compiled function
         The controller's law (``CONTROLLER_SIG``).
     gains : numpy.ndarray
@@ -229,31 +312,39 @@ def fly_rotor(
     -------
     SimResult
     """
-    believed = controller_vehicle or vehicle
-    alloc = np.r_[duty_to_thrust(believed).ravel(), believed.kf]
+    flown = rotor_batch(vehicle)
+    believed = (controller_vehicle,) if controller_vehicle is not None else flown
     meta = engine.get("meta")
     if meta is not None:  # the flown vehicle's "+" equivalent: its hover duty (effort), a log's K, l, d
-        meta["paper_equivalent"] = paper_equivalent(vehicle).to_dict()
+        meta["paper_equivalent"] = batch_equivalent(flown).to_dict()
+
+    def rows(make, vehicles):  # one row per distinct vehicle, spread over the n vehicles
+        made = {v: make(v) for v in dict.fromkeys(vehicles)}
+        return np.stack([made[v] for v in vehicles]) if len(vehicles) > 1 else next(iter(made.values()))
+
     return fly_rotor_vehicles(
         grid,
-        rotor_hover_state(vehicle, mission),
-        np.broadcast_to(vehicle.row(), (n, vehicle.row().size)),
-        alloc,
-        paper_equivalent(believed).rows(1)[0],
+        rows(lambda v: rotor_hover_state(v, mission), flown),
+        np.broadcast_to(rows(RotorVehicle.row, flown), (n, flown[0].row().size)),
+        rows(lambda v: np.r_[duty_to_thrust(v).ravel(), v.kf], believed),
+        rows(lambda v: paper_equivalent(v).rows(1)[0], believed),
         controller_function,
         gains,
         mission.function,
         mp,
         psi0=float(mission.reference(0.0)[0][REF_PSI]),
         limits=limits,
-        touchdown_speed=vehicle.touchdown_speed,
-        rotor_names=state_names(vehicle.n_rotors),
+        touchdown_speed=np.array([v.touchdown_speed for v in flown]) if len(flown) > 1 else flown[0].touchdown_speed,
+        rotor_names=state_names(flown[0].n_rotors),
         **engine,
     )
 
 
 __all__ = [
     "as_vehicle",
+    "batch_equivalent",
+    "rotor_batch",
+    "vehicle_record",
     "check_wind_acts",
     "designed_controller",
     "fly_rotor",
