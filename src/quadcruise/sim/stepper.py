@@ -180,7 +180,7 @@ class Stepper:
                 inp, controller, mission, disturbance, seed, first_vehicle, sensor_delay, periods, setpoint_width
             )
             self.carry = np.zeros((self.n, rotor_carry_width(self.sensor_delay)))
-            self._paper_state = np.zeros((self.n, STATE_SIZE))
+            self._paper_state = paper_states(self.state, self.vp, self.psi0)  # then written by each step
             self.log_rotor = np.empty((self.n, self.periods + 1, self.state.shape[1]))
             self.full_dynamics, self.max_step = False, float(max_step)
             self.limits = (limits or Limits()).array()
@@ -256,18 +256,7 @@ class Stepper:
         paper plant's state itself; for the rotor plant, position, velocity, the ZYX Euler angles
         of the quaternion, body rates and the thrusts of rotors 1..4
         (:func:`quadcruise.sim.rotor_flight.paper_state`), as of the last step."""
-        if not self.rotor:
-            return self.state
-        fresh = self.clock[:, 0] == 0  # not flown since a reset: the carry holds nothing yet
-        out = self._paper_state
-        out[~fresh] = self.carry[~fresh, 1 : 1 + STATE_SIZE]
-        if fresh.any():
-            out[fresh] = self._fresh_paper_state(np.flatnonzero(fresh))
-        return out
-
-    def _fresh_paper_state(self, rows: np.ndarray) -> np.ndarray:
-        """The paper-layout state of rotor vehicles at their initial state (full rotor effectiveness)."""
-        return paper_states(self.state[rows], self.vp[rows], self.psi0[rows])
+        return self._paper_state if self.rotor else self.state
 
     @property
     def period(self) -> np.ndarray:
@@ -338,7 +327,9 @@ class Stepper:
         elif self.drawn:
             self.rng[rows] = vehicle_states(self.seed if seed is None else seed, k, self.first_vehicle[rows])
         self.clock[rows] = 0
-        if not self.rotor:  # the rotor kernel starts a vehicle at period 0 afresh, carry unread
+        if self.rotor:  # the rotor kernel starts a vehicle at period 0 afresh, its carry unread
+            self._paper_state[rows] = paper_states(np.ascontiguousarray(start), self.vp[rows], self.psi0[rows])
+        else:
             self.carry[rows] = fresh_carry(np.ascontiguousarray(start), self.sensor_delay)
         self.saturated[rows] = 0.0
         self.status[rows] = int(ExitStatus.FINISHED)
