@@ -62,6 +62,11 @@ class SimulationError(RuntimeError):
     """A simulation could not be carried out as asked (not bad input, not divergence)."""
 
 
+class LogWarning(UserWarning):
+    """A flight's log kept less than every period because the whole would not fit (``fly``
+    with ``log_every`` left to it); the flight and its checks are the same."""
+
+
 class FlightWarning(UserWarning):
     """How a flight went, when it went wrong: a vehicle that did not finish, rotor duties
     clipped. Workflows that fly several (compare, reproduce) say whose flight it was."""

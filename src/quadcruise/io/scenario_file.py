@@ -105,6 +105,8 @@ def scenario_document(meta: dict, *, title: str = "") -> dict:
     if disturbances:
         doc["disturbances"] = disturbances
     simulation = {key: meta[k] for k, key in SIMULATION_FROM_META.items() if meta.get(k) is not None}
+    if meta.get("log_every_chosen"):  # fly chose it (a batch's log within budget): it chooses it again,
+        simulation.pop("log_every", None)  # and checks every period, as a log_every given would not
     if meta.get("n", 1) != 1 and not any(isinstance(v, list) for v in (meta.get("vehicle") or {}).values()):
         simulation["n"] = meta["n"]
     if simulation:

@@ -554,7 +554,7 @@ waiting at the end."""
 _pool: ThreadPoolExecutor | None = None
 
 
-def fly_vehicles(n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD) -> None:
+def fly_vehicles(n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD, after_piece=None) -> None:
     """Run the kernel over vehicles 0..n-1 of the batch arrays in ``args``, on numba's
     number of threads (``numba.get_num_threads()``): one range on this thread when that is
     1 or n is 1, else ``pieces_per_thread`` ranges per thread, handed out in turn.
@@ -567,18 +567,26 @@ def fly_vehicles(n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD
         The kernel's arguments after the vehicle range (its batch arrays, by role).
     pieces_per_thread : int
         Ranges per thread: fewer for short calls (a step), where each call's fixed cost counts.
+    after_piece : callable, optional
+        Called as ``after_piece(first, stop)`` on the thread that flew vehicles first..stop-1,
+        right after it (their rows still in its cache).
     """
     global _pool
     threads = min(n, get_num_threads())
     if threads <= 1:
         _kernel(0, n, *args)
+        if after_piece is not None:
+            after_piece(0, n)
         return
     bounds = np.linspace(0, n, min(n, pieces_per_thread * threads) + 1).round().astype(np.int64)
     pieces = itertools.count()  # next() on it is atomic under the GIL
 
     def work() -> None:
         while (k := next(pieces)) < bounds.shape[0] - 1:
-            _kernel(int(bounds[k]), int(bounds[k + 1]), *args)
+            first, stop = int(bounds[k]), int(bounds[k + 1])
+            _kernel(first, stop, *args)
+            if after_piece is not None:
+                after_piece(first, stop)
 
     if _pool is None:  # numba's threads can never exceed this
         _pool = ThreadPoolExecutor(max_workers=max(1, config.NUMBA_NUM_THREADS - 1), thread_name_prefix="quadcruise")

@@ -357,7 +357,7 @@ class Stepper:
             raise InputError(f"reset: mask must be a ({self.n},) bool array, got {mask.shape} {mask.dtype}")
         return mask
 
-    def step(self, commands=None) -> None:
+    def step(self, commands=None, *, after_piece=None, pieces_per_thread: int = STEP_PIECES_PER_THREAD) -> None:
         """Fly every vehicle that is not :attr:`done` on for :attr:`periods` control periods.
 
         Parameters
@@ -365,6 +365,11 @@ class Stepper:
         commands : (N, setpoint_width) array, optional
             Written into the first ``setpoint_width`` entries of each vehicle's gains row
             before the step (the setpoint a policy gives its action-mode controller).
+        after_piece : callable, optional
+            ``after_piece(first, stop)``, on the thread that flew vehicles first..stop-1, right
+            after it (:func:`~quadcruise.sim.engine.fly_vehicles`).
+        pieces_per_thread : int
+            Ranges of vehicles per thread.
 
         Raises
         ------
@@ -425,7 +430,8 @@ class Stepper:
                 t_stop=self.t_stop,
                 saturated=self.saturated,
             ),
-            STEP_PIECES_PER_THREAD,
+            pieces_per_thread,
+            after_piece,
         )
 
     def _step_rotor(self) -> None:

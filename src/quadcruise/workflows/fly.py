@@ -25,17 +25,19 @@ from quadcruise import checks
 from quadcruise._version import __version__
 from quadcruise.control import as_controller, controller_record
 from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
-from quadcruise.errors import FlightWarning, InputError, reject_unknown
+from quadcruise.errors import FlightWarning, InputError, LogWarning, reject_unknown
 from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, REF_Z, STATE_SIZE, X, Z
 from quadcruise.missions import Mission, as_mission, stack_params
 from quadcruise.model.equivalent import paper_equivalent
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
+from quadcruise.sim.chunked import simulate_watched
 from quadcruise.sim.engine import Limits, simulate, time_grid
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.status import ExitStatus
 from quadcruise.workflows.rotor_fly import as_vehicle, check_wind_acts, fly_rotor, rotor_flight_setup
+from quadcruise.workflows.track_watch import TrackWatch
 
 
 def default_duration(mission: Mission) -> float:
@@ -98,7 +100,7 @@ def fly(
     max_step: float | None = None,
     n: int | None = None,
     x0: Any = None,
-    log_every: int = 1,
+    log_every: int | None = None,
     limits: Limits | None = None,
     missions: list[Mission] | None = None,
     controller_vehicle: Vehicle | None = None,
@@ -138,8 +140,13 @@ def fly(
     x0 : (16,) or (N, 16) array, optional
         Initial states; by default each vehicle hovers at x = y = 0 at the mission's
         starting altitude and yaw.
-    log_every : int
-        Log every this many control periods.
+    log_every : int, optional
+        Log every this many control periods (a divisor of them). By default every period,
+        unless a batch's log would exceed :data:`LOG_BUDGET` (256 MiB): then the smallest divisor
+        that fits, said in a :class:`~quadcruise.errors.LogWarning`, and the track checks
+        (``lost track``, ``off track``) are made at every period as the flight goes, so the
+        statuses and times are those of the full log. A ``log_every`` given is kept, and the
+        checks read its log (a log over half the memory is refused).
     limits : Limits, optional
         Divergence bounds.
     missions : list of Mission, optional
@@ -216,7 +223,7 @@ def fly(
     dt = checks.number(w, "dt", dt, "pos", unit="s")
     max_step = checks.number(w, "max_step", max_step, "pos", unit="s", optional=True)
     n = checks.whole(w, "n", n, 1, optional=True)
-    log_every = checks.whole(w, "log_every", log_every, 1)
+    log_every = checks.whole(w, "log_every", log_every, 1, optional=True)
     checks.instance(w, "limits", limits, Limits)
     full_dynamics = checks.flag(w, "full_dynamics", full_dynamics)
     checks.instance(w, "environment", environment, (Environment, CustomDisturbance))
@@ -253,8 +260,22 @@ def fly(
     first = missions[0] if missions else mission
     duration = default_duration(first) if duration is None else duration
     d, h = duration, dt
+    watched = log_every is None and n > 1 and 0 < h <= d < math.inf and batch_log_every(n, round(d / h)) > 1
+    watched = watched and not rotor  # a rotor flight keeps its whole log (rotor_fly.py)
+    # a batch whose full log would not fit in LOG_BUDGET: a coarser log, checked at every period
+    log_every = batch_log_every(n, round(d / h)) if watched else 1 if log_every is None else log_every
     if 0 < h <= d < math.inf:  # sized before the grid is allocated
-        check_run_size(n, round(d / h), int(log_every), max(1, math.ceil(h / float(max_step or h) - 1e-9)))
+        substeps = max(1, math.ceil(h / float(max_step or h) - 1e-9))
+        check_run_size(n, round(d / h), int(log_every), substeps, watched)
+    if watched:
+        full, kept = log_bytes(n, round(d / h), 1) / 2**30, log_bytes(n, round(d / h), log_every) / 2**30
+        warnings.warn(
+            f"fly(): the log of {n:,} vehicles x {round(d / h) + 1:,} instants would take {full:.1f} GiB: logging "
+            f"every {log_every} periods ({kept:.2f} GiB; the track checks still see every period); give log_every "
+            "to choose",
+            LogWarning,
+            stacklevel=2,
+        )
     grid = time_grid(float(duration), float(dt))
     check_log_every(log_every, grid.size - 1)
     if sensors is not None:
@@ -278,6 +299,7 @@ def fly(
         "full_dynamics": bool(full_dynamics),
         "seed": seed,
         "log_every": int(log_every),
+        **({"log_every_chosen": True} if watched else {}),
         "max_track_error": None if max_track_error is None else float(max_track_error),
         "max_steady_error": None if max_steady_error is None else float(max_steady_error),
         "initial_state": given_x0,
@@ -300,31 +322,11 @@ def fly(
         if len(controllers) == 1
         else (np.stack([c.gains() for c in controllers]), np.stack([c.memory() for c in controllers]))
     )
-    common = {"memory": memory, "max_step": max_step or dt, "log_every": log_every, "limits": limits, "meta": meta}
-    common.update(seed=seed, first_vehicle=first_vehicle, **engine_inputs(environment, sensors, n, dt))
-    if rotor:
-        result = fly_rotor(grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, **common)
-    else:
-        result = simulate(
-            grid,
-            x0,
-            vehicle.rows(n),
-            controller.function,
-            gains,
-            first.function,
-            mp,
-            vp_ctrl=vp_ctrl,
-            full_dynamics=full_dynamics,
-            **common,
-        )
     bound = (
         track_bound(missions or [first], np.broadcast_to(x0, (n, STATE_SIZE)), n)
         if max_track_error is None
         else np.full(n, float(max_track_error))
     )
-    result.meta["max_track_error_m"] = bound.tolist() if n > 1 else float(bound[0])
-    err = position_error(result)
-    result = mark_lost_track(result, bound, err)
     steady = (
         (
             np.array([steady_bound(m, duration) for m in missions])
@@ -334,7 +336,6 @@ def fly(
         if max_steady_error is None
         else np.full(n, float(max_steady_error))
     )
-    result.meta["max_steady_error_m"] = steady.tolist() if n > 1 else float(steady[0])
     vertical = (
         (
             np.array([altitude_bound(m, duration) for m in missions])
@@ -344,8 +345,36 @@ def fly(
         if max_steady_error is None
         else steady
     )
+    options = dict(
+        memory=memory,
+        max_step=max_step or dt,
+        log_every=log_every,
+        limits=limits,
+        meta=meta,
+        seed=seed,
+        first_vehicle=first_vehicle,
+        **engine_inputs(environment, sensors, n, dt),
+    )
+    if rotor:  # the rotor plant's own path (rotor_fly.py), its log whole
+        result = fly_rotor(grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, **options)
+    else:
+        args = (grid, x0, vehicle.rows(n), controller.function, gains, first.function, mp)
+        options.update(vp_ctrl=vp_ctrl, full_dynamics=full_dynamics)
+        if watched:  # the log keeps every log_every-th period; the checks see every one
+            mission_record = meta["mission"] if isinstance(meta["mission"], dict) else {}
+            watch = TrackWatch(grid, mission_record, bound, steady, vertical)
+            result = simulate_watched(*args, watch=watch.feed, **options)
+            status, t_stop = watch.verdict(result.status, result.t_stop)
+            result = dataclasses.replace(result, status=status, t_stop=t_stop)
+        else:
+            result = simulate(*args, **options)
+    result.meta["max_track_error_m"] = bound.tolist() if n > 1 else float(bound[0])
+    result.meta["max_steady_error_m"] = steady.tolist() if n > 1 else float(steady[0])
     result.meta["max_altitude_error_m"] = vertical.tolist() if n > 1 else float(vertical[0])
-    result = mark_off_track(result, steady, err, vertical)
+    if not watched:
+        err = position_error(result)
+        result = mark_lost_track(result, bound, err)
+        result = mark_off_track(result, steady, err, vertical)
     _warn_about(result)
     return result
 
@@ -524,7 +553,67 @@ MAX_VEHICLE_STEPS = 2.0e10
 vehicle-steps per second on two cores, about two hours or more."""
 
 
-def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1) -> None:
+LOG_BUDGET = 2**28
+"""Largest log [bytes] a batch keeps when ``fly`` chooses ``log_every`` itself: 256 MiB, a quarter of
+the 1 GiB the issue allows, because writing the log is most of what a coarser log costs (about 2 s
+of CPU for 0.73 GB against a 6 s flight; docs/performance.md)."""
+
+
+def log_bytes(n: int, periods: int, log_every: int) -> int:
+    """Bytes of a flight's log: states, commands and references at every ``log_every``-th period.
+
+    Parameters
+    ----------
+    n : int
+        Number of vehicles.
+    periods : int
+        Control periods of the flight.
+    log_every : int
+        Log every this many periods.
+
+    Returns
+    -------
+    int
+        312 bytes per vehicle and logged instant.
+    """
+    from quadcruise.layout import CMD_SIZE, REF_SIZE
+
+    return n * (periods // log_every + 1) * 8 * (STATE_SIZE + CMD_SIZE + REF_SIZE)
+
+
+def batch_log_every(n: int, periods: int) -> int:
+    """The ``log_every`` a flight gets by default: 1 (every period) for one vehicle or a log within
+    :data:`LOG_BUDGET`, else the smallest divisor of the periods that keeps the log within it.
+
+    Parameters
+    ----------
+    n : int
+        Number of vehicles.
+    periods : int
+        Control periods of the flight.
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> batch_log_every(1, 10**6), batch_log_every(200, 1000), batch_log_every(2000, 10_000)
+    (1, 1, 25)
+    """
+    if n <= 1 or log_bytes(n, periods, 1) <= LOG_BUDGET:
+        return 1
+    small = [d for d in range(1, math.isqrt(periods) + 1) if periods % d == 0]
+    divisors = sorted(set(small + [periods // d for d in small]))
+    return next((d for d in divisors if log_bytes(n, periods, d) <= LOG_BUDGET), periods)
+
+
+WATCH_BYTES = 9
+"""Bytes per vehicle-period that the track checks at every period keep over the first half of a
+batch's flight (a moving reference's error and beyond-the-bounds flag: :mod:`~quadcruise.workflows.track_watch`)."""
+
+
+def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1, watched: bool = False) -> None:
     """Refuse, before anything is allocated, a flight whose log would not fit in memory or that
     would run for hours; the message says what to change.
 
@@ -538,12 +627,14 @@ def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1) -> Non
         Log every this many periods.
     substeps : int
         RK4 substeps per control period (``ceil(dt / max_step)``).
+    watched : bool
+        The track checks are made at every period as the flight goes (:data:`WATCH_BYTES`).
 
     Raises
     ------
     InputError
-        The log would take more than :data:`MAX_LOG_FRACTION` of the memory, or the flight more
-        than :data:`MAX_VEHICLE_STEPS` vehicle-steps.
+        The log (and what the checks keep) would take more than :data:`MAX_LOG_FRACTION` of the
+        memory, or the flight more than :data:`MAX_VEHICLE_STEPS` vehicle-steps.
 
     Examples
     --------
@@ -584,6 +675,14 @@ def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1) -> Non
             f"{steps // log_every + 1:,} logged instants), more than half of this machine's "
             f"{memory / 2**30:.0f} GiB: log less often (log_every={every:,}: in Python, or a scenario's "
             "[simulation]) or fly shorter"
+        )
+    watching = n * (steps // 2 + 2) * WATCH_BYTES if watched else 0
+    if watched and need + watching > MAX_LOG_FRACTION * memory:
+        raise InputError(
+            f"the flight's track checks at every period would keep {watching / 2**30:.1f} GiB ({n:,} vehicles x "
+            f"{steps // 2 + 1:,} periods of the first half x {WATCH_BYTES} bytes) beside its "
+            f"{need / 2**30:.2f} GiB log, more than half of this machine's {memory / 2**30:.0f} GiB: fly fewer "
+            "vehicles or shorter, or give log_every (the checks then read the log)"
         )
 
 

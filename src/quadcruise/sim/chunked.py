@@ -1,0 +1,149 @@
+"""A flight flown in chunks of control periods, every period's rows handed to a watcher while
+only every ``log_every``-th is kept: the same :class:`~quadcruise.sim.result.SimResult`, bit for
+bit, as :func:`~quadcruise.sim.engine.simulate` at that ``log_every``.
+
+The chunks go through :class:`~quadcruise.sim.stepper.Stepper` (the kernel's resume arguments),
+so the whole flight's log never exists: a batch keeps a coarse log and a chunk buffer of about
+:data:`CHUNK_VEHICLE_STEPS` rows, and a watcher (``fly``'s track checks) still sees each period.
+
+Examples
+--------
+>>> import numpy as np
+>>> from quadcruise.control import NLPD
+>>> from quadcruise.missions import Circle
+>>> from quadcruise.model.vehicle import Vehicle
+>>> from quadcruise.sim.engine import simulate, time_grid
+>>> t, c, m, v = time_grid(0.2, 1e-3), NLPD(), Circle(), Vehicle.paper()
+>>> x0 = np.zeros(16); x0[2] = 1.0; x0[12:] = v.m * v.g / 4     # hovering at 1 m
+>>> args = (t, x0, v.rows(2), c.function, c.gains(), m.function, m.params())
+>>> seen = []
+>>> def watch(k0, first, stop, x, r): seen.append((stop - first) * x.shape[1])
+>>> a = simulate_watched(*args, memory=c.memory(), log_every=50, watch=watch)
+>>> b = simulate(*args, memory=c.memory(), log_every=50)
+>>> bool(np.array_equal(a.states, b.states, equal_nan=True)), sum(seen)   # every vehicle's every period seen once
+(True, 402)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
+from quadcruise.sim.result import SimResult
+from quadcruise.sim.status import ExitStatus
+from quadcruise.sim.stepper import Stepper
+
+CHUNK_VEHICLE_STEPS = 2**18
+"""Vehicle-steps per chunk (vehicles x periods): a chunk buffer of about 80 MB (312 bytes a row)."""
+PIECES_PER_THREAD = 16
+"""Ranges of vehicles per thread in a chunk: about 2.5 MB of rows each at 2 threads."""
+
+
+def simulate_watched(
+    t_grid,
+    x0,
+    vp,
+    controller,
+    gains,
+    mission,
+    mp,
+    *,
+    watch: Callable[[int, int, int, np.ndarray, np.ndarray], None],
+    log_every: int = 1,
+    meta: dict | None = None,
+    chunk_vehicle_steps: int = CHUNK_VEHICLE_STEPS,
+    pieces_per_thread: int = PIECES_PER_THREAD,
+    **options,
+) -> SimResult:
+    """:func:`~quadcruise.sim.engine.simulate`, flown in chunks, with every instant's state and
+    reference shown to ``watch`` before only every ``log_every``-th is kept.
+
+    Parameters
+    ----------
+    t_grid, x0, vp, controller, gains, mission, mp
+        As in :func:`~quadcruise.sim.engine.simulate`.
+    watch : callable
+        Called as ``watch(k0, first, stop, states, references)`` for each chunk and piece of
+        vehicles, chunks in order, on the thread that flew the piece: vehicles first..stop-1 of
+        the (N, C, 16) states and (N, C, 11) references at the control instants
+        ``k0 .. k0 + C - 1`` (the whole flight's rows at ``log_every=1``: NaN after a vehicle
+        stopped, the state that broke a bound in the row after its last period). Views of a
+        buffer reused by the next chunk: copy what is kept.
+    log_every : int
+        Keep every this many periods in the result (a divisor of the grid's periods).
+    meta : dict, optional
+        Recorded in the result.
+    chunk_vehicle_steps : int
+        Vehicles x periods per chunk.
+    pieces_per_thread : int
+        Ranges of vehicles per thread and chunk, each watched and logged by its thread right
+        after it is flown.
+    **options
+        The other keywords of :func:`~quadcruise.sim.engine.simulate` (``memory``, ``vp_ctrl``,
+        ``disturbance``, ``disturbance_params``, ``disturbance_memory``, ``seed``,
+        ``first_vehicle``, ``sensor_std``, ``sensor_delay``, ``full_dynamics``, ``max_step``,
+        ``limits``).
+
+    Returns
+    -------
+    SimResult
+        Bit for bit what ``simulate(..., log_every=log_every)`` returns.
+    """
+    n_periods = np.shape(t_grid)[0] - 1
+    n = np.shape(vp)[0]
+    periods = int(max(1, min(n_periods, chunk_vehicle_steps // max(n, 1))))
+    s = Stepper(t_grid, x0, vp, controller, gains, mission, mp, periods=periods, **options)
+    t_grid = s.t_grid
+    n_log = n_periods // log_every + 1
+    logs = [np.empty((n, n_log, w)) for w in (STATE_SIZE, CMD_SIZE, REF_SIZE)]  # every row is written below
+    small = (s.log_x, s.log_cmd, s.log_ref)
+    held = None  # the row after the chunk of vehicles that stopped in its last period, and where it goes
+    k0 = 0
+    while k0 < n_periods:
+        flying = s.status == int(ExitStatus.FINISHED)
+        if not flying.any():  # all stopped: the rest of the log is blank, as the kernel leaves it
+            for big in logs:
+                big[:, -(-k0 // log_every) :] = np.nan
+        else:
+            k1 = min(k0 + periods, n_periods)
+            seen = k1 - k0 + (k1 == n_periods)  # the last instant of the grid is flown by the last chunk
+            first = -(-k0 // log_every) * log_every  # the kept periods in k0 .. k0 + seen - 1
+            rows = slice(first // log_every, (k0 + seen - 1) // log_every + 1)
+            cols = slice(first - k0, seen, log_every)
+
+            def after_piece(lo: int, hi: int, k0=k0, seen=seen, rows=rows, cols=cols) -> None:
+                watch(k0, lo, hi, s.log_x[:, :seen], s.log_ref[:, :seen])
+                for big, part in zip(logs, small, strict=True):
+                    big[lo:hi, rows] = part[lo:hi, cols]
+
+            s.step(after_piece=after_piece, pieces_per_thread=pieces_per_thread)
+        if held is not None:  # written over the blank rows that followed
+            for big, (who, row, part) in zip(logs, held, strict=True):
+                big[who, row] = part
+            held = None
+        if not flying.any():
+            break
+        stopped = np.flatnonzero(flying & (s.status != int(ExitStatus.FINISHED)))
+        if k1 < n_periods and k1 % log_every == 0 and stopped.size:  # the state that broke a bound, at k1
+            held = [(stopped, k1 // log_every, part[stopped, k1 - k0].copy()) for part in small]
+        k0 = k1
+    log_x, log_cmd, log_ref = logs
+    return SimResult(
+        t=t_grid[::log_every][:n_log].copy(),
+        states=log_x,
+        commands=log_cmd,
+        references=log_ref,
+        final_state=s.state,
+        status=s.status,
+        t_stop=s.t_stop,
+        memory=s.memory,
+        disturbance_memory=s.disturbance_memory,
+        duty_clipped_s=s.saturated[:, 0].copy(),
+        controller_limited_s=s.saturated[:, 1].copy(),
+        meta=dict(meta or {}),
+    )
+
+
+__all__ = ["CHUNK_VEHICLE_STEPS", "simulate_watched"]
