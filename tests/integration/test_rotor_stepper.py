@@ -118,3 +118,10 @@ def test_bad_rotor_arguments_are_one_clear_error():
         s.reset(x0=np.zeros(16))
     with pytest.raises(InputError, match="full_dynamics"):
         stepper("hover", "se3", vehicle="crazyflie", duration=0.01, full_dynamics=True)
+
+
+def test_after_piece_sees_every_rotor_vehicle_once_per_step():
+    s = stepper("hover", "se3", vehicle="crazyflie", duration=0.02, n=5)
+    seen = []
+    s.step(after_piece=lambda first, stop: seen.extend(range(first, stop)), pieces_per_thread=2)
+    assert sorted(seen) == list(range(5)) and s.period.tolist() == [1] * 5

@@ -462,7 +462,7 @@ def _rotor_flight_kernel(
 _pool: ThreadPoolExecutor | None = None
 
 
-def fly_rotor_pieces(n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD) -> None:
+def fly_rotor_pieces(n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD, after_piece=None) -> None:
     """The rotor kernel over vehicles 0..n-1 on numba's number of threads, in ranges handed out in
     turn (as :func:`quadcruise.sim.engine.fly_vehicles` does for the paper's kernel); each
     vehicle's arithmetic does not depend on its range, so a batch reproduces single flights bit
@@ -476,18 +476,26 @@ def fly_rotor_pieces(n: int, args: tuple, pieces_per_thread: int = PIECES_PER_TH
         The kernel's arguments after the vehicle range (``ROTOR_FLIGHT_SIG``, in order).
     pieces_per_thread : int
         Ranges per thread: fewer for short calls (a step), where each call's fixed cost counts.
+    after_piece : callable, optional
+        Called as ``after_piece(first, stop)`` on the thread that flew vehicles first..stop-1,
+        right after it (as :func:`quadcruise.sim.engine.fly_vehicles` calls it).
     """
     global _pool
     threads = min(n, get_num_threads())
     if threads <= 1:
         _rotor_flight_kernel(0, n, *args)
+        if after_piece is not None:
+            after_piece(0, n)
         return
     bounds = np.linspace(0, n, min(n, pieces_per_thread * threads) + 1).round().astype(np.int64)
     pieces = itertools.count()  # next() on it is atomic under the GIL
 
     def work() -> None:
         while (k := next(pieces)) < bounds.shape[0] - 1:
-            _rotor_flight_kernel(int(bounds[k]), int(bounds[k + 1]), *args)
+            first, stop = int(bounds[k]), int(bounds[k + 1])
+            _rotor_flight_kernel(first, stop, *args)
+            if after_piece is not None:
+                after_piece(first, stop)
 
     if _pool is None:
         _pool = ThreadPoolExecutor(max_workers=max(1, config.NUMBA_NUM_THREADS - 1), thread_name_prefix="rotors")

@@ -394,7 +394,7 @@ class Stepper:
                 )
             self.gains[:, : self.setpoint_width] = c
         if self.rotor:
-            self._step_rotor()
+            self._step_rotor(pieces_per_thread, after_piece)
             return
         fly_vehicles(
             self.n,
@@ -434,7 +434,7 @@ class Stepper:
             after_piece,
         )
 
-    def _step_rotor(self) -> None:
+    def _step_rotor(self, pieces_per_thread: int, after_piece) -> None:
         """:meth:`step` of the rotor plant: its kernel, with the arguments of ``ROTOR_FLIGHT_SIG``."""
         fly_rotor_pieces(
             self.n,
@@ -475,7 +475,8 @@ class Stepper:
                 self.t_stop,
                 self.saturated,
             ),
-            STEP_PIECES_PER_THREAD,
+            pieces_per_thread,
+            after_piece,
         )
 
 
