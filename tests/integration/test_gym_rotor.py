@@ -156,5 +156,9 @@ def test_rotor_env_bad_input_is_one_line():
     with pytest.raises(InputError, match="action 'rotors': the action has 4 entries and the vehicle 6 rotors"):
         QuadVectorEnv(2, vehicle=hexa, action="rotors")
     QuadVectorEnv(2, vehicle=hexa, action="attitude").reset(seed=0)  # the other modes fly any layout
+    bare = RotorVehicle.preset("crazyflie").replace(**dict.fromkeys(AERO_FIELDS, 0.0))
+    with pytest.raises(InputError, match="wind acts on a rotor-plant vehicle through its aerodynamics"):
+        QuadVectorEnv(2, vehicle=bare, population=Population(wind_spread=2.0))
+    QuadVectorEnv(2, vehicle="crazyflie", population=Population(wind_spread=2.0)).reset(seed=0)
     with pytest.raises(InputError, match="unknown vehicle preset|preset"):
         QuadVectorEnv(2, vehicle="no-such-drone")

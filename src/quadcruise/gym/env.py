@@ -178,8 +178,6 @@ class QuadVectorEnv(VectorEnv):
         if self.nominal_eq.batch_size is not None:
             raise InputError("the environment's vehicle must not be batched: use a population to vary it")
         check_can_hover(self.nominal_eq)
-        if self.rotor:
-            check_wind_acts(self.nominal, None if population is None else population.environment)
         self.population, self.action_mode, self.max_track_error = population, action, float(max_track_error)
         default = RANDOM_DURATION if self.random_mission else self.mission.duration
         self.duration = float(default if duration is None else duration)
@@ -192,6 +190,8 @@ class QuadVectorEnv(VectorEnv):
         except ValueError as err:
             raise InputError(str(err)) from None
         draw = self._draw(0, np.arange(n) * EPISODE_STRIDE, n)
+        if self.rotor:  # the drawn environment: a population's wind spread makes wind of still air
+            check_wind_acts(self.nominal, draw["environment"])
         self.sensors = None if population is None else population.noise
         if self.baseline is not None:
             function, gains, memory, width = (self.baseline.function, self.baseline.gains(), self.baseline.memory(), 0)
