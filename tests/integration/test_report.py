@@ -32,15 +32,8 @@ from quadcruise.io.plainjson import dumps
 from quadcruise.metrics.tables import cell
 from quadcruise.plots import animate
 from quadcruise.report import html as report
-from quadcruise.report.html import (
-    comparison_report,
-    flight_report,
-    html_report,
-    markdown_html,
-    reproduction_report,
-    table_html,
-    write_html_report,
-)
+from quadcruise.report.html import html_report, markdown_html, table_html, write_html_report
+from quadcruise.report.sections import comparison_report, flight_report, reproduction_report
 from quadcruise.workflows.compare import compare
 from quadcruise.workflows.reproduce import fitted_nlpd_loop, reproduce
 

@@ -75,7 +75,8 @@ from quadcruise.layout import (
 )
 from quadcruise.metrics import tracking_errors
 from quadcruise.missions import Circle, Hover, Step
-from quadcruise.missions.waypoints import MinimumSnap, WaypointTable
+from quadcruise.missions.minsnap import MinimumSnap
+from quadcruise.missions.waypoints import WaypointTable
 from quadcruise.model.actuators import mix
 from quadcruise.workflows.compare import Comparison, compare
 

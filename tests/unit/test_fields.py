@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 import quadcruise
+from quadcruise.cli.assignments import parse_assignments, parse_numbers
 from quadcruise.errors import InputError
 from quadcruise.fields import (
     CHECKS,
@@ -25,8 +26,6 @@ from quadcruise.fields import (
     check_value,
     instance_of,
     one_of,
-    parse_assignments,
-    parse_numbers,
     unit_field,
     validate,
     vector,

@@ -15,6 +15,9 @@ from quadcruise.errors import InputError
 from quadcruise.metrics import (
     StepInfo,
     control_effort,
+    conventions,
+    signals,
+    step,
     step_info,
     step_info_batch,
     time_in_saturation,
@@ -311,9 +314,10 @@ def test_time_in_saturation_sample_and_hold():
         time_in_saturation(t, bits[:4])
 
 
-def test_docstring_examples():
-    result = doctest.testmod(metrics, raise_on_error=False)
-    assert result.attempted > 5 and result.failed == 0
+@pytest.mark.parametrize("module", [step, signals, conventions, metrics], ids=lambda m: m.__name__)
+def test_docstring_examples(module):
+    result = doctest.testmod(module, raise_on_error=False)
+    assert result.attempted >= 2 and result.failed == 0
 
 
 # --- a whole flight: tracking after the transient, peak time, conventions, effort ------------

@@ -14,14 +14,8 @@ import quadcruise as qc
 from quadcruise.errors import InputError
 from quadcruise.layout import REF_AX, REF_AY, REF_AZ, REF_PSI, REF_PSI_DOT, REF_VX, REF_VY, REF_VZ, REF_X, REF_Y, REF_Z
 from quadcruise.missions import MISSIONS, mission_from_dict, mission_from_name, stack_params
-from quadcruise.missions.waypoints import (
-    SETTLE_S,
-    MinimumSnap,
-    Waypoints,
-    WaypointTable,
-    minimum_snap_coefficients,
-    read_waypoints_csv,
-)
+from quadcruise.missions.minsnap import MinimumSnap, minimum_snap_coefficients
+from quadcruise.missions.waypoints import SETTLE_S, Waypoints, WaypointTable, read_waypoints_csv
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "waypoints.csv"
 POS, VEL, ACC = [REF_X, REF_Y, REF_Z], [REF_VX, REF_VY, REF_VZ], [REF_AX, REF_AY, REF_AZ]
@@ -290,7 +284,7 @@ def test_minsnap_has_less_snap_than_the_alternatives():
     naive = minimum_snap_coefficients(pts, tk, stops=np.ones(len(tk), bool))
     assert best < 0.5 * snap_integral(naive, tk)
     # 2. any feasible change of the coefficients (same points, C3, rest at the ends) adds snap
-    from quadcruise.missions.waypoints import _derivative_row
+    from quadcruise.missions.minsnap import _derivative_row
 
     m_seg = len(tk) - 1
     rows = []
@@ -404,7 +398,7 @@ def kkt_minimum_snap(values, times, stops):
     """The minimum-snap QP in its other form, for comparison: all 8 coefficients of every
     segment as unknowns, the interpolation, rest and C1-C3 conditions as equality constraints,
     solved through the (dense) KKT system of min sum_i T_i^-7 a_i^T H a_i."""
-    from quadcruise.missions.waypoints import _derivative_row
+    from quadcruise.missions.minsnap import _derivative_row
 
     w = np.asarray(values, dtype=float).reshape(len(times), -1)
     dur = np.diff(np.asarray(times, dtype=float))

@@ -159,7 +159,7 @@ SETTLE_BAND_OPTION = click.option(
 
 def metric_options(rise: str = "10-90", settle_bands: tuple[float, ...] = ()) -> dict:
     """``--rise`` and ``--settle-band`` as keywords of :func:`quadcruise.metrics.flight_metrics`, checked
-    (:func:`~quadcruise.metrics.flight.metric_conventions`) before anything flies.
+    (:func:`~quadcruise.metrics.conventions.metric_conventions`) before anything flies.
 
     Parameters
     ----------
@@ -173,7 +173,7 @@ def metric_options(rise: str = "10-90", settle_bands: tuple[float, ...] = ()) ->
     dict
         ``rise`` and ``settle_bands``.
     """
-    from quadcruise.metrics.flight import metric_conventions
+    from quadcruise.metrics.conventions import metric_conventions
 
     kw = {"rise": rise, "settle_bands": tuple(settle_bands) or (0.02, 0.05)}
     metric_conventions(**kw)

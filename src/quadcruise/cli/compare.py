@@ -202,7 +202,8 @@ def compare(
         cmp.write(out, force=force, **conventions)
         click.echo(f"wrote metrics.csv and comparison.png to {out}")
     if report is not None:
-        from quadcruise.report.html import comparison_report, write_html_report
+        from quadcruise.report.html import write_html_report
+        from quadcruise.report.sections import comparison_report
 
         write_html_report(report, **comparison_report(cmp, **conventions))
         click.echo(f"wrote report {report}")

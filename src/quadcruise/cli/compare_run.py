@@ -186,7 +186,7 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
         The mission, the controllers (names, or label -> controller), the keywords (the
         scenario's vehicle as written, without drag added) and the scenario read.
     """
-    from quadcruise.fields import parse_assignments
+    from quadcruise.cli.assignments import parse_assignments
 
     if not mission.lower().endswith(".toml"):
         chosen = DEFAULT_COMPARED if controllers is None else controllers

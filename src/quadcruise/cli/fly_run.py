@@ -96,7 +96,8 @@ def fly_and_report(
         write_flight(result, out, fmt, metrics=metrics)
         click.echo(f"wrote traces, figure and metrics to {out}")
     if report is not None:
-        from quadcruise.report.html import flight_report, write_html_report
+        from quadcruise.report.html import write_html_report
+        from quadcruise.report.sections import flight_report
 
         write_html_report(report, **flight_report(result, metrics=metrics))
         click.echo(f"wrote report {report}")

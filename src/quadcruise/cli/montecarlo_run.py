@@ -23,7 +23,7 @@ __all__ = ["montecarlo_command", "parse_noise"]
 def parse_noise(text: str | None):
     """Parse a sensor noise spec, ``position=STD,velocity=STD,angle=STD,rate=STD,delay=S``.
 
-    Parsed by :func:`quadcruise.fields.parse_assignments`; the values are checked by
+    Parsed by :func:`quadcruise.cli.assignments.parse_assignments`; the values are checked by
     :class:`~quadcruise.disturbances.SensorNoise`.
 
     Parameters
@@ -52,8 +52,8 @@ def parse_noise(text: str | None):
     """
     if text is None or str(text).strip().lower() in ("", "none"):
         return None
+    from quadcruise.cli.assignments import parse_assignments
     from quadcruise.disturbances import SensorNoise
-    from quadcruise.fields import parse_assignments
 
     names = {
         "position": "position_std",

@@ -53,8 +53,8 @@ def controller_params(params: tuple[str, ...], poles_text: str | None) -> dict:
     -------
     dict
     """
+    from quadcruise.cli.assignments import parse_assignments
     from quadcruise.control.design import pd_from_poles
-    from quadcruise.fields import parse_assignments
 
     out = parse_assignments(params, "--controller-param")
     poles = _poles(poles_text, "--poles")
@@ -112,7 +112,7 @@ def mission_from_options(text: str, params: tuple[str, ...], smooth: bool):
     -------
     Mission
     """
-    from quadcruise.fields import parse_assignments
+    from quadcruise.cli.assignments import parse_assignments
     from quadcruise.missions import MISSIONS, mission_from_name
 
     mparams = parse_assignments(params, "--mission-param")
@@ -153,7 +153,7 @@ def flight_from_options(
     (Mission, Controller, dict, Scenario or None)
         The mission, the controller, the keywords of :func:`quadcruise.fly`, and the scenario read.
     """
-    from quadcruise.fields import parse_assignments
+    from quadcruise.cli.assignments import parse_assignments
     from quadcruise.missions import mission_from_name
 
     if not mission.lower().endswith(".toml"):

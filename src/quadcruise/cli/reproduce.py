@@ -92,7 +92,8 @@ def reproduce(out, fmt, force, report, scenario):
     with Bar("drawing", unit="figure") as drawn:
         write_reproduction(rep, out, force=force, fmt=fmt, progress=drawn)
     if report is not None:
-        from quadcruise.report.html import reproduction_report, write_html_report
+        from quadcruise.report.html import write_html_report
+        from quadcruise.report.sections import reproduction_report
 
         write_html_report(report, **reproduction_report(rep, written_figures(out)))
         click.echo(f"wrote report {report}")

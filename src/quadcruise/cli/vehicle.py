@@ -49,7 +49,7 @@ hummingbird, iris, qball-x4); or give the vehicle's fields, KEY=VALUE,..., or a 
         return None
     import dataclasses
 
-    from quadcruise.fields import parse_assignments
+    from quadcruise.cli.assignments import parse_assignments
     from quadcruise.model.vehicle import Vehicle
     from quadcruise.workflows.scenario import read_vehicle_file, vehicle_preset
 

@@ -17,10 +17,10 @@ from __future__ import annotations
 import re
 from typing import Any
 
+from quadcruise.cli.assignments import parse_numbers
 from quadcruise.disturbances import INTENSITIES, ConstantWind, Environment, ExternalForce, Gust, RotorLoss, Turbulence
 from quadcruise.disturbances.part import Part
 from quadcruise.errors import InputError
-from quadcruise.fields import parse_numbers
 
 PART_NAMES = {
     "constant": ConstantWind,

@@ -25,8 +25,15 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from quadcruise.metrics.flight import STEADY_BAND, TRANSIENT_MIN_ERROR, control_effort, tracking_errors
-from quadcruise.metrics.tracking import TRACKING_AXIS, first_crossing_batch, moving_reference, tracking_transient_batch
+from quadcruise.metrics.signals import control_effort, tracking_errors
+from quadcruise.metrics.tracking import (
+    STEADY_BAND,
+    TRACKING_AXIS,
+    TRANSIENT_MIN_ERROR,
+    first_crossing_batch,
+    moving_reference,
+    tracking_transient_batch,
+)
 
 __all__ = [
     "first_crossing_batch",

@@ -204,7 +204,7 @@ def conventions_text(conventions: dict | None) -> str:
     ----------
     conventions : dict or None
         A table's ``attrs["conventions"]``
-        (:func:`quadcruise.metrics.flight.metric_conventions`); None or empty for none.
+        (:func:`quadcruise.metrics.conventions.metric_conventions`); None or empty for none.
 
     Returns
     -------
@@ -214,7 +214,7 @@ def conventions_text(conventions: dict | None) -> str:
 
     Examples
     --------
-    >>> from quadcruise.metrics.flight import metric_conventions
+    >>> from quadcruise.metrics.conventions import metric_conventions
     >>> print(conventions_text(metric_conventions(rise=(0.0, 1.0))))
     rise_time_s: 0-100 % of the step (axis xyz: of the error's way to its steady level); settling_time_s: 2 % ...
     steady_*: 3-D position error from the 5 % settling time on (axis xyz, a moving reference: over the last ...

@@ -7,9 +7,10 @@ from typing import Any
 from quadcruise import checks
 from quadcruise.errors import InputError
 from quadcruise.missions.base import Mission, check_names
+from quadcruise.missions.minsnap import MinimumSnap
 from quadcruise.missions.shapes import Circle, Hover, Square, Step
 from quadcruise.missions.sysid import Sysid
-from quadcruise.missions.waypoints import MinimumSnap, Waypoints
+from quadcruise.missions.waypoints import Waypoints
 from quadcruise.model.vehicle import shared_default
 
 __all__ = ["MISSIONS", "as_mission", "mission_from_dict", "mission_from_name"]

@@ -6,7 +6,9 @@ Figures are embedded as base64 PNG, the 3-D view is plain JavaScript on a ``<can
 Content-Security-Policy forbids the page any request. The first script of the page
 records every error (``window.onerror``, ``console.error``, a blocked request) in
 ``<pre id="qc-errors">``, and each canvas gets ``data-rendered="1"`` once drawn, so a
-headless browser's DOM tells whether the page works.
+headless browser's DOM tells whether the page works. This module assembles the page and
+renders its parts (tables, figures, 3-D views, markdown); what a flight's, a comparison's or the
+reproduction's report holds: :mod:`quadcruise.report.sections`.
 
 Examples
 --------
@@ -41,9 +43,6 @@ from quadcruise.plots.thin import thinned
 __all__ = [
     "html_report",
     "write_html_report",
-    "flight_report",
-    "comparison_report",
-    "reproduction_report",
     "markdown_html",
     "table_html",
 ]
@@ -434,199 +433,6 @@ def write_html_report(path, **kwargs) -> Path:
     with atomic_path(path) as tmp:
         tmp.write_text(page, encoding="utf-8")
     return path
-
-
-def _metrics_table(frame, label: str = "value"):
-    """Metrics down, vehicles across for a few vehicles (one flight: one column, ``label``);
-    one row per vehicle otherwise."""
-    if len(frame) > 6:
-        return frame
-    shown = frame.set_index("vehicle").T
-    shown.columns = [label] if len(frame) == 1 else [f"vehicle {v}" for v in shown.columns]
-    return shown
-
-
-def _conventions_table(frame) -> dict:
-    """``{"Metric conventions": table}`` of what a metrics table's columns measure (its
-    ``attrs["conventions"]``), or ``{}`` if it records none."""
-    import pandas as pd
-
-    conv = frame.attrs.get("conventions")
-    if not conv:
-        return {}
-    values = {
-        "rise_time_s": "{:g}-{:g} % of the step (axis xyz: of the error's way to its steady level)".format(
-            *(100.0 * v for v in conv["rise"])
-        )
-    }
-    values.update({name: f"{100.0 * band:g} % band" for name, band in conv["settling_columns"].items()})
-    values["steady_rmse_m, steady_max_error_m"] = (
-        f"3-D position error from the {100.0 * conv['steady_band']:g} % "
-        "settling time on (axis xyz, a moving reference: over the last "
-        "half of the flight, once converged; the whole flight without a "
-        "transient)"
-    )
-    values["effort"] = conv["effort"]
-    return {"Metric conventions": pd.DataFrame({"meaning": values})}
-
-
-def flight_report(result, *, title: str | None = None, metrics=None) -> dict:
-    """Keywords of :func:`html_report` for one flight (one ``fly``).
-
-    Parameters
-    ----------
-    result : SimResult
-        The flight, of one vehicle or a batch.
-    title : str, optional
-        The page's title; by default "quadcruise: " and what the flight was.
-    metrics : pandas.DataFrame, optional
-        ``result.metrics()``, if already computed (saves computing them again).
-
-    Returns
-    -------
-    dict
-        ``title``, ``tables`` (the metrics, vehicles across for up to 6 vehicles, and the
-        run: controller, mission, duration [s], dt [s], vehicles, seed, version),
-        ``figures`` (the flight, of vehicle 0 in a batch, and a batch's envelope),
-        ``flights`` (the 3-D view) and ``config`` (``result.meta``).
-    """
-    import pandas as pd
-
-    from quadcruise.plots.flight import describe, plot_envelope, plot_flight
-
-    meta = result.meta or {}
-    ctrl, mission = meta.get("controller"), meta.get("mission")
-    mission = mission[0] if isinstance(mission, list) and mission else mission
-    run = {
-        "controller": ctrl.get("name") if isinstance(ctrl, dict) else ctrl,
-        "mission": mission.get("kind") if isinstance(mission, dict) else mission,
-        "duration_s": float(result.t[-1] - result.t[0]),
-        "dt_s": meta.get("dt_s"),
-        "vehicles": result.n,
-        "finished": f"{int(result.ok.sum())} of {result.n}",
-        "seed": meta.get("seed"),
-        "version": meta.get("version"),
-    }
-    run_table = pd.DataFrame({"value": {k: v for k, v in run.items() if v is not None}})
-    label = describe(result)
-    figures = {(f"Flight of vehicle 0: {label}" if result.n > 1 else f"Flight: {label}"): plot_flight(result)}
-    if result.n > 1:
-        figures[f"All {result.n} vehicles"] = plot_envelope(result)
-    metrics = result.metrics() if metrics is None else metrics
-    return {
-        "title": title or f"quadcruise: {label}",
-        "tables": {"Flight metrics": _metrics_table(metrics, label), **_conventions_table(metrics), "Run": run_table},
-        "figures": figures,
-        "flights": {label: result},
-        "config": meta,
-    }
-
-
-def comparison_report(cmp, *, title: str | None = None, **metric_kw) -> dict:
-    """Keywords of :func:`html_report` for a :class:`~quadcruise.workflows.compare.Comparison`.
-
-    Parameters
-    ----------
-    cmp : Comparison
-        The flights of several controllers.
-    title : str, optional
-        The page's title; by default the controllers and the mission.
-    **metric_kw
-        Keywords of :meth:`Comparison.table` (``rise``, ``settle_bands``, ...).
-
-    Returns
-    -------
-    dict
-        ``title``, ``tables`` (the metrics by controller, transposed when every flight
-        has one vehicle, and their conventions), ``figures`` (the paths), ``flights`` (one
-        3-D view of all) and ``config`` (:meth:`Comparison.to_dict` without the metrics).
-    """
-    table = cmp.table(**metric_kw)
-    if all(r.n == 1 for r in cmp.results.values()):
-        table = table.T  # metrics down, controllers across
-    config = {k: v for k, v in cmp.to_dict(**metric_kw).items() if k != "metrics"}
-    name = getattr(cmp.mission, "name", "mission")
-    return {
-        "title": title or f"quadcruise: {' vs '.join(cmp.results)} on {name}",
-        "tables": {"Metrics by controller": table, **_conventions_table(table)},
-        "figures": {f"Paths on {name}": cmp.plot()},
-        "flights": dict(cmp.results),
-        "config": config,
-    }
-
-
-def reproduction_report(rep, figures: dict | None = None, *, title: str | None = None) -> dict:
-    """Keywords of :func:`html_report` for a :class:`~quadcruise.workflows.reproduce.Reproduction`.
-
-    Parameters
-    ----------
-    rep : Reproduction
-        The runs.
-    figures : dict, optional
-        Caption -> Figure, PNG bytes or PNG file (e.g. those that
-        :func:`~quadcruise.workflows.reproduce.write_reproduction` wrote); ``None`` draws
-        them here.
-    title : str, optional
-        The page's title; by default the version and "reproduction of the paper".
-
-    Returns
-    -------
-    dict
-        ``title``, ``tables`` (each run beside the paper's numbers), ``figures``,
-        ``flights`` (3-D views of the circle and the square, each with every controller),
-        ``config`` and ``notes`` (where the numbers differ from the paper's, and why).
-    """
-    import pandas as pd
-
-    from quadcruise._version import __version__
-    from quadcruise.workflows.reproduce import (
-        FIGURES,
-        INTRO,
-        TRACE_EVERY,
-        baseline_comparison,
-        differences,
-        paper_figure,
-        paper_numbers,
-    )
-
-    rows = []
-    for r in rep.runs:
-        paper = paper_numbers(r)
-        rows.append(
-            {
-                "scenario": r["scenario"],
-                "controller": r["controller"],
-                "axis": r["axis"],
-                "rise_time_s": r["rise_time_s"],
-                "paper: rise_time_s": paper.get("rise_time_s"),
-                "settling_time_s": r["settling_time_s"],
-                "paper: settling_time_s": paper.get("settling_time_s"),
-                "settling_time_5pct_s": r["settling_time_5pct_s"],
-                "overshoot_pct": r["overshoot_pct"],
-                "paper: overshoot_pct": paper.get("overshoot_pct"),
-                "rmse_m": r["rmse_m"],
-                "max_error_m": r["max_error_m"],
-                "status": r["status"],
-            }
-        )
-    table = (
-        pd.DataFrame(rows).astype({c: float for c in rows[0] if c.endswith(("_s", "_pct", "_m"))})
-        if rows
-        else pd.DataFrame()
-    )
-    if figures is None:
-        light = {key: res.decimate(TRACE_EVERY) for key, res in rep.results.items()}
-        figures = {cap: fig for name, cap in FIGURES.items() if (fig := paper_figure(name, cap, light)) is not None}
-    flights = {scen: {c: res for (s, c), res in rep.results.items() if s == scen} for scen in ("circle", "square")}
-    notes = markdown_html(INTRO + "\n" + differences() + baseline_comparison(rep))
-    return {
-        "title": title or f"quadcruise {__version__}: reproduction of the paper",
-        "tables": {"Results against the paper": table},
-        "figures": figures,
-        "flights": {k: v for k, v in flights.items() if v},
-        "config": {"workflow": "reproduce", **rep.config, "version": __version__},
-        "notes": notes,
-    }
 
 
 def _inline(text: str) -> str:

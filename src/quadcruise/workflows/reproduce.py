@@ -239,7 +239,7 @@ def reproduce(
 
 def _rise_0_100(result: SimResult, mission: Step) -> float:
     """Rise time [s] of a step flight from the step to the first reaching of its target (0-100 %)."""
-    from quadcruise.metrics.flight import step_info
+    from quadcruise.metrics.step import step_info
 
     j = "xyz".index(mission.axis)
     y0 = getattr(mission, mission.axis)
