@@ -39,15 +39,6 @@ _UNITS = {"s": " of seconds", "m": " of metres"}
 def short_number(x: float) -> str:
     """A number as a message writes it: its repr when short, else 6 significant digits.
 
-    Parameters
-    ----------
-    x : float
-        Any real number (an int of any size too).
-
-    Returns
-    -------
-    str
-
     Examples
     --------
     >>> short_number(0.1), short_number(10**300), short_number(2)
@@ -64,18 +55,6 @@ def short_number(x: float) -> str:
 
 def describe(value: Any, limit: int = 60) -> str:
     """What was given, for a message: its type and a short form of it.
-
-    Parameters
-    ----------
-    value : Any
-        The value given.
-    limit : int
-        Most characters of its repr shown.
-
-    Returns
-    -------
-    str
-        E.g. ``str '0.001'``, ``int 3``, ``the class Circle``, ``None``.
 
     Examples
     --------
@@ -99,29 +78,7 @@ def describe(value: Any, limit: int = 60) -> str:
 
 
 def fail(where: str, name: str, value: Any, want: str, *, kind: bool = True, hint: str = "") -> None:
-    """Raise the one message: ``<where> argument <name> must be <want>, got <value>``.
-
-    Parameters
-    ----------
-    where : str
-        The function, e.g. ``"fly()"``.
-    name : str
-        The argument.
-    value : Any
-        What was given.
-    want : str
-        What is expected.
-    kind : bool
-        True: the value is of the wrong type (ArgumentTypeError); False: of the right type but
-        out of range (InputError).
-    hint : str
-        What to do, appended after a semicolon.
-
-    Raises
-    ------
-    ArgumentTypeError or InputError
-        Always.
-    """
+    """Raise the one message: ``<where> argument <name> must be <want>, got <value>``."""
     text = f"{where} argument {name} must be {want}, got {describe(value)}"
     if inspect.isclass(value) and not hint:
         hint = f"give an object, e.g. {value.__name__}()"
@@ -145,25 +102,6 @@ def number(
     infinite: bool = False,
 ) -> float | None:
     """A finite number (an int or a float, not a bool nor a string), as a float.
-
-    Parameters
-    ----------
-    where, name : str
-        The function and the argument, for the message.
-    value : Any
-        The value given.
-    check : {"real", "pos", "nonneg"}
-        Any finite number, > 0, or >= 0.
-    unit : str
-        Its unit ("s", "m", ...), for the message.
-    optional : bool
-        None is allowed (and returned).
-    infinite : bool
-        ``inf`` is allowed too (a bound that ``numpy.inf`` turns off).
-
-    Returns
-    -------
-    float or None
 
     Examples
     --------
@@ -193,21 +131,6 @@ def number(
 def whole(where: str, name: str, value: Any, minimum: int = 0, *, optional: bool = False) -> int | None:
     """A whole number >= ``minimum`` (an int or a numpy integer; not a bool, not a float).
 
-    Parameters
-    ----------
-    where, name : str
-        The function and the argument, for the message.
-    value : Any
-        The value given.
-    minimum : int
-        The smallest value accepted.
-    optional : bool
-        None is allowed (and returned).
-
-    Returns
-    -------
-    int or None
-
     Examples
     --------
     >>> whole("fly()", "seed", True)
@@ -229,17 +152,6 @@ def flag(where: str, name: str, value: Any) -> bool:
     """``True`` or ``False`` (a numpy bool too), nothing else: a string such as ``"no"`` is
     refused, not read as true.
 
-    Parameters
-    ----------
-    where, name : str
-        The function and the argument, for the message.
-    value : Any
-        The value given.
-
-    Returns
-    -------
-    bool
-
     Examples
     --------
     >>> flag("fly()", "full_dynamics", "no")
@@ -256,24 +168,6 @@ def instance(
     where: str, name: str, value: Any, cls: type | tuple, *, optional: bool = True, want: str | None = None
 ) -> Any:
     """An object of ``cls`` (None too if ``optional``), returned as given.
-
-    Parameters
-    ----------
-    where, name : str
-        The function and the argument, for the message.
-    value : Any
-        The value given.
-    cls : type or tuple of type
-        The class(es) accepted.
-    optional : bool
-        None is allowed.
-    want : str, optional
-        How the message names what is expected; "a <cls>" by default.
-
-    Returns
-    -------
-    Any
-        ``value``.
 
     Examples
     --------
@@ -293,43 +187,14 @@ def instance(
 
 
 def callback(where: str, name: str, value: Any) -> Any:
-    """None or a callable (a ``progress`` function), returned as given.
-
-    Parameters
-    ----------
-    where, name : str
-        The function and the argument, for the message.
-    value : Any
-        The value given.
-
-    Returns
-    -------
-    callable or None
-    """
+    """None or a callable (a ``progress`` function), returned as given."""
     if value is not None and not callable(value):
         fail(where, name, value, "a callable or None")
     return value
 
 
 def pair(where: str, name: str, value: Any, want: str, *, hint: str = "") -> tuple:
-    """Two items (a tuple, a list or a 1-D array of two), as a tuple; their values are checked
-    by the caller.
-
-    Parameters
-    ----------
-    where, name : str
-        The function and the argument, for the message.
-    value : Any
-        The value given.
-    want : str
-        What is expected, e.g. ``"a pair (low, high)"``.
-    hint : str
-        What to do, for the message.
-
-    Returns
-    -------
-    tuple
-        The two items.
+    """Two items (a tuple, a list or a 1-D array of two), as a tuple; the caller checks their values.
 
     Examples
     --------

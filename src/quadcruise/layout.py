@@ -33,25 +33,8 @@ from numba import types
 @dataclass(frozen=True)
 class Row:
     """One packed float64 row, declared once: an ordered list of named fields that yields the
-    offsets, the packing and the column names.
-
-    The compiled code reads a row through module-level int constants, which numba folds into
-    the machine code: unpack them from :attr:`offsets` where the row is declared, named
-    ``prefix + FIELD.upper()`` (``tests/unit/test_rows.py`` checks the names and the order)::
-
-        PD = Row.of("pd gains", "kp", "kd", prefix="PD_")
-        PD_KP, PD_KD = PD.offsets
-
-    Parameters
-    ----------
-    name : str
-        What the row is, for messages (``"nlpd gains"``).
-    fields : tuple of (str, int)
-        Each field's name and width (a vector field is wider than 1), in order.
-    parent : Row, optional
-        A row this one continues (a shared block first): its fields come first.
-    prefix : str
-        The prefix of the constants' names.
+    offsets, the packing and the column names. Unpack its offsets into module-level constants
+    (``PD_KP, PD_KD = PD.offsets``), which numba folds into the machine code.
 
     Examples
     --------
@@ -73,23 +56,7 @@ class Row:
 
     @classmethod
     def of(cls, name: str, *fields: str | tuple[str, int], parent: Row | None = None, prefix: str = "") -> Row:
-        """A row from its fields: a name, or (name, width) for a vector field.
-
-        Parameters
-        ----------
-        name : str
-            What the row is.
-        *fields : str or (str, int)
-            The fields in order.
-        parent : Row, optional
-            The row this one continues.
-        prefix : str
-            The prefix of the constants' names.
-
-        Returns
-        -------
-        Row
-        """
+        """A row from its fields: a name, or (name, width) for a vector field."""
         spec = tuple((f, 1) if isinstance(f, str) else (f[0], int(f[1])) for f in fields)
         names = [f for f, _ in spec] + ([f for f, _ in parent.all_fields] if parent else [])
         if len(set(names)) != len(names) or any(w < 1 for _, w in spec):
@@ -126,28 +93,8 @@ class Row:
         return tuple(f if w == 1 else f"{f}[{i}]" for f, w in self.all_fields for i in range(w))
 
     def pack(self, values: Mapping[str, Any], n: int | None = None, default: float | None = None) -> np.ndarray:
-        """The row (or rows) holding ``values``.
-
-        Parameters
-        ----------
-        values : mapping
-            Field name -> a number (or, with ``n``, one per vehicle); a vector field takes a
-            sequence of its width of such, or an (n, width) array.
-        n : int, optional
-            Number of vehicles: (n, size) rows; None: one (size,) row.
-        default : float, optional
-            The value of a field not in ``values``; None: every field must be given.
-
-        Returns
-        -------
-        numpy.ndarray
-            (size,) or (n, size) float64.
-
-        Raises
-        ------
-        ValueError
-            A field unknown, or missing without a default.
-        """
+        """The row holding ``values`` (field -> number), or with ``n`` one row per vehicle; ``default`` fills
+        a missing field."""
         widths = dict(self.all_fields)
         unknown, missing = set(values) - set(widths), set(widths) - set(values)
         if unknown or (missing and default is None):

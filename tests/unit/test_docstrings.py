@@ -2,10 +2,15 @@
 
 - Every public function, method, property and class defined in the package has a docstring
   (public: its name and its module's do not start with ``_``).
-- What users call (the names a package's ``__init__`` exports in ``__all__``, and their public
-  methods) carries the numpydoc sections: every argument under Parameters and no other name
-  (PR01, PR02), a Returns or Yields section when it returns a value (RT01, YD01).
-- Anything else may be one line. Once it has sections, they are checked the same way.
+- The public API, what users call, carries the numpydoc sections: every argument under
+  Parameters and no other name (PR01, PR02), a Returns or Yields section when it returns a
+  value (RT01, YD01). The public API is
+  (1) the names that ``quadcruise/__init__.py`` and each subpackage's ``__init__.py`` export
+  in ``__all__``; (2) the names the README and docs/ show users calling (``from quadcruise.x
+  import y`` or a dotted ``quadcruise.x.y`` in their text); (3) the classes these return, by
+  their return annotations; and the public methods of all these classes. A module's own
+  ``__all__`` (what its siblings import) does not make a name public.
+- Anything else, a helper, may be one line. Once it has sections, they are checked the same way.
 
 Run it as a script to list every problem: ``python tests/unit/test_docstrings.py``.
 """
@@ -15,8 +20,10 @@ from __future__ import annotations
 import importlib
 import inspect
 import pkgutil
+import re
 import sys
 from functools import cache
+from pathlib import Path
 
 import pytest
 from numpydoc.docscrape import NumpyDocString
@@ -61,18 +68,79 @@ def public_names(module: str) -> list[str]:
     return out
 
 
-@cache
-def exported() -> frozenset[str]:
-    """The names users are given: each package's ``__all__``, resolved to where they are defined."""
+ROOT = Path(__file__).resolve().parents[2]
+DOCS = (ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")))
+"""The pages whose ``quadcruise`` names are public API."""
+
+
+def _dotted(obj, name: str) -> str | None:
+    """``module.qualname`` of a function or class defined in the package, else None."""
+    home = _home(obj)
+    if home and home.startswith("quadcruise") and (inspect.isclass(obj) or callable(obj)):
+        return f"{home}.{getattr(obj, '__qualname__', name)}"
+    return None
+
+
+def package_exports() -> set[str]:
+    """The names ``quadcruise`` and its subpackages export in their ``__init__``'s ``__all__``."""
     out = set()
     for module in modules():
         mod = importlib.import_module(module)
-        for name in getattr(mod, "__all__", ()):
-            obj = getattr(mod, name, None)
-            home = _home(obj)
-            if home and home.startswith("quadcruise") and (inspect.isclass(obj) or callable(obj)):
-                out.add(f"{home}.{getattr(obj, '__qualname__', name)}")
-    return frozenset(out)
+        if hasattr(mod, "__path__"):  # a package, not a module
+            out.update(filter(None, (_dotted(getattr(mod, n, None), n) for n in getattr(mod, "__all__", ()))))
+    return out
+
+
+def shown_in_docs(pages=DOCS) -> set[str]:
+    """The functions and classes the pages name: ``from quadcruise.x import y`` or ``quadcruise.x.y``."""
+    found = set()
+    for page in pages:
+        text = Path(page).read_text()
+        for module, names in re.findall(r"from (quadcruise[\w.]*) import ([\w, ]+)", text):
+            found.update(f"{module}.{n.strip()}" for n in names.split(",") if n.strip())
+        found.update(re.findall(r"\bquadcruise(?:\.\w+)+", text))
+    out = set()
+    for name in found:
+        try:
+            obj = _resolve(name)
+        except AttributeError:
+            continue  # a word after a module's name (``quadcruise.cli.main``'s ``.py``)
+        if not inspect.ismodule(obj):
+            out.update(filter(None, [_dotted(obj, name.rsplit(".", 1)[1])]))
+    return out
+
+
+def returned_classes(name: str) -> set[str]:
+    """The package's classes that a function's return annotation names, looked up in its module."""
+    func = getattr(_resolve(name), "py_func", _resolve(name))
+    if inspect.isclass(func) or not callable(func):
+        return set()
+    annotation = inspect.signature(func).return_annotation
+    if annotation is inspect.Signature.empty:
+        return set()
+    scope = vars(importlib.import_module(func.__module__))
+    words = re.findall(r"[A-Za-z_]\w*", annotation if isinstance(annotation, str) else repr(annotation))
+    return {d for w in words if inspect.isclass(scope.get(w)) and (d := _dotted(scope[w], w))}
+
+
+def _callables(name: str) -> list[str]:
+    """A function's name, or a class's public methods."""
+    obj = _resolve(name)
+    if not inspect.isclass(obj):
+        return [name]
+    return [method for method in public_names(_home(obj)) if method.startswith(f"{name}.")]
+
+
+@cache
+def exported() -> frozenset[str]:
+    """The public API: package exports, names the docs show, and the classes these return."""
+    public = package_exports() | shown_in_docs()
+    new = set(public)
+    while new:  # what their functions and methods return, until nothing new
+        calls = [call for name in new for call in _callables(name)]
+        new = set().union(*map(returned_classes, calls)) - public
+        public |= new
+    return frozenset(public)
 
 
 def problems(name: str, required: bool) -> list[str]:
@@ -203,8 +271,30 @@ def test_the_validator_reads_numpydoc(tmp_path, monkeypatch):
     assert problems("qc_docstring_sample.one_line", False) == []  # a helper may be one line
 
 
+def test_public_api_is_what_users_call(tmp_path):
+    public = exported()
+    assert "quadcruise.workflows.fly.fly" in public  # qc.fly: the package's __all__
+    assert "quadcruise.control.position.NLPD" in public  # quadcruise.control's __all__
+    assert "quadcruise.control.design.pd_from_poles" in public  # the README imports it
+    assert "quadcruise.workflows.linearization.Linearization" in public  # what linearize (docs/paper.md) returns
+    assert "quadcruise.checks.number" not in public  # a helper, in its own module's __all__ only
+    assert "quadcruise.control.design.pid_from_poles" not in public
+    page = tmp_path / "page.md"
+    page.write_text(
+        "```python\nfrom quadcruise.control.design import pid_from_poles, PDGains\n```\n"
+        "`quadcruise.checks.number(...)`, the module `quadcruise.io.files`, `quadcruise.cli.main.py`\n"
+    )
+    assert shown_in_docs([page]) == {
+        "quadcruise.control.design.pid_from_poles",
+        "quadcruise.control.design.PDGains",
+        "quadcruise.checks.number",
+    }
+    assert returned_classes("quadcruise.workflows.analysis.linearize") == {
+        "quadcruise.workflows.linearization.Linearization"
+    }
+
+
 def test_the_validator_holds_our_rules():
-    assert "quadcruise.workflows.fly.fly" in exported()
     assert problems("quadcruise.workflows.fly.fly", True) == []
     assert problems("quadcruise.numeric.wrap_angle", True) == []
 

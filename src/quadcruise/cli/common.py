@@ -61,20 +61,7 @@ FORCE_OPTION = click.option("--force", is_flag=True, help="Replace a non-empty -
 
 
 def writable(ctx: click.Context, param: click.Parameter, value):
-    """A click callback: refuse an output path that could not be written, before any work.
-
-    Parameters
-    ----------
-    ctx : click.Context
-    param : click.Parameter
-    value : str or None
-        The path given, or None.
-
-    Returns
-    -------
-    str or None
-        ``value``, checked.
-    """
+    """A click callback: refuse an output path that could not be written, before any work."""
     if value is not None:
         from quadcruise.io.files import check_writable_place
 
@@ -86,20 +73,7 @@ def writable(ctx: click.Context, param: click.Parameter, value):
 
 
 def needs_out(out, **given) -> None:
-    """Refuse options that only shape the ``--out`` folder when no ``--out`` is given.
-
-    Parameters
-    ----------
-    out : str or None
-        ``--out``.
-    **given
-        Option name (``force``, ``format``) -> True where the user gave it.
-
-    Raises
-    ------
-    InputError
-        Naming the first such option.
-    """
+    """Refuse options that only shape the ``--out`` folder when no ``--out`` is given."""
     if out is None:
         for name, was_given in given.items():
             if was_given:
@@ -107,18 +81,7 @@ def needs_out(out, **given) -> None:
 
 
 def writable_with(*suffixes: str):
-    """A click callback: :func:`writable`, and the path must end in one of ``suffixes``.
-
-    Parameters
-    ----------
-    *suffixes : str
-        E.g. ``".html", ".htm"``.
-
-    Returns
-    -------
-    callable
-        The callback.
-    """
+    """A click callback: :func:`writable`, and the path must end in one of ``suffixes``."""
 
     def check(ctx: click.Context, param: click.Parameter, value):
         if value is not None and str(value).strip() and not str(value).lower().endswith(suffixes):
@@ -159,20 +122,7 @@ SETTLE_BAND_OPTION = click.option(
 
 def metric_options(rise: str = "10-90", settle_bands: tuple[float, ...] = ()) -> dict:
     """``--rise`` and ``--settle-band`` as keywords of :func:`quadcruise.metrics.flight_metrics`, checked
-    (:func:`~quadcruise.metrics.conventions.metric_conventions`) before anything flies.
-
-    Parameters
-    ----------
-    rise : {"10-90", "0-100"}
-        The rise-time levels in percent.
-    settle_bands : tuple of float
-        None (2 % and 5 %), one band (and 5 %) or two.
-
-    Returns
-    -------
-    dict
-        ``rise`` and ``settle_bands``.
-    """
+    (:func:`~quadcruise.metrics.conventions.metric_conventions`) before anything flies."""
     from quadcruise.metrics.conventions import metric_conventions
 
     kw = {"rise": rise, "settle_bands": tuple(settle_bands) or (0.02, 0.05)}
@@ -186,18 +136,7 @@ def friendly(func: Callable) -> Callable:
     one line each too, with the statuses of :mod:`quadcruise.cli.faults`; every warning
     raised meanwhile is shown plainly, ``warning: ...``; a progress bar still open is closed
     first, and on a terminal numba's first compilation is announced
-    (:mod:`quadcruise.cli.feedback`).
-
-    Parameters
-    ----------
-    func : callable
-        The command's function.
-
-    Returns
-    -------
-    callable
-        The wrapped function (same name, docstring and signature, so click's help holds).
-    """
+    (:mod:`quadcruise.cli.feedback`)."""
 
     @functools.wraps(func)
     def wrapper(*args, **kwargs):

@@ -57,24 +57,7 @@ def _once(names: list[str], what: str) -> None:
 
 
 def parse_targets(texts: Iterable[str]) -> tuple[Target, ...]:
-    """Targets from ``METRIC=VALUE`` or ``METRIC=VALUE+-TOLERANCE`` texts, a metric at most once.
-
-    Parameters
-    ----------
-    texts : iterable of str
-        E.g. ``("rise_time_s=1", "overshoot_pct=4+-1.5")``.
-
-    Returns
-    -------
-    tuple of Target
-        The tolerance 10 % of the value where not given (1 for a value of 0).
-
-    Raises
-    ------
-    InputError
-        Not of that form, an unknown metric, a negative value, a tolerance that is not
-        positive, or two targets on one metric.
-    """
+    """Targets from ``METRIC=VALUE`` or ``METRIC=VALUE+-TOLERANCE`` texts, a metric at most once."""
     out = []
     for text in texts:
         match = _TARGET.match(str(text))
@@ -94,22 +77,7 @@ def parse_targets(texts: Iterable[str]) -> tuple[Target, ...]:
 
 
 def parse_minimize(texts: Iterable[str]) -> tuple[str, ...]:
-    """The metrics to minimise, from texts each holding one or several, comma-separated.
-
-    Parameters
-    ----------
-    texts : iterable of str
-        E.g. ``("rmse_m", "effort,duty_clipped_s")``.
-
-    Returns
-    -------
-    tuple of str
-
-    Raises
-    ------
-    InputError
-        An unknown metric (the closest is named), an empty text, a metric given twice.
-    """
+    """The metrics to minimise, from texts each holding one or several, comma-separated."""
     out = []
     for text in texts:
         found = [_metric(n.strip(), f"minimize {n.strip()!r}") for n in str(text).split(",") if n.strip()]
@@ -121,24 +89,7 @@ def parse_minimize(texts: Iterable[str]) -> tuple[str, ...]:
 
 
 def parse_gains(text: str | None, controller=None) -> list[str] | None:
-    """The gains' names from ``--gains``, comma-separated (checked against the controller by the tune).
-
-    Parameters
-    ----------
-    text : str or None
-        E.g. ``"position.kp,position.kd"``; None: the tune's default.
-    controller : Controller, optional
-        The controller tuned, whose gains a message lists.
-
-    Returns
-    -------
-    list of str or None
-
-    Raises
-    ------
-    InputError
-        A text without a name.
-    """
+    """The gains' names from ``--gains``, comma-separated (checked against the controller by the tune)."""
     if text is None:
         return None
     names = [n.strip() for n in text.split(",") if n.strip()]
@@ -149,23 +100,7 @@ def parse_gains(text: str | None, controller=None) -> list[str] | None:
 
 
 def parse_bounds(texts: Iterable[str]) -> tuple[Bounds, ...]:
-    """Bounds from ``NAME=LOW:HIGH`` texts, several comma-separated in one text too.
-
-    Parameters
-    ----------
-    texts : iterable of str
-        E.g. ``("position.kp=0.5:10", "position.kd=1:8,max_tilt=0.2:1")``.
-
-    Returns
-    -------
-    tuple of Bounds
-
-    Raises
-    ------
-    InputError
-        Not of that form, not numbers, bounds reversed or empty (LOW >= HIGH), or a gain
-        bounded twice.
-    """
+    """Bounds from ``NAME=LOW:HIGH`` texts, several comma-separated in one text too."""
     out: dict[str, Bounds] = {}
     for text in texts:
         pieces = [piece for piece in str(text).split(",") if piece.strip()]
@@ -191,21 +126,6 @@ def parse_bounds(texts: Iterable[str]) -> tuple[Bounds, ...]:
 def parse_objective(text: str) -> str | float:
     """The statistic over a candidate's flights: ``worst`` (or ``max``), ``median``, or a
     quantile as ``0.9``, ``q0.9`` or ``q90``.
-
-    Parameters
-    ----------
-    text : str
-        The ``--objective`` option.
-
-    Returns
-    -------
-    str or float
-        ``"worst"`` or the quantile, in (0, 1).
-
-    Raises
-    ------
-    InputError
-        Anything else.
 
     Examples
     --------

@@ -58,28 +58,12 @@ def _raise_terminated(signum, frame) -> None:
 
 
 def stop_on_sigterm() -> None:
-    """Make SIGTERM raise :class:`Terminated` in the main thread (call it from there).
-
-    Without it SIGTERM ends the process at once: a sweep's Dask workers are left to notice on
-    their own, and temporary files beside the outputs stay.
-    """
+    """Make SIGTERM raise :class:`Terminated` in the main thread (call it from there)."""
     signal.signal(signal.SIGTERM, _raise_terminated)
 
 
 def interrupt_text(exc: KeyboardInterrupt) -> tuple[str, int]:
     """The line and the exit status for Ctrl-C or SIGTERM.
-
-    Parameters
-    ----------
-    exc : KeyboardInterrupt
-        Ctrl-C, or :class:`Terminated`.
-
-    Returns
-    -------
-    text : str
-        ``interrupted (...)`` or ``terminated (...)``.
-    status : int
-        :data:`EXIT_INTERRUPTED` or :data:`EXIT_TERMINATED`.
 
     Examples
     --------
@@ -93,15 +77,6 @@ def interrupt_text(exc: KeyboardInterrupt) -> tuple[str, int]:
 
 def fault_text(exc: OSError) -> str:
     """One line for an ``OSError`` that reached a command: the path, then the cause.
-
-    Parameters
-    ----------
-    exc : OSError
-        A :class:`~quadcruise.errors.WriteError` (its own line), or another ``OSError``.
-
-    Returns
-    -------
-    str
 
     Examples
     --------
@@ -127,13 +102,7 @@ def _stdout_to_devnull() -> None:
 
 class GuardedStdout:
     """Standard output whose write failures are one :class:`~quadcruise.errors.WriteError`,
-    and whose reader stopping (a broken pipe) drops the rest quietly.
-
-    Parameters
-    ----------
-    stream : io.TextIOBase
-        The text stream to write to (``sys.stdout``).
-    """
+    and whose reader stopping (a broken pipe) drops the rest quietly."""
 
     def __init__(self, stream) -> None:
         self._stream = stream
@@ -152,22 +121,7 @@ class GuardedStdout:
         raise self.fault from None
 
     def write(self, text: str) -> int:
-        """Write ``text``, or drop it once the reader is gone.
-
-        Parameters
-        ----------
-        text : str
-
-        Returns
-        -------
-        int
-            The characters taken.
-
-        Raises
-        ------
-        WriteError
-            If standard output could not be written, now or before.
-        """
+        """Write ``text``, or drop it once the reader is gone."""
         if not isinstance(text, str):
             return self._stream.write(text)  # a TypeError, as from the stream itself
         if self.fault is not None:
@@ -180,13 +134,7 @@ class GuardedStdout:
         return len(text)
 
     def flush(self) -> None:
-        """Flush, unless the reader is gone or a write failed (it said so).
-
-        Raises
-        ------
-        WriteError
-            If standard output could not be written.
-        """
+        """Flush, unless the reader is gone or a write failed (it said so)."""
         if self.fault is None and not self.reader_gone:
             try:
                 self._stream.flush()

@@ -48,13 +48,7 @@ _OPEN: weakref.WeakSet = weakref.WeakSet()  # the bars drawn and not closed yet
 
 
 def feedback_on() -> bool:
-    """Whether feedback is shown: ``QUADCRUISE_PROGRESS`` if set (``1``/``0``), else whether
-    stderr is a terminal.
-
-    Returns
-    -------
-    bool
-    """
+    """Whether feedback is shown: ``QUADCRUISE_PROGRESS`` if set (``1``/``0``), else whether stderr is a terminal."""
     value = os.environ.get(ENV, "").strip().lower()
     if value in ("1", "true", "yes", "on"):
         return True
@@ -86,17 +80,6 @@ class Bar:
     """A ``progress(done, total)`` callable that draws a bar on stderr (tqdm), when
     :func:`feedback_on`.
 
-    The bar appears at the first call and closes itself when ``done >= total``; it is
-    removed from the terminal then (the results follow on a clean line). Usable as a
-    context manager, which closes it on the way out.
-
-    Parameters
-    ----------
-    label : str
-        What is being done, e.g. ``"flying"``; shown before the bar.
-    unit : str
-        What is counted, e.g. ``"flight"``; shown with the rate.
-
     Examples
     --------
     >>> with Bar("drawing", unit="frame") as bar:
@@ -110,17 +93,7 @@ class Bar:
         self.closed = False
 
     def __call__(self, done: int, total: int, text: str | None = None) -> None:
-        """Show ``done`` of ``total``.
-
-        Parameters
-        ----------
-        done : int
-            Items done so far.
-        total : int
-            Items in all (it may change between calls).
-        text : str, optional
-            A short note shown after the bar at once (e.g. the best cost so far).
-        """
+        """Show ``done`` of ``total``."""
         if self.closed:
             return
         if self._bar is None:
@@ -170,19 +143,9 @@ def close_bars() -> None:
 
 @contextlib.contextmanager
 def compile_notice() -> Iterator[None]:
-    """Within it, say :data:`COMPILE_LINE` once on stderr when numba starts compiling.
-
-    numba compiles the engine and the controllers the first time they are used and keeps
-    the machine code on disk (see :mod:`quadcruise._cache`); later runs load it in a
-    fraction of a second and compile nothing, so they say nothing. numba announces each
-    compilation that misses its cache (its ``numba:compile`` event), which is exactly when
-    the wait comes: the line is said then, before the first flight, and only when
-    :func:`feedback_on`.
-
-    Yields
-    ------
-    None
-    """
+    """Within it, say :data:`COMPILE_LINE` once on stderr when numba starts compiling."""
+    # numba announces each compilation that misses its cache (its numba:compile event), which is
+    # exactly when the wait comes; a later run loads the machine code from disk and says nothing.
     if not feedback_on():
         yield
         return

@@ -13,22 +13,7 @@ __all__ = ["identify"]
 
 
 def base_vehicle(text: str):
-    """``--vehicle``: ``paper`` (Table I) or a TOML file with a ``[vehicle]`` table.
-
-    Parameters
-    ----------
-    text : str
-        The option's value.
-
-    Returns
-    -------
-    Vehicle
-
-    Raises
-    ------
-    InputError
-        An unknown name, or a file that is not a readable vehicle.
-    """
+    """``--vehicle``: ``paper`` (Table I) or a TOML file with a ``[vehicle]`` table."""
     from pathlib import Path
 
     from quadcruise.model.vehicle import Vehicle

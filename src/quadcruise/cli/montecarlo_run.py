@@ -23,24 +23,6 @@ __all__ = ["montecarlo_command", "parse_noise"]
 def parse_noise(text: str | None):
     """Parse a sensor noise spec, ``position=STD,velocity=STD,angle=STD,rate=STD,delay=S``.
 
-    Parsed by :func:`quadcruise.cli.assignments.parse_assignments`; the values are checked by
-    :class:`~quadcruise.disturbances.SensorNoise`.
-
-    Parameters
-    ----------
-    text : str or None
-        The spec: std of position [m], velocity [m/s], angles [rad], body rates [rad/s] and
-        the delay [s]; any left out are 0. None, "" or "none": no sensor noise.
-
-    Returns
-    -------
-    SensorNoise or None
-
-    Raises
-    ------
-    InputError
-        An unknown key, an item without ``=``, or a value that is not a number.
-
     Examples
     --------
     >>> parse_noise("position=0.01,delay=0.002").delay
@@ -105,50 +87,7 @@ def montecarlo_command(
     echo: Callable[[str], None] = click.echo,
 ) -> MonteCarloResult | Case:
     """What ``quadcruise montecarlo`` runs: build the population, fly it (or one case), print
-    the summary and the worst flights, write ``out``.
-
-    Parameters
-    ----------
-    mission, controller, n, seed, duration, dt, scenario, max_track_error_m
-        As :func:`quadcruise.montecarlo.scenario.sweep_spec`: None means "not given" (a
-        ``scenario`` file's value, else the default).
-    requirements : tuple of str
-        ``--require`` texts, ``METRIC<=VALUE`` each
-        (:func:`quadcruise.montecarlo.scenario.parse_requirement`).
-    wind, noise : str, optional
-        A :func:`~quadcruise.cli.wind.parse_wind` spec and a :func:`parse_noise` one.
-    turbulence : str, optional
-        Dryden turbulence added (:func:`~quadcruise.cli.objects.environment_from_options`).
-    vehicle, controller_vehicle : str, optional
-        The nominal vehicle and the controllers' model
-        (:func:`~quadcruise.cli.objects.vehicle_from_option`); ``KEY=VALUE`` fields change the
-        scenario's.
-    log_every : int, optional
-        Control periods between the logged instants the metrics are measured on.
-    mass_spread, inertia_spread, thrust_spread, bandwidth_spread, yaw_arm_spread, wind_spread, \
-offset, distribution, model_error : optional
-        :class:`~quadcruise.montecarlo.Population` fields.
-    chunk_size : int or str
-        Flights per task: a number (also as text) or "auto".
-    scheduler, workers, connect_timeout, out, resume, force, fmt
-        As :func:`quadcruise.montecarlo.montecarlo`.
-    case : int, optional
-        Fly flight ``case`` alone; with ``out``, write it there (into ``out/case-00000I`` beside its sweep).
-    worst, quiet : int, bool
-        How many worst flights to print; no progress bar.
-    echo : callable
-        Prints one text (the notes before flying go to stderr, :func:`quadcruise.cli.world.note`).
-
-    Returns
-    -------
-    MonteCarloResult or Case
-        The sweep, or the one flight.
-
-    Raises
-    ------
-    InputError
-        Bad input, before anything is written.
-    """
+    the summary and the worst flights, write ``out``."""
     import numpy as np
 
     from quadcruise.cli.wind import parse_wind

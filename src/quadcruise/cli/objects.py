@@ -10,25 +10,7 @@ __all__ = ["controller_from_options", "controller_params", "flight_from_options"
 
 
 def _poles(text: str | None, option: str):
-    """Parse comma-separated poles, e.g. ``-0.7,-4.3`` or ``-1+2j,-1-2j``.
-
-    Parameters
-    ----------
-    text : str or None
-        The option's value; None when it was not given.
-    option : str
-        The option's name, for the error message.
-
-    Returns
-    -------
-    list of complex or float, or None
-        The poles (:func:`quadcruise.control.design.parse_pole` of each); None for None.
-
-    Raises
-    ------
-    InputError
-        A pole is not a number.
-    """
+    """Parse comma-separated poles, e.g. ``-0.7,-4.3`` or ``-1+2j,-1-2j``."""
     if text is None:
         return None
     from quadcruise.control.design import parse_pole
@@ -40,19 +22,7 @@ def _poles(text: str | None, option: str):
 
 
 def controller_params(params: tuple[str, ...], poles_text: str | None) -> dict:
-    """The controller parameters that ``-c KEY=VALUE`` and ``--poles`` give.
-
-    Parameters
-    ----------
-    params : tuple of str
-        ``KEY=VALUE`` parameters.
-    poles_text : str or None
-        Closed-loop poles of the x/y loops; their PD gains become the ``position`` gains.
-
-    Returns
-    -------
-    dict
-    """
+    """The controller parameters that ``-c KEY=VALUE`` and ``--poles`` give."""
     from quadcruise.cli.assignments import parse_assignments
     from quadcruise.control.design import pd_from_poles
 
@@ -64,24 +34,7 @@ def controller_params(params: tuple[str, ...], poles_text: str | None) -> dict:
 
 
 def controller_from_options(name: str | None, params: tuple[str, ...], poles_text: str | None, base=None):
-    """The controller that ``--controller``, ``-c KEY=VALUE`` and ``--poles`` describe.
-
-    Parameters
-    ----------
-    name : str or None
-        The controller's name (:func:`quadcruise.control.controller_from_name`): a new one,
-        whatever ``base`` is. None: ``base`` changed by the parameters, else ``nlpd``.
-    params : tuple of str
-        ``KEY=VALUE`` parameters of the controller.
-    poles_text : str or None
-        Closed-loop poles of the x/y loops; their PD gains become the ``position`` gains.
-    base : Controller, optional
-        A controller (a scenario's) that the parameters change when no name is given.
-
-    Returns
-    -------
-    Controller
-    """
+    """The controller that ``--controller``, ``-c KEY=VALUE`` and ``--poles`` describe."""
     import dataclasses
 
     from quadcruise.control import controller_from_name
@@ -97,21 +50,7 @@ def controller_from_options(name: str | None, params: tuple[str, ...], poles_tex
 
 
 def mission_from_options(text: str, params: tuple[str, ...], smooth: bool):
-    """A mission from a name or a waypoint CSV, with KEY=VALUE parameters.
-
-    Parameters
-    ----------
-    text : str
-        A mission name, or a path ending in ``.csv`` (a waypoint table).
-    params : tuple of str
-        ``KEY=VALUE`` parameters of the mission.
-    smooth : bool
-        Fly a waypoint table as a minimum-snap path instead of constant-speed legs.
-
-    Returns
-    -------
-    Mission
-    """
+    """A mission from a name or a waypoint CSV, with KEY=VALUE parameters."""
     from quadcruise.cli.assignments import parse_assignments
     from quadcruise.missions import MISSIONS, mission_from_name
 
@@ -133,26 +72,7 @@ def flight_from_options(
     smooth: bool,
 ):
     """What ``quadcruise fly MISSION ...`` flies: from a mission name, a waypoint CSV or a scenario
-    file, with the options applied to it.
-
-    Parameters
-    ----------
-    mission : str
-        A mission name, a waypoint CSV (``.csv``) or a scenario file (``.toml``).
-    controller : str or None
-        ``--controller``; None: the scenario's controller, else ``nlpd``.
-    mission_params, controller_params : tuple of str
-        ``-m`` and ``-c`` ``KEY=VALUE`` parameters (with a scenario, they change its mission and controller).
-    poles_text : str or None
-        ``--poles`` of the x/y loops.
-    smooth : bool
-        ``--smooth``: a waypoint CSV as a minimum-snap path.
-
-    Returns
-    -------
-    (Mission, Controller, dict, Scenario or None)
-        The mission, the controller, the keywords of :func:`quadcruise.fly`, and the scenario read.
-    """
+    file, with the options applied to it."""
     from quadcruise.cli.assignments import parse_assignments
     from quadcruise.missions import mission_from_name
 

@@ -16,17 +16,6 @@ __all__ = ["command_line", "tune_command"]
 def command_line(mission: str, options: dict) -> str:
     """The command line that runs this tune again, from its options.
 
-    Parameters
-    ----------
-    mission : str
-        The MISSION argument.
-    options : dict
-        The options given, by parameter name (None, False, () and defaults left out).
-
-    Returns
-    -------
-    str
-
     Examples
     --------
     >>> command_line("step", {"targets": ("rise_time_s=1",), "seed": 1, "quiet": True})
@@ -89,53 +78,7 @@ def tune_command(
     log_every: int | None = None,
     echo: Callable[..., None] = click.echo,
 ):
-    """What ``quadcruise tune`` runs: build the tune, run it, print its progress and summary,
-    write ``out``.
-
-    Parameters
-    ----------
-    mission : str
-        A mission name, a waypoint CSV or a TOML scenario file.
-    mission_params : tuple of str
-        ``KEY=VALUE`` parameters of the mission (not with a scenario).
-    controller : str, optional
-        The controller's name; None: the scenario's controller (``controller_params``
-        change it), else ``nlpd``.
-    controller_params : tuple of str
-        ``KEY=VALUE`` parameters of the controller.
-    gains, bounds, targets, require, minimize, objective : str or tuple of str
-        As on the command line, read by :mod:`quadcruise.cli.criteria` into
-        :func:`quadcruise.tune.tune`'s objects.
-    samples, seed, budget, popsize : int
-        As :func:`quadcruise.tune.tune`.
-    mass_spread, inertia_spread, wind_spread : float
-        :class:`~quadcruise.montecarlo.Population` fields.
-    wind, noise : str, optional
-        A :func:`~quadcruise.cli.wind.parse_wind` spec and a
-        :func:`~quadcruise.cli.montecarlo_run.parse_noise` one.
-    vehicle, controller_vehicle, turbulence : str, optional
-        ``--vehicle``, ``--controller-vehicle``, ``--turbulence``
-        (:func:`~quadcruise.cli.objects.flight_world`), changing a scenario's.
-    log_every : int, optional
-        Control periods between the logged instants the metrics are measured on.
-    duration, dt : float, optional
-        Flight time and control period [s]: given, else the scenario's, else the defaults.
-    out : str, optional
-        The folder to write.
-    force, quiet : bool
-        Replace a folder quadcruise did not write; print no progress.
-    echo : callable
-        Prints a text (``err=True``: to stderr).
-
-    Returns
-    -------
-    TuneResult
-
-    Raises
-    ------
-    InputError
-        Bad input, before any flight and before anything is written.
-    """
+    """What ``quadcruise tune`` runs: build the tune, run it, print its progress and summary, write ``out``."""
     from quadcruise.cli.common import controller_from_options, mission_from_options
     from quadcruise.cli.montecarlo_run import parse_noise
     from quadcruise.io.files import check_output_dir

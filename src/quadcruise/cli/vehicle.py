@@ -9,31 +9,8 @@ __all__ = ["refuse_vehicle_fields", "vehicle_from_option"]
 
 
 def vehicle_from_option(text: str | None, option: str, base=None):
-    """The vehicle that ``--vehicle`` or ``--controller-vehicle`` describes.
-
-    The value is a preset's name (``paper``), ``KEY=VALUE,...`` fields of the vehicle changing
-    ``base``, both (``paper,m=1.4``: the preset changed), or a TOML file (``.toml``: the fields
-    at the top level, or a scenario's ``[vehicle]`` table).
-
-    Parameters
-    ----------
-    text : str or None
-        The option's value; None when it was not given.
-    option : str
-        The option's name, for the messages.
-    base : Vehicle, optional
-        The vehicle that bare ``KEY=VALUE`` fields change (a scenario's); Table I by default.
-
-    Returns
-    -------
-    Vehicle or None
-        None for None.
-
-    Raises
-    ------
-    InputError
-        An unknown preset or field, a value that is not one number, or a vehicle that
-        cannot be (e.g. a negative mass), naming the option.
+    """The vehicle that ``--vehicle`` or ``--controller-vehicle`` describes: a preset (``paper``), ``KEY=VALUE,...``
+    fields changing ``base``, both (``paper,m=1.4``), or a TOML file.
 
     Examples
     --------
@@ -85,22 +62,7 @@ hummingbird, iris, qball-x4); or give the vehicle's fields, KEY=VALUE,..., or a 
 
 
 def refuse_vehicle_fields(mission_params: dict, mission_cls, option: str = "-m") -> None:
-    """Refuse a vehicle's field given as a mission parameter, pointing to ``--vehicle``.
-
-    Parameters
-    ----------
-    mission_params : dict
-        The parsed ``-m KEY=VALUE`` parameters.
-    mission_cls : type
-        The mission's class: its own fields are not refused.
-    option : str
-        The option's name, for the message.
-
-    Raises
-    ------
-    InputError
-        A key that is a field of the vehicle and not of the mission.
-    """
+    """Refuse a vehicle's field given as a mission parameter, pointing to ``--vehicle``."""
     import dataclasses
 
     from quadcruise.model.vehicle import Vehicle

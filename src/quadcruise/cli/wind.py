@@ -39,22 +39,6 @@ def wind_from_name(name: str, **kw: Any) -> Part:
     """A part by name (``constant``/``wind``, ``gust``, ``dryden``/``turbulence``,
     ``loss``/``rotor_loss``, ``force``) with its fields as keywords.
 
-    Parameters
-    ----------
-    name : str
-        The part's name, in any case.
-    **kw
-        Its fields, in their units (see each class).
-
-    Returns
-    -------
-    ConstantWind, Gust, Turbulence, RotorLoss or ExternalForce
-
-    Raises
-    ------
-    InputError
-        An unknown name or field, or a bad value.
-
     Examples
     --------
     >>> wind_from_name("Gust", start=2.0).duration

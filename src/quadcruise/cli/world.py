@@ -25,20 +25,7 @@ def world_options(
 ):
     """The options that say what is flown and in what world, shared by ``fly``, ``compare``,
     ``tune`` and ``montecarlo``: ``--vehicle``, ``--controller-vehicle``, ``--wind``,
-    ``--turbulence``, ``--seed`` and ``--log-every``.
-
-    Parameters
-    ----------
-    wind_help : str
-        The help of ``--wind`` (what it acts on differs between the commands).
-    seed : bool
-        Add ``--seed`` (False where the command has its own).
-
-    Returns
-    -------
-    callable
-        A decorator adding the options to a click command.
-    """
+    ``--turbulence``, ``--seed`` and ``--log-every``."""
     options = [
         click.option(
             "--vehicle",
@@ -87,38 +74,12 @@ WORLD_OPTIONS = world_options()
 
 
 def note(text: str) -> None:
-    """Print one line of information on stderr, ``note: ...`` (not a warning: nothing is wrong).
-
-    Parameters
-    ----------
-    text : str
-        The line.
-    """
+    """Print one line of information on stderr, ``note: ...`` (not a warning: nothing is wrong)."""
     click.echo(f"note: {text}", err=True)
 
 
 def environment_from_options(wind: str | None, turbulence: str | None, base=None):
     """The disturbances that ``--wind`` and ``--turbulence`` describe.
-
-    Parameters
-    ----------
-    wind : str or None
-        A :func:`~quadcruise.cli.wind.parse_wind` spec: it replaces ``base`` (``none``: still air).
-    turbulence : str or None
-        ``LEVEL[@ALTITUDE[/AIRSPEED]]``, LEVEL light, moderate or severe (or w20 [m/s]), as
-        the wind spec's ``dryden:`` part: it adds Dryden turbulence or replaces the base's.
-    base : Environment, optional
-        The disturbances otherwise flown (a scenario's).
-
-    Returns
-    -------
-    Environment or None
-        None when there is none.
-
-    Raises
-    ------
-    InputError
-        A bad spec, or turbulence given both in ``--wind`` and by ``--turbulence``.
 
     Examples
     --------
@@ -161,28 +122,7 @@ def flight_world(
     *, vehicle: str | None, controller_vehicle: str | None, wind: str | None, turbulence: str | None, scenario=None
 ) -> tuple[dict, list[str]]:
     """The flown vehicle, the controller's model of it and the disturbances that the options
-    describe, a scenario's changed by them; and the notes to print before flying.
-
-    Parameters
-    ----------
-    vehicle, controller_vehicle : str or None
-        ``--vehicle``, ``--controller-vehicle`` (:func:`vehicle_from_option`); ``KEY=VALUE``
-        fields change the scenario's ``[vehicle]`` and ``[controller_vehicle]`` (Table I
-        where it has none).
-    wind, turbulence : str or None
-        ``--wind``, ``--turbulence`` (:func:`environment_from_options`).
-    scenario : Scenario, optional
-        The scenario flown.
-
-    Returns
-    -------
-    dict
-        ``vehicle`` (given the default drag where wind meets a vehicle without any),
-        ``controller_vehicle`` (None: the flown vehicle) and ``environment`` (or None).
-    list of str
-        One line each: the default drag given, or a changed vehicle whose controller is told
-        the truth.
-    """
+    describe, a scenario's changed by them; and the notes to print before flying."""
     from quadcruise.disturbances import default_drag_text, with_drag
     from quadcruise.model.vehicle import Vehicle
 

@@ -40,18 +40,6 @@ ATT_MEMORY = ATTITUDE_MEMORY.size
 def attitude_fields(attitude, yaw, i_limit: float) -> dict[str, float]:
     """The fields of :data:`ATTITUDE_GAINS`, for :meth:`Row.pack <quadcruise.layout.Row.pack>`.
 
-    Parameters
-    ----------
-    attitude, yaw : PIDGains
-        Roll and pitch PID, yaw PID: kp [1/s^2], ki [1/s^3], kd [1/s].
-    i_limit : float
-        Anti-windup bound on the integral term [rad/s^2].
-
-    Returns
-    -------
-    dict
-        Field name -> value.
-
     Examples
     --------
     >>> from quadcruise.control.design import PIDGains
@@ -75,26 +63,6 @@ def pid_axis(e, rate, integral, kp, ki, kd, i_limit, dt):
     """PID on one angle error with the derivative on the measured rate; anti-windup holds
     ``ki * integral`` within +-``i_limit`` (:func:`quadcruise.numeric.clamp`).
 
-    Parameters
-    ----------
-    e : float
-        Angle error [rad].
-    rate : float
-        Measured body rate [rad/s].
-    integral : float
-        Integral of e so far [rad s].
-    kp, ki, kd : float
-        Gains [1/s^2], [1/s^3], [1/s].
-    i_limit : float
-        Bound on the integral term [rad/s^2].
-    dt : float
-        Control period [s].
-
-    Returns
-    -------
-    (float, float, bool)
-        U* [rad/s^2], the new integral, whether anti-windup held it.
-
     Examples
     --------
     >>> u, integral, held = pid_axis(0.1, 0.0, 0.0, 88.2, 40.5, 14.9, 5.0, 0.001)
@@ -113,38 +81,6 @@ def pid_axis(e, rate, integral, kp, ki, kd, i_limit, dt):
 @njit(cache=True, inline="always", error_model="numpy")
 def attitude_law(phi_d, theta_d, psi_d, phi, theta, psi, p, q, r, k, g, integrals, dt):
     """Eqs (13)-(15) with PID, on scalars: returns ((U2, U3, U4), new integrals, flags).
-
-    Each angle is closed by :func:`pid_axis` (the yaw error wrapped into [-pi, pi) by
-    :func:`quadcruise.numeric.wrap_angle`), then eq (13) removes the coupling of eq (11).
-    Scalars in, scalars out: the controllers read their arrays once, call this, and write
-    once.
-
-    Parameters
-    ----------
-    phi_d, theta_d, psi_d : float
-        Roll, pitch and yaw setpoints [rad].
-    phi, theta, psi : float
-        Roll, pitch and yaw [rad].
-    p, q, r : float
-        Body rates [rad/s].
-    k : tuple of float
-        (k1, ..., k6) of eq (11): k1, k3, k5 [-], k2, k4 [1/(kg m)], k6 [1/(kg m^2)].
-    g : numpy.ndarray or tuple of float
-        The attitude gains, ATT_GAINS entries laid out as ``ATT_*``/``YAW_*``: kp [1/s^2],
-        ki [1/s^3], kd [1/s] of roll and pitch, the same of yaw, and i_limit [rad/s^2].
-    integrals : tuple of float
-        The roll, pitch and yaw error integrals so far [rad s].
-    dt : float
-        Control period [s].
-
-    Returns
-    -------
-    U : tuple of float
-        (U2, U3, U4): roll and pitch inputs [N] and yaw torque [N m].
-    integrals : tuple of float
-        The new roll, pitch and yaw error integrals [rad s].
-    flags : int
-        FLAG_INTEGRATOR_HOLD if anti-windup held any integral, else 0.
 
     Examples
     --------
@@ -170,37 +106,13 @@ def attitude_law(phi_d, theta_d, psi_d, phi, theta, psi, p, q, r, k, g, integral
 
 @njit(cache=True, inline="always", error_model="numpy")
 def decoupling_constants(vp):
-    """(k1, ..., k6) of a vehicle parameter row.
-
-    Parameters
-    ----------
-    vp : numpy.ndarray
-        A vehicle parameter row, PARAM_SIZE entries
-        (:meth:`quadcruise.model.vehicle.Vehicle.rows`).
-
-    Returns
-    -------
-    k1, k2, k3, k4, k5, k6 : float
-        The constants of eq (11): k1, k3, k5 [-], k2, k4 [1/(kg m)], k6 [1/(kg m^2)].
-    """
+    """(k1, ..., k6) of a vehicle parameter row."""
     return vp[P_K1], vp[P_K2], vp[P_K3], vp[P_K4], vp[P_K5], vp[P_K6]
 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def attitude_gains(gains):
-    """The attitude block (the first ATT_GAINS entries) of a gains vector, as a tuple.
-
-    Parameters
-    ----------
-    gains : numpy.ndarray
-        A controller's gains vector that starts with the attitude block.
-
-    Returns
-    -------
-    tuple of float
-        The attitude gains, ATT_GAINS entries laid out as ``ATT_*``/``YAW_*``: kp [1/s^2],
-        ki [1/s^3], kd [1/s] of roll and pitch, the same of yaw, and i_limit [rad/s^2].
-    """
+    """The attitude block (the first ATT_GAINS entries) of a gains vector, as a tuple."""
     return (
         gains[ATT_KP],
         gains[ATT_KI],
@@ -215,37 +127,7 @@ def attitude_gains(gains):
 @njit(cache=True, inline="always", error_model="numpy")
 def decoupled_attitude(x, phi_d, theta_d, psi_d, vp, g, mem, dt):
     """Eqs (13)-(15) with PID from arrays: the roll, pitch and yaw inputs (U2, U3, U4) and a
-    flag word; updates the integrals in ``mem[:ATT_MEMORY]``.
-
-    The array form of :func:`attitude_law`: it reads every entry it needs first and writes
-    ``mem`` last, so the controllers that inline it make no reference-count calls.
-
-    Parameters
-    ----------
-    x : numpy.ndarray
-        The state the controller sees, STATE_SIZE entries (angles [rad], body rates [rad/s]
-        are read).
-    phi_d, theta_d, psi_d : float
-        Roll, pitch and yaw setpoints [rad].
-    vp : numpy.ndarray
-        The vehicle parameter row, PARAM_SIZE entries (k1..k6 are read).
-    g : numpy.ndarray
-        The controller's gains vector, starting with the attitude block (:data:`ATTITUDE_GAINS`).
-    mem : numpy.ndarray
-        The controller's memory: its first ATT_MEMORY entries are the roll, pitch and yaw
-        error integrals [rad s], updated in place.
-    dt : float
-        Control period [s].
-
-    Returns
-    -------
-    U2, U3 : float
-        Roll and pitch inputs [N].
-    U4 : float
-        Yaw torque [N m].
-    flags : int
-        FLAG_INTEGRATOR_HOLD if anti-windup held any integral, else 0.
-    """
+    flag word; updates the integrals in ``mem[:ATT_MEMORY]``."""
     U, integrals, flags = attitude_law(
         phi_d,
         theta_d,

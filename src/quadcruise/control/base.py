@@ -95,28 +95,8 @@ class Controller(Validated):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags, d, K):
-    """Fill a controller's output ``cmd``: the duties for (U1..U4) (see
-    :func:`quadcruise.model.actuators.duties`; not clipped here), the desired inputs, the
-    attitude setpoints and the flag word. Straight-line code on scalars, so a controller that
-    reads its arrays first and calls this last makes no reference-count calls.
-
-    Parameters
-    ----------
-    cmd : numpy.ndarray
-        Output, CMD_SIZE float64 entries (all written), laid out as ``CMD_*`` of
-        :mod:`quadcruise.layout`.
-    U1, U2, U3 : float
-        Desired collective thrust, roll and pitch inputs [N].
-    U4 : float
-        Desired yaw torque [N m].
-    phi_d, theta_d, psi_d : float
-        Attitude setpoints [rad].
-    flags : int or float
-        Bit mask of ``FLAG_*`` (:mod:`quadcruise.layout`), stored as a float.
-    d : float
-        Yaw arm: rotor drag torque per unit thrust [m], > 0.
-    K : float
-        PWM gain: a rotor's steady thrust at duty 1 [N].
+    """Fill a controller's output ``cmd`` (``CMD_*``): the duties for U1..U4 (not clipped), the
+    inputs, the attitude setpoints and the flags; call it last, after every read.
 
     Examples
     --------

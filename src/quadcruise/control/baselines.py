@@ -119,24 +119,6 @@ UNIT_RATE = 1.0
 def saturated_pd(e, ev, kp, kd, ap, ad):
     """a_p tanh(k_p e / a_p) + a_d tanh(k_d e_v / a_d): slopes k_p, k_d at 0, |.| < a_p + a_d.
 
-    Parameters
-    ----------
-    e : float
-        Position error x_r - x along one axis of the yaw frame [m].
-    ev : float
-        Velocity error x_r' - x' along the same axis [m/s].
-    kp : float
-        Small-signal P gain k_p [1/s^2].
-    kd : float
-        Small-signal D gain k_d [1/s].
-    ap, ad : float
-        Saturation levels a_p, a_d of the P and D terms [m/s^2], > 0.
-
-    Returns
-    -------
-    float
-        The wanted acceleration along that axis [m/s^2].
-
     Examples
     --------
     >>> round(saturated_pd(0.01, 0.0, 3.01, 5.0, 3.01, 5.0), 6)   # small error: about k_p e
@@ -149,41 +131,8 @@ def saturated_pd(e, ev, kp, kd, ap, ad):
 
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def gonzalez(t, dt, x, ref, vp, gains, mem, cmd):
-    """Reconstructed Gonzalez baseline: saturated PD, small-angle mapping, decoupled PID.
-
-    One control period of :class:`Gonzalez` (the law is in the module docstring; the
-    attitude loop and the command are :func:`quadcruise.control.position.finish`'s);
-    compiled with :data:`quadcruise.layout.CONTROLLER_SIG`.
-
-    Parameters
-    ----------
-    t : float
-        Time at the start of the control period [s] (not used: the law is time-invariant).
-    dt : float
-        Length of the control period [s], > 0 (the attitude integrals' step).
-    x : numpy.ndarray
-        The state the controller sees, STATE_SIZE (16) float64 entries laid out as
-        :mod:`quadcruise.layout`: position [m] and velocity [m/s] (earth frame, z up),
-        roll, pitch, yaw [rad], body rates p, q, r [rad/s], rotor thrusts [N] (not read).
-    ref : numpy.ndarray
-        The mission's reference at t, REF_SIZE (11) float64 entries (``REF_*``): position
-        [m], velocity [m/s] and yaw [rad] are read (no acceleration feedforward, no yaw
-        rate).
-    vp : numpy.ndarray
-        The vehicle parameter row, PARAM_SIZE (21) float64 entries (``P_*``;
-        :meth:`quadcruise.model.vehicle.Vehicle.rows`): m [kg], g [m/s^2], K [N], d [m] and
-        k1..k6 are read.
-    gains : numpy.ndarray
-        :meth:`Gonzalez.gains`, :data:`GONZALEZ_GAINS` (15 float64 entries): the attitude
-        block (``ATTITUDE_GAINS``), then k_p [1/s^2], k_d [1/s],
-        a_p, a_d [m/s^2], the z PD gains [1/s^2], [1/s], max_tilt [rad] and its cosine.
-    mem : numpy.ndarray
-        The controller's memory, ``ATTITUDE_MEMORY`` (3 float64 entries), zeros at the start of a
-        flight: the roll, pitch and yaw error integrals [rad s], updated in place.
-    cmd : numpy.ndarray
-        Output, CMD_SIZE (12) float64 entries, all written: the four duties [-] (not
-        clipped), U1 [N], U2 [N], U3 [N], U4 [N m], the attitude setpoints [rad] and the
-        flags FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT and FLAG_INTEGRATOR_HOLD as they apply.
+    """One period of :class:`Gonzalez`: saturated PD, small-angle mapping, decoupled PID.
+    Arguments: ``CONTROLLER_SIG`` (:mod:`quadcruise.layout`); gains at the offsets of :data:`GONZALEZ_GAINS`.
 
     Examples
     --------

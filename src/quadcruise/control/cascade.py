@@ -176,24 +176,8 @@ def _derivative(value, last, state, dt, alpha, first):
 
 @njit(cache=True, error_model="numpy")
 def constrain_xy(v0x, v0y, v1x, v1y, vmax):
-    """PX4 ``ControlMath::constrainXY``: v0 + v1 limited to norm vmax, v0 taking priority.
-
-    If the sum is within vmax it is returned as it is; else, if v0 alone reaches vmax, v0
-    scaled to vmax; else v0 plus as much of v1 (along v1) as fits within vmax.
-
-    Parameters
-    ----------
-    v0x, v0y : float
-        The term with priority (the cascade's position P output) [m/s].
-    v1x, v1y : float
-        The other term (the velocity reference, fed forward) [m/s].
-    vmax : float
-        The largest norm of the result [m/s], > 0.
-
-    Returns
-    -------
-    (float, float)
-        The limited horizontal velocity setpoint (x, y) [m/s].
+    """PX4 ``ControlMath::constrainXY``: v0 + v1 limited to norm vmax, v0 taking priority (then as much
+    of v1, along v1, as fits).
 
     Examples
     --------
@@ -231,47 +215,8 @@ def _rate_axis(setpoint, rate, integral, last, state, dt, alpha, first, kp, ki, 
 
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def cascade(t, dt, x, ref, vp, G, mem, cmd):
-    """PX4-style cascade: P position, PID velocity, P attitude, PID body rate (G: the gains).
-
-    One control period of :class:`Cascade` (the four steps of the module docstring);
-    compiled with :data:`quadcruise.layout.CONTROLLER_SIG`. It reads every input array
-    first and writes ``mem`` and ``cmd`` last.
-
-    Parameters
-    ----------
-    t : float
-        Time at the start of the control period [s] (not used: the law is time-invariant).
-    dt : float
-        Length of the control period [s], > 0: the integrals' step, the backward differences'
-        interval and the derivative low-pass filters' discretisation.
-    x : numpy.ndarray
-        The state the controller sees, STATE_SIZE (16) float64 entries laid out as
-        :mod:`quadcruise.layout`: position [m] and velocity [m/s] (earth frame, z up),
-        roll, pitch, yaw [rad], body rates p, q, r [rad/s], rotor thrusts [N] (not read).
-    ref : numpy.ndarray
-        The mission's reference at t, REF_SIZE (11) float64 entries (``REF_*``): position
-        [m], velocity [m/s] and acceleration [m/s^2] (both fed forward), yaw [rad] and yaw
-        rate [rad/s] (fed forward in the body frame).
-    vp : numpy.ndarray
-        The vehicle parameter row, PARAM_SIZE (21) float64 entries (``P_*``;
-        :meth:`quadcruise.model.vehicle.Vehicle.rows`): m [kg], g [m/s^2], Jxx, Jyy, Jzz
-        [kg m^2], l [m], K [N] and d [m] are read.
-    G : numpy.ndarray
-        The gains, :data:`CASCADE_GAINS` (27 float64 entries) laid out as the ``C_*`` offsets
-        (:meth:`Cascade.gains`, in that class's order and units).
-    mem : numpy.ndarray
-        The controller's memory, :data:`CASCADE_MEMORY` (19 float64 entries), zeros at the start of
-        a flight (:meth:`Cascade.memory`), updated in place: the velocity integral (x, y, z)
-        [m/s^2] from ``M_VI``, the body-rate integral (roll, pitch, yaw) [rad/s^2] from
-        ``M_RI``, the last velocity [m/s] (``M_V``) and body rates [rad/s] (``M_W``), their
-        low-passed derivatives [m/s^2] (``M_VD``) and [rad/s^2] (``M_WD``), and ``M_INIT``:
-        0 before the first period, 1 after.
-    cmd : numpy.ndarray
-        Output, CMD_SIZE (12) float64 entries, all written
-        (:func:`~quadcruise.control.so3.command_from_rotation`): the four duties [-] (not
-        clipped), U1 [N], U2 [N], U3 [N], U4 [N m], the ZYX angles of R_d as the attitude
-        setpoints [rad], and the flags FLAG_TILT_LIMIT, FLAG_THRUST_LIMIT and
-        FLAG_INTEGRATOR_HOLD as they apply.
+    """One period of :class:`Cascade`: P position, PID velocity, P attitude, PID body rate.
+    Arguments: ``CONTROLLER_SIG`` (:mod:`quadcruise.layout`); the law is in the module docstring.
 
     Examples
     --------
@@ -382,18 +327,8 @@ def cascade(t, dt, x, ref, vp, G, mem, cmd):
 
 @dataclass(frozen=True)
 class RateGains(Validated):
-    """Body-rate PID per unit inertia: alpha = kp e + ki int(e) - kd w' [rad/s^2], torque J alpha.
-
-    kp [1/s], ki [1/s^2], kd [-]; the derivative acts on the measured rate.
-
-    Parameters
-    ----------
-    kp : float
-        Proportional gain [1/s], > 0.
-    ki : float
-        Integral gain [1/s^2], >= 0.
-    kd : float
-        Derivative gain [-], >= 0.
+    """Body-rate PID per unit inertia: alpha = kp e + ki int(e) - kd w' [rad/s^2], torque J alpha;
+    kp [1/s], ki [1/s^2], kd [-] on the measured rate.
 
     Examples
     --------
@@ -421,32 +356,8 @@ PX4_YAW_RATE_I_RATIO = 0.1 / 0.2
 
 
 def rate_pid_design(actuator_bandwidth: float = 15.0, yaw: bool = False) -> RateGains:
-    """Rate gains for a rotor lag of bandwidth w: w' = alpha, alpha' = w (alpha_c - alpha).
-
-    With alpha_c = kp e - kd w' the rate loop is s^2 + w (1 + kd) s + w kp. Roll and pitch:
-    its pair at wn = w, zeta = 0.8, so kp = w, kd = 2 zeta - 1 = 0.6. Yaw keeps PX4's shape
-    without D: zeta = 0.8 gives kp = w / (4 zeta^2). The integral keeps PX4's I/P ratio (its
-    zero at 1.3 rad/s, 0.5 rad/s for yaw, far below the crossovers).
-
-    For the Qball's w = 15 rad/s (:func:`rate_loops`, D low-passed at 30 Hz): the roll/pitch
-    rate loop crosses over at 12.7 rad/s, below the lag, with a 71 deg phase margin, and the
-    attitude loop around it (MC_ROLL_P = 6.5) at 6.9 rad/s with 45 deg and a gain margin of
-    3.2; its closed-loop poles are -3.3 +/- 9.0j (zeta 0.34), -17.4, -1.3, -178. Yaw: 5.5
-    rad/s and 65 deg, attitude (MC_YAW_P = 2.8) 3.0 rad/s and 60 deg. PX4's attitude gain
-    6.5 expects a rate loop faster than this lag allows, hence the modest attitude damping;
-    with the position and velocity loops the whole linearised x loop has a worst damping
-    ratio of 0.22 and a 1 m step overshoots 13 % (PX4's position P on a raw step).
-
-    Parameters
-    ----------
-    actuator_bandwidth : float
-        The rotor lag's bandwidth w [rad/s], > 0.
-    yaw : bool
-        The yaw rate loop (no D) instead of roll and pitch.
-
-    Returns
-    -------
-    RateGains
+    """Rate gains for a rotor lag of bandwidth w: w' = alpha, alpha' = w (alpha_c - alpha); pair at wn = w, zeta 0.8.
+    Why, and the margins they give: docs/paper.md, "The PX4-style cascade's rate gains".
 
     Examples
     --------
@@ -467,28 +378,8 @@ def rate_pid_design(actuator_bandwidth: float = 15.0, yaw: bool = False) -> Rate
 
 
 def rate_loops(controller, actuator_bandwidth: float = 15.0, axis: str = "roll") -> dict:
-    """Linearised single-axis loops of a Cascade at hover, as python-control transfer functions.
-
-    ``rate``: open loop of the rate PID (D low-passed at ``rate_d_cutoff``) over the rotor
-    lag and w' = alpha; ``attitude``: open loop K_att T_rate / s with T_rate the closed rate
-    loop; ``closed``: angle / angle setpoint. ``axis``: 'roll' (= 'pitch') or 'yaw'.
-
-    Parameters
-    ----------
-    controller : Cascade
-        The controller whose rate gains (``rate`` or ``yaw_rate``), attitude P (``roll_p``
-        or ``yaw_p``) [1/s] and ``rate_d_cutoff`` [Hz] are read.
-    actuator_bandwidth : float
-        The rotor lag's bandwidth w [rad/s], > 0.
-    axis : {"roll", "pitch", "yaw"}
-        Which loop: "roll" and "pitch" give the same one; any value but "yaw" gives it.
-
-    Returns
-    -------
-    dict of str to control.TransferFunction
-        ``rate`` (the rate open loop, body rate over rate error), ``attitude`` (the
-        attitude open loop, angle over angle error) and ``closed`` (angle over angle
-        setpoint), each dimensionless and in the Laplace variable s [1/s].
+    """Linearised single-axis loops of a Cascade at hover (python-control): ``rate`` and ``attitude`` open
+    loops, ``closed`` angle over setpoint; ``axis`` 'roll' (= 'pitch') or 'yaw'.
 
     Examples
     --------

@@ -26,13 +26,7 @@ from quadcruise.fields import unit_field as _f
 
 
 def python_control():
-    """python-control, imported on first use rather than with this module.
-
-    Returns
-    -------
-    module
-        The ``control`` package.
-    """
+    """python-control, imported on first use rather than with this module."""
     import control
 
     return control
@@ -166,23 +160,6 @@ class PIDGains(_Gains):
 def parse_pole(value) -> complex:
     """A pole from a number or a string such as "-0.7" or "-1+2j" ("-1+2i" too).
 
-    Parameters
-    ----------
-    value : float, complex or str
-        The pole, an s-plane value [rad/s]; blanks in a string are ignored.
-
-    Returns
-    -------
-    complex
-        The pole (not checked for stability: :func:`pd_from_poles` does that).
-
-    Raises
-    ------
-    ValueError
-        A string that is not a number; callers name the source.
-    TypeError
-        A value of another type (None, a list, ...).
-
     Examples
     --------
     >>> parse_pole("-1 + 2i"), parse_pole(-0.7)
@@ -262,27 +239,7 @@ def pd_from_poles(poles, source: str = "pd_from_poles") -> PDGains:
 
 
 def pid_from_poles(poles, source: str = "pid_from_poles") -> PIDGains:
-    """PID gains placing the three closed-loop poles of y'' = u at ``poles`` (s-plane).
-
-    s^3 + kd s^2 + kp s + ki = (s - p1)(s - p2)(s - p3).
-
-    Parameters
-    ----------
-    poles : sequence of float or complex
-        Three closed-loop poles [rad/s] in the open left half plane; a complex one with its
-        conjugate.
-    source : str
-        Where the poles came from, as a message names it.
-
-    Returns
-    -------
-    PIDGains
-        kp [1/s^2], ki [1/s^3] and kd [1/s].
-
-    Raises
-    ------
-    InputError
-        As :func:`pd_from_poles`, for three poles.
+    """PID gains placing the closed-loop poles of y'' = u: s^3 + kd s^2 + kp s + ki = (s - p1)(s - p2)(s - p3).
 
     Examples
     --------
@@ -297,16 +254,6 @@ def pid_from_poles(poles, source: str = "pid_from_poles") -> PIDGains:
 def position_pd_design(poles=PAPER_POSITION_POLES) -> PDGains:
     """PD gains of the x/y loops (eq 16); the paper's poles give Kp = 3.01, Kd = 5.0 (eq 18).
 
-    Parameters
-    ----------
-    poles : sequence of float or complex
-        Two closed-loop poles [rad/s]; the paper's (-0.7, -4.3) by default.
-
-    Returns
-    -------
-    PDGains
-        kp [1/s^2] and kd [1/s] (:func:`pd_from_poles`).
-
     Examples
     --------
     >>> position_pd_design((-1.0, -2.0))
@@ -317,18 +264,6 @@ def position_pd_design(poles=PAPER_POSITION_POLES) -> PDGains:
 
 def altitude_pd_design(poles=PAPER_POSITION_POLES) -> PDGains:
     """PD gains of the altitude loop z'' = u_z; by default the same poles as x/y.
-
-    With the 15 rad/s rotor lag, the default gains keep a 65 deg phase margin (crossover 4.8 rad/s).
-
-    Parameters
-    ----------
-    poles : sequence of float or complex
-        Two closed-loop poles [rad/s]; the paper's x/y poles (-0.7, -4.3) by default.
-
-    Returns
-    -------
-    PDGains
-        kp [1/s^2] and kd [1/s] (:func:`pd_from_poles`).
 
     Examples
     --------
@@ -347,35 +282,8 @@ ATTITUDE_INTEGRATOR_RATIO = 1.0 / 30.0
 
 
 def attitude_pid_design(actuator_bandwidth: float = 15.0) -> PIDGains:
-    """PID gains of a decoupled attitude loop phi'' = U2* (eq 15), chosen for the cascade.
-
-    The paper gives no attitude gains. Poles on the double integrator: a pair at
-    wn = 0.6 w with zeta = 0.8 and an integrator pole at w / 30, w the actuator bandwidth;
-    for the Qball's 15 rad/s, wn = 9 rad/s and s = -0.5, so Kp = 88.2, Ki = 40.5, Kd = 14.9.
-    The derivative acts on the measured rate. Why:
-
-    * the position loop (poles 0.7 and 4.3 rad/s) needs an attitude loop about twice as
-      fast as its fast pole, or the cascade loses stability; designs that place all four
-      poles of attitude + rotor lag are forced (their sum is -w) to about 4-5 rad/s and
-      make the cascade with the paper's position gains unstable;
-    * the 15 rad/s rotor lag caps the speed: with it, this loop has a 24.5 deg phase margin
-      (crossover ~12 rad/s) and closed-loop poles -3.54 +/- 12.3j, -7.42, -0.5;
-    * among pairs wn = 3-10 rad/s, zeta = 0.7-1, integrator poles 0.3-2 rad/s, derivative on
-      the error or on the measurement, this choice maximises the worst damping ratio of the
-      whole linearised cascade of :func:`cascade_state_space` with the paper's position
-      gains (0.37; the earlier -7, -7, -1 with the derivative on the error gave 0.08);
-    * the integrator (slow, 0.5 rad/s) only removes steady offsets, e.g. from a mass error.
-
-    Scaling every pole with the bandwidth leaves the margins unchanged (time scaling).
-
-    Parameters
-    ----------
-    actuator_bandwidth : float
-        The rotor lag's bandwidth w [rad/s], > 0.
-
-    Returns
-    -------
-    PIDGains
+    """PID gains of a decoupled attitude loop phi'' = U2* (eq 15): poles at 0.6 w (zeta 0.8) and w / 30.
+    Why these: docs/paper.md, "Attitude gains".
 
     Examples
     --------
@@ -394,28 +302,8 @@ def attitude_pid_design(actuator_bandwidth: float = 15.0) -> PIDGains:
 
 
 def cascade_state_space(position: PDGains, attitude: PIDGains, actuator_bandwidth: float = 15.0, g: float = 9.81):
-    """The x loop of the paper's controller linearised about hover, from x_r to x.
-
-    States (x, x', theta, q, theta'' (the lagged attitude input), int(theta_d - theta)):
-    u_x = Kp (x_r - x) - Kd x' (a step reference has no velocity), theta_d = u_x / g (the
-    inverse model at hover), U3* = Kp_a e + Ki_a int(e) - Kd_a q (attitude PID, derivative
-    on the rate), theta'' lags U3* at the actuator bandwidth w, and x'' = g theta.
-
-    Parameters
-    ----------
-    position : PDGains
-        The x loop's gains: kp [1/s^2], kd [1/s].
-    attitude : PIDGains
-        The pitch loop's gains: kp [1/s^2], ki [1/s^3], kd [1/s].
-    actuator_bandwidth : float
-        The rotor lag's bandwidth w [rad/s].
-    g : float
-        Gravitational acceleration [m/s^2].
-
-    Returns
-    -------
-    control.StateSpace
-        Six states as above, input x_r [m], output x [m].
+    """The x loop of the paper's controller linearised about hover, from x_r to x (states: docs/paper.md,
+    "Gain design").
 
     Examples
     --------
@@ -443,18 +331,6 @@ def cascade_state_space(position: PDGains, attitude: PIDGains, actuator_bandwidt
 def loop_transfer(gains: PDGains | PIDGains, actuator_bandwidth: float | None = None):
     """Open loop L(s) = C(s) w/(s+w) / s^2 (without the lag factor when the bandwidth is None).
 
-    Parameters
-    ----------
-    gains : PDGains or PIDGains
-        The loop's gains: kp [1/s^2], kd [1/s] (and ki [1/s^3]).
-    actuator_bandwidth : float or None
-        The rotor lag's bandwidth w [rad/s], > 0; None leaves the lag out.
-
-    Returns
-    -------
-    control.TransferFunction
-        L(s), from the error to the loop's output.
-
     Examples
     --------
     >>> L = loop_transfer(PDGains(kp=1.0, kd=2.0))
@@ -468,22 +344,6 @@ def loop_transfer(gains: PDGains | PIDGains, actuator_bandwidth: float | None = 
 
 def loop_margins(gains: PDGains | PIDGains, actuator_bandwidth: float | None = 15.0) -> dict:
     """Stability margins of :func:`loop_transfer` by ``control.stability_margins``.
-
-    Parameters
-    ----------
-    gains : PDGains or PIDGains
-        The loop's gains: kp [1/s^2], kd [1/s] (and ki [1/s^3]).
-    actuator_bandwidth : float or None
-        The rotor lag's bandwidth w [rad/s], > 0; 15 rad/s (the Qball-X4's) by default, None
-        leaves the lag out.
-
-    Returns
-    -------
-    dict
-        ``gain_margin`` (factor; below 1 it is how far the gain may *fall*, as for a PID on a
-        double integrator), ``phase_margin`` [deg], ``phase_crossover`` and
-        ``gain_crossover`` [rad/s] (NaN where there is none), and ``stable`` (all poles of
-        the unity-feedback loop in the open left half plane).
 
     Examples
     --------
@@ -504,25 +364,7 @@ def loop_margins(gains: PDGains | PIDGains, actuator_bandwidth: float | None = 1
 
 
 def check_with_control(gains: PDGains | PIDGains) -> dict:
-    """Cross-check gains with python-control's pole placement on the double integrator.
-
-    States (y, y') for PD, (int y, y, y') for PID; ``control.place`` (``control.acker`` for
-    repeated poles, which ``place`` refuses) at ``gains.poles`` must give (kp, kd) or
-    (ki, kp, kd).
-
-    Parameters
-    ----------
-    gains : PDGains or PIDGains
-        The loop's gains: kp [1/s^2], kd [1/s] (and ki [1/s^3]).
-
-    Returns
-    -------
-    dict
-        ``place_gain`` (the state-feedback gain, ordered as ``(kp, kd)`` or ``(ki, kp, kd)``),
-        ``gain_error`` (largest difference from the gains over the largest gain, [-]),
-        ``closed_loop_poles`` (eigenvalues of A - B K [rad/s]), ``pole_error`` (largest
-        distance to ``gains.poles`` [rad/s]) and ``step_info`` (python-control's
-        ``step_info`` of ``gains.closed_loop()``: times [s], overshoot [%] ...).
+    """Gains checked by python-control's ``place`` (``acker`` for repeated poles) on the double integrator.
 
     Examples
     --------

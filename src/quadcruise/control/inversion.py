@@ -20,24 +20,6 @@ from quadcruise.numeric import clamp, wrap_angle
 def tilt_joint(ux, uy, spsi, cpsi, a, max_tilt, flags):
     """Eqs (5) and (6) solved together for the roll and pitch setpoints, each limited to max_tilt.
 
-    Parameters
-    ----------
-    ux, uy : float
-        Wanted x and y accelerations [m/s^2].
-    spsi, cpsi : float
-        sin and cos of yaw.
-    a : float
-        U1 / m [m/s^2].
-    max_tilt : float
-        Roll and pitch setpoint limit [rad].
-    flags : int
-        The flags so far.
-
-    Returns
-    -------
-    (float, float, int)
-        phi_d [rad], theta_d [rad] and the flags (FLAG_ASIN_CLIP, FLAG_TILT_LIMIT added as they apply).
-
     Examples
     --------
     >>> phi, theta, flags = tilt_joint(0.981, 0.0, 0.0, 1.0, 9.81, 0.7, 0)    # yaw 0: x'' from pitch alone
@@ -60,20 +42,6 @@ def tilt_joint(ux, uy, spsi, cpsi, a, max_tilt, flags):
 def pitch_eq16(ux, sphi, cphi, spsi, cpsi, a):
     """Eq (16) from the sines and cosines of roll and yaw (see :func:`theta_from_eq5`).
 
-    Parameters
-    ----------
-    ux : float
-        Wanted x acceleration [m/s^2].
-    sphi, cphi, spsi, cpsi : float
-        sin and cos of roll and yaw.
-    a : float
-        U1 / m [m/s^2].
-
-    Returns
-    -------
-    (float, float, bool)
-        theta_d [rad], its sine (asin's argument, clamped to [-1, 1]) and whether it was clamped.
-
     Examples
     --------
     >>> theta, s, clipped = pitch_eq16(0.981, 0.0, 1.0, 0.0, 1.0, 9.81)
@@ -92,23 +60,6 @@ def pitch_eq16(ux, sphi, cphi, spsi, cpsi, a):
 @njit(cache=True, inline="always", error_model="numpy")
 def roll_eq19(uy, stheta, spsi, cpsi, a):
     """Eq (19), sign kept, from sin(theta) and the yaw's sine and cosine (see :func:`phi_from_eq6`).
-
-    Parameters
-    ----------
-    uy : float
-        Wanted y acceleration [m/s^2].
-    stheta : float
-        sin theta_d.
-    spsi, cpsi : float
-        sin and cos of yaw.
-    a : float
-        U1 / m [m/s^2].
-
-    Returns
-    -------
-    (float, bool)
-        phi_d [rad] (the root nearest level, wrapped by :func:`quadcruise.numeric.wrap_angle`
-        when cos psi <= 0) and whether asin's argument was clamped.
 
     Examples
     --------
@@ -139,26 +90,6 @@ def roll_eq19(uy, stheta, spsi, cpsi, a):
 def theta_from_eq5(ux, phi, psi, a):
     """Eq (16): the pitch that gives x'' = ux at roll phi, yaw psi and a = U1/m [m/s^2].
 
-    The angle form of :func:`pitch_eq16` (the paper's sequential inversion, step 3').
-
-    Parameters
-    ----------
-    ux : float
-        Wanted x acceleration [m/s^2].
-    phi : float
-        Roll [rad] (the current one in the paper's reading).
-    psi : float
-        Yaw [rad].
-    a : float
-        U1 / m [m/s^2].
-
-    Returns
-    -------
-    theta : float
-        The pitch setpoint theta_d [rad], not limited to a tilt.
-    clipped : bool
-        Whether asin's argument left [-1, 1] and was clamped.
-
     Examples
     --------
     >>> theta, clipped = theta_from_eq5(0.981, 0.0, 0.0, 9.81)
@@ -172,26 +103,6 @@ def theta_from_eq5(ux, phi, psi, a):
 @njit(cache=True, error_model="numpy")
 def phi_from_eq6(uy, theta, psi, a):
     """Eq (19), sign-preserving: the roll that gives y'' = uy at pitch theta, yaw psi.
-
-    The angle form of :func:`roll_eq19` (the paper's sequential inversion, step 4').
-
-    Parameters
-    ----------
-    uy : float
-        Wanted y acceleration [m/s^2].
-    theta : float
-        Pitch [rad] (the pitch setpoint theta_d in the sequential inversion).
-    psi : float
-        Yaw [rad].
-    a : float
-        U1 / m [m/s^2].
-
-    Returns
-    -------
-    phi : float
-        The roll setpoint phi_d [rad], the root nearest level, not limited to a tilt.
-    clipped : bool
-        Whether asin's argument left [-1, 1] and was clamped.
 
     Examples
     --------
@@ -207,22 +118,6 @@ def thrust_for_tilt(uz, cos_tilt, m, g, K, cos_max_tilt):
     """Altitude law: U1 = m (g + u_z) / (cos phi cos theta), limited to [0, 4 K] [N], and its
     flag. ``cos_tilt`` is cos phi cos theta; the compensation uses at most 1/cos(max_tilt) so
     that it cannot blow up.
-
-    Parameters
-    ----------
-    uz : float
-        Wanted z acceleration [m/s^2].
-    cos_tilt : float
-        cos phi cos theta.
-    m, g, K : float
-        Mass [kg], gravity [m/s^2], thrust per unit duty [N].
-    cos_max_tilt : float
-        cos of the tilt limit.
-
-    Returns
-    -------
-    (float, int)
-        U1 [N] and FLAG_THRUST_LIMIT if it was limited, else 0.
 
     Examples
     --------
@@ -240,21 +135,6 @@ def thrust_for_tilt(uz, cos_tilt, m, g, K, cos_max_tilt):
 @njit(cache=True, inline="always", error_model="numpy")
 def tilt_setpoint(angle, clipped, max_tilt, flags):
     """Limit a roll/pitch setpoint to max_tilt and add the flags that apply.
-
-    Parameters
-    ----------
-    angle : float
-        The setpoint [rad].
-    clipped : bool
-        Whether its asin argument was clamped (adds FLAG_ASIN_CLIP).
-    max_tilt : float
-        The limit [rad] (adds FLAG_TILT_LIMIT when it acts).
-    flags : int
-        The flags so far.
-
-    Returns
-    -------
-    (float, int)
 
     Examples
     --------

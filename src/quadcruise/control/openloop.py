@@ -17,30 +17,6 @@ from quadcruise.layout import CMD_FLAGS
 def duty_schedule(t, dt, x, ref, vp, gains, mem, cmd):
     """Hold the duties of the last schedule row whose time is <= t (the first row before it).
 
-    An engine controller (compiled as ``CONTROLLER_SIG`` on first use). It writes the four
-    duties into ``cmd`` and NaN into the generalized inputs and setpoints (open loop: there
-    are none); the flag word is left as it is.
-
-    Parameters
-    ----------
-    t : float
-        Time at the start of the control period [s].
-    dt : float
-        Length of the control period [s] (not used).
-    x : numpy.ndarray
-        The state the controller sees, STATE_SIZE entries (not used).
-    ref : numpy.ndarray
-        The mission's reference at t, REF_SIZE entries (not used).
-    vp : numpy.ndarray
-        The vehicle parameter row, PARAM_SIZE entries (not used).
-    gains : numpy.ndarray
-        The schedule, as :func:`pack_schedule` packs it: n, the times [s], the duties [-].
-    mem : numpy.ndarray
-        One entry: the index of the current row, advanced as t passes the next row's time
-        (0 at the start).
-    cmd : numpy.ndarray
-        Output, CMD_SIZE entries: the duties u1..u4 [-] in its first four.
-
     Examples
     --------
     >>> import numpy as np
@@ -66,19 +42,6 @@ def duty_schedule(t, dt, x, ref, vp, gains, mem, cmd):
 def pack_schedule(t: np.ndarray, duties: np.ndarray) -> np.ndarray:
     """The gains vector of :func:`duty_schedule`:
     ``[n, t_0 .. t_{n-1}, u1_0 .. u4_0, u1_1, ...]``.
-
-    Parameters
-    ----------
-    t : array_like, shape (n,)
-        Start time of each row [s], increasing.
-    duties : array_like, shape (n, 4)
-        PWM duties of rotors 1..4 [-] from each row's time on (the engine clips them to
-        [0, 1]).
-
-    Returns
-    -------
-    numpy.ndarray
-        1-D float64, length 1 + 5 n.
 
     Examples
     --------

@@ -146,68 +146,15 @@ filtered x and y errors [m]), there only with ``derivative="error"``."""
 @njit(cache=True, inline="always", error_model="numpy")
 def finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd):
     """Shared tail of the position controllers: the decoupled attitude PID (eqs 13-15), the
-    mixer inverse to duties, and the logged command.
-
-    Like :func:`~quadcruise.control.attitude.decoupled_attitude`, it reads before it writes
-    and writes last: the scalar-only rule of :mod:`quadcruise.sim.fastmath`.
-
-    Parameters
-    ----------
-    U1 : float
-        Collective thrust [N], already limited (:func:`~quadcruise.control.inversion.thrust_for_tilt`).
-    phi_d, theta_d, psi_d : float
-        Roll, pitch and yaw setpoints [rad].
-    flags : int
-        The position loop's flags so far (``FLAG_*`` of :mod:`quadcruise.layout`); the
-        attitude loop's FLAG_INTEGRATOR_HOLD is added.
-    dt : float
-        Control period [s] (the attitude integrals' step).
-    x : numpy.ndarray
-        The state the controller sees, STATE_SIZE (16) entries (angles [rad] and body
-        rates [rad/s] are read).
-    vp : numpy.ndarray
-        The vehicle parameter row, PARAM_SIZE (21) entries (k1..k6, d [m] and K [N] are
-        read).
-    gains : numpy.ndarray
-        The controller's gains vector, starting with the attitude block
-        (:data:`~quadcruise.control.attitude.ATTITUDE_GAINS`).
-    mem : numpy.ndarray
-        The controller's memory: its first 3 entries (``ATTITUDE_MEMORY``), the roll, pitch and yaw
-        error integrals [rad s], are updated in place.
-    cmd : numpy.ndarray
-        Output, CMD_SIZE (12) float64 entries, all written
-        (:func:`~quadcruise.control.base.write_command`): the four duties [-] (not clipped),
-        U1 [N], U2 [N], U3 [N], U4 [N m], the setpoints [rad] and the flags.
-    """
+    mixer inverse to duties, and the logged command."""
     U2, U3, U4, att_flags = decoupled_attitude(x, phi_d, theta_d, psi_d, vp, gains, mem, dt)
     write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags | att_flags, vp[P_D], vp[P_K])
 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def filtered_derivative(e, f, kd, n, decay):
-    """The derivative term Kd N s / (s + N) of an error, and its filter's next state.
-
-    The filter is f' = N (e - f); the term is Kd f' = Kd N (e - f). Its state f holds the
-    filtered error and is advanced over one control period with the error held (exact for
-    a held input): f+ = e + (f - e) exp(-N dt).
-
-    Parameters
-    ----------
-    e : float
-        The error now [m].
-    f : float
-        The filter's state [m].
-    kd : float
-        Derivative gain [1/s].
-    n : float
-        Filter bandwidth N [1/s].
-    decay : float
-        exp(-N dt) over one control period.
-
-    Returns
-    -------
-    (float, float)
-        The derivative term [m/s^2] and the filter's state for the next period [m].
+    """The derivative term Kd N s / (s + N) of an error, and its filter's next state: f' = N (e - f),
+    advanced over a period with e held, f+ = e + (f - e) exp(-N dt).
 
     Examples
     --------
@@ -221,46 +168,8 @@ def filtered_derivative(e, f, kd, n, decay):
 
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
-    """The paper's inverse-model nonlinear PD (eqs 16, 19) over decoupled attitude PID.
-
-    One control period of :class:`NLPD` (steps 1-5 of the module docstring, then
-    :func:`finish`); compiled with :data:`quadcruise.layout.CONTROLLER_SIG`.
-
-    Parameters
-    ----------
-    t : float
-        Time at the start of the control period [s] (not used: the law is time-invariant).
-    dt : float
-        Length of the control period [s], > 0: the attitude integrals' step and, with
-        ``derivative="error"``, the derivative filter's.
-    x : numpy.ndarray
-        The state the controller sees, STATE_SIZE (16) float64 entries laid out as
-        :mod:`quadcruise.layout`: position [m] and velocity [m/s] (earth frame, z up),
-        roll, pitch, yaw [rad], body rates p, q, r [rad/s], rotor thrusts [N] (not read).
-    ref : numpy.ndarray
-        The mission's reference at t, REF_SIZE (11) float64 entries (``REF_*``): position
-        [m], velocity [m/s], acceleration [m/s^2] (used only with acceleration
-        feedforward), yaw [rad] (the yaw setpoint) and yaw rate [rad/s] (not read).
-    vp : numpy.ndarray
-        The vehicle parameter row, PARAM_SIZE (21) float64 entries (``P_*``;
-        :meth:`quadcruise.model.vehicle.Vehicle.rows`): m [kg], g [m/s^2], K [N], d [m] and
-        k1..k6 are read.
-    gains : numpy.ndarray
-        :meth:`NLPD.gains`, :data:`NLPD_GAINS` (18 float64 entries): the attitude block
-        (``ATTITUDE_GAINS``), then at the offsets ``NL_KP_XY`` .. ``NL_FILTER_N`` the x/y and
-        z PD gains [1/s^2], [1/s], max_tilt [rad], the feedforward switch (0 or 1), cos and
-        sin of max_tilt, the inversion (0 joint, 1 sequential), the derivative form (0 on
-        the measurement, 1 on the error) and the filter bandwidth N [1/s].
-    mem : numpy.ndarray
-        The controller's memory (:meth:`NLPD.memory`), zeros at the start of a flight,
-        updated in place (:data:`NLPD_MEMORY`): the roll, pitch and yaw error integrals
-        [rad s], and with ``derivative="error"`` the filtered x and y errors [m] at
-        ``NL_FILTER_X``, ``NL_FILTER_Y``.
-    cmd : numpy.ndarray
-        Output, CMD_SIZE (12) float64 entries, all written (:func:`finish`): the four
-        duties [-] (not clipped), U1 [N], U2 [N], U3 [N], U4 [N m], the attitude setpoints
-        [rad] and the flags FLAG_THRUST_LIMIT, FLAG_TILT_LIMIT, FLAG_ASIN_CLIP and
-        FLAG_INTEGRATOR_HOLD as they apply.
+    """One period of :class:`NLPD`: the inverse-model nonlinear PD (eqs 16, 19) over decoupled attitude PID.
+    Arguments: ``CONTROLLER_SIG`` (:mod:`quadcruise.layout`); gains at the offsets of :data:`NLPD_GAINS`.
 
     Examples
     --------

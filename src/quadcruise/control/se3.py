@@ -108,40 +108,8 @@ SE3_KX, SE3_KV, SE3_KX_Z, SE3_KV_Z, SE3_K_R, SE3_K_W, SE3_MAX_TILT = SE3_GAINS.o
 
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def se3(t, dt, x, ref, vp, gains, mem, cmd):
-    """Geometric tracking control on SE(3) (Lee et al. 2010), moments per unit inertia.
-
-    One control period of :class:`SE3` (the law is in the module docstring); compiled with
-    :data:`quadcruise.layout.CONTROLLER_SIG`. It keeps no memory, reads every input array
-    first and writes ``cmd`` last.
-
-    Parameters
-    ----------
-    t : float
-        Time at the start of the control period [s] (not used: the law is static).
-    dt : float
-        Length of the control period [s] (not used: nothing is integrated).
-    x : numpy.ndarray
-        The state the controller sees, STATE_SIZE (16) float64 entries laid out as
-        :mod:`quadcruise.layout`: position [m] and velocity [m/s] (earth frame, z up),
-        roll, pitch, yaw [rad], body rates p, q, r [rad/s], rotor thrusts [N] (not read).
-    ref : numpy.ndarray
-        The mission's reference at t, REF_SIZE (11) float64 entries (``REF_*``): position
-        [m], velocity [m/s], acceleration [m/s^2] (fed forward), yaw [rad] and yaw rate
-        [rad/s] (the desired body rate about b3, w_d = (0, 0, psi_dot_d)).
-    vp : numpy.ndarray
-        The vehicle parameter row, PARAM_SIZE (21) float64 entries (``P_*``;
-        :meth:`quadcruise.model.vehicle.Vehicle.rows`): m [kg], g [m/s^2], Jxx, Jyy, Jzz
-        [kg m^2], l [m], K [N] and d [m] are read.
-    gains : numpy.ndarray
-        :meth:`SE3.gains`, 7 float64 entries: kx [1/s^2], kv [1/s] of x and y, the same of
-        z, kR [1/s^2], kw [1/s], max_tilt [rad].
-    mem : numpy.ndarray
-        The controller's memory: empty for SE3 (``memory_size`` 0), not read or written.
-    cmd : numpy.ndarray
-        Output, CMD_SIZE (12) float64 entries, all written
-        (:func:`~quadcruise.control.so3.command_from_rotation`): the four duties [-] (not
-        clipped), U1 [N], U2 [N], U3 [N], U4 [N m], the ZYX angles of R_d as the attitude
-        setpoints [rad], and the flags FLAG_TILT_LIMIT and FLAG_THRUST_LIMIT as they apply.
+    """One period of :class:`SE3`: geometric tracking on SE(3) (Lee et al. 2010), moments per unit inertia.
+    Arguments: ``CONTROLLER_SIG`` (:mod:`quadcruise.layout`); the law is in the module docstring.
 
     Examples
     --------
@@ -185,16 +153,6 @@ def se3(t, dt, x, ref, vp, gains, mem, cmd):
 def se3_attitude_design(actuator_bandwidth: float = 15.0) -> PDGains:
     """kR = wn^2 [1/s^2], kw = 2 zeta wn [1/s] per unit inertia at the attitude design's
     wn = 0.6 w, zeta = 0.8 (see :func:`quadcruise.control.design.attitude_pid_design`).
-
-    Parameters
-    ----------
-    actuator_bandwidth : float
-        The rotor lag's bandwidth w [rad/s], > 0.
-
-    Returns
-    -------
-    PDGains
-        kp = kR, kd = kw.
 
     Examples
     --------

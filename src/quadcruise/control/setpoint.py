@@ -107,21 +107,6 @@ def setpoint_gains(**scales: float) -> np.ndarray:
     """A gains row for an action-mode controller: zero setpoint (hover thrust, level, still),
     then :data:`DEFAULT_SCALES` with ``scales`` replacing some.
 
-    Parameters
-    ----------
-    **scales : float
-        Keys of :data:`DEFAULT_SCALES`, each > 0.
-
-    Returns
-    -------
-    numpy.ndarray
-        (SETPOINT_GAINS.size,) float64.
-
-    Raises
-    ------
-    ValueError
-        An unknown key or a value that is not > 0.
-
     Examples
     --------
     >>> setpoint_gains(max_tilt=0.3)[[0, S_MAX_TILT]].tolist()
@@ -151,23 +136,7 @@ def _wrapped(a):
 
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def rotor_setpoint(t, dt, x, ref, vp, G, mem, cmd):
-    """Rotor duties from ``G[0:4]``: duty i = hover duty (1 + G[i]) (``CONTROLLER_SIG``).
-
-    Parameters
-    ----------
-    t, dt : float
-        Time and period [s] (not read).
-    x, ref : numpy.ndarray
-        The state seen and the reference (not read).
-    vp : numpy.ndarray
-        The vehicle parameter row: m, g, K, d are read.
-    G : numpy.ndarray
-        (SETPOINT_GAINS.size,) the normalised setpoint, then the scales.
-    mem : numpy.ndarray
-        Memory (none used).
-    cmd : numpy.ndarray
-        Output (CMD_SIZE): the duties, and U1..U4 they give in steady state.
-    """
+    """Rotor duties from ``G[0:4]``: duty i = hover duty (1 + G[i]) (``CONTROLLER_SIG``)."""
     K, d = vp[P_K], vp[P_D]
     hover = vp[P_M] * vp[P_G] / (4.0 * K)
     u1, u2, u3, u4 = hover * (1.0 + G[S_A0]), hover * (1.0 + G[S_A1]), hover * (1.0 + G[S_A2]), hover * (1.0 + G[S_A3])
@@ -180,25 +149,7 @@ def rotor_setpoint(t, dt, x, ref, vp, G, mem, cmd):
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def rate_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     """Collective thrust m g (1 + G[0]) and body rates G[1:4] times the largest rates,
-    through a proportional rate loop (``CONTROLLER_SIG``; parameters as :func:`rotor_setpoint`).
-
-    Parameters
-    ----------
-    t, dt : float
-        Time and period [s] (not read).
-    x : numpy.ndarray
-        The state seen: the body rates are read.
-    ref : numpy.ndarray
-        The reference (not read).
-    vp : numpy.ndarray
-        The vehicle parameter row.
-    G : numpy.ndarray
-        (SETPOINT_GAINS.size,) the normalised setpoint, then the scales.
-    mem : numpy.ndarray
-        Memory (none used).
-    cmd : numpy.ndarray
-        Output (CMD_SIZE), duties not clipped.
-    """
+    through a proportional rate loop (``CONTROLLER_SIG``; parameters as :func:`rotor_setpoint`)."""
     m, g, K, d, l = vp[P_M], vp[P_G], vp[P_K], vp[P_D], vp[P_L]
     jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
     p, q, r = x[P], x[Q], x[R]
@@ -211,25 +162,7 @@ def rate_setpoint(t, dt, x, ref, vp, G, mem, cmd):
 @njit(CONTROLLER_SIG, cache=True, error_model="numpy")
 def attitude_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     """Collective thrust m g (1 + G[0]), roll and pitch G[1:3] times the largest tilt, yaw
-    G[3] pi, through proportional attitude and rate loops (``CONTROLLER_SIG``).
-
-    Parameters
-    ----------
-    t, dt : float
-        Time and period [s] (not read).
-    x : numpy.ndarray
-        The state seen: the Euler angles and body rates are read.
-    ref : numpy.ndarray
-        The reference (not read).
-    vp : numpy.ndarray
-        The vehicle parameter row.
-    G : numpy.ndarray
-        (SETPOINT_GAINS.size,) the normalised setpoint, then the scales.
-    mem : numpy.ndarray
-        Memory (none used).
-    cmd : numpy.ndarray
-        Output (CMD_SIZE), duties not clipped.
-    """
+    G[3] pi, through proportional attitude and rate loops (``CONTROLLER_SIG``)."""
     m, g, K, d, l = vp[P_M], vp[P_G], vp[P_K], vp[P_D], vp[P_L]
     jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
     phi, theta, psi, p, q, r = x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R]
@@ -245,25 +178,7 @@ def attitude_setpoint(t, dt, x, ref, vp, G, mem, cmd):
 def velocity_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     """Velocity G[0:3] times the largest speeds (earth frame) and yaw G[3] pi, through a
     proportional velocity loop, the thrust and tilt that give its acceleration (tilt limited),
-    and the attitude and rate loops (``CONTROLLER_SIG``).
-
-    Parameters
-    ----------
-    t, dt : float
-        Time and period [s] (not read).
-    x : numpy.ndarray
-        The state seen: velocity, Euler angles and body rates are read.
-    ref : numpy.ndarray
-        The reference (not read).
-    vp : numpy.ndarray
-        The vehicle parameter row.
-    G : numpy.ndarray
-        (SETPOINT_GAINS.size,) the normalised setpoint, then the scales.
-    mem : numpy.ndarray
-        Memory (none used).
-    cmd : numpy.ndarray
-        Output (CMD_SIZE), duties not clipped; the tilt-limit flag when the tilt was limited.
-    """
+    and the attitude and rate loops (``CONTROLLER_SIG``)."""
     m, g, K, d, l = vp[P_M], vp[P_G], vp[P_K], vp[P_D], vp[P_L]
     jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
     vx, vy, vz = x[VX], x[VY], x[VZ]

@@ -36,17 +36,6 @@ from quadcruise.numeric import clamp
 def rotation_zyx(phi, theta, psi):
     """Rz(psi) Ry(theta) Rx(phi): the body-to-earth rotation of the paper's angles.
 
-    Parameters
-    ----------
-    phi, theta, psi : float
-        Roll, pitch and yaw [rad] (ZYX Euler angles, as in the state).
-
-    Returns
-    -------
-    tuple of three 3-tuples of float
-        R by rows (``R[i][j]``), body to earth coordinates, z up; its third column is the
-        thrust direction b3 of eqs (5)-(7).
-
     Examples
     --------
     >>> import math
@@ -68,16 +57,6 @@ def rotation_zyx(phi, theta, psi):
 def euler_zyx(Rm):
     """(phi, theta, psi) of a rotation R = Rz(psi) Ry(theta) Rx(phi), |theta| <= pi/2.
 
-    Parameters
-    ----------
-    Rm : tuple of three 3-tuples
-        The rotation, by rows (``R[i][j]``).
-
-    Returns
-    -------
-    (float, float, float)
-        Roll, pitch, yaw [rad]; -R[2][0] is clamped to [-1, 1] before its asin (a NaN stays NaN).
-
     Examples
     --------
     >>> [round(a, 12) for a in euler_zyx(rotation_zyx(0.1, -0.2, 0.3))]
@@ -91,26 +70,6 @@ def euler_zyx(Rm):
 def limit_tilt(hx, hy, vz, max_tilt):
     """Scale the horizontal part (hx, hy) of a vector with vertical part vz so that the
     vector is at most ``max_tilt`` from the vertical; returns (hx, hy, limited).
-
-    A vector pointing level or down (vz <= 0) loses its horizontal part (and counts as
-    limited): the thrust direction then falls back to straight up.
-
-    Parameters
-    ----------
-    hx, hy : float
-        Horizontal components, earth frame (any unit, the same as ``vz``: the controllers
-        pass a force [N] or an acceleration [m/s^2]).
-    vz : float
-        Vertical component, z up (same unit).
-    max_tilt : float
-        Largest angle of the vector from the vertical [rad], in (0, pi/2).
-
-    Returns
-    -------
-    hx, hy : float
-        The horizontal components, scaled by a common factor in [0, 1] (same unit).
-    limited : bool
-        True if they were scaled (or zeroed because vz <= 0).
 
     Examples
     --------
@@ -139,19 +98,6 @@ def attitude_lee(b3x, b3y, b3z, psi):
     heading c1 = (cos psi, sin psi, 0) on the plane normal to b3: b2 = b3 x c1 / |b3 x c1|,
     b1 = b2 x b3. Needs b3 away from the horizontal heading (true for any tilt < 90 deg).
 
-    Parameters
-    ----------
-    b3x, b3y, b3z : float
-        The desired thrust direction b3_d, a unit vector in the earth frame [-], z up.
-    psi : float
-        The yaw reference [rad] that sets the heading c1.
-
-    Returns
-    -------
-    tuple of three 3-tuples of float
-        R_d by rows (``R[i][j]``), its columns b1_d, b2_d, b3_d (body to earth). Its ZYX
-        yaw equals psi only when b3_d is vertical (:func:`attitude_px4` keeps it exactly).
-
     Examples
     --------
     >>> [round(a, 12) + 0.0 for a in euler_zyx(attitude_lee(0.0, 0.0, 1.0, 0.3))]
@@ -169,19 +115,6 @@ def attitude_px4(b3x, b3y, b3z, psi):
     """Desired rotation as PX4's ``bodyzToAttitude``: b3 given (unit), b1 normal to the
     yaw frame's y axis c2 = (-sin psi, cos psi, 0): b1 = c2 x b3 / |c2 x b3|, b2 = b3 x b1.
     Its ZYX yaw is exactly psi (b1 stays in the vertical plane of the heading).
-
-    Parameters
-    ----------
-    b3x, b3y, b3z : float
-        The desired thrust direction b3_d, a unit vector in the earth frame [-], z up, with
-        b3z > 0 (below the horizontal the cross product c2 x b3 can vanish).
-    psi : float
-        The yaw reference [rad].
-
-    Returns
-    -------
-    tuple of three 3-tuples of float
-        R_d by rows (``R[i][j]``), its columns b1_d, b2_d, b3_d (body to earth).
 
     Examples
     --------
@@ -214,19 +147,6 @@ def error_lee(Rm, Rd):
     """Lee's attitude error e_R = vee(Rd^T R - R^T Rd) / 2 (body frame): sin(angle) times
     the axis of the rotation from the desired to the current attitude.
 
-    Parameters
-    ----------
-    Rm : tuple of three 3-tuples of float
-        The current rotation R, by rows (:func:`rotation_zyx` of the state's angles).
-    Rd : tuple of three 3-tuples of float
-        The desired rotation R_d, by rows.
-
-    Returns
-    -------
-    (float, float, float)
-        e_R in body axes [-] (sin of the angle times the unit axis; about the angle [rad]
-        when it is small). The controllers feed back -kR e_R.
-
     Examples
     --------
     >>> e = error_lee(rotation_zyx(0.1, 0.0, 0.0), rotation_zyx(0.0, 0.0, 0.0))
@@ -245,20 +165,6 @@ def error_quaternion(Rm, Rd):
     """PX4's attitude error 2 sign(w) (x, y, z) of the quaternion of R^T Rd (body frame):
     2 sin(angle / 2) times the axis of the rotation from the current to the desired
     attitude, angle in [0, pi]. The quaternion is taken by Shepperd's method.
-
-    Parameters
-    ----------
-    Rm : tuple of three 3-tuples of float
-        The current rotation R, by rows (:func:`rotation_zyx` of the state's angles).
-    Rd : tuple of three 3-tuples of float
-        The desired rotation R_d, by rows.
-
-    Returns
-    -------
-    (float, float, float)
-        The error in body axes [-] (2 sin(angle / 2) times the unit axis; about the angle
-        [rad] when it is small). Its sign is opposite to :func:`error_lee`'s: the rate
-        setpoint is +K times it.
 
     Examples
     --------
@@ -298,25 +204,6 @@ def error_quaternion(Rm, Rd):
 def command_from_rotation(U1, U2, U3, U4, Rd, flags, d, K, cmd):
     """Write the command (:func:`~quadcruise.control.base.write_command`) with the ZYX angles
     of the desired rotation Rd as the attitude setpoints (phi_d, theta_d, psi_d).
-
-    Parameters
-    ----------
-    U1, U2, U3 : float
-        Desired collective thrust, roll and pitch inputs [N].
-    U4 : float
-        Desired yaw torque [N m].
-    Rd : tuple of three 3-tuples of float
-        The desired rotation, by rows; its ZYX angles (:func:`euler_zyx`) are logged as
-        the attitude setpoints [rad].
-    flags : int
-        Bit mask of ``FLAG_*`` (:mod:`quadcruise.layout`).
-    d : float
-        Yaw arm: rotor drag torque per unit thrust [m], > 0.
-    K : float
-        PWM gain: a rotor's steady thrust at duty 1 [N].
-    cmd : numpy.ndarray
-        Output, CMD_SIZE (12) float64 entries, all written (``CMD_*`` of
-        :mod:`quadcruise.layout`).
 
     Examples
     --------

@@ -41,13 +41,7 @@ class Part(Validated):
         return next(iter(sizes), None)
 
     def to_dict(self) -> dict:
-        """The model's name and fields as plain values (lists for arrays and vectors).
-
-        Returns
-        -------
-        dict
-            ``{'model': name, field: value, ...}``.
-        """
+        """The model's name and fields as plain values (lists for arrays and vectors)."""
 
         def plain(v):
             return [plain(u) for u in v] if isinstance(v, tuple) else v.tolist() if isinstance(v, np.ndarray) else v

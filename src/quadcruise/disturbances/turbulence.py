@@ -83,12 +83,7 @@ def lateral_coefficients(a):
 @njit(cache=True, inline="always", error_model="numpy")
 def dryden_step(dt, sigma_u, sigma_v, sigma_w, t_u, t_w, dmem, started, state, ext):
     """Add the Dryden wind at the period's start to ``ext``'s wind, and advance the filters
-    (in ``dmem``, laid out as :data:`DRYDEN_MEMORY`) over the period ``dt`` [s].
-
-    ``sigma_*`` [m/s] and ``t_u``, ``t_w`` [s] are :meth:`Turbulence.sigmas` and
-    :meth:`Turbulence.time_constants`; ``started`` is the memory's started flag and ``state``
-    the vehicle's random generator state, both returned updated (the caller stores them).
-    """
+    (in ``dmem``, laid out as :data:`DRYDEN_MEMORY`) over the period ``dt`` [s]."""
     if started == 0.0:  # first period: draw the stationary start
         n0, n1, n2, n3, n4, state = five_normals(state)
         started, dmem[DRY_U] = 1.0, n0

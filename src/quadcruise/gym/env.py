@@ -44,20 +44,7 @@ has crashed for any purpose of training."""
 
 
 def random_circle(seed: int, episode_id: int) -> Circle:
-    """A random circle reference: radius U[0.5, 3] m, lap U[8, 20] s, either direction, any start angle.
-
-    Parameters
-    ----------
-    seed : int
-        The environment's seed.
-    episode_id : int
-        ``vehicle * EPISODE_STRIDE + episode``.
-
-    Returns
-    -------
-    Circle
-        At 1 m altitude, around the origin.
-    """
+    """A random circle reference: radius U[0.5, 3] m, lap U[8, 20] s, either direction, any start angle."""
     u = np.random.default_rng(np.random.SeedSequence([seed, episode_id], spawn_key=(RANDOM_MISSION_KEY,))).random(4)
     return Circle(
         radius=0.5 + 2.5 * u[0],

@@ -27,28 +27,7 @@ BASELINES = ("nlpd", "gonzalez", "se3", "cascade")
 
 
 def rollout(env: QuadVectorEnv, policy: Callable | None = None, *, seed: int = 0) -> tuple[np.ndarray, SimResult]:
-    """One episode of every vehicle of ``env``, from ``env.reset(seed=seed)`` to its end.
-
-    Parameters
-    ----------
-    env : QuadVectorEnv
-        The environment (its baseline controller flies when it has one).
-    policy : callable, optional
-        ``policy(obs) -> actions``, (N, OBS_SIZE) to (N, 4); None for a baseline environment.
-    seed : int
-        The episode's seed.
-
-    Returns
-    -------
-    (numpy.ndarray, SimResult)
-        Each vehicle's return (sum of rewards) and its flight, logged at every period, with its
-        status (the engine's, or ``lost track``), so that ``.metrics()`` scores it.
-
-    Raises
-    ------
-    InputError
-        A policy for a baseline environment, or none for a policy environment.
-    """
+    """One episode of every vehicle of ``env``, from ``env.reset(seed=seed)`` to its end."""
     if not isinstance(env, QuadVectorEnv):
         env = getattr(env, "unwrapped", env)
     if (policy is None) != (env.baseline is not None):

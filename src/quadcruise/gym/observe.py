@@ -47,43 +47,14 @@ REWARD_RATE = 0.05
 
 @njit(cache=True)
 def references(mission, t, mp, ref):
-    """The mission's reference of every vehicle at its own time.
-
-    Parameters
-    ----------
-    mission : compiled function with ``MISSION_SIG``
-    t : numpy.ndarray
-        (N,) each vehicle's time [s].
-    mp : numpy.ndarray
-        (N, Mp) mission parameter rows.
-    ref : numpy.ndarray
-        (N, REF_SIZE) output.
-    """
+    """The mission's reference of every vehicle at its own time."""
     for i in range(t.shape[0]):
         mission(t[i], mp[i], ref[i])
 
 
 @njit(cache=True)
 def observe(x, ref, vp, bound, obs, reward, lost):
-    """Observations, rewards and the tracking check of N vehicles (the module docstring's layout).
-
-    Parameters
-    ----------
-    x : numpy.ndarray
-        (N, 16) true states.
-    ref : numpy.ndarray
-        (N, REF_SIZE) references at the vehicles' times.
-    vp : numpy.ndarray
-        (N, PARAM_SIZE) the vehicle parameter rows the observation scales rotor thrusts by.
-    bound : float
-        Tracking bound [m]: a position error beyond it sets ``lost``.
-    obs : numpy.ndarray
-        (N, OBS_SIZE) float32 output.
-    reward : numpy.ndarray
-        (N,) float64 output.
-    lost : numpy.ndarray
-        (N,) bool output.
-    """
+    """Observations, rewards and the tracking check of N vehicles (the module docstring's layout)."""
     for i in range(x.shape[0]):
         Rm = rotation_zyx(x[i, PHI], x[i, THETA], x[i, PSI])
         ex, ey, ez = x[i, X] - ref[i, REF_X], x[i, X + 1] - ref[i, REF_X + 1], x[i, X + 2] - ref[i, REF_X + 2]

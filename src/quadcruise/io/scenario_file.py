@@ -65,21 +65,6 @@ def _part(d: dict | None) -> dict | None:
 def scenario_document(meta: dict, *, title: str = "") -> dict:
     """The scenario tables of a flight's recorded configuration.
 
-    Parameters
-    ----------
-    meta : dict
-        A flight's ``meta`` (:attr:`quadcruise.SimResult.meta`): ``vehicle``, ``controller``,
-        ``mission``, optionally ``environment``, ``sensors``, ``controller_vehicle``, and the
-        simulation settings (``duration_s``, ``dt_s``, ``max_step_s``, ``seed``, ...).
-    title : str
-        The scenario's title.
-
-    Returns
-    -------
-    dict
-        Tables ``vehicle``, ``controller``, ``mission``, ``disturbances``, ``simulation``
-        (and ``controller_vehicle``), ready for :func:`scenario_text`.
-
     Examples
     --------
     >>> doc = scenario_document({"mission": {"kind": "step", "size": 0.5}, "controller": {"name": "nlpd"},
@@ -115,23 +100,7 @@ def scenario_document(meta: dict, *, title: str = "") -> dict:
 
 
 def montecarlo_document(spec: dict, n: int, *, title: str = "") -> dict:
-    """The scenario tables of a Monte Carlo sweep: what ``quadcruise montecarlo --scenario`` reads.
-
-    Parameters
-    ----------
-    spec : dict
-        :meth:`quadcruise.montecarlo.MonteCarloSpec.to_dict`.
-    n : int
-        Number of flights.
-    title : str
-        The scenario's title.
-
-    Returns
-    -------
-    dict
-        The flight's tables (:func:`scenario_document`) and a ``[montecarlo]`` table: ``n``,
-        ``seed``, the population's fields and the spec's settings (:data:`SPEC_KEYS`).
-    """
+    """The scenario tables of a Monte Carlo sweep: what ``quadcruise montecarlo --scenario`` reads."""
     population = spec["population"]
     meta = {
         "mission": spec["mission"],
@@ -154,23 +123,7 @@ def montecarlo_document(spec: dict, n: int, *, title: str = "") -> dict:
 
 
 def comparison_document(meta: dict, controllers: dict, *, title: str = "") -> dict:
-    """The scenario tables of a comparison: what ``quadcruise compare`` reads.
-
-    Parameters
-    ----------
-    meta : dict
-        The recorded configuration of one of its flights (all share mission, vehicle and world).
-    controllers : dict
-        Label -> the controller's record (``to_dict()``), in the order flown.
-    title : str
-        The scenario's title.
-
-    Returns
-    -------
-    dict
-        The flight's tables without ``[controller]``, and ``[[compare.controllers]]``: one table
-        per controller, with its ``label``.
-    """
+    """The scenario tables of a comparison: what ``quadcruise compare`` reads."""
     doc = scenario_document({k: v for k, v in meta.items() if k != "controller"}, title=title)
     doc["compare"] = {"controllers": [_plain({"label": label, **record}) for label, record in controllers.items()]}
     return doc
@@ -178,17 +131,6 @@ def comparison_document(meta: dict, controllers: dict, *, title: str = "") -> di
 
 def scenario_text(doc: dict, *, header: str = "") -> str:
     """The scenario tables as TOML text.
-
-    Parameters
-    ----------
-    doc : dict
-        Tables as :func:`scenario_document` makes them.
-    header : str
-        Comment lines put first (each line gets a ``# ``).
-
-    Returns
-    -------
-    str
 
     Examples
     --------

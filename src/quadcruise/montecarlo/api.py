@@ -222,16 +222,7 @@ def check_montecarlo_arguments(
     spec_options: dict,
 ) -> None:
     """:func:`montecarlo`'s arguments checked, before any work, in the API's one message form
-    (:mod:`quadcruise.checks`): a wrong type is an ArgumentTypeError, a bad value an InputError.
-
-    Parameters
-    ----------
-    mission, controller, population, n, seed, environment, sensors, chunk_size, scheduler, workers, out, \
-resume, force, progress, connect_timeout
-        As :func:`montecarlo` was given them.
-    spec_options : dict
-        Its other keywords (``duration``, ``dt``, ``vehicle``, ...), checked by type here.
-    """
+    (:mod:`quadcruise.checks`): a wrong type is an ArgumentTypeError, a bad value an InputError."""
     w = "montecarlo()"
     as_mission(mission, w)
     as_controller(controller, w)

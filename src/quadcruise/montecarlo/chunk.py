@@ -23,36 +23,8 @@ __all__ = ["Case", "fly_chunk", "montecarlo_case", "reduce_chunk", "replay_case"
 
 # --- one chunk --------------------------------------------------------------------------
 def fly_chunk(spec: MonteCarloSpec, first, count: int, log_every: int | None = None, controller=None):
-    """Fly vehicles first .. first + count - 1 of the population as one batch:
-    ``(SimResult, Draw)``. Divergence and clipping are not warned about (they are in the
-    table).
-
-    ``first`` may also be the (count,) indices of the vehicles (repeats allowed), and
-    ``controller`` one controller per vehicle instead of the spec's: a tuner flies each of
-    its candidates on the same perturbed vehicles, their noise and turbulence included, as
-    one batch.
-
-    Parameters
-    ----------
-    spec : MonteCarloSpec
-        The sweep: mission, controller, population, seed, duration [s], dt [s], ...
-    first : int or array_like of int
-        Index of the first vehicle in the population, or the (count,) indices.
-    count : int
-        Number of vehicles, >= 1.
-    log_every : int, optional
-        Log every this many control periods; the spec's ``log_every`` by default.
-    controller : controller or list of controllers, optional
-        What to fly instead of the spec's controller (one per vehicle for a list).
-
-    Returns
-    -------
-    res : SimResult
-        The batch's flights (:func:`quadcruise.workflows.fly.fly`).
-    draw : Draw
-        The drawn vehicles, offsets, disturbances and table columns
-        (:meth:`quadcruise.montecarlo.population.Population.draw`).
-    """
+    """Fly vehicles first .. first + count - 1 (or the indices ``first``) as one batch, with the spec's
+    controller or one per vehicle: ``(SimResult, Draw)``; failures go in the table, not in warnings."""
     from quadcruise.workflows.fly import fly, hover_state
 
     draw = spec.population.draw(spec.seed, first, count, spec.vehicle, spec.dt)
@@ -81,32 +53,8 @@ def fly_chunk(spec: MonteCarloSpec, first, count: int, log_every: int | None = N
 
 
 def run_chunk(spec: MonteCarloSpec, first: int, count: int, threads: int | None = None) -> dict:
-    """Vehicles first .. first + count - 1, flown and reduced to a chunk (dict of arrays).
-
-    Keys: ``first``, ``count``, ``hash``, one array per column of
-    :data:`~quadcruise.montecarlo.result.COLUMNS`, and the kept paths: ``trace_vehicle``
-    (k,), ``trace_t`` (L,), ``trace_pos`` and ``trace_ref`` (k, L, 3), ``trace_sample`` (k,)
-    (True: one of the first ``max_traces`` vehicles; else kept as one of the first
-    ``max_failure_traces`` failures). A pure function of its arguments: this is the Dask
-    task. ``threads`` sets numba's threads for this call (1 on a Dask worker).
-
-    Parameters
-    ----------
-    spec : MonteCarloSpec
-        The sweep.
-    first : int
-        Index of the chunk's first vehicle in the population.
-    count : int
-        Number of vehicles, >= 1.
-    threads : int, optional
-        numba threads for this call, clipped to [1, NUMBA_NUM_THREADS]; left as set by
-        default. The setting stays in force on the calling thread afterwards.
-
-    Returns
-    -------
-    dict of str to numpy.ndarray
-        The chunk (:func:`reduce_chunk`).
-    """
+    """Vehicles first .. first + count - 1, flown and reduced to a chunk (dict of arrays): the Dask task, a
+    pure function of its arguments."""
     if threads is not None:
         import numba
 
@@ -116,28 +64,7 @@ def run_chunk(spec: MonteCarloSpec, first: int, count: int, threads: int | None 
 
 
 def reduce_chunk(spec: MonteCarloSpec, first: int, res, draw: Draw) -> dict:
-    """The chunk of :func:`run_chunk` from a flown batch and its draw.
-
-    Parameters
-    ----------
-    spec : MonteCarloSpec
-        The sweep (its hash, metric options, ``max_traces``, ``max_failure_traces`` and
-        ``trace_every`` are used).
-    first : int
-        Index of the batch's first vehicle in the population.
-    res : SimResult
-        The batch flown by :func:`fly_chunk`.
-    draw : Draw
-        Its draw.
-
-    Returns
-    -------
-    dict of str to numpy.ndarray
-        ``first``, ``count`` (int64), ``hash`` (str), one array per column of
-        :data:`~quadcruise.montecarlo.schema.COLUMNS` (one entry per vehicle, in the
-        column's unit), and the kept paths: ``trace_vehicle`` (k,) int64, ``trace_sample``
-        (k,) bool, ``trace_t`` (L,) [s], ``trace_pos`` and ``trace_ref`` (k, L, 3) [m].
-    """
+    """The chunk of :func:`run_chunk` from a flown batch and its draw."""
     count = res.n
     cols = sweep_metrics(res, spec)
     cols["vehicle"] = np.arange(first, first + count, dtype=np.int64)
@@ -159,37 +86,8 @@ def reduce_chunk(spec: MonteCarloSpec, first: int, res, draw: Draw) -> dict:
 
 # --- metrics of a chunk -----------------------------------------------------------------
 def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
-    """Per-vehicle metrics of a batch, vectorised: the columns of
-    :data:`~quadcruise.montecarlo.result.COLUMNS` but the vehicle index and the drawn values.
-
-    ``rmse_m``, ``max_error_m``, ``steady_rmse_m``, ``steady_max_error_m``,
-    ``rise_time_s``, ``settling_time_s`` (2 %), ``settling_time_5pct_s``,
-    ``overshoot_pct``, ``peak_time_s``, ``effort`` (about each vehicle's own hover duty),
-    ``duty_clipped_s`` and ``controller_limited_s`` equal
-    :func:`quadcruise.metrics.flight_metrics` on the same result (to rounding; the
-    transient is measured on the same axis with the same rules, by
-    :func:`quadcruise.metrics.batch.flight_metrics_batch`); ``final_error_m`` is the
-    position error at the end. Every metric of a vehicle that stopped early is NaN. Each
-    vehicle's numbers depend on its own rows only, so they do not change with the batch a
-    vehicle is flown in. The failure of each vehicle follows the spec's rules
-    (:data:`~quadcruise.montecarlo.schema.FAILURES`).
-
-    Parameters
-    ----------
-    result : SimResult
-        A flown batch of N vehicles.
-    spec : MonteCarloSpec
-        The sweep: its ``settle_band``, ``transient_until``, ``max_track_error_m`` [m],
-        ``max_clipped_s`` [s] and requirements are used.
-
-    Returns
-    -------
-    dict of str to numpy.ndarray
-        Column name -> (N,) array: the metrics above ([m], [s], [%], [-]), ``status``,
-        ``stop_time_s`` [s], ``transient_axis``, the failure flags ``diverged``,
-        ``lost_track``, ``saturated``, ``failed_requirement``, ``not_settled`` (bool) and
-        ``failure`` (int64, an index into FAILURES, 0 for none).
-    """
+    """Per-vehicle metrics of a batch, vectorised (the columns of ``COLUMNS`` but the index and the draw): each
+    equals :func:`quadcruise.metrics.flight_metrics` of that vehicle alone; NaN for one that stopped early."""
     t = result.t
     n = result.n
     status = np.asarray(result.status, dtype=np.int64)

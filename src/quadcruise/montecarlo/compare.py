@@ -24,36 +24,6 @@ def compare_population(
 ):
     """The controllers on the *same* Monte Carlo population.
 
-    Every controller flies the same n perturbed vehicles (same seed, so the same draws,
-    gusts and noise).
-
-    Parameters
-    ----------
-    mission : Mission or str
-        The mission, or its name.
-    controllers : str, sequence or mapping
-        The controllers, labelled as :func:`quadcruise.workflows.compare.labelled` does.
-    population : Population or None
-        The spreads.
-    n : int
-        Number of flights per controller.
-    seed : int
-        The population's seed.
-    progress : callable, optional
-        ``progress(done, total)``: the flights flown of all the controllers' (``n`` each),
-        as :func:`quadcruise.montecarlo.montecarlo` reports them.
-    **montecarlo_kw
-        Keywords of :func:`quadcruise.montecarlo.montecarlo` (duration, dt, scheduler, ...).
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per controller, indexed by label: ``flights``, ``failure_rate`` [-], and
-        the median (p50) and p95 of ``rmse_m``, ``max_error_m``, ``steady_rmse_m``,
-        ``steady_max_error_m`` [m] (the error after the transient: over the flights whose
-        transient settled) and ``settling_time_5pct_s`` [s], over the flights that kept
-        track (:meth:`MonteCarloResult.summary_data`).
-
     Examples
     --------
     >>> from quadcruise.montecarlo import Population

@@ -22,27 +22,8 @@ __all__ = ["write_outputs", "write_case", "case_folder", "case_text", "report_ma
 
 
 def write_outputs(result, out, *, fmt: str = "csv", force: bool = False) -> Path:
-    """The results of a sweep into ``out`` (see :mod:`quadcruise.montecarlo.store`).
-
-    Each file is written whole or not at all; quadcruise.json last, marked complete. A
-    folder holding this sweep's chunks is completed in place.
-
-    Parameters
-    ----------
-    result : MonteCarloResult
-        The sweep.
-    out : str or os.PathLike
-        The folder.
-    fmt : str
-        Format of the flights table: ``"csv"`` or ``"parquet"``.
-    force : bool
-        Replace a folder that holds something else (else InputError).
-
-    Returns
-    -------
-    pathlib.Path
-        The folder written.
-    """
+    """The results of a sweep into ``out``, each file whole or not at all, quadcruise.json last (marked
+    complete); see :mod:`quadcruise.montecarlo.store`."""
     from quadcruise.plots.flight import save_figure
 
     path = Path(out)
@@ -84,27 +65,8 @@ def write_outputs(result, out, *, fmt: str = "csv", force: bool = False) -> Path
 
 
 def write_case(case, out, *, fmt: str = "csv", force: bool = False) -> Path:
-    """One re-flown vehicle into ``out``, whole or not at all.
-
-    The folder holds its traces (``traces.csv`` or ``.parquet``), its row (case.json), a
-    figure of the flight (flight.png) and quadcruise.json.
-
-    Parameters
-    ----------
-    case : Case
-        The vehicle flown again (:func:`~quadcruise.montecarlo.montecarlo_case`).
-    out : str or os.PathLike
-        The folder.
-    fmt : str
-        Format of the traces: ``"csv"`` or ``"parquet"``.
-    force : bool
-        Replace a non-empty folder that quadcruise did not write (else InputError).
-
-    Returns
-    -------
-    pathlib.Path
-        The folder written.
-    """
+    """One re-flown vehicle into ``out``, whole or not at all: its traces, case.json, flight.png and
+    quadcruise.json."""
     from quadcruise.plots.flight import plot_flight, save_figure
 
     path = check_output_dir(out, force)
@@ -120,22 +82,7 @@ def write_case(case, out, *, fmt: str = "csv", force: bool = False) -> Path:
 
 
 def case_text(case, seed: int) -> str:
-    """One line on a re-flown vehicle: its outcome and its main metrics.
-
-    Parameters
-    ----------
-    case : Case
-        The vehicle flown again (:func:`~quadcruise.montecarlo.montecarlo_case`).
-    seed : int
-        The sweep's seed.
-
-    Returns
-    -------
-    str
-        ``flight I of seed S: REASON, rmse_m = ..., ...``: the RMSE and maximum error, the
-        same after the transient, the 5 % settling time [s] and the mass [kg], to 4
-        significant digits.
-    """
+    """One line on a re-flown vehicle: its outcome and its main metrics."""
     keys = ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "settling_time_5pct_s", "m")
     return f"flight {case.vehicle} of seed {seed}: {case.row['reason']}, " + ", ".join(
         f"{k} = {case.row[k]:.4g}" for k in keys
@@ -143,32 +90,7 @@ def case_text(case, seed: int) -> str:
 
 
 def case_folder(out, spec, case: int, *, force: bool = False) -> Path | None:
-    """Where flight ``case`` of the sweep ``spec``, flown again alone, is written.
-
-    Parameters
-    ----------
-    out : str or path-like or None
-        The folder asked for.
-    spec : MonteCarloSpec
-        The sweep the flight belongs to.
-    case : int
-        The flight's vehicle index.
-    force : bool
-        Replace a non-empty folder that quadcruise did not write.
-
-    Returns
-    -------
-    pathlib.Path or None
-        ``out/case-00000I`` if ``out`` holds this very sweep (its results stay beside),
-        else ``out``, checked (:func:`~quadcruise.io.files.check_output_dir`) before
-        anything is flown; None without ``out``.
-
-    Raises
-    ------
-    InputError
-        ``out`` holds a sweep flown with other options or code, or something else (unless
-        ``force``).
-    """
+    """Where flight ``case`` of the sweep ``spec``, flown again alone, is written."""
     if out is None:
         return None
     target = Path(out)
@@ -185,24 +107,7 @@ def case_folder(out, spec, case: int, *, force: bool = False) -> Path | None:
 
 
 def report_markdown(result, summary: dict, worst, table_name: str) -> str:
-    """report.md: what was flown, the failures, the quantiles, the worst flights, figures.
-
-    Parameters
-    ----------
-    result : MonteCarloResult
-        The sweep.
-    summary : dict
-        ``result.summary()``.
-    worst : pandas.DataFrame
-        ``result.worst(k)``; the first 10 rows are listed.
-    table_name : str
-        The flights table's file name.
-
-    Returns
-    -------
-    str
-        The Markdown text.
-    """
+    """report.md: what was flown, the failures, the quantiles, the worst flights, figures."""
     spec = result.spec
     pop = {k: v for k, v in spec.population.to_dict().items() if v not in (0.0, None)}
     f = summary["failures"]

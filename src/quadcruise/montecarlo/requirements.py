@@ -46,17 +46,7 @@ OPERATORS = tuple(_OPERATORS)
 
 
 def metric_hint(name: str) -> str:
-    """The closest metric's name, for a message: ``" (did you mean 'rmse_m'?)"`` or ``""``.
-
-    Parameters
-    ----------
-    name : str
-        A name that is not a metric.
-
-    Returns
-    -------
-    str
-    """
+    """The closest metric's name, for a message: ``" (did you mean 'rmse_m'?)"`` or ``""``."""
     close = _closest(name)
     return f" (did you mean '{close}'?)" if close else ""
 
@@ -69,32 +59,13 @@ def _closest(name: str) -> str | None:
 def check_metric(where: str, name: str, value: Any) -> str:
     """A metric's name, checked against the table's metrics, in the API's message form.
 
-    Parameters
-    ----------
-    where, name : str
-        The function and the argument, for the message (``"tune()"``, ``"minimize"``).
-    value : Any
-        The value given.
-
-    Returns
-    -------
-    str
-        ``value``.
-
-    Raises
-    ------
-    ArgumentTypeError
-        Not a string.
-    InputError
-        Not a metric of :data:`~quadcruise.montecarlo.schema.METRICS` (the closest is named).
-
     Examples
     --------
     >>> check_metric("tune()", "minimize", "rmse")          # doctest: +ELLIPSIS
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: tune() argument minimize must be a metric of the flights table, got str 'rmse'; \
-did you mean 'rmse_m'? metrics: rmse_m, ...
+    quadcruise.errors.InputError: tune() argument minimize must be a metric of the flights table, got str 'rmse'; did \
+you mean 'rmse_m'? metrics: rmse_m, ...
     """
     metrics = f"metrics: {', '.join(METRICS)}"
     if not isinstance(value, str):
@@ -191,29 +162,7 @@ _WANT = "Requirement objects or a mapping {metric: (op, value)}"
 
 
 def as_requirements(value: Any, where: str, name: str = "requirements") -> tuple[Requirement, ...]:
-    """A function's requirements argument as a tuple of :class:`Requirement`.
-
-    Parameters
-    ----------
-    value : Requirement, iterable of Requirement, mapping, or None
-        One requirement, several, or none; or a mapping of a metric to its ``(op, value)``
-        pair, ``{"overshoot_pct": ("<=", 5)}`` (two bounds on one metric: two objects in a list).
-    where, name : str
-        The function and the argument, for the message.
-
-    Returns
-    -------
-    tuple of Requirement
-        In the order given.
-
-    Raises
-    ------
-    ArgumentTypeError
-        Text (``"rmse_m<=0.5"``: the command line and scenario files read text; Python takes
-        objects), or anything else that is not of these forms.
-    InputError
-        A bad metric, comparison or bound.
-    """
+    """A function's requirements argument as a tuple of :class:`Requirement`."""
     if value is None:
         return ()
     if isinstance(value, Requirement):

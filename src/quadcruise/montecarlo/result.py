@@ -26,21 +26,7 @@ __all__ = ["MonteCarloResult", "Traces", "FAILURES", "COLUMNS", "METRICS"]
 
 @dataclass
 class Traces:
-    """The kept paths of a sweep.
-
-    Parameters
-    ----------
-    vehicle : ndarray of int, shape (k,)
-        The vehicles' indices.
-    t : ndarray, shape (L,)
-        Sample times [s].
-    pos : ndarray, shape (k, L, 3)
-        Positions [m] (NaN after a vehicle stopped).
-    ref : ndarray, shape (k, L, 3)
-        References [m].
-    sample : ndarray of bool, shape (k,)
-        True for the random sample (the first vehicles), False for extra failures.
-    """
+    """The kept paths of a sweep."""
 
     vehicle: np.ndarray
     t: np.ndarray

@@ -31,22 +31,6 @@ _REQUIREMENT = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|<|>)\s*([^<>=\
 def parse_requirement(text: str, where: str = "") -> Requirement:
     """A requirement from its text, ``"metric<=value"`` (``<``, ``>=``, ``>`` too; spaces allowed).
 
-    Parameters
-    ----------
-    text : str
-        The requirement, e.g. ``"steady_max_error_m<=0.2"`` or ``"rmse_m < 0.5"``.
-    where : str
-        Where the text was written, put before the message (``"s.toml: [montecarlo] requirements"``).
-
-    Returns
-    -------
-    Requirement
-
-    Raises
-    ------
-    InputError
-        One line naming the text and, for an unknown metric, the metrics available.
-
     Examples
     --------
     >>> parse_requirement("overshoot_pct <= 5")
@@ -80,18 +64,6 @@ def parse_requirement(text: str, where: str = "") -> Requirement:
 def parse_requirements(texts: str | Iterable[str] | None, where: str = "") -> tuple[Requirement, ...]:
     """Requirements from their texts, each read by :func:`parse_requirement`.
 
-    Parameters
-    ----------
-    texts : str, iterable of str, or None
-        One requirement, several, or none.
-    where : str
-        Where they were written, for the message.
-
-    Returns
-    -------
-    tuple of Requirement
-        In the order given.
-
     Examples
     --------
     >>> [r.text for r in parse_requirements(["rmse_m<0.5", "overshoot_pct <= 10"])]
@@ -107,28 +79,7 @@ def parse_requirements(texts: str | Iterable[str] | None, where: str = "") -> tu
 
 
 def merge_scenario(path, given: dict) -> tuple[Scenario, dict]:
-    """A scenario, and its ``[montecarlo]`` table (and ``[simulation]`` seed) under the
-    options given explicitly.
-
-    Parameters
-    ----------
-    path : str or path-like
-        The TOML scenario file (:func:`~quadcruise.workflows.scenario.load_scenario`).
-    given : dict
-        Options given explicitly: ``n``, ``seed`` and :class:`Population` fields (not
-        ``environment`` nor ``noise``). They win over the scenario's.
-
-    Returns
-    -------
-    scenario : Scenario
-    options : dict
-        The scenario's table updated with ``given``.
-
-    Raises
-    ------
-    InputError
-        The table has a key that is none of ``n``, ``seed`` and the Population fields.
-    """
+    """A scenario, and its ``[montecarlo]`` table (and ``[simulation]`` seed) under the options given explicitly."""
     sc = load_scenario(path)
     table = dict(sc.montecarlo)
     known = ({f.name for f in dataclasses.fields(Population)} - {"environment", "noise"}) | set(SPEC_KEYS)
@@ -161,50 +112,7 @@ def sweep_spec(
     log_every: int | None = None,
     **population,
 ) -> tuple[MonteCarloSpec, int]:
-    """The spec of a sweep and its number of flights; None means "not given".
-
-    Parameters
-    ----------
-    mission, controller : names or objects, optional
-        Given, else those of ``scenario``, else the circle and nlpd.
-    n, seed : int, optional
-        Number of flights and seed: given, else the scenario's, else 1000 and 0.
-    duration : float, optional
-        Flight time [s]: given, else the scenario's, else the mission's.
-    dt : float, optional
-        Control period [s]: given, else the scenario's, else 1 ms.
-    environment : Environment, optional
-        Disturbances (an empty one: none): given, else the scenario's.
-    noise : SensorNoise, optional
-        Sensor noise: given, else the scenario's.
-    scenario : str or path-like, optional
-        A TOML scenario file: mission, controller, nominal vehicle, disturbances, sensor
-        noise, simulation settings, and a ``[montecarlo]`` table (:func:`merge_scenario`).
-    requirements : sequence of Requirement
-        The user's pass criteria (:class:`MonteCarloSpec`'s ``requirements``); a scenario's
-        ``[montecarlo] requirements`` texts are read by :func:`parse_requirements`.
-    max_track_error_m : float, optional
-        The "lost track" bound [m]; the spec's default if None.
-    vehicle, controller_vehicle : Vehicle, optional
-        The nominal vehicle and the controllers' model of it: given, else the scenario's
-        ``[vehicle]`` and ``[controller_vehicle]``, else Table I and the nominal vehicle.
-    log_every : int, optional
-        Control periods between the logged instants the metrics are measured on (the
-        spec's ``log_dt`` is ``log_every * dt``): given, else the scenario's ``log_dt``, else 10 ms.
-    **population
-        :class:`Population` fields (spreads, offset, distribution, model_error): given, else
-        the scenario's, else the Population's defaults.
-
-    Returns
-    -------
-    spec : MonteCarloSpec
-    n : int
-
-    Raises
-    ------
-    InputError
-        An unknown or bad option, or a bad scenario.
-    """
+    """The spec of a sweep and its number of flights; None means "not given"."""
     given = {key: value for key, value in {**population, "n": n, "seed": seed}.items() if value is not None}
     options: dict = dict(
         duration=duration, dt=1e-3 if dt is None else dt, requirements=requirements, max_track_error_m=max_track_error_m

@@ -121,55 +121,14 @@ def _marker(path: Path, force: bool = False) -> dict | None:
 
 
 def holds_sweep(path: Path, spec: MonteCarloSpec, *, force: bool = False) -> tuple[dict | None, bool]:
-    """What folder ``path`` holds, and whether it is this very sweep.
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The folder; it need not exist.
-    spec : MonteCarloSpec
-        The sweep.
-    force : bool
-        Read a damaged marker as none (the folder is to be replaced) instead of refusing it.
-
-    Returns
-    -------
-    meta : dict or None
-        The folder's quadcruise.json, or None if it has none.
-    same : bool
-        True if it is a Monte Carlo folder of the same spec hash.
-
-    Raises
-    ------
-    InputError
-        If the folder's quadcruise.json is damaged (:func:`~quadcruise.io.files.read_marker`)
-        and not ``force``: the folder is never replaced for that alone.
-    """
+    """What folder ``path`` holds, and whether it is this very sweep."""
     meta = _marker(path, force) if path.is_dir() else None
     return meta, bool(meta) and meta.get("workflow") == "montecarlo" and meta.get("spec_hash") == spec.hash()
 
 
 class SweepFolder:
     """The output folder of a sweep: checked at construction (nothing is written), then
-    :meth:`prepare` (marker), :meth:`write_chunk`.
-
-    Parameters
-    ----------
-    out : str or os.PathLike
-        The folder.
-    spec : MonteCarloSpec
-        The sweep.
-    force : bool
-        Replace a folder that holds something else.
-    resume : bool
-        Load the chunks of this same sweep found in the folder.
-
-    Raises
-    ------
-    InputError
-        If the folder holds another sweep or another result and not ``force``, or
-        something quadcruise did not write (see :func:`~quadcruise.io.check_output_dir`).
-    """
+    :meth:`prepare` (marker), :meth:`write_chunk`."""
 
     def __init__(self, out, spec: MonteCarloSpec, *, force: bool, resume: bool) -> None:
         self.path = check_output_dir(out, force, workflow="montecarlo")
@@ -187,34 +146,12 @@ class SweepFolder:
         self.clear = self.path.is_dir() and any(self.path.iterdir()) and not self.resume
 
     def existing(self) -> Iterator[dict]:
-        """The chunks of this sweep already in the folder (none unless resuming).
-
-        Returns
-        -------
-        iterator of dict
-            Each chunk's arrays; unreadable or foreign chunk files are skipped with a
-            warning (their flights are flown again).
-        """
+        """The chunks of this sweep already in the folder (none unless resuming)."""
         return _read_chunks(self.path, self.hash) if self.resume else iter(())
 
     def prepare(self, n: int, chunk_size: int) -> None:
-        """Clear a folder that is not resumed, and write the marker (not complete).
-
-        The marker comes before the chunks' folder, so that a fault leaves either a folder
-        this sweep resumes or none of its own.
-
-        Parameters
-        ----------
-        n : int
-            Number of flights of the sweep.
-        chunk_size : int
-            Vehicles per chunk.
-
-        Raises
-        ------
-        WriteError
-            If the folder could not be cleared or written.
-        """
+        """Clear a folder that is not resumed, and write the marker (not complete)."""
+        # the marker before the chunks' folder: a fault leaves a folder this sweep resumes, or none of its own
         try:
             if self.clear:
                 shutil.rmtree(self.path)
@@ -228,15 +165,7 @@ class SweepFolder:
     def reclaim(self, n: int, chunk_size: int) -> None:
         """Write the marker again if it is gone or damaged since :meth:`prepare` (the folder
         removed or changed while the sweep ran), so that the results go where they were asked
-        for instead of being refused as another's.
-
-        Parameters
-        ----------
-        n : int
-            Number of flights of the sweep.
-        chunk_size : int
-            Vehicles per chunk.
-        """
+        for instead of being refused as another's."""
         try:
             held = read_marker(self.path)
         except InputError:
@@ -245,30 +174,12 @@ class SweepFolder:
             write_marker(self.path, self.spec, n, chunk_size=chunk_size, complete=False)
 
     def write_chunk(self, chunk: dict) -> None:
-        """Write one chunk as ``chunks/chunk-<first>.npz``, whole or not at all.
-
-        Parameters
-        ----------
-        chunk : dict of str to ndarray
-            The chunk's arrays, with its ``first`` vehicle and the spec ``hash``.
-        """
+        """Write one chunk as ``chunks/chunk-<first>.npz``, whole or not at all."""
         _write_chunk(self.path, chunk)
 
 
 def write_marker(path: Path, spec: MonteCarloSpec, n: int, **extra: Any) -> None:
-    """quadcruise.json of a sweep folder, whole or not at all.
-
-    Parameters
-    ----------
-    path : pathlib.Path
-        The folder.
-    spec : MonteCarloSpec
-        The sweep: its hash, seed and fields are recorded.
-    n : int
-        Number of flights.
-    **extra : Any
-        More entries, e.g. ``complete``, ``chunk_size``, ``table``.
-    """
+    """quadcruise.json of a sweep folder, whole or not at all."""
     doc = {
         "workflow": "montecarlo",
         "version": __version__,

@@ -262,21 +262,14 @@ class _Dask:
 
 @contextlib.contextmanager
 def _ctrl_c_for_this_process_only():
-    """Processes and threads started inside never see Ctrl-C (SIGINT); this one still does.
-
-    A terminal sends Ctrl-C to every process of the foreground group, local Dask workers
-    included, and each worker would print its own KeyboardInterrupt traceback. SIGINT is
-    blocked in this thread meanwhile: the threads started inside (Dask's event loop, which
-    starts the workers, and starts them again if one dies) and the processes they start keep it
-    blocked, and a Ctrl-C that came meanwhile is delivered here at the end. This process
-    then stops the sweep and closes the cluster, which ends its workers. multiprocessing's
-    resource tracker is started first: starting it unblocks SIGINT in the thread that does.
-    Outside the main thread, or where signal masks do not exist, it does nothing.
-
-    Yields
-    ------
-    None
-    """
+    """Processes and threads started inside never see Ctrl-C (SIGINT); this one still does."""
+    # A terminal sends Ctrl-C to every process of the foreground group, local Dask workers
+    # included, and each worker would print its own KeyboardInterrupt traceback. SIGINT is
+    # blocked in this thread meanwhile: the threads started inside (Dask's event loop, which
+    # starts the workers, and starts them again if one dies) and the processes they start keep
+    # it blocked, and a Ctrl-C that came meanwhile is delivered here at the end. This process
+    # then stops the sweep and closes the cluster, which ends its workers. multiprocessing's
+    # resource tracker is started first: starting it unblocks SIGINT in the thread that does.
     import signal
     import threading
 
@@ -307,22 +300,6 @@ def auto_chunk_size(spec: MonteCarloSpec, n: int, parallel: int = 1, threads: in
     and a multiple of the ``threads`` that share each chunk (when a chunk has that many), so
     that none of them waits for the others at the chunk's end.
 
-    Parameters
-    ----------
-    spec : MonteCarloSpec
-        The sweep (its log size per vehicle, :meth:`MonteCarloSpec.log_bytes`).
-    n : int
-        Number of flights of the sweep.
-    parallel : int
-        Chunks that run at once (Dask worker threads; 1 in this process).
-    threads : int
-        numba threads that share each chunk.
-
-    Returns
-    -------
-    int
-        Vehicles per chunk, in [1, 1024].
-
     Examples
     --------
     >>> from quadcruise.montecarlo.spec import MonteCarloSpec
@@ -342,20 +319,7 @@ cluster of a hundred cores; beyond it the number of flights is surely a slip."""
 
 
 def check_sweep_size(n: int, periods: int) -> None:
-    """Refuse a sweep beyond :data:`MAX_SWEEP_STEPS` before anything flies.
-
-    Parameters
-    ----------
-    n : int
-        Flights.
-    periods : int
-        Control periods per flight.
-
-    Raises
-    ------
-    InputError
-        Saying how many vehicle-steps that is, and what to change.
-    """
+    """Refuse a sweep beyond :data:`MAX_SWEEP_STEPS` before anything flies."""
     if n * periods > MAX_SWEEP_STEPS:
         raise InputError(
             f"{n:,} flights x {periods:,} control periods is {n * periods:.2g} vehicle-steps, "
@@ -377,55 +341,7 @@ def run_sweep(
     progress: Callable[[int, int], None] | None = None,
     connect_timeout: float = 10.0,
 ) -> MonteCarloResult:
-    """Fly vehicles 0 .. n-1 of ``spec``: see :func:`quadcruise.montecarlo.montecarlo`.
-
-    Every input is checked (and a scheduler address reached) before anything is written.
-    ``progress(done, total)`` is called at the start (done: flights found on disk) and
-    after each chunk; an exception from it (or Ctrl-C) stops the sweep, leaving the chunks
-    already written for a resume.
-
-    Parameters
-    ----------
-    spec : MonteCarloSpec
-        The sweep.
-    n : int
-        Number of flights, >= 1.
-    chunk_size : int or "auto"
-        Vehicles per chunk (:func:`auto_chunk_size` for "auto"); the result does not depend
-        on it.
-    scheduler : None, "none", "local" or an address
-        Where the chunks fly: this process (None, "none"), a new Dask LocalCluster
-        ("local"), or the Dask scheduler at an address such as "tcp://host:8786".
-    workers : int, optional
-        Worker processes of the "local" cluster, >= 1; the machine's cores by default.
-    out : str or pathlib.Path, optional
-        Folder to stream the chunks to and write the results in
-        (:class:`~quadcruise.montecarlo.store.SweepFolder`); nothing is written if None.
-    resume : bool
-        Load the chunks of this same sweep found in ``out`` instead of flying them again.
-    force : bool
-        Replace a folder ``out`` that holds something else.
-    fmt : {"csv", "parquet"}
-        Format of the flights table.
-    progress : callable, optional
-        ``progress(done, total)``, flights done and n.
-    connect_timeout : float
-        Time to wait for a scheduler given by address [s], > 0.
-
-    Returns
-    -------
-    MonteCarloResult
-        One table row per flight, the kept paths, and ``info`` on how it ran (scheduler,
-        chunk size, flights flown and resumed, wall time [s], flights per second,
-        vehicle-steps per second).
-
-    Raises
-    ------
-    InputError
-        A bad argument, an unreachable scheduler, or a folder that cannot be used.
-    SimulationError
-        Chunks that do not fit together (from other code or options, or overlapping).
-    """
+    """Fly vehicles 0 .. n-1 of ``spec``: see :func:`quadcruise.montecarlo.montecarlo`."""
     n = whole_number(n, "the number of flights", 1)
     check_sweep_size(n, spec.periods)
     if chunk_size != "auto" and (

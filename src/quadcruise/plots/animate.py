@@ -50,16 +50,6 @@ def check_animation_path(path) -> None:
     """Refuse an animation path this machine cannot write: a suffix other than .gif or
     .mp4, or .mp4 without ffmpeg.
 
-    Parameters
-    ----------
-    path : str or os.PathLike
-        Where the animation would go.
-
-    Raises
-    ------
-    InputError
-        Naming the path and what to do instead.
-
     Examples
     --------
     >>> check_animation_path("flight.gif")
@@ -110,38 +100,7 @@ def animate_flight(
     dpi: int = 80,
     progress: Callable[[int, int], None] | None = None,
 ) -> Path:
-    """Write an animation of one vehicle's flight, whole or not at all.
-
-    Parameters
-    ----------
-    result : SimResult
-        The flight.
-    path : str or Path
-        ``.gif`` (Pillow), or ``.mp4`` if ffmpeg is installed.
-    vehicle : int
-        Which of the result's vehicles.
-    fps : float
-        Frames per second of the animation [1/s] (a GIF shows each frame for at least
-        20 ms, so it plays at most 50 of them per second).
-    duration_s : float, optional
-        Length of the animation [s]; by default the flight's (real time, up to the end of
-        the flight or the instant the vehicle stopped). It has ``round(fps * duration_s)``
-        frames (at least 2), evenly spread over the flight.
-    every : int, optional
-        Instead, one frame per ``every`` logged instants.
-    trail_s : float, optional
-        Length of the bold trail behind the marker [s]; a tenth of the flight by default.
-    dpi : int
-        Resolution; the figure is 8 x 3.6 inches (640 x 288 pixels at 80 dpi).
-    progress : callable, optional
-        ``progress(done, total)``: called with 0 before the first frame is drawn and after
-        each frame, with the frames drawn and the frame count.
-
-    Returns
-    -------
-    Path
-        The file written. The frame count of a GIF is ``Image.open(path).n_frames``.
-    """
+    """Write an animation of one vehicle's flight (.gif by Pillow, .mp4 with ffmpeg), whole or not at all."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from PIL import Image

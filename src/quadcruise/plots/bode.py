@@ -14,20 +14,7 @@ __all__ = ["margin_label", "plot_bode"]
 
 
 def margin_label(m: dict) -> str:
-    """One loop's margins as its legend reads them.
-
-    Parameters
-    ----------
-    m : dict
-        What :func:`quadcruise.metrics.margins.margins` returns.
-
-    Returns
-    -------
-    str
-        Each margin with its unit and frequency, a short one marked, one without crossover left
-        out: ``PM 18.1° @ 10.8 rad/s (< 30°), GM down -3.98 dB @ 7.07 rad/s (> -6 dB), up +38.2 dB
-        @ 300 rad/s``; ``no crossover`` if none.
-    """
+    """One loop's margins as its legend reads them."""
     parts = []
     if math.isfinite(m["phase_margin"]) and math.isfinite(m["gain_crossover"]):
         short = f" (< {MIN_PHASE_MARGIN_DEG:g}°)" if m["phase_margin"] < MIN_PHASE_MARGIN_DEG else ""
@@ -73,38 +60,7 @@ def _draw(axes, system, w, start, label, style):
 def plot_bode(
     lin, *, loops: bool = False, omega=None, at: str = "input", progress: Callable[[int, int], None] | None = None
 ):
-    """Bode plots of the closed loop and, optionally, of the loop transfers with their margins.
-
-    Parameters
-    ----------
-    lin : Linearization
-        Any object with ``dt`` [s], ``controller`` (its ``name``), ``loops`` (the loop names),
-        ``closed_loop(loop)`` (set-point to output), ``loop_transfer(loop, at)`` and
-        ``margins(loop, at)`` (:class:`quadcruise.workflows.analysis.Linearization`).
-    loops : bool
-        Add a second column of the loop transfers (broken ``at``), each margin drawn as a
-        segment from its reference line to the curve at its crossover and named in the legend
-        (:func:`margin_label`; short margins flagged). y's margins are x's for a symmetric
-        vehicle and are then not marked twice. How to read them: docs/paper.md, "Linear
-        analysis of the full loop".
-    omega : array_like, optional
-        Frequencies [rad/s]; by default 800 from 0.01 rad/s to 0.9 of the Nyquist frequency
-        pi / dt (closer to it the sampling zeros near z = -1 turn the phase by half a turn
-        between two samples, which no unwrapping can tell from a jump).
-    at : str
-        Where the loops are broken: ``"input"`` or ``"output"``.
-    progress : callable, optional
-        ``progress(done, total)`` at the start and after each loop drawn.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-        Magnitude [dB] above phase [deg] against frequency [rad/s] of the closed loop
-        x_r->x, y_r->y (dashed: the same as x for a symmetric vehicle), z_r->z,
-        psi_r->psi; 2 or 4 axes. Every phase is unwrapped (continuous over frequency): a
-        closed loop's starts nearest 0 deg, a loop transfer's nearest -180 deg (python-control's
-        ``initial_phase``); grey lines mark -180 deg and every full turn from it.
-    """
+    """Bode plots of the closed loop and, optionally, of the loop transfers with their margins."""
     from matplotlib.figure import Figure
     from matplotlib.ticker import MultipleLocator, NullLocator
 

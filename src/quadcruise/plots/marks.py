@@ -50,19 +50,7 @@ SATURATION_STYLE = {
 
 @dataclass(frozen=True)
 class Event:
-    """Something that happened to a vehicle during its flight.
-
-    Parameters
-    ----------
-    kind : str
-        ``"gust"`` or ``"rotor_loss"`` (a key of :data:`EVENT_COLORS`).
-    start : float
-        When it began [s].
-    end : float
-        When it ended [s]; ``start`` for an instant (a rotor loss lasts to the end).
-    label : str
-        What it was, for a legend, e.g. ``"rotor 2 loses 30 % at 8 s"``.
-    """
+    """Something that happened to a vehicle during its flight."""
 
     kind: str
     start: float
@@ -84,24 +72,7 @@ def _pick(value, vehicle: int):
 
 
 def flight_events(meta, vehicle: int = 0) -> list[Event]:
-    """The events of ``meta["environment"]`` (as ``Environment.to_dict()`` writes it).
-
-    Read defensively: a missing or malformed environment, or a part without a time, gives
-    no event.
-
-    Parameters
-    ----------
-    meta : dict or None
-        A result's ``meta``.
-    vehicle : int
-        The vehicle, where a field holds one value per vehicle.
-
-    Returns
-    -------
-    list of Event
-        A gust (its ``start`` to ``start + duration``, labelled with its peak speed) and a
-        rotor loss (an instant, labelled with the rotor and the fraction lost), those that
-        are recorded.
+    """The events of ``meta["environment"]`` (as ``Environment.to_dict()`` writes it); none from a malformed one.
 
     Examples
     --------
@@ -134,21 +105,7 @@ def flight_events(meta, vehicle: int = 0) -> list[Event]:
 
 
 def intervals(t: np.ndarray, mask: np.ndarray) -> np.ndarray:
-    """The time intervals over which ``mask`` holds, each sample holding until the next.
-
-    Parameters
-    ----------
-    t : ndarray, shape (L,)
-        Sample times [s], increasing.
-    mask : ndarray of bool, shape (L,)
-        Where something holds.
-
-    Returns
-    -------
-    ndarray, shape (k, 2)
-        [start, end] [s] of each run of True samples: from its first sample's time to the
-        next sample's (one more sample step past the end for a run that ends the log).
-    """
+    """The time intervals over which ``mask`` holds, each sample holding until the next."""
     t, mask = np.asarray(t, float), np.asarray(mask, bool)
     if not mask.any():
         return np.zeros((0, 2))
@@ -160,22 +117,7 @@ def intervals(t: np.ndarray, mask: np.ndarray) -> np.ndarray:
 
 
 def saturation(result, vehicle: int = 0) -> dict[str, np.ndarray]:
-    """When a vehicle's controller flagged a limit, and when a duty it asked for was clipped.
-
-    Parameters
-    ----------
-    result : SimResult
-        The flight (its ``t`` and ``commands``, as logged: the duties before the engine
-        clipped them to [0, 1]).
-    vehicle : int
-        Which vehicle.
-
-    Returns
-    -------
-    dict of str to ndarray
-        ``"flagged"``: the :func:`intervals` in which ``commands[..., CMD_FLAGS]`` is not 0;
-        ``"clipped"``: those in which a duty asked for lies outside [0, 1].
-    """
+    """When a vehicle's controller flagged a limit, and when a duty it asked for was clipped."""
     cmd = result.commands[vehicle]
     flags = cmd[:, CMD_FLAGS]
     duties = cmd[:, CMD_U1 : CMD_U1 + 4]
@@ -185,43 +127,13 @@ def saturation(result, vehicle: int = 0) -> dict[str, np.ndarray]:
 
 
 def position_error(result, vehicle: int = 0) -> np.ndarray:
-    """The norm of the 3-D position error ``|p - p_ref|`` [m] at each logged instant.
-
-    Parameters
-    ----------
-    result : SimResult
-        The flight.
-    vehicle : int
-        Which vehicle.
-
-    Returns
-    -------
-    ndarray, shape (L,)
-        NaN where the position or the reference is not finite (after a stop, or no reference).
-    """
+    """The norm of the 3-D position error ``|p - p_ref|`` [m] at each logged instant."""
     d = result.states[vehicle, :, :3] - result.references[vehicle, :, :3]
     return np.sqrt(np.sum(d * d, axis=1))
 
 
 def mark_events(ax, events, t_range, *, label: bool = True) -> list[Event]:
-    """Draw events on a time axes: a gust as a band, a rotor loss as a vertical line.
-
-    Parameters
-    ----------
-    ax : matplotlib.axes.Axes
-        An axes with time [s] along x.
-    events : sequence of Event
-        What to draw.
-    t_range : (float, float)
-        The times shown [s]; an event outside them is left out.
-    label : bool
-        Give each event its legend entry (else it is drawn unlabelled).
-
-    Returns
-    -------
-    list of Event
-        The events drawn.
-    """
+    """Draw events on a time axes: a gust as a band, a rotor loss as a vertical line."""
     lo, hi = t_range
     drawn = []
     for e in events:
@@ -238,28 +150,8 @@ def mark_events(ax, events, t_range, *, label: bool = True) -> list[Event]:
 
 
 def shade(ax, spans: np.ndarray, *, min_width: float = 0.0, yrange=(0.0, 1.0), **style):
-    """Shade time intervals over the height of an axes, as one collection.
-
-    Parameters
-    ----------
-    ax : matplotlib.axes.Axes
-        An axes with time [s] along x.
-    spans : ndarray, shape (k, 2)
-        [start, end] [s] of each interval (:func:`intervals`).
-    min_width : float
-        Intervals closer than this [s] are merged and each is drawn at least this wide,
-        so that thousands of brief ones stay one visible, quickly drawn band.
-    yrange : (float, float)
-        Bottom and height of the shading in fractions of the axes' height (all of it by
-        default).
-    **style
-        Keywords of ``Axes.broken_barh`` (color, alpha, hatch, label, ...).
-
-    Returns
-    -------
-    matplotlib.collections.PolyCollection or None
-        The shading; None if there was no interval.
-    """
+    """Shade time intervals over the height of an axes, as one collection; intervals closer than
+    ``min_width`` [s] merge, each drawn at least that wide."""
     spans = np.asarray(spans, float).reshape(-1, 2)
     if not spans.size:
         return None
@@ -279,29 +171,12 @@ def _tick(value: float, _pos=None) -> str:
 
 
 def error_axes(ax, curves) -> bool:
-    """Draw position errors against time on a log scale.
-
-    A log scale shows the error through its whole range: metres in a transient and
-    millimetres while tracking, where a linear axis scaled to the transient flattens
-    every controller's steady error onto zero. Values below :data:`ERROR_FLOOR` (an exact
-    zero included) are drawn at it, and the floor is then drawn and named in the legend;
-    the y range runs from the decade below the least error shown (at least the floor, and
-    at least a decade below the largest) to just above the largest, so that at least two
-    decades are labelled, as plain numbers (1, 0.1, 0.01, 0.001, 1e-4).
-
-    Parameters
-    ----------
-    ax : matplotlib.axes.Axes
-        The axes; its y label is set.
-    curves : sequence of (ndarray, ndarray, dict)
-        Time [s], error [m] (NaN where undefined) and keywords of ``Axes.plot`` (color,
-        label, ...) of each curve.
-
-    Returns
-    -------
-    bool
-        False if no curve has a finite error (then nothing is drawn but a note).
-    """
+    """Draw position errors against time on a log scale, values below :data:`ERROR_FLOOR` at it;
+    False if none is finite."""
+    # A log scale shows the error through its whole range: metres in a transient and millimetres
+    # while tracking, which a linear axis scaled to the transient flattens onto zero. The y range
+    # runs from the decade below the least error shown to just above the largest, at least two
+    # decades labelled as plain numbers.
     finite = [e[np.isfinite(e)] for _, e, _ in curves]
     values = np.concatenate(finite) if finite else np.zeros(0)
     ax.set_ylabel("position error [m]")

@@ -55,17 +55,6 @@ METRIC_LABELS = {
 def metric_label(name: str) -> str:
     """A column of the sweep table as an axis label with its unit.
 
-    Parameters
-    ----------
-    name : str
-        The column, e.g. ``"rise_time_s"``.
-
-    Returns
-    -------
-    str
-        :data:`METRIC_LABELS`' entry, else the name with its unit suffix (``_s``, ``_m``,
-        ``_pct``, ``_deg``) written as a unit.
-
     Examples
     --------
     >>> metric_label("rmse_m"), metric_label("hover_time_s"), metric_label("K")
@@ -82,19 +71,6 @@ def metric_label(name: str) -> str:
 def degenerate(values: np.ndarray, n: int) -> str | None:
     """Why a column makes no histogram, or None if it makes one.
 
-    Parameters
-    ----------
-    values : ndarray
-        The column's values (NaN where not measured).
-    n : int
-        The number of flights.
-
-    Returns
-    -------
-    str or None
-        ``"not measured"`` if no value is finite, ``"<value> in all <k> flights measured"``
-        if every finite value is the same, else None.
-
     Examples
     --------
     >>> degenerate(np.array([0.0, 0.0, np.nan]), 3), degenerate(np.array([1.0, 2.0]), 2)
@@ -109,25 +85,7 @@ def degenerate(values: np.ndarray, n: int) -> str | None:
 
 
 def plot_histograms(result, metrics=None):
-    """Histograms of a sweep's metrics and a bar chart of its outcomes.
-
-    Parameters
-    ----------
-    result : MonteCarloResult
-        The sweep (its ``table``, ``spec``, ``n`` and ``failure_names`` are read).
-    metrics : sequence of str, optional
-        Columns of the table to draw; :data:`HISTOGRAM_METRICS` by default.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-        One panel per metric (40 bins of its finite values against the metric with its
-        unit (:func:`metric_label`) and the number of flights, with lines at 5 %, the
-        median and 95 %), then the count of flights per outcome
-        (:data:`~quadcruise.montecarlo.result.FAILURES`). A metric with no finite value,
-        or with one value in every flight (:func:`degenerate`), gets no panel: a note at
-        the foot of the figure says which were left out and why.
-    """
+    """Histograms of a sweep's metrics and a bar chart of its outcomes."""
     names = list(HISTOGRAM_METRICS if metrics is None else metrics)
     columns = {name: result.table[name].to_numpy(dtype=float) for name in names}
     skipped = {name: why for name in names if (why := degenerate(columns[name], result.n))}
@@ -179,22 +137,7 @@ def plot_histograms(result, metrics=None):
 
 
 def plot_envelope(result):
-    """The kept paths of a sweep from above, and the spread of their position error.
-
-    Parameters
-    ----------
-    result : MonteCarloResult
-        The sweep (its ``traces``, ``table`` and ``spec`` are read).
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-        Two axes: the top view [m] of the kept paths (the first vehicles, and the extra
-        failures kept; diverged in red, other failures in orange, both thin and translucent
-        underneath the flights that finished, in blue, which stay visible however many
-        failed) and the median and 5-95 % band of the position error norm [m] of the
-        sampled flights against time [s].
-    """
+    """The kept paths of a sweep from above, and the spread of their position error."""
     tr = result.traces
     fig = Figure(figsize=(13, 5.5), layout="constrained")
     top, ax_e = fig.subplots(1, 2, width_ratios=(1, 1.4))

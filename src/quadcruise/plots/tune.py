@@ -16,20 +16,7 @@ __all__ = ["plot_tune", "transient_axis"]
 
 
 def transient_axis(result) -> tuple[int, float, float]:
-    """The axis a flight's transient is measured on, its start value and its step time.
-
-    Parameters
-    ----------
-    result : SimResult
-        A flight.
-
-    Returns
-    -------
-    (int, float, float)
-        0, 1 or 2 for x, y, z: the stepped axis of a step mission, else the axis of the
-        largest initial error; the value it starts from [m]; the step time (the first
-        instant for other missions) [s].
-    """
+    """The axis a flight's transient is measured on, its start value and its step time."""
     mission = result.meta.get("mission") if isinstance(result.meta.get("mission"), dict) else {}
     if mission.get("kind") == "step" and mission.get("axis") in ("x", "y", "z"):
         return "xyz".index(mission["axis"]), float(mission[mission["axis"]]), float(mission["time"])
@@ -40,21 +27,7 @@ def transient_axis(result) -> tuple[int, float, float]:
 
 def plot_tune(result, *, title: str | None = None) -> Figure:
     """Two panels: the best cost after each generation, and the response of the tuned gains
-    (and of the starting ones) with the targets marked.
-
-    Parameters
-    ----------
-    result : TuneResult
-        Anything with ``history``, ``response``, ``start_response`` and ``targets``.
-    title : str, optional
-        The figure's title.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-        The targets drawn: rise time and settling time as vertical lines after the step (the
-        settling band as a shaded strip from there on), overshoot as a horizontal line.
-    """
+    (and of the starting ones) with the targets marked."""
     fig = Figure(figsize=(11.0, 4.2))
     ax_cost, ax_resp = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.0, 1.6]})
     hist = result.history

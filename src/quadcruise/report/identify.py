@@ -7,8 +7,7 @@ from pathlib import Path
 
 def identification_report(result, *, title: str | None = None) -> dict:
     """Keywords of :func:`quadcruise.report.html.html_report` for an identified vehicle: its
-    parameters and held-out validation as tables, measured against predicted, the Markdown report.
-    """
+    parameters and held-out validation as tables, measured against predicted, the Markdown report."""
     import pandas as pd
 
     from quadcruise.report.html import markdown_html

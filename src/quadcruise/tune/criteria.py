@@ -129,28 +129,8 @@ _TARGET_HINT = "write Target('overshoot_pct', 4, 1.5) or {'overshoot_pct': (4, 1
 
 
 def as_targets(value: Any, where: str, name: str = "targets") -> tuple[Target, ...]:
-    """A function's targets argument as a tuple of :class:`Target`, a metric at most once.
-
-    Parameters
-    ----------
-    value : Target, iterable of Target, mapping, or None
-        One target, several, or none; or a mapping of a metric to its value or to a pair
-        ``(value, tolerance)``.
-    where, name : str
-        The function and the argument, for the message.
-
-    Returns
-    -------
-    tuple of Target
-
-    Raises
-    ------
-    ArgumentTypeError
-        Text (``"rise_time_s=1"``: the command line reads text; Python takes objects), or
-        anything else that is not of these forms.
-    InputError
-        A bad metric, value or tolerance, or two targets on one metric.
-    """
+    """A function's targets (a Target, several, or a mapping metric -> value or (value, tolerance)) as a
+    tuple of :class:`Target`, a metric at most once."""
     if value is None:
         return ()
     if isinstance(value, Target):
@@ -183,25 +163,6 @@ def as_targets(value: Any, where: str, name: str = "targets") -> tuple[Target, .
 
 def as_minimize(value: Any, where: str, name: str = "minimize") -> tuple[str, ...]:
     """A function's minimised metrics: one metric's name or a list of them, a metric at most once.
-
-    Parameters
-    ----------
-    value : str, iterable of str, or None
-        ``"rmse_m"`` or ``["rmse_m", "effort"]``.
-    where, name : str
-        The function and the argument, for the message.
-
-    Returns
-    -------
-    tuple of str
-
-    Raises
-    ------
-    ArgumentTypeError
-        Not a string nor a list of strings.
-    InputError
-        An unknown metric (several in one string, ``"rmse_m,effort"``, are one unknown name:
-        give a list), or one given twice.
 
     Examples
     --------

@@ -47,26 +47,6 @@ REQUIREMENT_COST = 1e6
 def check_statistic(statistic: Any, where: str = "tune()", name: str = "objective") -> str | float:
     """The statistic over a candidate's flights: ``"worst"`` or a quantile in (0, 1).
 
-    Parameters
-    ----------
-    statistic : str or float
-        ``"worst"``, ``"median"`` (the quantile 0.5) or a quantile such as 0.9. The command
-        line's forms (``q90``, ``max``) are read by :func:`quadcruise.cli.criteria.parse_objective`.
-    where, name : str
-        The function and the argument, for the message.
-
-    Returns
-    -------
-    str or float
-        ``"worst"`` or the quantile.
-
-    Raises
-    ------
-    ArgumentTypeError
-        Neither one of those names nor a number.
-    InputError
-        Another name, or a number outside (0, 1).
-
     Examples
     --------
     >>> check_statistic("worst"), check_statistic("median"), check_statistic(0.9)
@@ -74,8 +54,8 @@ def check_statistic(statistic: Any, where: str = "tune()", name: str = "objectiv
     >>> check_statistic("q90")
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: tune() argument objective must be 'worst', 'median' or a quantile in (0, 1), \
-got str 'q90'
+    quadcruise.errors.InputError: tune() argument objective must be 'worst', 'median' or a quantile in (0, 1), got \
+str 'q90'
     """
     want = "'worst', 'median' or a quantile in (0, 1)"
     if isinstance(statistic, str):
@@ -90,22 +70,7 @@ got str 'q90'
 
 @dataclass
 class Evaluation:
-    """One generation flown: each candidate's gains, cost and flights.
-
-    Parameters
-    ----------
-    values : ndarray, shape (P, G)
-        The candidates' gains.
-    cost : ndarray, shape (P,)
-        Each candidate's cost.
-    flight_cost : ndarray, shape (P, M)
-        Each flight's cost.
-    metrics : dict of str to ndarray, shape (P, M)
-        Each flight's metrics (the table's columns: :data:`~quadcruise.montecarlo.schema.METRICS`,
-        ``status``, ``failure``, ``diverged``, ``lost_track``).
-    wall_s : float
-        Time to fly and measure the generation [s].
-    """
+    """One generation flown: each candidate's gains, cost and flights."""
 
     values: np.ndarray
     cost: np.ndarray
@@ -116,28 +81,7 @@ class Evaluation:
 
 @dataclass
 class Objective:
-    """Candidate gains -> costs, one batched flight per call.
-
-    Parameters
-    ----------
-    spec : MonteCarloSpec
-        The mission, nominal vehicle, population, seed, flight time and step, and the log
-        the metrics are measured on; its controller is the base of ``space``.
-    space : GainSpace
-        The searched gains.
-    targets, requirements : tuple
-        :class:`~quadcruise.tune.criteria.Target` and
-        :class:`~quadcruise.montecarlo.requirements.Requirement`.
-    minimize : tuple of str
-        Metrics whose values are added to the cost.
-    samples : int
-        Vehicles of the population each candidate flies (1: the nominal vehicle alone when
-        the population has no spread).
-    statistic : str or float
-        ``"worst"`` or a quantile (:func:`check_statistic`).
-    evaluations : list of Evaluation
-        Every generation flown so far (filled by calls).
-    """
+    """Candidate gains -> costs, one batched flight per call."""
 
     spec: MonteCarloSpec
     space: GainSpace
@@ -156,17 +100,7 @@ class Objective:
 
     def __call__(self, unit: np.ndarray) -> np.ndarray:
         """The costs of candidates given as positions in the unit cube, as scipy's
-        vectorised differential evolution calls it.
-
-        Parameters
-        ----------
-        unit : ndarray, shape (G,) or (G, P)
-            One candidate per column.
-
-        Returns
-        -------
-        ndarray, shape (P,) (a float for one candidate)
-        """
+        vectorised differential evolution calls it."""
         unit = np.asarray(unit, dtype=float)
         single = unit.ndim == 1
         ev = self.evaluate(self.space.values(unit[:, None].T if single else unit.T))
@@ -174,17 +108,7 @@ class Objective:
 
     def evaluate(self, values: np.ndarray) -> Evaluation:
         """Fly candidates (one batch: P candidates x M vehicles) and cost them; the
-        evaluation is kept in :attr:`evaluations`.
-
-        Parameters
-        ----------
-        values : ndarray, shape (P, G)
-            The candidates' gains.
-
-        Returns
-        -------
-        Evaluation
-        """
+        evaluation is kept in :attr:`evaluations`."""
         start = time.perf_counter()
         values = np.atleast_2d(np.asarray(values, dtype=float))
         p, m = values.shape[0], self.samples
@@ -207,18 +131,7 @@ class Objective:
         return ev
 
     def flight_cost(self, metrics: dict) -> np.ndarray:
-        """Each flight's cost (see the module).
-
-        Parameters
-        ----------
-        metrics : dict of str to ndarray
-            The flights' metrics, ``status`` and (if known) ``diverged`` and ``lost_track``.
-
-        Returns
-        -------
-        ndarray
-            Same shape as each metric.
-        """
+        """Each flight's cost (see the module)."""
         status = metrics["status"]
         stopped = metrics.get("diverged", status != 0)
         cost = np.zeros(status.shape)
@@ -239,33 +152,13 @@ class Objective:
         return np.where(failed, fallback, cost)
 
     def reduce(self, flight_cost: np.ndarray) -> np.ndarray:
-        """Each candidate's cost from its flights' costs: the worst or a quantile.
-
-        Parameters
-        ----------
-        flight_cost : ndarray, shape (P, M)
-
-        Returns
-        -------
-        ndarray, shape (P,)
-        """
+        """Each candidate's cost from its flights' costs: the worst or a quantile."""
         if self.statistic == "worst" or flight_cost.shape[1] == 1:
             return flight_cost.max(axis=1)
         return np.quantile(flight_cost, float(self.statistic), axis=1, method="higher")
 
     def statistic_of(self, values: np.ndarray) -> np.ndarray:
-        """A metric's value over each candidate's flights, by the objective's statistic
-        (worst: the largest).
-
-        Parameters
-        ----------
-        values : ndarray, shape (P, M)
-
-        Returns
-        -------
-        ndarray, shape (P,)
-            NaN where any flight (worst) or too many flights (a quantile) have none.
-        """
+        """A metric's value over each candidate's flights, by the objective's statistic (worst: the largest)."""
         if self.statistic == "worst" or values.shape[1] == 1:
             return values.max(axis=1)
         return np.quantile(values, float(self.statistic), axis=1, method="higher")

@@ -52,19 +52,7 @@ ZETA_BOUNDS = (0.1, 2.0)
 # --- gains ---------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Gain:
-    """One searched gain and its bounds.
-
-    Parameters
-    ----------
-    name : str
-        ``position.kp``, ``max_tilt``, ``position.wn``, ...
-    low, high : float
-        Its bounds (low < high).
-    log : bool
-        Searched on a log scale (bounds positive and a decade or more apart).
-    unit : str
-        Its unit.
-    """
+    """One searched gain and its bounds."""
 
     name: str
     low: float
@@ -73,35 +61,14 @@ class Gain:
     unit: str
 
     def from_unit(self, u: np.ndarray) -> np.ndarray:
-        """Values from positions in [0, 1] between the bounds (geometric on a log scale).
-
-        Parameters
-        ----------
-        u : ndarray
-            Positions in [0, 1].
-
-        Returns
-        -------
-        ndarray
-            The gain's values.
-        """
+        """Values from positions in [0, 1] between the bounds (geometric on a log scale)."""
         u = np.asarray(u, dtype=float)
         if self.log:
             return np.exp(np.log(self.low) + u * (np.log(self.high) - np.log(self.low)))
         return self.low + u * (self.high - self.low)
 
     def to_unit(self, value: float) -> float:
-        """The position in [0, 1] of a value between the bounds (:meth:`from_unit` inverted).
-
-        Parameters
-        ----------
-        value : float
-            The gain's value.
-
-        Returns
-        -------
-        float
-        """
+        """The position in [0, 1] of a value between the bounds (:meth:`from_unit` inverted)."""
         if self.log:
             return (math.log(value) - math.log(self.low)) / (math.log(self.high) - math.log(self.low))
         return (value - self.low) / (self.high - self.low)
@@ -115,17 +82,6 @@ def _pole_pair(gains: PDGains) -> dict[str, float]:
 
 def tunable_values(controller: Any) -> dict[str, tuple[float, str]]:
     """Every numeric gain of a controller by name, with its value and unit.
-
-    Parameters
-    ----------
-    controller : Controller
-        A frozen dataclass with ``units()`` (:class:`quadcruise.fields.Validated`).
-
-    Returns
-    -------
-    dict of str to (float, str)
-        ``position.kp`` -> (3.01, '1/s^2'), ...; also ``<field>.wn`` and ``<field>.zeta`` of
-        every PD gains field. Flags and choices are left out.
 
     Examples
     --------
@@ -227,25 +183,6 @@ _BOUNDS = "Bounds objects or a mapping {gain: (low, high)}"
 def as_bounds(value: Any, where: str, name: str = "bounds") -> dict[str, Bounds]:
     """A function's bounds argument as :class:`Bounds` by gain, a gain at most once.
 
-    Parameters
-    ----------
-    value : Bounds, iterable of Bounds, mapping, or None
-        ``{"position.kp": (0.5, 10)}`` or ``[Bounds("position.kp", 0.5, 10)]``.
-    where, name : str
-        The function and the argument, for the message.
-
-    Returns
-    -------
-    dict of str to Bounds
-
-    Raises
-    ------
-    ArgumentTypeError
-        Text (``"position.kp=0.5:10"``: the command line reads text; Python takes objects),
-        or anything else that is not of these forms.
-    InputError
-        Bounds not finite, reversed or empty, or a gain bounded twice.
-
     Examples
     --------
     >>> as_bounds({"position.kp": (0.5, 10)}, "tune()")
@@ -295,20 +232,7 @@ got tuple (10, 0.5); bounds reversed or empty
 
 
 def as_gain_names(value: Any, where: str, name: str = "gains") -> list[str]:
-    """A function's gains argument as a list of names (not yet checked against a controller).
-
-    Parameters
-    ----------
-    value : str, iterable of str, or None
-        One gain's name or a list of them.
-    where, name : str
-        The function and the argument, for the message.
-
-    Returns
-    -------
-    list of str
-        Empty for None.
-    """
+    """A function's gains argument as a list of names (not yet checked against a controller)."""
     if value is None:
         return []
     items = [value] if isinstance(value, str) else value

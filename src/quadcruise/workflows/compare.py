@@ -372,10 +372,7 @@ def compare(
 
 
 def labelled(controllers) -> dict:
-    """Label -> controller, in the order given, as :func:`compare` flies them.
-
-    Comma-separated names, a sequence of names or Controller objects (a repeated name gets '#2',
-    '#3', ...), or a mapping label -> name or Controller; InputError for none or a bad one.
+    """Label -> controller, in the order given, as :func:`compare` flies them (a repeated name gets '#2', ...).
 
     Examples
     --------

@@ -27,20 +27,7 @@ LOOPS = {"x": (2, "x"), "y": (1, "y"), "z": (0, "z"), "yaw": (3, "psi")}
 
 
 def to_generalized(n: int, mixer: np.ndarray) -> np.ndarray:
-    """The change of state that replaces the rotor thrusts F1..F4 by U1..U4 (up to scale).
-
-    Parameters
-    ----------
-    n : int
-        Number of states of the closed loop (the plant's, then the controller's memory).
-    mixer : numpy.ndarray
-        (4, 4) rotor thrusts to U1..U4 (:func:`quadcruise.model.actuators.mix`'s matrix).
-
-    Returns
-    -------
-    numpy.ndarray
-        (n, n): the identity but for the rotor-thrust block, ``mixer / mixer[0, 0]``.
-    """
+    """The change of state that replaces the rotor thrusts F1..F4 by U1..U4 (up to scale)."""
     S = np.eye(n)
     S[F1 : F1 + 4, F1 : F1 + 4] = mixer / mixer[0, 0]
     return S

@@ -18,33 +18,8 @@ DESIGN = {"x": "position", "y": "position", "z": "altitude", "yaw": "yaw"}
 
 
 def summary_data(lin, progress: Callable[[int, int], None] | None = None) -> dict:
-    """Poles, damping and margins of every loop beside the design's poles, as plain values.
-
-    Parameters
-    ----------
-    lin : Linearization
-        The closed loop (:class:`quadcruise.workflows.analysis.Linearization`, duck-typed).
-    progress : callable, optional
-        ``progress(done, total)`` at the start and after each of the four loops measured
-        (its poles and its margins at the input and the output).
-
-    Returns
-    -------
-    dict
-        ``controller`` (name), ``dt_s`` [s], ``stable``, ``spectral_radius``,
-        ``hover_residual`` and ``loops``: per loop, ``poles`` [rad/s] as [re, im] (one of
-        each pair, slowest first) with their ``natural_frequency`` [rad/s], ``damping`` and
-        ``step_weight`` (``lin.loop_modes``, a complex pair's two weights added: a pair is
-        one mode); the ``dominant`` pole, the mode of largest weight in the loop's step
-        response, and the ``slowest`` (least decay rate), which need not be the same: a slow
-        pole nearly cancelled by a zero weighs little; ``min_damping``; ``margins_input`` and
-        ``margins_output`` (:func:`quadcruise.metrics.margins.margins`) and ``low_margins``,
-        per break point the margins short of 30 deg or 6 dB
-        (:func:`quadcruise.metrics.margins.low_margins`); and where the controller has
-        design gains for the loop (``position`` for x and y, ``altitude``, ``yaw``), their
-        ``design_poles``, the ``nearest`` full-loop pole to each and its
-        ``nearest_rel_distance``.
-    """
+    """Poles, damping and margins of every loop beside the design's poles, as plain values (the keys:
+    docs/paper.md, "Linear analysis of the full loop")."""
     controller = lin.controller
     out = {
         "controller": getattr(controller, "name", "controller"),
@@ -107,21 +82,7 @@ SUMMARY_NOTES = (
 
 
 def summary_text(rep: dict) -> str:
-    """:func:`summary_data` as an aligned text table, one column per loop.
-
-    Parameters
-    ----------
-    rep : dict
-        What :func:`summary_data` returns.
-
-    Returns
-    -------
-    str
-        A heading line (controller, dt, stable or not, and the loops whose margins are short),
-        then one row per quantity: the dominant and slowest poles [rad/s], the least damping,
-        how far the design poles moved, and the phase margins [deg] and gain margins [dB]
-        at the input and the output, a short one marked (!); then :data:`SUMMARY_NOTES`.
-    """
+    """:func:`summary_data` as an aligned text table, one column per loop."""
 
     def pole(p):
         return f"{p[0]:.3g}" if p[1] == 0 else f"{p[0]:.3g}±{p[1]:.3g}j"

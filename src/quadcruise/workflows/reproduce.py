@@ -116,10 +116,19 @@ def paper_numbers(run: dict) -> dict:
 
 @dataclass
 class Reproduction:
-    """The flights of a reproduction (:func:`reproduce`): ``runs``, one dict per flight in the order
-    flown (``scenario``, ``controller``, ``axis``, ``status`` and the metrics of :data:`METRIC_KEYS`;
-    None where not applicable or not settled); ``results``, (scenario, controller) -> its
-    :class:`SimResult`; ``config``, as ``metrics.json`` records it; ``timings`` [s] per flight.
+    """The flights of a reproduction (:func:`reproduce`).
+
+    Parameters
+    ----------
+    runs : list of dict
+        One dict per flight in the order flown: ``scenario``, ``controller``, ``axis``,
+        ``status`` and the metrics of :data:`METRIC_KEYS` (None where not applicable or not settled).
+    results : dict
+        (scenario, controller) -> its :class:`SimResult`.
+    config : dict
+        The configuration, as ``metrics.json`` records it.
+    timings : dict
+        Wall time [s] per flight.
     """
 
     runs: list[dict]
@@ -135,17 +144,45 @@ class Reproduction:
         }
 
     def to_json(self) -> dict:
-        """The ``metrics.json`` document: ``runs``, ``paper`` (:data:`PAPER`), ``config``, ``version``."""
+        """The ``metrics.json`` document.
+
+        Returns
+        -------
+        dict
+            ``runs``, ``paper`` (:data:`PAPER`), ``config`` and ``version``.
+        """
         return {"runs": self.runs, "paper": PAPER, "config": self.config, "version": __version__}
 
     def to_pandas(self):
-        """One row per flight (scenario and controller), the keys of :attr:`runs` as columns."""
+        """The flights as a table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per flight (scenario and controller), the keys of :attr:`runs` as columns.
+        """
         import pandas as pd
 
         return pd.DataFrame(self.runs)
 
     def run(self, scenario: str, controller: str) -> dict:
-        """The metrics of one flight, ``runs``' entry for (scenario, controller); KeyError if not flown."""
+        """The metrics of one flight.
+
+        Parameters
+        ----------
+        scenario, controller : str
+            Which flight.
+
+        Returns
+        -------
+        dict
+            Its entry of :attr:`runs`.
+
+        Raises
+        ------
+        KeyError
+            If that flight was not flown.
+        """
         for r in self.runs:
             if r["scenario"] == scenario and r["controller"] == controller:
                 return r
@@ -354,8 +391,7 @@ def _cell(value, missing: str = "-") -> str:
 
 def results_table(rep: Reproduction) -> str:
     """Markdown table: each flight's metrics, the paper's in brackets where it reports one
-    (:func:`paper_numbers`); a flight that did not finish says so in bold, and a line counts them.
-    """
+    (:func:`paper_numbers`); a flight that did not finish says so in bold, and a line counts them."""
     lines = [
         "| scenario | controller | rise 10-90 % [s] (paper) | settling 2 % [s] (paper) | settling 5 % [s] "
         "| overshoot [%] (paper) | RMSE [m] | max error [m] |",
@@ -387,8 +423,7 @@ def _gains_text(controller) -> str:
 
 def fitted_table(rep: Reproduction) -> str:
     """Markdown table of the fit scenario, the paper's gains and the fitted ones, both rise
-    conventions, beside the paper's numbers; empty if it was not flown.
-    """
+    conventions, beside the paper's numbers; empty if it was not flown."""
     rows = [r for r in rep.runs if r["scenario"] == FIT_SCENARIO[0]]
     if not rows:
         return ""
@@ -450,8 +485,7 @@ def report_markdown(rep: Reproduction, figures: list[str]) -> str:
 
 def baseline_comparison(rep: Reproduction) -> str:
     """One line per scenario where both ``gonzalez`` and ``nlpd`` settled: the baseline's 5 % settling
-    and overshoot relative to nlpd's; empty if none.
-    """
+    and overshoot relative to nlpd's; empty if none."""
     pairs = []
     for r in rep.runs:
         if r["controller"] != "gonzalez":
@@ -479,11 +513,6 @@ def baseline_comparison(rep: Reproduction) -> str:
 
 def fitted_nlpd_loop() -> dict:
     """The fitted nlpd's x loop as ``quadcruise analyze`` linearises it about hover, beside the PD's own pair.
-
-    Keys: ``kp``, ``kd``; ``pd_pole``, ``pd_zeta``, ``pd_wn`` (s^2 + Kd s + Kp alone); ``dom_pole``,
-    ``dom_zeta``, ``dom_wn`` (the linearised closed loop's dominant pole); ``lin_rise`` (10-90 %),
-    ``lin_rise_0_100``, ``lin_settling`` (2 %) [s] and ``lin_overshoot`` [%] of that loop's step
-    (``control.step_info``). Poles in rad/s, complex, Im >= 0.
 
     Examples
     --------
@@ -529,16 +558,7 @@ def _pole_text(p: complex) -> str:
 
 
 def differences() -> str:
-    """The report's section on where our numbers differ from the paper's, and why, in short.
-
-    The reasoning in full is in docs/paper.md (the section of the same title); the fitted nlpd's
-    poles and its linear step response here are computed (:func:`fitted_nlpd_loop`), not typed in.
-
-    Returns
-    -------
-    str
-        Markdown.
-    """
+    """The report's section on where our numbers differ from the paper's, in short (in full: docs/paper.md)."""
     loop = fitted_nlpd_loop()
     loop["pd_pole"], loop["dom_pole"] = _pole_text(loop["pd_pole"]), _pole_text(loop["dom_pole"])
     return DIFFERENCES_TEMPLATE.format(**loop)
