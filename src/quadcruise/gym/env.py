@@ -17,8 +17,11 @@ from quadcruise.control import as_controller
 from quadcruise.control.setpoint import ACTION_CONTROLLERS, setpoint_gains
 from quadcruise.errors import InputError
 from quadcruise.gym.observe import OBS_SIZE, REF_SIZE, observe, references
+from quadcruise.gym.rotor import allocation_rows, drawn_rows, hover_starts
 from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, STATE_SIZE, X
 from quadcruise.missions import Circle, Mission, mission_from_name, stack_params
+from quadcruise.model.equivalent import paper_equivalent
+from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
 from quadcruise.sim.engine import Limits, time_grid
@@ -26,6 +29,7 @@ from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.stepper import Stepper
 from quadcruise.workflows.fly import check_can_hover
+from quadcruise.workflows.rotor_fly import as_vehicle, check_wind_acts, designed_controller
 
 EPISODE_STRIDE = 2**32
 """Episode e of vehicle i draws from the stream ``(seed, i * EPISODE_STRIDE + e)``: it depends on
@@ -50,6 +54,37 @@ def random_circle(seed: int, episode_id: int) -> Circle:
     )
 
 
+def default_max_step(vehicle, dt: float) -> float:
+    """The RK4 substep an environment flies by default: ``dt``; for a rotor-plant vehicle no
+    longer than half its faster motor time constant.
+
+    RK4 on the motor lag w' = (w_cmd - w) / tau is stable up to h = 2.78 tau, but a step of 2 tau
+    (the Hummingbird's 5 ms motors at 100 Hz) misstates the lag; at h = tau / 2 its error per
+    step is about (h / tau)^5 / 120 = 3e-4 of the step's change.
+
+    Parameters
+    ----------
+    vehicle : Vehicle or RotorVehicle
+        The nominal vehicle.
+    dt : float
+        The policy's period [s].
+
+    Returns
+    -------
+    float
+        [s].
+
+    Examples
+    --------
+    >>> from quadcruise.model.rotor_vehicle import RotorVehicle
+    >>> [default_max_step(RotorVehicle.preset(name), 0.01) for name in ("hummingbird", "crazyflie")]
+    [0.0025, 0.01]
+    """
+    if isinstance(vehicle, RotorVehicle):
+        return min(dt, 0.5 * min(vehicle.tau_up, vehicle.tau_down))
+    return dt
+
+
 class QuadVectorEnv(VectorEnv):
     """N quadrotors of one mission kind, stepped together (``gymnasium.vector.VectorEnv``).
 
@@ -64,12 +99,14 @@ class QuadVectorEnv(VectorEnv):
         The action mode (:mod:`quadcruise.control.setpoint`).
     controller : Controller or str, optional
         Fly this controller instead of the policy (a baseline: ``step`` then takes no actions).
-    vehicle : Vehicle, optional
-        The nominal vehicle (Table I by default).
+    vehicle : Vehicle, RotorVehicle or str, optional
+        The nominal vehicle (Table I by default), or a preset's name (``"crazyflie"``): a
+        RotorVehicle flies the rotor-speed plant (:mod:`quadcruise.gym.rotor`).
     dt : float
         The policy's period [s] (100 Hz by default), one control period of the engine.
     max_step : float, optional
-        Longest RK4 substep [s]; ``dt`` by default.
+        Longest RK4 substep [s]; by default ``dt``, for a rotor-plant vehicle no longer than half
+        its faster motor time constant (:func:`default_max_step`).
     duration : float, optional
         Episode length [s]; the mission's default duration by default (:data:`RANDOM_DURATION`
         for random references).
@@ -93,7 +130,7 @@ class QuadVectorEnv(VectorEnv):
         mission: Mission | str = "hover",
         action: str = "attitude",
         controller: Any = None,
-        vehicle: Vehicle | None = None,
+        vehicle: Vehicle | RotorVehicle | str | None = None,
         dt: float = 0.01,
         max_step: float | None = None,
         duration: float | None = None,
@@ -119,20 +156,29 @@ class QuadVectorEnv(VectorEnv):
         )
         if not isinstance(self.mission, Mission):
             raise InputError(f"mission must be a Mission or a name, got {type(mission).__name__}")
-        self.nominal = vehicle or Vehicle.paper()
-        if self.nominal.batch_size is not None:
+        self.nominal = as_vehicle(vehicle) or Vehicle.paper()
+        if not isinstance(self.nominal, (Vehicle, RotorVehicle)):
+            raise InputError(f"vehicle must be a Vehicle, a RotorVehicle or a preset's name, got {vehicle!r}")
+        self.rotor = isinstance(self.nominal, RotorVehicle)
+        # the paper vehicle the controllers believe: the rotor vehicle's "+" equivalent
+        self.nominal_eq = paper_equivalent(self.nominal) if self.rotor else self.nominal
+        if self.nominal_eq.batch_size is not None:
             raise InputError("the environment's vehicle must not be batched: use a population to vary it")
-        check_can_hover(self.nominal)
+        check_can_hover(self.nominal_eq)
         self.population, self.action_mode, self.max_track_error = population, action, float(max_track_error)
         default = RANDOM_DURATION if self.random_mission else self.mission.duration
         self.duration = float(default if duration is None else duration)
         grid = time_grid(self.duration, float(dt))
+        if self.rotor and isinstance(controller, str):  # gains designed for the vehicle, as fly does
+            controller = designed_controller(controller, self.nominal_eq.omega)
         self.baseline = None if controller is None else as_controller(controller)
         try:
             gains = setpoint_gains(**(scales or {}))
         except ValueError as err:
             raise InputError(str(err)) from None
         draw = self._draw(0, np.arange(n) * EPISODE_STRIDE, n)
+        if self.rotor:  # the drawn environment: a population's wind spread makes wind of still air
+            check_wind_acts(self.nominal, draw["environment"])
         self.sensors = None if population is None else population.noise
         if self.baseline is not None:
             function, gains, memory, width = (self.baseline.function, self.baseline.gains(), self.baseline.memory(), 0)
@@ -140,6 +186,9 @@ class QuadVectorEnv(VectorEnv):
             function, memory, width = ACTION_CONTROLLERS[action], None, 4
         env_kw = {} if draw["environment"] is None else draw["environment"].kwargs(n)
         sens_kw = {} if self.sensors is None else self.sensors.kwargs(float(dt))
+        rotor_kw = {}
+        if self.rotor:
+            rotor_kw = {"alloc": draw["alloc"], "psi0": draw["psi0"], "touchdown_speed": self.nominal.touchdown_speed}
         self.stepper = Stepper(
             grid,
             draw["x0"],
@@ -150,11 +199,12 @@ class QuadVectorEnv(VectorEnv):
             draw["mp"],
             memory=memory,
             vp_ctrl=draw["vp_ctrl"],
-            max_step=max_step or dt,
+            max_step=max_step or default_max_step(self.nominal, float(dt)),
             limits=limits or DEFAULT_LIMITS,
             setpoint_width=width,
             **env_kw,
             **sens_kw,
+            **rotor_kw,
         )
         self.dt = float(dt)
         self.single_action_space = spaces.Box(-1.0, 1.0, (4,), dtype=np.float32)
@@ -174,9 +224,9 @@ class QuadVectorEnv(VectorEnv):
         """The vehicle rows, initial states, mission rows and environment of k episodes."""
         pop = self.population
         if pop is None:
-            vehicle, offsets, environment = self.nominal, np.zeros((k, 3)), None
-        else:
-            d = pop.draw(seed, ids, k, self.nominal)
+            vehicle, offsets, environment = self.nominal_eq, np.zeros((k, 3)), None
+        else:  # a rotor vehicle's spreads are drawn on its equivalent (quadcruise.gym.rotor)
+            d = pop.draw(seed, ids, k, self.nominal_eq)
             vehicle, offsets, environment = d.vehicle, d.offsets, d.environment
         missions = [random_circle(seed, int(i)) for i in ids] if self.random_mission else [self.mission]
         if self.random_mission:
@@ -185,6 +235,20 @@ class QuadVectorEnv(VectorEnv):
             start = self._start_ref if hasattr(self, "_start_ref") else self.mission.reference(0.0)
             self._start_ref = start
         vp = vehicle.rows(k)
+        if self.rotor:
+            vp_ctrl = self.nominal_eq.rows(k) if pop is None or pop.model_error else vp
+            rows = drawn_rows(self.nominal, self.nominal_eq.rows(1)[0], vp)
+            x0, psi0 = hover_starts(rows, start, offsets)
+            alloc = allocation_rows(self.nominal, vp_ctrl, None if self.baseline is not None else self.action_mode)
+            return {
+                "vp": rows,
+                "vp_ctrl": vp_ctrl,
+                "x0": x0,
+                "psi0": psi0,
+                "alloc": alloc,
+                "mp": stack_params(missions, n=k),
+                "environment": environment,
+            }
         x0 = np.zeros((k, STATE_SIZE))  # level, still, rotors at the hover thrust
         x0[:, X : X + 3] = start[:, REF_X : REF_X + 3] + offsets  # on the reference, plus the drawn offset
         x0[:, PSI] = start[:, REF_PSI]
@@ -201,6 +265,8 @@ class QuadVectorEnv(VectorEnv):
         s = self.stepper
         draw = self._draw(self._seed, ids, k)
         s.vp[rows], s.vp_ctrl[rows], s.mp[rows] = draw["vp"], draw["vp_ctrl"], draw["mp"]
+        if self.rotor:
+            s.alloc[rows], s.psi0[rows] = draw["alloc"], draw["psi0"]
         env = draw["environment"]
         if env is not None:
             s.disturbance_params[rows] = env.params(k)
@@ -221,7 +287,7 @@ class QuadVectorEnv(VectorEnv):
     def _observe(self) -> None:
         s = self.stepper
         references(s.mission, s.time, s.mp, self._ref)
-        observe(s.state, self._ref, s.vp_ctrl, self.max_track_error, self._obs, self._reward, self._lost)
+        observe(s.paper_state, self._ref, s.vp_ctrl, self.max_track_error, self._obs, self._reward, self._lost)
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         """Start every vehicle's episode again (``options={"reset_mask": mask}``: some of them).
@@ -390,4 +456,4 @@ class QuadEnv(gymnasium.Env):
         return obs[0], float(r[0]), bool(term[0]), bool(trunc[0]), {k: v[0] for k, v in info.items()}
 
 
-__all__ = ["DEFAULT_LIMITS", "EPISODE_STRIDE", "QuadEnv", "QuadVectorEnv", "random_circle"]
+__all__ = ["DEFAULT_LIMITS", "EPISODE_STRIDE", "default_max_step", "QuadEnv", "QuadVectorEnv", "random_circle"]

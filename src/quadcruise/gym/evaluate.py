@@ -38,21 +38,21 @@ def rollout(env: QuadVectorEnv, policy: Callable | None = None, *, seed: int = 0
     states = np.full((n, length, STATE_SIZE), np.nan)
     commands = np.full((n, length, CMD_SIZE), np.nan)
     refs = np.full((n, length, REF_SIZE), np.nan)
-    states[:, 0] = s.state
+    states[:, 0] = s.paper_state
     returns = np.zeros(n)
     alive = np.ones(n, dtype=bool)
-    status, t_stop, final = np.zeros(n, dtype=np.int64), np.full(n, s.t_grid[-1]), s.state.copy()
+    status, t_stop, final = np.zeros(n, dtype=np.int64), np.full(n, s.t_grid[-1]), s.paper_state.copy()
     for k in range(length - 1):
         obs, reward, terminated, truncated, info = env.step(None if policy is None else policy(obs))
         returns[alive] += reward[alive]
         commands[alive, k] = s.log_cmd[alive, 0]
         refs[alive, k] = s.log_ref[alive, 0]
-        states[alive, k + 1] = s.state[alive]
+        states[alive, k + 1] = s.paper_state[alive]
         if k == length - 2:  # the last instant's reference and command
             commands[alive, k + 1] = s.log_cmd[alive, 1]
             refs[alive, k + 1] = s.log_ref[alive, 1]
         ended = alive & (terminated | truncated)  # as they ended: the next step restarts them
-        status[ended], final[ended] = info["status"][ended], s.state[ended]
+        status[ended], final[ended] = info["status"][ended], s.paper_state[ended]
         t_stop[ended & terminated] = s.t_stop[ended & terminated]
         alive &= ~ended
         if not alive.any():

@@ -135,11 +135,68 @@ def paper_state(xr, rp, ext, psi_last, out):
     return psi
 
 
+@njit(cache=True)
+def paper_states(x, rp, psi0):
+    """The paper-layout states of N rotor states at rest from disturbances (every rotor healthy).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        (N, 13 + n) rotor states.
+    rp : numpy.ndarray
+        (N, P) their vehicles' parameter rows.
+    psi0 : numpy.ndarray
+        (N,) the yaws [rad] each quaternion's is read near.
+
+    Returns
+    -------
+    numpy.ndarray
+        (N, 16) as :func:`paper_state` writes them.
+    """
+    out = np.empty((x.shape[0], STATE_SIZE))
+    ext = np.zeros(EXT_SIZE)
+    for j in range(4):
+        ext[EXT_E1 + j] = 1.0
+    for i in range(x.shape[0]):
+        paper_state(x[i], rp[i], ext, psi0[i], out[i])
+    return out
+
+
+C_PSI = 0
+C_TRUE = 1
+C_EXT = C_TRUE + STATE_SIZE
+C_HISTORY = C_EXT + EXT_SIZE
+"""Offsets in a row of the rotor kernel's ``carry``: the unwrapped yaw [rad], the paper-layout
+true state, the external inputs of the last period, then the sensor-delay ring buffer."""
+
+
+def rotor_carry_width(sensor_delay: int) -> int:
+    """Width of the rotor kernel's ``carry`` rows.
+
+    Parameters
+    ----------
+    sensor_delay : int
+        The sensor delay [control periods].
+
+    Returns
+    -------
+    int
+        1 + 16 + EXT_SIZE + (sensor_delay + 1) 16.
+
+    Examples
+    --------
+    >>> rotor_carry_width(0) - rotor_carry_width(1)
+    -16
+    """
+    return C_HISTORY + (int(sensor_delay) + 1) * STATE_SIZE
+
+
 _f8v = types.float64[::1]
 _f8m = types.float64[:, ::1]
 _f8c = types.float64[:, :, ::1]
 _u8m = types.uint64[:, ::1]
 _i8v = types.int64[::1]
+_i8m = types.int64[:, ::1]
 
 ROTOR_FLIGHT_SIG = types.void(
     types.int64,  # first
@@ -167,6 +224,9 @@ ROTOR_FLIGHT_SIG = types.void(
     _f8v,  # limits
     types.boolean,  # ground
     _f8v,  # touchdown
+    types.int64,  # n_step
+    _i8m,  # clock
+    _f8m,  # carry
     _f8c,  # log_x
     _f8c,  # log_rotor
     _f8c,  # log_cmd
@@ -206,6 +266,9 @@ def _rotor_flight_kernel(
     limits,
     ground,
     touchdown,
+    n_step,
+    clock,
+    carry,
     log_x,
     log_rotor,
     log_cmd,
@@ -218,7 +281,18 @@ def _rotor_flight_kernel(
 ):
     """Fly vehicles first .. stop - 1 of the batch (the module's steps; arguments:
     :func:`fly_rotor_vehicles`'s, one row per vehicle, ``alloc`` the n x 4 duty-to-thrust matrix
-    row by row and the controller vehicle's kf)."""
+    row by row and the controller vehicle's kf).
+
+    The resume contract of the paper kernel (:func:`quadcruise.sim.engine._kernel`): each
+    vehicle flies on from its period ``clock[i, 0]`` for at most ``n_step`` periods, and
+    everything it carries from one period to the next is read at the start and written back at
+    the end: its rotor state (``x0`` in, ``x_final`` out: they may be one array), ``clock`` (the
+    period reached, the RK4 steps flown), ``carry`` (:func:`rotor_carry_width`: the unwrapped yaw,
+    the paper-layout true state, the external inputs of the last period, the sensor-delay ring
+    buffer), ``mem``, ``dmem``, ``rng``, ``saturated`` (accumulated) and ``status`` (a vehicle
+    whose status is not FINISHED, or whose grid is flown, is left as it is). A vehicle at period
+    0 starts afresh from ``x0`` and ``psi0``. The log rows count from the first instant flown in
+    this call."""
     n_periods = t_grid.shape[0] - 1
     size = x0.shape[1]
     n = size - ROTOR_W1
@@ -236,6 +310,15 @@ def _rotor_flight_kernel(
     max_position, max_speed, max_rate = limits[0], limits[1], limits[2]
     cos_tilt = math.cos(limits[3])
     for i in range(first, stop):
+        k0 = clock[i, 0]
+        if status[i] != FINISHED or k0 >= n_periods:  # stopped, or its grid flown
+            blank_rows(log_x, i, 0)
+            blank_rows(log_rotor, i, 0)
+            blank_rows(log_cmd, i, 0)
+            blank_rows(log_ref, i, 0)
+            continue
+        k1 = min(k0 + n_step, n_periods)
+        k_reached = k1
         for j in range(size):
             x[j] = x0[i, j]
         rpi, ai, vci, gi, mpi, dpi, stdi = rp[i], alloc[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
@@ -247,16 +330,27 @@ def _rotor_flight_kernel(
             rngi[j] = rng[i, j]
         kf_ctrl = ai[4 * n]
         w_min, w_max = rpi[RP_W_MIN], rpi[RP_W_MAX]
-        still_air(0.0, 0.0, true, dpi, dmi, rngi, ext)
-        psi = paper_state(x, rpi, ext, psi0[i], true)
-        for d in range(sensor_delay + 1):
+        if k0 == 0:  # a fresh start: the true state of x0, seen through an empty delay line
+            still_air(0.0, 0.0, true, dpi, dmi, rngi, ext)
+            psi = paper_state(x, rpi, ext, psi0[i], true)
+            for d in range(sensor_delay + 1):
+                for j in range(STATE_SIZE):
+                    history[d, j] = true[j]
+        else:
+            psi = carry[i, C_PSI]
             for j in range(STATE_SIZE):
-                history[d, j] = true[j]
-        clipped_s = limited_s = 0.0
+                true[j] = carry[i, C_TRUE + j]
+            for j in range(EXT_SIZE):
+                ext[j] = carry[i, C_EXT + j]
+            for d in range(sensor_delay + 1):
+                for j in range(STATE_SIZE):
+                    history[d, j] = carry[i, C_HISTORY + d * STATE_SIZE + j]
+        clipped_s, limited_s = saturated[i, 0], saturated[i, 1]
+        steps = clock[i, 1]
         code = FINISHED
         t_end = t_grid[n_periods]
         rows_x = rows = 0
-        for k in range(n_periods + 1):
+        for k in range(k0, k1 + 1 if k1 == n_periods else k1):
             t = t_grid[k]
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
             mission(t, mpi, ref)
@@ -287,6 +381,7 @@ def _rotor_flight_kernel(
             if not (math.isfinite(u0) and math.isfinite(u1) and math.isfinite(u2) and math.isfinite(u3)):
                 code = BAD_COMMAND
                 t_end = t
+                k_reached = k
                 break
             held = False
             for r in range(n):
@@ -310,9 +405,11 @@ def _rotor_flight_kernel(
             h = dt / n_sub
             for sub in range(n_sub):
                 rotor_rk4_step(x, w_cmd, rpi, ext_r, h, work)
+                steps += 1
                 if ground and x[RZ] < 0.0 and ground_contact(x, touchdown[i]):
                     code = CRASHED
                     t_end = t + (sub + 1) * h
+                    k_reached = k + 1
                     break
             if code == CRASHED:  # mid-period: its state is the final one, at t_stop
                 psi = paper_state(x, rpi, ext, psi, true)
@@ -333,6 +430,7 @@ def _rotor_flight_kernel(
                 code = TILT_BOUND
             if code != FINISHED:
                 t_end = t_grid[k + 1]
+                k_reached = k + 1
                 if (k + 1) % log_every == 0:  # keep the state that broke the bound
                     log_row(log_x, i, rows, true)
                     log_row(log_rotor, i, rows, x)
@@ -347,6 +445,15 @@ def _rotor_flight_kernel(
         put_row(mem, i, mi)
         put_row(dmem, i, dmi)
         put_row(rng, i, rngi)
+        clock[i, 0], clock[i, 1] = k_reached, steps
+        carry[i, C_PSI] = psi
+        for j in range(STATE_SIZE):
+            carry[i, C_TRUE + j] = true[j]
+        for j in range(EXT_SIZE):
+            carry[i, C_EXT + j] = ext[j]
+        for d in range(sensor_delay + 1):
+            for j in range(STATE_SIZE):
+                carry[i, C_HISTORY + d * STATE_SIZE + j] = history[d, j]
         saturated[i, 0], saturated[i, 1] = clipped_s, limited_s
         status[i] = code
         t_stop[i] = t_end
@@ -355,21 +462,40 @@ def _rotor_flight_kernel(
 _pool: ThreadPoolExecutor | None = None
 
 
-def _in_pieces(n: int, *args) -> None:
-    """The kernel over vehicles 0..n-1 on numba's number of threads, in ranges handed out in turn
-    (as :func:`quadcruise.sim.engine.fly_vehicles` does for the paper's kernel); each vehicle's
-    arithmetic does not depend on its range, so a batch reproduces single flights bit for bit."""
+def fly_rotor_pieces(n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD, after_piece=None) -> None:
+    """The rotor kernel over vehicles 0..n-1 on numba's number of threads, in ranges handed out in
+    turn (as :func:`quadcruise.sim.engine.fly_vehicles` does for the paper's kernel); each
+    vehicle's arithmetic does not depend on its range, so a batch reproduces single flights bit
+    for bit.
+
+    Parameters
+    ----------
+    n : int
+        Number of vehicles.
+    args : tuple
+        The kernel's arguments after the vehicle range (``ROTOR_FLIGHT_SIG``, in order).
+    pieces_per_thread : int
+        Ranges per thread: fewer for short calls (a step), where each call's fixed cost counts.
+    after_piece : callable, optional
+        Called as ``after_piece(first, stop)`` on the thread that flew vehicles first..stop-1,
+        right after it (as :func:`quadcruise.sim.engine.fly_vehicles` calls it).
+    """
     global _pool
     threads = min(n, get_num_threads())
     if threads <= 1:
         _rotor_flight_kernel(0, n, *args)
+        if after_piece is not None:
+            after_piece(0, n)
         return
-    bounds = np.linspace(0, n, min(n, PIECES_PER_THREAD * threads) + 1).round().astype(np.int64)
+    bounds = np.linspace(0, n, min(n, pieces_per_thread * threads) + 1).round().astype(np.int64)
     pieces = itertools.count()  # next() on it is atomic under the GIL
 
     def work() -> None:
         while (k := next(pieces)) < bounds.shape[0] - 1:
-            _rotor_flight_kernel(int(bounds[k]), int(bounds[k + 1]), *args)
+            first, stop = int(bounds[k]), int(bounds[k + 1])
+            _rotor_flight_kernel(first, stop, *args)
+            if after_piece is not None:
+                after_piece(first, stop)
 
     if _pool is None:
         _pool = ThreadPoolExecutor(max_workers=max(1, config.NUMBA_NUM_THREADS - 1), thread_name_prefix="rotors")
@@ -377,6 +503,85 @@ def _in_pieces(n: int, *args) -> None:
     work()
     for h in helpers:
         h.result()
+
+
+def rotor_inputs(
+    t_grid,
+    x0,
+    rp,
+    alloc,
+    vp_ctrl,
+    gains,
+    mp,
+    *,
+    psi0=0.0,
+    memory=None,
+    disturbance=None,
+    disturbance_params=None,
+    disturbance_memory=None,
+    seed: int = 0,
+    first_vehicle=0,
+    sensor_std=None,
+    sensor_delay: int = 0,
+    max_step: float = 1e-3,
+    log_every: int = 1,
+    touchdown_speed=None,
+) -> dict:
+    """The rotor kernel's batch arrays, checked and broadcast to one row per vehicle (for
+    :func:`fly_rotor_vehicles` and :class:`quadcruise.sim.stepper.Stepper`).
+
+    Parameters
+    ----------
+    t_grid, x0, rp, alloc, vp_ctrl, gains, mp : array_like
+        As in :func:`fly_rotor_vehicles`.
+    psi0, memory, disturbance, disturbance_params, disturbance_memory, seed, first_vehicle : optional
+        As in :func:`fly_rotor_vehicles`.
+    sensor_std, sensor_delay, max_step, log_every, touchdown_speed : optional
+        As in :func:`fly_rotor_vehicles`.
+
+    Returns
+    -------
+    dict
+        ``inp`` (:func:`quadcruise.sim.engine.batch_inputs`'s arrays), ``rp``, ``x0``, ``alloc``,
+        ``psi0``, ``touchdown`` (inf without a ground) as C-ordered rows, ``n_rotors``.
+
+    Raises
+    ------
+    InputError
+        Arrays whose shapes do not fit, a bad grid, step or touchdown speed.
+    """
+    rp = np.array(np.atleast_2d(np.asarray(rp, dtype=float)), order="C")
+    n_vehicles = rp.shape[0]
+    n = int(rp[0, RP_N_ROTORS])
+    if np.any(rp[:, RP_N_ROTORS] != n):
+        raise InputError("the vehicles of one flight must have the same number of rotors")
+    x0 = np.array(np.broadcast_to(np.atleast_2d(np.asarray(x0, dtype=float)), (n_vehicles, ROTOR_W1 + n)), order="C")
+    if not np.all(np.isfinite(x0)):
+        raise InputError("the initial state must be finite")
+    alloc = np.array(np.broadcast_to(np.atleast_2d(np.asarray(alloc, dtype=float)), (n_vehicles, 4 * n + 1)), order="C")
+    psi0 = np.array(np.broadcast_to(np.asarray(psi0, dtype=float), (n_vehicles,)), order="C")
+    seen0 = np.zeros((n_vehicles, STATE_SIZE))  # only its shape is checked
+    inp = batch_inputs(
+        t_grid,
+        seen0,
+        np.array(np.broadcast_to(np.atleast_2d(np.asarray(vp_ctrl, dtype=float)), (n_vehicles, np.shape(vp_ctrl)[-1]))),
+        gains,
+        mp,
+        memory=memory,
+        disturbance=disturbance,
+        disturbance_params=disturbance_params,
+        disturbance_memory=disturbance_memory,
+        seed=seed,
+        first_vehicle=first_vehicle,
+        sensor_std=sensor_std,
+        sensor_delay=sensor_delay,
+        max_step=max_step,
+        log_every=log_every,
+    )
+    touchdown = np.array(np.broadcast_to(np.inf if touchdown_speed is None else touchdown_speed, (n_vehicles,)), float)
+    if touchdown_speed is not None and not np.all(touchdown > 0):
+        raise InputError(f"touchdown speed must be > 0 m/s, got {touchdown_speed!r}")
+    return {"inp": inp, "rp": rp, "x0": x0, "alloc": alloc, "psi0": psi0, "touchdown": touchdown, "n_rotors": n}
 
 
 def fly_rotor_vehicles(
@@ -453,23 +658,15 @@ def fly_rotor_vehicles(
     InputError
         Arrays whose shapes do not fit, a bad grid, step or touchdown speed.
     """
-    rp = np.array(np.atleast_2d(np.asarray(rp, dtype=float)), order="C")
-    n_vehicles = rp.shape[0]
-    n = int(rp[0, RP_N_ROTORS])
-    if np.any(rp[:, RP_N_ROTORS] != n):
-        raise InputError("the vehicles of one flight must have the same number of rotors")
-    x0 = np.array(np.broadcast_to(np.atleast_2d(np.asarray(x0, dtype=float)), (n_vehicles, ROTOR_W1 + n)), order="C")
-    if not np.all(np.isfinite(x0)):
-        raise InputError("the initial state must be finite")
-    alloc = np.array(np.broadcast_to(np.atleast_2d(np.asarray(alloc, dtype=float)), (n_vehicles, 4 * n + 1)), order="C")
-    psi0 = np.array(np.broadcast_to(np.asarray(psi0, dtype=float), (n_vehicles,)), order="C")
-    seen0 = np.zeros((n_vehicles, STATE_SIZE))  # only its shape is checked
-    inp = batch_inputs(
+    prep = rotor_inputs(
         t_grid,
-        seen0,
-        np.array(np.broadcast_to(np.atleast_2d(np.asarray(vp_ctrl, dtype=float)), (n_vehicles, np.shape(vp_ctrl)[-1]))),
+        x0,
+        rp,
+        alloc,
+        vp_ctrl,
         gains,
         mp,
+        psi0=psi0,
         memory=memory,
         disturbance=disturbance,
         disturbance_params=disturbance_params,
@@ -480,12 +677,11 @@ def fly_rotor_vehicles(
         sensor_delay=sensor_delay,
         max_step=max_step,
         log_every=log_every,
+        touchdown_speed=touchdown_speed,
     )
+    inp, rp, x0, alloc, psi0, touchdown = (prep[k] for k in ("inp", "rp", "x0", "alloc", "psi0", "touchdown"))
+    n_vehicles, n, ground = rp.shape[0], prep["n_rotors"], touchdown_speed is not None
     t_grid = inp["t_grid"]
-    ground = touchdown_speed is not None
-    touchdown = np.array(np.broadcast_to(np.inf if touchdown_speed is None else touchdown_speed, (n_vehicles,)), float)
-    if ground and not np.all(touchdown > 0):
-        raise InputError(f"touchdown speed must be > 0 m/s, got {touchdown_speed!r}")
     limits = limits or Limits()
     n_periods = t_grid.shape[0] - 1
     n_log = n_periods // log_every + 1
@@ -499,40 +695,45 @@ def fly_rotor_vehicles(
     t_stop = np.empty(n_vehicles)
     saturated = np.zeros((n_vehicles, 2))
     mem, dmem, rng = inp["memory"], inp["disturbance_memory"], inp["rng"]
-    _in_pieces(
+    fly_rotor_pieces(
         n_vehicles,
-        t_grid,
-        x0,
-        psi0,
-        rp,
-        alloc,
-        inp["vp"],
-        controller,
-        inp["gains"],
-        mem,
-        mission,
-        inp["mp"],
-        disturbance or still_air,
-        inp["disturbed"],
-        inp["disturbance_params"],
-        dmem,
-        rng,
-        inp["sensor_std"],
-        int(sensor_delay),
-        float(max_step),
-        int(log_every),
-        limits.array(),
-        ground,
-        touchdown,
-        log_x,
-        log_rotor,
-        log_cmd,
-        log_ref,
-        x_final,
-        seen_final,
-        status,
-        t_stop,
-        saturated,
+        (
+            t_grid,
+            x0,
+            psi0,
+            rp,
+            alloc,
+            inp["vp"],
+            controller,
+            inp["gains"],
+            mem,
+            mission,
+            inp["mp"],
+            disturbance or still_air,
+            inp["disturbed"],
+            inp["disturbance_params"],
+            dmem,
+            rng,
+            inp["sensor_std"],
+            int(sensor_delay),
+            float(max_step),
+            int(log_every),
+            limits.array(),
+            ground,
+            touchdown,
+            n_periods,
+            np.zeros((n_vehicles, 2), dtype=np.int64),
+            np.empty((n_vehicles, rotor_carry_width(sensor_delay))),
+            log_x,
+            log_rotor,
+            log_cmd,
+            log_ref,
+            x_final,
+            seen_final,
+            status,
+            t_stop,
+            saturated,
+        ),
     )
     return SimResult(
         t=t_grid[::log_every][:n_log].copy(),
@@ -553,4 +754,4 @@ def fly_rotor_vehicles(
     )
 
 
-__all__ = ["fly_rotor_vehicles", "paper_state"]
+__all__ = ["fly_rotor_pieces", "fly_rotor_vehicles", "paper_state", "paper_states", "rotor_carry_width", "rotor_inputs"]

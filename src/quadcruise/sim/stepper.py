@@ -10,6 +10,13 @@ cut into steps is bit for bit the flight :func:`~quadcruise.sim.engine.simulate`
 call. Each vehicle keeps its own period: after :meth:`Stepper.reset` of some of them, they
 start their grid again while the others fly on.
 
+The vehicles fly either plant: the paper's (:func:`~quadcruise.sim.engine.fly_vehicles`), or,
+given the rotor plant's arrays (``alloc``, ``psi0``, ``touchdown_speed``, as
+:func:`quadcruise.sim.rotor_flight.fly_rotor_vehicles` takes them), the rotor-speed plant
+(:func:`~quadcruise.sim.rotor_flight.fly_rotor_pieces`), whose kernel keeps the same resume
+contract. One API for both: :attr:`Stepper.state` is the plant's own state (16 entries, or the
+13 + n of the rotor state), :attr:`Stepper.paper_state` the paper-layout state of either.
+
 A policy reaches the plant through the controller too: a controller that reads its setpoint
 from the first ``setpoint_width`` entries of its gains row (the action modes of
 :mod:`quadcruise.gym`) is given that setpoint by ``step(commands)``.
@@ -34,6 +41,7 @@ from quadcruise.layout import CMD_SIZE, CONTROLLER_SIG, DISTURBANCE_SIG, MISSION
 from quadcruise.sim.engine import Limits, batch_inputs, fly_vehicles, fresh_carry, still_air
 from quadcruise.sim.kernel_args import KernelArgs
 from quadcruise.sim.rng import vehicle_states
+from quadcruise.sim.rotor_flight import fly_rotor_pieces, paper_states, rotor_carry_width, rotor_inputs
 from quadcruise.sim.status import ExitStatus
 
 STEP_PIECES_PER_THREAD = 1
@@ -75,9 +83,9 @@ class Stepper:
     t_grid : (M+1,) array
         Control instants [s] shared by the vehicles; each vehicle has its own place on it.
     x0 : (16,) or (N, 16) array
-        Initial states, restored by :meth:`reset`.
+        Initial states, restored by :meth:`reset` (rotor plant: (13 + n,) or (N, 13 + n) rotor states).
     vp : (N, PARAM_SIZE) array
-        Vehicle parameter rows.
+        Vehicle parameter rows (rotor plant: the rotor vehicles' rows).
     controller : compiled function with ``CONTROLLER_SIG``
     gains : (G,) or (N, G) array
         The controller's parameters; :attr:`gains` may be written between steps.
@@ -100,6 +108,14 @@ class Stepper:
     setpoint_width : int
         Number of leading gains entries that ``step(commands)`` writes (0: the controller
         flies alone, and ``step`` takes no commands).
+    alloc : (4 n + 1,) or (N, 4 n + 1) array, optional
+        Given, the vehicles fly the rotor plant: the controller vehicle's duty-to-thrust matrix
+        and kf, as :func:`~quadcruise.sim.rotor_flight.fly_rotor_vehicles` takes it (``vp_ctrl``
+        then required: the equivalent paper row the controller reads; ``full_dynamics`` not used).
+    psi0 : float or (N,) array
+        Rotor plant: the yaw [rad] the initial quaternion's is read near.
+    touchdown_speed : float or (N,) array, optional
+        Rotor plant: with it, a ground at z = 0.
     """
 
     def __init__(
@@ -126,7 +142,49 @@ class Stepper:
         limits: Limits | None = None,
         periods: int = 1,
         setpoint_width: int = 0,
+        alloc=None,
+        psi0=0.0,
+        touchdown_speed=None,
     ) -> None:
+        self.rotor = alloc is not None
+        if self.rotor:
+            if vp_ctrl is None:
+                raise InputError("Stepper: a rotor-plant flight needs vp_ctrl, the controller's equivalent paper row")
+            if full_dynamics:
+                raise InputError("Stepper: full_dynamics is the paper plant's option, not the rotor plant's")
+            prep = rotor_inputs(
+                t_grid,
+                x0,
+                vp,
+                alloc,
+                vp_ctrl,
+                gains,
+                mp,
+                psi0=psi0,
+                memory=memory,
+                disturbance=disturbance,
+                disturbance_params=disturbance_params,
+                disturbance_memory=disturbance_memory,
+                seed=seed,
+                first_vehicle=first_vehicle,
+                sensor_std=sensor_std,
+                sensor_delay=sensor_delay,
+                max_step=max_step,
+                touchdown_speed=touchdown_speed,
+            )
+            inp = prep["inp"]
+            inp["vp_ctrl"], inp["vp"], inp["x0"] = inp["vp"], prep["rp"], prep["x0"]
+            self.alloc, self.psi0, self.touchdown = prep["alloc"], prep["psi0"], prep["touchdown"]
+            self.ground = touchdown_speed is not None
+            self._init(
+                inp, controller, mission, disturbance, seed, first_vehicle, sensor_delay, periods, setpoint_width
+            )
+            self.carry = np.zeros((self.n, rotor_carry_width(self.sensor_delay)))
+            self._paper_state = paper_states(self.state, self.vp, self.psi0)  # then written by each step
+            self.log_rotor = np.empty((self.n, self.periods + 1, self.state.shape[1]))
+            self.full_dynamics, self.max_step = False, float(max_step)
+            self.limits = (limits or Limits()).array()
+            return
         inp = batch_inputs(
             t_grid,
             x0,
@@ -144,6 +202,13 @@ class Stepper:
             sensor_delay=sensor_delay,
             max_step=max_step,
         )
+        self._init(inp, controller, mission, disturbance, seed, first_vehicle, sensor_delay, periods, setpoint_width)
+        self.carry = fresh_carry(self._x0, self.sensor_delay)
+        self.full_dynamics, self.max_step = bool(full_dynamics), float(max_step)
+        self.limits = (limits or Limits()).array()
+
+    def _init(self, inp, controller, mission, disturbance, seed, first_vehicle, sensor_delay, periods, setpoint_width):
+        """What both plants hold: the batch arrays, memories, clocks, statuses and logs."""
         if int(periods) != periods or periods < 1:
             raise InputError(f"periods must be a whole number >= 1, got {periods!r}")
         self.n = n = inp["n"]
@@ -171,7 +236,6 @@ class Stepper:
         self.disturbance_memory = self._dmem0.copy()
         self.rng = inp["rng"]
         self.clock = np.zeros((n, 2), dtype=np.int64)
-        self.carry = fresh_carry(self._x0, self.sensor_delay)
         self.saturated = np.zeros((n, 2))
         self.status = np.zeros(n, dtype=np.int64)
         self.t_stop = np.full(n, np.nan)
@@ -185,8 +249,14 @@ class Stepper:
         )
         self.disturbance = compiled_address(disturbance or still_air, DISTURBANCE_SIG)
         self.disturbed = disturbance is not None
-        self.full_dynamics, self.max_step = bool(full_dynamics), float(max_step)
-        self.limits = (limits or Limits()).array()
+
+    @property
+    def paper_state(self) -> np.ndarray:
+        """(N, 16) the state in the paper layout (:data:`quadcruise.layout.STATE_NAMES`): the
+        paper plant's state itself; for the rotor plant, position, velocity, the ZYX Euler angles
+        of the quaternion, body rates and the thrusts of rotors 1..4
+        (:func:`quadcruise.sim.rotor_flight.paper_state`), as of the last step."""
+        return self._paper_state if self.rotor else self.state
 
     @property
     def period(self) -> np.ndarray:
@@ -229,15 +299,16 @@ class Stepper:
         k = rows.size
         if not k:
             return
+        width = self.state.shape[1]
         if x0 is None:
             start = self._x0[rows]
         else:
             start = np.asarray(x0, dtype=float)
-            start = (
-                np.broadcast_to(start, (k, STATE_SIZE)) if start.shape in ((STATE_SIZE,), (1, STATE_SIZE)) else start
-            )
-            if start.shape != (k, STATE_SIZE) or not np.isfinite(start).all():
-                raise InputError(f"reset: x0 must be finite and of shape (16,) or ({k}, 16), got {np.shape(x0)}")
+            start = np.broadcast_to(start, (k, width)) if start.shape in ((width,), (1, width)) else start
+            if start.shape != (k, width) or not np.isfinite(start).all():
+                raise InputError(
+                    f"reset: x0 must be finite and of shape ({width},) or ({k}, {width}), got {np.shape(x0)}"
+                )
         if disturbance_memory is not None:
             dmem = np.asarray(disturbance_memory, dtype=float)
             if dmem.shape != (k, self._dmem0.shape[1]):
@@ -256,7 +327,10 @@ class Stepper:
         elif self.drawn:
             self.rng[rows] = vehicle_states(self.seed if seed is None else seed, k, self.first_vehicle[rows])
         self.clock[rows] = 0
-        self.carry[rows] = fresh_carry(np.ascontiguousarray(start), self.sensor_delay)
+        if self.rotor:  # the rotor kernel starts a vehicle at period 0 afresh, its carry unread
+            self._paper_state[rows] = paper_states(np.ascontiguousarray(start), self.vp[rows], self.psi0[rows])
+        else:
+            self.carry[rows] = fresh_carry(np.ascontiguousarray(start), self.sensor_delay)
         self.saturated[rows] = 0.0
         self.status[rows] = int(ExitStatus.FINISHED)
         self.t_stop[rows] = np.nan
@@ -319,6 +393,9 @@ class Stepper:
                     f"step: commands must be finite (row {int(np.flatnonzero(~np.isfinite(c).all(axis=1))[0])} is not)"
                 )
             self.gains[:, : self.setpoint_width] = c
+        if self.rotor:
+            self._step_rotor(pieces_per_thread, after_piece)
+            return
         fly_vehicles(
             self.n,
             KernelArgs(
@@ -352,6 +429,51 @@ class Stepper:
                 status=self.status,
                 t_stop=self.t_stop,
                 saturated=self.saturated,
+            ),
+            pieces_per_thread,
+            after_piece,
+        )
+
+    def _step_rotor(self, pieces_per_thread: int, after_piece) -> None:
+        """:meth:`step` of the rotor plant: its kernel, with the arguments of ``ROTOR_FLIGHT_SIG``."""
+        fly_rotor_pieces(
+            self.n,
+            (
+                self.t_grid,
+                self.state,
+                self.psi0,
+                self.vp,
+                self.alloc,
+                self.vp_ctrl,
+                self.controller,
+                self.gains,
+                self.memory,
+                self.mission,
+                self.mp,
+                self.disturbance,
+                self.disturbed,
+                self.disturbance_params,
+                self.disturbance_memory,
+                self.rng,
+                self.sensor_std,
+                self.sensor_delay,
+                self.max_step,
+                1,
+                self.limits,
+                self.ground,
+                self.touchdown,
+                self.periods,
+                self.clock,
+                self.carry,
+                self.log_x,
+                self.log_rotor,
+                self.log_cmd,
+                self.log_ref,
+                self.state,
+                self._paper_state,
+                self.status,
+                self.t_stop,
+                self.saturated,
             ),
             pieces_per_thread,
             after_piece,
