@@ -127,9 +127,7 @@ def ulog_bytes(
     """
     head = [MAGIC + b"\x01" + struct.pack("<Q", start_us), _message("B", bytes(16) + struct.pack("<QQQ", 0, 0, 0))]
     nested = {kind: fields for topic in topics for kind, fields in topic.nested.items()}
-    head += [
-        _message("F", Topic(kind, fields, {}).format_message()) for kind, fields in nested.items()
-    ]
+    head += [_message("F", Topic(kind, fields, {}).format_message()) for kind, fields in nested.items()]
     head += [_message("F", topic.format_message()) for topic in topics]
     head += [_key_value("I", name, value) for name, value in (info or {}).items()]
     head += [_key_value("P", name, value) for name, value in (parameters or {}).items()]

@@ -16,8 +16,10 @@ whose ESCs report their speed: ``actuator_motors`` holds each rotor's *commanded
 ``w_max`` (PX4's normalised motor command with ``THR_MDL_FAC = 1``: thrust ``CT u^2``,
 ``CT = kf w_max^2``), ``esc_status`` the rotors' *measured* speeds [rpm] as ESC telemetry
 reports them (an integer), and ``CA_ROTOR*`` the vehicle's own rotors (``KM = -s km / kf``,
-positive counter-clockwise) (:func:`rotor_plant_parameters`). The topics carry the sensor noise the controller saw, drawn again
-from the flight's seed (:data:`NOISE_STREAM`); the accelerometer has none of its own.
+positive counter-clockwise) (:func:`rotor_plant_parameters`).
+
+The topics carry the sensor noise the controller saw, drawn again from the flight's seed
+(:data:`NOISE_STREAM`); the accelerometer has none of its own.
 """
 
 from __future__ import annotations
