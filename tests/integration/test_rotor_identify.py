@@ -118,9 +118,11 @@ def test_cli_identifies_and_the_vehicle_flies(flights, tmp_path):
     run = CliRunner().invoke
     res = run(
         main,
-        ["identify", str(path), "--vehicle", "iris", "--commands", "rad/s", "--mass", "1.535", "--out", str(out)],
+        ["identify", str(path), "--vehicle", "iris", "--commands", "rad/s", "--mass", "1.535", "--out", str(out)]
+        + ["--report", str(tmp_path / "r.html")],
     )
     assert res.exit_code == 0, res.output
+    assert (tmp_path / "r.html").stat().st_size > 0 and (out / "report.md").is_file()
     doc = json.loads((out / "identify.json").read_text())
     assert doc["parameters"]["Jxx"]["identifiable"] and doc["parameters"]["tau_down"]["identifiable"]
     toml = (out / "vehicle.toml").read_text()

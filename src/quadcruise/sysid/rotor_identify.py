@@ -354,5 +354,4 @@ def _validate(flight, data, betas, held, hubs, g, window, dt, motors, commands) 
         for j, name in enumerate("pqr"):
             ol[name] = {**scores(np.array(truth)[:, j], np.array(ends)[:, j]), "unit": "rad/s"}
     out["open_loop"] = ol
-    out["motor_one_step_rmse_rad_s"] = motors["rmse"]
     return out, traces
