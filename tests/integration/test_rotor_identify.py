@@ -134,3 +134,32 @@ def test_cli_identifies_and_the_vehicle_flies(flights, tmp_path):
 def test_rotor_speed_commands_need_a_rotor_plant(tmp_path):
     res = CliRunner().invoke(main, ["identify", str(tmp_path / "x.ulg"), "--commands", "rad/s", "--out", "o"])
     assert res.exit_code == 2 and len(res.output.strip().splitlines()) == 1 and "rotor plant" in res.output
+
+
+@pytest.mark.slow
+def test_csv_with_rotor_speeds(flights, tmp_path):
+    """The same flight as a CSV in quadcruise's frames: commanded speeds u1..u4 [rad/s] and
+    measured speeds w1..w4, the accelerometer from the velocity's derivative (no noise here)."""
+    from scipy.spatial.transform import Rotation
+
+    from quadcruise.sim.px4 import rotor_speed_commands
+
+    base, vehicle, flight = flights["iris"]
+    rs, t = flight.rotor_states[0], flight.t
+    rows = {"t": t}
+    commanded = rotor_speed_commands(flight.commands[0], flight.meta["vehicle"])
+    for i in range(4):
+        rows[f"u{i + 1}"], rows[f"w{i + 1}"] = commanded[:, i], rs[:, 13 + i]
+    for j, key in enumerate(("x", "y", "z", "vx", "vy", "vz", "qw", "qx", "qy", "qz", "p", "q", "r")):
+        rows[key] = rs[:, j]
+    accel = np.gradient(rs[:, 3:6], t, axis=0, edge_order=2)
+    rows["ax"], rows["ay"], rows["az"] = Rotation.from_quat(rs[:, [7, 8, 9, 6]]).inv().apply(accel + [0, 0, 9.81]).T
+    path = tmp_path / "iris.csv"
+    import pandas as pd
+
+    pd.DataFrame(rows).to_csv(path, index=False)
+    result = qc.identify(path, vehicle=base, mass=float(vehicle.m), commands="rad/s")
+    for key, tol in WITHIN.items():
+        p = result.parameters[key]
+        assert p["identifiable"] and abs(p["value"] / getattr(vehicle, key) - 1) < tol, (key, p)
+    assert not result.parameters["w_max"]["identifiable"] and "rad/s" in result.parameters["w_max"]["note"]

@@ -211,6 +211,8 @@ def identify_rotor(flight, base: RotorVehicle, mass: float | None, holdout: floa
             notes[f"tau_{direction}"] = motor_note
     if motor_note and "w_max" in found:
         notes["w_max"] = motor_note
+    if csv_speeds:
+        notes["w_max"] = "the commands are rotor speeds (rad/s): the log does not show the speed of a full command"
     if not any(coupling):
         why = (
             "the gyroscopic terms that give Jzz (q r, p r) are mostly sensor noise here: signal "
