@@ -299,7 +299,8 @@ def test_cli_real_logs_that_cannot_be_identified(tmp_path, name, match):
         (["--holdout", "0.95"], "holdout must be"),
         (["--mass", "-1"], "mass must be"),
         (["--commands", "rpm"], "commands must be"),
-        (["--vehicle", "iris"], "--vehicle"),
+        (["--vehicle", "nosuch"], "--vehicle"),
+        (["--vehicle", "iris"], "rotor speeds (esc_status) logged at 4 Hz"),
         (["--frame", "enu"], "frame 'enu' is for CSV"),
     ],
 )

@@ -13,7 +13,8 @@ __all__ = ["identify"]
 
 
 def base_vehicle(text: str):
-    """``--vehicle``: ``paper`` (Table I) or a TOML file with a ``[vehicle]`` table."""
+    """``--vehicle``: a preset (``paper``, Table I; ``iris``, ``crazyflie``, ...: the rotor plant) or a
+    TOML file with a ``[vehicle]`` table."""
     from pathlib import Path
 
     from quadcruise.model.vehicle import Vehicle
@@ -22,7 +23,12 @@ def base_vehicle(text: str):
         return Vehicle.paper()
     path = Path(text)
     if path.suffix.lower() != ".toml":
-        raise InputError(f"--vehicle: 'paper' or a TOML file with a [vehicle] table, got {text!r}")
+        try:
+            return Vehicle.preset(text.strip().lower())
+        except InputError:
+            raise InputError(
+                f"--vehicle: a preset (paper, iris, crazyflie, ...) or a TOML file with a [vehicle] table, got {text!r}"
+            ) from None
     if not path.is_file():
         raise InputError(f"--vehicle: {text}: no such file")
     from quadcruise.workflows.scenario import load_scenario
@@ -38,8 +44,8 @@ def base_vehicle(text: str):
     default="paper",
     show_default=True,
     metavar="BASE",
-    help="Base vehicle: 'paper' or a TOML file with a [vehicle] table (geometry when the log has none, "
-    "starting values, values for what the log cannot identify).",
+    help="Base vehicle: a preset (paper; iris, crazyflie, ...: identify the rotor plant) or a TOML file with a "
+    "[vehicle] table (geometry when the log has none, starting values, values for what the log cannot identify).",
 )
 @click.option(
     "--mass",
@@ -58,8 +64,9 @@ def base_vehicle(text: str):
     "--commands",
     default="duty",
     show_default=True,
-    metavar="duty|pwm:MIN:MAX",
-    help="Rotor commands: normalised duties, or PWM [us] with their range.",
+    metavar="duty|rad/s|pwm:MIN:MAX",
+    help="Rotor commands: normalised duties, rotor speeds (rad/s; ULog: actuator_motors x w_max, rotor plant), "
+    "or PWM [us] with their range.",
 )
 @click.option(
     "--holdout",

@@ -47,6 +47,7 @@ ULOG_TOPICS = (
     "actuator_motors",
     "actuator_outputs",
     "hover_thrust_estimate",
+    "esc_status",
 )
 """The topics read from a ULog (others are skipped)."""
 
@@ -61,7 +62,10 @@ class FlightLog:
     ``rotors`` (n, 3: x, y [m] FLU and yaw sign, from ``CA_ROTOR*``; or None), ``yaw_per_thrust``
     (``|CA_ROTOR0_KM|`` [m], or None), ``parameters`` (``THR_MDL_FAC``, ``MAV_TYPE``, ...),
     ``hover_thrust`` (PX4's own estimate: time, value; or None), ``rates_hz`` (each topic's median
-    rate), and in words where the ``commands`` came from and the ``resampling``.
+    rate), and in words where the ``commands`` came from and the ``resampling``. ``speeds`` (L, n),
+    or None: the rotors' measured speeds [rad/s] (ULog ``esc_status`` rpm, CSV ``w1..wn``);
+    ``speed_commands``: the commands ``u`` are rotor speeds [rad/s] (a CSV read with
+    ``commands="rad/s"``) rather than normalised.
     """
 
     source: str
@@ -80,6 +84,8 @@ class FlightLog:
     rates_hz: dict = field(default_factory=dict)
     commands: str = ""
     resampling: str = ""
+    speeds: np.ndarray | None = None
+    speed_commands: bool = False
 
     @property
     def n_rotors(self) -> int:
@@ -101,7 +107,8 @@ class FlightLog:
 
 
 def parse_commands(commands: str) -> tuple[str, float, float]:
-    """``"duty"`` or ``"pwm:MIN:MAX"`` as ``(kind, min, max)``; InputError for anything else or MIN >= MAX.
+    """``"duty"``, ``"rad/s"`` or ``"pwm:MIN:MAX"`` as ``(kind, min, max)``; InputError for anything
+    else or MIN >= MAX.
 
     Examples
     --------
@@ -111,6 +118,8 @@ def parse_commands(commands: str) -> tuple[str, float, float]:
     text = str(commands).strip().lower()
     if text == "duty":
         return "duty", 0.0, 1.0
+    if text == "rad/s":
+        return "rad/s", float("nan"), float("nan")
     parts = text.split(":")
     if parts[0] == "pwm" and len(parts) in (1, 3):
         if len(parts) == 1:
@@ -121,7 +130,7 @@ def parse_commands(commands: str) -> tuple[str, float, float]:
             lo = hi = float("nan")
         if np.isfinite(lo) and np.isfinite(hi) and lo < hi:
             return "pwm", lo, hi
-    raise InputError(f"commands must be 'duty' or 'pwm:MIN:MAX' (MIN < MAX, in us), got {commands!r}")
+    raise InputError(f"commands must be 'duty', 'rad/s' or 'pwm:MIN:MAX' (MIN < MAX, in us), got {commands!r}")
 
 
 def read_flight_log(path: str | os.PathLike, *, frame: str | None = None, commands: str = "duty") -> FlightLog:
@@ -135,8 +144,10 @@ def read_flight_log(path: str | os.PathLike, *, frame: str | None = None, comman
         A CSV's frames: ENU world / FLU body (default) or PX4's NED / FRD. A ULog is always
         PX4's: "ned" or None.
     commands : str
-        ``duty`` (default: ``actuator_motors``, or a CSV's ``u`` columns in [0, 1]) or
-        ``pwm:MIN:MAX`` (PWM [us]).
+        ``duty`` (default: ``actuator_motors``, or a CSV's ``u`` columns in [0, 1]),
+        ``rad/s`` (a CSV's ``u`` columns are commanded rotor speeds; a ULog's ``actuator_motors``
+        are the commanded speeds over ``w_max``, PX4's ``THR_MDL_FAC = 1``) or ``pwm:MIN:MAX``
+        (PWM [us]).
 
     Returns
     -------
@@ -239,13 +250,15 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
     if "vehicle_angular_velocity" not in topics and "sensor_combined" not in topics:
         missing.append("vehicle_angular_velocity or sensor_combined")
     kind, lo, hi = spec
-    if kind == "duty" and "actuator_motors" in topics:
+    if kind in ("duty", "rad/s") and "actuator_motors" in topics:
         cmd_topic = "actuator_motors"
     elif "actuator_outputs" in topics:
         cmd_topic = "actuator_outputs"
     else:
         cmd_topic = None
         missing.append("actuator_motors or actuator_outputs")
+    if kind == "rad/s" and "esc_status" not in topics:
+        missing.append("esc_status (the measured rotor speeds that commands 'rad/s' are fitted against)")
     if missing:
         raise InputError(f"{path}: missing topic(s) {', '.join(missing)}")
 
@@ -345,6 +358,16 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
         )
     u = _interp(times(cmd_topic), u_raw, t)
 
+    speeds = None
+    esc = topics.get("esc_status")
+    if esc is not None and all(f"esc[{i}].esc_rpm" in esc for i in range(n_rot)):
+        rpm = np.column_stack([esc[f"esc[{i}].esc_rpm"].astype(np.float64) for i in range(n_rot)])
+        speeds = _interp(times("esc_status"), np.abs(rpm) * (2.0 * np.pi / 60.0), t)
+    elif kind == "rad/s":
+        raise InputError(
+            f"{path}: commands 'rad/s' identify the rotor plant, which needs the rotor speeds: "
+            "no esc_status topic with one esc_rpm per rotor"
+        )
     rotors, km = _rotors(params, n_rot)
     hover = None
     if "hover_thrust_estimate" in topics:
@@ -383,8 +406,9 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
         parameters=kept,
         hover_thrust=hover,
         rates_hz=rates_hz,
-        commands=how,
+        commands=how + (" x w_max: commanded rotor speeds" if kind == "rad/s" else ""),
         resampling=resampling,
+        speeds=speeds,
     )
 
 
@@ -449,6 +473,12 @@ def _read_csv(path: Path, frame: str, spec: tuple[str, float, float]) -> FlightL
     if missing:
         raise InputError(f"{path}: missing column(s) {', '.join(missing)}")
     optional = [c for c in ("x", "y", "z", "ax", "ay", "az", "landed") if c in table.columns]
+    speed_cols = [f"w{i + 1}" for i in range(n_rot)]
+    if any(c in table.columns for c in speed_cols):
+        missing_w = [c for c in speed_cols if c not in table.columns]
+        if missing_w:
+            raise InputError(f"{path}: measured rotor speeds need w1..w{n_rot}: missing {', '.join(missing_w)}")
+        optional += speed_cols
     names = list(CSV_COLUMNS) + [f"u{i + 1}" for i in range(n_rot)] + optional
     for name in names:
         col = pd.to_numeric(table[name], errors="coerce").to_numpy(np.float64)
@@ -483,6 +513,8 @@ def _read_csv(path: Path, frame: str, spec: tuple[str, float, float]) -> FlightL
             raise InputError(f"{path}: a CSV's PWM commands need their range: commands='pwm:MIN:MAX'")
         u = (u - lo) / (hi - lo)
         how = f"CSV u columns, PWM mapped with {lo:g}..{hi:g} us"
+    elif kind == "rad/s":
+        how = "CSV u columns (commanded rotor speeds, rad/s)"
     else:
         how = "CSV u columns (normalised)"
     world = np.eye(3) if frame == "enu" else NED_TO_ENU
@@ -511,6 +543,8 @@ def _read_csv(path: Path, frame: str, spec: tuple[str, float, float]) -> FlightL
         rates=pick(("p", "q", "r")) @ body.T,
         specific_force=force,
         position=position,
+        speeds=pick(speed_cols) if speed_cols[0] in table.columns else None,
+        speed_commands=kind == "rad/s",
         rates_hz={"csv": round(1.0 / step, 1)},
         commands=how,
         resampling=f"the CSV's own rows ({frame.upper()} frames), landed rows left out",

@@ -24,7 +24,7 @@ from __future__ import annotations
 import os
 import struct
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -54,18 +54,28 @@ NUMPY_TYPES = {
 class Topic:
     """One topic: its ``name``, its ``fields`` as PX4 orders them (ULog type, array length or 0, name;
     ``uint64_t timestamp`` [us] first) and each field's ``values`` (a field not given is zeros).
+    A field whose type is a key of ``nested`` is a nested message of those fields (written whole,
+    its padding included); its values are given as ``"field.subfield"``.
     """
 
     name: str
     fields: Sequence[tuple[str, int, str]]
     values: Mapping[str, np.ndarray]
+    nested: Mapping[str, Sequence[tuple[str, int, str]]] = field(default_factory=dict)
+
+    def _dtype(self, kind: str):
+        if kind in self.nested:
+            return np.dtype(
+                [(name, self._dtype(k), (length,) if length else ()) for k, length, name in self.nested[kind]]
+            )
+        return NUMPY_TYPES[kind]
 
     def records(self, msg_id: int) -> np.ndarray:
         """The topic's data messages under ``msg_id``, headers included, as one packed structured array."""
         if not self.fields or self.fields[0][2] != "timestamp":
             raise ValueError(f"topic {self.name!r}: the first field must be the timestamp")
         packed = self.fields[:-1] if self.fields[-1][2].startswith("_padding") else self.fields  # as PX4 does
-        fields = [(name, NUMPY_TYPES[kind], (length,) if length else ()) for kind, length, name in packed]
+        fields = [(name, self._dtype(kind), (length,) if length else ()) for kind, length, name in packed]
         dtype = np.dtype([("size", "<u2"), ("type", "u1"), ("msg_id", "<u2"), *fields])
         n = len(self.values["timestamp"])
         out = np.zeros(n, dtype)
@@ -73,9 +83,13 @@ class Topic:
         out["type"] = ord("D")
         out["msg_id"] = msg_id
         for name, value in self.values.items():
-            if name not in dtype.names:
+            outer, _, inner = name.partition(".")
+            if outer not in dtype.names or (inner and inner not in (dtype[outer].base.names or ())):
                 raise ValueError(f"topic {self.name!r} has no field {name!r}")
-            out[name] = value
+            if inner:
+                out[outer][inner] = value
+            else:
+                out[name] = value
         return out
 
     def format_message(self) -> bytes:
@@ -112,6 +126,8 @@ def ulog_bytes(
     (str, int32 or float), the header's ``start_us`` [us].
     """
     head = [MAGIC + b"\x01" + struct.pack("<Q", start_us), _message("B", bytes(16) + struct.pack("<QQQ", 0, 0, 0))]
+    nested = {kind: fields for topic in topics for kind, fields in topic.nested.items()}
+    head += [_message("F", Topic(kind, fields, {}).format_message()) for kind, fields in nested.items()]
     head += [_message("F", topic.format_message()) for topic in topics]
     head += [_key_value("I", name, value) for name, value in (info or {}).items()]
     head += [_key_value("P", name, value) for name, value in (parameters or {}).items()]

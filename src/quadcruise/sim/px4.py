@@ -9,8 +9,17 @@ With ``A`` the ENU-to-NED swap and ``B = diag(1, -1, -1)`` (FLU to FRD)::
 
 The paper's "+" rotors (1 at -x, 2 at +y, 3 at +x, 4 at -y in FLU; 1 and 3 clockwise seen from
 above) are written as PX4's ``CA_ROTOR*`` parameters, so that a reader of the log can rebuild
-eqs (1)-(4). The topics carry the sensor noise the controller saw, drawn again
-from the flight's seed (:data:`NOISE_STREAM`); the accelerometer has none of its own.
+eqs (1)-(4).
+
+A rotor-plant flight (:mod:`quadcruise.model.rotor_plant`) is written as PX4 logs a vehicle
+whose ESCs report their speed: ``actuator_motors`` holds each rotor's *commanded speed* over
+``w_max`` (PX4's normalised motor command with ``THR_MDL_FAC = 1``: thrust ``CT u^2``,
+``CT = kf w_max^2``), ``esc_status`` the rotors' *measured* speeds [rpm] as ESC telemetry
+reports them (an integer), and ``CA_ROTOR*`` the vehicle's own rotors (``KM = -s km / kf``,
+positive counter-clockwise) (:func:`rotor_plant_parameters`).
+
+The topics carry the sensor noise the controller saw, drawn again from the flight's seed
+(:data:`NOISE_STREAM`); the accelerometer has none of its own.
 """
 
 from __future__ import annotations
@@ -33,12 +42,13 @@ RATES_HZ = {
     "vehicle_angular_velocity": 250.0,
     "actuator_motors": 250.0,
     "sensor_combined": 250.0,
+    "esc_status": 250.0,
     "vehicle_status": 1.0,
     "vehicle_land_detected": 1.0,
 }
 """Each topic's rate at most [Hz]: PX4's default logging profile's order of magnitude, capped
 by the flight's own log interval (a topic is written every k-th logged instant)."""
-SYSID_TOPICS = ("vehicle_attitude", "vehicle_angular_velocity", "actuator_motors", "sensor_combined")
+SYSID_TOPICS = ("vehicle_attitude", "vehicle_angular_velocity", "actuator_motors", "sensor_combined", "esc_status")
 """The topics PX4's system-identification logging profile writes at their full rate."""
 PROFILES = {
     "default": (RATES_HZ, 1),
@@ -133,6 +143,34 @@ SENSOR_COMBINED = (
     ("uint8_t", 0, "accel_calibration_count"),
     ("uint8_t", 0, "gyro_calibration_count"),
 )
+ESC_REPORT = (
+    ("uint64_t", 0, "timestamp"),
+    ("uint32_t", 0, "esc_errorcount"),
+    ("int32_t", 0, "esc_rpm"),
+    ("float", 0, "esc_voltage"),
+    ("float", 0, "esc_current"),
+    ("float", 0, "esc_temperature"),
+    ("uint16_t", 0, "failures"),
+    ("int8_t", 0, "esc_power"),
+    ("uint8_t", 0, "esc_address"),
+    ("uint8_t", 0, "esc_cmdcount"),
+    ("uint8_t", 0, "esc_state"),
+    ("uint8_t", 0, "actuator_function"),
+    ("uint8_t", 1, "_padding0"),
+)
+ESC_STATUS = (
+    ("uint64_t", 0, "timestamp"),
+    ("uint16_t", 0, "counter"),
+    ("uint8_t", 0, "esc_count"),
+    ("uint8_t", 0, "esc_connectiontype"),
+    ("uint8_t", 0, "esc_online_flags"),
+    ("uint8_t", 0, "esc_armed_flags"),
+    ("uint8_t", 2, "_padding0"),
+    ("esc_report", 8, "esc"),
+)
+"""PX4's ``esc_status`` (ESC telemetry): eight nested ``esc_report`` (:data:`ESC_REPORT`)."""
+MAX_ESCS = 8
+"""Rotors ``esc_status`` reports at most."""
 VEHICLE_STATUS = (
     ("uint64_t", 0, "timestamp"),
     ("uint64_t", 0, "armed_time"),
@@ -203,6 +241,51 @@ def rotor_parameters(arm: float, yaw_per_thrust: float, max_thrust: float) -> di
     return out
 
 
+def rotor_plant_parameters(rotors, kf: float, km: float, w_max: float) -> dict[str, float | int]:
+    """A rotor-plant vehicle's rotors as PX4's ``CA_ROTOR*`` parameters, with ``THR_MDL_FAC = 1``.
+
+    Parameters
+    ----------
+    rotors : sequence of (x, y, z, s)
+        The hubs in FLU [m] and each direction s (+1: drag moment about +z, clockwise from above).
+    kf, km : float
+        Thrust [N/(rad/s)^2] and yaw-moment [N m/(rad/s)^2] coefficients.
+    w_max : float
+        The rotor speed of a full command [rad/s].
+
+    Returns
+    -------
+    dict
+        ``CA_ROTOR_COUNT``, per rotor ``PX``, ``PY``, ``PZ`` (FRD), ``KM`` (yaw moment per unit thrust,
+        positive counter-clockwise: ``-s km / kf``) and ``CT`` (thrust at full command, ``kf w_max^2``),
+        ``THR_MDL_FAC`` 1 (thrust quadratic in the command, which is the speed over ``w_max``) and
+        ``MAV_TYPE`` (quadrotor, hexarotor, octorotor).
+
+    Examples
+    --------
+    >>> p = rotor_plant_parameters([(0.1, 0.1, 0.0, 1)], kf=1e-6, km=2e-8, w_max=1000.0)
+    >>> p["CA_ROTOR0_PY"], p["CA_ROTOR0_KM"], p["CA_ROTOR0_CT"]
+    (-0.1, -0.02, 1.0)
+    """
+    n = len(rotors)
+    out: dict[str, float | int] = {
+        "CA_ROTOR_COUNT": n,
+        "MAV_TYPE": {6: 13, 8: 14}.get(n, MAV_TYPE_QUADROTOR),
+        "THR_MDL_FAC": 1.0,
+    }
+    for i, (x, y, z, s) in enumerate(rotors):
+        out.update(
+            {
+                f"CA_ROTOR{i}_PX": float(x),
+                f"CA_ROTOR{i}_PY": -float(y),
+                f"CA_ROTOR{i}_PZ": -float(z),
+                f"CA_ROTOR{i}_KM": -float(s) * km / kf,
+                f"CA_ROTOR{i}_CT": kf * w_max**2,
+            }
+        )
+    return out
+
+
 def _every(t: np.ndarray, rate_hz: float) -> np.ndarray:
     step = float(t[1] - t[0]) if len(t) > 1 else 1.0
     k = max(1, int(round(1.0 / (rate_hz * step)))) if np.isfinite(rate_hz) else 1
@@ -218,10 +301,13 @@ def px4_topics(
     noise_std: np.ndarray | None = None,
     rng: np.random.Generator | None = None,
     rates_hz: dict[str, float] | None = None,
+    rotor_speeds: np.ndarray | None = None,
+    system_type: int = MAV_TYPE_QUADROTOR,
 ) -> list[Topic]:
     """One vehicle's flight as PX4 topics at ``rates_hz`` (a profile of :data:`PROFILES`;
-    :data:`RATES_HZ` by default), from its logged ``t``, ``states`` and ``duties``, with the sensor
-    noise ``noise_std`` (``SensorNoise.std_vector``) drawn from ``rng``.
+    :data:`RATES_HZ` by default), from its logged ``t``, ``states`` and ``duties`` (any number of
+    motor commands in [0, 1]), with the sensor noise ``noise_std`` (``SensorNoise.std_vector``)
+    drawn from ``rng``; ``rotor_speeds`` [rad/s] (L, n), when given, as ``esc_status`` [rpm].
     """
     us = np.round(t * 1e6).astype(np.uint64)
     accel = np.gradient(states[:, VX : VX + 3], t, axis=0, edge_order=2) if len(t) > 2 else np.zeros((len(t), 3))
@@ -235,17 +321,34 @@ def px4_topics(
     gyro = seen[:, P : P + 3] @ FLU_TO_FRD.T
     heading = np.arctan2(2.0 * (q[:, 0] * q[:, 3] + q[:, 1] * q[:, 2]), 1.0 - 2.0 * (q[:, 2] ** 2 + q[:, 3] ** 2))
     control = np.full((len(t), 12), np.nan)
-    control[:, :4] = duties
+    control[:, : duties.shape[1]] = duties
 
     rates_hz = RATES_HZ if rates_hz is None else rates_hz
 
-    def topic(name, fields, **values):
+    def topic(name, fields, nested=None, **values):
         rows = _every(t, rates_hz[name])
         values = {k: np.asarray(v)[rows] for k, v in values.items()}
-        return Topic(name, fields, {"timestamp": us[rows], **values})
+        return Topic(name, fields, {"timestamp": us[rows], **values}, nested or {})
 
     ones = np.ones(len(t), bool)
-    return [
+    esc = []
+    if rotor_speeds is not None:
+        n = rotor_speeds.shape[1]
+        rpm = np.zeros((len(t), MAX_ESCS), np.int32)
+        rpm[:, :n] = np.round(rotor_speeds * (60.0 / (2.0 * np.pi)))
+        esc = [
+            topic(
+                "esc_status",
+                ESC_STATUS,
+                nested={"esc_report": ESC_REPORT},
+                counter=np.arange(len(t)) % 65536,
+                esc_count=np.full(len(t), n),
+                esc_online_flags=np.full(len(t), (1 << n) - 1),
+                esc_armed_flags=np.full(len(t), (1 << n) - 1),
+                **{"esc.timestamp": np.repeat(us[:, None], MAX_ESCS, 1), "esc.esc_rpm": rpm},
+            )
+        ]
+    return esc + [
         topic(
             "vehicle_local_position",
             VEHICLE_LOCAL_POSITION,
@@ -289,11 +392,43 @@ def px4_topics(
             VEHICLE_STATUS,
             armed_time=np.zeros(len(t), np.uint64),
             arming_state=np.full(len(t), ARMING_STATE_ARMED),
-            system_type=np.full(len(t), MAV_TYPE_QUADROTOR),
+            system_type=np.full(len(t), system_type),
             vehicle_type=np.ones(len(t)),
         ),
         topic("vehicle_land_detected", VEHICLE_LAND_DETECTED, landed=~ones, maybe_landed=~ones, ground_contact=~ones),
     ]
+
+
+def rotor_speed_commands(commands: np.ndarray, flown: dict, believed: dict | None = None) -> np.ndarray:
+    """The rotor speeds [rad/s] a rotor-plant flight commanded, from its logged "+" equivalent duties.
+
+    As :mod:`quadcruise.sim.rotor_flight` computes them each control period: the controller
+    vehicle's :func:`~quadcruise.model.equivalent.duty_to_thrust` matrix, each thrust a speed
+    ``sqrt(f / kf)`` of the controller vehicle, held in the flown vehicle's [w_min, w_max].
+
+    Parameters
+    ----------
+    commands : numpy.ndarray
+        (L, CMD_SIZE) the logged commands.
+    flown, believed : dict
+        The flown and the controller vehicle's fields (``RotorVehicle.to_dict``; ``plant`` may be
+        among them); ``believed`` None: the flown vehicle.
+
+    Returns
+    -------
+    numpy.ndarray
+        (L, n) commanded rotor speeds [rad/s].
+    """
+    from quadcruise.model.equivalent import duty_to_thrust
+    from quadcruise.model.rotor_vehicle import RotorVehicle
+
+    def vehicle(fields: dict) -> RotorVehicle:
+        return RotorVehicle(**{k: v for k, v in fields.items() if k != "plant"})
+
+    controller = vehicle(believed or flown)
+    thrust = commands[:, CMD_U1 : CMD_U1 + 4] @ duty_to_thrust(controller).T
+    speed = np.sqrt(np.clip(thrust, 0.0, None) / controller.kf)
+    return np.clip(speed, float(flown["w_min"]), float(flown["w_max"]))
 
 
 def duties_of(commands: np.ndarray) -> np.ndarray:

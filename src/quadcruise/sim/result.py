@@ -335,16 +335,37 @@ class SimResult:
             std[first : first + 3] = value[vehicle] if isinstance(value, (list, tuple)) else value
         seed = self.meta.get("seed") or 0
         rng = np.random.default_rng([int(seed), int(vehicle), NOISE_STREAM])
-        topics = px4_topics(
-            t,
-            states,
-            duties_of(self.commands[vehicle][rows]),
-            g=field_of("g", 9.81),
-            noise_std=std,
-            rng=rng,
-            rates_hz=rates_hz,
-        )
-        params = rotor_parameters(field_of("l", 0.2), field_of("d", 0.0), field_of("K", 0.0))
+        flown = self.meta.get("vehicle") or {}
+        if self.rotor_states is not None and flown.get("plant") == "rotor":
+            from quadcruise.model.rotor_plant import ROTOR_W1
+            from quadcruise.sim.px4 import rotor_plant_parameters, rotor_speed_commands
+
+            speeds = self.rotor_states[vehicle][rows][:, ROTOR_W1:]
+            w_cmd = rotor_speed_commands(self.commands[vehicle][rows], flown, self.meta.get("controller_vehicle"))
+            w_max = float(flown["w_max"])
+            topics = px4_topics(
+                t,
+                states,
+                w_cmd / w_max,
+                g=field_of("g", 9.81),
+                noise_std=std,
+                rng=rng,
+                rates_hz=rates_hz,
+                rotor_speeds=speeds,
+                system_type={6: 13, 8: 14}.get(speeds.shape[1], 2),
+            )
+            params = rotor_plant_parameters(flown["rotors"], float(flown["kf"]), float(flown["km"]), w_max)
+        else:
+            topics = px4_topics(
+                t,
+                states,
+                duties_of(self.commands[vehicle][rows]),
+                g=field_of("g", 9.81),
+                noise_std=std,
+                rng=rng,
+                rates_hz=rates_hz,
+            )
+            params = rotor_parameters(field_of("l", 0.2), field_of("d", 0.0), field_of("K", 0.0))
         params["SDLOG_PROFILE"] = profile_bits
         write_ulog(
             path,

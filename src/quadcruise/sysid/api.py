@@ -22,32 +22,25 @@ from quadcruise.io.flightlog import FlightLog, parse_commands, read_flight_log
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.sysid.equations import signals
 from quadcruise.sysid.estimate import fit
+from quadcruise.sysid.logprep import (
+    CAUTION_SHARE,
+    MIN_EXCITATION,
+    MIN_FIT_S,
+    MIN_HELD_S,
+    MIN_SIGNAL_SHARE,
+    STAGES,
+    WINDOW_S,
+    command_hold,
+    command_rate,
+    coupling_signal,
+    log_info,
+    noise_level,
+    split_rows,
+)
 from quadcruise.sysid.physical import Z95, parameters
 from quadcruise.sysid.result import IdentifyResult
 from quadcruise.sysid.validate import validate
 
-MIN_EXCITATION = 1e-3
-"""The least excitation of an axis (:func:`_excitation`: the command combination's standard
-deviation, relative to the mean command) for its parameters to be identifiable at all: below it,
-whatever interval the residuals give reflects the absence of noise, not information."""
-MIN_SIGNAL_SHARE = 0.99
-"""The least share of a regressor's variance that must be signal, not noise, for its coefficient
-to be identifiable (noise biases it toward zero, which the intervals do not cover; the bias
-measured: docs/identify.md, "Known limitation")."""
-SETTLE_TAUS = 6.0
-"""Rotor time constants (of the base vehicle) left out at each segment's start, where the lag's
-state is taken as settled on the first command (why 6: docs/identify.md, "Known limitation")."""
-CAUTION_SHARE = 0.99
-"""Below this share of signal (not jitter) in a moment command, the result carries a caution."""
-MIN_FIT_S, MIN_HELD_S = 2.0, 0.5
-"""The least airborne time fitted and held out [s] (after each segment's settling)."""
-SYSID_PROFILE_BIT = 8
-"""``SDLOG_PROFILE``'s bit for PX4's system-identification logging profile."""
-STAGES = ("reading the log", "filtering", "fitting", "intervals", "validating")
-"""The stages ``progress`` counts."""
-WINDOW_S = 0.08
-"""The Savitzky-Golay window [s] (at least 5 samples): about a third of the fastest rotor lag it
-must pass (omega up to ~40 rad/s), and long enough to average gyro noise."""
 SHAPE_SPAN = 0.25
 """The least spread (5th to 95th percentile) of the rotor commands over which the thrust
 curve's shape f is fitted; over a narrower span u and u^2 cannot be told apart."""
@@ -84,17 +77,20 @@ def identify(
     ----------
     log : str, os.PathLike or FlightLog
         A PX4 log (``.ulg``), a CSV (see :mod:`quadcruise.io.flightlog`), or a log already read.
-    vehicle : Vehicle, optional
-        The base vehicle (the paper's Table I by default): the rotor arm when the log has no
-        ``CA_ROTOR*`` geometry, gravity, the starting rotor bandwidth, and the values reported
-        for what the log cannot identify.
+    vehicle : Vehicle, RotorVehicle or str, optional
+        The base vehicle (the paper's Table I by default; a preset's name): the rotor arm when the
+        log has no ``CA_ROTOR*`` geometry, gravity, the starting rotor bandwidth, and the values
+        reported for what the log cannot identify. A rotor-plant vehicle (``"iris"``,
+        ``"crazyflie"``, ...) identifies the rotor plant (kf, km, J, tau_up, tau_down, k_d, ...)
+        from a log with measured rotor speeds (:mod:`quadcruise.sysid.rotor_identify`).
     mass : float, optional
         The vehicle's mass [kg]. Without it, K and the inertias are identified per unit mass
         (``K_per_m``, ``Jxx_per_m``, ...), and the result says so.
     frame : {"enu", "ned"}, optional
         A CSV's frames (ENU/FLU by default); a ULog is always PX4's NED/FRD.
     commands : str
-        ``duty`` or ``pwm:MIN:MAX`` (see :func:`quadcruise.io.flightlog.read_flight_log`).
+        ``duty``, ``rad/s`` (rotor plant only) or ``pwm:MIN:MAX`` (see
+        :func:`quadcruise.io.flightlog.read_flight_log`).
     holdout : float
         The fraction of the airborne time, at its end, kept out of the fit and predicted.
     progress : callable, optional
@@ -122,15 +118,29 @@ def identify(
         isinstance(mass, bool) or not isinstance(mass, (int, float)) or not math.isfinite(mass) or mass <= 0
     ):
         raise InputError(f"mass must be a positive number of kg, got {mass!r}")
-    if vehicle is not None and not isinstance(vehicle, Vehicle):
-        raise InputError(f"vehicle must be a quadcruise Vehicle, got {type(vehicle).__name__}")
+    from quadcruise.model.rotor_vehicle import RotorVehicle
+
+    if isinstance(vehicle, str):
+        vehicle = Vehicle.preset(vehicle)
+    if vehicle is not None and not isinstance(vehicle, (Vehicle, RotorVehicle)):
+        raise InputError(f"vehicle must be a quadcruise Vehicle or RotorVehicle, got {type(vehicle).__name__}")
     base = vehicle or Vehicle.paper()
-    if base.batch_size is not None:
+    rotor = isinstance(base, RotorVehicle)
+    if not rotor and base.batch_size is not None:
         raise InputError("vehicle: the base vehicle must be one vehicle, not a batch")
-    parse_commands(commands)
+    kind = parse_commands(commands)[0]
+    if kind == "rad/s" and not rotor:
+        raise InputError(
+            "commands 'rad/s' are rotor speeds, which only the rotor plant has: give a rotor-plant base "
+            "vehicle (vehicle='iris', 'crazyflie' or a vehicle file with plant = \"rotor\")"
+        )
     report = progress or (lambda done, total, stage="": None)
 
     flight = log if isinstance(log, FlightLog) else read_flight_log(log, frame=frame, commands=commands)
+    if rotor:
+        from quadcruise.sysid.rotor_identify import identify_rotor
+
+        return identify_rotor(flight, base, mass, holdout, kind, report)
     report(1, len(STAGES), STAGES[0])
     rotors = flight.rotors
     if rotors is None:
@@ -143,13 +153,13 @@ def identify(
         rotors = np.array([[-arm, 0.0, 1.0], [0.0, arm, -1.0], [arm, 0.0, 1.0], [0.0, -arm, -1.0]])
     g = float(base.g)
     force_z = _specific_force_z(flight, g)
-    cmd_hz = _command_rate(flight)
+    cmd_hz = command_rate(flight)
     hold = command_hold(flight, cmd_hz)
     sig = signals(flight.t, flight.segment, flight.u, flight.rates, force_z, WINDOW_S, hold)
     report(2, len(STAGES), STAGES[1])
 
     omega0 = float(base.omega)
-    fit_rows, held = _split(flight, sig.window, omega0, holdout)
+    fit_rows, held = split_rows(flight, sig.window, omega0, holdout)
     if fit_rows.sum() * sig.dt < MIN_FIT_S or held.sum() * sig.dt < MIN_HELD_S:
         raise InputError(
             f"{flight.source}: {flight.duration:.1f} s airborne is too short to fit and hold out {holdout:g} of it"
@@ -163,7 +173,7 @@ def identify(
     result = fit(sig, fit_rows, rotors, omega0, f0, fit_omega=lag_seen, fit_shape=fit_shape, omega_bounds=bounds)
     report(3, len(STAGES), STAGES[2])
 
-    signal_share = _coupling_signal(flight, sig, fit_rows)
+    signal_share = coupling_signal(flight, sig, fit_rows)
     signal_share.update(_command_signal(sig, fit_rows, rotors, result.omega))
     coupling = (signal_share["qr"] >= MIN_SIGNAL_SHARE, signal_share["pr"] >= MIN_SIGNAL_SHARE)
     found = parameters(
@@ -250,7 +260,7 @@ def identify(
         parameters=table,
         validation=validation,
         traces=traces,
-        log=_log_info(flight, sig),
+        log=log_info(flight, sig),
         fit={
             "rows": result.rows,
             "held_out_rows": int(held.sum()),
@@ -287,39 +297,6 @@ def _excitation(u: np.ndarray, rotors: np.ndarray) -> dict[str, float]:
     }
 
 
-def _coupling_signal(flight: FlightLog, sig, rows: np.ndarray) -> dict[str, float]:
-    """The share of the filtered gyroscopic products' variance that is not sensor noise.
-
-    Each rate's white-noise level is read from its second differences (robust: median absolute
-    deviation); the noise a product ``q r`` carries is ``E[q^2] s_r^2 + E[r^2] s_q^2 + s_q^2 s_r^2``,
-    through the filter (times the sum of its squared weights)."""
-    from quadcruise.sysid.equations import kernels
-
-    noise = np.array([_noise_level(flight.rates[:, j], flight.segment) for j in range(3)])
-    gain = float(np.sum(kernels(sig.window, sig.dt)[1] ** 2))
-    raw = flight.rates[rows]
-    out = {}
-    for name, (a, b), col in (("qr", (1, 2), 0), ("pr", (0, 2), 1)):
-        noise_var = gain * (
-            np.mean(raw[:, a] ** 2) * noise[b] ** 2
-            + np.mean(raw[:, b] ** 2) * noise[a] ** 2
-            + noise[a] ** 2 * noise[b] ** 2
-        )
-        total = float(np.var(sig.products[rows, col]))
-        out[name] = max(0.0, 1.0 - noise_var / total) if total > 0 else 0.0
-    return out
-
-
-def _noise_level(x: np.ndarray, segment: np.ndarray) -> float:
-    """A white noise's standard deviation under a smooth signal: from second differences, robustly."""
-    second = []
-    for k in np.unique(segment):
-        v = x[segment == k]
-        second.append(v[2:] - 2 * v[1:-1] + v[:-2])
-    d2 = np.concatenate(second)
-    return 1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / np.sqrt(6.0)
-
-
 def _command_signal(sig, rows: np.ndarray, rotors: np.ndarray, omega: float) -> dict[str, float]:
     """The share of each moment regressor's filtered variance that is not sample-to-sample jitter
     of the logged commands (a command changing faster than it is logged is sampled, not seen:
@@ -340,7 +317,7 @@ def _command_signal(sig, rows: np.ndarray, rotors: np.ndarray, omega: float) -> 
     out = {}
     for axis, weights in combos.items():
         command = sig.u @ weights
-        noise_var = gain * _noise_level(command, sig.segment) ** 2
+        noise_var = gain * noise_level(command, sig.segment) ** 2
         lag = lagged(command[:, None], sig.segment, omega, sig.dt, sig.hold)
         regressor = smooth(lag, sig.segment, sig.window)[rows, 0]
         total = float(np.var(regressor))
@@ -401,64 +378,6 @@ def _specific_force_z(flight: FlightLog, g: float) -> np.ndarray:
     return body[:, 2]
 
 
-def _split(flight: FlightLog, window: int, omega0: float, holdout: float) -> tuple[np.ndarray, np.ndarray]:
-    """Rows fitted and rows held out: the tail ``holdout`` of the samples is held out; each
-    segment's first samples (the lag and filter settling) and last window are used by neither."""
-    n = len(flight.t)
-    dt = float(np.median(np.diff(flight.t)))
-    settle = window + math.ceil(SETTLE_TAUS / (omega0 * dt))
-    usable = np.zeros(n, bool)
-    for k in np.unique(flight.segment):
-        idx = np.flatnonzero(flight.segment == k)
-        usable[idx[settle : len(idx) - window]] = True  # room for the doubled window too
-    cut = round(n * (1.0 - holdout))
-    fit_rows, held = usable.copy(), usable.copy()
-    fit_rows[cut:] = False
-    held[: cut + window] = False  # a window's gap: no filtered sample in both
-    return fit_rows, held
-
-
-def command_hold(flight: FlightLog, cmd_hz: float) -> str:
-    """How the logged commands act between samples: ``"zero"`` (each held until the next) when
-    the log holds every command its controller computed, else ``"linear"``.
-
-    Every command is in the log when PX4's system-identification logging profile wrote it
-    (``SDLOG_PROFILE`` bit :data:`SYSID_PROFILE_BIT`: the actuator commands at the rate the rate
-    controller publishes them) and the commands come at the rate of the grid (the body rates').
-    A log that samples its commands more slowly (PX4's default profile) says only where they
-    passed, and a line between the samples is the better guess.
-
-    Parameters
-    ----------
-    flight : FlightLog
-        The log read.
-    cmd_hz : float
-        The rate of its command topic [Hz].
-
-    Returns
-    -------
-    {"zero", "linear"}
-
-    Examples
-    --------
-    >>> log = FlightLog(source="x.ulg", t=np.arange(0.0, 1.0, 1e-3), segment=np.zeros(1000, int),
-    ...                 u=np.zeros((1000, 4)), velocity=np.zeros((1000, 3)), quaternion=np.zeros((1000, 4)),
-    ...                 rates=np.zeros((1000, 3)), parameters={"SDLOG_PROFILE": 9})
-    >>> command_hold(log, 1000.0), command_hold(log, 250.0)
-    ('zero', 'linear')
-    """
-    profile = int(flight.parameters.get("SDLOG_PROFILE", 0) or 0)
-    grid_hz = 1.0 / float(np.median(np.diff(flight.t))) if len(flight.t) > 1 else 0.0
-    return "zero" if profile & SYSID_PROFILE_BIT and cmd_hz >= 0.9 * grid_hz else "linear"
-
-
-def _command_rate(flight: FlightLog) -> float:
-    for key in ("actuator_motors", "actuator_outputs", "csv"):
-        if key in flight.rates_hz and key in (flight.commands.split()[0], "csv"):
-            return float(flight.rates_hz[key])
-    return float(min(flight.rates_hz.values())) if flight.rates_hz else 0.0
-
-
 def _table(found: dict, base: Vehicle, notes: dict, f0: float, f0_source: str) -> dict[str, dict]:
     prior = {
         "K": base.K,
@@ -497,22 +416,3 @@ def _table(found: dict, base: Vehicle, notes: dict, f0: float, f0_source: str) -
                 row["estimate"] = entry["value"]
         out[name] = row
     return out
-
-
-def _log_info(flight: FlightLog, sig) -> dict:
-    info = {
-        "source": flight.source,
-        "airborne_s": flight.duration,
-        "segments": len(np.unique(flight.segment)),
-        "samples": len(flight.t),
-        "grid_hz": 1.0 / sig.dt,
-        "commands": flight.commands,
-        "resampling": flight.resampling,
-        "topic_rates_hz": flight.rates_hz,
-        "rotors": flight.n_rotors,
-        "rotor_geometry": "log (CA_ROTOR*)" if flight.rotors is not None else "base vehicle ('+', arm l)",
-        "parameters": flight.parameters,
-    }
-    if flight.hover_thrust is not None:
-        info["px4_hover_thrust_estimate"] = float(np.median(flight.hover_thrust[1]))
-    return info

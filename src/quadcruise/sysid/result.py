@@ -75,7 +75,8 @@ class IdentifyResult:
         return float(self.parameters["hover_duty"]["value"])
 
     def vehicle(self) -> Vehicle:
-        """The identified vehicle in the paper's plant (base values where the log could not tell).
+        """The identified vehicle in the paper's plant, or for a rotor-plant base vehicle a
+        RotorVehicle with the log's rotors (base values where the log could not tell).
 
         Without a mass, the base vehicle's mass scales the per-unit-mass values. The paper's
         plant has four "+" rotors at distance ``l``: ``l`` is the log's mean rotor distance,
@@ -88,6 +89,15 @@ class IdentifyResult:
         """
         m = float(self.mass) if self.mass is not None else float(self.base.m)
         values: dict[str, float] = {"m": m}
+        if self.fit.get("plant") == "rotor":  # a RotorVehicle: the identified fields, the log's rotors
+            for name in ("kf", "km", "Jxx", "Jyy", "Jzz", "k_d", "k_z", "J_rotor", "tau_up", "tau_down", "w_max"):
+                key = name if self.mass is not None or name in ("tau_up", "tau_down", "w_max") else f"{name}_per_m"
+                if key in self.parameters:
+                    per_m = key.endswith("_per_m")
+                    values[name] = float(self.parameters[key]["value"]) * (m if per_m else 1.0)
+            values["rotors"] = tuple(tuple(float(x) for x in row[:3]) + (int(row[3]),) for row in self.rotors)
+            values["source"] = f"identified from {Path(self.log['source']).name} (base: {self.base.source or 'a file'})"
+            return self.base.replace(**values)
         for name in ("K", "Jxx", "Jyy", "Jzz"):
             key = name if self.mass is not None else f"{name}_per_m"
             values[name] = float(self.parameters[key]["value"]) * (1.0 if self.mass is not None else m)
@@ -215,6 +225,20 @@ class IdentifyResult:
         import tomli_w
 
         v = self.vehicle()
+        if self.fit.get("plant") == "rotor":
+            origin = {
+                k.removesuffix("_per_m"): ("identified" if p["identifiable"] else "base vehicle")
+                for k, p in self.parameters.items()
+                if k not in ("hover_speed", "hover_duty")
+            }
+            head = [
+                f"# identified from {self.log['source']} by quadcruise identify (rotor plant)",
+                "# " + ", ".join(f"{k}: {s}" for k, s in origin.items()),
+                f"# m: {'given' if self.mass is not None else 'base vehicle (no mass given: kf, km, J scaled by it)'}"
+                f"; rotors: {self.log['rotor_geometry']}; the rest: the base vehicle's",
+            ]
+            fields = {k: x for k, x in v.to_dict().items() if x is not None}
+            return "\n".join(head) + "\n" + tomli_w.dumps({"vehicle": {"plant": "rotor", **fields}})
         origin = {}
         for name in ("K", "Jxx", "Jyy", "Jzz", "d", "omega"):
             key = name if self.mass is not None or name in ("d", "omega") else f"{name}_per_m"
