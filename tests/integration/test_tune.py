@@ -76,12 +76,13 @@ def test_the_same_seed_gives_the_same_gains(small):
         seed=2,
         **SMALL,
     )
-    assert again.gains == small.gains and again.to_pandas().equals(small.to_pandas())
+    assert again.gains == small.gains and again.history.equals(small.history)
 
 
 def test_result_speaks_like_every_result(small, tmp_path):
     assert isinstance(small, TuneResult)
-    hist = small.to_pandas()
+    hist = small.history
+    assert small.to_pandas().equals(small.flights) and small.metrics().equals(small.flights)
     assert list(hist.columns) == ["generation", "candidate", "position.kp", "cost"]
     assert len(hist) == 6 * (small.generations + 1) and small.cost == hist["cost"].min()
     summary = small.summary()
@@ -148,7 +149,7 @@ def test_requirements_rank_before_targets_and_failures_last(small):
     assert cost[2] == pytest.approx(REQUIREMENT_COST * (1 + 1 / 5))  # 1 point over a bound of 5
     assert cost[3] == FAILURE_COST * 1.5 and cost[4] == 10 * FAILURE_COST  # no rise time; did not finish
     assert obj.reduce(cost[None, :4]) == FAILURE_COST * 1.5
-    assert small.to_pandas()["cost"].min() < REQUIREMENT_COST
+    assert small.history["cost"].min() < REQUIREMENT_COST
 
 
 def test_gains_by_pole_pair_and_derived_saturation_levels():

@@ -47,7 +47,7 @@ class MonteCarloResult:
         What was flown.
     table : pandas.DataFrame
         One row per flight, sorted by vehicle index (see :data:`COLUMNS`), plus ``reason``
-        (the failure as text).
+        (the failure as text); :meth:`metrics` is its copy (``table`` is the old name, kept).
     traces : Traces
         The kept paths.
     info : dict
@@ -67,15 +67,25 @@ class MonteCarloResult:
         """Number of flights."""
         return len(self.table)
 
-    def to_pandas(self):
-        """The table: one row per flight (see :data:`quadcruise.montecarlo.schema.COLUMNS`).
+    def metrics(self):
+        """The metrics of every flight: one row per flight (see :data:`quadcruise.montecarlo.schema.COLUMNS`).
 
         Returns
         -------
         pandas.DataFrame
-            A copy, sorted by vehicle index.
+            A copy of :attr:`table` (the old name, kept), sorted by vehicle index.
         """
         return self.table.copy()
+
+    def to_pandas(self):
+        """The flights, one row each: :meth:`metrics`.
+
+        Returns
+        -------
+        pandas.DataFrame
+            :meth:`metrics`.
+        """
+        return self.metrics()
 
     def plot(self, kind: str = "histograms", **kwargs):
         """A figure of the sweep: ``"histograms"`` (:meth:`plot_histograms`) or ``"envelope"``

@@ -117,7 +117,7 @@ def comparison_report(cmp, *, title: str | None = None, **metric_kw) -> dict:
         has one vehicle, and their conventions), ``figures`` (the paths), ``flights`` (one
         3-D view of all) and ``config`` (:meth:`Comparison.to_dict` without the metrics).
     """
-    table = cmp.table(**metric_kw)
+    table = cmp.metrics(**metric_kw)
     if all(r.n == 1 for r in cmp.results.values()):
         table = table.T  # metrics down, controllers across
     config = {k: v for k, v in cmp.to_dict(**metric_kw).items() if k != "metrics"}

@@ -118,19 +118,29 @@ class RotorResult:
             out[good] = Rotation.from_quat(q[good], scalar_first=True).as_euler("ZYX")[:, ::-1]
         return out
 
-    def table(self, i: int = 0) -> tuple[tuple[str, ...], np.ndarray]:
-        """Vehicle i's log as one table: time, the states, the Euler angles.
+    def to_pandas(self, vehicle: int | None = None):
+        """The log, long-form: one row per vehicle and logged instant (as :meth:`SimResult.to_pandas`).
+
+        An open-loop replay flies no reference, so it has no per-flight metrics.
 
         Parameters
         ----------
-        i : int
-            The vehicle's index.
+        vehicle : int, optional
+            One vehicle's index; default: every vehicle.
 
         Returns
         -------
-        columns : tuple of str
-            ``t``, the state's names, ``phi``, ``theta``, ``psi``.
-        rows : numpy.ndarray
-            Shape (L, 1 + 13 + n + 3), SI units.
+        pandas.DataFrame
+            Columns ``vehicle``, ``t`` [s], the state's names, ``phi``, ``theta``, ``psi``
+            (:meth:`euler`), SI units.
         """
-        return ("t",) + tuple(self.names) + EULER_NAMES, np.column_stack([self.t, self.states[i], self.euler(i)])
+        import pandas as pd
+
+        if vehicle is not None and not 0 <= vehicle < self.n:
+            raise InputError(f"vehicle {vehicle} is not in this flight of {self.n} vehicles")
+        picks = range(self.n) if vehicle is None else [vehicle]
+        rows = np.concatenate([np.column_stack([self.states[i], self.euler(i)]) for i in picks])
+        frame = pd.DataFrame(rows, columns=list(self.names) + list(EULER_NAMES))
+        frame.insert(0, "t", np.tile(self.t, len(picks)))
+        frame.insert(0, "vehicle", np.repeat(np.asarray(list(picks)), len(self.t)))
+        return frame

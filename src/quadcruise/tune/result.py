@@ -56,9 +56,11 @@ class TuneResult:
     cost : float
         The tuned gains' cost.
     flights : pandas.DataFrame
-        The tuned gains' M flights: one row each, the metrics and ``cost``.
+        The tuned gains' M flights: one row each, the metrics and ``cost`` (what :meth:`metrics`
+        and :meth:`to_pandas` copy).
     history : pandas.DataFrame
-        Every candidate flown: ``generation`` (0: the first), ``candidate``, the gains, ``cost``.
+        Every candidate flown, one row per candidate (a candidate is M flights):
+        ``generation`` (0: the first), ``candidate``, the gains, ``cost``.
     response, start_response : SimResult
         The tuned and the starting gains on the nominal vehicle (the population's
         environment and sensor noise, no spread), logged at every control period.
@@ -243,15 +245,26 @@ class TuneResult:
         return out
 
     # --- ResultLike ----------------------------------------------------------------------
-    def to_pandas(self):
-        """The history: every candidate flown.
+    def metrics(self):
+        """The metrics of the tuned gains' M flights, one row per flight (:attr:`flights`).
 
         Returns
         -------
         pandas.DataFrame
-            ``generation``, ``candidate``, one column per gain, ``cost``.
+            A copy of :attr:`flights`: the metrics and ``cost``. Every candidate flown (one
+            row per candidate, not per flight) is :attr:`history`.
         """
-        return self.history.copy()
+        return self.flights.copy()
+
+    def to_pandas(self):
+        """The tuned gains' flights, one row each: :meth:`metrics`.
+
+        Returns
+        -------
+        pandas.DataFrame
+            :meth:`metrics`.
+        """
+        return self.metrics()
 
     def summary(self) -> Summary:
         """The gains found and the metrics they reach against the targets.

@@ -13,7 +13,7 @@ Examples
 --------
 >>> res = tune("step", "nlpd", targets={"rise_time_s": 1.5}, gains="position.kp",
 ...            bounds={"position.kp": (1.0, 10.0)}, duration=6.0, budget=3, popsize=6, seed=1)
->>> res.generations, len(res.to_pandas()) == 6 * (res.generations + 1)
+>>> res.generations, len(res.history) == 6 * (res.generations + 1)
 (3, True)
 """
 

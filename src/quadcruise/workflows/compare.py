@@ -6,7 +6,7 @@ Examples
 >>> cmp = compare("step", ("nlpd", "se3", "cascade"), duration=4.0, log_every=10)
 >>> list(cmp.results)
 ['nlpd', 'se3', 'cascade']
->>> table = cmp.table()
+>>> table = cmp.metrics()
 >>> table.index.tolist(), bool(table["status"].eq("finished").all())
 (['nlpd', 'se3', 'cascade'], True)
 >>> [ax.get_ylabel() for ax in cmp.plot().axes]
@@ -66,7 +66,7 @@ class Comparison:
     results: dict
     population: dict = field(default_factory=dict)
     population_table: Any = None
-    _tables: dict = field(default_factory=dict, init=False, repr=False)  # table() per keywords
+    _tables: dict = field(default_factory=dict, init=False, repr=False)  # metrics() per keywords
 
     @property
     def ok(self) -> dict:
@@ -96,8 +96,8 @@ class Comparison:
                 out[label] = res.status_text(int(bad[0])) + more
         return out
 
-    def table(self, **metric_kw: Any):
-        """The metrics of every flight, one row per controller.
+    def metrics(self, **metric_kw: Any):
+        """The metrics of every flight, one row per controller (per controller and vehicle for a batch).
 
         Computed once per set of keywords (the text, the files and a report share it).
 
@@ -120,6 +120,21 @@ class Comparison:
             self._tables[key] = self._table(metric_kw)
         return self._tables[key].copy()
 
+    def table(self, **metric_kw: Any):
+        """Old name of :meth:`metrics`, kept for existing code.
+
+        Parameters
+        ----------
+        **metric_kw : Any
+            Keywords of :meth:`metrics`.
+
+        Returns
+        -------
+        pandas.DataFrame
+            :meth:`metrics`.
+        """
+        return self.metrics(**metric_kw)
+
     def _table(self, metric_kw: dict):
         import pandas as pd
 
@@ -135,7 +150,7 @@ class Comparison:
         return table.set_index(["controller", "vehicle"])
 
     def to_pandas(self):
-        """The traces, long-form: one row per controller, vehicle and logged instant (per-flight: :meth:`table`).
+        """The traces, long-form: one row per controller, vehicle and logged instant (per-flight: :meth:`metrics`).
 
         Returns
         -------
@@ -164,17 +179,17 @@ class Comparison:
         Summary
             Controller label -> {metric: value} (NaN as None), as in :meth:`to_dict`'s ``metrics``.
         """
-        return Summary(self._rows(self.table(**metric_kw)), self.text(**metric_kw))
+        return Summary(self._rows(self.metrics(**metric_kw)), self.text(**metric_kw))
 
     def text(self, **metric_kw: Any) -> str:
-        """The table as aligned text, metrics down and controllers across (for a terminal).
+        """The metrics as aligned text, metrics down and controllers across (for a terminal).
 
         A missing settling time of a measured transient reads "did not settle".
 
         Parameters
         ----------
         **metric_kw : Any
-            Keywords of :meth:`table`.
+            Keywords of :meth:`metrics`.
 
         Returns
         -------
@@ -184,7 +199,7 @@ class Comparison:
         """
         from quadcruise.metrics.tables import conventions_text, metrics_text
 
-        table = self.table(**metric_kw)
+        table = self.metrics(**metric_kw)
         text = metrics_text(table, [" ".join(map(str, c)) if isinstance(c, tuple) else c for c in table.index])
         notes = conventions_text(table.attrs.get("conventions"))
         return f"{text}\n{notes}" if notes else text
@@ -218,7 +233,7 @@ class Comparison:
         Parameters
         ----------
         **metric_kw : Any
-            Keywords of :meth:`table`.
+            Keywords of :meth:`metrics`.
 
         Returns
         -------
@@ -226,10 +241,10 @@ class Comparison:
             ``workflow`` (``"compare"``), ``mission``, ``vehicle``, ``duration_s``, ``dt_s``,
             ``version`` (as the first flight recorded them), ``controllers`` (label ->
             parameters), ``metrics`` (label, or ``label/vehicle`` for a batch -> the row
-            of :meth:`table`) and ``metrics_conventions`` (the table's conventions).
+            of :meth:`metrics`) and ``metrics_conventions`` (the table's conventions).
         """
         first = next(iter(self.results.values()))
-        table = self.table(**metric_kw)
+        table = self.metrics(**metric_kw)
         rows = self._rows(table)
         return {
             "workflow": "compare",
@@ -287,7 +302,7 @@ class Comparison:
         force : bool
             Replace a non-empty folder that quadcruise did not write (else InputError).
         **metric_kw : Any
-            Keywords of :meth:`table` (the conventions of the metrics written).
+            Keywords of :meth:`metrics` (the conventions of the metrics written).
 
         Returns
         -------
@@ -300,7 +315,7 @@ class Comparison:
         out = check_output_dir(out, force)
         with atomic_dir(out) as tmp:
             tmp = Path(tmp)
-            self.table(**metric_kw).reset_index().to_csv(tmp / "metrics.csv", index=False)
+            self.metrics(**metric_kw).reset_index().to_csv(tmp / "metrics.csv", index=False)
             save_figure(self.plot(), tmp / "comparison.png")
             (tmp / MARKER).write_text(dumps(self.to_dict(**metric_kw), indent=2, sort_keys=True) + "\n")
             (tmp / "scenario.toml").write_text(self.scenario_toml())
@@ -343,7 +358,7 @@ def compare(
     Returns
     -------
     Comparison
-        ``.results``, ``.table()``, ``.text()``, ``.plot()``, ``.to_dict()``, ``.write(out)``.
+        ``.results``, ``.metrics()``, ``.text()``, ``.plot()``, ``.to_dict()``, ``.write(out)``.
     """
     for bad in ("missions", "controller", "mission"):
         if bad in fly_kw:

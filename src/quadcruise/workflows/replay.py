@@ -491,6 +491,6 @@ def write_rotor_states_csv(result: RotorResult, path: str | os.PathLike, vehicle
     vehicle : int
         The vehicle's index.
     """
-    columns, table = result.table(vehicle)
+    frame = result.to_pandas(vehicle).drop(columns="vehicle")
     with atomic_path(path) as tmp, open(tmp, "wb") as f:
-        np.savetxt(f, table, delimiter=",", fmt="%.15g", comments="", header=",".join(columns))
+        np.savetxt(f, frame.to_numpy(), delimiter=",", fmt="%.15g", comments="", header=",".join(frame.columns))

@@ -153,17 +153,28 @@ class Reproduction:
         """
         return {"runs": self.runs, "paper": PAPER, "config": self.config, "version": __version__}
 
-    def to_pandas(self):
-        """The flights as a table.
+    def metrics(self):
+        """The metrics of every flight: :attr:`runs` as a table.
 
         Returns
         -------
         pandas.DataFrame
-            One row per flight (scenario and controller), the keys of :attr:`runs` as columns.
+            One row per flight (scenario and controller) in the order flown, the keys of
+            :attr:`runs` as columns.
         """
         import pandas as pd
 
         return pd.DataFrame(self.runs)
+
+    def to_pandas(self):
+        """The flights, one row each: :meth:`metrics` (a collection of flights has no one time axis).
+
+        Returns
+        -------
+        pandas.DataFrame
+            :meth:`metrics`.
+        """
+        return self.metrics()
 
     def run(self, scenario: str, controller: str) -> dict:
         """The metrics of one flight.
