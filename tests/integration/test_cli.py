@@ -159,6 +159,33 @@ def test_compare_and_analyze(tmp_path):
     assert doc
 
 
+def test_analyze_takes_a_vehicle(tmp_path):
+    """--vehicle: a paper-plant preset is linearised as given; a rotor-plant one as its equivalent "+"
+    vehicle with the gains fly designs for its motors (se3's attitude kp = (0.6 w)^2, w = 1/40 ms for
+    the Iris), recorded in quadcruise.json."""
+    from quadcruise.model.equivalent import paper_equivalent
+    from quadcruise.model.rotor_vehicle import RotorVehicle
+
+    docs = {}
+    for name in ("paper", "qball-x4", "iris"):
+        res = run("analyze", "--controller", "se3", "--vehicle", name, "--out", tmp_path / name)
+        assert res.exit_code == 0, res.output
+        docs[name] = json.loads((tmp_path / name / "quadcruise.json").read_text())
+    iris = paper_equivalent(RotorVehicle.preset("iris"))
+    assert docs["iris"]["vehicle"]["omega"] == pytest.approx(iris.omega) == pytest.approx(40.0)
+    assert docs["iris"]["vehicle"]["m"] == pytest.approx(1.535)
+    assert docs["iris"]["controller"]["attitude"]["kp"] == pytest.approx((0.6 * 40.0) ** 2)
+    assert docs["qball-x4"]["vehicle"]["m"] == pytest.approx(1.4)
+    assert docs["paper"]["controller"] == docs["qball-x4"]["controller"]  # same motors: same gains
+    poles = {k: json.loads((tmp_path / k / "analysis.json").read_text())["loops"]["x"]["poles"] for k in docs}
+    assert poles["iris"] != poles["paper"]
+    # the Qball-X4 is Table I at 1.4 kg: a controller that knows the mass scales its thrust with it,
+    # so the linear loop (per unit mass, same inertia and motors) is the paper vehicle's
+    assert np.allclose(poles["qball-x4"], poles["paper"], atol=1e-5)
+    res = run("analyze", "--vehicle", "jumbo")
+    assert res.exit_code == 2 and "unknown vehicle preset 'jumbo'" in res.output
+
+
 def test_montecarlo_runs_writes_and_replays_a_case(tmp_path):
     out = tmp_path / "mc"
     args = [

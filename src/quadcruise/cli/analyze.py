@@ -24,11 +24,18 @@ __all__ = ["analyze"]
 @click.option("--poles", "position_poles", metavar="P1,P2", help="Closed-loop poles of the x/y loops [rad/s].")
 @click.option("--dt", type=SECONDS, default=1e-3, show_default=True, help="Control period [s].")
 @click.option(
+    "--vehicle",
+    "vehicle_text",
+    metavar="NAME|KEY=VALUE,...|FILE.toml",
+    help="The vehicle (default: the paper's Table I); a rotor-plant vehicle is linearised through its "
+    "equivalent '+' vehicle, with the gains fly designs for it.",
+)
+@click.option(
     "--out", type=click.Path(file_okay=False), callback=writable, help="Folder for analysis.json and Bode plots."
 )
 @FORCE_OPTION
 @friendly
-def analyze(controller, controller_params, position_poles, dt, out, force):
+def analyze(controller, controller_params, position_poles, dt, vehicle_text, out, force):
     """Linearise the closed loop about hover: poles, damping, margins of each loop, Bode plots.
 
     \f
@@ -43,6 +50,12 @@ def analyze(controller, controller_params, position_poles, dt, out, force):
         ``-0.7,-4.3``; their PD gains replace the controller's position gains. None: not given.
     dt : float
         ``--dt``: control period [s].
+    vehicle_text : str or None
+        ``--vehicle``: a preset, ``KEY=VALUE`` fields or a vehicle TOML file; None: Table I. A
+        rotor-plant vehicle is linearised as its equivalent "+" paper vehicle
+        (:func:`quadcruise.model.equivalent.paper_equivalent`: about hover, at zero airspeed, its
+        thrust kf w^2 and motor lag linearise to that vehicle's), its controller given by name designed
+        for it as ``fly`` designs it.
     out : str or None
         ``--out``: folder to write ``analysis.json`` and the Bode plots to; None: print only.
     force : bool
@@ -50,12 +63,22 @@ def analyze(controller, controller_params, position_poles, dt, out, force):
     """
     linearising = Bar("linearising about hover")
     linearising(0, 3)  # python-control takes a few seconds to load
+    from quadcruise.cli.objects import controller_for_vehicle
+    from quadcruise.cli.vehicle import vehicle_from_option
+    from quadcruise.model.equivalent import paper_equivalent
+    from quadcruise.model.rotor_vehicle import RotorVehicle
     from quadcruise.workflows.analysis import linearize
 
+    vehicle = vehicle_from_option(vehicle_text, "--vehicle")
     the_controller = controller_from_options(controller, controller_params, position_poles)
+    the_controller = controller_for_vehicle(
+        the_controller, controller, controller_params, position_poles, {"vehicle": vehicle}, None
+    )
+    if isinstance(vehicle, RotorVehicle):
+        vehicle = paper_equivalent(vehicle)
     if out is not None:
         check_output_dir(out, force)
-    lin = linearize(the_controller, dt=dt, progress=linearising)
+    lin = linearize(the_controller, vehicle, dt=dt, progress=linearising)
     click.echo(str(lin.summary(progress=Bar("margins", unit="loop"))))
     if out is not None:
         lin.write(out, force=force, progress=Bar("Bode plots"))

@@ -240,7 +240,19 @@ def linearize(
     sys = control.ss(A, np.vstack([Bp @ Kr, Hr]), Cy, 0.0, dt, inputs=INPUTS, outputs=OUTPUTS, states=names)
     mixer = vp[P_K] * np.array([mix(*row, vp[P_D]) for row in np.eye(4)]).T
     return Linearization(
-        sys, float(dt), controller, Ap, Bp, Kx, Km, Hx, Hm, mixer, _loops(A, mixer), float(np.max(np.abs(drift)))
+        sys,
+        float(dt),
+        controller,
+        Ap,
+        Bp,
+        Kx,
+        Km,
+        Hx,
+        Hm,
+        mixer,
+        _loops(A, mixer),
+        float(np.max(np.abs(drift))),
+        vehicle,
     )
 
 

@@ -80,6 +80,8 @@ class Linearization:
         Each loop's (``x``, ``y``, ``z``, ``yaw``) state indices.
     residual : float
         The largest drift rate at hover [state unit/s].
+    vehicle : Vehicle, optional
+        The vehicle linearised (recorded in the folder's ``quadcruise.json``).
     """
 
     sys: control.StateSpace
@@ -94,6 +96,7 @@ class Linearization:
     mixer: np.ndarray
     loops: dict
     residual: float
+    vehicle: object = None
 
     @property
     def stable(self) -> bool:
@@ -427,7 +430,15 @@ class Linearization:
                 if progress is not None:
                     progress(5 * k + 5, 10)
             (tmp / MARKER).write_text(
-                dumps({"workflow": "analyze", "controller": self.controller, "dt_s": self.dt, "version": __version__})
+                dumps(
+                    {
+                        "workflow": "analyze",
+                        "controller": self.controller,
+                        "vehicle": None if self.vehicle is None else self.vehicle.to_dict(),
+                        "dt_s": self.dt,
+                        "version": __version__,
+                    }
+                )
                 + "\n"
             )
         return out
