@@ -17,7 +17,8 @@ from quadcruise.disturbances import Environment, RotorLoss, SensorNoise, Turbule
 from quadcruise.errors import LogWarning
 from quadcruise.missions import Circle, Step
 from quadcruise.sim.chunked import simulate_watched
-from quadcruise.sim.engine import Limits, simulate, time_grid
+from quadcruise.sim.engine import simulate
+from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.status import ExitStatus
 from quadcruise.workflows import fly as fly_module
 from quadcruise.workflows.fly import batch_log_every, hover_state, log_bytes

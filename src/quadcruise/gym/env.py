@@ -21,7 +21,7 @@ from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, STATE_SIZE, X
 from quadcruise.missions import Circle, Mission, mission_from_name, stack_params
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
-from quadcruise.sim.engine import Limits, time_grid
+from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.stepper import Stepper

@@ -144,7 +144,7 @@ class MonteCarloSpec:
     max_altitude_error_m: float | None = None
 
     def __post_init__(self) -> None:
-        from quadcruise.sim.engine import time_grid
+        from quadcruise.sim.inputs import time_grid
         from quadcruise.workflows.fly import altitude_bound, check_can_hover, default_duration, steady_bound
 
         if isinstance(self.mission, str):

@@ -33,7 +33,8 @@ from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
 from quadcruise.sim.chunked import simulate_watched
-from quadcruise.sim.engine import Limits, simulate, time_grid
+from quadcruise.sim.engine import simulate
+from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.status import ExitStatus
 from quadcruise.workflows.rotor_fly import as_vehicle, check_wind_acts, fly_rotor, rotor_flight_setup

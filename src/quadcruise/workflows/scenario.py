@@ -359,7 +359,7 @@ def _consistent(
     if "duration" not in simulation or "dt" not in simulation:  # else the command line may give them
         return
     sim, duration, dt = where.at("simulation"), simulation["duration"], simulation["dt"]
-    periods = round(duration / dt)  # as sim.engine.time_grid counts them, without the grid
+    periods = round(duration / dt)  # as sim.inputs.time_grid counts them, without the grid
     if dt > duration or abs(periods * dt - duration) > 1e-9 * max(1.0, duration):
         raise sim.error(f"'dt' = {dt:g} s does not divide 'duration' = {duration:g} s into whole control periods")
     every = simulation.get("log_every", 1)

@@ -15,7 +15,7 @@ from quadcruise.errors import InputError
 from quadcruise.missions import Mission, mission_from_name, stack_params
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
-from quadcruise.sim.engine import Limits, time_grid
+from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.stepper import Stepper
 from quadcruise.workflows.fly import (
     check_can_hover,
