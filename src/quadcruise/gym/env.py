@@ -25,7 +25,7 @@ from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.stepper import Stepper
-from quadcruise.workflows.fly import check_can_hover
+from quadcruise.workflows.fly_inputs import check_can_hover
 
 EPISODE_STRIDE = 2**32
 """Episode e of vehicle i draws from the stream ``(seed, i * EPISODE_STRIDE + e)``: it depends on

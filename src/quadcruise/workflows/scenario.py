@@ -322,7 +322,7 @@ def _consistent(
     it), naming the file and the keys: the number of vehicles given by per-vehicle values, ``n``
     and ``initial_state``; and, when the file gives both ``duration`` and ``dt``, a ``dt`` that
     does not divide the duration or a ``log_every`` that does not divide the flight's control
-    periods (as :func:`~quadcruise.workflows.fly.check_log_every`)."""
+    periods (as :func:`~quadcruise.workflows.fly_inputs.check_log_every`)."""
     counts: dict[str, int] = {}
     for table, v in (("vehicle", vehicle), ("controller_vehicle", model)):
         if v is not None and getattr(v, "batch_size", None) is not None:
@@ -344,7 +344,7 @@ def _consistent(
         raise sim.error(f"'dt' = {dt:g} s does not divide 'duration' = {duration:g} s into whole control periods")
     every = simulation.get("log_every", 1)
     if periods % every:
-        from quadcruise.workflows.fly import nearest_divisors
+        from quadcruise.workflows.fly_inputs import nearest_divisors
 
         near = nearest_divisors(every, periods)
         raise sim.error(

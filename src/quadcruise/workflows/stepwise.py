@@ -17,7 +17,7 @@ from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
 from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.stepper import Stepper
-from quadcruise.workflows.fly import (
+from quadcruise.workflows.fly_inputs import (
     check_can_hover,
     default_duration,
     engine_inputs,
