@@ -24,7 +24,8 @@ from quadcruise.errors import InputError  # noqa: E402 - after the stale cache i
 
 if TYPE_CHECKING:  # what the names are, for readers and type checkers
     from quadcruise.model.vehicle import Vehicle
-    from quadcruise.sim.engine import Limits, simulate, time_grid
+    from quadcruise.sim.engine import simulate
+    from quadcruise.sim.inputs import Limits, time_grid
     from quadcruise.sim.result import SimResult
     from quadcruise.sim.status import STATUS_REASONS, ExitStatus
     from quadcruise.sysid.api import identify
@@ -44,7 +45,8 @@ if TYPE_CHECKING:  # what the names are, for readers and type checkers
 
 _LAZY = {
     "quadcruise.model.vehicle": ("Vehicle",),
-    "quadcruise.sim.engine": ("Limits", "simulate", "time_grid"),
+    "quadcruise.sim.engine": ("simulate",),
+    "quadcruise.sim.inputs": ("Limits", "time_grid"),
     "quadcruise.sim.result": ("SimResult",),
     "quadcruise.sim.status": ("STATUS_REASONS", "ExitStatus"),
     "quadcruise.sysid.api": ("identify",),

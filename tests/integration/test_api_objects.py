@@ -13,7 +13,7 @@ from quadcruise.disturbances import Environment, SensorNoise, Turbulence, with_d
 from quadcruise.metrics.summary import Summary
 from quadcruise.montecarlo import MonteCarloResult, Population, montecarlo
 from quadcruise.protocols import ControllerLike, ResultLike
-from quadcruise.workflows.fly import engine_inputs
+from quadcruise.workflows.fly_inputs import engine_inputs
 
 
 class PlainController:

@@ -21,7 +21,7 @@ from quadcruise.disturbances import ConstantWind, SensorNoise
 from quadcruise.errors import ArgumentTypeError, InputError
 from quadcruise.missions import Circle, Step
 from quadcruise.montecarlo import Population, montecarlo
-from quadcruise.sim.engine import Limits
+from quadcruise.sim.inputs import Limits
 from quadcruise.tune import Bounds, Requirement, Target, tune
 from quadcruise.workflows.analysis import linearize
 

@@ -17,10 +17,11 @@ from quadcruise.disturbances import Environment, RotorLoss, SensorNoise, Turbule
 from quadcruise.errors import LogWarning
 from quadcruise.missions import Circle, Step
 from quadcruise.sim.chunked import simulate_watched
-from quadcruise.sim.engine import Limits, simulate, time_grid
+from quadcruise.sim.engine import simulate
+from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.status import ExitStatus
-from quadcruise.workflows import fly as fly_module
-from quadcruise.workflows.fly import batch_log_every, hover_state, log_bytes
+from quadcruise.workflows import fly_inputs
+from quadcruise.workflows.fly_inputs import batch_log_every, hover_state, log_bytes
 
 FIN, LOST, OFF = int(ExitStatus.FINISHED), int(ExitStatus.LOST_TRACK), int(ExitStatus.OFF_TRACK)
 
@@ -34,7 +35,7 @@ def quiet(*args, **kwargs):
 def full_and_watched(monkeypatch, *args, **kwargs):
     """The flight with its whole log (the checks on it), and as a default batch over a tiny budget."""
     full = quiet(*args, log_every=1, **kwargs)
-    monkeypatch.setattr(fly_module, "LOG_BUDGET", 1)
+    monkeypatch.setattr(fly_inputs, "LOG_BUDGET", 1)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         watched = qc.fly(*args, **kwargs)
@@ -146,7 +147,7 @@ def test_the_chunked_flight_is_the_whole_flight_bit_for_bit_with_vehicles_stoppi
 
 
 def test_the_default_log_of_a_large_batch_fits_and_a_single_flight_logs_every_period():
-    assert log_bytes(2000, 10_000, batch_log_every(2000, 10_000)) <= fly_module.LOG_BUDGET <= 2**30
+    assert log_bytes(2000, 10_000, batch_log_every(2000, 10_000)) <= fly_inputs.LOG_BUDGET <= 2**30
     assert batch_log_every(1, 10**7) == 1  # one vehicle: every period, however long
     assert batch_log_every(100, 1000) == 1  # a log that fits: every period
     with warnings.catch_warnings():
@@ -156,7 +157,7 @@ def test_the_default_log_of_a_large_batch_fits_and_a_single_flight_logs_every_pe
 
 
 def test_an_explicit_log_every_is_kept_and_one_too_large_is_refused(monkeypatch):
-    monkeypatch.setattr(fly_module, "LOG_BUDGET", 1)
+    monkeypatch.setattr(fly_inputs, "LOG_BUDGET", 1)
     with warnings.catch_warnings():
         warnings.simplefilter("error", LogWarning)
         res = qc.fly("hover", n=3, duration=0.5, log_every=1)  # asked for: kept, no warning

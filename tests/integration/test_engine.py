@@ -8,6 +8,7 @@ import quadcruise as qc
 from quadcruise.control.openloop import duty_schedule, pack_schedule
 from quadcruise.disturbances import CustomDisturbance, SensorNoise
 from quadcruise.layout import F1, STATE_SIZE, X, Z
+from quadcruise.workflows.fly_inputs import hover_state
 from quadcruise.workflows.replay import no_reference
 from support.reference_model import rhs
 
@@ -175,7 +176,7 @@ def test_rows_after_a_stop_are_nan_and_the_rest_of_the_batch_flies_on(log_every)
     hover = np.tile(V.hover_duty * np.ones(4), (t.size, 1))
     grid = np.linspace(0, 10, 1001)
     mission = qc.missions.Hover()
-    x0 = qc.workflows.fly.hover_state(V, 2, mission)
+    x0 = hover_state(V, 2, mission)
     gains = np.stack([pack_schedule(t, spin), pack_schedule(t, hover)])
     res = qc.simulate(
         grid,

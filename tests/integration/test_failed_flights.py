@@ -173,7 +173,7 @@ def test_hovering_near_full_duty_warns():
 
 def test_fly_and_a_monte_carlo_sweep_judge_a_flight_by_the_same_rule():
     from quadcruise.montecarlo import Population, montecarlo
-    from quadcruise.workflows.fly import hover_state
+    from quadcruise.workflows.fly_inputs import hover_state
 
     # heavy vehicles (hover duty about 0.9) on a 5 m step: some sag off their point, some do not
     with warnings.catch_warnings():

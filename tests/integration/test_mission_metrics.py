@@ -226,7 +226,7 @@ def test_the_square_without_an_entry_says_so_and_one_settle_band_gives_two_colum
 def test_fly_and_a_sweep_agree_flight_by_flight_on_a_moving_reference():
     from quadcruise.metrics.batch import transient_batch
     from quadcruise.montecarlo import Population, montecarlo
-    from quadcruise.workflows.fly import hover_state
+    from quadcruise.workflows.fly_inputs import hover_state
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -21,7 +21,7 @@ from quadcruise.missions import Step
 from quadcruise.plots import flight as plots
 from quadcruise.plots import marks, plot_envelope, plot_flight, plot_paths, save_figure
 from quadcruise.plots import montecarlo as mc_plots
-from quadcruise.workflows.fly import hover_state
+from quadcruise.workflows.fly_inputs import hover_state
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

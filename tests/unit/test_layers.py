@@ -148,3 +148,22 @@ def test_no_private_name_crosses_modules():
 def test_the_check_sees_an_upward_import(low, high):
     """The rule itself: a low module importing a high one is upward (the check can fail)."""
     assert RANKS[group(high)] > RANKS[group(low)]
+
+
+MAX_MODULE_LINES = 650
+"""No grab-bag modules: each one idea, readable in one sitting (docs/architecture.md)."""
+
+
+def long_modules(limit: int = MAX_MODULE_LINES) -> dict[str, int]:
+    """The modules of the package over ``limit`` lines, with their line counts."""
+    counts = {m: len(p.read_text().splitlines()) for m, p in MODULES.items()}
+    return {m: n for m, n in counts.items() if n > limit}
+
+
+def test_no_module_is_over_the_line_limit():
+    assert not long_modules(), long_modules()
+
+
+def test_the_line_limit_sees_a_long_module():
+    """The rule itself: lowered below the engine's length, the check names the engine."""
+    assert "quadcruise.sim.engine" in long_modules(limit=600)

@@ -179,7 +179,7 @@ def compare(
         kwargs["seed"] = pop_seed if seed is None else seed
     if count is not None:
         from quadcruise.montecarlo.sweep import check_sweep_size
-        from quadcruise.workflows.fly import default_duration
+        from quadcruise.workflows.fly_inputs import default_duration
 
         duration_s = kwargs.get("duration") or default_duration(cmp_mission)
         check_sweep_size(count, round(duration_s / kwargs.get("dt", 1e-3)))

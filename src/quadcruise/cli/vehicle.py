@@ -28,7 +28,7 @@ hummingbird, iris, qball-x4); or give the vehicle's fields, KEY=VALUE,..., or a 
 
     from quadcruise.cli.assignments import parse_assignments
     from quadcruise.model.vehicle import Vehicle
-    from quadcruise.workflows.scenario import read_vehicle_file, vehicle_preset
+    from quadcruise.workflows.scenario_vehicle import read_vehicle_file, vehicle_preset
 
     text = str(text).strip()
     if text.lower().endswith(".toml"):

@@ -141,7 +141,7 @@ def flight_world(
     if vehicle is not None and isinstance(flown, Vehicle):  # a RotorVehicle that cannot lift cannot be made
         import warnings
 
-        from quadcruise.workflows.fly import check_can_hover
+        from quadcruise.workflows.fly_inputs import check_can_hover
 
         with warnings.catch_warnings():  # the flight itself warns of a vehicle with little left for control
             warnings.simplefilter("ignore")

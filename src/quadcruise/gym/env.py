@@ -24,11 +24,11 @@ from quadcruise.model.equivalent import paper_equivalent
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
-from quadcruise.sim.engine import Limits, time_grid
+from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.stepper import Stepper
-from quadcruise.workflows.fly import check_can_hover
+from quadcruise.workflows.fly_inputs import check_can_hover
 from quadcruise.workflows.rotor_fly import as_vehicle, check_wind_acts, designed_controller
 
 EPISODE_STRIDE = 2**32

@@ -25,7 +25,8 @@ __all__ = ["Case", "fly_chunk", "montecarlo_case", "reduce_chunk", "replay_case"
 def fly_chunk(spec: MonteCarloSpec, first, count: int, log_every: int | None = None, controller=None):
     """Fly vehicles first .. first + count - 1 (or the indices ``first``) as one batch, with the spec's
     controller or one per vehicle: ``(SimResult, Draw)``; failures go in the table, not in warnings."""
-    from quadcruise.workflows.fly import fly, hover_state
+    from quadcruise.workflows.fly import fly
+    from quadcruise.workflows.fly_inputs import hover_state
 
     draw = spec.population.draw(spec.seed, first, count, spec.vehicle, spec.dt)
     x0 = None  # a rotor-plant vehicle starts hovering at the mission's start (the spec refuses an offset)
@@ -134,7 +135,7 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
     diverged = stopped
     off = np.zeros(n, dtype=bool)
     if live.size:  # fly's rule (off_track_since), by the spec's bounds, on the sweep's log
-        from quadcruise.workflows.fly import off_track_since
+        from quadcruise.workflows.fly_failures import off_track_since
 
         d = result.states[live, :, X : X + 3] - refs[live]
         first = off_track_since(

@@ -99,12 +99,12 @@ class MonteCarloSpec:
         settled into 5 %, the error at the end, ``final_error_m``) exceeds this [m]. By
         default (None) the larger of 1 m and a quarter of the mission's extent (the longest
         side of the box holding its reference path over the flight,
-        :func:`quadcruise.workflows.fly.steady_bound`, the default of ``fly``'s
+        :func:`quadcruise.workflows.fly_failures.steady_bound`, the default of ``fly``'s
         ``max_steady_error``): 1 m for the built-in circle, square, step and hover. The
         value used is the field's value after construction, recorded with the spec.
     max_altitude_error_m : float, optional
         A flight is off track (counted as "lost track") too if its altitude error after the
-        transient exceeds this [m]. By default (None) :func:`quadcruise.workflows.fly.altitude_bound`
+        transient exceeds this [m]. By default (None) :func:`quadcruise.workflows.fly_failures.altitude_bound`
         (half the mission's lowest altitude: 0.5 m for the built-in missions), or
         ``max_track_error_m`` where that is given, as ``fly``'s ``max_steady_error`` bounds both.
     requirements : Requirement, sequence of Requirement, or mapping
@@ -149,8 +149,9 @@ class MonteCarloSpec:
     max_altitude_error_m: float | None = None
 
     def __post_init__(self) -> None:
-        from quadcruise.sim.engine import time_grid
-        from quadcruise.workflows.fly import altitude_bound, check_can_hover, default_duration, steady_bound
+        from quadcruise.sim.inputs import time_grid
+        from quadcruise.workflows.fly_failures import altitude_bound, steady_bound
+        from quadcruise.workflows.fly_inputs import check_can_hover, default_duration
 
         if isinstance(self.mission, str):
             object.__setattr__(self, "mission", mission_from_name(self.mission))

@@ -12,7 +12,8 @@ Examples
 >>> from quadcruise.control import NLPD
 >>> from quadcruise.missions import Circle
 >>> from quadcruise.model.vehicle import Vehicle
->>> from quadcruise.sim.engine import simulate, time_grid
+>>> from quadcruise.sim.engine import simulate
+>>> from quadcruise.sim.inputs import time_grid
 >>> t, c, m, v = time_grid(0.2, 1e-3), NLPD(), Circle(), Vehicle.paper()
 >>> x0 = np.zeros(16); x0[2] = 1.0; x0[12:] = v.m * v.g / 4     # hovering at 1 m
 >>> args = (t, x0, v.rows(2), c.function, c.gains(), m.function, m.params())

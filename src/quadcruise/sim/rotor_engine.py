@@ -42,7 +42,7 @@ from quadcruise.model.rotor_plant import (
     RZ,
     rotor_derivative,
 )
-from quadcruise.sim.engine import Limits
+from quadcruise.sim.inputs import Limits
 from quadcruise.sim.rotor_result import RotorResult
 from quadcruise.sim.status import ExitStatus
 

@@ -22,7 +22,7 @@ Each control period t_k, for each vehicle:
 5. RK4 substeps no longer than ``max_step`` fly the commanded speeds on the true vehicle, the
    quaternion renormalised after each, and with a ground each step that ends below z = 0 meets
    it (:func:`quadcruise.sim.rotor_engine.ground_contact`): held, or ``CRASHED``;
-6. the state is checked against :class:`~quadcruise.sim.engine.Limits`: non-finite, position,
+6. the state is checked against :class:`~quadcruise.sim.inputs.Limits`: non-finite, position,
    speed, body rate, and tilt: the angle between body z and world z above ``max_tilt``.
 
 The paper-layout states, commands and references are logged as the paper kernel logs them, and
@@ -60,20 +60,13 @@ from quadcruise.layout import (
     X,
 )
 from quadcruise.model.rotor_plant import QW, QX, QY, QZ, ROTOR_W1, RP, RP_KF, RP_N_ROTORS, RP_W_MAX, RP_W_MIN, RX, RZ
-from quadcruise.sim.engine import (
-    PIECES_PER_THREAD,
-    Limits,
-    batch_inputs,
-    beyond,
-    blank_rows,
-    log_row,
-    put_row,
-    still_air,
-)
+from quadcruise.sim.engine import beyond, blank_rows, log_row, put_row, still_air
+from quadcruise.sim.inputs import Limits, batch_inputs
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rng import next_normal
 from quadcruise.sim.rotor_engine import ROTOR_WORK_ROWS, ground_contact, rotor_rk4_step
 from quadcruise.sim.status import ExitStatus
+from quadcruise.sim.threads import PIECES_PER_THREAD
 
 FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, TILT_BOUND, BAD_COMMAND, CRASHED = (
     int(ExitStatus[name])

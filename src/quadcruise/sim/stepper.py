@@ -38,7 +38,8 @@ from numba.core.types.function_type import CompileResultWAP
 
 from quadcruise.errors import InputError
 from quadcruise.layout import CMD_SIZE, CONTROLLER_SIG, DISTURBANCE_SIG, MISSION_SIG, REF_SIZE, STATE_SIZE
-from quadcruise.sim.engine import Limits, batch_inputs, fly_vehicles, fresh_carry, still_air
+from quadcruise.sim.engine import fly_vehicles, still_air
+from quadcruise.sim.inputs import Limits, batch_inputs, fresh_carry
 from quadcruise.sim.kernel_args import KernelArgs
 from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.rotor_flight import fly_rotor_pieces, paper_states, rotor_carry_width, rotor_inputs

@@ -220,7 +220,7 @@ def tune(
         log_dt=log_dt,
         transient_until=transient_until,
     )
-    from quadcruise.workflows.fly import check_run_size
+    from quadcruise.workflows.fly_inputs import check_run_size
 
     check_run_size(popsize * samples, spec.periods, spec.log_every)  # one generation is one batch: size it first
     obj = Objective(spec, space, targets, requirements, minimize, samples, statistic)

@@ -31,7 +31,9 @@ from quadcruise.metrics.summary import Summary
 from quadcruise.missions import Mission, as_mission
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
-from quadcruise.workflows.fly import FLY_OPTIONS, flight_warnings_named, fly
+from quadcruise.workflows.fly import fly
+from quadcruise.workflows.fly_failures import flight_warnings_named
+from quadcruise.workflows.fly_inputs import FLY_OPTIONS
 from quadcruise.workflows.rotor_fly import as_vehicle, rotor_flight_setup
 
 __all__ = ["compare", "Comparison", "DEFAULT_CONTROLLERS"]

@@ -37,7 +37,8 @@ from quadcruise.layout import F1, P_K, STATE_NAMES, STATE_SIZE
 from quadcruise.model.rotor_plant import QW, ROTOR_W1, state_names
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
-from quadcruise.sim.engine import Limits, simulate
+from quadcruise.sim.engine import simulate
+from quadcruise.sim.inputs import Limits
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rotor_engine import replay_rotor_speeds
 from quadcruise.sim.rotor_result import RotorResult

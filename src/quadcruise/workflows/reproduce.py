@@ -39,7 +39,8 @@ from quadcruise.io.scenario_file import scenario_document, scenario_text
 from quadcruise.missions import Circle, Mission, Square, Step
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.result import SimResult
-from quadcruise.workflows.fly import flight_warnings_named, fly
+from quadcruise.workflows.fly import fly
+from quadcruise.workflows.fly_failures import flight_warnings_named
 
 PAPER = {
     "nlpd": {"rise_time_s": 1.0, "settling_time_s": 2.0, "overshoot_pct": 4.0},

@@ -21,9 +21,9 @@ from quadcruise.model.equivalent import duty_to_thrust, paper_equivalent
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
-from quadcruise.sim.engine import Limits, time_grid
+from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.stepper import Stepper
-from quadcruise.workflows.fly import (
+from quadcruise.workflows.fly_inputs import (
     check_can_hover,
     default_duration,
     engine_inputs,

@@ -1,6 +1,6 @@
 """``fly``'s lost-track and off-track checks, computed as the flight goes, at every control
 period, while the log keeps only every ``log_every``-th: the statuses and times that
-:func:`~quadcruise.workflows.fly.mark_lost_track` and :func:`~quadcruise.workflows.fly.mark_off_track`
+:func:`~quadcruise.workflows.fly_failures.mark_lost_track` and :func:`~quadcruise.workflows.fly_failures.mark_off_track`
 give on the full log (``log_every=1``), without that log.
 
 What each check needs of the whole flight, and what is kept for it (per vehicle):
@@ -34,7 +34,7 @@ from quadcruise.sim.status import ExitStatus
 
 TOLERANCE = 1e-12
 """An instant this close [s] before the end of the transient counts as after it (as in
-:func:`~quadcruise.workflows.fly.off_track_since`)."""
+:func:`~quadcruise.workflows.fly_failures.off_track_since`)."""
 
 
 # columns of the per-vehicle rows the compiled pass keeps (periods as grid indices, -1: none yet).
@@ -241,7 +241,7 @@ class TrackWatch:
 
     def verdict(self, status: np.ndarray, t_stop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The statuses and stop times after the checks: ``lost track`` from the first instant
-        beyond the tracking bound, then ``off track`` as :func:`~quadcruise.workflows.fly.mark_off_track`.
+        beyond the tracking bound, then ``off track`` as :func:`~quadcruise.workflows.fly_failures.mark_off_track`.
 
         Parameters
         ----------
@@ -303,7 +303,7 @@ class TrackWatch:
 def _moving_first_off(live, head_err, head_beyond, ints, floats, flags, t, kept, held):
     """Each live vehicle's first instant off track under a moving reference (-1: none), by
     :func:`~quadcruise.metrics.tracking_transient_batch`'s settling into STEADY_BAND and
-    :func:`~quadcruise.workflows.fly.off_track_since`, from the head kept and the tail's figures."""
+    :func:`~quadcruise.workflows.fly_failures.off_track_since`, from the head kept and the tail's figures."""
     length, line = t.shape[0], 1.0 - STEADY_BAND
     out = np.empty(live.shape[0], dtype=np.int64)
     for r in range(live.shape[0]):

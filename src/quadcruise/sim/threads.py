@@ -1,0 +1,70 @@
+"""Flying a batch on numba's threads: the vehicle range is cut into pieces that a pool of Python
+threads hands to a compiled kernel running without the GIL.
+
+Vehicles are independent and each one's arithmetic does not depend on the piece it falls in, so
+any split reproduces the single-thread flight bit for bit. (A ``prange`` kernel would do the
+same, but numba's parallel passes lengthen the cold compile, and with one vehicle the idle
+OpenMP thread spins: docs/performance.md.)
+"""
+
+from __future__ import annotations
+
+import itertools
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+from numba import config, get_num_threads
+
+PIECES_PER_THREAD = 8
+"""A batch is cut into this many pieces per thread, taken in turn by whichever thread is
+free, so a thread whose vehicles stopped early (or ran slower) does not leave the others
+waiting at the end."""
+
+_pool: ThreadPoolExecutor | None = None
+
+
+def fly_in_pieces(kernel, n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD, after_piece=None) -> None:
+    """Run ``kernel(first, stop, *args)`` over vehicles 0..n-1, on numba's number of threads
+    (``numba.get_num_threads()``): one range on this thread when that is 1 or n is 1, else
+    ``pieces_per_thread`` ranges per thread, handed out in turn.
+
+    Parameters
+    ----------
+    kernel : compiled function
+        Flies vehicles first..stop-1 of the batch arrays that follow (``nogil``).
+    n : int
+        Number of vehicles.
+    args : KernelArgs
+        The kernel's arguments after the vehicle range (its batch arrays, by role).
+    pieces_per_thread : int
+        Ranges per thread: fewer for short calls (a step), where each call's fixed cost counts.
+    after_piece : callable, optional
+        Called as ``after_piece(first, stop)`` on the thread that flew vehicles first..stop-1,
+        right after it (their rows still in its cache).
+    """
+    global _pool
+    threads = min(n, get_num_threads())
+    if threads <= 1:
+        kernel(0, n, *args)
+        if after_piece is not None:
+            after_piece(0, n)
+        return
+    bounds = np.linspace(0, n, min(n, pieces_per_thread * threads) + 1).round().astype(np.int64)
+    pieces = itertools.count()  # next() on it is atomic under the GIL
+
+    def work() -> None:
+        while (k := next(pieces)) < bounds.shape[0] - 1:
+            first, stop = int(bounds[k]), int(bounds[k + 1])
+            kernel(first, stop, *args)
+            if after_piece is not None:
+                after_piece(first, stop)
+
+    if _pool is None:  # numba's threads can never exceed this
+        _pool = ThreadPoolExecutor(max_workers=max(1, config.NUMBA_NUM_THREADS - 1), thread_name_prefix="quadcruise")
+    helpers = [_pool.submit(work) for _ in range(threads - 1)]
+    work()
+    for h in helpers:
+        h.result()
+
+
+__all__ = ["PIECES_PER_THREAD", "fly_in_pieces"]
