@@ -12,7 +12,7 @@ start their grid again while the others fly on.
 
 The vehicles fly either plant: the paper's (:func:`~quadcruise.sim.engine.fly_vehicles`), or,
 given the rotor plant's arrays (``alloc``, ``psi0``, ``touchdown_speed``, as
-:func:`quadcruise.sim.rotor_flight.fly_rotor_vehicles` takes them), the rotor-speed plant
+:func:`quadcruise.sim.rotor_batch.fly_rotor_vehicles` takes them), the rotor-speed plant
 (:func:`~quadcruise.sim.rotor_flight.fly_rotor_pieces`), whose kernel keeps the same resume
 contract. One API for both: :attr:`Stepper.state` is the plant's own state (16 entries, or the
 13 + n of the rotor state), :attr:`Stepper.paper_state` the paper-layout state of either.
@@ -42,7 +42,8 @@ from quadcruise.sim.engine import fly_vehicles, still_air
 from quadcruise.sim.inputs import Limits, batch_inputs, fresh_carry
 from quadcruise.sim.kernel_args import KernelArgs
 from quadcruise.sim.rng import vehicle_states
-from quadcruise.sim.rotor_flight import fly_rotor_pieces, paper_states, rotor_carry_width, rotor_inputs
+from quadcruise.sim.rotor_batch import rotor_inputs
+from quadcruise.sim.rotor_flight import fly_rotor_pieces, paper_states, rotor_carry_width
 from quadcruise.sim.status import ExitStatus
 
 STEP_PIECES_PER_THREAD = 1
@@ -111,7 +112,7 @@ class Stepper:
         flies alone, and ``step`` takes no commands).
     alloc : (4 n + 1,) or (N, 4 n + 1) array, optional
         Given, the vehicles fly the rotor plant: the controller vehicle's duty-to-thrust matrix
-        and kf, as :func:`~quadcruise.sim.rotor_flight.fly_rotor_vehicles` takes it (``vp_ctrl``
+        and kf, as :func:`~quadcruise.sim.rotor_batch.fly_rotor_vehicles` takes it (``vp_ctrl``
         then required: the equivalent paper row the controller reads; ``full_dynamics`` not used).
     psi0 : float or (N,) array
         Rotor plant: the yaw [rad] the initial quaternion's is read near.

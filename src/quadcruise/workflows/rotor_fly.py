@@ -1,7 +1,7 @@
 """What :func:`quadcruise.fly` does differently for a rotor-plant vehicle
 (:class:`~quadcruise.model.rotor_vehicle.RotorVehicle`): the vehicle by preset name, the
 controller's gains designed for the vehicle it believes, the initial hover, and the flight
-through :func:`quadcruise.sim.rotor_flight.fly_rotor_vehicles`.
+through :func:`quadcruise.sim.rotor_batch.fly_rotor_vehicles`.
 
 Gains: a controller given by name (``"se3"``) is designed for the controller vehicle's motor
 bandwidth, the ``omega`` = 1 / tau_up of its equivalent paper vehicle
@@ -37,7 +37,7 @@ from quadcruise.model.rotor_plant import QW, QZ, ROTOR_W1, RZ, state_names
 from quadcruise.model.rotor_vehicle import AERO_FIELDS, RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.result import SimResult
-from quadcruise.sim.rotor_flight import fly_rotor_vehicles
+from quadcruise.sim.rotor_batch import fly_rotor_vehicles
 
 # the controller fields designed for an actuator bandwidth w [rad/s], by controller name
 _DESIGNS = {
@@ -305,7 +305,7 @@ def fly_rotor(
     limits : Limits, optional
         Divergence bounds.
     **engine : Any
-        :func:`quadcruise.sim.rotor_flight.fly_rotor_vehicles`'s other keywords (memory,
+        :func:`quadcruise.sim.rotor_batch.fly_rotor_vehicles`'s other keywords (memory,
         disturbance, sensors, seed, first_vehicle, max_step, log_every, meta).
 
     Returns
