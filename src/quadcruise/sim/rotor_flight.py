@@ -32,12 +32,10 @@ the rotor state beside them. This path shares no code with the paper kernel's ho
 
 from __future__ import annotations
 
-import itertools
 import math
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
-from numba import config, get_num_threads, njit, types
+from numba import njit, types
 
 from quadcruise.layout import (
     CMD_FLAGS,
@@ -63,7 +61,7 @@ from quadcruise.sim.engine import beyond, blank_rows, log_row, put_row, still_ai
 from quadcruise.sim.rng import next_normal
 from quadcruise.sim.rotor_engine import ROTOR_WORK_ROWS, ground_contact, rotor_rk4_step
 from quadcruise.sim.status import ExitStatus
-from quadcruise.sim.threads import PIECES_PER_THREAD
+from quadcruise.sim.threads import PIECES_PER_THREAD, fly_in_pieces
 
 FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, TILT_BOUND, BAD_COMMAND, CRASHED = (
     int(ExitStatus[name])
@@ -449,9 +447,6 @@ def _rotor_flight_kernel(
         t_stop[i] = t_end
 
 
-_pool: ThreadPoolExecutor | None = None
-
-
 def fly_rotor_pieces(n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD, after_piece=None) -> None:
     """The rotor kernel over vehicles 0..n-1 on numba's number of threads, in ranges handed out in
     turn (as :func:`quadcruise.sim.engine.fly_vehicles` does for the paper's kernel); each
@@ -470,29 +465,7 @@ def fly_rotor_pieces(n: int, args: tuple, pieces_per_thread: int = PIECES_PER_TH
         Called as ``after_piece(first, stop)`` on the thread that flew vehicles first..stop-1,
         right after it (as :func:`quadcruise.sim.engine.fly_vehicles` calls it).
     """
-    global _pool
-    threads = min(n, get_num_threads())
-    if threads <= 1:
-        _rotor_flight_kernel(0, n, *args)
-        if after_piece is not None:
-            after_piece(0, n)
-        return
-    bounds = np.linspace(0, n, min(n, pieces_per_thread * threads) + 1).round().astype(np.int64)
-    pieces = itertools.count()  # next() on it is atomic under the GIL
-
-    def work() -> None:
-        while (k := next(pieces)) < bounds.shape[0] - 1:
-            first, stop = int(bounds[k]), int(bounds[k + 1])
-            _rotor_flight_kernel(first, stop, *args)
-            if after_piece is not None:
-                after_piece(first, stop)
-
-    if _pool is None:
-        _pool = ThreadPoolExecutor(max_workers=max(1, config.NUMBA_NUM_THREADS - 1), thread_name_prefix="rotors")
-    helpers = [_pool.submit(work) for _ in range(threads - 1)]
-    work()
-    for h in helpers:
-        h.result()
+    fly_in_pieces(_rotor_flight_kernel, n, args, pieces_per_thread, after_piece)
 
 
 __all__ = ["fly_rotor_pieces", "paper_state", "paper_states", "rotor_carry_width"]
