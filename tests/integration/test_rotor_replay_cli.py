@@ -76,7 +76,9 @@ BAD = {
         "t,w1,w2,w3,w4\n0,1800,1800,1800,1800\n0,1800,1800,1800,1800\n",
         "line 3, column 't': time 0 is not after the previous row's 0",
     ),
-    "duties": ("t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,0.1,0.1,0.1,0.1\n", "column(s) 'w1', 'w2', 'w3', 'w4': missing"),
+    "duty_above_one": ("t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,0.1,0.1,1.5,0.1\n", "line 3, column 'u3': duty 1.5 is not"),
+    "duties_missing_rotor": ("t,u1,u2,u3\n0,0.1,0.1,0.1\n1,0.1,0.1,0.1\n", "column(s) 'u4': missing"),
+    "a_fifth_duty": ("t,u1,u2,u3,u4,u5\n0,1,1,1,1,1\n1,1,1,1,1,1\n", "column 'u5', but the vehicle has 4 rotors"),
 }
 
 
@@ -158,3 +160,28 @@ def test_a_batched_vehicle_file_is_refused_not_cut_to_its_first(tmp_path):
     out = tmp_path / "s.csv"
     result = run("replay", str(pwm), "--vehicle", str(mine), "-o", str(out))
     assert result.exit_code == 2 and "replay flies one vehicle" in result.output and not out.exists()
+
+
+def test_duties_replay_as_the_speeds_of_the_command_to_speed_map(tmp_path):
+    """t,u1..u4 on a rotor vehicle: each rotor at u w_max (PX4's THR_MDL_FAC = 1), the same states as
+    the speeds given directly; a duty outside [0, 1] is one line naming the line and column."""
+    import pandas as pd
+
+    iris = Vehicle.preset("iris")
+    t = np.array([0.0, 0.5, 1.0, 1.5])
+    u = np.array([[0.6] * 4, [0.62, 0.62, 0.6, 0.6], [0.6] * 4, [0.6] * 4])  # rotors 1, 2 spin one way
+    duties, speeds = tmp_path / "u.csv", tmp_path / "w.csv"
+    pd.DataFrame(np.c_[t, u], columns=["t", "u1", "u2", "u3", "u4"]).to_csv(duties, index=False)
+    pd.DataFrame(np.c_[t, u * iris.w_max], columns=["t", "w1", "w2", "w3", "w4"]).to_csv(speeds, index=False)
+    for src, out in ((duties, tmp_path / "su.csv"), (speeds, tmp_path / "sw.csv")):
+        res = run("replay", str(src), "--vehicle", "iris", "-o", str(out))
+        assert res.exit_code == 0, res.output
+    a, b = pd.read_csv(tmp_path / "su.csv"), pd.read_csv(tmp_path / "sw.csv")
+    assert a.shape == b.shape and np.array_equal(a.to_numpy(), b.to_numpy())
+    assert a["w1"].iloc[0] == pytest.approx(0.6 * iris.w_max)
+    assert not np.allclose(a["r"].iloc[-1], 0.0)  # the yaw doublet turned it: the duties were read
+    bad = tmp_path / "bad.csv"
+    bad.write_text("t,u1,u2,u3,u4\n0,0.6,0.6,0.6,0.6\n1,0.6,1.2,0.6,0.6\n")
+    res = run("replay", str(bad), "--vehicle", "iris", "-o", str(tmp_path / "x.csv"))
+    assert res.exit_code == 2 and "line 3, column 'u2': duty 1.2 is not in [0, 1]" in res.output
+    assert not (tmp_path / "x.csv").exists()

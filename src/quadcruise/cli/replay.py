@@ -48,7 +48,8 @@ def replay(pwm_csv: str, out: str, vehicle_name: str | None, ground: bool, max_s
     """Replay commands open loop and write the states.
 
     For the paper's plant the columns are t,u1,u2,u3,u4 (PWM duties); for a rotor-plant
-    vehicle, t,w1,..,wn (commanded rotor speeds, rad/s, in the vehicle's range). Each row's
+    vehicle, t,w1,..,wn (commanded rotor speeds, rad/s, in the vehicle's range) or t,u1,..,un
+    (normalised commands in [0, 1], each rotor at u w_max: PX4's THR_MDL_FAC = 1). Each row's
     commands hold until the next row's time. The vehicle starts at rest at the origin, level,
     each rotor at the first row's command. The states are written even when the flight stops
     early (diverged, crashed); the exit status is then 1.
@@ -92,7 +93,7 @@ def replay(pwm_csv: str, out: str, vehicle_name: str | None, ground: bool, max_s
         )
 
     if isinstance(vehicle, RotorVehicle):
-        schedule = workflow.read_speed_csv(pwm_csv, vehicle.n_rotors, progress=Bar(f"reading {pwm_csv}", unit="row"))
+        schedule = workflow.read_rotor_csv(pwm_csv, vehicle, progress=Bar(f"reading {pwm_csv}", unit="row"))
         result = workflow.replay_rotors(
             schedule,
             vehicle,

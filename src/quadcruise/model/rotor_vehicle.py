@@ -241,6 +241,30 @@ class RotorVehicle(Validated):
         """Number of rotors."""
         return len(self.rotors)
 
+    def command_speed(self, duty):
+        """The rotor speed a normalised motor command (a duty) asks for: w = duty w_max [rad/s].
+
+        The vehicle's command-to-speed map: PX4's normalised motor command with ``THR_MDL_FAC``
+        = 1 (thrust kf w_max^2 duty^2, quadratic in the command), as ``to_ulog`` writes a rotor
+        flight's ``actuator_motors``.
+
+        Parameters
+        ----------
+        duty : float or array_like
+            Commands in [0, 1].
+
+        Returns
+        -------
+        float or numpy.ndarray
+            Commanded rotor speeds [rad/s].
+
+        Examples
+        --------
+        >>> RotorVehicle.preset("iris").command_speed(0.5)
+        550.0
+        """
+        return np.asarray(duty, dtype=float) * self.w_max if np.ndim(duty) else float(duty) * self.w_max
+
     @property
     def hover_speed(self) -> float:
         """Rotor speed [rad/s] at which the rotors together carry the weight: sqrt(m g / (n kf))."""

@@ -368,6 +368,55 @@ def read_speed_csv(
     return SpeedSchedule(t=data[:, 0], speeds=data[:, 1:], source=str(path), lines=tuple(lines))
 
 
+def read_rotor_csv(
+    path: str | os.PathLike, vehicle: RotorVehicle, progress: Callable[[int, int], None] | None = None
+) -> SpeedSchedule:
+    """Read a rotor-plant vehicle's commands: ``t,w1,..,wn`` rotor speeds [rad/s], or ``t,u1,..,un``
+    normalised commands (duties in [0, 1]) turned into speeds by the vehicle's command-to-speed map
+    (:meth:`~quadcruise.model.rotor_vehicle.RotorVehicle.command_speed`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The CSV file (a header, then at least two rows).
+    vehicle : RotorVehicle
+        The vehicle: its rotor count and command-to-speed map.
+    progress : callable, optional
+        ``progress(done, total)``: the rows read.
+
+    Returns
+    -------
+    SpeedSchedule
+        The commanded speeds, with ``source`` the file name and each row's file line.
+
+    Raises
+    ------
+    InputError
+        A missing or extra column, a duty outside [0, 1] or not finite (naming the line and
+        column), or times that do not increase.
+    """
+    n = vehicle.n_rotors
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as f:
+            header = [c.strip() for c in f.readline().split(",")]
+    except (OSError, UnicodeDecodeError):  # read_speed_csv names what is wrong with the file
+        header = []
+    if "w1" in header or "u1" not in header:
+        return read_speed_csv(path, n, progress)
+    columns = ("t",) + tuple(f"u{i + 1}" for i in range(n))
+    _, used, data, lines = read_numeric_csv(path, columns, (f"u{n + 1}",), progress=progress)
+    if len(used) > len(columns):
+        raise InputError(f"{path}: column '{used[len(columns)]}', but the vehicle has {n} rotors")
+    if data.shape[0] < 2:
+        raise InputError(f"{path}: needs at least two data rows (a start and an end time), found {data.shape[0]}")
+    u = data[:, 1:]
+    bad = ~(np.isfinite(u) & (u >= 0.0) & (u <= 1.0))
+    if bad.any():
+        k, j = (int(i) for i in np.argwhere(bad)[0])
+        raise InputError(f"{path}, line {lines[k]}, column 'u{j + 1}': duty {float(u[k, j])!r} is not in [0, 1]")
+    return SpeedSchedule(t=data[:, 0], speeds=vehicle.command_speed(u), source=str(path), lines=tuple(lines))
+
+
 ROTOR_MAX_STEP = 1e-4
 """Default longest RK4 substep [s] of a rotor-plant replay (why: docs/vehicles.md, "Step")."""
 
