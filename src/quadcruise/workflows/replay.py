@@ -261,17 +261,6 @@ def write_states_csv(
 
 
 # --- rotor-plant vehicles: commanded rotor speeds ---------------------------------------------
-def speed_columns(n_rotors: int) -> tuple[str, ...]:
-    """The input columns of a rotor-speed schedule: ``t, w1 .. wn``.
-
-    Examples
-    --------
-    >>> speed_columns(4)
-    ('t', 'w1', 'w2', 'w3', 'w4')
-    """
-    return ("t",) + tuple(f"w{i + 1}" for i in range(n_rotors))
-
-
 @dataclass(frozen=True, eq=False)
 class SpeedSchedule:
     """Piecewise-constant commanded rotor speeds: row k holds from t[k] until t[k+1].
@@ -356,8 +345,15 @@ def read_speed_csv(
     SpeedSchedule
         With ``source`` the file name and the file line of each row.
     """
-    columns = speed_columns(n_rotors)
-    _, used, data, lines = read_numeric_csv(path, columns, (f"w{n_rotors + 1}",), progress=progress)
+    data, lines = _rotor_table(path, n_rotors, "w", progress)
+    return SpeedSchedule(t=data[:, 0], speeds=data[:, 1:], source=str(path), lines=tuple(lines))
+
+
+def _rotor_table(path, n_rotors: int, letter: str, progress) -> tuple[np.ndarray, list]:
+    """The rows of a ``t,<letter>1..<letter>n`` CSV and their file lines; a column for a rotor the
+    vehicle lacks, or fewer than two rows, refused naming the file."""
+    columns = ("t",) + tuple(f"{letter}{i + 1}" for i in range(n_rotors))
+    _, used, data, lines = read_numeric_csv(path, columns, (f"{letter}{n_rotors + 1}",), progress=progress)
     if len(used) > len(columns):
         raise InputError(
             f"{path}: column '{used[len(columns)]}', but the vehicle has {n_rotors} rotors "
@@ -365,7 +361,7 @@ def read_speed_csv(
         )
     if data.shape[0] < 2:
         raise InputError(f"{path}: needs at least two data rows (a start and an end time), found {data.shape[0]}")
-    return SpeedSchedule(t=data[:, 0], speeds=data[:, 1:], source=str(path), lines=tuple(lines))
+    return data, lines
 
 
 def read_rotor_csv(
@@ -403,12 +399,7 @@ def read_rotor_csv(
         header = []
     if "w1" in header or "u1" not in header:
         return read_speed_csv(path, n, progress)
-    columns = ("t",) + tuple(f"u{i + 1}" for i in range(n))
-    _, used, data, lines = read_numeric_csv(path, columns, (f"u{n + 1}",), progress=progress)
-    if len(used) > len(columns):
-        raise InputError(f"{path}: column '{used[len(columns)]}', but the vehicle has {n} rotors")
-    if data.shape[0] < 2:
-        raise InputError(f"{path}: needs at least two data rows (a start and an end time), found {data.shape[0]}")
+    data, lines = _rotor_table(path, n, "u", progress)
     u = data[:, 1:]
     bad = ~(np.isfinite(u) & (u >= 0.0) & (u <= 1.0))
     if bad.any():
