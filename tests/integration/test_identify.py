@@ -117,33 +117,26 @@ def test_no_excitation_no_inertias(tmp_path):
     assert result.hover_duty == pytest.approx(qc.Vehicle.paper().hover_duty, rel=1e-3)
 
 
+def csv_log(flight):
+    """A flight as the CSV log identify reads: velocity, quaternion (w first), body rates, duties."""
+    from scipy.spatial.transform import Rotation
+
+    states = flight.states[0]
+    xyzw = Rotation.from_euler("ZYX", states[:, [PSI, THETA, PHI]]).as_quat()
+    table = pd.DataFrame({"t": flight.t, "vx": states[:, VX], "vy": states[:, VX + 1], "vz": states[:, VX + 2]})
+    table["qw"], table["qx"], table["qy"], table["qz"] = xyzw[:, 3], xyzw[:, 0], xyzw[:, 1], xyzw[:, 2]
+    table["p"], table["q"], table["r"] = states[:, P], states[:, P + 1], states[:, P + 2]
+    for i in range(4):
+        table[f"u{i + 1}"] = flight.commands[0][:, i]
+    return table
+
+
 def test_csv_log_without_accelerometer(tmp_path):
     """The same flight as a CSV (velocity, attitude, rates, duties; no accelerometer: the thrust
     line then comes from the velocity's derivative)."""
     vehicle = qc.Vehicle.paper()
     flight = excitation_flight(vehicle, 3)
-    states = flight.states[0]
-    from scipy.spatial.transform import Rotation
-
-    xyzw = Rotation.from_euler("ZYX", states[:, [PSI, THETA, PHI]]).as_quat()
-    table = pd.DataFrame(
-        {
-            "t": flight.t,
-            "vx": states[:, VX],
-            "vy": states[:, VX + 1],
-            "vz": states[:, VX + 2],
-            "qw": xyzw[:, 3],
-            "qx": xyzw[:, 0],
-            "qy": xyzw[:, 1],
-            "qz": xyzw[:, 2],
-            "p": states[:, P],
-            "q": states[:, P + 1],
-            "r": states[:, P + 2],
-        }
-    )
-    for i in range(4):
-        table[f"u{i + 1}"] = flight.commands[0][:, i]
-    table.to_csv(tmp_path / "flight.csv", index=False)
+    csv_log(flight).to_csv(tmp_path / "flight.csv", index=False)
     result = qc.identify(tmp_path / "flight.csv", mass=3.499)
     for key in TRUTH:
         assert result.parameters[key]["value"] == pytest.approx(
@@ -156,28 +149,8 @@ def test_two_airborne_segments(tmp_path):
     (no filter or lag reaching across the gap) and the vehicle still comes back."""
     vehicle = qc.Vehicle.paper().replace(Jyy=0.035)
     flight = excitation_flight(vehicle, 9)
-    states = flight.states[0]
-    from scipy.spatial.transform import Rotation
-
-    xyzw = Rotation.from_euler("ZYX", states[:, [PSI, THETA, PHI]]).as_quat()
-    table = pd.DataFrame(
-        {
-            "t": flight.t,
-            "vx": states[:, VX],
-            "vy": states[:, VX + 1],
-            "vz": states[:, VX + 2],
-            "qw": xyzw[:, 3],
-            "qx": xyzw[:, 0],
-            "qy": xyzw[:, 1],
-            "qz": xyzw[:, 2],
-            "p": states[:, P],
-            "q": states[:, P + 1],
-            "r": states[:, P + 2],
-            "landed": ((flight.t > 9.0) & (flight.t < 10.5)).astype(int),
-        }
-    )
-    for i in range(4):
-        table[f"u{i + 1}"] = flight.commands[0][:, i]
+    table = csv_log(flight)
+    table["landed"] = ((flight.t > 9.0) & (flight.t < 10.5)).astype(int)
     table.to_csv(tmp_path / "two.csv", index=False)
     result = qc.identify(tmp_path / "two.csv", mass=3.499)
     assert result.log["segments"] == 2
@@ -449,28 +422,7 @@ def test_cli_base_vehicle_gives_the_geometry_a_csv_lacks(tmp_path):
     """A CSV has no rotor geometry: the base vehicle's arm l is used, so a base with l 25 % longer
     gives inertias 25 % larger (the option is not ignored), and the right base gives the truth."""
     flight = excitation_flight(qc.Vehicle.paper(), 2)
-    states = flight.states[0]
-    from scipy.spatial.transform import Rotation
-
-    xyzw = Rotation.from_euler("ZYX", states[:, [PSI, THETA, PHI]]).as_quat()
-    table = pd.DataFrame(
-        {
-            "t": flight.t,
-            "vx": states[:, VX],
-            "vy": states[:, VX + 1],
-            "vz": states[:, VX + 2],
-            "qw": xyzw[:, 3],
-            "qx": xyzw[:, 0],
-            "qy": xyzw[:, 1],
-            "qz": xyzw[:, 2],
-            "p": states[:, P],
-            "q": states[:, P + 1],
-            "r": states[:, P + 2],
-        }
-    )
-    for i in range(4):
-        table[f"u{i + 1}"] = flight.commands[0][:, i]
-    table.to_csv(tmp_path / "f.csv", index=False)
+    csv_log(flight).to_csv(tmp_path / "f.csv", index=False)
     (tmp_path / "long.toml").write_text("[vehicle]\nl = 0.25\n")
     for base, factor in (("paper", 1.0), (tmp_path / "long.toml", 1.25)):
         out = tmp_path / f"out{factor}"
