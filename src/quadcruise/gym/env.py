@@ -226,17 +226,18 @@ class QuadVectorEnv(VectorEnv):
         if pop is None:
             vehicle, offsets, environment = self.nominal_eq, np.zeros((k, 3)), None
         else:  # a rotor vehicle's spreads are drawn on its equivalent (quadcruise.gym.rotor)
-            d = pop.draw(seed, ids, k, self.nominal_eq)
+            d = pop.draw(seed, ids, k, self.nominal_eq, batch_vehicle=False)
             vehicle, offsets, environment = d.vehicle, d.offsets, d.environment
-        missions = [random_circle(seed, int(i)) for i in ids] if self.random_mission else [self.mission]
         if self.random_mission:
-            start = np.concatenate([m.reference(0.0) for m in missions])
+            missions = [random_circle(seed, int(i)) for i in ids]
+            start, mp = np.concatenate([m.reference(0.0) for m in missions]), stack_params(missions, n=k)
         else:  # computed once: a reset is on the hot path
-            start = self._start_ref if hasattr(self, "_start_ref") else self.mission.reference(0.0)
-            self._start_ref = start
-        vp = vehicle.rows(k)
+            if not hasattr(self, "_start_ref"):
+                self._start_ref, self._mission_row = self.mission.reference(0.0), stack_params(self.mission, n=1)
+            start, mp = self._start_ref, np.repeat(self._mission_row, k, axis=0)
+        vp = self._rows(vehicle, k)
         if self.rotor:
-            vp_ctrl = self.nominal_eq.rows(k) if pop is None or pop.model_error else vp
+            vp_ctrl = self._rows(self.nominal_eq, k) if pop is None or pop.model_error else vp
             rows = drawn_rows(self.nominal, self.nominal_eq.rows(1)[0], vp)
             x0, psi0 = hover_starts(rows, start, offsets)
             alloc = allocation_rows(self.nominal, vp_ctrl, None if self.baseline is not None else self.action_mode)
@@ -246,15 +247,23 @@ class QuadVectorEnv(VectorEnv):
                 "x0": x0,
                 "psi0": psi0,
                 "alloc": alloc,
-                "mp": stack_params(missions, n=k),
+                "mp": mp,
                 "environment": environment,
             }
         x0 = np.zeros((k, STATE_SIZE))  # level, still, rotors at the hover thrust
         x0[:, X : X + 3] = start[:, REF_X : REF_X + 3] + offsets  # on the reference, plus the drawn offset
         x0[:, PSI] = start[:, REF_PSI]
         x0[:, F1 : F1 + 4] = (vp[:, P_M] * vp[:, P_G] / 4.0)[:, None]
-        vp_ctrl = self.nominal.rows(k) if pop is None or pop.model_error else vp
-        return {"vp": vp, "vp_ctrl": vp_ctrl, "x0": x0, "mp": stack_params(missions, n=k), "environment": environment}
+        vp_ctrl = self._rows(self.nominal, k) if pop is None or pop.model_error else vp
+        return {"vp": vp, "vp_ctrl": vp_ctrl, "x0": x0, "mp": mp, "environment": environment}
+
+    def _rows(self, vehicle, k: int) -> np.ndarray:
+        """``vehicle.rows(k)``; the nominal vehicle's row computed once (a reset is on the hot path)."""
+        if vehicle is not self.nominal_eq:
+            return vehicle.rows(k)
+        if not hasattr(self, "_nominal_row"):
+            self._nominal_row = self.nominal_eq.rows(1)
+        return np.repeat(self._nominal_row, k, axis=0)
 
     def _start(self, rows: np.ndarray) -> None:
         """Start new episodes of the vehicles ``rows``, each from its own (seed, vehicle, episode) stream."""
@@ -382,9 +391,12 @@ class QuadVectorEnv(VectorEnv):
             if actions is not None:
                 raise InputError("action: this environment flies a baseline controller; step(None)")
             s.step()
-        pending = np.flatnonzero(self._pending)
+        pending = np.flatnonzero(self._pending)  # done, so not flown: restarted now
+        if pending.size:
+            self._start(pending)
         self._observe()
         lost = self._lost & (s.status == int(ExitStatus.FINISHED))
+        lost[pending] = False
         if lost.any():
             s.status[lost] = int(ExitStatus.LOST_TRACK)
             s.t_stop[lost] = s.time[lost]
@@ -395,9 +407,6 @@ class QuadVectorEnv(VectorEnv):
         terminated[pending] = truncated[pending] = False
         self.returns += reward
         info = self._info()
-        if pending.size:
-            self._start(pending)
-            self._observe()
         self._pending = terminated | truncated
         return self._obs.copy(), reward, terminated, truncated, info
 

@@ -34,6 +34,7 @@ import numpy as np
 from quadcruise.errors import ArgumentTypeError, InputError
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
+from quadcruise.sim.fastmath import seeded_draws
 
 __all__ = ["Population", "Draw", "DRAW_KEY", "N_DRAWS", "SLOTS", "SPREADS", "ROTOR_SPREADS", "ROTOR_SLOTS", "CLIP"]
 
@@ -269,18 +270,30 @@ class Population:
             Unit draws [-]: standard normal clipped to [-3, 3], or uniform on
             [-sqrt 3, sqrt 3]; column :data:`SLOTS` feeds each quantity.
         """
-        out = np.empty((count, N_DRAWS))
         normal = self.distribution == "normal"
-        ids = [int(first) + k for k in range(count)] if np.ndim(first) == 0 else [int(i) for i in np.ravel(first)]
+        ids = int(first) + np.arange(count) if np.ndim(first) == 0 else np.ravel(first)
         if len(ids) != count:
             raise InputError(f"the population needs {count} vehicle indices, got {len(ids)}")
-        for k, i in enumerate(ids):
-            g = np.random.default_rng(np.random.SeedSequence([seed, i], spawn_key=(DRAW_KEY,)))
-            out[k] = g.standard_normal(N_DRAWS) if normal else g.random(N_DRAWS)
+        # vehicle i: np.random.default_rng(np.random.SeedSequence([seed, i], spawn_key=(DRAW_KEY,))), bit for bit
+        out = seeded_draws(seed, ids, DRAW_KEY, N_DRAWS, normal)
         clip = CLIP[self.distribution]
         return np.clip(out, -clip, clip) if normal else clip * (2.0 * out - 1.0)
 
-    def draw(self, seed: int, first, count: int, nominal: Vehicle | RotorVehicle, dt: float = 1e-3) -> Draw:
+    @property
+    def spreads_vehicle(self) -> bool:
+        """True if a spread perturbs the vehicle's parameters (not only its start, wind or sensors)."""
+        return any(getattr(self, name) > 0 for name in ROTOR_SPREADS)
+
+    def draw(
+        self,
+        seed: int,
+        first,
+        count: int,
+        nominal: Vehicle | RotorVehicle,
+        dt: float = 1e-3,
+        *,
+        batch_vehicle: bool = True,
+    ) -> Draw:
         """The vehicles first .. first + count - 1: parameters, offsets and environment.
 
         Parameters
@@ -296,6 +309,10 @@ class Population:
             The nominal vehicle (not batched).
         dt : float
             Control period [s] (unused: the draws do not depend on it).
+        batch_vehicle : bool
+            False: when no spread perturbs the vehicle, the Draw's vehicle is the (unbatched)
+            nominal paper vehicle itself, for a caller that needs only its rows (an
+            environment's reset); its rows equal the batch's.
 
         Returns
         -------
@@ -337,7 +354,9 @@ class Population:
         if env is not None and not env.parts:
             env = None
         if not rotor:
-            vehicles = nominal.replace(**{k: cols[k] for names in SPREADS.values() for k in names})
+            vehicles = nominal
+            if batch_vehicle or self.spreads_vehicle:
+                vehicles = nominal.replace(**{k: cols[k] for names in SPREADS.values() for k in names})
         return Draw(vehicle=vehicles, offsets=offsets, environment=env, sensors=self.noise, columns=cols)
 
     def _rotor_vehicles(self, nominal: RotorVehicle, z: np.ndarray) -> tuple[tuple, dict]:

@@ -27,6 +27,18 @@ rounding (the tests check it).
 - :func:`same_period`: the Dryden filters' coefficients are kept while the control period
   stays the same up to the grid's rounding. Plain: computed afresh every period.
 
+- :class:`DirectCall`: a kernel that a caller flies again and again with the same arrays (a
+  :class:`~quadcruise.sim.stepper.Stepper`'s step) is called through its compiled entry point,
+  once numba's dispatcher has checked those very arguments. Plain: ``kernel(first, stop,
+  *args)``, where the dispatcher types all 30-odd arguments at every call (about 40 us).
+
+- :func:`seed_sequence_words` and :func:`seeded_draws`: the words of
+  ``numpy.random.SeedSequence([seed, i], spawn_key)`` computed for many ``i`` in one compiled
+  call, NumPy's hashing restated, and a vehicle's draws taken from one reused PCG64 generator
+  set to the state that words seed (about 4 us a vehicle, not 12). Plain:
+  ``np.random.default_rng(np.random.SeedSequence([seed, i], spawn_key=(key,)))`` per vehicle.
+  Bit for bit the same (tests/unit/test_fastmath_seeds.py); an environment's reset draws them.
+
 Three more are ways of arranging code, not formulas, so they stay where they act:
 
 - Own copies (``sim.engine._kernel``): a vehicle's controller memory, disturbance memory
@@ -48,11 +60,23 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from quadcruise.sim.rng import ziggurat
 
-__all__ = ["turned", "SMALL_TURN", "SHORT_TURN", "TRIG_REFRESH", "five_normals", "same_period", "DT_TOLERANCE"]
+__all__ = [
+    "DirectCall",
+    "seed_sequence_words",
+    "seeded_draws",
+    "turned",
+    "SMALL_TURN",
+    "SHORT_TURN",
+    "TRIG_REFRESH",
+    "five_normals",
+    "same_period",
+    "DT_TOLERANCE",
+]
 
 SMALL_TURN = 0.03
 """Largest change of an angle over an RK4 stage [rad] for which :func:`turned` uses the
@@ -168,3 +192,186 @@ def same_period(cached, dt):
         True when they differ by at most ``DT_TOLERANCE`` relative.
     """
     return abs(cached - dt) <= DT_TOLERANCE * dt
+
+
+class DirectCall:
+    """``kernel(first, stop, *args)`` through the compiled entry point while ``args`` are the
+    very objects of the last call the dispatcher checked; through the dispatcher otherwise.
+
+    The entry point unboxes its arguments by the kernel's one signature without checking
+    their types, so it is taken only for the same objects (an array keeps its dtype and
+    layout, whatever is written into it); new objects go through the dispatcher, which
+    refuses a wrong type, and become the checked ones. Plain: ``kernel(first, stop, *args)``.
+
+    Parameters
+    ----------
+    kernel : numba Dispatcher
+        A kernel compiled for one explicit signature.
+    """
+
+    def __init__(self, kernel) -> None:
+        self.kernel = kernel
+        self.entry = kernel.overloads[kernel.signatures[0]].entry_point
+        self.checked: tuple = ()
+
+    def __call__(self, first: int, stop: int, *args) -> None:
+        checked = self.checked
+        if len(args) == len(checked) and all(a is b for a, b in zip(args, checked, strict=True)):
+            self.entry(first, stop, *args)
+            return
+        self.kernel(first, stop, *args)
+        self.checked = args
+
+
+# NumPy's SeedSequence (numpy/random/bit_generator.pyx), on 32-bit words held in uint64
+_U = np.uint64
+_M32, _SHIFT, _WORD = _U(0xFFFFFFFF), _U(16), _U(32)
+_INIT_A, _MULT_A, _INIT_B, _MULT_B = _U(0x43B0D7E5), _U(0x931E8875), _U(0x8B51F9DD), _U(0x58F38DED)
+_MIX_L, _MIX_R = _U(0xCA01F9DD), _U(0x4973F715)
+_POOL = 4
+
+
+@njit(cache=True)
+def _hashmix(value, h):
+    value = ((value ^ h) * ((h * _MULT_A) & _M32)) & _M32
+    return value ^ (value >> _SHIFT), (h * _MULT_A) & _M32
+
+
+@njit(cache=True)
+def _mix(x, y):
+    r = (_MIX_L * x - _MIX_R * y) & _M32
+    return r ^ (r >> _SHIFT)
+
+
+@njit(cache=True)
+def _seed_words(seed_words, ids, spawn_key, out):
+    """Row r of ``out``: ``SeedSequence([seed, ids[r]], spawn_key=(spawn_key,)).generate_state(W,
+    uint64)`` (no spawn key when it is < 0), ``seed_words`` the seed's 32-bit words."""
+    entropy = np.zeros(seed_words.shape[0] + 6, dtype=np.uint64)
+    pool = np.zeros(_POOL, dtype=np.uint64)
+    for r in range(ids.shape[0]):
+        n = 0
+        for w in seed_words:
+            entropy[n] = w
+            n += 1
+        i = ids[r]
+        entropy[n] = i & _M32  # an index's words, least significant first; 0 is one word
+        n += 1
+        i >>= _WORD
+        while i > 0:
+            entropy[n] = i & _M32
+            n += 1
+            i >>= _WORD
+        if spawn_key >= 0:
+            while n < _POOL:  # the run's entropy is padded to the pool before a spawn key
+                entropy[n] = 0
+                n += 1
+            entropy[n] = spawn_key
+            n += 1
+        h = _INIT_A
+        for k in range(_POOL):
+            pool[k], h = _hashmix(entropy[k] if k < n else _U(0), h)
+        for src in range(_POOL):
+            for dst in range(_POOL):
+                if src != dst:
+                    v, h = _hashmix(pool[src], h)
+                    pool[dst] = _mix(pool[dst], v)
+        for src in range(_POOL, n):
+            for dst in range(_POOL):
+                v, h = _hashmix(entropy[src], h)
+                pool[dst] = _mix(pool[dst], v)
+        h = _INIT_B
+        for k in range(out.shape[1]):
+            half = np.zeros(2, dtype=np.uint64)
+            for j in range(2):
+                v = pool[(2 * k + j) % _POOL] ^ h
+                h = (h * _MULT_B) & _M32
+                v = (v * h) & _M32
+                half[j] = v ^ (v >> _SHIFT)
+            out[r, k] = half[0] | (half[1] << _WORD)
+
+
+def seed_sequence_words(seed: int, ids, spawn_key: int | None, n_words: int) -> np.ndarray:
+    """``np.random.SeedSequence([seed, i], spawn_key=(spawn_key,)).generate_state(n_words, np.uint64)``
+    for each ``i`` of ``ids``, bit for bit, in one compiled call.
+
+    Parameters
+    ----------
+    seed : int
+        >= 0.
+    ids : array_like of int
+        The indices i, >= 0 and < 2**64.
+    spawn_key : int or None
+        One spawn key (>= 0, < 2**32), or None for none.
+    n_words : int
+        64-bit words per index.
+
+    Returns
+    -------
+    numpy.ndarray
+        (len(ids), n_words) uint64.
+
+    Raises
+    ------
+    ValueError
+        A negative seed or index (as SeedSequence).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> w = seed_sequence_words(7, [3, 2**40], 1, 2)
+    >>> bool((w[1] == np.random.SeedSequence([7, 2**40], spawn_key=(1,)).generate_state(2, np.uint64)).all())
+    True
+    """
+    seed = int(seed)
+    if not (isinstance(ids, np.ndarray) and ids.dtype.kind in "iu"):  # Python ints, some beyond int64
+        ids = np.array([int(i) for i in np.ravel(np.asarray(ids, dtype=object))], dtype=object)
+    ids = ids.ravel()
+    if seed < 0 or (ids.size and ids.min() < 0):
+        raise ValueError(f"seed and indices must be >= 0, got seed {seed}, indices from {ids.min(initial=0)}")
+    words = [seed & 0xFFFFFFFF]
+    seed >>= 32
+    while seed:
+        words.append(seed & 0xFFFFFFFF)
+        seed >>= 32
+    ids = np.array(ids.tolist(), dtype=np.uint64) if ids.dtype == object else ids.astype(np.uint64)
+    out = np.empty((ids.shape[0], int(n_words)), dtype=np.uint64)
+    _seed_words(np.array(words, dtype=np.uint64), ids, -1 if spawn_key is None else int(spawn_key), out)
+    return out
+
+
+_PCG_MULT = 0x2360ED051FC65DA44385DF649FCCF645
+_M128 = (1 << 128) - 1
+
+
+def seeded_draws(seed: int, ids, spawn_key: int, size: int, normal: bool) -> np.ndarray:
+    """Row r: ``np.random.default_rng(np.random.SeedSequence([seed, ids[r]],
+    spawn_key=(spawn_key,)))`` 's ``standard_normal(size)`` (or ``random(size)``), bit for bit.
+
+    Each row's PCG64 state is set from the words as ``numpy.random.PCG64`` seeds itself
+    (pcg_setseq_128_srandom_r: state 0, inc = 2 seq + 1, a step, state += seed, a step).
+
+    Parameters
+    ----------
+    seed, ids, spawn_key
+        As :func:`seed_sequence_words`.
+    size : int
+        Draws per row.
+    normal : bool
+        Standard normal draws; else uniform on [0, 1).
+
+    Returns
+    -------
+    numpy.ndarray
+        (len(ids), size) float64.
+    """
+    words = seed_sequence_words(seed, ids, spawn_key, 4)
+    bits = np.random.PCG64(0)
+    generator = np.random.Generator(bits)
+    out = np.empty((words.shape[0], int(size)))
+    for r, (s_hi, s_lo, i_hi, i_lo) in enumerate(words.tolist()):
+        inc = (((i_hi << 64) | i_lo) << 1 | 1) & _M128
+        state = ((inc + ((s_hi << 64) | s_lo)) * _PCG_MULT + inc) & _M128
+        bits.state = {"bit_generator": "PCG64", "state": {"state": state, "inc": inc}, "has_uint32": 0, "uinteger": 0}
+        out[r] = generator.standard_normal(size) if normal else generator.random(size)
+    return out

@@ -38,12 +38,12 @@ from numba.core.types.function_type import CompileResultWAP
 
 from quadcruise.errors import InputError
 from quadcruise.layout import CMD_SIZE, CONTROLLER_SIG, DISTURBANCE_SIG, MISSION_SIG, REF_SIZE, STATE_SIZE
-from quadcruise.sim.engine import fly_vehicles, still_air
+from quadcruise.sim.engine import direct_kernel, fly_vehicles, still_air
 from quadcruise.sim.inputs import Limits, batch_inputs, fresh_carry
 from quadcruise.sim.kernel_args import KernelArgs
 from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.rotor_batch import rotor_inputs
-from quadcruise.sim.rotor_flight import fly_rotor_pieces, paper_states, rotor_carry_width
+from quadcruise.sim.rotor_flight import direct_rotor_kernel, fly_rotor_pieces, paper_states, rotor_carry_width
 from quadcruise.sim.status import ExitStatus
 
 STEP_PIECES_PER_THREAD = 1
@@ -251,6 +251,7 @@ class Stepper:
         )
         self.disturbance = compiled_address(disturbance or still_air, DISTURBANCE_SIG)
         self.disturbed = disturbance is not None
+        self._kernel = direct_rotor_kernel() if self.rotor else direct_kernel()  # sim/fastmath.py
 
     @property
     def paper_state(self) -> np.ndarray:
@@ -434,6 +435,7 @@ class Stepper:
             ),
             pieces_per_thread,
             after_piece,
+            self._kernel,
         )
 
     def _step_rotor(self, pieces_per_thread: int, after_piece) -> None:
@@ -479,6 +481,7 @@ class Stepper:
             ),
             pieces_per_thread,
             after_piece,
+            self._kernel,
         )
 
 
