@@ -6,7 +6,9 @@ with ``log_every=1000`` (checks on the 11 logged instants), each call in a fresh
 alternating order (A B B A ...), and reports per call the wall time, the CPU time of the process
 during the call, its peak resident memory (``ru_maxrss``: the whole process, imports included)
 and the load average; then each variant's best and median and the ratio default / 1000.
-``--full`` adds ``log_every=1`` (the whole log: about 6.2 GB at the default size).
+``--full`` adds ``log_every=1`` (the whole log: about 6.2 GB at the default size). ``--chunk
+STEPS:PIECES`` (repeatable) adds the default call with other chunk sizes (``sim.chunked``'s
+``CHUNK_VEHICLE_STEPS`` and ``PIECES_PER_THREAD``), to choose them.
 
 Target (issue 26): the default costs at most 1.5 x the ``log_every=1000`` call, and its log
 stays within 1 GiB.
@@ -40,7 +42,12 @@ def child(variant: str, n: int, duration: float) -> dict:
 
     import quadcruise as qc
 
-    every = VARIANTS[variant]
+    if variant.startswith("chunk"):
+        import quadcruise.sim.chunked as chunked
+
+        steps, pieces = variant[len("chunk") :].split(":")
+        chunked.CHUNK_VEHICLE_STEPS, chunked.PIECES_PER_THREAD = int(steps), int(pieces)
+    every = VARIANTS.get(variant)
     kwargs = {} if every is None else {"log_every": every}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -81,13 +88,14 @@ def main(argv=None) -> int:
     ap.add_argument("--n", type=int, default=2000)
     ap.add_argument("--duration", type=float, default=10.0)
     ap.add_argument("--full", action="store_true", help="also log_every=1 (needs about 6.5 GB at the default size)")
+    ap.add_argument("--chunk", action="append", default=[], metavar="STEPS:PIECES", help="also these chunk sizes")
     ap.add_argument("--json", help="write the calls and the summary here")
     ap.add_argument("--child", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
         print(json.dumps(child(args.child, args.n, args.duration)))
         return 0
-    names = ["default", "every1000"] + (["full"] if args.full else [])
+    names = ["default", "every1000"] + (["full"] if args.full else []) + [f"chunk{c}" for c in args.chunk]
     print(f"qc.fly('circle', n={args.n}, duration={args.duration}): {args.rounds} rounds, load {os.getloadavg()}")
     calls = []
     for r in range(args.rounds):

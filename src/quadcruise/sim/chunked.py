@@ -54,8 +54,8 @@ def simulate_watched(
     watch: Callable[[int, int, int, np.ndarray, np.ndarray], None],
     log_every: int = 1,
     meta: dict | None = None,
-    chunk_vehicle_steps: int = CHUNK_VEHICLE_STEPS,
-    pieces_per_thread: int = PIECES_PER_THREAD,
+    chunk_vehicle_steps: int | None = None,
+    pieces_per_thread: int | None = None,
     **options,
 ) -> SimResult:
     """:func:`~quadcruise.sim.engine.simulate`, flown in chunks, with every instant's state and
@@ -76,11 +76,11 @@ def simulate_watched(
         Keep every this many periods in the result (a divisor of the grid's periods).
     meta : dict, optional
         Recorded in the result.
-    chunk_vehicle_steps : int
-        Vehicles x periods per chunk.
-    pieces_per_thread : int
+    chunk_vehicle_steps : int, optional
+        Vehicles x periods per chunk; :data:`CHUNK_VEHICLE_STEPS` by default.
+    pieces_per_thread : int, optional
         Ranges of vehicles per thread and chunk, each watched and logged by its thread right
-        after it is flown.
+        after it is flown; :data:`PIECES_PER_THREAD` by default.
     **options
         The other keywords of :func:`~quadcruise.sim.engine.simulate` (``memory``, ``vp_ctrl``,
         ``disturbance``, ``disturbance_params``, ``disturbance_memory``, ``seed``,
@@ -94,6 +94,8 @@ def simulate_watched(
     """
     n_periods = np.shape(t_grid)[0] - 1
     n = np.shape(vp)[0]
+    chunk_vehicle_steps = chunk_vehicle_steps or CHUNK_VEHICLE_STEPS  # read at the call (benchmarks/batchlog.py)
+    pieces_per_thread = pieces_per_thread or PIECES_PER_THREAD
     periods = int(max(1, min(n_periods, chunk_vehicle_steps // max(n, 1))))
     s = Stepper(t_grid, x0, vp, controller, gains, mission, mp, periods=periods, **options)
     t_grid = s.t_grid
