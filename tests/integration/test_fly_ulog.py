@@ -166,3 +166,19 @@ def test_compare_writes_one_log_per_controller(tmp_path):
     assert flown.exit_code == 0, flown.output
     assert (tmp_path / "c-se3.ulg").read_bytes() == (tmp_path / "fly-se3.ulg").read_bytes()
     assert (tmp_path / "c-nlpd.ulg").read_bytes() != (tmp_path / "c-se3.ulg").read_bytes()
+
+
+def test_compare_records_its_logs_and_its_scenario_writes_them_again(tmp_path):
+    """``compare --ulog --out``: scenario.toml names the logs; compare of it writes the same bytes."""
+    args = ("compare", "step", "--controllers", "nlpd,se3", "--duration", "1")
+    result = run(*args, "--ulog", tmp_path / "c.ulg", "--out", tmp_path / "out")
+    assert result.exit_code == 0, result.output
+    scenario = (tmp_path / "out" / "scenario.toml").read_text()
+    assert f"--ulog {tmp_path / 'c.ulg'}` writes the same bytes again" in scenario
+    assert str(tmp_path / "c-se3.ulg") in scenario
+    again = run("compare", tmp_path / "out" / "scenario.toml", "--ulog", tmp_path / "again.ulg")
+    assert again.exit_code == 0, again.output
+    for label in ("nlpd", "se3"):
+        assert (tmp_path / f"again-{label}.ulg").read_bytes() == (tmp_path / f"c-{label}.ulg").read_bytes()
+    plain = run(*args, "--out", tmp_path / "plain")  # without --ulog, no word of a log
+    assert plain.exit_code == 0 and "ulog" not in (tmp_path / "plain" / "scenario.toml").read_text()

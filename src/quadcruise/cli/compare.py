@@ -191,7 +191,10 @@ def compare(
         table = echo_population_comparison(cmp_mission, cmp.controllers, count, pop_seed, pop, kwargs)
         cmp = dataclasses.replace(cmp, population=population_record(count, pop_seed, pop), population_table=table)
     if ulog is not None:
-        click.echo("wrote PX4 logs " + ", ".join(map(str, write_comparison_ulogs(cmp, ulog))))
+        written = write_comparison_ulogs(cmp, ulog)
+        click.echo("wrote PX4 logs " + ", ".join(map(str, written)))
+        for result in cmp.results.values():  # said in scenario.toml, as fly's is
+            result.meta["ulog"] = {"path": str(ulog), "files": [str(p) for p in written]}
     if out is not None:
         cmp.write(out, force=force, **conventions)
         click.echo(f"wrote metrics.csv and comparison.png to {out}")

@@ -278,9 +278,14 @@ class Comparison:
         doc = comparison_document(first.meta, records)
         if self.population:
             doc["compare"]["population"] = plain(self.population)
-        return scenario_text(
-            doc, header=("written by quadcruise from a comparison; `quadcruise compare THIS_FILE` flies it again")
-        )
+        header = "written by quadcruise from a comparison; `quadcruise compare THIS_FILE` flies it again"
+        if first.meta.get("ulog"):
+            logs = first.meta["ulog"]
+            header += (
+                f"\nwritten as PX4 logs too ({', '.join(logs['files'])}): "
+                f"`quadcruise compare THIS_FILE --ulog {logs['path']}` writes the same bytes again"
+            )
+        return scenario_text(doc, header=header)
 
     @staticmethod
     def _rows(table) -> dict:
