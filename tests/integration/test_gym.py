@@ -94,9 +94,12 @@ def test_autoreset_is_per_vehicle():
             break
     assert terminated.tolist() == [False, True, False] and not truncated.any()
     assert info["status"][1] == int(ExitStatus.LOST_TRACK) and reward[1] == 0.0
+    assert info["episode_return"][1] > 0.0 and info["t"][1] > 0.0  # the ended episode's, at its last step
     t_before = env.stepper.time.copy()
     obs, reward, terminated, truncated, info = env.step(push)
     assert env.stepper.period[1] == 0 and reward[1] == 0.0 and not terminated[1]  # restarted
+    assert info["status"][1] == int(ExitStatus.FINISHED) and info["t"][1] == 0.0  # the new episode's info
+    assert info["episode_return"][1] == 0.0 and info["episode_return"][0] > 0.0
     assert np.linalg.norm(obs[1, :3]) < 2.0  # back near its reference
     assert np.allclose(env.stepper.time[[0, 2]], t_before[[0, 2]] + env.dt)  # the others flew on
     for _ in range(200):
