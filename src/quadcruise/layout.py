@@ -1,7 +1,7 @@
 """The engine's data layout: named columns of the state, reference and command vectors,
 the compiled signatures that controllers and missions must have, and :class:`Row`, the one
-declaration of every packed row (a controller's gains and memory, a disturbance's parameters
-and memory).
+declaration of every packed row (these vectors, the vehicle parameters and external inputs,
+a controller's gains and memory, a disturbance's parameters and memory).
 
 Everything the compiled engine touches is a flat ``float64`` vector (one vehicle) or a
 2-D array with a leading batch axis (N vehicles). The names below are the column indices;
@@ -120,97 +120,69 @@ class Row:
 
 # --- state: 16 columns -------------------------------------------------------------
 # position and velocity in the earth frame (z up), the paper's Euler angles and body
-# rates, and the four rotor thrusts (the actuator state).
-X, Y, Z, VX, VY, VZ, PHI, THETA, PSI, P, Q, R, F1, F2, F3, F4 = range(16)
-STATE_SIZE = 16
-STATE_NAMES = (
-    "x",
-    "y",
-    "z",
-    "vx",
-    "vy",
-    "vz",
-    "phi",
-    "theta",
-    "psi",
-    "p",
-    "q",
-    "r",
-    "F1",
-    "F2",
-    "F3",
-    "F4",
-)
-STATE_UNITS = (
-    "m",
-    "m",
-    "m",
-    "m/s",
-    "m/s",
-    "m/s",
-    "rad",
-    "rad",
-    "rad",
-    "rad/s",
-    "rad/s",
-    "rad/s",
-    "N",
-    "N",
-    "N",
-    "N",
-)
+# rates, and the four rotor thrusts (the actuator state): each column's name and unit.
+_STATE_UNITS = {
+    "x": "m",
+    "y": "m",
+    "z": "m",
+    "vx": "m/s",
+    "vy": "m/s",
+    "vz": "m/s",
+    "phi": "rad",
+    "theta": "rad",
+    "psi": "rad",
+    "p": "rad/s",
+    "q": "rad/s",
+    "r": "rad/s",
+    "F1": "N",
+    "F2": "N",
+    "F3": "N",
+    "F4": "N",
+}
+STATE = Row.of("state", *_STATE_UNITS)
+X, Y, Z, VX, VY, VZ, PHI, THETA, PSI, P, Q, R, F1, F2, F3, F4 = STATE.offsets
+STATE_SIZE = STATE.size
+STATE_NAMES = STATE.names
+STATE_UNITS = tuple(_STATE_UNITS[name] for name in STATE_NAMES)
 
 # --- reference: 11 columns -----------------------------------------------------------
 # what a mission asks for at time t: position, velocity, acceleration, yaw and yaw rate.
-(REF_X, REF_Y, REF_Z, REF_VX, REF_VY, REF_VZ, REF_AX, REF_AY, REF_AZ, REF_PSI, REF_PSI_DOT) = range(11)
-REF_SIZE = 11
-REF_NAMES = (
-    "x_ref",
-    "y_ref",
-    "z_ref",
-    "vx_ref",
-    "vy_ref",
-    "vz_ref",
-    "ax_ref",
-    "ay_ref",
-    "az_ref",
-    "psi_ref",
-    "psi_dot_ref",
-)
+# Tables name the columns ``x_ref``, ..., ``psi_dot_ref``.
+REFERENCE = Row.of("reference", "x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az", "psi", "psi_dot", prefix="REF_")
+REF_X, REF_Y, REF_Z, REF_VX, REF_VY, REF_VZ, REF_AX, REF_AY, REF_AZ, REF_PSI, REF_PSI_DOT = REFERENCE.offsets
+REF_SIZE = REFERENCE.size
+REF_NAMES = tuple(f"{name}_ref" for name in REFERENCE.names)
 
 # --- command: 12 columns -------------------------------------------------------------
 # what a controller returns each control period. Only the four duties drive the plant;
 # the rest is for logging and metrics. The engine clips the duties to [0, 1] and counts
 # the periods in which it had to (never silently).
+COMMAND = Row.of(
+    "command",
+    *("u1", "u2", "u3", "u4"),  # PWM duties asked of rotors 1..4 [-]
+    *("thrust", "tau_phi", "tau_theta", "tau_psi"),  # desired U1 [N], U2 [N], U3 [N], U4 [N m]
+    *("phi_d", "theta_d", "psi_d"),  # attitude setpoints [rad]
+    "flags",  # controller saturation bit mask
+    prefix="CMD_",
+)
 (
     CMD_U1,
     CMD_U2,
     CMD_U3,
-    CMD_U4,  # PWM duties asked of rotors 1..4 [-]
+    CMD_U4,
     CMD_THRUST,
     CMD_TAU_PHI,
     CMD_TAU_THETA,
-    CMD_TAU_PSI,  # desired U1 [N], U2 [N], U3 [N], U4 [N m]
+    CMD_TAU_PSI,
     CMD_PHI_D,
     CMD_THETA_D,
-    CMD_PSI_D,  # attitude setpoints [rad]
+    CMD_PSI_D,
     CMD_FLAGS,
-) = range(12)  # controller saturation bit mask
-CMD_SIZE = 12
-CMD_NAMES = (
-    "u1",
-    "u2",
-    "u3",
-    "u4",
-    "U1_d",
-    "U2_d",
-    "U3_d",
-    "U4_d",
-    "phi_d",
-    "theta_d",
-    "psi_d",
-    "flags",
-)
+) = COMMAND.offsets
+CMD_SIZE = COMMAND.size
+_CMD_TABLE_NAMES = {"thrust": "U1_d", "tau_phi": "U2_d", "tau_theta": "U3_d", "tau_psi": "U4_d"}
+CMD_NAMES = tuple(_CMD_TABLE_NAMES.get(name, name) for name in COMMAND.names)
+"""The columns' names in tables: the field's, but U1_d..U4_d for the desired thrust and moments."""
 
 # Bits a controller may set in cmd[CMD_FLAGS]; the engine counts periods with any bit set.
 FLAG_TILT_LIMIT = 1  # a roll/pitch setpoint was limited to the tilt limit
@@ -222,6 +194,13 @@ FLAG_INTEGRATOR_HOLD = 8  # anti-windup held an integrator
 # The physical parameters; k1..k6 (Section III of the paper) are derived from them when the
 # row is built, and so are 1/m and 1/J, so the compiled step never divides; then the drag
 # coefficients.
+PARAMS = Row.of(
+    "vehicle parameters",
+    *("m", "jxx", "jyy", "jzz", "l", "k", "omega", "d", "g"),
+    *("k1", "k2", "k3", "k4", "k5", "k6", "cd1", "cd2"),
+    *("inv_m", "inv_jxx", "inv_jyy", "inv_jzz"),
+    prefix="P_",
+)
 (
     P_M,
     P_JXX,
@@ -244,8 +223,8 @@ FLAG_INTEGRATOR_HOLD = 8  # anti-windup held an integrator
     P_INV_JXX,
     P_INV_JYY,
     P_INV_JZZ,
-) = range(21)
-PARAM_SIZE = 21
+) = PARAMS.offsets
+PARAM_SIZE = PARAMS.size
 
 # --- compiled signatures ---------------------------------------------------------------
 _f8 = types.float64
@@ -269,8 +248,13 @@ MissionType = types.FunctionType(MISSION_SIG)
 # force in the earth frame [N], a torque in the body frame [N m], the wind velocity in the
 # earth frame [m/s] (it acts through the vehicle's drag) and each rotor's effectiveness
 # (1 = healthy, 0.7 = lost 30 % of its thrust).
-(EXT_FX, EXT_FY, EXT_FZ, EXT_TX, EXT_TY, EXT_TZ, EXT_WX, EXT_WY, EXT_WZ, EXT_E1, EXT_E2, EXT_E3, EXT_E4) = range(13)
-EXT_SIZE = 13
+EXTERNAL = Row.of(
+    "external inputs", "fx", "fy", "fz", "tx", "ty", "tz", "wx", "wy", "wz", "e1", "e2", "e3", "e4", prefix="EXT_"
+)
+EXT_FX, EXT_FY, EXT_FZ, EXT_TX, EXT_TY, EXT_TZ, EXT_WX, EXT_WY, EXT_WZ, EXT_E1, EXT_E2, EXT_E3, EXT_E4 = (
+    EXTERNAL.offsets
+)
+EXT_SIZE = EXTERNAL.size
 
 #: ``disturbance(t, dt, x, dp, dmem, rng, ext) -> None``: writes the external inputs held
 #: over [t, t + dt] into ext (EXT_SIZE). dp: its parameters; dmem: its state (e.g. the

@@ -263,3 +263,19 @@ def test_compiled_controller_reads_its_rows_at_constant_offsets(name, gains, mem
     size = controller_from_name(name).gains().size
     assert row_offsets(function, CONTROLLER_SIG, gains) == (set(range(1, size)), 0)
     assert row_offsets(function, CONTROLLER_SIG, "mem") == (set(range(1, memory)), 0)
+
+
+@pytest.mark.parametrize("name", ["nlpd", "gonzalez", "se3", "cascade"])
+def test_compiled_controller_reads_the_engine_vectors_at_constant_offsets(name):
+    """The controllers read the state, reference and vehicle parameters and write the command
+    through quadcruise.layout's module-level ints (imported as the module: ``x[L.PHI]``), which
+    numba folds like imported names: every entry is reached at a constant offset, none through
+    an index computed at run time."""
+    from quadcruise.layout import CMD_SIZE, CONTROLLER_SIG, PARAM_SIZE, REF_SIZE, STATE_SIZE
+    from support.compiled_code import row_offsets
+
+    function = controller_from_name(name).function.py_func
+    for argument, size in (("x", STATE_SIZE), ("ref", REF_SIZE), ("vp", PARAM_SIZE), ("cmd", CMD_SIZE)):
+        constant, computed = row_offsets(function, CONTROLLER_SIG, argument)
+        assert computed == 0 and constant and constant <= set(range(1, size)), (argument, constant, computed)
+    assert row_offsets(function, CONTROLLER_SIG, "cmd")[0] == set(range(1, CMD_SIZE))  # the whole command

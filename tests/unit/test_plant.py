@@ -87,3 +87,20 @@ def test_matches_independent_model_pointwise():
         dx = np.empty(STATE_SIZE)
         derivative(x, u, vp, still_air_ext(), False, dx)
         np.testing.assert_allclose(dx, rhs(x, u), rtol=1e-13, atol=1e-13)
+
+
+def test_the_compiled_derivative_reaches_its_rows_at_constant_offsets():
+    """The plant reads the state, vehicle parameters and external inputs through quadcruise.layout's
+    module-level ints (``x[L.VX]``), which numba folds: each row is addressed at constant offsets
+    only, and the whole derivative is written."""
+    from numba import types
+
+    from quadcruise.layout import EXT_SIZE, PARAM_SIZE
+    from support.compiled_code import row_offsets
+
+    row = types.float64[::1]
+    signature = types.void(row, row, row, row, types.boolean, row)
+    for argument, size in (("x", STATE_SIZE), ("vp", PARAM_SIZE), ("ext", EXT_SIZE), ("dx", STATE_SIZE)):
+        constant, computed = row_offsets(derivative.py_func, signature, argument)
+        assert computed == 0 and constant and constant <= set(range(1, size)), (argument, constant, computed)
+    assert row_offsets(derivative.py_func, signature, "dx")[0] == set(range(1, STATE_SIZE))

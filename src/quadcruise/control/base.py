@@ -18,17 +18,8 @@ from typing import Any, ClassVar
 import numpy as np
 from numba import njit
 
+from quadcruise import layout as L
 from quadcruise.fields import Validated, between
-from quadcruise.layout import (
-    CMD_FLAGS,
-    CMD_PHI_D,
-    CMD_PSI_D,
-    CMD_TAU_PHI,
-    CMD_TAU_PSI,
-    CMD_TAU_THETA,
-    CMD_THETA_D,
-    CMD_THRUST,
-)
 from quadcruise.model.actuators import duties
 
 TILT = between(0.0, math.pi / 2, "()", text="(0, pi/2)")
@@ -108,6 +99,6 @@ def write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags, d, K):
     """
     u1, u2, u3, u4 = duties(U1, U2, U3, U4, d, K)
     cmd[0], cmd[1], cmd[2], cmd[3] = u1, u2, u3, u4
-    cmd[CMD_THRUST], cmd[CMD_TAU_PHI], cmd[CMD_TAU_THETA], cmd[CMD_TAU_PSI] = U1, U2, U3, U4
-    cmd[CMD_PHI_D], cmd[CMD_THETA_D], cmd[CMD_PSI_D] = phi_d, theta_d, psi_d
-    cmd[CMD_FLAGS] = flags
+    cmd[L.CMD_THRUST], cmd[L.CMD_TAU_PHI], cmd[L.CMD_TAU_THETA], cmd[L.CMD_TAU_PSI] = U1, U2, U3, U4
+    cmd[L.CMD_PHI_D], cmd[L.CMD_THETA_D], cmd[L.CMD_PSI_D] = phi_d, theta_d, psi_d
+    cmd[L.CMD_FLAGS] = flags

@@ -59,6 +59,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from quadcruise import layout as L
 from quadcruise.control.attitude import ATTITUDE_GAINS, ATTITUDE_MEMORY, attitude_fields
 from quadcruise.control.base import TILT, Controller
 from quadcruise.control.design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
@@ -66,31 +67,8 @@ from quadcruise.control.inversion import thrust_for_tilt, tilt_setpoint
 from quadcruise.control.position import finish
 from quadcruise.fields import instance_of
 from quadcruise.fields import unit_field as _f
-from quadcruise.layout import (
-    CONTROLLER_SIG,
-    P_G,
-    P_K,
-    P_M,
-    PHI,
-    PSI,
-    REF_PSI,
-    REF_VX,
-    REF_VY,
-    REF_VZ,
-    REF_X,
-    REF_Y,
-    REF_Z,
-    THETA,
-    VX,
-    VY,
-    VZ,
-    Row,
-    X,
-    Y,
-    Z,
-)
 
-GONZALEZ_GAINS = Row.of(
+GONZALEZ_GAINS = L.Row.of(
     "gonzalez gains",
     "kp_xy",
     "kd_xy",
@@ -129,7 +107,7 @@ def saturated_pd(e, ev, kp, kd, ap, ad):
     return ap * math.tanh(kp * e / ap) + ad * math.tanh(kd * ev / ad)
 
 
-@njit(CONTROLLER_SIG, cache=True, error_model="numpy")
+@njit(L.CONTROLLER_SIG, cache=True, error_model="numpy")
 def gonzalez(t, dt, x, ref, vp, gains, mem, cmd):
     """One period of :class:`Gonzalez`: saturated PD, small-angle mapping, decoupled PID.
     Arguments: ``CONTROLLER_SIG`` (:mod:`quadcruise.layout`); gains at the offsets of :data:`GONZALEZ_GAINS`.
@@ -147,16 +125,18 @@ def gonzalez(t, dt, x, ref, vp, gains, mem, cmd):
     0.0306
     """
     kp, kd, ap, ad, tilt = gains[GZ_KP_XY], gains[GZ_KD_XY], gains[GZ_SAT_P], gains[GZ_SAT_D], gains[GZ_MAX_TILT]
-    spsi, cpsi = math.sin(x[PSI]), math.cos(x[PSI])
-    ex, ey, evx, evy = ref[REF_X] - x[X], ref[REF_Y] - x[Y], ref[REF_VX] - x[VX], ref[REF_VY] - x[VY]
+    spsi, cpsi = math.sin(x[L.PSI]), math.cos(x[L.PSI])
+    ex, ey, evx, evy = ref[L.REF_X] - x[L.X], ref[L.REF_Y] - x[L.Y], ref[L.REF_VX] - x[L.VX], ref[L.REF_VY] - x[L.VY]
     uf = saturated_pd(cpsi * ex + spsi * ey, cpsi * evx + spsi * evy, kp, kd, ap, ad)  # forward
     ul = saturated_pd(cpsi * ey - spsi * ex, cpsi * evy - spsi * evx, kp, kd, ap, ad)  # left
-    uz = gains[GZ_KP_Z] * (ref[REF_Z] - x[Z]) + gains[GZ_KD_Z] * (ref[REF_VZ] - x[VZ])
-    g = vp[P_G]
-    U1, flags = thrust_for_tilt(uz, math.cos(x[PHI]) * math.cos(x[THETA]), vp[P_M], g, vp[P_K], gains[GZ_COS_MAX_TILT])
+    uz = gains[GZ_KP_Z] * (ref[L.REF_Z] - x[L.Z]) + gains[GZ_KD_Z] * (ref[L.REF_VZ] - x[L.VZ])
+    g = vp[L.P_G]
+    U1, flags = thrust_for_tilt(
+        uz, math.cos(x[L.PHI]) * math.cos(x[L.THETA]), vp[L.P_M], g, vp[L.P_K], gains[GZ_COS_MAX_TILT]
+    )
     theta_d, flags = tilt_setpoint(uf / g, False, tilt, flags)  # eq (5), small angle, yaw frame
     phi_d, flags = tilt_setpoint(-ul / g, False, tilt, flags)  # eq (6), small angle, yaw frame
-    finish(U1, phi_d, theta_d, ref[REF_PSI], flags, dt, x, vp, gains, mem, cmd)
+    finish(U1, phi_d, theta_d, ref[L.REF_PSI], flags, dt, x, vp, gains, mem, cmd)
 
 
 @dataclass(frozen=True)

@@ -49,52 +49,15 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from quadcruise import layout as L
 from quadcruise.control.base import TILT, Controller
 from quadcruise.control.design import python_control
 from quadcruise.control.so3 import attitude_px4, command_from_rotation, error_quaternion, limit_tilt, rotation_zyx
 from quadcruise.fields import Validated, between, check_value, instance_of
 from quadcruise.fields import unit_field as _f
-from quadcruise.layout import (
-    CONTROLLER_SIG,
-    FLAG_INTEGRATOR_HOLD,
-    FLAG_THRUST_LIMIT,
-    FLAG_TILT_LIMIT,
-    P_D,
-    P_G,
-    P_JXX,
-    P_JYY,
-    P_JZZ,
-    P_K,
-    P_L,
-    P_M,
-    PHI,
-    PSI,
-    REF_AX,
-    REF_AY,
-    REF_AZ,
-    REF_PSI,
-    REF_PSI_DOT,
-    REF_VX,
-    REF_VY,
-    REF_VZ,
-    REF_X,
-    REF_Y,
-    REF_Z,
-    THETA,
-    VX,
-    VY,
-    VZ,
-    P,
-    Q,
-    R,
-    Row,
-    X,
-    Y,
-    Z,
-)
 from quadcruise.numeric import clamp
 
-CASCADE_GAINS = Row.of(
+CASCADE_GAINS = L.Row.of(
     "cascade gains",
     "pos_xy",
     "pos_z",
@@ -155,7 +118,7 @@ CASCADE_GAINS = Row.of(
     C_VEL_D_LP,
     C_RATE_D_LP,
 ) = CASCADE_GAINS.offsets
-CASCADE_MEMORY = Row.of(
+CASCADE_MEMORY = L.Row.of(
     "cascade memory", ("vi", 3), ("ri", 3), ("v", 3), ("w", 3), ("vd", 3), ("wd", 3), "init", prefix="M_"
 )
 """The memory of :func:`cascade`: velocity integral [m/s^2], rate integral [rad/s^2], last
@@ -213,7 +176,7 @@ def _rate_axis(setpoint, rate, integral, last, state, dt, alpha, first, kp, ki, 
     return out, integral, d, held
 
 
-@njit(CONTROLLER_SIG, cache=True, error_model="numpy")
+@njit(L.CONTROLLER_SIG, cache=True, error_model="numpy")
 def cascade(t, dt, x, ref, vp, G, mem, cmd):
     """One period of :class:`Cascade`: P position, PID velocity, P attitude, PID body rate.
     Arguments: ``CONTROLLER_SIG`` (:mod:`quadcruise.layout`); the law is in the module docstring.
@@ -230,10 +193,10 @@ def cascade(t, dt, x, ref, vp, G, mem, cmd):
     (True, 1.0)
     """
     # every array entry read first, mem and cmd written last (fastmath's scalar-only rule)
-    m, g, K, l, d = vp[P_M], vp[P_G], vp[P_K], vp[P_L], vp[P_D]
-    jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
-    vx, vy, vz, p, q, r = x[VX], x[VY], x[VZ], x[P], x[Q], x[R]
-    phi, theta, psi = x[PHI], x[THETA], x[PSI]
+    m, g, K, l, d = vp[L.P_M], vp[L.P_G], vp[L.P_K], vp[L.P_L], vp[L.P_D]
+    jx, jy, jz = vp[L.P_JXX], vp[L.P_JYY], vp[L.P_JZZ]
+    vx, vy, vz, p, q, r = x[L.VX], x[L.VY], x[L.VZ], x[L.P], x[L.Q], x[L.R]
+    phi, theta, psi = x[L.PHI], x[L.THETA], x[L.PSI]
     vi_x, vi_y, vi_z = mem[M_VI], mem[M_VI + 1], mem[M_VI + 2]
     ri_1, ri_2, ri_3 = mem[M_RI], mem[M_RI + 1], mem[M_RI + 2]
     lv_x, lv_y, lv_z = mem[M_V], mem[M_V + 1], mem[M_V + 2]
@@ -263,35 +226,35 @@ def cascade(t, dt, x, ref, vp, G, mem, cmd):
         G[C_RATE_I_LIM],
     )
     vel_d_lp, rate_d_lp = G[C_VEL_D_LP], G[C_RATE_D_LP]
-    psi_d, yr = ref[REF_PSI], ref[REF_PSI_DOT]
+    psi_d, yr = ref[L.REF_PSI], ref[L.REF_PSI_DOT]
     av = dt / (dt + 1.0 / (2.0 * math.pi * vel_d_lp))
     aw = dt / (dt + 1.0 / (2.0 * math.pi * rate_d_lp))
     flags = 0
     # 1. position P -> velocity setpoint
     vsx, vsy = constrain_xy(
-        k_pos_xy * (ref[REF_X] - x[X]), k_pos_xy * (ref[REF_Y] - x[Y]), ref[REF_VX], ref[REF_VY], vmax_xy
+        k_pos_xy * (ref[L.REF_X] - x[L.X]), k_pos_xy * (ref[L.REF_Y] - x[L.Y]), ref[L.REF_VX], ref[L.REF_VY], vmax_xy
     )
-    vsz, _ = clamp(k_pos_z * (ref[REF_Z] - x[Z]) + ref[REF_VZ], -vmax_down, vmax_up)
+    vsz, _ = clamp(k_pos_z * (ref[L.REF_Z] - x[L.Z]) + ref[L.REF_VZ], -vmax_down, vmax_up)
     # 2. velocity PID -> acceleration -> thrust vector
     ex, ey, ez = vsx - vx, vsy - vy, vsz - vz
     dv_x = _derivative(vx, lv_x, dv_x, dt, av, first)
     dv_y = _derivative(vy, lv_y, dv_y, dt, av, first)
     dv_z = _derivative(vz, lv_z, dv_z, dt, av, first)
-    ax = kv_p_xy * ex + vi_x - kv_d_xy * dv_x + ref[REF_AX]
-    ay = kv_p_xy * ey + vi_y - kv_d_xy * dv_y + ref[REF_AY]
-    az = kv_p_z * ez + vi_z - kv_d_z * dv_z + ref[REF_AZ]
+    ax = kv_p_xy * ex + vi_x - kv_d_xy * dv_x + ref[L.REF_AX]
+    ay = kv_p_xy * ey + vi_y - kv_d_xy * dv_y + ref[L.REF_AY]
+    az = kv_p_z * ez + vi_z - kv_d_z * dv_z + ref[L.REF_AZ]
     hx, hy, tilted = limit_tilt(ax, ay, g, max_tilt)
     if tilted:
-        flags |= FLAG_TILT_LIMIT
+        flags |= L.FLAG_TILT_LIMIT
     n = math.sqrt(hx * hx + hy * hy + g * g)
     b3x, b3y, b3z = hx / n, hy / n, g / n
     u_min, u_max = thr_min * m * g, thr_max * 4.0 * K
     U1, limited = clamp(m * (g + az) / b3z, u_min, u_max)
     if limited:
-        flags |= FLAG_THRUST_LIMIT
+        flags |= L.FLAG_THRUST_LIMIT
         if (U1 == u_min and ez <= 0.0) or (U1 == u_max and ez >= 0.0):
             ez = 0.0  # vertical anti-windup
-            flags |= FLAG_INTEGRATOR_HOLD
+            flags |= L.FLAG_INTEGRATOR_HOLD
     px, py = U1 * b3x / m, U1 * b3y / m  # horizontal acceleration produced
     if ax * ax + ay * ay > px * px + py * py:  # tracking anti-windup
         ex -= 2.0 / kv_p_xy * (ax - px)
@@ -314,7 +277,7 @@ def cascade(t, dt, x, ref, vp, G, mem, cmd):
         sp3, r, ri_3, lw_3, dw_3, dt, aw, first, ky_p, ky_i, ky_d, rate_i_lim * 2.0 * d * K / jz
     )
     if h1 or h2 or h3:
-        flags |= FLAG_INTEGRATOR_HOLD
+        flags |= L.FLAG_INTEGRATOR_HOLD
     mem[M_VI], mem[M_VI + 1], mem[M_VI + 2] = vi_x, vi_y, vi_z
     mem[M_RI], mem[M_RI + 1], mem[M_RI + 2] = ri_1, ri_2, ri_3
     mem[M_V], mem[M_V + 1], mem[M_V + 2] = vx, vy, vz

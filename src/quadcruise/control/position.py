@@ -67,41 +67,15 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from quadcruise import layout as L
 from quadcruise.control.attitude import ATTITUDE_GAINS, ATTITUDE_MEMORY, attitude_fields, decoupled_attitude
 from quadcruise.control.base import TILT, Controller, write_command
 from quadcruise.control.design import PDGains, PIDGains, altitude_pd_design, attitude_pid_design, position_pd_design
 from quadcruise.control.inversion import pitch_eq16, roll_eq19, thrust_for_tilt, tilt_joint, tilt_setpoint
 from quadcruise.fields import instance_of
 from quadcruise.fields import unit_field as _f
-from quadcruise.layout import (
-    CONTROLLER_SIG,
-    P_D,
-    P_G,
-    P_K,
-    P_M,
-    PHI,
-    PSI,
-    REF_AX,
-    REF_AY,
-    REF_AZ,
-    REF_PSI,
-    REF_VX,
-    REF_VY,
-    REF_VZ,
-    REF_X,
-    REF_Y,
-    REF_Z,
-    THETA,
-    VX,
-    VY,
-    VZ,
-    Row,
-    X,
-    Y,
-    Z,
-)
 
-NLPD_GAINS = Row.of(
+NLPD_GAINS = L.Row.of(
     "nlpd gains",
     "kp_xy",
     "kd_xy",
@@ -137,7 +111,7 @@ through the filter N [1/s] of ``filter_n``)."""
 ) = NLPD_GAINS.offsets
 INVERSIONS = ("joint", "sequential")
 DERIVATIVES = ("measurement", "error")
-NLPD_MEMORY = Row.of("nlpd memory", "filter_x", "filter_y", parent=ATTITUDE_MEMORY, prefix="NL_")
+NLPD_MEMORY = L.Row.of("nlpd memory", "filter_x", "filter_y", parent=ATTITUDE_MEMORY, prefix="NL_")
 NL_FILTER_X, NL_FILTER_Y = NLPD_MEMORY.offsets
 """The memory of :func:`nlpd`: the attitude loop's, then the derivative filter's states (the
 filtered x and y errors [m]), there only with ``derivative="error"``."""
@@ -148,7 +122,7 @@ def finish(U1, phi_d, theta_d, psi_d, flags, dt, x, vp, gains, mem, cmd):
     """Shared tail of the position controllers: the decoupled attitude PID (eqs 13-15), the
     mixer inverse to duties, and the logged command."""
     U2, U3, U4, att_flags = decoupled_attitude(x, phi_d, theta_d, psi_d, vp, gains, mem, dt)
-    write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags | att_flags, vp[P_D], vp[P_K])
+    write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, flags | att_flags, vp[L.P_D], vp[L.P_K])
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -166,7 +140,7 @@ def filtered_derivative(e, f, kd, n, decay):
     return kd * n * (e - f), e + (f - e) * decay
 
 
-@njit(CONTROLLER_SIG, cache=True, error_model="numpy")
+@njit(L.CONTROLLER_SIG, cache=True, error_model="numpy")
 def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
     """One period of :class:`NLPD`: the inverse-model nonlinear PD (eqs 16, 19) over decoupled attitude PID.
     Arguments: ``CONTROLLER_SIG`` (:mod:`quadcruise.layout`); gains at the offsets of :data:`NLPD_GAINS`.
@@ -185,19 +159,23 @@ def nlpd(t, dt, x, ref, vp, gains, mem, cmd):
     """
     ff, tilt = gains[NL_ACCEL_FF], gains[NL_MAX_TILT]
     if gains[NL_DERIVATIVE] == 0.0:  # on the measurement, with the reference's velocity
-        ux = gains[NL_KP_XY] * (ref[REF_X] - x[X]) + gains[NL_KD_XY] * (ref[REF_VX] - x[VX]) + ff * ref[REF_AX]
-        uy = gains[NL_KP_XY] * (ref[REF_Y] - x[Y]) + gains[NL_KD_XY] * (ref[REF_VY] - x[VY]) + ff * ref[REF_AY]
+        ux = (
+            gains[NL_KP_XY] * (ref[L.REF_X] - x[L.X]) + gains[NL_KD_XY] * (ref[L.REF_VX] - x[L.VX]) + ff * ref[L.REF_AX]
+        )
+        uy = (
+            gains[NL_KP_XY] * (ref[L.REF_Y] - x[L.Y]) + gains[NL_KD_XY] * (ref[L.REF_VY] - x[L.VY]) + ff * ref[L.REF_AY]
+        )
     else:  # eq (17): on the whole error, filtered by N
-        ex, ey, n = ref[REF_X] - x[X], ref[REF_Y] - x[Y], gains[NL_FILTER_N]
+        ex, ey, n = ref[L.REF_X] - x[L.X], ref[L.REF_Y] - x[L.Y], gains[NL_FILTER_N]
         decay = math.exp(-n * dt)
         dx, fx = filtered_derivative(ex, mem[NL_FILTER_X], gains[NL_KD_XY], n, decay)
         dy, fy = filtered_derivative(ey, mem[NL_FILTER_Y], gains[NL_KD_XY], n, decay)
-        ux = gains[NL_KP_XY] * ex + dx + ff * ref[REF_AX]
-        uy = gains[NL_KP_XY] * ey + dy + ff * ref[REF_AY]
+        ux = gains[NL_KP_XY] * ex + dx + ff * ref[L.REF_AX]
+        uy = gains[NL_KP_XY] * ey + dy + ff * ref[L.REF_AY]
         mem[NL_FILTER_X], mem[NL_FILTER_Y] = fx, fy
-    uz = gains[NL_KP_Z] * (ref[REF_Z] - x[Z]) + gains[NL_KD_Z] * (ref[REF_VZ] - x[VZ]) + ff * ref[REF_AZ]
-    phi, theta, psi, psi_d = x[PHI], x[THETA], x[PSI], ref[REF_PSI]
-    m, g, K = vp[P_M], vp[P_G], vp[P_K]
+    uz = gains[NL_KP_Z] * (ref[L.REF_Z] - x[L.Z]) + gains[NL_KD_Z] * (ref[L.REF_VZ] - x[L.VZ]) + ff * ref[L.REF_AZ]
+    phi, theta, psi, psi_d = x[L.PHI], x[L.THETA], x[L.PSI], ref[L.REF_PSI]
+    m, g, K = vp[L.P_M], vp[L.P_G], vp[L.P_K]
     sphi, cphi = math.sin(phi), math.cos(phi)  # each computed once, shared
     spsi, cpsi = math.sin(psi), math.cos(psi)
     U1, flags = thrust_for_tilt(uz, cphi * math.cos(theta), m, g, K, gains[NL_COS_MAX_TILT])

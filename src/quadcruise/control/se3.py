@@ -54,59 +54,23 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from quadcruise import layout as L
 from quadcruise.control.base import TILT, Controller
 from quadcruise.control.design import ATTITUDE_WN_RATIO, ATTITUDE_ZETA, PDGains, altitude_pd_design, position_pd_design
 from quadcruise.control.so3 import attitude_lee, command_from_rotation, error_lee, limit_tilt, rotation_zyx
 from quadcruise.fields import check_value, instance_of
 from quadcruise.fields import unit_field as _f
-from quadcruise.layout import (
-    CONTROLLER_SIG,
-    FLAG_THRUST_LIMIT,
-    FLAG_TILT_LIMIT,
-    P_D,
-    P_G,
-    P_JXX,
-    P_JYY,
-    P_JZZ,
-    P_K,
-    P_L,
-    P_M,
-    PHI,
-    PSI,
-    REF_AX,
-    REF_AY,
-    REF_AZ,
-    REF_PSI,
-    REF_PSI_DOT,
-    REF_VX,
-    REF_VY,
-    REF_VZ,
-    REF_X,
-    REF_Y,
-    REF_Z,
-    THETA,
-    VX,
-    VY,
-    VZ,
-    P,
-    Q,
-    R,
-    Row,
-    X,
-    Y,
-    Z,
-)
 from quadcruise.numeric import clamp
 
 __all__ = ["SE3", "se3", "se3_attitude_design"]
 
-SE3_GAINS = Row.of("se3 gains", "kx", "kv", "kx_z", "kv_z", "k_r", "k_w", "max_tilt", prefix="SE3_")
+SE3_GAINS = L.Row.of("se3 gains", "kx", "kv", "kx_z", "kv_z", "k_r", "k_w", "max_tilt", prefix="SE3_")
 """The gains of :func:`se3`: kx [1/s^2], kv [1/s] of x and y, the same of z, kR [1/s^2], kw
 [1/s], max_tilt [rad]."""
 SE3_KX, SE3_KV, SE3_KX_Z, SE3_KV_Z, SE3_K_R, SE3_K_W, SE3_MAX_TILT = SE3_GAINS.offsets
 
 
-@njit(CONTROLLER_SIG, cache=True, error_model="numpy")
+@njit(L.CONTROLLER_SIG, cache=True, error_model="numpy")
 def se3(t, dt, x, ref, vp, gains, mem, cmd):
     """One period of :class:`SE3`: geometric tracking on SE(3) (Lee et al. 2010), moments per unit inertia.
     Arguments: ``CONTROLLER_SIG`` (:mod:`quadcruise.layout`); the law is in the module docstring.
@@ -123,17 +87,17 @@ def se3(t, dt, x, ref, vp, gains, mem, cmd):
     (True, True)
     """
     # every array entry read first, the command written last (fastmath's scalar-only rule)
-    phi, theta, psi, p, q, r = x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R]
-    m, g, K, l, d = vp[P_M], vp[P_G], vp[P_K], vp[P_L], vp[P_D]
-    jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
+    phi, theta, psi, p, q, r = x[L.PHI], x[L.THETA], x[L.PSI], x[L.P], x[L.Q], x[L.R]
+    m, g, K, l, d = vp[L.P_M], vp[L.P_G], vp[L.P_K], vp[L.P_L], vp[L.P_D]
+    jx, jy, jz = vp[L.P_JXX], vp[L.P_JYY], vp[L.P_JZZ]
     kx, kv, kx_z, kv_z = gains[SE3_KX], gains[SE3_KV], gains[SE3_KX_Z], gains[SE3_KV_Z]
     kr, kw, max_tilt = gains[SE3_K_R], gains[SE3_K_W], gains[SE3_MAX_TILT]
-    psi_d, yaw_rate_d = ref[REF_PSI], ref[REF_PSI_DOT]
-    fx = m * (kx * (ref[REF_X] - x[X]) + kv * (ref[REF_VX] - x[VX]) + ref[REF_AX])
-    fy = m * (kx * (ref[REF_Y] - x[Y]) + kv * (ref[REF_VY] - x[VY]) + ref[REF_AY])
-    fz = m * (kx_z * (ref[REF_Z] - x[Z]) + kv_z * (ref[REF_VZ] - x[VZ]) + ref[REF_AZ] + g)
+    psi_d, yaw_rate_d = ref[L.REF_PSI], ref[L.REF_PSI_DOT]
+    fx = m * (kx * (ref[L.REF_X] - x[L.X]) + kv * (ref[L.REF_VX] - x[L.VX]) + ref[L.REF_AX])
+    fy = m * (kx * (ref[L.REF_Y] - x[L.Y]) + kv * (ref[L.REF_VY] - x[L.VY]) + ref[L.REF_AY])
+    fz = m * (kx_z * (ref[L.REF_Z] - x[L.Z]) + kv_z * (ref[L.REF_VZ] - x[L.VZ]) + ref[L.REF_AZ] + g)
     fx, fy, tilted = limit_tilt(fx, fy, fz, max_tilt)
-    flags = FLAG_TILT_LIMIT if tilted else 0
+    flags = L.FLAG_TILT_LIMIT if tilted else 0
     Rm = rotation_zyx(phi, theta, psi)
     n = math.sqrt(fx * fx + fy * fy + fz * fz) if fz > 0.0 else 0.0
     if n > 0.0:
@@ -142,7 +106,7 @@ def se3(t, dt, x, ref, vp, gains, mem, cmd):
         Rd = attitude_lee(0.0, 0.0, 1.0, psi_d)
     U1, limited = clamp(fx * Rm[0][2] + fy * Rm[1][2] + fz * Rm[2][2], 0.0, 4.0 * K)
     if limited:
-        flags |= FLAG_THRUST_LIMIT
+        flags |= L.FLAG_THRUST_LIMIT
     ex, ey, ez = error_lee(Rm, Rd)
     mx = -jx * (kr * ex + kw * p) + (jz - jy) * q * r  # + (w x J w)_x
     my = -jy * (kr * ey + kw * q) + (jx - jz) * p * r

@@ -33,36 +33,8 @@ import math
 import numpy as np
 from numba import njit
 
+from quadcruise import layout as L
 from quadcruise.control.base import write_command
-from quadcruise.layout import (
-    CMD_FLAGS,
-    CMD_PHI_D,
-    CMD_PSI_D,
-    CMD_TAU_PHI,
-    CMD_TAU_PSI,
-    CMD_TAU_THETA,
-    CMD_THETA_D,
-    CMD_THRUST,
-    CONTROLLER_SIG,
-    P_D,
-    P_G,
-    P_JXX,
-    P_JYY,
-    P_JZZ,
-    P_K,
-    P_L,
-    P_M,
-    PHI,
-    PSI,
-    THETA,
-    VX,
-    VY,
-    VZ,
-    P,
-    Q,
-    R,
-    Row,
-)
 from quadcruise.model.actuators import mix
 
 DEFAULT_SCALES = {
@@ -82,7 +54,7 @@ DEFAULT_SCALES = {
 
 ACTION = ("a0", "a1", "a2", "a3")
 """The four normalised numbers of an action, the first entries of the gains row."""
-SETPOINT_GAINS = Row.of("setpoint gains", *ACTION, *DEFAULT_SCALES, prefix="S_")
+SETPOINT_GAINS = L.Row.of("setpoint gains", *ACTION, *DEFAULT_SCALES, prefix="S_")
 """An action-mode controller's gains row: the action, then the scales and gains of
 :data:`DEFAULT_SCALES`."""
 (
@@ -134,38 +106,38 @@ def _wrapped(a):
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
-@njit(CONTROLLER_SIG, cache=True, error_model="numpy")
+@njit(L.CONTROLLER_SIG, cache=True, error_model="numpy")
 def rotor_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     """Rotor duties from ``G[0:4]``: duty i = hover duty (1 + G[i]) (``CONTROLLER_SIG``)."""
-    K, d = vp[P_K], vp[P_D]
-    hover = vp[P_M] * vp[P_G] / (4.0 * K)
+    K, d = vp[L.P_K], vp[L.P_D]
+    hover = vp[L.P_M] * vp[L.P_G] / (4.0 * K)
     u1, u2, u3, u4 = hover * (1.0 + G[S_A0]), hover * (1.0 + G[S_A1]), hover * (1.0 + G[S_A2]), hover * (1.0 + G[S_A3])
     U1, U2, U3, U4 = mix(K * u1, K * u2, K * u3, K * u4, d)
     cmd[0], cmd[1], cmd[2], cmd[3] = u1, u2, u3, u4
-    cmd[CMD_THRUST], cmd[CMD_TAU_PHI], cmd[CMD_TAU_THETA], cmd[CMD_TAU_PSI] = U1, U2, U3, U4
-    cmd[CMD_PHI_D], cmd[CMD_THETA_D], cmd[CMD_PSI_D], cmd[CMD_FLAGS] = 0.0, 0.0, 0.0, 0.0
+    cmd[L.CMD_THRUST], cmd[L.CMD_TAU_PHI], cmd[L.CMD_TAU_THETA], cmd[L.CMD_TAU_PSI] = U1, U2, U3, U4
+    cmd[L.CMD_PHI_D], cmd[L.CMD_THETA_D], cmd[L.CMD_PSI_D], cmd[L.CMD_FLAGS] = 0.0, 0.0, 0.0, 0.0
 
 
-@njit(CONTROLLER_SIG, cache=True, error_model="numpy")
+@njit(L.CONTROLLER_SIG, cache=True, error_model="numpy")
 def rate_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     """Collective thrust m g (1 + G[0]) and body rates G[1:4] times the largest rates,
     through a proportional rate loop (``CONTROLLER_SIG``; parameters as :func:`rotor_setpoint`)."""
-    m, g, K, d, l = vp[P_M], vp[P_G], vp[P_K], vp[P_D], vp[P_L]
-    jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
-    p, q, r = x[P], x[Q], x[R]
+    m, g, K, d, l = vp[L.P_M], vp[L.P_G], vp[L.P_K], vp[L.P_D], vp[L.P_L]
+    jx, jy, jz = vp[L.P_JXX], vp[L.P_JYY], vp[L.P_JZZ]
+    p, q, r = x[L.P], x[L.Q], x[L.R]
     U1 = m * g * (1.0 + G[S_A0])
     sp1, sp2, sp3 = G[S_A1] * G[S_MAX_RATE_RP], G[S_A2] * G[S_MAX_RATE_RP], G[S_A3] * G[S_MAX_RATE_YAW]
     U2, U3, U4 = _rate_loop(sp1, sp2, sp3, p, q, r, G[S_KP_RATE_RP], G[S_KP_RATE_YAW], jx, jy, jz, l)
     write_command(cmd, U1, U2, U3, U4, 0.0, 0.0, 0.0, 0, d, K)
 
 
-@njit(CONTROLLER_SIG, cache=True, error_model="numpy")
+@njit(L.CONTROLLER_SIG, cache=True, error_model="numpy")
 def attitude_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     """Collective thrust m g (1 + G[0]), roll and pitch G[1:3] times the largest tilt, yaw
     G[3] pi, through proportional attitude and rate loops (``CONTROLLER_SIG``)."""
-    m, g, K, d, l = vp[P_M], vp[P_G], vp[P_K], vp[P_D], vp[P_L]
-    jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
-    phi, theta, psi, p, q, r = x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R]
+    m, g, K, d, l = vp[L.P_M], vp[L.P_G], vp[L.P_K], vp[L.P_D], vp[L.P_L]
+    jx, jy, jz = vp[L.P_JXX], vp[L.P_JYY], vp[L.P_JZZ]
+    phi, theta, psi, p, q, r = x[L.PHI], x[L.THETA], x[L.PSI], x[L.P], x[L.Q], x[L.R]
     U1 = m * g * (1.0 + G[S_A0])
     phi_d, theta_d, psi_d = G[S_A1] * G[S_MAX_TILT], G[S_A2] * G[S_MAX_TILT], G[S_A3] * math.pi
     k_att, k_yaw = G[S_K_ATT], G[S_K_ATT_YAW]
@@ -174,15 +146,15 @@ def attitude_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     write_command(cmd, U1, U2, U3, U4, phi_d, theta_d, psi_d, 0, d, K)
 
 
-@njit(CONTROLLER_SIG, cache=True, error_model="numpy")
+@njit(L.CONTROLLER_SIG, cache=True, error_model="numpy")
 def velocity_setpoint(t, dt, x, ref, vp, G, mem, cmd):
     """Velocity G[0:3] times the largest speeds (earth frame) and yaw G[3] pi, through a
     proportional velocity loop, the thrust and tilt that give its acceleration (tilt limited),
     and the attitude and rate loops (``CONTROLLER_SIG``)."""
-    m, g, K, d, l = vp[P_M], vp[P_G], vp[P_K], vp[P_D], vp[P_L]
-    jx, jy, jz = vp[P_JXX], vp[P_JYY], vp[P_JZZ]
-    vx, vy, vz = x[VX], x[VY], x[VZ]
-    phi, theta, psi, p, q, r = x[PHI], x[THETA], x[PSI], x[P], x[Q], x[R]
+    m, g, K, d, l = vp[L.P_M], vp[L.P_G], vp[L.P_K], vp[L.P_D], vp[L.P_L]
+    jx, jy, jz = vp[L.P_JXX], vp[L.P_JYY], vp[L.P_JZZ]
+    vx, vy, vz = x[L.VX], x[L.VY], x[L.VZ]
+    phi, theta, psi, p, q, r = x[L.PHI], x[L.THETA], x[L.PSI], x[L.P], x[L.Q], x[L.R]
     k_vel, tilt = G[S_K_VEL], G[S_MAX_TILT]
     ax = k_vel * (G[S_A0] * G[S_MAX_SPEED_XY] - vx)
     ay = k_vel * (G[S_A1] * G[S_MAX_SPEED_XY] - vy)

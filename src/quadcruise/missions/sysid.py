@@ -23,21 +23,8 @@ from typing import ClassVar
 
 from numba import njit
 
+from quadcruise import layout as L
 from quadcruise.fields import unit_field as _f
-from quadcruise.layout import (
-    REF_AX,
-    REF_AY,
-    REF_AZ,
-    REF_PSI,
-    REF_PSI_DOT,
-    REF_SIZE,
-    REF_VX,
-    REF_VY,
-    REF_VZ,
-    REF_X,
-    REF_Y,
-    REF_Z,
-)
 from quadcruise.missions.base import Mission
 
 __all__ = ["Sysid", "sysid_ref"]
@@ -76,9 +63,9 @@ def sysid_ref(t, mp, ref):
         Output, REF_SIZE float64 entries: position [m], velocity [m/s], acceleration
         [m/s^2], yaw [rad] and yaw rate [rad/s] at ``t`` (overwritten).
     """
-    for i in range(REF_SIZE):
+    for i in range(L.REF_SIZE):
         ref[i] = 0.0
-    ref[REF_X], ref[REF_Y], ref[REF_Z], ref[REF_PSI] = mp[0], mp[1], mp[2], mp[3]
+    ref[L.REF_X], ref[L.REF_Y], ref[L.REF_Z], ref[L.REF_PSI] = mp[0], mp[1], mp[2], mp[3]
     accel, climb, yaw_accel, spin, pulse, rest, settle = mp[4], mp[5], mp[6], mp[7], mp[8], mp[9], mp[10]
     repeats = int(mp[11])
     slot = 4.0 * pulse + rest  # one doublet and the hover after it
@@ -92,57 +79,57 @@ def sysid_ref(t, mp, ref):
     k = int(math.floor(tau / period))
     if k >= repeats:
         if repeats % 2 == 1:
-            ref[REF_PSI] += turn
+            ref[L.REF_PSI] += turn
         return
     sign = 1.0 if k % 2 == 0 else -1.0
     if k % 2 == 1:
-        ref[REF_PSI] += turn  # an odd repeat starts where the even one before it left the yaw
+        ref[L.REF_PSI] += turn  # an odd repeat starts where the even one before it left the yaw
     u = tau - k * period
     if u < 4.0 * slot:  # roll, pitch, thrust, yaw
         j = int(u / slot)
         w = u - j * slot
         if j == 0:
-            ref[REF_Y] += _doublet(w, pulse, accel)[0]
-            ref[REF_VY], ref[REF_AY] = _doublet(w, pulse, accel)[1], _doublet(w, pulse, accel)[2]
+            ref[L.REF_Y] += _doublet(w, pulse, accel)[0]
+            ref[L.REF_VY], ref[L.REF_AY] = _doublet(w, pulse, accel)[1], _doublet(w, pulse, accel)[2]
         elif j == 1:
-            ref[REF_X] += _doublet(w, pulse, accel)[0]
-            ref[REF_VX], ref[REF_AX] = _doublet(w, pulse, accel)[1], _doublet(w, pulse, accel)[2]
+            ref[L.REF_X] += _doublet(w, pulse, accel)[0]
+            ref[L.REF_VX], ref[L.REF_AX] = _doublet(w, pulse, accel)[1], _doublet(w, pulse, accel)[2]
         elif j == 2:
-            ref[REF_Z] += _doublet(w, pulse, climb)[0]
-            ref[REF_VZ], ref[REF_AZ] = _doublet(w, pulse, climb)[1], _doublet(w, pulse, climb)[2]
+            ref[L.REF_Z] += _doublet(w, pulse, climb)[0]
+            ref[L.REF_VZ], ref[L.REF_AZ] = _doublet(w, pulse, climb)[1], _doublet(w, pulse, climb)[2]
         else:
             angle, rate, _ = _doublet(w, pulse, yaw_accel)
-            ref[REF_PSI] += angle
-            ref[REF_PSI_DOT] = rate
+            ref[L.REF_PSI] += angle
+            ref[L.REF_PSI_DOT] = rate
         return
     u -= 4.0 * slot
     rate_step = spin / ramp
     if u < ramp:  # spin up
-        ref[REF_PSI] += sign * 0.5 * rate_step * u * u
-        ref[REF_PSI_DOT] = sign * rate_step * u
+        ref[L.REF_PSI] += sign * 0.5 * rate_step * u * u
+        ref[L.REF_PSI_DOT] = sign * rate_step * u
         return
     u -= ramp
     if u < hold:  # spinning: rest, then roll, pitch, roll, pitch
-        ref[REF_PSI] += sign * spin * (0.5 * ramp + u)
-        ref[REF_PSI_DOT] = sign * spin
+        ref[L.REF_PSI] += sign * spin * (0.5 * ramp + u)
+        ref[L.REF_PSI_DOT] = sign * spin
         w = u - rest
         if w >= 0.0:
             j = int(w / slot)
             w -= j * slot
             pos, vel, acc = _doublet(w, pulse, accel)
             if j % 2 == 0:
-                ref[REF_Y] += pos
-                ref[REF_VY], ref[REF_AY] = vel, acc
+                ref[L.REF_Y] += pos
+                ref[L.REF_VY], ref[L.REF_AY] = vel, acc
             else:
-                ref[REF_X] += pos
-                ref[REF_VX], ref[REF_AX] = vel, acc
+                ref[L.REF_X] += pos
+                ref[L.REF_VX], ref[L.REF_AX] = vel, acc
         return
     u -= hold
     if u < ramp:  # spin down
-        ref[REF_PSI] += sign * (spin * (0.5 * ramp + hold + u) - 0.5 * rate_step * u * u)
-        ref[REF_PSI_DOT] = sign * (spin - rate_step * u)
+        ref[L.REF_PSI] += sign * (spin * (0.5 * ramp + hold + u) - 0.5 * rate_step * u * u)
+        ref[L.REF_PSI_DOT] = sign * (spin - rate_step * u)
         return
-    ref[REF_PSI] += sign * turn  # the rest after the spin
+    ref[L.REF_PSI] += sign * turn  # the rest after the spin
 
 
 @dataclass(frozen=True)

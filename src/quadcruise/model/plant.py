@@ -48,53 +48,7 @@ import math
 
 from numba import njit
 
-from quadcruise.layout import (
-    EXT_E1,
-    EXT_E2,
-    EXT_E3,
-    EXT_E4,
-    EXT_FX,
-    EXT_FY,
-    EXT_FZ,
-    EXT_TX,
-    EXT_TY,
-    EXT_TZ,
-    EXT_WX,
-    EXT_WY,
-    EXT_WZ,
-    F1,
-    F2,
-    F3,
-    F4,
-    P_CD1,
-    P_CD2,
-    P_D,
-    P_G,
-    P_JXX,
-    P_JYY,
-    P_JZZ,
-    P_K,
-    P_K1,
-    P_K2,
-    P_K3,
-    P_K4,
-    P_K5,
-    P_K6,
-    P_M,
-    P_OMEGA,
-    PHI,
-    PSI,
-    THETA,
-    VX,
-    VY,
-    VZ,
-    P,
-    Q,
-    R,
-    X,
-    Y,
-    Z,
-)
+from quadcruise import layout as L
 from quadcruise.model.actuators import mix
 
 EULER_PITCH_LIMIT = math.radians(85.0)
@@ -123,12 +77,12 @@ def derivative(x, u, vp, ext, full, dx):
     """
     derivative_at(
         x,
-        math.sin(x[PHI]),
-        math.cos(x[PHI]),
-        math.sin(x[THETA]),
-        math.cos(x[THETA]),
-        math.sin(x[PSI]),
-        math.cos(x[PSI]),
+        math.sin(x[L.PHI]),
+        math.cos(x[L.PHI]),
+        math.sin(x[L.THETA]),
+        math.cos(x[L.THETA]),
+        math.sin(x[L.PSI]),
+        math.cos(x[L.PSI]),
         u,
         vp,
         ext,
@@ -165,40 +119,40 @@ def derivative_at(x, sphi, cphi, sth, cth, spsi, cpsi, u, vp, ext, full, dx):
     dx : ndarray, shape (16,)
         Output: the state's time derivative [unit/s].
     """
-    m = vp[P_M]
-    p, q, r = x[P], x[Q], x[R]
-    U1, U2, U3, U4 = mix(x[F1], x[F2], x[F3], x[F4], vp[P_D])  # (1)-(4)
+    m = vp[L.P_M]
+    p, q, r = x[L.P], x[L.Q], x[L.R]
+    U1, U2, U3, U4 = mix(x[L.F1], x[L.F2], x[L.F3], x[L.F4], vp[L.P_D])  # (1)-(4)
     a = U1 / m
 
-    fx, fy, fz = ext[EXT_FX], ext[EXT_FY], ext[EXT_FZ]
-    c1, c2 = vp[P_CD1], vp[P_CD2]
+    fx, fy, fz = ext[L.EXT_FX], ext[L.EXT_FY], ext[L.EXT_FZ]
+    c1, c2 = vp[L.P_CD1], vp[L.P_CD2]
     if c1 != 0.0 or c2 != 0.0:  # drag, air-relative
-        rx, ry, rz = x[VX] - ext[EXT_WX], x[VY] - ext[EXT_WY], x[VZ] - ext[EXT_WZ]
+        rx, ry, rz = x[L.VX] - ext[L.EXT_WX], x[L.VY] - ext[L.EXT_WY], x[L.VZ] - ext[L.EXT_WZ]
         c = c1 + c2 * math.sqrt(rx * rx + ry * ry + rz * rz)
         fx -= c * rx
         fy -= c * ry
         fz -= c * rz
 
-    dx[X] = x[VX]
-    dx[Y] = x[VY]
-    dx[Z] = x[VZ]
-    dx[VX] = (sphi * spsi + cphi * sth * cpsi) * a + fx / m  # (5)
-    dx[VY] = (-sphi * cpsi + cphi * sth * spsi) * a + fy / m  # (6)
-    dx[VZ] = cphi * cth * a - vp[P_G] + fz / m  # (7)
+    dx[L.X] = x[L.VX]
+    dx[L.Y] = x[L.VY]
+    dx[L.Z] = x[L.VZ]
+    dx[L.VX] = (sphi * spsi + cphi * sth * cpsi) * a + fx / m  # (5)
+    dx[L.VY] = (-sphi * cpsi + cphi * sth * spsi) * a + fy / m  # (6)
+    dx[L.VZ] = cphi * cth * a - vp[L.P_G] + fz / m  # (7)
     if full:
         s = q * sphi + r * cphi
-        dx[PHI] = p + s * sth / cth
-        dx[THETA] = q * cphi - r * sphi
-        dx[PSI] = s / cth
+        dx[L.PHI] = p + s * sth / cth
+        dx[L.THETA] = q * cphi - r * sphi
+        dx[L.PSI] = s / cth
     else:  # the paper's
-        dx[PHI] = p
-        dx[THETA] = q
-        dx[PSI] = r
-    dx[P] = vp[P_K1] * q * r + vp[P_K2] * U2 + ext[EXT_TX] / vp[P_JXX]  # (11) roll
-    dx[Q] = vp[P_K3] * p * r + vp[P_K4] * U3 + ext[EXT_TY] / vp[P_JYY]  # (11) pitch
-    dx[R] = vp[P_K5] * p * q + vp[P_K6] * U4 + ext[EXT_TZ] / vp[P_JZZ]  # (11) yaw
-    w, K = vp[P_OMEGA], vp[P_K]
-    dx[F1] = w * (ext[EXT_E1] * K * u[0] - x[F1])  # rotor lag
-    dx[F2] = w * (ext[EXT_E2] * K * u[1] - x[F2])
-    dx[F3] = w * (ext[EXT_E3] * K * u[2] - x[F3])
-    dx[F4] = w * (ext[EXT_E4] * K * u[3] - x[F4])
+        dx[L.PHI] = p
+        dx[L.THETA] = q
+        dx[L.PSI] = r
+    dx[L.P] = vp[L.P_K1] * q * r + vp[L.P_K2] * U2 + ext[L.EXT_TX] / vp[L.P_JXX]  # (11) roll
+    dx[L.Q] = vp[L.P_K3] * p * r + vp[L.P_K4] * U3 + ext[L.EXT_TY] / vp[L.P_JYY]  # (11) pitch
+    dx[L.R] = vp[L.P_K5] * p * q + vp[L.P_K6] * U4 + ext[L.EXT_TZ] / vp[L.P_JZZ]  # (11) yaw
+    w, K = vp[L.P_OMEGA], vp[L.P_K]
+    dx[L.F1] = w * (ext[L.EXT_E1] * K * u[0] - x[L.F1])  # rotor lag
+    dx[L.F2] = w * (ext[L.EXT_E2] * K * u[1] - x[L.F2])
+    dx[L.F3] = w * (ext[L.EXT_E3] * K * u[2] - x[L.F3])
+    dx[L.F4] = w * (ext[L.EXT_E4] * K * u[3] - x[L.F4])

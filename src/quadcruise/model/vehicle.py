@@ -37,33 +37,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from quadcruise import layout as L
 from quadcruise.errors import InputError
 from quadcruise.fields import Validated
 from quadcruise.fields import unit_field as _f
-from quadcruise.layout import (
-    P_CD1,
-    P_CD2,
-    P_D,
-    P_G,
-    P_INV_JXX,
-    P_INV_JYY,
-    P_INV_JZZ,
-    P_INV_M,
-    P_JXX,
-    P_JYY,
-    P_JZZ,
-    P_K,
-    P_K1,
-    P_K2,
-    P_K3,
-    P_K4,
-    P_K5,
-    P_K6,
-    P_L,
-    P_M,
-    P_OMEGA,
-    PARAM_SIZE,
-)
 
 
 @dataclass(frozen=True)
@@ -296,24 +273,24 @@ class Vehicle(Validated):
             n = size or 1
         if size is not None and size != n:
             raise InputError(f"vehicle batch has {size} entries but {n} vehicles were asked for")
-        out = np.empty((n, PARAM_SIZE))
+        out = np.empty((n, L.PARAM_SIZE))
         for col, name in (
-            (P_M, "m"),
-            (P_JXX, "Jxx"),
-            (P_JYY, "Jyy"),
-            (P_JZZ, "Jzz"),
-            (P_L, "l"),
-            (P_K, "K"),
-            (P_OMEGA, "omega"),
-            (P_D, "d"),
-            (P_G, "g"),
+            (L.P_M, "m"),
+            (L.P_JXX, "Jxx"),
+            (L.P_JYY, "Jyy"),
+            (L.P_JZZ, "Jzz"),
+            (L.P_L, "l"),
+            (L.P_K, "K"),
+            (L.P_OMEGA, "omega"),
+            (L.P_D, "d"),
+            (L.P_G, "g"),
         ):
             out[:, col] = getattr(self, name)
-        for col, value in zip((P_K1, P_K2, P_K3, P_K4, P_K5, P_K6), self.k, strict=False):
+        for col, value in zip((L.P_K1, L.P_K2, L.P_K3, L.P_K4, L.P_K5, L.P_K6), self.k, strict=False):
             out[:, col] = value
-        out[:, P_CD1] = self.drag_linear
-        out[:, P_CD2] = self.drag_quadratic
-        for col, src in ((P_INV_M, P_M), (P_INV_JXX, P_JXX), (P_INV_JYY, P_JYY), (P_INV_JZZ, P_JZZ)):
+        out[:, L.P_CD1] = self.drag_linear
+        out[:, L.P_CD2] = self.drag_quadratic
+        for col, src in ((L.P_INV_M, L.P_M), (L.P_INV_JXX, L.P_JXX), (L.P_INV_JYY, L.P_JYY), (L.P_INV_JZZ, L.P_JZZ)):
             out[:, col] = 1.0 / out[:, src]
         return out
 

@@ -25,27 +25,7 @@ import math
 import numpy as np
 from numba import njit
 
-from quadcruise.layout import (
-    CMD_FLAGS,
-    CMD_SIZE,
-    DISTURBANCE_SIG,
-    EXT_E1,
-    EXT_SIZE,
-    PHI,
-    PSI,
-    REF_SIZE,
-    STATE_SIZE,
-    THETA,
-    VX,
-    VY,
-    VZ,
-    P,
-    Q,
-    R,
-    X,
-    Y,
-    Z,
-)
+from quadcruise import layout as L
 from quadcruise.model.plant import EULER_PITCH_LIMIT, derivative_at
 from quadcruise.sim.fastmath import TRIG_REFRESH, DirectCall, turned
 from quadcruise.sim.inputs import TRIG_WIDTH, Limits, batch_inputs, carry_width, fresh_carry, time_grid
@@ -113,34 +93,34 @@ def rk4_step(x, u, vp, ext, full, h, work, fresh):
     """
     xt, trig = work[XT], work[TRIG]
     if fresh:
-        trig[0], trig[1] = math.sin(x[PHI]), math.cos(x[PHI])
-        trig[2], trig[3] = math.sin(x[THETA]), math.cos(x[THETA])
-        trig[4], trig[5] = math.sin(x[PSI]), math.cos(x[PSI])
+        trig[0], trig[1] = math.sin(x[L.PHI]), math.cos(x[L.PHI])
+        trig[2], trig[3] = math.sin(x[L.THETA]), math.cos(x[L.THETA])
+        trig[4], trig[5] = math.sin(x[L.PSI]), math.cos(x[L.PSI])
     sa, ca, sb, cb, sc, cc = trig[0], trig[1], trig[2], trig[3], trig[4], trig[5]
     for stage in range(4):
         s1, c1, s2, c2, s3, c3 = sa, ca, sb, cb, sc, cc
         if stage == 0:
-            for j in range(STATE_SIZE):
+            for j in range(L.STATE_SIZE):
                 xt[j] = x[j]
         else:
             w = h if stage == 3 else 0.5 * h
             k_in = work[stage - 1]
-            for j in range(STATE_SIZE):
+            for j in range(L.STATE_SIZE):
                 xt[j] = x[j] + w * k_in[j]
-            s1, c1 = turned(xt[PHI], sa, ca, w * k_in[PHI])
-            s2, c2 = turned(xt[THETA], sb, cb, w * k_in[THETA])
-            s3, c3 = turned(xt[PSI], sc, cc, w * k_in[PSI])
+            s1, c1 = turned(xt[L.PHI], sa, ca, w * k_in[L.PHI])
+            s2, c2 = turned(xt[L.THETA], sb, cb, w * k_in[L.THETA])
+            s3, c3 = turned(xt[L.PSI], sc, cc, w * k_in[L.PSI])
         derivative_at(xt, s1, c1, s2, c2, s3, c3, u, vp, ext, full, work[stage])
     c = h / 6.0
-    for j in range(STATE_SIZE):
+    for j in range(L.STATE_SIZE):
         xt[j] = c * (work[K1, j] + 2.0 * (work[K2, j] + work[K3, j]) + work[K4, j])  # the increment
         x[j] += xt[j]
-    trig[0], trig[1] = turned(x[PHI], sa, ca, xt[PHI])
-    trig[2], trig[3] = turned(x[THETA], sb, cb, xt[THETA])
-    trig[4], trig[5] = turned(x[PSI], sc, cc, xt[PSI])
+    trig[0], trig[1] = turned(x[L.PHI], sa, ca, xt[L.PHI])
+    trig[2], trig[3] = turned(x[L.THETA], sb, cb, xt[L.THETA])
+    trig[4], trig[5] = turned(x[L.PSI], sc, cc, xt[L.PSI])
 
 
-@njit(DISTURBANCE_SIG, cache=True)
+@njit(L.DISTURBANCE_SIG, cache=True)
 def still_air(t, dt, x, dp, dmem, rng, ext):
     """No disturbance: no force, torque or wind; every rotor healthy (``DISTURBANCE_SIG``).
 
@@ -157,9 +137,9 @@ def still_air(t, dt, x, dp, dmem, rng, ext):
     ext : numpy.ndarray
         (EXT_SIZE,) output: zeros, and the four rotor effectiveness entries 1.
     """
-    for j in range(EXT_SIZE):
+    for j in range(L.EXT_SIZE):
         ext[j] = 0.0
-    for j in range(EXT_E1, EXT_E1 + 4):
+    for j in range(L.EXT_E1, L.EXT_E1 + 4):
         ext[j] = 1.0
 
 
@@ -319,14 +299,14 @@ def _kernel(
     n_periods = t_grid.shape[0] - 1
     # scratch of this call, reused by its vehicles (a step of one period would otherwise spend
     # more on allocating it than on flying); every entry is set for each vehicle before use
-    x = np.empty(STATE_SIZE)
-    seen = np.empty(STATE_SIZE)
-    history = np.empty((sensor_delay + 1, STATE_SIZE))  # ring buffer of past states
-    ref = np.empty(REF_SIZE)
-    cmd = np.empty(CMD_SIZE)
+    x = np.empty(L.STATE_SIZE)
+    seen = np.empty(L.STATE_SIZE)
+    history = np.empty((sensor_delay + 1, L.STATE_SIZE))  # ring buffer of past states
+    ref = np.empty(L.REF_SIZE)
+    cmd = np.empty(L.CMD_SIZE)
     u = np.empty(4)
-    ext = np.empty(EXT_SIZE)
-    work = np.empty((WORK_ROWS, STATE_SIZE))
+    ext = np.empty(L.EXT_SIZE)
+    work = np.empty((WORK_ROWS, L.STATE_SIZE))
     mi, dmi, rngi = np.empty(mem.shape[1]), np.empty(dmem.shape[1]), np.empty(rng.shape[1], dtype=np.uint64)
     for i in range(first, stop):
         k0 = clock[i, 0]
@@ -337,16 +317,16 @@ def _kernel(
             continue
         k1 = min(k0 + n_step, n_periods)
         k_reached = k1
-        for j in range(STATE_SIZE):
+        for j in range(L.STATE_SIZE):
             x[j] = x0[i, j]
         for d in range(sensor_delay + 1):
-            for j in range(STATE_SIZE):
-                history[d, j] = carry[i, TRIG_WIDTH + d * STATE_SIZE + j]
-        for j in range(REF_SIZE):
+            for j in range(L.STATE_SIZE):
+                history[d, j] = carry[i, TRIG_WIDTH + d * L.STATE_SIZE + j]
+        for j in range(L.REF_SIZE):
             ref[j] = 0.0
         for j in range(4):
             u[j] = 0.0
-        for j in range(EXT_SIZE):
+        for j in range(L.EXT_SIZE):
             ext[j] = 0.0
         for j in range(TRIG_WIDTH):
             work[TRIG, j] = carry[i, j]
@@ -374,16 +354,16 @@ def _kernel(
             # what the controller sees: the state sensor_delay periods ago, plus noise
             newest = k % (sensor_delay + 1)  # in the ring buffer
             oldest = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
-            for j in range(STATE_SIZE):
+            for j in range(L.STATE_SIZE):
                 history[newest, j] = x[j]
             state = rngi[0]
-            for j in range(STATE_SIZE):
+            for j in range(L.STATE_SIZE):
                 seen[j] = history[oldest, j]
                 if stdi[j] != 0.0:
                     draw, state = next_normal(state)
                     seen[j] += stdi[j] * draw
             rngi[0] = state
-            for j in range(CMD_SIZE):
+            for j in range(L.CMD_SIZE):
                 cmd[j] = 0.0
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
             if k % log_every == 0:
@@ -405,7 +385,7 @@ def _kernel(
                 break
             if clipped:
                 clipped_s += dt
-            if cmd[CMD_FLAGS] != 0.0:
+            if cmd[L.CMD_FLAGS] != 0.0:
                 limited_s += dt
             if disturbed:
                 disturbance(t, dt, x, dpi, dmi, rngi, ext)
@@ -415,19 +395,19 @@ def _kernel(
                 rk4_step(x, u, vpi, ext, full, h, work, steps % TRIG_REFRESH == 0)
                 steps += 1
             finite = True
-            for j in range(STATE_SIZE):
+            for j in range(L.STATE_SIZE):
                 finite = finite and math.isfinite(x[j])
             if not finite:
                 code = NONFINITE
-            elif beyond(x[X], x[Y], x[Z], max_position):
+            elif beyond(x[L.X], x[L.Y], x[L.Z], max_position):
                 code = POSITION_BOUND
-            elif beyond(x[VX], x[VY], x[VZ], max_speed):
+            elif beyond(x[L.VX], x[L.VY], x[L.VZ], max_speed):
                 code = SPEED_BOUND
-            elif beyond(x[P], x[Q], x[R], max_rate):
+            elif beyond(x[L.P], x[L.Q], x[L.R], max_rate):
                 code = RATE_BOUND
-            elif beyond(x[PHI], x[THETA], 0.0, max_tilt):
+            elif beyond(x[L.PHI], x[L.THETA], 0.0, max_tilt):
                 code = TILT_BOUND
-            elif full and abs(x[THETA]) > EULER_PITCH_LIMIT:  # the full plant's 1/cos theta
+            elif full and abs(x[L.THETA]) > EULER_PITCH_LIMIT:  # the full plant's 1/cos theta
                 code = PITCH_SINGULAR
             if code != FINISHED:
                 t_end = t_grid[k + 1]
@@ -447,8 +427,8 @@ def _kernel(
         for j in range(TRIG_WIDTH):
             carry[i, j] = work[TRIG, j]
         for d in range(sensor_delay + 1):
-            for j in range(STATE_SIZE):
-                carry[i, TRIG_WIDTH + d * STATE_SIZE + j] = history[d, j]
+            for j in range(L.STATE_SIZE):
+                carry[i, TRIG_WIDTH + d * L.STATE_SIZE + j] = history[d, j]
         saturated[i, 0], saturated[i, 1] = clipped_s, limited_s
         status[i] = code
         t_stop[i] = t_end
@@ -577,10 +557,10 @@ def simulate(
     limits = limits or Limits()
     n_periods = t_grid.shape[0] - 1
     n_log = n_periods // log_every + 1
-    log_x = np.empty((n, n_log, STATE_SIZE))  # every row is written by the kernel:
-    log_cmd = np.empty((n, n_log, CMD_SIZE))  # logged, or NaN after a stop
-    log_ref = np.empty((n, n_log, REF_SIZE))
-    x_final = np.empty((n, STATE_SIZE))
+    log_x = np.empty((n, n_log, L.STATE_SIZE))  # every row is written by the kernel:
+    log_cmd = np.empty((n, n_log, L.CMD_SIZE))  # logged, or NaN after a stop
+    log_ref = np.empty((n, n_log, L.REF_SIZE))
+    x_final = np.empty((n, L.STATE_SIZE))
     status = np.zeros(n, dtype=np.int64)
     t_stop = np.empty(n)
     saturated = np.zeros((n, 2))

@@ -37,25 +37,7 @@ import math
 import numpy as np
 from numba import njit, types
 
-from quadcruise.layout import (
-    CMD_FLAGS,
-    CMD_SIZE,
-    EXT_E1,
-    EXT_SIZE,
-    F1,
-    PHI,
-    PSI,
-    REF_SIZE,
-    STATE_SIZE,
-    THETA,
-    ControllerType,
-    DisturbanceType,
-    MissionType,
-    P,
-    Q,
-    R,
-    X,
-)
+from quadcruise import layout as L
 from quadcruise.model.rotor_plant import QW, QX, QY, QZ, ROTOR_W1, RP, RP_KF, RP_N_ROTORS, RP_W_MAX, RP_W_MIN, RX, RZ
 from quadcruise.sim.engine import beyond, blank_rows, log_row, put_row, still_air
 from quadcruise.sim.fastmath import DirectCall
@@ -104,23 +86,23 @@ def paper_state(xr, rp, ext, psi_last, out):
     """
     qw, qx, qy, qz = xr[QW], xr[QX], xr[QY], xr[QZ]
     for j in range(6):
-        out[X + j] = xr[RX + j]
-    out[PHI] = math.atan2(2.0 * (qw * qx + qy * qz), 1.0 - 2.0 * (qx * qx + qy * qy))
+        out[L.X + j] = xr[RX + j]
+    out[L.PHI] = math.atan2(2.0 * (qw * qx + qy * qz), 1.0 - 2.0 * (qx * qx + qy * qy))
     s = 2.0 * (qw * qy - qx * qz)
-    out[THETA] = math.asin(max(-1.0, min(1.0, s)))
+    out[L.THETA] = math.asin(max(-1.0, min(1.0, s)))
     raw = math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
     turn = raw - psi_last
     psi = psi_last + turn - 2.0 * math.pi * math.floor(turn / (2.0 * math.pi) + 0.5)
-    out[PSI] = psi
-    out[P], out[Q], out[R] = xr[RP], xr[RP + 1], xr[RP + 2]
+    out[L.PSI] = psi
+    out[L.P], out[L.Q], out[L.R] = xr[RP], xr[RP + 1], xr[RP + 2]
     n = int(rp[RP_N_ROTORS])
     kf = rp[RP_KF]
     for i in range(4):
         if i < n:
             w = xr[ROTOR_W1 + i]
-            out[F1 + i] = ext[EXT_E1 + i] * kf * w * w
+            out[L.F1 + i] = ext[L.EXT_E1 + i] * kf * w * w
         else:
-            out[F1 + i] = 0.0
+            out[L.F1 + i] = 0.0
     return psi
 
 
@@ -142,10 +124,10 @@ def paper_states(x, rp, psi0):
     numpy.ndarray
         (N, 16) as :func:`paper_state` writes them.
     """
-    out = np.empty((x.shape[0], STATE_SIZE))
-    ext = np.zeros(EXT_SIZE)
+    out = np.empty((x.shape[0], L.STATE_SIZE))
+    ext = np.zeros(L.EXT_SIZE)
     for j in range(4):
-        ext[EXT_E1 + j] = 1.0
+        ext[L.EXT_E1 + j] = 1.0
     for i in range(x.shape[0]):
         paper_state(x[i], rp[i], ext, psi0[i], out[i])
     return out
@@ -153,8 +135,8 @@ def paper_states(x, rp, psi0):
 
 C_PSI = 0
 C_TRUE = 1
-C_EXT = C_TRUE + STATE_SIZE
-C_HISTORY = C_EXT + EXT_SIZE
+C_EXT = C_TRUE + L.STATE_SIZE
+C_HISTORY = C_EXT + L.EXT_SIZE
 """Offsets in a row of the rotor kernel's ``carry``: the unwrapped yaw [rad], the paper-layout
 true state, the external inputs of the last period, then the sensor-delay ring buffer."""
 
@@ -177,7 +159,7 @@ def rotor_carry_width(sensor_delay: int) -> int:
     >>> rotor_carry_width(0) - rotor_carry_width(1)
     -16
     """
-    return C_HISTORY + (int(sensor_delay) + 1) * STATE_SIZE
+    return C_HISTORY + (int(sensor_delay) + 1) * L.STATE_SIZE
 
 
 _f8v = types.float64[::1]
@@ -196,12 +178,12 @@ ROTOR_FLIGHT_SIG = types.void(
     _f8m,  # rp
     _f8m,  # alloc: duty -> thrust matrix (n x 4, row-major), then the controller's kf
     _f8m,  # vp_ctrl
-    ControllerType,
+    L.ControllerType,
     _f8m,  # gains
     _f8m,  # mem
-    MissionType,
+    L.MissionType,
     _f8m,  # mp
-    DisturbanceType,
+    L.DisturbanceType,
     types.boolean,  # disturbed
     _f8m,  # dp
     _f8m,  # dmem
@@ -286,12 +268,12 @@ def _rotor_flight_kernel(
     size = x0.shape[1]
     n = size - ROTOR_W1
     x = np.empty(size)
-    true = np.empty(STATE_SIZE)
-    seen = np.empty(STATE_SIZE)
-    history = np.empty((sensor_delay + 1, STATE_SIZE))
-    ref = np.empty(REF_SIZE)
-    cmd = np.empty(CMD_SIZE)
-    ext = np.empty(EXT_SIZE)
+    true = np.empty(L.STATE_SIZE)
+    seen = np.empty(L.STATE_SIZE)
+    history = np.empty((sensor_delay + 1, L.STATE_SIZE))
+    ref = np.empty(L.REF_SIZE)
+    cmd = np.empty(L.CMD_SIZE)
+    ext = np.empty(L.EXT_SIZE)
     ext_r = np.empty(9 + n)
     w_cmd = np.empty(n)
     work = np.empty((ROTOR_WORK_ROWS, size))
@@ -323,17 +305,17 @@ def _rotor_flight_kernel(
             still_air(0.0, 0.0, true, dpi, dmi, rngi, ext)
             psi = paper_state(x, rpi, ext, psi0[i], true)
             for d in range(sensor_delay + 1):
-                for j in range(STATE_SIZE):
+                for j in range(L.STATE_SIZE):
                     history[d, j] = true[j]
         else:
             psi = carry[i, C_PSI]
-            for j in range(STATE_SIZE):
+            for j in range(L.STATE_SIZE):
                 true[j] = carry[i, C_TRUE + j]
-            for j in range(EXT_SIZE):
+            for j in range(L.EXT_SIZE):
                 ext[j] = carry[i, C_EXT + j]
             for d in range(sensor_delay + 1):
-                for j in range(STATE_SIZE):
-                    history[d, j] = carry[i, C_HISTORY + d * STATE_SIZE + j]
+                for j in range(L.STATE_SIZE):
+                    history[d, j] = carry[i, C_HISTORY + d * L.STATE_SIZE + j]
         clipped_s, limited_s = saturated[i, 0], saturated[i, 1]
         steps = clock[i, 1]
         code = FINISHED
@@ -345,16 +327,16 @@ def _rotor_flight_kernel(
             mission(t, mpi, ref)
             newest = k % (sensor_delay + 1)
             oldest = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
-            for j in range(STATE_SIZE):
+            for j in range(L.STATE_SIZE):
                 history[newest, j] = true[j]
             state = rngi[0]
-            for j in range(STATE_SIZE):
+            for j in range(L.STATE_SIZE):
                 seen[j] = history[oldest, j]
                 if stdi[j] != 0.0:
                     draw, state = next_normal(state)
                     seen[j] += stdi[j] * draw
             rngi[0] = state
-            for j in range(CMD_SIZE):
+            for j in range(L.CMD_SIZE):
                 cmd[j] = 0.0
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
             if k % log_every == 0:
@@ -382,14 +364,14 @@ def _rotor_flight_kernel(
                 w_cmd[r] = w
             if held:
                 clipped_s += dt
-            if cmd[CMD_FLAGS] != 0.0:
+            if cmd[L.CMD_FLAGS] != 0.0:
                 limited_s += dt
             if disturbed:
                 disturbance(t, dt, true, dpi, dmi, rngi, ext)
             for j in range(9):
                 ext_r[j] = ext[j]
             for r in range(n):
-                ext_r[9 + r] = ext[EXT_E1 + r] if r < 4 else 1.0
+                ext_r[9 + r] = ext[L.EXT_E1 + r] if r < 4 else 1.0
             n_sub = max(1, int(math.ceil(dt / max_step - 1e-9)))
             h = dt / n_sub
             for sub in range(n_sub):
@@ -436,13 +418,13 @@ def _rotor_flight_kernel(
         put_row(rng, i, rngi)
         clock[i, 0], clock[i, 1] = k_reached, steps
         carry[i, C_PSI] = psi
-        for j in range(STATE_SIZE):
+        for j in range(L.STATE_SIZE):
             carry[i, C_TRUE + j] = true[j]
-        for j in range(EXT_SIZE):
+        for j in range(L.EXT_SIZE):
             carry[i, C_EXT + j] = ext[j]
         for d in range(sensor_delay + 1):
-            for j in range(STATE_SIZE):
-                carry[i, C_HISTORY + d * STATE_SIZE + j] = history[d, j]
+            for j in range(L.STATE_SIZE):
+                carry[i, C_HISTORY + d * L.STATE_SIZE + j] = history[d, j]
         saturated[i, 0], saturated[i, 1] = clipped_s, limited_s
         status[i] = code
         t_stop[i] = t_end

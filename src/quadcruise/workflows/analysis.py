@@ -41,23 +41,8 @@ import numpy as np
 from scipy.sparse.csgraph import connected_components
 
 from quadcruise import checks
+from quadcruise import layout as L
 from quadcruise.errors import InputError
-from quadcruise.layout import (
-    CMD_FLAGS,
-    CMD_SIZE,
-    EXT_E1,
-    EXT_SIZE,
-    F1,
-    P_D,
-    P_G,
-    P_K,
-    P_M,
-    REF_NAMES,
-    REF_Z,
-    STATE_NAMES,
-    STATE_SIZE,
-    Z,
-)
 from quadcruise.model.actuators import mix
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.workflows.linearization import INPUTS, LOOPS, OUTPUTS, Linearization, to_generalized
@@ -73,10 +58,10 @@ def _period(x, u, vp, dt, n_sub):
     kinematics (the exact ones agree to first order at hover): the next state."""
     from quadcruise.sim.engine import WORK_ROWS, rk4_step
 
-    ext = np.zeros(EXT_SIZE)
-    ext[EXT_E1 : EXT_E1 + 4] = 1.0
+    ext = np.zeros(L.EXT_SIZE)
+    ext[L.EXT_E1 : L.EXT_E1 + 4] = 1.0
     x, u = np.array(x, dtype=float), np.ascontiguousarray(u, dtype=float)
-    work = np.empty((WORK_ROWS, STATE_SIZE))
+    work = np.empty((WORK_ROWS, L.STATE_SIZE))
     for _ in range(n_sub):
         rk4_step(x, u, vp, ext, False, dt / n_sub, work, True)
     return x
@@ -192,18 +177,18 @@ def linearize(
     vp = np.ascontiguousarray(vehicle.rows()[0])
     gains = np.ascontiguousarray(controller.gains(), dtype=float)
     mem0 = np.array(controller.memory() if memory is None else memory, dtype=float).ravel()
-    n, C = STATE_SIZE + mem0.size, mem0.size
+    n, C = L.STATE_SIZE + mem0.size, mem0.size
     n_sub = max(1, math.ceil(dt / (max_step or dt) - 1e-9))
-    x0, ref0 = np.zeros(STATE_SIZE), np.zeros(len(REF_NAMES))
-    x0[Z], x0[F1 : F1 + 4], ref0[REF_Z] = hover_z, vp[P_M] * vp[P_G] / 4.0, hover_z
-    cols = [REF_NAMES.index(name) for name in INPUTS]
+    x0, ref0 = np.zeros(L.STATE_SIZE), np.zeros(len(L.REF_NAMES))
+    x0[L.Z], x0[L.F1 : L.F1 + 4], ref0[L.REF_Z] = hover_z, vp[L.P_M] * vp[L.P_G] / 4.0, hover_z
+    cols = [L.REF_NAMES.index(name) for name in INPUTS]
     step = _steps(progress, 3)
 
     def ctrl(v):  # (x, memory, set-points) -> (duties, next memory, flags)
-        ref, mem, cmd = ref0.copy(), v[STATE_SIZE:n].copy(), np.zeros(CMD_SIZE)
+        ref, mem, cmd = ref0.copy(), v[L.STATE_SIZE : n].copy(), np.zeros(L.CMD_SIZE)
         ref[cols] = v[n:]
-        controller.function(0.0, dt, np.ascontiguousarray(v[:STATE_SIZE]), ref, vp, gains, mem, cmd)
-        return np.concatenate([cmd[:4], mem, cmd[CMD_FLAGS : CMD_FLAGS + 1]])
+        controller.function(0.0, dt, np.ascontiguousarray(v[: L.STATE_SIZE]), ref, vp, gains, mem, cmd)
+        return np.concatenate([cmd[:4], mem, cmd[L.CMD_FLAGS : L.CMD_FLAGS + 1]])
 
     for _ in range(settle):
         mem0 = ctrl(np.concatenate([x0, mem0, ref0[cols]]))[4 : 4 + C]
@@ -211,7 +196,7 @@ def linearize(
     out0 = ctrl(v0)
     u0 = out0[:4]
     drift = np.concatenate([_period(x0, np.clip(u0, 0.0, 1.0), vp, dt, n_sub) - x0, out0[4 : 4 + C] - mem0]) / dt
-    names = list(STATE_NAMES) + [f"mem{i}" for i in range(C)]
+    names = list(L.STATE_NAMES) + [f"mem{i}" for i in range(C)]
     if not np.all(np.abs(drift) <= tol):
         i = int(np.argmax(np.where(np.isfinite(drift), np.abs(drift), np.inf)))
         who = getattr(controller, "name", "the controller")
@@ -231,14 +216,14 @@ def linearize(
     # the period map's Jacobian by the chain rule: controller, then plant (a duty clip is inactive)
     G = _jacobian(lambda v: ctrl(v)[: 4 + C], v0, eps)
     step()
-    P = _jacobian(lambda v: _period(v[:STATE_SIZE], v[STATE_SIZE:], vp, dt, n_sub), np.r_[x0, u0], eps)
+    P = _jacobian(lambda v: _period(v[: L.STATE_SIZE], v[L.STATE_SIZE :], vp, dt, n_sub), np.r_[x0, u0], eps)
     step()
-    Ap, Bp = P[:, :STATE_SIZE], P[:, STATE_SIZE:]
-    (Kx, Km, Kr), (Hx, Hm, Hr) = np.split(G[:4], [STATE_SIZE, n], axis=1), np.split(G[4:], [STATE_SIZE, n], axis=1)
+    Ap, Bp = P[:, : L.STATE_SIZE], P[:, L.STATE_SIZE :]
+    (Kx, Km, Kr), (Hx, Hm, Hr) = np.split(G[:4], [L.STATE_SIZE, n], axis=1), np.split(G[4:], [L.STATE_SIZE, n], axis=1)
     A = np.block([[Ap + Bp @ Kx, Bp @ Km], [Hx, Hm]])
-    Cy = np.eye(n)[[STATE_NAMES.index(name) for name in OUTPUTS]]
+    Cy = np.eye(n)[[L.STATE_NAMES.index(name) for name in OUTPUTS]]
     sys = control.ss(A, np.vstack([Bp @ Kr, Hr]), Cy, 0.0, dt, inputs=INPUTS, outputs=OUTPUTS, states=names)
-    mixer = vp[P_K] * np.array([mix(*row, vp[P_D]) for row in np.eye(4)]).T
+    mixer = vp[L.P_K] * np.array([mix(*row, vp[L.P_D]) for row in np.eye(4)]).T
     return Linearization(
         sys,
         float(dt),
@@ -262,7 +247,7 @@ def _loops(A, mixer):
     S = to_generalized(A.shape[0], mixer)
     At = np.abs(S @ A @ np.linalg.inv(S) - np.eye(A.shape[0]))
     _, label = connected_components(At > 1e-9 * At.max(), directed=False)
-    return {loop: np.flatnonzero(label == label[STATE_NAMES.index(state)]) for loop, (_, state) in LOOPS.items()}
+    return {loop: np.flatnonzero(label == label[L.STATE_NAMES.index(state)]) for loop, (_, state) in LOOPS.items()}
 
 
 def _steps(progress: Callable[[int, int], None] | None, total: int) -> Callable[[], None]:
