@@ -1,11 +1,20 @@
-"""Fixtures shared by several test modules."""
+"""Fixtures shared by several test modules, and one BLAS thread per test process."""
 
-import warnings
+import os
 
-import numpy as np
-import pytest
+# The suite runs on pytest-xdist's workers, one per core (pyproject.toml). OpenBLAS would start
+# a thread per core in each of them, and its threads wait for work by spinning: on cores that
+# the other workers are using, a least-squares fit (sysid's) took five times the CPU. Set
+# before numpy loads OpenBLAS here, and inherited by the workers and the processes the tests
+# start; an OPENBLAS_NUM_THREADS of your own wins.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import quadcruise as qc
+import warnings  # noqa: E402
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+import quadcruise as qc  # noqa: E402
 
 
 @pytest.fixture(scope="module")

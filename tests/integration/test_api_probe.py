@@ -6,9 +6,6 @@ them and exits 2), before any work. And what must pass still passes."""
 from __future__ import annotations
 
 import math
-import os
-import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -24,6 +21,7 @@ from quadcruise.montecarlo import Population, montecarlo
 from quadcruise.sim.inputs import Limits
 from quadcruise.tune import Bounds, Requirement, Target, tune
 from quadcruise.workflows.analysis import linearize
+from support.entry import run_entry
 
 EXAMPLES = Path(__file__).parents[2] / "examples"
 WRONG, BAD = TypeError, ValueError
@@ -297,16 +295,9 @@ def qc_controller(name):
 
 
 def quadcruise_cli(*args, cwd):
-    """The command line of this tree's package, whatever the folder it runs in."""
-    env = {**os.environ, "PYTHONPATH": str(Path(qc.__file__).parents[1])}
-    return subprocess.run(
-        [sys.executable, "-m", "quadcruise", *map(str, args)],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-        timeout=300,
-        env=env,
-    )
+    """The command line of this tree's package, whatever the folder it runs in (its entry
+    point in this process: support.entry)."""
+    return run_entry(*args, cwd=cwd)
 
 
 @pytest.mark.parametrize(

@@ -1,12 +1,14 @@
 """Bad inputs found by probing every command (each a traceback, a hang or an answer after the
-work before): one line, exit 2, before anything flies, nothing written."""
+work before): one line, exit 2, before anything flies, nothing written.
+
+Each runs the entry point in this process (support.entry: its status, stdout and stderr as
+a process gives them); tests/integration/test_cli.py runs the same kind of error as a process."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
-
 import pytest
+
+from support.entry import run_entry
 
 HUGE_PATH = "x,y,z\n0,0,1\n1e300,0,1\n"
 SCENARIOS = {
@@ -20,9 +22,7 @@ SCENARIOS = {
 
 
 def quadcruise(*args, cwd):
-    return subprocess.run(
-        [sys.executable, "-m", "quadcruise", *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=120
-    )
+    return run_entry(*args, cwd=cwd)
 
 
 @pytest.mark.parametrize(

@@ -11,6 +11,7 @@ import pytest
 from click.testing import CliRunner
 
 from quadcruise.cli import main
+from support.entry import run_entry
 
 
 def run(*args):
@@ -94,12 +95,29 @@ def test_fly_controller_options_reach_the_controller(tmp_path):
         (["analyze", "--poles", "0.7,-4"], "pole 0.7 is not in the open left half plane"),
     ],
 )
-def test_bad_options_are_one_line_with_status_two(args, words):
-    """Through the real entry point (click's own usage errors included), as a process."""
-    proc = subprocess.run([sys.executable, "-m", "quadcruise", *args], capture_output=True, text=True)
+def test_bad_options_are_one_line_with_status_two(args, words, tmp_path):
+    """Through the real entry point (click's own usage errors included), in this process
+    (support.entry); the next test runs two of them as processes."""
+    proc = run_entry(*args, cwd=tmp_path)
     assert proc.returncode == 2, proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: ") and words in lines[0], proc.stderr
+    assert not proc.stdout and list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["fly", "circle", "--bogus"], "No such option '--bogus'"),  # click's usage error
+        (["fly", "circle", "-m", "radius=-2"], "circle field 'radius' (circle radius, m) must be > 0"),  # ours
+    ],
+)
+def test_a_bad_option_ends_the_process_with_one_line_and_status_two(args, words, tmp_path):
+    """``python -m quadcruise`` as a process: its exit status, its stderr, nothing written."""
+    proc = subprocess.run([sys.executable, "-m", "quadcruise", *args], capture_output=True, text=True, cwd=tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.count("\n") == 1 and proc.stderr.startswith("error: ") and words in proc.stderr, proc.stderr
+    assert not proc.stdout and list(tmp_path.iterdir()) == []
 
 
 def test_fly_refuses_a_foreign_out_folder(tmp_path):

@@ -332,7 +332,7 @@ def test_a_stopped_sweep_ends_its_workers_says_one_line_and_resumes_to_the_same_
     tmp_path, sig, to_group, status, word
 ):
     psutil = pytest.importorskip("psutil")
-    n = 4000  # 2e7 vehicle-steps: seconds of flying once the workers run, so the signal lands mid-sweep
+    n = 1000  # 100 chunks, 5e6 vehicle-steps: seconds of flying once the workers run, so the signal lands mid-sweep
     options = ["--mission", "circle", "-n", n, "--seed", 5, "--mass-spread", 0.1, "--duration", 5, "--chunk-size", 10]
     args = ["montecarlo", *options, "--scheduler", "local", "--workers", 2, "--out", "mc", "--quiet"]
     env = {**os.environ, "PYTHONPATH": SRC, "QUADCRUISE_PROGRESS": "0"}

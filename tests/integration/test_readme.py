@@ -10,6 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from support.entry import run_entry
+
 ROOT = Path(__file__).parents[2]
 
 
@@ -43,9 +45,7 @@ def test_readme_tune_and_montecarlo_commands_do_what_the_table_says(tmp_path):
     targets and exits 0; the population is perturbed (its quantiles differ)."""
 
     def quadcruise(args):
-        return subprocess.run(
-            [sys.executable, "-m", "quadcruise", *args], cwd=tmp_path, capture_output=True, text=True, timeout=600
-        )
+        return run_entry(*args, cwd=tmp_path)  # the entry point, in this process (support.entry)
 
     tune = readme_command("tune")
     assert "--target" in tune and "DIR" in tune
