@@ -32,7 +32,10 @@ Examples
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
+from numba import get_num_threads, set_num_threads
 from numba.core.dispatcher import Dispatcher
 from numba.core.types.function_type import CompileResultWAP
 
@@ -45,6 +48,7 @@ from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.rotor_batch import rotor_inputs
 from quadcruise.sim.rotor_flight import direct_rotor_kernel, fly_rotor_pieces, paper_states, rotor_carry_width
 from quadcruise.sim.status import ExitStatus
+from quadcruise.sim.threads import ThreadPlan
 
 STEP_PIECES_PER_THREAD = 1
 """A step is short: one range of vehicles per thread, as each kernel call has a fixed cost."""
@@ -252,6 +256,7 @@ class Stepper:
         self.disturbance = compiled_address(disturbance or still_air, DISTURBANCE_SIG)
         self.disturbed = disturbance is not None
         self._kernel = direct_rotor_kernel() if self.rotor else direct_kernel()  # sim/fastmath.py
+        self._plan = ThreadPlan()  # one thread or all, for a step without a watcher
 
     @property
     def paper_state(self) -> np.ndarray:
@@ -396,6 +401,20 @@ class Stepper:
                     f"step: commands must be finite (row {int(np.flatnonzero(~np.isfinite(c).all(axis=1))[0])} is not)"
                 )
             self.gains[:, : self.setpoint_width] = c
+        if after_piece is not None:  # a chunk of a long flight: numba's threads
+            self._fly(pieces_per_thread, after_piece)
+            return
+        most, threads = get_num_threads(), self._plan.threads()
+        set_num_threads(threads)
+        start = time.perf_counter()
+        try:
+            self._fly(pieces_per_thread, None)
+        finally:
+            self._plan.record(threads, time.perf_counter() - start)
+            set_num_threads(most)
+
+    def _fly(self, pieces_per_thread: int, after_piece) -> None:
+        """One step through the plant's kernel, on numba's threads (as many as it is set to)."""
         if self.rotor:
             self._step_rotor(pieces_per_thread, after_piece)
             return

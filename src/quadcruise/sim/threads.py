@@ -67,4 +67,44 @@ def fly_in_pieces(kernel, n: int, args: tuple, pieces_per_thread: int = PIECES_P
         h.result()
 
 
-__all__ = ["PIECES_PER_THREAD", "fly_in_pieces"]
+class ThreadPlan:
+    """How many threads a short call repeated many times (a step of the step-wise engine) runs on:
+    one, or numba's number, whichever its recent calls took less time on.
+
+    Handing a piece to a second thread costs a wake-up of that thread, and on a virtual machine
+    whose other CPU is idle, of that CPU: 1,024 vehicles stepped one period took 0.7-1.0 M
+    env-steps/s on two threads and 1.4-1.6 M on one on the idle host, while on a busy one two threads
+    gave 2.3 M (docs/performance.md). So every :data:`KEEP` calls, :data:`TRIALS` calls on each
+    are timed, in turn, and the one with the smaller median is kept. The split never changes a
+    result (each vehicle's arithmetic is the same in any piece).
+    """
+
+    TRIALS = 8
+    KEEP = 512
+
+    def __init__(self) -> None:
+        self.calls = 0
+        self.times: dict[int, list[float]] = {}
+        self.chosen = 1
+
+    def threads(self) -> int:
+        """The number of threads of the next call."""
+        most = get_num_threads()
+        k = self.calls % (2 * self.TRIALS + self.KEEP)
+        if most <= 1:
+            return 1
+        if k < 2 * self.TRIALS:
+            return 1 if k % 2 == 0 else most
+        if k == 2 * self.TRIALS and self.times:
+            self.chosen = min(self.times, key=lambda c: float(np.median(self.times[c])))
+            self.times = {}
+        return min(self.chosen, most)
+
+    def record(self, threads: int, seconds: float) -> None:
+        """Count a call made on ``threads`` threads that took ``seconds``."""
+        if self.calls % (2 * self.TRIALS + self.KEEP) < 2 * self.TRIALS:
+            self.times.setdefault(threads, []).append(seconds)
+        self.calls += 1
+
+
+__all__ = ["PIECES_PER_THREAD", "ThreadPlan", "fly_in_pieces"]
