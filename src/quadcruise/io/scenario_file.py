@@ -129,6 +129,25 @@ def comparison_document(meta: dict, controllers: dict, *, title: str = "") -> di
     return doc
 
 
+def ulog_note(meta: dict, command: str) -> str:
+    """The scenario header's line naming the PX4 logs a run wrote (``meta["ulog"]``), or "".
+
+    Examples
+    --------
+    >>> print(ulog_note({"ulog": {"path": "f.ulg", "files": ["f.ulg"]}}, "fly").strip())
+    written as PX4 logs too (f.ulg): `quadcruise fly THIS_FILE --ulog f.ulg` writes the same bytes again
+    >>> ulog_note({}, "fly")
+    ''
+    """
+    logs = meta.get("ulog")
+    if not logs:
+        return ""
+    return (
+        f"\nwritten as PX4 logs too ({', '.join(logs['files'])}): "
+        f"`quadcruise {command} THIS_FILE --ulog {logs['path']}` writes the same bytes again"
+    )
+
+
 def scenario_text(doc: dict, *, header: str = "") -> str:
     """The scenario tables as TOML text.
 

@@ -465,7 +465,7 @@ class SimResult:
         >>> print(qc.fly("step", duration=2.0).scenario_toml().splitlines()[0])
         # written by quadcruise ... from a flight of nlpd on step; `quadcruise fly THIS_FILE` flies it again
         """
-        from quadcruise.io.scenario_file import scenario_document, scenario_text
+        from quadcruise.io.scenario_file import scenario_document, scenario_text, ulog_note
 
         scenario = self.meta.get("scenario") or {}
         doc = scenario_document(self.meta, title=scenario.get("title", ""))
@@ -476,13 +476,7 @@ class SimResult:
         )
         if self.meta.get("command_line"):
             header += "\nthe command line changed: " + " ".join(self.meta["command_line"])
-        if self.meta.get("ulog"):
-            logs = self.meta["ulog"]
-            header += (
-                f"\nwritten as a PX4 log too ({', '.join(logs['files'])}): "
-                f"`quadcruise fly THIS_FILE --ulog {logs['path']}` writes the same bytes again"
-            )
-        return scenario_text(doc, header=header)
+        return scenario_text(doc, header=header + ulog_note(self.meta, "fly"))
 
     def meta_json(self, **extra) -> str:
         """The recorded configuration as JSON.

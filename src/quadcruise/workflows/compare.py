@@ -271,7 +271,7 @@ class Comparison:
             its label and gains under ``[[compare.controllers]]``, and the population flown
             (``[compare] population``).
         """
-        from quadcruise.io.scenario_file import comparison_document, scenario_text
+        from quadcruise.io.scenario_file import comparison_document, scenario_text, ulog_note
 
         first = next(iter(self.results.values()))
         records = {label: controller_record(c) for label, c in self.controllers.items()}
@@ -279,13 +279,7 @@ class Comparison:
         if self.population:
             doc["compare"]["population"] = plain(self.population)
         header = "written by quadcruise from a comparison; `quadcruise compare THIS_FILE` flies it again"
-        if first.meta.get("ulog"):
-            logs = first.meta["ulog"]
-            header += (
-                f"\nwritten as PX4 logs too ({', '.join(logs['files'])}): "
-                f"`quadcruise compare THIS_FILE --ulog {logs['path']}` writes the same bytes again"
-            )
-        return scenario_text(doc, header=header)
+        return scenario_text(doc, header=header + ulog_note(first.meta, "compare"))
 
     @staticmethod
     def _rows(table) -> dict:
