@@ -15,7 +15,7 @@ rounding (the tests check it).
   branch, or a call of another compiled function (its error path): numba drops the pairs
   only where the function's control flow proves them redundant. Each is an atomic write to
   a counter that every thread of a batch shares (the rows are views of the batch's arrays).
-  ``tests/compiled_code.py`` finds them in a compiled body; the controller and disturbance
+  ``tests/support/compiled_code.py`` finds them in a compiled body; the controller and disturbance
   tests use it.
 - :func:`turned`: the sines and cosines of the angles, carried through the four stages of
   an RK4 step (``sim.engine.rk4_step``) by the angle-addition formulas, within
