@@ -165,6 +165,9 @@ class QuadVectorEnv(VectorEnv):
         if self.nominal_eq.batch_size is not None:
             raise InputError("the environment's vehicle must not be batched: use a population to vary it")
         check_can_hover(self.nominal_eq)
+        # what every reset reads, computed once (a reset is on the hot path)
+        self._nominal_row = self.nominal_eq.rows(1)
+        self._start_ref, self._mission_row = self.mission.reference(0.0), stack_params(self.mission, n=1)
         self.population, self.action_mode, self.max_track_error = population, action, float(max_track_error)
         default = RANDOM_DURATION if self.random_mission else self.mission.duration
         self.duration = float(default if duration is None else duration)
@@ -231,14 +234,12 @@ class QuadVectorEnv(VectorEnv):
         if self.random_mission:
             missions = [random_circle(seed, int(i)) for i in ids]
             start, mp = np.concatenate([m.reference(0.0) for m in missions]), stack_params(missions, n=k)
-        else:  # computed once: a reset is on the hot path
-            if not hasattr(self, "_start_ref"):
-                self._start_ref, self._mission_row = self.mission.reference(0.0), stack_params(self.mission, n=1)
+        else:
             start, mp = self._start_ref, np.repeat(self._mission_row, k, axis=0)
         vp = self._rows(vehicle, k)
         if self.rotor:
             vp_ctrl = self._rows(self.nominal_eq, k) if pop is None or pop.model_error else vp
-            rows = drawn_rows(self.nominal, self.nominal_eq.rows(1)[0], vp)
+            rows = drawn_rows(self.nominal, self._nominal_row[0], vp)
             x0, psi0 = hover_starts(rows, start, offsets)
             alloc = allocation_rows(self.nominal, vp_ctrl, None if self.baseline is not None else self.action_mode)
             return {
@@ -258,12 +259,8 @@ class QuadVectorEnv(VectorEnv):
         return {"vp": vp, "vp_ctrl": vp_ctrl, "x0": x0, "mp": mp, "environment": environment}
 
     def _rows(self, vehicle, k: int) -> np.ndarray:
-        """``vehicle.rows(k)``; the nominal vehicle's row computed once (a reset is on the hot path)."""
-        if vehicle is not self.nominal_eq:
-            return vehicle.rows(k)
-        if not hasattr(self, "_nominal_row"):
-            self._nominal_row = self.nominal_eq.rows(1)
-        return np.repeat(self._nominal_row, k, axis=0)
+        """``vehicle.rows(k)``, the nominal vehicle's from its row computed once."""
+        return np.repeat(self._nominal_row, k, axis=0) if vehicle is self.nominal_eq else vehicle.rows(k)
 
     def _start(self, rows: np.ndarray) -> None:
         """Start new episodes of the vehicles ``rows``, each from its own (seed, vehicle, episode) stream."""

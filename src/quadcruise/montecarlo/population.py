@@ -211,7 +211,7 @@ class Population:
         >>> Population().perturbs, Population(offset=0.1).perturbs
         (False, True)
         """
-        if any(getattr(self, name) > 0 for name in (*ROTOR_SPREADS, "offset", "wind_spread")):
+        if self.spreads_vehicle or self.offset > 0 or self.wind_spread > 0:
             return True
         if self.environment is not None and self.environment.turbulence is not None:
             return True

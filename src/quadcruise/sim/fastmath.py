@@ -233,8 +233,18 @@ _POOL = 4
 
 @njit(cache=True)
 def _hashmix(value, h):
-    value = ((value ^ h) * ((h * _MULT_A) & _M32)) & _M32
-    return value ^ (value >> _SHIFT), (h * _MULT_A) & _M32
+    """SeedSequence's hashmix: the mixed word and the next hash constant."""
+    h_next = (h * _MULT_A) & _M32
+    value = ((value ^ h) * h_next) & _M32
+    return value ^ (value >> _SHIFT), h_next
+
+
+@njit(cache=True)
+def _output_word(value, h):
+    """One 32-bit word of SeedSequence.generate_state from a pool word: the word and the next constant."""
+    h_next = (h * _MULT_B) & _M32
+    value = ((value ^ h) * h_next) & _M32
+    return value ^ (value >> _SHIFT), h_next
 
 
 @njit(cache=True)
@@ -281,14 +291,10 @@ def _seed_words(seed_words, ids, spawn_key, out):
                 v, h = _hashmix(entropy[src], h)
                 pool[dst] = _mix(pool[dst], v)
         h = _INIT_B
-        for k in range(out.shape[1]):
-            half = np.zeros(2, dtype=np.uint64)
-            for j in range(2):
-                v = pool[(2 * k + j) % _POOL] ^ h
-                h = (h * _MULT_B) & _M32
-                v = (v * h) & _M32
-                half[j] = v ^ (v >> _SHIFT)
-            out[r, k] = half[0] | (half[1] << _WORD)
+        for k in range(out.shape[1]):  # a 64-bit word: two 32-bit ones, the low first
+            low, h = _output_word(pool[(2 * k) % _POOL], h)
+            high, h = _output_word(pool[(2 * k + 1) % _POOL], h)
+            out[r, k] = low | (high << _WORD)
 
 
 def seed_sequence_words(seed: int, ids, spawn_key: int | None, n_words: int) -> np.ndarray:
@@ -329,12 +335,12 @@ def seed_sequence_words(seed: int, ids, spawn_key: int | None, n_words: int) -> 
     ids = ids.ravel()
     if seed < 0 or (ids.size and ids.min() < 0):
         raise ValueError(f"seed and indices must be >= 0, got seed {seed}, indices from {ids.min(initial=0)}")
+    ids = np.array(ids.tolist(), dtype=np.uint64) if ids.dtype == object else ids.astype(np.uint64)
     words = [seed & 0xFFFFFFFF]
     seed >>= 32
     while seed:
         words.append(seed & 0xFFFFFFFF)
         seed >>= 32
-    ids = np.array(ids.tolist(), dtype=np.uint64) if ids.dtype == object else ids.astype(np.uint64)
     out = np.empty((ids.shape[0], int(n_words)), dtype=np.uint64)
     _seed_words(np.array(words, dtype=np.uint64), ids, -1 if spawn_key is None else int(spawn_key), out)
     return out

@@ -72,11 +72,11 @@ class ThreadPlan:
     one, or numba's number, whichever its recent calls took less time on.
 
     Handing a piece to a second thread costs a wake-up of that thread, and on a virtual machine
-    whose other CPU is idle, of that CPU: 1,024 vehicles stepped one period took 0.7-1.0 M
-    env-steps/s on two threads and 1.4-1.6 M on one on the idle host, while on a busy one two threads
-    gave 2.3 M (docs/performance.md). So every :data:`KEEP` calls, :data:`TRIALS` calls on each
-    are timed, in turn, and the one with the smaller median is kept. The split never changes a
-    result (each vehicle's arithmetic is the same in any piece).
+    whose other CPU is idle, of that CPU: more than the half of a short step it flies, while on a
+    busy host two threads are faster (the figures: docs/gym.md, "Throughput"). So every
+    :data:`KEEP` calls, :data:`TRIALS` calls on each are timed, in turn, and the one with the
+    smaller median is kept. The split never changes a result (each vehicle's arithmetic is the
+    same in any piece).
     """
 
     TRIALS = 8
