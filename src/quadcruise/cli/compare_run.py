@@ -15,7 +15,7 @@ from quadcruise.cli.vehicle import refuse_vehicle_fields
 from quadcruise.errors import InputError
 
 __all__ = [
-    "DEFAULT_COMPARED",
+    "default_compared",
     "compared_from_options",
     "echo_population_comparison",
     "population_from_options",
@@ -163,8 +163,18 @@ def echo_population_comparison(mission, controllers, n: int, seed: int, pop, fli
     return table
 
 
-DEFAULT_COMPARED = "nlpd,gonzalez,se3,cascade"
-"""The controllers ``quadcruise compare`` flies when neither the options nor a scenario name any."""
+def default_compared() -> str:
+    """The controllers ``quadcruise compare`` flies when neither the options nor a scenario name
+    any: those declared ``compared=True`` (:func:`quadcruise.control.registry.compared_names`).
+
+    Returns
+    -------
+    str
+        Comma-separated names.
+    """
+    from quadcruise.control.registry import compared_names
+
+    return ",".join(compared_names())
 
 
 def compared_from_options(mission: str, controllers: str | None, mission_params: tuple[str, ...]):
@@ -176,7 +186,7 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
         A mission name, a waypoint CSV (``.csv``) or a scenario file (``.toml``).
     controllers : str or None
         ``--controllers``, comma-separated names; None: the scenario's ``[compare]`` controllers,
-        else its ``[controller]``, else :data:`DEFAULT_COMPARED`.
+        else its ``[controller]``, else :func:`default_compared`.
     mission_params : tuple of str
         ``-m KEY=VALUE`` parameters of the mission.
 
@@ -189,7 +199,7 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
     from quadcruise.cli.assignments import parse_assignments
 
     if not mission.lower().endswith(".toml"):
-        chosen = DEFAULT_COMPARED if controllers is None else controllers
+        chosen = default_compared() if controllers is None else controllers
         return mission_from_options(mission, mission_params, smooth=False), chosen, {}, None
     from quadcruise.missions import mission_from_name
     from quadcruise.workflows.scenario import load_scenario
@@ -204,7 +214,7 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
         controllers
         if controllers is not None
         else scenario.compare
-        or ({scenario.controller.name: scenario.controller} if scenario.controller is not None else DEFAULT_COMPARED)
+        or ({scenario.controller.name: scenario.controller} if scenario.controller is not None else default_compared())
     )
     return the_mission, chosen, scenario.fly_kwargs(drag=False), scenario
 

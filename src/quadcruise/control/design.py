@@ -285,6 +285,16 @@ def attitude_pid_design(actuator_bandwidth: float = 15.0) -> PIDGains:
     """PID gains of a decoupled attitude loop phi'' = U2* (eq 15): poles at 0.6 w (zeta 0.8) and w / 30.
     Why these: docs/paper.md, "Attitude gains".
 
+    Parameters
+    ----------
+    actuator_bandwidth : float
+        The rotor lag's bandwidth w [rad/s] (15: the paper's vehicle).
+
+    Returns
+    -------
+    PIDGains
+        kp [1/s^2], ki [1/s^3], kd [1/s].
+
     Examples
     --------
     >>> g = attitude_pid_design()

@@ -17,13 +17,15 @@ from collections.abc import Callable
 import numpy as np
 import pandas as pd
 
+from quadcruise.control.registry import baseline_names
 from quadcruise.errors import InputError
 from quadcruise.gym.env import QuadVectorEnv
 from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from quadcruise.sim.result import SimResult
 
 BASELINES = ("nlpd", "gonzalez", "se3", "cascade")
-"""The built-in controllers flown as baseline policies."""
+"""The built-in controllers flown as baseline policies (with any declared since with
+``baseline=True``: :func:`quadcruise.control.registry.baseline_names`)."""
 
 
 def rollout(env: QuadVectorEnv, policy: Callable | None = None, *, seed: int = 0) -> tuple[np.ndarray, SimResult]:
@@ -82,14 +84,15 @@ def rollout(env: QuadVectorEnv, policy: Callable | None = None, *, seed: int = 0
     return returns, result
 
 
-def baselines(controllers=BASELINES, *, num_envs: int = 8, seed: int = 0, **env_kwargs) -> pd.DataFrame:
+def baselines(controllers=None, *, num_envs: int = 8, seed: int = 0, **env_kwargs) -> pd.DataFrame:
     """Each built-in controller flown as a policy in the same environment, scored by the
     environment's return and by the project's flight metrics (their mean over the vehicles).
 
     Parameters
     ----------
-    controllers : sequence of str or Controller
-        The controllers.
+    controllers : sequence of str or Controller, optional
+        The controllers; by default every one declared ``baseline=True``
+        (:func:`quadcruise.control.registry.baseline_names`).
     num_envs : int
         Vehicles per controller (the same episodes: the same seed).
     seed : int
@@ -106,7 +109,7 @@ def baselines(controllers=BASELINES, *, num_envs: int = 8, seed: int = 0, **env_
         ``SimResult.metrics()``.
     """
     rows = []
-    for controller in controllers:
+    for controller in baseline_names() if controllers is None else controllers:
         env = QuadVectorEnv(num_envs, controller=controller, **env_kwargs)
         returns, flights = rollout(env, seed=seed)
         table = flights.metrics()

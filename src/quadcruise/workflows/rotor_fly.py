@@ -26,9 +26,7 @@ from typing import Any
 import numpy as np
 
 from quadcruise.control import CONTROLLERS, controller_from_name
-from quadcruise.control.cascade import rate_pid_design
-from quadcruise.control.design import attitude_pid_design
-from quadcruise.control.se3 import se3_attitude_design
+from quadcruise.control.registry import rotor_gains
 from quadcruise.errors import InputError
 from quadcruise.layout import REF_PSI, REF_Z
 from quadcruise.missions import Mission
@@ -39,22 +37,15 @@ from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rotor_batch import fly_rotor_vehicles
 
-# the controller fields designed for an actuator bandwidth w [rad/s], by controller name
-_DESIGNS = {
-    "nlpd": {"attitude": attitude_pid_design, "yaw": attitude_pid_design},
-    "gonzalez": {"attitude": attitude_pid_design, "yaw": attitude_pid_design},
-    "se3": {"attitude": se3_attitude_design},
-    "cascade": {"rate": rate_pid_design, "yaw_rate": lambda w: rate_pid_design(w, yaw=True)},
-}
-
 
 def designed_controller(name: str, bandwidth: float) -> Any:
-    """A built-in controller with the gains its design rules give for a motor bandwidth.
+    """A controller by name with the gains its design rules give for a motor bandwidth (its
+    ``rotor_design``, :func:`quadcruise.control.registry.register_controller`).
 
     Parameters
     ----------
     name : str
-        A built-in controller's name (``nlpd``, ``gonzalez``, ``se3``, ``cascade``).
+        A declared controller's name (``nlpd``, ``gonzalez``, ``se3``, ``cascade``, or a user's).
     bandwidth : float
         The rotor lag's bandwidth w [rad/s] (15 for the paper's vehicle: the defaults).
 
@@ -69,10 +60,10 @@ def designed_controller(name: str, bandwidth: float) -> Any:
     Raises
     ------
     InputError
-        An unknown name.
+        An unknown name, or a controller declared without a design for a rotor-plant vehicle.
     """
     base = controller_from_name(name)
-    return dataclasses.replace(base, **{field: design(bandwidth) for field, design in _DESIGNS[name].items()})
+    return dataclasses.replace(base, **rotor_gains(name, bandwidth))
 
 
 def as_vehicle(vehicle: Any) -> Any:
