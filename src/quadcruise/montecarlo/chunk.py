@@ -117,18 +117,7 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
             transient_until=spec.transient_until,
             hover_duty=None if hover is None else hover[live],
         )
-        for key in (
-            "rmse_m",
-            "max_error_m",
-            "steady_rmse_m",
-            "steady_max_error_m",
-            "final_error_m",
-            "effort",
-            "transient_axis",
-            "rise_time_s",
-            "overshoot_pct",
-            "peak_time_s",
-        ):
+        for key in (*(m for m in METRICS if m in got), "transient_axis"):  # the batch's own, by name
             out[key][live] = got[key]
         out["settling_time_s"][live], out["settling_time_5pct_s"][live] = got["settling_s"][:2]
         not_settled[live] = (got["transient_axis"] >= 0) & np.isnan(got["settling_s"][2])
@@ -151,7 +140,7 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
     # lost track: fly's own status (the error left 1 m + the mission's size at some instant), or
     # off track after the transient by the spec's bounds
     lost_track = ~diverged & ((status == int(ExitStatus.LOST_TRACK)) | off)
-    for key in FAILED_FLIGHT_METRICS + ("settling_time_5pct_s",):  # no transient or steady state to speak of
+    for key in FAILED_FLIGHT_METRICS:  # no transient or steady state to speak of
         out[key][lost_track] = np.nan
     saturated = out["duty_clipped_s"] > spec.max_clipped_s
     failed_requirement = np.zeros(n, dtype=bool)

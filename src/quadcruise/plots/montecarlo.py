@@ -15,32 +15,18 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
+from quadcruise.metrics.declared import METRICS as DECLARED_METRICS
+from quadcruise.metrics.declared import metric_names
+
 __all__ = ["plot_histograms", "plot_envelope", "metric_label", "degenerate", "METRIC_LABELS"]
 
 
-HISTOGRAM_METRICS = (
-    "rmse_m",
-    "max_error_m",
-    "final_error_m",
-    "rise_time_s",
-    "settling_time_5pct_s",
-    "overshoot_pct",
-    "effort",
-    "duty_clipped_s",
-)
-"""The metrics :func:`plot_histograms` draws by default."""
+HISTOGRAM_METRICS = metric_names(histogram=True)
+"""The metrics :func:`plot_histograms` draws by default (declared ``histogram=True`` in
+:mod:`quadcruise.metrics.declared`)."""
 
 METRIC_LABELS = {
-    "rmse_m": "RMSE [m]",
-    "max_error_m": "max error [m]",
-    "final_error_m": "final error [m]",
-    "rise_time_s": "rise time [s]",
-    "settling_time_s": "settling time 2 % [s]",
-    "settling_time_5pct_s": "settling time 5 % [s]",
-    "overshoot_pct": "overshoot [%]",
-    "effort": "effort [s]",
-    "duty_clipped_s": "duty clipped [s]",
-    "controller_limited_s": "controller limited [s]",
+    **{m.name: m.axis_label for m in DECLARED_METRICS},
     "stop_time_s": "stop time [s]",
     "m": "mass [kg]",
     "dx0": "start offset x [m]",
