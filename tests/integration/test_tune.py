@@ -282,7 +282,9 @@ RISE = ["--target", "rise_time_s=1"]
 @pytest.mark.parametrize(
     "args, message",
     [
-        (["--target", "rise=1"], "unknown metric 'rise'"),
+        (["--target", "rise=1"], "unknown metric 'rise' (did you mean 'rise_time_s'?)"),
+        (["--target", "settling=2"], "unknown metric 'settling' (did you mean 'settling_time_s'?)"),
+        (["--target", "overshoot=4"], "unknown metric 'overshoot' (did you mean 'overshoot_pct'?)"),
         (["--target", "overshoot_pct=-4"], "no metric is negative"),
         (["--minimize", "rmse"], "unknown metric 'rmse' (did you mean 'rmse_m'?)"),
         (["--gains", "position.kx", *RISE], "unknown gain 'position.kx' of nlpd (did you mean 'position.kp'?)"),
