@@ -341,6 +341,8 @@ def sweep_like(n=30, ok=10, seed=0):
         {
             "vehicle": np.arange(n),
             "failure": failure,
+            "diverged": failure == 1,
+            "lost_track": np.zeros(n, bool),
             "rmse_m": rng.gamma(2.0, 0.1, n),
             "max_error_m": rng.gamma(3.0, 0.2, n),
             "final_error_m": np.r_[rng.gamma(2.0, 0.01, n - 3), [np.nan] * 3],
@@ -376,7 +378,10 @@ def test_histograms_have_axis_labels():
     ]
     assert all(ax.get_ylabel() == "flights" for ax in shown)
     assert shown[-1].get_title() == "outcome of 30 flights" and shown[-1].get_xlabel() == "outcome"
-    assert sum(p.get_height() for p in hists[0].patches) == 30 and "27, 3 n/a" in hists[2].get_title()
+    kept = sweep_like().table.query("not diverged")  # the flights the summary's quantiles are over
+    gone = int(kept["final_error_m"].isna().sum())
+    assert sum(p.get_height() for p in hists[0].patches) == len(kept) < 30
+    assert f"{len(kept) - gone}, {gone} n/a" in hists[2].get_title() and gone > 0
     assert mc_plots.metric_label("hover_time_s") == "hover time [s]"
 
 
@@ -387,7 +392,8 @@ def test_histograms_leave_out_degenerate_metrics_and_say_so():
     assert not any(word in ax.get_title() for ax in shown for word in ("rise_time", "duty_clipped"))
     assert not any("not measured" in t.get_text() for ax in fig.axes for t in ax.texts)
     note = fig._supxlabel.get_text().replace("\u00a0", " ")  # no break inside an item
-    assert note == "not drawn: rise_time_s (not measured), duty_clipped_s (0 in all 30 flights)"
+    kept = int((~sweep_like().table["diverged"]).sum())  # the flights that kept track
+    assert note == f"not drawn: rise_time_s (not measured), duty_clipped_s (0 in all {kept} flights)"
     # nothing left out: no note
     fig = mc_plots.plot_histograms(sweep_like(), metrics=["rmse_m", "settling_time_5pct_s"])
     assert fig._supxlabel is None and len([ax for ax in fig.axes if ax.get_visible()]) == 3

@@ -50,8 +50,9 @@ def fly_chunk(spec: MonteCarloSpec, first, count: int, log_every: int | None = N
             first_vehicle=first,
             environment=draw.environment,
             sensors=draw.sensors,
-            max_steady_error=np.inf,
-        )  # sweep_metrics judges it, by the spec's bound
+            max_steady_error=spec.max_track_error_m,
+            max_altitude_error=spec.max_altitude_error_m,
+        )  # fly's own verdict, by the spec's bounds, at every period whatever the log keeps
     return res, draw
 
 
@@ -122,24 +123,10 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
         out["settling_time_s"][live], out["settling_time_5pct_s"][live] = got["settling_s"][:2]
         not_settled[live] = (got["transient_axis"] >= 0) & np.isnan(got["settling_s"][2])
     diverged = stopped
-    off = np.zeros(n, dtype=bool)
-    if live.size:  # fly's rule (off_track_since), by the spec's bounds, on the sweep's log
-        from quadcruise.workflows.fly_failures import off_track_since
-
-        d = result.states[live, :, X : X + 3] - refs[live]
-        first = off_track_since(
-            t,
-            np.sqrt((d * d).sum(axis=-1)),
-            d[:, :, 2],
-            got["transient_axis"] >= 0,
-            got["settled_at"],
-            np.full(live.size, spec.max_track_error_m),
-            np.full(live.size, spec.max_altitude_error_m),
-        )
-        off[live] = np.isfinite(first)
-    # lost track: fly's own status (the error left 1 m + the mission's size at some instant), or
-    # off track after the transient by the spec's bounds
-    lost_track = ~diverged & ((status == int(ExitStatus.LOST_TRACK)) | off)
+    # lost track: fly's own status, the one rule of a flight alone (fly_chunk gives it the spec's
+    # bounds): the error left the tracking bound (1 m + the mission's size) at some period, or
+    # off track after the transient (status and time those of `fly` of the same vehicle)
+    lost_track = ~diverged & np.isin(status, (int(ExitStatus.LOST_TRACK), int(ExitStatus.OFF_TRACK)))
     for key in FAILED_FLIGHT_METRICS:  # no transient or steady state to speak of
         out[key][lost_track] = np.nan
     saturated = out["duty_clipped_s"] > spec.max_clipped_s

@@ -84,10 +84,13 @@ def write_case(case, out, *, fmt: str = "csv", force: bool = False) -> Path:
 
 
 def case_text(case, seed: int) -> str:
-    """One line on a re-flown vehicle: its outcome and its main metrics."""
-    keys = tuple(k for k in WORST_COLUMNS if k != "stop_time_s")
-    return f"flight {case.vehicle} of seed {seed}: {case.row['reason']}, " + ", ".join(
-        f"{k} = {case.row[k]:.4g}" for k in keys
+    """One line on a re-flown vehicle: its status as ``fly`` says it (the same words and time
+    as the vehicle flown alone), the sweep's outcome, its main metrics and its mass (to 10
+    digits, to fly it alone: ``fly --vehicle m=...``)."""
+    keys = ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "settling_time_5pct_s")
+    return (
+        f"flight {case.vehicle} of seed {seed}: {case.result.status_text(0)} (the sweep's outcome: "
+        f"{case.row['reason']}), " + ", ".join(f"{k} = {case.row[k]:.4g}" for k in keys) + f", m = {case.row['m']:.10g}"
     )
 
 

@@ -93,6 +93,7 @@ def fly(
     first_vehicle: int | np.ndarray = 0,
     max_track_error: float | None = None,
     max_steady_error: float | None = None,
+    max_altitude_error: float | None = None,
     **unknown: Any,
 ) -> SimResult:
     """Fly a mission with a controller and return the logged flight.
@@ -125,10 +126,11 @@ def fly(
     log_every : int, optional
         Log every this many control periods (a divisor of them). By default every period,
         unless a batch's log would exceed :data:`LOG_BUDGET` (256 MiB): then the smallest divisor
-        that fits, said in a :class:`~quadcruise.errors.LogWarning`, and the track checks
-        (``lost track``, ``off track``) are made at every period as the flight goes, so the
-        statuses and times are those of the full log. A ``log_every`` given is kept, and the
-        checks read its log (a log over half the memory is refused).
+        that fits, said in a :class:`~quadcruise.errors.LogWarning`. A ``log_every`` given is
+        kept (a log over half the memory is refused). Either way the track checks (``lost
+        track``, ``off track``) are made at every period as the flight goes, so the statuses
+        and times are those of the full log, whatever the log keeps (on the paper's plant; a
+        rotor-plant flight's checks read its log).
     limits : Limits, optional
         Divergence bounds.
     missions : list of Mission, optional
@@ -170,6 +172,10 @@ def fly(
         missions), and on the altitude error alone :func:`altitude_bound` (half the
         mission's lowest altitude: 0.5 m for the built-in missions at 1 m), the rule a Monte
         Carlo sweep applies; a value given here bounds both; ``numpy.inf`` turns it off.
+    max_altitude_error : float, optional
+        The bound [m] on the altitude error alone after the transient (``off track`` too): by
+        default :func:`altitude_bound`, or ``max_steady_error`` where that is given; a Monte
+        Carlo sweep gives its ``max_altitude_error_m`` here; ``numpy.inf`` turns it off.
     **unknown : Any
         Refused: any other keyword is an InputError naming the options (see
         :data:`FLY_OPTIONS`), so a misspelt one is not silently ignored.
@@ -213,7 +219,8 @@ def fly(
     check_wind_acts(vehicle, environment)  # rotor_fly.py
     seed = checks.whole(w, "seed", seed)
     first_vehicle = vehicle_indices(first_vehicle)
-    for name, value in (("max_track_error", max_track_error), ("max_steady_error", max_steady_error)):
+    bounds = (("max_track_error", max_track_error), ("max_steady_error", max_steady_error))
+    for name, value in (*bounds, ("max_altitude_error", max_altitude_error)):
         checks.number(w, name, value, "pos", unit="m", optional=True, infinite=True)
     x0 = initial_states(x0)
     if rotor and (x0 is not None or full_dynamics):
@@ -242,14 +249,17 @@ def fly(
     first = missions[0] if missions else mission
     duration = default_duration(first) if duration is None else duration
     d, h = duration, dt
-    watched = log_every is None and n > 1 and 0 < h <= d < math.inf and batch_log_every(n, round(d / h)) > 1
-    watched = watched and not rotor  # a rotor flight keeps its whole log (rotor_fly.py)
+    chosen = log_every is None and n > 1 and 0 < h <= d < math.inf and batch_log_every(n, round(d / h)) > 1
+    chosen = chosen and not rotor  # a rotor flight keeps its whole log (rotor_fly.py)
     # a batch whose full log would not fit in LOG_BUDGET: a coarser log, checked at every period
-    log_every = batch_log_every(n, round(d / h)) if watched else 1 if log_every is None else log_every
+    log_every = batch_log_every(n, round(d / h)) if chosen else 1 if log_every is None else log_every
+    # the track checks see every period whatever the log keeps: a flight's status and time do not
+    # depend on its log (a Monte Carlo sweep's 10 ms log, `montecarlo --case`, `fly` alone agree)
+    watched = not rotor and log_every > 1 and 0 < h <= d < math.inf
     if 0 < h <= d < math.inf:  # sized before the grid is allocated
         substeps = max(1, math.ceil(h / float(max_step or h) - 1e-9))
         check_run_size(n, round(d / h), int(log_every), substeps, watched)
-    if watched:
+    if chosen:
         full, kept = log_bytes(n, round(d / h), 1) / 2**30, log_bytes(n, round(d / h), log_every) / 2**30
         warnings.warn(
             f"fly(): the log of {n:,} vehicles x {round(d / h) + 1:,} instants would take {full:.1f} GiB: logging "
@@ -281,9 +291,10 @@ def fly(
         "full_dynamics": bool(full_dynamics),
         "seed": seed,
         "log_every": int(log_every),
-        **({"log_every_chosen": True} if watched else {}),
+        **({"log_every_chosen": True} if chosen else {}),
         "max_track_error": None if max_track_error is None else float(max_track_error),
         "max_steady_error": None if max_steady_error is None else float(max_steady_error),
+        **({} if max_altitude_error is None else {"max_altitude_error": float(max_altitude_error)}),
         "initial_state": given_x0,
     }
     if environment is not None:
@@ -327,6 +338,8 @@ def fly(
         if max_steady_error is None
         else steady
     )
+    if max_altitude_error is not None:
+        vertical = np.full(n, float(max_altitude_error))
     options = dict(
         memory=memory,
         max_step=max_step or dt,

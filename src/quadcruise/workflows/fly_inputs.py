@@ -237,6 +237,7 @@ FLY_OPTIONS = (
     "first_vehicle",
     "max_track_error",
     "max_steady_error",
+    "max_altitude_error",
 )
 """The keywords :func:`fly` takes besides the mission and the controller."""
 
