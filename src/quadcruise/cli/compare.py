@@ -22,6 +22,7 @@ from quadcruise.cli.common import (
 )
 from quadcruise.cli.compare_run import (
     compared_from_options,
+    comparison_ulog_paths,
     echo_population_comparison,
     population_from_options,
     population_record,
@@ -191,13 +192,14 @@ def compare(
         table = echo_population_comparison(cmp_mission, cmp.controllers, count, pop_seed, pop, kwargs)
         cmp = dataclasses.replace(cmp, population=population_record(count, pop_seed, pop), population_table=table)
     if ulog is not None:
-        written = write_comparison_ulogs(cmp, ulog)
-        click.echo("wrote PX4 logs " + ", ".join(map(str, written)))
         for result in cmp.results.values():  # said in scenario.toml, as fly's is
-            result.meta["ulog"] = {"path": str(ulog), "files": [str(p) for p in written]}
-    if out is not None:
+            result.meta["ulog"] = {"path": str(ulog), "files": [str(p) for p in comparison_ulog_paths(cmp, ulog)]}
+    if out is not None:  # first: the folder is replaced whole, so a file named inside it comes after
         cmp.write(out, force=force, **conventions)
         click.echo(f"wrote metrics.csv and comparison.png to {out}")
+    if ulog is not None:
+        written = write_comparison_ulogs(cmp, ulog)
+        click.echo("wrote PX4 logs " + ", ".join(map(str, written)))
     if report is not None:
         from quadcruise.report.html import write_html_report
         from quadcruise.report.sections import comparison_report

@@ -20,6 +20,7 @@ __all__ = [
     "echo_population_comparison",
     "population_from_options",
     "population_record",
+    "comparison_ulog_paths",
     "write_comparison_ulogs",
 ]
 
@@ -219,6 +220,31 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
     return the_mission, chosen, scenario.fly_kwargs(drag=False), scenario
 
 
+def _labelled(path, label) -> Path:
+    """``PATH.ulg`` as ``PATH-LABEL.ulg``, the label's odd characters made ``_``."""
+    path = Path(path)
+    return path.with_name(f"{path.stem}-{re.sub(r'[^A-Za-z0-9._-]', '_', str(label))}{path.suffix}")
+
+
+def comparison_ulog_paths(cmp, path) -> list[Path]:
+    """The files :func:`write_comparison_ulogs` writes, in its order (said before writing them).
+
+    Parameters
+    ----------
+    cmp : Comparison
+        The flights.
+    path : str or os.PathLike
+        The path given (``.ulg``).
+
+    Returns
+    -------
+    list of pathlib.Path
+    """
+    from quadcruise.cli.fly_run import ulog_paths
+
+    return [p for label, result in cmp.results.items() for p in ulog_paths(_labelled(path, label), result.n)]
+
+
 def write_comparison_ulogs(cmp, path) -> list[Path]:
     """Write each controller's flight as a PX4 log, all or none.
 
@@ -245,11 +271,10 @@ def write_comparison_ulogs(cmp, path) -> list[Path]:
     """
     from quadcruise.cli.fly_run import write_ulogs
 
-    path, written = Path(path), []
+    written = []
     try:
         for label, result in cmp.results.items():
-            safe = re.sub(r"[^A-Za-z0-9._-]", "_", str(label))
-            written += write_ulogs(result, path.with_name(f"{path.stem}-{safe}{path.suffix}"))
+            written += write_ulogs(result, _labelled(path, label))
     except BaseException:
         for done in written:
             done.unlink(missing_ok=True)
