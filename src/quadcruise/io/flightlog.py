@@ -66,6 +66,12 @@ class FlightLog:
     or None: the rotors' measured speeds [rad/s] (ULog ``esc_status`` rpm, CSV ``w1..wn``);
     ``speed_commands``: the commands ``u`` are rotor speeds [rad/s] (a CSV read with
     ``commands="rad/s"``) rather than normalised.
+
+    A ULog's commands ``u`` are each rotor's *relative thrust* (thrust over its thrust at full
+    command), PX4's meaning of ``actuator_motors``; ``actuator_outputs`` (PWM) are mapped to the
+    signal x by the PWM range and to relative thrust through ``THR_MDL_FAC`` (``f x^2 + (1 - f)
+    x``), which is applied here and kept as ``thrust_factor`` (not in ``parameters``). With
+    ``commands="rad/s"`` ``u`` is the signal x instead (the commanded speed over ``w_max``).
     """
 
     source: str
@@ -86,6 +92,7 @@ class FlightLog:
     resampling: str = ""
     speeds: np.ndarray | None = None
     speed_commands: bool = False
+    thrust_factor: float | None = None
 
     @property
     def n_rotors(self) -> int:
@@ -145,9 +152,9 @@ def read_flight_log(path: str | os.PathLike, *, frame: str | None = None, comman
         PX4's: "ned" or None.
     commands : str
         ``duty`` (default: ``actuator_motors``, or a CSV's ``u`` columns in [0, 1]),
-        ``rad/s`` (a CSV's ``u`` columns are commanded rotor speeds; a ULog's ``actuator_motors``
-        are the commanded speeds over ``w_max``, PX4's ``THR_MDL_FAC = 1``) or ``pwm:MIN:MAX``
-        (PWM [us]).
+        ``rad/s`` (a CSV's ``u`` columns are commanded rotor speeds; a ULog's signal x, the
+        relative thrust of ``actuator_motors`` through the inverse of ``THR_MDL_FAC``, is the
+        commanded speed over ``w_max``) or ``pwm:MIN:MAX`` (``actuator_outputs``' PWM [us]).
 
     Returns
     -------
@@ -278,6 +285,9 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
     if any(c not in cmd for c in cols):
         raise InputError(f"{path}: {cmd_topic} has fewer than the {n_rot} rotor channels CA_ROTOR_COUNT says")
     raw = np.column_stack([cmd[c].astype(np.float64) for c in cols])
+    factor = float(params.get("THR_MDL_FAC", 0.0) or 0.0)
+    if not 0.0 <= factor <= 1.0:
+        raise InputError(f"{path}: parameter THR_MDL_FAC = {factor:g} is outside PX4's range [0, 1]")
     if cmd_topic == "actuator_outputs":
         if kind == "pwm" and np.isfinite(lo):
             lows, highs = np.full(n_rot, lo), np.full(n_rot, hi)
@@ -286,10 +296,14 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
             lows = np.array([_pwm_param(params, "MIN", i, 1000.0) for i in channels])
             highs = np.array([_pwm_param(params, "MAX", i, 2000.0) for i in channels])
             how = "actuator_outputs PWM mapped with the log's PWM_MAIN_MIN/MAX"
-        u_raw = (raw - lows) / (highs - lows)
+        signal = (raw - lows) / (highs - lows)
+        rel = factor * signal**2 + (1.0 - factor) * signal  # PX4's thrust model, THR_MDL_FAC
+        how += f", relative thrust through THR_MDL_FAC {factor:g}"
     else:
-        u_raw = raw
-        how = "actuator_motors (normalised)"
+        rel = raw
+        signal = _signal_of(rel, factor)
+        how = "actuator_motors (relative thrust)"
+    u_raw = signal if kind == "rad/s" else rel
 
     # airborne, armed
     t_status = times("vehicle_status")
@@ -389,7 +403,7 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
         "vectors and commands interpolated linearly, "
         "attitude by slerp, arming and landed states held from their last message"
     )
-    names = ("MAV_TYPE", "THR_MDL_FAC", "CA_ROTOR_COUNT", "SYS_AUTOSTART", "SDLOG_PROFILE")
+    names = ("MAV_TYPE", "CA_ROTOR_COUNT", "SYS_AUTOSTART", "SDLOG_PROFILE")  # THR_MDL_FAC: applied here
     kept = {k: params[k] for k in names if k in params}
     return FlightLog(
         source=str(path),
@@ -406,10 +420,20 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
         parameters=kept,
         hover_thrust=hover,
         rates_hz=rates_hz,
-        commands=how + (" x w_max: commanded rotor speeds" if kind == "rad/s" else ""),
+        commands=how
+        + (f"; signal x (THR_MDL_FAC {factor:g}) x w_max: commanded rotor speeds" if kind == "rad/s" else ""),
         resampling=resampling,
         speeds=speeds,
+        thrust_factor=factor,
     )
+
+
+def _signal_of(rel: np.ndarray, factor: float) -> np.ndarray:
+    """PX4's signal x of a relative thrust through ``THR_MDL_FAC`` f: the root of ``f x^2 + (1 - f) x = rel``."""
+    if factor <= 0.0:
+        return rel.copy()
+    b = 1.0 - factor
+    return -b / (2.0 * factor) + np.sqrt(b * b / (4.0 * factor**2) + np.clip(rel, 0.0, None) / factor)
 
 
 def _pwm_param(params: dict, which: str, i: int, default: float) -> float:
