@@ -204,6 +204,17 @@ VEHICLE_LAND_DETECTED = (
     ("bool", 0, "maybe_landed"),
     ("bool", 0, "landed"),
 )
+PWM_MIN, PWM_MAX, PWM_DISARMED = 1000.0, 2000.0, 900.0
+"""The PWM range [us] written as ``PWM_MAIN_MINi``/``PWM_MAIN_MAXi`` and ``PWM_MAIN_DISi`` (PX4's defaults)."""
+N_OUTPUTS = 16
+"""``actuator_outputs``' channels (PX4's ``NUM_ACTUATOR_OUTPUTS``)."""
+
+ACTUATOR_OUTPUTS = (
+    ("uint64_t", 0, "timestamp"),
+    ("uint32_t", 0, "noutputs"),
+    ("float", 16, "output"),
+    ("uint8_t", 4, "_padding0"),
+)
 ARMING_STATE_ARMED = 2
 """``vehicle_status.arming_state`` of an armed vehicle (PX4's ARMING_STATE_ARMED)."""
 MAV_TYPE_QUADROTOR = 2
@@ -320,7 +331,7 @@ def px4_topics(
     rates_hz: dict[str, float] | None = None,
     rotor_speeds: np.ndarray | None = None,
     system_type: int = MAV_TYPE_QUADROTOR,
-    setpoints: dict[str, dict[str, np.ndarray]] | None = None,
+    setpoints: dict[str, tuple] | None = None,
 ) -> list[Topic]:
     """One vehicle's flight as PX4 topics at ``rates_hz`` (a profile of :data:`PROFILES`;
     :data:`RATES_HZ` by default), from its logged ``t``, ``states`` and motor ``signal`` x (L, n)
@@ -330,7 +341,6 @@ def px4_topics(
     as ``esc_status`` [rpm]; ``setpoints``, when given, as
     :func:`~quadcruise.sim.px4_setpoints.setpoint_values` returns them.
     """
-    from quadcruise.sim.px4_setpoints import actuator_outputs, topic_of
 
     us = np.round(t * 1e6).astype(np.uint64)
     accel = np.gradient(states[:, VX : VX + 3], t, axis=0, edge_order=2) if len(t) > 2 else np.zeros((len(t), 3))
@@ -372,58 +382,73 @@ def px4_topics(
                 **{"esc.timestamp": np.repeat(us[:, None], MAX_ESCS, 1), "esc.esc_rpm": rpm},
             )
         ]
-    extra = [topic_of("actuator_outputs", us, _every(t, rates_hz["actuator_outputs"]), actuator_outputs(signal))]
-    for name, values in (setpoints or {}).items():
-        extra.append(topic_of(name, us, _every(t, rates_hz[name]), values))
-    return esc + extra + [
-        topic(
-            "vehicle_local_position",
-            VEHICLE_LOCAL_POSITION,
-            timestamp_sample=us,
-            x=pos[:, 0],
-            y=pos[:, 1],
-            z=pos[:, 2],
-            vx=vel[:, 0],
-            vy=vel[:, 1],
-            vz=vel[:, 2],
-            z_deriv=vel[:, 2],
-            ax=acc[:, 0],
-            ay=acc[:, 1],
-            az=acc[:, 2],
-            heading=heading,
-            xy_valid=ones,
-            z_valid=ones,
-            v_xy_valid=ones,
-            v_z_valid=ones,
-            heading_good_for_control=ones,
-            dist_bottom=-pos[:, 2],
-        ),
-        topic("vehicle_attitude", VEHICLE_ATTITUDE, timestamp_sample=us, q=q),
-        topic(
-            "vehicle_angular_velocity",
-            VEHICLE_ANGULAR_VELOCITY,
-            timestamp_sample=us,
-            xyz=gyro,
-            xyz_derivative=rate_dot @ FLU_TO_FRD.T,
-        ),
-        topic("actuator_motors", ACTUATOR_MOTORS, timestamp_sample=us, control=control),
-        topic(
-            "sensor_combined",
-            SENSOR_COMBINED,
-            gyro_rad=gyro,
-            accelerometer_m_s2=force,
-            gyro_integral_dt=np.full(len(t), int(np.diff(us[_every(t, rates_hz["sensor_combined"])][:2]).sum())),
-        ),
-        topic(
-            "vehicle_status",
-            VEHICLE_STATUS,
-            armed_time=np.zeros(len(t), np.uint64),
-            arming_state=np.full(len(t), ARMING_STATE_ARMED),
-            system_type=np.full(len(t), system_type),
-            vehicle_type=np.ones(len(t)),
-        ),
-        topic("vehicle_land_detected", VEHICLE_LAND_DETECTED, landed=~ones, maybe_landed=~ones, ground_contact=~ones),
-    ]
+    extra = [topic("actuator_outputs", ACTUATOR_OUTPUTS, **actuator_outputs(signal))]
+    for name, (fields, values) in (setpoints or {}).items():
+        stamp = {"timestamp_sample": us} if any(f[2] == "timestamp_sample" for f in fields) else {}
+        extra.append(topic(name, fields, **stamp, **values))
+    return (
+        esc
+        + extra
+        + [
+            topic(
+                "vehicle_local_position",
+                VEHICLE_LOCAL_POSITION,
+                timestamp_sample=us,
+                x=pos[:, 0],
+                y=pos[:, 1],
+                z=pos[:, 2],
+                vx=vel[:, 0],
+                vy=vel[:, 1],
+                vz=vel[:, 2],
+                z_deriv=vel[:, 2],
+                ax=acc[:, 0],
+                ay=acc[:, 1],
+                az=acc[:, 2],
+                heading=heading,
+                xy_valid=ones,
+                z_valid=ones,
+                v_xy_valid=ones,
+                v_z_valid=ones,
+                heading_good_for_control=ones,
+                dist_bottom=-pos[:, 2],
+            ),
+            topic("vehicle_attitude", VEHICLE_ATTITUDE, timestamp_sample=us, q=q),
+            topic(
+                "vehicle_angular_velocity",
+                VEHICLE_ANGULAR_VELOCITY,
+                timestamp_sample=us,
+                xyz=gyro,
+                xyz_derivative=rate_dot @ FLU_TO_FRD.T,
+            ),
+            topic("actuator_motors", ACTUATOR_MOTORS, timestamp_sample=us, control=control),
+            topic(
+                "sensor_combined",
+                SENSOR_COMBINED,
+                gyro_rad=gyro,
+                accelerometer_m_s2=force,
+                gyro_integral_dt=np.full(len(t), int(np.diff(us[_every(t, rates_hz["sensor_combined"])][:2]).sum())),
+            ),
+            topic(
+                "vehicle_status",
+                VEHICLE_STATUS,
+                armed_time=np.zeros(len(t), np.uint64),
+                arming_state=np.full(len(t), ARMING_STATE_ARMED),
+                system_type=np.full(len(t), system_type),
+                vehicle_type=np.ones(len(t)),
+            ),
+            topic(
+                "vehicle_land_detected", VEHICLE_LAND_DETECTED, landed=~ones, maybe_landed=~ones, ground_contact=~ones
+            ),
+        ]
+    )
+
+
+def actuator_outputs(signal: np.ndarray) -> dict[str, np.ndarray]:
+    """``actuator_outputs``' values: each rotor's signal ``x`` (L, n) as PWM [us], the other
+    channels at the disarmed value."""
+    out = np.full((len(signal), N_OUTPUTS), PWM_DISARMED)
+    out[:, : signal.shape[1]] = PWM_MIN + np.clip(signal, 0.0, 1.0) * (PWM_MAX - PWM_MIN)
+    return {"noutputs": np.full(len(signal), N_OUTPUTS), "output": out}
 
 
 def rotor_speed_commands(commands: np.ndarray, flown: dict, believed: dict | None = None, *, wanted: bool = False):

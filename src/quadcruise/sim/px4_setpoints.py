@@ -20,9 +20,10 @@ rotor's *desired* relative thrust (the controller's, before any clipping) and ``
 allocator's normalisation of ``pinv(E)`` (roll and pitch together, yaw alone, thrust by the
 mean norm of the thrust rows). For n equal rotors ``c_z = -sum(r) / n = -U1_d / (n CT)``.
 
-Also ``actuator_outputs``: the signal ``x`` PX4's output module makes of each relative thrust
-through ``THR_MDL_FAC`` (``rel = f x^2 + (1 - f) x``), as PWM ``PWM_MAIN_MINi + x (PWM_MAIN_MAXi -
-PWM_MAIN_MINi)`` [us] (PX4's ``FunctionMotors::updateValues`` and the PWM output's linear map).
+The parameters that go with ``actuator_outputs`` (:func:`quadcruise.sim.px4.actuator_outputs`:
+the signal ``x`` PX4's output module makes of each relative thrust through ``THR_MDL_FAC``,
+``rel = f x^2 + (1 - f) x``, as PWM ``PWM_MAIN_MINi + x (PWM_MAIN_MAXi - PWM_MAIN_MINi)`` [us]:
+``FunctionMotors::updateValues`` and the PWM output's linear map): :func:`pwm_parameters`.
 """
 
 from __future__ import annotations
@@ -30,20 +31,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from quadcruise.io.ulog import Topic
-
-PWM_MIN, PWM_MAX, PWM_DISARMED = 1000.0, 2000.0, 900.0
-"""The PWM range [us] written as ``PWM_MAIN_MINi``/``PWM_MAIN_MAXi`` and ``PWM_MAIN_DISi`` (PX4's defaults)."""
-N_OUTPUTS = 16
-"""``actuator_outputs``' channels (PX4's ``NUM_ACTUATOR_OUTPUTS``)."""
+from quadcruise.layout import REF_AX, REF_PSI, REF_PSI_DOT, REF_VX, REF_X
+from quadcruise.sim.px4 import ENU_TO_NED, PWM_DISARMED, PWM_MAX, PWM_MIN, attitude_ned_frd
 
 # PX4's formats (as PX4 v1.14/v1.15 logs them: tests/data/px4/sample_px4_events.ulg), field for field.
-ACTUATOR_OUTPUTS = (
-    ("uint64_t", 0, "timestamp"),
-    ("uint32_t", 0, "noutputs"),
-    ("float", 16, "output"),
-    ("uint8_t", 4, "_padding0"),
-)
 TRAJECTORY_SETPOINT = (
     ("uint64_t", 0, "timestamp"),
     ("float", 3, "position"),
@@ -106,23 +97,6 @@ SETPOINT_TOPICS = (
 """The setpoint topics written."""
 
 
-def signal_of(rel_thrust: np.ndarray, thrust_factor: float) -> np.ndarray:
-    """The signal ``x`` PX4's output module makes of a relative thrust (``FunctionMotors::updateValues``):
-    the root in [0, 1] of ``f x^2 + (1 - f) x = rel``; ``x = rel`` for ``f = 0``.
-
-    Examples
-    --------
-    >>> signal_of(np.array([0.25, 0.0]), 1.0).tolist(), signal_of(np.array([0.3]), 0.0).tolist()
-    ([0.5, 0.0], [0.3])
-    """
-    rel = np.asarray(rel_thrust, dtype=np.float64)
-    f = float(thrust_factor)
-    if not 0.0 < f <= 1.0:
-        return rel.copy()
-    b = 1.0 - f
-    return -b / (2.0 * f) + np.sqrt(b * b / (4.0 * f * f) + np.clip(rel, 0.0, None) / f)
-
-
 def pwm_parameters(n: int, thrust_factor: float) -> dict[str, float | int]:
     """``THR_MDL_FAC`` and, for the first ``n`` PWM outputs, motor ``i`` on output ``i``
     (``PWM_MAIN_FUNCi = 100 + i``) with :data:`PWM_MIN`, :data:`PWM_MAX` and :data:`PWM_DISARMED`.
@@ -142,14 +116,6 @@ def pwm_parameters(n: int, thrust_factor: float) -> dict[str, float | int]:
     return out
 
 
-def actuator_outputs(signal: np.ndarray) -> dict[str, np.ndarray]:
-    """``actuator_outputs``' values: each rotor's signal ``x`` (L, n) as PWM [us], the other
-    channels at the disarmed value."""
-    out = np.full((len(signal), N_OUTPUTS), PWM_DISARMED)
-    out[:, : signal.shape[1]] = PWM_MIN + np.clip(signal, 0.0, 1.0) * (PWM_MAX - PWM_MIN)
-    return {"noutputs": np.full(len(signal), N_OUTPUTS), "output": out}
-
-
 def effectiveness(params: dict) -> np.ndarray:
     """The control allocator's effectiveness ``E`` (6 x n: torque x, y, z, thrust x, y, z in FRD per
     unit relative thrust) of the ``CA_ROTOR*`` parameters (PX4's ``ActuatorEffectivenessRotors``).
@@ -158,7 +124,7 @@ def effectiveness(params: dict) -> np.ndarray:
     --------
     >>> p = {"CA_ROTOR_COUNT": 1, "CA_ROTOR0_PX": 0.1, "CA_ROTOR0_PY": 0.0, "CA_ROTOR0_PZ": 0.0,
     ...      "CA_ROTOR0_KM": 0.05, "CA_ROTOR0_CT": 10.0}
-    >>> effectiveness(p)[:, 0].round(6).tolist()     # pitch up, yaw right, thrust up
+    >>> (effectiveness(p)[:, 0].round(6) + 0.0).tolist()     # pitch up, yaw right, thrust up
     [0.0, 1.0, 0.5, 0.0, 0.0, -10.0]
     """
     axis = np.array([0.0, 0.0, -1.0])
@@ -205,11 +171,9 @@ def setpoint_values(
     Returns
     -------
     dict
-        Topic name -> field -> values.
+        Topic name -> (its PX4 format, field -> values), as
+        :func:`~quadcruise.sim.px4.px4_topics` takes them.
     """
-    from quadcruise.layout import REF_AX, REF_PSI, REF_PSI_DOT, REF_VX, REF_X
-    from quadcruise.sim.px4 import ENU_TO_NED, attitude_ned_frd
-
     e = effectiveness(params)
     c = (e @ rel_desired.T).T * normalisation(e)  # (L, 6)
     c[:, 3:5] = 0.0
@@ -228,7 +192,7 @@ def setpoint_values(
     if np.any(finite):
         thrust_ned[finite] = Rotation.from_quat(q_d[finite][:, [1, 2, 3, 0]]).apply(thrust[finite])
     nan = np.full(len(c), np.nan)
-    return {
+    values = {
         "trajectory_setpoint": {
             "position": pos,
             "velocity": vel,
@@ -256,10 +220,10 @@ def setpoint_values(
         "vehicle_thrust_setpoint": {"xyz": thrust},
         "vehicle_torque_setpoint": {"xyz": c[:, :3]},
     }
+    return {name: (FORMATS[name], v) for name, v in values.items()}
 
 
 FORMATS = {
-    "actuator_outputs": ACTUATOR_OUTPUTS,
     "trajectory_setpoint": TRAJECTORY_SETPOINT,
     "vehicle_local_position_setpoint": VEHICLE_LOCAL_POSITION_SETPOINT,
     "vehicle_attitude_setpoint": VEHICLE_ATTITUDE_SETPOINT,
@@ -268,11 +232,3 @@ FORMATS = {
     "vehicle_torque_setpoint": VEHICLE_TORQUE_SETPOINT,
 }
 """Each topic's PX4 format."""
-
-
-def topic_of(name: str, us: np.ndarray, rows: np.ndarray, values: dict[str, np.ndarray]) -> Topic:
-    """The topic ``name`` at the logged instants ``rows`` (timestamps ``us`` [us]); a format with a
-    ``timestamp_sample`` gets the same instants."""
-    fields = FORMATS[name]
-    extra = {"timestamp_sample": us[rows]} if any(f[2] == "timestamp_sample" for f in fields) else {}
-    return Topic(name, fields, {"timestamp": us[rows], **extra, **{k: np.asarray(v)[rows] for k, v in values.items()}})
