@@ -192,7 +192,7 @@ def check_duties(path, u: np.ndarray, names: list[str], *, at: np.ndarray | None
     >>> check_duties("f.csv", np.array([[0.5], [1500.0]]), ["u1"])
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: f.csv: row 3, column u1: 1500 is outside [0, 1], the range of normalised commands (duties) (PWM in microseconds? read them with --commands pwm:MIN:MAX, e.g. pwm:1000:2000)
+    quadcruise.errors.InputError: f.csv: row 3, column u1: 1500 is outside [0, 1], ... --commands pwm:MIN:MAX, ...
     """
     bad = np.argwhere((u < -1e-6) | (u > 1.0 + 1e-6))
     if not bad.size:
