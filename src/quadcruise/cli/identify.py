@@ -85,7 +85,8 @@ def check_keeps_log(log: str, out: str) -> None:
     default="duty",
     show_default=True,
     metavar="duty|rad/s|pwm:MIN:MAX",
-    help="Rotor commands: normalised duties, rotor speeds (rad/s; ULog: actuator_motors x w_max, rotor plant), "
+    help="Rotor commands: normalised duties (ULog: actuator_motors, relative thrust), rotor speeds (rad/s; ULog: the "
+    "signal x w_max, rotor plant), "
     "or PWM [us] with their range.",
 )
 @click.option(
