@@ -36,6 +36,26 @@ def base_vehicle(text: str):
     return load_scenario(path).vehicle
 
 
+def check_keeps_log(log: str, out: str) -> None:
+    """Refuse an ``--out`` folder that holds ``LOG`` (writing the folder replaces it, ``--force`` or not).
+
+    Examples
+    --------
+    >>> check_keeps_log("runs/a/flight.ulg", "runs/a")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: --out runs/a: holds the log being read (runs/a/flight.ulg), which writing ...
+    """
+    from pathlib import Path
+
+    read, folder = Path(log).resolve(), Path(out).resolve()
+    if folder == read or folder in read.parents:
+        raise InputError(
+            f"--out {out}: holds the log being read ({log}), which writing the folder would delete: "
+            "choose another folder"
+        )
+
+
 @click.command("identify")
 @click.argument("log", metavar="LOG")
 @click.option(
@@ -65,7 +85,8 @@ def base_vehicle(text: str):
     default="duty",
     show_default=True,
     metavar="duty|rad/s|pwm:MIN:MAX",
-    help="Rotor commands: normalised duties, rotor speeds (rad/s; ULog: actuator_motors x w_max, rotor plant), "
+    help="Rotor commands: normalised duties (ULog: actuator_motors, relative thrust), rotor speeds (rad/s; ULog: the "
+    "signal x w_max, rotor plant), "
     "or PWM [us] with their range.",
 )
 @click.option(
@@ -139,6 +160,7 @@ def identify(
 
     base = base_vehicle(vehicle)
     parse_commands(commands)
+    check_keeps_log(log, out)
     check_output_dir(out, force)
     words = (
         [

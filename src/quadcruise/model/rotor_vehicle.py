@@ -246,7 +246,7 @@ class RotorVehicle(Validated):
 
         The vehicle's command-to-speed map: PX4's normalised motor command with ``THR_MDL_FAC``
         = 1 (thrust kf w_max^2 duty^2, quadratic in the command), as ``to_ulog`` writes a rotor
-        flight's ``actuator_motors``.
+        flight's ``actuator_outputs`` (its ``actuator_motors``: the relative thrust duty^2).
 
         Parameters
         ----------
