@@ -226,8 +226,8 @@ def test_bad_input_on_a_rotor_sweep_is_one_line_exit_2(tmp_path, args, words):
 
 
 def test_the_library_refuses_what_a_rotor_sweep_cannot_fly_before_any_flight():
-    with pytest.raises(InputError, match="'offset': not for a rotor-plant vehicle"):
-        MonteCarloSpec("hover", "se3", Population(offset=0.1), vehicle="iris")
+    with pytest.raises(InputError, match="'full_dynamics': not for a rotor-plant vehicle"):
+        MonteCarloSpec("hover", "se3", Population(offset=0.1), vehicle="iris", full_dynamics=True)
     with pytest.raises(InputError, match="aerodynamics"):
         MonteCarloSpec("hover", "se3", Population(wind_spread=1.0), vehicle=RotorVehicle.preset("iris").without_aero())
     with pytest.raises(InputError, match="'aero_spread'"):

@@ -67,8 +67,8 @@ class MonteCarloSpec:
     vehicle : Vehicle, RotorVehicle or str
         The nominal vehicle (Table I), or a preset's name (``"iris"``); given drag if the population meets wind. A
         :class:`~quadcruise.model.rotor_vehicle.RotorVehicle` flies the rotor-speed plant (its
-        fields perturbed as :mod:`quadcruise.montecarlo.population` says; no start ``offset``,
-        no ``full_dynamics``; wind only on a vehicle with aerodynamics).
+        fields perturbed as :mod:`quadcruise.montecarlo.population` says; a start ``offset``
+        moves its hover; no ``full_dynamics``; wind only on a vehicle with aerodynamics).
     controller_vehicle : Vehicle, RotorVehicle or str, optional
         The vehicle every controller believes it flies (its model), of the nominal's plant;
         None: the nominal ``vehicle`` (or, with the population's ``model_error`` False, each
@@ -233,13 +233,11 @@ class MonteCarloSpec:
                 "vehicle and controller_vehicle must be of one plant: a RotorVehicle flown with a "
                 "RotorVehicle as the controller's model, or a paper Vehicle with a paper Vehicle"
             )
-        for name, bad in (("offset", self.population.offset > 0), ("full_dynamics", self.full_dynamics)):
-            if bad:
-                raise InputError(
-                    f"{'population field' if name == 'offset' else 'MonteCarloSpec field'} '{name}': not for a "
-                    "rotor-plant vehicle (it starts hovering at the mission's start; its plant has no "
-                    "Euler-angle kinematics to choose)"
-                )
+        if self.full_dynamics:
+            raise InputError(
+                "MonteCarloSpec field 'full_dynamics': not for a rotor-plant vehicle (its plant has no "
+                "Euler-angle kinematics to choose: it flies the quaternion)"
+            )
         believed = self.controller_vehicle or self.vehicle
         if believed.n_rotors != self.vehicle.n_rotors:
             raise InputError(

@@ -29,7 +29,7 @@ from quadcruise.missions import Mission, as_mission, stack_params
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
-from quadcruise.sim.chunked import simulate_watched
+from quadcruise.sim.chunked import simulate_watched, watch_again
 from quadcruise.sim.engine import simulate
 from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.result import SimResult
@@ -66,6 +66,7 @@ from quadcruise.workflows.rotor_fly import (
     check_wind_acts,
     fly_rotor,
     rotor_batch,
+    rotor_engine_inputs,
     rotor_flight_setup,
     vehicle_record,
 )
@@ -122,7 +123,9 @@ def fly(
         Number of vehicles; taken from ``vehicle``, ``x0`` or ``missions`` if they are batched.
     x0 : (16,) or (N, 16) array, optional
         Initial states; by default each vehicle hovers at x = y = 0 at the mission's
-        starting altitude and yaw.
+        starting altitude and yaw. A rotor-plant vehicle takes them in the same layout
+        (:func:`~quadcruise.workflows.rotor_fly.rotor_initial_states`: the Euler angles as its
+        quaternion, F1..F4 as its rotor speeds, or its hover for the hover thrusts).
     log_every : int, optional
         Log every this many control periods (a divisor of them). By default every period,
         unless a batch's log would exceed :data:`LOG_BUDGET` (256 MiB): then the smallest divisor
@@ -223,10 +226,10 @@ def fly(
     for name, value in (*bounds, ("max_altitude_error", max_altitude_error)):
         checks.number(w, name, value, "pos", unit="m", optional=True, infinite=True)
     x0 = initial_states(x0)
-    if rotor and (x0 is not None or full_dynamics):
+    if rotor and full_dynamics:
         raise InputError(
-            f"fly() argument {'x0' if x0 is not None else 'full_dynamics'}: not for a rotor-plant vehicle "
-            "(it starts hovering at the mission's start; its plant has no Euler-angle kinematics to choose)"
+            "fly() argument full_dynamics: not for a rotor-plant vehicle (its plant has no Euler-angle "
+            "kinematics to choose: it flies the quaternion)"
         )
     sizes = {
         s
@@ -249,18 +252,19 @@ def fly(
     first = missions[0] if missions else mission
     duration = default_duration(first) if duration is None else duration
     d, h = duration, dt
-    chosen = log_every is None and n > 1 and 0 < h <= d < math.inf and batch_log_every(n, round(d / h)) > 1
-    chosen = chosen and not rotor  # a rotor flight keeps its whole log (rotor_fly.py)
+    extra = (rotor_batch(vehicle)[0].n_rotors + 13) if rotor else 0  # a rotor flight logs its rotor state too
+    steps = round(d / h) if 0 < h <= d < math.inf else 0
+    chosen = log_every is None and n > 1 and steps > 0 and batch_log_every(n, steps, extra) > 1
     # a batch whose full log would not fit in LOG_BUDGET: a coarser log, checked at every period
-    log_every = batch_log_every(n, round(d / h)) if chosen else 1 if log_every is None else log_every
+    log_every = batch_log_every(n, steps, extra) if chosen else 1 if log_every is None else log_every
     # the track checks see every period whatever the log keeps: a flight's status and time do not
     # depend on its log (a Monte Carlo sweep's 10 ms log, `montecarlo --case`, `fly` alone agree)
-    watched = not rotor and log_every > 1 and 0 < h <= d < math.inf
-    if 0 < h <= d < math.inf:  # sized before the grid is allocated
+    watched = log_every > 1 and steps > 0
+    if steps:  # sized before the grid is allocated
         substeps = max(1, math.ceil(h / float(max_step or h) - 1e-9))
-        check_run_size(n, round(d / h), int(log_every), substeps, watched)
+        check_run_size(n, steps, int(log_every), substeps, watched, extra)
     if chosen:
-        full, kept = log_bytes(n, round(d / h), 1) / 2**30, log_bytes(n, round(d / h), log_every) / 2**30
+        full, kept = (log_bytes(n, steps, k, extra) / 2**30 for k in (1, log_every))
         warnings.warn(
             f"fly(): the log of {n:,} vehicles x {round(d / h) + 1:,} instants would take {full:.1f} GiB: logging "
             f"every {log_every} periods ({kept:.2f} GiB; the track checks still see every period); give log_every "
@@ -276,6 +280,7 @@ def fly(
         check_can_hover(vehicle)
     check_reference_fits(missions or [first], float(duration), limits or Limits())
     given_x0 = None if x0 is None else np.asarray(x0, dtype=float).tolist()
+    rotor_x0 = x0  # a rotor flight's own start: hovering at the mission's start unless given
     x0 = hover_state(batch_equivalent(rotor_batch(vehicle)[:1]) if rotor else vehicle, n, first) if x0 is None else x0
     meta = {
         "workflow": "fly",
@@ -350,19 +355,31 @@ def fly(
         first_vehicle=first_vehicle,
         **engine_inputs(environment, sensors, n, dt),
     )
-    if rotor:  # the rotor plant's own path (rotor_fly.py), its log whole
-        result = fly_rotor(grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, **options)
+    if watched:  # the log keeps every log_every-th period; the checks see every one
+        if rotor:  # the rotor plant's arrays (rotor_fly.py)
+            args, plant = rotor_engine_inputs(
+                grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, rotor_x0, meta
+            )
+        else:
+            args = (grid, x0, vehicle.rows(n), controller.function, gains, first.function, mp)
+            plant = dict(vp_ctrl=vp_ctrl, full_dynamics=full_dynamics)
+        options.update(plant)
+        mission_record = meta["mission"] if isinstance(meta["mission"], dict) else {}
+        watch = TrackWatch(grid, mission_record, bound, steady, vertical)
+        result = simulate_watched(*args, watch=watch.feed, **options)
+
+        def again(vehicles, periods, feed):  # the head of some vehicles, flown again (track_watch.py)
+            watch_again(*args, vehicles=vehicles, periods=periods, watch=feed, **options)
+
+        status, t_stop = watch.verdict(result.status, result.t_stop, again)
+        result = dataclasses.replace(result, status=status, t_stop=t_stop)
+    elif rotor:  # the rotor plant's whole log (rotor_fly.py)
+        result = fly_rotor(
+            grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, x0=rotor_x0, **options
+        )
     else:
         args = (grid, x0, vehicle.rows(n), controller.function, gains, first.function, mp)
-        options.update(vp_ctrl=vp_ctrl, full_dynamics=full_dynamics)
-        if watched:  # the log keeps every log_every-th period; the checks see every one
-            mission_record = meta["mission"] if isinstance(meta["mission"], dict) else {}
-            watch = TrackWatch(grid, mission_record, bound, steady, vertical)
-            result = simulate_watched(*args, watch=watch.feed, **options)
-            status, t_stop = watch.verdict(result.status, result.t_stop)
-            result = dataclasses.replace(result, status=status, t_stop=t_stop)
-        else:
-            result = simulate(*args, **options)
+        result = simulate(*args, vp_ctrl=vp_ctrl, full_dynamics=full_dynamics, **options)
     result.meta["max_track_error_m"] = bound.tolist() if n > 1 else float(bound[0])
     result.meta["max_steady_error_m"] = steady.tolist() if n > 1 else float(steady[0])
     result.meta["max_altitude_error_m"] = vertical.tolist() if n > 1 else float(vertical[0])
