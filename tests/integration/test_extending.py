@@ -73,6 +73,15 @@ def test_compare_on_paper_and_rotor_vehicles(gentle):
     assert (cmp.metrics()["status"] == "finished").all()
 
 
+def test_tune_starts_from_its_gains(gentle):
+    from quadcruise.tune import tune
+
+    res = tune("step", "gentle", gains="position.kp", targets={"rise_time_s": 2.0}, duration=6.0, budget=4, popsize=6)
+    assert res.start_gains == {"position.kp": 1.0}  # gentle's, not nlpd's 3.01
+    assert isinstance(res.controller, gentle) and res.controller.name == "gentle"
+    assert res.controller.position.kd == 2.5 and res.controller.position.kp == res.gains["position.kp"]
+
+
 def test_command_line_and_scenario_file(gentle, tmp_path):
     out = tmp_path / "flight"
     res = CliRunner().invoke(main, ["fly", "step", "--controller", "gentle", "--duration", "2", "--out", str(out)])
@@ -83,6 +92,9 @@ def test_command_line_and_scenario_file(gentle, tmp_path):
     assert again.exit_code == 0, again.output
     first, second = (np.loadtxt(p / "traces.csv", delimiter=",", skiprows=1) for p in (out, tmp_path / "again"))
     assert np.array_equal(first, second)
+    both = CliRunner().invoke(main, ["compare", "step", "--controllers", "nlpd,gentle", "--duration", "2"])
+    assert both.exit_code == 0, both.output
+    assert "gentle" in both.output and "nlpd" in both.output
 
 
 def test_gym_baselines_include_it(gentle):
@@ -93,6 +105,13 @@ def test_gym_baselines_include_it(gentle):
     table = baselines(num_envs=2, mission="hover", duration=0.5)
     assert list(table.index) == list(baseline_names())
     assert table.loc["gentle", "finished"] == 1.0
+    from quadcruise.gym.env import QuadVectorEnv
+
+    rotor = RotorVehicle.preset("crazyflie")
+    env = QuadVectorEnv(2, controller="gentle", vehicle=rotor, mission="hover", duration=0.5)
+    assert isinstance(env.baseline, gentle) and env.baseline.attitude == attitude_pid_design(
+        paper_equivalent(rotor).omega
+    )
 
 
 def test_without_rotor_design_one_line_on_a_rotor_vehicle(gentle):
