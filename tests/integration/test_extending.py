@@ -82,6 +82,15 @@ def test_tune_starts_from_its_gains(gentle):
     assert res.controller.position.kd == 2.5 and res.controller.position.kp == res.gains["position.kp"]
 
 
+def test_montecarlo_by_name(gentle):
+    from quadcruise.montecarlo import Population, montecarlo
+
+    by_name = montecarlo("step", "gentle", Population(mass_spread=0.1), n=4, seed=1, duration=2, scheduler="none")
+    by_object = montecarlo("step", gentle(), Population(mass_spread=0.1), n=4, seed=1, duration=2, scheduler="none")
+    assert by_name.spec.controller.name == "gentle"
+    assert by_name.table["rmse_m"].tolist() == by_object.table["rmse_m"].tolist()
+
+
 def test_command_line_and_scenario_file(gentle, tmp_path):
     out = tmp_path / "flight"
     res = CliRunner().invoke(main, ["fly", "step", "--controller", "gentle", "--duration", "2", "--out", str(out)])
