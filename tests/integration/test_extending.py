@@ -149,6 +149,14 @@ def test_declarations_refused():
     with pytest.raises(InputError, match="rotor_design must be callable"):
         register_controller("nlpd", NLPD, rotor_design=3.0, replace=True)
     assert controller_names()[:4] == ("nlpd", "gonzalez", "se3", "cascade")
+    entry = unregister_controller("cascade")
+    try:
+        assert "cascade" not in controller_names() and "cascade" not in compared_names()
+        with pytest.raises(InputError, match="unknown controller 'cascade'"):
+            qc.fly("hover", "cascade", duration=0.5)
+    finally:
+        register_controller(**entry._asdict())  # declared again as it was
+    assert controller_names()[:4] == ("nlpd", "gonzalez", "se3", "cascade") and "cascade" in compared_names()
 
 
 def test_an_installed_entry_point_declares_it_in_a_fresh_process(tmp_path):
