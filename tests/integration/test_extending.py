@@ -73,6 +73,24 @@ def test_compare_on_paper_and_rotor_vehicles(gentle):
     assert (cmp.metrics()["status"] == "finished").all()
 
 
+def test_tune_starts_from_its_gains(gentle):
+    from quadcruise.tune import tune
+
+    res = tune("step", "gentle", gains="position.kp", targets={"rise_time_s": 2.0}, duration=6.0, budget=4, popsize=6)
+    assert res.start_gains == {"position.kp": 1.0}  # gentle's, not nlpd's 3.01
+    assert isinstance(res.controller, gentle) and res.controller.name == "gentle"
+    assert res.controller.position.kd == 2.5 and res.controller.position.kp == res.gains["position.kp"]
+
+
+def test_montecarlo_by_name(gentle):
+    from quadcruise.montecarlo import Population, montecarlo
+
+    by_name = montecarlo("step", "gentle", Population(mass_spread=0.1), n=4, seed=1, duration=2, scheduler="none")
+    by_object = montecarlo("step", gentle(), Population(mass_spread=0.1), n=4, seed=1, duration=2, scheduler="none")
+    assert by_name.spec.controller.name == "gentle"
+    assert by_name.table["rmse_m"].tolist() == by_object.table["rmse_m"].tolist()
+
+
 def test_command_line_and_scenario_file(gentle, tmp_path):
     out = tmp_path / "flight"
     res = CliRunner().invoke(main, ["fly", "step", "--controller", "gentle", "--duration", "2", "--out", str(out)])
@@ -83,6 +101,9 @@ def test_command_line_and_scenario_file(gentle, tmp_path):
     assert again.exit_code == 0, again.output
     first, second = (np.loadtxt(p / "traces.csv", delimiter=",", skiprows=1) for p in (out, tmp_path / "again"))
     assert np.array_equal(first, second)
+    both = CliRunner().invoke(main, ["compare", "step", "--controllers", "nlpd,gentle", "--duration", "2"])
+    assert both.exit_code == 0, both.output
+    assert "gentle" in both.output and "nlpd" in both.output
 
 
 def test_gym_baselines_include_it(gentle):
@@ -93,6 +114,13 @@ def test_gym_baselines_include_it(gentle):
     table = baselines(num_envs=2, mission="hover", duration=0.5)
     assert list(table.index) == list(baseline_names())
     assert table.loc["gentle", "finished"] == 1.0
+    from quadcruise.gym.env import QuadVectorEnv
+
+    rotor = RotorVehicle.preset("crazyflie")
+    env = QuadVectorEnv(2, controller="gentle", vehicle=rotor, mission="hover", duration=0.5)
+    assert isinstance(env.baseline, gentle) and env.baseline.attitude == attitude_pid_design(
+        paper_equivalent(rotor).omega
+    )
 
 
 def test_without_rotor_design_one_line_on_a_rotor_vehicle(gentle):
@@ -121,6 +149,14 @@ def test_declarations_refused():
     with pytest.raises(InputError, match="rotor_design must be callable"):
         register_controller("nlpd", NLPD, rotor_design=3.0, replace=True)
     assert controller_names()[:4] == ("nlpd", "gonzalez", "se3", "cascade")
+    entry = unregister_controller("cascade")
+    try:
+        assert "cascade" not in controller_names() and "cascade" not in compared_names()
+        with pytest.raises(InputError, match="unknown controller 'cascade'"):
+            qc.fly("hover", "cascade", duration=0.5)
+    finally:
+        register_controller(**entry._asdict())  # declared again as it was
+    assert controller_names()[:4] == ("nlpd", "gonzalez", "se3", "cascade") and "cascade" in compared_names()
 
 
 def test_an_installed_entry_point_declares_it_in_a_fresh_process(tmp_path):

@@ -55,3 +55,34 @@ def test_the_check_finds_a_moved_file(tmp_path):
     assert not found(page, "control/no_such_module.py", "path") and found(page, "control/registry.py", "path")
     assert not found(page, "no_such_module.py", "path") and found(page, "chunk.py", "path")
     assert not found(ROOT / "docs" / "x.md", "nowhere.md", "link") and found(ROOT / "docs" / "x.md", "gym.md", "link")
+
+
+DOTTED = re.compile(r"`(quadcruise(?:\.[A-Za-z_][A-Za-z0-9_]*)+)")
+NOT_NAMES = {"quadcruise.json", "quadcruise.x.y", "quadcruise.controllers"}  # a file, a pattern, an entry-point group
+
+
+def resolves(dotted: str) -> bool:
+    """Whether ``quadcruise.a.b.c`` names a module or an attribute of one."""
+    import importlib
+
+    parts = dotted.split(".")
+    for k in range(len(parts), 0, -1):
+        try:
+            obj = importlib.import_module(".".join(parts[:k]))
+        except ImportError:
+            continue
+        for attr in parts[k:]:
+            if not hasattr(obj, attr):
+                return False
+            obj = getattr(obj, attr)
+        return True
+    return False
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+def test_cited_names_exist(page):
+    pytest.importorskip("gymnasium")  # docs/gym.md names quadcruise.gym's
+    names = {m.group(1) for m in DOTTED.finditer(page.read_text())} - NOT_NAMES
+    missing = sorted(n for n in names if not resolves(n))
+    assert not missing, f"{page.relative_to(ROOT)} names what does not exist: {', '.join(missing)}"
+    assert not resolves("quadcruise.control.no_such_name") and resolves("quadcruise.control.registry.declared")

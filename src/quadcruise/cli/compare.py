@@ -37,7 +37,9 @@ __all__ = ["compare"]
 @click.command("compare")
 @click.argument("mission", metavar="MISSION")
 @click.option(
-    "--controllers", help="Comma-separated controller names (default nlpd,gonzalez,se3,cascade, or the scenario's)."
+    "--controllers",
+    help="Comma-separated controller names (default: the scenario's, else those declared compared: "
+    "nlpd,gonzalez,se3,cascade and any of yours, docs/extending.md).",
 )
 @click.option("--duration", type=SECONDS, help="Flight time [s] (default: the mission's).")
 @click.option("--dt", type=SECONDS, help="Control period [s] (default 0.001, or the scenario's).")

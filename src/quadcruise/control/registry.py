@@ -19,10 +19,9 @@ Examples
 
 from __future__ import annotations
 
-import dataclasses
 import importlib
 from collections.abc import Callable, Mapping
-from typing import Any
+from typing import Any, NamedTuple
 
 from quadcruise.errors import InputError
 
@@ -46,8 +45,7 @@ package declares its controllers there (``[project.entry-points."quadcruise.cont
 Design = Callable[[float], Mapping[str, Any]]
 
 
-@dataclasses.dataclass(frozen=True)
-class ControllerEntry:
+class ControllerEntry(NamedTuple):
     """One declared controller.
 
     Parameters
@@ -166,7 +164,7 @@ def unregister_controller(name: str) -> ControllerEntry:
     Returns
     -------
     ControllerEntry
-        What was declared (``register_controller(**dataclasses.asdict(entry))`` declares it again).
+        What was declared (``register_controller(**entry._asdict())`` declares it again).
 
     Raises
     ------
