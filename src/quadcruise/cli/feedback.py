@@ -119,6 +119,7 @@ class Bar:
         self._lines: bool | None = None  # off a terminal: plain lines (decided at the first call)
         self._start = self._said = 0.0
         self._last: tuple[int, int] = (0, 0)
+        self._note: str | None = None  # the last note (a tuner's best cost), said after the line
         self._lines_said = 0
 
     def _line(self, done: int, total: int, end: bool = False) -> None:
@@ -134,6 +135,8 @@ class Bar:
             text += f"after {_duration(elapsed)}"
             if 0 < done < total:
                 text += f", about {_duration(elapsed * (total - done) / done)} left"
+        if self._note:
+            text += f"; {self._note}"
         try:
             sys.stderr.write(text + "\n")
             sys.stderr.flush()
@@ -151,6 +154,7 @@ class Bar:
             self._start = self._said = time.monotonic()
         if self._lines:
             self._last = (done, total)
+            self._note = text if text is not None else self._note
             _OPEN.add(self)
             if done >= total:
                 self.close()

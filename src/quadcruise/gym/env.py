@@ -411,6 +411,10 @@ class QuadVectorEnv(VectorEnv):
 class QuadEnv(gymnasium.Env):
     """One quadrotor (``gymnasium.make``): a :class:`QuadVectorEnv` of one vehicle, without autoreset.
 
+    Gymnasium's convention: once ``step`` has returned ``terminated`` or ``truncated``, the user
+    calls ``reset``. A ``step`` before that raises ``gymnasium.error.ResetNeeded`` (as stepping
+    before the first reset does), rather than fly past the mission's end and pay reward for it.
+
     Parameters
     ----------
     **kwargs : Any
@@ -423,6 +427,7 @@ class QuadEnv(gymnasium.Env):
         self.vec = QuadVectorEnv(1, **kwargs)
         self.action_space = self.vec.single_action_space
         self.observation_space = self.vec.single_observation_space
+        self._ended: str | None = "has not begun"  # why step needs a reset first, or None
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         """Start an episode (see :meth:`QuadVectorEnv.reset`).
@@ -440,6 +445,7 @@ class QuadEnv(gymnasium.Env):
         """
         super().reset(seed=seed)
         obs, info = self.vec.reset(seed=seed)
+        self._ended = None
         return obs[0], {k: v[0] for k, v in info.items()}
 
     def step(self, action):
@@ -453,12 +459,31 @@ class QuadEnv(gymnasium.Env):
         Returns
         -------
         (obs, reward, terminated, truncated, info)
+
+        Raises
+        ------
+        gymnasium.error.ResetNeeded
+            If the episode has ended (a step returned terminated or truncated) or not begun.
         """
+        if self._ended is not None:
+            raise gymnasium.error.ResetNeeded(
+                f"step(): the episode {self._ended}; call reset() to start the next one"
+            )  # fmt: skip
         a = None if action is None else np.asarray(action)
         if a is not None and a.shape != (4,):
             raise InputError(f"action: expected shape (4,), got {a.shape}")
         self.vec._pending[:] = False  # no autoreset: the user resets
         obs, r, term, trunc, info = self.vec.step(None if a is None else a[None, :])
+        if term[0] or trunc[0]:
+            self._ended = (
+                "has ended ("
+                + (
+                    "terminated: " + ExitStatus(int(info["status"][0])).reason
+                    if term[0]
+                    else "truncated: the mission's end"
+                )
+                + ")"
+            )
         return obs[0], float(r[0]), bool(term[0]), bool(trunc[0]), {k: v[0] for k, v in info.items()}
 
 
