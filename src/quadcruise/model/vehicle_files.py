@@ -232,6 +232,11 @@ def vehicle_from_table(table: dict, plants: Mapping[str, type], where: str = "ve
         base.update(table)
         table = base
     plant = table.pop("plant", "rotor" if "rotors" in table else "paper")
+    if not isinstance(plant, str):
+        raise InputError(
+            f"{where}: [vehicle] 'plant' must be the name of a plant ({' or '.join(plants)}), got "
+            f"{type(plant).__name__} {plant!r}"
+        )
     if plant not in plants:
         raise InputError(
             f"{where}: [vehicle] 'plant' = {plant!r}: here the vehicle must be for the {' or '.join(plants)} plant"
