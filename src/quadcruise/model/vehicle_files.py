@@ -42,6 +42,7 @@ from pathlib import Path
 from typing import Any
 
 from quadcruise.errors import InputError
+from quadcruise.io.files import not_a_file
 
 PRESET_DIR = Path(__file__).with_name("preset_files")
 """Where the preset files are."""
@@ -170,7 +171,7 @@ def _read_table(path: Path) -> dict:
     if path.is_dir():
         raise InputError(f"{path}: is a folder, not a vehicle file")
     if not path.is_file():
-        raise InputError(f"{path}: no such file")
+        raise InputError(f"{path}: {not_a_file(path)}")
     try:
         doc = tomllib.loads(path.read_text(encoding="utf-8-sig"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
