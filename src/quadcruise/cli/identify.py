@@ -6,7 +6,7 @@ import shlex
 
 import click
 
-from quadcruise.cli.common import Bar, friendly, writable, writable_with
+from quadcruise.cli.common import Bar, distinct_outputs, friendly, writable, writable_with
 from quadcruise.errors import InputError
 from quadcruise.io.files import not_a_file
 
@@ -138,6 +138,7 @@ def identify(
     from quadcruise.sysid.api import STAGES
     from quadcruise.sysid.api import identify as run_identify
 
+    distinct_outputs(out, report=report)
     base = base_vehicle(vehicle)
     parse_commands(commands)
     check_output_dir(out, force)
