@@ -457,6 +457,7 @@ CHUNKS = {
     "without a column": (lambda p: rewritten(p, rmse_m=None), "it lacks rmse_m"),
     "with a wrong count": (lambda p: rewritten(p, count=np.int64(12)), "columns do not hold one value per flight"),
     "of another sweep": (lambda p: rewritten(p, hash=np.str_("0123456789abcdef")), "belongs to another sweep"),
+    "a FIFO": (lambda p: (p.unlink(), os.mkfifo(p)), "a FIFO, not a regular file"),  # it hung the resume
 }
 
 
@@ -605,3 +606,26 @@ def test_ctrl_c_while_the_command_loads_is_one_line_exit_130(tmp_path, delay):
         check=True,
     )
     assert import_only.stdout.strip() == "default_int_handler"
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["fly", "in.csv"],
+        ["fly", "in.toml"],
+        ["fly", "hover", "--vehicle", "in.toml"],
+        ["identify", "in.csv", "--out", "x"],
+    ],
+)
+def test_a_fifo_given_as_an_input_file_is_one_line_not_a_wait(tmp_path, args):
+    """A FIFO where a file is expected is named as such (it was 'no such file'), and nothing
+    opens it: opening a FIFO waits for a writer."""
+    for name in ("in.csv", "in.toml"):
+        os.mkfifo(tmp_path / name)
+    proc = quadcruise_cli(*args, cwd=tmp_path, timeout=120)
+    assert proc.returncode == 2
+    assert one_line(proc.stderr).endswith(
+        "in.csv: a FIFO, not a regular file" if "in.csv" in args else "in.toml: a FIFO, not a regular file"
+    )
+    (tmp_path / "real.csv").write_text("x,y,z\n0,0,1\n1,0,1\n")
+    assert quadcruise_cli("fly", "real.csv", "--duration", "0.2", cwd=tmp_path).returncode in (0, 1)  # a file flies

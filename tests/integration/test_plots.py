@@ -217,14 +217,22 @@ def test_early_stop_is_marked_and_explained(diverged):
     assert t_stop < time_axes[0].get_xlim()[1] < diverged.t[-1]
 
 
-@pytest.mark.parametrize("which", ["circle", "step", "diverged"])
+@pytest.mark.parametrize("which", ["circle", "step", "diverged", "clipped"])
 def test_plot_flight_panels_stay_inside_and_apart(which, request):
     """The flight figure's grid is fixed, not found by a layout engine: each panel with its
     tick labels, axis labels and legends stays inside the figure and clear of the others and
-    of the title (two lines when the flight stopped)."""
+    of the title (two lines when the flight stopped). The legends right of the wide panels are
+    measured and the grid narrowed for them: "duty clipped (asked outside [0, 1])" was cut."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-    fig = plot_flight(request.getfixturevalue(which))
+    if which == "clipped":
+        step = request.getfixturevalue("step")
+        commands = step.commands.copy()
+        commands[0, 100:120, CMD_U1 + 2] = 1.3  # asked for more than full duty
+        fig = plot_flight(dataclasses.replace(step, commands=commands))
+        assert "duty clipped (asked outside [0, 1])" in legend_texts(axis_by_ylabel(fig, "rotor duty"))
+    else:
+        fig = plot_flight(request.getfixturevalue(which))
     renderer = FigureCanvasAgg(fig).get_renderer()
     fig.draw(renderer)
     boxes = [ax.get_tightbbox(renderer) for ax in fig.axes] + [fig._suptitle.get_window_extent(renderer)]

@@ -14,6 +14,7 @@ from quadcruise.cli.common import (
     SECONDS,
     SETTLE_BAND_OPTION,
     Bar,
+    distinct_outputs,
     friendly,
     metric_options,
     needs_out,
@@ -161,6 +162,7 @@ def compare(
     from quadcruise.workflows.compare import compare as run_compare
 
     needs_out(out, force=force)
+    distinct_outputs(out, report=report, ulog=ulog)
     conventions = metric_options(rise, settle_bands)
     if log_every is not None:
         whole_number(log_every, "--log-every", minimum=1)

@@ -6,8 +6,9 @@ import shlex
 
 import click
 
-from quadcruise.cli.common import Bar, friendly, writable, writable_with
+from quadcruise.cli.common import Bar, distinct_outputs, friendly, writable, writable_with
 from quadcruise.errors import InputError
+from quadcruise.io.files import not_a_file
 
 __all__ = ["identify"]
 
@@ -30,7 +31,7 @@ def base_vehicle(text: str):
                 f"--vehicle: a preset (paper, iris, crazyflie, ...) or a TOML file with a [vehicle] table, got {text!r}"
             ) from None
     if not path.is_file():
-        raise InputError(f"--vehicle: {text}: no such file")
+        raise InputError(f"--vehicle: {text}: {not_a_file(path)}")
     from quadcruise.workflows.scenario import load_scenario
 
     return load_scenario(path).vehicle
@@ -158,6 +159,7 @@ def identify(
     from quadcruise.sysid.api import STAGES
     from quadcruise.sysid.api import identify as run_identify
 
+    distinct_outputs(out, report=report)
     base = base_vehicle(vehicle)
     parse_commands(commands)
     check_keeps_log(log, out)

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from quadcruise.checks import describe
 from quadcruise.errors import InputError
 from quadcruise.fields import Validated, check_value
 from quadcruise.fields import unit_field as _f
@@ -181,7 +182,7 @@ def _char_from_poles(poles, n: int, who: str) -> np.ndarray:
     except (TypeError, ValueError):
         p = np.array([None])
     if p.dtype.kind not in "iufc":
-        raise InputError(f"{who}: poles must be numbers, got {poles!r}")
+        raise InputError(f"{who}: poles must be numbers, got {describe(poles)}")
     p = p.astype(complex)
     if p.ndim != 1 or p.size != n:
         raise InputError(f"{who} needs {n} poles, got {p.size}")

@@ -220,33 +220,76 @@ MARKER_LIMIT = 16 * 2**20
 sweep's spec with its seeds some MB at most); a larger one is taken as damaged."""
 
 
-class _NotSmallFile(OSError):
-    """A file that is not a regular file, or larger than asked: not to be read."""
+class NotRegularFile(OSError):
+    """A path that is not a regular file (a FIFO, a folder, a device), or one larger than asked:
+    not to be read. Its message says which."""
 
 
-def _small_file(path: Path, limit: int) -> bytes:
-    """The bytes of ``path`` if it is a regular file of at most ``limit`` bytes.
+def _kind(mode: int) -> str:
+    import stat
 
-    It is opened without blocking and checked on the open descriptor, so that a FIFO (whose
-    ``open`` would wait for a writer), a device or a folder put there is refused, not read.
+    return "a FIFO" if stat.S_ISFIFO(mode) else "a folder" if stat.S_ISDIR(mode) else "a device or socket"
+
+
+def not_a_file(path: str | os.PathLike) -> str:
+    """Why ``path`` cannot be read as a file, for a message: no such file, or what it is instead.
+
+    Examples
+    --------
+    >>> not_a_file("/no/such/file.csv"), not_a_file("/")
+    ('no such file', 'a folder, not a regular file')
+    """
+    try:
+        return f"{_kind(os.stat(path).st_mode)}, not a regular file"
+    except OSError:
+        return "no such file"
+
+
+def open_regular(path: str | os.PathLike):
+    """Open a regular file for reading in binary, without waiting on what is not one.
+
+    The path is opened without blocking and checked on the open descriptor, so that a FIFO
+    put where a file was expected (whose ``open`` would wait for a writer forever), a folder
+    or a device is refused, not read.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    io.BufferedReader
+        The file, open for reading.
+
+    Raises
+    ------
+    NotRegularFile
+        If ``path`` is not a regular file (an ``OSError``, as a file that cannot be opened).
     """
     import stat
 
     fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
     try:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            kind = "a FIFO" if stat.S_ISFIFO(info.st_mode) else "a folder" if stat.S_ISDIR(info.st_mode) else "a device"
-            raise _NotSmallFile(f"{kind}, not a regular file")
-        if info.st_size > limit:
-            raise _NotSmallFile(f"{info.st_size} bytes, more than a marker's {limit}")
-        with os.fdopen(fd, "rb", closefd=False) as f:
-            data = f.read(limit + 1)
-        if len(data) > limit:
-            raise _NotSmallFile(f"more than a marker's {limit} bytes")
-        return data
-    finally:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            raise NotRegularFile(f"{_kind(mode)}, not a regular file")
+        return os.fdopen(fd, "rb")
+    except BaseException:
         os.close(fd)
+        raise
+
+
+def _small_file(path: Path, limit: int) -> bytes:
+    """The bytes of ``path`` if it is a regular file (:func:`open_regular`) of at most ``limit`` bytes."""
+    with open_regular(path) as f:
+        size = os.fstat(f.fileno()).st_size
+        if size > limit:
+            raise NotRegularFile(f"{size} bytes, more than a marker's {limit}")
+        data = f.read(limit + 1)
+    if len(data) > limit:
+        raise NotRegularFile(f"more than a marker's {limit} bytes")
+    return data
 
 
 def read_marker(folder: str | os.PathLike) -> dict | None:
@@ -294,7 +337,7 @@ def read_marker(folder: str | os.PathLike) -> dict | None:
         text = _small_file(path, MARKER_LIMIT).decode("utf-8")
         doc = json.loads(text)
         why = None if isinstance(doc, dict) else f"a JSON {type(doc).__name__.replace('list', 'array')}, not an object"
-    except _NotSmallFile as exc:
+    except NotRegularFile as exc:
         why = str(exc)
     except OSError as exc:
         why = f"cannot be read: {(exc.strerror or str(exc)).lower()}"
@@ -553,7 +596,7 @@ def read_numeric_csv(
     if path.is_dir():
         raise InputError(f"{path}: is a folder, not a file")
     if not path.is_file():
-        raise InputError(f"{path}: no such file")
+        raise InputError(f"{path}: {not_a_file(path)}")  # a FIFO, too: it would not be opened
     fast = _read_at_once(path, required, optional, blank_ok)
     if fast is not None:
         if progress is not None:

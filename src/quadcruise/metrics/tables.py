@@ -17,6 +17,7 @@ rmse_m                  0.01234     2.000e-05
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
 
 import numpy as np
@@ -136,6 +137,15 @@ def metric_cell(value: Any, metric: Any, axis: Any, missing: str = "-", status: 
     return text, number
 
 
+def _short_status(status) -> str:
+    """A status as a table's cell: its kind (``off track``), not its reason, which is said in
+    full under the table (a reason of 130 characters padded every row of ``fly``'s table)."""
+    text = str(status)
+    kind = text.split(":", 1)[0].strip() or text
+    when = re.search(r" at t = \S+ s$", text) if kind != text else None
+    return kind + (when.group(0) if when else "")
+
+
 def metrics_text(frame, labels) -> str:
     """A table of metrics as aligned text, with the metrics down and the flights across.
 
@@ -158,7 +168,10 @@ def metrics_text(frame, labels) -> str:
     statuses = frame["status"].tolist() if "status" in frame.columns else [None] * len(frame)
     shown = pd.DataFrame(
         {
-            label: [metric_cell(v, col, axis, status=status)[0] for col, v in row.items()]
+            label: [
+                _short_status(v) if col == "status" else metric_cell(v, col, axis, status=status)[0]
+                for col, v in row.items()
+            ]
             for label, axis, status, (_, row) in zip(labels, axes, statuses, frame.iterrows(), strict=False)
         },
         index=list(frame.columns),

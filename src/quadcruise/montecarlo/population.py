@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from quadcruise.checks import describe
 from quadcruise.errors import ArgumentTypeError, InputError
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
@@ -170,7 +171,7 @@ class Population:
             wrong_type = isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating))
             if wrong_type or not math.isfinite(value) or value < 0:
                 raise (ArgumentTypeError if wrong_type else InputError)(
-                    f"population field '{name}' must be a number >= 0, got {value!r}"
+                    f"population field '{name}' must be a number >= 0, got {describe(value)}"
                 )
             object.__setattr__(self, name, float(value))
             limit = 1.0 / CLIP[self.distribution]

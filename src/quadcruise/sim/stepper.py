@@ -37,6 +37,7 @@ import time
 import numpy as np
 from numba import get_num_threads, set_num_threads
 
+from quadcruise.checks import describe
 from quadcruise.errors import InputError
 from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from quadcruise.sim.engine import direct_kernel, fly_vehicles, still_air
@@ -188,11 +189,12 @@ class Stepper:
     def _init(self, inp, controller, mission, disturbance, seed, first_vehicle, sensor_delay, periods, setpoint_width):
         """What both plants hold: the batch arrays, memories, clocks, statuses and logs."""
         if int(periods) != periods or periods < 1:
-            raise InputError(f"periods must be a whole number >= 1, got {periods!r}")
+            raise InputError(f"periods must be a whole number >= 1, got {describe(periods)}")
         self.n = n = inp["n"]
         if not (0 <= int(setpoint_width) <= inp["gains"].shape[1]):
             raise InputError(
-                f"setpoint_width must be in 0..{inp['gains'].shape[1]} (the gains' width), got {setpoint_width!r}"
+                f"setpoint_width must be in 0..{inp['gains'].shape[1]} (the gains' width), "
+                f"got {describe(setpoint_width)}"
             )
         self.t_grid = inp["t_grid"]
         self.periods, self.setpoint_width = int(periods), int(setpoint_width)

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from quadcruise import checks
 from quadcruise.errors import InputError
 from quadcruise.io.flightlog import FlightLog, parse_commands, read_flight_log
 from quadcruise.model.vehicle import Vehicle
@@ -110,14 +111,19 @@ def identify(
     >>> identify("flight.ulg", holdout=1.5)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: holdout must be a fraction in [0.05, 0.6], got 1.5
+    quadcruise.errors.InputError: holdout must be a fraction in [0.05, 0.6], got float 1.5
     """
+    where = "identify()"
+    checks.instance(where, "log", log, (str, os.PathLike, FlightLog), optional=False, want="a path or a FlightLog")
+    checks.instance(where, "frame", frame, str, want="'enu' or 'ned'")
+    checks.instance(where, "commands", commands, str, optional=False, want="'duty', 'rad/s' or 'pwm:MIN:MAX'")
+    checks.callback(where, "progress", progress)  # before the log is read
     if isinstance(holdout, bool) or not isinstance(holdout, (int, float)) or not 0.05 <= holdout <= 0.6:
-        raise InputError(f"holdout must be a fraction in [0.05, 0.6], got {holdout!r}")
+        raise InputError(f"holdout must be a fraction in [0.05, 0.6], got {checks.describe(holdout)}")
     if mass is not None and (
         isinstance(mass, bool) or not isinstance(mass, (int, float)) or not math.isfinite(mass) or mass <= 0
     ):
-        raise InputError(f"mass must be a positive number of kg, got {mass!r}")
+        raise InputError(f"mass must be a positive number of kg, got {checks.describe(mass)}")
     from quadcruise.model.rotor_vehicle import RotorVehicle
 
     if isinstance(vehicle, str):

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from quadcruise import checks
+from quadcruise.checks import describe
 from quadcruise.control import as_controller
 from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import InputError
@@ -351,7 +352,7 @@ def check_run_size(
     from quadcruise.layout import CMD_SIZE, REF_SIZE
 
     if log_every < 1:
-        raise InputError(f"log_every must be a whole number >= 1, got {log_every!r}")
+        raise InputError(f"log_every must be a whole number >= 1, got {describe(log_every)}")
 
     def many(k: int) -> str:  # a count as a message writes it: short, whatever its size
         return f"{k:,}" if k < 10**12 else f"{float(k):.3g}"

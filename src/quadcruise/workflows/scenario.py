@@ -72,6 +72,7 @@ from typing import Any
 
 from quadcruise.control import Controller
 from quadcruise.errors import InputError
+from quadcruise.io.files import not_a_file
 from quadcruise.missions import Mission
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.workflows.scenario_controller import COMPARE_POPULATION_KEYS, compare_table, controller_table
@@ -246,7 +247,7 @@ def load_scenario(path: str | Path) -> Scenario:
     if path.is_dir():
         raise InputError(f"{path}: is a folder, not a scenario file")
     if not path.is_file():
-        raise InputError(f"{path}: no such file")
+        raise InputError(f"{path}: {not_a_file(path)}")
     try:
         doc = tomllib.loads(path.read_text(encoding="utf-8-sig"))  # a byte-order mark is dropped
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
