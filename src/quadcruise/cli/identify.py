@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import shlex
+import sys
 
 import click
 
@@ -128,7 +129,9 @@ def identify(
     """Identify the vehicle that flew LOG (a PX4 .ulg or a CSV) and check it on held-out data.
 
     Fits thrust, inertias, yaw moment and rotor lag by equation error, with 95 % intervals;
-    what the log cannot identify is said so and taken from --vehicle.
+    what the log cannot identify is said so and taken from --vehicle. The first line is the
+    verdict: exit 0 when the model fits the log, 1 when it does not (no intervals then), 2 for
+    bad input.
 
     \f
     Parameters
@@ -203,3 +206,5 @@ def identify(
 
         write_html_report(report, **identification_report(result))
         click.echo(f"wrote report {report}")
+    if not result.fits:  # written, said, and the status says it: 1, the model does not fit the log
+        sys.exit(1)
