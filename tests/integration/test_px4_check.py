@@ -83,6 +83,7 @@ def test_the_cli_takes_a_params_file(tmp_path):
     assert res.exit_code == 0, res.output
     doc = json.loads((tmp_path / "c" / "check.json").read_text())
     assert doc["parameters_used"]["MC_ROLL_P"] == 3.25 and doc["parameters_unused"] == ["SYS_AUTOSTART"]
+    assert "not used by the loops: SYS_AUTOSTART" in res.output
     assert doc["loops"]["attitude"]["axes"]["roll"]["r2"] < GOOD_FIT
 
 
