@@ -1,7 +1,7 @@
 """``px4-check``: a PX4 log's own signals fed through quadcruise's PX4 loops, with the log's
 parameters, and what the loops give compared with what PX4 logged.
 
-Per loop, at each logged output sample while airborne (``vehicle_land_detected.landed``
+Per loop, at each logged output sample while airborne (armed, ``vehicle_land_detected.landed``
 false):
 
 - attitude (:func:`~quadcruise.control.px4loops.attitude_control`): ``vehicle_attitude`` and
@@ -47,6 +47,7 @@ from quadcruise.control.px4loops import (
     rate_control,
 )
 from quadcruise.errors import InputError
+from quadcruise.io.flightlog import ARMED, MULTICOPTER_TYPES
 from quadcruise.io.px4defaults import RELEASE
 from quadcruise.io.px4params import Px4Parameters, read_params
 
@@ -57,6 +58,7 @@ GOOD_FIT = 0.8
 FLYING = 5
 """``takeoff_status.takeoff_state`` of a flying vehicle (PX4's TAKEOFF_STATE_FLIGHT)."""
 TOPICS = (
+    "vehicle_status",
     "vehicle_land_detected",
     "vehicle_attitude",
     "vehicle_attitude_setpoint",
@@ -376,9 +378,19 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
     if "vehicle_land_detected" not in T:
         raise InputError(f"{path}: no vehicle_land_detected topic: cannot tell when the vehicle was airborne")
     land = T["vehicle_land_detected"]
+    status = T.get("vehicle_status")
+    if status is not None and "system_type" in status:
+        kinds = set(np.unique(status["system_type"]).tolist())
+        vtol = bool(np.any(status.get("is_vtol", np.zeros(1))))
+        if vtol or not kinds <= set(MULTICOPTER_TYPES):
+            what = "a VTOL" if vtol else f"MAV_TYPE {sorted(kinds)}"
+            raise InputError(f"{path}: not a multicopter ({what}): px4-check checks PX4's multicopter loops")
 
     def airborne(t_us):
-        return _held(land, "landed", t_us, 1) == 0
+        up = _held(land, "landed", t_us, 1) == 0
+        if status is not None and "arming_state" in status:
+            up &= _held(status, "arming_state", t_us, 0) == ARMED
+        return up
 
     needs = {
         "attitude": ("vehicle_attitude", "vehicle_attitude_setpoint", "vehicle_rates_setpoint"),
@@ -403,7 +415,9 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
     if not any(f["samples"] for v in loops.values() if "axes" in v for f in v["axes"].values()):
         raise InputError(f"{path}: nothing to check: the vehicle was never airborne in this log")
     rates = {n: _rate_hz(T[n]["timestamp"]) for n in TOPICS if n in T}
-    limits = [
+    version = _version(info)
+    limits = [] if version.startswith("1.15.") else [f"the log ran PX4 {version}; the loops are PX4 v1.15's"]
+    limits += [
         "logged rates [Hz]: " + ", ".join(f"{n} {r:.0f}" for n, r in rates.items() if r),
         "the loops run at 50-250 Hz: inputs between logged samples are interpolated (attitude, rates) or held "
         "(trajectory setpoint, hover thrust); a setpoint may come from an input that was never logged",
@@ -412,7 +426,7 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
         "position loop: the takeoff ramp and the land detector's setpoint overrides are not modelled (only flying "
         "samples are compared), and the D term uses the estimator's acceleration where PX4 differentiates the velocity",
     ]
-    return Px4Check(str(path), params, loops, _version(info), limits, command)
+    return Px4Check(str(path), params, loops, version, limits, command)
 
 
 def _rate_hz(t_us: np.ndarray) -> float:
