@@ -11,6 +11,9 @@ false):
   (``xyz``, ``xyz_derivative``) at each ``vehicle_torque_setpoint``'s ``timestamp_sample``
   (the gyro sample it was computed from), ``vehicle_rates_setpoint`` and the integral of
   ``rate_ctrl_status`` interpolated to its time; ``vehicle_torque_setpoint`` is compared;
+- rate integral: the same inputs at the logged gyro samples (50 Hz where PX4 integrates at the
+  gyro rate), with the allocator's saturation (``control_allocator_status``) and the land
+  detector, integrated by us from the log's first value; ``rate_ctrl_status`` is compared;
 - position (:func:`~quadcruise.control.px4loops.position_control`), while
   ``takeoff_status`` says flying and the land detector sees no ground contact: ``vehicle_local_position`` and the last
   ``trajectory_setpoint`` and ``hover_thrust_estimate`` at each
@@ -66,6 +69,7 @@ TOPICS = (
     "vehicle_angular_velocity",
     "vehicle_torque_setpoint",
     "rate_ctrl_status",
+    "control_allocator_status",
     "vehicle_local_position",
     "vehicle_local_position_setpoint",
     "trajectory_setpoint",
@@ -139,16 +143,16 @@ class Px4Check:
 
     def table(self) -> str:
         """A short text table: loop, axis, samples, R^2, RMSE with its unit, PX4's topic."""
-        lines = [f"{'loop':<9} {'axis':<8} {'n':>5} {'R2':>7} {'RMSE':>10}  {'unit':<7} compared with"]
+        lines = [f"{'loop':<13} {'axis':<8} {'n':>5} {'R2':>7} {'RMSE':>10}  {'unit':<7} compared with"]
         for loop, info in self.loops.items():
             if "absent" in info:
-                lines.append(f"{loop:<9} absent: {info['absent']}")
+                lines.append(f"{loop:<13} absent: {info['absent']}")
                 continue
             for axis, f in info["axes"].items():
                 r2 = "-" if f["r2"] is None else f"{f['r2']:.3f}"
                 rmse = "-" if f["rmse"] is None else f"{f['rmse']:.3g}"
                 unit = _unit(loop, axis)
-                lines.append(f"{loop:<9} {axis:<8} {f['samples']:>5} {r2:>7} {rmse:>10}  {unit:<7} {info['output']}")
+                lines.append(f"{loop:<13} {axis:<8} {f['samples']:>5} {r2:>7} {rmse:>10}  {unit:<7} {info['output']}")
         return "\n".join(lines)
 
     def write(self, folder: str | os.PathLike, *, force: bool = False) -> Path:
@@ -180,7 +184,7 @@ class Px4Check:
 def _unit(loop: str, axis: str) -> str:
     if loop == "attitude":
         return "rad/s"
-    if loop == "rate" or axis.startswith("T_"):
+    if loop.startswith("rate") or axis.startswith("T_"):
         return "norm"
     return "m/s" if axis.startswith("v_") else "m/s^2"
 
@@ -275,6 +279,53 @@ def _rate(T: dict, g: np.ndarray, airborne) -> dict:
     return {
         "inputs": "vehicle_angular_velocity at the output's gyro sample, vehicle_rates_setpoint, rate_ctrl_status",
         "output": "vehicle_torque_setpoint",
+        "unit": "normalised torque",
+        "axes": axes,
+    }
+
+
+def _rate_integral(T: dict, g: np.ndarray, airborne) -> dict:
+    av, sp, st, land = (
+        T["vehicle_angular_velocity"],
+        T["vehicle_rates_setpoint"],
+        T["rate_ctrl_status"],
+        T["vehicle_land_detected"],
+    )
+    tg = av["timestamp_sample"]
+    held = _held(land, "landed", tg, 1) != 0  # PX4 holds the integral while landed or maybe landed
+    if "maybe_landed" in land:
+        held |= _held(land, "maybe_landed", tg, 1) != 0
+    rsp = np.stack([np.interp(tg, sp["timestamp"], sp[a]) for a in ("roll", "pitch", "yaw")], axis=1)
+    w, dw = _vec(av, "xyz"), _vec(av, "xyz_derivative")
+    sat_pos = np.zeros((tg.size, 3), bool)
+    sat_neg = np.zeros((tg.size, 3), bool)
+    if "control_allocator_status" in T:  # as MulticopterRateControl reads it: unallocated torque when not achieved
+        ca = T["control_allocator_status"]
+        missed = _held(ca, "torque_setpoint_achieved", tg, 1) == 0
+        for i in range(3):
+            left = _held(ca, f"unallocated_torque[{i}]", tg, 0.0)
+            sat_pos[:, i] = missed & (left > 1.1920929e-07)
+            sat_neg[:, i] = missed & (left < -1.1920929e-07)
+    names = ("rollspeed_integ", "pitchspeed_integ", "yawspeed_integ")
+    integ = tuple(float(np.interp(tg[0], st["timestamp"], st[n])) for n in names)
+    ours = np.empty((tg.size, 3))
+    for k in range(tg.size):
+        dt = (tg[k] - tg[k - 1]) * 1e-6 if k else 0.0
+        _, integ = rate_control(
+            tuple(w[k]), tuple(rsp[k]), tuple(dw[k]), dt, bool(held[k]), g,
+            tuple(sat_pos[k]), tuple(sat_neg[k]), integ,
+        )  # fmt: skip
+        ours[k] = integ
+    ts = st["timestamp"]
+    m = airborne(ts) & (ts >= tg[0]) & (ts <= tg[-1])
+    axes = {
+        ax: fit(st[n][m].astype(float), np.interp(ts[m], tg, ours[:, i]))
+        for i, (ax, n) in enumerate(zip(("roll", "pitch", "yaw"), names, strict=True))
+    }
+    return {
+        "inputs": "vehicle_angular_velocity, vehicle_rates_setpoint, control_allocator_status, vehicle_land_detected "
+        "(our integral from the log's first, at the logged gyro samples)",
+        "output": "rate_ctrl_status",
         "unit": "normalised torque",
         "axes": axes,
     }
@@ -395,6 +446,7 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
     needs = {
         "attitude": ("vehicle_attitude", "vehicle_attitude_setpoint", "vehicle_rates_setpoint"),
         "rate": ("vehicle_angular_velocity", "vehicle_rates_setpoint", "vehicle_torque_setpoint", "rate_ctrl_status"),
+        "rate_integral": ("vehicle_angular_velocity", "vehicle_rates_setpoint", "rate_ctrl_status"),
         "position": ("vehicle_local_position", "vehicle_local_position_setpoint", "trajectory_setpoint"),
     }
     loops: dict[str, dict] = {}
@@ -406,6 +458,8 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
             loops[loop] = _attitude(T, g, airborne)
         elif loop == "rate":
             loops[loop] = _rate(T, g, airborne)
+        elif loop == "rate_integral":
+            loops[loop] = _rate_integral(T, g, airborne)
         else:
             loops[loop] = _position(T, g, params, airborne)
     if all("absent" in v for v in loops.values()):
