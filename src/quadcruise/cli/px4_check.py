@@ -62,10 +62,12 @@ def px4_check(log: str, params: str | None, out: str, force: bool) -> None:
         f"{result.log}: PX4 {result.px4_version}; loops of PX4 v1.15 with the parameters of {result.params.source}"
     )
     click.echo(result.table())
-    if result.params.unused:
+    unused = result.params.unused
+    if 0 < len(unused) <= 12:
+        click.echo(f"not used by the loops: {', '.join(unused)} (of {result.params.source})")
+    elif unused:
         click.echo(
-            f"{len(result.params.unused)} parameters of {result.params.source} are not used by the loops "
-            f"(listed in {out}/check.json)"
+            f"{len(unused)} parameters of {result.params.source} are not used by the loops (listed in {out}/check.json)"
         )
     result.write(out, force=force)
     click.echo(f"wrote {out}/check.json")

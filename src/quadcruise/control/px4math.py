@@ -3,7 +3,9 @@
 As PX4's ``matrix`` library and ``src/modules/mc_pos_control/PositionControl/ControlMath.cpp``
 (release v1.15) compute them, in PX4's frames (NED world, FRD body). A quaternion is
 ``(w, x, y, z)``, Hamilton's product, rotating body vectors into the world (``R(q) v_body``).
-The tuples keep a compiled caller free of array allocations.
+The tuples keep a compiled caller free of array allocations. quadcruise's own frames (ENU
+world, FLU body) are converted at the edge: :func:`enu_to_ned`, :func:`flu_to_frd`,
+:func:`quat_enu_flu_to_ned_frd` (the swaps :mod:`quadcruise.sim.px4` writes logs with).
 """
 
 from __future__ import annotations
@@ -26,6 +28,9 @@ __all__ = [
     "constrain_xy",
     "body_z_to_attitude",
     "add_if_not_nan",
+    "enu_to_ned",
+    "flu_to_frd",
+    "quat_enu_flu_to_ned_frd",
 ]
 
 _EPS32 = 1.1920929e-07
@@ -228,3 +233,29 @@ def add_if_not_nan(setpoint, addition):
     if not math.isfinite(setpoint):
         return addition
     return setpoint
+
+
+_H = math.sqrt(0.5)
+
+
+@njit(cache=True, inline="always")
+def enu_to_ned(v):
+    """A world vector from ENU to NED (its own inverse): ``(y, x, -z)``."""
+    return (v[1], v[0], -v[2])
+
+
+@njit(cache=True, inline="always")
+def flu_to_frd(v):
+    """A body vector from FLU to FRD (its own inverse): ``(x, -y, -z)``."""
+    return (v[0], -v[1], -v[2])
+
+
+@njit(cache=True, inline="always")
+def quat_enu_flu_to_ned_frd(q):
+    """An attitude (FLU body to ENU world) as PX4's (FRD body to NED world), its own inverse.
+
+    ``R_ned_frd = A R_enu_flu B`` with ``A`` the ENU/NED swap (a half turn about
+    ``(1, 1, 0)/sqrt 2``) and ``B = diag(1, -1, -1)`` (a half turn about x): the quaternion
+    ``q_A q q_B``, ``q_A = (0, 1/sqrt 2, 1/sqrt 2, 0)``, ``q_B = (0, 1, 0, 0)``.
+    """
+    return qmul(qmul((0.0, _H, _H, 0.0), q), (0.0, 1.0, 0.0, 0.0))

@@ -84,6 +84,16 @@ class Px4Parameters(Mapping):
     def with_values(self, **values: float) -> Px4Parameters:
         """A copy with ``values`` set, each checked against PX4's range.
 
+        Parameters
+        ----------
+        **values : float
+            Parameters by PX4's name, in PX4's units.
+
+        Returns
+        -------
+        Px4Parameters
+            The copy (``from_file`` counts the names set here as given).
+
         Raises
         ------
         InputError

@@ -1,7 +1,7 @@
 """``px4-check``: a PX4 log's own signals fed through quadcruise's PX4 loops, with the log's
 parameters, and what the loops give compared with what PX4 logged.
 
-Per loop, at each logged output sample while airborne (``vehicle_land_detected.landed``
+Per loop, at each logged output sample while airborne (armed, ``vehicle_land_detected.landed``
 false):
 
 - attitude (:func:`~quadcruise.control.px4loops.attitude_control`): ``vehicle_attitude`` and
@@ -11,6 +11,9 @@ false):
   (``xyz``, ``xyz_derivative``) at each ``vehicle_torque_setpoint``'s ``timestamp_sample``
   (the gyro sample it was computed from), ``vehicle_rates_setpoint`` and the integral of
   ``rate_ctrl_status`` interpolated to its time; ``vehicle_torque_setpoint`` is compared;
+- rate integral: the same inputs at the logged gyro samples (50 Hz where PX4 integrates at the
+  gyro rate), with the allocator's saturation (``control_allocator_status``) and the land
+  detector, integrated by us from the log's first value; ``rate_ctrl_status`` is compared;
 - position (:func:`~quadcruise.control.px4loops.position_control`), while
   ``takeoff_status`` says flying and the land detector sees no ground contact: ``vehicle_local_position`` and the last
   ``trajectory_setpoint`` and ``hover_thrust_estimate`` at each
@@ -47,6 +50,7 @@ from quadcruise.control.px4loops import (
     rate_control,
 )
 from quadcruise.errors import InputError
+from quadcruise.io.flightlog import ARMED, MULTICOPTER_TYPES
 from quadcruise.io.px4defaults import RELEASE
 from quadcruise.io.px4params import Px4Parameters, read_params
 
@@ -57,6 +61,7 @@ GOOD_FIT = 0.8
 FLYING = 5
 """``takeoff_status.takeoff_state`` of a flying vehicle (PX4's TAKEOFF_STATE_FLIGHT)."""
 TOPICS = (
+    "vehicle_status",
     "vehicle_land_detected",
     "vehicle_attitude",
     "vehicle_attitude_setpoint",
@@ -64,6 +69,7 @@ TOPICS = (
     "vehicle_angular_velocity",
     "vehicle_torque_setpoint",
     "rate_ctrl_status",
+    "control_allocator_status",
     "vehicle_local_position",
     "vehicle_local_position_setpoint",
     "trajectory_setpoint",
@@ -137,16 +143,16 @@ class Px4Check:
 
     def table(self) -> str:
         """A short text table: loop, axis, samples, R^2, RMSE with its unit, PX4's topic."""
-        lines = [f"{'loop':<9} {'axis':<8} {'n':>5} {'R2':>7} {'RMSE':>10}  {'unit':<7} compared with"]
+        lines = [f"{'loop':<13} {'axis':<8} {'n':>5} {'R2':>7} {'RMSE':>10}  {'unit':<7} compared with"]
         for loop, info in self.loops.items():
             if "absent" in info:
-                lines.append(f"{loop:<9} absent: {info['absent']}")
+                lines.append(f"{loop:<13} absent: {info['absent']}")
                 continue
             for axis, f in info["axes"].items():
                 r2 = "-" if f["r2"] is None else f"{f['r2']:.3f}"
                 rmse = "-" if f["rmse"] is None else f"{f['rmse']:.3g}"
                 unit = _unit(loop, axis)
-                lines.append(f"{loop:<9} {axis:<8} {f['samples']:>5} {r2:>7} {rmse:>10}  {unit:<7} {info['output']}")
+                lines.append(f"{loop:<13} {axis:<8} {f['samples']:>5} {r2:>7} {rmse:>10}  {unit:<7} {info['output']}")
         return "\n".join(lines)
 
     def write(self, folder: str | os.PathLike, *, force: bool = False) -> Path:
@@ -178,7 +184,7 @@ class Px4Check:
 def _unit(loop: str, axis: str) -> str:
     if loop == "attitude":
         return "rad/s"
-    if loop == "rate" or axis.startswith("T_"):
+    if loop.startswith("rate") or axis.startswith("T_"):
         return "norm"
     return "m/s" if axis.startswith("v_") else "m/s^2"
 
@@ -273,6 +279,53 @@ def _rate(T: dict, g: np.ndarray, airborne) -> dict:
     return {
         "inputs": "vehicle_angular_velocity at the output's gyro sample, vehicle_rates_setpoint, rate_ctrl_status",
         "output": "vehicle_torque_setpoint",
+        "unit": "normalised torque",
+        "axes": axes,
+    }
+
+
+def _rate_integral(T: dict, g: np.ndarray, airborne) -> dict:
+    av, sp, st, land = (
+        T["vehicle_angular_velocity"],
+        T["vehicle_rates_setpoint"],
+        T["rate_ctrl_status"],
+        T["vehicle_land_detected"],
+    )
+    tg = av["timestamp_sample"]
+    held = _held(land, "landed", tg, 1) != 0  # PX4 holds the integral while landed or maybe landed
+    if "maybe_landed" in land:
+        held |= _held(land, "maybe_landed", tg, 1) != 0
+    rsp = np.stack([np.interp(tg, sp["timestamp"], sp[a]) for a in ("roll", "pitch", "yaw")], axis=1)
+    w, dw = _vec(av, "xyz"), _vec(av, "xyz_derivative")
+    sat_pos = np.zeros((tg.size, 3), bool)
+    sat_neg = np.zeros((tg.size, 3), bool)
+    if "control_allocator_status" in T:  # as MulticopterRateControl reads it: unallocated torque when not achieved
+        ca = T["control_allocator_status"]
+        missed = _held(ca, "torque_setpoint_achieved", tg, 1) == 0
+        for i in range(3):
+            left = _held(ca, f"unallocated_torque[{i}]", tg, 0.0)
+            sat_pos[:, i] = missed & (left > 1.1920929e-07)
+            sat_neg[:, i] = missed & (left < -1.1920929e-07)
+    names = ("rollspeed_integ", "pitchspeed_integ", "yawspeed_integ")
+    integ = tuple(float(np.interp(tg[0], st["timestamp"], st[n])) for n in names)
+    ours = np.empty((tg.size, 3))
+    for k in range(tg.size):
+        dt = (tg[k] - tg[k - 1]) * 1e-6 if k else 0.0
+        _, integ = rate_control(
+            tuple(w[k]), tuple(rsp[k]), tuple(dw[k]), dt, bool(held[k]), g,
+            tuple(sat_pos[k]), tuple(sat_neg[k]), integ,
+        )  # fmt: skip
+        ours[k] = integ
+    ts = st["timestamp"]
+    m = airborne(ts) & (ts >= tg[0]) & (ts <= tg[-1])
+    axes = {
+        ax: fit(st[n][m].astype(float), np.interp(ts[m], tg, ours[:, i]))
+        for i, (ax, n) in enumerate(zip(("roll", "pitch", "yaw"), names, strict=True))
+    }
+    return {
+        "inputs": "vehicle_angular_velocity, vehicle_rates_setpoint, control_allocator_status, vehicle_land_detected "
+        "(our integral from the log's first, at the logged gyro samples)",
+        "output": "rate_ctrl_status",
         "unit": "normalised torque",
         "axes": axes,
     }
@@ -376,13 +429,24 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
     if "vehicle_land_detected" not in T:
         raise InputError(f"{path}: no vehicle_land_detected topic: cannot tell when the vehicle was airborne")
     land = T["vehicle_land_detected"]
+    status = T.get("vehicle_status")
+    if status is not None and "system_type" in status:
+        kinds = set(np.unique(status["system_type"]).tolist())
+        vtol = bool(np.any(status.get("is_vtol", np.zeros(1))))
+        if vtol or not kinds <= set(MULTICOPTER_TYPES):
+            what = "a VTOL" if vtol else f"MAV_TYPE {sorted(kinds)}"
+            raise InputError(f"{path}: not a multicopter ({what}): px4-check checks PX4's multicopter loops")
 
     def airborne(t_us):
-        return _held(land, "landed", t_us, 1) == 0
+        up = _held(land, "landed", t_us, 1) == 0
+        if status is not None and "arming_state" in status:
+            up &= _held(status, "arming_state", t_us, 0) == ARMED
+        return up
 
     needs = {
         "attitude": ("vehicle_attitude", "vehicle_attitude_setpoint", "vehicle_rates_setpoint"),
         "rate": ("vehicle_angular_velocity", "vehicle_rates_setpoint", "vehicle_torque_setpoint", "rate_ctrl_status"),
+        "rate_integral": ("vehicle_angular_velocity", "vehicle_rates_setpoint", "rate_ctrl_status"),
         "position": ("vehicle_local_position", "vehicle_local_position_setpoint", "trajectory_setpoint"),
     }
     loops: dict[str, dict] = {}
@@ -394,6 +458,8 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
             loops[loop] = _attitude(T, g, airborne)
         elif loop == "rate":
             loops[loop] = _rate(T, g, airborne)
+        elif loop == "rate_integral":
+            loops[loop] = _rate_integral(T, g, airborne)
         else:
             loops[loop] = _position(T, g, params, airborne)
     if all("absent" in v for v in loops.values()):
@@ -403,7 +469,9 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
     if not any(f["samples"] for v in loops.values() if "axes" in v for f in v["axes"].values()):
         raise InputError(f"{path}: nothing to check: the vehicle was never airborne in this log")
     rates = {n: _rate_hz(T[n]["timestamp"]) for n in TOPICS if n in T}
-    limits = [
+    version = _version(info)
+    limits = [] if version.startswith("1.15.") else [f"the log ran PX4 {version}; the loops are PX4 v1.15's"]
+    limits += [
         "logged rates [Hz]: " + ", ".join(f"{n} {r:.0f}" for n, r in rates.items() if r),
         "the loops run at 50-250 Hz: inputs between logged samples are interpolated (attitude, rates) or held "
         "(trajectory setpoint, hover thrust); a setpoint may come from an input that was never logged",
@@ -412,7 +480,7 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
         "position loop: the takeoff ramp and the land detector's setpoint overrides are not modelled (only flying "
         "samples are compared), and the D term uses the estimator's acceleration where PX4 differentiates the velocity",
     ]
-    return Px4Check(str(path), params, loops, _version(info), limits, command)
+    return Px4Check(str(path), params, loops, version, limits, command)
 
 
 def _rate_hz(t_us: np.ndarray) -> float:
