@@ -30,7 +30,7 @@ from quadcruise.control.cascade import rate_pid_design
 from quadcruise.control.design import attitude_pid_design
 from quadcruise.control.se3 import se3_attitude_design
 from quadcruise.errors import InputError
-from quadcruise.layout import REF_PSI, REF_Z
+from quadcruise.layout import PSI, REF_PSI, REF_Z
 from quadcruise.missions import Mission
 from quadcruise.model.equivalent import duty_to_thrust, paper_equivalent
 from quadcruise.model.rotor_plant import QW, QZ, ROTOR_W1, RZ, state_names
@@ -307,7 +307,7 @@ def rotor_initial_states(vehicles: tuple[RotorVehicle, ...], x0: np.ndarray, n: 
     >>> r[2], np.round(r[6:10], 6).tolist(), bool(np.all(r[13:] == v.hover_speed))
     (1.0, [0.707107, 0.0, 0.0, 0.707107], True)
     """
-    from quadcruise.layout import F1, PHI, PSI, THETA, P, X
+    from quadcruise.layout import F1, PHI, THETA, P, X
 
     x0 = np.broadcast_to(np.atleast_2d(np.asarray(x0, dtype=float)), (n, 16))
     flown = vehicles if len(vehicles) == n else vehicles * n
@@ -408,7 +408,7 @@ def rotor_engine_inputs(
     plant = dict(
         alloc=rows(lambda v: np.r_[duty_to_thrust(v).ravel(), v.kf], believed),
         vp_ctrl=rows(lambda v: paper_equivalent(v).rows(1)[0], believed),
-        psi0=psi if x0 is None else np.broadcast_to(np.atleast_2d(x0)[:, 8], (n,)).copy(),
+        psi0=psi if x0 is None else np.broadcast_to(np.atleast_2d(x0)[:, PSI], (n,)).copy(),
         touchdown_speed=np.array([v.touchdown_speed for v in flown]) if len(flown) > 1 else flown[0].touchdown_speed,
         rotor_names=state_names(flown[0].n_rotors),
     )
