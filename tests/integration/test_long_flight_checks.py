@@ -153,6 +153,10 @@ def test_x0_starts_a_rotor_vehicle_where_it_says():
     # the kernel's own quaternion -> Euler (atan2/asin) reads back the angles given
     np.testing.assert_allclose(moved.states[1, 0, [PHI, THETA, PSI]], [0.1, -0.2, 0.4], atol=1e-14)
     assert moved.status_text(1) == "finished"  # it levels and holds
+    fleet = [iris, iris.replace(m=iris.m * 1.2), iris]  # one vehicle each: each its own hover
+    starts = np.concatenate([hover_state(paper_equivalent(v), 1, qc.missions.Hover()) for v in fleet])
+    mixed = quiet("hover", "se3", vehicle=fleet, duration=0.1, x0=starts)
+    assert [float(w) for w in mixed.rotor_states[:, 0, 13]] == [v.hover_speed for v in fleet]
     thrust = x0[2].copy()
     thrust[12:] = [2.0, 4.0, 4.0, 4.0]  # a four-rotor vehicle: each rotor's speed from its thrust
     spun = quiet("hover", "se3", vehicle="iris", duration=0.1, x0=thrust)

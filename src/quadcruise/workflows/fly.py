@@ -68,6 +68,7 @@ from quadcruise.workflows.rotor_fly import (
     rotor_batch,
     rotor_engine_inputs,
     rotor_flight_setup,
+    rotor_initial_states,
     vehicle_record,
 )
 from quadcruise.workflows.track_watch import TrackWatch
@@ -248,6 +249,8 @@ def fly(
     n = sizes.pop() if sizes else 1
     if n < 1:
         raise InputError(f"the number of vehicles must be at least 1, got {n}")
+    if rotor and x0 is not None:  # what cannot start its rotors, refused before any work
+        rotor_initial_states(rotor_batch(vehicle), x0, n)
     mp = stack_params(missions if missions is not None else mission, n=None if missions else n)
     first = missions[0] if missions else mission
     duration = default_duration(first) if duration is None else duration

@@ -28,7 +28,7 @@ import numpy as np
 from quadcruise.control import CONTROLLERS, controller_from_name
 from quadcruise.control.registry import rotor_gains
 from quadcruise.errors import InputError
-from quadcruise.layout import REF_PSI, REF_Z
+from quadcruise.layout import PSI, REF_PSI, REF_Z
 from quadcruise.missions import Mission
 from quadcruise.model.equivalent import duty_to_thrust, paper_equivalent
 from quadcruise.model.rotor_plant import QW, QZ, ROTOR_W1, RZ, state_names
@@ -295,13 +295,13 @@ def rotor_initial_states(vehicles: tuple[RotorVehicle, ...], x0: np.ndarray, n: 
     >>> v = RotorVehicle.preset("iris")
     >>> x = np.zeros(16); x[2] = 1.0; x[8] = np.pi / 2; x[12:] = v.m * v.g / 4
     >>> r = rotor_initial_states((v,), x, 1)[0]
-    >>> r[2], np.round(r[6:10], 6).tolist(), bool(np.all(r[13:] == v.hover_speed))
+    >>> float(r[2]), np.round(r[6:10], 6).tolist(), bool(np.all(r[13:] == v.hover_speed))
     (1.0, [0.707107, 0.0, 0.0, 0.707107], True)
     """
-    from quadcruise.layout import F1, PHI, PSI, THETA, P, X
+    from quadcruise.layout import F1, PHI, THETA, P, X
 
     x0 = np.broadcast_to(np.atleast_2d(np.asarray(x0, dtype=float)), (n, 16))
-    flown = vehicles if len(vehicles) == n else vehicles * n
+    flown = vehicles if len(vehicles) == n else vehicles[:1] * n
     out = np.zeros((n, ROTOR_W1 + flown[0].n_rotors))
     out[:, :6] = x0[:, X : X + 6]
     out[:, RP_RATES : RP_RATES + 3] = x0[:, P : P + 3]
@@ -311,13 +311,15 @@ def rotor_initial_states(vehicles: tuple[RotorVehicle, ...], x0: np.ndarray, n: 
     out[:, QW + 1] = sf * ct * cp - cf * st * sp
     out[:, QW + 2] = cf * st * cp + sf * ct * sp
     out[:, QZ] = cf * ct * sp - sf * st * cp
-    for i, v in enumerate(flown):
-        thrust = x0[i, F1 : F1 + 4]
-        if np.all(thrust == v.m * v.g / 4.0):
-            out[i, ROTOR_W1:] = v.hover_speed
-        elif v.n_rotors != 4 or np.any(thrust < 0):
+    thrust = x0[:, F1 : F1 + 4]
+    for v in dict.fromkeys(flown):  # each distinct vehicle once, over its rows
+        rows = np.array([u == v for u in flown]) if len(vehicles) > 1 else np.ones(n, dtype=bool)
+        hover = np.all(thrust[rows] == v.m * v.g / 4.0, axis=1)
+        bad = ~hover & ((v.n_rotors != 4) | np.any(thrust[rows] < 0, axis=1))
+        if bad.any():
+            i = int(np.flatnonzero(rows)[np.argmax(bad)])
             raise InputError(
-                f"fly() argument x0, row {i}: rotor thrusts {thrust.tolist()} cannot start "
+                f"fly() argument x0, row {i}: rotor thrusts {thrust[i].tolist()} cannot start "
                 + (
                     f"a {v.n_rotors}-rotor vehicle (x0 holds four rotors' thrusts F1..F4): give its hover, "
                     f"F1..F4 = m g / 4 = {v.m * v.g / 4.0:.6g} N, as hover_state does"
@@ -325,8 +327,10 @@ def rotor_initial_states(vehicles: tuple[RotorVehicle, ...], x0: np.ndarray, n: 
                     else "its rotors (a thrust must be >= 0 N)"
                 )
             )
-        else:
-            out[i, ROTOR_W1:] = np.sqrt(thrust / v.kf)
+        speed = np.full((int(rows.sum()), v.n_rotors), v.hover_speed)
+        if v.n_rotors == 4:
+            speed[~hover] = np.sqrt(thrust[rows][~hover] / v.kf)
+        out[rows, ROTOR_W1:] = speed
     return out
 
 
@@ -399,7 +403,7 @@ def rotor_engine_inputs(
     plant = dict(
         alloc=rows(lambda v: np.r_[duty_to_thrust(v).ravel(), v.kf], believed),
         vp_ctrl=rows(lambda v: paper_equivalent(v).rows(1)[0], believed),
-        psi0=psi if x0 is None else np.broadcast_to(np.atleast_2d(x0)[:, 8], (n,)).copy(),
+        psi0=psi if x0 is None else np.broadcast_to(np.atleast_2d(x0)[:, PSI], (n,)).copy(),
         touchdown_speed=np.array([v.touchdown_speed for v in flown]) if len(flown) > 1 else flown[0].touchdown_speed,
         rotor_names=state_names(flown[0].n_rotors),
     )
