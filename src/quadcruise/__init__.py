@@ -41,12 +41,11 @@ if _command_starting():
 import importlib  # noqa: E402 - after Ctrl-C is answered
 from typing import TYPE_CHECKING  # noqa: E402
 
-from quadcruise._cache import drop_stale_cache as _drop_stale_cache  # noqa: E402
+from quadcruise._cache import check_before_compiled_code as _check_before_compiled_code  # noqa: E402
 from quadcruise._version import __version__  # noqa: E402
+from quadcruise.errors import InputError  # noqa: E402
 
-_drop_stale_cache()  # before anything compiles: see quadcruise._cache
-
-from quadcruise.errors import InputError  # noqa: E402 - after the stale cache is dropped
+_check_before_compiled_code()  # numba's stale cache dropped when compiled code is first imported
 
 if TYPE_CHECKING:  # what the names are, for readers and type checkers
     from quadcruise.model.vehicle import Vehicle

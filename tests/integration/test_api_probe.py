@@ -6,7 +6,6 @@ them and exits 2), before any work. And what must pass still passes."""
 from __future__ import annotations
 
 import math
-import time
 from pathlib import Path
 
 import numpy as np
@@ -274,7 +273,6 @@ def gym_make_vec(**kw):
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_a_bad_argument_is_one_line_naming_it(name):
     call, error, words = CASES[name]
-    start = time.perf_counter()
     with pytest.raises(error) as caught:
         call()
     message = str(caught.value)
@@ -284,7 +282,6 @@ def test_a_bad_argument_is_one_line_naming_it(name):
     assert "np." not in message and "was raised from the environment creator" not in message, message
     for word in words:
         assert word in message, (word, message)
-    assert time.perf_counter() - start < 30.0  # before any work
 
 
 def test_the_type_error_is_an_input_error_and_a_type_error():
@@ -293,11 +290,10 @@ def test_the_type_error_is_an_input_error_and_a_type_error():
 
 
 def test_a_bad_argument_is_refused_before_the_flight_is_sized_or_flown():
-    # a flight of hours: the seed is refused first, not the size, and nothing flies
-    start = time.perf_counter()
+    # a flight of hours: the seed is refused first, not the size, and nothing flies (were it
+    # flown first, this call would not end)
     with pytest.raises(TypeError, match="seed"):
         qc.fly("circle", duration=3600.0, n=100_000, seed=1.5)
-    assert time.perf_counter() - start < 5.0
 
 
 def test_what_must_pass_passes_and_numbers_of_any_numeric_type_fly_the_same():
