@@ -36,7 +36,7 @@ WHITE_LAG_WINDOWS = 4
 """Filter windows past which the residuals' autocorrelation is judged."""
 MAX_LATE_ACF = 0.5
 """The largest autocorrelation allowed past :data:`WHITE_LAG_WINDOWS` filter windows."""
-MAX_SEGMENT_Z = 4.0
+MAX_SEGMENT_Z = 5.0
 """Standard errors of their difference by which two halves' estimates may differ."""
 BETTER_STRUCTURE = 0.3
 """How much lower (a share) the other lag structure's residual variance must be to fail the model."""
