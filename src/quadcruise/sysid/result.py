@@ -158,6 +158,7 @@ class IdentifyResult:
                 "white": "white residuals",
                 "segments": "segments agree",
                 "commands": "every command seen",
+                "structure": "its lag fits better than the other",
             }
             checks = self.verdict.get("checks", {})
             if checks.get("commands", {}).get("control_hz", 0) is None:

@@ -2,7 +2,7 @@
 
 An interval is only as good as the model it is computed in: a wrong structure (a rotor plant read
 as the paper's, a missing term) or commands the log did not see (a log that samples them) give
-tight intervals around a wrong value. Four checks, each able to fail on its own
+tight intervals around a wrong value. Five checks, each able to fail on its own
 (docs/identify.md, "The verdict"):
 
 - **every command seen**: the commands are logged at the rate the controller computed them
@@ -15,10 +15,15 @@ tight intervals around a wrong value. Four checks, each able to fail on its own
   (:data:`WHITE_LAG_WINDOWS` filter windows), under :data:`MAX_LATE_ACF` (what the filter and
   sensor noise leave is short; an unmodelled dynamic leaves a long tail);
 - **segments agree**: the parameters fitted on the first and second half of the fitted time apart
-  by at most :data:`MAX_SEGMENT_Z` standard errors of their difference.
+  by at most :data:`MAX_SEGMENT_Z` standard errors of their difference;
+- **structure**: the other lag structure (a rotor's speed lagging and its thrust the square, or
+  the paper's thrust lagging) fitted to the same rows leaves no equation's residual variance
+  :data:`BETTER_STRUCTURE` lower (the paper's plant on a rotor vehicle's log, or the reverse).
 """
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 
@@ -31,8 +36,10 @@ WHITE_LAG_WINDOWS = 4
 """Filter windows past which the residuals' autocorrelation is judged."""
 MAX_LATE_ACF = 0.5
 """The largest autocorrelation allowed past :data:`WHITE_LAG_WINDOWS` filter windows."""
-MAX_SEGMENT_Z = 4.0
+MAX_SEGMENT_Z = 5.0
 """Standard errors of their difference by which two halves' estimates may differ."""
+BETTER_STRUCTURE = 0.3
+"""How much lower (a share) the other lag structure's residual variance must be to fail the model."""
 SAMPLED_SHARE = 0.9
 """Commands logged below this share of the controller's rate are sampled, not all seen."""
 FITS = "fits"
@@ -214,6 +221,33 @@ def command_check(cmd_hz: float, control_hz: float | None) -> dict:
     }
 
 
+def structure_check(sigma: dict, other_sigma: dict, lag_of: str, other: str, y_var: dict | None = None) -> dict:
+    """Whether the other lag structure (a rotor's speed lagging, its thrust the square; or the
+    paper's thrust lagging) fits the log better: each equation's residual variance against the
+    model's; better by more than :data:`BETTER_STRUCTURE` on any equation fails.
+
+    Examples
+    --------
+    >>> structure_check({"thrust": 1.0}, {"thrust": 0.5}, "thrust", "speed")["ok"]
+    False
+    """
+    ratio = {c: (other_sigma[c] / sigma[c]) ** 2 for c in sigma if sigma[c] > 0}
+    dust = {c for c in ratio if y_var is not None and sigma[c] ** 2 <= NEGLIGIBLE * y_var.get(c, 0.0)}
+    bad = {c: r for c, r in ratio.items() if r < 1.0 - BETTER_STRUCTURE and c not in dust}
+    what = {
+        "speed": "the rotors' speed lagging (a rotor-plant vehicle: --vehicle iris, a file)",
+        "thrust": "the thrust lagging (the paper's plant: --vehicle paper)",
+    }
+    return {
+        "ok": not bad,
+        "variance_ratio": ratio,
+        "other": other,
+        "why": f"the log fits {what[other]} better than this model's {lag_of} lag: residual variance "
+        + ", ".join(f"{c} {100 * (1 - r):.0f} % lower" for c, r in bad.items())
+        + " (or neither is the vehicle's: unequal motor time constants, a missing term)",
+    }
+
+
 def withhold(table: dict, verdict: dict) -> dict:
     """The table of a model that does not fit: each value the best fit's, no interval, not identifiable.
 
@@ -285,6 +319,19 @@ def paper_verdict(flight, sig, fit_rows, held, rotors, result, mass, g, cmd_hz, 
         halves.append({k: v for k, v in found.items() if v["identifiable"]})
     checks["segments"] = segment_check(*halves)
     checks["commands"] = command_check(cmd_hz, control_rate(rates, rates))
+    other = "speed" if sig.lag_of == "thrust" else "thrust"
+    alt = fit(
+        dataclasses.replace(sig, lag_of=other),
+        fit_rows,
+        rotors,
+        result.omega,
+        result.shape_f,
+        fit_omega=result.omega_fitted,
+        fit_shape=False,
+        omega_bounds=(0.5, min(500.0, 0.5 / sig.dt)),
+    )
+    y_var = {c: float(np.var(data[c][0][fit_rows])) for c in data}
+    checks["structure"] = structure_check(result.sigma, alt.sigma, sig.lag_of, other, y_var)
     return judge(checks)
 
 
