@@ -45,6 +45,7 @@ def identified(tmp_path_factory):
 
 
 def test_the_sweep_spreads_as_the_intervals_say(identified, tmp_path):
+    assert json.loads((identified / "identify.json").read_text()).get("verdict", "fits") == "fits"
     out = tmp_path / "mc"
     result = run(
         "montecarlo", "--mission", "hover", "--duration", "0.2", "-n", N, "--seed", 4,
@@ -110,6 +111,10 @@ def test_bad_identifications_are_one_line(identified, tmp_path):
     per_m.write_text(json.dumps({**data, "per_unit_mass": True}))
     with pytest.raises(InputError, match="per unit mass"):
         Population.from_identification(per_m)
+    unfit = tmp_path / "unfit.json"
+    unfit.write_text(json.dumps({**data, "verdict": "does not fit", "verdict_reasons": ["held-out R^2 ax -0.3"]}))
+    with pytest.raises(InputError, match="does not fit the log .held-out R.2 ax -0.3"):
+        Population.from_identification(unfit)
     with pytest.raises(InputError, match="no such file"):
         Population.from_identification(tmp_path / "none.json")
     with pytest.raises(InputError, match="inertia_spread.*Jxx.*draws from its estimate"):

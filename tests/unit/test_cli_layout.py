@@ -61,9 +61,10 @@ def test_every_cli_module_is_short(path):
 
 @pytest.mark.parametrize("name", sorted(main.commands))
 def test_each_command_has_its_own_module(name):
-    """Command ``name`` is defined in ``quadcruise.cli.<name>``, which defines no other."""
+    """Command ``name`` is defined in ``quadcruise.cli.<name>`` (a hyphen as an underscore), which
+    defines no other."""
     module = main.commands[name].callback.__module__
-    assert module == f"quadcruise.cli.{name}"
+    assert module == f"quadcruise.cli.{name.replace('-', '_')}"
     assert [n for n, c in main.commands.items() if c.callback.__module__ == module] == [name]
 
 
@@ -81,6 +82,7 @@ def test_the_entry_points_stay():
         "fly",
         "identify",
         "montecarlo",
+        "px4-check",
         "replay",
         "reproduce",
         "tune",

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import shlex
+import sys
 
 import click
 
-from quadcruise.cli.common import Bar, friendly, writable, writable_with
+from quadcruise.cli.common import Bar, distinct_outputs, friendly, writable, writable_with
 from quadcruise.errors import InputError
+from quadcruise.io.files import not_a_file
 
 __all__ = ["identify"]
 
@@ -30,7 +32,7 @@ def base_vehicle(text: str):
                 f"--vehicle: a preset (paper, iris, crazyflie, ...) or a TOML file with a [vehicle] table, got {text!r}"
             ) from None
     if not path.is_file():
-        raise InputError(f"--vehicle: {text}: no such file")
+        raise InputError(f"--vehicle: {text}: {not_a_file(path)}")
     from quadcruise.workflows.scenario import load_scenario
 
     return load_scenario(path).vehicle
@@ -127,7 +129,9 @@ def identify(
     """Identify the vehicle that flew LOG (a PX4 .ulg or a CSV) and check it on held-out data.
 
     Fits thrust, inertias, yaw moment and rotor lag by equation error, with 95 % intervals;
-    what the log cannot identify is said so and taken from --vehicle.
+    what the log cannot identify is said so and taken from --vehicle. The first line is the
+    verdict: exit 0 when the model fits the log, 1 when it does not (no intervals then), 2 for
+    bad input.
 
     \f
     Parameters
@@ -158,6 +162,7 @@ def identify(
     from quadcruise.sysid.api import STAGES
     from quadcruise.sysid.api import identify as run_identify
 
+    distinct_outputs(out, report=report)
     base = base_vehicle(vehicle)
     parse_commands(commands)
     check_keeps_log(log, out)
@@ -201,3 +206,5 @@ def identify(
 
         write_html_report(report, **identification_report(result))
         click.echo(f"wrote report {report}")
+    if not result.fits:  # written, said, and the status says it: 1, the model does not fit the log
+        sys.exit(1)

@@ -4,7 +4,7 @@ The group lives here, each command in its own module (:mod:`quadcruise.cli.fly`,
 :mod:`~quadcruise.cli.replay`, :mod:`~quadcruise.cli.reproduce`,
 :mod:`~quadcruise.cli.compare`, :mod:`~quadcruise.cli.analyze`,
 :mod:`~quadcruise.cli.montecarlo`, :mod:`~quadcruise.cli.tune`, :mod:`~quadcruise.cli.vehicles`,
-:mod:`~quadcruise.cli.identify`), what they share in :mod:`quadcruise.cli.common`;
+:mod:`~quadcruise.cli.identify`, :mod:`~quadcruise.cli.px4_check`), what they share in :mod:`quadcruise.cli.common`;
 the larger commands keep what they run after parsing in a ``*_run`` module beside them
 (:mod:`~quadcruise.cli.compare_run`, :mod:`~quadcruise.cli.montecarlo_run`, :mod:`~quadcruise.cli.tune_run`).
 Bad input prints one line, ``error: ...``, and exits with status 2; a flight that did not
@@ -16,6 +16,7 @@ SIGTERM, 143 (:mod:`quadcruise.cli.faults`).
 from __future__ import annotations
 
 import gc
+import signal
 import sys
 
 import click
@@ -27,6 +28,7 @@ from quadcruise.cli.faults import EXIT_FAULT, fault_text, guard_stdout, interrup
 from quadcruise.cli.fly import fly
 from quadcruise.cli.identify import identify
 from quadcruise.cli.montecarlo import montecarlo
+from quadcruise.cli.px4_check import px4_check
 from quadcruise.cli.replay import replay
 from quadcruise.cli.reproduce import reproduce
 from quadcruise.cli.tune import tune
@@ -50,6 +52,7 @@ main.add_command(montecarlo)
 main.add_command(tune)
 main.add_command(vehicles)
 main.add_command(identify)
+main.add_command(px4_check)
 
 
 def run() -> None:
@@ -68,6 +71,7 @@ def run() -> None:
         Always: 0 on success, 2 for bad input, 74 for a file or standard output that could
         not be written, 130 when interrupted, 143 when terminated, else the command's status.
     """
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # the loading's handler (quadcruise/__init__) ends
     guard_stdout()
     stop_on_sigterm()
     try:

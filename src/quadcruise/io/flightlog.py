@@ -24,6 +24,7 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from quadcruise.errors import InputError
 from quadcruise.io import logchecks
+from quadcruise.io.files import not_a_file
 
 NED_TO_ENU = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
 """``A``: NED vectors to ENU (its own inverse)."""
@@ -192,7 +193,7 @@ def read_flight_log(path: str | os.PathLike, *, frame: str | None = None, comman
     if kind not in (".ulg", ".csv"):
         raise InputError(f"{path}: a flight log is a PX4 log (.ulg) or a CSV (.csv), got {path.suffix!r}")
     if not path.is_file():
-        raise InputError(f"{path}: no such file")
+        raise InputError(f"{path}: {not_a_file(path)}")
     frame_name = None if frame is None else str(frame).strip().lower()
     if frame_name not in (None, "enu", "ned"):
         raise InputError(f"{path}: frame must be 'enu' or 'ned', got {frame!r}")

@@ -3,7 +3,7 @@
 ``quadcruise identify`` writes each parameter's estimate and 95 % interval (``identify.json``);
 :class:`Identified` reads them and draws, for vehicle i of a sweep::
 
-    theta_i = theta_hat + L z_i,    L L^T = C,    z_i ~ N(0, I) clipped to [-3, 3]
+    theta_i = theta_hat + L z_i,    L L^T = C,    z_i ~ N(0, I) truncated to [-3, 3]
 
 with ``C`` the estimates' covariance: ``identify.json``'s ``"covariance"`` (``{"names": [...],
 "matrix": [[...]]}``, in the parameters' units) for the parameters it lists, else the diagonal
@@ -34,7 +34,7 @@ DRAW_KEY = 2
 Z95 = 1.959963984540054
 """The standard normal's 97.5 % quantile: a 95 % interval is +-Z95 standard deviations."""
 CLIP = 3.0
-"""Largest |z| drawn (as the population's normal draws)."""
+"""Largest |z| drawn (as the population's normal draws: a draw beyond is drawn again from the same stream)."""
 
 
 @dataclass(frozen=True)
@@ -124,6 +124,12 @@ class Identified:
         params = data.get("parameters") if isinstance(data, dict) else None
         if not isinstance(params, dict):
             raise InputError(f"{path}: not an identification (no 'parameters')")
+        if data.get("verdict") == "does not fit":
+            why = (data.get("verdict_reasons") or ["see its report"])[0]
+            raise InputError(
+                f"{path}: identify's verdict: the model does not fit the log ({why}); its values describe no vehicle "
+                "to draw from"
+            )
         if data.get("per_unit_mass"):
             raise InputError(
                 f"{path}: identified per unit mass (no --mass): the vehicles cannot be drawn; identify with --mass"
@@ -169,7 +175,18 @@ class Identified:
     def draw(self, seed: int, ids) -> np.ndarray:
         """The drawn parameters of vehicles ``ids``: (len(ids), len(names)), columns as :attr:`names`."""
         ids = np.ravel(ids)
-        z = np.clip(seeded_draws(int(seed), ids, DRAW_KEY, len(self.names), True), -CLIP, CLIP)
+        k = len(self.names)
+        z = seeded_draws(int(seed), ids, DRAW_KEY, k, True)
+        for r in np.flatnonzero(np.any(np.abs(z) > CLIP, axis=1)):  # truncated: drawn again from the same stream
+            spare = 4 * k
+            while True:
+                more = seeded_draws(int(seed), ids[r : r + 1], DRAW_KEY, k + spare, True)[0, k:]
+                more = more[np.abs(more) <= CLIP]
+                bad = np.flatnonzero(np.abs(z[r]) > CLIP)
+                if more.size >= bad.size:
+                    z[r, bad] = more[: bad.size]
+                    break
+                spare *= 2
         cov = np.asarray(self.covariance, dtype=np.float64)
         w, v = np.linalg.eigh(cov)  # L = V sqrt(W): any semi-definite C
         root = v * np.sqrt(np.clip(w, 0.0, None))

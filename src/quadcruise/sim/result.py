@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from quadcruise.checks import describe
 from quadcruise.errors import InputError
 from quadcruise.layout import CMD_NAMES, REF_NAMES, STATE_NAMES
 from quadcruise.metrics.summary import Summary
@@ -219,7 +220,7 @@ class SimResult:
             With ``t``, ``states``, ``commands`` and ``references`` thinned; the rest shared.
         """
         if int(every) != every or every < 1:
-            raise InputError(f"decimation step must be a positive integer, got {every!r}")
+            raise InputError(f"decimation step must be a positive integer, got {describe(every)}")
         keep = slice(None, None, int(every))
         return dataclasses.replace(
             self,
@@ -333,7 +334,7 @@ class SimResult:
             raise InputError(f"to_ulog: profile must be one of {', '.join(PROFILES)}, got {profile!r}")
         rates_hz, profile_bits = PROFILES[profile]
         if isinstance(vehicle, bool) or not isinstance(vehicle, (int, np.integer)) or not 0 <= vehicle < self.n:
-            raise InputError(f"to_ulog: vehicle must be an index in [0, {self.n}), got {vehicle!r}")
+            raise InputError(f"to_ulog: vehicle must be an index in [0, {self.n}), got {describe(vehicle)}")
         if not str(path).endswith(".ulg"):
             raise InputError(f"to_ulog: a PX4 log's name ends in .ulg, got {str(path)!r}")
         rows = np.isfinite(self.states[vehicle]).all(axis=1)

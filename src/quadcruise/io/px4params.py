@@ -1,0 +1,345 @@
+"""PX4 parameters in and out: a ULog's or a QGroundControl ``.params`` file's, checked against
+PX4's ranges (:mod:`quadcruise.io.px4defaults`), and written back as a ``.params`` file.
+
+A QGroundControl parameter file is text, one parameter a line, tab separated::
+
+    # Vehicle-Id Component-Id Name Value Type
+    1	1	MC_ROLLRATE_P	0.18	9
+
+with ``#`` comments and MAVLink's ``MAV_PARAM_TYPE`` (9 a 32-bit float, 6 a 32-bit integer;
+1-8 the other integer widths). A ULog holds the parameters at the start of the log
+(``initial_parameters``) and the changes made in flight (``changed_parameters``); the values
+read are those at the log's end (each change applied in order).
+
+Only the parameters the PX4 loops use (:data:`~quadcruise.io.px4defaults.PX4_PARAMETERS`) are
+checked; the others are kept by name in :attr:`Px4Parameters.unused`, so that a caller can
+say once which were not used.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import struct
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from quadcruise.errors import InputError
+from quadcruise.io.files import atomic_path
+from quadcruise.io.px4defaults import FLOAT, INT32, PX4_PARAMETERS, RELEASE
+
+__all__ = ["Px4Parameters", "read_params", "parse_params_text", "write_params", "params_text", "changed"]
+
+INTEGER_TYPES = frozenset(range(1, 9))
+"""MAV_PARAM_TYPE of the integers (UINT8 .. INT64); 9 is REAL32, 10 REAL64."""
+
+
+@dataclass(frozen=True)
+class Px4Parameters(Mapping):
+    """PX4 parameters by name, as read from ``source``; a mapping name -> value.
+
+    ``values`` holds every parameter the loops use: the file's where it has them, PX4
+    v1.15's default elsewhere (:attr:`from_file` says which came from the file).
+
+    Parameters
+    ----------
+    values : dict of str to float
+        Each used parameter's value, in PX4's units.
+    source : str
+        Where they were read (a path, or ``"defaults"``).
+    from_file : tuple of str
+        The used parameters the source set.
+    unused : tuple of str
+        The source's parameters the loops do not use, sorted.
+
+    Examples
+    --------
+    >>> p = Px4Parameters.defaults()
+    >>> p["MC_ROLLRATE_P"], p.source
+    (0.15, 'defaults')
+    """
+
+    values: dict
+    source: str = "defaults"
+    from_file: tuple = ()
+    unused: tuple = field(default=())
+
+    @classmethod
+    def defaults(cls) -> Px4Parameters:
+        """PX4 v1.15's defaults of every parameter the loops use."""
+        return cls({k: float(v.default) for k, v in PX4_PARAMETERS.items()})
+
+    def __getitem__(self, name: str) -> float:
+        return self.values[name]
+
+    def __iter__(self):
+        return iter(self.values)
+
+    def __len__(self) -> int:
+        return len(self.values)
+
+    def with_values(self, **values: float) -> Px4Parameters:
+        """A copy with ``values`` set, each checked against PX4's range.
+
+        Parameters
+        ----------
+        **values : float
+            Parameters by PX4's name, in PX4's units.
+
+        Returns
+        -------
+        Px4Parameters
+            The copy (``from_file`` counts the names set here as given).
+
+        Raises
+        ------
+        InputError
+            For a name the loops do not use or a value outside PX4's range.
+        """
+        merged = dict(self.values)
+        for name, value in values.items():
+            merged[name] = _checked(name, value, "argument")
+        return Px4Parameters(merged, self.source, tuple(sorted(set(self.from_file) | set(values))), self.unused)
+
+
+def _checked(name: str, value, where: str) -> float:
+    """``value`` as a float if ``name`` is used and the value lies within PX4's range."""
+    spec = PX4_PARAMETERS.get(name)
+    if spec is None:
+        raise InputError(f"{where}: {name} is not a parameter of the PX4 loops (see docs/px4.md)")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{where}: {name} = {value!r} is not a number") from None
+    if not math.isfinite(number):
+        raise InputError(f"{where}: {name} = {value} is not a finite number")
+    if spec.kind == INT32 and number != round(number):
+        raise InputError(f"{where}: {name} = {number:g} is not an integer (PX4 declares it INT32)")
+    low = -math.inf if spec.minimum is None else spec.minimum
+    high = math.inf if spec.maximum is None else spec.maximum
+    # PX4 stores floats as float32: a bound is met when the float32 values meet it
+    n32, lo32, hi32 = (float(np.float32(v)) for v in (number, low, high))
+    if not lo32 <= n32 <= hi32:
+        lo = "-inf" if spec.minimum is None else f"{spec.minimum:g}"
+        hi = "inf" if spec.maximum is None else f"{spec.maximum:g}"
+        unit = f" {spec.unit}" if spec.unit else ""
+        raise InputError(f"{where}: {name} = {number:g}{unit} is outside PX4 {RELEASE}'s range [{lo}, {hi}]")
+    return number
+
+
+def _collect(raw: dict, where_of, source: str) -> Px4Parameters:
+    values = {k: float(v.default) for k, v in PX4_PARAMETERS.items()}
+    for name, value in raw.items():
+        if name in PX4_PARAMETERS:
+            values[name] = _checked(name, value, where_of(name))
+    used = tuple(sorted(n for n in raw if n in PX4_PARAMETERS))
+    unused = tuple(sorted(n for n in raw if n not in PX4_PARAMETERS))
+    return Px4Parameters(values, source, used, unused)
+
+
+def parse_params_text(text: str, source: str = "<text>") -> Px4Parameters:
+    """Parameters from a QGroundControl ``.params`` file's text.
+
+    Parameters
+    ----------
+    text : str
+        The file's text.
+    source : str
+        Its name, for messages.
+
+    Returns
+    -------
+    Px4Parameters
+
+    Raises
+    ------
+    InputError
+        One line naming the file, the line and the parameter: a line that is not five fields,
+        a type that is not MAV_PARAM_TYPE, a value that is not a number (or not an integer for
+        an integer type), a parameter twice, a used parameter outside PX4's range.
+
+    Examples
+    --------
+    >>> p = parse_params_text("# a comment\\n1\\t1\\tMC_ROLL_P\\t7.5\\t9\\n1\\t1\\tSYS_AUTOSTART\\t4001\\t6\\n")
+    >>> p["MC_ROLL_P"], p.unused
+    (7.5, ('SYS_AUTOSTART',))
+    >>> parse_params_text("1\\t1\\tMC_ROLL_P\\t30\\t9\\n", "my.params")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: my.params, line 1: MC_ROLL_P = 30 1/s is outside PX4 v1.15's range [0, 12]
+    """
+    raw: dict[str, float] = {}
+    lines: dict[str, int] = {}
+    for number, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        fields = stripped.split("\t") if "\t" in stripped else stripped.split()
+        fields = [f.strip() for f in fields]
+        where = f"{source}, line {number}"
+        if len(fields) != 5:
+            raise InputError(
+                f"{where}: not a QGroundControl parameter line (Vehicle-Id Component-Id Name Value Type, "
+                f"tab separated): {stripped[:60]!r}"
+            )
+        _, _, name, value, kind = fields
+        try:
+            kind_number = int(kind)
+        except ValueError:
+            kind_number = -1
+        if kind_number not in INTEGER_TYPES and kind_number not in (9, 10):
+            raise InputError(f"{where}: {name}: type {kind!r} is not a MAV_PARAM_TYPE (9 float, 6 int32, 1-10)")
+        try:
+            parsed = float(value)
+        except ValueError:
+            raise InputError(f"{where}: {name} = {value!r} is not a number") from None
+        if not math.isfinite(parsed):
+            raise InputError(f"{where}: {name} = {value!r} is not a finite number")
+        if kind_number in INTEGER_TYPES and parsed != round(parsed):
+            raise InputError(f"{where}: {name} = {value!r} is not an integer (type {kind_number})")
+        if name in raw:
+            raise InputError(f"{where}: {name} is set twice (first on line {lines[name]})")
+        raw[name], lines[name] = parsed, number
+    if not raw:
+        raise InputError(f"{source}: no parameters: not a QGroundControl .params file")
+    return _collect(raw, lambda n: f"{source}, line {lines[n]}", source)
+
+
+def _read_ulog_params(path: Path) -> Px4Parameters:
+    from pyulog import ULog
+    from pyulog.core import ULogException
+
+    from quadcruise.io.logchecks import check_ulog_framing
+
+    check_ulog_framing(path)
+    try:
+        log = ULog(str(path), message_name_filter_list=[])
+    except (ULogException, struct.error, ValueError, IndexError) as exc:
+        raise InputError(f"{path}: not a readable PX4 log ({exc})") from None
+    raw = dict(log.initial_parameters)
+    for _, name, value in log.changed_parameters:
+        raw[name] = value
+    if not raw:
+        raise InputError(f"{path}: the log holds no parameters")
+    return _collect(raw, lambda n: f"{path}", str(path))
+
+
+def read_params(path: str | os.PathLike) -> Px4Parameters:
+    """PX4 parameters from a ULog (``.ulg``) or a QGroundControl file (``.params``, ``.txt``).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    Px4Parameters
+        Every parameter the loops use (the file's, else PX4 v1.15's default); the file's
+        others in ``unused``.
+
+    Raises
+    ------
+    InputError
+        One line naming the file (and line and parameter): a missing file, another format, an
+        unreadable log, a bad line, a value out of PX4's range.
+
+    Examples
+    --------
+    >>> read_params("gains.yaml")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: gains.yaml: PX4 parameters come from a PX4 log (.ulg) or a QGroundControl ...
+    """
+    path = Path(path)
+    kind = path.suffix.lower()
+    if kind not in (".ulg", ".params", ".txt"):
+        raise InputError(
+            f"{path}: PX4 parameters come from a PX4 log (.ulg) or a QGroundControl file (.params), got {path.suffix!r}"
+        )
+    if not path.is_file():
+        raise InputError(f"{path}: no such file")
+    if kind == ".ulg":
+        return _read_ulog_params(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise InputError(f"{path}: not a text file: not a QGroundControl .params file") from None
+    return parse_params_text(text, str(path))
+
+
+def changed(values: Mapping[str, float]) -> dict[str, float]:
+    """The used parameters of ``values`` whose float32 value differs from PX4 v1.15's default.
+
+    Examples
+    --------
+    >>> changed({"MC_ROLL_P": 6.5, "MC_PITCH_P": 7.0})
+    {'MC_PITCH_P': 7.0}
+    """
+    out = {}
+    for name, value in values.items():
+        spec = PX4_PARAMETERS.get(name)
+        if spec is not None and np.float32(value) != np.float32(spec.default):
+            out[name] = float(value)
+    return out
+
+
+def params_text(values: Mapping[str, float], vehicle_id: int = 1, component_id: int = 1, note: str = "") -> str:
+    """A QGroundControl ``.params`` file's text: the parameters that differ from the defaults.
+
+    Floats are written as Python's shortest repr (read back to the same float64), integers
+    as integers; the header names the PX4 release whose defaults were left out.
+
+    Parameters
+    ----------
+    values : Mapping of str to float
+        Parameters by name (each checked against PX4's range).
+    vehicle_id, component_id : int
+        MAVLink ids (QGroundControl's first two columns).
+    note : str
+        One more comment line (e.g. the command that made it).
+
+    Returns
+    -------
+    str
+        The file's text, ending in a newline.
+
+    Examples
+    --------
+    >>> print(params_text({"MC_ROLL_P": 7.25, "MC_PITCH_P": 6.5, "MPC_USE_HTE": 0}).splitlines()[-2:])
+    ['1\\t1\\tMC_ROLL_P\\t7.25\\t9', '1\\t1\\tMPC_USE_HTE\\t0\\t6']
+    """
+    diff = changed({k: _checked(k, v, "parameters") for k, v in values.items()})
+    lines = [
+        "# Onboard parameters for Vehicle 1, written by quadcruise",
+        f"# PX4 {RELEASE}: only the parameters that differ from its defaults",
+    ]
+    if note:
+        lines.append(f"# {note}")
+    lines += ["#", "# Vehicle-Id\tComponent-Id\tName\tValue\tType"]
+    for name in sorted(diff):
+        spec = PX4_PARAMETERS[name]
+        value = diff[name]
+        text = str(int(round(value))) if spec.kind == INT32 else repr(float(value))
+        lines.append(f"{vehicle_id}\t{component_id}\t{name}\t{text}\t{INT32 if spec.kind == INT32 else FLOAT}")
+    return "\n".join(lines) + "\n"
+
+
+def write_params(path: str | os.PathLike, values: Mapping[str, float], note: str = "") -> Path:
+    """Write ``values`` as a QGroundControl ``.params`` file (:func:`params_text`), atomically.
+
+    Raises
+    ------
+    InputError
+        For a value outside PX4's range (nothing is written).
+    WriteError
+        If the file could not be written.
+    """
+    text = params_text(values, note=note)
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return path

@@ -1,0 +1,126 @@
+"""PX4 parameters in and out (:mod:`quadcruise.io.px4params`): a ULog's read as pyulog reads
+them, PX4 v1.15's defaults checked against the defaults a v1.15 SITL log itself records, a
+QGroundControl file read, written and read back exactly, and every bad file refused in one
+line naming the file and the parameter."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from pyulog import ULog
+
+from quadcruise.errors import InputError
+from quadcruise.io.px4defaults import PX4_PARAMETERS, RELEASE
+from quadcruise.io.px4params import Px4Parameters, changed, parse_params_text, read_params, write_params
+
+LOG = Path(__file__).parents[1] / "data" / "px4" / "sample_px4_events.ulg"
+
+
+@pytest.fixture(scope="module")
+def ulog():
+    return ULog(str(LOG), message_name_filter_list=[])
+
+
+def test_a_ulogs_parameters_are_pyulogs(ulog):
+    p = read_params(LOG)
+    raw = ulog.initial_parameters
+    assert set(p.from_file) == set(PX4_PARAMETERS)  # the log has every one
+    for name in PX4_PARAMETERS:
+        assert p[name] == raw[name]
+    assert p["MC_ROLLRATE_K"] == pytest.approx(1.05)  # the SITL airframe's own
+    assert set(p.unused) == set(raw) - set(PX4_PARAMETERS) and list(p.unused) == sorted(p.unused)
+    assert p.source == str(LOG)
+
+
+def test_the_defaults_are_those_the_v115_log_records(ulog):
+    """The log (PX4 1.15.0 dev) records PX4's system default of each parameter whose value
+    differs from it; the others hold their default. Our table must agree with both."""
+    assert ulog.msg_info_dict["ver_sw_release"] >> 16 == 0x010F  # v1.15
+    system = ulog.get_default_parameters(0)
+    for name, spec in PX4_PARAMETERS.items():
+        expected = system.get(name, ulog.initial_parameters[name])
+        assert np.float32(spec.default) == np.float32(expected), name
+    assert "MC_ROLLRATE_K" in system  # one that the airframe changed
+
+
+def test_a_params_file_round_trips_exactly(tmp_path):
+    values = dict(Px4Parameters.defaults())
+    values.update(MC_ROLLRATE_P=0.1873456789012345, MPC_XY_VEL_P_ACC=2.25, MPC_USE_HTE=0, MC_YAW_P=2.8)
+    path = write_params(tmp_path / "tuned.params", values, note="made by a test")
+    text = path.read_text()
+    assert f"PX4 {RELEASE}" in text and "# made by a test" in text
+    rows = [line.split("\t") for line in text.splitlines() if not line.startswith("#")]
+    assert [r[2] for r in rows] == ["MC_ROLLRATE_P", "MPC_USE_HTE", "MPC_XY_VEL_P_ACC"]  # only what changed
+    assert [r[4] for r in rows] == ["9", "6", "9"] and all(r[:2] == ["1", "1"] for r in rows)
+    back = read_params(path)
+    assert dict(back) == values  # exact, float for float
+    assert back.unused == () and set(back.from_file) == {"MC_ROLLRATE_P", "MPC_USE_HTE", "MPC_XY_VEL_P_ACC"}
+
+
+def test_a_qgroundcontrol_file_is_read(tmp_path):
+    text = (
+        "# Onboard parameters for Vehicle 1\n#\n# Stack: PX4 Pro\n# Vehicle-Id Component-Id Name Value Type\n"
+        "1\t1\tMC_PITCHRATE_P\t0.180000007152557373\t9\n"
+        "1\t1\tSYS_AUTOSTART\t4001\t6\n"
+        "1\t1\tMPC_TILTMAX_AIR\t35\t9\n"
+        "1\t1\tBAT1_N_CELLS\t4\t6\n"
+    )
+    (tmp_path / "x500.params").write_text(text)
+    p = read_params(tmp_path / "x500.params")
+    assert p["MC_PITCHRATE_P"] == pytest.approx(0.18) and p["MPC_TILTMAX_AIR"] == 35.0
+    assert p["MC_ROLL_P"] == 6.5  # the default where the file is silent
+    assert p.unused == ("BAT1_N_CELLS", "SYS_AUTOSTART")
+    assert changed(p) == {"MC_PITCHRATE_P": p["MC_PITCHRATE_P"], "MPC_TILTMAX_AIR": 35.0}
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("1\t1\tMC_ROLL_P\t13\t9\n", "f.params, line 1: MC_ROLL_P = 13 1/s is outside PX4 v1.15's range [0, 12]"),
+        ("1\t1\tMPC_THR_MIN\t0.01\t9\n", "f.params, line 1: MPC_THR_MIN = 0.01 norm is outside PX4 v1.15's range"),
+        ("# c\n1\t1\tMC_ROLL_P\tfast\t9\n", "f.params, line 2: MC_ROLL_P = 'fast' is not a number"),
+        ("1\t1\tMC_ROLL_P\tnan\t9\n", "f.params, line 1: MC_ROLL_P = 'nan' is not a finite number"),
+        ("1\t1\tMC_ROLL_P\t6\n", "f.params, line 1: not a QGroundControl parameter line"),
+        ("1\t1\tMC_ROLL_P\t6\t12\n", "f.params, line 1: MC_ROLL_P: type '12' is not a MAV_PARAM_TYPE"),
+        ("1\t1\tMPC_USE_HTE\t0.5\t6\n", "f.params, line 1: MPC_USE_HTE = '0.5' is not an integer"),
+        ("1\t1\tMC_ROLL_P\t6\t9\n1\t1\tMC_ROLL_P\t7\t9\n", "f.params, line 2: MC_ROLL_P is set twice"),
+        ("# only comments\n", "f.params: no parameters"),
+    ],
+    ids=["high", "low", "word", "nan", "fields", "type", "fraction", "twice", "empty"],
+)
+def test_bad_params_files_are_refused_in_one_line(tmp_path, text, message):
+    (tmp_path / "f.params").write_text(text)
+    with pytest.raises(InputError) as caught:
+        read_params(tmp_path / "f.params")
+    said = str(caught.value)
+    assert said.startswith(str(tmp_path / "f.params")) and message.split("f.params")[1] in said
+    assert "\n" not in said
+
+
+def test_a_value_below_a_floor_without_ceiling_is_refused():
+    with pytest.raises(InputError, match=r"MC_RR_INT_LIM = -0.1 is outside PX4 v1.15's range \[0, inf\]"):
+        parse_params_text("1\t1\tMC_RR_INT_LIM\t-0.1\t9\n", "g.params")
+    assert parse_params_text("1\t1\tMC_RR_INT_LIM\t2.5\t9\n")["MC_RR_INT_LIM"] == 2.5  # no ceiling
+
+
+def test_other_formats_and_files_are_refused(tmp_path):
+    with pytest.raises(InputError, match=r"gains.yaml: PX4 parameters come from a PX4 log \(.ulg\)"):
+        read_params(tmp_path / "gains.yaml")
+    with pytest.raises(InputError, match="missing.params: no such file"):
+        read_params(tmp_path / "missing.params")
+    (tmp_path / "fake.ulg").write_bytes(b"not a log at all, just text")
+    with pytest.raises(InputError, match="fake.ulg: not a PX4 log"):
+        read_params(tmp_path / "fake.ulg")
+    (tmp_path / "binary.params").write_bytes(b"\xff\xfe\x00\x01")
+    with pytest.raises(InputError, match="binary.params: not a text file"):
+        read_params(tmp_path / "binary.params")
+
+
+def test_writing_refuses_a_value_out_of_range_and_writes_nothing(tmp_path):
+    with pytest.raises(InputError, match="MPC_THR_HOVER = 0.95 norm is outside"):
+        write_params(tmp_path / "t.params", {"MPC_THR_HOVER": 0.95})
+    assert not (tmp_path / "t.params").exists()
+    with pytest.raises(InputError, match="NOT_A_PARAM is not a parameter of the PX4 loops"):
+        Px4Parameters.defaults().with_values(NOT_A_PARAM=1.0)
