@@ -12,11 +12,37 @@ compiling before it does (:mod:`quadcruise.cli.feedback`), and ``quadcruise --he
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING
+import os as _os
+import sys as _sys
 
-from quadcruise._cache import drop_stale_cache as _drop_stale_cache
-from quadcruise._version import __version__
+
+def _quit_on_interrupt(signum, frame):  # pragma: no cover - runs in a command's first instants
+    _sys.stderr.write("error: interrupted\n")
+    _sys.stderr.flush()
+    _os._exit(130)  # 128 + SIGINT, as a command's own Ctrl-C (quadcruise.cli.faults)
+
+
+def _command_starting() -> bool:
+    """Whether this process is the ``quadcruise`` command: its script, or ``python -m quadcruise``."""
+    main = getattr(_sys.modules.get("__main__"), "__file__", None) or ""
+    if _os.path.basename(main).lower() in ("quadcruise", "quadcruise-script.py"):
+        return True
+    argv = list(getattr(_sys, "orig_argv", ()))
+    return "-m" in argv and argv[argv.index("-m") + 1 : argv.index("-m") + 2] == ["quadcruise"]
+
+
+if _command_starting():
+    # Ctrl-C while the command loads (numba, pandas, matplotlib: a few tenths of a second) is one
+    # line and status 130, not a traceback of imports; cli.main.run puts Python's handler back
+    import signal as _signal
+
+    _signal.signal(_signal.SIGINT, _quit_on_interrupt)
+
+import importlib  # noqa: E402 - after Ctrl-C is answered
+from typing import TYPE_CHECKING  # noqa: E402
+
+from quadcruise._cache import drop_stale_cache as _drop_stale_cache  # noqa: E402
+from quadcruise._version import __version__  # noqa: E402
 
 _drop_stale_cache()  # before anything compiles: see quadcruise._cache
 

@@ -72,6 +72,13 @@ class FlightWarning(UserWarning):
     clipped. Workflows that fly several (compare, reproduce) say whose flight it was."""
 
 
+def _plain(value):
+    """A numpy scalar as the Python number it holds, so that a message shows ``inf``, not
+    ``np.float64(inf)`` (numpy 2's repr); anything else as it is."""
+    item = getattr(value, "item", None)
+    return item() if callable(item) and getattr(value, "shape", None) == () else value
+
+
 def whole_number(value, what: str, minimum: int = 0) -> int:
     """``value`` as an int if it is a whole number >= ``minimum`` (not a bool, not a float).
 
@@ -109,7 +116,7 @@ def whole_number(value, what: str, minimum: int = 0) -> int:
     wrong_type = isinstance(value, bool) or not isinstance(value, numbers.Integral)
     if wrong_type or value < minimum:
         raise (ArgumentTypeError if wrong_type else InputError)(
-            f"{what} must be a whole number >= {minimum}, got {value!r}"
+            f"{what} must be a whole number >= {minimum}, got {_plain(value)!r}"
         )
     return int(value)
 

@@ -229,10 +229,30 @@ def test_bode_draws_closed_loops_and_loop_transfers(lin):
     assert len(fig.axes[0].lines) == 4 + 1  # four loops and the 0 dB line
 
 
+@pytest.mark.parametrize("loops", [True, False])
+def test_bode_legends_cover_no_axis(lin, loops):
+    """The legends sit under the axes, clear of every panel with its ticks and labels (the loop
+    transfers' legend, inside its magnitude panel, covered its axis and curves), and inside the figure."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    fig = lin.plot(loops=loops)
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    fig.draw(renderer)
+    assert len(fig.legends) == (2 if loops else 1) and all(ax.get_legend() is None for ax in fig.axes)
+    panels = [ax.get_tightbbox(renderer) for ax in fig.axes]
+    for legend in fig.legends:
+        box = legend.get_window_extent(renderer)
+        assert fig.bbox.x0 <= box.x0 and box.x1 <= fig.bbox.x1 and fig.bbox.y0 <= box.y0, box
+        assert not any(box.overlaps(panel) for panel in panels), box
+    if loops:
+        left, right = (legend.get_window_extent(renderer) for legend in fig.legends)
+        assert not left.overlaps(right)
+
+
 def test_bode_marks_each_loops_margins_at_its_crossovers(lin):
     fig = lin.plot()
     mag_l, phase_l = fig.axes[1], fig.axes[3]
-    texts = [t.get_text() for t in mag_l.get_legend().get_texts()]
+    texts = [t.get_text() for t in fig.legends[-1].get_texts()]  # the loop transfers' legend, under them
     assert texts[0] == (
         "L x: PM 18.1° @ 10.8 rad/s (< 30°), GM down -3.98 dB @ 7.07 rad/s (> -6 dB), up +38.2 dB @ 134 rad/s"
     )

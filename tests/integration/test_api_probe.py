@@ -196,7 +196,79 @@ CASES = {
     "Requirement value nan": (lambda: Requirement("rmse_m", "<", math.nan), BAD, ["Requirement()", "value"]),
     "Bounds reversed": (lambda: Bounds("position.kp", 2, 1), BAD, ["Bounds()", "high", "low = 2"]),
     "Bounds str": (lambda: Bounds("position.kp", "1", 2), WRONG, ["Bounds()", "low", "str '1'"]),
+    # issue 33: identify, replay_rotors, read_speed_csv, Vehicle.load; each checked before the file is read
+    "identify int": (lambda: qc.identify(123), WRONG, ["identify()", "argument log", "int 123"]),
+    "identify progress": (lambda: qc.identify("no_such.ulg", progress=5), WRONG, ["progress", "callable", "int 5"]),
+    "identify frame": (lambda: qc.identify("no_such.ulg", frame=1), WRONG, ["identify()", "frame", "int 1"]),
+    "identify commands": (lambda: qc.identify("no_such.ulg", commands=None), WRONG, ["commands", "None"]),
+    "identify holdout float64": (lambda: qc.identify("x.ulg", holdout=np.float64(2.0)), BAD, ["holdout", "2.0"]),
+    "replay_rotors int": (lambda: qc.replay_rotors(3, crazyflie()), WRONG, ["replay_rotors()", "SpeedSchedule"]),
+    "replay_rotors no such file": (lambda: qc.replay_rotors("x.csv", crazyflie()), BAD, ["x.csv: no such file"]),
+    "replay_rotors wind": (
+        lambda: qc.replay_rotors(speeds(), crazyflie(), wind="north"),
+        WRONG,
+        ["replay_rotors()", "wind", "str 'north'"],
+    ),
+    "replay_rotors wind short": (lambda: qc.replay_rotors(speeds(), crazyflie(), wind=[1, 2]), BAD, ["wind", "3"]),
+    "replay_rotors max_step": (
+        lambda: qc.replay_rotors(speeds(), crazyflie(), max_step="small"),
+        WRONG,
+        ["replay_rotors()", "max_step", "str 'small'"],
+    ),
+    "replay_rotors ground": (lambda: qc.replay_rotors(speeds(), crazyflie(), ground="no"), WRONG, ["ground"]),
+    "replay_rotors progress": (lambda: qc.replay_rotors(speeds(), crazyflie(), progress=1), WRONG, ["progress"]),
+    "read_speed_csv n str": (
+        lambda: qc.read_speed_csv(SPEEDS, "4"),
+        WRONG,
+        ["read_speed_csv()", "n_rotors", "str '4'"],
+    ),
+    "read_speed_csv n 0": (lambda: qc.read_speed_csv(SPEEDS, 0), BAD, ["n_rotors", ">= 1"]),
+    "read_speed_csv path": (lambda: qc.read_speed_csv(7, 4), WRONG, ["read_speed_csv()", "path", "int 7"]),
+    "read_duty_csv path": (lambda: qc.read_duty_csv(7), WRONG, ["read_duty_csv()", "path", "int 7"]),
+    "Vehicle.load int": (lambda: qc.Vehicle.load(123), WRONG, ["Vehicle.load()", "name_or_path", "int 123"]),
+    "Vehicle.load list": (lambda: qc.Vehicle.load(["iris"]), WRONG, ["Vehicle.load()", "list ['iris']"]),
+    "Vehicle.load unknown": (lambda: qc.Vehicle.load("irys"), BAD, ["unknown vehicle preset 'irys'", "'iris'"]),
+    # the gym: gymnasium.make and make_vec hand their keywords to the environment; reset takes a seed
+    "make limits": (lambda: gym_make(limits=5), WRONG, ["make()", "limits", "Limits", "int 5"]),
+    "make action list": (lambda: gym_make(action=["rotors"]), WRONG, ["make()", "action", "list ['rotors']"]),
+    "make scales text": (lambda: gym_make(scales="fast"), WRONG, ["make()", "scales", "str 'fast'"]),
+    "make max_step text": (lambda: gym_make(max_step="small"), WRONG, ["make()", "max_step", "str 'small'"]),
+    "make dt text": (lambda: gym_make(dt="0.01"), WRONG, ["make()", "dt", "str '0.01'"]),
+    "make dt 0": (lambda: gym_make(dt=0.0), BAD, ["make()", "dt", "positive"]),
+    "make duration text": (lambda: gym_make(duration="5"), WRONG, ["make()", "duration"]),
+    "make_vec dt text": (lambda: gym_make_vec(dt="0.01"), WRONG, ["make()", "dt", "str '0.01'"]),
+    "make_vec reset seed 1.5": (lambda: gym_make_vec().reset(seed=1.5), WRONG, ["reset()", "seed", "float 1.5"]),
+    "make_vec reset seed text": (lambda: gym_make_vec().reset(seed="abc"), WRONG, ["reset()", "seed", "str 'abc'"]),
+    "make_vec reset seed -1": (lambda: gym_make_vec().reset(seed=-1), BAD, ["reset()", "seed", ">= 0"]),
+    "make reset seed 1.5": (lambda: gym_make().reset(seed=1.5), WRONG, ["reset()", "seed", "float 1.5"]),
 }
+
+SPEEDS = "no_such_speeds.csv"  # the arguments are refused before the file is looked for
+
+
+def crazyflie():
+    return qc.Vehicle.load("crazyflie")
+
+
+def speeds():
+    """A two-row schedule of hover speeds for the Crazyflie (what the arguments after it need)."""
+    from quadcruise.workflows.replay import SpeedSchedule
+
+    return SpeedSchedule(t=np.array([0.0, 0.1]), speeds=np.full((2, 4), 2000.0), source="two rows")
+
+
+def gym_make(**kw):
+    gymnasium = pytest.importorskip("gymnasium")
+    import quadcruise.gym  # noqa: F401 (registers the environments)
+
+    return gymnasium.make("quadcruise/Hover-v0", **kw)
+
+
+def gym_make_vec(**kw):
+    gymnasium = pytest.importorskip("gymnasium")
+    import quadcruise.gym  # noqa: F401
+
+    return gymnasium.make_vec("quadcruise/Hover-v0", num_envs=2, vectorization_mode="vector_entry_point", **kw)
 
 
 @pytest.mark.parametrize("name", sorted(CASES))
@@ -209,6 +281,7 @@ def test_a_bad_argument_is_one_line_naming_it(name):
     assert isinstance(caught.value, InputError), type(caught.value)  # the CLI's exit 2
     assert (error is WRONG) == isinstance(caught.value, TypeError), type(caught.value)
     assert "\n" not in message and len(message) < 400, message
+    assert "np." not in message and "was raised from the environment creator" not in message, message
     for word in words:
         assert word in message, (word, message)
     assert time.perf_counter() - start < 30.0  # before any work
@@ -333,3 +406,64 @@ def test_scenario_and_number_messages_are_one_short_line_naming_where(tmp_path, 
     if args[1].startswith("{"):
         assert f"{args[1][1:-1]}.toml" in lines[0]  # the file is named
     assert not proc.stdout.strip() and sorted(p.name for p in tmp_path.iterdir()) == sorted(f"{k}.toml" for k in files)
+
+
+def test_what_must_pass_passes_through_the_issue_33_entries(tmp_path):
+    """identify, replay_rotors, read_speed_csv, Vehicle.load and the gym take what they document:
+    a path or a schedule, numpy numbers, a seed of any integer type."""
+    path = tmp_path / "speeds.csv"
+    path.write_text("t,w1,w2,w3,w4\n0,2000,2000,2000,2000\n0.05,2100,2100,2100,2100\n")
+    cf = crazyflie()
+    by_path = qc.replay_rotors(str(path), cf, wind=np.array([1.0, 0.0, 0.0]), max_step=np.float64(5e-4))
+    by_schedule = qc.replay_rotors(qc.read_speed_csv(path, np.int64(4)), cf, wind=(1, 0, 0), max_step=5e-4)
+    np.testing.assert_array_equal(by_path.states, by_schedule.states)
+    gymnasium = pytest.importorskip("gymnasium")
+    import quadcruise.gym  # noqa: F401
+
+    env = gymnasium.make("quadcruise/Hover-v0", dt=np.float64(0.01), max_step=0.005, scales={"max_tilt": 0.4})
+    obs_np, _ = env.reset(seed=np.int64(7))
+    obs_int, _ = env.reset(seed=7)
+    np.testing.assert_array_equal(obs_np, obs_int)
+    assert not np.array_equal(env.reset(seed=8)[0], obs_int)  # the seed is used
+    vec = gym_make_vec()
+    first, _ = vec.reset(seed=np.uint8(3))
+    np.testing.assert_array_equal(first, vec.reset(seed=3)[0])
+
+
+@pytest.mark.parametrize(
+    "change, words",
+    [
+        ('plant = ["rotor"]', "'plant' must be the name of a plant (paper or rotor), got list ['rotor']"),
+        ("w_max = 1e200", "vehicle field 'w_max' (1e+200 rad/s) is out of range"),
+    ],
+)
+def test_a_vehicle_file_with_a_wrong_plant_or_an_overflowing_speed_is_one_line(tmp_path, change, words):
+    """Vehicle.load, fly --vehicle and identify --vehicle: one line naming the file and the key
+    (they raised TypeError: unhashable type, and OverflowError)."""
+    from quadcruise.model.vehicle_files import preset_path
+
+    text = preset_path("iris").read_text()
+    key = change.split(" = ")[0]
+    bad = "\n".join(change if line.startswith(f"{key} = ") else line for line in text.splitlines())
+    assert bad != text
+    (tmp_path / "v.toml").write_text(bad)
+    (tmp_path / "log.ulg").write_bytes(b"")  # the vehicle is refused before the log is read
+    with pytest.raises(InputError) as caught:
+        qc.Vehicle.load(tmp_path / "v.toml")
+    assert words in str(caught.value) and str(tmp_path / "v.toml") in str(caught.value)
+    for args in (["fly", "hover", "--duration", "0.1"], ["identify", "log.ulg", "--out", "id"]):
+        proc = quadcruise_cli(*args, "--vehicle", "v.toml", cwd=tmp_path)
+        assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
+        assert proc.stderr.count("\n") == 1 and words in proc.stderr
+    assert qc.Vehicle.load(preset_path("iris")).w_max == 1100.0  # the file as shipped still loads
+
+
+def test_a_non_finite_cell_is_named_without_a_numpy_repr(tmp_path):
+    (tmp_path / "duties.csv").write_text("t,u1,u2,u3,u4\n0,0.5,0.5,0.5,0.5\n1,inf,0.5,0.5,0.5\n")
+    (tmp_path / "speeds.csv").write_text("t,w1,w2,w3,w4\n0,2000,2000,2000,2000\ninf,2000,2000,2000,2000\n")
+    with pytest.raises(InputError) as duty:
+        qc.read_duty_csv(tmp_path / "duties.csv")
+    with pytest.raises(InputError) as speed:
+        qc.read_speed_csv(tmp_path / "speeds.csv", 4)
+    assert str(duty.value).endswith("line 3, column 'u1': duty is not finite (inf)"), duty.value
+    assert str(speed.value).endswith("line 3, column 't': time is not finite (inf)"), speed.value

@@ -166,8 +166,8 @@ def test_an_explicit_log_every_is_kept_and_one_too_large_is_refused(monkeypatch)
         qc.fly("hover", n=20_000, duration=60.0, log_every=1)  # 374 GB: refused before flying
 
 
-def test_a_batch_whose_checks_would_not_fit_is_refused_before_flying():
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", LogWarning)  # refused before it says what it would log
-        with pytest.raises(qc.InputError, match="track checks at every period would keep 75.4 GiB"):
-            qc.fly("circle", n=200_000, duration=90.0)  # (refused on a machine of less than 150 GiB)
+def test_the_checks_keep_a_fixed_size_per_vehicle_whatever_the_flight_length():
+    # (issue 31: a 200,000-vehicle 90 s circle was refused for 75 GiB of per-period checks)
+    fly_inputs.check_run_size(200_000, 90_000, batch_log_every(200_000, 90_000), 1, watched=True)
+    with pytest.raises(qc.InputError, match="log_every=.*: in Python"):  # the log itself is still sized
+        fly_inputs.check_run_size(200_000, 90_000, 1, 1, watched=True)

@@ -363,3 +363,39 @@ def test_compare_on_the_same_population():
     assert "nlpd" in table and "gonzalez" in table and "failure_rate" in table
     # the list is read the same way for both tables: a space after the comma is fine
     assert table.count("nlpd") == 1 and table.count("gonzalez") == 1
+
+
+def test_a_failed_flights_table_stays_narrow_and_its_reason_is_said_in_full():
+    """The status cell holds the kind and the time; the reason (130 characters) is the line
+    under the table: it padded every row of the table to about 150 columns."""
+    res = run("fly", "circle", "--vehicle", "m=4.549", "--controller-vehicle", "paper")
+    assert res.exit_code == 1, res.output
+    lines = res.output.splitlines()
+    status = next(line for line in lines if line.startswith("status"))
+    reason = next(line for line in lines if line.startswith("vehicle 0 did not fly its mission: "))
+    kind, why = reason.removeprefix("vehicle 0 did not fly its mission: ").split(": ", 1)
+    when = why[why.rindex(" at t = ") :]
+    assert len(why) > 80 and " ".join(status.split()[1:]) == f"{kind}{when}", (status, reason)
+    table = lines[1 : lines.index(next(line for line in lines if line.startswith("controller_limited_s"))) + 1]
+    assert max(map(len, table)) < 60, table
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["fly", "hover", "--duration", "0.2", "--out", "F.html", "--report", "F.html"],
+        ["fly", "hover", "--duration", "0.2", "--out", "F.ulg", "--ulog", "./F.ulg"],
+        ["fly", "hover", "--duration", "0.2", "--report", "r.html", "--animate", "r.html"],
+        ["compare", "hover", "--controllers", "nlpd,se3", "--out", "F.html", "--report", "F.html"],
+        ["reproduce", "--out", "F.htm", "--report", "F.htm"],
+        ["identify", "log.ulg", "--out", "F.html", "--report", "F.html"],
+    ],
+)
+def test_a_file_option_naming_the_out_folder_or_another_file_is_refused_before_any_work(tmp_path, args):
+    """The folder and the file would be written one over the other after the work (a report
+    written where --out put its folder failed, exit 74, after flying)."""
+    proc = run_entry(*args, cwd=tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    (line,) = proc.stderr.splitlines()
+    assert line.startswith("error: --") and "name the same path: give each its own" in line, line
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # nothing flown, nothing written

@@ -457,6 +457,7 @@ CHUNKS = {
     "without a column": (lambda p: rewritten(p, rmse_m=None), "it lacks rmse_m"),
     "with a wrong count": (lambda p: rewritten(p, count=np.int64(12)), "columns do not hold one value per flight"),
     "of another sweep": (lambda p: rewritten(p, hash=np.str_("0123456789abcdef")), "belongs to another sweep"),
+    "a FIFO": (lambda p: (p.unlink(), os.mkfifo(p)), "a FIFO, not a regular file"),  # it hung the resume
 }
 
 
@@ -478,3 +479,153 @@ def test_a_damaged_chunk_is_flown_again_with_a_warning_and_no_file_left_open(ref
     assert res.info["flown"] == 10 and res.info["resumed"] == 30
     pd.testing.assert_frame_equal(res.table, ref.table, check_exact=True)
     same_sweep(out, ref_out)
+
+
+# --- issue 33: markers that are no small file, temporaries an interrupt could leave, Ctrl-C at start
+@pytest.mark.parametrize(
+    "make, why",
+    [
+        (lambda p: os.mkfifo(p), "a FIFO, not a regular file"),  # open() would wait for a writer: every command hung
+        (lambda p: p.write_text("[" * 100_000 + "]" * 100_000), "not JSON: nested too deeply"),  # a RecursionError
+        (lambda p: p.mkdir(), "a folder, not a regular file"),
+    ],
+    ids=["fifo", "nested", "folder"],
+)
+def test_a_marker_that_is_no_small_json_file_is_one_line_exit_2(tmp_path, make, why):
+    (tmp_path / "out").mkdir()
+    make(tmp_path / "out" / MARKER)
+    runner = CliRunner()
+    res = runner.invoke(main, ["fly", "hover", "--duration", "0.2", "--out", str(tmp_path / "out")])
+    assert res.exit_code == 2 and res.exception is None or isinstance(res.exception, SystemExit), res.output
+    assert f"error: {tmp_path / 'out' / MARKER}: damaged ({why})" in res.output
+    with pytest.raises(InputError, match="damaged"):
+        quadcruise.io.read_marker(tmp_path / "out")
+    forced = runner.invoke(main, ["fly", "hover", "--duration", "0.2", "--out", str(tmp_path / "out"), "--force"])
+    assert forced.exit_code == 0, forced.output  # the way out the message gives
+    assert json.loads((tmp_path / "out" / MARKER).read_text())["workflow"] == "fly"
+
+
+def test_a_marker_too_large_is_refused_unread(tmp_path, monkeypatch):
+    import quadcruise.io.files as files
+
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / MARKER).write_text(json.dumps({"workflow": "fly", "pad": "x" * 200}))
+    assert quadcruise.io.read_marker(tmp_path / "out")["workflow"] == "fly"  # a marker within the limit is read
+    monkeypatch.setattr(files, "MARKER_LIMIT", 100)
+    with pytest.raises(InputError, match=r"damaged \(\d+ bytes, more than a marker's 100\)"):
+        quadcruise.io.read_marker(tmp_path / "out")
+
+
+def test_an_interrupt_as_a_temporary_is_made_leaves_none(tmp_path, monkeypatch):
+    """Ctrl-C right after the temporary is made, before its name is returned (mkstemp's and
+    mkdtemp's window), leaves nothing beside the path."""
+    real_mkdir, real_open = os.mkdir, os.open
+
+    def mkdir_then_interrupt(path, *args, **kw):
+        real_mkdir(path, *args, **kw)
+        if str(path).endswith(".tmp"):
+            raise KeyboardInterrupt
+
+    def open_then_interrupt(path, flags, *args, **kw):
+        fd = real_open(path, flags, *args, **kw)
+        if str(path).endswith(".tmp"):
+            os.close(fd)
+            raise KeyboardInterrupt
+        return fd
+
+    monkeypatch.setattr(os, "mkdir", mkdir_then_interrupt)
+    with pytest.raises(KeyboardInterrupt), atomic_dir(tmp_path / "int"):
+        pass
+    monkeypatch.setattr(os, "open", open_then_interrupt)
+    with pytest.raises(KeyboardInterrupt), atomic_path(tmp_path / "r.html"):
+        pass
+    assert files_under(tmp_path) == []
+
+
+def test_an_interrupt_between_the_two_moves_of_a_folder_replaced_waits_for_the_second(tmp_path, monkeypatch):
+    folder = tmp_path / "out"
+    folder.mkdir()
+    (folder / "old.txt").write_text("old")
+    real = os.replace
+
+    def signal_on_first(src, dst):
+        if Path(dst).name == ".out.old":
+            os.kill(os.getpid(), signal.SIGINT)  # Ctrl-C, between moving the old folder aside and the new one in
+        return real(src, dst)
+
+    monkeypatch.setattr(os, "replace", signal_on_first)
+    with pytest.raises(KeyboardInterrupt), atomic_dir(folder) as tmp:
+        (tmp / "new.txt").write_text("new")
+    assert files_under(tmp_path) == ["out", "out/new.txt"]  # the new folder whole, the old one removed
+
+
+@pytest.mark.parametrize("command", ["fly", "compare"])
+def test_a_log_named_inside_the_out_folder_is_kept(tmp_path, command):
+    """The --out folder is written first and the log into it after: it was replaced after the
+    log (fly: 'wrote PX4 log', exit 0, no file; compare: its own folder refused after flying)."""
+    from pyulog import ULog
+
+    out = tmp_path / "F"
+    args = ["fly", "hover"] if command == "fly" else ["compare", "hover", "--controllers", "nlpd,se3"]
+    for _ in range(2):  # and again: the folder, now quadcruise's, is replaced with its logs
+        res = CliRunner().invoke(main, [*args, "--duration", "0.3", "--out", str(out), "--ulog", str(out / "f.ulg")])
+        assert res.exit_code == 0, res.output
+        logs = sorted(out.glob("*.ulg"))
+        names = ["f.ulg"] if command == "fly" else ["f-nlpd.ulg", "f-se3.ulg"]
+        assert [p.name for p in logs] == names and (out / MARKER).is_file()
+        assert all("wrote PX4 log" in res.output and str(p) in res.output for p in logs)
+        for p in logs:
+            assert ULog(str(p)).data_list  # what pyulog reads back
+        assert "f.ulg" in (out / "scenario.toml").read_text() or command == "compare"
+
+
+@pytest.mark.parametrize("delay", [0.1, 0.3])
+def test_ctrl_c_while_the_command_loads_is_one_line_exit_130(tmp_path, delay):
+    """Ctrl-C while numba, pandas and matplotlib load (before the command runs) is the command's
+    one line and status 130, not a traceback of imports."""
+    env = {**os.environ, "PYTHONPATH": SRC, "QUADCRUISE_PROGRESS": "0"}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "quadcruise", "fly", "hover", "--duration", "0.5", "--out", "out"],
+        cwd=tmp_path,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=as_from_a_terminal,
+    )
+    time.sleep(delay)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=300)
+    assert proc.returncode == 130 and one_line(err).startswith("error: interrupted"), err
+    assert files_under(tmp_path) == []
+    import_only = subprocess.run(  # a library user's Ctrl-C stays Python's own KeyboardInterrupt
+        [sys.executable, "-c", "import signal, quadcruise; print(signal.getsignal(signal.SIGINT).__name__)"],
+        env=env,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert import_only.stdout.strip() == "default_int_handler"
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["fly", "in.csv"],
+        ["fly", "in.toml"],
+        ["fly", "hover", "--vehicle", "in.toml"],
+        ["identify", "in.csv", "--out", "x"],
+    ],
+)
+def test_a_fifo_given_as_an_input_file_is_one_line_not_a_wait(tmp_path, args):
+    """A FIFO where a file is expected is named as such (it was 'no such file'), and nothing
+    opens it: opening a FIFO waits for a writer."""
+    for name in ("in.csv", "in.toml"):
+        os.mkfifo(tmp_path / name)
+    proc = quadcruise_cli(*args, cwd=tmp_path, timeout=120)
+    assert proc.returncode == 2
+    assert one_line(proc.stderr).endswith(
+        "in.csv: a FIFO, not a regular file" if "in.csv" in args else "in.toml: a FIFO, not a regular file"
+    )
+    (tmp_path / "real.csv").write_text("x,y,z\n0,0,1\n1,0,1\n")
+    assert quadcruise_cli("fly", "real.csv", "--duration", "0.2", cwd=tmp_path).returncode in (0, 1)  # a file flies

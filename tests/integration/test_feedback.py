@@ -31,11 +31,15 @@ def write_schedule(path: Path, rows: int) -> Path:
 
 def invoke(monkeypatch, forced: bool, args: list[str]):
     """Run the command line in this process, stdout and stderr apart (stderr is not a
-    terminal here: without the variable the feedback is off)."""
+    terminal here: without the variable no bar is drawn, and the plain lines said off a
+    terminal are pushed beyond any run, so that a slow host does not print one)."""
+    from quadcruise.cli import feedback
+
     if forced:
         monkeypatch.setenv(ENV, "1")
     else:
         monkeypatch.delenv(ENV, raising=False)
+        monkeypatch.setattr(feedback, "LINE_EVERY_S", float("inf"))
     res = CliRunner().invoke(main, [str(a) for a in args])
     assert res.exit_code == 0, res.output
     return res
@@ -123,6 +127,44 @@ def test_feedback_follows_the_terminal_unless_the_variable_says(monkeypatch):
     monkeypatch.undo()
     monkeypatch.setenv(ENV, "1")
     assert feedback.feedback_on()
+
+
+PIPED = """
+import sys
+from quadcruise.cli import feedback
+feedback.LINE_EVERY_S = float(sys.argv[1])
+from quadcruise.cli import main
+main(sys.argv[2:])
+"""
+
+
+@pytest.mark.parametrize("every", [0.0, 3600.0])
+def test_off_a_terminal_progress_is_said_in_plain_lines_a_log_can_hold(every):
+    """stderr a pipe (a CI log): a line every LINE_EVERY_S (0 here: at every chunk) and one at the
+    end, no carriage return or bar; work shorter than LINE_EVERY_S writes nothing to stderr."""
+    args = ["montecarlo", "--n", "6", "--duration", "1", "--mass-spread", "0.1", "--scheduler", "none"]
+    env = {k: v for k, v in os.environ.items() if k != ENV}
+    run = subprocess.run(
+        [sys.executable, "-c", PIPED, str(every), *args, "--chunk-size", "2"],
+        capture_output=True,  # stdout and stderr: pipes
+        text=True,
+        env=env,
+        timeout=600,
+    )
+    assert run.returncode == 0, run.stderr
+    assert "6 flights of nlpd on circle" in run.stdout and "flying" not in run.stdout
+    lines = [line for line in run.stderr.splitlines() if line.startswith("flying")]
+    if every == 0.0:
+        assert "\r" not in run.stderr
+        assert [line.split(" (")[0] for line in lines] == [
+            "flying: 2 of 6 flights",
+            "flying: 4 of 6 flights",
+            "flying: 6 of 6 flights",
+        ], run.stderr
+        assert re.fullmatch(r"flying: 2 of 6 flights \(33 %\) after \d+ s, about \d+ s left", lines[0])
+        assert re.fullmatch(r"flying: 6 of 6 flights \(100 %\) in \d+ s", lines[-1])
+    else:
+        assert lines == [] and not BAR_TEXT.search(run.stderr), run.stderr
 
 
 def test_the_bar_takes_a_note_for_reuse(capsys, monkeypatch):

@@ -170,6 +170,45 @@ def test_a_rollout_keeps_each_flight_as_it_ended():
     assert returns[1] < returns[0]
 
 
+def test_baselines_score_in_the_registered_environments_own_domain():
+    """By default Hover-v0 as gymnasium.make_vec makes it (its 0.3 m start offsets), not a hover
+    without offset, which scored every controller 500 a return and 0 m RMSE."""
+    table = baselines(("nlpd", "se3"), num_envs=3, seed=2, duration=1.0)
+    for name in ("nlpd", "se3"):
+        vec = gymnasium.make_vec(
+            "quadcruise/Hover-v0", num_envs=3, vectorization_mode="vector_entry_point", controller=name, duration=1.0
+        )
+        assert vec.population.offset == 0.3
+        returns, flights = rollout(vec, seed=2)
+        assert table.loc[name, "mean_return"] == returns.mean()
+        assert table.loc[name, "rmse_m"] == pytest.approx(flights.metrics()["rmse_m"].mean(), rel=1e-12)
+        assert np.linalg.norm(flights.states[:, 0, :3] - flights.references[:, 0, :3], axis=1).min() > 0.01
+    assert (table["mean_reward"] < 0.95).all() and (table["rmse_m"] > 0.05).all()
+    # the other direction: a hover with no offset (what the default was) is perfect for every controller
+    still = baselines(("nlpd", "se3"), num_envs=3, seed=2, duration=1.0, population=None)
+    assert (still["mean_reward"] == 1.0).all() and (still["rmse_m"] == 0.0).all()
+    with pytest.raises(InputError, match="env_id 'Hover' is not a registered environment"):
+        baselines(env_id="Hover")
+
+
+@pytest.mark.parametrize("ending", ["truncated", "terminated"])
+def test_a_single_env_must_be_reset_after_its_episode_ends(ending):
+    """gymnasium's convention (Env.step: "If true, the user needs to call reset"): a step after the end
+    raises ResetNeeded instead of flying on and paying reward (0.4435 a step before)."""
+    kw = dict(duration=0.05) if ending == "truncated" else dict(max_track_error=0.05)  # Hover-v0: 0.3 m offsets
+    env = gymnasium.make("quadcruise/Hover-v0", **kw)
+    env.reset(seed=0)
+    for _ in range(10):
+        _, reward, terminated, truncated, info = env.step(np.zeros(4))
+        if terminated or truncated:
+            break
+    assert (terminated, truncated) == (ending == "terminated", ending == "truncated")
+    with pytest.raises(gymnasium.error.ResetNeeded, match=f"has ended \\({ending}"):
+        env.step(np.zeros(4))
+    env.reset(seed=1)  # and after a reset it flies again
+    assert np.isfinite(env.step(np.zeros(4))[1])
+
+
 def test_a_baseline_in_the_env_flies_what_fly_flies():
     env = QuadVectorEnv(2, mission="circle", controller="nlpd", dt=0.002, duration=2.0)
     returns, flights = rollout(env, seed=0)
@@ -182,7 +221,7 @@ def test_a_baseline_in_the_env_flies_what_fly_flies():
     err = np.linalg.norm(whole.states[:, 1:, :3] - whole.references[:, 1:, :3], axis=2)
     rate = np.linalg.norm(whole.states[:, 1:, 9:12], axis=2)
     np.testing.assert_allclose(returns, np.exp(-err / 0.5 - 0.05 * rate).sum(axis=1), rtol=1e-9)
-    table = baselines(("nlpd", "cascade"), num_envs=2, mission="circle", dt=0.002, duration=2.0)
+    table = baselines(("nlpd", "cascade"), env_id="quadcruise/Track-v0", num_envs=2, dt=0.002, duration=2.0)
     assert table.loc["nlpd", "mean_return"] == pytest.approx(returns.mean())
     assert table.loc["nlpd", "rmse_m"] == pytest.approx(whole.metrics()["rmse_m"].mean(), rel=1e-9)
     assert (table["finished"] == 1.0).all()

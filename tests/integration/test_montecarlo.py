@@ -90,11 +90,44 @@ def test_draws_depend_on_seed_and_index_only():
     for name in ("Jxx", "K", "omega", "dx0"):
         assert np.array_equal(more.columns[name], whole.columns[name])
     assert not np.array_equal(POP.draw(6, 0, 10, v).columns["m"], whole.columns["m"])
-    # normal draws are clipped at 3 sigma: every value positive and within the band
+    # normal draws are truncated at 3 sigma: every value positive and within the band
     m = Population(mass_spread=0.3).draw(0, 0, 2000, v).columns["m"]
     assert m.min() >= v.m * (1 - 0.9) - 1e-12 and m.max() <= v.m * (1 + 0.9) + 1e-12
     u = Population(mass_spread=0.1, distribution="uniform").draw(0, 0, 4000, v).columns["m"]
     assert abs(np.std(u / v.m) - 0.1) < 0.005 and np.all(np.abs(u / v.m - 1) <= 0.1 * 3**0.5)
+
+
+def numpy_normals(seed: int, i: int):
+    """numpy's generator of vehicle i's draws, SeedSequence([seed, i], spawn_key=(1,))."""
+    return np.random.default_rng(np.random.SeedSequence([seed, i], spawn_key=(1,)))
+
+
+def truncated_draws(seed: int, i: int) -> np.ndarray:
+    """The documented draws of vehicle i, independently: 16 standard normals of numpy's
+    generator, each beyond 3 sigma replaced in order by the stream's next draws within it."""
+    g = numpy_normals(seed, i)
+    z = g.standard_normal(16)
+    for k in np.flatnonzero(np.abs(z) > 3.0):
+        while abs(v := g.standard_normal()) > 3.0:
+            pass
+        z[k] = v
+    return z
+
+
+def test_normal_draws_are_truncated_not_clipped():
+    """A clip at 3 sigma gave each of the 0.13 % of vehicles beyond it the same mass: a 10,000-flight
+    sweep's "worst 5" were five identical rows (m = 1.3 x nominal). Truncated: every vehicle its own."""
+    pop = Population(mass_spread=0.1)
+    z = pop.unit_draws(1, 0, 10_000)
+    assert np.abs(z).max() <= 3.0 and len(np.unique(z[:, 0])) == 10_000
+    m = pop.draw(1, 0, 10_000, Vehicle.paper()).columns["m"]
+    assert len(np.unique(m)) == 10_000
+    past = [i for i in range(300) if np.abs(numpy_normals(1, i).standard_normal(16)).max() > 3.0]
+    assert len(past) >= 3  # vehicles with a draw beyond 3 sigma, drawn again
+    for i in [*past, 0, 1, 299]:
+        np.testing.assert_array_equal(z[i], truncated_draws(1, i), err_msg=str(i))
+        clipped = np.clip(numpy_normals(1, i).standard_normal(16), -3.0, 3.0)  # the old rule
+        assert np.array_equal(clipped, z[i]) == (i not in past)
 
 
 @pytest.mark.parametrize(
@@ -140,6 +173,32 @@ def test_a_case_flown_alone_equals_its_row(reference):
         assert same_row(case.row, res.table.iloc[i].to_dict()), i
     full = montecarlo_case(res.spec, 3, log_every=1)  # every period, for a close look
     assert full.result.t.size == res.spec.periods + 1 and same_row(full.row, res.table.iloc[3].to_dict())
+
+
+def test_a_case_and_fly_of_the_same_vehicle_give_one_status_and_time():
+    """One rule for a flight's status: montecarlo --case K, a sweep's row and fly of the same vehicle alone
+    (its log every period, the sweep's every 10 ms) say the same status at the same instant; off track
+    (heavy vehicles sag) and finished alike."""
+    import quadcruise as qc
+    from quadcruise.montecarlo.output import case_text
+    from quadcruise.sim.status import ExitStatus
+
+    spec = MonteCarloSpec("circle", population=Population(mass_spread=0.1), seed=1)
+    seen = set()
+    for i in (576, 1):  # of a 2,000-flight sweep of seed 1: 576 (m = 4.50 kg) sags off track, 1 flies
+        case = montecarlo_case(spec, i)
+        alone = qc.fly("circle", vehicle=Vehicle.paper().replace(m=case.row["m"]), controller_vehicle=Vehicle.paper())
+        coarse = qc.fly(
+            "circle", vehicle=Vehicle.paper().replace(m=case.row["m"]), controller_vehicle=Vehicle.paper(), log_every=10
+        )
+        assert case.result.meta["log_every"] == 10 and alone.meta["log_every"] == 1
+        for other in (case.result, coarse):
+            assert other.status[0] == alone.status[0] and other.t_stop[0] == alone.t_stop[0], (i, other.status_text())
+        assert case.row["status"] == alone.status[0] and case.row["stop_time_s"] == alone.t_stop[0]
+        assert alone.status_text(0) in case_text(case, 1)
+        seen.add(ExitStatus(int(alone.status[0])))
+        assert case.row["reason"] == ("lost track" if alone.status[0] == ExitStatus.OFF_TRACK else "ok")
+    assert seen == {ExitStatus.OFF_TRACK, ExitStatus.FINISHED}
 
 
 def test_sweep_metrics_equal_flight_metrics():
@@ -204,6 +263,13 @@ def test_lost_track_is_the_error_after_the_transient_beyond_a_bound():
     assert (tab.loc[~lost, "steady_max_error_m"] <= 0.3).all() and tab.loc[lost, "steady_max_error_m"].isna().all()
     assert res.spec.max_altitude_error_m == 0.3  # a bound given bounds the altitude too
     assert "lost track" in res.summary_text() and "> 0.3 m" in res.summary_text()
+    # the histograms count the flights the quantiles are over (not the lost ones)
+    fig = res.plot_histograms(["rmse_m", "effort"])
+    rmse, effort = fig.axes[0], fig.axes[1]
+    assert sum(p.get_height() for p in rmse.patches) == res.summary()["metrics"]["rmse_m"]["count"] == (~lost).sum()
+    kept = tab.loc[~lost, "effort"]  # and each axis spans its own data
+    assert effort.get_xlim()[0] <= kept.min() and effort.get_xlim()[1] >= kept.max()
+    assert effort.get_xlim()[1] - effort.get_xlim()[0] < 2 * (kept.max() - kept.min())
     with pytest.raises(InputError, match="max_track_error_m"):
         MonteCarloSpec("circle", max_track_error_m=-1.0)
 

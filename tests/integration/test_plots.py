@@ -217,14 +217,22 @@ def test_early_stop_is_marked_and_explained(diverged):
     assert t_stop < time_axes[0].get_xlim()[1] < diverged.t[-1]
 
 
-@pytest.mark.parametrize("which", ["circle", "step", "diverged"])
+@pytest.mark.parametrize("which", ["circle", "step", "diverged", "clipped"])
 def test_plot_flight_panels_stay_inside_and_apart(which, request):
     """The flight figure's grid is fixed, not found by a layout engine: each panel with its
     tick labels, axis labels and legends stays inside the figure and clear of the others and
-    of the title (two lines when the flight stopped)."""
+    of the title (two lines when the flight stopped). The legends right of the wide panels are
+    measured and the grid narrowed for them: "duty clipped (asked outside [0, 1])" was cut."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-    fig = plot_flight(request.getfixturevalue(which))
+    if which == "clipped":
+        step = request.getfixturevalue("step")
+        commands = step.commands.copy()
+        commands[0, 100:120, CMD_U1 + 2] = 1.3  # asked for more than full duty
+        fig = plot_flight(dataclasses.replace(step, commands=commands))
+        assert "duty clipped (asked outside [0, 1])" in legend_texts(axis_by_ylabel(fig, "rotor duty"))
+    else:
+        fig = plot_flight(request.getfixturevalue(which))
     renderer = FigureCanvasAgg(fig).get_renderer()
     fig.draw(renderer)
     boxes = [ax.get_tightbbox(renderer) for ax in fig.axes] + [fig._suptitle.get_window_extent(renderer)]
@@ -341,6 +349,8 @@ def sweep_like(n=30, ok=10, seed=0):
         {
             "vehicle": np.arange(n),
             "failure": failure,
+            "diverged": failure == 1,
+            "lost_track": np.zeros(n, bool),
             "rmse_m": rng.gamma(2.0, 0.1, n),
             "max_error_m": rng.gamma(3.0, 0.2, n),
             "final_error_m": np.r_[rng.gamma(2.0, 0.01, n - 3), [np.nan] * 3],
@@ -376,7 +386,10 @@ def test_histograms_have_axis_labels():
     ]
     assert all(ax.get_ylabel() == "flights" for ax in shown)
     assert shown[-1].get_title() == "outcome of 30 flights" and shown[-1].get_xlabel() == "outcome"
-    assert sum(p.get_height() for p in hists[0].patches) == 30 and "27, 3 n/a" in hists[2].get_title()
+    kept = sweep_like().table.query("not diverged")  # the flights the summary's quantiles are over
+    gone = int(kept["final_error_m"].isna().sum())
+    assert sum(p.get_height() for p in hists[0].patches) == len(kept) < 30
+    assert f"{len(kept) - gone}, {gone} n/a" in hists[2].get_title() and gone > 0
     assert mc_plots.metric_label("hover_time_s") == "hover time [s]"
 
 
@@ -387,7 +400,8 @@ def test_histograms_leave_out_degenerate_metrics_and_say_so():
     assert not any(word in ax.get_title() for ax in shown for word in ("rise_time", "duty_clipped"))
     assert not any("not measured" in t.get_text() for ax in fig.axes for t in ax.texts)
     note = fig._supxlabel.get_text().replace("\u00a0", " ")  # no break inside an item
-    assert note == "not drawn: rise_time_s (not measured), duty_clipped_s (0 in all 30 flights)"
+    kept = int((~sweep_like().table["diverged"]).sum())  # the flights that kept track
+    assert note == f"not drawn: rise_time_s (not measured), duty_clipped_s (0 in all {kept} flights)"
     # nothing left out: no note
     fig = mc_plots.plot_histograms(sweep_like(), metrics=["rmse_m", "settling_time_5pct_s"])
     assert fig._supxlabel is None and len([ax for ax in fig.axes if ax.get_visible()]) == 3

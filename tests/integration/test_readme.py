@@ -26,6 +26,11 @@ def test_readme_python_example_runs_as_a_script(tmp_path):
     run = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr[-3000:]
     assert "Traceback" not in run.stderr
+    # every flight that warns is one the README says fails, and how (the robustness example: off track)
+    warned = re.findall(r"FlightWarning: (?:[^\n]*?: )?vehicle \d+ (\w+ \w+)", run.stderr)
+    said = [ln for ln in text.splitlines() if "# off track: ..." in ln]
+    assert warned == ["off track"] and len(said) == 1, run.stderr[-3000:]
+    assert "off track: the position or altitude error after the transient" in run.stdout
     assert "flights of nlpd on circle" in run.stdout  # the Monte Carlo summary, as a table
     assert (tmp_path / "mc-out" / "quadcruise.json").is_file()
     assert "every target and requirement met" in run.stdout  # the tune example meets what it asks for

@@ -447,3 +447,81 @@ def test_labels_cannot_break_out_of_the_page(circle):
     dom = Dom(html_report(title=evil, flights={evil: circle.decimate(50)}, config={"x": evil}))
     assert evil not in dom.text["qc-data"] and json.loads(dom.text["qc-data"])["flights"][0]["label"] == evil
     assert not dom.find("script", src="") and len(dom.find("script")) == 3  # hook, data, viewer
+
+
+# --- issue 33: the identify and reproduce reports show their tables -----------------------------
+
+
+@pytest.fixture(scope="module")
+def identified(tmp_path_factory):
+    """An identification of a sysid flight's PX4 log (what `quadcruise identify --report` reports)."""
+    folder = tmp_path_factory.mktemp("identify")
+    log = qc.fly("sysid").to_ulog(folder / "sysid.ulg")
+    return qc.identify(log, mass=3.499)
+
+
+@pytest.fixture(scope="module")
+def fitted_rep():
+    return reproduce(scenarios=("step",), controllers=("nlpd",), fitted=True)
+
+
+def no_markdown_table(page: str) -> None:
+    """No line of a Markdown table (``| a | b |``, ``|---|``) anywhere in the page's text."""
+    text = re.sub(r"<script.*?</script>|<style.*?</style>", "", page, flags=re.S)
+    assert "|---" not in text and not re.search(r"\|\s*\w[^|<]*\|\s*\w", text), re.findall(r".{40}\|.{40}", text)[:3]
+
+
+def test_the_identify_report_is_built_from_the_result(identified):
+    from quadcruise.report.identify import identification_report
+
+    kw = identification_report(identified)
+    params = kw["tables"]["Parameters (95 % intervals)"]
+    assert list(params.index) == list(identified.parameters)  # every parameter, one row each
+    for name, p in identified.parameters.items():
+        assert params.loc[name, "value"] == pytest.approx(p["value"])
+        assert params.loc[name, "identifiable"] == ("yes" if p["identifiable"] else "no")
+    assert kw["tables"]["The log and the fit"].loc["log", "value"] == identified.log["source"]
+    assert "|" in identified.report_md()  # report.md keeps its Markdown tables, for a Markdown reader
+    page = html_report(**kw)
+    no_markdown_table(page)
+    assert page.count("<table>") == 3 and "hover_duty" in page
+
+
+def test_the_reproduce_report_shows_the_fitted_table_it_speaks_of(fitted_rep, rep):
+    kw = reproduction_report(fitted_rep, figures={})
+    fitted = kw["tables"]["Fitted to the paper's transients (both rise conventions)"]
+    runs = [r for r in fitted_rep.runs if r["scenario"] == "entry"]
+    assert list(fitted.index) == [r["controller"] for r in runs] and len(runs) >= 3
+    for r in runs:  # both conventions, as the text says, and the paper's numbers beside them
+        assert fitted.loc[r["controller"], "rise_0_100_s"] == pytest.approx(r["rise_0_100_s"])
+        assert fitted.loc[r["controller"], "rise_time_s"] == pytest.approx(r["rise_time_s"])
+    assert fitted["paper: overshoot_pct"].notna().all()
+    page = html_report(**kw)
+    no_markdown_table(page)
+    assert "table of fitted gains, where flown, gives both" in page and "below gives both" not in page
+    assert "gains fitted to its numbers" in page  # the note that explains the table
+    unfitted = reproduction_report(rep, figures={})  # not flown: no table, and no note of one
+    assert list(unfitted["tables"]) == ["Results against the paper"]
+    assert "gains fitted to its numbers" not in unfitted["notes"]
+
+
+@pytest.mark.browser
+def test_browser_renders_the_identify_and_reproduce_tables(identified, fitted_rep, tmp_path):
+    from quadcruise.report.identify import identification_report
+
+    for name, kw, tables in (
+        ("identify", identification_report(identified), 3),
+        ("reproduce", reproduction_report(fitted_rep, figures={}), 2),
+    ):
+        page = write_html_report(tmp_path / f"{name}.html", **kw)
+        dom = rendered_dom(page)
+        assert dom.text["qc-errors"] == "", dom.text["qc-errors"]
+        assert len(dom.find("table")) == tables, name
+        shot = tmp_path / f"{name}.png"
+        chromium(page, f"--screenshot={shot}")
+        img = np.asarray(Image.open(shot).convert("RGB")).astype(int)
+        assert img.reshape(-1, 3).std(axis=0).max() > 20  # a page drawn, not one colour
+        if os.environ.get("QUADCRUISE_ARTIFACTS"):
+            out = Path(os.environ["QUADCRUISE_ARTIFACTS"])
+            out.mkdir(parents=True, exist_ok=True)
+            shutil.copy(shot, out / f"{name}_report_screenshot.png")

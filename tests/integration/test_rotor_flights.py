@@ -118,10 +118,6 @@ def test_the_command_line_flies_a_preset_and_its_scenario_flies_it_again(tmp_pat
 @pytest.mark.parametrize(
     "args, words",
     [
-        (
-            ["montecarlo", "--mission", "hover", "-n", "2", "--offset", "0.1", "--duration", "1"],
-            "'offset': not for a rotor-plant vehicle",
-        ),
         (["fly", "hover", "--wind", "constant:2,0,0", "--duration", "1"], "has none"),
         (["fly", "hover", "--controller-vehicle", "paper", "--duration", "1"], "of one plant"),
         (["tune", "step", "--minimize", "rmse_m", "--wind-spread", "1", "--duration", "1"], "has none"),

@@ -77,7 +77,9 @@ def test_round_trip_recovers_the_rotor_plant(name, flights, tmp_path):
 @pytest.mark.slow
 def test_the_log_holds_the_rotor_plant_as_px4_logs_it(flights, tmp_path):
     """Read back with pyulog alone: esc_status holds the flown rotor speeds in rpm, actuator_motors
-    the commanded speeds over w_max, CA_ROTOR* the vehicle's own rotors (FRD, KM positive CCW)."""
+    each rotor's relative thrust (the commanded speed over w_max, squared: THR_MDL_FAC 1),
+    actuator_outputs that speed ratio as PWM (PX4's FunctionMotors with THR_MDL_FAC 1: x =
+    sqrt(rel)), CA_ROTOR* the vehicle's own rotors (FRD, KM positive CCW)."""
     _, vehicle, flight = flights["crazyflie"]
     log = ULog(str(flight.to_ulog(tmp_path / "cf.ulg")))
     esc = log.get_dataset("esc_status").data
@@ -86,9 +88,13 @@ def test_the_log_holds_the_rotor_plant_as_px4_logs_it(flights, tmp_path):
         rpm = esc[f"esc[{i}].esc_rpm"].astype(float)
         assert np.max(np.abs(rpm - speeds[:, i] * 60 / (2 * math.pi))) <= 0.5 + 1e-6
     control = np.column_stack([log.get_dataset("actuator_motors").data[f"control[{i}]"] for i in range(4)])
-    assert np.all((control >= 0) & (control <= 1)) and np.median(control) * vehicle.w_max == pytest.approx(
+    assert np.all((control >= 0) & (control <= 1)) and np.sqrt(np.median(control)) * vehicle.w_max == pytest.approx(
         vehicle.hover_speed, rel=0.05
     )
+    outputs = log.get_dataset("actuator_outputs").data
+    rows = np.searchsorted(log.get_dataset("actuator_motors").data["timestamp"], outputs["timestamp"])
+    for i in range(4):
+        assert np.allclose(outputs[f"output[{i}]"], 1000 + 1000 * np.sqrt(control[rows, i]), atol=2e-3)
     params = log.initial_parameters
     for i, (x, y, z, s) in enumerate(vehicle.rotors):
         assert params[f"CA_ROTOR{i}_PZ"] == pytest.approx(-z)

@@ -105,6 +105,30 @@ def test_result_speaks_like_every_result(small, tmp_path):
     assert sc.fly().metrics().iloc[0]["rise_time_s"] == pytest.approx(small.reached("rise_time_s"), abs=0.02)
 
 
+@pytest.mark.parametrize("controller, vehicle", [("nlpd", None), ("se3", "iris")], ids=["paper plant", "rotor plant"])
+def test_a_tuned_folder_flies_its_own_numbers(controller, vehicle, tmp_path):
+    """`fly DIR/scenario.toml` gives the tuned row: the same flight, logged as the search measured
+    it (its 10 ms log, not every period: 0.2003 against 0.1993 m before) and judged by its bounds."""
+    from quadcruise.montecarlo.schema import METRICS
+
+    kw = {} if vehicle is None else {"vehicle": qc.Vehicle.preset(vehicle)}
+    res = tune("step", controller, minimize=["rmse_m"], seed=1, duration=4.0, budget=1, popsize=5, **kw)
+    out = res.write(tmp_path / "t")
+    flown = load_scenario(out / "scenario.toml").fly()
+    row, again = res.flights.iloc[0], flown.metrics().iloc[0]
+    assert flown.meta["log_every"] == res.spec.log_every == 10 and res.response.meta["log_every"] == 10
+    assert (flown.rotor_states is not None) == (vehicle is not None)
+    assert again["status"] == "finished" and row["status"] == 0
+    shared = [m for m in METRICS if m in again.index]
+    assert {"rmse_m", "steady_max_error_m", "rise_time_s", "overshoot_pct", "effort"} <= set(shared)
+    for m in shared:  # NaN (a 2 % band never reached) equal to NaN
+        np.testing.assert_allclose(float(again[m]), row[m], rtol=1e-12, atol=0, err_msg=m)
+    assert float(again["rmse_m"]) == pytest.approx(res.reached("rmse_m"), rel=1e-12)
+    # the other direction: the same gains logged every period measure another RMSE
+    fine = qc.fly("step", res.controller, duration=4.0, seed=1, **kw)
+    assert abs(float(fine.metrics().iloc[0]["rmse_m"]) - row["rmse_m"]) > 1e-6
+
+
 def test_robust_tune_flies_each_candidate_on_the_same_perturbed_vehicles():
     pop = Population(mass_spread=0.05, inertia_spread=0.1)  # none sags off its altitude: every sample flies
     res = tune(
@@ -258,7 +282,9 @@ RISE = ["--target", "rise_time_s=1"]
 @pytest.mark.parametrize(
     "args, message",
     [
-        (["--target", "rise=1"], "unknown metric 'rise'"),
+        (["--target", "rise=1"], "unknown metric 'rise' (did you mean 'rise_time_s'?)"),
+        (["--target", "settling=2"], "unknown metric 'settling' (did you mean 'settling_time_s'?)"),
+        (["--target", "overshoot=4"], "unknown metric 'overshoot' (did you mean 'overshoot_pct'?)"),
         (["--target", "overshoot_pct=-4"], "no metric is negative"),
         (["--minimize", "rmse"], "unknown metric 'rmse' (did you mean 'rmse_m'?)"),
         (["--gains", "position.kx", *RISE], "unknown gain 'position.kx' of nlpd (did you mean 'position.kp'?)"),

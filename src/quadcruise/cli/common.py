@@ -25,6 +25,7 @@ __all__ = [
     "SETTLE_BAND_OPTION",
     "Bar",
     "friendly",
+    "distinct_outputs",
     "needs_out",
     "writable_with",
     "metric_options",
@@ -78,6 +79,34 @@ def needs_out(out, **given) -> None:
         for name, was_given in given.items():
             if was_given:
                 raise InputError(f"--{name} shapes the --out folder; without --out it would change nothing")
+
+
+def distinct_outputs(out, **files) -> None:
+    """Refuse, before any work, a file option that names the ``--out`` folder itself, or two
+    that name one file: the folder or the other would be written over it after the work.
+
+    A file named inside ``--out`` is kept: the folder is written first and the file after.
+
+    Parameters
+    ----------
+    out : str or None
+        The ``--out`` folder.
+    **files : str or None
+        Option name (``report``, ``ulog``, ``animate``) -> the path given, or None.
+
+    Raises
+    ------
+    InputError
+        Naming both options and the path.
+    """
+    from pathlib import Path
+
+    given = [(f"--{name}", path) for name, path in files.items() if path is not None]
+    given = ([("--out", out)] if out is not None else []) + given
+    for i, (name, path) in enumerate(given):
+        for other, seen in given[:i]:
+            if Path(path).resolve() == Path(seen).resolve():
+                raise InputError(f"{name} {path} and {other} {seen} name the same path: give each its own")
 
 
 def writable_with(*suffixes: str):

@@ -14,6 +14,7 @@ from quadcruise.cli.common import (
     SECONDS,
     SETTLE_BAND_OPTION,
     Bar,
+    distinct_outputs,
     friendly,
     metric_options,
     needs_out,
@@ -22,6 +23,7 @@ from quadcruise.cli.common import (
 )
 from quadcruise.cli.compare_run import (
     compared_from_options,
+    comparison_ulog_paths,
     echo_population_comparison,
     population_from_options,
     population_record,
@@ -36,7 +38,9 @@ __all__ = ["compare"]
 @click.command("compare")
 @click.argument("mission", metavar="MISSION")
 @click.option(
-    "--controllers", help="Comma-separated controller names (default nlpd,gonzalez,se3,cascade, or the scenario's)."
+    "--controllers",
+    help="Comma-separated controller names (default: the scenario's, else those declared compared: "
+    "nlpd,gonzalez,se3,cascade and any of yours, docs/extending.md).",
 )
 @click.option("--duration", type=SECONDS, help="Flight time [s] (default: the mission's).")
 @click.option("--dt", type=SECONDS, help="Control period [s] (default 0.001, or the scenario's).")
@@ -158,6 +162,7 @@ def compare(
     from quadcruise.workflows.compare import compare as run_compare
 
     needs_out(out, force=force)
+    distinct_outputs(out, report=report, ulog=ulog)
     conventions = metric_options(rise, settle_bands)
     if log_every is not None:
         whole_number(log_every, "--log-every", minimum=1)
@@ -191,13 +196,14 @@ def compare(
         table = echo_population_comparison(cmp_mission, cmp.controllers, count, pop_seed, pop, kwargs)
         cmp = dataclasses.replace(cmp, population=population_record(count, pop_seed, pop), population_table=table)
     if ulog is not None:
-        written = write_comparison_ulogs(cmp, ulog)
-        click.echo("wrote PX4 logs " + ", ".join(map(str, written)))
         for result in cmp.results.values():  # said in scenario.toml, as fly's is
-            result.meta["ulog"] = {"path": str(ulog), "files": [str(p) for p in written]}
-    if out is not None:
+            result.meta["ulog"] = {"path": str(ulog), "files": [str(p) for p in comparison_ulog_paths(cmp, ulog)]}
+    if out is not None:  # first: the folder is replaced whole, so a file named inside it comes after
         cmp.write(out, force=force, **conventions)
         click.echo(f"wrote metrics.csv and comparison.png to {out}")
+    if ulog is not None:
+        written = write_comparison_ulogs(cmp, ulog)
+        click.echo("wrote PX4 logs " + ", ".join(map(str, written)))
     if report is not None:
         from quadcruise.report.html import write_html_report
         from quadcruise.report.sections import comparison_report

@@ -15,11 +15,12 @@ from quadcruise.cli.vehicle import refuse_vehicle_fields
 from quadcruise.errors import InputError
 
 __all__ = [
-    "DEFAULT_COMPARED",
+    "default_compared",
     "compared_from_options",
     "echo_population_comparison",
     "population_from_options",
     "population_record",
+    "comparison_ulog_paths",
     "write_comparison_ulogs",
 ]
 
@@ -163,8 +164,18 @@ def echo_population_comparison(mission, controllers, n: int, seed: int, pop, fli
     return table
 
 
-DEFAULT_COMPARED = "nlpd,gonzalez,se3,cascade"
-"""The controllers ``quadcruise compare`` flies when neither the options nor a scenario name any."""
+def default_compared() -> str:
+    """The controllers ``quadcruise compare`` flies when neither the options nor a scenario name
+    any: those declared ``compared=True`` (:func:`quadcruise.control.registry.compared_names`).
+
+    Returns
+    -------
+    str
+        Comma-separated names.
+    """
+    from quadcruise.control.registry import compared_names
+
+    return ",".join(compared_names())
 
 
 def compared_from_options(mission: str, controllers: str | None, mission_params: tuple[str, ...]):
@@ -176,7 +187,7 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
         A mission name, a waypoint CSV (``.csv``) or a scenario file (``.toml``).
     controllers : str or None
         ``--controllers``, comma-separated names; None: the scenario's ``[compare]`` controllers,
-        else its ``[controller]``, else :data:`DEFAULT_COMPARED`.
+        else its ``[controller]``, else :func:`default_compared`.
     mission_params : tuple of str
         ``-m KEY=VALUE`` parameters of the mission.
 
@@ -189,7 +200,7 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
     from quadcruise.cli.assignments import parse_assignments
 
     if not mission.lower().endswith(".toml"):
-        chosen = DEFAULT_COMPARED if controllers is None else controllers
+        chosen = default_compared() if controllers is None else controllers
         return mission_from_options(mission, mission_params, smooth=False), chosen, {}, None
     from quadcruise.missions import mission_from_name
     from quadcruise.workflows.scenario import load_scenario
@@ -204,9 +215,34 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
         controllers
         if controllers is not None
         else scenario.compare
-        or ({scenario.controller.name: scenario.controller} if scenario.controller is not None else DEFAULT_COMPARED)
+        or ({scenario.controller.name: scenario.controller} if scenario.controller is not None else default_compared())
     )
     return the_mission, chosen, scenario.fly_kwargs(drag=False), scenario
+
+
+def _labelled(path, label) -> Path:
+    """``PATH.ulg`` as ``PATH-LABEL.ulg``, the label's odd characters made ``_``."""
+    path = Path(path)
+    return path.with_name(f"{path.stem}-{re.sub(r'[^A-Za-z0-9._-]', '_', str(label))}{path.suffix}")
+
+
+def comparison_ulog_paths(cmp, path) -> list[Path]:
+    """The files :func:`write_comparison_ulogs` writes, in its order (said before writing them).
+
+    Parameters
+    ----------
+    cmp : Comparison
+        The flights.
+    path : str or os.PathLike
+        The path given (``.ulg``).
+
+    Returns
+    -------
+    list of pathlib.Path
+    """
+    from quadcruise.cli.fly_run import ulog_paths
+
+    return [p for label, result in cmp.results.items() for p in ulog_paths(_labelled(path, label), result.n)]
 
 
 def write_comparison_ulogs(cmp, path) -> list[Path]:
@@ -235,11 +271,10 @@ def write_comparison_ulogs(cmp, path) -> list[Path]:
     """
     from quadcruise.cli.fly_run import write_ulogs
 
-    path, written = Path(path), []
+    written = []
     try:
         for label, result in cmp.results.items():
-            safe = re.sub(r"[^A-Za-z0-9._-]", "_", str(label))
-            written += write_ulogs(result, path.with_name(f"{path.stem}-{safe}{path.suffix}"))
+            written += write_ulogs(result, _labelled(path, label))
     except BaseException:
         for done in written:
             done.unlink(missing_ok=True)

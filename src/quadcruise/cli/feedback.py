@@ -1,5 +1,5 @@
-"""Feedback on long work, on stderr, on a terminal only: progress bars drawn by tqdm and one
-line when numba starts compiling.
+"""Feedback on long work, on stderr: progress bars drawn by tqdm on a terminal (a plain line
+every few seconds elsewhere) and one line when numba starts compiling.
 
 The library reports progress through a plain ``progress(done, total)`` callable and prints
 nothing; :class:`Bar` is such a callable that draws a bar. Anything that takes one can be
@@ -7,10 +7,12 @@ given ``Bar("what it does", unit="what it counts")``: it draws from its first ca
 when ``done`` reaches ``total`` (or at :meth:`Bar.close`, or when the command ends: see
 :func:`close_bars`). An optional third argument, a short text, is shown after the bar.
 
-Whether anything is shown is decided when it is drawn (:func:`feedback_on`): on a terminal
-(stderr is a TTY) yes, else nothing at all, so a log or a pipe holds only the results. The
-environment variable ``QUADCRUISE_PROGRESS`` overrides it: ``1`` shows the feedback
-anywhere (the tests capture it so), ``0`` never.
+Whether a bar is drawn is decided when it is drawn (:func:`feedback_on`): on a terminal
+(stderr is a TTY) yes. Elsewhere (a CI log, a pipe) a bar that is still running after
+:data:`LINE_EVERY_S` says where it is in a plain line, one every :data:`LINE_EVERY_S`, and
+one more when it ends (:func:`lines_on`): a log holds them, and work of a few seconds
+writes nothing but its results. The environment variable ``QUADCRUISE_PROGRESS``
+overrides both: ``1`` draws the bar anywhere (the tests capture it so), ``0`` shows nothing.
 
 Examples
 --------
@@ -29,12 +31,13 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
+import time
 import weakref
 from collections.abc import Iterator
 
 from tqdm import tqdm
 
-__all__ = ["COMPILE_LINE", "ENV", "Bar", "close_bars", "compile_notice", "feedback_on"]
+__all__ = ["COMPILE_LINE", "ENV", "LINE_EVERY_S", "Bar", "close_bars", "compile_notice", "feedback_on", "lines_on"]
 
 ENV = "QUADCRUISE_PROGRESS"
 """The environment variable that turns the feedback on (``1``) or off (``0``) anywhere."""
@@ -43,6 +46,9 @@ COMPILE_LINE = "compiling the engine and controllers for this machine, once (num
 """What :func:`compile_notice` says. Measured with an empty ``NUMBA_CACHE_DIR``, less the warm
 run, on two shared cores: ``fly hover`` 6-8 s, ``analyze`` 7 s, ``montecarlo`` 10 s, ``compare``
 (four controllers) 11-13 s."""
+
+LINE_EVERY_S = 10.0
+"""Off a terminal: seconds between two progress lines (the first after as long)."""
 
 _OPEN: weakref.WeakSet = weakref.WeakSet()  # the bars drawn and not closed yet
 
@@ -58,6 +64,23 @@ def feedback_on() -> bool:
         return bool(sys.stderr.isatty())
     except (AttributeError, ValueError):  # no stderr, or a closed one
         return False
+
+
+def lines_on() -> bool:
+    """Whether progress is said in plain lines: stderr is not a terminal and
+    ``QUADCRUISE_PROGRESS`` is not set."""
+    if os.environ.get(ENV, "").strip():
+        return False
+    try:
+        return sys.stderr is not None and not sys.stderr.isatty()
+    except (AttributeError, ValueError):  # a closed stderr
+        return False
+
+
+def _duration(seconds: float) -> str:
+    """``42 s``, ``3 min 05 s``."""
+    seconds = max(0, round(seconds))
+    return f"{seconds} s" if seconds < 60 else f"{seconds // 60} min {seconds % 60:02d} s"
 
 
 def _size() -> dict:
@@ -78,7 +101,9 @@ class _Tqdm(tqdm):
 
 class Bar:
     """A ``progress(done, total)`` callable that draws a bar on stderr (tqdm), when
-    :func:`feedback_on`.
+    :func:`feedback_on`, or says it in a plain line every :data:`LINE_EVERY_S` when
+    :func:`lines_on`, e.g. ``flying: 2,500 of 10,000 flights (25 %) after 40 s, about 2 min
+    00 s left``.
 
     Examples
     --------
@@ -91,10 +116,50 @@ class Bar:
         self.unit = unit
         self._bar: tqdm | None = None
         self.closed = False
+        self._lines: bool | None = None  # off a terminal: plain lines (decided at the first call)
+        self._start = self._said = 0.0
+        self._last: tuple[int, int] = (0, 0)
+        self._note: str | None = None  # the last note (a tuner's best cost), said after the line
+        self._lines_said = 0
+
+    def _line(self, done: int, total: int, end: bool = False) -> None:
+        """One plain line on stderr: where the work is, how long it has taken and (not at the end) is left."""
+        now = time.monotonic()
+        elapsed = now - self._start
+        units = self.unit if total == 1 else self.unit + "s"
+        share = f" ({100 * done / total:.0f} %)" if total > 0 else ""
+        text = f"{self.label}: {done:,} of {total:,} {units}{share} "
+        if end:
+            text += f"in {_duration(elapsed)}"
+        else:
+            text += f"after {_duration(elapsed)}"
+            if 0 < done < total:
+                text += f", about {_duration(elapsed * (total - done) / done)} left"
+        if self._note:
+            text += f"; {self._note}"
+        try:
+            sys.stderr.write(text + "\n")
+            sys.stderr.flush()
+        except (AttributeError, OSError, ValueError):  # stderr gone: the work goes on
+            self._lines = False
+        self._said = now
+        self._lines_said += 1
 
     def __call__(self, done: int, total: int, text: str | None = None) -> None:
         """Show ``done`` of ``total``."""
         if self.closed:
+            return
+        if self._lines is None:
+            self._lines = lines_on()
+            self._start = self._said = time.monotonic()
+        if self._lines:
+            self._last = (done, total)
+            self._note = text if text is not None else self._note
+            _OPEN.add(self)
+            if done >= total:
+                self.close()
+            elif done > 0 and time.monotonic() - self._said >= LINE_EVERY_S:
+                self._line(done, total)
             return
         if self._bar is None:
             self._bar = _Tqdm(
@@ -122,7 +187,11 @@ class Bar:
             bar.set_postfix_str(text)  # drawn now
 
     def close(self) -> None:
-        """Remove the bar (nothing happens if it is closed already)."""
+        """Remove the bar (nothing happens if it is closed already); off a terminal, a last
+        line if any was said, with the time it all took."""
+        if self._lines and not self.closed and self._lines_said:
+            done, total = self._last
+            self._line(done, total, end=done >= total)
         self.closed = True
         _OPEN.discard(self)
         if self._bar is not None:

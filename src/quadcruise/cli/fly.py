@@ -14,6 +14,7 @@ from quadcruise.cli.common import (
     RISE_OPTION,
     SECONDS,
     SETTLE_BAND_OPTION,
+    distinct_outputs,
     friendly,
     metric_options,
     needs_out,
@@ -176,6 +177,7 @@ def fly(
     from quadcruise.errors import whole_number
 
     needs_out(out, force=force, format=fmt != "csv")
+    distinct_outputs(out, report=report, animate=animate, ulog=ulog)
     conventions = metric_options(rise, settle_bands)
     if seed is not None:
         whole_number(seed, "--seed")

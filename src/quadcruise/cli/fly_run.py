@@ -89,12 +89,12 @@ def fly_and_report(
     click.echo(conventions_text(metrics.attrs.get("conventions")))
     for i in np.flatnonzero(~result.ok):
         click.echo(f"vehicle {i} did not fly its mission: {result.status_text(int(i))}")
+    if out is not None:  # first: the folder is replaced whole, so a file named inside it comes after
+        write_flight(result, out, fmt, metrics=metrics)
+        click.echo(f"wrote traces, figure and metrics to {out}")
     if ulog is not None:
         written = write_ulogs(result, ulog)
         click.echo(f"wrote PX4 log{'s' if len(written) > 1 else ''} " + ", ".join(map(str, written)))
-    if out is not None:
-        write_flight(result, out, fmt, metrics=metrics)
-        click.echo(f"wrote traces, figure and metrics to {out}")
     if report is not None:
         from quadcruise.report.html import write_html_report
         from quadcruise.report.sections import flight_report

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import shlex
+import sys
 
 import click
 
-from quadcruise.cli.common import Bar, friendly, writable, writable_with
+from quadcruise.cli.common import Bar, distinct_outputs, friendly, writable, writable_with
 from quadcruise.errors import InputError
+from quadcruise.io.files import not_a_file
 
 __all__ = ["identify"]
 
@@ -30,10 +32,30 @@ def base_vehicle(text: str):
                 f"--vehicle: a preset (paper, iris, crazyflie, ...) or a TOML file with a [vehicle] table, got {text!r}"
             ) from None
     if not path.is_file():
-        raise InputError(f"--vehicle: {text}: no such file")
+        raise InputError(f"--vehicle: {text}: {not_a_file(path)}")
     from quadcruise.workflows.scenario import load_scenario
 
     return load_scenario(path).vehicle
+
+
+def check_keeps_log(log: str, out: str) -> None:
+    """Refuse an ``--out`` folder that holds ``LOG`` (writing the folder replaces it, ``--force`` or not).
+
+    Examples
+    --------
+    >>> check_keeps_log("runs/a/flight.ulg", "runs/a")
+    Traceback (most recent call last):
+        ...
+    quadcruise.errors.InputError: --out runs/a: holds the log being read (runs/a/flight.ulg), which writing ...
+    """
+    from pathlib import Path
+
+    read, folder = Path(log).resolve(), Path(out).resolve()
+    if folder == read or folder in read.parents:
+        raise InputError(
+            f"--out {out}: holds the log being read ({log}), which writing the folder would delete: "
+            "choose another folder"
+        )
 
 
 @click.command("identify")
@@ -65,7 +87,8 @@ def base_vehicle(text: str):
     default="duty",
     show_default=True,
     metavar="duty|rad/s|pwm:MIN:MAX",
-    help="Rotor commands: normalised duties, rotor speeds (rad/s; ULog: actuator_motors x w_max, rotor plant), "
+    help="Rotor commands: normalised duties (ULog: actuator_motors, relative thrust), rotor speeds (rad/s; ULog: the "
+    "signal x w_max, rotor plant), "
     "or PWM [us] with their range.",
 )
 @click.option(
@@ -106,7 +129,9 @@ def identify(
     """Identify the vehicle that flew LOG (a PX4 .ulg or a CSV) and check it on held-out data.
 
     Fits thrust, inertias, yaw moment and rotor lag by equation error, with 95 % intervals;
-    what the log cannot identify is said so and taken from --vehicle.
+    what the log cannot identify is said so and taken from --vehicle. The first line is the
+    verdict: exit 0 when the model fits the log, 1 when it does not (no intervals then), 2 for
+    bad input.
 
     \f
     Parameters
@@ -137,8 +162,10 @@ def identify(
     from quadcruise.sysid.api import STAGES
     from quadcruise.sysid.api import identify as run_identify
 
+    distinct_outputs(out, report=report)
     base = base_vehicle(vehicle)
     parse_commands(commands)
+    check_keeps_log(log, out)
     check_output_dir(out, force)
     words = (
         [
@@ -179,3 +206,5 @@ def identify(
 
         write_html_report(report, **identification_report(result))
         click.echo(f"wrote report {report}")
+    if not result.fits:  # written, said, and the status says it: 1, the model does not fit the log
+        sys.exit(1)

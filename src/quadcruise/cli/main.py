@@ -16,6 +16,7 @@ SIGTERM, 143 (:mod:`quadcruise.cli.faults`).
 from __future__ import annotations
 
 import gc
+import signal
 import sys
 
 import click
@@ -70,6 +71,7 @@ def run() -> None:
         Always: 0 on success, 2 for bad input, 74 for a file or standard output that could
         not be written, 130 when interrupted, 143 when terminated, else the command's status.
     """
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # the loading's handler (quadcruise/__init__) ends
     guard_stdout()
     stop_on_sigterm()
     try:

@@ -6,7 +6,7 @@ import sys
 
 import click
 
-from quadcruise.cli.common import FORCE_OPTION, FORMAT_OPTION, REPORT_OPTION, Bar, friendly, writable
+from quadcruise.cli.common import FORCE_OPTION, FORMAT_OPTION, REPORT_OPTION, Bar, distinct_outputs, friendly, writable
 from quadcruise.io.files import check_output_dir
 
 __all__ = ["reproduce"]
@@ -60,6 +60,7 @@ def reproduce(out, fmt, force, report, scenario):
     from quadcruise.workflows.reproduce import reproduce as run_reproduce
 
     start = time.perf_counter()
+    distinct_outputs(out, report=report)
     check_output_dir(out, force, workflow="reproduce")
     settings = {}
     if scenario is not None:

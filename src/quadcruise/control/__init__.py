@@ -14,12 +14,15 @@ Built-in controllers by name (see :func:`controller_from_name`):
 The ``nlpd`` module (:mod:`.position`) is imported with this package, and so compiled (or
 loaded from numba's cache) with it; each other controller module is imported only when its
 controller is first asked for, so flying ``nlpd`` never pays for the others.
+
+Each is declared once in :mod:`.registry` (name, class, design for a rotor-plant vehicle,
+gym baseline, compared by default); a user's own controller is declared the same way, with
+:func:`register_controller`, and then flies by name everywhere (docs/extending.md).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import importlib
 import inspect
 from collections.abc import Mapping
 from typing import Any
@@ -27,32 +30,32 @@ from typing import Any
 import numpy as np
 
 from quadcruise import checks
+from quadcruise.control import registry
 from quadcruise.control.base import Controller
 from quadcruise.control.position import NLPD
+from quadcruise.control.registry import register_controller
 from quadcruise.errors import InputError
 from quadcruise.model.vehicle import shared_default
 from quadcruise.protocols import ControllerLike
 
 
 class _Registry(Mapping):
-    """Controller name -> class, importing each module on first use."""
-
-    _where = {
-        "nlpd": ("quadcruise.control.position", "NLPD"),
-        "gonzalez": ("quadcruise.control.baselines", "Gonzalez"),
-        "se3": ("quadcruise.control.se3", "SE3"),
-        "cascade": ("quadcruise.control.cascade", "Cascade"),
-    }
+    """Controller name -> class, as declared in :mod:`quadcruise.control.registry` (each module
+    imported on first use)."""
 
     def __getitem__(self, name: str) -> type[Controller]:
-        module, attr = self._where[name]
-        return getattr(importlib.import_module(module), attr)
+        if name not in self:
+            raise KeyError(name)
+        return registry.declared(name).load()
+
+    def __contains__(self, name: object) -> bool:
+        return isinstance(name, str) and name in registry.controller_names()
 
     def __iter__(self):
-        return iter(self._where)
+        return iter(registry.controller_names())
 
     def __len__(self) -> int:
-        return len(self._where)
+        return len(registry.controller_names())
 
 
 CONTROLLERS: Mapping[str, type[Controller]] = _Registry()
@@ -64,7 +67,8 @@ def controller_from_name(name: str, **params: Any) -> Controller:
     Parameters
     ----------
     name : str
-        A key of :data:`CONTROLLERS`: 'nlpd', 'gonzalez', 'se3' or 'cascade'.
+        A key of :data:`CONTROLLERS`: 'nlpd', 'gonzalez', 'se3', 'cascade', or one declared by
+        :func:`~quadcruise.control.registry.register_controller`.
     **params : Any
         Parameters of that controller (its dataclass fields), in their units: gain sets
         such as ``position`` (a :class:`~quadcruise.control.design.PDGains`, kp [1/s^2],
@@ -226,8 +230,9 @@ def controller_record(controller: ControllerLike) -> dict:
 
 def __getattr__(name: str):
     """``from quadcruise.control import Gonzalez`` etc. without importing them eagerly."""
-    for key, (_, attr) in _Registry._where.items():
-        if attr == name:
+    for key in registry.controller_names():
+        cls = registry.declared(key).cls
+        if (cls.rpartition(":")[2] if isinstance(cls, str) else cls.__name__) == name:
             return CONTROLLERS[key]
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
@@ -244,4 +249,5 @@ __all__ = [
     "compiled_for_engine",
     "controller_from_name",
     "controller_record",
+    "register_controller",
 ]

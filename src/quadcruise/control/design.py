@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from quadcruise.checks import describe
 from quadcruise.errors import InputError
 from quadcruise.fields import Validated, check_value
 from quadcruise.fields import unit_field as _f
@@ -181,7 +182,7 @@ def _char_from_poles(poles, n: int, who: str) -> np.ndarray:
     except (TypeError, ValueError):
         p = np.array([None])
     if p.dtype.kind not in "iufc":
-        raise InputError(f"{who}: poles must be numbers, got {poles!r}")
+        raise InputError(f"{who}: poles must be numbers, got {describe(poles)}")
     p = p.astype(complex)
     if p.ndim != 1 or p.size != n:
         raise InputError(f"{who} needs {n} poles, got {p.size}")
@@ -284,6 +285,16 @@ ATTITUDE_INTEGRATOR_RATIO = 1.0 / 30.0
 def attitude_pid_design(actuator_bandwidth: float = 15.0) -> PIDGains:
     """PID gains of a decoupled attitude loop phi'' = U2* (eq 15): poles at 0.6 w (zeta 0.8) and w / 30.
     Why these: docs/paper.md, "Attitude gains".
+
+    Parameters
+    ----------
+    actuator_bandwidth : float
+        The rotor lag's bandwidth w [rad/s] (15: the paper's vehicle).
+
+    Returns
+    -------
+    PIDGains
+        kp [1/s^2], ki [1/s^3], kd [1/s].
 
     Examples
     --------

@@ -34,6 +34,7 @@ import numpy as np
 from numba import njit
 
 from quadcruise import layout as L
+from quadcruise.checks import describe
 from quadcruise.control.base import write_command
 from quadcruise.model.actuators import mix
 
@@ -90,7 +91,7 @@ def setpoint_gains(**scales: float) -> np.ndarray:
     values = {**DEFAULT_SCALES, **scales}
     for key, value in values.items():
         if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            raise ValueError(f"action scale {key!r} must be a number > 0, got {value!r}")
+            raise ValueError(f"action scale {key!r} must be a number > 0, got {describe(value)}")
     return SETPOINT_GAINS.pack({**dict.fromkeys(ACTION, 0.0), **{k: float(v) for k, v in values.items()}})
 
 

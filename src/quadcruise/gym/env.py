@@ -13,9 +13,10 @@ import numpy as np
 from gymnasium import spaces
 from gymnasium.vector import AutoresetMode, VectorEnv
 
+from quadcruise import checks
 from quadcruise.control import as_controller
 from quadcruise.control.setpoint import ACTION_CONTROLLERS, setpoint_gains
-from quadcruise.errors import InputError
+from quadcruise.errors import ArgumentTypeError, InputError
 from quadcruise.gym.observe import OBS_SIZE, REF_SIZE, observe, references
 from quadcruise.gym.rotor import allocation_rows, drawn_rows, hover_starts
 from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, STATE_SIZE, X
@@ -140,13 +141,20 @@ class QuadVectorEnv(VectorEnv):
         scales: dict | None = None,
     ) -> None:
         if not (isinstance(num_envs, (int, np.integer)) and num_envs >= 1):
-            raise InputError(f"num_envs must be a whole number >= 1, got {num_envs!r}")
+            raise InputError(f"num_envs must be a whole number >= 1, got {checks.describe(num_envs)}")
+        w = "make()"  # gymnasium.make and make_vec hand their keywords here: each checked before any work
+        checks.instance(w, "action", action, str, optional=False, want=f"one of {', '.join(ACTION_CONTROLLERS)}")
+        checks.number(w, "dt", dt, "pos", unit="s")
+        checks.number(w, "max_step", max_step, "pos", unit="s", optional=True)
+        checks.number(w, "duration", duration, "pos", unit="s", optional=True)
+        checks.instance(w, "limits", limits, Limits)
+        checks.instance(w, "scales", scales, dict, want="a dict of action scales (control.setpoint.DEFAULT_SCALES)")
         if action not in ACTION_CONTROLLERS:
             raise InputError(f"unknown action mode {action!r}; valid: {', '.join(ACTION_CONTROLLERS)}")
         if population is not None and not isinstance(population, Population):
             raise InputError(f"population must be a quadcruise Population, got {type(population).__name__}")
         if not (isinstance(max_track_error, (int, float)) and max_track_error > 0):
-            raise InputError(f"max_track_error must be a positive number [m], got {max_track_error!r}")
+            raise InputError(f"max_track_error must be a positive number [m], got {checks.describe(max_track_error)}")
         n = self.num_envs = int(num_envs)
         self.random_mission = isinstance(mission, str) and mission.strip().lower() == "random"
         self.mission = (
@@ -158,7 +166,9 @@ class QuadVectorEnv(VectorEnv):
             raise InputError(f"mission must be a Mission or a name, got {type(mission).__name__}")
         self.nominal = as_vehicle(vehicle) or Vehicle.paper()
         if not isinstance(self.nominal, (Vehicle, RotorVehicle)):
-            raise InputError(f"vehicle must be a Vehicle, a RotorVehicle or a preset's name, got {vehicle!r}")
+            raise InputError(
+                f"vehicle must be a Vehicle, a RotorVehicle or a preset's name, got {checks.describe(vehicle)}"
+            )
         self.rotor = isinstance(self.nominal, RotorVehicle)
         # the paper vehicle the controllers believe: the rotor vehicle's "+" equivalent
         self.nominal_eq = paper_equivalent(self.nominal) if self.rotor else self.nominal
@@ -311,11 +321,10 @@ class QuadVectorEnv(VectorEnv):
         (numpy.ndarray, dict)
             The observations (N, OBS_SIZE) and infos.
         """
+        seed = checks.whole("reset()", "seed", seed, optional=True)  # 1.5 was truncated, "abc" a ValueError
         mask = None if not options else options.get("reset_mask")
         if seed is not None or not hasattr(self, "_seeded"):
-            self._seed = int(np.random.SeedSequence().entropy % (2**63)) if seed is None else int(seed)
-            if self._seed < 0:
-                raise InputError(f"seed must be >= 0, got {seed}")
+            self._seed = int(np.random.SeedSequence().entropy % (2**63)) if seed is None else seed
             self._seeded = True
             self._episode[:] = 0
         rows = np.arange(self.num_envs) if mask is None else np.flatnonzero(self.stepper.check_mask(mask))
@@ -408,8 +417,24 @@ class QuadVectorEnv(VectorEnv):
         return self._obs.copy(), reward, terminated, truncated, info
 
 
+class _MadeArgumentTypeError(ArgumentTypeError):
+    """An argument of the wrong type to ``gymnasium.make``: its one line kept whole.
+
+    ``gymnasium.make`` raises a ``TypeError`` from an environment's constructor again as
+    ``type(e)(f"{e} was raised from the environment creator ... with kwargs (...)")``, a line
+    of every keyword's repr; this type keeps the first part, the line that names the argument.
+    """
+
+    def __init__(self, text: str) -> None:
+        super().__init__(text.split(" was raised from the environment creator", 1)[0])
+
+
 class QuadEnv(gymnasium.Env):
     """One quadrotor (``gymnasium.make``): a :class:`QuadVectorEnv` of one vehicle, without autoreset.
+
+    Gymnasium's convention: once ``step`` has returned ``terminated`` or ``truncated``, the user
+    calls ``reset``. A ``step`` before that raises ``gymnasium.error.ResetNeeded`` (as stepping
+    before the first reset does), rather than fly past the mission's end and pay reward for it.
 
     Parameters
     ----------
@@ -420,9 +445,13 @@ class QuadEnv(gymnasium.Env):
     metadata: ClassVar[dict] = {"render_modes": []}
 
     def __init__(self, **kwargs: Any) -> None:
-        self.vec = QuadVectorEnv(1, **kwargs)
+        try:
+            self.vec = QuadVectorEnv(1, **kwargs)
+        except ArgumentTypeError as exc:
+            raise _MadeArgumentTypeError(str(exc)) from None
         self.action_space = self.vec.single_action_space
         self.observation_space = self.vec.single_observation_space
+        self._ended: str | None = "has not begun"  # why step needs a reset first, or None
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         """Start an episode (see :meth:`QuadVectorEnv.reset`).
@@ -438,8 +467,10 @@ class QuadEnv(gymnasium.Env):
         -------
         (numpy.ndarray, dict)
         """
+        seed = checks.whole("reset()", "seed", seed, optional=True)  # before gymnasium's own seeding
         super().reset(seed=seed)
         obs, info = self.vec.reset(seed=seed)
+        self._ended = None
         return obs[0], {k: v[0] for k, v in info.items()}
 
     def step(self, action):
@@ -453,12 +484,31 @@ class QuadEnv(gymnasium.Env):
         Returns
         -------
         (obs, reward, terminated, truncated, info)
+
+        Raises
+        ------
+        gymnasium.error.ResetNeeded
+            If the episode has ended (a step returned terminated or truncated) or not begun.
         """
+        if self._ended is not None:
+            raise gymnasium.error.ResetNeeded(
+                f"step(): the episode {self._ended}; call reset() to start the next one"
+            )  # fmt: skip
         a = None if action is None else np.asarray(action)
         if a is not None and a.shape != (4,):
             raise InputError(f"action: expected shape (4,), got {a.shape}")
         self.vec._pending[:] = False  # no autoreset: the user resets
         obs, r, term, trunc, info = self.vec.step(None if a is None else a[None, :])
+        if term[0] or trunc[0]:
+            self._ended = (
+                "has ended ("
+                + (
+                    "terminated: " + ExitStatus(int(info["status"][0])).reason
+                    if term[0]
+                    else "truncated: the mission's end"
+                )
+                + ")"
+            )
         return obs[0], float(r[0]), bool(term[0]), bool(trunc[0]), {k: v[0] for k, v in info.items()}
 
 

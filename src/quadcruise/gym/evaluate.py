@@ -17,13 +17,15 @@ from collections.abc import Callable
 import numpy as np
 import pandas as pd
 
+from quadcruise.control.registry import baseline_names
 from quadcruise.errors import InputError
 from quadcruise.gym.env import QuadVectorEnv
 from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from quadcruise.sim.result import SimResult
 
 BASELINES = ("nlpd", "gonzalez", "se3", "cascade")
-"""The built-in controllers flown as baseline policies."""
+"""The built-in controllers flown as baseline policies (with any declared since with
+``baseline=True``: :func:`quadcruise.control.registry.baseline_names`)."""
 
 
 def rollout(env: QuadVectorEnv, policy: Callable | None = None, *, seed: int = 0) -> tuple[np.ndarray, SimResult]:
@@ -82,20 +84,31 @@ def rollout(env: QuadVectorEnv, policy: Callable | None = None, *, seed: int = 0
     return returns, result
 
 
-def baselines(controllers=BASELINES, *, num_envs: int = 8, seed: int = 0, **env_kwargs) -> pd.DataFrame:
+def baselines(
+    controllers=None, *, env_id: str = "quadcruise/Hover-v0", num_envs: int = 8, seed: int = 0, **env_kwargs
+) -> pd.DataFrame:
     """Each built-in controller flown as a policy in the same environment, scored by the
     environment's return and by the project's flight metrics (their mean over the vehicles).
 
+    The environment is the registered ``env_id``'s, its defaults included (Hover-v0's start
+    offset of 0.3 m, Track-v0's circle), as ``gymnasium.make_vec(env_id, ...)`` makes it: the
+    numbers a policy trained there is compared with.
+
     Parameters
     ----------
-    controllers : sequence of str or Controller
-        The controllers.
+    controllers : sequence of str or Controller, optional
+        The controllers; by default every one declared ``baseline=True``
+        (:func:`quadcruise.control.registry.baseline_names`).
+    env_id : str
+        The registered environment (``"quadcruise/Hover-v0"`` or ``"quadcruise/Track-v0"``)
+        whose keywords are the defaults.
     num_envs : int
         Vehicles per controller (the same episodes: the same seed).
     seed : int
         The episodes' seed.
     **env_kwargs
-        Keywords of :class:`QuadVectorEnv` (mission, vehicle, dt, population, ...).
+        Keywords of :class:`QuadVectorEnv` (mission, vehicle, dt, population, ...) that
+        change the environment's (``population=None``: no domain randomisation).
 
     Returns
     -------
@@ -105,9 +118,18 @@ def baselines(controllers=BASELINES, *, num_envs: int = 8, seed: int = 0, **env_
         vehicles that flew the whole episode), and the mean of each numeric column of
         ``SimResult.metrics()``.
     """
+    import gymnasium
+
+    try:
+        registered = dict(gymnasium.spec(env_id).kwargs) if isinstance(env_id, str) else None
+    except gymnasium.error.Error:
+        registered = None
+    if registered is None:
+        raise InputError(f"baselines(): env_id {env_id!r} is not a registered environment; quadcruise/Hover-v0 or "
+                         "quadcruise/Track-v0")  # fmt: skip
     rows = []
-    for controller in controllers:
-        env = QuadVectorEnv(num_envs, controller=controller, **env_kwargs)
+    for controller in baseline_names() if controllers is None else controllers:
+        env = QuadVectorEnv(num_envs, controller=controller, **{**registered, **env_kwargs})
         returns, flights = rollout(env, seed=seed)
         table = flights.metrics()
         periods = env.stepper.t_grid.shape[0] - 1

@@ -4,17 +4,49 @@ from __future__ import annotations
 
 import contextlib
 import os
+import secrets
 import shutil
-import tempfile
+import signal
+import threading
 from pathlib import Path
 
 from quadcruise.errors import WriteError
 
 
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
+def _temporary_names(path: Path):
+    """Names for a temporary beside ``path``, ``.NAME.<random>.tmp``, one per try.
+
+    The caller holds each name before it makes the file or folder (with a call that fails if
+    it exists), so that an interrupt at any moment leaves it a name to remove: ``mkstemp``'s
+    name is known only once the file exists, and Ctrl-C in between left an empty
+    ``.NAME.*.tmp`` behind. 64 random bits make a clash with another's temporary negligible.
+    """
+    while True:
+        yield path.with_name(f".{path.name}.{secrets.token_hex(8)}.tmp")
+
+
+@contextlib.contextmanager
+def _interrupts_deferred():
+    """Hold Ctrl-C and SIGTERM back for a few system calls that must run together; a signal
+    received meanwhile is raised as its handler raises it, once they are done (in the main
+    thread only, where Python runs signal handlers; elsewhere nothing changes)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held: list[int] = []
+    kept = {}
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        kept[sig] = signal.getsignal(sig)
+        if callable(kept[sig]):
+            signal.signal(sig, lambda signum, frame: held.append(signum))
+    try:
+        yield
+    finally:
+        for sig, handler in kept.items():
+            if callable(handler):
+                signal.signal(sig, handler)
+        for signum in held[:1]:
+            kept[signum](signum, None)
 
 
 @contextlib.contextmanager
@@ -53,10 +85,13 @@ def atomic_path(path: str | os.PathLike):
     tmp = None
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-        os.close(fd)
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; a result file is an ordinary file
-        yield Path(tmp)
+        for tmp in _temporary_names(path):  # noqa: B007 (tmp is the name made)
+            try:
+                os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))  # the umask applies
+                break
+            except FileExistsError:
+                continue
+        yield tmp
         os.replace(tmp, path)
     except BaseException as exc:
         if tmp is not None:
@@ -99,21 +134,30 @@ def atomic_dir(path: str | os.PathLike):
     tmp = None
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent))
-        os.chmod(tmp, 0o777 & ~_umask())
-        yield tmp
-        if path.exists():
-            old = path.with_name(f".{path.name}.old")
-            _remove(old)
-            os.replace(path, old)
+        for tmp in _temporary_names(path):  # noqa: B007 (tmp is the name made)
             try:
-                os.replace(tmp, path)
-            except BaseException:
-                os.replace(old, path)  # the old folder back where it was
-                raise
-            _remove(old)
-        else:
-            os.replace(tmp, path)
+                os.mkdir(tmp, 0o777)  # the umask applies
+                break
+            except FileExistsError:
+                continue
+        yield tmp
+        old, swapped = path.with_name(f".{path.name}.old"), False
+        try:
+            with _interrupts_deferred():  # Ctrl-C between the two moves would leave no folder at path
+                if path.exists():
+                    _remove(old)
+                    os.replace(path, old)
+                    try:
+                        os.replace(tmp, path)
+                    except BaseException:
+                        os.replace(old, path)  # the old folder back where it was
+                        raise
+                    swapped = True
+                else:
+                    os.replace(tmp, path)
+        finally:
+            if swapped:
+                _remove(old)
     except BaseException as exc:
         if tmp is not None:
             _remove(tmp)
@@ -161,9 +205,91 @@ def check_writable_place(path: str | os.PathLike) -> None:
     if not parent.is_dir():
         raise InputError(f"{path}: cannot write there ({parent} is not a folder)")
     try:  # the only sure test: make something there, and remove it
-        os.rmdir(tempfile.mkdtemp(prefix=".quadcruise-probe.", dir=parent))
+        probe = parent / f".quadcruise-probe.{secrets.token_hex(8)}"
+        try:
+            os.mkdir(probe)
+        finally:
+            with contextlib.suppress(OSError):
+                os.rmdir(probe)
     except OSError as exc:
         raise InputError(f"{path}: cannot write there ({exc.strerror.lower()} in {parent})") from None
+
+
+MARKER_LIMIT = 16 * 2**20
+"""The largest :data:`MARKER` read [bytes]: a marker holds a configuration (a few kB, a
+sweep's spec with its seeds some MB at most); a larger one is taken as damaged."""
+
+
+class NotRegularFile(OSError):
+    """A path that is not a regular file (a FIFO, a folder, a device), or one larger than asked:
+    not to be read. Its message says which."""
+
+
+def _kind(mode: int) -> str:
+    import stat
+
+    return "a FIFO" if stat.S_ISFIFO(mode) else "a folder" if stat.S_ISDIR(mode) else "a device or socket"
+
+
+def not_a_file(path: str | os.PathLike) -> str:
+    """Why ``path`` cannot be read as a file, for a message: no such file, or what it is instead.
+
+    Examples
+    --------
+    >>> not_a_file("/no/such/file.csv"), not_a_file("/")
+    ('no such file', 'a folder, not a regular file')
+    """
+    try:
+        return f"{_kind(os.stat(path).st_mode)}, not a regular file"
+    except OSError:
+        return "no such file"
+
+
+def open_regular(path: str | os.PathLike):
+    """Open a regular file for reading in binary, without waiting on what is not one.
+
+    The path is opened without blocking and checked on the open descriptor, so that a FIFO
+    put where a file was expected (whose ``open`` would wait for a writer forever), a folder
+    or a device is refused, not read.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file.
+
+    Returns
+    -------
+    io.BufferedReader
+        The file, open for reading.
+
+    Raises
+    ------
+    NotRegularFile
+        If ``path`` is not a regular file (an ``OSError``, as a file that cannot be opened).
+    """
+    import stat
+
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOCTTY", 0))
+    try:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            raise NotRegularFile(f"{_kind(mode)}, not a regular file")
+        return os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+def _small_file(path: Path, limit: int) -> bytes:
+    """The bytes of ``path`` if it is a regular file (:func:`open_regular`) of at most ``limit`` bytes."""
+    with open_regular(path) as f:
+        size = os.fstat(f.fileno()).st_size
+        if size > limit:
+            raise NotRegularFile(f"{size} bytes, more than a marker's {limit}")
+        data = f.read(limit + 1)
+    if len(data) > limit:
+        raise NotRegularFile(f"more than a marker's {limit} bytes")
+    return data
 
 
 def read_marker(folder: str | os.PathLike) -> dict | None:
@@ -183,8 +309,10 @@ def read_marker(folder: str | os.PathLike) -> dict | None:
     ------
     InputError
         If the marker cannot be read or is not a JSON object (truncated, filled with NUL
-        bytes, a list): what the folder holds (a Monte Carlo sweep's chunks, perhaps) is
-        then unknown, so it is not to be replaced unless forced. The message says how.
+        bytes, a list, nested too deeply), or is not a regular file of at most
+        :data:`MARKER_LIMIT` bytes (a FIFO is not opened for reading: it would wait):
+        what the folder holds (a Monte Carlo sweep's chunks, perhaps) is then unknown, so
+        it is not to be replaced unless forced. The message says how.
 
     Examples
     --------
@@ -204,14 +332,19 @@ def read_marker(folder: str | os.PathLike) -> dict | None:
     path = folder / MARKER
     if not os.path.lexists(path):
         return None
+    text = ""
     try:
-        text = path.read_bytes().decode("utf-8")
+        text = _small_file(path, MARKER_LIMIT).decode("utf-8")
         doc = json.loads(text)
         why = None if isinstance(doc, dict) else f"a JSON {type(doc).__name__.replace('list', 'array')}, not an object"
+    except NotRegularFile as exc:
+        why = str(exc)
     except OSError as exc:
         why = f"cannot be read: {(exc.strerror or str(exc)).lower()}"
     except UnicodeDecodeError:
         why = "not UTF-8 text"
+    except RecursionError:
+        why = "not JSON: nested too deeply"
     except json.JSONDecodeError as exc:
         why = (
             "empty"
@@ -463,7 +596,7 @@ def read_numeric_csv(
     if path.is_dir():
         raise InputError(f"{path}: is a folder, not a file")
     if not path.is_file():
-        raise InputError(f"{path}: no such file")
+        raise InputError(f"{path}: {not_a_file(path)}")  # a FIFO, too: it would not be opened
     fast = _read_at_once(path, required, optional, blank_ok)
     if fast is not None:
         if progress is not None:

@@ -11,6 +11,8 @@ Frames: with ``A`` the NED/ENU axis swap and ``B = diag(1, -1, -1)`` (FRD/FLU),
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
 import struct
 from dataclasses import dataclass, field
@@ -21,6 +23,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
 from quadcruise.errors import InputError
+from quadcruise.io import logchecks
+from quadcruise.io.files import not_a_file
 
 NED_TO_ENU = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
 """``A``: NED vectors to ENU (its own inverse)."""
@@ -50,6 +54,18 @@ ULOG_TOPICS = (
     "esc_status",
 )
 """The topics read from a ULog (others are skipped)."""
+NEEDED_FIELDS = {
+    "vehicle_attitude": [f"q[{i}]" for i in range(4)],
+    "vehicle_local_position": ["x", "y", "z", "vx", "vy", "vz"],
+    "vehicle_angular_velocity": [f"xyz[{i}]" for i in range(3)],
+    "sensor_combined": [f"gyro_rad[{i}]" for i in range(3)] + [f"accelerometer_m_s2[{i}]" for i in range(3)],
+    "hover_thrust_estimate": ["hover_thrust"],
+}
+"""The fields read of each topic (a topic without one of them is refused)."""
+SENSOR_FIELDS = {
+    True: NEEDED_FIELDS["sensor_combined"],  # the rates' topic too
+    False: [f"accelerometer_m_s2[{i}]" for i in range(3)],
+}
 
 
 @dataclass(frozen=True, eq=False)
@@ -66,6 +82,12 @@ class FlightLog:
     or None: the rotors' measured speeds [rad/s] (ULog ``esc_status`` rpm, CSV ``w1..wn``);
     ``speed_commands``: the commands ``u`` are rotor speeds [rad/s] (a CSV read with
     ``commands="rad/s"``) rather than normalised.
+
+    A ULog's commands ``u`` are each rotor's *relative thrust* (thrust over its thrust at full
+    command), PX4's meaning of ``actuator_motors``; ``actuator_outputs`` (PWM) are mapped to the
+    signal x by the PWM range and to relative thrust through ``THR_MDL_FAC`` (``f x^2 + (1 - f)
+    x``), which is applied here and kept as ``thrust_factor`` (not in ``parameters``). With
+    ``commands="rad/s"`` ``u`` is the signal x instead (the commanded speed over ``w_max``).
     """
 
     source: str
@@ -86,6 +108,7 @@ class FlightLog:
     resampling: str = ""
     speeds: np.ndarray | None = None
     speed_commands: bool = False
+    thrust_factor: float | None = None
 
     @property
     def n_rotors(self) -> int:
@@ -145,9 +168,9 @@ def read_flight_log(path: str | os.PathLike, *, frame: str | None = None, comman
         PX4's: "ned" or None.
     commands : str
         ``duty`` (default: ``actuator_motors``, or a CSV's ``u`` columns in [0, 1]),
-        ``rad/s`` (a CSV's ``u`` columns are commanded rotor speeds; a ULog's ``actuator_motors``
-        are the commanded speeds over ``w_max``, PX4's ``THR_MDL_FAC = 1``) or ``pwm:MIN:MAX``
-        (PWM [us]).
+        ``rad/s`` (a CSV's ``u`` columns are commanded rotor speeds; a ULog's signal x, the
+        relative thrust of ``actuator_motors`` through the inverse of ``THR_MDL_FAC``, is the
+        commanded speed over ``w_max``) or ``pwm:MIN:MAX`` (``actuator_outputs``' PWM [us]).
 
     Returns
     -------
@@ -170,7 +193,7 @@ def read_flight_log(path: str | os.PathLike, *, frame: str | None = None, comman
     if kind not in (".ulg", ".csv"):
         raise InputError(f"{path}: a flight log is a PX4 log (.ulg) or a CSV (.csv), got {path.suffix!r}")
     if not path.is_file():
-        raise InputError(f"{path}: no such file")
+        raise InputError(f"{path}: {not_a_file(path)}")
     frame_name = None if frame is None else str(frame).strip().lower()
     if frame_name not in (None, "enu", "ned"):
         raise InputError(f"{path}: frame must be 'enu' or 'ned', got {frame!r}")
@@ -185,24 +208,6 @@ def read_flight_log(path: str | os.PathLike, *, frame: str | None = None, comman
 
 
 # --- ULog ---------------------------------------------------------------------------------
-
-
-def check_ulog_framing(path: Path) -> None:
-    """Refuse a file that is not a ULog, or whose last message runs past its end (truncated)."""
-    data = path.read_bytes()
-    if len(data) < 16 or data[:7] != b"ULog\x01\x12\x35":
-        raise InputError(f"{path}: not a PX4 log (ULog): its first bytes are not ULog's header")
-    pos, size = 16, len(data)
-    while pos + 3 <= size:
-        (length,) = struct.unpack_from("<H", data, pos)
-        if pos + 3 + length > size:
-            raise InputError(
-                f"{path}: truncated PX4 log: the message at byte {pos} needs {length} bytes, "
-                f"the file ends after {size - pos - 3}"
-            )
-        pos += 3 + length
-    if pos != size:
-        raise InputError(f"{path}: truncated PX4 log: {size - pos} stray byte(s) at its end")
 
 
 def _median_rate(t: np.ndarray) -> float:
@@ -222,11 +227,16 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
     from pyulog import ULog
     from pyulog.core import ULogException
 
-    check_ulog_framing(path)
+    logchecks.check_ulog_framing(path)
+    said = io.StringIO()  # pyulog prints what it finds damaged: said here, in one line, instead
     try:
-        log = ULog(str(path), message_name_filter_list=list(ULOG_TOPICS))
-    except (ULogException, struct.error, ValueError, IndexError) as exc:
+        with contextlib.redirect_stdout(said):
+            log = ULog(str(path), message_name_filter_list=list(ULOG_TOPICS))
+    except (ULogException, struct.error, ValueError, IndexError, UnicodeDecodeError) as exc:
         raise InputError(f"{path}: not a readable PX4 log ({exc})") from None
+    if log.file_corruption or "corrupt" in said.getvalue():
+        first = next((line.strip() for line in said.getvalue().splitlines() if line.strip()), "")
+        raise InputError(f"{path}: corrupt PX4 log (pyulog: {first or 'damaged messages'})")
     topics: dict[str, dict[str, np.ndarray]] = {}
     for d in log.data_list:
         if d.multi_id == 0 or d.name not in topics:
@@ -261,12 +271,16 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
         missing.append("esc_status (the measured rotor speeds that commands 'rad/s' are fitted against)")
     if missing:
         raise InputError(f"{path}: missing topic(s) {', '.join(missing)}")
+    logchecks.check_fields(path, topics, {**NEEDED_FIELDS, "vehicle_status": ["arming_state"]})
 
     def times(name: str) -> np.ndarray:
         return (topics[name]["timestamp"].astype(np.float64) - float(log.start_timestamp)) * 1e-6
 
+    for name in topics:
+        logchecks.check_clock(path, name, times(name))
+
     # commands
-    n_rot = int(params.get("CA_ROTOR_COUNT", 0)) or 4
+    n_rot = logchecks.check_rotor_count(path, params)
     cmd = topics[cmd_topic]
     prefix = "control" if cmd_topic == "actuator_motors" else "output"
     channels = list(range(n_rot))
@@ -278,6 +292,9 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
     if any(c not in cmd for c in cols):
         raise InputError(f"{path}: {cmd_topic} has fewer than the {n_rot} rotor channels CA_ROTOR_COUNT says")
     raw = np.column_stack([cmd[c].astype(np.float64) for c in cols])
+    factor = float(params.get("THR_MDL_FAC", 0.0) or 0.0)
+    if not 0.0 <= factor <= 1.0:
+        raise InputError(f"{path}: parameter THR_MDL_FAC = {factor:g} is outside PX4's range [0, 1]")
     if cmd_topic == "actuator_outputs":
         if kind == "pwm" and np.isfinite(lo):
             lows, highs = np.full(n_rot, lo), np.full(n_rot, hi)
@@ -286,10 +303,14 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
             lows = np.array([_pwm_param(params, "MIN", i, 1000.0) for i in channels])
             highs = np.array([_pwm_param(params, "MAX", i, 2000.0) for i in channels])
             how = "actuator_outputs PWM mapped with the log's PWM_MAIN_MIN/MAX"
-        u_raw = (raw - lows) / (highs - lows)
+        signal = (raw - lows) / (highs - lows)
+        rel = factor * signal**2 + (1.0 - factor) * signal  # PX4's thrust model, THR_MDL_FAC
+        how += f", relative thrust through THR_MDL_FAC {factor:g}"
     else:
-        u_raw = raw
-        how = "actuator_motors (normalised)"
+        rel = raw
+        signal = _signal_of(rel, factor)
+        how = "actuator_motors (relative thrust)"
+    u_raw = signal if kind == "rad/s" else rel
 
     # airborne, armed
     t_status = times("vehicle_status")
@@ -326,11 +347,13 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
         )
     keep = segment >= 0
     t = grid[keep]
+    _check_values(path, topics, times, [rate_topic, accel_topic], t)
 
     att = topics["vehicle_attitude"]
     q_ned = np.column_stack([att[f"q[{i}]"] for i in range(4)]).astype(np.float64)
-    r_ned = Rotation.from_quat(q_ned[:, [1, 2, 3, 0]])
-    t_att, first = np.unique(times("vehicle_attitude"), return_index=True)
+    used_att = logchecks.bracket(times("vehicle_attitude"), t[0], t[-1])
+    r_ned = Rotation.from_quat(q_ned[used_att][:, [1, 2, 3, 0]])
+    t_att, first = np.unique(times("vehicle_attitude")[used_att], return_index=True)
     r_enu = (
         Rotation.from_matrix(NED_TO_ENU)
         * Slerp(t_att, r_ned[first])(np.clip(t, t_att[0], t_att[-1]))
@@ -357,6 +380,13 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
             @ FRD_TO_FLU.T
         )
     u = _interp(times(cmd_topic), u_raw, t)
+    if kind != "rad/s":
+        hint = (
+            f"the PWM is outside its range {lows.min():g}..{highs.max():g} us"
+            if cmd_topic == "actuator_outputs"
+            else "PX4's actuator_motors holds each rotor's relative thrust, in [0, 1]"
+        )
+        logchecks.check_duties(path, u, [f"{cmd_topic}.{c}" for c in cols], at=t, hint=hint)
 
     speeds = None
     esc = topics.get("esc_status")
@@ -369,6 +399,7 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
             "no esc_status topic with one esc_rpm per rotor"
         )
     rotors, km = _rotors(params, n_rot)
+    logchecks.check_geometry(path, rotors)
     hover = None
     if "hover_thrust_estimate" in topics:
         h = topics["hover_thrust_estimate"]
@@ -389,7 +420,7 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
         "vectors and commands interpolated linearly, "
         "attitude by slerp, arming and landed states held from their last message"
     )
-    names = ("MAV_TYPE", "THR_MDL_FAC", "CA_ROTOR_COUNT", "SYS_AUTOSTART", "SDLOG_PROFILE")
+    names = ("MAV_TYPE", "CA_ROTOR_COUNT", "SYS_AUTOSTART", "SDLOG_PROFILE")  # THR_MDL_FAC: applied here
     kept = {k: params[k] for k in names if k in params}
     return FlightLog(
         source=str(path),
@@ -406,10 +437,31 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
         parameters=kept,
         hover_thrust=hover,
         rates_hz=rates_hz,
-        commands=how + (" x w_max: commanded rotor speeds" if kind == "rad/s" else ""),
+        commands=how
+        + (f"; signal x (THR_MDL_FAC {factor:g}) x w_max: commanded rotor speeds" if kind == "rad/s" else ""),
         resampling=resampling,
         speeds=speeds,
+        thrust_factor=factor,
     )
+
+
+def _signal_of(rel: np.ndarray, factor: float) -> np.ndarray:
+    """PX4's signal x of a relative thrust through ``THR_MDL_FAC`` f: the root of ``f x^2 + (1 - f) x = rel``."""
+    if factor <= 0.0:
+        return rel.copy()
+    b = 1.0 - factor
+    return -b / (2.0 * factor) + np.sqrt(b * b / (4.0 * factor**2) + np.clip(rel, 0.0, None) / factor)
+
+
+def _check_values(path: Path, topics: dict, times, sources: list, t: np.ndarray) -> None:
+    """Refuse non-finite values and non-unit quaternions where the airborne stretch ``t`` reads them."""
+    att = topics["vehicle_attitude"]
+    q = np.column_stack([att[f"q[{i}]"] for i in range(4)]).astype(np.float64)
+    logchecks.check_quaternions(path, "vehicle_attitude", times("vehicle_attitude"), q, t[0], t[-1])
+    for name in ["vehicle_local_position", *(n for n in sources if n)]:
+        fields = NEEDED_FIELDS[name] if name != "sensor_combined" else SENSOR_FIELDS[name in sources[:1]]
+        columns = {f: topics[name][f] for f in fields}
+        logchecks.check_finite(path, name, times(name), columns, t[0], t[-1])
 
 
 def _pwm_param(params: dict, which: str, i: int, default: float) -> float:
@@ -489,6 +541,8 @@ def _read_csv(path: Path, frame: str, spec: tuple[str, float, float]) -> FlightL
             )
         table[name] = col
     t = table["t"].to_numpy(np.float64)
+    if len(t) < 3:
+        raise InputError(f"{path}: {len(t)} row(s): a flight log needs rows over at least {MIN_SEGMENT_S:g} s airborne")
     back = np.flatnonzero(np.diff(t) <= 0)
     if back.size:
         raise InputError(
@@ -507,16 +561,21 @@ def _read_csv(path: Path, frame: str, spec: tuple[str, float, float]) -> FlightL
             f"{path}: nothing to identify: no airborne stretch of {MIN_SEGMENT_S:g} s (landed column, or too few rows)"
         )
     kind, lo, hi = spec
-    u = table[[f"u{i + 1}" for i in range(n_rot)]].to_numpy()
+    u_names = [f"u{i + 1}" for i in range(n_rot)]
+    u = table[u_names].to_numpy()
     if kind == "pwm":
         if not np.isfinite(lo):
             raise InputError(f"{path}: a CSV's PWM commands need their range: commands='pwm:MIN:MAX'")
         u = (u - lo) / (hi - lo)
         how = f"CSV u columns, PWM mapped with {lo:g}..{hi:g} us"
+        logchecks.check_duties(
+            path, np.where(keep[:, None], u, 0.5), u_names, hint=f"outside the PWM range {lo:g}..{hi:g} us"
+        )
     elif kind == "rad/s":
         how = "CSV u columns (commanded rotor speeds, rad/s)"
     else:
         how = "CSV u columns (normalised)"
+        logchecks.check_duties(path, np.where(keep[:, None], u, 0.5), u_names)
     world = np.eye(3) if frame == "enu" else NED_TO_ENU
     body = np.eye(3) if frame == "enu" else FRD_TO_FLU
     q = table[["qw", "qx", "qy", "qz"]].to_numpy()

@@ -39,6 +39,7 @@ SIMULATION_FROM_META = {
     "log_every": "log_every",
     "max_track_error": "max_track_error",
     "max_steady_error": "max_steady_error",
+    "max_altitude_error": "max_altitude_error",
     "initial_state": "initial_state",
 }
 """Keys of a flight's meta and the [simulation] keys they become."""
@@ -91,7 +92,7 @@ def scenario_document(meta: dict, *, title: str = "") -> dict:
         doc["disturbances"] = disturbances
     simulation = {key: meta[k] for k, key in SIMULATION_FROM_META.items() if meta.get(k) is not None}
     if meta.get("log_every_chosen"):  # fly chose it (a batch's log within budget): it chooses it again,
-        simulation.pop("log_every", None)  # and checks every period, as a log_every given would not
+        simulation.pop("log_every", None)
     if meta.get("n", 1) != 1 and not any(isinstance(v, list) for v in (meta.get("vehicle") or {}).values()):
         simulation["n"] = meta["n"]
     if simulation:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from quadcruise.checks import describe
 from quadcruise.errors import InputError
 from quadcruise.metrics.tracking import STEADY_BAND
 
@@ -87,7 +88,9 @@ def metric_conventions(rise=(0.1, 0.9), settle_bands=(0.02, 0.05)) -> dict:
         levels = tuple(float(v) for v in rise)
         bands = tuple(float(b) for b in np.atleast_1d(np.asarray(settle_bands, dtype=float)))
     except (TypeError, ValueError):
-        raise InputError(f"rise levels and settle_bands must be numbers, got {rise!r}, {settle_bands!r}") from None
+        raise InputError(
+            f"rise levels and settle_bands must be numbers, got {describe(rise)}, {describe(settle_bands)}"
+        ) from None
     if len(bands) == 1:  # the second column: 5 %, or 2 % beside a first 5 %
         bands = bands + ((0.02,) if bands[0] == STEADY_BAND else (STEADY_BAND,))
     if len(bands) == 2 and bands[0] == bands[1]:

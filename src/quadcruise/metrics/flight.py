@@ -14,6 +14,7 @@ import numpy as np
 
 from quadcruise.errors import InputError
 from quadcruise.metrics.conventions import metric_conventions, settling_column
+from quadcruise.metrics.declared import metric_names
 from quadcruise.metrics.signals import control_effort, tracking_errors
 from quadcruise.metrics.step import StepInfo, step_info, transient_info
 from quadcruise.metrics.tracking import STEADY_BAND, TRANSIENT_MIN_ERROR, moving_reference, tracking_transient_batch
@@ -27,16 +28,10 @@ __all__ = [
 
 
 _AXIS_NAMES = ("x", "y", "z")
-FAILED_FLIGHT_METRICS = (
-    "rise_time_s",
-    "settling_time_s",
-    "overshoot_pct",
-    "peak_time_s",
-    "steady_rmse_m",
-    "steady_max_error_m",
-)
-"""The metrics (besides the second settling column) that are NaN for a flight that did not finish:
-a vehicle that lost its track has no transient or steady state to measure."""
+FAILED_FLIGHT_METRICS = metric_names(kind=("transient", "steady"))
+"""The metrics that are NaN for a flight that did not finish (those declared of kind
+``transient`` or ``steady``, :mod:`~quadcruise.metrics.declared`): a vehicle that lost its
+track has no transient or steady state to measure."""
 TRACKING_AXIS_NAME = "xyz"
 """The ``axis`` a moving reference's transient is measured on: the size of the 3-D error."""
 
@@ -182,7 +177,7 @@ def flight_metrics(
                 steady = (np.nan, np.nan) if settled is None else _steady_errors(t, pos, ref, t_step + settled)
             row["steady_rmse_m"], row["steady_max_error_m"] = steady
             if not result.ok[i]:  # lost or off track: no transient or steady state to speak of
-                row.update({key: np.nan for key in FAILED_FLIGHT_METRICS + (second,)})
+                row.update({key: np.nan for key in row if key in FAILED_FLIGHT_METRICS or key == second})
         if hover is not None:
             duties = result.commands[i, :, CMD_U1 : CMD_U1 + 4]
             row["effort"] = float(control_effort(t, duties - hover[i])["integral"])

@@ -17,9 +17,12 @@ rmse_m                  0.01234     2.000e-05
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
 
 import numpy as np
+
+from quadcruise.metrics.declared import metric as declared_metric
 
 __all__ = [
     "cell",
@@ -40,12 +43,6 @@ NO_TRANSIENT = "no transient"
 """A transient metric of a flight that started on its reference (the default square): nothing to measure."""
 NO_OVERSHOOT = "no overshoot"
 """The peak time of a moving reference's entry that never went below its steady level."""
-UNSETTLED_METRICS = ("settling", "steady_", "overshoot")
-"""Prefixes of the metrics that are missing because a measured transient did not settle."""
-TRANSIENT_METRICS = ("rise_time", "settling", "overshoot", "peak_time")
-"""Prefixes of the transient metrics."""
-FAILED_METRICS = TRANSIENT_METRICS + ("steady_",)
-"""Prefixes of the metrics a failed flight does not have."""
 
 
 def cell(value: Any, missing: str = "-") -> tuple[str, bool]:
@@ -127,18 +124,26 @@ def metric_cell(value: Any, metric: Any, axis: Any, missing: str = "-", status: 
     (('no transient', False), ('failed flight', False))
     """
     text, number = cell(value, missing)
-    if text != missing or not isinstance(metric, str):
+    declared = declared_metric(metric)  # its kind and its missing words: metrics/declared.py
+    if text != missing or declared is None:
         return text, number
-    if isinstance(status, str) and status != "finished" and metric.startswith(FAILED_METRICS):
+    if isinstance(status, str) and status != "finished" and declared.kind in ("transient", "steady"):
         return FAILED_FLIGHT, False
     measured = isinstance(axis, str) and bool(axis.strip())
-    if measured and metric.startswith(UNSETTLED_METRICS):
-        return DID_NOT_SETTLE, False
-    if measured and metric.startswith("peak_time"):
-        return NO_OVERSHOOT, False
-    if axis == "" and metric.startswith(TRANSIENT_METRICS):
+    if measured and declared.absent:
+        return declared.absent, False
+    if axis == "" and declared.kind == "transient":
         return NO_TRANSIENT, False
     return text, number
+
+
+def _short_status(status) -> str:
+    """A status as a table's cell: its kind (``off track``), not its reason, which is said in
+    full under the table (a reason of 130 characters padded every row of ``fly``'s table)."""
+    text = str(status)
+    kind = text.split(":", 1)[0].strip() or text
+    when = re.search(r" at t = \S+ s$", text) if kind != text else None
+    return kind + (when.group(0) if when else "")
 
 
 def metrics_text(frame, labels) -> str:
@@ -163,7 +168,10 @@ def metrics_text(frame, labels) -> str:
     statuses = frame["status"].tolist() if "status" in frame.columns else [None] * len(frame)
     shown = pd.DataFrame(
         {
-            label: [metric_cell(v, col, axis, status=status)[0] for col, v in row.items()]
+            label: [
+                _short_status(v) if col == "status" else metric_cell(v, col, axis, status=status)[0]
+                for col, v in row.items()
+            ]
             for label, axis, status, (_, row) in zip(labels, axes, statuses, frame.iterrows(), strict=False)
         },
         index=list(frame.columns),

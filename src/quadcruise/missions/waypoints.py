@@ -30,6 +30,7 @@ from typing import Any, ClassVar
 import numpy as np
 from numba import njit
 
+from quadcruise.checks import short_number
 from quadcruise.errors import InputError
 from quadcruise.fields import instance_of
 from quadcruise.fields import unit_field as _f
@@ -125,7 +126,7 @@ class WaypointTable:
         bad = np.argwhere(~np.isfinite(np.column_stack([c for _, c in named])))
         if bad.size:  # the first bad cell, row by row
             k, j = bad[0]
-            raise InputError(f"{where(k, named[j][0])}: value is not finite ({named[j][1][k]!r})")
+            raise InputError(f"{where(k, named[j][0])}: value is not finite ({short_number(named[j][1][k])})")
         if t is not None and t[0] != 0.0:
             raise InputError(f"{where(0, 't')}: the first arrival time must be 0, got {t[0]:g}")
         k = None if t is None else _after_first(np.diff(t) <= 0)

@@ -165,7 +165,12 @@ class RotorVehicle(Validated):
             raise InputError(
                 f"vehicle field 'w_max' ({self.w_max:g} rad/s) must be above 'w_min' ({self.w_min:g} rad/s)"
             )
-        lift, weight = self.n_rotors * self.kf * self.w_max**2, self.m * self.g
+        lift, weight = self.n_rotors * self.kf * self.w_max * self.w_max, self.m * self.g
+        if not (math.isfinite(self.w_max * self.w_max) and math.isfinite(lift)):  # w_max**2: an OverflowError
+            raise InputError(
+                f"vehicle field 'w_max' ({self.w_max:g} rad/s) is out of range: w_max^2 "
+                f"or {self.n_rotors} rotors x kf w_max^2 is not a finite number"
+            )
         if not lift > weight:
             raise InputError(
                 f"vehicle cannot lift itself: {self.n_rotors} rotors x kf w_max^2 = {lift:.4g} N, "
@@ -246,7 +251,7 @@ class RotorVehicle(Validated):
 
         The vehicle's command-to-speed map: PX4's normalised motor command with ``THR_MDL_FAC``
         = 1 (thrust kf w_max^2 duty^2, quadratic in the command), as ``to_ulog`` writes a rotor
-        flight's ``actuator_motors``.
+        flight's ``actuator_outputs`` (its ``actuator_motors``: the relative thrust duty^2).
 
         Parameters
         ----------

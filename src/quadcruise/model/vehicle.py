@@ -156,11 +156,16 @@ class Vehicle(Validated):
         ------
         InputError
             An unknown preset, a missing or bad file, an unknown key or a bad value, naming
-            the file and the key.
+            the file and the key; an ``ArgumentTypeError`` (one) for anything but text or a path.
         """
+        import os
+
+        from quadcruise import checks
         from quadcruise.model.rotor_vehicle import RotorVehicle
         from quadcruise.model.vehicle_files import load_vehicle
 
+        want = "a preset's name or the path of a vehicle file"
+        checks.instance("Vehicle.load()", "name_or_path", name_or_path, (str, os.PathLike), optional=False, want=want)
         return load_vehicle(name_or_path, {"paper": cls, "rotor": RotorVehicle})
 
     def replace(self, **changes: Any) -> Vehicle:

@@ -42,6 +42,7 @@ from pathlib import Path
 from typing import Any
 
 from quadcruise.errors import InputError
+from quadcruise.io.files import not_a_file
 
 PRESET_DIR = Path(__file__).with_name("preset_files")
 """Where the preset files are."""
@@ -170,7 +171,7 @@ def _read_table(path: Path) -> dict:
     if path.is_dir():
         raise InputError(f"{path}: is a folder, not a vehicle file")
     if not path.is_file():
-        raise InputError(f"{path}: no such file")
+        raise InputError(f"{path}: {not_a_file(path)}")
     try:
         doc = tomllib.loads(path.read_text(encoding="utf-8-sig"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
@@ -232,6 +233,11 @@ def vehicle_from_table(table: dict, plants: Mapping[str, type], where: str = "ve
         base.update(table)
         table = base
     plant = table.pop("plant", "rotor" if "rotors" in table else "paper")
+    if not isinstance(plant, str):
+        raise InputError(
+            f"{where}: [vehicle] 'plant' must be the name of a plant ({' or '.join(plants)}), got "
+            f"{type(plant).__name__} {plant!r}"
+        )
     if plant not in plants:
         raise InputError(
             f"{where}: [vehicle] 'plant' = {plant!r}: here the vehicle must be for the {' or '.join(plants)} plant"

@@ -16,6 +16,7 @@ from quadcruise.errors import InputError, WriteError
 from quadcruise.io.files import MARKER, atomic_dir, atomic_path, check_output_dir, write_table
 from quadcruise.io.plainjson import dumps
 from quadcruise.io.scenario_file import montecarlo_document, scenario_text
+from quadcruise.metrics.declared import metric
 from quadcruise.montecarlo.schema import engine_stops
 from quadcruise.montecarlo.store import holds_sweep, write_marker
 
@@ -83,10 +84,13 @@ def write_case(case, out, *, fmt: str = "csv", force: bool = False) -> Path:
 
 
 def case_text(case, seed: int) -> str:
-    """One line on a re-flown vehicle: its outcome and its main metrics."""
-    keys = ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "settling_time_5pct_s", "m")
-    return f"flight {case.vehicle} of seed {seed}: {case.row['reason']}, " + ", ".join(
-        f"{k} = {case.row[k]:.4g}" for k in keys
+    """One line on a re-flown vehicle: its status as ``fly`` says it (the same words and time
+    as the vehicle flown alone), the sweep's outcome, its main metrics and its mass (to 10
+    digits, to fly it alone: ``fly --vehicle m=...``)."""
+    keys = ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "settling_time_5pct_s")
+    return (
+        f"flight {case.vehicle} of seed {seed}: {case.result.status_text(0)} (the sweep's outcome: "
+        f"{case.row['reason']}), " + ", ".join(f"{k} = {case.row[k]:.4g}" for k in keys) + f", m = {case.row['m']:.10g}"
     )
 
 
@@ -107,8 +111,27 @@ def case_folder(out, spec, case: int, *, force: bool = False) -> Path | None:
     return target
 
 
+WORST_COLUMNS = (
+    "rmse_m",
+    "max_error_m",
+    "steady_rmse_m",
+    "steady_max_error_m",
+    "settling_time_5pct_s",
+    "stop_time_s",
+    "m",
+)
+"""The columns of report.md's worst flights (and of :func:`case_text`, but the stop time)."""
+
+
+def _missing(declared, measured: bool) -> str:
+    """A missing value of the worst flights' table: its declared words if a transient was measured."""
+    return declared.absent if declared is not None and declared.absent and measured else "-"
+
+
 def report_markdown(result, summary: dict, worst, table_name: str) -> str:
     """report.md: what was flown, the failures, the quantiles, the worst flights, figures."""
+    from quadcruise.plots.montecarlo import metric_label
+
     spec = result.spec
     pop = {k: v for k, v in spec.population.to_dict().items() if v not in (0.0, None)}
     f = summary["failures"]
@@ -181,23 +204,12 @@ def report_markdown(result, summary: dict, worst, table_name: str) -> str:
         "\n## Worst flights\n",
         "Fly one alone again: `quadcruise montecarlo <the same options> --case VEHICLE`, or in Python "
         "`quadcruise.montecarlo.montecarlo_case(spec, VEHICLE)`; it gives the same row.\n",
-        "| vehicle | reason | rmse [m] | max error [m] | steady rmse [m] | steady max error [m] "
-        "| settling 5 % [s] | stop [s] | m [kg] |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| vehicle | reason | " + " | ".join(metric_label(k) for k in WORST_COLUMNS) + " |",
+        "|---|---|" + "---|" * len(WORST_COLUMNS),
     ]
     for _, r in worst.head(10).iterrows():
-        unsettled = "did not settle" if r["transient_axis"] >= 0 else "-"
         cells = " | ".join(
-            (unsettled if k.startswith(("steady", "settling")) else "-") if not np.isfinite(r[k]) else f"{r[k]:.4g}"
-            for k in (
-                "rmse_m",
-                "max_error_m",
-                "steady_rmse_m",
-                "steady_max_error_m",
-                "settling_time_5pct_s",
-                "stop_time_s",
-                "m",
-            )
+            f"{r[k]:.4g}" if np.isfinite(r[k]) else _missing(metric(k), r["transient_axis"] >= 0) for k in WORST_COLUMNS
         )
         lines.append(f"| {int(r['vehicle'])} | {r['reason']} | {cells} |")
     info = result.info

@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from quadcruise.checks import describe
 from quadcruise.errors import ArgumentTypeError, InputError
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
@@ -93,8 +94,8 @@ ROTOR_SLOTS = {
 """The unit draw that perturbs each field of a rotor-plant vehicle: the paper slot of the same
 quantity (kf: K's, tau: omega's, km: d's); one draw for the body drag, one for the rotor terms."""
 CLIP = {"normal": 3.0, "uniform": math.sqrt(3.0)}
-"""Largest |unit draw|: normal draws are clipped at 3 sigma, uniform ones span +-sqrt(3)
-(unit standard deviation)."""
+"""Largest |unit draw|: normal draws are truncated at 3 sigma (a draw beyond is drawn again:
+:meth:`Population.unit_draws`), uniform ones span +-sqrt(3) (unit standard deviation)."""
 
 
 @dataclass(frozen=True)
@@ -106,11 +107,11 @@ class Population:
     mass_spread, inertia_spread, thrust_spread, bandwidth_spread, yaw_arm_spread : float
         Relative standard deviations of m; of Jxx, Jyy, Jzz (each drawn on its own); of the
         thrust gain K; of the rotor bandwidth omega; of the yaw moment arm d. A value is
-        ``nominal * (1 + spread * z)`` with z a unit draw: normal clipped to [-3, 3], or
+        ``nominal * (1 + spread * z)`` with z a unit draw: normal truncated to [-3, 3], or
         uniform on [-sqrt 3, sqrt 3]. So that every value stays positive a spread must be
         < 1/3 (normal) or < 1/sqrt 3 (uniform).
     offset : float
-        Standard deviation [m] of the initial position offset on each axis (same clipping).
+        Standard deviation [m] of the initial position offset on each axis (same truncation).
     wind_spread : float
         Standard deviation [m/s] of a steady horizontal wind on x and on y, drawn per vehicle
         and added to the environment's steady wind.
@@ -170,7 +171,7 @@ class Population:
             wrong_type = isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating))
             if wrong_type or not math.isfinite(value) or value < 0:
                 raise (ArgumentTypeError if wrong_type else InputError)(
-                    f"population field '{name}' must be a number >= 0, got {value!r}"
+                    f"population field '{name}' must be a number >= 0, got {describe(value)}"
                 )
             object.__setattr__(self, name, float(value))
             limit = 1.0 / CLIP[self.distribution]
@@ -267,8 +268,18 @@ class Population:
         Returns
         -------
         ndarray, shape (count, 16)
-            Unit draws [-]: standard normal clipped to [-3, 3], or uniform on
-            [-sqrt 3, sqrt 3]; column :data:`SLOTS` feeds each quantity.
+            Unit draws [-]: standard normal truncated to [-3, 3], or uniform on
+            [-sqrt 3, sqrt 3]; column :data:`SLOTS` feeds each quantity. A normal draw
+            beyond 3 sigma (0.27 % of them) is replaced, in column order, by the next draws of
+            the vehicle's stream that fall within: a clip would give each such vehicle the
+            same value, so that a 10,000-vehicle sweep held a dozen identical copies of the
+            +3 sigma vehicle.
+
+        Examples
+        --------
+        >>> z = Population(mass_spread=0.1).unit_draws(1, 0, 10_000)
+        >>> bool(np.abs(z).max() <= 3.0), len(np.unique(z[:, 0])) == 10_000
+        (True, True)
         """
         normal = self.distribution == "normal"
         ids = int(first) + np.arange(count) if np.ndim(first) == 0 else np.ravel(first)
@@ -277,7 +288,19 @@ class Population:
         # vehicle i: np.random.default_rng(np.random.SeedSequence([seed, i], spawn_key=(DRAW_KEY,))), bit for bit
         out = seeded_draws(seed, ids, DRAW_KEY, N_DRAWS, normal)
         clip = CLIP[self.distribution]
-        return np.clip(out, -clip, clip) if normal else clip * (2.0 * out - 1.0)
+        if not normal:
+            return clip * (2.0 * out - 1.0)
+        beyond = np.abs(out) > clip
+        for r in np.flatnonzero(beyond.any(axis=1)):  # truncated: drawn again from the same stream
+            slots, spare = np.flatnonzero(beyond[r]), N_DRAWS
+            while True:
+                more = seeded_draws(seed, ids[r : r + 1], DRAW_KEY, 2 * N_DRAWS + spare, True)[0, N_DRAWS:]
+                more = more[np.abs(more) <= clip]
+                if more.size >= slots.size:
+                    out[r, slots] = more[: slots.size]
+                    break
+                spare *= 2
+        return out
 
     @property
     def spreads_vehicle(self) -> bool:

@@ -51,9 +51,32 @@ def metric_hint(name: str) -> str:
     return f" (did you mean '{close}'?)" if close else ""
 
 
+_UNITS = ("_m", "_s", "_pct")
+
+
+def _base(metric: str) -> str:
+    """A metric's name without its unit: ``rise_time_s`` -> ``rise_time``."""
+    return next((metric[: -len(u)] for u in _UNITS if metric.endswith(u)), metric)
+
+
 def _closest(name: str) -> str | None:
-    close = difflib.get_close_matches(str(name), METRICS, n=1)
-    return close[0] if close else None
+    """The metric a mistyped or shortened name most likely means: the one whose name (less its unit)
+    it begins, the shortest of them (``rise`` -> ``rise_time_s``, ``settling`` -> ``settling_time_s``,
+    ``overshoot`` -> ``overshoot_pct``), else the closest spelling (``rmse`` -> ``rmse_m``).
+
+    Examples
+    --------
+    >>> [_closest(n) for n in ("rise", "settling", "Overshoot", "peak-time", "rmse", "steady_max_eror", "zzz")]
+    ['rise_time_s', 'settling_time_s', 'overshoot_pct', 'peak_time_s', 'rmse_m', 'steady_max_error_m', None]
+    """
+    word = str(name).strip().lower().replace("-", "_").replace(" ", "_")
+    if word in METRICS:
+        return word
+    bases = {_base(m): m for m in METRICS}
+    if word and (begun := [b for b in bases if b == _base(word) or b.startswith(word)]):
+        return bases[min(begun, key=len)]
+    close = difflib.get_close_matches(_base(word), list(bases), n=1) or difflib.get_close_matches(word, METRICS, n=1)
+    return bases.get(close[0], close[0]) if close else None
 
 
 def check_metric(where: str, name: str, value: Any) -> str:

@@ -17,6 +17,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from quadcruise.errors import InputError
+from quadcruise.metrics.declared import metric
 from quadcruise.metrics.summary import Summary
 from quadcruise.montecarlo.schema import COLUMNS, FAILURES, METRICS, engine_stops
 from quadcruise.montecarlo.spec import MonteCarloSpec
@@ -247,7 +248,8 @@ class MonteCarloResult:
         """The k worst flights.
 
         Failures come first (diverged, earliest stop first; then lost track, saturated,
-        failed a requirement), then the flights by ``by``, largest first.
+        failed a requirement), then the flights by ``by``, worst first (largest first, smallest
+        for a metric declared ``better="higher"``, :mod:`quadcruise.metrics.declared`).
 
         Parameters
         ----------
@@ -274,6 +276,8 @@ class MonteCarloResult:
         rank = (len(FAILURES) - np.arange(len(FAILURES))) % len(FAILURES)  # 0 for ok, diverged highest
         rank = rank[tab["failure"].to_numpy()]
         value = tab[by].to_numpy(dtype=float)
+        if (declared := metric(by)) is not None and declared.better == "higher":
+            value = -value  # the worst of a higher-is-better metric is its smallest
         stop = np.where(tab["failure"].to_numpy() == 1, tab["stop_time_s"].to_numpy(), 0.0)
         order = np.lexsort((tab["vehicle"].to_numpy(), np.nan_to_num(-value, nan=np.inf), stop, -rank))
         out = tab.iloc[order[:k]].copy()

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from quadcruise.metrics.declared import metric_names
 from quadcruise.montecarlo.population import SLOTS
 
 __all__ = ["COLUMNS", "FAILURES", "METRICS", "engine_stops"]
@@ -15,23 +16,9 @@ stopped the flight; its error after the transient exceeded the spec's ``max_trac
 its rotor duties were clipped for longer than ``max_clipped_s``; it missed one of the
 spec's ``requirements``. A transient that did not settle is a metric (``not_settled``),
 not a failure."""
-METRICS = (
-    "rmse_m",
-    "max_error_m",
-    "steady_rmse_m",
-    "steady_max_error_m",
-    "final_error_m",
-    "rise_time_s",
-    "settling_time_s",
-    "settling_time_5pct_s",
-    "overshoot_pct",
-    "peak_time_s",
-    "effort",
-    "duty_clipped_s",
-    "controller_limited_s",
-)
+METRICS = metric_names()
 """The metrics summarised by quantiles (NaN where not applicable is left out), and those a
-requirement may name."""
+requirement may name: every metric declared in :mod:`quadcruise.metrics.declared`."""
 COLUMNS = {
     "vehicle": np.int64,
     "status": np.int64,

@@ -24,6 +24,7 @@ from typing import Any
 
 from quadcruise._cache import code_digest
 from quadcruise._version import __version__
+from quadcruise.checks import describe
 from quadcruise.control import CONTROLLERS, as_controller, controller_record
 from quadcruise.errors import InputError, whole_number
 from quadcruise.io.plainjson import dumps
@@ -67,8 +68,8 @@ class MonteCarloSpec:
     vehicle : Vehicle, RotorVehicle or str
         The nominal vehicle (Table I), or a preset's name (``"iris"``); given drag if the population meets wind. A
         :class:`~quadcruise.model.rotor_vehicle.RotorVehicle` flies the rotor-speed plant (its
-        fields perturbed as :mod:`quadcruise.montecarlo.population` says; no start ``offset``,
-        no ``full_dynamics``; wind only on a vehicle with aerodynamics).
+        fields perturbed as :mod:`quadcruise.montecarlo.population` says; a start ``offset``
+        moves its hover; no ``full_dynamics``; wind only on a vehicle with aerodynamics).
     controller_vehicle : Vehicle, RotorVehicle or str, optional
         The vehicle every controller believes it flies (its model), of the nominal's plant;
         None: the nominal ``vehicle`` (or, with the population's ``model_error`` False, each
@@ -196,23 +197,23 @@ class MonteCarloSpec:
         for name in ("log_dt", "trace_dt", "settle_band"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise InputError(f"{name} must be a positive number, got {value!r}")
+                raise InputError(f"{name} must be a positive number, got {describe(value)}")
         if not 0 < self.settle_band < 1:
-            raise InputError(f"settle_band must be a fraction in (0, 1), got {self.settle_band!r}")
+            raise InputError(f"settle_band must be a fraction in (0, 1), got {describe(self.settle_band)}")
         if not (math.isfinite(self.max_clipped_s) and self.max_clipped_s >= 0):
-            raise InputError(f"max_clipped_s must be >= 0, got {self.max_clipped_s!r}")
+            raise InputError(f"max_clipped_s must be >= 0, got {describe(self.max_clipped_s)}")
         for name in ("max_traces", "max_failure_traces"):
             if int(getattr(self, name)) != getattr(self, name) or getattr(self, name) < 0:
-                raise InputError(f"{name} must be a whole number >= 0, got {getattr(self, name)!r}")
+                raise InputError(f"{name} must be a whole number >= 0, got {describe(getattr(self, name))}")
         object.__setattr__(self, "requirements", as_requirements(self.requirements, "MonteCarloSpec()"))
         bound = steady_bound(self.mission, self.duration) if self.max_track_error_m is None else self.max_track_error_m
         if isinstance(bound, bool) or not (isinstance(bound, (int, float)) and math.isfinite(bound) and bound > 0):
-            raise InputError(f"max_track_error_m must be a positive number [m], got {bound!r}")
+            raise InputError(f"max_track_error_m must be a positive number [m], got {describe(bound)}")
         zbound = self.max_altitude_error_m
         if zbound is None:
             zbound = altitude_bound(self.mission, self.duration) if self.max_track_error_m is None else bound
         if isinstance(zbound, bool) or not (isinstance(zbound, (int, float)) and math.isfinite(zbound) and zbound > 0):
-            raise InputError(f"max_altitude_error_m must be a positive number [m], got {zbound!r}")
+            raise InputError(f"max_altitude_error_m must be a positive number [m], got {describe(zbound)}")
         object.__setattr__(self, "max_track_error_m", float(bound))
         object.__setattr__(self, "max_altitude_error_m", float(zbound))
         if self.population.needs_drag and not self.rotor:
@@ -233,13 +234,11 @@ class MonteCarloSpec:
                 "vehicle and controller_vehicle must be of one plant: a RotorVehicle flown with a "
                 "RotorVehicle as the controller's model, or a paper Vehicle with a paper Vehicle"
             )
-        for name, bad in (("offset", self.population.offset > 0), ("full_dynamics", self.full_dynamics)):
-            if bad:
-                raise InputError(
-                    f"{'population field' if name == 'offset' else 'MonteCarloSpec field'} '{name}': not for a "
-                    "rotor-plant vehicle (it starts hovering at the mission's start; its plant has no "
-                    "Euler-angle kinematics to choose)"
-                )
+        if self.full_dynamics:
+            raise InputError(
+                "MonteCarloSpec field 'full_dynamics': not for a rotor-plant vehicle (its plant has no "
+                "Euler-angle kinematics to choose: it flies the quaternion)"
+            )
         believed = self.controller_vehicle or self.vehicle
         if believed.n_rotors != self.vehicle.n_rotors:
             raise InputError(

@@ -30,7 +30,7 @@ import numpy as np
 from quadcruise._cache import code_digest
 from quadcruise._version import __version__
 from quadcruise.errors import InputError, WriteError
-from quadcruise.io.files import MARKER, atomic_path, check_output_dir, read_marker
+from quadcruise.io.files import MARKER, atomic_path, check_output_dir, open_regular, read_marker
 from quadcruise.io.plainjson import dumps
 from quadcruise.montecarlo.schema import COLUMNS
 from quadcruise.montecarlo.spec import MonteCarloSpec
@@ -56,7 +56,7 @@ TRACES = ("trace_vehicle", "trace_sample", "trace_t", "trace_pos", "trace_ref")
 
 def _load_chunk(path: Path) -> dict:
     """The arrays of one chunk file; ValueError or OSError if it is not a whole .npz archive."""
-    with open(path, "rb") as f:  # closed whatever np.load makes of it
+    with open_regular(path) as f:  # closed whatever np.load makes of it; a FIFO is refused, not waited on
         if f.read(4) not in (b"PK\x03\x04", b"PK\x05\x06"):
             raise ValueError("not an .npz archive")
         f.seek(0)

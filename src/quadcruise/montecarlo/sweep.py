@@ -37,6 +37,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from quadcruise.checks import describe
 from quadcruise.errors import InputError, SimulationError, WriteError, whole_number
 from quadcruise.io.files import check_table_format
 from quadcruise.montecarlo.chunk import fly_chunk, reduce_chunk, run_chunk, sweep_metrics
@@ -347,10 +348,10 @@ def run_sweep(
     if chunk_size != "auto" and (
         isinstance(chunk_size, bool) or not isinstance(chunk_size, (int, np.integer)) or chunk_size < 1
     ):
-        raise InputError(f"chunk size must be a whole number >= 1 or 'auto', got {chunk_size!r}")
+        raise InputError(f"chunk size must be a whole number >= 1 or 'auto', got {describe(chunk_size)}")
     workers = None if workers is None else whole_number(workers, "workers", 1)
     if not (isinstance(connect_timeout, (int, float)) and math.isfinite(connect_timeout) and connect_timeout > 0):
-        raise InputError(f"connect_timeout must be a positive number of seconds, got {connect_timeout!r}")
+        raise InputError(f"connect_timeout must be a positive number of seconds, got {describe(connect_timeout)}")
     check_table_format(fmt)
     mode = _scheduler(scheduler)
     folder = SweepFolder(out, spec, force=force, resume=resume) if out is not None else None

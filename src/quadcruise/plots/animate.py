@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from quadcruise.checks import describe
 from quadcruise.errors import InputError, SimulationError
 from quadcruise.io.files import atomic_path
 from quadcruise.plots.thin import thinned
@@ -72,12 +73,12 @@ def _frame_indices(t: np.ndarray, end: int, fps: float, duration_s, every) -> np
     """Logged instant shown in each frame."""
     if every is not None:
         if int(every) != every or every < 1:
-            raise InputError(f"every must be a positive integer, got {every!r}")
+            raise InputError(f"every must be a positive integer, got {describe(every)}")
         return np.arange(0, end, int(every))
     span = float(t[end - 1] - t[0])
     duration_s = span if duration_s is None else float(duration_s)
     if not np.isfinite(duration_s) or duration_s <= 0:
-        raise InputError(f"duration_s must be positive, got {duration_s!r}")
+        raise InputError(f"duration_s must be positive, got {describe(duration_s)}")
     n = max(2, int(round(fps * duration_s)))
     times = np.linspace(t[0], t[end - 1], n)
     return np.clip(np.searchsorted(t[:end], times, side="right") - 1, 0, end - 1)
@@ -114,7 +115,7 @@ def animate_flight(
     if not 0 <= vehicle < result.n:
         raise InputError(f"vehicle {vehicle} is not in this result of {result.n} vehicle(s)")
     if not (np.isfinite(fps) and fps > 0):
-        raise InputError(f"fps must be positive, got {fps!r}")
+        raise InputError(f"fps must be positive, got {describe(fps)}")
     t = result.t
     pos, ref = result.states[vehicle, :, :3], result.references[vehicle, :, :3]
     psi = result.state("psi")[vehicle]

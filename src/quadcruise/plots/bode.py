@@ -100,8 +100,13 @@ def plot_bode(
         axes[1, col].set_ylim(low, high)
         handles, labels = axes[0, col].get_legend_handles_labels()
         keep = [(h, lb) for h, lb in zip(handles, labels, strict=False) if not lb.startswith(("PM ", "GM "))]
-        axes[0, col].legend(
-            *zip(*keep, strict=False), fontsize=7 if col else 8, loc="upper right" if col else "lower left"
+        # under the figure, below the axes and their labels: inside the axes, the margins' long
+        # labels covered the magnitude axis and its curves; constrained layout makes room for it
+        fig.legend(
+            *zip(*keep, strict=False),
+            fontsize=7 if col else 8,
+            loc="outside lower " + ("center" if axes.shape[1] == 1 else "right" if col else "left"),
+            ncols=1 if col or axes.shape[1] == 1 else 2,
         )
         for ax in axes[:, col]:
             ax.grid(True, which="both", alpha=0.3)

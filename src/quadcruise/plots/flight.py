@@ -250,6 +250,7 @@ def plot_flight(result, vehicle: int = 0, *, title: str | None = None) -> Figure
     for ax in (ax_e, ax_u):
         if ax.get_legend_handles_labels()[0]:
             _legend(ax, loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0)
+    _room_for_legends(fig, gs, [ax.get_legend() for ax in (ax_e, ax_u) if ax.get_legend() is not None])
     for ax in (pos_axes[2], att_axes[2], ax_u):
         ax.set_xlabel("time [s]")
     for ax in pos_axes[:2] + att_axes[:2] + [ax_e]:
@@ -261,6 +262,28 @@ def plot_flight(result, vehicle: int = 0, *, title: str | None = None) -> Figure
             title += f"\n{result.status_text(vehicle)}"
     fig.suptitle(title, color="tab:red" if stopped else "k")
     return fig
+
+
+def _room_for_legends(fig, gs, legends) -> None:
+    """Narrow the grid so that the legends right of the wide panels fit in the figure: they are
+    measured (their text only, not the figure drawn), since their labels (a clipped duty, a
+    gust, a rotor's loss) vary; ``FLIGHT_MARGINS["right"]`` is kept when they fit."""
+    if not legends:
+        return
+    get = getattr(fig.canvas, "get_renderer", None)
+    if get is None:
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+        get = FigureCanvasAgg(fig).get_renderer
+    renderer = get()
+    width = max(legend.get_window_extent(renderer).width for legend in legends) / fig.bbox.width
+    right = min(FLIGHT_MARGINS["right"], 0.99 - width - 0.005 * (FLIGHT_MARGINS["right"] - FLIGHT_MARGINS["left"]))
+    if right < FLIGHT_MARGINS["right"]:
+        gs.update(right=right)
+        for ax in fig.axes:  # GridSpec.update moves only the axes of pyplot's figures
+            spec = ax.get_subplotspec()
+            if spec is not None and spec.get_gridspec() is gs:
+                ax.set_position(spec.get_position(fig))
 
 
 def _duties(ax, result, vehicle: int, spans: dict, min_width: float) -> None:

@@ -15,32 +15,18 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
+from quadcruise.metrics.declared import METRICS as DECLARED_METRICS
+from quadcruise.metrics.declared import metric_names
+
 __all__ = ["plot_histograms", "plot_envelope", "metric_label", "degenerate", "METRIC_LABELS"]
 
 
-HISTOGRAM_METRICS = (
-    "rmse_m",
-    "max_error_m",
-    "final_error_m",
-    "rise_time_s",
-    "settling_time_5pct_s",
-    "overshoot_pct",
-    "effort",
-    "duty_clipped_s",
-)
-"""The metrics :func:`plot_histograms` draws by default."""
+HISTOGRAM_METRICS = metric_names(histogram=True)
+"""The metrics :func:`plot_histograms` draws by default (declared ``histogram=True`` in
+:mod:`quadcruise.metrics.declared`)."""
 
 METRIC_LABELS = {
-    "rmse_m": "RMSE [m]",
-    "max_error_m": "max error [m]",
-    "final_error_m": "final error [m]",
-    "rise_time_s": "rise time [s]",
-    "settling_time_s": "settling time 2 % [s]",
-    "settling_time_5pct_s": "settling time 5 % [s]",
-    "overshoot_pct": "overshoot [%]",
-    "effort": "effort [s]",
-    "duty_clipped_s": "duty clipped [s]",
-    "controller_limited_s": "controller limited [s]",
+    **{m.name: m.axis_label for m in DECLARED_METRICS},
     "stop_time_s": "stop time [s]",
     "m": "mass [kg]",
     "dx0": "start offset x [m]",
@@ -85,10 +71,15 @@ def degenerate(values: np.ndarray, n: int) -> str | None:
 
 
 def plot_histograms(result, metrics=None):
-    """Histograms of a sweep's metrics and a bar chart of its outcomes."""
+    """Histograms of a sweep's metrics over the flights that kept track (those the summary's
+    quantiles are over: a flight that diverged or lost track is left out, so that its numbers
+    do not pass for a good flight's), and a bar chart of every flight's outcome."""
     names = list(HISTOGRAM_METRICS if metrics is None else metrics)
-    columns = {name: result.table[name].to_numpy(dtype=float) for name in names}
-    skipped = {name: why for name in names if (why := degenerate(columns[name], result.n))}
+    tab = result.table
+    kept = ~(tab["diverged"].to_numpy(dtype=bool) | tab["lost_track"].to_numpy(dtype=bool))
+    n_kept = int(np.count_nonzero(kept))
+    columns = {name: tab[name].to_numpy(dtype=float)[kept] for name in names}
+    skipped = {name: why for name in names if (why := degenerate(columns[name], n_kept))}
     panels = [name for name in names if name not in skipped] + ["failures"]
     cols = min(3, len(panels))
     rows = math.ceil(len(panels) / cols)
@@ -115,10 +106,12 @@ def plot_histograms(result, metrics=None):
         ax.hist(v, bins=40, color="tab:blue", alpha=0.8)
         for q, style in zip(np.percentile(v, [5, 50, 95]), (":", "-", ":"), strict=False):
             ax.axvline(q, color="k", ls=style, lw=1.0)
-        missing = result.n - v.size
+        missing = n_kept - v.size
         ax.set_title(f"{name}  (n = {v.size:,}" + (f", {missing:,} n/a)" if missing else ")"), fontsize="medium")
         ax.set(xlabel=metric_label(name), ylabel="flights")
         ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=5))  # small values (effort ~0.002 s) in powers of ten:
+        ax.ticklabel_format(axis="x", style="sci", scilimits=(-2, 4), useMathText=True)  # no overlap
         ax.grid(True, alpha=0.3)
     for ax in axes[len(panels) :]:
         ax.set_visible(False)
@@ -129,9 +122,12 @@ def plot_histograms(result, metrics=None):
             fontsize="small",
             color="0.3",
         )
+    left_out = result.n - n_kept
     fig.suptitle(
         f"{result.spec.controller.name} on {result.spec.mission.name}: {result.n:,} flights, seed "
-        f"{result.spec.seed} (lines: 5 %, median, 95 %)"
+        f"{result.spec.seed}; metrics of the {n_kept:,} that kept track"
+        + (f" ({left_out:,} that diverged or lost track left out)" if left_out else "")
+        + " (lines: 5 %, median, 95 %)"
     )
     return fig
 

@@ -131,6 +131,45 @@ def comparison_report(cmp, *, title: str | None = None, **metric_kw) -> dict:
     }
 
 
+def _fitted_table(rep):
+    """The fit scenario's flights, the paper's gains and the fitted ones, with both rise conventions
+    beside the paper's numbers (report.md's fitted table, as data); empty if it was not flown."""
+    import pandas as pd
+
+    from quadcruise.workflows.reproduce import CONTROLLERS, FIT_SCENARIO, FITTED, paper_numbers
+
+    factories = {**CONTROLLERS, **FITTED}
+    rows = []
+    for r in rep.runs:
+        if r["scenario"] != FIT_SCENARIO[0]:
+            continue
+        gains, paper = factories[r["controller"]]().position, paper_numbers(r)
+        rows.append(
+            {
+                "controller": r["controller"],
+                "fitted": "yes" if r["fitted"] else "no",
+                "Kp": gains.kp,
+                "Kd": gains.kd,
+                "zeta": gains.damping,
+                "wn_rad_s": gains.natural_frequency,
+                "rise_time_s": r["rise_time_s"],
+                "rise_0_100_s": r.get("rise_0_100_s"),
+                "paper: rise_time_s": paper.get("rise_time_s"),
+                "settling_time_s": r["settling_time_s"],
+                "paper: settling_time_s": paper.get("settling_time_s"),
+                "overshoot_pct": r["overshoot_pct"],
+                "paper: overshoot_pct": paper.get("overshoot_pct"),
+                "status": r["status"],
+            }
+        )
+    if not rows:
+        return pd.DataFrame()
+    return pd.DataFrame(rows).set_index("controller").astype({c: float for c in rows[0] if c.endswith(NUMERIC)})
+
+
+NUMERIC = ("_s", "_pct", "Kp", "Kd", "zeta")
+
+
 def reproduction_report(rep, figures: dict | None = None, *, title: str | None = None) -> dict:
     """Keywords of :func:`html_report` for a :class:`~quadcruise.workflows.reproduce.Reproduction`.
 
@@ -148,7 +187,8 @@ def reproduction_report(rep, figures: dict | None = None, *, title: str | None =
     Returns
     -------
     dict
-        ``title``, ``tables`` (each run beside the paper's numbers), ``figures``,
+        ``title``, ``tables`` (each run beside the paper's numbers; the fit scenario's gains and
+        both rise conventions, when it was flown), ``figures``,
         ``flights`` (3-D views of the circle and the square, each with every controller),
         ``config`` and ``notes`` (where the numbers differ from the paper's, and why).
     """
@@ -157,6 +197,7 @@ def reproduction_report(rep, figures: dict | None = None, *, title: str | None =
     from quadcruise._version import __version__
     from quadcruise.workflows.reproduce import (
         FIGURES,
+        FITTED_NOTE,
         INTRO,
         TRACE_EVERY,
         baseline_comparison,
@@ -194,10 +235,16 @@ def reproduction_report(rep, figures: dict | None = None, *, title: str | None =
         light = {key: res.decimate(TRACE_EVERY) for key, res in rep.results.items()}
         figures = {cap: fig for name, cap in FIGURES.items() if (fig := paper_figure(name, cap, light)) is not None}
     flights = {scen: {c: res for (s, c), res in rep.results.items() if s == scen} for scen in ("circle", "square")}
-    notes = markdown_html(INTRO + "\n" + differences() + baseline_comparison(rep))
+    fitted = _fitted_table(rep)
+    notes = markdown_html(
+        INTRO + "\n" + (FITTED_NOTE if len(fitted) else "") + differences() + baseline_comparison(rep)
+    )
     return {
         "title": title or f"quadcruise {__version__}: reproduction of the paper",
-        "tables": {"Results against the paper": table},
+        "tables": {
+            "Results against the paper": table,
+            **({"Fitted to the paper's transients (both rise conventions)": fitted} if len(fitted) else {}),
+        },
         "figures": figures,
         "flights": {k: v for k, v in flights.items() if v},
         "config": {"workflow": "reproduce", **rep.config, "version": __version__},

@@ -56,6 +56,7 @@ def simulate_watched(
     meta: dict | None = None,
     chunk_vehicle_steps: int | None = None,
     pieces_per_thread: int | None = None,
+    rotor_names: tuple[str, ...] = (),
     **options,
 ) -> SimResult:
     """:func:`~quadcruise.sim.engine.simulate`, flown in chunks, with every instant's state and
@@ -81,16 +82,20 @@ def simulate_watched(
     pieces_per_thread : int, optional
         Ranges of vehicles per thread and chunk, each watched and logged by its thread right
         after it is flown; :data:`PIECES_PER_THREAD` by default.
+    rotor_names : tuple of str
+        The rotor plant's state names (with ``alloc``: the result's ``rotor_names``).
     **options
         The other keywords of :func:`~quadcruise.sim.engine.simulate` (``memory``, ``vp_ctrl``,
         ``disturbance``, ``disturbance_params``, ``disturbance_memory``, ``seed``,
         ``first_vehicle``, ``sensor_std``, ``sensor_delay``, ``full_dynamics``, ``max_step``,
-        ``limits``).
+        ``limits``); or, for the rotor plant, :class:`~quadcruise.sim.stepper.Stepper`'s
+        (``alloc``, ``psi0``, ``touchdown_speed``; ``vp`` the rotor parameter rows).
 
     Returns
     -------
     SimResult
-        Bit for bit what ``simulate(..., log_every=log_every)`` returns.
+        Bit for bit what ``simulate(..., log_every=log_every)`` returns (for the rotor plant,
+        :func:`~quadcruise.sim.rotor_batch.fly_rotor_vehicles`'s, its rotor states too).
     """
     n_periods = np.shape(t_grid)[0] - 1
     n = np.shape(vp)[0]
@@ -100,8 +105,9 @@ def simulate_watched(
     s = Stepper(t_grid, x0, vp, controller, gains, mission, mp, periods=periods, **options)
     t_grid = s.t_grid
     n_log = n_periods // log_every + 1
-    logs = [np.empty((n, n_log, w)) for w in (STATE_SIZE, CMD_SIZE, REF_SIZE)]  # every row is written below
-    small = (s.log_x, s.log_cmd, s.log_ref)
+    widths = (STATE_SIZE, CMD_SIZE, REF_SIZE) + ((s.state.shape[1],) if s.rotor else ())
+    logs = [np.empty((n, n_log, w)) for w in widths]  # every row is written below
+    small = (s.log_x, s.log_cmd, s.log_ref) + ((s.log_rotor,) if s.rotor else ())
     held = None  # the row after the chunk of vehicles that stopped in its last period, and where it goes
     k0 = 0
     while k0 < n_periods:
@@ -132,13 +138,16 @@ def simulate_watched(
         if k1 < n_periods and k1 % log_every == 0 and stopped.size:  # the state that broke a bound, at k1
             held = [(stopped, k1 // log_every, part[stopped, k1 - k0].copy()) for part in small]
         k0 = k1
-    log_x, log_cmd, log_ref = logs
+    log_x, log_cmd, log_ref = logs[:3]
+    rotor = {}
+    if s.rotor:  # the rotor plant's own state, logged and final
+        rotor = {"rotor_states": logs[3], "rotor_final_state": s.state, "rotor_names": tuple(rotor_names)}
     return SimResult(
         t=t_grid[::log_every][:n_log].copy(),
         states=log_x,
         commands=log_cmd,
         references=log_ref,
-        final_state=s.state,
+        final_state=s.paper_state,
         status=s.status,
         t_stop=s.t_stop,
         memory=s.memory,
@@ -146,7 +155,67 @@ def simulate_watched(
         duty_clipped_s=s.saturated[:, 0].copy(),
         controller_limited_s=s.saturated[:, 1].copy(),
         meta=dict(meta or {}),
+        **rotor,
     )
 
 
-__all__ = ["CHUNK_VEHICLE_STEPS", "simulate_watched"]
+def watch_again(
+    t_grid,
+    x0,
+    vp,
+    controller,
+    gains,
+    mission,
+    mp,
+    *,
+    vehicles: np.ndarray,
+    periods: int,
+    watch: Callable[[int, int, int, np.ndarray, np.ndarray], None],
+    chunk_vehicle_steps: int | None = None,
+    pieces_per_thread: int | None = None,
+    **options,
+) -> None:
+    """The first instants of some vehicles of a flight flown again, bit for bit as
+    :func:`simulate_watched` flew them, each chunk's rows handed to ``watch``; nothing logged.
+
+    The other vehicles are stopped before the first period (the kernel passes over them), and
+    each vehicle's arithmetic does not depend on the others, nor on how the flight is cut.
+
+    Parameters
+    ----------
+    t_grid, x0, vp, controller, gains, mission, mp
+        As the flight's (:func:`simulate_watched`).
+    vehicles : numpy.ndarray
+        (N,) bool: the vehicles to fly again.
+    periods : int
+        Fly until at least the instants ``0 .. periods - 1`` have been watched.
+    watch : callable
+        As in :func:`simulate_watched` (the rows of the other vehicles are NaN).
+    chunk_vehicle_steps, pieces_per_thread : int, optional
+        As in :func:`simulate_watched`.
+    **options
+        As in :func:`simulate_watched` (``log_every`` and ``meta`` are not used).
+    """
+    options.pop("log_every", None), options.pop("meta", None), options.pop("rotor_names", None)
+    n_periods = np.shape(t_grid)[0] - 1
+    n = np.shape(vp)[0]
+    chunk_vehicle_steps = chunk_vehicle_steps or CHUNK_VEHICLE_STEPS
+    pieces_per_thread = pieces_per_thread or PIECES_PER_THREAD
+    chunk = int(max(1, min(n_periods, chunk_vehicle_steps // max(n, 1), periods)))  # the buffer holds all N
+    s = Stepper(t_grid, x0, vp, controller, gains, mission, mp, periods=chunk, **options)
+    s.status[~np.asarray(vehicles, dtype=bool)] = int(ExitStatus.LOST_TRACK)  # not flown
+    k0 = 0
+    while k0 < periods and (s.status == int(ExitStatus.FINISHED)).any():
+        k1 = min(k0 + chunk, n_periods)
+        seen = k1 - k0 + (k1 == n_periods)
+
+        def after_piece(lo: int, hi: int, k0=k0, seen=seen) -> None:
+            watch(k0, lo, hi, s.log_x[:, :seen], s.log_ref[:, :seen])
+
+        s.step(after_piece=after_piece, pieces_per_thread=pieces_per_thread)
+        if k1 >= n_periods:
+            break
+        k0 = k1
+
+
+__all__ = ["CHUNK_VEHICLE_STEPS", "simulate_watched", "watch_again"]

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from quadcruise import checks
+from quadcruise.checks import describe
 from quadcruise.errors import InputError
 from quadcruise.layout import STATE_SIZE
 from quadcruise.sim.rng import vehicle_states
@@ -137,9 +138,9 @@ def time_grid(duration: float, dt: float, t0: float = 0.0) -> np.ndarray:
     [0.0, 0.001, 0.002, 0.003]
     """
     if not (math.isfinite(duration) and duration > 0):
-        raise InputError(f"duration must be a positive number of seconds, got {duration!r}")
+        raise InputError(f"duration must be a positive number of seconds, got {describe(duration)}")
     if not (math.isfinite(dt) and dt > 0):
-        raise InputError(f"dt must be a positive number of seconds, got {dt!r}")
+        raise InputError(f"dt must be a positive number of seconds, got {describe(dt)}")
     if dt > duration:
         raise InputError(f"dt ({dt:g} s) is larger than the duration ({duration:g} s)")
     if duration / dt > MAX_STEPS:
@@ -211,9 +212,9 @@ def batch_inputs(
     if not np.all(np.isfinite(t_grid)) or np.any(np.diff(t_grid) <= 0):
         raise InputError("the time grid must be finite and strictly increasing")
     if not (math.isfinite(max_step) and max_step > 0):
-        raise InputError(f"max_step must be a positive number of seconds, got {max_step!r}")
+        raise InputError(f"max_step must be a positive number of seconds, got {describe(max_step)}")
     if int(log_every) != log_every or log_every < 1:
-        raise InputError(f"log_every must be a positive integer, got {log_every!r}")
+        raise InputError(f"log_every must be a positive integer, got {describe(log_every)}")
     vp = np.ascontiguousarray(vp, dtype=float)
     n = vp.shape[0]
     x0 = _batch("initial state", x0, n, STATE_SIZE)
@@ -229,7 +230,7 @@ def batch_inputs(
     if not np.all(np.isfinite(std)) or np.any(std < 0):
         raise InputError("sensor noise standard deviations must be finite and >= 0")
     if int(sensor_delay) != sensor_delay or sensor_delay < 0:
-        raise InputError(f"sensor delay must be a whole number of periods >= 0, got {sensor_delay!r}")
+        raise InputError(f"sensor delay must be a whole number of periods >= 0, got {describe(sensor_delay)}")
     # the random streams, when anything draws from them (SeedSequence: ~25 us a vehicle)
     disturbed = disturbance is not None
     drawn = disturbed or bool(np.any(std))

@@ -11,12 +11,17 @@ The paper's "+" rotors (1 at -x, 2 at +y, 3 at +x, 4 at -y in FLU; 1 and 3 clock
 above) are written as PX4's ``CA_ROTOR*`` parameters, so that a reader of the log can rebuild
 eqs (1)-(4).
 
-A rotor-plant flight (:mod:`quadcruise.model.rotor_plant`) is written as PX4 logs a vehicle
-whose ESCs report their speed: ``actuator_motors`` holds each rotor's *commanded speed* over
-``w_max`` (PX4's normalised motor command with ``THR_MDL_FAC = 1``: thrust ``CT u^2``,
-``CT = kf w_max^2``), ``esc_status`` the rotors' *measured* speeds [rpm] as ESC telemetry
-reports them (an integer), and ``CA_ROTOR*`` the vehicle's own rotors (``KM = -s km / kf``,
-positive counter-clockwise) (:func:`rotor_plant_parameters`).
+The commands are written with PX4's meanings: ``actuator_motors`` holds each rotor's *relative
+thrust* (thrust over the rotor's thrust at full command, ``CA_ROTORi_CT``), ``actuator_outputs``
+the *signal* ``x`` the output module makes of it through ``THR_MDL_FAC`` (``rel = f x^2 + (1 - f)
+x``), as PWM between ``PWM_MAIN_MINi`` and ``PWM_MAIN_MAXi`` (:mod:`quadcruise.sim.px4_setpoints`).
+The paper's vehicle: thrust ``K u``, so ``f = 0`` and both are the duty ``u``. A rotor-plant
+flight (:mod:`quadcruise.model.rotor_plant`): the signal is the commanded speed over ``w_max``
+and ``f = 1`` (thrust ``kf w^2 = CT x^2``, ``CT = kf w_max^2``); it is written as PX4 logs a
+vehicle whose ESCs report their speed: ``esc_status`` the rotors' *measured* speeds [rpm] as ESC
+telemetry reports them (an integer), and ``CA_ROTOR*`` the vehicle's own rotors (``KM = -s km /
+kf``, positive counter-clockwise) (:func:`rotor_plant_parameters`). The setpoints PX4's viewers
+overlay are written too (:func:`quadcruise.sim.px4_setpoints.setpoint_values`).
 
 The topics carry the sensor noise the controller saw, drawn again from the flight's seed
 (:data:`NOISE_STREAM`); the accelerometer has none of its own.
@@ -45,14 +50,25 @@ RATES_HZ = {
     "esc_status": 250.0,
     "vehicle_status": 1.0,
     "vehicle_land_detected": 1.0,
+    "actuator_outputs": 10.0,
+    "trajectory_setpoint": 5.0,
+    "vehicle_local_position_setpoint": 10.0,
+    "vehicle_attitude_setpoint": 20.0,
+    "vehicle_rates_setpoint": 50.0,
+    "vehicle_thrust_setpoint": 50.0,
+    "vehicle_torque_setpoint": 50.0,
 }
-"""Each topic's rate at most [Hz]: PX4's default logging profile's order of magnitude, capped
-by the flight's own log interval (a topic is written every k-th logged instant)."""
+"""Each topic's rate at most [Hz]: PX4's default logging profile's order of magnitude (the
+setpoints and ``actuator_outputs`` at its intervals, ``logged_topics.cpp``), capped by the
+flight's own log interval (a topic is written every k-th logged instant)."""
 SYSID_TOPICS = ("vehicle_attitude", "vehicle_angular_velocity", "actuator_motors", "sensor_combined", "esc_status")
 """The topics PX4's system-identification logging profile writes at their full rate."""
+SYSID_PROFILE_BIT = 8
+"""``SDLOG_PROFILE``'s bit for PX4's system-identification profile: the commands at the rate the
+rate controller publishes them. Written only when the log holds every control period."""
 PROFILES = {
     "default": (RATES_HZ, 1),
-    "sysid": ({**RATES_HZ, **dict.fromkeys(SYSID_TOPICS, float("inf"))}, 1 | 8),
+    "sysid": ({**RATES_HZ, **dict.fromkeys(SYSID_TOPICS, float("inf"))}, 1 | SYSID_PROFILE_BIT),
 }
 """Logging profiles: each topic's rate at most [Hz] and the ``SDLOG_PROFILE`` bits PX4 writes
 for it (1 default, 8 system identification: every logged instant; why, docs/identify.md)."""
@@ -188,6 +204,17 @@ VEHICLE_LAND_DETECTED = (
     ("bool", 0, "maybe_landed"),
     ("bool", 0, "landed"),
 )
+PWM_MIN, PWM_MAX, PWM_DISARMED = 1000.0, 2000.0, 900.0
+"""The PWM range [us] written as ``PWM_MAIN_MINi``/``PWM_MAIN_MAXi`` and ``PWM_MAIN_DISi`` (PX4's defaults)."""
+N_OUTPUTS = 16
+"""``actuator_outputs``' channels (PX4's ``NUM_ACTUATOR_OUTPUTS``)."""
+
+ACTUATOR_OUTPUTS = (
+    ("uint64_t", 0, "timestamp"),
+    ("uint32_t", 0, "noutputs"),
+    ("float", 16, "output"),
+    ("uint8_t", 4, "_padding0"),
+)
 ARMING_STATE_ARMED = 2
 """``vehicle_status.arming_state`` of an armed vehicle (PX4's ARMING_STATE_ARMED)."""
 MAV_TYPE_QUADROTOR = 2
@@ -295,20 +322,26 @@ def _every(t: np.ndarray, rate_hz: float) -> np.ndarray:
 def px4_topics(
     t: np.ndarray,
     states: np.ndarray,
-    duties: np.ndarray,
+    signal: np.ndarray,
     *,
     g: float,
+    thrust_factor: float = 0.0,
     noise_std: np.ndarray | None = None,
     rng: np.random.Generator | None = None,
     rates_hz: dict[str, float] | None = None,
     rotor_speeds: np.ndarray | None = None,
     system_type: int = MAV_TYPE_QUADROTOR,
+    setpoints: dict[str, tuple] | None = None,
 ) -> list[Topic]:
     """One vehicle's flight as PX4 topics at ``rates_hz`` (a profile of :data:`PROFILES`;
-    :data:`RATES_HZ` by default), from its logged ``t``, ``states`` and ``duties`` (any number of
-    motor commands in [0, 1]), with the sensor noise ``noise_std`` (``SensorNoise.std_vector``)
-    drawn from ``rng``; ``rotor_speeds`` [rad/s] (L, n), when given, as ``esc_status`` [rpm].
+    :data:`RATES_HZ` by default), from its logged ``t``, ``states`` and motor ``signal`` x (L, n)
+    in [0, 1] with ``thrust_factor`` f (``THR_MDL_FAC``): ``actuator_motors`` the relative thrust
+    ``f x^2 + (1 - f) x``, ``actuator_outputs`` x as PWM; the sensor noise ``noise_std``
+    (``SensorNoise.std_vector``) drawn from ``rng``; ``rotor_speeds`` [rad/s] (L, n), when given,
+    as ``esc_status`` [rpm]; ``setpoints``, when given, as
+    :func:`~quadcruise.sim.px4_setpoints.setpoint_values` returns them.
     """
+
     us = np.round(t * 1e6).astype(np.uint64)
     accel = np.gradient(states[:, VX : VX + 3], t, axis=0, edge_order=2) if len(t) > 2 else np.zeros((len(t), 3))
     rate_dot = np.gradient(states[:, P : P + 3], t, axis=0, edge_order=2) if len(t) > 2 else np.zeros((len(t), 3))
@@ -320,8 +353,9 @@ def px4_topics(
     pos, vel, acc = (seen[:, X : X + 3] @ ENU_TO_NED.T, seen[:, VX : VX + 3] @ ENU_TO_NED.T, accel @ ENU_TO_NED.T)
     gyro = seen[:, P : P + 3] @ FLU_TO_FRD.T
     heading = np.arctan2(2.0 * (q[:, 0] * q[:, 3] + q[:, 1] * q[:, 2]), 1.0 - 2.0 * (q[:, 2] ** 2 + q[:, 3] ** 2))
+    signal = np.asarray(signal, dtype=np.float64)
     control = np.full((len(t), 12), np.nan)
-    control[:, : duties.shape[1]] = duties
+    control[:, : signal.shape[1]] = thrust_factor * signal**2 + (1.0 - thrust_factor) * signal
 
     rates_hz = RATES_HZ if rates_hz is None else rates_hz
 
@@ -348,58 +382,76 @@ def px4_topics(
                 **{"esc.timestamp": np.repeat(us[:, None], MAX_ESCS, 1), "esc.esc_rpm": rpm},
             )
         ]
-    return esc + [
-        topic(
-            "vehicle_local_position",
-            VEHICLE_LOCAL_POSITION,
-            timestamp_sample=us,
-            x=pos[:, 0],
-            y=pos[:, 1],
-            z=pos[:, 2],
-            vx=vel[:, 0],
-            vy=vel[:, 1],
-            vz=vel[:, 2],
-            z_deriv=vel[:, 2],
-            ax=acc[:, 0],
-            ay=acc[:, 1],
-            az=acc[:, 2],
-            heading=heading,
-            xy_valid=ones,
-            z_valid=ones,
-            v_xy_valid=ones,
-            v_z_valid=ones,
-            heading_good_for_control=ones,
-            dist_bottom=-pos[:, 2],
-        ),
-        topic("vehicle_attitude", VEHICLE_ATTITUDE, timestamp_sample=us, q=q),
-        topic(
-            "vehicle_angular_velocity",
-            VEHICLE_ANGULAR_VELOCITY,
-            timestamp_sample=us,
-            xyz=gyro,
-            xyz_derivative=rate_dot @ FLU_TO_FRD.T,
-        ),
-        topic("actuator_motors", ACTUATOR_MOTORS, timestamp_sample=us, control=control),
-        topic(
-            "sensor_combined",
-            SENSOR_COMBINED,
-            gyro_rad=gyro,
-            accelerometer_m_s2=force,
-            gyro_integral_dt=np.full(len(t), int(np.diff(us[_every(t, rates_hz["sensor_combined"])][:2]).sum())),
-        ),
-        topic(
-            "vehicle_status",
-            VEHICLE_STATUS,
-            armed_time=np.zeros(len(t), np.uint64),
-            arming_state=np.full(len(t), ARMING_STATE_ARMED),
-            system_type=np.full(len(t), system_type),
-            vehicle_type=np.ones(len(t)),
-        ),
-        topic("vehicle_land_detected", VEHICLE_LAND_DETECTED, landed=~ones, maybe_landed=~ones, ground_contact=~ones),
-    ]
+    extra = [topic("actuator_outputs", ACTUATOR_OUTPUTS, **actuator_outputs(signal))]
+    for name, (fields, values) in (setpoints or {}).items():
+        stamp = {"timestamp_sample": us} if any(f[2] == "timestamp_sample" for f in fields) else {}
+        extra.append(topic(name, fields, **stamp, **values))
+    return (
+        esc
+        + extra
+        + [
+            topic(
+                "vehicle_local_position",
+                VEHICLE_LOCAL_POSITION,
+                timestamp_sample=us,
+                x=pos[:, 0],
+                y=pos[:, 1],
+                z=pos[:, 2],
+                vx=vel[:, 0],
+                vy=vel[:, 1],
+                vz=vel[:, 2],
+                z_deriv=vel[:, 2],
+                ax=acc[:, 0],
+                ay=acc[:, 1],
+                az=acc[:, 2],
+                heading=heading,
+                xy_valid=ones,
+                z_valid=ones,
+                v_xy_valid=ones,
+                v_z_valid=ones,
+                heading_good_for_control=ones,
+                dist_bottom=-pos[:, 2],
+            ),
+            topic("vehicle_attitude", VEHICLE_ATTITUDE, timestamp_sample=us, q=q),
+            topic(
+                "vehicle_angular_velocity",
+                VEHICLE_ANGULAR_VELOCITY,
+                timestamp_sample=us,
+                xyz=gyro,
+                xyz_derivative=rate_dot @ FLU_TO_FRD.T,
+            ),
+            topic("actuator_motors", ACTUATOR_MOTORS, timestamp_sample=us, control=control),
+            topic(
+                "sensor_combined",
+                SENSOR_COMBINED,
+                gyro_rad=gyro,
+                accelerometer_m_s2=force,
+                gyro_integral_dt=np.full(len(t), int(np.diff(us[_every(t, rates_hz["sensor_combined"])][:2]).sum())),
+            ),
+            topic(
+                "vehicle_status",
+                VEHICLE_STATUS,
+                armed_time=np.zeros(len(t), np.uint64),
+                arming_state=np.full(len(t), ARMING_STATE_ARMED),
+                system_type=np.full(len(t), system_type),
+                vehicle_type=np.ones(len(t)),
+            ),
+            topic(
+                "vehicle_land_detected", VEHICLE_LAND_DETECTED, landed=~ones, maybe_landed=~ones, ground_contact=~ones
+            ),
+        ]
+    )
 
 
-def rotor_speed_commands(commands: np.ndarray, flown: dict, believed: dict | None = None) -> np.ndarray:
+def actuator_outputs(signal: np.ndarray) -> dict[str, np.ndarray]:
+    """``actuator_outputs``' values: each rotor's signal ``x`` (L, n) as PWM [us], the other
+    channels at the disarmed value."""
+    out = np.full((len(signal), N_OUTPUTS), PWM_DISARMED)
+    out[:, : signal.shape[1]] = PWM_MIN + np.clip(signal, 0.0, 1.0) * (PWM_MAX - PWM_MIN)
+    return {"noutputs": np.full(len(signal), N_OUTPUTS), "output": out}
+
+
+def rotor_speed_commands(commands: np.ndarray, flown: dict, believed: dict | None = None, *, wanted: bool = False):
     """The rotor speeds [rad/s] a rotor-plant flight commanded, from its logged "+" equivalent duties.
 
     As :mod:`quadcruise.sim.rotor_flight` computes them each control period: the controller
@@ -413,11 +465,13 @@ def rotor_speed_commands(commands: np.ndarray, flown: dict, believed: dict | Non
     flown, believed : dict
         The flown and the controller vehicle's fields (``RotorVehicle.to_dict``; ``plant`` may be
         among them); ``believed`` None: the flown vehicle.
+    wanted : bool
+        Also return the thrusts the controller wanted of each rotor, before any limit [N].
 
     Returns
     -------
     numpy.ndarray
-        (L, n) commanded rotor speeds [rad/s].
+        (L, n) commanded rotor speeds [rad/s] (and, with ``wanted``, the (L, n) thrusts).
     """
     from quadcruise.model.equivalent import duty_to_thrust
     from quadcruise.model.rotor_vehicle import RotorVehicle
@@ -428,7 +482,8 @@ def rotor_speed_commands(commands: np.ndarray, flown: dict, believed: dict | Non
     controller = vehicle(believed or flown)
     thrust = commands[:, CMD_U1 : CMD_U1 + 4] @ duty_to_thrust(controller).T
     speed = np.sqrt(np.clip(thrust, 0.0, None) / controller.kf)
-    return np.clip(speed, float(flown["w_min"]), float(flown["w_max"]))
+    speed = np.clip(speed, float(flown["w_min"]), float(flown["w_max"]))
+    return (speed, thrust) if wanted else speed
 
 
 def duties_of(commands: np.ndarray) -> np.ndarray:

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from quadcruise.checks import describe
 from quadcruise.errors import InputError
 from quadcruise.layout import CMD_NAMES, REF_NAMES, STATE_NAMES
 from quadcruise.metrics.summary import Summary
@@ -219,7 +220,7 @@ class SimResult:
             With ``t``, ``states``, ``commands`` and ``references`` thinned; the rest shared.
         """
         if int(every) != every or every < 1:
-            raise InputError(f"decimation step must be a positive integer, got {every!r}")
+            raise InputError(f"decimation step must be a positive integer, got {describe(every)}")
         keep = slice(None, None, int(every))
         return dataclasses.replace(
             self,
@@ -280,7 +281,13 @@ class SimResult:
         """Write one vehicle's flight as a PX4 log (ULog), in PX4's conventions (:mod:`quadcruise.sim.px4`).
 
         The topics are :func:`quadcruise.sim.px4.px4_topics`', at the rates of ``profile`` (at most
-        the flight's log rate); pyulog, PX4 Flight Review and PlotJuggler read it.
+        the flight's log rate), with the setpoints PX4's viewers overlay
+        (:mod:`quadcruise.sim.px4_setpoints`); pyulog, PX4 Flight Review and PlotJuggler read it.
+        ``actuator_motors`` is each rotor's relative thrust, ``actuator_outputs`` the PWM signal
+        through ``THR_MDL_FAC`` (PX4's meanings). The info messages ``quadcruise_control_rate_hz``
+        and ``quadcruise_log_rate_hz`` give the controller's rate and the log's own (a flight
+        logged every k-th period: the timestamps are those instants, and ``SDLOG_PROFILE`` does not
+        claim the system-identification profile, which holds every command).
 
         Parameters
         ----------
@@ -310,7 +317,16 @@ class SimResult:
         """
         from quadcruise._version import __version__
         from quadcruise.io.ulog import write_ulog
-        from quadcruise.sim.px4 import NOISE_STREAM, PROFILES, duties_of, px4_topics, rotor_parameters
+        from quadcruise.layout import CMD_PHI_D, CMD_U1
+        from quadcruise.sim.px4 import (
+            NOISE_STREAM,
+            PROFILES,
+            SYSID_PROFILE_BIT,
+            duties_of,
+            px4_topics,
+            rotor_parameters,
+        )
+        from quadcruise.sim.px4_setpoints import pwm_parameters, setpoint_values
 
         if profile is None:
             profile = "sysid" if (self.meta.get("mission") or {}).get("kind") == "sysid" else "default"
@@ -318,11 +334,11 @@ class SimResult:
             raise InputError(f"to_ulog: profile must be one of {', '.join(PROFILES)}, got {profile!r}")
         rates_hz, profile_bits = PROFILES[profile]
         if isinstance(vehicle, bool) or not isinstance(vehicle, (int, np.integer)) or not 0 <= vehicle < self.n:
-            raise InputError(f"to_ulog: vehicle must be an index in [0, {self.n}), got {vehicle!r}")
+            raise InputError(f"to_ulog: vehicle must be an index in [0, {self.n}), got {describe(vehicle)}")
         if not str(path).endswith(".ulg"):
             raise InputError(f"to_ulog: a PX4 log's name ends in .ulg, got {str(path)!r}")
         rows = np.isfinite(self.states[vehicle]).all(axis=1)
-        t, states = self.t[rows], self.states[vehicle][rows]
+        t, states, commands = self.t[rows], self.states[vehicle][rows], self.commands[vehicle][rows]
 
         def field_of(name, default):
             value = (self.meta.get("paper_equivalent") or self.meta.get("vehicle") or {}).get(name, default)
@@ -336,43 +352,50 @@ class SimResult:
         seed = self.meta.get("seed") or 0
         rng = np.random.default_rng([int(seed), int(vehicle), NOISE_STREAM])
         flown = self.meta.get("vehicle") or {}
+        rotor_speeds, system_type = None, 2
         if self.rotor_states is not None and flown.get("plant") == "rotor":
             from quadcruise.model.rotor_plant import ROTOR_W1
             from quadcruise.sim.px4 import rotor_plant_parameters, rotor_speed_commands
 
-            speeds = self.rotor_states[vehicle][rows][:, ROTOR_W1:]
-            w_cmd = rotor_speed_commands(self.commands[vehicle][rows], flown, self.meta.get("controller_vehicle"))
-            w_max = float(flown["w_max"])
-            topics = px4_topics(
-                t,
-                states,
-                w_cmd / w_max,
-                g=field_of("g", 9.81),
-                noise_std=std,
-                rng=rng,
-                rates_hz=rates_hz,
-                rotor_speeds=speeds,
-                system_type={6: 13, 8: 14}.get(speeds.shape[1], 2),
-            )
-            params = rotor_plant_parameters(flown["rotors"], float(flown["kf"]), float(flown["km"]), w_max)
+            rotor_speeds = self.rotor_states[vehicle][rows][:, ROTOR_W1:]
+            w_cmd, wanted = rotor_speed_commands(commands, flown, self.meta.get("controller_vehicle"), wanted=True)
+            w_max, kf = float(flown["w_max"]), float(flown["kf"])
+            signal, factor = w_cmd / w_max, 1.0  # thrust kf w^2 = CT x^2: THR_MDL_FAC 1
+            desired = wanted / (kf * w_max**2)
+            system_type = {6: 13, 8: 14}.get(rotor_speeds.shape[1], 2)
+            params = rotor_plant_parameters(flown["rotors"], kf, float(flown["km"]), w_max)
         else:
-            topics = px4_topics(
-                t,
-                states,
-                duties_of(self.commands[vehicle][rows]),
-                g=field_of("g", 9.81),
-                noise_std=std,
-                rng=rng,
-                rates_hz=rates_hz,
-            )
+            signal, factor = duties_of(commands), 0.0  # thrust K u: THR_MDL_FAC 0
+            desired = commands[:, CMD_U1 : CMD_U1 + 4]
             params = rotor_parameters(field_of("l", 0.2), field_of("d", 0.0), field_of("K", 0.0))
-        params["SDLOG_PROFILE"] = profile_bits
-        write_ulog(
-            path,
-            topics,
-            info={"sys_name": "quadcruise", "ver_sw": __version__, "ver_hw": "SIMULATION"},
-            parameters=params,
+        params.update(pwm_parameters(signal.shape[1], factor))
+        setpoints = None
+        if self.references is not None:
+            attitude_d = commands[:, CMD_PHI_D : CMD_PHI_D + 3]
+            setpoints = setpoint_values(self.references[vehicle][rows], attitude_d, desired, params)
+        topics = px4_topics(
+            t,
+            states,
+            signal,
+            g=field_of("g", 9.81),
+            thrust_factor=factor,
+            noise_std=std,
+            rng=rng,
+            rates_hz=rates_hz,
+            rotor_speeds=rotor_speeds,
+            system_type=system_type,
+            setpoints=setpoints,
         )
+        info = {"sys_name": "quadcruise", "ver_sw": __version__, "ver_hw": "SIMULATION"}
+        control_dt = float(self.meta.get("dt_s") or 0.0)
+        log_dt = float(np.median(np.diff(t))) if len(t) > 1 else control_dt
+        if control_dt > 0.0:  # the log's true rate: every command only when it logs every control period
+            info["quadcruise_control_rate_hz"] = 1.0 / control_dt
+            info["quadcruise_log_rate_hz"] = 1.0 / log_dt if log_dt > 0.0 else 0.0
+            if log_dt > 1.000001 * control_dt:
+                profile_bits &= ~SYSID_PROFILE_BIT
+        params["SDLOG_PROFILE"] = profile_bits
+        write_ulog(path, topics, info=info, parameters=params)
         return Path(path)
 
     def summary(self) -> Summary:

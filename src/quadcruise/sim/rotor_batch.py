@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from quadcruise.checks import describe
 from quadcruise.errors import InputError
 from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from quadcruise.model.rotor_plant import ROTOR_W1, RP_N_ROTORS
@@ -90,7 +91,7 @@ def rotor_inputs(
     )
     touchdown = np.array(np.broadcast_to(np.inf if touchdown_speed is None else touchdown_speed, (n_vehicles,)), float)
     if touchdown_speed is not None and not np.all(touchdown > 0):
-        raise InputError(f"touchdown speed must be > 0 m/s, got {touchdown_speed!r}")
+        raise InputError(f"touchdown speed must be > 0 m/s, got {describe(touchdown_speed)}")
     return {"inp": inp, "rp": rp, "x0": x0, "alloc": alloc, "psi0": psi0, "touchdown": touchdown, "n_rotors": n}
 
 

@@ -23,6 +23,7 @@ import math
 import numpy as np
 from numba import njit
 
+from quadcruise.checks import describe
 from quadcruise.errors import InputError
 from quadcruise.model.rotor_plant import (
     QW,
@@ -243,7 +244,7 @@ def replay_rotor_speeds(
     if t.ndim != 1 or t.shape[0] < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
         raise InputError("the schedule's times must be at least two, finite and strictly increasing")
     if not (math.isfinite(max_step) and max_step > 0):
-        raise InputError(f"max_step must be a positive number of seconds, got {max_step!r}")
+        raise InputError(f"max_step must be a positive number of seconds, got {describe(max_step)}")
     rp = np.atleast_2d(np.ascontiguousarray(rp, dtype=float))
     n = int(rp[0, RP_N_ROTORS])
     if np.any(rp[:, RP_N_ROTORS] != n):
@@ -268,7 +269,7 @@ def replay_rotor_speeds(
         np.broadcast_to(np.inf if touchdown_speed is None else touchdown_speed, (N,)), dtype=float
     )
     if ground and not np.all(touchdown > 0):
-        raise InputError(f"touchdown speed must be > 0 m/s, got {touchdown_speed!r}")
+        raise InputError(f"touchdown speed must be > 0 m/s, got {describe(touchdown_speed)}")
     _replay_kernel(
         t, w_cmd, x0, rp, ext, float(max_step), limits.array(), ground, touchdown, log_x, x_final, status, t_stop
     )

@@ -36,11 +36,10 @@ import time
 
 import numpy as np
 from numba import get_num_threads, set_num_threads
-from numba.core.dispatcher import Dispatcher
-from numba.core.types.function_type import CompileResultWAP
 
+from quadcruise.checks import describe
 from quadcruise.errors import InputError
-from quadcruise.layout import CMD_SIZE, CONTROLLER_SIG, DISTURBANCE_SIG, MISSION_SIG, REF_SIZE, STATE_SIZE
+from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from quadcruise.sim.engine import direct_kernel, fly_vehicles, still_air
 from quadcruise.sim.inputs import Limits, batch_inputs, fresh_carry
 from quadcruise.sim.kernel_args import KernelArgs
@@ -52,32 +51,6 @@ from quadcruise.sim.threads import ThreadPlan
 
 STEP_PIECES_PER_THREAD = 1
 """A step is short: one range of vehicles per thread, as each kernel call has a fixed cost."""
-
-
-def compiled_address(function, signature):
-    """A compiled function as the kernel takes it, its address looked up once.
-
-    numba hands a jit function (a ``Dispatcher``) to the kernel by looking up its compiled
-    code at every call, a fixed cost of about 0.1-0.4 ms per function that a whole flight
-    never notices but a step of a few microseconds per vehicle does. A
-    ``CompileResultWAP`` holds the address instead (the same machine code, called through
-    its C wrapper; the flight is bit for bit the same, tests/integration/test_stepper.py).
-
-    Parameters
-    ----------
-    function : numba Dispatcher, cfunc or wrapper-address object
-        The controller, mission or disturbance.
-    signature : numba signature
-        Its signature (``CONTROLLER_SIG``, ``MISSION_SIG``, ``DISTURBANCE_SIG``).
-
-    Returns
-    -------
-    object
-        A ``CompileResultWAP`` for a jit function; anything else as given.
-    """
-    if isinstance(function, Dispatcher):
-        return CompileResultWAP(function.get_compile_result(signature))
-    return function
 
 
 class Stepper:
@@ -216,11 +189,12 @@ class Stepper:
     def _init(self, inp, controller, mission, disturbance, seed, first_vehicle, sensor_delay, periods, setpoint_width):
         """What both plants hold: the batch arrays, memories, clocks, statuses and logs."""
         if int(periods) != periods or periods < 1:
-            raise InputError(f"periods must be a whole number >= 1, got {periods!r}")
+            raise InputError(f"periods must be a whole number >= 1, got {describe(periods)}")
         self.n = n = inp["n"]
         if not (0 <= int(setpoint_width) <= inp["gains"].shape[1]):
             raise InputError(
-                f"setpoint_width must be in 0..{inp['gains'].shape[1]} (the gains' width), got {setpoint_width!r}"
+                f"setpoint_width must be in 0..{inp['gains'].shape[1]} (the gains' width), "
+                f"got {describe(setpoint_width)}"
             )
         self.t_grid = inp["t_grid"]
         self.periods, self.setpoint_width = int(periods), int(setpoint_width)
@@ -249,11 +223,11 @@ class Stepper:
         self.log_x = np.empty((n, rows, STATE_SIZE))
         self.log_cmd = np.empty((n, rows, CMD_SIZE))
         self.log_ref = np.empty((n, rows, REF_SIZE))
-        self.controller, self.mission = (
-            compiled_address(controller, CONTROLLER_SIG),
-            compiled_address(mission, MISSION_SIG),
-        )
-        self.disturbance = compiled_address(disturbance or still_air, DISTURBANCE_SIG)
+        # the jit functions themselves: numba calls a jit function passed as an argument through
+        # its own calling convention, which carries an exception raised in it to the caller
+        # (not through its C wrapper, which would print the exception and carry on)
+        self.controller, self.mission = controller, mission
+        self.disturbance = disturbance or still_air
         self.disturbed = disturbance is not None
         self._kernel = direct_rotor_kernel() if self.rotor else direct_kernel()  # sim/fastmath.py
         self._plan = ThreadPlan()  # one thread or all, for a step without a watcher

@@ -10,6 +10,8 @@ OpenMP thread spins: docs/performance.md.)
 from __future__ import annotations
 
 import itertools
+import os
+import threading
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -21,12 +23,40 @@ free, so a thread whose vehicles stopped early (or ran slower) does not leave th
 waiting at the end."""
 
 _pool: ThreadPoolExecutor | None = None
+_pool_lock = threading.Lock()
+
+
+def _forget_pool() -> None:
+    """In a child made by ``os.fork``: drop the parent's pool, whose threads the child does
+    not have (work handed to it would wait forever); the child's first batch makes its own."""
+    global _pool, _pool_lock
+    _pool, _pool_lock = None, threading.Lock()
+
+
+if hasattr(os, "register_at_fork"):  # POSIX
+    os.register_at_fork(after_in_child=_forget_pool)
+
+
+def _helpers() -> ThreadPoolExecutor:
+    """The process's pool of helper threads, made on first use (numba's threads can never exceed
+    ``NUMBA_NUM_THREADS``)."""
+    global _pool
+    with _pool_lock:
+        if _pool is None:
+            _pool = ThreadPoolExecutor(
+                max_workers=max(1, config.NUMBA_NUM_THREADS - 1), thread_name_prefix="quadcruise"
+            )
+        return _pool
 
 
 def fly_in_pieces(kernel, n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD, after_piece=None) -> None:
     """Run ``kernel(first, stop, *args)`` over vehicles 0..n-1, on numba's number of threads
     (``numba.get_num_threads()``): one range on this thread when that is 1 or n is 1, else
     ``pieces_per_thread`` ranges per thread, handed out in turn.
+
+    An exception raised by the kernel (a controller, mission or disturbance that raised) or
+    by ``after_piece`` reaches the caller once every piece under way has ended; no piece starts
+    after it.
 
     Parameters
     ----------
@@ -42,7 +72,6 @@ def fly_in_pieces(kernel, n: int, args: tuple, pieces_per_thread: int = PIECES_P
         Called as ``after_piece(first, stop)`` on the thread that flew vehicles first..stop-1,
         right after it (their rows still in its cache).
     """
-    global _pool
     threads = min(n, get_num_threads())
     if threads <= 1:
         kernel(0, n, *args)
@@ -51,20 +80,24 @@ def fly_in_pieces(kernel, n: int, args: tuple, pieces_per_thread: int = PIECES_P
         return
     bounds = np.linspace(0, n, min(n, pieces_per_thread * threads) + 1).round().astype(np.int64)
     pieces = itertools.count()  # next() on it is atomic under the GIL
+    failed: list[BaseException] = []
 
     def work() -> None:
-        while (k := next(pieces)) < bounds.shape[0] - 1:
+        while not failed and (k := next(pieces)) < bounds.shape[0] - 1:
             first, stop = int(bounds[k]), int(bounds[k + 1])
-            kernel(first, stop, *args)
-            if after_piece is not None:
-                after_piece(first, stop)
+            try:
+                kernel(first, stop, *args)
+                if after_piece is not None:
+                    after_piece(first, stop)
+            except BaseException as exc:  # a controller, mission or disturbance raised: no more pieces
+                failed.append(exc)
 
-    if _pool is None:  # numba's threads can never exceed this
-        _pool = ThreadPoolExecutor(max_workers=max(1, config.NUMBA_NUM_THREADS - 1), thread_name_prefix="quadcruise")
-    helpers = [_pool.submit(work) for _ in range(threads - 1)]
+    helpers = [_helpers().submit(work) for _ in range(threads - 1)]
     work()
-    for h in helpers:
+    for h in helpers:  # every piece ends before the caller sees the arrays, or the error
         h.result()
+    if failed:
+        raise failed[0]
 
 
 class ThreadPlan:

@@ -10,6 +10,7 @@ the coefficients into the vehicle's parameters with 95 % intervals
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from collections.abc import Callable
@@ -17,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from quadcruise import checks
 from quadcruise.errors import InputError
 from quadcruise.io.flightlog import FlightLog, parse_commands, read_flight_log
 from quadcruise.model.vehicle import Vehicle
@@ -31,15 +33,18 @@ from quadcruise.sysid.logprep import (
     STAGES,
     WINDOW_S,
     command_hold,
+    command_meaning,
     command_rate,
     coupling_signal,
     log_info,
+    log_rates,
     noise_level,
     split_rows,
 )
 from quadcruise.sysid.physical import Z95, parameters
 from quadcruise.sysid.result import IdentifyResult
 from quadcruise.sysid.validate import validate
+from quadcruise.sysid.verdict import paper_verdict, withhold
 
 SHAPE_SPAN = 0.25
 """The least spread (5th to 95th percentile) of the rotor commands over which the thrust
@@ -110,14 +115,19 @@ def identify(
     >>> identify("flight.ulg", holdout=1.5)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: holdout must be a fraction in [0.05, 0.6], got 1.5
+    quadcruise.errors.InputError: holdout must be a fraction in [0.05, 0.6], got float 1.5
     """
+    where = "identify()"
+    checks.instance(where, "log", log, (str, os.PathLike, FlightLog), optional=False, want="a path or a FlightLog")
+    checks.instance(where, "frame", frame, str, want="'enu' or 'ned'")
+    checks.instance(where, "commands", commands, str, optional=False, want="'duty', 'rad/s' or 'pwm:MIN:MAX'")
+    checks.callback(where, "progress", progress)  # before the log is read
     if isinstance(holdout, bool) or not isinstance(holdout, (int, float)) or not 0.05 <= holdout <= 0.6:
-        raise InputError(f"holdout must be a fraction in [0.05, 0.6], got {holdout!r}")
+        raise InputError(f"holdout must be a fraction in [0.05, 0.6], got {checks.describe(holdout)}")
     if mass is not None and (
         isinstance(mass, bool) or not isinstance(mass, (int, float)) or not math.isfinite(mass) or mass <= 0
     ):
-        raise InputError(f"mass must be a positive number of kg, got {mass!r}")
+        raise InputError(f"mass must be a positive number of kg, got {checks.describe(mass)}")
     from quadcruise.model.rotor_vehicle import RotorVehicle
 
     if isinstance(vehicle, str):
@@ -137,12 +147,27 @@ def identify(
     report = progress or (lambda done, total, stage="": None)
 
     flight = log if isinstance(log, FlightLog) else read_flight_log(log, frame=frame, commands=commands)
+    rotor_base = None
     if rotor:
-        from quadcruise.sysid.rotor_identify import identify_rotor
+        from quadcruise.sysid.rotor_identify import MIN_SPEED_SAMPLES, identify_rotor
 
-        return identify_rotor(flight, base, mass, holdout, kind, report)
+        speed_hz = float(flight.rates_hz.get("esc_status", flight.rates_hz.get("csv", 0.0)))
+        if kind == "rad/s" or (flight.speeds is not None and speed_hz >= MIN_SPEED_SAMPLES / WINDOW_S):
+            return identify_rotor(flight, base, mass, holdout, kind, report)
+        # no rotor speeds (or too slow to use): the rotor plant from the commands alone
+        from quadcruise.model.equivalent import paper_equivalent
+
+        rotor_base = base
+        base = paper_equivalent(base).replace(K=float(base.kf * base.w_max**2))  # one rotor's full thrust
     report(1, len(STAGES), STAGES[0])
     rotors = flight.rotors
+    if rotors is None and rotor_base is not None:
+        rotors = np.array([[x, y, s] for x, y, _, s in rotor_base.rotors], dtype=float)
+        if len(rotors) != flight.n_rotors:
+            raise InputError(
+                f"{flight.source}: {flight.n_rotors} rotor commands and no CA_ROTOR* geometry: the base "
+                f"vehicle has {len(rotors)} rotors"
+            )
     if rotors is None:
         if flight.n_rotors != 4:
             raise InputError(
@@ -152,10 +177,16 @@ def identify(
         arm = float(base.l)
         rotors = np.array([[-arm, 0.0, 1.0], [0.0, arm, -1.0], [arm, 0.0, 1.0], [0.0, -arm, -1.0]])
     g = float(base.g)
+    lag_of = "thrust"
+    if rotor_base is not None:  # the rotor plant: relative thrust, whose square root (the speed) lags
+        meaning, f_log = command_meaning(flight)
+        u_rel = flight.u if meaning == "thrust" else f_log * flight.u**2 + (1.0 - f_log) * flight.u
+        flight = dataclasses.replace(flight, u=u_rel, commands=flight.commands + "; relative thrust (rotor plant)")
+        lag_of = "speed"
     force_z = _specific_force_z(flight, g)
     cmd_hz = command_rate(flight)
     hold = command_hold(flight, cmd_hz)
-    sig = signals(flight.t, flight.segment, flight.u, flight.rates, force_z, WINDOW_S, hold)
+    sig = signals(flight.t, flight.segment, flight.u, flight.rates, force_z, WINDOW_S, hold, lag_of)
     report(2, len(STAGES), STAGES[1])
 
     omega0 = float(base.omega)
@@ -167,8 +198,8 @@ def identify(
     lag_seen = cmd_hz >= 2.0 * omega0  # a sample at least every tau/2
     u_fit = sig.u[fit_rows]
     span = float(np.percentile(u_fit, 95) - np.percentile(u_fit, 5))
-    fit_shape = span >= SHAPE_SPAN
-    f0 = float(flight.parameters.get("THR_MDL_FAC", 0.0) or 0.0)
+    meaning, f0 = command_meaning(flight)
+    fit_shape = span >= SHAPE_SPAN and meaning == "signal"
     bounds = (0.5, min(500.0, 0.5 / sig.dt))
     result = fit(sig, fit_rows, rotors, omega0, f0, fit_omega=lag_seen, fit_shape=fit_shape, omega_bounds=bounds)
     report(3, len(STAGES), STAGES[2])
@@ -181,7 +212,9 @@ def identify(
         mass,
         flight.n_rotors,
         g,
-        systematic=_sensitivity(flight, force_z, fit_rows, rotors, result, mass, g, cmd_hz, bounds, coupling, hold),
+        systematic=_sensitivity(
+            flight, force_z, fit_rows, rotors, result, mass, g, cmd_hz, bounds, coupling, hold, lag_of
+        ),
         coupling=coupling,
     )
     notes: dict[str, str] = {}
@@ -245,18 +278,28 @@ def identify(
     elif result.omega <= bounds[0] * 1.01 or result.omega >= bounds[1] * 0.99:
         found["omega"]["identifiable"] = False
         notes["omega"] = f"the fit ran to the end of its search interval {bounds[0]:g}..{bounds[1]:g} rad/s"
-    if not fit_shape:
+    if meaning == "thrust":
+        notes["thrust_curve_f"] = (
+            "the commands are PX4's relative thrust (actuator_motors; THR_MDL_FAC maps thrust to the "
+            "output signal after it): thrust is linear in them"
+        )
+    elif not fit_shape:
         notes["thrust_curve_f"] = (
             f"the commands span only {span:.2f} (5th to 95th percentile): the thrust curve's "
             f"shape is not seen; f fixed at {f0:g} (the log's THR_MDL_FAC, else 0)"
         )
     f0_source = "the log's THR_MDL_FAC" if "THR_MDL_FAC" in flight.parameters else "linear thrust, f = 0"
+    f0_source = "relative thrust: linear" if meaning == "thrust" else f0_source
     table = _table(found, base, notes, f0, f0_source)
     report(4, len(STAGES), STAGES[3])
 
     validation, traces = validate(sig, held, result, rotors, flight, g)
+    verdict = paper_verdict(flight, sig, fit_rows, held, rotors, result, mass, g, cmd_hz, log_rates(flight))
+    if not verdict["fits"]:
+        table = withhold(table, verdict)
     report(5, len(STAGES), STAGES[4])
-    return IdentifyResult(
+    result = IdentifyResult(
+        verdict=verdict,
         parameters=table,
         validation=validation,
         traces=traces,
@@ -275,6 +318,7 @@ def identify(
             "omega_used": result.omega,
             "command_hold": hold,
             "thrust_curve_fitted": fit_shape,
+            "commands_are": "relative thrust" if meaning == "thrust" else f"signal (thrust curve f = {f0:g})",
             "residual_std": result.sigma,
             "coefficients": dict(zip(result.names, result.values.tolist(), strict=False)),
         },
@@ -282,6 +326,11 @@ def identify(
         mass=mass,
         rotors=rotors,
     )
+    if rotor_base is not None:
+        from quadcruise.sysid.commands_alone import as_rotor_result
+
+        return as_rotor_result(result, rotor_base)
+    return result
 
 
 def _excitation(u: np.ndarray, rotors: np.ndarray) -> dict[str, float]:
@@ -326,7 +375,18 @@ def _command_signal(sig, rows: np.ndarray, rotors: np.ndarray, omega: float) -> 
 
 
 def _sensitivity(
-    flight, force_z, rows, rotors, result, mass, g, cmd_hz, bounds, coupling=(True, True), hold="linear"
+    flight,
+    force_z,
+    rows,
+    rotors,
+    result,
+    mass,
+    g,
+    cmd_hz,
+    bounds,
+    coupling=(True, True),
+    hold="linear",
+    lag_of="thrust",
 ) -> dict[str, float]:
     """Systematic half-ranges: each parameter refitted (1) with the commands shifted by half
     their logging interval either way (a log that samples its commands says when they changed
@@ -335,7 +395,7 @@ def _sensitivity(
     dynamics). The two half-ranges are combined in quadrature."""
 
     def refit(u, window_s):
-        sig = signals(flight.t, flight.segment, u, flight.rates, force_z, window_s, hold)
+        sig = signals(flight.t, flight.segment, u, flight.rates, force_z, window_s, hold, lag_of)
         again = fit(
             sig,
             rows,

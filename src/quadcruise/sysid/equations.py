@@ -33,8 +33,9 @@ ROTATION_TERMS = {
 class Signals:
     """A log's samples through the matched filters: ``t`` [s], ``segment``, commands ``u`` (L, n),
     body ``rates`` [rad/s] (FLU), ``rate_dot`` [rad/s^2], ``force_z`` [m/s^2], ``products`` (q r, p r,
-    p q, filtered after the product), the filter's ``window`` [samples], the grid's ``dt`` [s] and
-    ``hold``, how the commands act between samples (:func:`lagged`).
+    p q, filtered after the product), the filter's ``window`` [samples], the grid's ``dt`` [s],
+    ``hold``, how the commands act between samples (:func:`lagged`), and ``lag_of``, what lags
+    (``"thrust"``, the paper's plant; ``"speed"``, a rotor's speed, the thrust its square).
     """
 
     t: np.ndarray
@@ -47,6 +48,7 @@ class Signals:
     window: int
     dt: float
     hold: str = "linear"
+    lag_of: str = "thrust"
 
 
 def kernels(window: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
@@ -89,9 +91,10 @@ def smooth(x: np.ndarray, segment: np.ndarray, window: int, deriv: int = 0, dt: 
     return out.reshape(x.shape)
 
 
-def signals(t, segment, u, rates, force_z, window_s: float, hold: str = "linear") -> Signals:
+def signals(t, segment, u, rates, force_z, window_s: float, hold: str = "linear", lag_of: str = "thrust") -> Signals:
     """Filter a log's samples for the regressions (a window of ``window_s``, at least 5 samples, odd;
-    ``hold`` as :func:`lagged`)."""
+    ``hold`` as :func:`lagged`; ``lag_of`` ``"thrust"``, the paper's lag of the thrust, or
+    ``"speed"``, a rotor's lag of its speed, the thrust its square: :func:`regressions`)."""
     dt = float(np.median(np.diff(t))) if len(t) > 1 else 1.0
     window = max(5, round(window_s / dt) | 1)
     p, q, r = rates.T
@@ -106,6 +109,7 @@ def signals(t, segment, u, rates, force_z, window_s: float, hold: str = "linear"
         window=window,
         dt=dt,
         hold=hold,
+        lag_of=lag_of,
     )
 
 
@@ -156,6 +160,10 @@ def regressions(
         quad = smooth(lagged(u * u, sig.segment, omega, sig.dt, sig.hold), sig.segment, sig.window)
         shape = (1.0 - f) * lin + f * quad
         thrust = (sig.force_z, np.column_stack([lin.sum(1), quad.sum(1)]), ("KL", "KQ"))
+    elif sig.lag_of == "speed":  # u relative thrust: the speed sqrt(u) lags, the thrust is its square
+        speed = lagged(np.sqrt((1.0 - f) * u + f * u * u), sig.segment, omega, sig.dt, sig.hold)
+        shape = smooth(speed * speed, sig.segment, sig.window)
+        thrust = (sig.force_z, shape.sum(1)[:, None], ("Km",))
     else:
         shape = smooth(lagged((1.0 - f) * u + f * u * u, sig.segment, omega, sig.dt, sig.hold), sig.segment, sig.window)
         thrust = (sig.force_z, shape.sum(1)[:, None], ("Km",))

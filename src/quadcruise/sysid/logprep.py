@@ -137,6 +137,74 @@ def command_rate(flight: FlightLog) -> float:
     return float(min(flight.rates_hz.values())) if flight.rates_hz else 0.0
 
 
+def command_meaning(flight: FlightLog) -> tuple[str, float]:
+    """What the logged commands ``u`` are, and the thrust curve that maps them to thrust.
+
+    PX4's ``actuator_motors`` holds each motor's **relative thrust** (0-1): ``THR_MDL_FAC`` ``f`` acts
+    after it, when the output module turns thrust into the signal ``x`` sent to the ESC,
+    ``thrust = f x^2 + (1 - f) x`` (PX4 ``FunctionMotors::updateValues``, ``motor_params.c``). So
+    ``actuator_motors`` is thrust (``("thrust", 0.0)``: linear), while ``actuator_outputs`` (PWM
+    mapped to 0-1) and a CSV's ``u`` columns are the signal (``("signal", f)``, the log's
+    ``THR_MDL_FAC``, else 0).
+
+    Parameters
+    ----------
+    flight : FlightLog
+        The log read.
+
+    Returns
+    -------
+    tuple of (str, float)
+        ``"thrust"`` or ``"signal"``, and ``f``.
+
+    Examples
+    --------
+    >>> log = FlightLog(source="x.ulg", t=np.zeros(1), segment=np.zeros(1, int), u=np.zeros((1, 4)),
+    ...                 velocity=np.zeros((1, 3)), quaternion=np.zeros((1, 4)), rates=np.zeros((1, 3)),
+    ...                 parameters={"THR_MDL_FAC": 0.5}, commands="actuator_motors (normalised)")
+    >>> command_meaning(log)
+    ('thrust', 0.0)
+    """
+    f = float(flight.parameters.get("THR_MDL_FAC", 0.0) or 0.0)
+    if flight.commands.split(" ")[0] == "actuator_motors" or "relative thrust" in flight.commands:
+        return "thrust", 0.0  # (a reader that applied THR_MDL_FAC to actuator_outputs says so)
+    return "signal", f
+
+
+def log_rates(flight: FlightLog) -> dict:
+    """What a ULog says of its own rates: ``IMU_GYRO_RATEMAX`` (PX4's rate loop runs on each gyro
+    sample it publishes) and the information messages ``quadcruise_control_rate_hz`` and
+    ``quadcruise_log_rate_hz`` (written by ``SimResult.to_ulog``); empty for a CSV.
+
+    Parameters
+    ----------
+    flight : FlightLog
+        The log read (its ``source`` is read again, its data messages skipped).
+
+    Returns
+    -------
+    dict
+    """
+    from pathlib import Path
+
+    path = Path(flight.source)
+    if path.suffix.lower() != ".ulg" or not path.is_file():
+        return {}
+    from pyulog import ULog
+
+    try:
+        log = ULog(str(path), message_name_filter_list=[])
+    except Exception:  # noqa: BLE001 - read once already: a second reading adds nothing to refuse
+        return {}
+    out = {}
+    for key in ("quadcruise_control_rate_hz", "quadcruise_log_rate_hz"):
+        if key in log.msg_info_dict:
+            out[key] = log.msg_info_dict[key]
+    if "IMU_GYRO_RATEMAX" in log.initial_parameters:
+        out["IMU_GYRO_RATEMAX"] = log.initial_parameters["IMU_GYRO_RATEMAX"]
+    return out
+
+
 def log_info(flight: FlightLog, sig) -> dict:
     """What the report says of the log: source, airborne time, grid, topics' rates, geometry, parameters.
 

@@ -51,8 +51,8 @@ def mapping(fit: Fit, mass: float | None, n_rotors: int, g: float, jzz_weights: 
     def phys(v: np.ndarray) -> dict:
         if "KQ" in idx:
             kl, kq = v[idx["KL"]], v[idx["KQ"]]
-        else:
-            kl, kq = v[idx["Km"]], 0.0
+        else:  # f fixed: the hover command is the logged command's (the signal's), not the thrust's
+            kl, kq = v[idx["Km"]] * (1.0 - fit.shape_f), v[idx["Km"]] * fit.shape_f
         km = kl + kq
         jxx, jyy = km / v[idx["b_roll"]], km / v[idx["b_pitch"]]
         jzz = w1 * (jyy - v[idx["k1"]] * jxx) + w2 * (jxx + v[idx["k3"]] * jyy)

@@ -30,6 +30,71 @@ CHANNEL_LABELS = {
 """The validated channels and how figures label them."""
 
 
+W_MAX_NOMINAL = 1000.0
+"""The full-command rotor speed [rad/s] of a rotor-plant vehicle identified from commands alone
+when the base vehicle gives none: the log determines the thrust at full command, ``kf w_max^2``,
+not the speed (no rotor inertia or rotor drag is identified, so the speed's scale changes nothing
+the plant does)."""
+MASS_FIELDS = ("m", "K", "kf", "km", "Jxx", "Jyy", "Jzz", "k_d", "k_z", "J_rotor")
+"""The vehicle fields that scale with the mass (absent from a vehicle identified without one)."""
+
+
+def plus_arm(rotors: np.ndarray) -> float | None:
+    """The arm [m] when ``rotors`` (x, y FLU, yaw sign) are the paper's four "+" rotors, else None.
+
+    The paper's plant: rotors on +-x spin with yaw sign +1, on +-y with -1, all at one distance.
+
+    Examples
+    --------
+    >>> plus = np.array([[-0.2, 0, 1], [0, 0.2, -1], [0.2, 0, 1], [0, -0.2, -1]])
+    >>> plus_arm(plus), plus_arm(plus @ np.diag([0.7, 0.7, 1]) + np.array([[0, 0.14, 0]] * 4))
+    (0.2, None)
+    """
+    rotors = np.asarray(rotors, dtype=float)
+    if rotors.shape != (4, 3):
+        return None
+    arm = float(np.mean(np.hypot(rotors[:, 0], rotors[:, 1])))
+    want = {(-1, 0, 1), (0, 1, -1), (1, 0, 1), (0, -1, -1)}
+    have = {(round(x / arm), round(y / arm), int(np.sign(sgn))) for x, y, sgn in rotors} if arm > 0 else set()
+    close = arm > 0 and np.allclose(np.abs(rotors[:, :2]).max(axis=1), arm, rtol=0.02)
+    close = close and np.allclose(np.abs(rotors[:, :2]).min(axis=1), 0.0, atol=0.02 * arm)
+    return arm if close and have == want else None
+
+
+def rotor_equivalent(rotors: np.ndarray, values: dict, base, log_name: str):
+    """A rotor-plant vehicle with ``rotors`` (x, y, yaw sign) and the paper plant's identified
+    ``values`` (m, K per rotor, J, d, omega): ``kf = K / w_max^2``, ``km = d kf``,
+    ``tau_up = tau_down = 1 / omega``, ``w_max`` the base's (:data:`W_MAX_NOMINAL` for a paper base).
+
+    Examples
+    --------
+    >>> x = np.array([[0.15, -0.25, 1], [-0.15, 0.19, 1], [0.15, 0.25, -1], [-0.15, -0.19, -1]])
+    >>> v = rotor_equivalent(x, {"m": 1.5, "K": 7.4, "Jxx": 0.03, "Jyy": 0.03, "Jzz": 0.05, "d": 0.05,
+    ...                          "omega": 20.0}, Vehicle.paper(), "f.ulg")
+    >>> round(v.kf * v.w_max**2, 6), v.n_rotors, v.tau_up
+    (7.4, 4, 0.05)
+    """
+    from quadcruise.model.rotor_vehicle import RotorVehicle
+
+    w_max = float(getattr(base, "w_max", W_MAX_NOMINAL))
+    kf = values["K"] / w_max**2
+    return RotorVehicle(
+        m=values["m"],
+        Jxx=values["Jxx"],
+        Jyy=values["Jyy"],
+        Jzz=values["Jzz"],
+        kf=kf,
+        km=values["d"] * kf,
+        tau_up=1.0 / values["omega"],
+        tau_down=1.0 / values["omega"],
+        w_min=0.0,
+        w_max=w_max,
+        rotors=tuple((float(x), float(y), 0.0, int(np.sign(sgn))) for x, y, sgn in rotors),
+        g=float(base.g),
+        source=f"identified from {log_name} by quadcruise identify (commands alone: kf w_max^2 = K)",
+    )
+
+
 @dataclass(frozen=True, eq=False)
 class IdentifyResult:
     """An identified vehicle.
@@ -57,6 +122,9 @@ class IdentifyResult:
         The rotor geometry used (x, y [m] FLU, yaw sign).
     command : str
         The command line that produced it (set by the CLI; empty from Python).
+    verdict : dict
+        Whether the model fits the log (:func:`quadcruise.sysid.verdict.judge`): ``verdict``
+        (``"fits"`` or ``"does not fit"``), ``fits``, ``reasons``, ``checks``.
     """
 
     parameters: dict
@@ -68,45 +136,98 @@ class IdentifyResult:
     mass: float | None
     rotors: np.ndarray
     command: str = field(default="")
+    verdict: dict = field(default_factory=dict)
+
+    @property
+    def fits(self) -> bool:
+        """Whether the model fits the log (:mod:`quadcruise.sysid.verdict`): True when no check failed."""
+        return bool(self.verdict.get("fits", True))
+
+    def verdict_line(self) -> str:
+        """The verdict in one line: ``verdict: the model fits the log`` or why it does not.
+
+        Returns
+        -------
+        str
+        """
+        if not self.verdict:
+            return "verdict: not judged"
+        if self.fits:
+            names = {
+                "held_out": "held out",
+                "white": "white residuals",
+                "segments": "segments agree",
+                "commands": "every command seen",
+            }
+            checks = self.verdict.get("checks", {})
+            if checks.get("commands", {}).get("control_hz", 0) is None:
+                names["commands"] = "the log does not say its control rate"
+            done = [names.get(k, k) for k in checks]
+            return f"verdict: the model fits the log ({', '.join(done)})"
+        return "verdict: the model DOES NOT FIT the log, no intervals: " + "; ".join(self.verdict["reasons"])
 
     @property
     def hover_duty(self) -> float:
         """The per-rotor command that holds level hover [-]."""
         return float(self.parameters["hover_duty"]["value"])
 
-    def vehicle(self) -> Vehicle:
-        """The identified vehicle in the paper's plant, or for a rotor-plant base vehicle a
-        RotorVehicle with the log's rotors (base values where the log could not tell).
+    def vehicle(self, mass: float | None = None):
+        """The vehicle the log flew: the identified values, the log's rotors, the base vehicle's
+        values only for what the log could not tell.
 
-        Without a mass, the base vehicle's mass scales the per-unit-mass values. The paper's
-        plant has four "+" rotors at distance ``l``: ``l`` is the log's mean rotor distance,
-        and a log with n != 4 rotors gets ``K`` scaled by n/4 so that the total thrust and the
-        hover hold (its moments then only approximate the real layout's).
+        A log whose rotors are the paper's four "+" ones (``CA_ROTOR*``, or none: the base's) gives
+        the paper's plant (``l`` the rotors' distance); any other layout (x, hexa, ...) a
+        rotor-plant vehicle with the log's rotors, ``kf = K / w_max^2``, ``km = d kf`` and
+        ``tau_up = tau_down = 1 / omega`` (:func:`rotor_equivalent`). A rotor-plant base vehicle
+        gives its plant's fields. No mass is invented: without one (here or given to identify)
+        this refuses.
+
+        Parameters
+        ----------
+        mass : float, optional
+            The mass [kg] when identify had none (the per-unit-mass values are scaled by it).
 
         Returns
         -------
-        Vehicle
+        Vehicle or RotorVehicle
+
+        Raises
+        ------
+        InputError
+            No mass, here or in the identification.
         """
-        m = float(self.mass) if self.mass is not None else float(self.base.m)
-        values: dict[str, float] = {"m": m}
+        from quadcruise.errors import InputError
+
+        m = mass if mass is not None else self.mass
+        if m is None:
+            raise InputError(
+                "the log gives no mass and identify had none: K and the inertias are per unit mass; "
+                "give it (vehicle(mass=KG), or identify --mass KG)"
+            )
+        return self._vehicle(float(m))
+
+    def _vehicle(self, m: float):
+        values: dict[str, Any] = {"m": m}
+        scale = 1.0 if self.mass is not None else m
         if self.fit.get("plant") == "rotor":  # a RotorVehicle: the identified fields, the log's rotors
             for name in ("kf", "km", "Jxx", "Jyy", "Jzz", "k_d", "k_z", "J_rotor", "tau_up", "tau_down", "w_max"):
                 key = name if self.mass is not None or name in ("tau_up", "tau_down", "w_max") else f"{name}_per_m"
                 if key in self.parameters:
                     per_m = key.endswith("_per_m")
-                    values[name] = float(self.parameters[key]["value"]) * (m if per_m else 1.0)
+                    values[name] = float(self.parameters[key]["value"]) * (scale if per_m else 1.0)
             values["rotors"] = tuple(tuple(float(x) for x in row[:3]) + (int(row[3]),) for row in self.rotors)
             values["source"] = f"identified from {Path(self.log['source']).name} (base: {self.base.source or 'a file'})"
             return self.base.replace(**values)
         for name in ("K", "Jxx", "Jyy", "Jzz"):
             key = name if self.mass is not None else f"{name}_per_m"
-            values[name] = float(self.parameters[key]["value"]) * (1.0 if self.mass is not None else m)
+            values[name] = float(self.parameters[key]["value"]) * scale
         for name in ("d", "omega"):
             values[name] = float(self.parameters[name]["value"])
-        values["K"] *= len(self.rotors) / 4.0
-        arm = float(np.mean(np.hypot(self.rotors[:, 0], self.rotors[:, 1])))
-        values["l"] = arm
-        return self.base.replace(**values)
+        arm = plus_arm(self.rotors)
+        if arm is not None:
+            values["l"] = arm
+            return self.base.replace(**{k: v for k, v in values.items()})
+        return rotor_equivalent(self.rotors, values, self.base, Path(self.log["source"]).name)
 
     def to_pandas(self):
         """One row per identified parameter (not per sample: the held-out samples are in :attr:`traces`).
@@ -142,10 +263,11 @@ class IdentifyResult:
             ``validation_r2`` (channel -> R^2); prints as a table.
         """
         lines = [
+            self.verdict_line(),
             (
                 f"{self.log['source']}: {self.log['airborne_s']:.1f} s airborne, "
                 f"{'mass ' + format(self.mass, 'g') + ' kg' if self.mass is not None else 'no mass given'}"
-            )
+            ),
         ]
         if self.mass is None:
             lines.append("  no mass: K and the inertias are per unit mass (_per_m)")
@@ -159,6 +281,7 @@ class IdentifyResult:
         r2 = {k: v["r2"] for k, v in self.validation.items() if k in CHANNEL_LABELS}
         lines.append("  held-out R^2: " + ", ".join(f"{k} {v:.3f}" for k, v in r2.items()))
         data = {
+            "verdict": self.verdict.get("verdict"),
             "parameters": {k: v["value"] for k, v in self.parameters.items()},
             "identifiable": [k for k, v in self.parameters.items() if v["identifiable"]],
             "hover_duty": self.hover_duty,
@@ -202,6 +325,9 @@ class IdentifyResult:
 
         return plain(
             {
+                "verdict": self.verdict.get("verdict"),
+                "verdict_reasons": self.verdict.get("reasons", []),
+                "verdict_checks": self.verdict.get("checks", {}),
                 "parameters": {k: {kk: vv for kk, vv in v.items()} for k, v in self.parameters.items()},
                 "hover_duty": self.hover_duty,
                 "mass_kg": self.mass,
@@ -215,49 +341,55 @@ class IdentifyResult:
         )
 
     def vehicle_toml(self) -> str:
-        """The identified vehicle as a ``[vehicle]`` table.
+        """The identified vehicle as a ``[vehicle]`` table (:meth:`vehicle`).
+
+        Without a mass, ``m`` and each field that scales with it hold a string saying so (the
+        value per unit mass for the latter): ``quadcruise fly`` refuses the file, in one line,
+        until they are numbers.
 
         Returns
         -------
         str
-            TOML that ``quadcruise fly --scenario`` reads.
+            TOML that ``quadcruise fly --vehicle`` reads.
         """
         import tomli_w
 
-        v = self.vehicle()
-        if self.fit.get("plant") == "rotor":
-            origin = {
-                k.removesuffix("_per_m"): ("identified" if p["identifiable"] else "base vehicle")
-                for k, p in self.parameters.items()
-                if k not in ("hover_speed", "hover_duty")
-            }
-            head = [
-                f"# identified from {self.log['source']} by quadcruise identify (rotor plant)",
-                "# " + ", ".join(f"{k}: {s}" for k, s in origin.items()),
-                f"# m: {'given' if self.mass is not None else 'base vehicle (no mass given: kf, km, J scaled by it)'}"
-                f"; rotors: {self.log['rotor_geometry']}; the rest: the base vehicle's",
-            ]
-            fields = {k: x for k, x in v.to_dict().items() if x is not None}
-            return "\n".join(head) + "\n" + tomli_w.dumps({"vehicle": {"plant": "rotor", **fields}})
-        origin = {}
-        for name in ("K", "Jxx", "Jyy", "Jzz", "d", "omega"):
-            key = name if self.mass is not None or name in ("d", "omega") else f"{name}_per_m"
-            origin[name] = "identified" if self.parameters[key]["identifiable"] else "base vehicle"
+        v = self._vehicle(float(self.mass) if self.mass is not None else 1.0)
+        rotor = self.fit.get("plant") == "rotor"
+        origin = {
+            k.removesuffix("_per_m"): ("identified" if p["identifiable"] else p.get("source", "base vehicle"))
+            for k, p in self.parameters.items()
+            if k not in ("hover_speed", "hover_duty", "thrust_curve_f")
+        }
+        plant = "rotor" if rotor or not hasattr(v, "K") else "paper"
         head = [
-            f"# identified from {self.log['source']} by quadcruise identify",
+            f"# {self.verdict_line()}",
+            f"# identified from {self.log['source']} by quadcruise identify ({plant} plant)",
             "# " + ", ".join(f"{k}: {s}" for k, s in origin.items()),
-            (
-                f"# m: {'given' if self.mass is not None else 'base vehicle (no mass given: K, J scaled by it)'}"
-                f"; l: mean rotor distance of the {self.log['rotor_geometry']}"
-            ),
+            f"# rotors: {self.log['rotor_geometry']}; the rest: the base vehicle's",
         ]
-        if len(self.rotors) != 4:
+        if plant == "rotor" and not rotor:
             head.append(
-                f"# the log's vehicle has {len(self.rotors)} rotors, the paper's plant 4: K scaled by "
-                f"{len(self.rotors)}/4 (same total thrust and hover; moments approximate)"
+                "# the log's rotors are not the paper's '+': a rotor-plant vehicle from the commands alone, "
+                f"kf w_max^2 = K, km = d kf, tau = 1/omega, w_max {v.w_max:g} rad/s (not in the log)"
             )
-        body = tomli_w.dumps({"vehicle": {"preset": "paper", **{k: float(x) for k, x in v.to_dict().items()}}})
-        return "\n".join(head) + "\n" + body
+        fields = {k: x for k, x in v.to_dict().items() if x is not None}
+        if plant == "paper":
+            fields = {"preset": "paper", **{k: float(x) for k, x in fields.items()}}
+        else:
+            fields = {"plant": "rotor", **fields}
+        if self.mass is None:
+            head.append(
+                "# NO MASS: identify ran without --mass. m and the fields marked 'per unit mass' are strings: "
+                "write the mass [kg] in m and each such field's number times it (or identify again with --mass)"
+            )
+            for key in MASS_FIELDS[1:]:
+                if key in fields and isinstance(fields[key], float) and fields[key] != 0.0:
+                    fields[key] = f"{fields[key]:.6g} per unit mass: times m [kg]"
+            fields["m"] = "unknown: identify ran without --mass; write the vehicle's mass [kg]"
+            order = ["preset", "plant", "m"]
+            fields = {k: fields[k] for k in order if k in fields} | {k: x for k, x in fields.items() if k not in order}
+        return "\n".join(head) + "\n" + tomli_w.dumps({"vehicle": fields})
 
     def report_md(self) -> str:
         """The report, in Markdown.
@@ -268,6 +400,8 @@ class IdentifyResult:
         """
         lines = [
             f"# Identified vehicle: {Path(self.log['source']).name}",
+            "",
+            f"**{self.verdict_line()}**",
             "",
             (
                 f"- log: `{self.log['source']}`, {self.log['airborne_s']:.1f} s airborne in "

@@ -24,6 +24,7 @@ from quadcruise.sysid.logprep import (
     STAGES,
     WINDOW_S,
     command_hold,
+    command_meaning,
     command_rate,
     coupling_signal,
     log_info,
@@ -41,6 +42,7 @@ from quadcruise.sysid.rotor import (
 )
 from quadcruise.sysid.rotor import rigid_body_parameters as physical
 from quadcruise.sysid.validate import scores
+from quadcruise.sysid.verdict import rotor_verdict, withhold
 
 MASS_FREE = ("tau_up", "tau_down", "w_max", "hover_speed", "hover_duty")
 """Parameters that do not scale with the mass."""
@@ -155,7 +157,8 @@ def identify_rotor(flight, base: RotorVehicle, mass: float | None, holdout: floa
     cmd_hz = command_rate(flight)
     hold = command_hold(flight, cmd_hz)
     csv_speeds = flight.speed_commands
-    shape_f = 1.0 if kind == "rad/s" else float(flight.parameters.get("THR_MDL_FAC", 0.0) or 0.0)
+    # rad/s: u is the signal, the speed over w_max; else relative thrust (speed sqrt(u)) or the signal through f
+    shape_f = 1.0 if kind == "rad/s" else command_meaning(flight)[1]
     commands = flight.u if csv_speeds else command_speeds(flight.u, shape_f)
     hover = float(np.median(flight.speeds[fit_rows]))
     motors = fit_motors(
@@ -231,11 +234,20 @@ def identify_rotor(flight, base: RotorVehicle, mass: float | None, holdout: floa
     report(4, len(STAGES), STAGES[3])
 
     validation, traces = _validate(flight, data, betas, held, hubs, g, window, dt, motors, commands)
+
+    def refit_half(rows):
+        again = fit_rigid_body(data, rows, flight.segment, window)
+        return physical(again[0], again[1], again[2], mass, n, g, coupling=coupling)[0]
+
+    verdict = rotor_verdict(data, betas, fit_rows, held, flight.segment, window, refit_half)
+    if not verdict["fits"]:
+        table = withhold(table, verdict)
     report(5, len(STAGES), STAGES[4])
     log = log_info(flight, sig)
     log["rotor_geometry"] = where
     log["rotor_speeds_hz"] = speed_hz
     return IdentifyResult(
+        verdict=verdict,
         parameters=table,
         validation=validation,
         traces=traces,

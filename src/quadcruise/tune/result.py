@@ -63,7 +63,10 @@ class TuneResult:
         ``generation`` (0: the first), ``candidate``, the gains, ``cost``.
     response, start_response : SimResult
         The tuned and the starting gains on the nominal vehicle (the population's
-        environment and sensor noise, no spread), logged at every control period.
+        environment and sensor noise, no spread), flown as the search flew them: logged
+        every ``spec.log_every`` periods (the log the metrics were measured on) and judged
+        by the spec's bounds, so that the folder's scenario.toml, flown again, gives the
+        tuned metrics.
     spec : MonteCarloSpec
         Mission, nominal vehicle, population, seed, flight time and step.
     info : dict
@@ -145,6 +148,9 @@ class TuneResult:
             seed=spec.seed,
             environment=spec.population.environment,
             sensors=spec.population.noise,
+            log_every=spec.log_every,  # the search's log and bounds: its metrics, flown again
+            max_steady_error=spec.max_track_error_m,
+            max_altitude_error=spec.max_altitude_error_m,
         )
         import warnings
 

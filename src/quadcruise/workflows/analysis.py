@@ -42,6 +42,7 @@ from scipy.sparse.csgraph import connected_components
 
 from quadcruise import checks
 from quadcruise import layout as L
+from quadcruise.checks import describe
 from quadcruise.errors import InputError
 from quadcruise.model.actuators import mix
 from quadcruise.model.vehicle import Vehicle
@@ -168,7 +169,7 @@ def linearize(
     if vehicle.batch_size not in (None, 1):
         raise InputError(f"linearize takes one vehicle, got a batch of {vehicle.batch_size}")
     if not (math.isfinite(dt) and dt > 0):
-        raise InputError(f"dt must be a positive number of seconds, got {dt!r}")
+        raise InputError(f"dt must be a positive number of seconds, got {describe(dt)}")
     if dt < MIN_DT:
         raise InputError(
             f"dt = {dt:g} s is below {MIN_DT:g} s: the discrete poles would lie within rounding of 1 "

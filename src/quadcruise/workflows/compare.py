@@ -25,6 +25,7 @@ import numpy as np
 
 from quadcruise import checks
 from quadcruise.control import Controller, as_controller, controller_record
+from quadcruise.control.registry import compared_names
 from quadcruise.errors import InputError, reject_unknown
 from quadcruise.io.plainjson import dumps, plain
 from quadcruise.metrics.summary import Summary
@@ -39,7 +40,9 @@ from quadcruise.workflows.rotor_fly import as_vehicle, rotor_flight_setup
 __all__ = ["compare", "Comparison", "DEFAULT_CONTROLLERS"]
 
 DEFAULT_CONTROLLERS = ("nlpd", "gonzalez", "se3", "cascade")
-"""The paper's controller, its reconstructed baseline, geometric SE(3) and the PX4 cascade."""
+"""The built-in controllers compare flies by default: the paper's controller, its reconstructed
+baseline, geometric SE(3) and the PX4 cascade (with any controller declared since with
+``compared=True``: :func:`quadcruise.control.registry.compared_names`)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -327,7 +330,7 @@ class Comparison:
 
 def compare(
     mission: Mission | str = "circle",
-    controllers: Sequence[Controller | str] | Mapping[str, Controller | str] = DEFAULT_CONTROLLERS,
+    controllers: Sequence[Controller | str] | Mapping[str, Controller | str] | None = None,
     *,
     vehicle=None,
     duration: float | None = None,
@@ -341,9 +344,10 @@ def compare(
     ----------
     mission : Mission or str
         A mission, or its name ('hover', 'step', 'circle', 'square') for the defaults.
-    controllers : sequence or mapping
+    controllers : sequence or mapping, optional
         Names or Controller objects, labelled by their name (a repeated name gets '#2',
-        '#3', ...), or a mapping label -> name or Controller.
+        '#3', ...), or a mapping label -> name or Controller; by default every controller
+        declared ``compared=True`` (:func:`quadcruise.control.registry.compared_names`).
     vehicle : Vehicle, optional
         Table I by default.
     duration : float, optional
@@ -375,6 +379,8 @@ def compare(
     checks.number(w, "duration", duration, "pos", unit="s", optional=True)
     checks.number(w, "dt", dt, "pos", unit="s")
     checks.callback(w, "progress", progress)
+    if controllers is None:
+        controllers = compared_names()
     chosen = labelled(controllers)
     if isinstance(vehicle, RotorVehicle):  # a controller named gets gains designed for it, as fly gives them
         believed = fly_kw.get("controller_vehicle")

@@ -29,7 +29,7 @@ from quadcruise.missions import Mission, as_mission, stack_params
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
-from quadcruise.sim.chunked import simulate_watched
+from quadcruise.sim.chunked import simulate_watched, watch_again
 from quadcruise.sim.engine import simulate
 from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.result import SimResult
@@ -66,7 +66,9 @@ from quadcruise.workflows.rotor_fly import (
     check_wind_acts,
     fly_rotor,
     rotor_batch,
+    rotor_engine_inputs,
     rotor_flight_setup,
+    rotor_initial_states,
     vehicle_record,
 )
 from quadcruise.workflows.track_watch import TrackWatch
@@ -93,6 +95,7 @@ def fly(
     first_vehicle: int | np.ndarray = 0,
     max_track_error: float | None = None,
     max_steady_error: float | None = None,
+    max_altitude_error: float | None = None,
     **unknown: Any,
 ) -> SimResult:
     """Fly a mission with a controller and return the logged flight.
@@ -121,14 +124,17 @@ def fly(
         Number of vehicles; taken from ``vehicle``, ``x0`` or ``missions`` if they are batched.
     x0 : (16,) or (N, 16) array, optional
         Initial states; by default each vehicle hovers at x = y = 0 at the mission's
-        starting altitude and yaw.
+        starting altitude and yaw. A rotor-plant vehicle takes them in the same layout
+        (:func:`~quadcruise.workflows.rotor_fly.rotor_initial_states`: the Euler angles as its
+        quaternion, F1..F4 as its rotor speeds, or its hover for the hover thrusts).
     log_every : int, optional
         Log every this many control periods (a divisor of them). By default every period,
         unless a batch's log would exceed :data:`LOG_BUDGET` (256 MiB): then the smallest divisor
-        that fits, said in a :class:`~quadcruise.errors.LogWarning`, and the track checks
-        (``lost track``, ``off track``) are made at every period as the flight goes, so the
-        statuses and times are those of the full log. A ``log_every`` given is kept, and the
-        checks read its log (a log over half the memory is refused).
+        that fits, said in a :class:`~quadcruise.errors.LogWarning`. A ``log_every`` given is
+        kept (a log over half the memory is refused). Either way the track checks (``lost
+        track``, ``off track``) are made at every period as the flight goes, so the statuses
+        and times are those of the full log, whatever the log keeps (on the paper's plant; a
+        rotor-plant flight's checks read its log).
     limits : Limits, optional
         Divergence bounds.
     missions : list of Mission, optional
@@ -170,6 +176,10 @@ def fly(
         missions), and on the altitude error alone :func:`altitude_bound` (half the
         mission's lowest altitude: 0.5 m for the built-in missions at 1 m), the rule a Monte
         Carlo sweep applies; a value given here bounds both; ``numpy.inf`` turns it off.
+    max_altitude_error : float, optional
+        The bound [m] on the altitude error alone after the transient (``off track`` too): by
+        default :func:`altitude_bound`, or ``max_steady_error`` where that is given; a Monte
+        Carlo sweep gives its ``max_altitude_error_m`` here; ``numpy.inf`` turns it off.
     **unknown : Any
         Refused: any other keyword is an InputError naming the options (see
         :data:`FLY_OPTIONS`), so a misspelt one is not silently ignored.
@@ -213,13 +223,14 @@ def fly(
     check_wind_acts(vehicle, environment)  # rotor_fly.py
     seed = checks.whole(w, "seed", seed)
     first_vehicle = vehicle_indices(first_vehicle)
-    for name, value in (("max_track_error", max_track_error), ("max_steady_error", max_steady_error)):
+    bounds = (("max_track_error", max_track_error), ("max_steady_error", max_steady_error))
+    for name, value in (*bounds, ("max_altitude_error", max_altitude_error)):
         checks.number(w, name, value, "pos", unit="m", optional=True, infinite=True)
     x0 = initial_states(x0)
-    if rotor and (x0 is not None or full_dynamics):
+    if rotor and full_dynamics:
         raise InputError(
-            f"fly() argument {'x0' if x0 is not None else 'full_dynamics'}: not for a rotor-plant vehicle "
-            "(it starts hovering at the mission's start; its plant has no Euler-angle kinematics to choose)"
+            "fly() argument full_dynamics: not for a rotor-plant vehicle (its plant has no Euler-angle "
+            "kinematics to choose: it flies the quaternion)"
         )
     sizes = {
         s
@@ -238,19 +249,25 @@ def fly(
     n = sizes.pop() if sizes else 1
     if n < 1:
         raise InputError(f"the number of vehicles must be at least 1, got {n}")
+    if rotor and x0 is not None:  # what cannot start its rotors, refused before any work
+        rotor_initial_states(rotor_batch(vehicle), x0, n)
     mp = stack_params(missions if missions is not None else mission, n=None if missions else n)
     first = missions[0] if missions else mission
     duration = default_duration(first) if duration is None else duration
     d, h = duration, dt
-    watched = log_every is None and n > 1 and 0 < h <= d < math.inf and batch_log_every(n, round(d / h)) > 1
-    watched = watched and not rotor  # a rotor flight keeps its whole log (rotor_fly.py)
+    extra = (rotor_batch(vehicle)[0].n_rotors + 13) if rotor else 0  # a rotor flight logs its rotor state too
+    steps = round(d / h) if 0 < h <= d < math.inf else 0
+    chosen = log_every is None and n > 1 and steps > 0 and batch_log_every(n, steps, extra) > 1
     # a batch whose full log would not fit in LOG_BUDGET: a coarser log, checked at every period
-    log_every = batch_log_every(n, round(d / h)) if watched else 1 if log_every is None else log_every
-    if 0 < h <= d < math.inf:  # sized before the grid is allocated
+    log_every = batch_log_every(n, steps, extra) if chosen else 1 if log_every is None else log_every
+    # the track checks see every period whatever the log keeps: a flight's status and time do not
+    # depend on its log (a Monte Carlo sweep's 10 ms log, `montecarlo --case`, `fly` alone agree)
+    watched = log_every > 1 and steps > 0
+    if steps:  # sized before the grid is allocated
         substeps = max(1, math.ceil(h / float(max_step or h) - 1e-9))
-        check_run_size(n, round(d / h), int(log_every), substeps, watched)
-    if watched:
-        full, kept = log_bytes(n, round(d / h), 1) / 2**30, log_bytes(n, round(d / h), log_every) / 2**30
+        check_run_size(n, steps, int(log_every), substeps, watched, extra)
+    if chosen:
+        full, kept = (log_bytes(n, steps, k, extra) / 2**30 for k in (1, log_every))
         warnings.warn(
             f"fly(): the log of {n:,} vehicles x {round(d / h) + 1:,} instants would take {full:.1f} GiB: logging "
             f"every {log_every} periods ({kept:.2f} GiB; the track checks still see every period); give log_every "
@@ -266,6 +283,7 @@ def fly(
         check_can_hover(vehicle)
     check_reference_fits(missions or [first], float(duration), limits or Limits())
     given_x0 = None if x0 is None else np.asarray(x0, dtype=float).tolist()
+    rotor_x0 = x0  # a rotor flight's own start: hovering at the mission's start unless given
     x0 = hover_state(batch_equivalent(rotor_batch(vehicle)[:1]) if rotor else vehicle, n, first) if x0 is None else x0
     meta = {
         "workflow": "fly",
@@ -281,9 +299,10 @@ def fly(
         "full_dynamics": bool(full_dynamics),
         "seed": seed,
         "log_every": int(log_every),
-        **({"log_every_chosen": True} if watched else {}),
+        **({"log_every_chosen": True} if chosen else {}),
         "max_track_error": None if max_track_error is None else float(max_track_error),
         "max_steady_error": None if max_steady_error is None else float(max_steady_error),
+        **({} if max_altitude_error is None else {"max_altitude_error": float(max_altitude_error)}),
         "initial_state": given_x0,
     }
     if environment is not None:
@@ -327,6 +346,8 @@ def fly(
         if max_steady_error is None
         else steady
     )
+    if max_altitude_error is not None:
+        vertical = np.full(n, float(max_altitude_error))
     options = dict(
         memory=memory,
         max_step=max_step or dt,
@@ -337,19 +358,31 @@ def fly(
         first_vehicle=first_vehicle,
         **engine_inputs(environment, sensors, n, dt),
     )
-    if rotor:  # the rotor plant's own path (rotor_fly.py), its log whole
-        result = fly_rotor(grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, **options)
+    if watched:  # the log keeps every log_every-th period; the checks see every one
+        if rotor:  # the rotor plant's arrays (rotor_fly.py)
+            args, plant = rotor_engine_inputs(
+                grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, rotor_x0, meta
+            )
+        else:
+            args = (grid, x0, vehicle.rows(n), controller.function, gains, first.function, mp)
+            plant = dict(vp_ctrl=vp_ctrl, full_dynamics=full_dynamics)
+        options.update(plant)
+        mission_record = meta["mission"] if isinstance(meta["mission"], dict) else {}
+        watch = TrackWatch(grid, mission_record, bound, steady, vertical)
+        result = simulate_watched(*args, watch=watch.feed, **options)
+
+        def again(vehicles, periods, feed):  # the head of some vehicles, flown again (track_watch.py)
+            watch_again(*args, vehicles=vehicles, periods=periods, watch=feed, **options)
+
+        status, t_stop = watch.verdict(result.status, result.t_stop, again)
+        result = dataclasses.replace(result, status=status, t_stop=t_stop)
+    elif rotor:  # the rotor plant's whole log (rotor_fly.py)
+        result = fly_rotor(
+            grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, x0=rotor_x0, **options
+        )
     else:
         args = (grid, x0, vehicle.rows(n), controller.function, gains, first.function, mp)
-        options.update(vp_ctrl=vp_ctrl, full_dynamics=full_dynamics)
-        if watched:  # the log keeps every log_every-th period; the checks see every one
-            mission_record = meta["mission"] if isinstance(meta["mission"], dict) else {}
-            watch = TrackWatch(grid, mission_record, bound, steady, vertical)
-            result = simulate_watched(*args, watch=watch.feed, **options)
-            status, t_stop = watch.verdict(result.status, result.t_stop)
-            result = dataclasses.replace(result, status=status, t_stop=t_stop)
-        else:
-            result = simulate(*args, **options)
+        result = simulate(*args, vp_ctrl=vp_ctrl, full_dynamics=full_dynamics, **options)
     result.meta["max_track_error_m"] = bound.tolist() if n > 1 else float(bound[0])
     result.meta["max_steady_error_m"] = steady.tolist() if n > 1 else float(steady[0])
     result.meta["max_altitude_error_m"] = vertical.tolist() if n > 1 else float(vertical[0])

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from quadcruise import checks
+from quadcruise.checks import describe
 from quadcruise.control import as_controller
 from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import InputError
@@ -237,6 +238,7 @@ FLY_OPTIONS = (
     "first_vehicle",
     "max_track_error",
     "max_steady_error",
+    "max_altitude_error",
 )
 """The keywords :func:`fly` takes besides the mission and the controller."""
 
@@ -253,7 +255,7 @@ the 1 GiB the issue allows, because writing the log is most of what a coarser lo
 of CPU for 0.73 GB against a 6 s flight; docs/performance.md)."""
 
 
-def log_bytes(n: int, periods: int, log_every: int) -> int:
+def log_bytes(n: int, periods: int, log_every: int, extra: int = 0) -> int:
     """Bytes of a flight's log: states, commands and references at every ``log_every``-th period.
 
     Parameters
@@ -264,18 +266,20 @@ def log_bytes(n: int, periods: int, log_every: int) -> int:
         Control periods of the flight.
     log_every : int
         Log every this many periods.
+    extra : int
+        More numbers logged per row (a rotor-plant flight's own state: 13 + rotors).
 
     Returns
     -------
     int
-        312 bytes per vehicle and logged instant.
+        312 bytes (+ 8 ``extra``) per vehicle and logged instant.
     """
     from quadcruise.layout import CMD_SIZE, REF_SIZE
 
-    return n * (periods // log_every + 1) * 8 * (STATE_SIZE + CMD_SIZE + REF_SIZE)
+    return n * (periods // log_every + 1) * 8 * (STATE_SIZE + CMD_SIZE + REF_SIZE + extra)
 
 
-def batch_log_every(n: int, periods: int) -> int:
+def batch_log_every(n: int, periods: int, extra: int = 0) -> int:
     """The ``log_every`` a flight gets by default: 1 (every period) for one vehicle or a log within
     :data:`LOG_BUDGET`, else the smallest divisor of the periods that keeps the log within it.
 
@@ -285,6 +289,8 @@ def batch_log_every(n: int, periods: int) -> int:
         Number of vehicles.
     periods : int
         Control periods of the flight.
+    extra : int
+        More numbers logged per row (:func:`log_bytes`).
 
     Returns
     -------
@@ -295,19 +301,23 @@ def batch_log_every(n: int, periods: int) -> int:
     >>> batch_log_every(1, 10**6), batch_log_every(200, 1000), batch_log_every(2000, 10_000)
     (1, 1, 25)
     """
-    if n <= 1 or log_bytes(n, periods, 1) <= LOG_BUDGET:
+    if n <= 1 or log_bytes(n, periods, 1, extra) <= LOG_BUDGET:
         return 1
     small = [d for d in range(1, math.isqrt(periods) + 1) if periods % d == 0]
     divisors = sorted(set(small + [periods // d for d in small]))
-    return next((d for d in divisors if log_bytes(n, periods, d) <= LOG_BUDGET), periods)
+    return next((d for d in divisors if log_bytes(n, periods, d, extra) <= LOG_BUDGET), periods)
 
 
-WATCH_BYTES = 9
-"""Bytes per vehicle-period that the track checks at every period keep over the first half of a
-batch's flight (a moving reference's error and beyond-the-bounds flag: :mod:`~quadcruise.workflows.track_watch`)."""
+WATCH_BYTES = 8 * 8 + 17 * 8 + 6 + 8 + 8
+"""Bytes per vehicle that the track checks at every period keep, whatever the flight's length
+(:class:`~quadcruise.workflows.track_watch.TrackWatch`: 8 periods, 17 figures, 6 flags, the
+bounds' step response and its index); the head of a vehicle flown again is read in groups of
+at most :data:`~quadcruise.workflows.track_watch.HEAD_BYTES`."""
 
 
-def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1, watched: bool = False) -> None:
+def check_run_size(
+    n: int, steps: int, log_every: int, substeps: int = 1, watched: bool = False, extra: int = 0
+) -> None:
     """Refuse, before anything is allocated, a flight whose log would not fit in memory or that
     would run for hours; the message says what to change.
 
@@ -323,6 +333,8 @@ def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1, watche
         RK4 substeps per control period (``ceil(dt / max_step)``).
     watched : bool
         The track checks are made at every period as the flight goes (:data:`WATCH_BYTES`).
+    extra : int
+        More numbers logged per row (:func:`log_bytes`).
 
     Raises
     ------
@@ -340,7 +352,7 @@ def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1, watche
     from quadcruise.layout import CMD_SIZE, REF_SIZE
 
     if log_every < 1:
-        raise InputError(f"log_every must be a whole number >= 1, got {log_every!r}")
+        raise InputError(f"log_every must be a whole number >= 1, got {describe(log_every)}")
 
     def many(k: int) -> str:  # a count as a message writes it: short, whatever its size
         return f"{k:,}" if k < 10**12 else f"{float(k):.3g}"
@@ -356,7 +368,7 @@ def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1, watche
             f"{n * steps * substeps:.2g} substeps, hours of computing: a larger max_step, fewer "
             "vehicles or a shorter duration"
         )
-    row = 8 * (STATE_SIZE + CMD_SIZE + REF_SIZE)
+    row = 8 * (STATE_SIZE + CMD_SIZE + REF_SIZE + extra)
     need = n * (steps // log_every + 2) * row
     try:
         memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
@@ -370,13 +382,12 @@ def check_run_size(n: int, steps: int, log_every: int, substeps: int = 1, watche
             f"{memory / 2**30:.0f} GiB: log less often (log_every={every:,}: in Python, or a scenario's "
             "[simulation]) or fly shorter"
         )
-    watching = n * (steps // 2 + 2) * WATCH_BYTES if watched else 0
+    watching = n * WATCH_BYTES if watched else 0
     if watched and need + watching > MAX_LOG_FRACTION * memory:
         raise InputError(
             f"the flight's track checks at every period would keep {watching / 2**30:.1f} GiB ({n:,} vehicles x "
-            f"{steps // 2 + 1:,} periods of the first half x {WATCH_BYTES} bytes) beside its "
-            f"{need / 2**30:.2f} GiB log, more than half of this machine's {memory / 2**30:.0f} GiB: fly fewer "
-            "vehicles or shorter, or give log_every (the checks then read the log)"
+            f"{WATCH_BYTES} bytes) beside its {need / 2**30:.2f} GiB log, more than half of this machine's "
+            f"{memory / 2**30:.0f} GiB: fly fewer vehicles"
         )
 
 

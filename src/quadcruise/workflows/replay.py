@@ -96,12 +96,12 @@ def _validated(t, duties, source: str, lines: list[int] | None = None):
     for k in range(int(np.argmax(bad)) if bad.any() else t.shape[0], t.shape[0]):
         where = f"{source}, line {lines[k]}" if lines else f"{source}, row {k + 1}"
         if not math.isfinite(t[k]):
-            raise InputError(f"{where}, column 't': time is not finite ({t[k]!r})")
+            raise InputError(f"{where}, column 't': time is not finite ({checks.short_number(t[k])})")
         if k and t[k] <= t[k - 1]:
             raise InputError(f"{where}, column 't': time {t[k]:g} is not after the previous row's {t[k - 1]:g}")
         for j in range(4):
             if not math.isfinite(u[k, j]):
-                raise InputError(f"{where}, column 'u{j + 1}': duty is not finite ({u[k, j]!r})")
+                raise InputError(f"{where}, column 'u{j + 1}': duty is not finite ({checks.short_number(u[k, j])})")
             if not 0.0 <= u[k, j] <= 1.0:
                 raise InputError(f"{where}, column 'u{j + 1}': duty {u[k, j]:g} is outside [0, 1]")
     return t, u
@@ -123,6 +123,8 @@ def read_duty_csv(path: str | os.PathLike, progress: Callable[[int, int], None] 
     DutySchedule
         With ``source`` the file name.
     """
+    checks.instance("read_duty_csv()", "path", path, (str, os.PathLike), optional=False, want="a path")
+    checks.callback("read_duty_csv()", "progress", progress)
     _, _, data, lines = read_numeric_csv(path, INPUT_COLUMNS, progress=progress)
     if data.shape[0] < 2:
         raise InputError(f"{path}: needs at least two data rows (a start and an end time), found {data.shape[0]}")
@@ -301,11 +303,11 @@ class SpeedSchedule:
             k = int(np.argmax(bad))
             where = self.where(k)
             if not math.isfinite(t[k]):
-                raise InputError(f"{where}, column 't': time is not finite ({t[k]!r})")
+                raise InputError(f"{where}, column 't': time is not finite ({checks.short_number(t[k])})")
             if k and not t[k] > t[k - 1]:
                 raise InputError(f"{where}, column 't': time {t[k]:g} is not after the previous row's {t[k - 1]:g}")
             j = int(np.argmax(~np.isfinite(w[k])))
-            raise InputError(f"{where}, column 'w{j + 1}': rotor speed is not finite ({w[k, j]!r})")
+            raise InputError(f"{where}, column 'w{j + 1}': rotor speed is not finite ({checks.short_number(w[k, j])})")
         object.__setattr__(self, "t", t)
         object.__setattr__(self, "speeds", w)
 
@@ -345,6 +347,10 @@ def read_speed_csv(
     SpeedSchedule
         With ``source`` the file name and the file line of each row.
     """
+    w = "read_speed_csv()"
+    checks.instance(w, "path", path, (str, os.PathLike), optional=False, want="a path")
+    n_rotors = checks.whole(w, "n_rotors", n_rotors, 1)
+    checks.callback(w, "progress", progress)
     data, lines = _rotor_table(path, n_rotors, "w", progress)
     return SpeedSchedule(t=data[:, 0], speeds=data[:, 1:], source=str(path), lines=tuple(lines))
 
@@ -413,7 +419,7 @@ ROTOR_MAX_STEP = 1e-4
 
 
 def replay_rotors(
-    schedule: SpeedSchedule,
+    schedule: SpeedSchedule | str | os.PathLike,
     vehicle: RotorVehicle,
     *,
     max_step: float = ROTOR_MAX_STEP,
@@ -429,9 +435,9 @@ def replay_rotors(
 
     Parameters
     ----------
-    schedule : SpeedSchedule
+    schedule : SpeedSchedule, str or os.PathLike
         The commanded speeds [rad/s] and their times [s]; every speed within the vehicle's
-        [w_min, w_max].
+        [w_min, w_max]; or the path of a ``t,w1,..,wn`` CSV of them (:func:`read_speed_csv`).
     vehicle : RotorVehicle
         The vehicle (:meth:`quadcruise.Vehicle.preset`); its rotor count must be the
         schedule's.
@@ -460,8 +466,31 @@ def replay_rotors(
         A rotor count that does not match, a speed outside the vehicle's range (naming the
         row and column), a bad wind or step.
     """
+    w = "replay_rotors()"  # every argument checked before any work
+    checks.instance(
+        w,
+        "schedule",
+        schedule,
+        (SpeedSchedule, str, os.PathLike),
+        optional=False,
+        want="a SpeedSchedule or the path of a t,w1,..,wn CSV file",
+    )
     if not isinstance(vehicle, RotorVehicle):
         raise InputError(f"replay_rotors needs a rotor-plant vehicle (RotorVehicle), got {type(vehicle).__name__}")
+    max_step = checks.number(w, "max_step", max_step, "pos", unit="s")
+    checks.instance(w, "limits", limits, Limits)
+    ground = checks.flag(w, "ground", ground)
+    checks.callback(w, "progress", progress)
+    if isinstance(wind, (str, bytes)) or not np.iterable(wind):
+        checks.fail(w, "wind", wind, "3 finite numbers [m/s]")
+    try:
+        wind = np.asarray(wind, dtype=float)
+    except (TypeError, ValueError):
+        checks.fail(w, "wind", wind, "3 finite numbers [m/s]")
+    if wind.shape != (3,) or not np.all(np.isfinite(wind)):
+        raise InputError(f"wind must be 3 finite numbers [m/s], got {wind.tolist()!r}")
+    if not isinstance(schedule, SpeedSchedule):
+        schedule = read_speed_csv(schedule, vehicle.n_rotors)
     n = vehicle.n_rotors
     if schedule.speeds.shape[1] != n:
         raise InputError(
@@ -474,17 +503,13 @@ def replay_rotors(
             f"{schedule.where(k)}, column 'w{j + 1}': rotor speed {schedule.speeds[k, j]:g} rad/s is "
             f"outside the vehicle's [{vehicle.w_min:g}, {vehicle.w_max:g}]"
         )
-    wind = np.asarray(wind, dtype=float)
-    if wind.shape != (3,) or not np.all(np.isfinite(wind)):
-        raise InputError(f"wind must be 3 finite numbers [m/s], got {wind.tolist()!r}")
-    if isinstance(max_step, (int, float)) and max_step > 0:
-        substeps = float(np.sum(np.ceil(np.diff(schedule.t) / max_step - 1e-9)))
-        if substeps > MAX_SUBSTEPS:
-            raise InputError(
-                f"{schedule.source}: {schedule.t[-1] - schedule.t[0]:g} s of rotor speeds at max_step "
-                f"{max_step:g} s is {substeps:.3g} RK4 substeps, hours of computing: a larger "
-                "--max-step or a shorter table"
-            )
+    substeps = float(np.sum(np.ceil(np.diff(schedule.t) / max_step - 1e-9)))
+    if substeps > MAX_SUBSTEPS:
+        raise InputError(
+            f"{schedule.source}: {schedule.t[-1] - schedule.t[0]:g} s of rotor speeds at max_step "
+            f"{max_step:g} s is {substeps:.3g} RK4 substeps, hours of computing: a larger "
+            "--max-step or a shorter table"
+        )
     x0 = np.zeros(ROTOR_W1 + n)
     x0[QW] = 1.0
     x0[ROTOR_W1:] = schedule.speeds[0]

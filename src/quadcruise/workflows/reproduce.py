@@ -475,8 +475,8 @@ the rise time are given; the paper does not say which it used.
 INTRO = (
     "Our value first, the paper's in brackets. Transients are measured on x from hover; the rise is "
     "10-90 % (python-control's convention) in this table, while the paper does not say which convention "
-    "its rise follows: the fitted table below gives both. Settling uses the 2 % band (5 % beside it); RMSE "
-    "is the 3-D position error over the whole flight, transient included."
+    "its rise follows (the table of fitted gains, where flown, gives both). Settling uses the 2 % band "
+    "(5 % beside it); RMSE is the 3-D position error over the whole flight, transient included."
 )
 """The sentences above the results table: what each column measures."""
 

@@ -26,35 +26,27 @@ from typing import Any
 import numpy as np
 
 from quadcruise.control import CONTROLLERS, controller_from_name
-from quadcruise.control.cascade import rate_pid_design
-from quadcruise.control.design import attitude_pid_design
-from quadcruise.control.se3 import se3_attitude_design
+from quadcruise.control.registry import rotor_gains
 from quadcruise.errors import InputError
-from quadcruise.layout import REF_PSI, REF_Z
+from quadcruise.layout import PSI, REF_PSI, REF_Z
 from quadcruise.missions import Mission
 from quadcruise.model.equivalent import duty_to_thrust, paper_equivalent
 from quadcruise.model.rotor_plant import QW, QZ, ROTOR_W1, RZ, state_names
+from quadcruise.model.rotor_plant import RP as RP_RATES
 from quadcruise.model.rotor_vehicle import AERO_FIELDS, RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rotor_batch import fly_rotor_vehicles
 
-# the controller fields designed for an actuator bandwidth w [rad/s], by controller name
-_DESIGNS = {
-    "nlpd": {"attitude": attitude_pid_design, "yaw": attitude_pid_design},
-    "gonzalez": {"attitude": attitude_pid_design, "yaw": attitude_pid_design},
-    "se3": {"attitude": se3_attitude_design},
-    "cascade": {"rate": rate_pid_design, "yaw_rate": lambda w: rate_pid_design(w, yaw=True)},
-}
-
 
 def designed_controller(name: str, bandwidth: float) -> Any:
-    """A built-in controller with the gains its design rules give for a motor bandwidth.
+    """A controller by name with the gains its design rules give for a motor bandwidth (its
+    ``rotor_design``, :func:`quadcruise.control.registry.register_controller`).
 
     Parameters
     ----------
     name : str
-        A built-in controller's name (``nlpd``, ``gonzalez``, ``se3``, ``cascade``).
+        A declared controller's name (``nlpd``, ``gonzalez``, ``se3``, ``cascade``, or a user's).
     bandwidth : float
         The rotor lag's bandwidth w [rad/s] (15 for the paper's vehicle: the defaults).
 
@@ -69,10 +61,10 @@ def designed_controller(name: str, bandwidth: float) -> Any:
     Raises
     ------
     InputError
-        An unknown name.
+        An unknown name, or a controller declared without a design for a rotor-plant vehicle.
     """
     base = controller_from_name(name)
-    return dataclasses.replace(base, **{field: design(bandwidth) for field, design in _DESIGNS[name].items()})
+    return dataclasses.replace(base, **rotor_gains(name, bandwidth))
 
 
 def as_vehicle(vehicle: Any) -> Any:
@@ -268,7 +260,81 @@ def rotor_hover_state(vehicle: RotorVehicle, mission: Mission) -> np.ndarray:
     return x0
 
 
-def fly_rotor(
+def rotor_initial_states(vehicles: tuple[RotorVehicle, ...], x0: np.ndarray, n: int) -> np.ndarray:
+    """Rotor-plant initial states from ``fly(x0=)``'s paper-layout states (:data:`~quadcruise.layout.STATE_NAMES`).
+
+    Position, velocity and body rates are copied, the ZYX Euler angles become the quaternion
+    ``q = qz(psi) qy(theta) qx(phi)``; a rotor starts at ``w_i = sqrt(F_i / kf)``, the inverse of
+    the paper layout's ``F_i = kf w_i^2`` (:func:`~quadcruise.sim.rotor_flight.paper_state`), and
+    at its hover speed exactly where F1..F4 are all the hover thrust ``m g / 4`` that
+    :func:`~quadcruise.workflows.fly_inputs.hover_state` gives.
+
+    Parameters
+    ----------
+    vehicles : tuple of RotorVehicle
+        One vehicle for all, or one per vehicle.
+    x0 : numpy.ndarray
+        (16,) or (n, 16) paper-layout states.
+    n : int
+        Number of vehicles.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 13 + rotors) rotor states.
+
+    Raises
+    ------
+    InputError
+        A negative thrust, or thrusts other than the hover's for a vehicle without four rotors
+        (the paper layout holds four rotors' thrusts).
+
+    Examples
+    --------
+    >>> from quadcruise.model.rotor_vehicle import RotorVehicle
+    >>> v = RotorVehicle.preset("iris")
+    >>> x = np.zeros(16); x[2] = 1.0; x[8] = np.pi / 2; x[12:] = v.m * v.g / 4
+    >>> r = rotor_initial_states((v,), x, 1)[0]
+    >>> float(r[2]), np.round(r[6:10], 6).tolist(), bool(np.all(r[13:] == v.hover_speed))
+    (1.0, [0.707107, 0.0, 0.0, 0.707107], True)
+    """
+    from quadcruise.layout import F1, PHI, THETA, P, X
+
+    x0 = np.broadcast_to(np.atleast_2d(np.asarray(x0, dtype=float)), (n, 16))
+    flown = vehicles if len(vehicles) == n else vehicles[:1] * n
+    out = np.zeros((n, ROTOR_W1 + flown[0].n_rotors))
+    out[:, :6] = x0[:, X : X + 6]
+    out[:, RP_RATES : RP_RATES + 3] = x0[:, P : P + 3]
+    h = 0.5 * x0[:, [PHI, THETA, PSI]]
+    (cf, ct, cp), (sf, st, sp) = np.cos(h).T, np.sin(h).T
+    out[:, QW] = cf * ct * cp + sf * st * sp
+    out[:, QW + 1] = sf * ct * cp - cf * st * sp
+    out[:, QW + 2] = cf * st * cp + sf * ct * sp
+    out[:, QZ] = cf * ct * sp - sf * st * cp
+    thrust = x0[:, F1 : F1 + 4]
+    for v in dict.fromkeys(flown):  # each distinct vehicle once, over its rows
+        rows = np.array([u == v for u in flown]) if len(vehicles) > 1 else np.ones(n, dtype=bool)
+        hover = np.all(thrust[rows] == v.m * v.g / 4.0, axis=1)
+        bad = ~hover & ((v.n_rotors != 4) | np.any(thrust[rows] < 0, axis=1))
+        if bad.any():
+            i = int(np.flatnonzero(rows)[np.argmax(bad)])
+            raise InputError(
+                f"fly() argument x0, row {i}: rotor thrusts {thrust[i].tolist()} cannot start "
+                + (
+                    f"a {v.n_rotors}-rotor vehicle (x0 holds four rotors' thrusts F1..F4): give its hover, "
+                    f"F1..F4 = m g / 4 = {v.m * v.g / 4.0:.6g} N, as hover_state does"
+                    if v.n_rotors != 4
+                    else "its rotors (a thrust must be >= 0 N)"
+                )
+            )
+        speed = np.full((int(rows.sum()), v.n_rotors), v.hover_speed)
+        if v.n_rotors == 4:
+            speed[~hover] = np.sqrt(thrust[rows][~hover] / v.kf)
+        out[rows, ROTOR_W1:] = speed
+    return out
+
+
+def rotor_engine_inputs(
     grid: np.ndarray,
     vehicle: RotorVehicle,
     controller_vehicle: RotorVehicle | None,
@@ -277,11 +343,11 @@ def fly_rotor(
     mission: Mission,
     mp: np.ndarray,
     n: int,
-    *,
-    limits: Any = None,
-    **engine: Any,
-) -> SimResult:
-    """The closed-loop flight of ``n`` copies of a rotor-plant vehicle, for :func:`quadcruise.fly`.
+    x0: np.ndarray | None = None,
+    meta: dict | None = None,
+) -> tuple[tuple, dict]:
+    """The arrays of ``n`` rotor-plant flights, as :class:`~quadcruise.sim.stepper.Stepper`
+    (and so :func:`~quadcruise.sim.chunked.simulate_watched`) takes them, for :func:`quadcruise.fly`.
 
     Parameters
     ----------
@@ -302,19 +368,20 @@ def fly_rotor(
         Mission parameter rows.
     n : int
         Number of vehicles.
-    limits : Limits, optional
-        Divergence bounds.
-    **engine : Any
-        :func:`quadcruise.sim.rotor_batch.fly_rotor_vehicles`'s other keywords (memory,
-        disturbance, sensors, seed, first_vehicle, max_step, log_every, meta).
+    x0 : numpy.ndarray, optional
+        (16,) or (n, 16) paper-layout initial states (:func:`rotor_initial_states`); hovering
+        at the mission's start by default.
+    meta : dict, optional
+        The flight's record: the flown vehicle's "+" equivalent is added to it.
 
     Returns
     -------
-    SimResult
+    tuple
+        ``(args, options)``: the positional arguments (grid, rotor x0, rotor rows, controller,
+        gains, mission, mp) and ``vp_ctrl``, ``alloc``, ``psi0``, ``touchdown_speed``, ``rotor_names``.
     """
     flown = rotor_batch(vehicle)
     believed = (controller_vehicle,) if controller_vehicle is not None else flown
-    meta = engine.get("meta")
     if meta is not None:  # the flown vehicle's "+" equivalent: its hover duty (effort), a log's K, l, d
         meta["paper_equivalent"] = batch_equivalent(flown).to_dict()
 
@@ -322,22 +389,62 @@ def fly_rotor(
         made = {v: make(v) for v in dict.fromkeys(vehicles)}
         return np.stack([made[v] for v in vehicles]) if len(vehicles) > 1 else next(iter(made.values()))
 
-    return fly_rotor_vehicles(
+    psi = float(mission.reference(0.0)[0][REF_PSI])
+    start = rows(lambda v: rotor_hover_state(v, mission), flown) if x0 is None else rotor_initial_states(flown, x0, n)
+    args = (
         grid,
-        rows(lambda v: rotor_hover_state(v, mission), flown),
+        start,
         np.broadcast_to(rows(RotorVehicle.row, flown), (n, flown[0].row().size)),
-        rows(lambda v: np.r_[duty_to_thrust(v).ravel(), v.kf], believed),
-        rows(lambda v: paper_equivalent(v).rows(1)[0], believed),
         controller_function,
         gains,
         mission.function,
         mp,
-        psi0=float(mission.reference(0.0)[0][REF_PSI]),
-        limits=limits,
+    )
+    plant = dict(
+        alloc=rows(lambda v: np.r_[duty_to_thrust(v).ravel(), v.kf], believed),
+        vp_ctrl=rows(lambda v: paper_equivalent(v).rows(1)[0], believed),
+        psi0=psi if x0 is None else np.broadcast_to(np.atleast_2d(x0)[:, PSI], (n,)).copy(),
         touchdown_speed=np.array([v.touchdown_speed for v in flown]) if len(flown) > 1 else flown[0].touchdown_speed,
         rotor_names=state_names(flown[0].n_rotors),
-        **engine,
     )
+    return args, plant
+
+
+def fly_rotor(
+    grid: np.ndarray,
+    vehicle: RotorVehicle,
+    controller_vehicle: RotorVehicle | None,
+    controller_function: Any,
+    gains: np.ndarray,
+    mission: Mission,
+    mp: np.ndarray,
+    n: int,
+    *,
+    x0: np.ndarray | None = None,
+    **engine: Any,
+) -> SimResult:
+    """The closed-loop flight of ``n`` rotor-plant vehicles with their whole log (at ``log_every``).
+
+    Parameters
+    ----------
+    grid, vehicle, controller_vehicle, controller_function, gains, mission, mp, n, x0
+        As in :func:`rotor_engine_inputs`.
+    **engine : Any
+        :func:`quadcruise.sim.rotor_batch.fly_rotor_vehicles`'s other keywords (memory,
+        disturbance, sensors, seed, first_vehicle, max_step, log_every, limits, meta).
+
+    Returns
+    -------
+    SimResult
+    """
+    args, plant = rotor_engine_inputs(
+        grid, vehicle, controller_vehicle, controller_function, gains, mission, mp, n, x0, engine.get("meta")
+    )
+    t, start, rp, function, gains, mission_function, mp = args
+    alloc, vp_ctrl = plant.pop("alloc"), plant.pop("vp_ctrl")
+    return fly_rotor_vehicles(
+        t, start, rp, alloc, vp_ctrl, function, gains, mission_function, mp, **plant, **engine
+    )  # fmt: skip
 
 
 __all__ = [
@@ -348,6 +455,8 @@ __all__ = [
     "check_wind_acts",
     "designed_controller",
     "fly_rotor",
+    "rotor_engine_inputs",
+    "rotor_initial_states",
     "rotor_flight_setup",
     "rotor_hover_state",
 ]

@@ -34,7 +34,8 @@ A scenario has up to seven tables; every one is optional::
     duration = 30.0
     dt = 0.001
     full_dynamics = false
-    seed = 1                  # also: max_step, log_every, n, max_track_error, max_steady_error, initial_state
+    seed = 1                  # also: max_step, log_every, n, max_track_error, max_steady_error,
+                              # max_altitude_error, initial_state
 
     [montecarlo]              # read by `quadcruise montecarlo` (quadcruise.montecarlo.scenario)
     n = 1000
@@ -71,6 +72,7 @@ from typing import Any
 
 from quadcruise.control import Controller
 from quadcruise.errors import InputError
+from quadcruise.io.files import not_a_file
 from quadcruise.missions import Mission
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.workflows.scenario_controller import COMPARE_POPULATION_KEYS, compare_table, controller_table
@@ -120,7 +122,7 @@ class Scenario:
     simulation : dict
         The checked ``[simulation]`` table: ``duration`` [s], ``dt`` [s], ``max_step`` [s],
         ``full_dynamics``, ``seed``, ``log_every``, ``n``, ``max_track_error`` [m],
-        ``max_steady_error`` [m] and ``initial_state`` (16 state values in the units of
+        ``max_steady_error`` [m], ``max_altitude_error`` [m] and ``initial_state`` (16 state values in the units of
         :data:`quadcruise.layout.STATE_UNITS`, or one row per vehicle), each only if given.
     montecarlo : dict
         The ``[montecarlo]`` table as written (checked by ``quadcruise montecarlo``).
@@ -183,12 +185,14 @@ class Scenario:
         dict
             ``duration`` [s] (None if not given), ``dt`` [s], ``vehicle``, and those of
             ``max_step``, ``full_dynamics``, ``seed``, ``log_every``, ``n``,
-            ``max_track_error``, ``max_steady_error``, ``x0`` (the initial state), ``controller_vehicle``,
+            ``max_track_error``, ``max_steady_error``, ``max_altitude_error``, ``x0`` (the initial
+            state), ``controller_vehicle``,
             ``environment`` and ``sensors`` the scenario gives.
         """
         sim = self.simulation
         kw: dict[str, Any] = {"duration": sim.get("duration"), "dt": self.dt}
-        for key in ("max_step", "full_dynamics", "seed", "log_every", "n", "max_track_error", "max_steady_error"):
+        bounds = ("max_track_error", "max_steady_error", "max_altitude_error")
+        for key in ("max_step", "full_dynamics", "seed", "log_every", "n", *bounds):
             if key in sim:
                 kw[key] = sim[key]
         if "initial_state" in sim:
@@ -243,7 +247,7 @@ def load_scenario(path: str | Path) -> Scenario:
     if path.is_dir():
         raise InputError(f"{path}: is a folder, not a scenario file")
     if not path.is_file():
-        raise InputError(f"{path}: no such file")
+        raise InputError(f"{path}: {not_a_file(path)}")
     try:
         doc = tomllib.loads(path.read_text(encoding="utf-8-sig"))  # a byte-order mark is dropped
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:

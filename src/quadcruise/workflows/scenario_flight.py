@@ -20,6 +20,7 @@ SIMULATION_KEYS = {
     "n": int,
     "max_track_error": float,
     "max_steady_error": float,
+    "max_altitude_error": float,
     "initial_state": list,
 }
 DISTURBANCE_KEYS = ("wind", "gust", "turbulence", "rotor_loss", "force", "sensor_noise")
@@ -88,7 +89,7 @@ def _table(where: Where, key: str, value, cls: type) -> dict:
     return value
 
 
-OFF_WHEN_INFINITE = ("max_track_error", "max_steady_error")
+OFF_WHEN_INFINITE = ("max_track_error", "max_steady_error", "max_altitude_error")
 """[simulation] bounds that ``inf`` turns off (as in :func:`quadcruise.fly`); every other number is finite."""
 
 
@@ -108,7 +109,7 @@ def simulation_table(where: Where, table: dict) -> dict:
     for key in ("duration", "dt", "max_step"):
         if key in out and out[key] <= 0:
             raise where.error(f"'{key}' must be > 0 seconds, got {out[key]!r}")
-    for key in ("max_track_error", "max_steady_error"):
+    for key in OFF_WHEN_INFINITE:
         if key in out and out[key] <= 0:
             raise where.error(f"'{key}' must be > 0 metres, got {out[key]!r}")
     if "initial_state" in out and out["initial_state"].shape[-1:] != (16,):

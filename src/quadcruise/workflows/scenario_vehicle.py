@@ -8,6 +8,7 @@ import tomllib
 from pathlib import Path
 
 from quadcruise.errors import InputError
+from quadcruise.io.files import not_a_file
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.model.vehicle_files import PRESETS, vehicle_from_table
@@ -76,7 +77,7 @@ def read_vehicle_file(path: str | Path) -> Vehicle:
     """
     path = Path(path)
     if not path.is_file():
-        raise InputError(f"{path}: no such file")
+        raise InputError(f"{path}: {not_a_file(path)}")
     try:
         doc = tomllib.loads(path.read_text(encoding="utf-8-sig"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from quadcruise.checks import describe
 from quadcruise.errors import InputError
 from quadcruise.layout import REF_PSI
 from quadcruise.missions import Mission, mission_from_name, stack_params
@@ -85,7 +86,9 @@ def stepper(
         mission = mission_from_name(mission)
     vehicle = as_vehicle(vehicle) or Vehicle.paper()
     if not isinstance(vehicle, (Vehicle, RotorVehicle)):
-        raise InputError(f"stepper: vehicle must be a Vehicle, a RotorVehicle or a preset's name, got {vehicle!r}")
+        raise InputError(
+            f"stepper: vehicle must be a Vehicle, a RotorVehicle or a preset's name, got {describe(vehicle)}"
+        )
     rotor, controller = rotor_flight_setup(vehicle, controller_vehicle, controller)  # a name: designed for it
     controllers = per_vehicle_controllers(controller)
     if len(controllers) != 1:
@@ -116,7 +119,7 @@ def stepper(
         raise InputError(f"the number of vehicles is ambiguous: n = {n}, vehicle has {vehicle.batch_size}")
     duration = default_duration(mission) if duration is None else duration
     if not (isinstance(max_step, (int, float)) and max_step > 0) and max_step is not None:
-        raise InputError(f"max_step must be a positive number of seconds, got {max_step!r}")
+        raise InputError(f"max_step must be a positive number of seconds, got {describe(max_step)}")
     grid = time_grid(float(duration), float(dt))
     if sensors is not None:
         sensors.check_fits(duration)
@@ -153,7 +156,7 @@ def _rotor_stepper(mission, controller, vehicle, controller_vehicle, **kw: Any) 
     duration = default_duration(mission) if kw["duration"] is None else kw["duration"]
     max_step = kw["max_step"]
     if not (isinstance(max_step, (int, float)) and max_step > 0) and max_step is not None:
-        raise InputError(f"max_step must be a positive number of seconds, got {max_step!r}")
+        raise InputError(f"max_step must be a positive number of seconds, got {describe(max_step)}")
     grid = time_grid(float(duration), float(dt))
     if kw["sensors"] is not None:
         kw["sensors"].check_fits(duration)

@@ -1,7 +1,8 @@
 """``fly``'s lost-track and off-track checks, computed as the flight goes, at every control
 period, while the log keeps only every ``log_every``-th: the statuses and times that
 :func:`~quadcruise.workflows.fly_failures.mark_lost_track` and :func:`~quadcruise.workflows.fly_failures.mark_off_track`
-give on the full log (``log_every=1``), without that log.
+give on the full log (``log_every=1``), without that log, in memory that does not grow with the
+flight's length (a fixed number of figures per vehicle).
 
 What each check needs of the whole flight, and what is kept for it (per vehicle):
 
@@ -10,13 +11,20 @@ What each check needs of the whole flight, and what is kept for it (per vehicle)
   where the error last left the 5 % band (:data:`~quadcruise.metrics.STEADY_BAND`):
 
   * a step, or a reference that holds still: the band is known from the first instant
-    (the step's size, the initial error), so the last excursion out of it is followed as
-    the flight goes, with the first instant beyond the bounds since it;
-  * a moving reference: the band is measured from the error's level over the last
-    quarter of the flight (:func:`~quadcruise.metrics.tracking_transient_batch`), known only
-    at the end; the transient counts only if it ended in the first half, so the error and
-    the beyond-the-bounds flags of the first half are kept (9 bytes per vehicle-period),
-    and of the second half the largest error, the level and the first instant beyond.
+    (the step's size, the initial error), so the last excursion out of it is followed as the
+    flight goes, with the first instant beyond the bounds since it;
+  * a moving reference: the band is measured from the error's level ``E`` over the last quarter
+    of the flight (:func:`~quadcruise.metrics.tracking_transient_batch`), known only at the
+    end; the transient counts only if it ended in the first half (the head). Kept: the
+    initial error, the last instant of the head beyond the bounds and the largest error
+    after it, the head's last three errors, and of the second half the largest error, the
+    level and the first instant beyond. If the error after the head's last instant beyond
+    the bounds rose above the band (the usual case: the entry from a start away from the
+    path), the transient ended after that instant, and the answer is the first instant
+    beyond in the second half (or none, or the end if it never settled), found from these
+    figures alone. Otherwise (a vehicle whose error sits near the bound, found only at the
+    end) the head of those vehicles alone is flown again (``again``, the same flight bit
+    for bit), in groups of at most :data:`HEAD_BYTES`, and read with ``E`` known.
 
 docs/performance.md ("A batch that fits in memory") says why this way and what it costs.
 """
@@ -24,6 +32,7 @@ docs/performance.md ("A batch that fits in memory") says why this way and what i
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
@@ -32,32 +41,45 @@ from quadcruise.layout import REF_X, X
 from quadcruise.metrics.tracking import FINAL_FRACTION, STEADY_BAND, TRANSIENT_MIN_ERROR
 from quadcruise.sim.status import ExitStatus
 
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
 TOLERANCE = 1e-12
 """An instant this close [s] before the end of the transient counts as after it (as in
 :func:`~quadcruise.workflows.fly_failures.off_track_since`)."""
+HEAD_BYTES = 2**26
+"""Most bytes [B] of head rows (9 a vehicle-period) kept at once when the head of the vehicles
+whose verdict the kept figures leave open is flown again: 64 MiB, a group of vehicles per
+flight again (a 10 s flight at 1 kHz: about 1,500 vehicles a group)."""
+AMBIGUOUS = -2
+"""The answer of :func:`_moving_summary` for a vehicle whose head must be read again."""
 
 
 # columns of the per-vehicle rows the compiled pass keeps (periods as grid indices, -1: none yet).
 # ints: the first period beyond the tracking bound (LOST), beyond the steady bounds (FIRST_OFF), beyond
 # them at or after the last excursion's anchor and after it (SINCE, SINCE_AFTER), beyond them in the
 # second half (TAIL_FIRST); the anchor (EV_ANCHOR: the first period at or after the excursion's
-# sample); a still reference's axis (HOLD_AXIS).
+# sample); a still reference's axis (HOLD_AXIS); the last period of the head beyond them (LAST_BEYOND).
 # floats: the reference's largest move (MOVED); the largest error over the last quarter (LEVEL) and
 # over the second half (TAIL_MAX); the last excursion's time and response, and the next sample's
 # (EV_TAU, EV_Z, EV_TAU1, EV_Z1); a still reference's initial error on its axis (HOLD_E0); the step
-# axis's position at the previous period (PREV_POS); the reference at the start (REF0, 3 columns).
+# axis's position at the previous period (PREV_POS); the error at the start (E0), its largest value in
+# the head after LAST_BEYOND (AFTER_MAX), at the head's last three periods (END_ERR, 3 columns); the
+# reference at the start (REF0, 3 columns).
 # flags: the error finite throughout (FINITE); beyond the bounds at the last period (OFF_AT_END); the
 # response out of the band there (OUT_AT_END); the next sample still to come (PENDING); beyond at
 # the previous period (PREV_BEYOND); a still reference's transient measured (HOLD_MEASURED).
-LOST, FIRST_OFF, SINCE, SINCE_AFTER, TAIL_FIRST, EV_ANCHOR, HOLD_AXIS = range(7)
-MOVED, LEVEL, TAIL_MAX, EV_TAU, EV_TAU1, EV_Z, EV_Z1, HOLD_E0, PREV_POS, REF0 = range(10)  # REF0: 3 columns
+LOST, FIRST_OFF, SINCE, SINCE_AFTER, TAIL_FIRST, EV_ANCHOR, HOLD_AXIS, LAST_BEYOND = range(8)
+MOVED, LEVEL, TAIL_MAX, EV_TAU, EV_TAU1, EV_Z, EV_Z1, HOLD_E0, PREV_POS, E0, AFTER_MAX = range(11)
+END_ERR, REF0 = 11, 14  # 3 columns each
+INT_WIDTH, FLOAT_WIDTH, FLAG_WIDTH = 8, REF0 + 3, 6
 FINITE, OFF_AT_END, OUT_AT_END, PENDING, PREV_BEYOND, HOLD_MEASURED = range(6)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def _watch_chunk(
     k0, first, stop, xs, refs, c, t, track_bound, bound, zbound,
-    ints, floats, flags, head_err, head_beyond, plan, step_plan, virtual,
+    ints, floats, flags, plan, step_plan, virtual,
 ):  # fmt: skip
     """The instants k0 .. k0 + c - 1 of vehicles first..stop-1, in time order (:meth:`TrackWatch.feed`).
 
@@ -73,7 +95,10 @@ def _watch_chunk(
     for i in range(first, stop):
         lost, first_off, since, since_after = ints[i, LOST], ints[i, FIRST_OFF], ints[i, SINCE], ints[i, SINCE_AFTER]
         tail_first, ev_anchor, hold_axis = ints[i, TAIL_FIRST], ints[i, EV_ANCHOR], ints[i, HOLD_AXIS]
+        last_beyond = ints[i, LAST_BEYOND]
         moved, level, tail_max = floats[i, MOVED], floats[i, LEVEL], floats[i, TAIL_MAX]
+        e0, after_max = floats[i, E0], floats[i, AFTER_MAX]
+        end0, end1, end2 = floats[i, END_ERR], floats[i, END_ERR + 1], floats[i, END_ERR + 2]
         ev_tau, ev_tau1, ev_z, ev_z1 = floats[i, EV_TAU], floats[i, EV_TAU1], floats[i, EV_Z], floats[i, EV_Z1]
         hold_e0, prev_pos = floats[i, HOLD_E0], floats[i, PREV_POS]
         r0x, r0y, r0z = floats[i, REF0], floats[i, REF0 + 1], floats[i, REF0 + 2]
@@ -106,8 +131,20 @@ def _watch_chunk(
                 if moved_k > moved:  # NaN (stopped) ignored, as numpy.fmax
                     moved = moved_k
             if kept > 0:
-                if g < kept:
-                    head_err[i, g], head_beyond[i, g] = err, over
+                if g < kept:  # the head: what its end of the transient needs (_moving_summary)
+                    if g == 0:
+                        e0 = err
+                    if over:
+                        last_beyond, after_max = g, -np.inf
+                    elif err > after_max:
+                        after_max = err
+                    slot = g - (kept - 3)
+                    if slot == 0:
+                        end0 = err
+                    elif slot == 1:
+                        end1 = err
+                    elif slot == 2:
+                        end2 = err
                 else:
                     if err > tail_max:
                         tail_max = err
@@ -151,7 +188,10 @@ def _watch_chunk(
                 prev_pos = xs[i, col, X + axis]
         ints[i, LOST], ints[i, FIRST_OFF], ints[i, SINCE], ints[i, SINCE_AFTER] = lost, first_off, since, since_after
         ints[i, TAIL_FIRST], ints[i, EV_ANCHOR], ints[i, HOLD_AXIS] = tail_first, ev_anchor, hold_axis
+        ints[i, LAST_BEYOND] = last_beyond
         floats[i, MOVED], floats[i, LEVEL], floats[i, TAIL_MAX] = moved, level, tail_max
+        floats[i, E0], floats[i, AFTER_MAX] = e0, after_max
+        floats[i, END_ERR], floats[i, END_ERR + 1], floats[i, END_ERR + 2] = end0, end1, end2
         floats[i, EV_TAU], floats[i, EV_TAU1], floats[i, EV_Z], floats[i, EV_Z1] = ev_tau, ev_tau1, ev_z, ev_z1
         floats[i, HOLD_E0], floats[i, PREV_POS] = hold_e0, prev_pos
         floats[i, REF0], floats[i, REF0 + 1], floats[i, REF0 + 2] = r0x, r0y, r0z
@@ -201,15 +241,13 @@ class TrackWatch:
             [self.step, self.followed, axis, after, anchor0, self.kept, int(np.argmax(final))], dtype=np.int64
         )
         self.step_plan = np.array([self.t_step, y0, size])
-        self.ints = np.full((n, 7), -1, dtype=np.int64)
+        self.ints = np.full((n, INT_WIDTH), -1, dtype=np.int64)
         self.ints[:, EV_ANCHOR] = anchor0
-        self.floats = np.full((n, REF0 + 3), np.nan)
+        self.floats = np.full((n, FLOAT_WIDTH), np.nan)
         self.floats[:, [MOVED, PREV_POS]] = 0.0
-        self.floats[:, [LEVEL, TAIL_MAX]] = -np.inf
-        self.flags = np.zeros((n, 6), dtype=bool)
+        self.floats[:, [LEVEL, TAIL_MAX, AFTER_MAX]] = -np.inf
+        self.flags = np.zeros((n, FLAG_WIDTH), dtype=bool)
         self.flags[:, FINITE] = True
-        self.head_err = np.empty((n, self.kept))
-        self.head_beyond = np.empty((n, self.kept), dtype=bool)
         self.virtual = np.zeros(n)  # the step's response at its own instant
 
     def feed(self, k0: int, first: int, stop: int, states: np.ndarray, references: np.ndarray) -> None:
@@ -236,10 +274,12 @@ class TrackWatch:
             virtual[first:stop] = (ys0 - self.step_plan[1]) / self.step_plan[2]
         _watch_chunk(
             k0, first, stop, states, references, c, self.t, self.track_bound, self.bound, self.zbound,
-            self.ints, self.floats, self.flags, self.head_err, self.head_beyond, self.plan, self.step_plan, virtual,
+            self.ints, self.floats, self.flags, self.plan, self.step_plan, virtual,
         )  # fmt: skip
 
-    def verdict(self, status: np.ndarray, t_stop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def verdict(
+        self, status: np.ndarray, t_stop: np.ndarray, again: Callable | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """The statuses and stop times after the checks: ``lost track`` from the first instant
         beyond the tracking bound, then ``off track`` as :func:`~quadcruise.workflows.fly_failures.mark_off_track`.
 
@@ -247,6 +287,12 @@ class TrackWatch:
         ----------
         status, t_stop : numpy.ndarray
             (N,) the engine's exit codes and stop times [s].
+        again : callable, optional
+            ``again(vehicles, periods, watch)`` flies the (N,) bool mask ``vehicles`` of the same
+            flight again, bit for bit, for at least its first ``periods`` instants, handing their
+            rows to ``watch`` as the first flight did (:func:`~quadcruise.sim.chunked.watch_again`):
+            the head of a moving reference's vehicles whose verdict the kept figures leave open
+            (see the module's docstring). Without it, such a vehicle is an error.
 
         Returns
         -------
@@ -261,18 +307,18 @@ class TrackWatch:
         live = np.flatnonzero((status == finished) & (np.isfinite(self.bound) | np.isfinite(self.zbound)))
         if not live.size or t.size < 2 or not self.flags[live, FINITE].all():
             return status, t_stop
-        first = self._off_since(live)
+        first = self._off_since(live, again)
         off = first >= 0
         status[live[off]] = int(ExitStatus.OFF_TRACK)
         t_stop[live[off]] = t[first[off]]
         return status, t_stop
 
-    def _off_since(self, live: np.ndarray) -> np.ndarray:
+    def _off_since(self, live: np.ndarray, again: Callable | None) -> np.ndarray:
         """(len(live),) the first instant off track of each live vehicle, -1 for none."""
         t, ints, floats, flags = self.t, self.ints[live], self.floats[live], self.flags[live]
         moving = not self.kind_step and float(floats[:, MOVED].max()) >= TRANSIENT_MIN_ERROR
         if moving:
-            return self._moving_off(live)
+            return self._moving_off(live, again)
         measured = flags[:, HOLD_MEASURED] if not self.step else np.full(live.size, self.followed)
         out = ints[:, FIRST_OFF].copy()  # not measured: from the first instant
         if not self.followed:
@@ -292,11 +338,123 @@ class TrackWatch:
         answer = np.where(at_end, np.where(flags[:, OFF_AT_END], t.size - 1, -1), answer)
         return np.where(measured, answer, out)
 
-    def _moving_off(self, live: np.ndarray) -> np.ndarray:
-        """:meth:`_off_since` for a moving reference (the rule of ``tracking_transient_batch``)."""
-        return _moving_first_off(
-            live, self.head_err, self.head_beyond, self.ints, self.floats, self.flags, self.t, self.kept, self.held
-        )
+    def _moving_off(self, live: np.ndarray, again: Callable | None) -> np.ndarray:
+        """:meth:`_off_since` for a moving reference (the rule of ``tracking_transient_batch``):
+        from the kept figures, and for the vehicles they leave open, from their head flown again."""
+        out = _moving_summary(live, self.ints, self.floats, self.flags, self.t, self.kept, self.held)
+        open_ = np.flatnonzero(out == AMBIGUOUS)
+        if not open_.size:
+            return out
+        if again is None:
+            raise RuntimeError("TrackWatch.verdict: a vehicle's head must be flown again, and no `again` was given")
+        group = max(1, HEAD_BYTES // (9 * max(self.kept, 1)))
+        for start in range(0, open_.size, group):
+            rows = open_[start : start + group]
+            who = live[rows]
+            head = HeadRecord(who, self.kept, self.bound, self.zbound)
+            again(head.mask, self.kept, head.feed)
+            out[rows] = _moving_first_off(
+                np.arange(who.size), head.err, head.beyond, self.ints[who], self.floats[who], self.flags[who],
+                self.t, self.kept, self.held,
+            )  # fmt: skip
+        return out
+
+
+class HeadRecord:
+    """The error and the beyond-the-bounds flag at every instant of the head (the first ``kept``
+    instants) of some vehicles, fed as :meth:`TrackWatch.feed` is (9 bytes a vehicle-period).
+
+    Parameters
+    ----------
+    who : numpy.ndarray
+        (M,) the vehicles' indices in the batch.
+    kept : int
+        Instants of the head.
+    bound, zbound : numpy.ndarray
+        (N,) the steady bounds [m] on the 3-D error and on the altitude error.
+    """
+
+    def __init__(self, who: np.ndarray, kept: int, bound: np.ndarray, zbound: np.ndarray) -> None:
+        self.kept, self.bound, self.zbound = int(kept), bound, zbound
+        self.mask = np.zeros(bound.size, dtype=bool)
+        self.mask[who] = True
+        self.rows = np.full(bound.size, -1, dtype=np.int64)
+        self.rows[who] = np.arange(who.size)
+        self.err = np.full((who.size, self.kept), np.nan)
+        self.beyond = np.zeros((who.size, self.kept), dtype=bool)
+
+    def feed(self, k0: int, first: int, stop: int, states: np.ndarray, references: np.ndarray) -> None:
+        """Take vehicles first..stop-1's rows of the instants ``k0 .. k0 + C - 1`` (as :meth:`TrackWatch.feed`)."""
+        _record_head(
+            k0, first, stop, states, references, states.shape[1], self.kept, self.bound, self.zbound,
+            self.rows, self.err, self.beyond,
+        )  # fmt: skip
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _record_head(k0, first, stop, xs, refs, c, kept, bound, zbound, rows, head_err, head_beyond):
+    """The head's error and flag of the vehicles with a row (``rows[i] >= 0``), by the arithmetic
+    of :func:`_watch_chunk` (the same numbers)."""
+    for i in range(first, stop):
+        r = rows[i]
+        if r < 0:
+            continue
+        b_steady, b_alt = bound[i], zbound[i]
+        for col in range(c):
+            g = k0 + col
+            if g >= kept:
+                break
+            px, py, pz = xs[i, col, X], xs[i, col, X + 1], xs[i, col, X + 2]
+            rx, ry, rz = refs[i, col, REF_X], refs[i, col, REF_X + 1], refs[i, col, REF_X + 2]
+            dx, dy, dz = px - rx, py - ry, pz - rz
+            err = math.sqrt(dx * dx + dy * dy + dz * dz)
+            head_err[r, g], head_beyond[r, g] = err, err > b_steady or abs(dz) > b_alt
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _moving_summary(live, ints, floats, flags, t, kept, held):
+    """:func:`_moving_first_off` from the kept figures alone, or :data:`AMBIGUOUS` where they do
+    not decide it.
+
+    With ``z(e) = (e0 - e) / (e0 - E)`` and ``last`` the head's last instant with ``z < 1 - band``
+    (``z`` falls as ``e`` grows, so one comparison of the largest error after the head's last
+    instant beyond the bounds says whether ``last`` is after it): if it is, no instant beyond
+    lies between ``last`` and the head's end, so the answer is the second half's first (or the
+    end's rule when the transient did not settle, which the head's last three errors decide);
+    if it is not, the answer depends on where ``last`` lies before that instant: open."""
+    length, line = t.shape[0], 1.0 - STEADY_BAND
+    out = np.empty(live.shape[0], dtype=np.int64)
+    for r in range(live.shape[0]):
+        i = live[r]
+        e0, level = floats[i, E0], floats[i, LEVEL]
+        if not (e0 >= TRANSIENT_MIN_ERROR and level < e0):  # no transient measured: the whole flight
+            out[r] = ints[i, FIRST_OFF]
+            continue
+        scale = e0 - level
+        settle = 1.0  # any finite value: settled within the head
+        if kept < length and (e0 - floats[i, TAIL_MAX]) / (e0 - level) < line:
+            settle = np.nan  # above the line in the second half: not converged
+        elif kept < 4 or kept >= length or not t[kept - 3] < held or not (e0 - floats[i, AFTER_MAX]) / scale < line:
+            out[r] = AMBIGUOUS
+            continue
+        else:
+            z0 = (e0 - floats[i, END_ERR]) / scale
+            z1 = (e0 - floats[i, END_ERR + 1]) / scale
+            z2 = (e0 - floats[i, END_ERR + 2]) / scale
+            if z2 < line:  # above at the head's last instant: not settled in time
+                settle = np.nan
+            elif z1 < line or z0 < line:  # last = kept - 2 or kept - 3: where it crossed
+                k = kept - 2 if z1 < line else kept - 3
+                zk, zk1 = (z1, z2) if z1 < line else (z0, z1)
+                settle = t[k] + (line - zk) / (zk1 - zk) * (t[k + 1] - t[k]) - t[0]
+                if settle > held - t[0] + 1e-12:
+                    settle = np.nan
+            # else last < kept - 3: settled by t[kept - 3] < held
+        if np.isnan(settle):  # from the last instant
+            out[r] = length - 1 if flags[i, OFF_AT_END] else -1
+        else:  # settled after the head's last instant beyond: the second half's first
+            out[r] = ints[i, TAIL_FIRST]
+    return out
 
 
 @njit(cache=True, nogil=True, error_model="numpy")

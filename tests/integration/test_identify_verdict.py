@@ -1,0 +1,209 @@
+"""identify on the logs a drone engineer has: PX4's meanings of the commands, the verdict before any
+interval, the log's own geometry, no invented mass, and the rotor plant from its commands alone.
+
+Truths are the flown vehicles' fields and PX4's own parameters as pyulog reads them; the logs that
+need a PX4 parameter quadcruise does not write (``IMU_GYRO_RATEMAX``, a ``THR_MDL_FAC`` other than
+the SITL log's) get it by adding PX4's own parameter message to a copy of the file.
+"""
+
+from __future__ import annotations
+
+import json
+import struct
+import tomllib
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+from pyulog import ULog
+from scipy.spatial.transform import Rotation
+
+import quadcruise as qc
+from quadcruise.cli.main import main
+from quadcruise.disturbances import SensorNoise
+from quadcruise.missions import Sysid
+
+SITL = Path(__file__).parents[1] / "data" / "px4" / "sample_px4_events.ulg"
+NOISE = SensorNoise(position_std=0.01, velocity_std=0.02, angle_std=0.005, rate_std=0.01)
+LIGHT = dict(m=1.4, Jxx=0.02, Jyy=0.025, Jzz=0.035)
+
+
+def with_parameter(src: Path, dst: Path, kind: str, name: str, value) -> Path:
+    """A copy of a ULog with PX4 parameter ``name`` set to ``value`` (its ``P`` message's value
+    replaced, or a new ``P`` message added after the flag bits): ULog's own format."""
+    data = bytearray(src.read_bytes())
+    key = f"{kind} {name}".encode()
+    packed = struct.pack("<f" if kind == "float" else "<i", value)
+    at = data.find(bytes([len(key)]) + key)
+    if at >= 0:
+        start = at + 1 + len(key)
+        data[start : start + 4] = packed
+    else:
+        payload = bytes([len(key)]) + key + packed
+        pos = 16
+        (size,) = struct.unpack_from("<H", data, pos)
+        if data[pos + 2] == ord("B"):  # the flag bits come first
+            pos += 3 + size
+        data[pos:pos] = struct.pack("<HB", len(payload), ord("P")) + payload
+    dst.write_bytes(bytes(data))
+    return dst
+
+
+def run(*args):
+    return CliRunner().invoke(main, [str(a) for a in args])
+
+
+def test_thr_mdl_fac_maps_the_signal_not_the_relative_thrust(tmp_path):
+    """PX4's actuator_motors is relative thrust, THR_MDL_FAC maps the output signal to it. The SITL
+    log (THR_MDL_FAC 0: its PWM signal is its relative thrust) with THR_MDL_FAC set to 0.5: the
+    actuator_motors hover command does not move; the PWM outputs' becomes f x^2 + (1 - f) x."""
+    params = ULog(str(SITL), message_name_filter_list=[]).initial_parameters
+    assert params["THR_MDL_FAC"] == 0.0
+    changed = with_parameter(SITL, tmp_path / "f05.ulg", "float", "THR_MDL_FAC", 0.5)
+    assert ULog(str(changed), message_name_filter_list=[]).initial_parameters["THR_MDL_FAC"] == 0.5
+    before = {c: qc.identify(SITL, commands=c) for c in ("duty", "pwm:1000:2000")}
+    after = {c: qc.identify(changed, commands=c) for c in ("duty", "pwm:1000:2000")}
+    motors = "duty"
+    for key in ("hover_duty", "K_per_m"):  # actuator_motors: THR_MDL_FAC changes nothing
+        assert after[motors].parameters[key]["value"] == pytest.approx(
+            before[motors].parameters[key]["value"], rel=1e-9
+        )
+    pwm = "pwm:1000:2000"
+    x = before[pwm].hover_duty  # the hover signal (f = 0: also the relative thrust)
+    assert after[pwm].hover_duty == pytest.approx(x, rel=0.02)  # the same signal (the rotors differ: Jensen)
+    thrust = 0.5 * x * x + 0.5 * x  # ... is less relative thrust through f = 0.5: more thrust per unit of it
+    k_before, k_after = (r[pwm].parameters["K_per_m"]["value"] for r in (before, after))
+    assert k_after == pytest.approx(k_before * x / thrust, rel=0.02)
+    assert k_after / k_before > 1.2  # the factor is applied: the check can fail
+
+
+def sysid_flight(log_every: int, seed: int = 5, vehicle=None):
+    vehicle = vehicle or qc.Vehicle.paper().replace(**LIGHT)
+    return qc.fly(Sysid(repeats=1), "se3", vehicle=vehicle, sensors=NOISE, seed=seed, log_every=log_every)
+
+
+def test_a_log_that_samples_its_commands_does_not_fit(tmp_path):
+    """The same closed-loop sysid flight (se3 at 1 kHz) logged every period and every 10th, each
+    with PX4's IMU_GYRO_RATEMAX = 1000 (the rate loop's rate): the first fits, exit 0, truth inside;
+    the decimated one does not fit, exit 1, no interval, and says why in its first line."""
+    truth = {"K": 120.0, "Jxx": 0.02, "Jyy": 0.025, "Jzz": 0.035}
+    for every in (1, 10):
+        log = sysid_flight(every).to_ulog(tmp_path / f"raw{every}.ulg")
+        log = with_parameter(log, tmp_path / f"le{every}.ulg", "int32_t", "IMU_GYRO_RATEMAX", 1000)
+        out = tmp_path / f"out{every}"
+        res = run("identify", log, "--mass", 1.4, "--out", out)
+        doc = json.loads((out / "identify.json").read_text())
+        first = res.output.splitlines()[0]
+        if every == 1:
+            assert res.exit_code == 0, res.output
+            assert doc["verdict"] == "fits" and first.startswith("verdict: the model fits")
+            for key, value in truth.items():
+                lo, hi = doc["parameters"][key]["ci95"]
+                assert lo <= value <= hi, (key, doc["parameters"][key])
+        else:
+            assert res.exit_code == 1, res.output
+            assert doc["verdict"] == "does not fit" and first.startswith("verdict: the model DOES NOT FIT")
+            assert "100 Hz" in first and "1000 Hz" in first
+            assert all(p["ci95"] == [None, None] for p in doc["parameters"].values())
+            assert "DOES NOT FIT" in (out / "report.md").read_text()
+
+
+def test_without_mass_no_mass_is_invented(tmp_path):
+    """identify without --mass: vehicle.toml says m is unknown and fly refuses it in one line;
+    with the mass written in, it flies."""
+    log = sysid_flight(1, seed=7).to_ulog(tmp_path / "f.ulg")
+    out = tmp_path / "ident"
+    res = run("identify", log, "--out", out)
+    assert res.exit_code == 0, res.output
+    text = (out / "vehicle.toml").read_text()
+    assert "NO MASS" in text and "3.499" not in text
+    fly = run("fly", "hover", "--vehicle", out / "vehicle.toml", "--duration", 1)
+    assert fly.exit_code == 2 and "'m'" in fly.output and len(fly.output.strip().splitlines()) == 1, fly.output
+    result = qc.identify(log)
+    with pytest.raises(qc.InputError, match="no mass"):
+        result.vehicle()
+    vehicle = result.vehicle(mass=1.4)
+    assert vehicle.m == 1.4 and vehicle.Jxx == pytest.approx(0.02, rel=0.05)
+
+
+def rotor_csv(flight, vehicle, seed: int) -> pd.DataFrame:
+    """A rotor-plant flight as the CSV a log without ESC telemetry gives: each rotor's relative thrust
+    (commanded speed over w_max, squared: PX4's actuator_motors), velocity, attitude, body rates and
+    accelerometer (quadcruise's frames), with the sensor noise of :data:`NOISE` on the rates and
+    velocity (seeded)."""
+    from quadcruise.sim.px4 import rotor_speed_commands
+
+    rs, t = flight.rotor_states[0], flight.t
+    rng = np.random.default_rng(seed)
+    table = pd.DataFrame({"t": t})
+    for j, key in enumerate(("vx", "vy", "vz", "qw", "qx", "qy", "qz", "p", "q", "r")):
+        table[key] = rs[:, 3 + j]
+    for key in ("vx", "vy", "vz"):
+        table[key] += rng.normal(0.0, NOISE.velocity_std, len(t))
+    for key in ("p", "q", "r"):
+        table[key] += rng.normal(0.0, NOISE.rate_std, len(t))
+    accel = np.gradient(rs[:, 3:6], t, axis=0, edge_order=2)
+    body = Rotation.from_quat(rs[:, [7, 8, 9, 6]]).inv().apply(accel + [0, 0, vehicle.g])
+    table["ax"], table["ay"], table["az"] = body.T
+    w = rotor_speed_commands(flight.commands[0], flight.meta["vehicle"], flight.meta.get("controller_vehicle"))
+    for i in range(w.shape[1]):
+        table[f"u{i + 1}"] = (w[:, i] / vehicle.w_max) ** 2
+    return table
+
+
+def test_an_x_quad_without_esc_telemetry_from_its_commands(tmp_path):
+    """An x-quad (the Iris's rotors, no rotor inertia or drag, equal motor time constants) flies
+    sysid; its log has commands (relative thrust) and no rotor speeds. identify with the Iris as the
+    base: the verdict fits, Jxx and Jyy within 10 % and inside their intervals, kf w_max^2 (the
+    thrust at full command) inside its interval, the motor time constant inside; w_max said not
+    identifiable."""
+    iris = qc.Vehicle.preset("iris")
+    vehicle = iris.replace(J_rotor=0.0, k_d=0.0, k_z=0.0, tau_up=0.02, tau_down=0.02, Jxx=0.035, Jyy=0.045)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        flight = sysid_flight(1, seed=11, vehicle=vehicle)
+    rotor_csv(flight, vehicle, seed=11).to_csv(tmp_path / "x.csv", index=False)
+    result = qc.identify(tmp_path / "x.csv", vehicle=iris, mass=float(vehicle.m))
+    assert result.fits, result.verdict_line()
+    p = result.parameters
+    for key in ("Jxx", "Jyy"):
+        truth = float(getattr(vehicle, key))
+        assert p[key]["identifiable"] and p[key]["value"] == pytest.approx(truth, rel=0.1), key
+        assert p[key]["ci95"][0] <= truth <= p[key]["ci95"][1], (key, p[key])
+    full = vehicle.kf * vehicle.w_max**2
+    assert p["K"]["ci95"][0] <= full <= p["K"]["ci95"][1], p["K"]
+    assert p["tau_up"]["ci95"][0] <= 0.02 <= p["tau_up"]["ci95"][1], p["tau_up"]
+    assert not p["w_max"]["identifiable"] and "no rotor speeds" in p["w_max"]["note"]
+    flown = result.vehicle()
+    assert flown.n_rotors == 4 and flown.kf * flown.w_max**2 == pytest.approx(p["K"]["value"])
+    assert np.allclose(np.asarray(flown.rotors)[:, :2], np.asarray(iris.rotors)[:, :2])
+
+
+def test_the_sitl_log_with_a_rotor_base_is_identified_from_its_commands(tmp_path):
+    """The SITL log (no usable ESC telemetry: esc_status at 4 Hz) with the Iris as the base: the rotor
+    plant from the commands alone, not refused; the log's x geometry; the hover command within 5 % of
+    PX4's hover_thrust_estimate; the verdict (commands at 10 Hz of a rate loop at 800 Hz) does not
+    fit, exit 1; no mass invented in vehicle.toml."""
+    out = tmp_path / "o"
+    res = run("identify", SITL, "--vehicle", "iris", "--out", out)
+    assert res.exit_code == 1, res.output
+    assert res.output.startswith("verdict: the model DOES NOT FIT") and "800 Hz" in res.output.splitlines()[0]
+    doc = json.loads((out / "identify.json").read_text())
+    assert doc["verdict"] == "does not fit" and doc["mass_kg"] is None
+    log = ULog(str(SITL), message_name_filter_list=["hover_thrust_estimate"])
+    data = log.data_list[0].data
+    px4 = float(np.median(data["hover_thrust"][data["valid"].astype(bool)]))
+    assert doc["parameters"]["hover_duty"]["value"] == pytest.approx(px4, rel=0.05)
+    assert not doc["parameters"]["w_max"]["identifiable"]
+    toml = (out / "vehicle.toml").read_text()
+    assert 'plant = "rotor"' in toml and "NO MASS" in toml
+    params = ULog(str(SITL), message_name_filter_list=[]).initial_parameters
+    rotors = tomllib.loads(toml)["vehicle"]["rotors"]
+    for i, (x, y, _, s) in enumerate(rotors):
+        assert (x, -y) == pytest.approx((params[f"CA_ROTOR{i}_PX"], params[f"CA_ROTOR{i}_PY"]))
+        assert s == -np.sign(params[f"CA_ROTOR{i}_KM"])
+    fly = run("fly", "hover", "--vehicle", out / "vehicle.toml", "--duration", 1)
+    assert fly.exit_code == 2 and "'m'" in fly.output, fly.output
