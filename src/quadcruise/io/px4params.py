@@ -212,7 +212,7 @@ def _read_ulog_params(path: Path) -> Px4Parameters:
     from pyulog import ULog
     from pyulog.core import ULogException
 
-    from quadcruise.io.flightlog import check_ulog_framing
+    from quadcruise.io.logchecks import check_ulog_framing
 
     check_ulog_framing(path)
     try:

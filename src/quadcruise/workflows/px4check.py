@@ -200,7 +200,7 @@ def _read(path: Path) -> tuple[dict, dict, dict]:
     from pyulog import ULog
     from pyulog.core import ULogException
 
-    from quadcruise.io.flightlog import check_ulog_framing
+    from quadcruise.io.logchecks import check_ulog_framing
 
     if path.suffix.lower() != ".ulg":
         raise InputError(f"{path}: px4-check reads a PX4 log (.ulg), got {path.suffix!r}")
