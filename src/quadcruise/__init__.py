@@ -24,9 +24,13 @@ def _quit_on_interrupt(signum, frame):  # pragma: no cover - runs in a command's
 
 def _command_starting() -> bool:
     """Whether this process is the ``quadcruise`` command: its script, or ``python -m quadcruise``."""
-    main = getattr(_sys.modules.get("__main__"), "__file__", None) or ""
-    if _os.path.basename(main).lower() in ("quadcruise", "quadcruise-script.py"):
-        return True
+    module = _sys.modules.get("__main__")
+    main = getattr(module, "__file__", None) or ""
+    if getattr(module, "__name__", "") == "__main__" and _os.path.basename(main).lower() in (
+        "quadcruise",
+        "quadcruise-script.py",
+    ):
+        return True  # not a worker process it spawns (multiprocessing names its copy __mp_main__)
     argv = list(getattr(_sys, "orig_argv", ()))
     return "-m" in argv and argv[argv.index("-m") + 1 : argv.index("-m") + 2] == ["quadcruise"]
 

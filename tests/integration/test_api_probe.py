@@ -236,6 +236,12 @@ CASES = {
     "make dt 0": (lambda: gym_make(dt=0.0), BAD, ["make()", "dt", "positive"]),
     "make duration text": (lambda: gym_make(duration="5"), WRONG, ["make()", "duration"]),
     "make_vec dt text": (lambda: gym_make_vec(dt="0.01"), WRONG, ["make()", "dt", "str '0.01'"]),
+    "make vehicle int": (lambda: gym_make(vehicle=123), WRONG, ["make()", "vehicle", "int 123"]),
+    "make mission int": (lambda: gym_make(mission=5), WRONG, ["make()", "mission", "int 5"]),
+    "make population text": (lambda: gym_make(population="wide"), WRONG, ["make()", "population", "str 'wide'"]),
+    "make controller int": (lambda: gym_make(controller=5), WRONG, ["make()", "controller", "int 5"]),
+    "make max_track_error": (lambda: gym_make(max_track_error=np.float64(-1)), BAD, ["max_track_error", "-1.0"]),
+    "make_vec num_envs 1.5": (lambda: gym_make_vec(num_envs=1.5), WRONG, ["make()", "num_envs", "float 1.5"]),
     "make_vec reset seed 1.5": (lambda: gym_make_vec().reset(seed=1.5), WRONG, ["reset()", "seed", "float 1.5"]),
     "make_vec reset seed text": (lambda: gym_make_vec().reset(seed="abc"), WRONG, ["reset()", "seed", "str 'abc'"]),
     "make_vec reset seed -1": (lambda: gym_make_vec().reset(seed=-1), BAD, ["reset()", "seed", ">= 0"]),
@@ -263,11 +269,11 @@ def gym_make(**kw):
     return gymnasium.make("quadcruise/Hover-v0", **kw)
 
 
-def gym_make_vec(**kw):
+def gym_make_vec(num_envs=2, **kw):
     gymnasium = pytest.importorskip("gymnasium")
     import quadcruise.gym  # noqa: F401
 
-    return gymnasium.make_vec("quadcruise/Hover-v0", num_envs=2, vectorization_mode="vector_entry_point", **kw)
+    return gymnasium.make_vec("quadcruise/Hover-v0", num_envs=num_envs, vectorization_mode="vector_entry_point", **kw)
 
 
 @pytest.mark.parametrize("name", sorted(CASES))
