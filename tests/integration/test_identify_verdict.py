@@ -99,18 +99,27 @@ def test_a_log_that_samples_its_commands_does_not_fit(tmp_path):
         out = tmp_path / f"out{every}"
         res = run("identify", log, "--mass", 1.4, "--out", out)
         doc = json.loads((out / "identify.json").read_text())
-        first = res.output.splitlines()[0]
+        first = res.stdout.splitlines()[0]  # stdout's first line (a progress line may go to stderr)
         if every == 1:
             assert res.exit_code == 0, res.output
             assert doc["verdict"] == "fits" and first.startswith("verdict: the model fits")
             for key, value in truth.items():
                 lo, hi = doc["parameters"][key]["ci95"]
                 assert lo <= value <= hi, (key, doc["parameters"][key])
+            # the joint covariance of the identified parameters: its diagonal is the intervals'
+            cov = doc["covariance"]
+            matrix = np.asarray(cov["matrix"])
+            assert set(truth) <= set(cov["names"]) and np.all(np.linalg.eigvalsh(matrix) > -1e-12 * matrix.max())
+            for i, name in enumerate(cov["names"]):
+                lo, hi = doc["parameters"][name]["ci95"]
+                assert matrix[i, i] == pytest.approx(((hi - lo) / (2 * 1.959963984540054)) ** 2, rel=1e-6)
+            jxx, k = cov["names"].index("Jxx"), cov["names"].index("K")
+            assert matrix[jxx, k] != 0.0  # Jxx = K / b_roll: correlated with K
         else:
             assert res.exit_code == 1, res.output
             assert doc["verdict"] == "does not fit" and first.startswith("verdict: the model DOES NOT FIT")
             assert "100 Hz" in first and "1000 Hz" in first
-            assert all(p["ci95"] == [None, None] for p in doc["parameters"].values())
+            assert all(p["ci95"] == [None, None] for p in doc["parameters"].values()) and doc["covariance"] is None
             assert "DOES NOT FIT" in (out / "report.md").read_text()
 
 
@@ -193,7 +202,8 @@ def test_the_sitl_log_with_a_rotor_base_is_identified_from_its_commands(tmp_path
     out = tmp_path / "o"
     res = run("identify", SITL, "--vehicle", "iris", "--out", out)
     assert res.exit_code == 1, res.output
-    assert res.output.startswith("verdict: the model DOES NOT FIT") and "800 Hz" in res.output.splitlines()[0]
+    first = res.stdout.splitlines()[0]  # stdout's first line (a progress line may go to stderr)
+    assert first.startswith("verdict: the model DOES NOT FIT") and "800 Hz" in first
     doc = json.loads((out / "identify.json").read_text())
     assert doc["verdict"] == "does not fit" and doc["mass_kg"] is None
     log = ULog(str(SITL), message_name_filter_list=["hover_thrust_estimate"])

@@ -6,8 +6,9 @@ tight intervals around a wrong value. Five checks, each able to fail on its own
 (docs/identify.md, "The verdict"):
 
 - **every command seen**: the commands are logged at the rate the controller computed them
-  (PX4's ``IMU_GYRO_RATEMAX``, the rate loop's rate, or the rate the writer recorded); a log that
-  samples them leaves the commands between samples unknown, not held;
+  (PX4's ``IMU_GYRO_RATEMAX``, the rate loop's rate, or the rate the writer recorded), or do not
+  change between samples (:data:`STILL_SHARE`: an open-loop schedule of steps); a log that samples
+  changing commands leaves the commands between samples unknown, not held;
 - **held out**: each equation's residual on the held-out tail, against its residual in the fit:
   mean square at most :data:`MAX_HELD_RATIO` times the fitted one (a model that holds predicts
   data it was not fitted on as well as the data it was);
@@ -40,6 +41,8 @@ MAX_SEGMENT_Z = 5.0
 """Standard errors of their difference by which two halves' estimates may differ."""
 BETTER_STRUCTURE = 0.3
 """How much lower (a share) the other lag structure's residual variance must be to fail the model."""
+STILL_SHARE = 0.95
+"""The least share of unchanged consecutive commands for sampled commands to count as all seen."""
 SAMPLED_SHARE = 0.9
 """Commands logged below this share of the controller's rate are sampled, not all seen."""
 FITS = "fits"
@@ -202,23 +205,46 @@ def segment_check(first: dict, second: dict) -> dict:
     }
 
 
-def command_check(cmd_hz: float, control_hz: float | None) -> dict:
-    """Whether the log holds every command its controller computed.
+def command_check(cmd_hz: float, control_hz: float | None, still: float = 0.0) -> dict:
+    """Whether the log holds every command its controller computed, or commands that did not change
+    between its samples.
+
+    ``still`` is the share of consecutive logged commands that did not change at all (an open-loop
+    schedule of steps: what was not logged equals what was, but at its steps); at least
+    :data:`STILL_SHARE` passes however slowly they are logged.
 
     Examples
     --------
     >>> command_check(100.0, 1000.0)["ok"], command_check(1000.0, 1000.0)["ok"], command_check(250.0, None)["ok"]
     (False, True, True)
+    >>> command_check(250.0, 1000.0, still=0.99)["ok"]
+    True
     """
-    ok = control_hz is None or cmd_hz >= SAMPLED_SHARE * control_hz
+    ok = control_hz is None or cmd_hz >= SAMPLED_SHARE * control_hz or still >= STILL_SHARE
     return {
         "ok": bool(ok),
         "command_hz": cmd_hz,
         "control_hz": control_hz,
+        "unchanged_share": still,
         "why": f"the commands are logged at {cmd_hz:g} Hz and the controller computed them at "
-        f"{control_hz or 0:g} Hz: the commands between samples are unknown (log every command: PX4's "
-        "system-identification profile)",
+        f"{control_hz or 0:g} Hz, changing between samples ({100 * (1 - still):.0f} % of them): the commands "
+        "between samples are unknown (log every command: PX4's system-identification profile)",
     }
+
+
+def unchanged_share(u: np.ndarray, segment: np.ndarray) -> float:
+    """The share of consecutive samples (within segments) whose commands did not change at all.
+
+    Examples
+    --------
+    >>> unchanged_share(np.array([[0.5], [0.5], [0.6], [0.6]]), np.zeros(4, int))
+    0.6666666666666666
+    """
+    if len(u) < 2:
+        return 0.0
+    same = np.all(u[1:] == u[:-1], axis=1) & (segment[1:] == segment[:-1])
+    pairs = int(np.sum(segment[1:] == segment[:-1]))
+    return float(np.sum(same)) / pairs if pairs else 0.0
 
 
 def structure_check(sigma: dict, other_sigma: dict, lag_of: str, other: str, y_var: dict | None = None) -> dict:
@@ -318,7 +344,7 @@ def paper_verdict(flight, sig, fit_rows, held, rotors, result, mass, g, cmd_hz, 
             found = {}
         halves.append({k: v for k, v in found.items() if v["identifiable"]})
     checks["segments"] = segment_check(*halves)
-    checks["commands"] = command_check(cmd_hz, control_rate(rates, rates))
+    checks["commands"] = command_check(cmd_hz, control_rate(rates, rates), unchanged_share(flight.u, flight.segment))
     other = "speed" if sig.lag_of == "thrust" else "thrust"
     alt = fit(
         dataclasses.replace(sig, lag_of=other),
