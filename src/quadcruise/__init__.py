@@ -59,6 +59,7 @@ if TYPE_CHECKING:  # what the names are, for readers and type checkers
     from quadcruise.sim.status import STATUS_REASONS, ExitStatus
     from quadcruise.sysid.api import identify
     from quadcruise.sysid.result import IdentifyResult
+    from quadcruise.workflows.commands import CommandSchedule, read_commands
     from quadcruise.workflows.compare import Comparison, compare
     from quadcruise.workflows.fly import fly
     from quadcruise.workflows.replay import (
@@ -82,7 +83,8 @@ _LAZY = {
     "quadcruise.sysid.result": ("IdentifyResult",),
     "quadcruise.workflows.compare": ("Comparison", "compare"),
     "quadcruise.workflows.fly": ("fly",),
-    "quadcruise.workflows.replay": (
+    "quadcruise.workflows.commands": ("CommandSchedule", "read_commands"),
+    "quadcruise.workflows.replay": (  # replay and write_states_csv; the others deprecated aliases
         "DutySchedule",
         "SpeedSchedule",
         "read_duty_csv",
@@ -96,6 +98,7 @@ _LAZY = {
 _HOME = {name: module for module, names in _LAZY.items() for name in names}
 
 __all__ = [
+    "CommandSchedule",
     "Comparison",
     "DutySchedule",
     "ExitStatus",
@@ -110,6 +113,7 @@ __all__ = [
     "compare",
     "fly",
     "identify",
+    "read_commands",
     "read_duty_csv",
     "read_speed_csv",
     "replay",

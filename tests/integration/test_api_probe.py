@@ -159,9 +159,14 @@ CASES = {
         ["montecarlo()", "requirements key", "did you mean 'rmse_m'?"],
     ),
     # replay
-    "replay int": (lambda: qc.replay(3), WRONG, ["schedule", "DutySchedule", "path"]),
+    "replay int": (lambda: qc.replay(3), WRONG, ["commands", "CommandSchedule", "DataFrame", "path"]),
     "replay max_step 0": (lambda: qc.replay(EXAMPLES / "pwm_step.csv", max_step=0.0), BAD, ["max_step"]),
-    "replay vehicle": (lambda: qc.replay(EXAMPLES / "pwm_step.csv", vehicle="paper"), WRONG, ["vehicle"]),
+    "replay vehicle": (lambda: qc.replay(EXAMPLES / "pwm_step.csv", vehicle=3), WRONG, ["vehicle", "preset"]),
+    "replay vehicle name": (
+        lambda: qc.replay(EXAMPLES / "pwm_step.csv", vehicle="crazyfly"),
+        BAD,
+        ["unknown vehicle preset 'crazyfly'"],
+    ),
     "replay full_dynamics": (
         lambda: qc.replay(EXAMPLES / "pwm_step.csv", full_dynamics="no"),
         WRONG,
@@ -325,7 +330,7 @@ def test_what_must_pass_passes_and_numbers_of_any_numeric_type_fly_the_same():
 def test_replay_takes_a_path_as_well_as_a_schedule():
     path = EXAMPLES / "pwm_step.csv"
     by_path = qc.replay(str(path))
-    by_schedule = qc.replay(qc.read_duty_csv(path))
+    by_schedule = qc.replay(qc.read_commands(path))
     np.testing.assert_array_equal(by_path.states, by_schedule.states)
     assert by_path.meta["source"] == str(path)
     assert qc.replay(path).t.size == by_path.t.size  # a pathlib.Path too

@@ -172,7 +172,7 @@ class QuadVectorEnv(VectorEnv):
             )
         self.rotor = isinstance(self.nominal, RotorVehicle)
         # the paper vehicle the controllers believe: the rotor vehicle's "+" equivalent
-        self.nominal_eq = paper_equivalent(self.nominal) if self.rotor else self.nominal
+        self.nominal_eq = paper_equivalent(self.nominal)
         if self.nominal_eq.batch_size is not None:
             raise InputError("the environment's vehicle must not be batched: use a population to vary it")
         check_can_hover(self.nominal_eq)
