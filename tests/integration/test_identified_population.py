@@ -99,7 +99,9 @@ def test_a_covariance_comes_back_as_the_draws_correlation(identified, tmp_path):
     assert np.corrcoef(cols["Jxx"], cols["Jyy"])[0, 1] == pytest.approx(rho, abs=0.03)
     assert abs(np.corrcoef(cols["Jxx"], cols["Jzz"])[0, 1]) < 0.06
     assert np.std(cols["Jyy"], ddof=1) == pytest.approx(sig[j], rel=0.05)
-    independent = Population.from_identification(identified)  # identify.json without a covariance
+    data.pop("covariance")  # identify.json without a covariance: the intervals' diagonal
+    (folder / "identify.json").write_text(json.dumps(data))
+    independent = Population.from_identification(folder / "identify.json")
     assert not independent.identified.correlated
     cols = independent.draw(seed=3, first=0, count=4000, nominal=nominal).columns
     assert abs(np.corrcoef(cols["Jxx"], cols["Jyy"])[0, 1]) < 0.06
