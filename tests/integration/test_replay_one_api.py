@@ -114,7 +114,7 @@ def test_what_a_plant_cannot_fly_is_refused_by_name():
         qc.replay(six, vehicle="crazyflie")
     with pytest.raises(qc.InputError, match="argument ground: the paper's plant replays without a ground"):
         qc.replay(PWM, ground=True)
-    with pytest.raises(qc.InputError, match="argument wind: the paper's plant replays without wind"):
+    with pytest.raises(qc.InputError, match="argument wind: the paper's plant replays in still air"):
         qc.replay(PWM, wind=(1.0, 0.0, 0.0))
     with pytest.raises(qc.InputError, match="argument full_dynamics: the rotor plant's kinematics"):
         qc.replay(FLIP, vehicle="crazyflie", full_dynamics=True)

@@ -47,8 +47,9 @@ __all__ = ["replay"]
 def replay(pwm_csv: str, out: str, vehicle_name: str | None, ground: bool, max_step: float | None) -> None:
     """Replay commands open loop and write the states.
 
-    For the paper's plant the columns are t,u1,u2,u3,u4 (PWM duties); for a rotor-plant
-    vehicle, t,w1,..,wn (commanded rotor speeds, rad/s, in the vehicle's range) or t,u1,..,un
+    The table's columns say what it holds and the vehicle which plant flies it. For the
+    paper's plant the columns are t,u1,u2,u3,u4 (PWM duties); for a rotor-plant vehicle,
+    t,w1,..,wn (commanded rotor speeds, rad/s, in the vehicle's range) or t,u1,..,un
     (normalised commands in [0, 1], each rotor at u w_max: PX4's THR_MDL_FAC = 1). Each row's
     commands hold until the next row's time. The vehicle starts at rest at the origin, level,
     each rotor at the first row's command. The states are written even when the flight stops

@@ -183,11 +183,16 @@ def _replay(commands, vehicle, max_step, limits, full_dynamics, wind, ground, pr
     checks.callback(w, "progress", progress)
     if wind is not None:
         wind = _wind(w, wind)
-    if not plant.takes_speeds and (ground or wind is not None):
-        option = "ground" if ground else "wind"
+    if not plant.takes_speeds and ground:
         raise InputError(
-            f"{w} argument {option}: the paper's plant replays without {'a ground' if ground else 'wind'}: "
-            f"give a rotor-plant vehicle ({ROTOR_VEHICLES})"
+            f"{w} argument ground: the paper's plant replays without a ground: give a rotor-plant "
+            f"vehicle ({ROTOR_VEHICLES})"
+        )
+    if not plant.takes_speeds and wind is not None:
+        raise InputError(
+            f"{w} argument wind: the paper's plant replays in still air (its wind acts through a drag "
+            "model: qc.fly with an Environment and disturbances.with_drag); a rotor-plant vehicle "
+            f"replays in wind ({ROTOR_VEHICLES})"
         )
     if plant.takes_speeds and full_dynamics:
         raise InputError(
@@ -415,7 +420,7 @@ def replay_rotors(
         optional=False,
         want="a SpeedSchedule or the path of a t,w1,..,wn CSV file",
     )
-    if not isinstance(vehicle, RotorVehicle):
+    if not replay_plant(vehicle).takes_speeds:  # the one plant question, replay_plant's
         raise InputError(f"replay_rotors needs a rotor-plant vehicle (RotorVehicle), got {type(vehicle).__name__}")
     if max_step is None:
         checks.fail(w, "max_step", max_step, "a number > 0 [s]")
