@@ -56,6 +56,12 @@ def test_our_rate_integral_follows_pxs(check):
     assert r2(capped, "rate_integral", "roll") < 0.5
 
 
+def test_the_allocation_gives_pxs_motor_commands(check):
+    motors = check.loops["allocation"]["axes"]
+    assert set(motors) == {"motor1", "motor2", "motor3", "motor4"}
+    assert all(f["r2"] > 0.9999 and f["rmse"] < 1e-6 and f["samples"] > 100 for f in motors.values())
+
+
 def test_the_position_loop_is_checked_while_flying(check):
     position = check.loops["position"]["axes"]
     assert position["v_north"]["r2"] > 0.99 and position["v_down"]["r2"] > 0.95

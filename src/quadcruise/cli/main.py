@@ -89,7 +89,8 @@ def run() -> None:
         click.echo(f"error: {fault_text(exc)}", err=True)
         sys.exit(EXIT_FAULT)
     except (click.exceptions.Abort, KeyboardInterrupt) as exc:
-        text, status = interrupt_text(exc if isinstance(exc, KeyboardInterrupt) else KeyboardInterrupt())
+        command = sys.argv[1] if len(sys.argv) > 1 else ""  # the sweep's way on is said for a sweep only
+        text, status = interrupt_text(exc if isinstance(exc, KeyboardInterrupt) else KeyboardInterrupt(), command)
         click.echo(f"error: {text}", err=True)
         sys.exit(status)
     finally:

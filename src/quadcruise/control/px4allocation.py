@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["rotor_effectiveness", "mix_matrix", "allocate", "rotors_from_params"]
+__all__ = ["rotor_effectiveness", "mix_matrix", "allocate", "allocate_into", "rotors_from_params"]
 
 _EPS32 = 1.1920929e-07
 
@@ -130,45 +130,73 @@ def rotors_from_params(params) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.n
 
 
 @njit(cache=True)
-def _gain(vector, sp, lo, hi):
-    """``computeDesaturationGain``: the step along ``vector`` that removes the saturation;
-    rotors whose entry is under 0.2 in size are not used."""
+def _gain(mix, col, sp, lo, hi, headroom):
+    """``computeDesaturationGain`` along ``mix[:, col]``: the step that removes the saturation
+    (the upper bounds raised by ``headroom`` times the range); rotors whose entry is under 0.2
+    in size are not used."""
     k_min = 0.0
     k_max = 0.0
     for i in range(sp.size):
-        if abs(vector[i]) < 0.2:
+        v = mix[i, col]
+        if abs(v) < 0.2:
             continue
+        top = hi[i] + headroom * (hi[i] - lo[i])
         if sp[i] < lo[i]:
-            k = (lo[i] - sp[i]) / vector[i]
+            k = (lo[i] - sp[i]) / v
             k_min = min(k_min, k)
             k_max = max(k_max, k)
-        if sp[i] > hi[i]:
-            k = (hi[i] - sp[i]) / vector[i]
+        if sp[i] > top:
+            k = (top - sp[i]) / v
             k_min = min(k_min, k)
             k_max = max(k_max, k)
     return k_min + k_max
 
 
 @njit(cache=True)
-def _desaturate(sp, vector, lo, hi, increase_only):
-    """``desaturateActuators``: one full step, then half a step, along ``vector``."""
-    gain = _gain(vector, sp, lo, hi)
+def _desaturate(sp, mix, col, lo, hi, increase_only, headroom):
+    """``desaturateActuators``: one full step, then half a step, along ``mix[:, col]``."""
+    gain = _gain(mix, col, sp, lo, hi, headroom)
     if increase_only and gain < 0.0:
         return
     for i in range(sp.size):
-        sp[i] += gain * vector[i]
-    gain = 0.5 * _gain(vector, sp, lo, hi)
+        sp[i] += gain * mix[i, col]
+    gain = 0.5 * _gain(mix, col, sp, lo, hi, headroom)
     for i in range(sp.size):
-        sp[i] += gain * vector[i]
+        sp[i] += gain * mix[i, col]
 
 
 @njit(cache=True)
 def _mix_yaw(sp, mix, control, lo, hi):
     for i in range(sp.size):
         sp[i] += mix[i, 2] * control[2]
-    headroom = hi + (hi - lo) * 0.15  # some yaw response at full thrust
-    _desaturate(sp, mix[:, 2].copy(), lo, headroom, False)
-    _desaturate(sp, mix[:, 5].copy(), lo, hi, True)
+    _desaturate(sp, mix, 2, lo, hi, False, 0.15)  # some yaw response at full thrust
+    _desaturate(sp, mix, 5, lo, hi, True, 0.0)
+
+
+@njit(cache=True)
+def allocate_into(sp, mix, control, airmode, lo, hi):
+    """:func:`allocate` written into ``sp`` (shape (n,)), allocating nothing: the compiled
+    controller's form (:mod:`quadcruise.control.px4`)."""
+    n = mix.shape[0]
+    for i in range(n):
+        sp[i] = 0.0
+    if airmode == 2:
+        for i in range(n):
+            for j in range(6):
+                sp[i] += mix[i, j] * control[j]
+        _desaturate(sp, mix, 5, lo, hi, False, 0.0)
+        _desaturate(sp, mix, 2, lo, hi, False, 0.0)
+        return
+    for i in range(n):
+        for j in (0, 1, 3, 4, 5):
+            sp[i] += mix[i, j] * control[j]
+    if airmode == 1:
+        _desaturate(sp, mix, 5, lo, hi, False, 0.0)
+    else:
+        _desaturate(sp, mix, 5, lo, hi, True, 0.0)  # thrust only reduced
+        _desaturate(sp, mix, 0, lo, hi, False, 0.0)
+        _desaturate(sp, mix, 1, lo, hi, False, 0.0)
+    _mix_yaw(sp, mix, control, lo, hi)
 
 
 @njit(cache=True)
@@ -191,23 +219,6 @@ def allocate(mix, control, airmode, lo, hi):
     numpy.ndarray, shape (n,)
         Rotor setpoints, before PX4's final clipping to ``[lo, hi]``.
     """
-    n = mix.shape[0]
-    sp = np.zeros(n)
-    if airmode == 2:
-        for i in range(n):
-            for j in range(6):
-                sp[i] += mix[i, j] * control[j]
-        _desaturate(sp, mix[:, 5].copy(), lo, hi, False)
-        _desaturate(sp, mix[:, 2].copy(), lo, hi, False)
-        return sp
-    for i in range(n):
-        for j in (0, 1, 3, 4, 5):
-            sp[i] += mix[i, j] * control[j]
-    if airmode == 1:
-        _desaturate(sp, mix[:, 5].copy(), lo, hi, False)
-    else:
-        _desaturate(sp, mix[:, 5].copy(), lo, hi, True)  # thrust only reduced
-        _desaturate(sp, mix[:, 0].copy(), lo, hi, False)
-        _desaturate(sp, mix[:, 1].copy(), lo, hi, False)
-    _mix_yaw(sp, mix, control, lo, hi)
+    sp = np.zeros(mix.shape[0])
+    allocate_into(sp, mix, control, airmode, lo, hi)
     return sp

@@ -100,6 +100,20 @@ _TABLE = {
     "MPC_THR_HOVER": Px4Param(0.5, "norm", 0.1, 0.8, FLOAT, "position"),
     "MPC_THR_XY_MARG": Px4Param(0.3, "norm", 0.0, 0.5, FLOAT, "position"),
     "MPC_USE_HTE": Px4Param(1, "", 0, 1, INT32, "position"),
+    "MPC_VELD_LP": Px4Param(5.0, "Hz", 0.0, 10.0, FLOAT, "position"),
+    # sensors/vehicle_angular_velocity/imu_gyro_parameters.c
+    "IMU_GYRO_CUTOFF": Px4Param(40.0, "Hz", 0.0, 1000.0, FLOAT, "filters"),
+    "IMU_DGYRO_CUTOFF": Px4Param(30.0, "Hz", 0.0, 1000.0, FLOAT, "filters"),
+    # control_allocator/module.yaml, lib/mixer_module/params.c
+    "MC_AIRMODE": Px4Param(0, "", 0, 2, INT32, "allocation"),
+    "THR_MDL_FAC": Px4Param(0.0, "", 0.0, 1.0, FLOAT, "allocation"),
+    "CA_ROTOR_COUNT": Px4Param(0, "", 0, 12, INT32, "allocation"),
 }
+for _i in range(12):  # CA_ROTOR${i}_*: position [m], thrust axis, thrust coefficient, moment ratio
+    for _c in "XYZ":
+        _TABLE[f"CA_ROTOR{_i}_P{_c}"] = Px4Param(0.0, "m", -100.0, 100.0, FLOAT, "allocation")
+        _TABLE[f"CA_ROTOR{_i}_A{_c}"] = Px4Param(-1.0 if _c == "Z" else 0.0, "", -100.0, 100.0, FLOAT, "allocation")
+    _TABLE[f"CA_ROTOR{_i}_CT"] = Px4Param(6.5, "", 0.0, 100.0, FLOAT, "allocation")
+    _TABLE[f"CA_ROTOR{_i}_KM"] = Px4Param(0.05, "", -1.0, 1.0, FLOAT, "allocation")
 PX4_PARAMETERS: dict[str, Px4Param] = dict(_TABLE)
 """Each parameter the loops use, by PX4's name: its v1.15 default, unit, range, type and loop."""

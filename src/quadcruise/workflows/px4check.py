@@ -14,6 +14,10 @@ false):
 - rate integral: the same inputs at the logged gyro samples (50 Hz where PX4 integrates at the
   gyro rate), with the allocator's saturation (``control_allocator_status``) and the land
   detector, integrated by us from the log's first value; ``rate_ctrl_status`` is compared;
+- allocation (:func:`~quadcruise.control.px4allocation.allocate`): ``vehicle_torque_setpoint``
+  and ``vehicle_thrust_setpoint`` of each ``actuator_motors`` sample's gyro sample, through the
+  log's own ``CA_ROTOR*`` geometry (always the log's, whatever the parameters given) and
+  ``MC_AIRMODE``; ``actuator_motors`` is compared;
 - position (:func:`~quadcruise.control.px4loops.position_control`), while
   ``takeoff_status`` says flying and the land detector sees no ground contact: ``vehicle_local_position`` and the last
   ``trajectory_setpoint`` and ``hover_thrust_estimate`` at each
@@ -39,6 +43,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
+from quadcruise.control.px4allocation import allocate, mix_matrix, rotor_effectiveness, rotors_from_params
 from quadcruise.control.px4loops import (
     G_TILT_MAX,
     G_VEL_D,
@@ -70,6 +75,8 @@ TOPICS = (
     "vehicle_torque_setpoint",
     "rate_ctrl_status",
     "control_allocator_status",
+    "vehicle_thrust_setpoint",
+    "actuator_motors",
     "vehicle_local_position",
     "vehicle_local_position_setpoint",
     "trajectory_setpoint",
@@ -184,12 +191,12 @@ class Px4Check:
 def _unit(loop: str, axis: str) -> str:
     if loop == "attitude":
         return "rad/s"
-    if loop.startswith("rate") or axis.startswith("T_"):
+    if loop.startswith("rate") or loop == "allocation" or axis.startswith("T_"):
         return "norm"
     return "m/s" if axis.startswith("v_") else "m/s^2"
 
 
-def _read(path: Path) -> tuple[dict, dict]:
+def _read(path: Path) -> tuple[dict, dict, dict]:
     from pyulog import ULog
     from pyulog.core import ULogException
 
@@ -208,7 +215,10 @@ def _read(path: Path) -> tuple[dict, dict]:
     for d in log.data_list:
         if d.multi_id == 0 or d.name not in topics:
             topics[d.name] = {k: np.asarray(v) for k, v in d.data.items()}
-    return topics, log.msg_info_dict
+    raw = dict(log.initial_parameters)
+    for _, name, value in log.changed_parameters:
+        raw[name] = value
+    return topics, log.msg_info_dict, raw
 
 
 def _version(info: dict) -> str:
@@ -331,6 +341,37 @@ def _rate_integral(T: dict, g: np.ndarray, airborne) -> dict:
     }
 
 
+def _allocation(T: dict, raw: dict, airborne) -> dict:
+    if "CA_ROTOR_COUNT" not in raw or int(raw["CA_ROTOR_COUNT"]) < 1:
+        return {"absent": "the log has no CA_ROTOR_COUNT (no rotor geometry)"}
+    try:
+        geometry = rotors_from_params(raw)
+    except KeyError as exc:
+        return {"absent": f"the log has no {exc.args[0]}"}
+    mix, _ = mix_matrix(rotor_effectiveness(*geometry))
+    n = mix.shape[0]
+    motors, torque, thrust = T["actuator_motors"], T["vehicle_torque_setpoint"], T["vehicle_thrust_setpoint"]
+    row_t = {int(t): i for i, t in enumerate(torque["timestamp_sample"])}
+    row_f = {int(t): i for i, t in enumerate(thrust["timestamp_sample"])}
+    airmode = int(raw.get("MC_AIRMODE", 0))
+    up = airborne(motors["timestamp"])
+    lo, hi = np.zeros(n), np.ones(n)
+    ours = np.full((motors["timestamp"].size, n), np.nan)
+    for k, t in enumerate(motors["timestamp_sample"]):
+        i, j = row_t.get(int(t)), row_f.get(int(t))
+        if not up[k] or i is None or j is None:
+            continue
+        control = [torque[f"xyz[{a}]"][i] for a in range(3)] + [thrust[f"xyz[{a}]"][j] for a in range(3)]
+        ours[k] = np.clip(allocate(mix, np.array(control, float), airmode, lo, hi), 0.0, 1.0)
+    logged = _vec(motors, "control", n)
+    return {
+        "inputs": "vehicle_torque_setpoint and vehicle_thrust_setpoint of the same gyro sample, the log's CA_ROTOR*",
+        "output": "actuator_motors",
+        "unit": "normalised command",
+        "axes": {f"motor{m + 1}": fit(logged[:, m], ours[:, m]) for m in range(n)},
+    }
+
+
 def _position(T: dict, g: np.ndarray, params: Px4Parameters, airborne) -> dict:
     lp, out, tr = T["vehicle_local_position"], T["vehicle_local_position_setpoint"], T["trajectory_setpoint"]
     t_us = out["timestamp"]
@@ -423,7 +464,7 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
         none of the loops' topics; one line naming the file.
     """
     path = Path(log)
-    T, info = _read(path)
+    T, info, raw = _read(path)
     params = read_params(path) if params is None else params
     g = px4_gains(params)
     if "vehicle_land_detected" not in T:
@@ -447,6 +488,7 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
         "attitude": ("vehicle_attitude", "vehicle_attitude_setpoint", "vehicle_rates_setpoint"),
         "rate": ("vehicle_angular_velocity", "vehicle_rates_setpoint", "vehicle_torque_setpoint", "rate_ctrl_status"),
         "rate_integral": ("vehicle_angular_velocity", "vehicle_rates_setpoint", "rate_ctrl_status"),
+        "allocation": ("vehicle_torque_setpoint", "vehicle_thrust_setpoint", "actuator_motors"),
         "position": ("vehicle_local_position", "vehicle_local_position_setpoint", "trajectory_setpoint"),
     }
     loops: dict[str, dict] = {}
@@ -460,6 +502,8 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
             loops[loop] = _rate(T, g, airborne)
         elif loop == "rate_integral":
             loops[loop] = _rate_integral(T, g, airborne)
+        elif loop == "allocation":
+            loops[loop] = _allocation(T, raw, airborne)
         else:
             loops[loop] = _position(T, g, params, airborne)
     if all("absent" in v for v in loops.values()):
