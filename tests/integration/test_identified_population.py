@@ -4,7 +4,7 @@ A 1.4 kg vehicle of the paper's kind flies ``sysid`` with sensor noise, is ident
 mass, and the sweep draws each identified parameter from its estimate: the flights' drawn K,
 Jxx, Jyy, Jzz, d and omega must centre on the estimates and spread as the 95 % intervals say
 (sigma = half-width / 1.96: ~95 % of the draws inside each interval), checked on the sweep's own
-table by sample statistics; a covariance in ``identify.json`` must come back as the draws'
+table by sample statistics; ``identify.json``'s covariance must come back as the draws'
 correlation, and without one the draws are independent (both directions); the sweep's
 ``scenario.toml`` flies the same vehicles again. Bad inputs are one line.
 """
@@ -81,27 +81,38 @@ def test_the_scenario_flies_the_same_vehicles(identified, tmp_path):
 
 
 def test_a_covariance_comes_back_as_the_draws_correlation(identified, tmp_path):
+    """identify.json's own covariance (the delta method's): the draws' correlations are its own; a
+    covariance written in (Jxx-Jyy 0.8) comes back; without one, the draws are independent."""
+    nominal = qc.Vehicle.paper().replace(m=1.4)
+    data = json.loads((identified / "identify.json").read_text())
+    assert "covariance" in data
+    own = Population.from_identification(identified)
+    assert own.identified.correlated
+    names = list(own.identified.names)
+    listed = data["covariance"]["names"]
+    at = [listed.index(n) for n in names]
+    matrix = np.asarray(data["covariance"]["matrix"])[np.ix_(at, at)]
+    expected = matrix / np.sqrt(np.outer(np.diag(matrix), np.diag(matrix)))
+    cols = own.draw(seed=3, first=0, count=4000, nominal=nominal).columns
+    drawn = np.corrcoef(np.array([cols[n] for n in names]))
+    assert np.allclose(drawn, expected, atol=0.06), (names, drawn.round(2), expected.round(2))
+
     folder = tmp_path / "ident"
     shutil.copytree(identified, folder)
-    data = json.loads((folder / "identify.json").read_text())
-    fields = ("K", "Jxx", "Jyy", "Jzz", "d", "omega")
-    names = [n for n, p in data["parameters"].items() if p["identifiable"] and n in fields]
-    sig = [(data["parameters"][n]["ci95"][1] - data["parameters"][n]["ci95"][0]) / (2 * 1.959964) for n in names]
+    sig = np.sqrt(np.diag(matrix))
     rho, i, j = 0.8, names.index("Jxx"), names.index("Jyy")
-    matrix = np.diag(np.square(sig))
-    matrix[i, j] = matrix[j, i] = rho * sig[i] * sig[j]
-    data["covariance"] = {"names": names[::-1], "matrix": matrix[::-1, ::-1].tolist()}  # its own order
+    written = np.diag(sig**2)
+    written[i, j] = written[j, i] = rho * sig[i] * sig[j]
+    data["covariance"] = {"names": names[::-1], "matrix": written[::-1, ::-1].tolist()}  # its own order
     (folder / "identify.json").write_text(json.dumps(data))
-    nominal = qc.Vehicle.paper().replace(m=1.4)
-    correlated = Population.from_identification(folder / "identify.json")
-    assert correlated.identified.correlated and correlated.identified.names == tuple(names)
-    cols = correlated.draw(seed=3, first=0, count=4000, nominal=nominal).columns
+    cols = Population.from_identification(folder).draw(seed=3, first=0, count=4000, nominal=nominal).columns
     assert np.corrcoef(cols["Jxx"], cols["Jyy"])[0, 1] == pytest.approx(rho, abs=0.03)
     assert abs(np.corrcoef(cols["Jxx"], cols["Jzz"])[0, 1]) < 0.06
     assert np.std(cols["Jyy"], ddof=1) == pytest.approx(sig[j], rel=0.05)
-    data.pop("covariance")  # identify.json without a covariance: the intervals' diagonal
+
+    del data["covariance"]
     (folder / "identify.json").write_text(json.dumps(data))
-    independent = Population.from_identification(folder / "identify.json")
+    independent = Population.from_identification(folder)
     assert not independent.identified.correlated
     cols = independent.draw(seed=3, first=0, count=4000, nominal=nominal).columns
     assert abs(np.corrcoef(cols["Jxx"], cols["Jyy"])[0, 1]) < 0.06
