@@ -58,8 +58,9 @@ class EstimateResult:
     figures : dict
         RMS differences from EKF2 (``roll_deg``, ``pitch_deg``, ``yaw_deg``, ``altitude_m``,
         ``horizontal_m``), EKF2's own roll and pitch RMS (what an estimate of "level" would
-        score: ``ekf2_roll_rms_deg``, ``ekf2_pitch_rms_deg``), the samples counted and the
-        updates the gate refused.
+        score: ``ekf2_roll_rms_deg``, ``ekf2_pitch_rms_deg``), the samples counted, the
+        updates the gate refused and each stream's mean NIS (its degrees of freedom if the
+        settings fit the log's sensors).
     config : dict
         What was run: settings, declination and its source, alignment, start.
     command : str
@@ -268,6 +269,7 @@ def estimate_log(
         "attitude_samples": int(at.sum()),
         "position_samples": int(pt.sum()),
         "gated_updates": {n: int(np.sum(v < 0)) for n, v in run.nis.items()},
+        "mean_nis": {n: float(np.mean(np.abs(v))) if v.size else None for n, v in run.nis.items()},
     }
     config = {
         "settings": {f: getattr(settings, f) for f in settings.units()},
