@@ -91,3 +91,31 @@ def test_log_without_a_needed_topic_is_refused(tmp_path, topic):
     assert res.exit_code == 2
     assert f"no {topic}" in res.output and "Traceback" not in res.output
     assert len(res.output.strip().splitlines()) == 1 and not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (["--declination", "nan"], "--declination must be a finite number"),
+        ([], "not a PX4 log"),
+    ],
+)
+def test_bad_input_one_line_exit_2(tmp_path, args, words):
+    log = str(SITL)
+    if not args:  # a file that is no ULog
+        log = str(tmp_path / "notes.ulg")
+        Path(log).write_text("not a log\n")
+    res = CliRunner().invoke(main, ["estimate", log, "--out", str(tmp_path / "o"), *args])
+    assert res.exit_code == 2 and words in res.output, res.output
+    assert len(res.output.strip().splitlines()) == 1 and not (tmp_path / "o").exists()
+
+
+def test_given_declination_is_recorded(tmp_path):
+    res = CliRunner().invoke(main, ["estimate", str(SITL), "--out", str(tmp_path / "o"), "--declination", "3.32"])
+    assert res.exit_code == 0, res.output
+    doc = json.loads((tmp_path / "o" / "estimate.json").read_text())
+    assert doc["config"]["declination_source"] == "given"
+    assert doc["config"]["declination_rad"] == pytest.approx(np.radians(3.32))
+    assert doc["rms"]["yaw_deg"] < 2.0
+    marker = json.loads((tmp_path / "o" / "quadcruise.json").read_text())
+    assert "--declination 3.32" in marker["command"]
