@@ -5,8 +5,6 @@ chi-square 95 % bounds over Monte Carlo runs; a filter told the wrong noise fail
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation

@@ -152,3 +152,29 @@ def test_magnetometer_field_geometry_and_noise():
 def test_bad_parameters_are_refused_by_name(make, words):
     with pytest.raises(InputError, match=words):
         make()
+
+
+def test_step_functions_give_the_series_readings():
+    from quadcruise.sensors.baro import baro_read
+    from quadcruise.sensors.mag import mag_read
+    from quadcruise.sim.rng import vehicle_states
+
+    b = Baro(rate=10.0, noise_std=0.2, bias_init=0.0, drift=0.1)
+    ts, h, bias = b.measure(np.array([0.0, 2.0]), np.array([3.0, 3.0]), seed=9)
+    s, st, steps = vehicle_states(9, 1)[0, 0], np.zeros(1), []  # bias_init 0: no switch-on draw
+    for _ in ts:
+        r, s = baro_read(np.array([10.0, 0.2, 0.0, 0.1]), st, 3.0, np.uint64(s))  # back in Python a state is an int
+        steps.append(r)
+    assert np.allclose(steps, h)
+    out = np.empty(3)
+    mag_read(np.array([0.0, 0.0]), np.array([0.1, 0.0, -0.1]), 0.2, 0.3, 0.4, out, vehicle_states(1, 1)[0, 0])
+    assert np.allclose(out, [0.3, 0.3, 0.3])
+
+
+def test_sensor_rate_must_divide_the_control_rate():
+    from quadcruise.sensors.timing import periods_per_sample
+
+    assert periods_per_sample("imu", 250.0, 0.001) == 4 and periods_per_sample("imu", 1000.0, 0.001) == 1
+    for rate in (300.0, 2000.0):
+        with pytest.raises(InputError, match=f"imu rate {rate:g} Hz does not divide the control rate 1000 Hz"):
+            periods_per_sample("imu", rate, 0.001)

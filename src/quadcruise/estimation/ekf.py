@@ -55,7 +55,7 @@ def quat_exp(rx, ry, rz):
     Examples
     --------
     >>> import math
-    >>> [round(c, 6) for c in quat_exp(0.0, 0.0, math.pi)]
+    >>> [round(float(c), 6) for c in quat_exp(0.0, 0.0, math.pi)]
     [0.0, 0.0, 0.0, 1.0]
     """
     out = np.empty(4)
@@ -75,7 +75,7 @@ def quat_log(q):
     Examples
     --------
     >>> import numpy as np
-    >>> [round(c, 6) for c in quat_log(quat_exp(0.1, -0.2, 0.3))]
+    >>> [round(float(c), 6) for c in quat_log(quat_exp(0.1, -0.2, 0.3))]
     [0.1, -0.2, 0.3]
     """
     w = q[0]

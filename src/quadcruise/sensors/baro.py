@@ -83,6 +83,31 @@ class Baro(Validated):
 
 
 @njit(cache=True)
+def baro_read(row, st, z, s):
+    """One reading of the true altitude ``z`` [m]; the offset ``st[0]`` then walks one period.
+
+    Parameters
+    ----------
+    row : numpy.ndarray
+        (rate, noise_std, bias_init, drift).
+    st : numpy.ndarray
+        (1,) the offset [m] (drawn at switch-on with std ``bias_init`` by the caller), updated.
+    z : float
+        True altitude [m].
+    s : numpy.uint64
+        Generator state.
+
+    Returns
+    -------
+    tuple
+        (the reading [m], the advanced generator state).
+    """
+    h, s = noisy(z, st[0], row[1], s)
+    st[0], s = walk(st[0], row[3], 1.0 / row[0], s)
+    return h, s
+
+
+@njit(cache=True)
 def baro_series(row, h, bias, s):
     """Readings in place of the true altitudes ``h`` (K,) and their offsets into ``bias``.
 
@@ -102,9 +127,9 @@ def baro_series(row, h, bias, s):
     numpy.uint64
         The advanced generator state.
     """
-    b, s = noisy(0.0, 0.0, row[2], s)
+    st = np.empty(1)
+    st[0], s = noisy(0.0, 0.0, row[2], s)
     for k in range(h.shape[0]):
-        bias[k] = b
-        h[k], s = noisy(h[k], b, row[1], s)
-        b, s = walk(b, row[3], 1.0 / row[0], s)
+        bias[k] = st[0]
+        h[k], s = baro_read(row, st, h[k], s)
     return s

@@ -45,7 +45,7 @@ class Gps(Validated):
 
     Examples
     --------
-    >>> Gps(rate=5.0).row()[0]
+    >>> float(Gps(rate=5.0).row()[0])
     5.0
     """
 

@@ -72,7 +72,7 @@ class Imu(Validated):
 
     Examples
     --------
-    >>> Imu(rate=400.0).row()[0]
+    >>> float(Imu(rate=400.0).row()[0])
     400.0
     >>> round(BMI088.gyro_noise / DEG, 3)       # 0.014 deg/s/sqrt(Hz)
     0.014

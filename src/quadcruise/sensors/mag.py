@@ -103,6 +103,34 @@ class Magnetometer(Validated):
 
 
 @njit(cache=True)
+def mag_read(row, bias, bx, by, bz, out, s):
+    """One reading of the true body field (bx, by, bz) [G] into ``out`` (3,).
+
+    Parameters
+    ----------
+    row : numpy.ndarray
+        (noise_std, bias_std) [G].
+    bias : numpy.ndarray
+        (3,) the hard-iron bias [G].
+    bx, by, bz : float
+        The true field in the body frame [G], ``R^T B``.
+    out : numpy.ndarray
+        (3,) float64, written.
+    s : numpy.uint64
+        Generator state.
+
+    Returns
+    -------
+    numpy.uint64
+        The advanced generator state.
+    """
+    out[0], s = noisy(bx, bias[0], row[0], s)
+    out[1], s = noisy(by, bias[1], row[0], s)
+    out[2], s = noisy(bz, bias[2], row[0], s)
+    return s
+
+
+@njit(cache=True)
 def mag_series(row, field, bias, s):
     """Readings in place of the true body fields ``field`` (K, 3); the drawn bias into ``bias``.
 
@@ -125,6 +153,5 @@ def mag_series(row, field, bias, s):
     for i in range(3):
         bias[i], s = noisy(0.0, 0.0, row[1], s)
     for k in range(field.shape[0]):
-        for i in range(3):
-            field[k, i], s = noisy(field[k, i], bias[i], row[0], s)
+        s = mag_read(row, bias, field[k, 0], field[k, 1], field[k, 2], field[k], s)
     return s

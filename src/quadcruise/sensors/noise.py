@@ -6,7 +6,10 @@ walk of density ``b`` (unit/s/sqrt(Hz), i.e. unit/sqrt(s) per second of flight) 
 ``b * sqrt(dt)`` per step of ``dt`` seconds, so that its spread after time T is ``b * sqrt(T)``
 (IEEE Std 952-1997, Annex C: angle and rate random walk). Every draw comes from a SplitMix64
 state (:mod:`quadcruise.sim.rng`) handed in and returned, so that a stream depends on its seed
-only.
+only. The state must reach a compiled function as a ``numpy.uint64`` (a row of
+:func:`~quadcruise.sim.rng.vehicle_states`, or ``np.uint64(s)``): a state returned to Python
+comes back as an ``int``, which numba would type as int64, and the generator would then stall;
+the ``measure`` methods cast it.
 
 Examples
 --------
