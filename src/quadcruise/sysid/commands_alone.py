@@ -56,8 +56,9 @@ def rotor_table(parameters: dict, base, mass_given: bool) -> dict:
     --------
     >>> from quadcruise.model.rotor_vehicle import RotorVehicle
     >>> row = lambda v, lo, hi: {"value": v, "ci95": [lo, hi], "identifiable": True, "unit": "-", "source": "log"}
-    >>> table = rotor_table({"K": row(7.0, 6.9, 7.1), "d": row(0.06, 0.059, 0.061), "omega": row(40.0, 39.0, 41.0)},
-    ...                     RotorVehicle.preset("iris"), True)
+    >>> inertias = {name: row(0.03, 0.029, 0.031) for name in ("Jxx", "Jyy", "Jzz")}
+    >>> table = rotor_table({"K": row(7.0, 6.9, 7.1), "d": row(0.06, 0.059, 0.061), "omega": row(40.0, 39.0, 41.0),
+    ...                      **inertias}, RotorVehicle.preset("iris"), True)
     >>> round(table["kf"]["value"] * 1100.0**2, 6), table["tau_up"]["ci95"] == [1 / 41.0, 1 / 39.0]
     (7.0, True)
     """
