@@ -494,17 +494,24 @@ class IdentifyResult:
             The folder: ``identify.json``, ``vehicle.toml``, ``report.md``, ``fit.png``,
             ``quadcruise.json``.
         force : bool
-            Replace a non-empty folder quadcruise did not write.
+            Replace a non-empty folder quadcruise did not write (a folder holding the log read is
+            refused all the same: writing it would delete the log).
 
         Returns
         -------
         pathlib.Path
             The folder.
+
+        Raises
+        ------
+        InputError
+            Before anything is written: ``folder`` holds the log (or is not writable, or holds
+            something else, unless ``force``).
         """
         from quadcruise._version import __version__
         from quadcruise.io.files import MARKER, atomic_dir, check_output_dir
 
-        out = check_output_dir(folder, force)
+        out = check_output_dir(folder, force, inputs=[self.log.get("source")])
         with atomic_dir(out) as tmp:
             tmp = Path(tmp)
             (tmp / "identify.json").write_text(json.dumps(self.to_json(), indent=2) + "\n")
