@@ -288,3 +288,53 @@ def test_identify_never_deletes_the_log_it_reads(tmp_path):
         assert len(lines) == 1 and "holds the log being read" in lines[0], lines
         assert log.read_bytes() == (tmp_path / "f.ulg").read_bytes()
         assert sorted(p.name for p in folder.iterdir()) == before
+
+
+def test_the_library_write_never_deletes_the_log_it_read(tmp_path):
+    """``IdentifyResult.write(D)`` with the log read inside D (a folder quadcruise wrote, so it
+    would be replaced whole): refused in one line before anything is written, ``force`` or not;
+    the same result writes to another folder."""
+    from quadcruise.errors import InputError
+
+    folder = tmp_path / "D"
+    qc.identify(SITL).write(folder)  # D: a folder quadcruise wrote
+    log = folder / "flight.ulg"
+    log.write_bytes(SITL.read_bytes())
+    before = sorted(p.name for p in folder.iterdir())
+    result = qc.identify(log)
+    for force in (False, True):
+        with pytest.raises(InputError, match="holds .*flight.ulg, which this run reads") as caught:
+            result.write(folder, force=force)
+        assert "\n" not in str(caught.value)
+        assert log.read_bytes() == SITL.read_bytes()
+        assert sorted(p.name for p in folder.iterdir()) == before
+    other = result.write(tmp_path / "E")  # the other direction: elsewhere it writes
+    assert (other / "identify.json").is_file() and log.read_bytes() == SITL.read_bytes()
+
+
+def test_fly_never_deletes_the_scenario_or_vehicle_it_read(tmp_path):
+    """``fly D/scenario.toml --out D`` and ``fly ... --vehicle D/vehicle.toml --out D`` (D written
+    by quadcruise): refused in one line, exit 2, before flying, the inputs kept; the library's
+    ``SimResult.write(D)`` of a flight flown from D's scenario likewise; to another folder it flies."""
+    from quadcruise.errors import InputError
+    from quadcruise.workflows.scenario import load_scenario
+
+    folder = tmp_path / "D"
+    assert run("fly", "hover", "--duration", "0.5", "--out", folder).exit_code == 0
+    scenario = folder / "scenario.toml"
+    (folder / "vehicle.toml").write_text('[vehicle]\npreset = "paper"\nm = 3.6\n')
+    kept = {p.name: p.read_bytes() for p in folder.iterdir() if p.is_file()}
+    for args in ((scenario,), ("hover", "--duration", "0.5", "--vehicle", folder / "vehicle.toml")):
+        for extra in ((), ("--force",)):
+            result = run("fly", *args, "--out", folder, *extra)
+            assert result.exit_code == 2, result.output
+            lines = result.stderr.strip().splitlines()
+            assert len(lines) == 1 and "which this run reads" in lines[0], lines
+            assert {p.name: p.read_bytes() for p in folder.iterdir() if p.is_file()} == kept
+    flight = load_scenario(scenario).fly()
+    with pytest.raises(InputError, match="which this run reads"):
+        flight.write(folder)
+    assert {p.name: p.read_bytes() for p in folder.iterdir() if p.is_file()} == kept
+    elsewhere = run("fly", scenario, "--out", tmp_path / "E")
+    assert elsewhere.exit_code == 0, elsewhere.output
+    assert (tmp_path / "E" / "scenario.toml").is_file()

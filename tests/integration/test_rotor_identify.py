@@ -67,6 +67,11 @@ def test_round_trip_recovers_the_rotor_plant(name, flights, tmp_path):
     assert k_d["identifiable"] and k_d["ci95"][0] <= vehicle.k_d <= k_d["ci95"][1], k_d
     hover = result.parameters["hover_speed"]
     assert hover["value"] == pytest.approx(vehicle.hover_speed, rel=0.01)
+    # hover_duty: the hover's relative thrust (speed over full speed, squared), not the signal
+    duty = result.parameters["hover_duty"]
+    assert duty["value"] == pytest.approx((vehicle.hover_speed / vehicle.w_max) ** 2, rel=0.02)
+    assert duty["ci95"][0] <= (vehicle.hover_speed / vehicle.w_max) ** 2 <= duty["ci95"][1], duty
+    assert abs(duty["value"] - vehicle.hover_speed / vehicle.w_max) > 0.1
     for channel in ("p_dot", "q_dot", "r_dot"):
         assert result.validation[channel]["r2"] > 0.9, (channel, result.validation[channel])
     identified = result.vehicle()

@@ -76,7 +76,7 @@ def analyze(controller, controller_params, position_poles, dt, vehicle_text, out
     if vehicle is not None:  # None: linearize's default, Table I
         vehicle = paper_equivalent(vehicle)  # a rotor-plant vehicle's "+" equivalent, a paper one as it is
     if out is not None:
-        check_output_dir(out, force)
+        check_output_dir(out, force, inputs=[vehicle_text])
     lin = linearize(the_controller, vehicle, dt=dt, progress=linearising)
     click.echo(str(lin.summary(progress=Bar("margins", unit="loop"))))
     if out is not None:

@@ -167,7 +167,7 @@ def compare(
     if log_every is not None:
         whole_number(log_every, "--log-every", minimum=1)
     if out is not None:
-        check_output_dir(out, force)
+        check_output_dir(out, force, inputs=(mission, vehicle, controller_vehicle, wind, turbulence))
     cmp_mission, chosen, kwargs, scenario = compared_from_options(mission, controllers, mission_params)
     world, notes = flight_world(
         vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind, turbulence=turbulence, scenario=scenario

@@ -215,7 +215,20 @@ def fly(
         **{k: v for k, v in flown.items() if v is not None},
     }
     result = fly_and_report(
-        the_mission, the_controller, kwargs, out, fmt, force, report, animate, given, scenario, conventions, notes, ulog
+        the_mission,
+        the_controller,
+        kwargs,
+        out,
+        fmt,
+        force,
+        report,
+        animate,
+        given,
+        scenario,
+        conventions,
+        notes,
+        ulog,
+        inputs=(mission, vehicle, controller_vehicle, wind, turbulence),
     )
     if not result.ok.all():
         sys.exit(1)  # a vehicle did not fly its mission: diverged, lost track, out of bounds

@@ -30,6 +30,7 @@ def fly_and_report(
     conventions=None,
     notes=(),
     ulog=None,
+    inputs=(),
 ):
     """Fly, print the metrics and each unfinished vehicle's reason, and write what was asked for.
 
@@ -59,6 +60,9 @@ def fly_and_report(
         Lines printed on stderr (``note: ...``) once the options are checked, before flying.
     ulog : str, optional
         Path of a PX4 log of the flight (one file per vehicle for a batch: :func:`ulog_paths`).
+    inputs : sequence of str
+        The files the options name (scenario, vehicle, wind): an ``out`` that holds one is
+        refused before flying (writing the folder would delete it).
 
     Returns
     -------
@@ -74,7 +78,7 @@ def fly_and_report(
 
         check_animation_path(animate)  # suffix, and ffmpeg for .mp4: before anything flies
     if out is not None:
-        check_output_dir(out, force)
+        check_output_dir(out, force, inputs=[scenario.source if scenario is not None else None, *inputs])
     for line in notes:
         note(line)
     result = run_fly(mission, controller, **kwargs)

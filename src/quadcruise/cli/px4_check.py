@@ -55,7 +55,7 @@ def px4_check(log: str, params: str | None, out: str, force: bool) -> None:
     from quadcruise.workflows.px4check import px4_check as run_check
 
     chosen = read_params(params) if params is not None else None
-    check_output_dir(out, force)
+    check_output_dir(out, force, inputs=[log, params])
     words = ["quadcruise", "px4-check", log, "--out", out] + (["--params", params] if params else [])
     result = run_check(log, chosen, command=shlex.join(words))
     click.echo(

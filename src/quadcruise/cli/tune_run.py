@@ -140,7 +140,7 @@ def tune_command(
     if not wanted["targets"] and not wanted["minimize"]:
         raise InputError("nothing to tune for: give a target (--target METRIC=VALUE) or a metric to --minimize")
     if out is not None:
-        check_output_dir(out, force)
+        check_output_dir(out, force, inputs=(mission, vehicle, controller_vehicle, wind, turbulence))
     kwargs: dict = {"duration": duration, "dt": 1e-3 if dt is None else dt}
     sensors = parse_noise(noise)
     sc = None

@@ -361,7 +361,7 @@ def read_marker(folder: str | os.PathLike) -> dict | None:
     )
 
 
-def check_output_dir(path: str | os.PathLike, force: bool = False, *, workflow: str | None = None) -> Path:
+def check_output_dir(path: str | os.PathLike, force: bool = False, *, workflow: str | None = None, inputs=()) -> Path:
     """Refuse a non-empty folder that quadcruise did not write, unless ``force``.
 
     Parameters
@@ -369,13 +369,13 @@ def check_output_dir(path: str | os.PathLike, force: bool = False, *, workflow: 
     path : str or os.PathLike
         The output folder; it need not exist.
     force : bool
-        Accept a non-empty folder without a :data:`MARKER` file (it will be replaced), one
-        whose marker is damaged, or one that holds a Monte Carlo sweep when another workflow
-        writes.
+        Accept a non-empty folder without a :data:`MARKER` file (it will be replaced), one whose
+        marker is damaged, or one that holds a Monte Carlo sweep when another workflow writes.
     workflow : str, optional
-        What will write there; ``"montecarlo"`` may resume a sweep's folder (its own rules
-        apply), any other writer must be forced to replace one. ``"reproduce"``, whose
-        folder has a default name, replaces only a reproduction's folder unless forced.
+        What will write there; ``"montecarlo"`` may resume a sweep's folder (its own rules apply), any other
+        writer must be forced to replace one; ``"reproduce"`` (a default name) replaces only a reproduction's.
+    inputs : iterable of path, optional
+        Files the run reads: a folder holding one is refused, ``force`` or not.
 
     Returns
     -------
@@ -385,12 +385,13 @@ def check_output_dir(path: str | os.PathLike, force: bool = False, *, workflow: 
     Raises
     ------
     InputError
-        If ``path`` is a file; or, unless ``force``, a non-empty folder without
+        If ``path`` is a file or holds an input; or, unless ``force``, a non-empty folder without
         :data:`MARKER`, with a damaged one (:func:`read_marker`), or holding a sweep.
     """
     from quadcruise.errors import InputError
+    from quadcruise.io.keep_inputs import check_keeps_inputs
 
-    path = Path(path)
+    check_keeps_inputs(path := Path(path), inputs)  # whatever force says: the input would be lost
     if path.exists() and not path.is_dir():
         raise InputError(f"{path}: exists and is not a folder")
     check_writable_place(path)

@@ -461,7 +461,7 @@ class SimResult:
         from quadcruise.plots.flight import plot_flight, save_figure
 
         check_table_format(fmt)
-        out = check_output_dir(out, force)
+        out = check_output_dir(out, force, inputs=[self.meta.get("scenario", {}).get("source")])
         metrics = self.metrics() if metrics is None else metrics
         with atomic_dir(out) as tmp:
             tmp = Path(tmp)

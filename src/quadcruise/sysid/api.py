@@ -295,7 +295,12 @@ def identify(
     report(4, len(STAGES), STAGES[3])
 
     validation, traces = validate(sig, held, result, rotors, flight, g)
-    verdict = paper_verdict(flight, sig, fit_rows, held, rotors, result, mass, g, cmd_hz, log_rates(flight))
+    # a log whose command changes identify nothing (a hover) is judged on its commands' level
+    changes = [k for k in table if k.removesuffix("_per_m") in ("Jxx", "Jyy", "Jzz", "d", "omega")]
+    level = None
+    if not any(table[k]["identifiable"] for k in changes):
+        level = float(np.max(np.std(u_fit, axis=0) / np.maximum(np.abs(np.mean(u_fit, axis=0)), 1e-12)))
+    verdict = paper_verdict(flight, sig, fit_rows, held, rotors, result, mass, g, cmd_hz, log_rates(flight), level)
     if not verdict["fits"]:
         table = withhold(table, verdict)
     # the joint covariance of what is reported with an interval (montecarlo --population draws from it)

@@ -26,21 +26,6 @@ Z95 = 1.959963984540054
 """The two-sided 95 % normal quantile."""
 
 
-def hover_command(km: float, kq: float, n: int, g: float) -> float:
-    """The per-rotor command ``u`` of level hover, ``n (km u + kq u^2) = g`` (NaN when no positive root).
-
-    Examples
-    --------
-    >>> round(hover_command(10.0, 0.0, 4, 9.81), 6)
-    0.24525
-    """
-    c = g / n
-    if abs(kq) < 1e-12 * max(abs(km), 1e-300):
-        return c / km if km > 0 else float("nan")
-    disc = km * km + 4.0 * kq * c
-    return float((-km + np.sqrt(disc)) / (2.0 * kq)) if disc >= 0 else float("nan")
-
-
 def mapping(fit: Fit, mass: float | None, n_rotors: int, g: float, jzz_weights: tuple[float, float]):
     """The function ``values -> {parameter: value}`` from the coefficient vector."""
     idx = {name: i for i, name in enumerate(fit.names)}
@@ -62,7 +47,8 @@ def mapping(fit: Fit, mass: float | None, n_rotors: int, g: float, jzz_weights: 
             f"Jyy{suffix}": jyy * scale,
             f"Jzz{suffix}": jzz * scale,
             "d": v[idx["b_yaw"]] * jzz / km,
-            "hover_duty": hover_command(kl, kq, n_rotors, g),
+            # the relative thrust s(u) of hover (PX4's hover_thrust_estimate's units), on any thrust curve
+            "hover_duty": g / (n_rotors * km) if km > 0 else float("nan"),
         }
         if "KQ" in idx:
             out["thrust_curve_f"] = kq / km

@@ -35,6 +35,12 @@ W_MAX_NOMINAL = 1000.0
 when the base vehicle gives none: the log determines the thrust at full command, ``kf w_max^2``,
 not the speed (no rotor inertia or rotor drag is identified, so the speed's scale changes nothing
 the plant does)."""
+HOVER_DUTY_MEANING = (
+    "each rotor's relative thrust at level hover (0-1, thrust over the thrust at full command: PX4's "
+    "actuator_motors and hover_thrust_estimate), not the output signal x that THR_MDL_FAC f maps it to "
+    "(f x^2 + (1 - f) x = hover_duty)"
+)
+"""What ``hover_duty`` means, written beside it in ``identify.json``."""
 MASS_FIELDS = ("m", "K", "kf", "km", "Jxx", "Jyy", "Jzz", "k_d", "k_z", "J_rotor")
 """The vehicle fields that scale with the mass (absent from a vehicle identified without one)."""
 
@@ -169,7 +175,10 @@ class IdentifyResult:
 
     @property
     def hover_duty(self) -> float:
-        """The per-rotor command that holds level hover [-]."""
+        """Each rotor's relative thrust (0-1, thrust over the thrust at full command) that holds
+        level hover [-]: PX4's ``actuator_motors`` and ``hover_thrust_estimate`` units on every
+        path (paper or rotor plant, with or without rotor speeds), not the output signal x that
+        ``THR_MDL_FAC`` makes of it (``f x^2 + (1 - f) x`` = this)."""
         return float(self.parameters["hover_duty"]["value"])
 
     def vehicle(self, mass: float | None = None):
@@ -331,8 +340,12 @@ class IdentifyResult:
                 "verdict_reasons": self.verdict.get("reasons", []),
                 "verdict_checks": self.verdict.get("checks", {}),
                 "covariance": self.fit.get("covariance") if self.fits else None,
-                "parameters": {k: {kk: vv for kk, vv in v.items()} for k, v in self.parameters.items()},
+                "parameters": {
+                    k: {kk: vv for kk, vv in v.items()} | ({"meaning": HOVER_DUTY_MEANING} if k == "hover_duty" else {})
+                    for k, v in self.parameters.items()
+                },
                 "hover_duty": self.hover_duty,
+                "hover_duty_meaning": HOVER_DUTY_MEANING,
                 "mass_kg": self.mass,
                 "per_unit_mass": self.mass is None,
                 "validation": self.validation,
@@ -481,17 +494,24 @@ class IdentifyResult:
             The folder: ``identify.json``, ``vehicle.toml``, ``report.md``, ``fit.png``,
             ``quadcruise.json``.
         force : bool
-            Replace a non-empty folder quadcruise did not write.
+            Replace a non-empty folder quadcruise did not write (a folder holding the log read is
+            refused all the same: writing it would delete the log).
 
         Returns
         -------
         pathlib.Path
             The folder.
+
+        Raises
+        ------
+        InputError
+            Before anything is written: ``folder`` holds the log (or is not writable, or holds
+            something else, unless ``force``).
         """
         from quadcruise._version import __version__
         from quadcruise.io.files import MARKER, atomic_dir, check_output_dir
 
-        out = check_output_dir(folder, force)
+        out = check_output_dir(folder, force, inputs=[self.log.get("source")])
         with atomic_dir(out) as tmp:
             tmp = Path(tmp)
             (tmp / "identify.json").write_text(json.dumps(self.to_json(), indent=2) + "\n")

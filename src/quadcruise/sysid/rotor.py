@@ -267,7 +267,9 @@ def fit_rigid_body(data: dict, rows: np.ndarray, segment: np.ndarray, window: in
         r = rows_of[c]
         betas[c], *_ = np.linalg.lstsq(X[r], y[r], rcond=None)
         resid[c] = y[r] - X[r] @ betas[c]
-        sigma[c] = max(float(np.std(resid[c])), 1e-300)
+        # the paper plant's floor (estimate.py): a noise-free hover's residual is exactly 0, and
+        # 1e-300 squared underflows to a division by zero (NaN covariance, eigh failing)
+        sigma[c] = max(float(np.std(resid[c])), 1e-12)
     names = [n for c in channels for n in data[c][2]]
     p = len(names)
     values = np.concatenate([betas[c] for c in channels])

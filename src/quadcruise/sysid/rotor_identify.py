@@ -30,7 +30,7 @@ from quadcruise.sysid.logprep import (
     log_info,
     split_rows,
 )
-from quadcruise.sysid.physical import RELATIVE_HALF_WIDTH, Z95, hover_command
+from quadcruise.sysid.physical import RELATIVE_HALF_WIDTH, Z95
 from quadcruise.sysid.result import IdentifyResult
 from quadcruise.sysid.rotor import (
     ROTOR_UNITS,
@@ -129,7 +129,8 @@ def identify_rotor(flight, base: RotorVehicle, mass: float | None, holdout: floa
 
     def refit(win, speeds):
         again = rigid(aero["k_d"], aero["k_z"], win, speeds, covariance=False)[1]
-        return rigid_body_mapping(again[0], mass, n, g, weights)(again[1])
+        with np.errstate(all="ignore"):  # an unexcited axis's coefficient may be 0: inf, said below
+            return rigid_body_mapping(again[0], mass, n, g, weights)(again[1])
 
     others = [refit(max(5, round(WINDOW_S * factor / dt) | 1), flight.speeds) for factor in (0.5, 2.0)]
     shifted = []
@@ -143,7 +144,8 @@ def identify_rotor(flight, base: RotorVehicle, mass: float | None, holdout: floa
     spread = {}
     for key in found:
         vals = [found[key]["value"]] + [o[key] for o in others]
-        timing = 0.5 * abs(shifted[1][key] - shifted[0][key])
+        with np.errstate(invalid="ignore"):  # inf - inf: an unexcited axis, not identifiable anyway
+            timing = 0.5 * abs(shifted[1][key] - shifted[0][key])
         window_spread = 0.5 * (max(vals) - min(vals)) if np.all(np.isfinite(vals)) else np.inf
         spread[key] = float(np.hypot(timing, window_spread))
     # the speeds' resolution (integer rpm): a scale error of up to +-RPM_RESOLUTION / the hover speed
@@ -194,10 +196,12 @@ def identify_rotor(flight, base: RotorVehicle, mass: float | None, holdout: floa
         }
     w_max = found["w_max"]["value"] if found.get("w_max", {}).get("identifiable") else float(base.w_max)
     h = found["hover_speed"]
-    duty = hover_command(1.0 - shape_f, shape_f, 1, (h["value"] / w_max) ** 2)
+    # the hover's relative thrust (speed over full speed, squared: PX4's actuator_motors and
+    # hover_thrust_estimate), not the output signal THR_MDL_FAC makes of it
+    duty = (h["value"] / w_max) ** 2
     found["hover_duty"] = {
         "value": duty,
-        "se": h["se"] * duty / h["value"] if h["value"] else np.inf,
+        "se": 2.0 * h["se"] * duty / h["value"] if h["value"] else np.inf,
         "identifiable": h["identifiable"],
     }
     found["hover_duty"]["ci95"] = [duty - Z95 * found["hover_duty"]["se"], duty + Z95 * found["hover_duty"]["se"]]
@@ -302,7 +306,7 @@ def _table(found: dict, base: RotorVehicle, notes: dict, mass: float | None) -> 
         if field == "hover_speed":
             prior = base.hover_speed
         elif field == "hover_duty":
-            prior = base.hover_speed / base.w_max
+            prior = (base.hover_speed / base.w_max) ** 2
         else:
             prior = float(getattr(base, field)) / (float(base.m) if name.endswith("_per_m") else 1.0)
         unit = ROTOR_UNITS[field] + ("/kg" if name.endswith("_per_m") else "")

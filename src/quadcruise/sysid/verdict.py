@@ -33,6 +33,12 @@ MAX_HELD_RATIO = 2.0
 NEGLIGIBLE = 1e-4
 """A residual mean square under this share of its regressand's variance (R^2 over 0.9999) is
 negligible: the held-out and whiteness checks judge noise and missing dynamics, not dust."""
+DUST_RMS = 1e-6
+"""A residual whose root mean square is under this [m/s^2, rad/s^2] is negligible whatever its
+regressand: a thousandth of the derivative noise of the best gyroscope (1e-3 rad/s at 1 kHz gives
+about 5e-3 rad/s^2 through the 0.08 s filter), so only a noise-free simulated log has one. A
+hover without noise has residuals of 1e-13 rad/s^2 (floating-point dust) whose regressand is dust
+too: relative to it (:data:`NEGLIGIBLE`) they looked like a model that does not fit."""
 WHITE_LAG_WINDOWS = 4
 """Filter windows past which the residuals' autocorrelation is judged."""
 MAX_LATE_ACF = 0.5
@@ -43,6 +49,11 @@ BETTER_STRUCTURE = 0.3
 """How much lower (a share) the other lag structure's residual variance must be to fail the model."""
 STILL_SHARE = 0.95
 """The least share of unchanged consecutive commands for sampled commands to count as all seen."""
+LEVEL_SPREAD = 0.05
+"""Each rotor's commands' standard deviation over their mean under which a log whose changes
+identify nothing (no inertia, ``d`` nor lag identifiable: a hover) is judged on its commands'
+level alone: sampled commands then lose nothing the fit uses (the sampled mean is the mean), and
+any thrust curve's curvature moves the mean thrust by about the spread squared (< 0.3 %)."""
 SAMPLED_SHARE = 0.9
 """Commands logged below this share of the controller's rate are sampled, not all seen."""
 FITS = "fits"
@@ -93,6 +104,18 @@ def late_autocorrelation(e: np.ndarray, segment: np.ndarray, lag: int) -> float:
     return float(np.mean((e[lag:] * e[:-lag])[same]) / var)
 
 
+def negligible_residual(mean_square: float, y_var: float = 0.0) -> bool:
+    """Whether a residual of this mean square is dust: under :data:`NEGLIGIBLE` of its regressand's
+    variance, or under :data:`DUST_RMS` squared (a noise-free hover, whose regressand is dust too).
+
+    Examples
+    --------
+    >>> negligible_residual(4e-27), negligible_residual(1e-6, 1.0), negligible_residual(1e-3, 1.0)
+    (True, True, False)
+    """
+    return mean_square <= NEGLIGIBLE * y_var or mean_square <= DUST_RMS**2
+
+
 def judge(checks: dict) -> dict:
     """The verdict from the checks' results: ``{"verdict", "fits", "reasons", "checks"}``.
 
@@ -141,7 +164,7 @@ def residual_checks(
         late[c] = late_autocorrelation(e, seg_fit, lag)
 
     def negligible(c, e, y):
-        return y is not None and c in y and float(np.mean(e**2)) <= NEGLIGIBLE * float(np.var(y[c]))
+        return negligible_residual(float(np.mean(e**2)), float(np.var(y[c])) if y is not None and c in y else 0.0)
 
     bad_held = {c: r for c, r in ratios.items() if not r <= MAX_HELD_RATIO and not negligible(c, resid_held[c], y_held)}
     bad_white = {c: a for c, a in late.items() if not abs(a) <= MAX_LATE_ACF and not negligible(c, resid_fit[c], y_fit)}
@@ -205,13 +228,16 @@ def segment_check(first: dict, second: dict) -> dict:
     }
 
 
-def command_check(cmd_hz: float, control_hz: float | None, still: float = 0.0) -> dict:
+def command_check(cmd_hz: float, control_hz: float | None, still: float = 0.0, level: float | None = None) -> dict:
     """Whether the log holds every command its controller computed, or commands that did not change
     between its samples.
 
     ``still`` is the share of consecutive logged commands that did not change at all (an open-loop
     schedule of steps: what was not logged equals what was, but at its steps); at least
-    :data:`STILL_SHARE` passes however slowly they are logged.
+    :data:`STILL_SHARE` passes however slowly they are logged. ``level``, when given, is the largest
+    spread of a rotor's commands over their mean on a log whose command changes identify nothing
+    (a hover: no inertia, ``d`` nor lag identifiable); under :data:`LEVEL_SPREAD` it passes too (what
+    is fitted comes from the commands' level, which sampling keeps).
 
     Examples
     --------
@@ -219,13 +245,17 @@ def command_check(cmd_hz: float, control_hz: float | None, still: float = 0.0) -
     (False, True, True)
     >>> command_check(250.0, 1000.0, still=0.99)["ok"]
     True
+    >>> command_check(250.0, 1000.0, level=0.02)["ok"], command_check(250.0, 1000.0, level=0.3)["ok"]
+    (True, False)
     """
-    ok = control_hz is None or cmd_hz >= SAMPLED_SHARE * control_hz or still >= STILL_SHARE
+    level_only = level is not None and level < LEVEL_SPREAD
+    ok = control_hz is None or cmd_hz >= SAMPLED_SHARE * control_hz or still >= STILL_SHARE or level_only
     return {
         "ok": bool(ok),
         "command_hz": cmd_hz,
         "control_hz": control_hz,
         "unchanged_share": still,
+        "level_spread": level,
         "why": f"the commands are logged at {cmd_hz:g} Hz and the controller computed them at "
         f"{control_hz or 0:g} Hz, changing between samples ({100 * (1 - still):.0f} % of them): the commands "
         "between samples are unknown (log every command: PX4's system-identification profile)",
@@ -258,7 +288,7 @@ def structure_check(sigma: dict, other_sigma: dict, lag_of: str, other: str, y_v
     False
     """
     ratio = {c: (other_sigma[c] / sigma[c]) ** 2 for c in sigma if sigma[c] > 0}
-    dust = {c for c in ratio if y_var is not None and sigma[c] ** 2 <= NEGLIGIBLE * y_var.get(c, 0.0)}
+    dust = {c for c in ratio if negligible_residual(sigma[c] ** 2, (y_var or {}).get(c, 0.0))}
     bad = {c: r for c, r in ratio.items() if r < 1.0 - BETTER_STRUCTURE and c not in dust}
     what = {
         "speed": "the rotors' speed lagging (a rotor-plant vehicle: --vehicle iris, a file)",
@@ -303,10 +333,11 @@ def withhold(table: dict, verdict: dict) -> dict:
     return out
 
 
-def paper_verdict(flight, sig, fit_rows, held, rotors, result, mass, g, cmd_hz, rates) -> dict:
+def paper_verdict(flight, sig, fit_rows, held, rotors, result, mass, g, cmd_hz, rates, level=None) -> dict:
     """The checks of this module on the paper plant's fit (:func:`quadcruise.sysid.api.identify`'s
     signals, rows, rotors, :class:`~quadcruise.sysid.estimate.Fit`, mass, gravity, command rate and
-    :func:`~quadcruise.sysid.logprep.log_rates`): :func:`judge`'s verdict."""
+    :func:`~quadcruise.sysid.logprep.log_rates`; ``level``: :func:`command_check`'s): :func:`judge`'s
+    verdict."""
     from quadcruise.sysid.equations import regressions
     from quadcruise.sysid.estimate import fit
     from quadcruise.sysid.physical import parameters
@@ -344,7 +375,9 @@ def paper_verdict(flight, sig, fit_rows, held, rotors, result, mass, g, cmd_hz, 
             found = {}
         halves.append({k: v for k, v in found.items() if v["identifiable"]})
     checks["segments"] = segment_check(*halves)
-    checks["commands"] = command_check(cmd_hz, control_rate(rates, rates), unchanged_share(flight.u, flight.segment))
+    checks["commands"] = command_check(
+        cmd_hz, control_rate(rates, rates), unchanged_share(flight.u, flight.segment), level
+    )
     other = "speed" if sig.lag_of == "thrust" else "thrust"
     alt = fit(
         dataclasses.replace(sig, lag_of=other),

@@ -316,7 +316,8 @@ class Comparison:
         from quadcruise.io.files import MARKER, atomic_dir, check_output_dir
         from quadcruise.plots.flight import save_figure
 
-        out = check_output_dir(out, force)
+        scenarios = [r.meta.get("scenario", {}).get("source") for r in self.results.values()]
+        out = check_output_dir(out, force, inputs=scenarios)
         with atomic_dir(out) as tmp:
             tmp = Path(tmp)
             self.metrics(**metric_kw).reset_index().to_csv(tmp / "metrics.csv", index=False)

@@ -180,7 +180,7 @@ class Px4Check:
         from quadcruise._version import __version__
         from quadcruise.io.files import MARKER, atomic_dir, check_output_dir
 
-        out = check_output_dir(folder, force)
+        out = check_output_dir(folder, force, inputs=[self.log])
         with atomic_dir(out) as tmp:
             (Path(tmp) / "check.json").write_text(json.dumps(self.to_json(), indent=2) + "\n")
             marker = {"workflow": "px4-check", "version": __version__, "command": self.command, "log": self.log}
