@@ -162,3 +162,40 @@ def test_a_geometry_that_is_not_the_vehicles_is_refused_in_one_line():
 def test_a_2000_vehicle_batch_flies():
     res = qc.fly("hover", "px4", vehicle="iris", n=2000, duration=2.0)
     assert res.n == 2000 and all(s == 0 for s in np.asarray(res.status))
+
+
+def test_fly_params_flies_the_logs_parameters_and_lists_the_unused_once(tmp_path):
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    out = tmp_path / "f"
+    res = CliRunner().invoke(
+        main, ["fly", "step", "--controller", "px4", "--vehicle", "iris", "--params", str(LOG), "--out", str(out)]
+    )
+    assert res.exit_code == 0, res.output
+    assert res.stderr.count("not used by the px4 controller") == 1 and "BAT1_CAPACITY" in res.stderr
+    record = (out / "quadcruise.json").read_text()
+    assert "--params" in record and '"MC_ROLLRATE_K": 1.0499999523162842' in record
+    again = CliRunner().invoke(main, ["fly", str(out / "scenario.toml"), "--out", str(tmp_path / "g")])
+    assert again.exit_code == 0, again.output  # the folder's scenario flies the same flight
+    assert (tmp_path / "g" / "metrics.csv").read_text() == (out / "metrics.csv").read_text()
+
+
+@pytest.mark.parametrize(
+    ("text", "args", "message"),
+    [
+        ("1\t1\tMC_ROLL_P\t13\t9\n", [], "bad.params, line 1: MC_ROLL_P = 13 1/s is outside PX4 v1.15's range"),
+        ("1\t1\tMC_ROLL_P\tfast\t9\n", [], "bad.params, line 1"),
+        ("1\t1\tMC_ROLL_P\t7\t9\n", ["--controller", "se3"], "--controller se3 has none"),
+    ],
+)
+def test_fly_params_refuses_bad_input_in_one_line(tmp_path, text, args, message):
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    bad = tmp_path / "bad.params"
+    bad.write_text(text)
+    res = CliRunner().invoke(main, ["fly", "hover", "--vehicle", "iris", "--params", str(bad), *args])
+    assert res.exit_code == 2 and message in res.stderr and res.stderr.count("\n") == 1, res.stderr

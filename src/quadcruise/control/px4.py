@@ -57,6 +57,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from collections.abc import Mapping
 
 import numpy as np
@@ -74,7 +75,7 @@ from quadcruise.control.px4kernel import (
 )
 from quadcruise.control.px4loops import G_RATE_D, G_RATE_I, G_RATE_P, G_THR_HOVER, G_THR_MIN, PX4_GAINS, px4_gains
 from quadcruise.errors import InputError
-from quadcruise.fields import Check, between, instance_of
+from quadcruise.fields import Check, between
 from quadcruise.fields import unit_field as _f
 from quadcruise.io.px4params import Px4Parameters, read_params
 
@@ -98,6 +99,25 @@ def _rotors_ok(value) -> bool:
     )
 
 
+class _ParamsCheck(Check):
+    """PX4's parameters as stored: a Px4Parameters as given; a path (a scenario file's
+    ``params = "x500.params"``) read; a mapping (a result's record, ``{"values": {...}}``, or
+    parameters by name) over PX4's defaults, each checked against PX4's range."""
+
+    def convert(self, site, value):
+        if isinstance(value, Px4Parameters):
+            return value
+        if isinstance(value, (str, os.PathLike)):
+            return read_params(value)
+        if isinstance(value, Mapping):
+            values = value.get("values", value)
+            if isinstance(values, Mapping):
+                source = str(value.get("source", "defaults")) if "values" in value else "defaults"
+                p = Px4Parameters.defaults().with_values(**{str(k): v for k, v in values.items()})
+                return dataclasses.replace(p, source=source)
+        site.fail(self.want, repr(value))
+
+
 @dataclasses.dataclass(frozen=True)
 class Px4(Controller):
     """PX4's multicopter controller (v1.15) with PX4's parameters (module docstring).
@@ -106,7 +126,8 @@ class Px4(Controller):
     ----------
     params : Px4Parameters
         PX4's parameters by name, PX4's units (:func:`quadcruise.io.px4params.read_params`);
-        PX4 v1.15's defaults.
+        PX4 v1.15's defaults. A path is read, a mapping set over the defaults (a scenario
+        file's ``[controller]`` ``params = "x500.params"``).
     rotors : tuple
         The vehicle's rotors (x, y, z [m], direction), FLU, in PX4's order (``CA_ROTOR0`` first),
         as :class:`~quadcruise.model.rotor_vehicle.RotorVehicle` gives them; () is PX4's
@@ -138,7 +159,10 @@ class Px4(Controller):
     memory_size = PX4C_MEMORY.size
 
     params: Px4Parameters = _f(
-        unit="-", doc="PX4's parameters by name", check=instance_of(Px4Parameters), factory=Px4Parameters.defaults
+        unit="-",
+        doc="PX4's parameters by name",
+        check=_ParamsCheck("params", "PX4 parameters: a .ulg or .params path, or a mapping name -> value"),
+        factory=Px4Parameters.defaults,
     )
     rotors: tuple = _f(
         (),
