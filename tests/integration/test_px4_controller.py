@@ -199,3 +199,50 @@ def test_fly_params_refuses_bad_input_in_one_line(tmp_path, text, args, message)
     bad.write_text(text)
     res = CliRunner().invoke(main, ["fly", "hover", "--vehicle", "iris", "--params", str(bad), *args])
     assert res.exit_code == 2 and message in res.stderr and res.stderr.count("\n") == 1, res.stderr
+
+
+def test_tune_px4_writes_tuned_params_that_fly_the_tuned_metrics_exactly(tmp_path):
+    import csv
+
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+    from quadcruise.io.px4params import read_params
+
+    out = tmp_path / "t"
+    args = ["tune", "step", "--controller", "px4", "--vehicle", "iris", "--duration", "8", "--quiet"]
+    args += ["--gains", "params.MPC_XY_P,params.MPC_XY_VEL_P_ACC", "--target", "rise_time_s=1.2"]
+    res = CliRunner().invoke(main, [*args, "--budget", "3", "--popsize", "6", "--out", str(out)])
+    assert res.exit_code in (0, 1), res.output
+    tuned = read_params(out / "tuned.params")
+    doc = (out / "tuned.params").read_text()
+    assert "# PX4 v1.15" in doc and "MC_ROLL_P\t" not in doc  # only what differs from PX4's defaults
+    from quadcruise.workflows.scenario import load_scenario
+
+    values = load_scenario(out / "scenario.toml").controller.params  # the tuned controller, as the folder keeps it
+    assert dict(tuned) == dict(values)  # the round trip is exact, every parameter
+    assert tuned["MPC_XY_P"] != 0.95 and tuned["THR_MDL_FAC"] == 1.0
+    flown = tmp_path / "f"
+    again = CliRunner().invoke(
+        main,
+        ["fly", "step", "--vehicle", "iris", "--params", str(out / "tuned.params"), "--duration", "8"]
+        + ["--log-every", "10", "--out", str(flown)],
+    )
+    assert again.exit_code == 0, again.output
+    with open(out / "flights.csv") as f:
+        best = next(csv.DictReader(f))
+    with open(flown / "metrics.csv") as f:
+        got = next(csv.DictReader(f))
+    for name in ("rmse_m", "rise_time_s", "settling_time_s", "overshoot_pct", "effort"):
+        assert float(got[name]) == float(best[name]), name
+
+
+def test_px4s_parameters_are_searched_by_name_within_pxs_range():
+    from quadcruise.tune.space import GainSpace, tunable_values
+
+    assert tunable_values(Px4())["params.MC_ROLL_P"] == (6.5, "1/s")
+    space = GainSpace.build(Px4(), ["params.MC_ROLL_P", "params.MC_ROLLRATE_P"])
+    (roll, rate) = space.gains
+    assert (roll.low, roll.high) == (0.65, 12.0) and (rate.low, rate.high) == (0.015, 0.5)  # PX4's @max
+    c = space.controllers([[7.0, 0.2]])[0]
+    assert c.params["MC_ROLL_P"] == 7.0 and c.params["MC_ROLLRATE_P"] == 0.2
