@@ -49,8 +49,8 @@ Examples
 --------
 >>> import quadcruise as qc
 >>> res = qc.fly("step", "px4", vehicle="iris", duration=6.0)
->>> str(res.status[0]), bool(abs(res.final_state[0, 0] - 1.0) < 0.05)
-('FINISHED', True)
+>>> res.status_text(), bool(abs(res.final_state[0, 0] - 1.0) < 0.05)
+('finished', True)
 """
 
 from __future__ import annotations
@@ -148,7 +148,7 @@ class Px4(Controller):
     --------
     >>> c = Px4()
     >>> c.gains().shape, c.memory().shape
-    ((366,), (111,))
+    ((242,), (113,))
     >>> Px4(thrust_curve=2.0)
     Traceback (most recent call last):
         ...
@@ -274,7 +274,7 @@ class Px4(Controller):
         Returns
         -------
         numpy.ndarray
-            :data:`PX4C_GAINS` (366) float64 entries: PX4's loops' gains in SI units, the
+            :data:`PX4C_GAINS` (242) float64 entries: PX4's loops' gains in SI units, the
             allocation, the vehicle's layout, the filters and the flags (see the row).
         """
         p = self.params
