@@ -246,3 +246,26 @@ def test_px4s_parameters_are_searched_by_name_within_pxs_range():
     assert (roll.low, roll.high) == (0.65, 12.0) and (rate.low, rate.high) == (0.015, 0.5)  # PX4's @max
     c = space.controllers([[7.0, 0.2]])[0]
     assert c.params["MC_ROLL_P"] == 7.0 and c.params["MC_ROLLRATE_P"] == 0.2
+
+
+def test_compare_params_flies_px4_with_the_logs_parameters_beside_the_others(tmp_path):
+    import csv
+
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    common = ["step", "--vehicle", "iris", "--params", str(LOG), "--duration", "6"]
+    res = CliRunner().invoke(
+        main, ["compare", *common[:1], "--controllers", "se3", *common[1:], "--out", str(tmp_path / "c")]
+    )
+    assert res.exit_code == 0, res.output
+    assert res.stderr.count("not used by the px4 controller") == 1
+    fly = CliRunner().invoke(main, ["fly", *common, "--out", str(tmp_path / "f")])
+    assert fly.exit_code == 0, fly.output
+    with open(tmp_path / "c" / "metrics.csv") as f:
+        rows = {r.get("controller") or r.get("label"): r for r in csv.DictReader(f)}
+    with open(tmp_path / "f" / "metrics.csv") as f:
+        alone = next(csv.DictReader(f))
+    assert set(rows) == {"se3", "px4"}  # px4 added beside the named ones
+    assert float(rows["px4"]["rise_time_s"]) == float(alone["rise_time_s"])
