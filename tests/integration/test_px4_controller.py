@@ -269,3 +269,21 @@ def test_compare_params_flies_px4_with_the_logs_parameters_beside_the_others(tmp
         alone = next(csv.DictReader(f))
     assert set(rows) == {"se3", "px4"}  # px4 added beside the named ones
     assert float(rows["px4"]["rise_time_s"]) == float(alone["rise_time_s"])
+
+
+def test_montecarlo_params_flies_px4_with_the_logs_parameters(tmp_path):
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    args = ["montecarlo", "--mission", "step", "--vehicle", "iris", "--params", str(LOG), "-n", "8"]
+    args += ["--duration", "6", "--mass-spread", "0.05", "--scheduler", "none"]
+    res = CliRunner().invoke(main, [*args, "--out", str(tmp_path / "m")])
+    assert res.exit_code == 0, res.output
+    assert res.stderr.count("not used by the px4 controller") == 1
+    record = (tmp_path / "m" / "quadcruise.json").read_text()
+    assert '"name": "px4"' in record and '"MC_ROLLRATE_K": 1.0499999523162842' in record
+    bad = tmp_path / "bad.params"
+    bad.write_text("1\t1\tMC_ROLL_P\t13\t9\n")
+    res = CliRunner().invoke(main, [*args[:6], str(bad), *args[7:], "--out", str(tmp_path / "n")])
+    assert res.exit_code == 2 and "MC_ROLL_P = 13" in res.stderr and not (tmp_path / "n").exists()
