@@ -24,7 +24,11 @@ Figures (``--figures``, comma-separated; the default: single,batch):
 - ``mc1``: one chunk of that population, 34 flights of 60 s on one thread: the task of
   one Dask worker;
 - ``mcplain``: 272 flights of that population in one batched call on numba's threads,
-  logging the start and the end only: the Monte Carlo benchmark's ``plain`` run.
+  logging the start and the end only: the Monte Carlo benchmark's ``plain`` run;
+- ``gym``: 200 steps of ``gymnasium.make_vec("quadcruise/Hover-v0", num_envs=1024,
+  vectorization_mode="vector_entry_point", action="rotors")`` with random actions (seeded;
+  autoreset included), as benchmarks/gym.py steps it: rates are env-steps per second;
+- ``gym1``: 2,000 steps of one ``gymnasium.make("quadcruise/Hover-v0", action="rotors")``.
 
 Rates are vehicle-steps per second. Before each process the script waits (up to
 ``--wait`` seconds) until the other processes of the host leave its cores idle: less than
@@ -57,6 +61,8 @@ FIGURES = {  # name: (vehicles, flight seconds, timed calls per process)
     "mc": (136, 60.0, 2),
     "mc1": (34, 60.0, 3),
     "mcplain": (272, 60.0, 2),
+    "gym": (1024, 0.2, 3),  # the gym figures' "seconds" x HZ are their steps
+    "gym1": (1, 2.0, 3),
 }
 
 
@@ -71,6 +77,8 @@ def figure_call(name: str, duration: float | None = None):
 
     n, full, _ = FIGURES[name]
     duration = duration or full
+    if name in ("gym", "gym1"):
+        return gym_call(n, round(duration * HZ))
     if name in ("single", "batch"):  # Table I's mass, spread +/- 10 % over a batch
         vehicle = qc.Vehicle(m=3.499 * np.linspace(0.9, 1.1, n)) if n > 1 else None
         every = math.gcd(1000, round(duration * HZ))  # log_every must divide the periods (0.1 s warm-up: 100)
@@ -94,6 +102,33 @@ def figure_call(name: str, duration: float | None = None):
             numba.set_num_threads(threads)
 
     return one_task
+
+
+def gym_call(n: int, steps: int):
+    """A zero-argument call that makes ``steps`` steps of random actions in ``n`` environments."""
+    import gymnasium
+    import numpy as np
+
+    import quadcruise.gym  # noqa: F401 - registers the environments
+
+    if n == 1:
+        env = gymnasium.make("quadcruise/Hover-v0", action="rotors")
+    else:
+        env = gymnasium.make_vec(
+            "quadcruise/Hover-v0", num_envs=n, vectorization_mode="vector_entry_point", action="rotors"
+        )
+    env.reset(seed=0)
+    actions = np.random.default_rng(0).uniform(-1.0, 1.0, (steps, n, 4)).astype(np.float32)
+    if n == 1:
+        actions = actions[:, 0]
+
+    def call():
+        for k in range(steps):
+            _, _, terminated, truncated, _ = env.step(actions[k])
+            if n == 1 and (terminated or truncated):
+                env.reset()
+
+    return call
 
 
 def child(names: list[str], tree: str, warm: bool) -> dict:

@@ -44,12 +44,13 @@ def main() -> None:
         duration=float(t[-1]),
         sensors=noise,
         seed=1,
-        log_every=4,
+        dt=0.004,  # commanded at 250 Hz, every command logged (a log of every 4th of 1 kHz does not fit)
+        max_step=0.001,
         max_track_error=1e6,
         max_steady_error=1e6,
     )
     with tempfile.TemporaryDirectory() as folder:
-        path = flight.to_ulog(Path(folder) / "sysid.ulg")
+        path = flight.to_ulog(Path(folder) / "sysid.ulg", profile="sysid")
         size = os.path.getsize(path)
         times = []
         for _ in range(args.rounds):

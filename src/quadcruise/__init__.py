@@ -24,9 +24,13 @@ def _quit_on_interrupt(signum, frame):  # pragma: no cover - runs in a command's
 
 def _command_starting() -> bool:
     """Whether this process is the ``quadcruise`` command: its script, or ``python -m quadcruise``."""
-    main = getattr(_sys.modules.get("__main__"), "__file__", None) or ""
-    if _os.path.basename(main).lower() in ("quadcruise", "quadcruise-script.py"):
-        return True
+    module = _sys.modules.get("__main__")
+    main = getattr(module, "__file__", None) or ""
+    if getattr(module, "__name__", "") == "__main__" and _os.path.basename(main).lower() in (
+        "quadcruise",
+        "quadcruise-script.py",
+    ):
+        return True  # not a worker process it spawns (multiprocessing names its copy __mp_main__)
     argv = list(getattr(_sys, "orig_argv", ()))
     return "-m" in argv and argv[argv.index("-m") + 1 : argv.index("-m") + 2] == ["quadcruise"]
 
@@ -41,12 +45,11 @@ if _command_starting():
 import importlib  # noqa: E402 - after Ctrl-C is answered
 from typing import TYPE_CHECKING  # noqa: E402
 
-from quadcruise._cache import drop_stale_cache as _drop_stale_cache  # noqa: E402
+from quadcruise._cache import check_before_compiled_code as _check_before_compiled_code  # noqa: E402
 from quadcruise._version import __version__  # noqa: E402
+from quadcruise.errors import InputError  # noqa: E402
 
-_drop_stale_cache()  # before anything compiles: see quadcruise._cache
-
-from quadcruise.errors import InputError  # noqa: E402 - after the stale cache is dropped
+_check_before_compiled_code()  # numba's stale cache dropped when compiled code is first imported
 
 if TYPE_CHECKING:  # what the names are, for readers and type checkers
     from quadcruise.model.vehicle import Vehicle
@@ -56,6 +59,7 @@ if TYPE_CHECKING:  # what the names are, for readers and type checkers
     from quadcruise.sim.status import STATUS_REASONS, ExitStatus
     from quadcruise.sysid.api import identify
     from quadcruise.sysid.result import IdentifyResult
+    from quadcruise.workflows.commands import CommandSchedule, read_commands
     from quadcruise.workflows.compare import Comparison, compare
     from quadcruise.workflows.fly import fly
     from quadcruise.workflows.replay import (
@@ -79,7 +83,8 @@ _LAZY = {
     "quadcruise.sysid.result": ("IdentifyResult",),
     "quadcruise.workflows.compare": ("Comparison", "compare"),
     "quadcruise.workflows.fly": ("fly",),
-    "quadcruise.workflows.replay": (
+    "quadcruise.workflows.commands": ("CommandSchedule", "read_commands"),
+    "quadcruise.workflows.replay": (  # replay and write_states_csv; the others deprecated aliases
         "DutySchedule",
         "SpeedSchedule",
         "read_duty_csv",
@@ -93,6 +98,7 @@ _LAZY = {
 _HOME = {name: module for module, names in _LAZY.items() for name in names}
 
 __all__ = [
+    "CommandSchedule",
     "Comparison",
     "DutySchedule",
     "ExitStatus",
@@ -107,6 +113,7 @@ __all__ = [
     "compare",
     "fly",
     "identify",
+    "read_commands",
     "read_duty_csv",
     "read_speed_csv",
     "replay",

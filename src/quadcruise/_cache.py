@@ -4,12 +4,14 @@ and the code a Monte Carlo sweep was flown with (:func:`code_digest`).
 numba keys each cached function on the file that defines it, not on the files of the
 functions it calls and inlines: the engine's kernel inlines the plant's derivative, so an
 edit to ``model/plant.py`` alone would leave a stale kernel in the cache (a checkout of
-another commit, an edited source tree). At import, before anything compiles, we stamp the
-package's compiled sources (the contents of every ``.py`` file that uses numba) and, when the stamp differs from the
-one stored beside the cache, remove the
-package's cached machine code (in the ``__pycache__`` folders, or under ``NUMBA_CACHE_DIR``
-when it is set), which numba then compiles afresh. A read-only install is left alone
-(numba caches such a package elsewhere, and an upgrade replaces every file there anyway).
+another commit, an edited source tree). When the first of the package's modules that may hold
+compiled code is imported (any but ``errors``, ``_version``, this one and the command line: see
+:func:`check_before_compiled_code`), before anything compiles, we stamp the package's compiled
+sources (the contents of every ``.py`` file that uses numba) and, when the stamp differs from the
+one stored beside the cache, remove the package's cached machine code (in the ``__pycache__``
+folders, or under ``NUMBA_CACHE_DIR`` when it is set), which numba then compiles afresh. So
+``import quadcruise`` alone imports no numba and deletes nothing. A read-only install is left
+alone (numba caches such a package elsewhere, and an upgrade replaces every file there anyway).
 """
 
 from __future__ import annotations
@@ -17,11 +19,23 @@ from __future__ import annotations
 import contextlib
 import functools
 import hashlib
+import importlib.abc
 import os
+import sys
+import threading
 from pathlib import Path
 
 PACKAGE = Path(os.path.abspath(__file__)).parent  # as numba names the source files
 STAMP = "quadcruise-sources.stamp"
+WITHOUT_COMPILED_CODE = (
+    "quadcruise.errors",
+    "quadcruise._version",
+    "quadcruise._cache",
+    "quadcruise.__main__",
+    "quadcruise.cli",
+)
+"""The package's modules (and packages) whose import leaves the stamp check for later: they hold
+and load no compiled code of their own."""
 
 
 def _digest(package: Path, compiled_only: bool) -> str:
@@ -132,3 +146,50 @@ def drop_stale_cache(package: Path = PACKAGE, numba_cache_dir: str | None = None
     except OSError:
         return False
     return True
+
+
+_lock = threading.Lock()
+_checked = False
+
+
+def check_stamp_once() -> None:
+    """:func:`drop_stale_cache` for this package, once per process (later calls return at once)."""
+    global _checked
+    with _lock:
+        if _checked:
+            return
+        _checked = True
+        _remove_finder()
+        drop_stale_cache()
+
+
+class _BeforeCompiledCode(importlib.abc.MetaPathFinder):
+    """Runs :func:`check_stamp_once` when a module of the package outside
+    :data:`WITHOUT_COMPILED_CODE` is first imported; it finds no module itself."""
+
+    def find_spec(self, fullname, path, target=None):
+        if fullname.startswith("quadcruise.") and not any(
+            fullname == light or fullname.startswith(light + ".") for light in WITHOUT_COMPILED_CODE
+        ):
+            check_stamp_once()
+        return None  # the import goes on as usual
+
+
+def _remove_finder() -> None:
+    sys.meta_path[:] = [f for f in sys.meta_path if not isinstance(f, _BeforeCompiledCode)]
+
+
+def check_before_compiled_code() -> None:
+    """Make the first import of a module of the package that may hold compiled code (any outside
+    :data:`WITHOUT_COMPILED_CODE`) run :func:`check_stamp_once` first: ``import quadcruise``
+    calls it, and deletes nothing itself.
+
+    Examples
+    --------
+    >>> import subprocess, sys
+    >>> code = "import sys, quadcruise; print('numba' in sys.modules)"
+    >>> subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).stdout.strip()
+    'False'
+    """
+    if not _checked and not any(isinstance(f, _BeforeCompiledCode) for f in sys.meta_path):
+        sys.meta_path.insert(0, _BeforeCompiledCode())

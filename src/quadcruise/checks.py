@@ -60,6 +60,8 @@ def describe(value: Any, limit: int = 60) -> str:
     --------
     >>> describe(3), describe("x"), describe(None), describe(1e300)
     ('int 3', "str 'x'", 'None', 'float 1e+300')
+    >>> describe(np.float64("inf")), describe([np.float64(1.5), np.int64(2)])
+    ('float64 inf', 'list [1.5, 2]')
     """
     if value is None:
         return "None"
@@ -72,9 +74,21 @@ def describe(value: Any, limit: int = 60) -> str:
         return f"{kind} {short_number(value)}"
     if isinstance(value, np.ndarray):
         return f"{kind} of shape {value.shape}"
-    text = " ".join(repr(value).split())
+    text = " ".join(repr(_plain(value)).split())
     text = text if len(text) <= limit else text[: limit - 3] + "..."
     return f"{kind} {text}"
+
+
+def _plain(value: Any) -> Any:
+    """Numpy scalars, within lists, tuples and dicts too, as the Python values they hold: numpy
+    2 writes ``np.float64(inf)`` where a message should say ``inf``."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if type(value) in (list, tuple):
+        return type(value)(_plain(v) for v in value)
+    if type(value) is dict:
+        return {_plain(k): _plain(v) for k, v in value.items()}
+    return value
 
 
 def fail(where: str, name: str, value: Any, want: str, *, kind: bool = True, hint: str = "") -> None:

@@ -6,7 +6,6 @@ them and exits 2), before any work. And what must pass still passes."""
 from __future__ import annotations
 
 import math
-import time
 from pathlib import Path
 
 import numpy as np
@@ -160,9 +159,14 @@ CASES = {
         ["montecarlo()", "requirements key", "did you mean 'rmse_m'?"],
     ),
     # replay
-    "replay int": (lambda: qc.replay(3), WRONG, ["schedule", "DutySchedule", "path"]),
+    "replay int": (lambda: qc.replay(3), WRONG, ["commands", "CommandSchedule", "DataFrame", "path"]),
     "replay max_step 0": (lambda: qc.replay(EXAMPLES / "pwm_step.csv", max_step=0.0), BAD, ["max_step"]),
-    "replay vehicle": (lambda: qc.replay(EXAMPLES / "pwm_step.csv", vehicle="paper"), WRONG, ["vehicle"]),
+    "replay vehicle": (lambda: qc.replay(EXAMPLES / "pwm_step.csv", vehicle=3), WRONG, ["vehicle", "preset"]),
+    "replay vehicle name": (
+        lambda: qc.replay(EXAMPLES / "pwm_step.csv", vehicle="crazyfly"),
+        BAD,
+        ["unknown vehicle preset 'crazyfly'"],
+    ),
     "replay full_dynamics": (
         lambda: qc.replay(EXAMPLES / "pwm_step.csv", full_dynamics="no"),
         WRONG,
@@ -237,6 +241,12 @@ CASES = {
     "make dt 0": (lambda: gym_make(dt=0.0), BAD, ["make()", "dt", "positive"]),
     "make duration text": (lambda: gym_make(duration="5"), WRONG, ["make()", "duration"]),
     "make_vec dt text": (lambda: gym_make_vec(dt="0.01"), WRONG, ["make()", "dt", "str '0.01'"]),
+    "make vehicle int": (lambda: gym_make(vehicle=123), WRONG, ["make()", "vehicle", "int 123"]),
+    "make mission int": (lambda: gym_make(mission=5), WRONG, ["make()", "mission", "int 5"]),
+    "make population text": (lambda: gym_make(population="wide"), WRONG, ["make()", "population", "str 'wide'"]),
+    "make controller int": (lambda: gym_make(controller=5), WRONG, ["make()", "controller", "int 5"]),
+    "make max_track_error": (lambda: gym_make(max_track_error=np.float64(-1)), BAD, ["max_track_error", "-1.0"]),
+    "make_vec num_envs 1.5": (lambda: gym_make_vec(num_envs=1.5), WRONG, ["make()", "num_envs", "float 1.5"]),
     "make_vec reset seed 1.5": (lambda: gym_make_vec().reset(seed=1.5), WRONG, ["reset()", "seed", "float 1.5"]),
     "make_vec reset seed text": (lambda: gym_make_vec().reset(seed="abc"), WRONG, ["reset()", "seed", "str 'abc'"]),
     "make_vec reset seed -1": (lambda: gym_make_vec().reset(seed=-1), BAD, ["reset()", "seed", ">= 0"]),
@@ -264,17 +274,16 @@ def gym_make(**kw):
     return gymnasium.make("quadcruise/Hover-v0", **kw)
 
 
-def gym_make_vec(**kw):
+def gym_make_vec(num_envs=2, **kw):
     gymnasium = pytest.importorskip("gymnasium")
     import quadcruise.gym  # noqa: F401
 
-    return gymnasium.make_vec("quadcruise/Hover-v0", num_envs=2, vectorization_mode="vector_entry_point", **kw)
+    return gymnasium.make_vec("quadcruise/Hover-v0", num_envs=num_envs, vectorization_mode="vector_entry_point", **kw)
 
 
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_a_bad_argument_is_one_line_naming_it(name):
     call, error, words = CASES[name]
-    start = time.perf_counter()
     with pytest.raises(error) as caught:
         call()
     message = str(caught.value)
@@ -284,7 +293,6 @@ def test_a_bad_argument_is_one_line_naming_it(name):
     assert "np." not in message and "was raised from the environment creator" not in message, message
     for word in words:
         assert word in message, (word, message)
-    assert time.perf_counter() - start < 30.0  # before any work
 
 
 def test_the_type_error_is_an_input_error_and_a_type_error():
@@ -293,11 +301,10 @@ def test_the_type_error_is_an_input_error_and_a_type_error():
 
 
 def test_a_bad_argument_is_refused_before_the_flight_is_sized_or_flown():
-    # a flight of hours: the seed is refused first, not the size, and nothing flies
-    start = time.perf_counter()
+    # a flight of hours: the seed is refused first, not the size, and nothing flies (were it
+    # flown first, this call would not end)
     with pytest.raises(TypeError, match="seed"):
         qc.fly("circle", duration=3600.0, n=100_000, seed=1.5)
-    assert time.perf_counter() - start < 5.0
 
 
 def test_what_must_pass_passes_and_numbers_of_any_numeric_type_fly_the_same():
@@ -323,7 +330,7 @@ def test_what_must_pass_passes_and_numbers_of_any_numeric_type_fly_the_same():
 def test_replay_takes_a_path_as_well_as_a_schedule():
     path = EXAMPLES / "pwm_step.csv"
     by_path = qc.replay(str(path))
-    by_schedule = qc.replay(qc.read_duty_csv(path))
+    by_schedule = qc.replay(qc.read_commands(path))
     np.testing.assert_array_equal(by_path.states, by_schedule.states)
     assert by_path.meta["source"] == str(path)
     assert qc.replay(path).t.size == by_path.t.size  # a pathlib.Path too

@@ -261,8 +261,8 @@ def test_compiled_controller_reads_its_rows_at_constant_offsets(name, gains, mem
 
     function = controller_from_name(name).function.py_func
     size = controller_from_name(name).gains().size
-    assert row_offsets(function, CONTROLLER_SIG, gains) == (set(range(1, size)), 0)
-    assert row_offsets(function, CONTROLLER_SIG, "mem") == (set(range(1, memory)), 0)
+    assert row_offsets(function, CONTROLLER_SIG, gains) == (set(range(size)), 0)
+    assert row_offsets(function, CONTROLLER_SIG, "mem") == (set(range(memory)), 0)
 
 
 @pytest.mark.parametrize("name", ["nlpd", "gonzalez", "se3", "cascade"])
@@ -277,5 +277,5 @@ def test_compiled_controller_reads_the_engine_vectors_at_constant_offsets(name):
     function = controller_from_name(name).function.py_func
     for argument, size in (("x", STATE_SIZE), ("ref", REF_SIZE), ("vp", PARAM_SIZE), ("cmd", CMD_SIZE)):
         constant, computed = row_offsets(function, CONTROLLER_SIG, argument)
-        assert computed == 0 and constant and constant <= set(range(1, size)), (argument, constant, computed)
-    assert row_offsets(function, CONTROLLER_SIG, "cmd")[0] == set(range(1, CMD_SIZE))  # the whole command
+        assert computed == 0 and constant and constant <= set(range(size)), (argument, constant, computed)
+    assert row_offsets(function, CONTROLLER_SIG, "cmd")[0] == set(range(CMD_SIZE))  # the whole command

@@ -451,5 +451,5 @@ def test_compiled_disturbance_reads_its_rows_at_constant_offsets():
     from support.compiled_code import row_offsets
 
     function = environment_disturbance.py_func
-    assert row_offsets(function, DISTURBANCE_SIG, "dp") == (set(range(1, PARAMS_SIZE)), 0)
-    assert row_offsets(function, DISTURBANCE_SIG, "dmem") == (set(range(1, MEMORY_SIZE)), 0)
+    assert row_offsets(function, DISTURBANCE_SIG, "dp") == (set(range(PARAMS_SIZE)), 0)
+    assert row_offsets(function, DISTURBANCE_SIG, "dmem") == (set(range(MEMORY_SIZE)), 0)

@@ -296,6 +296,12 @@ def test_a_rotor_flight_logs_relative_thrust_and_its_signal(tmp_path):
     rows = np.searchsorted(motors["timestamp"], t_us[same])
     assert np.array_equal(flight.u[same], np.column_stack([motors[f"control[{i}]"][rows] for i in range(4)]))
     assert flight.thrust_factor == 1.0 and "THR_MDL_FAC" not in flight.parameters
+    # actuator_outputs read back through THR_MDL_FAC 1: the same relative thrust; rad/s: its signal
+    pwm = read_flight_log(tmp_path / "h.ulg", commands="pwm:1000:2000")
+    late = pwm.t > 5.0
+    assert np.allclose(pwm.u[late], hover, rtol=1e-4)
+    speeds = read_flight_log(tmp_path / "h.ulg", commands="rad/s")
+    assert np.allclose(speeds.u[late] * w_max, math.sqrt(m * g / (4 * kf)), rtol=1e-4)  # the hover speed
 
 
 def test_a_decimated_log_says_its_true_rate(tmp_path):

@@ -114,6 +114,15 @@ def test_gym_step():
             assert not raising
 
 
+def test_sweep_in_process():
+    from quadcruise.montecarlo import montecarlo
+
+    with pytest.raises(ValueError, match=MESSAGE):
+        montecarlo("hover", Law(), None, 4, scheduler="none", chunk_size=2, **QUIET)
+    res = montecarlo("hover", Law(raising=False), None, 4, scheduler="none", chunk_size=2, **QUIET)
+    assert (res.metrics()["status"] == 0).all()
+
+
 def test_dask_sweep(tmp_path):
     distributed = pytest.importorskip("distributed")
     from quadcruise.montecarlo import montecarlo

@@ -25,7 +25,7 @@ def test_example_replays_and_writes_states(tmp_path):
     header = out.read_text().splitlines()[0]
     assert header == "t,x,y,z,vx,vy,vz,phi,theta,psi,p,q,r,F1,F2,F3,F4"
     data = np.loadtxt(out, delimiter=",", skiprows=1)
-    schedule = qc.read_duty_csv(EXAMPLE)
+    schedule = qc.read_commands(EXAMPLE)
     assert data.shape == (len(schedule.t), 17)
     np.testing.assert_array_equal(data[:, 0], schedule.t)
     np.testing.assert_allclose(
@@ -109,7 +109,7 @@ def test_a_long_schedule_names_its_first_bad_row():
     u = np.full((3000, 4), 0.5)
     u[2000, 1], u[2500, 2] = 1.5, np.nan
     with pytest.raises(qc.InputError, match=r"schedule, row 2001, column 'u2': duty 1.5 is outside \[0, 1\]"):
-        qc.DutySchedule(t=t, duties=u)
+        qc.CommandSchedule(t=t, duties=u)
     t[1200] = t[1199]
     with pytest.raises(qc.InputError, match=r"row 1201, column 't': time 1.199 is not after"):
-        qc.DutySchedule(t=t, duties=u)
+        qc.CommandSchedule(t=t, duties=u)

@@ -404,14 +404,10 @@ def test_gif_frames_and_no_temp(tmp_path):
         assert img.n_frames == 10
 
 
-def test_gif_of_twenty_seconds_is_fast(circle, tmp_path):
-    start = time.perf_counter()
+def test_gif_of_twenty_seconds(circle, tmp_path):
     out = animate.animate_flight(circle, tmp_path / "circle.gif", fps=25)
-    took = time.perf_counter() - start
-    print(f"500 frames in {took:.1f} s")
     with Image.open(out) as img:
         assert img.n_frames == 500
-    assert took < 30.0
 
 
 def test_gif_of_a_stopped_vehicle(diverged, tmp_path):

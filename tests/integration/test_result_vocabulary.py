@@ -15,7 +15,7 @@ from quadcruise.montecarlo import montecarlo
 from quadcruise.montecarlo.schema import METRICS
 from quadcruise.tune import tune
 from quadcruise.workflows.compare import compare
-from quadcruise.workflows.replay import SpeedSchedule, replay_rotors
+from quadcruise.workflows.replay import CommandSchedule, replay
 from quadcruise.workflows.reproduce import reproduce
 
 CF = RotorVehicle.preset("crazyflie")
@@ -49,7 +49,7 @@ def tuned():
 
 def rotor_replay():
     h = CF.hover_speed
-    res = replay_rotors(SpeedSchedule(t=[0.0, 0.5, 1.0], speeds=[[1.02 * h] * 4] * 3), CF)
+    res = replay(CommandSchedule(t=[0.0, 0.5, 1.0], speeds=[[1.02 * h] * 4] * 3), vehicle=CF)
     return res, {"flights": None, "samples": len(res.t)}
 
 

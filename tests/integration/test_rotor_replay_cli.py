@@ -10,7 +10,7 @@ from click.testing import CliRunner
 
 from quadcruise import Vehicle
 from quadcruise.cli import main
-from quadcruise.workflows.replay import read_speed_csv, replay_rotors
+from quadcruise.workflows.replay import read_commands, replay
 
 FLIP = Path(__file__).resolve().parents[2] / "examples" / "crazyflie_flip.csv"
 HEADER = "t,x,y,z,vx,vy,vz,qw,qx,qy,qz,p,q,r,w1,w2,w3,w4,phi,theta,psi"
@@ -27,7 +27,7 @@ def test_the_flip_example_replays_through_inverted_and_writes_states(tmp_path):
     assert out.read_text().splitlines()[0] == HEADER
     data = np.loadtxt(out, delimiter=",", skiprows=1)
     vehicle = Vehicle.preset("crazyflie")
-    res = replay_rotors(read_speed_csv(FLIP, 4), vehicle)
+    res = replay(read_commands(FLIP, vehicle), vehicle)
     np.testing.assert_allclose(data[:, 1:18], res.states[0], rtol=1e-14, atol=1e-14)  # written to 15 digits
     # the first row is the start: at rest, level, at the origin, rotors at the first command
     np.testing.assert_array_equal(data[0, 1:14], [0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0])
@@ -76,7 +76,10 @@ BAD = {
         "t,w1,w2,w3,w4\n0,1800,1800,1800,1800\n0,1800,1800,1800,1800\n",
         "line 3, column 't': time 0 is not after the previous row's 0",
     ),
-    "duty_above_one": ("t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,0.1,0.1,1.5,0.1\n", "line 3, column 'u3': duty 1.5 is not"),
+    "duty_above_one": (
+        "t,u1,u2,u3,u4\n0,0.1,0.1,0.1,0.1\n1,0.1,0.1,1.5,0.1\n",
+        "line 3, column 'u3': duty 1.5 is outside [0, 1]",
+    ),
     "duties_missing_rotor": ("t,u1,u2,u3\n0,0.1,0.1,0.1\n1,0.1,0.1,0.1\n", "column(s) 'u4': missing"),
     "a_fifth_duty": ("t,u1,u2,u3,u4,u5\n0,1,1,1,1,1\n1,1,1,1,1,1\n", "column 'u5', but the vehicle has 4 rotors"),
 }
@@ -183,5 +186,5 @@ def test_duties_replay_as_the_speeds_of_the_command_to_speed_map(tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("t,u1,u2,u3,u4\n0,0.6,0.6,0.6,0.6\n1,0.6,1.2,0.6,0.6\n")
     res = run("replay", str(bad), "--vehicle", "iris", "-o", str(tmp_path / "x.csv"))
-    assert res.exit_code == 2 and "line 3, column 'u2': duty 1.2 is not in [0, 1]" in res.output
+    assert res.exit_code == 2 and "line 3, column 'u2': duty 1.2 is outside [0, 1]" in res.output
     assert not (tmp_path / "x.csv").exists()

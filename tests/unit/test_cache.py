@@ -2,8 +2,10 @@
 
 import hashlib
 import os
+import subprocess
+import sys
 
-from quadcruise._cache import drop_stale_cache, sources_stamp
+from quadcruise._cache import PACKAGE, STAMP, cache_dirs, drop_stale_cache, sources_stamp
 
 
 def test_cache_files_go_when_any_source_changes(tmp_path):
@@ -53,3 +55,25 @@ def test_a_numba_cache_dir_is_cleaned_too(tmp_path):
     assert not drop_stale_cache(pkg, str(tmp_path / "nc")) and stale.exists()
     (pkg / "engine.py").write_text("import numba\nx = 1\n")
     assert drop_stale_cache(pkg, str(tmp_path / "nc")) and not stale.exists()
+
+
+def _python(code: str, cache_dir) -> str:
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache_dir))
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    return out.stdout.strip()
+
+
+def test_import_quadcruise_loads_no_numba_and_deletes_nothing_until_compiled_code_loads(tmp_path):
+    stale = cache_dirs(PACKAGE, str(tmp_path))[0] / "engine._kernel-1.py311.nbi"
+    stale.parent.mkdir(parents=True)
+    stale.write_bytes(b"machine code of other sources")  # no stamp beside it: stale
+    loaded = _python(
+        "import sys, quadcruise\n"
+        "print(sorted(m for m in sys.modules if m.split('.')[0] in ('numba', 'llvmlite', 'quadcruise')))",
+        tmp_path,
+    )
+    assert loaded == str(["quadcruise", "quadcruise._cache", "quadcruise._version", "quadcruise.errors"])
+    assert stale.exists()  # import quadcruise deleted nothing
+    _python("import quadcruise.layout", tmp_path)  # the first module that may hold compiled code
+    assert not stale.exists() and (stale.parent / STAMP).read_text() == sources_stamp(PACKAGE)

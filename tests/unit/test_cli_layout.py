@@ -79,6 +79,7 @@ def test_the_entry_points_stay():
     assert set(main.commands) == {
         "analyze",
         "compare",
+        "estimate",
         "fly",
         "identify",
         "montecarlo",

@@ -1,11 +1,10 @@
 """The speed tricks of an environment's reset against their plain formulas: NumPy's own
-SeedSequence and default_rng (seeded draws), numba's dispatcher (DirectCall)."""
+SeedSequence and default_rng (seeded draws)."""
 
 import numpy as np
 import pytest
-from numba import njit
 
-from quadcruise.sim.fastmath import DirectCall, seed_sequence_words, seeded_draws
+from quadcruise.sim.fastmath import seed_sequence_words, seeded_draws
 
 SEEDS = [0, 1, 11, 2**32 - 1, 2**32, 2**63 - 1, 2**64 + 7]
 IDS = [0, 1, 2**32 - 1, 2**32, 2**33 + 5, 2**64 - 1, 1023 * 2**32 + 99, 123456789]
@@ -39,26 +38,3 @@ def test_negative_seeds_and_indices_are_refused_as_by_numpy():
     with pytest.raises(ValueError, match=">= 0"):
         seed_sequence_words(1, np.array([3, -2]), 1, 1)
     assert seeded_draws(1, [], 1, 16, True).shape == (0, 16)
-
-
-@njit("void(int64, int64, float64[::1], float64)", cache=False)
-def _fill(first, stop, out, value):
-    for i in range(first, stop):
-        out[i] = value + i
-
-
-def test_direct_call_equals_the_dispatcher_and_checks_new_arguments():
-    call = DirectCall(_fill)
-    out, plain = np.zeros(5), np.zeros(5)
-    _fill(0, 5, plain, 2.0)
-    call(0, 5, out, 2.0)  # first call: through the dispatcher
-    value = 2.0
-    call(0, 5, out, value)  # new float object: checked again
-    assert np.array_equal(out, plain)
-    out[:] = 0.0
-    call(1, 4, out, value)  # the same objects: the entry point
-    assert out.tolist() == [0.0, 3.0, 4.0, 5.0, 0.0]
-    with pytest.raises(TypeError):  # a new array of the wrong type never reaches the entry point
-        call(0, 5, np.zeros(5, dtype=np.int64), value)
-    with pytest.raises(TypeError):
-        call(0, 5, np.zeros(10)[::2], value)  # not contiguous

@@ -34,6 +34,8 @@ RANKS = {
     "quadcruise.missions": 6,
     "quadcruise.control": 7,
     "quadcruise.disturbances": 8,
+    "quadcruise.sensors": 8,
+    "quadcruise.estimation": 8,
     "quadcruise.workflows": 9,
     "quadcruise.sysid": 9,
     "quadcruise.montecarlo": 10,

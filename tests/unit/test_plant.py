@@ -102,5 +102,5 @@ def test_the_compiled_derivative_reaches_its_rows_at_constant_offsets():
     signature = types.void(row, row, row, row, types.boolean, row)
     for argument, size in (("x", STATE_SIZE), ("vp", PARAM_SIZE), ("ext", EXT_SIZE), ("dx", STATE_SIZE)):
         constant, computed = row_offsets(derivative.py_func, signature, argument)
-        assert computed == 0 and constant and constant <= set(range(1, size)), (argument, constant, computed)
-    assert row_offsets(derivative.py_func, signature, "dx")[0] == set(range(1, STATE_SIZE))
+        assert computed == 0 and constant and constant <= set(range(size)), (argument, constant, computed)
+    assert row_offsets(derivative.py_func, signature, "dx")[0] == set(range(STATE_SIZE))

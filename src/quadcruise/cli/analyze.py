@@ -66,7 +66,6 @@ def analyze(controller, controller_params, position_poles, dt, vehicle_text, out
     from quadcruise.cli.objects import controller_for_vehicle
     from quadcruise.cli.vehicle import vehicle_from_option
     from quadcruise.model.equivalent import paper_equivalent
-    from quadcruise.model.rotor_vehicle import RotorVehicle
     from quadcruise.workflows.analysis import linearize
 
     vehicle = vehicle_from_option(vehicle_text, "--vehicle")
@@ -74,8 +73,8 @@ def analyze(controller, controller_params, position_poles, dt, vehicle_text, out
     the_controller = controller_for_vehicle(
         the_controller, controller, controller_params, position_poles, {"vehicle": vehicle}, None
     )
-    if isinstance(vehicle, RotorVehicle):
-        vehicle = paper_equivalent(vehicle)
+    if vehicle is not None:  # None: linearize's default, Table I
+        vehicle = paper_equivalent(vehicle)  # a rotor-plant vehicle's "+" equivalent, a paper one as it is
     if out is not None:
         check_output_dir(out, force)
     lin = linearize(the_controller, vehicle, dt=dt, progress=linearising)

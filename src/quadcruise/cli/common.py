@@ -183,7 +183,7 @@ def friendly(func: Callable) -> Callable:
                 sys.exit(EXIT_FAULT)
             except KeyboardInterrupt as exc:
                 close_bars()
-                text, status = interrupt_text(exc)
+                text, status = interrupt_text(exc, func.__name__)
                 click.echo(("\n" if sys.stderr.isatty() else "") + f"error: {text}", err=True)  # after a ^C
                 sys.exit(status)
             finally:

@@ -165,14 +165,8 @@ def echo_population_comparison(mission, controllers, n: int, seed: int, pop, fli
 
 
 def default_compared() -> str:
-    """The controllers ``quadcruise compare`` flies when neither the options nor a scenario name
-    any: those declared ``compared=True`` (:func:`quadcruise.control.registry.compared_names`).
-
-    Returns
-    -------
-    str
-        Comma-separated names.
-    """
+    """The controllers (comma-separated) ``quadcruise compare`` flies when neither the options nor a
+    scenario name any: those declared ``compared=True`` (:func:`~quadcruise.control.registry.compared_names`)."""
     from quadcruise.control.registry import compared_names
 
     return ",".join(compared_names())

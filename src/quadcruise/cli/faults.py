@@ -62,17 +62,21 @@ def stop_on_sigterm() -> None:
     signal.signal(signal.SIGTERM, _raise_terminated)
 
 
-def interrupt_text(exc: KeyboardInterrupt) -> tuple[str, int]:
-    """The line and the exit status for Ctrl-C or SIGTERM.
+def interrupt_text(exc: KeyboardInterrupt, command: str | None = "montecarlo") -> tuple[str, int]:
+    """The line and the exit status for Ctrl-C or SIGTERM; the sweep's way on only for a sweep
+    (``command``: the command interrupted; None: not known).
 
     Examples
     --------
     >>> interrupt_text(Terminated())
     ('terminated (a montecarlo sweep with --out resumes if run again)', 143)
+    >>> interrupt_text(KeyboardInterrupt(), "identify")
+    ('interrupted', 130)
     """
+    hint = f" ({_RESUMES})" if command in ("montecarlo", None) else ""
     if isinstance(exc, Terminated):
-        return f"terminated ({_RESUMES})", EXIT_TERMINATED
-    return f"interrupted ({_RESUMES})", EXIT_INTERRUPTED
+        return f"terminated{hint}", EXIT_TERMINATED
+    return f"interrupted{hint}", EXIT_INTERRUPTED
 
 
 def fault_text(exc: OSError) -> str:

@@ -4,7 +4,8 @@ The group lives here, each command in its own module (:mod:`quadcruise.cli.fly`,
 :mod:`~quadcruise.cli.replay`, :mod:`~quadcruise.cli.reproduce`,
 :mod:`~quadcruise.cli.compare`, :mod:`~quadcruise.cli.analyze`,
 :mod:`~quadcruise.cli.montecarlo`, :mod:`~quadcruise.cli.tune`, :mod:`~quadcruise.cli.vehicles`,
-:mod:`~quadcruise.cli.identify`, :mod:`~quadcruise.cli.px4_check`), what they share in :mod:`quadcruise.cli.common`;
+:mod:`~quadcruise.cli.identify`, :mod:`~quadcruise.cli.px4_check`,
+:mod:`~quadcruise.cli.estimate`), what they share in :mod:`quadcruise.cli.common`;
 the larger commands keep what they run after parsing in a ``*_run`` module beside them
 (:mod:`~quadcruise.cli.compare_run`, :mod:`~quadcruise.cli.montecarlo_run`, :mod:`~quadcruise.cli.tune_run`).
 Bad input prints one line, ``error: ...``, and exits with status 2; a flight that did not
@@ -24,6 +25,7 @@ import click
 from quadcruise._version import __version__
 from quadcruise.cli.analyze import analyze
 from quadcruise.cli.compare import compare
+from quadcruise.cli.estimate import estimate
 from quadcruise.cli.faults import EXIT_FAULT, fault_text, guard_stdout, interrupt_text, stop_on_sigterm
 from quadcruise.cli.fly import fly
 from quadcruise.cli.identify import identify
@@ -53,6 +55,7 @@ main.add_command(tune)
 main.add_command(vehicles)
 main.add_command(identify)
 main.add_command(px4_check)
+main.add_command(estimate)
 
 
 def run() -> None:
@@ -89,7 +92,8 @@ def run() -> None:
         click.echo(f"error: {fault_text(exc)}", err=True)
         sys.exit(EXIT_FAULT)
     except (click.exceptions.Abort, KeyboardInterrupt) as exc:
-        text, status = interrupt_text(exc if isinstance(exc, KeyboardInterrupt) else KeyboardInterrupt())
+        command = sys.argv[1] if len(sys.argv) > 1 else ""  # the sweep's way on is said for a sweep only
+        text, status = interrupt_text(exc if isinstance(exc, KeyboardInterrupt) else KeyboardInterrupt(), command)
         click.echo(f"error: {text}", err=True)
         sys.exit(status)
     finally:

@@ -42,6 +42,14 @@ __all__ = ["montecarlo", "montecarlo_command", "parse_noise"]
 @click.option(
     "--aero-spread", type=float, show_default="0", help="Relative std of a rotor vehicle's aerodynamic coefficients."
 )
+@click.option(
+    "--population",
+    "identification",
+    type=click.Path(),
+    metavar="DIR/identify.json",
+    help="Draw the parameters identify found from their estimate and covariance (the vehicles the log is "
+    "consistent with); the nominal vehicle is that folder's vehicle.toml unless --vehicle is given.",
+)
 @click.option("--distribution", type=click.Choice(["normal", "uniform"]), show_default="normal")
 @click.option("--offset", type=float, show_default="0", help="Std of the start position [m].")
 @click.option("--noise", metavar="position=STD,velocity=STD,angle=STD,rate=STD,delay=S", help="Sensor noise and delay.")
@@ -137,6 +145,10 @@ def montecarlo(**options):
             mass m, of each inertia, of the thrust gain K, of the actuator bandwidth, of the
             yaw moment arm d, and of a rotor-plant vehicle's aerodynamic coefficients (on a
             rotor-plant vehicle: kf, 1 / tau_up and 1 / tau_down, km; :mod:`quadcruise.montecarlo.population`).
+        identification : str or None
+            ``--population``: an ``identify.json`` (or its folder) whose identified parameters
+            each vehicle draws from their estimated distribution
+            (:meth:`~quadcruise.montecarlo.population.Population.from_identification`).
         distribution : {"normal", "uniform"} or None
             ``--distribution``: distribution of the random draws.
         offset : float or None

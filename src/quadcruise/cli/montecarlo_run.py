@@ -66,6 +66,7 @@ def montecarlo_command(
     bandwidth_spread: float | None = None,
     yaw_arm_spread: float | None = None,
     aero_spread: float | None = None,
+    identification: str | None = None,
     distribution: str | None = None,
     model_error: bool | None = None,
     chunk_size: str | int = "auto",
@@ -122,6 +123,15 @@ def montecarlo_command(
     from quadcruise.workflows.scenario import load_scenario
 
     sc = load_scenario(scenario) if scenario is not None else None
+    identified = None
+    if identification is not None:
+        from pathlib import Path
+
+        from quadcruise.montecarlo.identified import Identified
+
+        identified = Identified.read(identification)
+        if vehicle is None:  # the vehicle it identified
+            vehicle = str(Path(identified.source).parent / "vehicle.toml")
 
     nominal = vehicle_from_option(vehicle, "--vehicle", sc.vehicle if sc is not None else None)
     believed = vehicle_from_option(
@@ -161,6 +171,7 @@ def montecarlo_command(
             offset=offset,
             yaw_arm_spread=yaw_arm_spread,
             aero_spread=aero_spread,
+            identified=identified,
             wind_spread=wind_spread,
             distribution=distribution,
             model_error=model_error,

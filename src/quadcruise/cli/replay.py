@@ -47,8 +47,9 @@ __all__ = ["replay"]
 def replay(pwm_csv: str, out: str, vehicle_name: str | None, ground: bool, max_step: float | None) -> None:
     """Replay commands open loop and write the states.
 
-    For the paper's plant the columns are t,u1,u2,u3,u4 (PWM duties); for a rotor-plant
-    vehicle, t,w1,..,wn (commanded rotor speeds, rad/s, in the vehicle's range) or t,u1,..,un
+    The table's columns say what it holds and the vehicle which plant flies it. For the
+    paper's plant the columns are t,u1,u2,u3,u4 (PWM duties); for a rotor-plant vehicle,
+    t,w1,..,wn (commanded rotor speeds, rad/s, in the vehicle's range) or t,u1,..,un
     (normalised commands in [0, 1], each rotor at u w_max: PX4's THR_MDL_FAC = 1). Each row's
     commands hold until the next row's time. The vehicle starts at rest at the origin, level,
     each rotor at the first row's command. The states are written even when the flight stops
@@ -75,9 +76,10 @@ def replay(pwm_csv: str, out: str, vehicle_name: str | None, ground: bool, max_s
     import sys
 
     from quadcruise.errors import InputError
-    from quadcruise.model.rotor_vehicle import RotorVehicle
     from quadcruise.model.vehicle import Vehicle
-    from quadcruise.workflows import replay as workflow
+    from quadcruise.workflows.commands import ROTOR_VEHICLES, read_commands, replay_plant
+    from quadcruise.workflows.replay import replay as fly_open_loop
+    from quadcruise.workflows.replay import write_states_csv
 
     if os.path.exists(out) and os.path.exists(pwm_csv) and os.path.samefile(pwm_csv, out):
         raise click.BadParameter(f"{out} is the input file: write the states elsewhere", param_hint="'-o'")
@@ -86,28 +88,13 @@ def replay(pwm_csv: str, out: str, vehicle_name: str | None, ground: bool, max_s
         raise InputError(
             f"{vehicle_name}: replay flies one vehicle and writes its states: give one value per field, not a list"
         )
-    if ground and not isinstance(vehicle, RotorVehicle):
+    if ground and not replay_plant(vehicle).takes_speeds:
         raise InputError(
-            "option '--ground': the paper's plant has no ground: give a rotor-plant --vehicle "
-            "(crazyflie, hummingbird, iris or a file)"
+            f"option '--ground': the paper's plant has no ground: give a rotor-plant --vehicle ({ROTOR_VEHICLES})"
         )
-
-    if isinstance(vehicle, RotorVehicle):
-        schedule = workflow.read_rotor_csv(pwm_csv, vehicle, progress=Bar(f"reading {pwm_csv}", unit="row"))
-        result = workflow.replay_rotors(
-            schedule,
-            vehicle,
-            max_step=workflow.ROTOR_MAX_STEP if max_step is None else max_step,
-            ground=ground,
-            progress=Bar("flying", unit="row"),
-        )
-        workflow.write_rotor_states_csv(result, out)
-    else:
-        schedule = workflow.read_duty_csv(pwm_csv, progress=Bar(f"reading {pwm_csv}", unit="row"))
-        result = workflow.replay(
-            schedule, vehicle, max_step=1e-3 if max_step is None else max_step, progress=Bar("flying", unit="row")
-        )
-        workflow.write_states_csv(result, out, progress=Bar(f"writing {out}", unit="row"))
+    schedule = read_commands(pwm_csv, vehicle, progress=Bar(f"reading {pwm_csv}", unit="row"))
+    result = fly_open_loop(schedule, vehicle, max_step=max_step, ground=ground, progress=Bar("flying", unit="row"))
+    write_states_csv(result, out, progress=Bar(f"writing {out}", unit="row"))
     click.echo(
         f"wrote {len(result.t)} states to {out} "
         f"(t = {result.t[0]:g} .. {result.t[-1]:g} s, final z = {result.final_state[0, 2]:.4f} m)"

@@ -140,9 +140,8 @@ class QuadVectorEnv(VectorEnv):
         limits: Limits | None = None,
         scales: dict | None = None,
     ) -> None:
-        if not (isinstance(num_envs, (int, np.integer)) and num_envs >= 1):
-            raise InputError(f"num_envs must be a whole number >= 1, got {checks.describe(num_envs)}")
         w = "make()"  # gymnasium.make and make_vec hand their keywords here: each checked before any work
+        checks.whole(w, "num_envs", num_envs, 1)
         checks.instance(w, "action", action, str, optional=False, want=f"one of {', '.join(ACTION_CONTROLLERS)}")
         checks.number(w, "dt", dt, "pos", unit="s")
         checks.number(w, "max_step", max_step, "pos", unit="s", optional=True)
@@ -151,10 +150,12 @@ class QuadVectorEnv(VectorEnv):
         checks.instance(w, "scales", scales, dict, want="a dict of action scales (control.setpoint.DEFAULT_SCALES)")
         if action not in ACTION_CONTROLLERS:
             raise InputError(f"unknown action mode {action!r}; valid: {', '.join(ACTION_CONTROLLERS)}")
-        if population is not None and not isinstance(population, Population):
-            raise InputError(f"population must be a quadcruise Population, got {type(population).__name__}")
-        if not (isinstance(max_track_error, (int, float)) and max_track_error > 0):
-            raise InputError(f"max_track_error must be a positive number [m], got {checks.describe(max_track_error)}")
+        checks.instance(w, "population", population, Population)
+        checks.instance(w, "mission", mission, (Mission, str), optional=False, want="a Mission or a mission's name")
+        checks.instance(
+            w, "vehicle", vehicle, (Vehicle, RotorVehicle, str), want="a Vehicle, a RotorVehicle or a preset's name"
+        )
+        checks.number(w, "max_track_error", max_track_error, "pos", unit="m", infinite=True)
         n = self.num_envs = int(num_envs)
         self.random_mission = isinstance(mission, str) and mission.strip().lower() == "random"
         self.mission = (
@@ -171,7 +172,7 @@ class QuadVectorEnv(VectorEnv):
             )
         self.rotor = isinstance(self.nominal, RotorVehicle)
         # the paper vehicle the controllers believe: the rotor vehicle's "+" equivalent
-        self.nominal_eq = paper_equivalent(self.nominal) if self.rotor else self.nominal
+        self.nominal_eq = paper_equivalent(self.nominal)
         if self.nominal_eq.batch_size is not None:
             raise InputError("the environment's vehicle must not be batched: use a population to vary it")
         check_can_hover(self.nominal_eq)
@@ -184,7 +185,7 @@ class QuadVectorEnv(VectorEnv):
         grid = time_grid(self.duration, float(dt))
         if self.rotor and isinstance(controller, str):  # gains designed for the vehicle, as fly does
             controller = designed_controller(controller, self.nominal_eq.omega)
-        self.baseline = None if controller is None else as_controller(controller)
+        self.baseline = None if controller is None else as_controller(controller, w)
         try:
             gains = setpoint_gains(**(scales or {}))
         except ValueError as err:
@@ -417,7 +418,7 @@ class QuadVectorEnv(VectorEnv):
         return self._obs.copy(), reward, terminated, truncated, info
 
 
-class _MadeArgumentTypeError(ArgumentTypeError):
+class MakeArgumentTypeError(ArgumentTypeError):
     """An argument of the wrong type to ``gymnasium.make``: its one line kept whole.
 
     ``gymnasium.make`` raises a ``TypeError`` from an environment's constructor again as
@@ -448,7 +449,7 @@ class QuadEnv(gymnasium.Env):
         try:
             self.vec = QuadVectorEnv(1, **kwargs)
         except ArgumentTypeError as exc:
-            raise _MadeArgumentTypeError(str(exc)) from None
+            raise MakeArgumentTypeError(str(exc)) from None
         self.action_space = self.vec.single_action_space
         self.observation_space = self.vec.single_observation_space
         self._ended: str | None = "has not begun"  # why step needs a reset first, or None

@@ -35,6 +35,9 @@ Examples
 >>> eq = paper_equivalent(RotorVehicle.preset("iris"))
 >>> round(eq.K, 3), eq.omega, round(eq.d, 4), round(eq.l, 4)
 (7.066, 40.0, 0.06, 0.247)
+>>> from quadcruise.model.vehicle import Vehicle
+>>> paper_equivalent(Vehicle.paper()) is Vehicle.paper()
+True
 """
 
 from __future__ import annotations
@@ -48,13 +51,15 @@ from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 
 
-def paper_equivalent(vehicle: RotorVehicle) -> Vehicle:
-    """The paper-plant vehicle a controller believes for a rotor-plant vehicle (the module's rules).
+def paper_equivalent(vehicle: RotorVehicle | Vehicle) -> Vehicle:
+    """The paper-plant vehicle a controller believes for a vehicle (the module's rules): a
+    rotor-plant vehicle's "+" equivalent, or a paper vehicle itself.
 
     Parameters
     ----------
-    vehicle : RotorVehicle
-        The rotor-plant vehicle.
+    vehicle : RotorVehicle or Vehicle
+        The vehicle; a :class:`~quadcruise.model.vehicle.Vehicle` (the paper's plant) is
+        returned as given, so that a caller need not ask which plant it has.
 
     Returns
     -------
@@ -68,6 +73,8 @@ def paper_equivalent(vehicle: RotorVehicle) -> Vehicle:
     InputError
         A vehicle whose equivalent cannot be (km = 0 gives d = 0: no yaw moment).
     """
+    if isinstance(vehicle, Vehicle):
+        return vehicle
     arm = float(np.mean([math.hypot(x, y) for x, y, _, _ in vehicle.rotors]))
     return Vehicle(
         m=vehicle.m,

@@ -131,6 +131,10 @@ class Population:
         Relative standard deviation of a rotor-plant vehicle's aerodynamic coefficients: one
         factor for c_Dx, c_Dy, c_Dz, another for k_d, k_z, k_h, k_flap. The paper's vehicle
         has none to spread (a sweep of it refuses a value > 0).
+    identified : Identified, optional
+        Parameters identified from a log, each vehicle's drawn from their estimate and
+        covariance (:mod:`quadcruise.montecarlo.identified`; :meth:`from_identification`),
+        instead of the nominal's; a spread of the same field is refused.
 
     Raises
     ------
@@ -147,7 +151,7 @@ class Population:
     >>> Population(mass_spread=-0.1)
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: population field 'mass_spread' must be a number >= 0, got -0.1
+    quadcruise.errors.InputError: population field 'mass_spread' must be a number >= 0, got float -0.1
     """
 
     mass_spread: float = 0.0
@@ -162,6 +166,34 @@ class Population:
     noise: Any = None
     model_error: bool = True
     aero_spread: float = 0.0
+    identified: Any = None
+
+    @classmethod
+    def from_identification(cls, source, **fields) -> Population:
+        """The vehicles a log is consistent with: each identified parameter drawn from its
+        estimate and covariance (:mod:`quadcruise.montecarlo.identified`).
+
+        Parameters
+        ----------
+        source : str or os.PathLike
+            ``identify.json``, or the folder ``quadcruise identify --out`` wrote.
+        **fields
+            The population's other fields (an offset, wind, noise, a spread of a field not identified).
+
+        Returns
+        -------
+        Population
+
+        Examples
+        --------
+        >>> Population.from_identification("missing/identify.json")
+        Traceback (most recent call last):
+            ...
+        quadcruise.errors.InputError: missing/identify.json: no such file (an identification is the ...
+        """
+        from quadcruise.montecarlo.identified import Identified
+
+        return cls(identified=Identified.read(source), **fields)
 
     def __post_init__(self) -> None:
         if self.distribution not in CLIP:
@@ -196,6 +228,20 @@ class Population:
             if np.ndim(self.noise.std_vector()) > 1:
                 raise InputError("the population's sensor noise must be the same for every vehicle")
         object.__setattr__(self, "model_error", bool(self.model_error))
+        if self.identified is not None:
+            from quadcruise.montecarlo.identified import Identified
+
+            if isinstance(self.identified, dict):  # as to_dict wrote it (a sweep's scenario.toml)
+                object.__setattr__(self, "identified", Identified.from_dict(self.identified))
+            if not isinstance(self.identified, Identified):
+                raise InputError("population field 'identified' must be an Identified or None")
+            for spread, names in ROTOR_SPREADS.items():
+                both = [n for n in names if n in self.identified.names]
+                if getattr(self, spread) > 0 and both:
+                    raise InputError(
+                        f"population field '{spread}' spreads {', '.join(both)}, which the identification "
+                        f"{self.identified.source} draws from its estimate: give one of them"
+                    )
 
     @property
     def needs_drag(self) -> bool:
@@ -305,7 +351,7 @@ class Population:
     @property
     def spreads_vehicle(self) -> bool:
         """True if a spread perturbs the vehicle's parameters (not only its start, wind or sensors)."""
-        return any(getattr(self, name) > 0 for name in ROTOR_SPREADS)
+        return self.identified is not None or any(getattr(self, name) > 0 for name in ROTOR_SPREADS)
 
     def draw(
         self,
@@ -351,13 +397,15 @@ class Population:
                 "the paper's vehicle has none (its drag comes with the wind)"
             )
         z = self.unit_draws(seed, first, count)
+        drawn = self._identified_draws(seed, first, count, nominal)
         cols: dict[str, np.ndarray] = {}
         if rotor:
-            vehicles, cols = self._rotor_vehicles(nominal, z)
+            vehicles, cols = self._rotor_vehicles(nominal, z, drawn)
         else:
             for spread, names in SPREADS.items():
                 for name in names:
                     cols[name] = getattr(nominal, name) * (1.0 + getattr(self, spread) * z[:, SLOTS[name]])
+            cols.update(drawn)
         offsets = self.offset * z[:, [SLOTS["dx0"], SLOTS["dy0"], SLOTS["dz0"]]]
         cols.update(dx0=offsets[:, 0], dy0=offsets[:, 1], dz0=offsets[:, 2])
         env = self.environment
@@ -382,8 +430,24 @@ class Population:
                 vehicles = nominal.replace(**{k: cols[k] for names in SPREADS.values() for k in names})
         return Draw(vehicle=vehicles, offsets=offsets, environment=env, sensors=self.noise, columns=cols)
 
-    def _rotor_vehicles(self, nominal: RotorVehicle, z: np.ndarray) -> tuple[tuple, dict]:
-        """The drawn rotor-plant vehicles (one per row of unit draws ``z``) and their table columns."""
+    def _identified_draws(self, seed: int, first, count: int, nominal) -> dict[str, np.ndarray]:
+        """The identified parameters drawn for vehicles first .. first + count - 1 (none: {})."""
+        if self.identified is None:
+            return {}
+        fields = {f.name for f in dataclasses.fields(nominal)}
+        foreign = [n for n in self.identified.names if n not in fields]
+        if foreign:
+            raise InputError(
+                f"the identification {self.identified.source} draws {', '.join(foreign)}, which the nominal "
+                f"{type(nominal).__name__} does not have: fly the vehicle it identified (its vehicle.toml)"
+            )
+        ids = int(first) + np.arange(count) if np.ndim(first) == 0 else np.ravel(first)
+        values = self.identified.draw(seed, ids)
+        return {name: values[:, j] for j, name in enumerate(self.identified.names)}
+
+    def _rotor_vehicles(self, nominal: RotorVehicle, z: np.ndarray, drawn: dict | None = None) -> tuple[tuple, dict]:
+        """The drawn rotor-plant vehicles (one per row of unit draws ``z``; ``drawn``: identified
+        fields' values) and their table columns."""
         factors = {}
         for spread, names in ROTOR_SPREADS.items():
             for name in names:
@@ -395,6 +459,7 @@ class Population:
                 if f[k] != 1.0:  # a field not spread keeps its very value
                     base = getattr(nominal, name)
                     changes[name] = float(base / f[k] if name.startswith("tau") else base * f[k])
+            changes.update({name: float(values[k]) for name, values in (drawn or {}).items()})
             vehicles.append(_drawn(nominal, changes))
         # the table's columns: the drawn vehicles' "+" equivalents (K, d) and motor bandwidth (omega)
         cols = {name: np.array([getattr(v, name) for v in vehicles]) for name in ("m", "Jxx", "Jyy", "Jzz")}
@@ -412,8 +477,10 @@ class Population:
             Field name -> value; the environment and the noise as their ``to_dict()``.
         """
         out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
-        for key in ("environment", "noise"):
+        for key in ("environment", "noise", "identified"):
             out[key] = None if out[key] is None else out[key].to_dict()
+        if out["identified"] is None:
+            del out["identified"]  # a population without one: its configuration (and hash) as before
         return out
 
 

@@ -27,7 +27,7 @@ from numba import njit
 
 from quadcruise import layout as L
 from quadcruise.model.plant import EULER_PITCH_LIMIT, derivative_at
-from quadcruise.sim.fastmath import TRIG_REFRESH, DirectCall, turned
+from quadcruise.sim.fastmath import TRIG_REFRESH, turned
 from quadcruise.sim.inputs import TRIG_WIDTH, Limits, batch_inputs, carry_width, fresh_carry, time_grid
 from quadcruise.sim.kernel_args import KERNEL_SIG, KernelArgs
 from quadcruise.sim.result import SimResult
@@ -435,24 +435,16 @@ def _kernel(
 
 
 def fly_vehicles(
-    n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD, after_piece=None, kernel=None
+    n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD, after_piece=None, threads=None
 ) -> None:
     """Fly vehicles 0..n-1 of the batch arrays in ``args`` with the kernel, on numba's threads.
 
     Parameters
     ----------
-    n, args, pieces_per_thread, after_piece
+    n, args, pieces_per_thread, after_piece, threads
         As in :func:`quadcruise.sim.threads.fly_in_pieces`.
-    kernel : DirectCall, optional
-        The kernel as :func:`direct_kernel` gives it; the kernel itself by default.
     """
-    fly_in_pieces(kernel or _kernel, n, args, pieces_per_thread, after_piece)
-
-
-def direct_kernel() -> DirectCall:
-    """The kernel for a caller that flies the same arrays call after call (a step-wise engine):
-    a :class:`~quadcruise.sim.fastmath.DirectCall` of it."""
-    return DirectCall(_kernel)
+    fly_in_pieces(_kernel, n, args, pieces_per_thread, after_piece, threads)
 
 
 def simulate(
@@ -617,7 +609,6 @@ def simulate(
 
 __all__ = [
     "Limits",
-    "direct_kernel",
     "fly_vehicles",
     "simulate",
     "time_grid",

@@ -27,11 +27,6 @@ rounding (the tests check it).
 - :func:`same_period`: the Dryden filters' coefficients are kept while the control period
   stays the same up to the grid's rounding. Plain: computed afresh every period.
 
-- :class:`DirectCall`: a kernel that a caller flies again and again with the same arrays (a
-  :class:`~quadcruise.sim.stepper.Stepper`'s step) is called through its compiled entry point,
-  once numba's dispatcher has checked those very arguments. Plain: ``kernel(first, stop,
-  *args)``, where the dispatcher types all 30-odd arguments at every call (about 40 us).
-
 - :func:`seed_sequence_words` and :func:`seeded_draws`: the words of
   ``numpy.random.SeedSequence([seed, i], spawn_key)`` computed for many ``i`` in one compiled
   call, NumPy's hashing restated, and a vehicle's draws taken from one reused PCG64 generator
@@ -66,7 +61,6 @@ from numba import njit
 from quadcruise.sim.rng import ziggurat
 
 __all__ = [
-    "DirectCall",
     "seed_sequence_words",
     "seeded_draws",
     "turned",
@@ -192,35 +186,6 @@ def same_period(cached, dt):
         True when they differ by at most ``DT_TOLERANCE`` relative.
     """
     return abs(cached - dt) <= DT_TOLERANCE * dt
-
-
-class DirectCall:
-    """``kernel(first, stop, *args)`` through the compiled entry point while ``args`` are the
-    very objects of the last call the dispatcher checked; through the dispatcher otherwise.
-
-    The entry point unboxes its arguments by the kernel's one signature without checking
-    their types, so it is taken only for the same objects (an array keeps its dtype and
-    layout, whatever is written into it); new objects go through the dispatcher, which
-    refuses a wrong type, and become the checked ones. Plain: ``kernel(first, stop, *args)``.
-
-    Parameters
-    ----------
-    kernel : numba Dispatcher
-        A kernel compiled for one explicit signature.
-    """
-
-    def __init__(self, kernel) -> None:
-        self.kernel = kernel
-        self.entry = kernel.overloads[kernel.signatures[0]].entry_point
-        self.checked: tuple = ()
-
-    def __call__(self, first: int, stop: int, *args) -> None:
-        checked = self.checked
-        if len(args) == len(checked) and all(a is b for a, b in zip(args, checked, strict=True)):
-            self.entry(first, stop, *args)
-            return
-        self.kernel(first, stop, *args)
-        self.checked = args
 
 
 # NumPy's SeedSequence (numpy/random/bit_generator.pyx), on 32-bit words held in uint64

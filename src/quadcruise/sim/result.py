@@ -4,7 +4,7 @@ configuration that produced them.
 Examples
 --------
 >>> import quadcruise as qc
->>> res = qc.replay(qc.DutySchedule(t=[0.0, 0.5], duties=[[0.0] * 4] * 2))
+>>> res = qc.replay(qc.CommandSchedule(t=[0.0, 0.5], duties=[[0.0] * 4] * 2))
 >>> res.n, res.ok.tolist(), res.status_text(0)
 (1, [True], 'finished')
 >>> round(float(res.state("z")[0, -1]), 4)   # free fall for 0.5 s: -g t^2 / 2

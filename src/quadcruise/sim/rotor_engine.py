@@ -201,7 +201,7 @@ def replay_rotor_speeds(
 ) -> RotorResult:
     """Fly N rotor-plant vehicles open loop through a schedule of rotor speeds.
 
-    The array-level entry point that :func:`quadcruise.workflows.replay.replay_rotors` builds on.
+    The array-level entry point that :func:`quadcruise.workflows.replay.replay` builds on.
 
     Parameters
     ----------

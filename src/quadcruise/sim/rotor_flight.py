@@ -40,7 +40,6 @@ from numba import njit, types
 from quadcruise import layout as L
 from quadcruise.model.rotor_plant import QW, QX, QY, QZ, ROTOR_W1, RP, RP_KF, RP_N_ROTORS, RP_W_MAX, RP_W_MIN, RX, RZ
 from quadcruise.sim.engine import beyond, blank_rows, log_row, put_row, still_air
-from quadcruise.sim.fastmath import DirectCall
 from quadcruise.sim.rng import next_normal
 from quadcruise.sim.rotor_engine import ROTOR_WORK_ROWS, ground_contact, rotor_rk4_step
 from quadcruise.sim.status import ExitStatus
@@ -431,7 +430,7 @@ def _rotor_flight_kernel(
 
 
 def fly_rotor_pieces(
-    n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD, after_piece=None, kernel=None
+    n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD, after_piece=None, threads=None
 ) -> None:
     """The rotor kernel over vehicles 0..n-1 on numba's number of threads, in ranges handed out in
     turn (as :func:`quadcruise.sim.engine.fly_vehicles` does for the paper's kernel); each
@@ -449,16 +448,10 @@ def fly_rotor_pieces(
     after_piece : callable, optional
         Called as ``after_piece(first, stop)`` on the thread that flew vehicles first..stop-1,
         right after it (as :func:`quadcruise.sim.engine.fly_vehicles` calls it).
-    kernel : DirectCall, optional
-        The kernel as :func:`direct_rotor_kernel` gives it; the kernel itself by default.
+    threads : int, optional
+        At most this many threads; numba's number by default.
     """
-    fly_in_pieces(kernel or _rotor_flight_kernel, n, args, pieces_per_thread, after_piece)
+    fly_in_pieces(_rotor_flight_kernel, n, args, pieces_per_thread, after_piece, threads)
 
 
-def direct_rotor_kernel() -> DirectCall:
-    """The rotor kernel for a caller that flies the same arrays call after call (a step-wise
-    engine): a :class:`~quadcruise.sim.fastmath.DirectCall` of it."""
-    return DirectCall(_rotor_flight_kernel)
-
-
-__all__ = ["direct_rotor_kernel", "fly_rotor_pieces", "paper_state", "paper_states", "rotor_carry_width"]
+__all__ = ["fly_rotor_pieces", "paper_state", "paper_states", "rotor_carry_width"]

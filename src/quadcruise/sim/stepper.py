@@ -23,7 +23,9 @@ from the first ``setpoint_width`` entries of its gains row (the action modes of
 
 Examples
 --------
->>> import numpy as np
+>>> import time
+
+import numpy as np
 >>> from quadcruise.workflows.stepwise import stepper
 >>> s = stepper("hover", "nlpd", duration=0.01, n=2)
 >>> s.step(); s.period.tolist(), s.status.tolist()
@@ -35,17 +37,16 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from numba import get_num_threads, set_num_threads
 
 from quadcruise.checks import describe
 from quadcruise.errors import InputError
 from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
-from quadcruise.sim.engine import direct_kernel, fly_vehicles, still_air
+from quadcruise.sim.engine import fly_vehicles, still_air
 from quadcruise.sim.inputs import Limits, batch_inputs, fresh_carry
 from quadcruise.sim.kernel_args import KernelArgs
 from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.rotor_batch import rotor_inputs
-from quadcruise.sim.rotor_flight import direct_rotor_kernel, fly_rotor_pieces, paper_states, rotor_carry_width
+from quadcruise.sim.rotor_flight import fly_rotor_pieces, paper_states, rotor_carry_width
 from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.threads import ThreadPlan
 
@@ -229,7 +230,6 @@ class Stepper:
         self.controller, self.mission = controller, mission
         self.disturbance = disturbance or still_air
         self.disturbed = disturbance is not None
-        self._kernel = direct_rotor_kernel() if self.rotor else direct_kernel()  # sim/fastmath.py
         self._plan = ThreadPlan()  # one thread or all, for a step without a watcher
 
     @property
@@ -376,21 +376,19 @@ class Stepper:
                 )
             self.gains[:, : self.setpoint_width] = c
         if after_piece is not None:  # a chunk of a long flight: numba's threads
-            self._fly(pieces_per_thread, after_piece)
+            self._fly(pieces_per_thread, after_piece, None)
             return
-        most, threads = get_num_threads(), self._plan.threads()
-        set_num_threads(threads)
+        threads = self._plan.threads()
         start = time.perf_counter()
         try:
-            self._fly(pieces_per_thread, None)
+            self._fly(pieces_per_thread, None, threads)
         finally:
             self._plan.record(threads, time.perf_counter() - start)
-            set_num_threads(most)
 
-    def _fly(self, pieces_per_thread: int, after_piece) -> None:
-        """One step through the plant's kernel, on numba's threads (as many as it is set to)."""
+    def _fly(self, pieces_per_thread: int, after_piece, threads) -> None:
+        """One step through the plant's kernel, on at most ``threads`` of numba's threads."""
         if self.rotor:
-            self._step_rotor(pieces_per_thread, after_piece)
+            self._step_rotor(pieces_per_thread, after_piece, threads)
             return
         fly_vehicles(
             self.n,
@@ -428,10 +426,10 @@ class Stepper:
             ),
             pieces_per_thread,
             after_piece,
-            self._kernel,
+            threads,
         )
 
-    def _step_rotor(self, pieces_per_thread: int, after_piece) -> None:
+    def _step_rotor(self, pieces_per_thread: int, after_piece, threads) -> None:
         """:meth:`step` of the rotor plant: its kernel, with the arguments of ``ROTOR_FLIGHT_SIG``."""
         fly_rotor_pieces(
             self.n,
@@ -474,7 +472,7 @@ class Stepper:
             ),
             pieces_per_thread,
             after_piece,
-            self._kernel,
+            threads,
         )
 
 

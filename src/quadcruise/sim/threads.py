@@ -49,7 +49,9 @@ def _helpers() -> ThreadPoolExecutor:
         return _pool
 
 
-def fly_in_pieces(kernel, n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD, after_piece=None) -> None:
+def fly_in_pieces(
+    kernel, n: int, args: tuple, pieces_per_thread: int = PIECES_PER_THREAD, after_piece=None, threads=None
+) -> None:
     """Run ``kernel(first, stop, *args)`` over vehicles 0..n-1, on numba's number of threads
     (``numba.get_num_threads()``): one range on this thread when that is 1 or n is 1, else
     ``pieces_per_thread`` ranges per thread, handed out in turn.
@@ -71,8 +73,10 @@ def fly_in_pieces(kernel, n: int, args: tuple, pieces_per_thread: int = PIECES_P
     after_piece : callable, optional
         Called as ``after_piece(first, stop)`` on the thread that flew vehicles first..stop-1,
         right after it (their rows still in its cache).
+    threads : int, optional
+        At most this many threads; numba's number by default.
     """
-    threads = min(n, get_num_threads())
+    threads = min(n, get_num_threads() if threads is None else threads)
     if threads <= 1:
         kernel(0, n, *args)
         if after_piece is not None:

@@ -212,6 +212,7 @@ def identify(
         mass,
         flight.n_rotors,
         g,
+        covariance=(joint := {}),
         systematic=_sensitivity(
             flight, force_z, fit_rows, rotors, result, mass, g, cmd_hz, bounds, coupling, hold, lag_of
         ),
@@ -297,6 +298,14 @@ def identify(
     verdict = paper_verdict(flight, sig, fit_rows, held, rotors, result, mass, g, cmd_hz, log_rates(flight))
     if not verdict["fits"]:
         table = withhold(table, verdict)
+    # the joint covariance of what is reported with an interval (montecarlo --population draws from it)
+    listed = [n for n in joint.get("names", []) if n in table and table[n]["identifiable"]]
+    if listed and rotor_base is None:
+        pick = [joint["names"].index(n) for n in listed]
+        full = np.asarray(joint["matrix"])
+        joint = {"names": listed, "matrix": full[np.ix_(pick, pick)].tolist()}
+    else:
+        joint = None
     report(5, len(STAGES), STAGES[4])
     result = IdentifyResult(
         verdict=verdict,
@@ -321,6 +330,7 @@ def identify(
             "commands_are": "relative thrust" if meaning == "thrust" else f"signal (thrust curve f = {f0:g})",
             "residual_std": result.sigma,
             "coefficients": dict(zip(result.names, result.values.tolist(), strict=False)),
+            "covariance": joint,
         },
         base=base,
         mass=mass,

@@ -91,6 +91,8 @@ def rotor_table(parameters: dict, base, mass_given: bool) -> dict:
     for name in ("tau_up", "tau_down"):
         row = dict(omega_row, unit="s")
         row["value"] = 1.0 / omega_row["value"]
+        if "estimate" in omega_row:
+            row["estimate"] = 1.0 / omega_row["estimate"]
         if omega_row["identifiable"]:
             lo, hi = omega_row["ci95"]
             row["ci95"] = [1.0 / hi, 1.0 / lo]

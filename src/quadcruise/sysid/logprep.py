@@ -91,7 +91,8 @@ def command_hold(flight: FlightLog, cmd_hz: float) -> str:
 
     Every command is in the log when PX4's system-identification logging profile wrote it
     (``SDLOG_PROFILE`` bit :data:`SYSID_PROFILE_BIT`: the actuator commands at the rate the rate
-    controller publishes them) and the commands come at the rate of the grid (the body rates').
+    controller publishes them), or the log says its control rate (:func:`log_rates`) and the
+    commands come at it, and the commands come at the rate of the grid (the body rates').
     A log that samples its commands more slowly (PX4's default profile) says only where they
     passed, and a line between the samples is the better guess.
 
@@ -116,7 +117,9 @@ def command_hold(flight: FlightLog, cmd_hz: float) -> str:
     """
     profile = int(flight.parameters.get("SDLOG_PROFILE", 0) or 0)
     grid_hz = 1.0 / float(np.median(np.diff(flight.t))) if len(flight.t) > 1 else 0.0
-    return "zero" if profile & SYSID_PROFILE_BIT and cmd_hz >= 0.9 * grid_hz else "linear"
+    control = log_rates(flight).get("quadcruise_control_rate_hz")
+    every = profile & SYSID_PROFILE_BIT or (control is not None and cmd_hz >= 0.9 * float(control))
+    return "zero" if every and cmd_hz >= 0.9 * grid_hz else "linear"
 
 
 def command_rate(flight: FlightLog) -> float:

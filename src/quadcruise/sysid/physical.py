@@ -51,8 +51,8 @@ def mapping(fit: Fit, mass: float | None, n_rotors: int, g: float, jzz_weights: 
     def phys(v: np.ndarray) -> dict:
         if "KQ" in idx:
             kl, kq = v[idx["KL"]], v[idx["KQ"]]
-        else:  # f fixed: the hover command is the logged command's (the signal's), not the thrust's
-            kl, kq = v[idx["Km"]] * (1.0 - fit.shape_f), v[idx["Km"]] * fit.shape_f
+        else:  # f fixed: the regressor is the relative thrust s(u), and so is the hover command
+            kl, kq = v[idx["Km"]], 0.0
         km = kl + kq
         jxx, jyy = km / v[idx["b_roll"]], km / v[idx["b_pitch"]]
         jzz = w1 * (jyy - v[idx["k1"]] * jxx) + w2 * (jxx + v[idx["k3"]] * jyy)
@@ -100,12 +100,16 @@ def parameters(
     g: float,
     systematic: dict[str, float] | None = None,
     coupling: tuple[bool, bool] = (True, True),
+    covariance: dict | None = None,
 ) -> dict[str, dict]:
     """The physical parameters: name -> ``{"value", "se", "ci95": [lo, hi], "identifiable"}``.
 
     ``systematic`` adds a uniform error's variance (half-range^2 / 3) per name; ``coupling`` says
     whether roll's and pitch's gyroscopic terms may give Jzz (one whose regressor is mostly sensor
-    noise is biased toward zero and must not).
+    noise is biased toward zero and must not). ``covariance``, a dict, is filled with the
+    identifiable parameters' joint covariance, ``{"names": [...], "matrix": [[...]]}``: the delta
+    method's, plus each systematic term's variance on the diagonal (its diagonal is each interval's
+    standard error squared).
     """
     # Jzz's two estimates, weighted by their inverse variances
     est, jzz, rows = [], [], []
@@ -156,4 +160,10 @@ def parameters(
                 f"(more than {CONSISTENCY_SIGMAS:g} standard errors apart): the log does not "
                 "fit the model there (commands changing faster than logged, a missing term)"
             )
+    if covariance is not None:
+        keep = [i for i, name in enumerate(names) if out[name]["identifiable"]]
+        matrix = cov[np.ix_(keep, keep)].copy()
+        for j, i in enumerate(keep):
+            matrix[j, j] = out[names[i]]["se"] ** 2
+        covariance.update(names=[names[i] for i in keep], matrix=matrix.tolist())
     return out

@@ -157,7 +157,8 @@ class IdentifyResult:
                 "held_out": "held out",
                 "white": "white residuals",
                 "segments": "segments agree",
-                "commands": "every command seen",
+                "commands": "the commands all logged or unchanged between samples",
+                "structure": "its lag fits better than the other",
             }
             checks = self.verdict.get("checks", {})
             if checks.get("commands", {}).get("control_hz", 0) is None:
@@ -318,8 +319,9 @@ class IdentifyResult:
         Returns
         -------
         dict
-            ``parameters``, ``hover_duty``, ``mass_kg``, ``per_unit_mass``, ``validation``,
-            ``log``, ``fit``, ``command``.
+            ``verdict`` (and its reasons and checks), ``covariance`` (the identified parameters'
+            joint covariance, ``{"names", "matrix"}``, or None), ``parameters``, ``hover_duty``,
+            ``mass_kg``, ``per_unit_mass``, ``validation``, ``log``, ``fit``, ``command``.
         """
         from quadcruise.io.plainjson import plain
 
@@ -328,6 +330,7 @@ class IdentifyResult:
                 "verdict": self.verdict.get("verdict"),
                 "verdict_reasons": self.verdict.get("reasons", []),
                 "verdict_checks": self.verdict.get("checks", {}),
+                "covariance": self.fit.get("covariance") if self.fits else None,
                 "parameters": {k: {kk: vv for kk, vv in v.items()} for k, v in self.parameters.items()},
                 "hover_duty": self.hover_duty,
                 "mass_kg": self.mass,

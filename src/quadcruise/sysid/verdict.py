@@ -2,12 +2,13 @@
 
 An interval is only as good as the model it is computed in: a wrong structure (a rotor plant read
 as the paper's, a missing term) or commands the log did not see (a log that samples them) give
-tight intervals around a wrong value. Four checks, each able to fail on its own
+tight intervals around a wrong value. Five checks, each able to fail on its own
 (docs/identify.md, "The verdict"):
 
 - **every command seen**: the commands are logged at the rate the controller computed them
-  (PX4's ``IMU_GYRO_RATEMAX``, the rate loop's rate, or the rate the writer recorded); a log that
-  samples them leaves the commands between samples unknown, not held;
+  (PX4's ``IMU_GYRO_RATEMAX``, the rate loop's rate, or the rate the writer recorded), or do not
+  change between samples (:data:`STILL_SHARE`: an open-loop schedule of steps); a log that samples
+  changing commands leaves the commands between samples unknown, not held;
 - **held out**: each equation's residual on the held-out tail, against its residual in the fit:
   mean square at most :data:`MAX_HELD_RATIO` times the fitted one (a model that holds predicts
   data it was not fitted on as well as the data it was);
@@ -15,10 +16,15 @@ tight intervals around a wrong value. Four checks, each able to fail on its own
   (:data:`WHITE_LAG_WINDOWS` filter windows), under :data:`MAX_LATE_ACF` (what the filter and
   sensor noise leave is short; an unmodelled dynamic leaves a long tail);
 - **segments agree**: the parameters fitted on the first and second half of the fitted time apart
-  by at most :data:`MAX_SEGMENT_Z` standard errors of their difference.
+  by at most :data:`MAX_SEGMENT_Z` standard errors of their difference;
+- **structure**: the other lag structure (a rotor's speed lagging and its thrust the square, or
+  the paper's thrust lagging) fitted to the same rows leaves no equation's residual variance
+  :data:`BETTER_STRUCTURE` lower (the paper's plant on a rotor vehicle's log, or the reverse).
 """
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 
@@ -31,8 +37,12 @@ WHITE_LAG_WINDOWS = 4
 """Filter windows past which the residuals' autocorrelation is judged."""
 MAX_LATE_ACF = 0.5
 """The largest autocorrelation allowed past :data:`WHITE_LAG_WINDOWS` filter windows."""
-MAX_SEGMENT_Z = 4.0
+MAX_SEGMENT_Z = 5.0
 """Standard errors of their difference by which two halves' estimates may differ."""
+BETTER_STRUCTURE = 0.3
+"""How much lower (a share) the other lag structure's residual variance must be to fail the model."""
+STILL_SHARE = 0.95
+"""The least share of unchanged consecutive commands for sampled commands to count as all seen."""
 SAMPLED_SHARE = 0.9
 """Commands logged below this share of the controller's rate are sampled, not all seen."""
 FITS = "fits"
@@ -195,22 +205,72 @@ def segment_check(first: dict, second: dict) -> dict:
     }
 
 
-def command_check(cmd_hz: float, control_hz: float | None) -> dict:
-    """Whether the log holds every command its controller computed.
+def command_check(cmd_hz: float, control_hz: float | None, still: float = 0.0) -> dict:
+    """Whether the log holds every command its controller computed, or commands that did not change
+    between its samples.
+
+    ``still`` is the share of consecutive logged commands that did not change at all (an open-loop
+    schedule of steps: what was not logged equals what was, but at its steps); at least
+    :data:`STILL_SHARE` passes however slowly they are logged.
 
     Examples
     --------
     >>> command_check(100.0, 1000.0)["ok"], command_check(1000.0, 1000.0)["ok"], command_check(250.0, None)["ok"]
     (False, True, True)
+    >>> command_check(250.0, 1000.0, still=0.99)["ok"]
+    True
     """
-    ok = control_hz is None or cmd_hz >= SAMPLED_SHARE * control_hz
+    ok = control_hz is None or cmd_hz >= SAMPLED_SHARE * control_hz or still >= STILL_SHARE
     return {
         "ok": bool(ok),
         "command_hz": cmd_hz,
         "control_hz": control_hz,
+        "unchanged_share": still,
         "why": f"the commands are logged at {cmd_hz:g} Hz and the controller computed them at "
-        f"{control_hz or 0:g} Hz: the commands between samples are unknown (log every command: PX4's "
-        "system-identification profile)",
+        f"{control_hz or 0:g} Hz, changing between samples ({100 * (1 - still):.0f} % of them): the commands "
+        "between samples are unknown (log every command: PX4's system-identification profile)",
+    }
+
+
+def unchanged_share(u: np.ndarray, segment: np.ndarray) -> float:
+    """The share of consecutive samples (within segments) whose commands did not change at all.
+
+    Examples
+    --------
+    >>> unchanged_share(np.array([[0.5], [0.5], [0.6], [0.6]]), np.zeros(4, int))
+    0.6666666666666666
+    """
+    if len(u) < 2:
+        return 0.0
+    same = np.all(u[1:] == u[:-1], axis=1) & (segment[1:] == segment[:-1])
+    pairs = int(np.sum(segment[1:] == segment[:-1]))
+    return float(np.sum(same)) / pairs if pairs else 0.0
+
+
+def structure_check(sigma: dict, other_sigma: dict, lag_of: str, other: str, y_var: dict | None = None) -> dict:
+    """Whether the other lag structure (a rotor's speed lagging, its thrust the square; or the
+    paper's thrust lagging) fits the log better: each equation's residual variance against the
+    model's; better by more than :data:`BETTER_STRUCTURE` on any equation fails.
+
+    Examples
+    --------
+    >>> structure_check({"thrust": 1.0}, {"thrust": 0.5}, "thrust", "speed")["ok"]
+    False
+    """
+    ratio = {c: (other_sigma[c] / sigma[c]) ** 2 for c in sigma if sigma[c] > 0}
+    dust = {c for c in ratio if y_var is not None and sigma[c] ** 2 <= NEGLIGIBLE * y_var.get(c, 0.0)}
+    bad = {c: r for c, r in ratio.items() if r < 1.0 - BETTER_STRUCTURE and c not in dust}
+    what = {
+        "speed": "the rotors' speed lagging (a rotor-plant vehicle: --vehicle iris, a file)",
+        "thrust": "the thrust lagging (the paper's plant: --vehicle paper)",
+    }
+    return {
+        "ok": not bad,
+        "variance_ratio": ratio,
+        "other": other,
+        "why": f"the log fits {what[other]} better than this model's {lag_of} lag: residual variance "
+        + ", ".join(f"{c} {100 * (1 - r):.0f} % lower" for c, r in bad.items())
+        + " (or neither is the vehicle's: unequal motor time constants, a missing term)",
     }
 
 
@@ -284,7 +344,20 @@ def paper_verdict(flight, sig, fit_rows, held, rotors, result, mass, g, cmd_hz, 
             found = {}
         halves.append({k: v for k, v in found.items() if v["identifiable"]})
     checks["segments"] = segment_check(*halves)
-    checks["commands"] = command_check(cmd_hz, control_rate(rates, rates))
+    checks["commands"] = command_check(cmd_hz, control_rate(rates, rates), unchanged_share(flight.u, flight.segment))
+    other = "speed" if sig.lag_of == "thrust" else "thrust"
+    alt = fit(
+        dataclasses.replace(sig, lag_of=other),
+        fit_rows,
+        rotors,
+        result.omega,
+        result.shape_f,
+        fit_omega=result.omega_fitted,
+        fit_shape=False,
+        omega_bounds=(0.5, min(500.0, 0.5 / sig.dt)),
+    )
+    y_var = {c: float(np.var(data[c][0][fit_rows])) for c in data}
+    checks["structure"] = structure_check(result.sigma, alt.sigma, sig.lag_of, other, y_var)
     return judge(checks)
 
 

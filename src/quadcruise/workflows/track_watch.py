@@ -434,7 +434,10 @@ def _moving_summary(live, ints, floats, flags, t, kept, held):
         settle = 1.0  # any finite value: settled within the head
         if kept < length and (e0 - floats[i, TAIL_MAX]) / (e0 - level) < line:
             settle = np.nan  # above the line in the second half: not converged
-        elif kept < 4 or kept >= length or not t[kept - 3] < held or not (e0 - floats[i, AFTER_MAX]) / scale < line:
+        elif kept < 4 or kept >= length or not t[kept - 3] + 1e-9 < held:  # too short a head to read its end
+            out[r] = AMBIGUOUS
+            continue
+        elif not (e0 - floats[i, AFTER_MAX]) / scale < line:  # the last instant above is before one beyond
             out[r] = AMBIGUOUS
             continue
         else:
@@ -449,7 +452,7 @@ def _moving_summary(live, ints, floats, flags, t, kept, held):
                 settle = t[k] + (line - zk) / (zk1 - zk) * (t[k + 1] - t[k]) - t[0]
                 if settle > held - t[0] + 1e-12:
                     settle = np.nan
-            # else last < kept - 3: settled by t[kept - 3] < held
+            # else last < kept - 3: settled by t[kept - 3], before the head's end (held)
         if np.isnan(settle):  # from the last instant
             out[r] = length - 1 if flags[i, OFF_AT_END] else -1
         else:  # settled after the head's last instant beyond: the second half's first
