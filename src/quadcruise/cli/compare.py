@@ -27,8 +27,10 @@ from quadcruise.cli.compare_run import (
     echo_population_comparison,
     population_from_options,
     population_record,
+    with_px4_params,
     write_comparison_ulogs,
 )
+from quadcruise.cli.objects import PARAMS_OPTION
 from quadcruise.cli.world import flight_world, note, world_options
 from quadcruise.io.files import check_output_dir
 
@@ -42,6 +44,7 @@ __all__ = ["compare"]
     help="Comma-separated controller names (default: the scenario's, else those declared compared: "
     "nlpd,gonzalez,se3,cascade and any of yours, docs/extending.md).",
 )
+@PARAMS_OPTION
 @click.option("--duration", type=SECONDS, help="Flight time [s] (default: the mission's).")
 @click.option("--dt", type=SECONDS, help="Control period [s] (default 0.001, or the scenario's).")
 @click.option(
@@ -89,6 +92,7 @@ __all__ = ["compare"]
 def compare(
     mission,
     controllers,
+    px4_params,
     duration,
     dt,
     mission_params,
@@ -117,6 +121,9 @@ def compare(
         of a waypoint CSV, flown as constant-speed legs.
     controllers : str
         ``--controllers``: comma-separated controller names.
+    px4_params : str or None
+        ``--params``: PX4's parameters (a log or a ``.params`` file) of the px4 controller
+        (:func:`~quadcruise.cli.compare_run.with_px4_params`; px4 is added when not named).
     duration : float or None
         ``--duration``: flight time [s]; None: the mission's.
     dt : float
@@ -172,6 +179,7 @@ def compare(
     world, notes = flight_world(
         vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind, turbulence=turbulence, scenario=scenario
     )
+    chosen = with_px4_params(chosen, px4_params, world)
     kwargs = {
         **{k: v for k, v in kwargs.items() if k not in world},
         **{k: v for k, v in world.items() if v is not None},

@@ -22,7 +22,7 @@ from quadcruise.cli.common import (
     writable_with,
 )
 from quadcruise.cli.fly_run import fly_and_report
-from quadcruise.cli.objects import controller_for_vehicle, flight_from_options
+from quadcruise.cli.objects import PARAMS_OPTION, controller_for_vehicle, controller_with_params, flight_from_options
 from quadcruise.cli.world import WORLD_OPTIONS, flight_world
 
 __all__ = ["fly"]
@@ -50,6 +50,7 @@ __all__ = ["fly"]
     metavar="KEY=VALUE",
     help="Controller parameter, e.g. -c max_tilt=0.5 (repeatable).",
 )
+@PARAMS_OPTION
 @click.option(
     "--poles",
     "position_poles",
@@ -89,6 +90,7 @@ def fly(
     max_step,
     mission_params,
     controller_params,
+    px4_params,
     position_poles,
     out,
     fmt,
@@ -136,6 +138,9 @@ def fly(
         scenario, they change its mission).
     controller_params : tuple of str
         ``-c``/``--controller-param``: the controller's parameters, each ``KEY=VALUE``.
+    px4_params : str or None
+        ``--params``: a PX4 log or QGroundControl ``.params`` file whose PX4 parameters the px4
+        controller flies (:func:`~quadcruise.cli.objects.controller_with_params`).
     position_poles : str or None
         ``--poles``: comma-separated closed-loop poles of the x/y loops [rad/s], e.g.
         ``-0.7,-4.3``; their PD gains replace the controller's position gains. None: not given.
@@ -201,14 +206,25 @@ def fly(
         + [f"-c {p}" for p in controller_params]
         + ([f"--controller {controller}"] if controller else [])
         + ([f"--poles {position_poles}"] if position_poles else [])
+        + ([f"--params {px4_params}"] if px4_params else [])
     )
     the_mission, the_controller, kwargs, scenario = flight_from_options(
-        mission, controller, mission_params, controller_params, position_poles, smooth
+        mission,
+        "px4" if px4_params and controller is None else controller,
+        mission_params,
+        () if px4_params else controller_params,
+        None if px4_params else position_poles,
+        smooth,
     )
     flown, notes = flight_world(**world, scenario=scenario)
-    the_controller = controller_for_vehicle(
-        the_controller, controller, controller_params, position_poles, flown, scenario
-    )
+    if px4_params:
+        the_controller = controller_with_params(
+            the_controller, controller, px4_params, controller_params, position_poles, flown
+        )
+    else:
+        the_controller = controller_for_vehicle(
+            the_controller, controller, controller_params, position_poles, flown, scenario
+        )
     kwargs = {
         **{k: v for k, v in kwargs.items() if k not in flown},
         **overrides,

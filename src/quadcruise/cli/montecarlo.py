@@ -9,6 +9,7 @@ import click
 
 from quadcruise.cli.common import SECONDS, friendly, writable
 from quadcruise.cli.montecarlo_run import montecarlo_command, parse_noise
+from quadcruise.cli.objects import PARAMS_OPTION
 from quadcruise.cli.world import world_options
 
 __all__ = ["montecarlo", "montecarlo_command", "parse_noise"]
@@ -20,6 +21,7 @@ __all__ = ["montecarlo", "montecarlo_command", "parse_noise"]
     help="Mission: a name, a waypoint CSV or a scenario file (as --scenario); default: the scenario's, else circle.",
 )
 @click.option("--controller", help="Controller name (default: the scenario's, else nlpd).")
+@PARAMS_OPTION
 @click.option("-n", "--n", "n", type=int, show_default="1000", help="Number of flights.")
 @click.option("--seed", type=int, show_default="0", help="Seed of every random draw.")
 @click.option("--duration", type=SECONDS, help="Flight time [s] (default: the mission's).")
@@ -113,6 +115,8 @@ def montecarlo(**options):
 
         mission, controller : str
             ``--mission``, ``--controller``: the mission's and the controller's names.
+        px4_params : str or None
+            ``--params``: PX4's parameters (a log or a ``.params`` file) flown by the px4 controller.
         n : int or None
             ``-n``/``--n``: number of flights.
         seed : int or None

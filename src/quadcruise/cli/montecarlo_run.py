@@ -51,6 +51,7 @@ def montecarlo_command(
     *,
     mission: str | None = None,
     controller: str | None = None,
+    px4_params: str | None = None,
     n: int | None = None,
     seed: int | None = None,
     duration: float | None = None,
@@ -138,6 +139,15 @@ def montecarlo_command(
         "--controller-vehicle",
         sc.controller_vehicle if sc is not None and sc.controller_vehicle else None,
     )
+    if px4_params is not None:  # --params: px4 with a file's PX4 parameters, on the vehicle it believes
+        from quadcruise.cli.objects import controller_with_params
+
+        world = {"vehicle": nominal, "controller_vehicle": believed}
+        if nominal is None and sc is None:
+            from quadcruise.model.vehicle import Vehicle as _PaperVehicle
+
+            world["vehicle"] = _PaperVehicle.paper()
+        controller = controller_with_params(None, controller, px4_params, (), None, world)
     environment = None
     if wind is not None or turbulence is not None:
         environment = environment_from_options(wind, turbulence, sc.environment if sc is not None else None)

@@ -3,11 +3,24 @@
 
 from __future__ import annotations
 
+import click
+
 from quadcruise.cli.vehicle import refuse_vehicle_fields
 from quadcruise.errors import InputError
 
+PARAMS_OPTION = click.option(
+    "--params",
+    "px4_params",
+    type=click.Path(dir_okay=False),
+    metavar="LOG.ulg|FILE.params",
+    help="PX4's parameters from a PX4 log or a QGroundControl file, flown by the px4 controller "
+    "(the default controller with this option); parameters the px4 controller does not use are listed once.",
+)
+
 __all__ = [
+    "PARAMS_OPTION",
     "controller_for_vehicle",
+    "controller_with_params",
     "controller_from_options",
     "controller_params",
     "flight_from_options",
@@ -89,6 +102,54 @@ def controller_for_vehicle(
         return controller
     designed = rotor_flight_setup(world["vehicle"], world.get("controller_vehicle"), name or controller.name)[1]
     return controller_from_options(None, params, poles_text, base=designed)
+
+
+def controller_with_params(controller, name: str | None, path: str | None, params, poles_text, world):
+    """``--params``: the px4 controller with a log's or a ``.params`` file's PX4 parameters.
+
+    Parameters
+    ----------
+    controller : Controller
+        The controller the other options made (returned as it is without ``path``).
+    name : str or None
+        ``--controller``: None or ``px4`` (another name is refused with ``--params``).
+    path : str or None
+        ``--params``.
+    params : tuple of str
+        ``-c KEY=VALUE``, applied over the controller read (its fields: ``position_rate``, ...).
+    poles_text : str or None
+        ``--poles`` (refused: the px4 controller has no PD position gains).
+    world : dict
+        :func:`quadcruise.cli.world.flight_world`'s: the controller's vehicle gives the rotor layout.
+
+    Returns
+    -------
+    Controller
+        :meth:`quadcruise.control.px4.Px4.from_params` of the file, for the vehicle the controller believes.
+
+    Raises
+    ------
+    InputError
+        Another controller named, ``--poles``, or a bad file (one line naming the file and parameter).
+    """
+    if path is None:
+        return controller
+    if name not in (None, "px4"):
+        raise InputError(f"--params sets PX4's parameters of the px4 controller; --controller {name} has none")
+    if poles_text is not None:
+        raise InputError("--poles: the px4 controller takes its position gains from --params (MPC_XY_P, ...)")
+    from quadcruise.control.px4 import Px4
+    from quadcruise.io.px4params import read_params
+
+    read = read_params(path)
+    believed = world.get("controller_vehicle") or world.get("vehicle")
+    px4 = Px4.from_params(read, vehicle=believed)
+    if read.unused:
+        names = ", ".join(read.unused)
+        click.echo(
+            f"note: {len(read.unused)} parameters of {path} are not used by the px4 controller: {names}", err=True
+        )
+    return controller_from_options(None, params, None, base=px4)
 
 
 def mission_from_options(text: str, params: tuple[str, ...], smooth: bool):

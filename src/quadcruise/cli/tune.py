@@ -9,6 +9,7 @@ import sys
 import click
 
 from quadcruise.cli.common import SECONDS, friendly, writable
+from quadcruise.cli.objects import PARAMS_OPTION
 from quadcruise.cli.tune_run import tune_command
 from quadcruise.cli.world import world_options
 
@@ -26,6 +27,7 @@ __all__ = ["tune"]
     help="Mission parameter, e.g. -m size=2 (repeatable).",
 )
 @click.option("--controller", help="Controller name (default: the scenario's, else nlpd).")
+@PARAMS_OPTION
 @click.option(
     "-c",
     "--controller-param",
@@ -123,6 +125,9 @@ def tune(**options):
             ``--controller``: the controller's name (a scenario's controller unless given).
         controller_params : tuple of str
             ``-c``: the controller's parameters, each ``KEY=VALUE``, kept during the search.
+        px4_params : str or None
+            ``--params``: PX4's parameters (a log or a ``.params`` file) of the px4 controller;
+            with px4, ``--out`` also writes ``tuned.params``.
         gains : str or None
             ``--gains``: the gains searched, comma-separated.
         bounds : tuple of str

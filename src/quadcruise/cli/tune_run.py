@@ -21,7 +21,7 @@ def command_line(mission: str, options: dict) -> str:
     >>> command_line("step", {"targets": ("rise_time_s=1",), "seed": 1, "quiet": True})
     'quadcruise tune step --target rise_time_s=1 --seed 1'
     """
-    flags = {"mission_params": "-m", "controller_params": "-c", "targets": "--target"}
+    flags = {"mission_params": "-m", "controller_params": "-c", "targets": "--target", "px4_params": "--params"}
     skip = {"out", "force", "quiet"}
     words = ["quadcruise", "tune", mission]
     for name, value in options.items():
@@ -52,6 +52,7 @@ def tune_command(
     mission_params: tuple = (),
     controller: str | None = None,
     controller_params: tuple = (),
+    px4_params: str | None = None,
     gains: str | None = None,
     bounds: tuple = (),
     targets: tuple = (),
@@ -81,7 +82,7 @@ def tune_command(
     """What ``quadcruise tune`` runs: build the tune, run it, print its progress and summary, write ``out``."""
     from quadcruise.cli.common import controller_from_options, mission_from_options
     from quadcruise.cli.montecarlo_run import parse_noise
-    from quadcruise.cli.objects import controller_for_vehicle
+    from quadcruise.cli.objects import controller_for_vehicle, controller_with_params
     from quadcruise.io.files import check_output_dir
     from quadcruise.montecarlo.population import Population
     from quadcruise.tune import tune
@@ -156,12 +157,18 @@ def tune_command(
         sensors = sensors if sensors is not None else sc.sensor_noise
     else:
         the_mission = mission_from_options(mission, mission_params, False)
-        the_controller = controller_from_options(controller, controller_params, None)
+        the_controller = controller_from_options(
+            controller or ("px4" if px4_params else None), () if px4_params else controller_params, None
+        )
     world, notes = flight_world(
         vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind, turbulence=turbulence, scenario=sc
     )
     rotor = isinstance(world["vehicle"], RotorVehicle)
-    the_controller = controller_for_vehicle(the_controller, controller, controller_params, None, world, sc)
+    if px4_params:
+        the_controller = controller_with_params(the_controller, controller, px4_params, controller_params, None, world)
+    else:
+        the_controller = controller_for_vehicle(the_controller, controller, controller_params, None, world, sc)
+    the_controller = as_px4_parameters(the_controller, world, bool(px4_params))
     wanted["gains"] = parse_gains(gains, the_controller)
     environment = world["environment"]
     if wind_spread > 0 and not rotor and not any("wind acts only through drag" in line for line in notes):
@@ -202,4 +209,58 @@ def tune_command(
     if out is not None:
         result.write(out, force=True)
         echo(f"wrote {out}: `quadcruise fly {out}/scenario.toml` flies the tuned gains")
+        if _px4_form(result.controller):
+            from pathlib import Path
+
+            from quadcruise.io.px4params import write_params
+
+            path = write_params(Path(out) / "tuned.params", result.controller.params, note=command_line(mission, given))
+            echo(
+                f"wrote {path}: `quadcruise fly MISSION --params {path}` (with the same vehicle) flies the tuned gains"
+            )
     return result
+
+
+def _px4_form(controller) -> bool:
+    """A px4 controller flying PX4's parameters as they are (what ``--params`` reads back)."""
+    return getattr(controller, "name", None) == "px4" and not (
+        controller.hover_from_vehicle or controller.rate_bandwidth > 0.0
+    )
+
+
+def as_px4_parameters(controller, world: dict, given: bool):
+    """A px4 controller on a rotor-plant vehicle (or from ``--params``) in PX4's parameter form: its
+    vehicle-dependent design written as PX4 parameters and the vehicle's rotors, exactly what
+    ``fly --params tuned.params`` builds, so the tuned file flies the tuned flight.
+
+    Parameters
+    ----------
+    controller : Controller
+        The controller to tune.
+    world : dict
+        :func:`quadcruise.cli.world.flight_world`'s.
+    given : bool
+        ``--params`` was given.
+
+    Returns
+    -------
+    Controller
+        ``controller`` itself unless it is px4 on a rotor-plant vehicle or from ``--params``.
+
+    Raises
+    ------
+    InputError
+        A design value outside PX4's range (PX4 could not fly it).
+    """
+    from quadcruise.model.equivalent import paper_equivalent
+    from quadcruise.model.rotor_vehicle import RotorVehicle
+
+    believed = world.get("controller_vehicle") or world.get("vehicle")
+    if getattr(controller, "name", None) != "px4" or not (given or isinstance(believed, RotorVehicle)):
+        return controller
+    if _px4_form(controller) and (given or controller.rotors):
+        return controller
+    from quadcruise.control.px4 import Px4
+
+    plain = controller.resolved(paper_equivalent(believed) if isinstance(believed, RotorVehicle) else believed)
+    return Px4.from_params(plain.params, vehicle=believed, position_rate=controller.position_rate)

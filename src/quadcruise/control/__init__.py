@@ -67,7 +67,7 @@ def controller_from_name(name: str, **params: Any) -> Controller:
     Parameters
     ----------
     name : str
-        A key of :data:`CONTROLLERS`: 'nlpd', 'gonzalez', 'se3', 'cascade', or one declared by
+        A key of :data:`CONTROLLERS`: 'nlpd', 'gonzalez', 'se3', 'cascade', 'px4', or one declared by
         :func:`~quadcruise.control.registry.register_controller`.
     **params : Any
         Parameters of that controller (its dataclass fields), in their units: gain sets
@@ -92,7 +92,7 @@ def controller_from_name(name: str, **params: Any) -> Controller:
     >>> controller_from_name("pid")
     Traceback (most recent call last):
         ...
-    quadcruise.errors.InputError: unknown controller 'pid'; choose one of nlpd, gonzalez, se3, cascade
+    quadcruise.errors.InputError: unknown controller 'pid'; choose one of nlpd, gonzalez, se3, cascade, px4
     """
     if name not in CONTROLLERS:
         raise InputError(f"unknown controller {name!r}; choose one of {', '.join(CONTROLLERS)}")

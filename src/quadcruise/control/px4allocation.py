@@ -129,7 +129,7 @@ def rotors_from_params(params) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.n
     return pos, axes, ct, km
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", error_model="numpy")
 def _gain(mix, col, sp, lo, hi, headroom):
     """``computeDesaturationGain`` along ``mix[:, col]``: the step that removes the saturation
     (the upper bounds raised by ``headroom`` times the range); rotors whose entry is under 0.2
@@ -152,12 +152,12 @@ def _gain(mix, col, sp, lo, hi, headroom):
     return k_min + k_max
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", error_model="numpy")
 def _desaturate(sp, mix, col, lo, hi, increase_only, headroom):
     """``desaturateActuators``: one full step, then half a step, along ``mix[:, col]``."""
     gain = _gain(mix, col, sp, lo, hi, headroom)
-    if increase_only and gain < 0.0:
-        return
+    if gain == 0.0 or (increase_only and gain < 0.0):
+        return  # nothing saturated: the half step would be 0 too
     for i in range(sp.size):
         sp[i] += gain * mix[i, col]
     gain = 0.5 * _gain(mix, col, sp, lo, hi, headroom)
@@ -165,7 +165,7 @@ def _desaturate(sp, mix, col, lo, hi, increase_only, headroom):
         sp[i] += gain * mix[i, col]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always", error_model="numpy")
 def _mix_yaw(sp, mix, control, lo, hi):
     for i in range(sp.size):
         sp[i] += mix[i, 2] * control[2]
@@ -173,11 +173,20 @@ def _mix_yaw(sp, mix, control, lo, hi):
     _desaturate(sp, mix, 5, lo, hi, True, 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def allocate_into(sp, mix, control, airmode, lo, hi):
     """:func:`allocate` written into ``sp`` (shape (n,)), allocating nothing: the compiled
     controller's form (:mod:`quadcruise.control.px4`)."""
     n = mix.shape[0]
+    inside = True  # every rotor within its range with all six axes mixed: no step would move it
+    for i in range(n):
+        v = 0.0
+        for j in (0, 1, 2, 3, 4, 5) if airmode == 2 else (0, 1, 3, 4, 5, 2):  # the slow path's order
+            v += mix[i, j] * control[j]
+        sp[i] = v
+        inside = inside and lo[i] <= v <= hi[i]
+    if inside:
+        return
     for i in range(n):
         sp[i] = 0.0
     if airmode == 2:

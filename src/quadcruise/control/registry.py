@@ -302,6 +302,17 @@ def _cascade_design(w: float) -> dict[str, Any]:
     return {"rate": rate_pid_design(w), "yaw_rate": rate_pid_design(w, yaw=True)}
 
 
+def _px4_design(w: float) -> dict[str, Any]:
+    """PX4's defaults on a rotor-plant vehicle: the rate gains designed for its lag, the hover
+    thrust from its weight (``MPC_THR_MIN`` at most half of it), its thrust per command u^2
+    (speed u w_max) and PX4's thrust model matched to it (``THR_MDL_FAC`` = 1)
+    (:mod:`quadcruise.control.px4`)."""
+    from quadcruise.io.px4params import Px4Parameters
+
+    params = Px4Parameters.defaults().with_values(THR_MDL_FAC=1.0)
+    return {"params": params, "rate_bandwidth": w, "hover_from_vehicle": True, "thrust_curve": 1.0}
+
+
 for _name, _cls, _design in (
     ("nlpd", "quadcruise.control.position:NLPD", _pid_design),
     ("gonzalez", "quadcruise.control.baselines:Gonzalez", _pid_design),
@@ -309,3 +320,4 @@ for _name, _cls, _design in (
     ("cascade", "quadcruise.control.cascade:Cascade", _cascade_design),
 ):
     register_controller(_name, _cls, rotor_design=_design, baseline=True, compared=True)
+register_controller("px4", "quadcruise.control.px4:Px4", rotor_design=_px4_design)

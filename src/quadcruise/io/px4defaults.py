@@ -104,6 +104,8 @@ _TABLE = {
     # sensors/vehicle_angular_velocity/imu_gyro_parameters.c
     "IMU_GYRO_CUTOFF": Px4Param(40.0, "Hz", 0.0, 1000.0, FLOAT, "filters"),
     "IMU_DGYRO_CUTOFF": Px4Param(30.0, "Hz", 0.0, 1000.0, FLOAT, "filters"),
+    # sensors/vehicle_imu/imu_parameters.c: the rate of the integrated IMU, hence of EKF2's attitude
+    "IMU_INTEG_RATE": Px4Param(200, "Hz", 100, 1000, INT32, "attitude"),
     # control_allocator/module.yaml, lib/mixer_module/params.c
     "MC_AIRMODE": Px4Param(0, "", 0, 2, INT32, "allocation"),
     "THR_MDL_FAC": Px4Param(0.0, "", 0.0, 1.0, FLOAT, "allocation"),

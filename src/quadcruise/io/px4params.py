@@ -81,6 +81,38 @@ class Px4Parameters(Mapping):
     def __len__(self) -> int:
         return len(self.values)
 
+    def unit_of(self, name: str) -> str:
+        """PX4's unit of a parameter ("-" where PX4 gives none).
+
+        Parameters
+        ----------
+        name : str
+            A parameter the loops use.
+
+        Returns
+        -------
+        str
+        """
+        return PX4_PARAMETERS[name].unit or "-"
+
+    def bounds_of(self, name: str) -> tuple[float, float, str]:
+        """PX4's range of a parameter, as a search's bounds are cut to it.
+
+        Parameters
+        ----------
+        name : str
+            A parameter the loops use.
+
+        Returns
+        -------
+        tuple
+            ``(low, high, "[]")``, infinite where PX4 declares no bound.
+        """
+        spec = PX4_PARAMETERS[name]
+        low = -math.inf if spec.minimum is None else float(spec.minimum)
+        high = math.inf if spec.maximum is None else float(spec.maximum)
+        return low, high, "[]"
+
     def with_values(self, **values: float) -> Px4Parameters:
         """A copy with ``values`` set, each checked against PX4's range.
 

@@ -94,7 +94,11 @@ def tunable_values(controller: Any) -> dict[str, tuple[float, str]]:
     out: dict[str, tuple[float, str]] = {}
     for f in dataclasses.fields(controller):
         value = getattr(controller, f.name)
-        if dataclasses.is_dataclass(value):
+        if isinstance(value, Mapping) and hasattr(value, "with_values"):  # px4's parameters, by PX4's names
+            for key, inner in value.items():
+                if _is_number(inner):
+                    out[f"{f.name}.{key}"] = (float(inner), value.unit_of(key))
+        elif dataclasses.is_dataclass(value):
             for g in dataclasses.fields(value):
                 inner = getattr(value, g.name)
                 if _is_number(inner):
@@ -118,10 +122,13 @@ def _within_range(base: Any, name: str, low: float, high: float) -> tuple[float,
     approached to a relative 1e-9, a closed one reached."""
     owner, _, leaf = name.rpartition(".")
     obj = getattr(base, owner) if owner else base
-    if not dataclasses.is_dataclass(obj):
+    if hasattr(obj, "bounds_of"):  # px4's parameters: PX4's range
+        limits = obj.bounds_of(leaf)
+    elif not dataclasses.is_dataclass(obj):
         return low, high
-    check = next((f.metadata.get("check") for f in dataclasses.fields(obj) if f.name == leaf), None)
-    limits = getattr(check, "bounds", None)
+    else:
+        check = next((f.metadata.get("check") for f in dataclasses.fields(obj) if f.name == leaf), None)
+        limits = getattr(check, "bounds", None)
     if limits is None:
         return low, high
     lo, hi, closed = limits
@@ -411,7 +418,11 @@ class GainSpace:
                 if set(changes) & set(POLE_NAMES):
                     pair = {**_pole_pair(inner), **changes}
                     changes = {"kp": pair["wn"] ** 2, "kd": 2.0 * pair["zeta"] * pair["wn"]}
-                top[owner] = dataclasses.replace(inner, **changes)
+                top[owner] = (
+                    inner.with_values(**changes)
+                    if hasattr(inner, "with_values")
+                    else dataclasses.replace(inner, **changes)
+                )
             out.append(dataclasses.replace(self.base, **top))
         return out
 

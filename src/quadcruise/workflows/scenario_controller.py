@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from typing import Any
 
 from quadcruise.control import CONTROLLERS, Controller
@@ -59,6 +60,8 @@ def controller_table(where: Where, table: dict) -> Controller:
             poles = _poles(where, key, value)
             design = pd_from_poles if len(poles) == 2 else pid_from_poles
             params[key[:-6]] = where.wrap(design, poles)
+        elif isinstance(getattr(defaults, key), (tuple, Mapping)):  # px4's rotors and params: its own checks
+            params[key] = value
         elif key in gain_fields:
             if not isinstance(value, dict):
                 raise where.error(f"'{key}' must be a table of gains, e.g. {{ kp = 3.01, kd = 5.0 }}")

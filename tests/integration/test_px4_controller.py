@@ -1,0 +1,289 @@
+"""The ``px4`` controller (PX4 v1.15's loops as an engine controller): it flies every preset's
+step and circle by name and the Iris with the SITL log's own parameters; its output, period by
+period, is PX4's pieces composed here independently (scipy's Butterworth for the gyro filter,
+px4loops' rate loop, px4allocation's allocate, the vehicle's own allocation matrix); the
+vehicle-dependent design written back as PX4 parameters flies the same flight; bad parameter
+geometry is refused in one line."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy import signal
+
+import quadcruise as qc
+from quadcruise import layout as L
+from quadcruise.control.px4 import Px4, px4_controller
+from quadcruise.control.px4allocation import allocate, mix_matrix
+from quadcruise.control.px4loops import G_THR_HOVER, ONE_G, rate_control
+from quadcruise.control.registry import rotor_gains
+from quadcruise.errors import InputError
+from quadcruise.model.allocation import allocation_matrix
+from quadcruise.model.equivalent import paper_equivalent
+from quadcruise.model.rotor_vehicle import RotorVehicle
+
+LOG = Path(__file__).parents[1] / "data" / "px4" / "sample_px4_events.ulg"
+PRESETS = ("iris", "crazyflie", "hummingbird", "qball-x4", "paper")
+
+
+@pytest.fixture(autouse=True)
+def _quiet():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        yield
+
+
+@pytest.mark.parametrize("vehicle", PRESETS)
+@pytest.mark.parametrize("mission", ["step", "circle"])
+def test_px4_flies_every_presets_step_and_circle(vehicle, mission):
+    res = qc.fly(mission, "px4", vehicle=vehicle, duration=10.0)
+    assert res.status_text() == "finished", res.status_text()
+    ref_end = res.references[0][-1, :3] if res.references.ndim == 3 else res.references[-1, :3]
+    assert np.abs(res.final_state[0, :3] - ref_end).max() < 0.2  # the circle's lag at its end: 0.07-0.13 m
+
+
+def test_px4_flies_the_iris_with_the_sitl_logs_parameters():
+    """PX4's parameters as the log has them (CA_ROTOR* of the SITL Iris, THR_MDL_FAC 0,
+    MPC_THR_HOVER 0.5): no hover-thrust estimator, so the Iris (u^2 thrust: hover at 0.73)
+    sags at first, then the velocity integral holds it."""
+    v = RotorVehicle.preset("iris")
+    c = Px4.from_params(LOG, vehicle=v)
+    assert c.params["CA_ROTOR_COUNT"] == 4 and c.params["MC_ROLLRATE_K"] == pytest.approx(1.05)
+    assert len(c.params.unused) > 500  # listed, not dropped
+    for mission in ("step", "circle"):
+        res = qc.fly(mission, c, vehicle=v, duration=10.0)
+        assert res.status_text() == "finished"
+        z = res.states[0][:, L.Z]
+        assert z.min() > 0.2 and abs(z[-1] - 1.0) < 0.05
+
+
+def _plus_wrench(cmd):
+    return cmd[L.CMD_THRUST], cmd[L.CMD_TAU_PHI], cmd[L.CMD_TAU_THETA], cmd[L.CMD_TAU_PSI]
+
+
+def test_the_controllers_rate_loop_is_px4loops_on_the_same_inputs():
+    """60 periods at 1 kHz, level on the reference (so the position and attitude loops ask for
+    zero rates), body rates varying: each period's wrench equals PX4's pieces composed here,
+    with the gyro filter from scipy and the vehicle's own rotor geometry."""
+    v = RotorVehicle.preset("iris")
+    eq = paper_equivalent(v)
+    c = Px4.from_params(LOG, vehicle=v)
+    vp, G, mem, cmd = eq.rows()[0], c.gains(), c.memory(), np.zeros(L.CMD_SIZE)
+    g = c.loop_gains(eq)
+    dt, n = 0.001, 60
+    t = np.arange(n) * dt
+    flu = np.column_stack([0.3 * np.sin(40 * t), -0.2 * np.cos(25 * t), 0.1 * np.sin(10 * t) + 0.05])
+    frd = flu * [1.0, -1.0, -1.0]
+    # the gyro filter: PX4's 2-pole Butterworth is scipy's butter at the same rate, settled at the first sample
+    b, a = signal.butter(2, c.params["IMU_GYRO_CUTOFF"], fs=1.0 / dt)
+    filtered = np.column_stack(
+        [signal.lfilter(b, a, frd[:, k], zi=signal.lfilter_zi(b, a) * frd[0, k])[0] for k in range(3)]
+    )
+    alpha = dt / (dt + 1.0 / (2 * math.pi * c.params["IMU_DGYRO_CUTOFF"]))
+    accel = np.zeros((n, 3))
+    for k in range(1, n):
+        accel[k] = accel[k - 1] + alpha * ((frd[k] - frd[k - 1]) / dt - accel[k - 1])
+    eff, _ = c.geometry()
+    mix, _ = mix_matrix(eff)
+    B = allocation_matrix(v)
+    full = v.kf * v.w_max**2
+    integ, sat = (0.0, 0.0, 0.0), (False, False, False)
+    hover = c.params["MPC_THR_HOVER"]
+    assert g[G_THR_HOVER] == hover
+    for k in range(n):
+        x = np.zeros(L.STATE_SIZE)
+        x[L.Z], x[L.P], x[L.Q], x[L.R] = 1.0, *flu[k]
+        ref = np.zeros(L.REF_SIZE)
+        ref[L.REF_Z] = 1.0
+        px4_controller(t[k], dt, x, ref, vp, G, mem, cmd)
+        torque, integ = rate_control(
+            tuple(filtered[k]), (0.0, 0.0, 0.0), tuple(accel[k]), dt, False, g, sat, sat, integ
+        )
+        # the position loop on the reference: the hover thrust (level, no integral yet)
+        sp = np.clip(allocate(mix, np.array([*torque, 0.0, 0.0, -hover]), 0, np.zeros(4), np.ones(4)), 0, 1)
+        f = full * sp**2 if c.params["THR_MDL_FAC"] == 0 else None  # THR_MDL_FAC 0: command = thrust; rotor thrust u^2
+        T, mx, my, mz = B @ f
+        got = _plus_wrench(cmd)
+        assert got[0] == pytest.approx(T, rel=1e-9)
+        assert got[1] == pytest.approx(mx / eq.l, abs=1e-9)
+        assert got[2] == pytest.approx(my / eq.l, abs=1e-9)
+        assert got[3] == pytest.approx(mz, abs=1e-9)
+    assert abs(integ[0]) > 0.0  # the integral took part
+    assert ONE_G > 9.8
+
+
+def test_a_wrong_rate_gain_is_seen_by_that_comparison():
+    """The other direction: twice MC_ROLLRATE_P changes the roll moment (so the comparison above can fail)."""
+    v = RotorVehicle.preset("iris")
+    eq = paper_equivalent(v)
+    outs = []
+    for p in (0.15, 0.3):
+        c = Px4.from_params({"MC_ROLLRATE_P": p}, vehicle=v)
+        x = np.zeros(L.STATE_SIZE)
+        x[L.Z], x[L.P] = 1.0, 0.3
+        ref = np.zeros(L.REF_SIZE)
+        ref[L.REF_Z] = 1.0
+        cmd = np.zeros(L.CMD_SIZE)
+        px4_controller(0.0, 0.001, x, ref, eq.rows()[0], c.gains(), c.memory(), cmd)
+        outs.append(cmd[L.CMD_TAU_PHI])
+    assert outs[0] < 0.0 and outs[1] == pytest.approx(2 * outs[0], rel=1e-6)
+
+
+def test_the_design_written_as_px4_parameters_flies_the_same_flight():
+    v = RotorVehicle.preset("iris")
+    eq = paper_equivalent(v)
+    designed = dataclasses.replace(Px4(), **rotor_gains("px4", eq.omega))
+    plain = designed.resolved(eq)
+    assert not plain.hover_from_vehicle and plain.rate_bandwidth == 0.0
+    assert plain.params["MC_ROLLRATE_K"] == 1.0 and 0.0 < plain.params["MC_ROLLRATE_P"] < 0.5
+    a = qc.fly("step", designed, vehicle=v, duration=4.0)
+    b = qc.fly("step", plain, vehicle=v, duration=4.0)
+    np.testing.assert_allclose(a.states, b.states, rtol=0, atol=1e-12)
+
+
+def test_a_geometry_that_is_not_the_vehicles_is_refused_in_one_line():
+    v = RotorVehicle.preset("iris")
+    with pytest.raises(InputError, match=r"CA_ROTOR_COUNT = 6, the vehicle has 4 rotors"):
+        Px4.from_params({"CA_ROTOR_COUNT": 6}, vehicle=v)
+    swapped = {"CA_ROTOR_COUNT": 4}
+    for i, (x, y, km) in enumerate([(1, -1, 0.05), (-1, -1, 0.05), (1, -1, -0.05), (-1, 1, -0.05)]):
+        swapped.update({f"CA_ROTOR{i}_PX": x, f"CA_ROTOR{i}_PY": y, f"CA_ROTOR{i}_KM": km})
+    with pytest.raises(InputError, match=r"CA_ROTOR0 .* is not the vehicle's rotor 1"):
+        Px4.from_params(swapped, vehicle=v)
+    with pytest.raises(InputError, match=r"MC_ROLL_P = 13"):
+        Px4.from_params({"MC_ROLL_P": 13}, vehicle=v)
+
+
+def test_a_2000_vehicle_batch_flies():
+    res = qc.fly("hover", "px4", vehicle="iris", n=2000, duration=2.0)
+    assert res.n == 2000 and all(s == 0 for s in np.asarray(res.status))
+
+
+def test_fly_params_flies_the_logs_parameters_and_lists_the_unused_once(tmp_path):
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    out = tmp_path / "f"
+    res = CliRunner().invoke(
+        main, ["fly", "step", "--controller", "px4", "--vehicle", "iris", "--params", str(LOG), "--out", str(out)]
+    )
+    assert res.exit_code == 0, res.output
+    assert res.stderr.count("not used by the px4 controller") == 1 and "BAT1_CAPACITY" in res.stderr
+    record = (out / "quadcruise.json").read_text()
+    assert "--params" in record and '"MC_ROLLRATE_K": 1.0499999523162842' in record
+    again = CliRunner().invoke(main, ["fly", str(out / "scenario.toml"), "--out", str(tmp_path / "g")])
+    assert again.exit_code == 0, again.output  # the folder's scenario flies the same flight
+    assert (tmp_path / "g" / "metrics.csv").read_text() == (out / "metrics.csv").read_text()
+
+
+@pytest.mark.parametrize(
+    ("text", "args", "message"),
+    [
+        ("1\t1\tMC_ROLL_P\t13\t9\n", [], "bad.params, line 1: MC_ROLL_P = 13 1/s is outside PX4 v1.15's range"),
+        ("1\t1\tMC_ROLL_P\tfast\t9\n", [], "bad.params, line 1"),
+        ("1\t1\tMC_ROLL_P\t7\t9\n", ["--controller", "se3"], "--controller se3 has none"),
+    ],
+)
+def test_fly_params_refuses_bad_input_in_one_line(tmp_path, text, args, message):
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    bad = tmp_path / "bad.params"
+    bad.write_text(text)
+    res = CliRunner().invoke(main, ["fly", "hover", "--vehicle", "iris", "--params", str(bad), *args])
+    assert res.exit_code == 2 and message in res.stderr and res.stderr.count("\n") == 1, res.stderr
+
+
+def test_tune_px4_writes_tuned_params_that_fly_the_tuned_metrics_exactly(tmp_path):
+    import csv
+
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+    from quadcruise.io.px4params import read_params
+
+    out = tmp_path / "t"
+    args = ["tune", "step", "--controller", "px4", "--vehicle", "iris", "--duration", "8", "--quiet"]
+    args += ["--gains", "params.MPC_XY_P,params.MPC_XY_VEL_P_ACC", "--target", "rise_time_s=1.2"]
+    res = CliRunner().invoke(main, [*args, "--budget", "3", "--popsize", "6", "--out", str(out)])
+    assert res.exit_code in (0, 1), res.output
+    tuned = read_params(out / "tuned.params")
+    doc = (out / "tuned.params").read_text()
+    assert "# PX4 v1.15" in doc and "MC_ROLL_P\t" not in doc  # only what differs from PX4's defaults
+    from quadcruise.workflows.scenario import load_scenario
+
+    values = load_scenario(out / "scenario.toml").controller.params  # the tuned controller, as the folder keeps it
+    assert dict(tuned) == dict(values)  # the round trip is exact, every parameter
+    assert tuned["MPC_XY_P"] != 0.95 and tuned["THR_MDL_FAC"] == 1.0
+    flown = tmp_path / "f"
+    again = CliRunner().invoke(
+        main,
+        ["fly", "step", "--vehicle", "iris", "--params", str(out / "tuned.params"), "--duration", "8"]
+        + ["--log-every", "10", "--out", str(flown)],
+    )
+    assert again.exit_code == 0, again.output
+    with open(out / "flights.csv") as f:
+        best = next(csv.DictReader(f))
+    with open(flown / "metrics.csv") as f:
+        got = next(csv.DictReader(f))
+    for name in ("rmse_m", "rise_time_s", "settling_time_s", "overshoot_pct", "effort"):
+        assert float(got[name]) == float(best[name]), name
+
+
+def test_px4s_parameters_are_searched_by_name_within_pxs_range():
+    from quadcruise.tune.space import GainSpace, tunable_values
+
+    assert tunable_values(Px4())["params.MC_ROLL_P"] == (6.5, "1/s")
+    space = GainSpace.build(Px4(), ["params.MC_ROLL_P", "params.MC_ROLLRATE_P"])
+    (roll, rate) = space.gains
+    assert (roll.low, roll.high) == (0.65, 12.0) and (rate.low, rate.high) == (0.015, 0.5)  # PX4's @max
+    c = space.controllers([[7.0, 0.2]])[0]
+    assert c.params["MC_ROLL_P"] == 7.0 and c.params["MC_ROLLRATE_P"] == 0.2
+
+
+def test_compare_params_flies_px4_with_the_logs_parameters_beside_the_others(tmp_path):
+    import csv
+
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    common = ["step", "--vehicle", "iris", "--params", str(LOG), "--duration", "6"]
+    res = CliRunner().invoke(
+        main, ["compare", *common[:1], "--controllers", "se3", *common[1:], "--out", str(tmp_path / "c")]
+    )
+    assert res.exit_code == 0, res.output
+    assert res.stderr.count("not used by the px4 controller") == 1
+    fly = CliRunner().invoke(main, ["fly", *common, "--out", str(tmp_path / "f")])
+    assert fly.exit_code == 0, fly.output
+    with open(tmp_path / "c" / "metrics.csv") as f:
+        rows = {r.get("controller") or r.get("label"): r for r in csv.DictReader(f)}
+    with open(tmp_path / "f" / "metrics.csv") as f:
+        alone = next(csv.DictReader(f))
+    assert set(rows) == {"se3", "px4"}  # px4 added beside the named ones
+    assert float(rows["px4"]["rise_time_s"]) == float(alone["rise_time_s"])
+
+
+def test_montecarlo_params_flies_px4_with_the_logs_parameters(tmp_path):
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    args = ["montecarlo", "--mission", "step", "--vehicle", "iris", "--params", str(LOG), "-n", "8"]
+    args += ["--duration", "6", "--mass-spread", "0.05", "--scheduler", "none"]
+    res = CliRunner().invoke(main, [*args, "--out", str(tmp_path / "m")])
+    assert res.exit_code == 0, res.output
+    assert res.stderr.count("not used by the px4 controller") == 1
+    record = (tmp_path / "m" / "quadcruise.json").read_text()
+    assert '"name": "px4"' in record and '"MC_ROLLRATE_K": 1.0499999523162842' in record
+    bad = tmp_path / "bad.params"
+    bad.write_text("1\t1\tMC_ROLL_P\t13\t9\n")
+    res = CliRunner().invoke(main, [*args[:6], str(bad), *args[7:], "--out", str(tmp_path / "n")])
+    assert res.exit_code == 2 and "MC_ROLL_P = 13" in res.stderr and not (tmp_path / "n").exists()
