@@ -65,7 +65,12 @@ def run_chunk(spec: MonteCarloSpec, first: int, count: int, threads: int | None 
     pure function of its arguments."""
     if threads is not None:
         import numba
+        from numba.core.config import reload_config
 
+        # numba reads NUMBA_NUM_THREADS when it is imported; a Dask worker's environment may have
+        # changed it since (its env= is applied after the worker started): read it again before
+        # the threads start, or a later compilation would find it changed and refuse
+        reload_config()
         numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
     res, draw = fly_chunk(spec, first, count)
     return reduce_chunk(spec, first, res, draw)
