@@ -73,7 +73,8 @@ def analyze(controller, controller_params, position_poles, dt, vehicle_text, out
     the_controller = controller_for_vehicle(
         the_controller, controller, controller_params, position_poles, {"vehicle": vehicle}, None
     )
-    vehicle = paper_equivalent(vehicle)  # a rotor-plant vehicle's "+" equivalent, a paper one as it is
+    if vehicle is not None:  # None: Table I's vehicle, as linearize() takes it
+        vehicle = paper_equivalent(vehicle)  # a rotor-plant vehicle's "+" equivalent, a paper one as it is
     if out is not None:
         check_output_dir(out, force)
     lin = linearize(the_controller, vehicle, dt=dt, progress=linearising)
