@@ -100,6 +100,8 @@ def test_a_log_that_samples_its_commands_does_not_fit(tmp_path):
         res = run("identify", log, "--mass", 1.4, "--out", out)
         doc = json.loads((out / "identify.json").read_text())
         first = res.stdout.splitlines()[0]  # stdout's first line (a progress line may go to stderr)
+        # a check says why only when it failed (no failure sentence on a check that passed)
+        assert all((c["why"] == "") == c["ok"] for c in doc["verdict_checks"].values()), doc["verdict_checks"]
         if every == 1:
             assert res.exit_code == 0, res.output
             assert doc["verdict"] == "fits" and first.startswith("verdict: the model fits")
