@@ -92,6 +92,14 @@ def inf_accelerations(tp, start):
     return with_values(tp, accelerometer_m_s2=a)
 
 
+def motor_at_five(tp, start):
+    if tp.name != "actuator_motors":
+        return tp
+    u = tp.values["control"].astype(np.float64).copy()
+    u[window(tp, start), 0] = 5.0
+    return with_values(tp, control=u)
+
+
 def without_vx(tp, start):
     if tp.name != "vehicle_local_position":
         return tp
@@ -157,6 +165,10 @@ ULOG_CASES = {
     "inf accelerations": (
         lambda p: rewrite(p, inf_accelerations),
         r"sensor_combined\.accelerometer_m_s2\[2\] is inf at t = 21(\.\d+)? s",
+    ),
+    "a relative thrust of 5": (
+        lambda p: rewrite(p, motor_at_five),
+        r"actuator_motors\.control\[0\] at t = 21\.0\d* s: 5 is outside \[0, 1\]",  # the log's sample, not the grid's
     ),
     "CA_ROTOR_COUNT -1": (
         lambda p: rewrite(p, param_edit=rotor_count),
