@@ -97,8 +97,12 @@ def test_a_log_that_samples_its_commands_does_not_fit(tmp_path):
         log = sysid_flight(every).to_ulog(tmp_path / f"raw{every}.ulg")
         log = with_parameter(log, tmp_path / f"le{every}.ulg", "int32_t", "IMU_GYRO_RATEMAX", 1000)
         out = tmp_path / f"out{every}"
-        res = run("identify", log, "--mass", 1.4, "--out", out)
+        res = run("identify", log, "--mass", 1.4, "--out", out, "--report", tmp_path / f"le{every}.html")
         doc = json.loads((out / "identify.json").read_text())
+        # the HTML report says the verdict in its page, before the configuration's JSON
+        page = (tmp_path / f"le{every}.html").read_text().split('id="config"')[0]
+        assert ("the model fits the log" in page) == (every == 1)
+        assert ("the model DOES NOT FIT the log" in page) == (every != 1)
         first = res.stdout.splitlines()[0]  # stdout's first line (a progress line may go to stderr)
         # a check says why only when it failed (no failure sentence on a check that passed)
         assert all((c["why"] == "") == c["ok"] for c in doc["verdict_checks"].values()), doc["verdict_checks"]
