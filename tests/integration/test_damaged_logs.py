@@ -300,3 +300,19 @@ def test_identify_never_deletes_the_log_it_reads(tmp_path):
         assert len(lines) == 1 and "holds the log being read" in lines[0], lines
         assert log.read_bytes() == (tmp_path / "f.ulg").read_bytes()
         assert sorted(p.name for p in folder.iterdir()) == before
+
+
+def test_a_log_too_short_to_fit_says_how_long_it_needs(tmp_path):
+    """3 s of a flight: one line with the seconds usable and the seconds needed, exit 2, nothing
+    written; 5 s of the same flight is identified (a verdict, exit 0 or 1)."""
+    for seconds, codes in ((3.0, (2,)), (5.0, (0, 1))):
+        log = qc.fly("sysid", "nlpd", duration=seconds).to_ulog(tmp_path / f"s{seconds:g}.ulg")
+        result = run("identify", log, "--out", tmp_path / f"out{seconds:g}")
+        assert result.exit_code in codes, result.output
+        if seconds == 3.0:
+            lines = result.stderr.strip().splitlines()
+            assert len(lines) == 1 and lines[0].startswith(f"error: {log}: 3.0 s airborne is too short"), lines
+            assert re.search(r"\d\.\d\d s to fit, \d\.\d\d s held out; at least 2 s and 0\.5 s\)$", lines[0]), lines
+            assert not (tmp_path / "out3").exists()
+        else:
+            assert (tmp_path / "out5" / "identify.json").is_file()

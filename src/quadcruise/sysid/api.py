@@ -193,7 +193,10 @@ def identify(
     fit_rows, held = split_rows(flight, sig.window, omega0, holdout)
     if fit_rows.sum() * sig.dt < MIN_FIT_S or held.sum() * sig.dt < MIN_HELD_S:
         raise InputError(
-            f"{flight.source}: {flight.duration:.1f} s airborne is too short to fit and hold out {holdout:g} of it"
+            f"{flight.source}: {flight.duration:.1f} s airborne is too short to fit and hold out {holdout:g} of it "
+            f"(usable after the filter's edges: {fit_rows.sum() * sig.dt:.2f} s to fit, "
+            f"{held.sum() * sig.dt:.2f} s held out; "
+            f"at least {MIN_FIT_S:g} s and {MIN_HELD_S:g} s)"
         )
     lag_seen = cmd_hz >= 2.0 * omega0  # a sample at least every tau/2
     u_fit = sig.u[fit_rows]
