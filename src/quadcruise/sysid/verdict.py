@@ -33,6 +33,10 @@ MAX_HELD_RATIO = 2.0
 NEGLIGIBLE = 1e-4
 """A residual mean square under this share of its regressand's variance (R^2 over 0.9999) is
 negligible: the held-out and whiteness checks judge noise and missing dynamics, not dust."""
+DUST = 1e-9
+"""A residual whose root mean square is under this (in its equation's units: m/s^2, rad/s^2, a
+thousandth of a micro-g) is dust however little its regressand varies: a noise-free hover's
+residuals are rounding, and their ratios and correlations say nothing about the model."""
 WHITE_LAG_WINDOWS = 4
 """Filter windows past which the residuals' autocorrelation is judged."""
 MAX_LATE_ACF = 0.5
@@ -145,7 +149,8 @@ def residual_checks(
         late[c] = late_autocorrelation(e, seg_fit, lag)
 
     def negligible(c, e, y):
-        return y is not None and c in y and float(np.mean(e**2)) <= NEGLIGIBLE * float(np.var(y[c]))
+        square = float(np.mean(e**2))
+        return square <= DUST**2 or (y is not None and c in y and square <= NEGLIGIBLE * float(np.var(y[c])))
 
     bad_held = {c: r for c, r in ratios.items() if not r <= MAX_HELD_RATIO and not negligible(c, resid_held[c], y_held)}
     bad_white = {c: a for c, a in late.items() if not abs(a) <= MAX_LATE_ACF and not negligible(c, resid_fit[c], y_fit)}
