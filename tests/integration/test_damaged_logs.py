@@ -10,6 +10,7 @@ out, a clock that jumps back). The CSVs are a quadcruise flight's.
 
 from __future__ import annotations
 
+import json
 import re
 import struct
 from pathlib import Path
@@ -316,3 +317,17 @@ def test_a_log_too_short_to_fit_says_how_long_it_needs(tmp_path):
             assert not (tmp_path / "out3").exists()
         else:
             assert (tmp_path / "out5" / "identify.json").is_file()
+
+
+def test_the_thrust_curve_note_names_the_topic_the_commands_came_from(tmp_path):
+    """The SITL log read from actuator_motors (relative thrust) and, with that topic left out, from
+    actuator_outputs (PWM through THR_MDL_FAC): each note names its own topic."""
+    topics, params, start = sitl_topics()
+    pwm = tmp_path / "pwm.ulg"
+    write_ulog(pwm, [tp for tp in topics if tp.name != "actuator_motors"], parameters=params, start_us=start)
+    for log, topic in ((SITL, "actuator_motors"), (pwm, "actuator_outputs")):
+        out = tmp_path / topic
+        result = run("identify", log, "--out", out)
+        assert result.exit_code in (0, 1), result.output
+        note = json.loads((out / "identify.json").read_text())["parameters"]["thrust_curve_f"]["note"]
+        assert topic in note and ({"actuator_motors", "actuator_outputs"} - {topic}).pop() not in note, note

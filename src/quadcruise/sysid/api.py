@@ -282,7 +282,12 @@ def identify(
     elif result.omega <= bounds[0] * 1.01 or result.omega >= bounds[1] * 0.99:
         found["omega"]["identifiable"] = False
         notes["omega"] = f"the fit ran to the end of its search interval {bounds[0]:g}..{bounds[1]:g} rad/s"
-    if meaning == "thrust":
+    if meaning == "thrust" and "actuator_outputs" in flight.commands:
+        notes["thrust_curve_f"] = (
+            "the commands are PX4's PWM (actuator_outputs) read back to relative thrust through the log's "
+            "THR_MDL_FAC: thrust is linear in that"
+        )
+    elif meaning == "thrust":
         notes["thrust_curve_f"] = (
             "the commands are PX4's relative thrust (actuator_motors; THR_MDL_FAC maps thrust to the "
             "output signal after it): thrust is linear in them"
