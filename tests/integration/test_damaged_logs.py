@@ -10,6 +10,7 @@ out, a clock that jumps back). The CSVs are a quadcruise flight's.
 
 from __future__ import annotations
 
+import json
 import re
 import struct
 from pathlib import Path
@@ -92,6 +93,14 @@ def inf_accelerations(tp, start):
     return with_values(tp, accelerometer_m_s2=a)
 
 
+def motor_at_five(tp, start):
+    if tp.name != "actuator_motors":
+        return tp
+    u = tp.values["control"].astype(np.float64).copy()
+    u[window(tp, start), 0] = 5.0
+    return with_values(tp, control=u)
+
+
 def without_vx(tp, start):
     if tp.name != "vehicle_local_position":
         return tp
@@ -157,6 +166,10 @@ ULOG_CASES = {
     "inf accelerations": (
         lambda p: rewrite(p, inf_accelerations),
         r"sensor_combined\.accelerometer_m_s2\[2\] is inf at t = 21(\.\d+)? s",
+    ),
+    "a relative thrust of 5": (
+        lambda p: rewrite(p, motor_at_five),
+        r"actuator_motors\.control\[0\] at t = 21\.0\d* s: 5 is outside \[0, 1\]",  # the log's sample, not the grid's
     ),
     "CA_ROTOR_COUNT -1": (
         lambda p: rewrite(p, param_edit=rotor_count),
@@ -338,3 +351,33 @@ def test_fly_never_deletes_the_scenario_or_vehicle_it_read(tmp_path):
     elsewhere = run("fly", scenario, "--out", tmp_path / "E")
     assert elsewhere.exit_code == 0, elsewhere.output
     assert (tmp_path / "E" / "scenario.toml").is_file()
+
+
+def test_a_log_too_short_to_fit_says_how_long_it_needs(tmp_path):
+    """3 s of a flight: one line with the seconds usable and the seconds needed, exit 2, nothing
+    written; 5 s of the same flight is identified (a verdict, exit 0 or 1)."""
+    for seconds, codes in ((3.0, (2,)), (5.0, (0, 1))):
+        log = qc.fly("sysid", "nlpd", duration=seconds).to_ulog(tmp_path / f"s{seconds:g}.ulg")
+        result = run("identify", log, "--out", tmp_path / f"out{seconds:g}")
+        assert result.exit_code in codes, result.output
+        if seconds == 3.0:
+            lines = result.stderr.strip().splitlines()
+            assert len(lines) == 1 and lines[0].startswith(f"error: {log}: 3.0 s airborne is too short"), lines
+            assert re.search(r"\d\.\d\d s to fit, \d\.\d\d s held out; at least 2 s and 0\.5 s\)$", lines[0]), lines
+            assert not (tmp_path / "out3").exists()
+        else:
+            assert (tmp_path / "out5" / "identify.json").is_file()
+
+
+def test_the_thrust_curve_note_names_the_topic_the_commands_came_from(tmp_path):
+    """The SITL log read from actuator_motors (relative thrust) and, with that topic left out, from
+    actuator_outputs (PWM through THR_MDL_FAC): each note names its own topic."""
+    topics, params, start = sitl_topics()
+    pwm = tmp_path / "pwm.ulg"
+    write_ulog(pwm, [tp for tp in topics if tp.name != "actuator_motors"], parameters=params, start_us=start)
+    for log, topic in ((SITL, "actuator_motors"), (pwm, "actuator_outputs")):
+        out = tmp_path / topic
+        result = run("identify", log, "--out", out)
+        assert result.exit_code in (0, 1), result.output
+        note = json.loads((out / "identify.json").read_text())["parameters"]["thrust_curve_f"]["note"]
+        assert topic in note and ({"actuator_motors", "actuator_outputs"} - {topic}).pop() not in note, note

@@ -97,9 +97,15 @@ def test_a_log_that_samples_its_commands_does_not_fit(tmp_path):
         log = sysid_flight(every).to_ulog(tmp_path / f"raw{every}.ulg")
         log = with_parameter(log, tmp_path / f"le{every}.ulg", "int32_t", "IMU_GYRO_RATEMAX", 1000)
         out = tmp_path / f"out{every}"
-        res = run("identify", log, "--mass", 1.4, "--out", out)
+        res = run("identify", log, "--mass", 1.4, "--out", out, "--report", tmp_path / f"le{every}.html")
         doc = json.loads((out / "identify.json").read_text())
+        # the HTML report says the verdict in its page, before the configuration's JSON
+        page = (tmp_path / f"le{every}.html").read_text().split('id="config"')[0]
+        assert ("the model fits the log" in page) == (every == 1)
+        assert ("the model DOES NOT FIT the log" in page) == (every != 1)
         first = res.stdout.splitlines()[0]  # stdout's first line (a progress line may go to stderr)
+        # a check says why only when it failed (no failure sentence on a check that passed)
+        assert all((c["why"] == "") == c["ok"] for c in doc["verdict_checks"].values()), doc["verdict_checks"]
         if every == 1:
             assert res.exit_code == 0, res.output
             assert doc["verdict"] == "fits" and first.startswith("verdict: the model fits")
@@ -299,3 +305,24 @@ def test_x_quad_without_esc_telemetry_over_seeds(rate):
             assert p["value"] == pytest.approx(truth, rel=0.1), (seed, key, p)
             inside[key] += p["ci95"][0] <= truth <= p["ci95"][1]
     assert all(v >= 4 for v in inside.values()), inside
+
+
+def test_a_noise_free_hover_fits_and_gives_back_its_command(tmp_path):
+    """``fly hover --vehicle iris --ulog`` then ``identify --mass 1.535``: residuals of rounding
+    (a noise-free hover) are no evidence against the model; the verdict fits, exit 0, and the hover
+    command is the relative thrust actuator_motors holds, as pyulog reads it (K = kf w_max^2)."""
+    from quadcruise.model.rotor_vehicle import RotorVehicle
+
+    iris = RotorVehicle.preset("iris")
+    log = qc.fly("hover", "se3", vehicle=iris, duration=6.0).to_ulog(tmp_path / "h.ulg")
+    logged = ULog(str(log)).get_dataset("actuator_motors").data["control[0]"].astype(float)
+    out = tmp_path / "out"
+    res = run("identify", log, "--mass", iris.m, "--out", out)
+    assert res.exit_code == 0, res.output
+    doc = json.loads((out / "identify.json").read_text())
+    assert doc["verdict"] == "fits", doc["verdict_reasons"]
+    lo, hi = doc["parameters"]["hover_duty"]["ci95"]
+    # the log holds float32: its value is the command to 6e-8 (a noise-free interval is narrower)
+    assert np.ptp(logged) == 0 and lo - 1e-7 <= logged[0] <= hi + 1e-7 and hi - lo < 1e-4
+    lo, hi = doc["parameters"]["K"]["ci95"]
+    assert iris.kf * iris.w_max**2 == pytest.approx((lo + hi) / 2, rel=1e-6)

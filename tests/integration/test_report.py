@@ -480,7 +480,9 @@ def test_the_identify_report_is_built_from_the_result(identified):
     assert "|" in identified.report_md()  # report.md keeps its Markdown tables, for a Markdown reader
     page = html_report(**kw)
     no_markdown_table(page)
-    assert page.count("<table>") == 3 and "hover_duty" in page
+    assert page.count("<table>") == 4 and "hover_duty" in page
+    assert list(kw["tables"])[0] == "Verdict"  # first, as the summary's first line
+    assert kw["tables"]["Verdict"].loc["verdict", "value"] == identified.verdict_line().removeprefix("verdict: ")
 
 
 def test_the_reproduce_report_shows_the_fitted_table_it_speaks_of(fitted_rep, rep):
@@ -506,7 +508,7 @@ def test_browser_renders_the_identify_and_reproduce_tables(identified, fitted_re
     from quadcruise.report.identify import identification_report
 
     for name, kw, tables in (
-        ("identify", identification_report(identified), 3),
+        ("identify", identification_report(identified), 4),  # the verdict, parameters, validation, the log
         ("reproduce", reproduction_report(fitted_rep, figures={}), 2),
     ):
         page = write_html_report(tmp_path / f"{name}.html", **kw)

@@ -386,7 +386,15 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
             if cmd_topic == "actuator_outputs"
             else "PX4's actuator_motors holds each rotor's relative thrust, in [0, 1]"
         )
-        logchecks.check_duties(path, u, [f"{cmd_topic}.{c}" for c in cols], at=t, hint=hint)
+        names = [f"{cmd_topic}.{c}" for c in cols]
+        # the log's own samples inside the airborne segments first (the value and time it holds),
+        # then what the grid interpolates (the samples just outside a segment count there)
+        t_cmd, seg = times(cmd_topic), segment[keep]
+        inside = np.zeros(t_cmd.shape, bool)
+        for k in np.unique(seg):
+            inside |= (t_cmd >= t[seg == k][0]) & (t_cmd <= t[seg == k][-1])
+        logchecks.check_duties(path, u_raw[inside], names, at=t_cmd[inside], hint=hint)
+        logchecks.check_duties(path, u, names, at=t, hint=hint)
 
     speeds = None
     esc = topics.get("esc_status")

@@ -67,9 +67,10 @@ def run_chunk(spec: MonteCarloSpec, first: int, count: int, threads: int | None 
         import numba
         from numba.core.config import reload_config
 
-        # numba reads NUMBA_NUM_THREADS when it is imported; a Dask worker's environment may have
-        # changed it since (its env= is applied after the worker started): read it again before
-        # the threads start, or a later compilation would find it changed and refuse
+        # A Dask worker spawned from the ``quadcruise`` script imported numba (its thread count
+        # from the CPUs) before the nanny set NUMBA_NUM_THREADS=1: read the environment again before
+        # the threads are launched, else the first compile in the worker (an empty cache) re-reads it
+        # and numba refuses to change the count of threads already running.
         reload_config()
         numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
     res, draw = fly_chunk(spec, first, count)

@@ -11,6 +11,19 @@ import html
 from pathlib import Path
 
 
+def _verdict(result):
+    """Whether the model fits the log, first (the summary's first line): the checks it passed, or
+    each reason it does not fit, one row each."""
+    import pandas as pd
+
+    line = result.verdict_line().removeprefix("verdict: ")
+    if result.fits or not result.verdict:
+        return pd.DataFrame({"value": {"verdict": line}})
+    facts = {"verdict": "the model DOES NOT FIT the log: no intervals"}
+    facts.update({f"reason {i + 1}": why for i, why in enumerate(result.verdict.get("reasons", []))})
+    return pd.DataFrame({"value": facts})
+
+
 def _parameters(result):
     """One row per parameter: value, interval, unit, identifiable, where it comes from, note."""
     import pandas as pd
@@ -99,6 +112,7 @@ def identification_report(result, *, title: str | None = None) -> dict:
     return {
         "title": title or f"quadcruise identify: {name}",
         "tables": {
+            "Verdict": _verdict(result),
             "Parameters (95 % intervals)": _parameters(result),
             "Held-out validation": pd.DataFrame(rows).T,
             "The log and the fit": _log_and_fit(result),

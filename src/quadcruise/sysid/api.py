@@ -193,7 +193,10 @@ def identify(
     fit_rows, held = split_rows(flight, sig.window, omega0, holdout)
     if fit_rows.sum() * sig.dt < MIN_FIT_S or held.sum() * sig.dt < MIN_HELD_S:
         raise InputError(
-            f"{flight.source}: {flight.duration:.1f} s airborne is too short to fit and hold out {holdout:g} of it"
+            f"{flight.source}: {flight.duration:.1f} s airborne is too short to fit and hold out {holdout:g} of it "
+            f"(usable after the filter's edges: {fit_rows.sum() * sig.dt:.2f} s to fit, "
+            f"{held.sum() * sig.dt:.2f} s held out; "
+            f"at least {MIN_FIT_S:g} s and {MIN_HELD_S:g} s)"
         )
     lag_seen = cmd_hz >= 2.0 * omega0  # a sample at least every tau/2
     u_fit = sig.u[fit_rows]
@@ -279,7 +282,12 @@ def identify(
     elif result.omega <= bounds[0] * 1.01 or result.omega >= bounds[1] * 0.99:
         found["omega"]["identifiable"] = False
         notes["omega"] = f"the fit ran to the end of its search interval {bounds[0]:g}..{bounds[1]:g} rad/s"
-    if meaning == "thrust":
+    if meaning == "thrust" and "actuator_outputs" in flight.commands:
+        notes["thrust_curve_f"] = (
+            "the commands are PX4's PWM (actuator_outputs) read back to relative thrust through the log's "
+            "THR_MDL_FAC: thrust is linear in that"
+        )
+    elif meaning == "thrust":
         notes["thrust_curve_f"] = (
             "the commands are PX4's relative thrust (actuator_motors; THR_MDL_FAC maps thrust to the "
             "output signal after it): thrust is linear in them"

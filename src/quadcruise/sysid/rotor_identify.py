@@ -99,7 +99,9 @@ def identify_rotor(flight, base: RotorVehicle, mass: float | None, holdout: floa
     fit_rows, held = split_rows(flight, window, 1.0 / slow, holdout)
     if fit_rows.sum() * dt < MIN_FIT_S or held.sum() * dt < MIN_HELD_S:
         raise InputError(
-            f"{flight.source}: {flight.duration:.1f} s airborne is too short to fit and hold out {holdout:g} of it"
+            f"{flight.source}: {flight.duration:.1f} s airborne is too short to fit and hold out {holdout:g} of it "
+            f"(usable after the filter's edges: {fit_rows.sum() * dt:.2f} s to fit, {held.sum() * dt:.2f} s held out; "
+            f"at least {MIN_FIT_S:g} s and {MIN_HELD_S:g} s)"
         )
     gyro = base.J_rotor > 0.0
     c_d = np.array([base.c_Dx, base.c_Dy, base.c_Dz])

@@ -120,6 +120,7 @@ def judge(checks: dict) -> dict:
     """The verdict from the checks' results: ``{"verdict", "fits", "reasons", "checks"}``.
 
     ``checks``: name -> ``{"ok": bool, "why": str, ...}``; the verdict fits when every one is ok.
+    A check that passed keeps no ``why`` (``""``): its sentence says how it would have failed.
 
     Examples
     --------
@@ -127,7 +128,10 @@ def judge(checks: dict) -> dict:
     'fits'
     >>> judge({"held_out": {"ok": False, "why": "yaw residual 3x"}})["reasons"]
     ['yaw residual 3x']
+    >>> judge({"commands": {"ok": True, "why": "the commands between samples are unknown"}})["checks"]
+    {'commands': {'ok': True, 'why': ''}}
     """
+    checks = {name: c if not c["ok"] else {**c, "why": ""} for name, c in checks.items()}
     reasons = [c["why"] for c in checks.values() if not c["ok"]]
     return {"verdict": NOT_FIT if reasons else FITS, "fits": not reasons, "reasons": reasons, "checks": checks}
 
