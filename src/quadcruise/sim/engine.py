@@ -32,12 +32,13 @@ from quadcruise.sim.inputs import TRIG_WIDTH, Limits, batch_inputs, carry_width,
 from quadcruise.sim.kernel_args import KERNEL_SIG, KernelArgs
 from quadcruise.sim.period import (
     beyond,
-    blank_rows,
+    blank_logs,
     body_bounds,
     close_vehicle,
     give_back,
     log_period,
     log_row,
+    period_of,
     put_row,
     read_history,
     sense,
@@ -254,9 +255,7 @@ def _kernel(
     for i in range(first, stop):
         k0 = clock[i, 0]
         if status[i] != FINISHED or k0 >= n_periods:  # stopped, or its grid flown
-            blank_rows(log_x, i, 0)
-            blank_rows(log_cmd, i, 0)
-            blank_rows(log_ref, i, 0)
+            blank_logs(i, 0, 0, log_x, log_cmd, log_ref)
             continue
         k1 = min(k0 + n_step, n_periods)
         k_reached = k1
@@ -281,8 +280,7 @@ def _kernel(
         if not disturbed:  # set once (a kept trick: quadcruise.sim.fastmath)
             still_air(0.0, 0.0, x, dpi, dmi, rngi, ext)
         for k in range(k0, k1 + 1 if k1 == n_periods else k1):
-            t = t_grid[k]
-            dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
+            t, dt = period_of(t_grid, k, n_periods)
             mission(t, mpi, ref)
             sense(k, sensor_delay, history, x, seen, stdi, rngi)  # the state sensor_delay periods ago, noisy
             for j in range(L.CMD_SIZE):
@@ -325,9 +323,7 @@ def _kernel(
                     log_row(log_x, i, rows, x)
                     rows_x += 1
                 break
-        blank_rows(log_x, i, rows_x)  # rows after a stop: NaN
-        blank_rows(log_cmd, i, rows)
-        blank_rows(log_ref, i, rows)
+        blank_logs(i, rows_x, rows, log_x, log_cmd, log_ref)  # rows after a stop: NaN
         put_row(x_final, i, x)
         give_back(i, mi, dmi, rngi, mem, dmem, rng)
         for j in range(TRIG_WIDTH):

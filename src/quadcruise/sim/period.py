@@ -62,6 +62,23 @@ def blank_rows(log, i, first):
 
 
 @njit(cache=True, inline="always")
+def blank_logs(i, rows_x, rows, log_x, log_cmd, log_ref):
+    """NaN in vehicle i's rows not flown: its states from ``rows_x`` on, its commands and
+    references from ``rows`` on."""
+    blank_rows(log_x, i, rows_x)
+    blank_rows(log_cmd, i, rows)
+    blank_rows(log_ref, i, rows)
+
+
+@njit(cache=True, inline="always")
+def period_of(t_grid, k, n_periods):
+    """The start t_k [s] of period k and its length [s] (at the grid's last instant, the length
+    of the period before it)."""
+    t = t_grid[k]
+    return t, (t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1])
+
+
+@njit(cache=True, inline="always")
 def read_history(carry, i, at, history):
     """The sensor-delay ring buffer ``history`` (delay + 1 states) from vehicle i's carry row,
     where it starts at column ``at``."""
@@ -160,12 +177,14 @@ def close_vehicle(i, k_reached, steps, clipped_s, limited_s, code, t_end, clock,
 
 __all__ = [
     "beyond",
+    "blank_logs",
     "blank_rows",
     "body_bounds",
     "close_vehicle",
     "give_back",
     "log_period",
     "log_row",
+    "period_of",
     "put_row",
     "read_history",
     "sense",

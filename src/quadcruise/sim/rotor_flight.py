@@ -62,12 +62,14 @@ from quadcruise.model.rotor_plant import (
 from quadcruise.sim.engine import still_air
 from quadcruise.sim.kernel_args import ROTOR_KERNEL_SIG
 from quadcruise.sim.period import (
+    blank_logs,
     blank_rows,
     body_bounds,
     close_vehicle,
     give_back,
     log_period,
     log_row,
+    period_of,
     put_row,
     read_history,
     sense,
@@ -267,10 +269,8 @@ def _rotor_flight_kernel(
     for i in range(first, stop):
         k0 = clock[i, 0]
         if status[i] != FINISHED or k0 >= n_periods:  # stopped, or its grid flown
-            blank_rows(log_x, i, 0)
+            blank_logs(i, 0, 0, log_x, log_cmd, log_ref)
             blank_rows(log_rotor, i, 0)
-            blank_rows(log_cmd, i, 0)
-            blank_rows(log_ref, i, 0)
             continue
         k1 = min(k0 + n_step, n_periods)
         k_reached = k1
@@ -298,8 +298,7 @@ def _rotor_flight_kernel(
         t_end = t_grid[n_periods]
         rows_x = rows = 0
         for k in range(k0, k1 + 1 if k1 == n_periods else k1):
-            t = t_grid[k]
-            dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
+            t, dt = period_of(t_grid, k, n_periods)
             mission(t, mpi, ref)
             sense(k, sensor_delay, history, true, seen, stdi, rngi)
             for j in range(L.CMD_SIZE):
@@ -360,10 +359,8 @@ def _rotor_flight_kernel(
                     log_row(log_rotor, i, rows, x)
                     rows_x += 1
                 break
-        blank_rows(log_x, i, rows_x)
+        blank_logs(i, rows_x, rows, log_x, log_cmd, log_ref)
         blank_rows(log_rotor, i, rows_x)
-        blank_rows(log_cmd, i, rows)
-        blank_rows(log_ref, i, rows)
         put_row(x_final, i, x)
         put_row(seen_final, i, true)
         give_back(i, mi, dmi, rngi, mem, dmem, rng)
