@@ -272,7 +272,7 @@ def _kernel(
         vpi, vci, gi, mpi, dpi, stdi = vp[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
         take(i, mem, dmem, rng, mi, dmi, rngi)
         clipped_s, limited_s = saturated[i, 0], saturated[i, 1]
-        max_tilt = limits[3]
+        max_position, max_speed, max_rate, max_tilt = limits[0], limits[1], limits[2], limits[3]
         code = FINISHED
         t_end = t_grid[n_periods]
         rows_x = rows = 0
@@ -311,7 +311,22 @@ def _kernel(
             for _ in range(n_sub):
                 rk4_step(x, u, vpi, ext, full, h, work, steps % TRIG_REFRESH == 0)
                 steps += 1
-            code = body_bounds(x, x[L.X], x[L.Y], x[L.Z], x[L.VX], x[L.VY], x[L.VZ], x[L.P], x[L.Q], x[L.R], limits)
+            code = body_bounds(
+                x,
+                L.STATE_SIZE,
+                x[L.X],
+                x[L.Y],
+                x[L.Z],
+                x[L.VX],
+                x[L.VY],
+                x[L.VZ],
+                x[L.P],
+                x[L.Q],
+                x[L.R],
+                max_position,
+                max_speed,
+                max_rate,
+            )
             if code == FINISHED and beyond(x[L.PHI], x[L.THETA], 0.0, max_tilt):
                 code = TILT_BOUND
             elif code == FINISHED and full and abs(x[L.THETA]) > EULER_PITCH_LIMIT:  # the full plant's 1/cos theta

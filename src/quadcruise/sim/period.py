@@ -130,20 +130,21 @@ def substeps(dt, max_step):
 
 
 @njit(cache=True, inline="always")
-def body_bounds(x, px, py, pz, vx, vy, vz, p, q, r, limits):
-    """The status of a state after a period, from the checks both plants make: every entry of
-    ``x`` finite, then position [m], velocity [m/s] and body rates [rad/s] within ``limits``
-    (:class:`~quadcruise.sim.inputs.Limits`); FINISHED if all hold (the plant checks its tilt)."""
+def body_bounds(x, width, px, py, pz, vx, vy, vz, p, q, r, max_position, max_speed, max_rate):
+    """The status of a state after a period, from the checks both plants make: the first ``width``
+    entries of ``x`` finite (the paper plant passes its constant width, which the compiler
+    unrolls), then position [m], velocity [m/s] and body rates [rad/s] within their bounds;
+    FINISHED if all hold (the plant checks its tilt)."""
     finite = True
-    for j in range(x.shape[0]):
+    for j in range(width):
         finite = finite and math.isfinite(x[j])
     if not finite:
         return NONFINITE
-    if beyond(px, py, pz, limits[0]):
+    if beyond(px, py, pz, max_position):
         return POSITION_BOUND
-    if beyond(vx, vy, vz, limits[1]):
+    if beyond(vx, vy, vz, max_speed):
         return SPEED_BOUND
-    if beyond(p, q, r, limits[2]):
+    if beyond(p, q, r, max_rate):
         return RATE_BOUND
     return FINISHED
 

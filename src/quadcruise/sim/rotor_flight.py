@@ -265,7 +265,7 @@ def _rotor_flight_kernel(
     w_cmd = np.empty(n)
     work = np.empty((ROTOR_WORK_ROWS, size))
     mi, dmi, rngi = np.empty(mem.shape[1]), np.empty(dmem.shape[1]), np.empty(rng.shape[1], dtype=np.uint64)
-    cos_tilt = math.cos(limits[3])
+    max_position, max_speed, max_rate, cos_tilt = limits[0], limits[1], limits[2], math.cos(limits[3])
     for i in range(first, stop):
         k0 = clock[i, 0]
         if status[i] != FINISHED or k0 >= n_periods:  # stopped, or its grid flown
@@ -348,7 +348,22 @@ def _rotor_flight_kernel(
                 psi = paper_state(x, rpi, ext, psi, true)
                 break
             psi = paper_state(x, rpi, ext, psi, true)
-            code = body_bounds(x, x[RX], x[RY], x[RZ], x[RVX], x[RVY], x[RVZ], x[RP], x[RQ], x[RR], limits)
+            code = body_bounds(
+                x,
+                size,
+                x[RX],
+                x[RY],
+                x[RZ],
+                x[RVX],
+                x[RVY],
+                x[RVZ],
+                x[RP],
+                x[RQ],
+                x[RR],
+                max_position,
+                max_speed,
+                max_rate,
+            )
             if code == FINISHED and 1.0 - 2.0 * (x[QX] * x[QX] + x[QY] * x[QY]) < cos_tilt:
                 code = TILT_BOUND
             if code != FINISHED:
