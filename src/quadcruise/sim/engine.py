@@ -36,18 +36,16 @@ from quadcruise.sim.period import (
     body_bounds,
     close_vehicle,
     give_back,
-    log_period,
     log_row,
-    period_of,
     put_row,
     read_history,
-    sense,
     substeps,
     take,
     take_row,
     write_history,
 )
 from quadcruise.sim.result import SimResult
+from quadcruise.sim.rng import next_normal
 from quadcruise.sim.status import STATUS_REASONS, ExitStatus
 from quadcruise.sim.threads import PIECES_PER_THREAD, fly_in_pieces
 
@@ -280,14 +278,28 @@ def _kernel(
         if not disturbed:  # set once (a kept trick: quadcruise.sim.fastmath)
             still_air(0.0, 0.0, x, dpi, dmi, rngi, ext)
         for k in range(k0, k1 + 1 if k1 == n_periods else k1):
-            t, dt = period_of(t_grid, k, n_periods)
+            t = t_grid[k]
+            dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
             mission(t, mpi, ref)
-            sense(k, sensor_delay, history, x, seen, stdi, rngi)  # the state sensor_delay periods ago, noisy
+            # what the controller sees: the state sensor_delay periods ago, plus noise
+            newest = k % (sensor_delay + 1)  # in the ring buffer
+            oldest = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
+            for j in range(L.STATE_SIZE):
+                history[newest, j] = x[j]
+            state = rngi[0]
+            for j in range(L.STATE_SIZE):
+                seen[j] = history[oldest, j]
+                if stdi[j] != 0.0:
+                    draw, state = next_normal(state)
+                    seen[j] += stdi[j] * draw
+            rngi[0] = state
             for j in range(L.CMD_SIZE):
                 cmd[j] = 0.0
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
             if k % log_every == 0:
-                log_period(log_x, log_cmd, log_ref, i, rows, x, cmd, ref)
+                log_row(log_x, i, rows, x)
+                log_row(log_cmd, i, rows, cmd)
+                log_row(log_ref, i, rows, ref)
                 rows += 1
                 rows_x = rows
             if k == n_periods:
@@ -311,9 +323,11 @@ def _kernel(
             for _ in range(n_sub):
                 rk4_step(x, u, vpi, ext, full, h, work, steps % TRIG_REFRESH == 0)
                 steps += 1
+            finite = True
+            for j in range(L.STATE_SIZE):
+                finite = finite and math.isfinite(x[j])
             code = body_bounds(
-                x,
-                L.STATE_SIZE,
+                finite,
                 x[L.X],
                 x[L.Y],
                 x[L.Z],

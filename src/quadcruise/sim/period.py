@@ -1,11 +1,15 @@
-"""The period code both plants' kernels share, once: what a vehicle carries in and out of a call,
-the sensor ring buffer and its noise, the log, the saturation time and the body's bounds.
+"""The period code both plants' kernels share, once: what a vehicle carries in and out of a call
+(its memories, the sensor ring buffer, its logs blanked after a stop, what it reached), the
+substeps of a period and the body's bounds.
 
 Each helper is compiled inline into the kernel that calls it (``inline="always"``: numba inlines
 its IR before typing), so the kernels of :mod:`quadcruise.sim.engine` and
 :mod:`quadcruise.sim.rotor_flight` run the same machine code as when these lines were written in
 each; they follow the scalar-only rule of :mod:`quadcruise.sim.fastmath` (rows copied element
-by element, no slice of a shared array).
+by element, no slice of a shared array). What runs every period takes scalars only: an array
+handed to an inlined helper costs numba's reference counting (an atomic increment and decrement)
+each time, which made the paper kernel 10 % slower when the sensor ring buffer, the period's
+instant and the log were helpers too (docs/performance.md); those stay written in each kernel.
 """
 
 from __future__ import annotations
@@ -16,7 +20,6 @@ import numpy as np
 from numba import njit
 
 from quadcruise import layout as L
-from quadcruise.sim.rng import next_normal
 from quadcruise.sim.status import ExitStatus
 
 FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND = (
@@ -71,14 +74,6 @@ def blank_logs(i, rows_x, rows, log_x, log_cmd, log_ref):
 
 
 @njit(cache=True, inline="always")
-def period_of(t_grid, k, n_periods):
-    """The start t_k [s] of period k and its length [s] (at the grid's last instant, the length
-    of the period before it)."""
-    t = t_grid[k]
-    return t, (t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1])
-
-
-@njit(cache=True, inline="always")
 def read_history(carry, i, at, history):
     """The sensor-delay ring buffer ``history`` (delay + 1 states) from vehicle i's carry row,
     where it starts at column ``at``."""
@@ -96,32 +91,6 @@ def write_history(carry, i, at, history):
 
 
 @njit(cache=True, inline="always")
-def sense(k, sensor_delay, history, true, seen, std, rng):
-    """What the controller sees at period k: the true state stored in the ring buffer, and the
-    state ``sensor_delay`` periods ago read from it into ``seen``, plus white noise of standard
-    deviations ``std`` drawn from the vehicle's stream ``rng``."""
-    newest = k % (sensor_delay + 1)  # in the ring buffer
-    oldest = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
-    for j in range(L.STATE_SIZE):
-        history[newest, j] = true[j]
-    state = rng[0]
-    for j in range(L.STATE_SIZE):
-        seen[j] = history[oldest, j]
-        if std[j] != 0.0:
-            draw, state = next_normal(state)
-            seen[j] += std[j] * draw
-    rng[0] = state
-
-
-@njit(cache=True, inline="always")
-def log_period(log_x, log_cmd, log_ref, i, row, x, cmd, ref):
-    """One logged instant of vehicle i: its state, command and reference."""
-    log_row(log_x, i, row, x)
-    log_row(log_cmd, i, row, cmd)
-    log_row(log_ref, i, row, ref)
-
-
-@njit(cache=True, inline="always")
 def substeps(dt, max_step):
     """The number of equal RK4 substeps no longer than ``max_step`` [s] in a period dt [s], and
     their length [s]."""
@@ -130,14 +99,11 @@ def substeps(dt, max_step):
 
 
 @njit(cache=True, inline="always")
-def body_bounds(x, width, px, py, pz, vx, vy, vz, p, q, r, max_position, max_speed, max_rate):
-    """The status of a state after a period, from the checks both plants make: the first ``width``
-    entries of ``x`` finite (the paper plant passes its constant width, which the compiler
-    unrolls), then position [m], velocity [m/s] and body rates [rad/s] within their bounds;
-    FINISHED if all hold (the plant checks its tilt)."""
-    finite = True
-    for j in range(width):
-        finite = finite and math.isfinite(x[j])
+def body_bounds(finite, px, py, pz, vx, vy, vz, p, q, r, max_position, max_speed, max_rate):
+    """The status of a state after a period, from the checks both plants make: ``finite`` (every
+    entry of the state), then position [m], velocity [m/s] and body rates [rad/s] within their
+    bounds; FINISHED if all hold (the plant checks its tilt). Scalars only: an array handed to an
+    inlined helper costs reference counting in every period."""
     if not finite:
         return NONFINITE
     if beyond(px, py, pz, max_position):
@@ -183,12 +149,9 @@ __all__ = [
     "body_bounds",
     "close_vehicle",
     "give_back",
-    "log_period",
     "log_row",
-    "period_of",
     "put_row",
     "read_history",
-    "sense",
     "substeps",
     "take",
     "write_history",

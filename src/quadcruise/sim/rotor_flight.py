@@ -67,17 +67,15 @@ from quadcruise.sim.period import (
     body_bounds,
     close_vehicle,
     give_back,
-    log_period,
     log_row,
-    period_of,
     put_row,
     read_history,
-    sense,
     substeps,
     take,
     take_row,
     write_history,
 )
+from quadcruise.sim.rng import next_normal
 from quadcruise.sim.rotor_engine import ROTOR_WORK_ROWS, ground_contact, rotor_rk4_step
 from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.threads import PIECES_PER_THREAD, fly_in_pieces
@@ -298,14 +296,28 @@ def _rotor_flight_kernel(
         t_end = t_grid[n_periods]
         rows_x = rows = 0
         for k in range(k0, k1 + 1 if k1 == n_periods else k1):
-            t, dt = period_of(t_grid, k, n_periods)
+            t = t_grid[k]
+            dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
             mission(t, mpi, ref)
-            sense(k, sensor_delay, history, true, seen, stdi, rngi)
+            # what the controller sees: the state sensor_delay periods ago, plus noise
+            newest = k % (sensor_delay + 1)  # in the ring buffer
+            oldest = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
+            for j in range(L.STATE_SIZE):
+                history[newest, j] = true[j]
+            state = rngi[0]
+            for j in range(L.STATE_SIZE):
+                seen[j] = history[oldest, j]
+                if stdi[j] != 0.0:
+                    draw, state = next_normal(state)
+                    seen[j] += stdi[j] * draw
+            rngi[0] = state
             for j in range(L.CMD_SIZE):
                 cmd[j] = 0.0
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
             if k % log_every == 0:
-                log_period(log_x, log_cmd, log_ref, i, rows, true, cmd, ref)
+                log_row(log_x, i, rows, true)
+                log_row(log_cmd, i, rows, cmd)
+                log_row(log_ref, i, rows, ref)
                 log_row(log_rotor, i, rows, x)
                 rows += 1
                 rows_x = rows
@@ -348,9 +360,11 @@ def _rotor_flight_kernel(
                 psi = paper_state(x, rpi, ext, psi, true)
                 break
             psi = paper_state(x, rpi, ext, psi, true)
+            finite = True
+            for j in range(size):
+                finite = finite and math.isfinite(x[j])
             code = body_bounds(
-                x,
-                size,
+                finite,
                 x[RX],
                 x[RY],
                 x[RZ],
