@@ -26,8 +26,8 @@ Each control period t_k, for each vehicle:
    speed, body rate, and tilt: the angle between body z and world z above ``max_tilt``.
 
 The paper-layout states, commands and references are logged as the paper kernel logs them, and
-the rotor state beside them. This path shares no code with the paper kernel's hot loop
-(:func:`quadcruise.sim.engine._kernel`), whose flights and speed stay as they are.
+the rotor state beside them. The per-vehicle code it shares with the paper kernel
+(:func:`quadcruise.sim.engine._kernel`) is in :mod:`quadcruise.sim.period`, inlined into both.
 """
 
 from __future__ import annotations
