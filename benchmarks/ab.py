@@ -28,7 +28,10 @@ Figures (``--figures``, comma-separated; the default: single,batch):
 - ``gym``: 200 steps of ``gymnasium.make_vec("quadcruise/Hover-v0", num_envs=1024,
   vectorization_mode="vector_entry_point", action="rotors")`` with random actions (seeded;
   autoreset included), as benchmarks/gym.py steps it: rates are env-steps per second;
-- ``gym1``: 2,000 steps of one ``gymnasium.make("quadcruise/Hover-v0", action="rotors")``.
+- ``gym1``: 2,000 steps of one ``gymnasium.make("quadcruise/Hover-v0", action="rotors")``;
+- ``rsingle``, ``rbatch``: the rotor-speed plant, ``qc.fly("circle", "se3", vehicle="iris")``, one
+  vehicle x 60 s and 2,000 x 10 s; ``psingle``, ``pbatch``: the same calls on the paper's plant
+  (``vehicle="paper"``), for the rotor plant's rate as a ratio of the paper plant's.
 
 Rates are vehicle-steps per second. Before each process the script waits (up to
 ``--wait`` seconds) until the other processes of the host leave its cores idle: less than
@@ -63,7 +66,12 @@ FIGURES = {  # name: (vehicles, flight seconds, timed calls per process)
     "mcplain": (272, 60.0, 2),
     "gym": (1024, 0.2, 3),  # the gym figures' "seconds" x HZ are their steps
     "gym1": (1, 2.0, 3),
+    "rsingle": (1, 60.0, 20),
+    "rbatch": (2000, 10.0, 2),
+    "psingle": (1, 60.0, 20),
+    "pbatch": (2000, 10.0, 2),
 }
+PLANTS = {"rsingle": "iris", "rbatch": "iris", "psingle": "paper", "pbatch": "paper"}
 
 
 # --- the child: one process of one side --------------------------------------------------
@@ -83,6 +91,11 @@ def figure_call(name: str, duration: float | None = None):
         vehicle = qc.Vehicle(m=3.499 * np.linspace(0.9, 1.1, n)) if n > 1 else None
         every = math.gcd(1000, round(duration * HZ))  # log_every must divide the periods (0.1 s warm-up: 100)
         return lambda: qc.fly("circle", "nlpd", vehicle=vehicle, duration=duration, dt=1.0 / HZ, log_every=every)
+    if name in PLANTS:  # se3 on either plant: the same call
+        every = math.gcd(1000, round(duration * HZ))
+        return lambda: qc.fly(
+            "circle", "se3", vehicle=PLANTS[name], n=n, duration=duration, dt=1.0 / HZ, log_every=every
+        )
     # the Monte Carlo benchmark's population (benchmarks/, this script's folder, is on sys.path)
     from montecarlo import make_spec
 

@@ -20,7 +20,7 @@ from quadcruise.gym.evaluate import rollout
 from quadcruise.layout import P_D, P_JXX, P_JYY, P_JZZ, P_K, P_M, P_OMEGA
 from quadcruise.missions import Circle
 from quadcruise.model.equivalent import paper_equivalent
-from quadcruise.model.rotor_plant import RP_JXX, RP_KF, RP_KM, RP_M, RP_TAU_UP
+from quadcruise.model.rotor_plant import ROTOR_P_JXX, ROTOR_P_KF, ROTOR_P_KM, ROTOR_P_M, ROTOR_P_TAU_UP
 from quadcruise.model.rotor_vehicle import AERO_FIELDS, RotorVehicle
 from quadcruise.montecarlo.population import Population
 from quadcruise.sim.status import ExitStatus
@@ -121,22 +121,22 @@ def test_domain_randomisation_draws_rotor_vehicles_per_vehicle_seed():
     np.testing.assert_array_equal(s4.vp[:2], s2.vp)  # vehicle i's draw does not depend on N
     nominal = RotorVehicle.preset("crazyflie")
     rows = s4.vp
-    assert len(set(rows[:, RP_M])) == 4 and np.std(rows[:, RP_M] / nominal.m) > 0.01
+    assert len(set(rows[:, ROTOR_P_M])) == 4 and np.std(rows[:, ROTOR_P_M] / nominal.m) > 0.01
     for i in range(4):  # each drawn rotor vehicle's "+" equivalent is the drawn paper row its controller reads
         drawn = nominal.replace(
-            m=rows[i, RP_M],
-            Jxx=rows[i, RP_JXX],
-            Jyy=rows[i, RP_JXX + 1],
-            Jzz=rows[i, RP_JXX + 2],
-            kf=rows[i, RP_KF],
-            km=rows[i, RP_KM],
-            tau_up=rows[i, RP_TAU_UP],
-            tau_down=rows[i, RP_TAU_UP + 1],
+            m=rows[i, ROTOR_P_M],
+            Jxx=rows[i, ROTOR_P_JXX],
+            Jyy=rows[i, ROTOR_P_JXX + 1],
+            Jzz=rows[i, ROTOR_P_JXX + 2],
+            kf=rows[i, ROTOR_P_KF],
+            km=rows[i, ROTOR_P_KM],
+            tau_up=rows[i, ROTOR_P_TAU_UP],
+            tau_down=rows[i, ROTOR_P_TAU_UP + 1],
         )
         eq = paper_equivalent(drawn)
         for name, col in (("m", P_M), ("Jxx", P_JXX), ("Jyy", P_JYY), ("Jzz", P_JZZ), ("K", P_K), ("d", P_D)):
             assert getattr(eq, name) == pytest.approx(s4.vp_ctrl[i, col], rel=1e-12)
-        assert nominal.tau_up / rows[i, RP_TAU_UP] == pytest.approx(s4.vp_ctrl[i, P_OMEGA] / four.nominal_eq.omega)
+        assert nominal.tau_up / rows[i, ROTOR_P_TAU_UP] == pytest.approx(s4.vp_ctrl[i, P_OMEGA] / four.nominal_eq.omega)
     rng = np.random.default_rng(1)
     for _ in range(30):
         a = rng.uniform(-0.2, 0.2, (4, 4)).astype(np.float32)

@@ -45,3 +45,37 @@ def test_row_offsets_tell_constant_from_run_time_indices():
 def test_reference_count_calls_found_where_they_are_and_only_there():
     assert reference_count_calls(_counted, SIG)  # an array handed to a call that may raise
     assert reference_count_calls(_offsets, SIG) == []
+
+
+def test_the_rotor_plant_reads_its_rows_at_constant_offsets():
+    """The rotor plant's compiled code reads its state and parameter rows through the constants
+    of their ``layout.Row``s (quadcruise.model.rotor_plant): every rigid-body column and every
+    parameter of the row's head at a constant offset; at run time only what depends on the rotor
+    count (a rotor's speed, its arm)."""
+    from quadcruise.model.rotor_plant import (
+        ROTOR_ARM,
+        ROTOR_BODY,
+        ROTOR_P_ROTORS,
+        ROTOR_P_W_MAX,
+        ROTOR_P_W_MIN,
+        ROTOR_PARAMS,
+        rotor_derivative,
+    )
+    from quadcruise.sim.rotor_flight import paper_state
+
+    row = types.float64[::1]
+    signature = types.void(row, row, row, row, row)
+    body = set(range(ROTOR_BODY.size))
+    position = {ROTOR_BODY.offsets[0], ROTOR_BODY.offsets[1], ROTOR_BODY.offsets[2]}  # not read: no force depends on it
+    assert row_offsets(rotor_derivative.py_func, signature, "x") == (body - position, 1)  # a rotor's speed: in the loop
+    assert row_offsets(rotor_derivative.py_func, signature, "dx") == (body, 1)
+    head = set(range(ROTOR_PARAMS.size)) - {ROTOR_P_W_MIN, ROTOR_P_W_MAX}  # the speed range: the kernel's
+    assert ROTOR_P_ROTORS == ROTOR_PARAMS.size
+    assert row_offsets(rotor_derivative.py_func, signature, "rp") == (head, ROTOR_ARM.size)  # one rotor's arm
+    ext = row_offsets(rotor_derivative.py_func, signature, "ext")
+    assert ext == ({L.EXT_FX, L.EXT_FY, L.EXT_FZ, L.EXT_TX, L.EXT_TY, L.EXT_TZ, L.EXT_WX, L.EXT_WY, L.EXT_WZ}, 1)
+    # the kernel's view of it in the paper layout: the rigid body at constant offsets, all 16 written
+    paper_sig = types.float64(row, row, row, types.float64, row)
+    rotors_1_to_4 = {ROTOR_BODY.size + i for i in range(4)}  # its loop over range(4): unrolled
+    assert row_offsets(paper_state.py_func, paper_sig, "xr") == (body | rotors_1_to_4, 0)
+    assert row_offsets(paper_state.py_func, paper_sig, "out") == (set(range(L.STATE_SIZE)), 0)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from quadcruise import InputError, Vehicle
-from quadcruise.model.rotor_plant import RP_KF, RP_N_ROTORS, RP_ROTORS, RP_TAU_DOWN
+from quadcruise.model.rotor_plant import ROTOR_P_KF, ROTOR_P_N_ROTORS, ROTOR_P_ROTORS, ROTOR_P_TAU_DOWN
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle_files import PRESETS, preset_source
 
@@ -61,8 +61,8 @@ def test_rotorpy_numbers_and_rotor_order():
 def test_row_layout():
     v = RotorVehicle.preset("iris")
     row = v.row()
-    assert row[RP_KF] == v.kf and row[RP_TAU_DOWN] == v.tau_down and row[RP_N_ROTORS] == 4
-    assert np.array_equal(row[RP_ROTORS:].reshape(4, 4), np.array(v.rotors))
+    assert row[ROTOR_P_KF] == v.kf and row[ROTOR_P_TAU_DOWN] == v.tau_down and row[ROTOR_P_N_ROTORS] == 4
+    assert np.array_equal(row[ROTOR_P_ROTORS:].reshape(4, 4), np.array(v.rotors))
 
 
 CF = RotorVehicle.preset("crazyflie")
@@ -100,7 +100,7 @@ def test_what_can_fly_is_accepted():
     # a hexarotor, rotors around the centre at 60 degrees, directions alternating
     hexa = [[0.2 * math.cos(k * math.pi / 3), 0.2 * math.sin(k * math.pi / 3), 0.0, (-1) ** k] for k in range(6)]
     v = CF.replace(rotors=hexa, m=0.04)
-    assert v.n_rotors == 6 and v.row().shape == (RP_ROTORS + 24,)
+    assert v.n_rotors == 6 and v.row().shape == (ROTOR_P_ROTORS + 24,)
     # just able to lift itself; and a "+" quad with a rotor on each axis
     just = CF.replace(w_max=math.sqrt(CF.m * CF.g / (4 * CF.kf)) * 1.001)
     assert just.w_max > just.hover_speed

@@ -25,17 +25,17 @@ from quadcruise.model.equivalent import duty_to_thrust
 from quadcruise.model.rotor_plant import (
     QW,
     QZ,
+    ROTOR_P_G,
+    ROTOR_P_JXX,
+    ROTOR_P_JYY,
+    ROTOR_P_JZZ,
+    ROTOR_P_KF,
+    ROTOR_P_KM,
+    ROTOR_P_M,
+    ROTOR_P_N_ROTORS,
+    ROTOR_P_TAU_DOWN,
+    ROTOR_P_TAU_UP,
     ROTOR_W1,
-    RP_G,
-    RP_JXX,
-    RP_JYY,
-    RP_JZZ,
-    RP_KF,
-    RP_KM,
-    RP_M,
-    RP_N_ROTORS,
-    RP_TAU_DOWN,
-    RP_TAU_UP,
     RX,
 )
 from quadcruise.model.rotor_vehicle import RotorVehicle
@@ -63,14 +63,14 @@ def drawn_rows(nominal: RotorVehicle, nominal_eq: np.ndarray, drawn_eq: np.ndarr
     cols = [P_M, P_JXX, P_JYY, P_JZZ, P_K, P_D, P_OMEGA]  # nonzero on a vehicle that flies
     f = np.zeros_like(drawn_eq)
     f[:, cols] = drawn_eq[:, cols] / nominal_eq[cols]
-    rows[:, RP_M] *= f[:, P_M]
-    rows[:, RP_JXX] *= f[:, P_JXX]
-    rows[:, RP_JYY] *= f[:, P_JYY]
-    rows[:, RP_JZZ] *= f[:, P_JZZ]
-    rows[:, RP_KF] *= f[:, P_K]
-    rows[:, RP_KM] *= f[:, P_K] * f[:, P_D]
-    rows[:, RP_TAU_UP] /= f[:, P_OMEGA]
-    rows[:, RP_TAU_DOWN] /= f[:, P_OMEGA]
+    rows[:, ROTOR_P_M] *= f[:, P_M]
+    rows[:, ROTOR_P_JXX] *= f[:, P_JXX]
+    rows[:, ROTOR_P_JYY] *= f[:, P_JYY]
+    rows[:, ROTOR_P_JZZ] *= f[:, P_JZZ]
+    rows[:, ROTOR_P_KF] *= f[:, P_K]
+    rows[:, ROTOR_P_KM] *= f[:, P_K] * f[:, P_D]
+    rows[:, ROTOR_P_TAU_UP] /= f[:, P_OMEGA]
+    rows[:, ROTOR_P_TAU_DOWN] /= f[:, P_OMEGA]
     return rows
 
 
@@ -145,12 +145,12 @@ def hover_starts(rows: np.ndarray, start: np.ndarray, offsets: np.ndarray) -> tu
         (K,) the start yaws [rad].
     """
     k = rows.shape[0]
-    n = int(rows[0, RP_N_ROTORS])
+    n = int(rows[0, ROTOR_P_N_ROTORS])
     psi = np.broadcast_to(start[:, REF_PSI], (k,)).astype(float)
     x0 = np.zeros((k, ROTOR_W1 + n))
     x0[:, RX : RX + 3] = start[:, REF_X : REF_X + 3] + offsets
     x0[:, QW], x0[:, QZ] = np.cos(0.5 * psi), np.sin(0.5 * psi)
-    x0[:, ROTOR_W1:] = np.sqrt(rows[:, RP_M] * rows[:, RP_G] / (n * rows[:, RP_KF]))[:, None]
+    x0[:, ROTOR_W1:] = np.sqrt(rows[:, ROTOR_P_M] * rows[:, ROTOR_P_G] / (n * rows[:, ROTOR_P_KF]))[:, None]
     return x0, psi
 
 

@@ -36,8 +36,8 @@ outside); then w_i stays in that range too. R is the rotation of q / |q| (as Rot
 a torque [N m] (body), the wind [m/s] (world), then one effectiveness per rotor
 (``EXT_E1 + i``), so ``9 + n`` entries.
 
-The vehicle's parameters reach the compiled code as one flat row (``RP_*`` below, then four
-entries per rotor: x, y, z [m] and s), built by :meth:`quadcruise.model.rotor_vehicle.RotorVehicle.row`.
+The vehicle's parameters reach the compiled code as one flat row (``ROTOR_PARAMS`` below, ``ROTOR_P_*``,
+then ``ROTOR_ARM`` per rotor: x, y, z [m] and s), built by :meth:`quadcruise.model.rotor_vehicle.RotorVehicle.row`.
 """
 
 from __future__ import annotations
@@ -46,40 +46,88 @@ import math
 
 from numba import njit
 
-from quadcruise.layout import EXT_E1, EXT_FX, EXT_FY, EXT_FZ, EXT_TX, EXT_TY, EXT_TZ, EXT_WX, EXT_WY, EXT_WZ
+from quadcruise.layout import EXT_E1, EXT_FX, EXT_FY, EXT_FZ, EXT_TX, EXT_TY, EXT_TZ, EXT_WX, EXT_WY, EXT_WZ, Row
 
-# --- state columns ----------------------------------------------------------------------------
-RX, RY, RZ, RVX, RVY, RVZ, QW, QX, QY, QZ, RP, RQ, RR = range(13)
-ROTOR_W1 = 13
+# --- state row: 13 columns, then one rotor speed per rotor ------------------------------------
+_ROTOR_BODY_UNITS = {
+    "x": "m",
+    "y": "m",
+    "z": "m",
+    "vx": "m/s",
+    "vy": "m/s",
+    "vz": "m/s",
+    "qw": "-",
+    "qx": "-",
+    "qy": "-",
+    "qz": "-",
+    "p": "rad/s",
+    "q": "rad/s",
+    "r": "rad/s",
+}
+ROTOR_BODY = Row.of("rotor-plant state", *_ROTOR_BODY_UNITS, prefix="R")
+"""The rotor state's rigid-body part; the rotor speeds w1..wn [rad/s] follow it."""
+RX, RY, RZ, RVX, RVY, RVZ, RQW, RQX, RQY, RQZ, RP, RQ, RR = ROTOR_BODY.offsets
+QW, QX, QY, QZ = RQW, RQX, RQY, RQZ
+"""The quaternion's columns, scalar first."""
+ROTOR_W1 = ROTOR_BODY.size
 """Column of rotor 1's speed; rotor i (from 0) is at ``ROTOR_W1 + i``."""
-ROTOR_BODY_NAMES = ("x", "y", "z", "vx", "vy", "vz", "qw", "qx", "qy", "qz", "p", "q", "r")
-ROTOR_BODY_UNITS = ("m", "m", "m", "m/s", "m/s", "m/s", "-", "-", "-", "-", "rad/s", "rad/s", "rad/s")
+ROTOR_BODY_NAMES = ROTOR_BODY.names
+ROTOR_BODY_UNITS = tuple(_ROTOR_BODY_UNITS[name] for name in ROTOR_BODY_NAMES)
 
-# --- parameter row ----------------------------------------------------------------------------
+# --- parameter row: 20 columns (RotorVehicle's field names), then four per rotor ---------------
+ROTOR_PARAM_UNITS = {
+    "m": "kg",
+    "Jxx": "kg m^2",
+    "Jyy": "kg m^2",
+    "Jzz": "kg m^2",
+    "kf": "N/(rad/s)^2",
+    "km": "N m/(rad/s)^2",
+    "tau_up": "s",
+    "tau_down": "s",
+    "w_min": "rad/s",
+    "w_max": "rad/s",
+    "g": "m/s^2",
+    "c_Dx": "N/(m/s)^2",
+    "c_Dy": "N/(m/s)^2",
+    "c_Dz": "N/(m/s)^2",
+    "k_d": "N/(rad/s m/s)",
+    "k_z": "N/(rad/s m/s)",
+    "k_h": "N/(m/s)^2",
+    "k_flap": "N m/(rad/s m/s)",
+    "J_rotor": "kg m^2",
+    "n_rotors": "-",
+}
+ROTOR_PARAMS = Row.of("rotor vehicle parameters", *ROTOR_PARAM_UNITS, prefix="ROTOR_P_")
+"""The vehicle's row (:meth:`quadcruise.model.rotor_vehicle.RotorVehicle.row`), each field named as
+the vehicle's; then :data:`ROTOR_ARM` per rotor from :data:`ROTOR_P_ROTORS` on."""
 (
-    RP_M,
-    RP_JXX,
-    RP_JYY,
-    RP_JZZ,
-    RP_KF,
-    RP_KM,
-    RP_TAU_UP,
-    RP_TAU_DOWN,
-    RP_W_MIN,
-    RP_W_MAX,
-    RP_G,
-    RP_CDX,
-    RP_CDY,
-    RP_CDZ,
-    RP_KD,
-    RP_KZ,
-    RP_KH,
-    RP_KFLAP,
-    RP_J_ROTOR,
-    RP_N_ROTORS,
-) = range(20)
-RP_ROTORS = 20
-"""First column of the rotors: rotor i's x, y, z [m] and direction s at ``RP_ROTORS + 4 i`` on."""
+    ROTOR_P_M,
+    ROTOR_P_JXX,
+    ROTOR_P_JYY,
+    ROTOR_P_JZZ,
+    ROTOR_P_KF,
+    ROTOR_P_KM,
+    ROTOR_P_TAU_UP,
+    ROTOR_P_TAU_DOWN,
+    ROTOR_P_W_MIN,
+    ROTOR_P_W_MAX,
+    ROTOR_P_G,
+    ROTOR_P_C_DX,
+    ROTOR_P_C_DY,
+    ROTOR_P_C_DZ,
+    ROTOR_P_K_D,
+    ROTOR_P_K_Z,
+    ROTOR_P_K_H,
+    ROTOR_P_K_FLAP,
+    ROTOR_P_J_ROTOR,
+    ROTOR_P_N_ROTORS,
+) = ROTOR_PARAMS.offsets
+ROTOR_P_ROTORS = ROTOR_PARAMS.size
+"""First column of the rotors: rotor i's :data:`ROTOR_ARM` at ``ROTOR_P_ROTORS + ROTOR_ARM.size i``."""
+ROTOR_ARM = Row.of("rotor", "x", "y", "z", "s", prefix="ARM_")
+"""One rotor's entries of the parameter row: its hub x, y, z [m] (body frame) and direction s (+1 or -1)."""
+ARM_X, ARM_Y, ARM_Z, ARM_S = ROTOR_ARM.offsets
+ARM_SIZE = ROTOR_ARM.size
 
 
 def state_names(n_rotors: int) -> tuple[str, ...]:
@@ -114,7 +162,7 @@ def rotor_derivative(x, w_cmd, rp, ext, dx):
         speeds [rad/s].
     w_cmd : ndarray, shape (n,)
         Commanded rotor speeds [rad/s], within [w_min, w_max].
-    rp : ndarray, shape (RP_ROTORS + 4 n,)
+    rp : ndarray, shape (ROTOR_P_ROTORS + 4 n,)
         The vehicle's parameter row.
     ext : ndarray, shape (9 + n,)
         External force [N] (world), torque [N m] (body), wind [m/s] (world), rotor
@@ -122,9 +170,16 @@ def rotor_derivative(x, w_cmd, rp, ext, dx):
     dx : ndarray, shape (13 + n,)
         Output: the state's time derivative.
     """
-    n = int(rp[RP_N_ROTORS])
-    kf, km, kd, kz, kh, kflap = rp[RP_KF], rp[RP_KM], rp[RP_KD], rp[RP_KZ], rp[RP_KH], rp[RP_KFLAP]
-    tau_up, tau_down, j_rotor = rp[RP_TAU_UP], rp[RP_TAU_DOWN], rp[RP_J_ROTOR]
+    n = int(rp[ROTOR_P_N_ROTORS])
+    kf, km, kd, kz, kh, kflap = (
+        rp[ROTOR_P_KF],
+        rp[ROTOR_P_KM],
+        rp[ROTOR_P_K_D],
+        rp[ROTOR_P_K_Z],
+        rp[ROTOR_P_K_H],
+        rp[ROTOR_P_K_FLAP],
+    )
+    tau_up, tau_down, j_rotor = rp[ROTOR_P_TAU_UP], rp[ROTOR_P_TAU_DOWN], rp[ROTOR_P_J_ROTOR]
     qw, qx, qy, qz = x[QW], x[QX], x[QY], x[QZ]
     p, q, r = x[RP], x[RQ], x[RR]
     s = 2.0 / (qw * qw + qx * qx + qy * qy + qz * qz)  # R of q / |q|
@@ -139,8 +194,8 @@ def rotor_derivative(x, w_cmd, rp, ext, dx):
     mx = my = mz = 0.0  # body moment [N m]
     h = h_dot = 0.0  # rotors' angular momentum about body z
     for i in range(n):
-        base = RP_ROTORS + 4 * i
-        px, py, pz, sign = rp[base], rp[base + 1], rp[base + 2], rp[base + 3]
+        base = ROTOR_P_ROTORS + ARM_SIZE * i
+        px, py, pz, sign = rp[base + ARM_X], rp[base + ARM_Y], rp[base + ARM_Z], rp[base + ARM_S]
         w = x[ROTOR_W1 + i]
         e = ext[EXT_E1 + i]
         lx = ub + q * pz - r * py  # airspeed at the hub: v_b + Omega x r_i
@@ -161,21 +216,21 @@ def rotor_derivative(x, w_cmd, rp, ext, dx):
         h -= sign * j_rotor * w
         h_dot -= sign * j_rotor * w_dot
     speed = math.sqrt(ub * ub + vb * vb + wb * wb)  # parasitic drag
-    fx -= speed * rp[RP_CDX] * ub
-    fy -= speed * rp[RP_CDY] * vb
-    fz -= speed * rp[RP_CDZ] * wb
-    inv_m = 1.0 / rp[RP_M]
+    fx -= speed * rp[ROTOR_P_C_DX] * ub
+    fy -= speed * rp[ROTOR_P_C_DY] * vb
+    fz -= speed * rp[ROTOR_P_C_DZ] * wb
+    inv_m = 1.0 / rp[ROTOR_P_M]
     dx[RX] = x[RVX]
     dx[RY] = x[RVY]
     dx[RZ] = x[RVZ]
     dx[RVX] = (r00 * fx + r01 * fy + r02 * fz + ext[EXT_FX]) * inv_m
     dx[RVY] = (r10 * fx + r11 * fy + r12 * fz + ext[EXT_FY]) * inv_m
-    dx[RVZ] = (r20 * fx + r21 * fy + r22 * fz + ext[EXT_FZ]) * inv_m - rp[RP_G]
+    dx[RVZ] = (r20 * fx + r21 * fy + r22 * fz + ext[EXT_FZ]) * inv_m - rp[ROTOR_P_G]
     dx[QW] = -0.5 * (qx * p + qy * q + qz * r)  # q (x) (0, Omega) / 2
     dx[QX] = 0.5 * (qw * p + qy * r - qz * q)
     dx[QY] = 0.5 * (qw * q + qz * p - qx * r)
     dx[QZ] = 0.5 * (qw * r + qx * q - qy * p)
-    jxx, jyy, jzz = rp[RP_JXX], rp[RP_JYY], rp[RP_JZZ]
+    jxx, jyy, jzz = rp[ROTOR_P_JXX], rp[ROTOR_P_JYY], rp[ROTOR_P_JZZ]
     lx_, ly_, lz_ = jxx * p, jyy * q, jzz * r + h  # body and rotors' angular momentum
     dx[RP] = (mx + ext[EXT_TX] - (q * lz_ - r * ly_)) / jxx
     dx[RQ] = (my + ext[EXT_TY] - (r * lx_ - p * lz_)) / jyy

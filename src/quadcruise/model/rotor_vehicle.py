@@ -31,29 +31,7 @@ import numpy as np
 from quadcruise.errors import InputError
 from quadcruise.fields import Check, Validated
 from quadcruise.fields import unit_field as _f
-from quadcruise.model.rotor_plant import (
-    RP_CDX,
-    RP_CDY,
-    RP_CDZ,
-    RP_G,
-    RP_J_ROTOR,
-    RP_JXX,
-    RP_JYY,
-    RP_JZZ,
-    RP_KD,
-    RP_KF,
-    RP_KFLAP,
-    RP_KH,
-    RP_KM,
-    RP_KZ,
-    RP_M,
-    RP_N_ROTORS,
-    RP_ROTORS,
-    RP_TAU_DOWN,
-    RP_TAU_UP,
-    RP_W_MAX,
-    RP_W_MIN,
-)
+from quadcruise.model.rotor_plant import ROTOR_ARM, ROTOR_PARAMS
 from quadcruise.model.vehicle_files import load_vehicle
 
 AERO_FIELDS = ("c_Dx", "c_Dy", "c_Dz", "k_d", "k_z", "k_h", "k_flap")
@@ -281,35 +259,12 @@ class RotorVehicle(Validated):
         Returns
         -------
         numpy.ndarray
-            Shape (RP_ROTORS + 4 n,), float64: the fields in SI units at ``RP_*``, then each
-            rotor's x, y, z [m] and direction.
+            Shape (ROTOR_P_ROTORS + 4 n,), float64: the fields of ``ROTOR_PARAMS`` in SI units (at
+            ``ROTOR_P_*``), then each rotor's ``ROTOR_ARM``: x, y, z [m] and direction s.
         """
-        out = np.zeros(RP_ROTORS + 4 * self.n_rotors)
-        for col, name in (
-            (RP_M, "m"),
-            (RP_JXX, "Jxx"),
-            (RP_JYY, "Jyy"),
-            (RP_JZZ, "Jzz"),
-            (RP_KF, "kf"),
-            (RP_KM, "km"),
-            (RP_TAU_UP, "tau_up"),
-            (RP_TAU_DOWN, "tau_down"),
-            (RP_W_MIN, "w_min"),
-            (RP_W_MAX, "w_max"),
-            (RP_G, "g"),
-            (RP_CDX, "c_Dx"),
-            (RP_CDY, "c_Dy"),
-            (RP_CDZ, "c_Dz"),
-            (RP_KD, "k_d"),
-            (RP_KZ, "k_z"),
-            (RP_KH, "k_h"),
-            (RP_KFLAP, "k_flap"),
-            (RP_J_ROTOR, "J_rotor"),
-        ):
-            out[col] = getattr(self, name)
-        out[RP_N_ROTORS] = self.n_rotors
-        out[RP_ROTORS:] = np.asarray(self.rotors, dtype=float).ravel()
-        return out
+        head = ROTOR_PARAMS.pack({name: getattr(self, name) for name, _ in ROTOR_PARAMS.all_fields})
+        arms = [ROTOR_ARM.pack(dict(zip(("x", "y", "z", "s"), rotor, strict=True))) for rotor in self.rotors]
+        return np.concatenate([head, *arms])
 
     def to_dict(self) -> dict:
         """The fields as plain values (rotors as a list of lists), for result bundles and TOML.

@@ -30,6 +30,20 @@ from quadcruise.model.plant import EULER_PITCH_LIMIT, derivative_at
 from quadcruise.sim.fastmath import TRIG_REFRESH, turned
 from quadcruise.sim.inputs import TRIG_WIDTH, Limits, batch_inputs, carry_width, fresh_carry, time_grid
 from quadcruise.sim.kernel_args import KERNEL_SIG, KernelArgs
+from quadcruise.sim.period import (
+    beyond,
+    blank_logs,
+    body_bounds,
+    close_vehicle,
+    give_back,
+    log_row,
+    put_row,
+    read_history,
+    substeps,
+    take,
+    take_row,
+    write_history,
+)
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rng import next_normal
 from quadcruise.sim.status import STATUS_REASONS, ExitStatus
@@ -143,25 +157,8 @@ def still_air(t, dt, x, dp, dmem, rng, ext):
         ext[j] = 1.0
 
 
-# The per-period helpers below follow the scalar-only rule of quadcruise.sim.fastmath.
-
-
-@njit(cache=True, inline="always")
-def beyond(a, b, c, bound):
-    """Whether |a|, |b| or |c| exceeds bound.
-
-    Parameters
-    ----------
-    a, b, c : float
-        Three components (of a position [m], velocity [m/s], rates [rad/s] or angles [rad]).
-    bound : float
-        The bound, in their unit.
-
-    Returns
-    -------
-    bool
-    """
-    return abs(a) > bound or abs(b) > bound or abs(c) > bound
+# The per-period helpers below follow the scalar-only rule of quadcruise.sim.fastmath; those
+# both plants' kernels share are in quadcruise.sim.period.
 
 
 @njit(cache=True, inline="always")
@@ -186,61 +183,6 @@ def clip_duty(v):
     if v > 1.0:
         return 1.0, True, True
     return v, False, True
-
-
-@njit(cache=True, inline="always")
-def log_row(log, i, row, v):
-    """log[i, row, :] = v, element by element (a slice takes a reference on the shared log
-    array: the scalar-only rule of :mod:`quadcruise.sim.fastmath`).
-
-    Parameters
-    ----------
-    log : numpy.ndarray
-        (N, L, W) log of the batch.
-    i, row : int
-        The vehicle and the logged instant.
-    v : numpy.ndarray
-        (W,) the values to log.
-    """
-    for j in range(v.shape[0]):
-        log[i, row, j] = v[j]
-
-
-@njit(cache=True, inline="always")
-def put_row(a, i, v):
-    """a[i, :] = v, element by element: numba compiles a slice assignment with a shape
-    check of its own, which costs seconds of compile time.
-
-    Parameters
-    ----------
-    a : numpy.ndarray
-        (N, W) array of the batch.
-    i : int
-        The vehicle.
-    v : numpy.ndarray
-        (W,) the values.
-    """
-    for j in range(v.shape[0]):
-        a[i, j] = v[j]
-
-
-@njit(cache=True, inline="always")
-def blank_rows(log, i, first):
-    """NaN in the rows of vehicle i from ``first`` on: the log is allocated empty, and a
-    vehicle that stopped early leaves its last rows unwritten.
-
-    Parameters
-    ----------
-    log : numpy.ndarray
-        (N, L, W) log of the batch.
-    i : int
-        The vehicle.
-    first : int
-        The first logged instant to blank.
-    """
-    for row in range(first, log.shape[1]):
-        for j in range(log.shape[2]):
-            log[i, row, j] = np.nan
 
 
 @njit(KERNEL_SIG, cache=True, nogil=True, error_model="numpy")
@@ -311,17 +253,12 @@ def _kernel(
     for i in range(first, stop):
         k0 = clock[i, 0]
         if status[i] != FINISHED or k0 >= n_periods:  # stopped, or its grid flown
-            blank_rows(log_x, i, 0)
-            blank_rows(log_cmd, i, 0)
-            blank_rows(log_ref, i, 0)
+            blank_logs(i, 0, 0, log_x, log_cmd, log_ref)
             continue
         k1 = min(k0 + n_step, n_periods)
         k_reached = k1
-        for j in range(L.STATE_SIZE):
-            x[j] = x0[i, j]
-        for d in range(sensor_delay + 1):
-            for j in range(L.STATE_SIZE):
-                history[d, j] = carry[i, TRIG_WIDTH + d * L.STATE_SIZE + j]
+        take_row(x0, i, x)
+        read_history(carry, i, TRIG_WIDTH, history)
         for j in range(L.REF_SIZE):
             ref[j] = 0.0
         for j in range(4):
@@ -331,14 +268,7 @@ def _kernel(
         for j in range(TRIG_WIDTH):
             work[TRIG, j] = carry[i, j]
         vpi, vci, gi, mpi, dpi, stdi = vp[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
-        # what changes every period is this vehicle's own copy, the memories written back at
-        # the end (a kept trick against false sharing: quadcruise.sim.fastmath)
-        for j in range(mi.shape[0]):
-            mi[j] = mem[i, j]
-        for j in range(dmi.shape[0]):
-            dmi[j] = dmem[i, j]
-        for j in range(rngi.shape[0]):
-            rngi[j] = rng[i, j]
+        take(i, mem, dmem, rng, mi, dmi, rngi)
         clipped_s, limited_s = saturated[i, 0], saturated[i, 1]
         max_position, max_speed, max_rate, max_tilt = limits[0], limits[1], limits[2], limits[3]
         code = FINISHED
@@ -389,25 +319,31 @@ def _kernel(
                 limited_s += dt
             if disturbed:
                 disturbance(t, dt, x, dpi, dmi, rngi, ext)
-            n_sub = max(1, int(math.ceil(dt / max_step - 1e-9)))
-            h = dt / n_sub
+            n_sub, h = substeps(dt, max_step)
             for _ in range(n_sub):
                 rk4_step(x, u, vpi, ext, full, h, work, steps % TRIG_REFRESH == 0)
                 steps += 1
             finite = True
             for j in range(L.STATE_SIZE):
                 finite = finite and math.isfinite(x[j])
-            if not finite:
-                code = NONFINITE
-            elif beyond(x[L.X], x[L.Y], x[L.Z], max_position):
-                code = POSITION_BOUND
-            elif beyond(x[L.VX], x[L.VY], x[L.VZ], max_speed):
-                code = SPEED_BOUND
-            elif beyond(x[L.P], x[L.Q], x[L.R], max_rate):
-                code = RATE_BOUND
-            elif beyond(x[L.PHI], x[L.THETA], 0.0, max_tilt):
+            code = body_bounds(
+                finite,
+                x[L.X],
+                x[L.Y],
+                x[L.Z],
+                x[L.VX],
+                x[L.VY],
+                x[L.VZ],
+                x[L.P],
+                x[L.Q],
+                x[L.R],
+                max_position,
+                max_speed,
+                max_rate,
+            )
+            if code == FINISHED and beyond(x[L.PHI], x[L.THETA], 0.0, max_tilt):
                 code = TILT_BOUND
-            elif full and abs(x[L.THETA]) > EULER_PITCH_LIMIT:  # the full plant's 1/cos theta
+            elif code == FINISHED and full and abs(x[L.THETA]) > EULER_PITCH_LIMIT:  # the full plant's 1/cos theta
                 code = PITCH_SINGULAR
             if code != FINISHED:
                 t_end = t_grid[k + 1]
@@ -416,22 +352,13 @@ def _kernel(
                     log_row(log_x, i, rows, x)
                     rows_x += 1
                 break
-        blank_rows(log_x, i, rows_x)  # rows after a stop: NaN
-        blank_rows(log_cmd, i, rows)
-        blank_rows(log_ref, i, rows)
+        blank_logs(i, rows_x, rows, log_x, log_cmd, log_ref)  # rows after a stop: NaN
         put_row(x_final, i, x)
-        put_row(mem, i, mi)
-        put_row(dmem, i, dmi)
-        put_row(rng, i, rngi)
-        clock[i, 0], clock[i, 1] = k_reached, steps
+        give_back(i, mi, dmi, rngi, mem, dmem, rng)
         for j in range(TRIG_WIDTH):
             carry[i, j] = work[TRIG, j]
-        for d in range(sensor_delay + 1):
-            for j in range(L.STATE_SIZE):
-                carry[i, TRIG_WIDTH + d * L.STATE_SIZE + j] = history[d, j]
-        saturated[i, 0], saturated[i, 1] = clipped_s, limited_s
-        status[i] = code
-        t_stop[i] = t_end
+        write_history(carry, i, TRIG_WIDTH, history)
+        close_vehicle(i, k_reached, steps, clipped_s, limited_s, code, t_end, clock, saturated, status, t_stop)
 
 
 def fly_vehicles(

@@ -1,5 +1,6 @@
-"""The engine kernel's arguments, declared once: :class:`KernelArgs` names them in order with
-their numba types, and yields :data:`KERNEL_SIG`.
+"""The engine kernels' arguments, declared once: :class:`KernelArgs` (the paper plant's kernel)
+and :class:`RotorKernelArgs` (the rotor plant's) name them in order with their numba types, and
+yield :data:`KERNEL_SIG` and :data:`ROTOR_KERNEL_SIG`.
 
 The kernel itself takes them as a flat list (grouped into tuples it ran slower:
 docs/performance.md); :func:`quadcruise.sim.engine.simulate` and
@@ -69,4 +70,55 @@ class KernelArgs(NamedTuple):
 KERNEL_SIG = types.void(types.int64, types.int64, *KernelArgs.__annotations__.values())
 """The kernel's signature: the first and the stop vehicle of its range, then :class:`KernelArgs`."""
 
-__all__ = ["KERNEL_SIG", "KernelArgs"]
+
+class RotorKernelArgs(NamedTuple):
+    """The rotor plant's kernel's arguments after its range of vehicles
+    (:func:`quadcruise.sim.rotor_batch.fly_rotor_vehicles` says what each holds): those of
+    :class:`KernelArgs` of the same name mean the same, ``x0``/``x_final`` and ``vp`` (``rp``
+    here) are the rotor plant's own; the rotor plant adds ``psi0`` (the yaw the initial
+    quaternion's is read near), ``alloc`` (the duty-to-thrust matrix and the controller's kf),
+    ``ground``, ``touchdown``, ``log_rotor`` and ``seen_final`` (the paper-layout final state), and
+    has no ``full``.
+    """
+
+    t_grid: _f8v
+    x0: _f8m
+    psi0: _f8v
+    rp: _f8m
+    alloc: _f8m
+    vp_ctrl: _f8m
+    controller: ControllerType
+    gains: _f8m
+    mem: _f8m
+    mission: MissionType
+    mp: _f8m
+    disturbance: DisturbanceType
+    disturbed: types.boolean
+    dp: _f8m
+    dmem: _f8m
+    rng: _u8m
+    sensor_std: _f8m
+    sensor_delay: types.int64
+    max_step: types.float64
+    log_every: types.int64
+    limits: _f8v
+    ground: types.boolean
+    touchdown: _f8v
+    n_step: types.int64
+    clock: _i8m
+    carry: _f8m
+    log_x: _f8c
+    log_rotor: _f8c
+    log_cmd: _f8c
+    log_ref: _f8c
+    x_final: _f8m
+    seen_final: _f8m
+    status: _i8v
+    t_stop: _f8v
+    saturated: _f8m
+
+
+ROTOR_KERNEL_SIG = types.void(types.int64, types.int64, *RotorKernelArgs.__annotations__.values())
+"""The rotor kernel's signature: the first and the stop vehicle of its range, then :class:`RotorKernelArgs`."""
+
+__all__ = ["KERNEL_SIG", "ROTOR_KERNEL_SIG", "KernelArgs", "RotorKernelArgs"]

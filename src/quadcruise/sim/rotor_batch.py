@@ -9,9 +9,10 @@ import numpy as np
 from quadcruise.checks import describe
 from quadcruise.errors import InputError
 from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
-from quadcruise.model.rotor_plant import ROTOR_W1, RP_N_ROTORS
+from quadcruise.model.rotor_plant import ROTOR_P_N_ROTORS, ROTOR_W1
 from quadcruise.sim.engine import still_air
 from quadcruise.sim.inputs import Limits, batch_inputs
+from quadcruise.sim.kernel_args import RotorKernelArgs
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rotor_flight import fly_rotor_pieces, rotor_carry_width
 
@@ -53,7 +54,8 @@ def rotor_inputs(
     Returns
     -------
     dict
-        ``inp`` (:func:`quadcruise.sim.engine.batch_inputs`'s arrays), ``rp``, ``x0``, ``alloc``,
+        :func:`quadcruise.sim.inputs.batch_inputs`'s arrays for the rotor plant: ``vp`` the rotor
+        rows ``rp``, ``vp_ctrl`` the controller's paper row, ``x0`` the rotor states; and ``alloc``,
         ``psi0``, ``touchdown`` (inf without a ground) as C-ordered rows, ``n_rotors``.
 
     Raises
@@ -63,8 +65,8 @@ def rotor_inputs(
     """
     rp = np.array(np.atleast_2d(np.asarray(rp, dtype=float)), order="C")
     n_vehicles = rp.shape[0]
-    n = int(rp[0, RP_N_ROTORS])
-    if np.any(rp[:, RP_N_ROTORS] != n):
+    n = int(rp[0, ROTOR_P_N_ROTORS])
+    if np.any(rp[:, ROTOR_P_N_ROTORS] != n):
         raise InputError("the vehicles of one flight must have the same number of rotors")
     x0 = np.array(np.broadcast_to(np.atleast_2d(np.asarray(x0, dtype=float)), (n_vehicles, ROTOR_W1 + n)), order="C")
     if not np.all(np.isfinite(x0)):
@@ -92,7 +94,9 @@ def rotor_inputs(
     touchdown = np.array(np.broadcast_to(np.inf if touchdown_speed is None else touchdown_speed, (n_vehicles,)), float)
     if touchdown_speed is not None and not np.all(touchdown > 0):
         raise InputError(f"touchdown speed must be > 0 m/s, got {describe(touchdown_speed)}")
-    return {"inp": inp, "rp": rp, "x0": x0, "alloc": alloc, "psi0": psi0, "touchdown": touchdown, "n_rotors": n}
+    inp["vp_ctrl"], inp["vp"], inp["x0"] = inp["vp"], rp, x0  # the paper rows checked: the controller's
+    inp.update(alloc=alloc, psi0=psi0, touchdown=touchdown, n_rotors=n)
+    return inp
 
 
 def fly_rotor_vehicles(
@@ -169,7 +173,7 @@ def fly_rotor_vehicles(
     InputError
         Arrays whose shapes do not fit, a bad grid, step or touchdown speed.
     """
-    prep = rotor_inputs(
+    inp = rotor_inputs(
         t_grid,
         x0,
         rp,
@@ -190,9 +194,7 @@ def fly_rotor_vehicles(
         log_every=log_every,
         touchdown_speed=touchdown_speed,
     )
-    inp, rp, x0, alloc, psi0, touchdown = (prep[k] for k in ("inp", "rp", "x0", "alloc", "psi0", "touchdown"))
-    n_vehicles, n, ground = rp.shape[0], prep["n_rotors"], touchdown_speed is not None
-    t_grid = inp["t_grid"]
+    n_vehicles, n, t_grid = inp["vp"].shape[0], inp["n_rotors"], inp["t_grid"]
     limits = limits or Limits()
     n_periods = t_grid.shape[0] - 1
     n_log = n_periods // log_every + 1
@@ -205,45 +207,45 @@ def fly_rotor_vehicles(
     status = np.zeros(n_vehicles, dtype=np.int64)
     t_stop = np.empty(n_vehicles)
     saturated = np.zeros((n_vehicles, 2))
-    mem, dmem, rng = inp["memory"], inp["disturbance_memory"], inp["rng"]
+    mem, dmem = inp["memory"], inp["disturbance_memory"]
     fly_rotor_pieces(
         n_vehicles,
-        (
-            t_grid,
-            x0,
-            psi0,
-            rp,
-            alloc,
-            inp["vp"],
-            controller,
-            inp["gains"],
-            mem,
-            mission,
-            inp["mp"],
-            disturbance or still_air,
-            inp["disturbed"],
-            inp["disturbance_params"],
-            dmem,
-            rng,
-            inp["sensor_std"],
-            int(sensor_delay),
-            float(max_step),
-            int(log_every),
-            limits.array(),
-            ground,
-            touchdown,
-            n_periods,
-            np.zeros((n_vehicles, 2), dtype=np.int64),
-            np.empty((n_vehicles, rotor_carry_width(sensor_delay))),
-            log_x,
-            log_rotor,
-            log_cmd,
-            log_ref,
-            x_final,
-            seen_final,
-            status,
-            t_stop,
-            saturated,
+        RotorKernelArgs(
+            t_grid=t_grid,
+            x0=inp["x0"],
+            psi0=inp["psi0"],
+            rp=inp["vp"],
+            alloc=inp["alloc"],
+            vp_ctrl=inp["vp_ctrl"],
+            controller=controller,
+            gains=inp["gains"],
+            mem=mem,
+            mission=mission,
+            mp=inp["mp"],
+            disturbance=disturbance or still_air,
+            disturbed=inp["disturbed"],
+            dp=inp["disturbance_params"],
+            dmem=dmem,
+            rng=inp["rng"],
+            sensor_std=inp["sensor_std"],
+            sensor_delay=int(sensor_delay),
+            max_step=float(max_step),
+            log_every=int(log_every),
+            limits=limits.array(),
+            ground=touchdown_speed is not None,
+            touchdown=inp["touchdown"],
+            n_step=n_periods,
+            clock=np.zeros((n_vehicles, 2), dtype=np.int64),
+            carry=np.empty((n_vehicles, rotor_carry_width(sensor_delay))),
+            log_x=log_x,
+            log_rotor=log_rotor,
+            log_cmd=log_cmd,
+            log_ref=log_ref,
+            x_final=x_final,
+            seen_final=seen_final,
+            status=status,
+            t_stop=t_stop,
+            saturated=saturated,
         ),
     )
     return SimResult(

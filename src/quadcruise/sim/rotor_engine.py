@@ -30,9 +30,9 @@ from quadcruise.model.rotor_plant import (
     QX,
     QY,
     QZ,
+    ROTOR_P_N_ROTORS,
     ROTOR_W1,
     RP,
-    RP_N_ROTORS,
     RQ,
     RR,
     RVX,
@@ -246,8 +246,8 @@ def replay_rotor_speeds(
     if not (math.isfinite(max_step) and max_step > 0):
         raise InputError(f"max_step must be a positive number of seconds, got {describe(max_step)}")
     rp = np.atleast_2d(np.ascontiguousarray(rp, dtype=float))
-    n = int(rp[0, RP_N_ROTORS])
-    if np.any(rp[:, RP_N_ROTORS] != n):
+    n = int(rp[0, ROTOR_P_N_ROTORS])
+    if np.any(rp[:, ROTOR_P_N_ROTORS] != n):
         raise InputError("the vehicles of one replay must have the same number of rotors")
     x0 = np.array(np.broadcast_to(np.atleast_2d(x0), (rp.shape[0], ROTOR_W1 + n)), dtype=float, order="C")
     w_cmd = np.ascontiguousarray(w_cmd, dtype=float)

@@ -26,8 +26,8 @@ Each control period t_k, for each vehicle:
    speed, body rate, and tilt: the angle between body z and world z above ``max_tilt``.
 
 The paper-layout states, commands and references are logged as the paper kernel logs them, and
-the rotor state beside them. This path shares no code with the paper kernel's hot loop
-(:func:`quadcruise.sim.engine._kernel`), whose flights and speed stay as they are.
+the rotor state beside them. The per-vehicle code it shares with the paper kernel
+(:func:`quadcruise.sim.engine._kernel`) is in :mod:`quadcruise.sim.period`, inlined into both.
 """
 
 from __future__ import annotations
@@ -35,11 +35,46 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, types
+from numba import njit
 
 from quadcruise import layout as L
-from quadcruise.model.rotor_plant import QW, QX, QY, QZ, ROTOR_W1, RP, RP_KF, RP_N_ROTORS, RP_W_MAX, RP_W_MIN, RX, RZ
-from quadcruise.sim.engine import beyond, blank_rows, log_row, put_row, still_air
+from quadcruise.layout import Row
+from quadcruise.model.rotor_plant import (
+    QW,
+    QX,
+    QY,
+    QZ,
+    ROTOR_P_KF,
+    ROTOR_P_N_ROTORS,
+    ROTOR_P_W_MAX,
+    ROTOR_P_W_MIN,
+    ROTOR_W1,
+    RP,
+    RQ,
+    RR,
+    RVX,
+    RVY,
+    RVZ,
+    RX,
+    RY,
+    RZ,
+)
+from quadcruise.sim.engine import still_air
+from quadcruise.sim.kernel_args import ROTOR_KERNEL_SIG
+from quadcruise.sim.period import (
+    blank_logs,
+    blank_rows,
+    body_bounds,
+    close_vehicle,
+    give_back,
+    log_row,
+    put_row,
+    read_history,
+    substeps,
+    take,
+    take_row,
+    write_history,
+)
 from quadcruise.sim.rng import next_normal
 from quadcruise.sim.rotor_engine import ROTOR_WORK_ROWS, ground_contact, rotor_rk4_step
 from quadcruise.sim.status import ExitStatus
@@ -93,9 +128,9 @@ def paper_state(xr, rp, ext, psi_last, out):
     turn = raw - psi_last
     psi = psi_last + turn - 2.0 * math.pi * math.floor(turn / (2.0 * math.pi) + 0.5)
     out[L.PSI] = psi
-    out[L.P], out[L.Q], out[L.R] = xr[RP], xr[RP + 1], xr[RP + 2]
-    n = int(rp[RP_N_ROTORS])
-    kf = rp[RP_KF]
+    out[L.P], out[L.Q], out[L.R] = xr[RP], xr[RQ], xr[RR]
+    n = int(rp[ROTOR_P_N_ROTORS])
+    kf = rp[ROTOR_P_KF]
     for i in range(4):
         if i < n:
             w = xr[ROTOR_W1 + i]
@@ -132,12 +167,11 @@ def paper_states(x, rp, psi0):
     return out
 
 
-C_PSI = 0
-C_TRUE = 1
-C_EXT = C_TRUE + L.STATE_SIZE
-C_HISTORY = C_EXT + L.EXT_SIZE
-"""Offsets in a row of the rotor kernel's ``carry``: the unwrapped yaw [rad], the paper-layout
-true state, the external inputs of the last period, then the sensor-delay ring buffer."""
+ROTOR_CARRY = Row.of("rotor kernel carry", "psi", ("true", L.STATE_SIZE), ("ext", L.EXT_SIZE), prefix="C_")
+"""A row of the rotor kernel's ``carry``: the unwrapped yaw [rad], the paper-layout true state, the
+external inputs of the last period; the sensor-delay ring buffer follows at ``C_HISTORY``."""
+C_PSI, C_TRUE, C_EXT = ROTOR_CARRY.offsets
+C_HISTORY = ROTOR_CARRY.size
 
 
 def rotor_carry_width(sensor_delay: int) -> int:
@@ -161,55 +195,7 @@ def rotor_carry_width(sensor_delay: int) -> int:
     return C_HISTORY + (int(sensor_delay) + 1) * L.STATE_SIZE
 
 
-_f8v = types.float64[::1]
-_f8m = types.float64[:, ::1]
-_f8c = types.float64[:, :, ::1]
-_u8m = types.uint64[:, ::1]
-_i8v = types.int64[::1]
-_i8m = types.int64[:, ::1]
-
-ROTOR_FLIGHT_SIG = types.void(
-    types.int64,  # first
-    types.int64,  # stop
-    _f8v,  # t_grid
-    _f8m,  # x0 (rotor states)
-    _f8v,  # psi0
-    _f8m,  # rp
-    _f8m,  # alloc: duty -> thrust matrix (n x 4, row-major), then the controller's kf
-    _f8m,  # vp_ctrl
-    L.ControllerType,
-    _f8m,  # gains
-    _f8m,  # mem
-    L.MissionType,
-    _f8m,  # mp
-    L.DisturbanceType,
-    types.boolean,  # disturbed
-    _f8m,  # dp
-    _f8m,  # dmem
-    _u8m,  # rng
-    _f8m,  # sensor_std
-    types.int64,  # sensor_delay
-    types.float64,  # max_step
-    types.int64,  # log_every
-    _f8v,  # limits
-    types.boolean,  # ground
-    _f8v,  # touchdown
-    types.int64,  # n_step
-    _i8m,  # clock
-    _f8m,  # carry
-    _f8c,  # log_x
-    _f8c,  # log_rotor
-    _f8c,  # log_cmd
-    _f8c,  # log_ref
-    _f8m,  # x_final (rotor)
-    _f8m,  # seen_final (paper layout)
-    _i8v,  # status
-    _f8v,  # t_stop
-    _f8m,  # saturated
-)
-
-
-@njit(ROTOR_FLIGHT_SIG, cache=True, nogil=True, error_model="numpy")
+@njit(ROTOR_KERNEL_SIG, cache=True, nogil=True, error_model="numpy")
 def _rotor_flight_kernel(
     first,
     stop,
@@ -249,8 +235,8 @@ def _rotor_flight_kernel(
     t_stop,
     saturated,
 ):
-    """Fly vehicles first .. stop - 1 of the batch (the module's steps; arguments:
-    :func:`fly_rotor_vehicles`'s, one row per vehicle, ``alloc`` the n x 4 duty-to-thrust matrix
+    """Fly vehicles first .. stop - 1 of the batch (the module's steps; the other arguments are
+    :class:`~quadcruise.sim.kernel_args.RotorKernelArgs`, one row per vehicle, ``alloc`` the n x 4 duty-to-thrust matrix
     row by row and the controller vehicle's kf).
 
     The resume contract of the paper kernel (:func:`quadcruise.sim.engine._kernel`): each
@@ -277,29 +263,20 @@ def _rotor_flight_kernel(
     w_cmd = np.empty(n)
     work = np.empty((ROTOR_WORK_ROWS, size))
     mi, dmi, rngi = np.empty(mem.shape[1]), np.empty(dmem.shape[1]), np.empty(rng.shape[1], dtype=np.uint64)
-    max_position, max_speed, max_rate = limits[0], limits[1], limits[2]
-    cos_tilt = math.cos(limits[3])
+    max_position, max_speed, max_rate, cos_tilt = limits[0], limits[1], limits[2], math.cos(limits[3])
     for i in range(first, stop):
         k0 = clock[i, 0]
         if status[i] != FINISHED or k0 >= n_periods:  # stopped, or its grid flown
-            blank_rows(log_x, i, 0)
+            blank_logs(i, 0, 0, log_x, log_cmd, log_ref)
             blank_rows(log_rotor, i, 0)
-            blank_rows(log_cmd, i, 0)
-            blank_rows(log_ref, i, 0)
             continue
         k1 = min(k0 + n_step, n_periods)
         k_reached = k1
-        for j in range(size):
-            x[j] = x0[i, j]
+        take_row(x0, i, x)
         rpi, ai, vci, gi, mpi, dpi, stdi = rp[i], alloc[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
-        for j in range(mi.shape[0]):
-            mi[j] = mem[i, j]
-        for j in range(dmi.shape[0]):
-            dmi[j] = dmem[i, j]
-        for j in range(rngi.shape[0]):
-            rngi[j] = rng[i, j]
+        take(i, mem, dmem, rng, mi, dmi, rngi)
         kf_ctrl = ai[4 * n]
-        w_min, w_max = rpi[RP_W_MIN], rpi[RP_W_MAX]
+        w_min, w_max = rpi[ROTOR_P_W_MIN], rpi[ROTOR_P_W_MAX]
         if k0 == 0:  # a fresh start: the true state of x0, seen through an empty delay line
             still_air(0.0, 0.0, true, dpi, dmi, rngi, ext)
             psi = paper_state(x, rpi, ext, psi0[i], true)
@@ -312,9 +289,7 @@ def _rotor_flight_kernel(
                 true[j] = carry[i, C_TRUE + j]
             for j in range(L.EXT_SIZE):
                 ext[j] = carry[i, C_EXT + j]
-            for d in range(sensor_delay + 1):
-                for j in range(L.STATE_SIZE):
-                    history[d, j] = carry[i, C_HISTORY + d * L.STATE_SIZE + j]
+            read_history(carry, i, C_HISTORY, history)
         clipped_s, limited_s = saturated[i, 0], saturated[i, 1]
         steps = clock[i, 1]
         code = FINISHED
@@ -324,7 +299,8 @@ def _rotor_flight_kernel(
             t = t_grid[k]
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
             mission(t, mpi, ref)
-            newest = k % (sensor_delay + 1)
+            # what the controller sees: the state sensor_delay periods ago, plus noise
+            newest = k % (sensor_delay + 1)  # in the ring buffer
             oldest = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
             for j in range(L.STATE_SIZE):
                 history[newest, j] = true[j]
@@ -340,9 +316,9 @@ def _rotor_flight_kernel(
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
             if k % log_every == 0:
                 log_row(log_x, i, rows, true)
-                log_row(log_rotor, i, rows, x)
                 log_row(log_cmd, i, rows, cmd)
                 log_row(log_ref, i, rows, ref)
+                log_row(log_rotor, i, rows, x)
                 rows += 1
                 rows_x = rows
             if k == n_periods:
@@ -371,8 +347,7 @@ def _rotor_flight_kernel(
                 ext_r[j] = ext[j]
             for r in range(n):
                 ext_r[9 + r] = ext[L.EXT_E1 + r] if r < 4 else 1.0
-            n_sub = max(1, int(math.ceil(dt / max_step - 1e-9)))
-            h = dt / n_sub
+            n_sub, h = substeps(dt, max_step)
             for sub in range(n_sub):
                 rotor_rk4_step(x, w_cmd, rpi, ext_r, h, work)
                 steps += 1
@@ -388,15 +363,22 @@ def _rotor_flight_kernel(
             finite = True
             for j in range(size):
                 finite = finite and math.isfinite(x[j])
-            if not finite:
-                code = NONFINITE
-            elif beyond(x[RX], x[RX + 1], x[RX + 2], max_position):
-                code = POSITION_BOUND
-            elif beyond(x[RX + 3], x[RX + 4], x[RX + 5], max_speed):
-                code = SPEED_BOUND
-            elif beyond(x[RP], x[RP + 1], x[RP + 2], max_rate):
-                code = RATE_BOUND
-            elif 1.0 - 2.0 * (x[QX] * x[QX] + x[QY] * x[QY]) < cos_tilt:
+            code = body_bounds(
+                finite,
+                x[RX],
+                x[RY],
+                x[RZ],
+                x[RVX],
+                x[RVY],
+                x[RVZ],
+                x[RP],
+                x[RQ],
+                x[RR],
+                max_position,
+                max_speed,
+                max_rate,
+            )
+            if code == FINISHED and 1.0 - 2.0 * (x[QX] * x[QX] + x[QY] * x[QY]) < cos_tilt:
                 code = TILT_BOUND
             if code != FINISHED:
                 t_end = t_grid[k + 1]
@@ -406,27 +388,18 @@ def _rotor_flight_kernel(
                     log_row(log_rotor, i, rows, x)
                     rows_x += 1
                 break
-        blank_rows(log_x, i, rows_x)
+        blank_logs(i, rows_x, rows, log_x, log_cmd, log_ref)
         blank_rows(log_rotor, i, rows_x)
-        blank_rows(log_cmd, i, rows)
-        blank_rows(log_ref, i, rows)
         put_row(x_final, i, x)
         put_row(seen_final, i, true)
-        put_row(mem, i, mi)
-        put_row(dmem, i, dmi)
-        put_row(rng, i, rngi)
-        clock[i, 0], clock[i, 1] = k_reached, steps
+        give_back(i, mi, dmi, rngi, mem, dmem, rng)
         carry[i, C_PSI] = psi
         for j in range(L.STATE_SIZE):
             carry[i, C_TRUE + j] = true[j]
         for j in range(L.EXT_SIZE):
             carry[i, C_EXT + j] = ext[j]
-        for d in range(sensor_delay + 1):
-            for j in range(L.STATE_SIZE):
-                carry[i, C_HISTORY + d * L.STATE_SIZE + j] = history[d, j]
-        saturated[i, 0], saturated[i, 1] = clipped_s, limited_s
-        status[i] = code
-        t_stop[i] = t_end
+        write_history(carry, i, C_HISTORY, history)
+        close_vehicle(i, k_reached, steps, clipped_s, limited_s, code, t_end, clock, saturated, status, t_stop)
 
 
 def fly_rotor_pieces(
@@ -441,8 +414,8 @@ def fly_rotor_pieces(
     ----------
     n : int
         Number of vehicles.
-    args : tuple
-        The kernel's arguments after the vehicle range (``ROTOR_FLIGHT_SIG``, in order).
+    args : RotorKernelArgs
+        The kernel's arguments after the vehicle range (:class:`~quadcruise.sim.kernel_args.RotorKernelArgs`).
     pieces_per_thread : int
         Ranges per thread: fewer for short calls (a step), where each call's fixed cost counts.
     after_piece : callable, optional

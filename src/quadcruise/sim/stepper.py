@@ -43,7 +43,7 @@ from quadcruise.errors import InputError
 from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from quadcruise.sim.engine import fly_vehicles, still_air
 from quadcruise.sim.inputs import Limits, batch_inputs, fresh_carry
-from quadcruise.sim.kernel_args import KernelArgs
+from quadcruise.sim.kernel_args import KernelArgs, RotorKernelArgs
 from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.rotor_batch import rotor_inputs
 from quadcruise.sim.rotor_flight import fly_rotor_pieces, paper_states, rotor_carry_width
@@ -126,53 +126,10 @@ class Stepper:
         psi0=0.0,
         touchdown_speed=None,
     ) -> None:
-        self.rotor = alloc is not None
-        if self.rotor:
-            if vp_ctrl is None:
-                raise InputError("Stepper: a rotor-plant flight needs vp_ctrl, the controller's equivalent paper row")
-            if full_dynamics:
-                raise InputError("Stepper: full_dynamics is the paper plant's option, not the rotor plant's")
-            prep = rotor_inputs(
-                t_grid,
-                x0,
-                vp,
-                alloc,
-                vp_ctrl,
-                gains,
-                mp,
-                psi0=psi0,
-                memory=memory,
-                disturbance=disturbance,
-                disturbance_params=disturbance_params,
-                disturbance_memory=disturbance_memory,
-                seed=seed,
-                first_vehicle=first_vehicle,
-                sensor_std=sensor_std,
-                sensor_delay=sensor_delay,
-                max_step=max_step,
-                touchdown_speed=touchdown_speed,
-            )
-            inp = prep["inp"]
-            inp["vp_ctrl"], inp["vp"], inp["x0"] = inp["vp"], prep["rp"], prep["x0"]
-            self.alloc, self.psi0, self.touchdown = prep["alloc"], prep["psi0"], prep["touchdown"]
-            self.ground = touchdown_speed is not None
-            self._init(
-                inp, controller, mission, disturbance, seed, first_vehicle, sensor_delay, periods, setpoint_width
-            )
-            self.carry = np.zeros((self.n, rotor_carry_width(self.sensor_delay)))
-            self._paper_state = paper_states(self.state, self.vp, self.psi0)  # then written by each step
-            self.log_rotor = np.empty((self.n, self.periods + 1, self.state.shape[1]))
-            self.full_dynamics, self.max_step = False, float(max_step)
-            self.limits = (limits or Limits()).array()
-            return
-        inp = batch_inputs(
-            t_grid,
-            x0,
-            vp,
-            gains,
-            mp,
+        if int(periods) != periods or periods < 1:
+            raise InputError(f"periods must be a whole number >= 1, got {describe(periods)}")
+        shared = dict(
             memory=memory,
-            vp_ctrl=vp_ctrl,
             disturbance=disturbance,
             disturbance_params=disturbance_params,
             disturbance_memory=disturbance_memory,
@@ -182,15 +139,23 @@ class Stepper:
             sensor_delay=sensor_delay,
             max_step=max_step,
         )
-        self._init(inp, controller, mission, disturbance, seed, first_vehicle, sensor_delay, periods, setpoint_width)
-        self.carry = fresh_carry(self._x0, self.sensor_delay)
-        self.full_dynamics, self.max_step = bool(full_dynamics), float(max_step)
-        self.limits = (limits or Limits()).array()
-
-    def _init(self, inp, controller, mission, disturbance, seed, first_vehicle, sensor_delay, periods, setpoint_width):
-        """What both plants hold: the batch arrays, memories, clocks, statuses and logs."""
-        if int(periods) != periods or periods < 1:
-            raise InputError(f"periods must be a whole number >= 1, got {describe(periods)}")
+        self.rotor = alloc is not None  # the plant: the rotor-speed plant's arrays given, or the paper's
+        if self.rotor:
+            if vp_ctrl is None:
+                raise InputError("Stepper: a rotor-plant flight needs vp_ctrl, the controller's equivalent paper row")
+            if full_dynamics:
+                raise InputError("Stepper: full_dynamics is the paper plant's option, not the rotor plant's")
+            inp = rotor_inputs(
+                t_grid, x0, vp, alloc, vp_ctrl, gains, mp, psi0=psi0, touchdown_speed=touchdown_speed, **shared
+            )
+            self.alloc, self.psi0, self.touchdown = inp["alloc"], inp["psi0"], inp["touchdown"]
+            self.ground = touchdown_speed is not None
+            self.carry = np.zeros((inp["n"], rotor_carry_width(int(sensor_delay))))
+            self._paper_state = paper_states(inp["x0"], inp["vp"], self.psi0)  # then written by each step
+            self.log_rotor = np.empty((inp["n"], int(periods) + 1, inp["x0"].shape[1]))
+        else:
+            inp = batch_inputs(t_grid, x0, vp, gains, mp, vp_ctrl=vp_ctrl, **shared)
+            self.carry = fresh_carry(inp["x0"], int(sensor_delay))
         self.n = n = inp["n"]
         if not (0 <= int(setpoint_width) <= inp["gains"].shape[1]):
             raise InputError(
@@ -230,6 +195,8 @@ class Stepper:
         self.controller, self.mission = controller, mission
         self.disturbance = disturbance or still_air
         self.disturbed = disturbance is not None
+        self.full_dynamics, self.max_step = bool(full_dynamics), float(max_step)
+        self.limits = (limits or Limits()).array()
         self._plan = ThreadPlan()  # one thread or all, for a step without a watcher
 
     @property
@@ -386,94 +353,55 @@ class Stepper:
             self._plan.record(threads, time.perf_counter() - start)
 
     def _fly(self, pieces_per_thread: int, after_piece, threads) -> None:
-        """One step through the plant's kernel, on at most ``threads`` of numba's threads."""
+        """One step through the plant's kernel, on at most ``threads`` of numba's threads: its
+        arguments by name, those of both plants first."""
+        shared = dict(
+            t_grid=self.t_grid,
+            x0=self.state,
+            vp_ctrl=self.vp_ctrl,
+            controller=self.controller,
+            gains=self.gains,
+            mem=self.memory,
+            mission=self.mission,
+            mp=self.mp,
+            disturbance=self.disturbance,
+            disturbed=self.disturbed,
+            dp=self.disturbance_params,
+            dmem=self.disturbance_memory,
+            rng=self.rng,
+            sensor_std=self.sensor_std,
+            sensor_delay=self.sensor_delay,
+            max_step=self.max_step,
+            log_every=1,
+            limits=self.limits,
+            n_step=self.periods,
+            clock=self.clock,
+            carry=self.carry,
+            log_x=self.log_x,
+            log_cmd=self.log_cmd,
+            log_ref=self.log_ref,
+            x_final=self.state,
+            status=self.status,
+            t_stop=self.t_stop,
+            saturated=self.saturated,
+        )
         if self.rotor:
-            self._step_rotor(pieces_per_thread, after_piece, threads)
-            return
-        fly_vehicles(
-            self.n,
-            KernelArgs(
-                t_grid=self.t_grid,
-                x0=self.state,
-                vp=self.vp,
-                vp_ctrl=self.vp_ctrl,
-                controller=self.controller,
-                gains=self.gains,
-                mem=self.memory,
-                mission=self.mission,
-                mp=self.mp,
-                disturbance=self.disturbance,
-                disturbed=self.disturbed,
-                dp=self.disturbance_params,
-                dmem=self.disturbance_memory,
-                rng=self.rng,
-                sensor_std=self.sensor_std,
-                sensor_delay=self.sensor_delay,
-                full=self.full_dynamics,
-                max_step=self.max_step,
-                log_every=1,
-                limits=self.limits,
-                n_step=self.periods,
-                clock=self.clock,
-                carry=self.carry,
-                log_x=self.log_x,
-                log_cmd=self.log_cmd,
-                log_ref=self.log_ref,
-                x_final=self.state,
-                status=self.status,
-                t_stop=self.t_stop,
-                saturated=self.saturated,
-            ),
-            pieces_per_thread,
-            after_piece,
-            threads,
-        )
-
-    def _step_rotor(self, pieces_per_thread: int, after_piece, threads) -> None:
-        """:meth:`step` of the rotor plant: its kernel, with the arguments of ``ROTOR_FLIGHT_SIG``."""
-        fly_rotor_pieces(
-            self.n,
-            (
-                self.t_grid,
-                self.state,
-                self.psi0,
-                self.vp,
-                self.alloc,
-                self.vp_ctrl,
-                self.controller,
-                self.gains,
-                self.memory,
-                self.mission,
-                self.mp,
-                self.disturbance,
-                self.disturbed,
-                self.disturbance_params,
-                self.disturbance_memory,
-                self.rng,
-                self.sensor_std,
-                self.sensor_delay,
-                self.max_step,
-                1,
-                self.limits,
-                self.ground,
-                self.touchdown,
-                self.periods,
-                self.clock,
-                self.carry,
-                self.log_x,
-                self.log_rotor,
-                self.log_cmd,
-                self.log_ref,
-                self.state,
-                self._paper_state,
-                self.status,
-                self.t_stop,
-                self.saturated,
-            ),
-            pieces_per_thread,
-            after_piece,
-            threads,
-        )
+            fly, args = (
+                fly_rotor_pieces,
+                RotorKernelArgs(
+                    **shared,
+                    psi0=self.psi0,
+                    rp=self.vp,
+                    alloc=self.alloc,
+                    ground=self.ground,
+                    touchdown=self.touchdown,
+                    log_rotor=self.log_rotor,
+                    seen_final=self._paper_state,
+                ),
+            )
+        else:
+            fly, args = fly_vehicles, KernelArgs(**shared, vp=self.vp, full=self.full_dynamics)
+        fly(self.n, args, pieces_per_thread, after_piece, threads)
 
 
 __all__ = ["Stepper"]

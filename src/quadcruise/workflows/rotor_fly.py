@@ -32,7 +32,7 @@ from quadcruise.layout import PSI, REF_PSI, REF_Z
 from quadcruise.missions import Mission
 from quadcruise.model.equivalent import duty_to_thrust, paper_equivalent
 from quadcruise.model.rotor_plant import QW, QZ, ROTOR_W1, RZ, state_names
-from quadcruise.model.rotor_plant import RP as RP_RATES
+from quadcruise.model.rotor_plant import RP as RATE_P
 from quadcruise.model.rotor_vehicle import AERO_FIELDS, RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.result import SimResult
@@ -304,7 +304,7 @@ def rotor_initial_states(vehicles: tuple[RotorVehicle, ...], x0: np.ndarray, n: 
     flown = vehicles if len(vehicles) == n else vehicles[:1] * n
     out = np.zeros((n, ROTOR_W1 + flown[0].n_rotors))
     out[:, :6] = x0[:, X : X + 6]
-    out[:, RP_RATES : RP_RATES + 3] = x0[:, P : P + 3]
+    out[:, RATE_P : RATE_P + 3] = x0[:, P : P + 3]
     h = 0.5 * x0[:, [PHI, THETA, PSI]]
     (cf, ct, cp), (sf, st, sp) = np.cos(h).T, np.sin(h).T
     out[:, QW] = cf * ct * cp + sf * st * sp
