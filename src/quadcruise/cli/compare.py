@@ -27,10 +27,9 @@ from quadcruise.cli.compare_run import (
     echo_population_comparison,
     population_from_options,
     population_record,
-    with_px4_params,
     write_comparison_ulogs,
 )
-from quadcruise.cli.objects import PARAMS_OPTION
+from quadcruise.cli.objects import PARAMS_OPTION, with_px4_params
 from quadcruise.cli.world import flight_world, note, world_options
 from quadcruise.io.files import check_output_dir
 
@@ -123,7 +122,7 @@ def compare(
         ``--controllers``: comma-separated controller names.
     px4_params : str or None
         ``--params``: PX4's parameters (a log or a ``.params`` file) of the px4 controller
-        (:func:`~quadcruise.cli.compare_run.with_px4_params`; px4 is added when not named).
+        (:func:`~quadcruise.cli.objects.with_px4_params`; px4 is added when not named).
     duration : float or None
         ``--duration``: flight time [s]; None: the mission's.
     dt : float

@@ -172,43 +172,6 @@ def default_compared() -> str:
     return ",".join(compared_names())
 
 
-def with_px4_params(chosen, path: str | None, world: dict):
-    """``compare --params``: the px4 entry of the compared controllers flown with a log's or a
-    ``.params`` file's PX4 parameters (px4 added when not named).
-
-    Parameters
-    ----------
-    chosen : str or dict
-        :func:`compared_from_options`'s controllers: comma-separated names, or label -> controller.
-    path : str or None
-        ``--params``.
-    world : dict
-        :func:`quadcruise.cli.world.flight_world`'s: the controller's vehicle.
-
-    Returns
-    -------
-    str or dict
-        ``chosen`` without ``path``; else label -> controller, px4's read from ``path``.
-
-    Raises
-    ------
-    InputError
-        A bad parameter file (one line naming it).
-    """
-    if path is None:
-        return chosen
-    from quadcruise.cli.objects import controller_with_params
-
-    px4 = controller_with_params(None, None, path, (), None, world)
-    if isinstance(chosen, str):
-        names = [n.strip() for n in chosen.split(",") if n.strip()]
-        chosen = {n: n for n in names}
-    out = {label: (px4 if getattr(c, "name", c) == "px4" else c) for label, c in dict(chosen).items()}
-    if px4 not in out.values():
-        out["px4"] = px4
-    return out
-
-
 def compared_from_options(mission: str, controllers: str | None, mission_params: tuple[str, ...]):
     """What ``quadcruise compare MISSION ...`` flies: the mission, controllers and keywords.
 

@@ -60,7 +60,7 @@ the vehicle's layout (n x 3: y / l, -x / l, direction, FLU), each rotor's range,
 [Hz], the position and attitude loops' periods [s], the two vehicle flags and the designed rate P, I, D per
 unit inertia (roll, pitch, yaw)."""
 (
-    X_N,
+    X_N_ROTORS,
     X_MIX,
     X_ALLOC,
     X_GEOM,
@@ -68,7 +68,7 @@ unit inertia (roll, pitch, yaw)."""
     X_HI,
     X_AIRMODE,
     X_THR_MDL_FAC,
-    X_CURVE,
+    X_THRUST_CURVE,
     X_GYRO_CUTOFF,
     X_DGYRO_CUTOFF,
     X_VELD_LP,
@@ -227,11 +227,11 @@ def resolve_gains(gains, vp, g):
     g : numpy.ndarray
         Output: :data:`~quadcruise.control.px4loops.PX4_GAINS`'s row.
     """
-    n = int(gains[X_N])
+    n = int(gains[X_N_ROTORS])
     for i in range(_NG):
         g[i] = gains[i]
     full = 4.0 * vp[L.P_K] / n  # a rotor's full thrust [N]
-    curve, fac = gains[X_CURVE], gains[X_THR_MDL_FAC]
+    curve, fac = gains[X_THRUST_CURVE], gains[X_THR_MDL_FAC]
     if gains[X_HOVER_AUTO] != 0.0:
         f = vp[L.P_M] * vp[L.P_G] / (n * full)  # each rotor's share of the weight, over its full thrust
         u = f if curve <= 0.0 else (-(1.0 - curve) + math.sqrt((1.0 - curve) ** 2 + 4.0 * curve * f)) / (2.0 * curve)
@@ -273,7 +273,7 @@ def px4_controller(t, dt, x, ref, vp, gains, mem, cmd):
     g = mem[Y_G : Y_G + _NG]
     if first:
         resolve_gains(gains, vp, g)
-    n = int(gains[X_N])
+    n = int(gains[X_N_ROTORS])
     # the state in PX4's frames
     pos = (x[L.Y], x[L.X], -x[L.Z])
     vel = (x[L.VY], x[L.VX], -x[L.VZ])
@@ -352,7 +352,7 @@ def px4_controller(t, dt, x, ref, vp, gains, mem, cmd):
     allocate_into(sp, mix, control, int(gains[X_AIRMODE]), lo, hi)
     # 6. the vehicle: thrust model, rotor thrusts, wrench; the allocator's saturation
     full = 4.0 * vp[L.P_K] / n
-    fac, curve = gains[X_THR_MDL_FAC], gains[X_CURVE]
+    fac, curve = gains[X_THR_MDL_FAC], gains[X_THRUST_CURVE]
     T = mx = my = mz = 0.0
     got0 = got1 = got2 = got3 = 0.0
     for i in range(n):
