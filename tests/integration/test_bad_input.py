@@ -23,6 +23,11 @@ CASES = [
     (["fly", "circle", "-c", "foo=1"], "nlpd has no parameter 'foo'"),
     (["fly", "circle", "--duration", "1e9"], "control periods"),
     (["fly", "circle", "--duration", "1e5"], "log less often"),
+    # inf and nan named by the option, not the library's Python argument ("fly() argument duration")
+    (["fly", "circle", "--duration", "inf"], "Invalid value for '--duration'"),
+    (["fly", "circle", "--dt", "nan"], "Invalid value for '--dt'"),
+    (["fly", "circle", "--max-step", "inf"], "Invalid value for '--max-step'"),
+    (["montecarlo", "--n", "2", "--duration", "inf"], "Invalid value for '--duration'"),
     (["fly", "waypoints"], "give its CSV file as the mission"),
     (["fly", "minsnap"], "--smooth"),
     (["fly", "circle", "--smooth"], "--smooth"),
