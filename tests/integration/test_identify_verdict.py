@@ -174,7 +174,8 @@ def rotor_csv(flight, vehicle, seed: int) -> pd.DataFrame:
 
 def test_an_x_quad_without_esc_telemetry_from_its_commands(tmp_path):
     """An x-quad (the Iris's rotors, no rotor inertia or drag, equal motor time constants) flies
-    sysid; its log has commands (relative thrust) and no rotor speeds. identify with the Iris as the
+    sysid; its log has commands (relative thrust, every one: PX4's system-identification profile)
+    and no rotor speeds. identify with the Iris as the
     base: the verdict fits, Jxx and Jyy within 10 % and inside their intervals, kf w_max^2 (the
     thrust at full command) inside its interval, the motor time constant inside; w_max said not
     identifiable."""
@@ -183,8 +184,12 @@ def test_an_x_quad_without_esc_telemetry_from_its_commands(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         flight = sysid_flight(1, seed=11, vehicle=vehicle)
+    # as a CSV (which cannot say its control rate) its closed-loop commands, changing at every
+    # sample, may have been sampled: does not fit; as the PX4 log with every command (SDLOG_PROFILE)
     rotor_csv(flight, vehicle, seed=11).to_csv(tmp_path / "x.csv", index=False)
-    result = qc.identify(tmp_path / "x.csv", vehicle=iris, mass=float(vehicle.m))
+    csv = qc.identify(tmp_path / "x.csv", vehicle=iris, mass=float(vehicle.m))
+    assert not csv.fits and "does not say its control rate" in csv.verdict_line(), csv.verdict_line()
+    result = qc.identify(no_esc_log(flight, vehicle, seed=11, rate=1000.0), vehicle=iris, mass=float(vehicle.m))
     assert result.fits, result.verdict_line()
     p = result.parameters
     for key in ("Jxx", "Jyy"):
@@ -326,3 +331,77 @@ def test_a_noise_free_hover_fits_and_gives_back_its_command(tmp_path):
     assert np.ptp(logged) == 0 and lo - 1e-7 <= logged[0] <= hi + 1e-7 and hi - lo < 1e-4
     lo, hi = doc["parameters"]["K"]["ci95"]
     assert iris.kf * iris.w_max**2 == pytest.approx((lo + hi) / 2, rel=1e-6)
+
+
+def without_rate_info(src: Path, dst: Path, keep_every: int, profile: bool = True) -> Path:
+    """A copy of a quadcruise ULog (read by pyulog) with no word of its control rate (no information
+    messages) and its command topics kept every ``keep_every``-th sample: a log that does not say
+    it sampled its commands. ``profile`` False drops ``SDLOG_PROFILE`` too (a log that does not
+    say it logged every command)."""
+    from quadcruise.io.ulog import NUMPY_TYPES, Topic, write_ulog
+
+    log = ULog(str(src))
+    topics = []
+    for d in log.data_list:
+        fields = [(f[0], f[1], f[2]) for f in log.message_formats[d.name].fields]
+        if any(kind not in NUMPY_TYPES for kind, _, _ in fields):
+            continue
+        values = {}
+        for _kind, length, name in fields:
+            if name.startswith("_padding"):
+                continue
+            values[name] = np.column_stack([d.data[f"{name}[{i}]"] for i in range(length)]) if length else d.data[name]
+        if d.name in ("actuator_motors", "actuator_outputs"):
+            values = {k: v[::keep_every] for k, v in values.items()}
+        topics.append(Topic(d.name, fields, values))
+    params = dict(log.initial_parameters)
+    if not profile:
+        params.pop("SDLOG_PROFILE", None)
+    write_ulog(dst, topics, parameters=params, start_us=int(log.start_timestamp))
+    return dst
+
+
+def test_a_log_that_does_not_say_its_rate_and_samples_its_commands_does_not_fit(tmp_path):
+    """The closed-loop sysid flight (se3 at 1 kHz, every command logged) rewritten without its
+    control rate and its commands kept every 100th (10 Hz): they change at every logged sample, so
+    the log does not fit and says why (log every command or state the rate), exit 1, no interval
+    (it was reported as fitting, Jxx +13 %, Jyy +11 %; the same made from an Iris flight gave K
+    [7.141, 7.160], truth 7.0664: docs/identify.md). Kept whole
+    without SDLOG_PROFILE either: the same (nothing says all were seen). Kept whole with PX4's
+    system-identification profile, or with the rate stated (IMU_GYRO_RATEMAX 1000): fits, K inside."""
+    raw = sysid_flight(1).to_ulog(tmp_path / "raw.ulg")
+    cases = {
+        "le100": without_rate_info(raw, tmp_path / "le100.ulg", 100),
+        "bare": without_rate_info(raw, tmp_path / "bare.ulg", 1, profile=False),
+    }
+    for name, log in cases.items():
+        assert "quadcruise_control_rate_hz" not in ULog(str(log), message_name_filter_list=[]).msg_info_dict
+        result = qc.identify(log, mass=1.4)
+        line = result.verdict_line()
+        assert not result.fits and "does not say its control rate" in line and "IMU_GYRO_RATEMAX" in line, line
+        assert all(p["ci95"] == [None, None] for p in result.parameters.values())
+        res = run("identify", log, "--mass", 1.4, "--out", tmp_path / f"o{name}")
+        assert res.exit_code == 1 and res.stdout.startswith("verdict: the model DOES NOT FIT"), res.output
+    profiled = without_rate_info(raw, tmp_path / "all.ulg", 1)
+    stated = with_parameter(cases["bare"], tmp_path / "stated.ulg", "int32_t", "IMU_GYRO_RATEMAX", 1000)
+    for log in (profiled, stated):
+        result = qc.identify(log, mass=1.4)
+        assert result.fits, result.verdict_line()
+        lo, hi = result.parameters["K"]["ci95"]
+        assert lo <= 120.0 <= hi, result.parameters["K"]
+
+
+def test_held_commands_without_a_rate_still_fit():
+    """The other direction of the rule for logs that do not say their rate: commands repeated
+    exactly between changes (a 250 Hz schedule logged at 1 kHz: 3 of 4 unchanged) pass, commands
+    changing at every sample fail, a hover's level passes."""
+    from quadcruise.sysid.verdict import command_check, unchanged_share
+
+    seg = np.zeros(400, int)
+    held = np.repeat(np.linspace(0.4, 0.6, 100), 4)[:, None] * np.ones((1, 4))
+    moving = np.linspace(0.4, 0.6, 400)[:, None] * np.ones((1, 4))
+    assert command_check(1000.0, None, unchanged_share(held, seg))["ok"]
+    check = command_check(1000.0, None, unchanged_share(moving, seg))
+    assert not check["ok"] and "does not say its control rate" in check["why"]
+    assert command_check(1000.0, None, unchanged_share(moving, seg), level=0.01)["ok"]
+    assert command_check(1000.0, None, unchanged_share(moving, seg), every=True)["ok"]

@@ -6,6 +6,7 @@ mission or a controller."""
 from __future__ import annotations
 
 import functools
+import math
 import sys
 import warnings
 from collections.abc import Callable
@@ -55,8 +56,25 @@ FORMAT_OPTION = click.option(
     callback=_table_format,
     help="Format of the traces.",
 )
-SECONDS = click.FloatRange(min=0.0, min_open=True)
-"""A time option's type (--duration, --dt, --max-step): a positive number of seconds, said by the option's name."""
+
+
+class _Seconds(click.FloatRange):
+    """A positive, finite number of seconds: ``FloatRange(min=0, min_open=True)`` let ``inf`` and
+    ``nan`` through to the library, whose refusal named its Python argument (``fly() argument
+    duration``), not the option."""
+
+    name = "seconds"
+
+    def convert(self, value, param, ctx):
+        x = super().convert(value, param, ctx)
+        if not math.isfinite(x):
+            self.fail(f"{value!r} is not a finite number of seconds (give a positive number, e.g. 10)", param, ctx)
+        return x
+
+
+SECONDS = _Seconds(min=0.0, min_open=True)
+"""A time option's type (--duration, --dt, --max-step): a positive finite number of seconds, said by the
+option's name (``fly --duration inf``: "Invalid value for '--duration'")."""
 
 FORCE_OPTION = click.option("--force", is_flag=True, help="Replace a non-empty --out folder not written by quadcruise.")
 

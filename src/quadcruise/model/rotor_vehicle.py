@@ -34,6 +34,10 @@ from quadcruise.fields import unit_field as _f
 from quadcruise.model.rotor_plant import ROTOR_ARM, ROTOR_PARAMS
 from quadcruise.model.vehicle_files import load_vehicle
 
+MAX_THRUST_TO_WEIGHT = 100.0
+"""The largest full thrust over weight, ``n kf w_max^2 / (m g)``, a vehicle file may give: racing
+quadrotors reach about 15, the presets 1.9 to 10.2; beyond it a coefficient is out of physical range
+(``kf = 1e300`` had left a yaw column 1e-308 of the thrust's: an allocation "of rank 3")."""
 AERO_FIELDS = ("c_Dx", "c_Dy", "c_Dz", "k_d", "k_z", "k_h", "k_flap")
 """The aerodynamic coefficients (RotorPy's names); all zero is RotorPy's ``aero=False``."""
 
@@ -153,6 +157,12 @@ class RotorVehicle(Validated):
             raise InputError(
                 f"vehicle cannot lift itself: {self.n_rotors} rotors x kf w_max^2 = {lift:.4g} N, "
                 f"its weight m g = {weight:.4g} N"
+            )
+        if lift > MAX_THRUST_TO_WEIGHT * weight:
+            raise InputError(
+                f"vehicle field 'kf' ({self.kf:g} N/(rad/s)^2) is out of physical range: {self.n_rotors} rotors x "
+                f"kf w_max^2 = {lift:.4g} N is {lift / weight:.3g} times the weight m g = {weight:.4g} N "
+                f"(at most {MAX_THRUST_TO_WEIGHT:g}; a rotor's kf is about 1e-8 to 1e-4)"
             )
         angles = sorted(math.atan2(y, x) for x, y, _, _ in self.rotors if math.hypot(x, y) > 0.0)
         gaps = (

@@ -168,7 +168,7 @@ class IdentifyResult:
             }
             checks = self.verdict.get("checks", {})
             if checks.get("commands", {}).get("control_hz", 0) is None:
-                names["commands"] = "the log does not say its control rate"
+                names["commands"] = "the log does not say its control rate: its commands held between changes"
             done = [names.get(k, k) for k in checks]
             return f"verdict: the model fits the log ({', '.join(done)})"
         return "verdict: the model DOES NOT FIT the log, no intervals: " + "; ".join(self.verdict["reasons"])

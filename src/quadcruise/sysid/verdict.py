@@ -28,6 +28,8 @@ import dataclasses
 
 import numpy as np
 
+from quadcruise.sysid.logprep import SYSID_PROFILE_BIT
+
 MAX_HELD_RATIO = 2.0
 """The largest ratio of an equation's held-out mean square residual to its fitted one."""
 NEGLIGIBLE = 1e-4
@@ -49,6 +51,12 @@ BETTER_STRUCTURE = 0.3
 """How much lower (a share) the other lag structure's residual variance must be to fail the model."""
 STILL_SHARE = 0.95
 """The least share of unchanged consecutive commands for sampled commands to count as all seen."""
+HELD_SHARE = 2.0 / 3.0
+"""On a log that does not say its control rate, the least share of unchanged consecutive commands
+(each command repeated exactly, held 3 samples on average) for the log to count as holding every
+command: commands that change at (nearly) every logged sample were sampled, as far as the log
+shows (a 1 kHz controller's commands kept every 100th gave K +1 % with an interval excluding the
+truth)."""
 LEVEL_SPREAD = 0.05
 """Each rotor's commands' standard deviation over their mean under which a log whose changes
 identify nothing (no inertia, ``d`` nor lag identifiable: a hover) is judged on its commands'
@@ -232,7 +240,9 @@ def segment_check(first: dict, second: dict) -> dict:
     }
 
 
-def command_check(cmd_hz: float, control_hz: float | None, still: float = 0.0, level: float | None = None) -> dict:
+def command_check(
+    cmd_hz: float, control_hz: float | None, still: float = 0.0, level: float | None = None, every: bool = False
+) -> dict:
     """Whether the log holds every command its controller computed, or commands that did not change
     between its samples.
 
@@ -241,28 +251,47 @@ def command_check(cmd_hz: float, control_hz: float | None, still: float = 0.0, l
     :data:`STILL_SHARE` passes however slowly they are logged. ``level``, when given, is the largest
     spread of a rotor's commands over their mean on a log whose command changes identify nothing
     (a hover: no inertia, ``d`` nor lag identifiable); under :data:`LEVEL_SPREAD` it passes too (what
-    is fitted comes from the commands' level, which sampling keeps).
+    is fitted comes from the commands' level, which sampling keeps). ``every``: the log says it holds
+    every command (PX4's system-identification logging profile, its commands at the body rates'
+    rate). A log that says neither its control rate (``control_hz`` None) nor ``every`` passes only
+    when its commands are held, repeating exactly (``still`` at least :data:`HELD_SHARE`): commands
+    changing at (nearly) every sample were sampled.
 
     Examples
     --------
     >>> command_check(100.0, 1000.0)["ok"], command_check(1000.0, 1000.0)["ok"], command_check(250.0, None)["ok"]
-    (False, True, True)
+    (False, True, False)
+    >>> command_check(250.0, None, still=0.75)["ok"], command_check(250.0, None, every=True)["ok"]
+    (True, True)
     >>> command_check(250.0, 1000.0, still=0.99)["ok"]
     True
     >>> command_check(250.0, 1000.0, level=0.02)["ok"], command_check(250.0, 1000.0, level=0.3)["ok"]
     (True, False)
     """
     level_only = level is not None and level < LEVEL_SPREAD
-    ok = control_hz is None or cmd_hz >= SAMPLED_SHARE * control_hz or still >= STILL_SHARE or level_only
+    if control_hz is None and not every:
+        ok = still >= HELD_SHARE or level_only
+        why = (
+            f"the log does not say its control rate and its commands (logged at {cmd_hz:g} Hz) change at "
+            f"{100 * (1 - still):.0f} % of its samples: sampled, not held, so the commands between samples "
+            "are unknown (log every command, PX4: SDLOG_PROFILE with bit 3, or state the controller's rate: "
+            "the log's IMU_GYRO_RATEMAX)"
+        )
+    else:
+        ok = every or control_hz is None or cmd_hz >= SAMPLED_SHARE * control_hz or still >= STILL_SHARE or level_only
+        why = (
+            f"the commands are logged at {cmd_hz:g} Hz and the controller computed them at "
+            f"{control_hz or 0:g} Hz, changing between samples ({100 * (1 - still):.0f} % of them): the commands "
+            "between samples are unknown (log every command: PX4's system-identification profile)"
+        )
     return {
         "ok": bool(ok),
         "command_hz": cmd_hz,
         "control_hz": control_hz,
         "unchanged_share": still,
         "level_spread": level,
-        "why": f"the commands are logged at {cmd_hz:g} Hz and the controller computed them at "
-        f"{control_hz or 0:g} Hz, changing between samples ({100 * (1 - still):.0f} % of them): the commands "
-        "between samples are unknown (log every command: PX4's system-identification profile)",
+        "every_logged": bool(every),
+        "why": why,
     }
 
 
@@ -379,8 +408,14 @@ def paper_verdict(flight, sig, fit_rows, held, rotors, result, mass, g, cmd_hz, 
             found = {}
         halves.append({k: v for k, v in found.items() if v["identifiable"]})
     checks["segments"] = segment_check(*halves)
+    profile = int(flight.parameters.get("SDLOG_PROFILE", 0) or 0)
     checks["commands"] = command_check(
-        cmd_hz, control_rate(rates, rates), unchanged_share(flight.u, flight.segment), level
+        cmd_hz,
+        control_rate(rates, rates),
+        unchanged_share(flight.u, flight.segment),
+        level,
+        # PX4's system-identification profile logs every command: at the grid's (the body rates') rate
+        every=bool(profile & SYSID_PROFILE_BIT) and cmd_hz >= SAMPLED_SHARE / sig.dt,
     )
     other = "speed" if sig.lag_of == "thrust" else "thrust"
     alt = fit(
