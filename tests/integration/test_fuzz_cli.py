@@ -168,6 +168,8 @@ def scenario_keys() -> list[tuple[str, str, str]]:
                 if isinstance(default, str)
                 else "flag"
                 if isinstance(default, bool)
+                else "rows"
+                if isinstance(default, tuple)
                 else "number"
             )
             keys.append((f"controller:{name}", f.name, kind))
@@ -185,6 +187,7 @@ BAD_TOML = {
     "bound": ['"xyz"', "[]", "true", "nan", "-inf", "0", "-1"],  # inf turns a bound off: not bad
     "flag": ['"xyz"', "2", "[]"],
     "table": ["1", '"xyz"', "[1, 2]", "{ nonsense = 1 }"],
+    "rows": ['"xyz"', "1", "[1, 2]", "[[1, 2, 3]]", "true"],  # a tuple of rows ([] is its default: not bad)
 }
 
 

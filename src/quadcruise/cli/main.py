@@ -19,6 +19,7 @@ from __future__ import annotations
 import gc
 import signal
 import sys
+import warnings
 
 import click
 
@@ -95,6 +96,8 @@ def run() -> None:
         command = sys.argv[1] if len(sys.argv) > 1 else ""  # the sweep's way on is said for a sweep only
         text, status = interrupt_text(exc if isinstance(exc, KeyboardInterrupt) else KeyboardInterrupt(), command)
         click.echo(f"error: {text}", err=True)
+        # a file an interrupted import had open is closed at exit: no news to a user, one line stays one
+        warnings.filterwarnings("ignore", category=ResourceWarning)
         sys.exit(status)
     finally:
         gc.freeze()
