@@ -163,11 +163,13 @@ def test_step_functions_give_the_series_readings():
     ts, h, bias = b.measure(np.array([0.0, 2.0]), np.array([3.0, 3.0]), seed=9)
     s, st, steps = vehicle_states(9, 1)[0, 0], np.zeros(1), []  # bias_init 0: no switch-on draw
     for _ in ts:
-        r, s = baro_read(np.array([10.0, 0.2, 0.0, 0.1]), st, 3.0, np.uint64(s))  # back in Python a state is an int
+        r, s = baro_read(b.row(), st, 3.0, np.uint64(s))  # back in Python a state is an int
         steps.append(r)
     assert np.allclose(steps, h)
     out = np.empty(3)
-    mag_read(np.array([0.0, 0.0]), np.array([0.1, 0.0, -0.1]), 0.2, 0.3, 0.4, out, vehicle_states(1, 1)[0, 0])
+    mag_read(
+        Magnetometer(noise_std=0.0).row(), np.array([0.1, 0.0, -0.1]), 0.2, 0.3, 0.4, out, vehicle_states(1, 1)[0, 0]
+    )
     assert np.allclose(out, [0.3, 0.3, 0.3])
 
 

@@ -13,13 +13,14 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from quadcruise.fields import Validated, unit_field
+from quadcruise.fields import unit_field
+from quadcruise.sensors.model import SensorModel
 from quadcruise.sensors.noise import noisy, sample_times, walk
 from quadcruise.sim.rng import vehicle_states
 
 
 @dataclass(frozen=True)
-class Baro(Validated):
+class Baro(SensorModel):
     """A barometer's parameters.
 
     Parameters
@@ -74,12 +75,17 @@ class Baro(Validated):
         ts = sample_times(float(t[0]), float(t[-1]), self.rate)
         out, bias = np.interp(ts, t, z), np.empty(ts.size)
         baro_series(
-            np.array([self.rate, self.noise_std, self.bias_init, self.drift]),
+            self.row(),
             out,
             bias,
             vehicle_states(seed, 1, first=vehicle)[0, 0],
         )
         return ts, out, bias
+
+
+BARO_ROW = Baro.layout("BARO_")
+"""The compiled functions' parameter row: :class:`Baro`'s fields in order (:meth:`Baro.row`)."""
+BARO_RATE, BARO_NOISE_STD, BARO_BIAS_INIT, BARO_DRIFT = BARO_ROW.offsets
 
 
 @njit(cache=True)
@@ -89,7 +95,7 @@ def baro_read(row, st, z, s):
     Parameters
     ----------
     row : numpy.ndarray
-        (rate, noise_std, bias_init, drift).
+        :meth:`Baro.row` (rate, noise_std, bias_init, drift).
     st : numpy.ndarray
         (1,) the offset [m] (drawn at switch-on with std ``bias_init`` by the caller), updated.
     z : float
@@ -102,8 +108,8 @@ def baro_read(row, st, z, s):
     tuple
         (the reading [m], the advanced generator state).
     """
-    h, s = noisy(z, st[0], row[1], s)
-    st[0], s = walk(st[0], row[3], 1.0 / row[0], s)
+    h, s = noisy(z, st[0], row[BARO_NOISE_STD], s)
+    st[0], s = walk(st[0], row[BARO_DRIFT], 1.0 / row[BARO_RATE], s)
     return h, s
 
 
@@ -114,7 +120,7 @@ def baro_series(row, h, bias, s):
     Parameters
     ----------
     row : numpy.ndarray
-        (rate, noise_std, bias_init, drift).
+        :meth:`Baro.row` (rate, noise_std, bias_init, drift).
     h : numpy.ndarray
         (K,) true altitude [m], overwritten by the readings.
     bias : numpy.ndarray
@@ -128,7 +134,7 @@ def baro_series(row, h, bias, s):
         The advanced generator state.
     """
     st = np.empty(1)
-    st[0], s = noisy(0.0, 0.0, row[2], s)
+    st[0], s = noisy(0.0, 0.0, row[BARO_BIAS_INIT], s)
     for k in range(h.shape[0]):
         bias[k] = st[0]
         h[k], s = baro_read(row, st, h[k], s)

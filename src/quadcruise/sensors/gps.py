@@ -13,15 +13,14 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from quadcruise.fields import Validated, unit_field
+from quadcruise.fields import unit_field
+from quadcruise.sensors.model import SensorModel
 from quadcruise.sensors.noise import noisy, sample_times
 from quadcruise.sim.rng import vehicle_states
 
-RATE, LATENCY, POS_H, POS_V, VEL_H, VEL_V, OUT_START, OUT_LEN, ROW_SIZE = 0, 1, 2, 3, 4, 5, 6, 7, 8
-
 
 @dataclass(frozen=True)
-class Gps(Validated):
+class Gps(SensorModel):
     """A GNSS receiver's parameters.
 
     Parameters
@@ -58,27 +57,6 @@ class Gps(Validated):
     outage_start: float = unit_field(0.0, "s", "outage start", "nonneg")
     outage_duration: float = unit_field(0.0, "s", "outage duration", "nonneg")
     name = "gps"
-
-    def row(self) -> np.ndarray:
-        """The parameters in the offsets' order.
-
-        Returns
-        -------
-        numpy.ndarray
-            (ROW_SIZE,) float64.
-        """
-        return np.array(
-            [
-                self.rate,
-                self.latency,
-                self.horizontal_std,
-                self.vertical_std,
-                self.velocity_std,
-                self.vertical_velocity_std,
-                self.outage_start,
-                self.outage_duration,
-            ]
-        )
 
     def measure(self, t: np.ndarray, position: np.ndarray, velocity: np.ndarray, seed: int, vehicle: int = 0) -> tuple:
         """The fixes of a true trajectory, from an explicit seed.
@@ -117,6 +95,20 @@ class Gps(Validated):
         return ts, ts + self.latency, out
 
 
+GPS_ROW = Gps.layout("GPS_")
+"""The compiled functions' parameter row: :class:`Gps`'s fields in order (:meth:`Gps.row`)."""
+(
+    GPS_RATE,
+    GPS_LATENCY,
+    GPS_HORIZONTAL_STD,
+    GPS_VERTICAL_STD,
+    GPS_VELOCITY_STD,
+    GPS_VERTICAL_VELOCITY_STD,
+    GPS_OUTAGE_START,
+    GPS_OUTAGE_DURATION,
+) = GPS_ROW.offsets
+
+
 @njit(cache=True)
 def gps_read(row, px, py, pz, vx, vy, vz, out, s):
     """One fix of the true ENU position and velocity into ``out`` (6,).
@@ -137,12 +129,12 @@ def gps_read(row, px, py, pz, vx, vy, vz, out, s):
     numpy.uint64
         The advanced generator state.
     """
-    out[0], s = noisy(px, 0.0, row[POS_H], s)
-    out[1], s = noisy(py, 0.0, row[POS_H], s)
-    out[2], s = noisy(pz, 0.0, row[POS_V], s)
-    out[3], s = noisy(vx, 0.0, row[VEL_H], s)
-    out[4], s = noisy(vy, 0.0, row[VEL_H], s)
-    out[5], s = noisy(vz, 0.0, row[VEL_V], s)
+    out[0], s = noisy(px, 0.0, row[GPS_HORIZONTAL_STD], s)
+    out[1], s = noisy(py, 0.0, row[GPS_HORIZONTAL_STD], s)
+    out[2], s = noisy(pz, 0.0, row[GPS_VERTICAL_STD], s)
+    out[3], s = noisy(vx, 0.0, row[GPS_VELOCITY_STD], s)
+    out[4], s = noisy(vy, 0.0, row[GPS_VELOCITY_STD], s)
+    out[5], s = noisy(vz, 0.0, row[GPS_VERTICAL_VELOCITY_STD], s)
     return s
 
 

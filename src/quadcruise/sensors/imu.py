@@ -21,7 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from quadcruise.fields import Validated, unit_field
+from quadcruise.fields import unit_field
+from quadcruise.sensors.model import SensorModel
 from quadcruise.sensors.noise import digitise, noisy, sample_std, walk
 from quadcruise.sim.rng import vehicle_states
 
@@ -30,15 +31,12 @@ G0 = 9.80665
 """Standard gravity [m/s^2], to turn datasheet g into m/s^2."""
 
 # the parameter row's offsets
-RATE, GYRO_N, GYRO_RW, GYRO_B0, GYRO_RANGE, GYRO_LSB = 0, 1, 2, 3, 4, 5
-ACC_N, ACC_RW, ACC_B0, ACC_RANGE, ACC_LSB, SCALE, MISALIGN = 6, 7, 8, 9, 10, 11, 12
-ROW_SIZE = 13
 # the state's offsets: gyro bias, accel bias, gyro matrix (row-major), accel matrix
 ST_BG, ST_BA, ST_MG, ST_MA, STATE_SIZE = 0, 3, 6, 15, 24
 
 
 @dataclass(frozen=True)
-class Imu(Validated):
+class Imu(SensorModel):
     """An IMU's parameters: rate, noise densities, bias walk, range and resolution.
 
     Parameters
@@ -93,32 +91,6 @@ class Imu(Validated):
     misalignment: float = unit_field(0.0, "rad", "cross-axis misalignment std", "nonneg")
     name = "imu"
 
-    def row(self) -> np.ndarray:
-        """The parameters as the compiled functions take them, in the offsets' order.
-
-        Returns
-        -------
-        numpy.ndarray
-            (ROW_SIZE,) float64.
-        """
-        return np.array(
-            [
-                self.rate,
-                self.gyro_noise,
-                self.gyro_bias_walk,
-                self.gyro_bias_init,
-                self.gyro_range,
-                self.gyro_lsb,
-                self.accel_noise,
-                self.accel_bias_walk,
-                self.accel_bias_init,
-                self.accel_range,
-                self.accel_lsb,
-                self.scale_error,
-                self.misalignment,
-            ]
-        )
-
     def measure(self, rates: np.ndarray, forces: np.ndarray, seed: int, vehicle: int = 0) -> tuple:
         """The IMU's readings of a true series sampled at its rate, from an explicit seed.
 
@@ -151,6 +123,25 @@ class Imu(Validated):
         out = np.empty((rates.shape[0], 6))
         imu_series(row, st, rates, forces, out, np.uint64(s))  # a Python int would type as int64
         return out, st
+
+
+IMU_ROW = Imu.layout("IMU_")
+"""The compiled functions' parameter row: :class:`Imu`'s fields in order (:meth:`Imu.row`)."""
+(
+    IMU_RATE,
+    IMU_GYRO_NOISE,
+    IMU_GYRO_BIAS_WALK,
+    IMU_GYRO_BIAS_INIT,
+    IMU_GYRO_RANGE,
+    IMU_GYRO_LSB,
+    IMU_ACCEL_NOISE,
+    IMU_ACCEL_BIAS_WALK,
+    IMU_ACCEL_BIAS_INIT,
+    IMU_ACCEL_RANGE,
+    IMU_ACCEL_LSB,
+    IMU_SCALE_ERROR,
+    IMU_MISALIGNMENT,
+) = IMU_ROW.offsets
 
 
 BMI088 = Imu(
@@ -211,17 +202,17 @@ def imu_start(row, st, s):
         The advanced generator state.
     """
     for i in range(3):
-        b, s = noisy(0.0, 0.0, row[GYRO_B0], s)
+        b, s = noisy(0.0, 0.0, row[IMU_GYRO_BIAS_INIT], s)
         st[ST_BG + i] = b
-        b, s = noisy(0.0, 0.0, row[ACC_B0], s)
+        b, s = noisy(0.0, 0.0, row[IMU_ACCEL_BIAS_INIT], s)
         st[ST_BA + i] = b
     for m in (ST_MG, ST_MA):
         for i in range(3):
             for j in range(3):
                 if i == j:
-                    e, s = noisy(1.0, 0.0, row[SCALE], s)
+                    e, s = noisy(1.0, 0.0, row[IMU_SCALE_ERROR], s)
                 else:
-                    e, s = noisy(0.0, 0.0, row[MISALIGN], s)
+                    e, s = noisy(0.0, 0.0, row[IMU_MISALIGNMENT], s)
                 st[m + 3 * i + j] = e
     return s
 
@@ -249,18 +240,18 @@ def imu_read(row, st, wx, wy, wz, fx, fy, fz, out, s):
     numpy.uint64
         The advanced generator state.
     """
-    rate = row[RATE]
-    gstd, astd = sample_std(row[GYRO_N], rate), sample_std(row[ACC_N], rate)
+    rate = row[IMU_RATE]
+    gstd, astd = sample_std(row[IMU_GYRO_NOISE], rate), sample_std(row[IMU_ACCEL_NOISE], rate)
     for i in range(3):
         g = st[ST_MG + 3 * i] * wx + st[ST_MG + 3 * i + 1] * wy + st[ST_MG + 3 * i + 2] * wz
         a = st[ST_MA + 3 * i] * fx + st[ST_MA + 3 * i + 1] * fy + st[ST_MA + 3 * i + 2] * fz
         g, s = noisy(g, st[ST_BG + i], gstd, s)
         a, s = noisy(a, st[ST_BA + i], astd, s)
-        out[i] = digitise(g, row[GYRO_LSB], row[GYRO_RANGE])
-        out[3 + i] = digitise(a, row[ACC_LSB], row[ACC_RANGE])
+        out[i] = digitise(g, row[IMU_GYRO_LSB], row[IMU_GYRO_RANGE])
+        out[3 + i] = digitise(a, row[IMU_ACCEL_LSB], row[IMU_ACCEL_RANGE])
     for i in range(3):
-        st[ST_BG + i], s = walk(st[ST_BG + i], row[GYRO_RW], 1.0 / rate, s)
-        st[ST_BA + i], s = walk(st[ST_BA + i], row[ACC_RW], 1.0 / rate, s)
+        st[ST_BG + i], s = walk(st[ST_BG + i], row[IMU_GYRO_BIAS_WALK], 1.0 / rate, s)
+        st[ST_BA + i], s = walk(st[ST_BA + i], row[IMU_ACCEL_BIAS_WALK], 1.0 / rate, s)
     return s
 
 

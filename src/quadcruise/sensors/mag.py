@@ -15,13 +15,14 @@ import numpy as np
 from numba import njit
 from scipy.spatial.transform import Rotation
 
-from quadcruise.fields import Validated, unit_field
+from quadcruise.fields import unit_field
+from quadcruise.sensors.model import SensorModel
 from quadcruise.sensors.noise import noisy, sample_times
 from quadcruise.sim.rng import vehicle_states
 
 
 @dataclass(frozen=True)
-class Magnetometer(Validated):
+class Magnetometer(SensorModel):
     """A magnetometer's parameters and the field it sits in.
 
     Parameters
@@ -98,8 +99,14 @@ class Magnetometer(Validated):
         q = np.asarray(quaternion, float)[k]
         out = Rotation.from_quat(q[:, [1, 2, 3, 0]]).inv().apply(self.world_field())
         bias = np.zeros(3)
-        mag_series(np.array([self.noise_std, self.bias_std]), out, bias, vehicle_states(seed, 1, first=vehicle)[0, 0])
+        mag_series(self.row(), out, bias, vehicle_states(seed, 1, first=vehicle)[0, 0])
         return ts, out, bias
+
+
+MAG_ROW = Magnetometer.layout("MAG_")
+"""The compiled functions' parameter row: :class:`Magnetometer`'s fields in order
+(:meth:`Magnetometer.row`)."""
+MAG_RATE, MAG_STRENGTH, MAG_DECLINATION, MAG_INCLINATION, MAG_NOISE_STD, MAG_BIAS_STD = MAG_ROW.offsets
 
 
 @njit(cache=True)
@@ -109,7 +116,7 @@ def mag_read(row, bias, bx, by, bz, out, s):
     Parameters
     ----------
     row : numpy.ndarray
-        (noise_std, bias_std) [G].
+        :meth:`Magnetometer.row`.
     bias : numpy.ndarray
         (3,) the hard-iron bias [G].
     bx, by, bz : float
@@ -124,9 +131,9 @@ def mag_read(row, bias, bx, by, bz, out, s):
     numpy.uint64
         The advanced generator state.
     """
-    out[0], s = noisy(bx, bias[0], row[0], s)
-    out[1], s = noisy(by, bias[1], row[0], s)
-    out[2], s = noisy(bz, bias[2], row[0], s)
+    out[0], s = noisy(bx, bias[0], row[MAG_NOISE_STD], s)
+    out[1], s = noisy(by, bias[1], row[MAG_NOISE_STD], s)
+    out[2], s = noisy(bz, bias[2], row[MAG_NOISE_STD], s)
     return s
 
 
@@ -137,7 +144,7 @@ def mag_series(row, field, bias, s):
     Parameters
     ----------
     row : numpy.ndarray
-        (noise_std, bias_std) [G].
+        :meth:`Magnetometer.row`.
     field : numpy.ndarray
         (K, 3) true field in the body frame [G], overwritten by the readings.
     bias : numpy.ndarray
@@ -151,7 +158,7 @@ def mag_series(row, field, bias, s):
         The advanced generator state.
     """
     for i in range(3):
-        bias[i], s = noisy(0.0, 0.0, row[1], s)
+        bias[i], s = noisy(0.0, 0.0, row[MAG_BIAS_STD], s)
     for k in range(field.shape[0]):
         s = mag_read(row, bias, field[k, 0], field[k, 1], field[k, 2], field[k], s)
     return s
