@@ -68,6 +68,11 @@ SENSOR_FIELDS = {
 }
 
 
+RATE_INFO = ("quadcruise_control_rate_hz", "quadcruise_log_rate_hz", "IMU_GYRO_RATEMAX")
+"""What a ULog may say of its own rates: a quadcruise log's information messages (its control
+and logging rates), and PX4's ``IMU_GYRO_RATEMAX`` (its rate loop runs on each gyro sample)."""
+
+
 @dataclass(frozen=True, eq=False)
 class FlightLog:
     """A flight's airborne stretches on one time grid, in quadcruise's frames.
@@ -81,7 +86,9 @@ class FlightLog:
     rate), and in words where the ``commands`` came from and the ``resampling``. ``speeds`` (L, n),
     or None: the rotors' measured speeds [rad/s] (ULog ``esc_status`` rpm, CSV ``w1..wn``);
     ``speed_commands``: the commands ``u`` are rotor speeds [rad/s] (a CSV read with
-    ``commands="rad/s"``) rather than normalised.
+    ``commands="rad/s"``) rather than normalised. ``rate_info``: what a ULog says of its own
+    rates (:data:`RATE_INFO`: ``IMU_GYRO_RATEMAX``, and a quadcruise log's information messages
+    ``quadcruise_control_rate_hz`` and ``quadcruise_log_rate_hz``); empty for a CSV.
 
     A ULog's commands ``u`` are each rotor's *relative thrust* (thrust over its thrust at full
     command), PX4's meaning of ``actuator_motors``; ``actuator_outputs`` (PWM) are mapped to the
@@ -109,6 +116,7 @@ class FlightLog:
     speeds: np.ndarray | None = None
     speed_commands: bool = False
     thrust_factor: float | None = None
+    rate_info: dict = field(default_factory=dict)
 
     @property
     def n_rotors(self) -> int:
@@ -430,7 +438,9 @@ def _read_ulog(path: Path, spec: tuple[str, float, float]) -> FlightLog:
     )
     names = ("MAV_TYPE", "CA_ROTOR_COUNT", "SYS_AUTOSTART", "SDLOG_PROFILE")  # THR_MDL_FAC: applied here
     kept = {k: params[k] for k in names if k in params}
+    said_rates = {**log.msg_info_dict, **params}
     return FlightLog(
+        rate_info={k: said_rates[k] for k in RATE_INFO if k in said_rates},
         source=str(path),
         t=t,
         segment=segment[keep],

@@ -182,30 +182,13 @@ def log_rates(flight: FlightLog) -> dict:
     Parameters
     ----------
     flight : FlightLog
-        The log read (its ``source`` is read again, its data messages skipped).
+        The log read (its ``rate_info``, kept when it was read).
 
     Returns
     -------
     dict
     """
-    from pathlib import Path
-
-    path = Path(flight.source)
-    if path.suffix.lower() != ".ulg" or not path.is_file():
-        return {}
-    from pyulog import ULog
-
-    try:
-        log = ULog(str(path), message_name_filter_list=[])
-    except Exception:  # noqa: BLE001 - read once already: a second reading adds nothing to refuse
-        return {}
-    out = {}
-    for key in ("quadcruise_control_rate_hz", "quadcruise_log_rate_hz"):
-        if key in log.msg_info_dict:
-            out[key] = log.msg_info_dict[key]
-    if "IMU_GYRO_RATEMAX" in log.initial_parameters:
-        out["IMU_GYRO_RATEMAX"] = log.initial_parameters["IMU_GYRO_RATEMAX"]
-    return out
+    return dict(flight.rate_info)
 
 
 def log_info(flight: FlightLog, sig) -> dict:
