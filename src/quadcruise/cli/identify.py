@@ -48,10 +48,9 @@ def check_keeps_log(log: str, out: str) -> None:
         ...
     quadcruise.errors.InputError: --out runs/a: holds the log being read (runs/a/flight.ulg), which writing ...
     """
-    from pathlib import Path
+    from quadcruise.io.keep_inputs import holds
 
-    read, folder = Path(log).resolve(), Path(out).resolve()
-    if folder == read or folder in read.parents:
+    if holds(out, log):
         raise InputError(
             f"--out {out}: holds the log being read ({log}), which writing the folder would delete: "
             "choose another folder"

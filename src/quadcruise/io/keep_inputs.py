@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-__all__ = ["check_keeps_inputs"]
+__all__ = ["check_keeps_inputs", "holds"]
 
 
 def check_keeps_inputs(folder: str | os.PathLike, inputs=()) -> None:
@@ -39,16 +39,24 @@ def check_keeps_inputs(folder: str | os.PathLike, inputs=()) -> None:
     """
     from quadcruise.errors import InputError
 
-    target = Path(folder).resolve()
+    target = Path(folder)
     for given in inputs:
         if given is None or not str(given).strip():
             continue
-        read = Path(given)
-        if not read.exists():
-            continue
-        read = read.resolve()
-        if read == target or target in read.parents:
+        if Path(given).exists() and holds(target, given):
             raise InputError(
                 f"{folder}: holds {given}, which this run reads; writing the folder would delete it: "
                 "choose another folder"
             )
+
+
+def holds(folder: str | os.PathLike, path: str | os.PathLike) -> bool:
+    """Whether ``folder`` is ``path`` or holds it (at any depth), after links and ``..``.
+
+    Examples
+    --------
+    >>> holds("runs/a", "runs/a/flight.ulg"), holds("runs/a", "runs/ab/flight.ulg"), holds("runs/a", "runs/a")
+    (True, False, True)
+    """
+    folder, path = Path(folder).resolve(), Path(path).resolve()
+    return path == folder or folder in path.parents
