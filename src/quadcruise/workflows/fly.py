@@ -133,8 +133,7 @@ def fly(
         that fits, said in a :class:`~quadcruise.errors.LogWarning`. A ``log_every`` given is
         kept (a log over half the memory is refused). Either way the track checks (``lost
         track``, ``off track``) are made at every period as the flight goes, so the statuses
-        and times are those of the full log, whatever the log keeps (on the paper's plant; a
-        rotor-plant flight's checks read its log).
+        and times are those of the full log, whatever the log keeps (on both plants).
     limits : Limits, optional
         Divergence bounds.
     missions : list of Mission, optional
