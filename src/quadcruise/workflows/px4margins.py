@@ -128,8 +128,8 @@ def rotor_gains(controller, vehicle) -> dict:
     >>> from quadcruise.control.px4 import Px4
     >>> import quadcruise as qc
     >>> r = rotor_gains(Px4(), qc.Vehicle.paper())
-    >>> round(r["accel"], 9)
-    1.0
+    >>> round(r["accel"], 6), round(9.81 / 9.80665, 6)   # the vehicle's g over PX4's CONSTANTS_ONE_G
+    (1.000342, 1.000342)
     """
     from quadcruise.control.px4kernel import X_GEOM, X_MIX, X_N_ROTORS
     from quadcruise.control.px4loops import G_THR_HOVER
@@ -146,7 +146,11 @@ def rotor_gains(controller, vehicle) -> dict:
     # collective thrust c: each rotor's command -mix[i, 5] * (-c); the vertical acceleration per unit of it
     per_collective = -sum(gains[X_MIX + 6 * i + 5] for i in range(n)) * slope / vp[L.P_M]
     hover = controller.loop_gains(vehicle)[G_THR_HOVER]
-    return {"torque": torque, "accel": per_collective * hover / _G, "hover_command": s_h}
+    return {
+        "torque": [float(t) for t in torque],
+        "accel": float(per_collective * hover / _G),
+        "hover_command": float(s_h),
+    }
 
 
 def _rate_controller(g, a, T, gyro_hz, dgyro_hz):
