@@ -126,11 +126,12 @@ def rise_time(T: control.StateSpace, horizon: float = 5.0) -> float:
     >>> round(rise_time(T), 3)                    # ln 9 / 10
     0.22
     """
+    T = control.ss(T)
     n = int(round(horizon / T.dt))
-    A, B, C = np.asarray(T.A), np.asarray(T.B).ravel(), np.asarray(T.C).ravel()
+    A, B, C, D = np.asarray(T.A), np.asarray(T.B).ravel(), np.asarray(T.C).ravel(), float(np.asarray(T.D).ravel()[0])
     x, y = np.zeros(A.shape[0]), np.empty(n)
     for k in range(n):
-        y[k] = C @ x
+        y[k] = C @ x + D
         x = A @ x + B
     final = y[-1]
     if not np.isfinite(final) or final == 0.0:
