@@ -292,3 +292,11 @@ def test_analyze_refuses_an_unknown_suffix_and_poles_for_px4(tmp_path):
     assert res.exit_code == 2 and "x.json" in res.stderr and res.stderr.count("\n") == 1, res.stderr
     res = CliRunner().invoke(main, ["analyze", "--controller", "px4", "--poles", "-1,-2"])
     assert res.exit_code == 2 and "--poles" in res.stderr and res.stderr.count("\n") == 1, res.stderr
+
+
+def test_linearize_refuses_the_multi_rate_px4_controller():
+    from quadcruise.errors import InputError
+    from quadcruise.workflows.analysis import linearize
+
+    with pytest.raises(InputError, match="px4_margins"):
+        linearize("px4")  # one period at t = 0 runs only the rate loop: an answer that would look right

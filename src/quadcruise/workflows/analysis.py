@@ -158,6 +158,13 @@ def linearize(
     """
     w = "linearize()"  # every argument checked before any work
     controller = _as_controller(controller)  # (its function may be plain Python: it is called here)
+    from quadcruise.control.px4 import Px4
+
+    if isinstance(controller, Px4):  # its loops run at their own rates, which one period at t = 0 misses
+        raise InputError(
+            "linearize differentiates one period of a single-rate loop; the px4 controller runs its loops at "
+            "their own rates: use quadcruise.workflows.px4margins.px4_margins (analyze --controller px4)"
+        )
     vehicle = checks.instance(w, "vehicle", vehicle, Vehicle) or Vehicle.paper()
     dt = checks.number(w, "dt", dt, "pos", unit="s")
     hover_z = checks.number(w, "hover_z", hover_z, unit="m")
