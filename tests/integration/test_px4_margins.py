@@ -267,7 +267,7 @@ def test_analyze_params_reads_the_logs_parameters(tmp_path):
         ("1\t1\tMC_ROLL_P\tfast\t9\n", [], "bad.params, line 1"),
         ("1\t1\tMC_ROLL_P\t7\t9\n", ["--controller", "nlpd"], "--controller nlpd has none"),
         ("1\t1\tMC_ROLL_P\t7\t9\n", ["--poles", "-1,-2"], "--poles"),
-        ("1\t1\tMC_ROLL_P\t7\t9\n", ["--dt", "0.1"], "dt = 0.1 s"),
+        ("1\t1\tMC_ROLL_P\t7\t9\n", ["--dt", "0.1"], "--dt 0.1"),
     ],
 )
 def test_analyze_params_refuses_bad_input_in_one_line(tmp_path, text, args, message):

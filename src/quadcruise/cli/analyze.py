@@ -106,6 +106,8 @@ def _analyze_px4(controller, controller_params, position_poles, dt, vehicle_text
     from quadcruise.cli.vehicle import vehicle_from_option
     from quadcruise.errors import InputError
 
+    if dt > 0.05:
+        raise InputError(f"--dt {dt:g}: the px4 controller's rate loop runs at the control period, at most 0.05 s")
     if position_poles is not None and px4_params is None:
         raise InputError("--poles: the px4 controller takes its position gains from PX4's MPC_* parameters")
     vehicle = vehicle_from_option(vehicle_text, "--vehicle")
