@@ -343,3 +343,17 @@ def test_linearize_refuses_the_multi_rate_px4_controller():
 
     with pytest.raises(InputError, match="px4_margins"):
         linearize("px4")  # one period at t = 0 runs only the rate loop: an answer that would look right
+
+
+@pytest.mark.parametrize("controller", ["px4", "nlpd"])
+def test_analyze_exits_1_on_an_unstable_loop_and_0_on_a_stable_one(controller):
+    """A closed loop that could never have flown says so in the exit status as well as the table."""
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    slow = "omega=3.0" if controller == "px4" else "omega=0.5"  # rotors far slower than the design's
+    res = CliRunner().invoke(main, ["analyze", "--controller", controller, "--vehicle", slow])
+    assert res.exit_code == 1 and "UNSTABLE" in res.output, res.output
+    res = CliRunner().invoke(main, ["analyze", "--controller", controller])
+    assert res.exit_code == 0 and "UNSTABLE" not in res.output, res.output

@@ -3,6 +3,8 @@ folder written on request."""
 
 from __future__ import annotations
 
+import sys
+
 import click
 
 from quadcruise.cli.common import FORCE_OPTION, SECONDS, Bar, controller_from_options, friendly, writable
@@ -98,6 +100,8 @@ def analyze(controller, controller_params, position_poles, dt, vehicle_text, out
     if out is not None:
         lin.write(out, force=force, progress=Bar("Bode plots"))
         click.echo(f"wrote analysis.json and Bode plots to {out}")
+    if not lin.stable:
+        sys.exit(1)  # the closed loop about hover is unstable: it could never have flown
 
 
 def _analyze_px4(controller, controller_params, position_poles, dt, vehicle_text, out, px4_params, force):
@@ -122,7 +126,10 @@ def _analyze_px4(controller, controller_params, position_poles, dt, vehicle_text
     from quadcruise.workflows.px4margins import px4_margins
 
     result = px4_margins(the_controller, vehicle, dt=dt)
-    click.echo(str(result.summary()))
+    summary = result.summary()
+    click.echo(str(summary))
     if out is not None:
         result.write(out, force=force, progress=Bar("Bode plots", unit="loop"))
         click.echo(f"wrote analysis.json and bode.png to {out}")
+    if not all(e["stable"] for axes in summary["loops"].values() for e in axes.values()):
+        sys.exit(1)  # a loop is unstable about hover: it could never have flown
