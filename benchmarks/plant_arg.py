@@ -4,7 +4,7 @@ and ``python benchmarks/plant_arg.py --cache`` (numba's cache across processes).
 
 The prototype is the paper plant's RK4 step (:func:`quadcruise.sim.engine.rk4_step`, compiled
 here once more with its signature, ``STEP_SIG``) flown by one small kernel, N vehicles x M
-steps at h = 1 ms; each step first clips the vehicle's duties to [0, 1] (``paper_clip``, the
+steps at h = 1 ms; each step first clips the vehicle's duties (not with ``--step-only``) to [0, 1] (``paper_clip``, the
 plant's per-period command: a small function that numba inlines where it can), then takes the
 RK4 step. Two forms differ only in how they reach the plant's two functions:
 
@@ -121,28 +121,60 @@ def inputs(n: int) -> tuple[np.ndarray, ...]:
     return x, u, vp
 
 
-def run(which: str, x, u, vp, steps: int) -> tuple[float, np.ndarray]:
+@njit(types.void(*_KERNEL_TAIL), cache=True, nogil=True, error_model="numpy")
+def step_inline(x, u, vp, h, steps, out):
+    """The step alone (``--step-only``), reached as a global jit function."""
+    work = np.zeros((WORK_ROWS, L.STATE_SIZE))
+    ext = np.zeros(L.EXT_SIZE)
+    ext[L.EXT_E1 :] = 1.0
+    for i in range(x.shape[0]):
+        xi = x[i].copy()
+        for k in range(steps):
+            paper_step(xi, u[i], vp[i], ext, False, h, work, k % 64 == 0)
+        out[i] = xi
+
+
+@njit(types.void(StepType, *_KERNEL_TAIL), cache=True, nogil=True, error_model="numpy")
+def step_passed(step, x, u, vp, h, steps, out):
+    """The step alone (``--step-only``), passed in as a first-class function."""
+    work = np.zeros((WORK_ROWS, L.STATE_SIZE))
+    ext = np.zeros(L.EXT_SIZE)
+    ext[L.EXT_E1 :] = 1.0
+    for i in range(x.shape[0]):
+        xi = x[i].copy()
+        for k in range(steps):
+            step(xi, u[i], vp[i], ext, False, h, work, k % 64 == 0)
+        out[i] = xi
+
+
+def run(which: str, x, u, vp, steps: int, step_only: bool = False) -> tuple[float, np.ndarray]:
     """CPU seconds of one call, and the final states."""
     out = np.empty_like(x)
     start = time.process_time()
-    if which == "inline":
+    if step_only:
+        if which == "inline":
+            step_inline(x, u, vp, 1e-3, steps, out)
+        else:
+            step_passed(paper_step, x, u, vp, 1e-3, steps, out)
+    elif which == "inline":
         kernel_inline(x, u, vp, 1e-3, steps, out)
     else:
         kernel_passed(paper_clip, paper_step, x, u, vp, 1e-3, steps, out)
     return time.process_time() - start, out
 
 
-def ab(rounds: int, n: int, steps: int) -> None:
+def ab(rounds: int, n: int, steps: int, step_only: bool = False) -> None:
     """Alternating rounds, one process: ns per vehicle-step by CPU time."""
     x, u, vp = inputs(n)
-    a0, b0 = run("inline", x, u, vp, 10)[1], run("passed", x, u, vp, 10)[1]  # load or compile, untimed
+    a0, b0 = (run(which, x, u, vp, 10, step_only)[1] for which in ("inline", "passed"))  # load or compile, untimed
     same = np.array_equal(a0, b0)
     times: dict[str, list[float]] = {"inline": [], "passed": []}
     for r in range(rounds):
         for which in ("inline", "passed") if r % 2 == 0 else ("passed", "inline"):
-            times[which].append(run(which, x, u, vp, steps)[0] / (n * steps) * 1e9)
+            times[which].append(run(which, x, u, vp, steps, step_only)[0] / (n * steps) * 1e9)
     a, b = times["inline"], times["passed"]
-    print(f"{n} vehicles x {steps} steps, {rounds} rounds alternating; CPU ns per vehicle-step (best / median)")
+    what = "the step alone" if step_only else "the duty clip, then the step"
+    print(f"{what}: {n} vehicles x {steps} steps, {rounds} rounds alternating; CPU ns per vehicle-step (best / median)")
     print(f"  inline  {min(a):7.1f} / {statistics.median(a):7.1f}")
     print(f"  passed  {min(b):7.1f} / {statistics.median(b):7.1f}")
     print(f"  passed/inline: {min(b) / min(a):.3f} (best), {statistics.median(b) / statistics.median(a):.3f} (median)")
@@ -176,12 +208,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--rounds", type=int, default=6)
     parser.add_argument("--vehicles", type=int, default=200)
     parser.add_argument("--steps", type=int, default=2000)
+    parser.add_argument("--step-only", action="store_true", help="the kernels that take the step alone, no clip")
     parser.add_argument("--cache", action="store_true", help="check numba's cache across two fresh processes")
     args = parser.parse_args(argv)
     if args.cache:
         cache_check()
     else:
-        ab(args.rounds, args.vehicles, args.steps)
+        ab(args.rounds, args.vehicles, args.steps, args.step_only)
     return 0
 
 
