@@ -78,7 +78,7 @@ class PaperPlant(Plant):
 
     def check_vehicles(self, vehicles: tuple) -> None:
         """A vehicle that cannot lift itself refused, one that barely can warned of."""
-        hover_check(vehicles[0], stacklevel=4)
+        hover_check(vehicles[0], stacklevel=3)  # the warning points at fly's caller
 
     def flight(self, grid, vehicle, controller_vehicle, controller, gains, mission, mp, n, *, x0, paper_x0, meta, **kw):
         """:func:`~quadcruise.sim.engine.simulate`'s arguments: the rows of ``vehicle`` (and of the
