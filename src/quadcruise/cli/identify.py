@@ -21,8 +21,6 @@ def base_vehicle(text: str):
 
     from quadcruise.model.vehicle import Vehicle
 
-    if text.strip().lower() == "paper":
-        return Vehicle.paper()
     path = Path(text)
     if path.suffix.lower() != ".toml":
         try:

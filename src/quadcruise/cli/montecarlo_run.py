@@ -192,7 +192,7 @@ def montecarlo_command(
             0,
             f"the controllers are told the nominal vehicle ({vehicle}): their only model error is the "
             "spreads'; --controller-vehicle "
-            + (f"{vehicle.split(',')[0]},m=..." if spec.rotor else "paper")
+            + (spec.plant.default_preset or f"{vehicle.split(',')[0]},m=...")
             + " (or KEY=VALUE,...) gives them another belief",
         )
     if case is None:

@@ -93,15 +93,17 @@ def controller_for_vehicle(
     -------
     Controller
         ``controller`` for the paper's plant or a scenario's controller; else the named controller
-        (nlpd by default) with the gains :func:`quadcruise.workflows.rotor_fly.rotor_flight_setup`
-        designs for the vehicle the controller believes, changed by ``params`` and ``poles_text``.
+        (nlpd by default) with the gains :func:`quadcruise.workflows.rotor_fly.flight_setup`
+        designs for the vehicle the controller believes, where its plant designs gains, changed by
+        ``params`` and ``poles_text``.
     """
-    from quadcruise.model.rotor_vehicle import RotorVehicle
-    from quadcruise.workflows.rotor_fly import rotor_flight_setup
+    from quadcruise.sim import plants
+    from quadcruise.workflows.rotor_fly import flight_setup
 
-    if not isinstance(world.get("vehicle"), RotorVehicle) or (scenario is not None and name is None):
+    vehicle = world.get("vehicle")
+    if vehicle is None or not plants.of(vehicle).designs_gains or (scenario is not None and name is None):
         return controller
-    designed = rotor_flight_setup(world["vehicle"], world.get("controller_vehicle"), name or controller.name)[1]
+    designed = flight_setup(vehicle, world.get("controller_vehicle"), name or controller.name)[1]
     return controller_from_options(None, params, poles_text, base=designed)
 
 

@@ -127,7 +127,7 @@ def tune_command(
     )
     from quadcruise.cli.world import flight_world
     from quadcruise.errors import InputError, whole_number
-    from quadcruise.model.rotor_vehicle import RotorVehicle
+    from quadcruise.sim import plants
 
     if log_every is not None:
         whole_number(log_every, "--log-every", minimum=1)
@@ -163,7 +163,7 @@ def tune_command(
     world, notes = flight_world(
         vehicle=vehicle, controller_vehicle=controller_vehicle, wind=wind, turbulence=turbulence, scenario=sc
     )
-    rotor = isinstance(world["vehicle"], RotorVehicle)
+    plant = plants.of(world["vehicle"])
     if px4_params:
         the_controller = controller_with_params(the_controller, controller, px4_params, controller_params, None, world)
     else:
@@ -171,7 +171,7 @@ def tune_command(
     the_controller = as_px4_parameters(the_controller, world, bool(px4_params))
     wanted["gains"] = parse_gains(gains, the_controller)
     environment = world["environment"]
-    if wind_spread > 0 and not rotor and not any("wind acts only through drag" in line for line in notes):
+    if wind_spread > 0 and plant.drag_for_wind and not any("wind acts only through drag" in line for line in notes):
         from quadcruise.disturbances import default_drag_text, with_drag
 
         if world["vehicle"].drag_linear == 0 and world["vehicle"].drag_quadratic == 0:
@@ -253,14 +253,15 @@ def as_px4_parameters(controller, world: dict, given: bool):
         A design value outside PX4's range (PX4 could not fly it).
     """
     from quadcruise.model.equivalent import paper_equivalent
-    from quadcruise.model.rotor_vehicle import RotorVehicle
+    from quadcruise.sim import plants
 
     believed = world.get("controller_vehicle") or world.get("vehicle")
-    if getattr(controller, "name", None) != "px4" or not (given or isinstance(believed, RotorVehicle)):
+    designs = believed is not None and plants.of(believed).designs_gains  # designed for the vehicle believed
+    if getattr(controller, "name", None) != "px4" or not (given or designs):
         return controller
     if _px4_form(controller) and (given or controller.rotors):
         return controller
     from quadcruise.control.px4 import Px4
 
-    plain = controller.resolved(paper_equivalent(believed) if isinstance(believed, RotorVehicle) else believed)
+    plain = controller.resolved(paper_equivalent(believed))  # a paper vehicle is its own equivalent
     return Px4.from_params(plain.params, vehicle=believed, position_rate=controller.position_rate)

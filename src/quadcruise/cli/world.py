@@ -125,44 +125,40 @@ def flight_world(
     describe, a scenario's changed by them; and the notes to print before flying."""
     from quadcruise.disturbances import default_drag_text, with_drag
     from quadcruise.model.vehicle import Vehicle
+    from quadcruise.sim import plants
 
     base = scenario.vehicle if scenario is not None else Vehicle.paper()
     flown = vehicle_from_option(vehicle, "--vehicle", base) or base
+    plant = plants.of(flown, "--vehicle")
     believed_base = scenario.controller_vehicle if scenario is not None else None
     believed = (
         vehicle_from_option(
             controller_vehicle,
             "--controller-vehicle",
-            believed_base or (Vehicle.paper() if isinstance(flown, Vehicle) else flown),  # bare fields change it
+            # bare fields change the plant's default vehicle (the paper's), or the flown one
+            believed_base or (Vehicle.preset(plant.default_preset) if plant.default_preset else flown),
         )
         or believed_base
     )
     env = environment_from_options(wind, turbulence, scenario.environment if scenario is not None else None)
-    if vehicle is not None and isinstance(flown, Vehicle):  # a RotorVehicle that cannot lift cannot be made
+    if vehicle is not None:
         import warnings
-
-        from quadcruise.workflows.fly_inputs import check_can_hover
 
         with warnings.catch_warnings():  # the flight itself warns of a vehicle with little left for control
             warnings.simplefilter("ignore")
-            check_can_hover(flown)  # before any note: a vehicle that cannot lift is bad input
+            plant.check_vehicles((flown,))  # before any note: a vehicle that cannot lift is bad input
     notes = []
     if vehicle is not None and believed is None and flown != Vehicle.paper():
         notes.append(
             f"the controller is told the flown vehicle ({vehicle}), so it flies without model error; "
             + (
-                "--controller-vehicle paper (or KEY=VALUE,...) gives it another belief"
-                if isinstance(flown, Vehicle)
+                f"--controller-vehicle {plant.default_preset} (or KEY=VALUE,...) gives it another belief"
+                if plant.default_preset
                 else "--controller-vehicle KEY=VALUE,... (the flown vehicle changed), PRESET,KEY=VALUE,... or "
                 "FILE.toml gives it another belief"
             )
         )
-    if (
-        env is not None
-        and env.needs_drag
-        and isinstance(flown, Vehicle)
-        and flown.drag_linear == flown.drag_quadratic == 0
-    ):
+    if env is not None and env.needs_drag and plant.drag_for_wind and flown.drag_linear == flown.drag_quadratic == 0:
         flown = with_drag(flown)
         notes.append(default_drag_text())
     return {"vehicle": flown, "controller_vehicle": believed, "environment": env}, notes

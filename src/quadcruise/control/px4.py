@@ -204,7 +204,7 @@ class Px4(Controller):
         InputError
             A bad file or value (one line naming it), or ``CA_ROTOR*`` that do not fit the vehicle.
         """
-        from quadcruise.model.rotor_vehicle import RotorVehicle
+        from quadcruise.sim import plants
 
         if isinstance(params, Px4Parameters):
             p = params
@@ -213,8 +213,8 @@ class Px4(Controller):
         else:
             p = read_params(params)
         base = {"params": p, "hover_from_vehicle": False, "rate_bandwidth": 0.0}
-        if isinstance(vehicle, RotorVehicle):
-            base.update(rotors=tuple(tuple(map(float, r)) for r in vehicle.rotors), thrust_curve=1.0)
+        if vehicle is not None:  # what PX4's CA_ROTOR* and THR_MDL_FAC say of the vehicle's plant
+            base.update(plants.of(vehicle).px4_fields(vehicle))
         base.update(fields)
         out = cls(**base)
         out.geometry()  # CA_ROTOR* checked against the vehicle, before any flight

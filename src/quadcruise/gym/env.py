@@ -18,19 +18,20 @@ from quadcruise.control import as_controller
 from quadcruise.control.setpoint import ACTION_CONTROLLERS, setpoint_gains
 from quadcruise.errors import ArgumentTypeError, InputError
 from quadcruise.gym.observe import OBS_SIZE, REF_SIZE, observe, references
-from quadcruise.gym.rotor import allocation_rows, drawn_rows, hover_starts
+from quadcruise.gym.rotor import rotor_episodes
 from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, STATE_SIZE, X
 from quadcruise.missions import Circle, Mission, mission_from_name, stack_params
 from quadcruise.model.equivalent import paper_equivalent
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
+from quadcruise.sim import plants
 from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.stepper import Stepper
 from quadcruise.workflows.fly_inputs import check_can_hover
-from quadcruise.workflows.rotor_fly import as_vehicle, check_wind_acts, designed_controller
+from quadcruise.workflows.rotor_fly import as_vehicle, designed_controller
 
 EPISODE_STRIDE = 2**32
 """Episode e of vehicle i draws from the stream ``(seed, i * EPISODE_STRIDE + e)``: it depends on
@@ -81,9 +82,7 @@ def default_max_step(vehicle, dt: float) -> float:
     >>> [default_max_step(RotorVehicle.preset(name), 0.01) for name in ("hummingbird", "crazyflie")]
     [0.0025, 0.01]
     """
-    if isinstance(vehicle, RotorVehicle):
-        return min(dt, 0.5 * min(vehicle.tau_up, vehicle.tau_down))
-    return dt
+    return plants.of(vehicle).longest_step(vehicle, dt)
 
 
 class QuadVectorEnv(VectorEnv):
@@ -170,7 +169,7 @@ class QuadVectorEnv(VectorEnv):
             raise InputError(
                 f"vehicle must be a Vehicle, a RotorVehicle or a preset's name, got {checks.describe(vehicle)}"
             )
-        self.rotor = isinstance(self.nominal, RotorVehicle)
+        self.plant = plants.of(self.nominal)
         # the paper vehicle the controllers believe: the rotor vehicle's "+" equivalent
         self.nominal_eq = paper_equivalent(self.nominal)
         if self.nominal_eq.batch_size is not None:
@@ -183,16 +182,16 @@ class QuadVectorEnv(VectorEnv):
         default = RANDOM_DURATION if self.random_mission else self.mission.duration
         self.duration = float(default if duration is None else duration)
         grid = time_grid(self.duration, float(dt))
-        if self.rotor and isinstance(controller, str):  # gains designed for the vehicle, as fly does
-            controller = designed_controller(controller, self.nominal_eq.omega)
+        if self.plant.designs_gains and isinstance(controller, str):  # designed for the vehicle, as fly does
+            controller = designed_controller(controller, self.plant.bandwidths((self.nominal,))[0])
         self.baseline = None if controller is None else as_controller(controller, w)
         try:
             gains = setpoint_gains(**(scales or {}))
         except ValueError as err:
             raise InputError(str(err)) from None
         draw = self._draw(0, np.arange(n) * EPISODE_STRIDE, n)
-        if self.rotor:  # the drawn environment: a population's wind spread makes wind of still air
-            check_wind_acts(self.nominal, draw["environment"])
+        # the drawn environment: a population's wind spread makes wind of still air
+        self.plant.check_environment((self.nominal,), draw["environment"])
         self.sensors = None if population is None else population.noise
         if self.baseline is not None:
             function, gains, memory, width = (self.baseline.function, self.baseline.gains(), self.baseline.memory(), 0)
@@ -200,9 +199,6 @@ class QuadVectorEnv(VectorEnv):
             function, memory, width = ACTION_CONTROLLERS[action], None, 4
         env_kw = {} if draw["environment"] is None else draw["environment"].kwargs(n)
         sens_kw = {} if self.sensors is None else self.sensors.kwargs(float(dt))
-        rotor_kw = {}
-        if self.rotor:
-            rotor_kw = {"alloc": draw["alloc"], "psi0": draw["psi0"], "touchdown_speed": self.nominal.touchdown_speed}
         self.stepper = Stepper(
             grid,
             draw["x0"],
@@ -218,7 +214,8 @@ class QuadVectorEnv(VectorEnv):
             setpoint_width=width,
             **env_kw,
             **sens_kw,
-            **rotor_kw,
+            **draw["own"],  # the plant's own rows (rotor plant: allocation, initial yaw) and arrays
+            **draw["fixed"],
         )
         self.dt = float(dt)
         self.single_action_space = spaces.Box(-1.0, 1.0, (4,), dtype=np.float32)
@@ -247,27 +244,18 @@ class QuadVectorEnv(VectorEnv):
             start, mp = np.concatenate([m.reference(0.0) for m in missions]), stack_params(missions, n=k)
         else:
             start, mp = self._start_ref, np.repeat(self._mission_row, k, axis=0)
+        return {**EPISODES[self.plant.name](self, vehicle, start, offsets, mp, k), "environment": environment}
+
+    def _paper_episodes(self, vehicle, start: np.ndarray, offsets: np.ndarray, mp: np.ndarray, k: int) -> dict:
+        """The arrays of k episodes of a paper vehicle (``vehicle`` the drawn ones)."""
+        pop = self.population
         vp = self._rows(vehicle, k)
-        if self.rotor:
-            vp_ctrl = self._rows(self.nominal_eq, k) if pop is None or pop.model_error else vp
-            rows = drawn_rows(self.nominal, self._nominal_row[0], vp)
-            x0, psi0 = hover_starts(rows, start, offsets)
-            alloc = allocation_rows(self.nominal, vp_ctrl, None if self.baseline is not None else self.action_mode)
-            return {
-                "vp": rows,
-                "vp_ctrl": vp_ctrl,
-                "x0": x0,
-                "psi0": psi0,
-                "alloc": alloc,
-                "mp": mp,
-                "environment": environment,
-            }
         x0 = np.zeros((k, STATE_SIZE))  # level, still, rotors at the hover thrust
         x0[:, X : X + 3] = start[:, REF_X : REF_X + 3] + offsets  # on the reference, plus the drawn offset
         x0[:, PSI] = start[:, REF_PSI]
         x0[:, F1 : F1 + 4] = (vp[:, P_M] * vp[:, P_G] / 4.0)[:, None]
         vp_ctrl = self._rows(self.nominal, k) if pop is None or pop.model_error else vp
-        return {"vp": vp, "vp_ctrl": vp_ctrl, "x0": x0, "mp": mp, "environment": environment}
+        return {"vp": vp, "vp_ctrl": vp_ctrl, "x0": x0, "mp": mp, "own": {}, "fixed": {}}
 
     def _rows(self, vehicle, k: int) -> np.ndarray:
         """``vehicle.rows(k)``, the nominal vehicle's from its row computed once."""
@@ -282,8 +270,8 @@ class QuadVectorEnv(VectorEnv):
         s = self.stepper
         draw = self._draw(self._seed, ids, k)
         s.vp[rows], s.vp_ctrl[rows], s.mp[rows] = draw["vp"], draw["vp_ctrl"], draw["mp"]
-        if self.rotor:
-            s.alloc[rows], s.psi0[rows] = draw["alloc"], draw["psi0"]
+        for key, value in draw["own"].items():  # the plant's own rows (rotor plant: allocation, initial yaw)
+            getattr(s, key)[rows] = value
         env = draw["environment"]
         if env is not None:
             s.disturbance_params[rows] = env.params(k)
@@ -416,6 +404,11 @@ class QuadVectorEnv(VectorEnv):
         info = self._info()
         self._pending = terminated | truncated
         return self._obs.copy(), reward, terminated, truncated, info
+
+
+EPISODES = {"paper": QuadVectorEnv._paper_episodes, "rotor": rotor_episodes}
+"""How an environment's episodes start, by the nominal vehicle's plant (:mod:`quadcruise.sim.plants`):
+``episodes(env, vehicle, start, offsets, mp, k) -> dict`` of the Stepper's rows."""
 
 
 class MakeArgumentTypeError(ArgumentTypeError):

@@ -154,4 +154,24 @@ def hover_starts(rows: np.ndarray, start: np.ndarray, offsets: np.ndarray) -> tu
     return x0, psi
 
 
+def rotor_episodes(env, vehicle, start: np.ndarray, offsets: np.ndarray, mp: np.ndarray, k: int) -> dict:
+    """The arrays of k episodes of a rotor-plant vehicle (``vehicle`` the drawn paper equivalents):
+    its drawn rows, the controller's paper rows and allocation, the hover starts, and in ``own``
+    the Stepper's rotor-plant rows (``alloc``, ``psi0``), in ``fixed`` its ground."""
+    pop = env.population
+    vp = env._rows(vehicle, k)
+    vp_ctrl = env._rows(env.nominal_eq, k) if pop is None or pop.model_error else vp
+    rows = drawn_rows(env.nominal, env._nominal_row[0], vp)
+    x0, psi0 = hover_starts(rows, start, offsets)
+    alloc = allocation_rows(env.nominal, vp_ctrl, None if env.baseline is not None else env.action_mode)
+    return {
+        "vp": rows,
+        "vp_ctrl": vp_ctrl,
+        "x0": x0,
+        "mp": mp,
+        "own": {"alloc": alloc, "psi0": psi0},
+        "fixed": {"touchdown_speed": env.nominal.touchdown_speed},
+    }
+
+
 __all__ = ["allocation_rows", "drawn_rows", "hover_starts"]

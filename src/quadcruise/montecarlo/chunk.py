@@ -25,24 +25,20 @@ __all__ = ["Case", "fly_chunk", "montecarlo_case", "reduce_chunk", "replay_case"
 def fly_chunk(spec: MonteCarloSpec, first, count: int, log_every: int | None = None, controller=None):
     """Fly vehicles first .. first + count - 1 (or the indices ``first``) as one batch, with the spec's
     controller or one per vehicle: ``(SimResult, Draw)``; failures go in the table, not in warnings."""
-    from quadcruise.model.equivalent import paper_equivalent
     from quadcruise.workflows.fly import fly
     from quadcruise.workflows.fly_inputs import hover_state
 
     draw = spec.population.draw(spec.seed, first, count, spec.vehicle, spec.dt)
-    x0 = None  # a rotor-plant vehicle without an offset: hovering at the mission's start (rotor_fly.py)
-    if not spec.rotor:
-        x0 = hover_state(draw.vehicle, count, spec.mission)
-        x0[:, X : X + 3] += draw.offsets
-    elif np.any(draw.offsets):  # the paper layout's hover thrusts: each rotor at its hover speed
-        x0 = np.concatenate([hover_state(paper_equivalent(v), 1, spec.mission) for v in draw.vehicle])
+    x0 = None  # without an offset: hovering at the mission's start, fly's own start on either plant
+    if np.any(draw.offsets):  # the paper layout's hover thrusts (a rotor plant's: each rotor at its hover speed)
+        x0 = hover_state(spec.plant.equivalent(spec.plant.vehicles(draw.vehicle)), count, spec.mission)
         x0[:, X : X + 3] += draw.offsets
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         res = fly(
             spec.mission,
             spec.controller if controller is None else controller,
-            vehicle=list(draw.vehicle) if spec.rotor else draw.vehicle,
+            vehicle=draw.vehicle,  # a rotor-plant population's: a tuple, one per vehicle
             controller_vehicle=spec.model_vehicle,
             duration=spec.duration,
             dt=spec.dt,

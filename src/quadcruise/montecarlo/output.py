@@ -140,11 +140,7 @@ def report_markdown(result, summary: dict, worst, table_name: str) -> str:
         f"quadcruise {__version__}, seed {spec.seed}, {spec.duration:g} s at dt = {spec.dt:g} s, "
         f"metrics on a {spec.dt * spec.log_every:g} s log; spec hash `{spec.hash()}`.\n",
         "Population: " + (", ".join(f"{k} = {v}" for k, v in pop.items()) or "nominal") + ".\n",
-        *(
-            [f"Vehicle: the rotor-speed plant, {spec.vehicle.n_rotors} rotors ({spec.vehicle.source or 'user'}).\n"]
-            if spec.rotor
-            else []
-        ),
+        *[f"Vehicle: {said}.\n" for said in [spec.plant.describe(spec.vehicle)] if said],
         f"## Failures: {f['count']:,} of {summary['flights']:,} ({100 * f['rate']:.2f} %)\n",
         "Each flight counts once, under the first that applies: diverged (the engine stopped it), "
         f"lost track (its position error after the transient, or at the end if the transient never "

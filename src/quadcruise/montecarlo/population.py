@@ -35,6 +35,7 @@ from quadcruise.checks import describe
 from quadcruise.errors import ArgumentTypeError, InputError
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
+from quadcruise.sim import plants
 from quadcruise.sim.fastmath import seeded_draws
 
 __all__ = ["Population", "Draw", "DRAW_KEY", "N_DRAWS", "SLOTS", "SPREADS", "ROTOR_SPREADS", "ROTOR_SLOTS", "CLIP"]
@@ -388,24 +389,13 @@ class Population:
         Draw
             The batched vehicles and what was drawn for them.
         """
-        rotor = isinstance(nominal, RotorVehicle)
-        if not rotor and nominal.batch_size is not None:
+        plant = plants.of(nominal, "the nominal vehicle of a population")
+        if plant.count(nominal) is not None:
             raise InputError("the nominal vehicle of a population must not be batched")
-        if not rotor and self.aero_spread > 0:
-            raise InputError(
-                "population field 'aero_spread' perturbs a rotor-plant vehicle's aerodynamic coefficients; "
-                "the paper's vehicle has none (its drag comes with the wind)"
-            )
+        plant.refuse("population", "aero_spread", self.aero_spread > 0, label="field")
         z = self.unit_draws(seed, first, count)
         drawn = self._identified_draws(seed, first, count, nominal)
-        cols: dict[str, np.ndarray] = {}
-        if rotor:
-            vehicles, cols = self._rotor_vehicles(nominal, z, drawn)
-        else:
-            for spread, names in SPREADS.items():
-                for name in names:
-                    cols[name] = getattr(nominal, name) * (1.0 + getattr(self, spread) * z[:, SLOTS[name]])
-            cols.update(drawn)
+        vehicles, cols = VEHICLE_DRAWS[plant.name](self, nominal, z, drawn, batch_vehicle)
         offsets = self.offset * z[:, [SLOTS["dx0"], SLOTS["dy0"], SLOTS["dz0"]]]
         cols.update(dx0=offsets[:, 0], dy0=offsets[:, 1], dz0=offsets[:, 2])
         env = self.environment
@@ -424,10 +414,6 @@ class Population:
             env = dataclasses.replace(env or Environment(), wind=ConstantWind(velocity=wind))
         if env is not None and not env.parts:
             env = None
-        if not rotor:
-            vehicles = nominal
-            if batch_vehicle or self.spreads_vehicle:
-                vehicles = nominal.replace(**{k: cols[k] for names in SPREADS.values() for k in names})
         return Draw(vehicle=vehicles, offsets=offsets, environment=env, sensors=self.noise, columns=cols)
 
     def _identified_draws(self, seed: int, first, count: int, nominal) -> dict[str, np.ndarray]:
@@ -445,9 +431,24 @@ class Population:
         values = self.identified.draw(seed, ids)
         return {name: values[:, j] for j, name in enumerate(self.identified.names)}
 
-    def _rotor_vehicles(self, nominal: RotorVehicle, z: np.ndarray, drawn: dict | None = None) -> tuple[tuple, dict]:
+    def _paper_vehicles(self, nominal: Vehicle, z: np.ndarray, drawn: dict, batch_vehicle: bool) -> tuple:
+        """The drawn paper vehicles, one batched Vehicle (the nominal itself where nothing spreads it
+        and ``batch_vehicle`` is False), and their table columns."""
+        cols: dict[str, np.ndarray] = {}
+        for spread, names in SPREADS.items():
+            for name in names:
+                cols[name] = getattr(nominal, name) * (1.0 + getattr(self, spread) * z[:, SLOTS[name]])
+        cols.update(drawn)
+        vehicles = nominal
+        if batch_vehicle or self.spreads_vehicle:
+            vehicles = nominal.replace(**{k: cols[k] for names in SPREADS.values() for k in names})
+        return vehicles, cols
+
+    def _rotor_vehicles(
+        self, nominal: RotorVehicle, z: np.ndarray, drawn: dict | None = None, batch_vehicle: bool = True
+    ) -> tuple[tuple, dict]:
         """The drawn rotor-plant vehicles (one per row of unit draws ``z``; ``drawn``: identified
-        fields' values) and their table columns."""
+        fields' values) and their table columns (``batch_vehicle``: a tuple of them always)."""
         factors = {}
         for spread, names in ROTOR_SPREADS.items():
             for name in names:
@@ -482,6 +483,11 @@ class Population:
         if out["identified"] is None:
             del out["identified"]  # a population without one: its configuration (and hash) as before
         return out
+
+
+VEHICLE_DRAWS = {"paper": Population._paper_vehicles, "rotor": Population._rotor_vehicles}
+"""How a population spreads each plant's vehicle, by the plant's name (:mod:`quadcruise.sim.plants`):
+``draw(population, nominal, z, drawn, batch_vehicle) -> (vehicles, columns)``."""
 
 
 def _drawn(nominal: RotorVehicle, changes: dict) -> RotorVehicle:

@@ -152,7 +152,7 @@ class MonteCarloSpec:
     def __post_init__(self) -> None:
         from quadcruise.sim.inputs import time_grid
         from quadcruise.workflows.fly_failures import altitude_bound, steady_bound
-        from quadcruise.workflows.fly_inputs import check_can_hover, default_duration
+        from quadcruise.workflows.fly_inputs import default_duration
 
         if isinstance(self.mission, str):
             object.__setattr__(self, "mission", mission_from_name(self.mission))
@@ -165,22 +165,11 @@ class MonteCarloSpec:
             raise InputError(f"mission must be a name or a Mission, got {type(self.mission).__name__}")
         if not isinstance(self.population, Population):
             raise InputError("population must be a Population")
-        if isinstance(self.vehicle, RotorVehicle) or isinstance(self.controller_vehicle, RotorVehicle):
-            self._check_rotor(named)
-        elif not isinstance(self.vehicle, Vehicle) or self.vehicle.batch_size is not None:
+        if not isinstance(self.vehicle, (Vehicle, RotorVehicle)) or self.plant.count(self.vehicle) is not None:
             raise InputError("the nominal vehicle must be one (unbatched) Vehicle")
-        elif self.population.aero_spread > 0:
-            raise InputError(
-                "population field 'aero_spread' perturbs a rotor-plant vehicle's aerodynamic coefficients; "
-                "the paper's vehicle has none to spread (give a rotor-plant vehicle: iris, crazyflie, ...)"
-            )
-        else:
-            with warnings.catch_warnings():  # fly() warns of a vehicle with little left for control
-                warnings.simplefilter("ignore")
-                check_can_hover(self.vehicle)  # before any chunk flies: a nominal that cannot lift
+        self._check_plant(named)
         if self.controller_vehicle is not None:
-            plant = RotorVehicle if self.rotor else Vehicle
-            if not isinstance(self.controller_vehicle, plant) or getattr(self.controller_vehicle, "batch_size", None):
+            if self.plant.count(self.controller_vehicle) is not None:
                 raise InputError("the controller's vehicle must be one (unbatched) Vehicle")
             if not self.population.model_error:
                 raise InputError(
@@ -216,50 +205,46 @@ class MonteCarloSpec:
             raise InputError(f"max_altitude_error_m must be a positive number [m], got {describe(zbound)}")
         object.__setattr__(self, "max_track_error_m", float(bound))
         object.__setattr__(self, "max_altitude_error_m", float(zbound))
-        if self.population.needs_drag and not self.rotor:
+        if self.population.needs_drag and self.plant.drag_for_wind:
             from quadcruise.disturbances import with_drag
 
             object.__setattr__(self, "vehicle", with_drag(self.vehicle, warn=True))
 
-    def _check_rotor(self, named: str | None) -> None:
-        """A rotor-plant sweep's own checks, before any work; a controller named gets gains
-        designed for the vehicle it believes (as :func:`quadcruise.fly` gives them)."""
-        from quadcruise.model.equivalent import duty_to_thrust, paper_equivalent
-        from quadcruise.workflows.rotor_fly import check_wind_acts, designed_controller
+    def _check_plant(self, named: str | None) -> None:
+        """The plant's own checks of the sweep, before any work (:class:`~quadcruise.sim.plants.Plant`);
+        where the plant designs gains, a controller named gets them designed for the vehicle it
+        believes (as :func:`quadcruise.fly` gives them)."""
+        from quadcruise.workflows.rotor_fly import designed_controller
 
-        if not isinstance(self.vehicle, RotorVehicle) or not isinstance(
-            self.controller_vehicle, (RotorVehicle, type(None))
-        ):
-            raise InputError(
-                "vehicle and controller_vehicle must be of one plant: a RotorVehicle flown with a "
-                "RotorVehicle as the controller's model, or a paper Vehicle with a paper Vehicle"
-            )
-        if self.full_dynamics:
-            raise InputError(
-                "MonteCarloSpec field 'full_dynamics': not for a rotor-plant vehicle (its plant has no "
-                "Euler-angle kinematics to choose: it flies the quaternion)"
-            )
-        believed = self.controller_vehicle or self.vehicle
-        if believed.n_rotors != self.vehicle.n_rotors:
-            raise InputError(
-                f"the controller vehicle has {believed.n_rotors} rotors, the flown vehicle "
-                f"{self.vehicle.n_rotors}: the controller's rotor commands would not fit"
-            )
-        duty_to_thrust(believed)
+        plant, flown = self.plant, (self.vehicle,)
+        plant.check_controller_vehicle(flown, self.controller_vehicle, where="")
+        plant.refuse("MonteCarloSpec", "full_dynamics", self.full_dynamics, label="field")
+        plant.refuse("population", "aero_spread", self.population.aero_spread > 0, label="field")
+        with warnings.catch_warnings():  # fly() warns of a vehicle with little left for control
+            warnings.simplefilter("ignore")
+            plant.check_vehicles(flown)  # before any chunk flies: a nominal that cannot lift
         env = self.population.environment
         if self.population.wind_spread > 0 and env is None:
             from quadcruise.disturbances import ConstantWind, Environment
 
             env = Environment(wind=ConstantWind())
-        check_wind_acts(self.vehicle, env)
-        if named in CONTROLLERS:
-            object.__setattr__(self, "controller", designed_controller(named, paper_equivalent(believed).omega))
+        plant.check_environment(flown, env)
+        if plant.designs_gains and named in CONTROLLERS:
+            bandwidth = plant.bandwidths((self.controller_vehicle or self.vehicle,))[0]
+            object.__setattr__(self, "controller", designed_controller(named, bandwidth))
 
     # --- derived ------------------------------------------------------------------------
     @property
+    def plant(self):
+        """The nominal vehicle's plant (:func:`quadcruise.sim.plants.of`)."""
+        from quadcruise.sim import plants
+
+        return plants.of(self.vehicle)
+
+    @property
     def rotor(self) -> bool:
-        """True for a rotor-plant sweep (a :class:`~quadcruise.model.rotor_vehicle.RotorVehicle` nominal)."""
-        return isinstance(self.vehicle, RotorVehicle)
+        """True for a rotor-plant sweep (kept for callers of old; ask :attr:`plant`)."""
+        return self.plant.name == "rotor"
 
     @property
     def model_vehicle(self) -> Vehicle | None:
@@ -293,8 +278,8 @@ class MonteCarloSpec:
         int
             Logged instants times (16 + 12 + 11) float64 values of 8 bytes.
         """
-        rotor = self.vehicle.n_rotors + 13 if self.rotor else 0  # a rotor flight logs its rotor state too
-        return (self.periods // self.log_every + 1) * (STATE_SIZE + CMD_SIZE + REF_SIZE + rotor) * 8
+        own = self.plant.log_width((self.vehicle,))  # a plant's own state logged too (rotor: 13 + n)
+        return (self.periods // self.log_every + 1) * (STATE_SIZE + CMD_SIZE + REF_SIZE + own) * 8
 
     def to_dict(self) -> dict:
         """Plain values (for quadcruise.json and the hash).

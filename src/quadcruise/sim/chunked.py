@@ -31,7 +31,6 @@ from collections.abc import Callable
 
 import numpy as np
 
-from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.stepper import Stepper
@@ -105,9 +104,8 @@ def simulate_watched(
     s = Stepper(t_grid, x0, vp, controller, gains, mission, mp, periods=periods, **options)
     t_grid = s.t_grid
     n_log = n_periods // log_every + 1
-    widths = (STATE_SIZE, CMD_SIZE, REF_SIZE) + ((s.state.shape[1],) if s.rotor else ())
-    logs = [np.empty((n, n_log, w)) for w in widths]  # every row is written below
-    small = (s.log_x, s.log_cmd, s.log_ref) + ((s.log_rotor,) if s.rotor else ())
+    small = (s.log_x, s.log_cmd, s.log_ref) + s.plant.own_logs(s)  # the plant's own state's log too
+    logs = [np.empty((n, n_log, part.shape[2])) for part in small]  # every row is written below
     held = None  # the row after the chunk of vehicles that stopped in its last period, and where it goes
     k0 = 0
     while k0 < n_periods:
@@ -139,9 +137,7 @@ def simulate_watched(
             held = [(stopped, k1 // log_every, part[stopped, k1 - k0].copy()) for part in small]
         k0 = k1
     log_x, log_cmd, log_ref = logs[:3]
-    rotor = {}
-    if s.rotor:  # the rotor plant's own state, logged and final
-        rotor = {"rotor_states": logs[3], "rotor_final_state": s.state, "rotor_names": tuple(rotor_names)}
+    own = s.plant.result_parts(s, tuple(logs[3:]), rotor_names)  # the plant's own state, logged and final
     return SimResult(
         t=t_grid[::log_every][:n_log].copy(),
         states=log_x,
@@ -155,7 +151,7 @@ def simulate_watched(
         duty_clipped_s=s.saturated[:, 0].copy(),
         controller_limited_s=s.saturated[:, 1].copy(),
         meta=dict(meta or {}),
-        **rotor,
+        **own,
     )
 
 

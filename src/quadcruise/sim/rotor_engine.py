@@ -44,6 +44,7 @@ from quadcruise.model.rotor_plant import (
     rotor_derivative,
 )
 from quadcruise.sim.inputs import Limits
+from quadcruise.sim.period import body_bounds
 from quadcruise.sim.rotor_result import RotorResult
 from quadcruise.sim.status import ExitStatus
 
@@ -163,14 +164,10 @@ def _replay_kernel(t, w_cmd, x0, rp, ext, max_step, limits, ground, touchdown, l
             finite = True
             for j in range(size):
                 finite = finite and math.isfinite(x[j])
-            if not finite:
-                code = NONFINITE
-            elif abs(x[RX]) > max_position or abs(x[RY]) > max_position or abs(x[RZ]) > max_position:
-                code = POSITION_BOUND
-            elif abs(x[RVX]) > max_speed or abs(x[RVY]) > max_speed or abs(x[RVZ]) > max_speed:
-                code = SPEED_BOUND
-            elif abs(x[RP]) > max_rate or abs(x[RQ]) > max_rate or abs(x[RR]) > max_rate:
-                code = RATE_BOUND
+            code = body_bounds(  # the checks of both closed-loop kernels (sim/period.py): no tilt bound here
+                finite, x[RX], x[RY], x[RZ], x[RVX], x[RVY], x[RVZ], x[RP], x[RQ], x[RR],
+                max_position, max_speed, max_rate,
+            )  # fmt: skip
             for j in range(size):
                 log_x[i, k + 1, j] = x[j]
             logged = k + 2

@@ -41,12 +41,10 @@ import numpy as np
 from quadcruise.checks import describe
 from quadcruise.errors import InputError
 from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
-from quadcruise.sim.engine import fly_vehicles, still_air
-from quadcruise.sim.inputs import Limits, batch_inputs, fresh_carry
-from quadcruise.sim.kernel_args import KernelArgs, RotorKernelArgs
+from quadcruise.sim.engine import still_air
+from quadcruise.sim.inputs import Limits
+from quadcruise.sim.plants import of_arrays
 from quadcruise.sim.rng import vehicle_states
-from quadcruise.sim.rotor_batch import rotor_inputs
-from quadcruise.sim.rotor_flight import fly_rotor_pieces, paper_states, rotor_carry_width
 from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.threads import ThreadPlan
 
@@ -139,23 +137,11 @@ class Stepper:
             sensor_delay=sensor_delay,
             max_step=max_step,
         )
-        self.rotor = alloc is not None  # the plant: the rotor-speed plant's arrays given, or the paper's
-        if self.rotor:
-            if vp_ctrl is None:
-                raise InputError("Stepper: a rotor-plant flight needs vp_ctrl, the controller's equivalent paper row")
-            if full_dynamics:
-                raise InputError("Stepper: full_dynamics is the paper plant's option, not the rotor plant's")
-            inp = rotor_inputs(
-                t_grid, x0, vp, alloc, vp_ctrl, gains, mp, psi0=psi0, touchdown_speed=touchdown_speed, **shared
-            )
-            self.alloc, self.psi0, self.touchdown = inp["alloc"], inp["psi0"], inp["touchdown"]
-            self.ground = touchdown_speed is not None
-            self.carry = np.zeros((inp["n"], rotor_carry_width(int(sensor_delay))))
-            self._paper_state = paper_states(inp["x0"], inp["vp"], self.psi0)  # then written by each step
-            self.log_rotor = np.empty((inp["n"], int(periods) + 1, inp["x0"].shape[1]))
-        else:
-            inp = batch_inputs(t_grid, x0, vp, gains, mp, vp_ctrl=vp_ctrl, **shared)
-            self.carry = fresh_carry(inp["x0"], int(sensor_delay))
+        self.plant = of_arrays(alloc)  # the plant: the rotor-speed plant's arrays given, or the paper's
+        self.sensor_delay = int(sensor_delay)
+        own = dict(alloc=alloc, psi0=psi0, touchdown_speed=touchdown_speed, full_dynamics=full_dynamics)
+        own["periods"] = periods
+        inp = self.plant.stepper_inputs(self, t_grid, x0, vp, gains, mp, vp_ctrl, shared, own)
         self.n = n = inp["n"]
         if not (0 <= int(setpoint_width) <= inp["gains"].shape[1]):
             raise InputError(
@@ -164,7 +150,6 @@ class Stepper:
             )
         self.t_grid = inp["t_grid"]
         self.periods, self.setpoint_width = int(periods), int(setpoint_width)
-        self.sensor_delay = int(sensor_delay)
         self.drawn = inp["drawn"]
         self.seed = int(seed)
         self.first_vehicle = (
@@ -205,7 +190,12 @@ class Stepper:
         paper plant's state itself; for the rotor plant, position, velocity, the ZYX Euler angles
         of the quaternion, body rates and the thrusts of rotors 1..4
         (:func:`quadcruise.sim.rotor_flight.paper_state`), as of the last step."""
-        return self._paper_state if self.rotor else self.state
+        return self.plant.observed(self)
+
+    @property
+    def rotor(self) -> bool:
+        """Whether the vehicles fly the rotor-speed plant (kept for callers of old; ask :attr:`plant`)."""
+        return self.plant.name == "rotor"
 
     @property
     def period(self) -> np.ndarray:
@@ -276,10 +266,7 @@ class Stepper:
         elif self.drawn:
             self.rng[rows] = vehicle_states(self.seed if seed is None else seed, k, self.first_vehicle[rows])
         self.clock[rows] = 0
-        if self.rotor:  # the rotor kernel starts a vehicle at period 0 afresh, its carry unread
-            self._paper_state[rows] = paper_states(np.ascontiguousarray(start), self.vp[rows], self.psi0[rows])
-        else:
-            self.carry[rows] = fresh_carry(np.ascontiguousarray(start), self.sensor_delay)
+        self.plant.restart(self, rows, start)
         self.saturated[rows] = 0.0
         self.status[rows] = int(ExitStatus.FINISHED)
         self.t_stop[rows] = np.nan
@@ -353,8 +340,8 @@ class Stepper:
             self._plan.record(threads, time.perf_counter() - start)
 
     def _fly(self, pieces_per_thread: int, after_piece, threads) -> None:
-        """One step through the plant's kernel, on at most ``threads`` of numba's threads: its
-        arguments by name, those of both plants first."""
+        """One step through the plant's kernel, on at most ``threads`` of numba's threads: the
+        arguments of every plant by name, then the plant's own (:meth:`Plant.step_args`)."""
         shared = dict(
             t_grid=self.t_grid,
             x0=self.state,
@@ -385,23 +372,7 @@ class Stepper:
             t_stop=self.t_stop,
             saturated=self.saturated,
         )
-        if self.rotor:
-            fly, args = (
-                fly_rotor_pieces,
-                RotorKernelArgs(
-                    **shared,
-                    psi0=self.psi0,
-                    rp=self.vp,
-                    alloc=self.alloc,
-                    ground=self.ground,
-                    touchdown=self.touchdown,
-                    log_rotor=self.log_rotor,
-                    seen_final=self._paper_state,
-                ),
-            )
-        else:
-            fly, args = fly_vehicles, KernelArgs(**shared, vp=self.vp, full=self.full_dynamics)
-        fly(self.n, args, pieces_per_thread, after_piece, threads)
+        self.plant.fly_pieces(self.n, self.plant.step_args(self, shared), pieces_per_thread, after_piece, threads)
 
 
 __all__ = ["Stepper"]

@@ -10,7 +10,6 @@ the coefficients into the vehicle's parameters with 95 % intervals
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import os
 from collections.abc import Callable
@@ -22,6 +21,8 @@ from quadcruise import checks
 from quadcruise.errors import InputError
 from quadcruise.io.flightlog import FlightLog, parse_commands, read_flight_log
 from quadcruise.model.vehicle import Vehicle
+from quadcruise.sim import plants
+from quadcruise.sysid.basis import BASES
 from quadcruise.sysid.equations import signals
 from quadcruise.sysid.estimate import fit
 from quadcruise.sysid.logprep import (
@@ -135,11 +136,11 @@ def identify(
     if vehicle is not None and not isinstance(vehicle, (Vehicle, RotorVehicle)):
         raise InputError(f"vehicle must be a quadcruise Vehicle or RotorVehicle, got {type(vehicle).__name__}")
     base = vehicle or Vehicle.paper()
-    rotor = isinstance(base, RotorVehicle)
-    if not rotor and base.batch_size is not None:
+    plant = plants.of(base)
+    if plant.count(base) is not None:
         raise InputError("vehicle: the base vehicle must be one vehicle, not a batch")
     kind = parse_commands(commands)[0]
-    if kind == "rad/s" and not rotor:
+    if kind == "rad/s" and not plant.takes_speeds:
         raise InputError(
             "commands 'rad/s' are rotor speeds, which only the rotor plant has: give a rotor-plant base "
             "vehicle (vehicle='iris', 'crazyflie' or a vehicle file with plant = \"rotor\")"
@@ -147,42 +148,14 @@ def identify(
     report = progress or (lambda done, total, stage="": None)
 
     flight = log if isinstance(log, FlightLog) else read_flight_log(log, frame=frame, commands=commands)
-    rotor_base = None
-    if rotor:
-        from quadcruise.sysid.rotor_identify import MIN_SPEED_SAMPLES, identify_rotor
-
-        speed_hz = float(flight.rates_hz.get("esc_status", flight.rates_hz.get("csv", 0.0)))
-        if kind == "rad/s" or (flight.speeds is not None and speed_hz >= MIN_SPEED_SAMPLES / WINDOW_S):
-            return identify_rotor(flight, base, mass, holdout, kind, report)
-        # no rotor speeds (or too slow to use): the rotor plant from the commands alone
-        from quadcruise.model.equivalent import paper_equivalent
-
-        rotor_base = base
-        base = paper_equivalent(base).replace(K=float(base.kf * base.w_max**2))  # one rotor's full thrust
+    done, basis = BASES[plant.name](flight, base, mass, holdout, kind, report)  # sysid/basis.py
+    if done is not None:  # the base's plant identified on its own (the rotor plant, with rotor speeds)
+        return done
+    base = basis.vehicle
     report(1, len(STAGES), STAGES[0])
-    rotors = flight.rotors
-    if rotors is None and rotor_base is not None:
-        rotors = np.array([[x, y, s] for x, y, _, s in rotor_base.rotors], dtype=float)
-        if len(rotors) != flight.n_rotors:
-            raise InputError(
-                f"{flight.source}: {flight.n_rotors} rotor commands and no CA_ROTOR* geometry: the base "
-                f"vehicle has {len(rotors)} rotors"
-            )
-    if rotors is None:
-        if flight.n_rotors != 4:
-            raise InputError(
-                f"{flight.source}: {flight.n_rotors} rotor commands and no CA_ROTOR* geometry: "
-                "the base vehicle has the paper's four '+' rotors"
-            )
-        arm = float(base.l)
-        rotors = np.array([[-arm, 0.0, 1.0], [0.0, arm, -1.0], [arm, 0.0, 1.0], [0.0, -arm, -1.0]])
+    rotors = flight.rotors if flight.rotors is not None else basis.geometry(flight)
     g = float(base.g)
-    lag_of = "thrust"
-    if rotor_base is not None:  # the rotor plant: relative thrust, whose square root (the speed) lags
-        meaning, f_log = command_meaning(flight)
-        u_rel = flight.u if meaning == "thrust" else f_log * flight.u**2 + (1.0 - f_log) * flight.u
-        flight = dataclasses.replace(flight, u=u_rel, commands=flight.commands + "; relative thrust (rotor plant)")
-        lag_of = "speed"
+    flight, lag_of = basis.commands(flight), basis.lag_of
     force_z = _specific_force_z(flight, g)
     cmd_hz = command_rate(flight)
     hold = command_hold(flight, cmd_hz)
@@ -313,7 +286,7 @@ def identify(
         table = withhold(table, verdict)
     # the joint covariance of what is reported with an interval (montecarlo --population draws from it)
     listed = [n for n in joint.get("names", []) if n in table and table[n]["identifiable"]]
-    if listed and rotor_base is None:
+    if listed and basis.covariance:
         pick = [joint["names"].index(n) for n in listed]
         full = np.asarray(joint["matrix"])
         joint = {"names": listed, "matrix": full[np.ix_(pick, pick)].tolist()}
@@ -349,11 +322,7 @@ def identify(
         mass=mass,
         rotors=rotors,
     )
-    if rotor_base is not None:
-        from quadcruise.sysid.commands_alone import as_rotor_result
-
-        return as_rotor_result(result, rotor_base)
-    return result
+    return basis.finish(result)
 
 
 def _excitation(u: np.ndarray, rotors: np.ndarray) -> dict[str, float]:

@@ -216,18 +216,34 @@ class IdentifyResult:
             )
         return self._vehicle(float(m))
 
+    @property
+    def plant(self):
+        """The plant identified (:mod:`quadcruise.sim.plants`): the fit's ``plant``, the paper's by default."""
+        from quadcruise.sim import plants
+
+        return plants.named(self.fit.get("plant"))
+
     def _vehicle(self, m: float):
+        return VEHICLES[self.plant.name](self, m)
+
+    def _rotor_vehicle(self, m: float):
+        """A RotorVehicle: the identified fields, the log's rotors, the base's for the rest."""
         values: dict[str, Any] = {"m": m}
         scale = 1.0 if self.mass is not None else m
-        if self.fit.get("plant") == "rotor":  # a RotorVehicle: the identified fields, the log's rotors
-            for name in ("kf", "km", "Jxx", "Jyy", "Jzz", "k_d", "k_z", "J_rotor", "tau_up", "tau_down", "w_max"):
-                key = name if self.mass is not None or name in ("tau_up", "tau_down", "w_max") else f"{name}_per_m"
-                if key in self.parameters:
-                    per_m = key.endswith("_per_m")
-                    values[name] = float(self.parameters[key]["value"]) * (scale if per_m else 1.0)
-            values["rotors"] = tuple(tuple(float(x) for x in row[:3]) + (int(row[3]),) for row in self.rotors)
-            values["source"] = f"identified from {Path(self.log['source']).name} (base: {self.base.source or 'a file'})"
-            return self.base.replace(**values)
+        for name in ("kf", "km", "Jxx", "Jyy", "Jzz", "k_d", "k_z", "J_rotor", "tau_up", "tau_down", "w_max"):
+            key = name if self.mass is not None or name in ("tau_up", "tau_down", "w_max") else f"{name}_per_m"
+            if key in self.parameters:
+                per_m = key.endswith("_per_m")
+                values[name] = float(self.parameters[key]["value"]) * (scale if per_m else 1.0)
+        values["rotors"] = tuple(tuple(float(x) for x in row[:3]) + (int(row[3]),) for row in self.rotors)
+        values["source"] = f"identified from {Path(self.log['source']).name} (base: {self.base.source or 'a file'})"
+        return self.base.replace(**values)
+
+    def _paper_vehicle(self, m: float):
+        """A paper Vehicle where the log's rotors are a "+", else a rotor-plant vehicle from the
+        commands alone (:func:`rotor_equivalent`)."""
+        values: dict[str, Any] = {"m": m}
+        scale = 1.0 if self.mass is not None else m
         for name in ("K", "Jxx", "Jyy", "Jzz"):
             key = name if self.mass is not None else f"{name}_per_m"
             values[name] = float(self.parameters[key]["value"]) * scale
@@ -370,30 +386,27 @@ class IdentifyResult:
         """
         import tomli_w
 
+        from quadcruise.sim import plants
+
         v = self._vehicle(float(self.mass) if self.mass is not None else 1.0)
-        rotor = self.fit.get("plant") == "rotor"
+        written = plants.of(v)  # a paper fit of rotors that are not a "+" writes a rotor-plant vehicle
         origin = {
             k.removesuffix("_per_m"): ("identified" if p["identifiable"] else p.get("source", "base vehicle"))
             for k, p in self.parameters.items()
             if k not in ("hover_speed", "hover_duty", "thrust_curve_f")
         }
-        plant = "rotor" if rotor or not hasattr(v, "K") else "paper"
         head = [
             f"# {self.verdict_line()}",
-            f"# identified from {self.log['source']} by quadcruise identify ({plant} plant)",
+            f"# identified from {self.log['source']} by quadcruise identify ({written.name} plant)",
             "# " + ", ".join(f"{k}: {s}" for k, s in origin.items()),
             f"# rotors: {self.log['rotor_geometry']}; the rest: the base vehicle's",
         ]
-        if plant == "rotor" and not rotor:
+        if written is not self.plant:
             head.append(
                 "# the log's rotors are not the paper's '+': a rotor-plant vehicle from the commands alone, "
                 f"kf w_max^2 = K, km = d kf, tau = 1/omega, w_max {v.w_max:g} rad/s (not in the log)"
             )
-        fields = {k: x for k, x in v.to_dict().items() if x is not None}
-        if plant == "paper":
-            fields = {"preset": "paper", **{k: float(x) for k, x in fields.items()}}
-        else:
-            fields = {"plant": "rotor", **fields}
+        fields = written.file_fields({k: x for k, x in v.to_dict().items() if x is not None})
         if self.mass is None:
             head.append(
                 "# NO MASS: identify ran without --mass. m and the fields marked 'per unit mass' are strings: "
@@ -530,3 +543,7 @@ class IdentifyResult:
             }
             (tmp / MARKER).write_text(json.dumps(marker, indent=2) + "\n")
         return out
+
+
+VEHICLES = {"paper": IdentifyResult._paper_vehicle, "rotor": IdentifyResult._rotor_vehicle}
+"""The vehicle an identification writes, by the plant identified (``fit["plant"]``, the paper's by default)."""

@@ -35,11 +35,12 @@ from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.montecarlo.population import Population
 from quadcruise.montecarlo.spec import MonteCarloSpec
+from quadcruise.sim import plants
 from quadcruise.tune.criteria import Requirement, Target, as_minimize, as_requirements, as_targets
 from quadcruise.tune.objective import Objective, check_statistic
 from quadcruise.tune.result import TuneResult
 from quadcruise.tune.space import Bounds, GainSpace
-from quadcruise.workflows.rotor_fly import as_vehicle, rotor_flight_setup
+from quadcruise.workflows.rotor_fly import as_vehicle, flight_setup
 
 __all__ = ["tune", "ABS_TOL", "TUNE_OPTIONS"]
 
@@ -200,8 +201,8 @@ def tune(
     checks.number(w, "transient_until", transient_until, "pos", unit="s", optional=True)
     checks.callback(w, "progress", progress)
     checks.instance(w, "command", command, str, optional=False)
-    if isinstance(vehicle, RotorVehicle) and isinstance(controller, str):  # designed for it, as fly does
-        controller = rotor_flight_setup(vehicle, controller_vehicle, controller)[1]
+    if vehicle is not None and plants.of(vehicle).designs_gains and isinstance(controller, str):  # as fly does
+        controller = flight_setup(vehicle, controller_vehicle, controller)[1]
     base = as_controller(controller, w)
     space = GainSpace.build(base, gains, bounds, where=w)
     popsize = (

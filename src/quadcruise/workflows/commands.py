@@ -35,6 +35,7 @@ from quadcruise import checks
 from quadcruise.errors import InputError
 from quadcruise.io.files import read_numeric_csv
 from quadcruise.model.rotor_vehicle import RotorVehicle
+from quadcruise.sim import plants
 
 PAPER_ROTORS = 4
 """The paper's quadrotor's rotors: its duty table is ``t,u1,u2,u3,u4``."""
@@ -102,9 +103,8 @@ def replay_plant(vehicle: Any) -> ReplayPlant:
     >>> replay_plant(Vehicle.paper()).takes_speeds, replay_plant(Vehicle.preset("iris")).n_rotors
     (False, 4)
     """
-    if isinstance(vehicle, RotorVehicle):
-        return ReplayPlant("rotor", vehicle.n_rotors, True, 1e-4)
-    return ReplayPlant("paper", PAPER_ROTORS, False, 1e-3)
+    plant = plants.of(vehicle)
+    return ReplayPlant(plant.name, plant.n_rotors(vehicle), plant.takes_speeds, plant.replay_step)
 
 
 @dataclass(frozen=True, eq=False)

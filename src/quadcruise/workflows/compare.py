@@ -32,10 +32,11 @@ from quadcruise.metrics.summary import Summary
 from quadcruise.missions import Mission, as_mission
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
+from quadcruise.sim import plants
 from quadcruise.workflows.fly import fly
 from quadcruise.workflows.fly_failures import flight_warnings_named
 from quadcruise.workflows.fly_inputs import FLY_OPTIONS
-from quadcruise.workflows.rotor_fly import as_vehicle, rotor_flight_setup
+from quadcruise.workflows.rotor_fly import as_vehicle, flight_setup
 
 __all__ = ["compare", "Comparison", "DEFAULT_CONTROLLERS"]
 
@@ -383,10 +384,10 @@ def compare(
     if controllers is None:
         controllers = compared_names()
     chosen = labelled(controllers)
-    if isinstance(vehicle, RotorVehicle):  # a controller named gets gains designed for it, as fly gives them
+    if vehicle is not None and plants.of(vehicle).designs_gains:  # a controller named: designed, as fly does
         believed = fly_kw.get("controller_vehicle")
         chosen = {
-            label: rotor_flight_setup(vehicle, believed, ctrl.name)[1] if named else ctrl
+            label: flight_setup(vehicle, believed, ctrl.name)[1] if named else ctrl
             for (label, ctrl), named in zip(chosen.items(), named_entries(controllers), strict=True)
         }
     results = {}

@@ -30,7 +30,6 @@ from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
 from quadcruise.sim.chunked import simulate_watched, watch_again
-from quadcruise.sim.engine import simulate
 from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.result import SimResult
 from quadcruise.workflows.fly_failures import (
@@ -47,7 +46,6 @@ from quadcruise.workflows.fly_failures import warn_about as _warn_about  # the n
 from quadcruise.workflows.fly_inputs import (
     FLY_OPTIONS,
     batch_log_every,
-    check_can_hover,
     check_log_every,
     check_reference_fits,
     check_run_size,
@@ -60,17 +58,7 @@ from quadcruise.workflows.fly_inputs import (
     per_vehicle_controllers,
     vehicle_indices,
 )
-from quadcruise.workflows.rotor_fly import (
-    as_vehicle,
-    batch_equivalent,
-    check_wind_acts,
-    fly_rotor,
-    rotor_batch,
-    rotor_engine_inputs,
-    rotor_flight_setup,
-    rotor_initial_states,
-    vehicle_record,
-)
+from quadcruise.workflows.rotor_fly import as_vehicle, flight_setup
 from quadcruise.workflows.track_watch import TrackWatch
 
 
@@ -207,7 +195,8 @@ def fly(
     missions = fly_missions(missions)
     vehicle = checks.instance(w, "vehicle", as_vehicle(vehicle), (Vehicle, RotorVehicle, tuple)) or Vehicle.paper()
     controller_vehicle = checks.instance(w, "controller_vehicle", controller_vehicle, (Vehicle, RotorVehicle))
-    rotor, controller = rotor_flight_setup(vehicle, controller_vehicle, controller)  # rotor_fly.py
+    plant, controller = flight_setup(vehicle, controller_vehicle, controller)  # the plant asked (sim/plants)
+    flown = plant.vehicles(vehicle)
     controllers = per_vehicle_controllers(controller)
     controller = controllers[0]
     duration = checks.number(w, "duration", duration, "pos", unit="s", optional=True)
@@ -219,22 +208,18 @@ def fly(
     full_dynamics = checks.flag(w, "full_dynamics", full_dynamics)
     checks.instance(w, "environment", environment, (Environment, CustomDisturbance))
     checks.instance(w, "sensors", sensors, SensorNoise)
-    check_wind_acts(vehicle, environment)  # rotor_fly.py
+    plant.check_environment(flown, environment)
     seed = checks.whole(w, "seed", seed)
     first_vehicle = vehicle_indices(first_vehicle)
     bounds = (("max_track_error", max_track_error), ("max_steady_error", max_steady_error))
     for name, value in (*bounds, ("max_altitude_error", max_altitude_error)):
         checks.number(w, name, value, "pos", unit="m", optional=True, infinite=True)
     x0 = initial_states(x0)
-    if rotor and full_dynamics:
-        raise InputError(
-            "fly() argument full_dynamics: not for a rotor-plant vehicle (its plant has no Euler-angle "
-            "kinematics to choose: it flies the quaternion)"
-        )
+    plant.refuse(w, "full_dynamics", full_dynamics)
     sizes = {
         s
         for s in (
-            len(vehicle) if isinstance(vehicle, tuple) else getattr(vehicle, "batch_size", None),
+            plant.count(vehicle),
             None if x0 is None or np.ndim(x0) < 2 else np.shape(x0)[0],
             None if missions is None else len(missions),
             n,
@@ -248,13 +233,13 @@ def fly(
     n = sizes.pop() if sizes else 1
     if n < 1:
         raise InputError(f"the number of vehicles must be at least 1, got {n}")
-    if rotor and x0 is not None:  # what cannot start its rotors, refused before any work
-        rotor_initial_states(rotor_batch(vehicle), x0, n)
+    if x0 is not None:  # what cannot start the plant, refused before any work
+        plant.check_x0(flown, x0, n)
     mp = stack_params(missions if missions is not None else mission, n=None if missions else n)
     first = missions[0] if missions else mission
     duration = default_duration(first) if duration is None else duration
     d, h = duration, dt
-    extra = (rotor_batch(vehicle)[0].n_rotors + 13) if rotor else 0  # a rotor flight logs its rotor state too
+    extra = plant.log_width(flown)  # a plant's own state logged beside the paper layout (rotor: 13 + n)
     steps = round(d / h) if 0 < h <= d < math.inf else 0
     chosen = log_every is None and n > 1 and steps > 0 and batch_log_every(n, steps, extra) > 1
     # a batch whose full log would not fit in LOG_BUDGET: a coarser log, checked at every period
@@ -278,18 +263,17 @@ def fly(
     check_log_every(log_every, grid.size - 1)
     if sensors is not None:
         sensors.check_fits(duration)
-    if not rotor:  # a RotorVehicle that cannot lift itself cannot be made
-        check_can_hover(vehicle)
+    plant.check_vehicles(flown)
     check_reference_fits(missions or [first], float(duration), limits or Limits())
     given_x0 = None if x0 is None else np.asarray(x0, dtype=float).tolist()
-    rotor_x0 = x0  # a rotor flight's own start: hovering at the mission's start unless given
-    x0 = hover_state(batch_equivalent(rotor_batch(vehicle)[:1]) if rotor else vehicle, n, first) if x0 is None else x0
+    given = x0  # a plant with a state of its own starts from it: hovering at the mission's start unless given
+    x0 = hover_state(plant.equivalent(flown[:1]), n, first) if x0 is None else x0
     meta = {
         "workflow": "fly",
         "mission": [m.to_dict() for m in missions] if missions else mission.to_dict(),
         "controller": controller_record(controller),
         **({"controllers": [controller_record(c) for c in controllers]} if len(controllers) > 1 else {}),
-        "vehicle": vehicle_record(rotor_batch(vehicle)) if rotor else vehicle.to_dict(),
+        "vehicle": plant.record(flown),
         "duration_s": float(duration),
         "dt_s": float(dt),
         "max_step_s": float(max_step or dt),
@@ -313,10 +297,7 @@ def fly(
     if sensors is not None:
         meta["sensors"] = sensors.to_dict()
     if controller_vehicle is not None:
-        meta["controller_vehicle"] = (
-            {"plant": "rotor", **controller_vehicle.to_dict()} if rotor else controller_vehicle.to_dict()
-        )
-    vp_ctrl = None if controller_vehicle is None or rotor else controller_vehicle.rows(n)
+        meta["controller_vehicle"] = plant.controller_record(controller_vehicle)
     gains, memory = (
         (controller.gains(), controller.memory())
         if len(controllers) == 1
@@ -357,15 +338,12 @@ def fly(
         first_vehicle=first_vehicle,
         **engine_inputs(environment, sensors, n, dt),
     )
+    args, own = plant.flight(
+        grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n,
+        x0=given, paper_x0=x0, meta=meta, full_dynamics=full_dynamics,
+    )  # fmt: skip
+    options.update(own)
     if watched:  # the log keeps every log_every-th period; the checks see every one
-        if rotor:  # the rotor plant's arrays (rotor_fly.py)
-            args, plant = rotor_engine_inputs(
-                grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, rotor_x0, meta
-            )
-        else:
-            args = (grid, x0, vehicle.rows(n), controller.function, gains, first.function, mp)
-            plant = dict(vp_ctrl=vp_ctrl, full_dynamics=full_dynamics)
-        options.update(plant)
         mission_record = meta["mission"] if isinstance(meta["mission"], dict) else {}
         watch = TrackWatch(grid, mission_record, bound, steady, vertical)
         result = simulate_watched(*args, watch=watch.feed, **options)
@@ -375,13 +353,8 @@ def fly(
 
         status, t_stop = watch.verdict(result.status, result.t_stop, again)
         result = dataclasses.replace(result, status=status, t_stop=t_stop)
-    elif rotor:  # the rotor plant's whole log (rotor_fly.py)
-        result = fly_rotor(
-            grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, x0=rotor_x0, **options
-        )
-    else:
-        args = (grid, x0, vehicle.rows(n), controller.function, gains, first.function, mp)
-        result = simulate(*args, vp_ctrl=vp_ctrl, full_dynamics=full_dynamics, **options)
+    else:  # the whole log
+        result = plant.fly(args, options)
     result.meta["max_track_error_m"] = bound.tolist() if n > 1 else float(bound[0])
     result.meta["max_steady_error_m"] = steady.tolist() if n > 1 else float(steady[0])
     result.meta["max_altitude_error_m"] = vertical.tolist() if n > 1 else float(vertical[0])

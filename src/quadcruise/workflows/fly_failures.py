@@ -13,6 +13,7 @@ import numpy as np
 from quadcruise.errors import FlightWarning
 from quadcruise.layout import REF_X, REF_Z, X
 from quadcruise.missions import Mission
+from quadcruise.sim import plants
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.status import ExitStatus
 
@@ -309,9 +310,7 @@ def warn_about(result: SimResult) -> None:
         warnings.warn(f"vehicle {first} {result.status_text(first)}{more}", FlightWarning, stacklevel=3)
     clipped = result.duty_clipped_s
     if np.any(clipped > 0):
-        what = "rotor duties were clipped to [0, 1]"
-        if result.rotor_states is not None:  # a rotor-plant flight: its speeds, not duties (rotor_flight.py)
-            what = "rotor speed commands were held in [w_min, w_max]"
+        what = plants.of_result(result).saturation  # duties clipped, or a rotor plant's speeds held
         warnings.warn(
             f"{what} for up to {clipped.max():.3f} s ({np.count_nonzero(clipped)} of {result.n} vehicles)",
             FlightWarning,

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 import os
-import warnings
 from typing import Any
 
 import numpy as np
@@ -22,6 +21,7 @@ from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, REF_Z, STATE_SI
 from quadcruise.missions import Mission
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.inputs import Limits
+from quadcruise.sim.plants.paper import hover_check
 
 
 def default_duration(mission: Mission) -> float:
@@ -457,10 +457,6 @@ def nearest_divisors(k: int, n: int) -> tuple[int, int]:
     return below, above
 
 
-HOVER_DUTY_WARNING = 0.7
-"""A hover duty above this leaves less than 30 % of the rotors' thrust for control: ``fly`` warns."""
-
-
 def check_can_hover(vehicle: Vehicle) -> None:
     """Refuse a vehicle that cannot lift itself; warn when hovering leaves little for control.
 
@@ -483,26 +479,7 @@ def check_can_hover(vehicle: Vehicle) -> None:
         ...
     quadcruise.errors.InputError: the vehicle of mass 60 kg cannot lift itself: hovering needs 588.6 N, its ...
     """
-    duty = np.atleast_1d(np.asarray(vehicle.hover_duty, dtype=float))
-    m = np.broadcast_to(np.asarray(vehicle.m, dtype=float), duty.shape)
-    k = np.broadcast_to(np.asarray(vehicle.K, dtype=float), duty.shape)
-    g = np.broadcast_to(np.asarray(vehicle.g, dtype=float), duty.shape)
-    bad = np.flatnonzero(~(duty <= 1.0))
-    if bad.size:
-        i = int(bad[0])
-        which = f"vehicle {i} (mass {m[i]:g} kg)" if duty.size > 1 else f"the vehicle of mass {m[i]:g} kg"
-        raise InputError(
-            f"{which} cannot lift itself: hovering needs {m[i] * g[i]:.4g} N, its four rotors "
-            f"give at most {4 * k[i]:g} N (K = {k[i]:g} N each)"
-        )
-    close = np.flatnonzero(duty > HOVER_DUTY_WARNING)
-    if close.size:
-        i = int(close[0])
-        warnings.warn(
-            f"the vehicle{'' if duty.size == 1 else f' {i}'} hovers at {100 * duty[i]:.0f} % duty, "
-            f"leaving {100 * (1 - duty[i]):.0f} % of its thrust for control",
-            stacklevel=3,
-        )
+    hover_check(vehicle, stacklevel=3)  # the paper plant's own check (sim/plants/paper.py)
 
 
 def check_reference_fits(missions: list[Mission], duration: float, limits: Limits) -> None:

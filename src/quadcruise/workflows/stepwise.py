@@ -4,8 +4,8 @@ The arrays are the ones ``fly`` hands the engine (initial hover state, gains, me
 mission parameters, disturbance and sensor arrays, seeds), so stepping the result through
 the flight's grid flies the flight ``fly`` flies, period by period. A rotor-plant vehicle
 (:class:`~quadcruise.model.rotor_vehicle.RotorVehicle` or a preset's name) flies the rotor
-plant, with what :func:`quadcruise.workflows.rotor_fly.fly_rotor` hands its kernel: the
-controller designed for the vehicle it believes, the hover at the mission's start, a ground.
+plant, with what ``fly`` hands its kernel (:meth:`quadcruise.sim.plants.rotor.RotorPlant.flight`):
+the controller designed for the vehicle it believes, the hover at the mission's start, a ground.
 """
 
 from __future__ import annotations
@@ -16,22 +16,14 @@ import numpy as np
 
 from quadcruise.checks import describe
 from quadcruise.errors import InputError
-from quadcruise.layout import REF_PSI
 from quadcruise.missions import Mission, mission_from_name, stack_params
-from quadcruise.model.equivalent import duty_to_thrust, paper_equivalent
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
 from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.stepper import Stepper
-from quadcruise.workflows.fly_inputs import (
-    check_can_hover,
-    default_duration,
-    engine_inputs,
-    hover_state,
-    per_vehicle_controllers,
-)
-from quadcruise.workflows.rotor_fly import as_vehicle, check_wind_acts, rotor_flight_setup, rotor_hover_state
+from quadcruise.workflows.fly_inputs import default_duration, engine_inputs, hover_state, per_vehicle_controllers
+from quadcruise.workflows.rotor_fly import as_vehicle, flight_setup
 
 
 def stepper(
@@ -89,98 +81,45 @@ def stepper(
         raise InputError(
             f"stepper: vehicle must be a Vehicle, a RotorVehicle or a preset's name, got {describe(vehicle)}"
         )
-    rotor, controller = rotor_flight_setup(vehicle, controller_vehicle, controller)  # a name: designed for it
+    plant, controller = flight_setup(vehicle, controller_vehicle, controller)  # a name: designed for it
+    flown = plant.vehicles(vehicle)
     controllers = per_vehicle_controllers(controller)
     if len(controllers) != 1:
         raise InputError("stepper: give one controller (its gains rows may be written between steps)")
     controller = controllers[0]
-    if rotor:
-        return _rotor_stepper(
-            mission,
-            controller,
-            vehicle,
-            controller_vehicle,
-            duration=duration,
-            dt=dt,
-            max_step=max_step,
-            n=n or 1,
-            x0=x0,
-            limits=limits,
-            full_dynamics=full_dynamics,
-            environment=environment,
-            sensors=sensors,
-            seed=seed,
-            first_vehicle=first_vehicle,
-            periods=periods,
-            setpoint_width=setpoint_width,
-        )
-    n = n or vehicle.batch_size or (np.shape(x0)[0] if x0 is not None and np.ndim(x0) == 2 else 1)
-    if vehicle.batch_size not in (None, n):
-        raise InputError(f"the number of vehicles is ambiguous: n = {n}, vehicle has {vehicle.batch_size}")
+    plant.refuse("stepper:", "full_dynamics", full_dynamics)
+    plant.check_environment(flown, environment)
+    count = plant.count(vehicle)
+    n = n or count or (np.shape(x0)[0] if x0 is not None and np.ndim(x0) == 2 else 1)
+    if count not in (None, n):
+        raise InputError(f"the number of vehicles is ambiguous: n = {n}, vehicle has {count}")
     duration = default_duration(mission) if duration is None else duration
     if not (isinstance(max_step, (int, float)) and max_step > 0) and max_step is not None:
         raise InputError(f"max_step must be a positive number of seconds, got {describe(max_step)}")
     grid = time_grid(float(duration), float(dt))
     if sensors is not None:
         sensors.check_fits(duration)
-    check_can_hover(vehicle)
-    x0 = hover_state(vehicle, n, mission) if x0 is None else x0
-    vp_ctrl = None if controller_vehicle is None else controller_vehicle.rows(n)
+    plant.check_vehicles(flown)
+    gains, mp = controller.gains(), stack_params(mission, n=n)
+    hover = hover_state(plant.equivalent(flown[:1]), n, mission)
+    args, own = plant.flight(
+        grid, vehicle, controller_vehicle, controller.function, gains, mission, mp, n,
+        x0=None, paper_x0=hover, meta=None, full_dynamics=full_dynamics,
+    )  # fmt: skip
+    own.pop("rotor_names", None)  # a result's column names: the Stepper keeps none
+    if x0 is not None:  # the plant's own state (the rotor plant's: 13 + n entries)
+        args = (args[0], x0, *args[2:])
     return Stepper(
-        grid,
-        x0,
-        vehicle.rows(n),
-        controller.function,
-        controller.gains(),
-        mission.function,
-        stack_params(mission, n=n),
+        *args,
         memory=controller.memory(),
-        vp_ctrl=vp_ctrl,
-        full_dynamics=full_dynamics,
         seed=seed,
         first_vehicle=first_vehicle,
         max_step=max_step or dt,
         limits=limits,
         periods=periods,
         setpoint_width=setpoint_width,
+        **own,
         **engine_inputs(environment, sensors, n, dt),
-    )
-
-
-def _rotor_stepper(mission, controller, vehicle, controller_vehicle, **kw: Any) -> Stepper:
-    """:func:`stepper` of a rotor-plant vehicle (its keywords; ``controller`` already designed)."""
-    if kw["full_dynamics"]:
-        raise InputError("stepper: full_dynamics is the paper plant's option, not a rotor-plant vehicle's")
-    check_wind_acts(vehicle, kw["environment"])
-    n, dt = kw["n"], kw["dt"]
-    duration = default_duration(mission) if kw["duration"] is None else kw["duration"]
-    max_step = kw["max_step"]
-    if not (isinstance(max_step, (int, float)) and max_step > 0) and max_step is not None:
-        raise InputError(f"max_step must be a positive number of seconds, got {describe(max_step)}")
-    grid = time_grid(float(duration), float(dt))
-    if kw["sensors"] is not None:
-        kw["sensors"].check_fits(duration)
-    believed = controller_vehicle or vehicle
-    return Stepper(
-        grid,
-        rotor_hover_state(vehicle, mission) if kw["x0"] is None else kw["x0"],
-        np.broadcast_to(vehicle.row(), (n, vehicle.row().size)),
-        controller.function,
-        controller.gains(),
-        mission.function,
-        stack_params(mission, n=n),
-        memory=controller.memory(),
-        vp_ctrl=paper_equivalent(believed).rows(1)[0],
-        seed=kw["seed"],
-        first_vehicle=kw["first_vehicle"],
-        max_step=max_step or dt,
-        limits=kw["limits"],
-        periods=kw["periods"],
-        setpoint_width=kw["setpoint_width"],
-        alloc=np.r_[duty_to_thrust(believed).ravel(), believed.kf],
-        psi0=float(mission.reference(0.0)[0][REF_PSI]),
-        touchdown_speed=vehicle.touchdown_speed,
-        **engine_inputs(kw["environment"], kw["sensors"], n, dt),
     )
 
 
