@@ -23,7 +23,7 @@ from quadcruise.model.actuators import duties
 from quadcruise.model.equivalent import paper_equivalent
 from quadcruise.sim.engine import WORK_ROWS, rk4_step
 from quadcruise.workflows.px4margins import px4_margins, rotor_gains
-from quadcruise.workflows.rotor_fly import rotor_flight_setup
+from quadcruise.workflows.rotor_fly import flight_setup
 from quadcruise.workflows.scenario_vehicle import vehicle_preset
 
 DT = 1e-3
@@ -36,7 +36,7 @@ def _iris_with(source, **values):
     """The Iris and px4 by name (``designed``) or with the SITL log's parameters (``log``: its
     CA_ROTOR*, THR_MDL_FAC 0 on a thrust per command u^2, MPC_THR_HOVER 0.5), ``values`` set over them."""
     v = vehicle_preset("iris")
-    px4 = rotor_flight_setup(v, None, "px4")[1] if source == "designed" else Px4.from_params(LOG, vehicle=v)
+    px4 = flight_setup(v, None, "px4")[1] if source == "designed" else Px4.from_params(LOG, vehicle=v)
     return v, dataclasses.replace(px4, params=px4.params.with_values(**values)) if values else px4
 
 
@@ -219,7 +219,7 @@ def _attitude_by_transfer_functions(px4, vehicle, a, w):
 @pytest.mark.parametrize(("a", "axis"), [(0, "roll"), (2, "yaw")])
 def test_attitude_loop_is_the_decimated_rate_loop_of_scipys_transfer_functions(vehicle_name, a, axis):
     vehicle = vehicle_preset(vehicle_name)
-    px4 = rotor_flight_setup(vehicle, None, "px4")[1] if vehicle_name == "iris" else Px4()
+    px4 = flight_setup(vehicle, None, "px4")[1] if vehicle_name == "iris" else Px4()
     model = px4_margins(px4, vehicle, dt=DT)
     wc = model.margins("attitude", axis)["gain_crossover"]
     for w in (0.2 * wc, wc, 3.0 * wc):

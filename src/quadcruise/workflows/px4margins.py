@@ -324,9 +324,11 @@ def px4_margins(
     if isinstance(controller, str):
         if controller != "px4":
             raise InputError(f"{w}: controller {controller!r} is not px4 (analyse it with linearize)")
-        from quadcruise.workflows.rotor_fly import rotor_flight_setup
+        from quadcruise.workflows.rotor_fly import flight_setup
 
-        controller = rotor_flight_setup(vehicle, None, "px4")[1] if isinstance(vehicle, RotorVehicle) else Px4()
+        controller = flight_setup(vehicle, None, "px4")[1]  # designed for the vehicle where its plant designs gains
+        if isinstance(controller, str):
+            controller = Px4()
     if not isinstance(controller, Px4):
         checks.fail(w, "controller", controller, "the px4 controller (a Px4 or 'px4')")
     paper = paper_equivalent(vehicle)
