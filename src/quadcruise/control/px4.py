@@ -143,12 +143,24 @@ class Px4(Controller):
         duties, 1 a rotor-plant vehicle (speed ``u w_max``).
     position_rate : float
         The position loop's rate [Hz] (EKF2's 100 Hz).
+    hover_estimator : bool
+        Run PX4's hover-thrust estimator (:mod:`quadcruise.control.px4hover`) where ``MPC_USE_HTE``
+        is 1, its estimate replacing ``MPC_THR_HOVER`` once valid and flying (``MPC_USE_HTE``,
+        ``HTE_*``); off by default (flights then fly ``MPC_THR_HOVER`` as before).
+    takeoff : bool
+        Start on the ground at the first step of PX4's takeoff ramp (``MPC_TKO_RAMP_T``,
+        ``MPC_TILTMAX_LND``), landed as PX4's land detector sees it until the thrust setpoint
+        lifts (the rate integral held while landed), flying when the ramp ends
+        (:func:`~quadcruise.control.px4kernel.px4_controller`). For a flight with a ground.
+    takeoff_speed_up : float
+        The climb rate the ramp ends at [m/s] (the flight task's ``vehicle_constraints.speed_up``);
+        0: ``MPC_Z_VEL_MAX_UP``.
 
     Examples
     --------
     >>> c = Px4()
     >>> c.gains().shape, c.memory().shape
-    ((242,), (113,))
+    ((253,), (132,))
     >>> Px4(thrust_curve=2.0)
     Traceback (most recent call last):
         ...
@@ -174,6 +186,9 @@ class Px4(Controller):
     rate_bandwidth: float = _f(15.0, "rad/s", "rotor lag the rate gains are designed for (0: PX4's)", "nonneg")
     thrust_curve: float = _f(0.0, "-", "the flown vehicle's thrust curve (1 - a) u + a u^2", between(0.0, 1.0))
     position_rate: float = _f(100.0, "Hz", "position loop rate", "pos")
+    hover_estimator: bool = _f(False, "-", "PX4's hover-thrust estimator (with MPC_USE_HTE = 1)", "flag")
+    takeoff: bool = _f(False, "-", "start on the ground in PX4's takeoff ramp, with its land detector", "flag")
+    takeoff_speed_up: float = _f(0.0, "m/s", "the takeoff ramp's target climb rate (0: MPC_Z_VEL_MAX_UP)", "nonneg")
 
     @property
     def function(self):
@@ -274,7 +289,7 @@ class Px4(Controller):
         Returns
         -------
         numpy.ndarray
-            :data:`PX4C_GAINS` (242) float64 entries: PX4's loops' gains in SI units, the
+            :data:`PX4C_GAINS` (253) float64 entries: PX4's loops' gains in SI units, the
             allocation, the vehicle's layout, the filters and the flags (see the row).
         """
         p = self.params
@@ -308,6 +323,17 @@ class Px4(Controller):
             hover_auto=float(self.hover_from_vehicle),
             designed=float(self.rate_bandwidth > 0.0),
             design=[rp.kp, rp.ki, rp.kd, rp.kp, rp.ki, rp.kd, yaw.kp, yaw.ki, yaw.kd],
+            hte=float(self.hover_estimator and p["MPC_USE_HTE"] == 1),
+            takeoff=float(self.takeoff),
+            tko_ramp_t=p["MPC_TKO_RAMP_T"],
+            tko_speed_up=self.takeoff_speed_up or p["MPC_Z_VEL_MAX_UP"],
+            tilt_lnd=math.radians(p["MPC_TILTMAX_LND"]),
+            hte_noise=p["HTE_HT_NOISE"],
+            hte_gate=p["HTE_ACC_GATE"],
+            hte_err_init=p["HTE_HT_ERR_INIT"],
+            hte_vxy=p["HTE_VXY_THR"],
+            hte_vz=p["HTE_VZ_THR"],
+            hte_range=p["HTE_THR_RANGE"],
         )
         return PX4C_GAINS.pack(values)
 

@@ -345,7 +345,8 @@ def position_control(pos, vel, vel_dot, pos_sp, vel_sp, acc_sp, dt, g, hover, ti
     vp1 = vp1 if math.isfinite(vp1) else 0.0
     vp2 = vp2 if math.isfinite(vp2) else 0.0
     v0, v1 = constrain_xy((vp0, vp1), (v0 - vp0, v1 - vp1), g[G_VMAX_XY])
-    v2 = min(max(v2, -g[G_VMAX_UP]), g[G_VMAX_DN])
+    lo, hi = -g[G_VMAX_UP], g[G_VMAX_DN]  # math::constrain: the lower bound wins (the takeoff ramp's lo > hi)
+    v2 = lo if v2 < lo else (hi if v2 > hi else v2)
     # velocity PID, D on the measured acceleration
     iz = min(max(vel_int[2], -ONE_G), ONE_G)
     e0, e1, e2 = v0 - vel[0], v1 - vel[1], v2 - vel[2]
