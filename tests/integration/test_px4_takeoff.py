@@ -1,0 +1,161 @@
+"""The whole loop: the PX4 1.15 SITL log's takeoff flown again (its trajectory_setpoints, its
+parameters, PX4's takeoff ramp, land detector and hover-thrust estimator) on the vehicle the log
+flew, jMAVSim's Iris, and its height and attitude compared with the log; the wrong vehicle or the
+wrong hover thrust fits clearly worse; ``px4-check --fly`` writes it; bad options are one line."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from quadcruise.cli.main import main
+from quadcruise.control import px4kernel as K
+from quadcruise.control.px4 import Px4
+from quadcruise.io.px4params import read_params
+from quadcruise.workflows.px4check import TOPICS, _read
+from quadcruise.workflows.px4fly import compare_takeoff, fly_takeoff, jmavsim_iris, takeoff_segment
+
+LOG = Path(__file__).parents[1] / "data" / "px4" / "sample_px4_events.ulg"
+DEG = np.pi / 180.0
+
+
+@pytest.fixture(scope="module")
+def log():
+    T, info, _ = _read(LOG, TOPICS + ("vehicle_constraints", "sensor_combined"))
+    return T, int(info["start_timestamp_us"]), read_params(LOG)
+
+
+@pytest.fixture(scope="module")
+def flown(log):
+    T, start, params = log
+    flight = fly_takeoff(T, params, log_start_us=start)
+    compare_takeoff(flight, T)
+    return flight
+
+
+def height_rmse(log, **kw):
+    T, start, params = log
+    flight = fly_takeoff(T, kw.pop("params", params), log_start_us=start, **kw)
+    assert flight.status == "finished"
+    return compare_takeoff(flight, T)["height"]
+
+
+def test_the_segment_is_the_logs_ramp_to_its_return(log):
+    """From takeoff_status's ramp-up (15.94 s into the log) to the return (RTL at 22.14 s), read
+    off the log's own messages: 'Takeoff detected' at 16.75 s, 'RTL: start return' at 22.14 s."""
+    T, start, _ = log
+    a, b = takeoff_segment(T)
+    assert (a - start) * 1e-6 == pytest.approx(15.94, abs=0.01)
+    assert (b - start) * 1e-6 == pytest.approx(22.136, abs=0.01)
+
+
+def test_the_takeoff_flies_as_the_log_did(flown):
+    """The height over the ramp's start tracks the log's (EKF2's vehicle_local_position, 10 Hz)
+    with R^2 >= 0.99 and an RMSE under 0.08 m, no sample off by 0.15 m (measured 0.997, 0.044 m,
+    0.093 m: the lift-off a tenth of a second early and the climb 5 cm ahead). Bound: twice the
+    measured error, under half of what a 20 % wrong mass gives (0.16 to 0.19 m). Roll and pitch
+    stay within 0.6 deg RMS of the log's (its 0.1 to 0.45 deg offsets are the estimator's,
+    which the simulated vehicle, level on a flat ground, has not: R^2 means nothing at that
+    size), yaw within 0.3 deg."""
+    assert flown.status == "finished"
+    h = flown.fit["height"]
+    assert h["samples"] >= 60
+    assert h["r2"] >= 0.99 and h["rmse"] < 0.08 and h["max_error"] < 0.15
+    for name, bound in (("roll", 0.6), ("pitch", 0.6), ("yaw", 0.3)):
+        assert flown.fit[name]["samples"] >= 120
+        assert flown.fit[name]["rmse"] < bound * DEG
+    t, logged, ours = flown.series["height"]
+    assert logged.max() > 2.0 and ours[-1] == pytest.approx(logged[-1], abs=0.1)  # both climbed the 2 m
+
+
+def test_pxs_takeoff_state_machine_ran(flown):
+    """The controller ended flying (takeoff state 5 after the 3 s ramp), not landed, in the air,
+    its tilt limit slewed back to MPC_TILTMAX_AIR; the estimator converged to the vehicle's hover
+    thrust (0.8 g / 16 N = 0.4905) as PX4's did in the log (0.490)."""
+    mem = flown.result.memory[0]
+    assert mem[K.Y_TKO_STATE] == K.TAKEOFF_FLIGHT and mem[K.Y_LANDED] == 0.0 and mem[K.Y_IN_AIR] == 1.0
+    assert mem[K.Y_TILT] == pytest.approx(np.radians(45.0))
+    assert mem[K.Y_HTE] == pytest.approx(0.4905, abs=0.005)
+
+
+@pytest.mark.parametrize(
+    "change",
+    [
+        {"vehicle": jmavsim_iris(1.0)},
+        {"vehicle": jmavsim_iris(0.65)},
+        {"hover": 0.35, "hover_estimator": False},
+        {"hover": 0.65},
+        {"thrust_curve": 1.0},
+    ],
+    ids=["mass 1.0 kg", "mass 0.65 kg", "MPC_THR_HOVER 0.35", "MPC_THR_HOVER 0.65", "thrust u^2"],
+)
+def test_the_wrong_vehicle_or_hover_thrust_fits_clearly_worse(log, flown, change):
+    """A mass 25 % off, MPC_THR_HOVER 0.15 off the vehicle's hover thrust, or a thrust growing with
+    the square of the command (identify says linear): the height's RMSE is over three times the
+    right vehicle's (measured 0.16, 0.19, 0.29, 0.22, 0.28 m against 0.044 m). The estimator does
+    not rescue the takeoff: PX4 uses it only once valid (2 s after its first estimate over 1 m),
+    which is after this segment in the log as here."""
+    change = dict(change)
+    if "hover" in change:
+        change["params"] = log[2].with_values(MPC_THR_HOVER=change.pop("hover"))
+    worse = height_rmse(log, **change)
+    assert worse["rmse"] > 3.0 * flown.fit["height"]["rmse"]
+    assert worse["r2"] < flown.fit["height"]["r2"] - 0.03
+
+
+def test_the_estimator_finds_a_heavier_vehicles_hover_thrust():
+    """On a hover flight of jMAVSim's Iris made 1.0 kg (true hover thrust 1.0 g / 16 N = 0.613)
+    with the log's MPC_THR_HOVER 0.5, the estimator's valid estimate replaces it (within 0.01)
+    and the velocity integral no longer carries the weight PX4's hover thrust missed; without it
+    MPC_THR_HOVER stays 0.5 and the integral holds the difference, g (0.613 - 0.5) / 0.5."""
+    import quadcruise as qc
+
+    vehicle = jmavsim_iris(1.0)
+    truth = vehicle.m * vehicle.g / (4 * vehicle.kf * vehicle.w_max**2)
+    ends = {}
+    for on in (True, False):
+        c = Px4.from_params(LOG, vehicle, thrust_curve=0.0, hover_estimator=on)
+        res = qc.fly("hover", c, vehicle=vehicle, duration=12.0, dt=1 / 250)
+        assert res.status_text() == "finished"
+        ends[on] = res.memory[0]
+    assert ends[True][K.Y_HTE_VALID] == 1.0
+    assert ends[True][K.Y_G + K.G_THR_HOVER] == pytest.approx(truth, abs=0.01)
+    assert abs(ends[True][K.Y_VEL_INT + 2]) < 0.1
+    assert ends[False][K.Y_G + K.G_THR_HOVER] == 0.5
+    assert abs(ends[False][K.Y_VEL_INT + 2]) == pytest.approx(9.80665 * (truth - 0.5) / 0.5, rel=0.1)
+
+
+def test_px4_check_fly_writes_the_comparison(tmp_path):
+    """``px4-check LOG --fly --out DIR``: the loops' table, then the flight's; check.json's
+    ``flight`` with the fit read back; takeoff.png."""
+    out = tmp_path / "check"
+    r = CliRunner().invoke(main, ["px4-check", str(LOG), "--fly", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "takeoff flight 6.2 s of the log (15.94 to 22.14 s), finished" in r.output
+    doc = json.loads((out / "check.json").read_text())
+    fit = doc["flight"]["fit"]
+    assert fit["height"]["r2"] >= 0.99 and fit["height"]["rmse"] < 0.08
+    assert doc["flight"]["vehicle"]["m"] == 0.8 and doc["flight"]["controller"]["hover_estimator"] is True
+    assert doc["command"].endswith("--fly")
+    assert (out / "takeoff.png").stat().st_size > 10_000
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--vehicle", "m=1.0"], "error: --vehicle is for the flight: give --fly too"),
+        (["--fly", "--vehicle", "paper"], "--fly flies the rotor plant with a ground: give a rotor-plant vehicle"),
+        (["--fly", "--vehicle", "m=-1"], "--vehicle 'm=-1': "),
+        (["--fly", "--thrust-curve", "2"], "Invalid value for '--thrust-curve'"),
+    ],
+)
+def test_bad_fly_options_are_one_line(tmp_path, args, message):
+    out = tmp_path / "bad"
+    r = CliRunner().invoke(main, ["px4-check", str(LOG), "--out", str(out), *args])
+    assert r.exit_code == 2, r.output
+    assert message in r.output and "Traceback" not in r.output
+    assert not out.exists()
