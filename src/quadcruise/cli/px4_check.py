@@ -36,7 +36,7 @@ __all__ = ["px4_check"]
     is_flag=True,
     help="Also fly LOG's takeoff (its trajectory_setpoints, from the takeoff ramp) with the parameters, on the ground "
     "with PX4's takeoff, land detector and hover-thrust estimator, and compare height, roll, pitch, yaw with LOG "
-    "(takeoff.png; exit 1 if the flight did not finish).",
+    "(takeoff.png, vehicle.toml; exit 1 if the flight did not finish).",
 )
 @click.option(
     "--vehicle",
@@ -141,7 +141,7 @@ def px4_check(
             f"{len(unused)} parameters of {result.params.source} are not used by the loops (listed in {out}/check.json)"
         )
     result.write(out, force=force)
-    click.echo(f"wrote {out}/check.json" + (" and takeoff.png" if fly else ""))
+    click.echo(f"wrote {out}/check.json" + (", takeoff.png and vehicle.toml" if fly else ""))
     if result.flight is not None and result.flight.status != "finished":
         click.echo(f"error: the takeoff flight did not finish: {result.flight.status}", err=True)
         sys.exit(1)

@@ -23,7 +23,8 @@ The vehicle of the shared SITL log (:func:`jmavsim_iris`): PX4 v1.15's airframe 
 ``Simulator.buildMulticopter`` (github.com/PX4/jMAVSim, ``src/me/drton/jmavsim/Simulator.java``)
 makes a quadrotor x of 0.8 kg, arm 0.33 / 2 m, 4.0 N and 0.05 N m per rotor at full command
 (thrust linear in the command), a 5 ms rotor time constant, inertia diag(0.005, 0.005, 0.009)
-kg m^2: hover at 0.8 g / 16 = 0.49 of full thrust. ``quadcruise identify`` of the log with
+kg m^2, a drag ``-0.01 |v| v`` [N] (``setDragMove(0.01)``, ``getAirFlowForce``): hover at
+0.8 g / 16 = 0.49 of full thrust. ``quadcruise identify`` of the log with
 ``--mass 0.8`` finds K = 3.99 N and a hover duty of 0.491 (its verdict: the model does not fit,
 the commands being logged at 10 Hz), and PX4's own ``hover_thrust_estimate`` in the log says
 0.49: the three agree.
@@ -71,7 +72,8 @@ def jmavsim_iris(m: float = 0.8) -> RotorVehicle:
     RotorVehicle
         Rotors in PX4's ``CA_ROTOR`` order (front right, rear left counter-clockwise; front left,
         rear right), ``w_max`` 1000 rad/s (jMAVSim gives thrust per command, not a speed: kf and
-        km are set so that full speed gives its 4.0 N and 0.05 N m).
+        km are set so that full speed gives its 4.0 N and 0.05 N m), its drag as ``c_D`` 0.01 on
+        each axis (``-|v| c_D v``, isotropic as jMAVSim's).
 
     Examples
     --------
@@ -92,6 +94,9 @@ def jmavsim_iris(m: float = 0.8) -> RotorVehicle:
         w_min=0.0,
         w_max=1000.0,
         rotors=((a, -a, 0.0, -1.0), (-a, a, 0.0, -1.0), (a, a, 0.0, 1.0), (-a, -a, 0.0, 1.0)),
+        c_Dx=0.01,
+        c_Dy=0.01,
+        c_Dz=0.01,
         source="jMAVSim Simulator.buildMulticopter (github.com/PX4/jMAVSim): PX4 SITL airframe 10017 jmavsim_iris",
     )
 
@@ -497,7 +502,8 @@ def flight_table(flight: TakeoffFlight) -> str:
 
 
 def write_flight(flight: TakeoffFlight, folder: str | Path) -> list[str]:
-    """Write ``takeoff.png`` (:func:`takeoff_figure`) into ``folder``.
+    """Write ``takeoff.png`` (:func:`takeoff_figure`) and ``vehicle.toml`` (the vehicle flown, as
+    ``fly --vehicle`` reads it) into ``folder``.
 
     Parameters
     ----------
@@ -511,6 +517,17 @@ def write_flight(flight: TakeoffFlight, folder: str | Path) -> list[str]:
     list of str
         The files written.
     """
+    import tomli_w
+
     folder = Path(folder)
     takeoff_figure(flight).savefig(folder / "takeoff.png", dpi=110)
-    return ["takeoff.png"]
+    v = flight.vehicle
+    fields = {"plant": "rotor", **{k: x for k, x in v.to_dict().items() if x is not None}}
+    fields["rotors"] = [list(r) for r in v.rotors]
+    head = (
+        f"# the vehicle px4-check --fly flew: {v.source or 'given with --vehicle'}\n"
+        f"# its thrust per PX4 command: thrust_curve {flight.controller.thrust_curve:g} (fly it with "
+        f"-c thrust_curve={flight.controller.thrust_curve:g} beside --params)\n"
+    )
+    (folder / "vehicle.toml").write_text(head + tomli_w.dumps({"vehicle": fields}))
+    return ["takeoff.png", "vehicle.toml"]
