@@ -20,7 +20,8 @@ mission's reference converted at the edge from ENU/FLU, :mod:`quadcruise.control
    held in between;
 4. the rate loop (:func:`~quadcruise.control.px4loops.rate_control`), every period (PX4's
    runs at the gyro rate), its integral held in a direction the allocator saturated in the
-   period before (``control_allocator_status``); never landed (flights start airborne);
+   period before (``control_allocator_status``), and held while PX4's land detector says
+   landed (only with ``takeoff``: other flights start airborne);
 5. the allocation (:func:`~quadcruise.control.px4allocation.allocate_into`): the normalised
    torque and thrust through the ``CA_ROTOR*`` geometry's normalised pseudo-inverse with
    PX4's sequential desaturation (``MC_AIRMODE``), each rotor's relative thrust clipped to
@@ -31,6 +32,11 @@ mission's reference converted at the edge from ENU/FLU, :mod:`quadcruise.control
    wrench (T, Mx, My, Mz) of the vehicle's own rotor layout (``rotors``), handed to the engine
    as the duties of its "+" equivalent (for a quadrotor whose layout the controller knows,
    the engine's mixer gives back these very rotor thrusts).
+
+With ``takeoff`` the flight starts on the ground in PX4's takeoff ramp and with
+``hover_estimator`` PX4's hover-thrust estimator runs (:mod:`quadcruise.control.px4hover`): both
+at the position loop (:func:`~quadcruise.control.px4kernel.px4_controller`); a NaN yaw setpoint
+holds the current yaw, as PX4's ``PositionControl`` does.
 
 PX4's default rate gains are for PX4's vehicles: in normalised torque, on a vehicle whose
 full torque over inertia is far larger than its rotor lag allows (the paper's 800 rad/s^2
