@@ -159,3 +159,15 @@ def test_bad_fly_options_are_one_line(tmp_path, args, message):
     assert r.exit_code == 2, r.output
     assert message in r.output and "Traceback" not in r.output
     assert not out.exists()
+
+
+def test_a_flight_that_crashes_says_so(tmp_path):
+    """A vehicle with a thousandth of jMAVSim's roll and pitch inertia tumbles at lift-off: the
+    table, check.json's status and the exit status (1) say it crashed; the comparison stops there."""
+    out = tmp_path / "crash"
+    r = CliRunner().invoke(main, ["px4-check", str(LOG), "--fly", "--vehicle", "Jxx=2e-6,Jyy=2e-6", "--out", str(out)])
+    assert r.exit_code == 1, r.output
+    assert "error: the takeoff flight did not finish: crashed" in r.output
+    doc = json.loads((out / "check.json").read_text())
+    assert doc["flight"]["status"].startswith("crashed")
+    assert doc["flight"]["fit"]["height"]["samples"] < 40  # 62 in the whole segment

@@ -406,8 +406,9 @@ def compare_takeoff(flight: TakeoffFlight, T: dict) -> dict:
     m = (t_lp >= flight.start_us) & (t_lp <= flight.end_us)
     tl = (t_lp[m] - flight.start_us) * 1e-6
     h_log = -(np.asarray(lp["z"], float)[m] - flight.ground)
-    h_ours = np.interp(tl, t_sim, res.states[0, :, L.Z])
-    h_ours[tl > stop] = np.nan
+    z = res.states[0, :, L.Z]
+    h_ours = np.interp(tl, t_sim[np.isfinite(z)], z[np.isfinite(z)])
+    h_ours[(tl > stop) | (tl > t_sim[np.isfinite(z)][-1])] = np.nan
     fit["height"] = _fit(h_log, h_ours, tl)
     series["height"] = (tl, h_log, h_ours)
     t_att = np.asarray(att["timestamp"], np.int64)
@@ -416,10 +417,13 @@ def compare_takeoff(flight: TakeoffFlight, T: dict) -> dict:
     q = np.stack([np.asarray(att[f"q[{i}]"], float)[m] for i in range(4)], axis=1)
     log_euler = Rotation.from_quat(q[:, [1, 2, 3, 0]]).as_euler("ZYX")[:, ::-1]  # roll, pitch, yaw
     ang = res.states[0, :, L.PHI : L.PSI + 1]
-    r_enu = Rotation.from_euler("ZYX", ang[:, ::-1]).as_matrix()
+    flown = np.all(np.isfinite(ang), axis=1)  # a flight that stopped has NaN rows after its stop
+    r_enu = Rotation.from_euler("ZYX", ang[flown, ::-1]).as_matrix()
     ours_all = Rotation.from_matrix(_A @ r_enu @ _B).as_euler("ZYX")[:, ::-1]
     ours_all[:, 2] = np.unwrap(ours_all[:, 2])
-    ours = np.stack([np.interp(ta, t_sim, ours_all[:, i]) for i in range(3)], axis=1)
+    t_flown = t_sim[flown]
+    ours = np.stack([np.interp(ta, t_flown, ours_all[:, i]) for i in range(3)], axis=1)
+    ours[ta > t_flown[-1]] = np.nan
     ours[ta > stop] = np.nan
     ours[:, 2] = log_euler[:, 2] + np.angle(np.exp(1j * (ours[:, 2] - log_euler[:, 2])))  # yaw error wrapped
     for i, name in enumerate(("roll", "pitch", "yaw")):
