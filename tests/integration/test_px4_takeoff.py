@@ -151,6 +151,7 @@ def test_px4_check_fly_writes_the_comparison(tmp_path):
         (["--fly", "--vehicle", "paper"], "--fly flies the rotor plant with a ground: give a rotor-plant vehicle"),
         (["--fly", "--vehicle", "m=-1"], "--vehicle 'm=-1': "),
         (["--fly", "--thrust-curve", "2"], "Invalid value for '--thrust-curve'"),
+        (["--fly", "--thrust-curve", "nan"], "error: --thrust-curve nan: must be a number in [0, 1]"),
     ],
 )
 def test_bad_fly_options_are_one_line(tmp_path, args, message):

@@ -108,6 +108,8 @@ def px4_check(
                                    ("--no-hover-estimator", no_hte)) if on]  # fmt: skip
     if given and not fly:
         raise InputError(f"{given[0]} is for the flight: give --fly too")
+    if not 0.0 <= thrust_curve <= 1.0:  # FloatRange lets nan through
+        raise InputError(f"--thrust-curve {thrust_curve}: must be a number in [0, 1]")
     flight = None
     if fly:
         from quadcruise.cli.vehicle import vehicle_from_option

@@ -145,6 +145,7 @@ PX4C_MEMORY = L.Row.of(
     "hover_param",
     "thr_min_param",
     "vmax_up_param",
+    "acc_sp_z",
     prefix="Y_",
 )
 """The memory of :func:`px4_controller`: a flag set after period one, the rate integral, the
@@ -156,7 +157,8 @@ attitude-loop time and its held rate setpoint, the loops' gains for this vehicle
 hover-thrust estimator's state (:data:`~quadcruise.control.px4hover.HTE_STATE`), whether it is
 valid and since when its test passes, the land detector's in-air and landed flags, the takeoff
 state (4 ramp-up, 5 flight, PX4's numbers) and the ramp's progress, the tilt limit [rad], the last
-thrust setpoint's z (NED), and the hover thrust, minimum thrust and climb limit as resolved."""
+thrust setpoint's z (NED), the hover thrust, minimum thrust and climb limit as resolved, and the
+last acceleration setpoint's z (NED, for ``updateHoverThrust``)."""
 (
     Y_INIT,
     Y_INTEG,
@@ -193,6 +195,7 @@ thrust setpoint's z (NED), and the hover thrust, minimum thrust and climb limit 
     Y_HOVER_PARAM,
     Y_THR_MIN_PARAM,
     Y_VMAX_UP_PARAM,
+    Y_ACC_SP_Z,
 ) = PX4C_MEMORY.offsets
 _EPS = 1.1920929e-07
 YAW_DESIGN_SHARE = 0.5
@@ -454,7 +457,7 @@ def px4_controller(t, dt, x, ref, vp, gains, mem, cmd):
         if flying and gains[X_HTE] != 0.0 and mem[Y_HTE_VALID] != 0.0:  # updateHoverThrust
             new = mem[Y_HTE + HTE_HOVER]
             if new != g[G_THR_HOVER]:
-                mem[Y_VEL_INT + 2] = hover_thrust_integral(mem[Y_VEL_INT + 2], g[G_THR_HOVER], new)
+                mem[Y_VEL_INT + 2] = hover_thrust_integral(mem[Y_VEL_INT + 2], g[G_THR_HOVER], new, mem[Y_ACC_SP_Z])
                 g[G_THR_HOVER] = new
         b = 2.0 * math.pi * gains[X_VELD_LP] * dtp
         alpha_v = b / (1.0 + b)
@@ -468,7 +471,7 @@ def px4_controller(t, dt, x, ref, vp, gains, mem, cmd):
             acc_sp = (acc_sp[0], acc_sp[1], math.nan)
         vel_int = (mem[Y_VEL_INT], mem[Y_VEL_INT + 1], mem[Y_VEL_INT + 2])
         tilt = g[G_TILT_MAX] if gains[X_TAKEOFF] == 0.0 else mem[Y_TILT]
-        _, _, thr, vel_int, valid = position_control(
+        _, acc_out, thr, vel_int, valid = position_control(
             pos, vel, (vd0, vd1, vd2), pos_sp, vel_sp, acc_sp, dtp, g, g[G_THR_HOVER], tilt, vel_int
         )
         if gains[X_HTE] != 0.0:  # on the thrust that made the acceleration just measured
@@ -479,6 +482,7 @@ def px4_controller(t, dt, x, ref, vp, gains, mem, cmd):
                 mem[Y_QD + k] = qd_new[k]
             mem[Y_THRUST] = math.sqrt(thr[0] * thr[0] + thr[1] * thr[1] + thr[2] * thr[2])
             mem[Y_THR_Z] = thr[2]
+            mem[Y_ACC_SP_Z] = acc_out[2]
             _log_setpoint(mem, qd_new, psi_ref)
             for a in range(3):
                 mem[Y_VEL_INT + a] = vel_int[a]

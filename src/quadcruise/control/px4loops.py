@@ -274,10 +274,12 @@ def attitude_control(q, qd, yawspeed_sp, g):
 
 
 @njit(cache=True, inline="always")
-def hover_thrust_integral(vel_int_z, hover_old, hover_new):
+def hover_thrust_integral(vel_int_z, hover_old, hover_new, acc_sp_z):
     """``PositionControl::updateHoverThrust``: the vertical velocity integral [m/s^2] moved so
-    that a new hover thrust leaves the thrust output as it was."""
-    return vel_int_z + (hover_new - hover_old) * (ONE_G / hover_new)
+    that a new hover thrust leaves the thrust output as it was: with the last acceleration
+    setpoint ``a`` (NED z), the thrust ``a h / g - h`` is kept by adding
+    ``(a - g) h_old / h_new + g - a`` (at ``a = 0``: ``(h_new - h_old) g / h_new``)."""
+    return vel_int_z + (acc_sp_z - ONE_G) * hover_old / hover_new + ONE_G - acc_sp_z
 
 
 @njit(cache=True, error_model="numpy")

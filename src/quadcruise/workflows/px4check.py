@@ -425,7 +425,8 @@ def _position(T: dict, g: np.ndarray, params: Px4Parameters, airborne) -> dict:
     ours = np.full((idx.size, 9), np.nan)
     for k in range(idx.size):
         if k > 0 and hover[k] != hover[k - 1]:
-            vel_int = (vel_int[0], vel_int[1], hover_thrust_integral(vel_int[2], hover[k - 1], hover[k]))
+            last_a = ours[k - 1, 5] if math.isfinite(ours[k - 1, 5]) else 0.0  # our acceleration setpoint before
+            vel_int = (vel_int[0], vel_int[1], hover_thrust_integral(vel_int[2], hover[k - 1], hover[k], last_a))
         dt = (t_us[idx[k]] - t_us[idx[k - 1]]) * 1e-6 if k > 0 else 0.0
         pos = (state["x"][k], state["y"][k], state["z"][k])
         vel = (state["vx"][k], state["vy"][k], state["vz"][k])
