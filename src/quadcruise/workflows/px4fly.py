@@ -290,9 +290,9 @@ class TakeoffFlight:
                 "takeoff_speed_up": self.controller.takeoff_speed_up,
                 "thrust_curve": self.controller.thrust_curve,
             },
-            "compared": "height over the ramp's start (vehicle_local_position.z) and roll, pitch, yaw "
-            "(vehicle_attitude), NED/FRD, at the log's samples",
-            "units": {"height": "m", "roll": "rad", "pitch": "rad", "yaw": "rad"},
+            "compared": "height over the ramp's start (vehicle_local_position.z), the collective thrust setpoint "
+            "(vehicle_thrust_setpoint), roll, pitch, yaw (vehicle_attitude), NED/FRD, at the log's samples",
+            "units": {"height": "m", "thrust": "normalised", "roll": "rad", "pitch": "rad", "yaw": "rad"},
             "fit": self.fit,
         }
 
@@ -381,6 +381,19 @@ def _fit(logged: np.ndarray, ours: np.ndarray, t: np.ndarray) -> dict:
     }
 
 
+def _relative_thrust(flight: TakeoffFlight, force: np.ndarray) -> np.ndarray:
+    """PX4's collective thrust setpoint (normalised) of the controller's total thrust command [N]:
+    the rotors' mean force over a rotor's full thrust through the vehicle's thrust curve
+    (``f = (1 - c) u + c u^2``) to the command u, then through ``THR_MDL_FAC`` back to PX4's relative
+    thrust (``s = (1 - fac) u + fac u^2``). Exact while the rotors share the thrust evenly (a vertical
+    takeoff); a mean otherwise."""
+    v, c = flight.vehicle, flight.controller
+    f = np.clip(np.asarray(force, float) / (v.n_rotors * v.kf * v.w_max**2), 0.0, None)
+    curve, fac = c.thrust_curve, c.params["THR_MDL_FAC"]
+    u = f if curve <= 0.0 else (-(1.0 - curve) + np.sqrt((1.0 - curve) ** 2 + 4.0 * curve * f)) / (2.0 * curve)
+    return (1.0 - fac) * u + fac * u * u
+
+
 def compare_takeoff(flight: TakeoffFlight, T: dict) -> dict:
     """Height and roll, pitch, yaw of the flight against the log (module docstring); fills
     ``flight.fit`` and ``flight.series`` and returns the fit.
@@ -394,8 +407,9 @@ def compare_takeoff(flight: TakeoffFlight, T: dict) -> dict:
     Returns
     -------
     dict
-        ``{"height" | "roll" | "pitch" | "yaw": {"r2", "rmse", "samples", "max_error", "max_error_at_s"}}``,
-        the largest error's time from the ramp's start [s].
+        ``{"height" | "thrust" | "roll" | "pitch" | "yaw": {"r2", "rmse", "samples", "max_error",
+        "max_error_at_s"}}``, the largest error's time from the ramp's start [s]; ``thrust``: the
+        collective thrust setpoint against ``vehicle_thrust_setpoint`` (normalised), where logged.
     """
     res = flight.result
     t_sim = res.t
@@ -411,6 +425,18 @@ def compare_takeoff(flight: TakeoffFlight, T: dict) -> dict:
     h_ours[(tl > stop) | (tl > t_sim[np.isfinite(z)][-1])] = np.nan
     fit["height"] = _fit(h_log, h_ours, tl)
     series["height"] = (tl, h_log, h_ours)
+    if "vehicle_thrust_setpoint" in T:  # the collective thrust setpoint, PX4's normalised thrust
+        th = T["vehicle_thrust_setpoint"]
+        t_th = np.asarray(th["timestamp"], np.int64)
+        m = (t_th >= flight.start_us) & (t_th <= flight.end_us)
+        tt = (t_th[m] - flight.start_us) * 1e-6
+        thrust = _relative_thrust(flight, res.commands[0, :, L.CMD_THRUST])
+        ok = np.isfinite(thrust)
+        ours_t = np.interp(tt, t_sim[ok], thrust[ok]) if ok.any() else np.full(tt.size, np.nan)
+        ours_t[(tt > stop) | (ok.any() and tt > t_sim[ok][-1])] = np.nan
+        logged_t = -np.asarray(th["xyz[2]"], float)[m]
+        fit["thrust"] = _fit(logged_t, ours_t, tt)
+        series["thrust"] = (tt, logged_t, ours_t)
     t_att = np.asarray(att["timestamp"], np.int64)
     m = (t_att >= flight.start_us) & (t_att <= flight.end_us)
     ta = (t_att[m] - flight.start_us) * 1e-6
@@ -434,7 +460,8 @@ def compare_takeoff(flight: TakeoffFlight, T: dict) -> dict:
 
 
 def takeoff_figure(flight: TakeoffFlight):
-    """Height and roll, pitch, yaw of the log and of the flight, against the time from the ramp's start.
+    """Height, thrust setpoint and roll, pitch, yaw of the log and of the flight, against the time
+    from the ramp's start.
 
     Parameters
     ----------
@@ -447,18 +474,12 @@ def takeoff_figure(flight: TakeoffFlight):
     """
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(8.0, 8.0))
-    axes = fig.subplots(4, 1, sharex=True)
-    for ax, (name, unit, scale) in zip(
-        axes,
-        (
-            ("height", "m", 1.0),
-            ("roll", "deg", 180 / np.pi),
-            ("pitch", "deg", 180 / np.pi),
-            ("yaw", "deg", 180 / np.pi),
-        ),
-        strict=True,
-    ):
+    panels = [("height", "m", 1.0), ("thrust", "norm", 1.0), ("roll", "deg", 180 / np.pi)]
+    panels += [("pitch", "deg", 180 / np.pi), ("yaw", "deg", 180 / np.pi)]
+    panels = [p for p in panels if p[0] in flight.series]
+    fig = Figure(figsize=(8.0, 1.9 * len(panels) + 0.5))
+    axes = fig.subplots(len(panels), 1, sharex=True)
+    for ax, (name, unit, scale) in zip(axes, panels, strict=True):
         t, log, ours = flight.series[name]
         f = flight.fit[name]
         ax.plot(t, log * scale, "k.-", ms=3, lw=1, label="PX4 log")
@@ -495,7 +516,7 @@ def flight_table(flight: TakeoffFlight) -> str:
         f"{'flight':<13} {'signal':<8} {'n':>5} {'R2':>7} {'RMSE':>10}  {'unit':<7} largest error (from the ramp)",
     ]
     for name, f in flight.fit.items():
-        scale, unit = (1.0, "m") if name == "height" else (180.0 / math.pi, "deg")
+        scale, unit = {"height": (1.0, "m"), "thrust": (1.0, "norm")}.get(name, (180.0 / math.pi, "deg"))
         r2 = "-" if f["r2"] is None else f"{f['r2']:.3f}"
         rmse = "-" if f["rmse"] is None else f"{f['rmse'] * scale:.3g}"
         worst = (
