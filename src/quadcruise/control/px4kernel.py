@@ -306,8 +306,9 @@ def _takeoff_step(mem, gains, g, dtp, altitude):
     ``_in_air``) once not landed and over 1 m above the ground. Takeoff (``TakeoffHandling``):
     ramp-up becomes flight once the ramp's progress reaches 1, the progress grows by
     ``dt / MPC_TKO_RAMP_T``, the climb limit goes from ``-g / MPC_Z_VEL_P_ACC`` (no thrust) to
-    the target; until flight the minimum thrust is 0 and the hover thrust the parameter; the tilt
-    limit slews at 0.2 rad/s between ``MPC_TILTMAX_LND`` and ``MPC_TILTMAX_AIR``. Returns whether flying."""
+    the target (the flight task's climb rate, at most ``MPC_Z_VEL_MAX_UP``); until flight the
+    minimum thrust is 0 and the hover thrust the parameter; the tilt limit slews at 0.2 rad/s
+    between ``MPC_TILTMAX_LND`` and ``MPC_TILTMAX_AIR``. Returns whether flying."""
     if mem[Y_LANDED] != 0.0:
         low = mem[Y_THR_MIN_PARAM] + (g[G_THR_HOVER] - mem[Y_THR_MIN_PARAM]) * 0.1
         if mem[Y_THRUST] > low:
@@ -318,7 +319,7 @@ def _takeoff_step(mem, gains, g, dtp, altitude):
         return True
     if mem[Y_TKO_STATE] == TAKEOFF_RAMPUP and mem[Y_TKO_PROGRESS] >= 1.0:
         mem[Y_TKO_STATE] = TAKEOFF_FLIGHT
-    target = gains[X_TKO_SPEED_UP]
+    target = min(gains[X_TKO_SPEED_UP], mem[Y_VMAX_UP_PARAM])  # PX4: a flight task's faster climb is capped
     limit = target
     if mem[Y_TKO_STATE] == TAKEOFF_RAMPUP:
         ramp = gains[X_TKO_RAMP_T]
