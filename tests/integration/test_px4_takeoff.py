@@ -190,3 +190,17 @@ def test_a_flight_that_crashes_says_so(tmp_path):
     doc = json.loads((out / "check.json").read_text())
     assert doc["flight"]["status"].startswith("crashed")
     assert doc["flight"]["fit"]["height"]["samples"] < 40  # 62 in the whole segment
+
+
+def test_a_log_without_a_takeoff_is_one_line(tmp_path):
+    """quadcruise's own PX4 log of an Iris hover (no takeoff_status): refused in one line naming
+    the log and the topic, exit 2, nothing written."""
+    import quadcruise as qc
+
+    own = tmp_path / "own.ulg"
+    qc.fly("hover", "px4", vehicle="iris", duration=1.0).to_ulog(own)
+    out = tmp_path / "out"
+    r = CliRunner().invoke(main, ["px4-check", str(own), "--fly", "--out", str(out)])
+    assert r.exit_code == 2, r.output
+    assert r.output.strip() == f"error: {own}: the log has no takeoff_status: cannot fly its takeoff"
+    assert not out.exists()

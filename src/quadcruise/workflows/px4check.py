@@ -485,6 +485,13 @@ def px4_check(
     path = Path(log)
     T, info, raw = _read(path, TOPICS + (("vehicle_constraints", "sensor_combined") if fly is not None else ()))
     params = read_params(path) if params is None else params
+    if fly is not None:  # a log without a takeoff is refused before any work
+        from quadcruise.workflows.px4fly import takeoff_segment
+
+        try:
+            takeoff_segment(T)
+        except InputError as exc:
+            raise InputError(f"{path}: {exc}") from None
     g = px4_gains(params)
     if "vehicle_land_detected" not in T:
         raise InputError(f"{path}: no vehicle_land_detected topic: cannot tell when the vehicle was airborne")
