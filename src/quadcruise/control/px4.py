@@ -157,7 +157,8 @@ class Px4(Controller):
         Start on the ground at the first step of PX4's takeoff ramp (``MPC_TKO_RAMP_T``,
         ``MPC_TILTMAX_LND``), landed as PX4's land detector sees it until the thrust setpoint
         lifts (the rate integral held while landed), flying when the ramp ends
-        (:func:`~quadcruise.control.px4kernel.px4_controller`). For a flight with a ground.
+        (:func:`~quadcruise.control.px4kernel.px4_controller`). For a flight that starts on a
+        ground (``px4-check --fly``, :func:`quadcruise.workflows.px4fly.fly_takeoff`), not from a hover.
     takeoff_speed_up : float
         The climb rate the ramp ends at [m/s] (the flight task's ``vehicle_constraints.speed_up``);
         0: ``MPC_Z_VEL_MAX_UP``.

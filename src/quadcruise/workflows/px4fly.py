@@ -221,9 +221,10 @@ def _setpoint_mission(T: dict, start: int, end: int, ground: float) -> tuple[np.
     return np.concatenate([[float(keep.size)], times, ref.ravel()]), float(times[0])
 
 
-def _gyro_rate(T: dict, params: Px4Parameters | None) -> float:
-    """The rate loop's rate [Hz]: the log's ``vehicle_angular_velocity`` samples where dense
-    enough (``timestamp_sample``), else ``sensor_combined``'s, else 250 Hz (SITL's)."""
+def _gyro_rate(T: dict) -> float:
+    """The rate loop's rate [Hz], PX4's gyro rate: ``sensor_combined``'s sample rate where it is
+    logged densely (every sample: 250 Hz in the SITL log), else ``vehicle_angular_velocity``'s
+    ``timestamp_sample`` spacing, else 250 Hz (SITL's)."""
     for name, key in (("sensor_combined", "timestamp"), ("vehicle_angular_velocity", "timestamp_sample")):
         if name in T and key in T[name]:
             dt = np.diff(np.asarray(T[name][key], float)) * 1e-6
@@ -345,7 +346,7 @@ def fly_takeoff(
         params, vehicle, thrust_curve=thrust_curve, takeoff=True, hover_estimator=hover_estimator,
         takeoff_speed_up=speed_up,
     )  # fmt: skip
-    rate = _gyro_rate(T, params)
+    rate = _gyro_rate(T)
     dt = 1.0 / rate
     n_steps = int(math.floor((end - start) * 1e-6 / dt))
     grid = np.arange(n_steps + 1) * dt
