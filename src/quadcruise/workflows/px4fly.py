@@ -21,13 +21,14 @@ yaw (NED, FRD: PX4's Euler angles) of the flight against ``vehicle_local_positio
 The vehicle of the shared SITL log (:func:`jmavsim_iris`): PX4 v1.15's airframe 10017
 ``jmavsim_iris`` (``SYS_AUTOSTART`` 10017; ``PX4_SIMULATOR`` jmavsim) flies in jMAVSim, whose
 ``Simulator.buildMulticopter`` (github.com/PX4/jMAVSim, ``src/me/drton/jmavsim/Simulator.java``)
-makes a quadrotor x of 0.8 kg, arm 0.33 / 2 m, 4.0 N and 0.05 N m per rotor at full command
-(thrust linear in the command), a 5 ms rotor time constant, inertia diag(0.005, 0.005, 0.009)
+makes a quadrotor x of 0.8 kg, arm 0.33 / 2 m, 4.0 N and 0.05 N m per rotor at full command,
+a 5 ms rotor time constant, inertia diag(0.005, 0.005, 0.009)
 kg m^2, a drag ``-0.01 |v| v`` [N] (``setDragMove(0.01)``, ``getAirFlowForce``): hover at
-0.8 g / 16 = 0.49 of full thrust. ``quadcruise identify`` of the log with
-``--mass 0.8`` finds K = 3.99 N and a hover duty of 0.491 (its verdict: the model does not fit,
-the commands being logged at 10 Hz), and PX4's own ``hover_thrust_estimate`` in the log says
-0.49: the three agree.
+0.8 g / 16 = 0.49 of full thrust, its thrust taken linear in PX4's command. ``quadcruise
+identify`` of the log with ``--mass 0.8`` finds K = 3.99 N and a hover duty of 0.491 (its
+verdict: the model does not fit, the commands being logged at 10 Hz), and PX4's own
+``hover_thrust_estimate`` in the log says 0.49: the three agree (a thrust growing as the
+command squared would hover at 0.70).
 """
 
 from __future__ import annotations
