@@ -170,6 +170,12 @@ def test_px4_check_fly_writes_the_comparison(tmp_path):
         (["--fly", "--vehicle", "m=-1"], "--vehicle 'm=-1': "),
         (["--fly", "--thrust-curve", "2"], "Invalid value for '--thrust-curve'"),
         (["--fly", "--thrust-curve", "nan"], "error: --thrust-curve nan: must be a number in [0, 1]"),
+        (["--fly-until", "25"], "error: --fly-until is for the flight: give --fly too"),
+        (["--fly", "--fly-until", "nan"], "error: --fly-until nan: must be a finite time in the log [s]"),
+        (
+            ["--fly", "--fly-until", "10"],
+            "--fly-until: the flight runs from the takeoff ramp's start to the log's end, 15.94 to 31.09 s of the log",
+        ),
     ],
 )
 def test_bad_fly_options_are_one_line(tmp_path, args, message):
@@ -204,3 +210,19 @@ def test_a_log_without_a_takeoff_is_one_line(tmp_path):
     assert r.exit_code == 2, r.output
     assert r.output.strip() == f"error: {own}: the log has no takeoff_status: cannot fly its takeoff"
     assert not out.exists()
+
+
+def test_fly_until_flies_the_return_too(log):
+    """``--fly-until 25.5``: the takeoff, the hold and the return's descent to just above the
+    ground (the log touches down at 25.7 s): the height still within 0.06 m RMS (measured
+    0.035 m), the thrust setpoint within 0.01 (0.004); the estimator, valid from 22.5 s on, holds
+    the vehicle's hover thrust, as PX4's did (0.490)."""
+    T, start, params = log
+    flight = fly_takeoff(T, params, log_start_us=start, until_s=25.5)
+    assert flight.status == "finished"
+    assert (flight.end_us - start) * 1e-6 == pytest.approx(25.5)
+    fit = compare_takeoff(flight, T)
+    assert fit["height"]["samples"] > 90 and fit["height"]["rmse"] < 0.06 and fit["height"]["r2"] > 0.99
+    assert fit["thrust"]["rmse"] < 0.01
+    mem = flight.result.memory[0]
+    assert mem[K.Y_HTE_VALID] == 1.0 and mem[K.Y_G + K.G_THR_HOVER] == pytest.approx(0.4905, abs=0.005)

@@ -3,6 +3,7 @@ PX4 logged (a folder with ``check.json``)."""
 
 from __future__ import annotations
 
+import math
 import shlex
 import sys
 
@@ -56,6 +57,15 @@ __all__ = ["px4_check"]
     "identify's thrust_curve_f of a PX4 log give).",
 )
 @click.option(
+    "--fly-until",
+    "until",
+    default=None,
+    type=float,
+    metavar="SECONDS",
+    help="With --fly: fly to this time of LOG [s from its start] instead of the takeoff's end (its return "
+    "comes next in a SITL log).",
+)
+@click.option(
     "--no-hover-estimator",
     "no_hte",
     is_flag=True,
@@ -70,6 +80,7 @@ def px4_check(
     fly: bool,
     vehicle_text: str | None,
     thrust_curve: float,
+    until: float | None,
     no_hte: bool,
     force: bool,
 ) -> None:
@@ -94,6 +105,8 @@ def px4_check(
         ``--vehicle``: the vehicle flown.
     thrust_curve : float
         ``--thrust-curve``: its thrust per command.
+    until : float or None
+        ``--fly-until``: the flight's end [s of the log].
     no_hte : bool
         ``--no-hover-estimator``.
     force : bool
@@ -104,12 +117,15 @@ def px4_check(
     from quadcruise.io.px4params import read_params
     from quadcruise.workflows.px4check import px4_check as run_check
 
-    given = [name for name, on in (("--vehicle", vehicle_text is not None), ("--thrust-curve", thrust_curve != 0.0),
-                                   ("--no-hover-estimator", no_hte)) if on]  # fmt: skip
+    options = (("--vehicle", vehicle_text is not None), ("--thrust-curve", thrust_curve != 0.0),
+               ("--fly-until", until is not None), ("--no-hover-estimator", no_hte))  # fmt: skip
+    given = [name for name, on in options if on]
     if given and not fly:
         raise InputError(f"{given[0]} is for the flight: give --fly too")
     if not 0.0 <= thrust_curve <= 1.0:  # FloatRange lets nan through
         raise InputError(f"--thrust-curve {thrust_curve}: must be a number in [0, 1]")
+    if until is not None and not math.isfinite(until):
+        raise InputError(f"--fly-until {until}: must be a finite time in the log [s]")
     flight = None
     if fly:
         from quadcruise.cli.vehicle import vehicle_from_option
@@ -121,7 +137,7 @@ def px4_check(
             raise InputError(
                 f"--vehicle {vehicle_text!r}: --fly flies the rotor plant with a ground: give a rotor-plant vehicle"
             )
-        flight = {"vehicle": vehicle, "thrust_curve": thrust_curve, "hover_estimator": not no_hte}
+        flight = {"vehicle": vehicle, "thrust_curve": thrust_curve, "hover_estimator": not no_hte, "until_s": until}
     chosen = read_params(params) if params is not None else None
     check_output_dir(out, force, inputs=[log, params])
     words = ["quadcruise", "px4-check", log, "--out", out] + (["--params", params] if params else [])

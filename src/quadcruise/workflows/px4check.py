@@ -470,7 +470,7 @@ def px4_check(
     fly : dict, optional
         Fly the log's takeoff too, with these keywords of
         :func:`~quadcruise.workflows.px4fly.fly_takeoff` (``vehicle``, ``hover_estimator``,
-        ``thrust_curve``): ``{}`` for its defaults.
+        ``thrust_curve``, ``until_s``): ``{}`` for its defaults.
 
     Returns
     -------
@@ -489,7 +489,9 @@ def px4_check(
         from quadcruise.workflows.px4fly import takeoff_segment
 
         try:
-            takeoff_segment(T)
+            until = fly.get("until_s")
+            start_us = int(info.get("start_timestamp_us", 0))
+            takeoff_segment(T, None if until is None else start_us + int(round(until * 1e6)), start_us)
         except InputError as exc:
             raise InputError(f"{path}: {exc}") from None
     g = px4_gains(params)

@@ -149,13 +149,18 @@ def _held(topic: dict, name: str, t_us) -> np.ndarray:
     return np.asarray(topic[name])[np.clip(i, 0, None)]
 
 
-def takeoff_segment(T: dict) -> tuple[int, int]:
+def takeoff_segment(T: dict, until_us: int | None = None, log_start_us: int = 0) -> tuple[int, int]:
     """The takeoff segment of a log's topics (module docstring), in the log's microseconds.
 
     Parameters
     ----------
     T : dict
         Topics by name, fields by name (as :func:`quadcruise.workflows.px4check` reads them).
+    until_us : int, optional
+        End there instead [us, the log's clock]: after the ramp's start, within the log
+        (``px4-check --fly-until``: more of the flight, e.g. the return's descent).
+    log_start_us : int
+        The log's start [us], for the times a refusal names.
 
     Returns
     -------
@@ -165,7 +170,8 @@ def takeoff_segment(T: dict) -> tuple[int, int]:
     Raises
     ------
     InputError
-        No ``takeoff_status`` ramp-up, or a topic the flight needs missing.
+        No ``takeoff_status`` ramp-up, a topic the flight needs missing, or ``until_us`` outside
+        (ramp start, log end].
     """
     for name in ("takeoff_status", "trajectory_setpoint", "vehicle_local_position", "vehicle_attitude"):
         if name not in T or len(T[name]["timestamp"]) < 2:
@@ -191,6 +197,14 @@ def takeoff_segment(T: dict) -> tuple[int, int]:
             again = np.flatnonzero((t > t[flown[0]]) & (landed != 0))
             if again.size:
                 end = min(end, int(t[again[0]]))
+    if until_us is not None:
+        last = int(min(T["vehicle_local_position"]["timestamp"][-1], T["vehicle_attitude"]["timestamp"][-1]))
+        if not start < until_us <= last:
+            raise InputError(
+                f"--fly-until: the flight runs from the takeoff ramp's start to the log's end, "
+                f"{(start - log_start_us) * 1e-6:.2f} to {(last - log_start_us) * 1e-6:.2f} s of the log"
+            )
+        end = until_us
     if end <= start:
         raise InputError("the log ends where its takeoff ramp starts: nothing to fly")
     return start, end
@@ -308,6 +322,7 @@ def fly_takeoff(
     thrust_curve: float = 0.0,
     max_step: float = 1e-3,
     log_start_us: int = 0,
+    until_s: float | None = None,
 ) -> TakeoffFlight:
     """Fly a log's takeoff segment (module docstring).
 
@@ -327,6 +342,8 @@ def fly_takeoff(
         Longest RK4 substep [s].
     log_start_us : int
         The log's start [us] (``ULog.start_timestamp``), for the times reported.
+    until_s : float, optional
+        End the flight there [s from the log's start] instead of at the takeoff's end.
 
     Returns
     -------
@@ -335,7 +352,8 @@ def fly_takeoff(
     from quadcruise.workflows.rotor_fly import fly_rotor
 
     vehicle = vehicle or jmavsim_iris()
-    start, end = takeoff_segment(T)
+    until = None if until_s is None else log_start_us + int(round(until_s * 1e6))
+    start, end = takeoff_segment(T, until, log_start_us)
     lp, att = T["vehicle_local_position"], T["vehicle_attitude"]
     ground = float(np.interp(start, lp["timestamp"], np.asarray(lp["z"], float)))
     mp, _ = _setpoint_mission(T, start, end, ground)
