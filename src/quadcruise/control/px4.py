@@ -167,7 +167,7 @@ class Px4(Controller):
     --------
     >>> c = Px4()
     >>> c.gains().shape, c.memory().shape
-    ((253,), (132,))
+    ((253,), (133,))
     >>> Px4(thrust_curve=2.0)
     Traceback (most recent call last):
         ...
