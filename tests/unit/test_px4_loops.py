@@ -365,12 +365,24 @@ def test_position_invalid_state():
 
 def test_position_update_hover_thrust():
     """Zero velocity setpoint: the thrust is the hover thrust (0.6); a new hover thrust (0.7)
-    moved into the integral leaves the output the same."""
-    _, _, thr, vel_int, valid = run(vel_sp=ZERO3, hover=0.6)
+    moved into the integral leaves the output the same (PositionControlTest's case); and while
+    accelerating (a climb's velocity error), PX4's
+    ``(a - g) h_old / h_new + g - a`` still leaves it the same, the simpler ``(h_new - h_old)
+    g / h_new`` would not."""
+    _, acc, thr, vel_int, valid = run(vel_sp=ZERO3, hover=0.6)
     assert valid and thr[2] == pytest.approx(-0.6)
-    vel_int = (vel_int[0], vel_int[1], hover_thrust_integral(vel_int[2], 0.6, 0.7))
+    vel_int = (vel_int[0], vel_int[1], hover_thrust_integral(vel_int[2], 0.6, 0.7, acc[2]))
     _, _, thr, _, valid = run(vel_sp=ZERO3, hover=0.7, vel_int=vel_int)
     assert valid and thr[2] == pytest.approx(-0.6)
+    climb = (0.0, 0.0, -0.1)
+    _, acc, thr0, _, valid = run(vel_sp=climb, hover=0.6)  # the integral 0 going in
+    assert valid and acc[2] < -0.5 and -0.85 < thr0[2] < -0.6  # accelerating, not saturated
+    moved = hover_thrust_integral(0.0, 0.6, 0.7, acc[2])
+    _, _, thr, _, _ = run(vel_sp=climb, hover=0.7, vel_int=(0.0, 0.0, moved))
+    assert thr[2] == pytest.approx(thr0[2], abs=1e-6)
+    simple = (0.7 - 0.6) * 9.80665 / 0.7
+    _, _, thr, _, _ = run(vel_sp=climb, hover=0.7, vel_int=(0.0, 0.0, simple))
+    assert abs(thr[2] - thr0[2]) > 1e-3
 
 
 def test_position_integrator_does_not_wind_up_on_invalid_setpoint():

@@ -20,7 +20,8 @@ mission's reference converted at the edge from ENU/FLU, :mod:`quadcruise.control
    held in between;
 4. the rate loop (:func:`~quadcruise.control.px4loops.rate_control`), every period (PX4's
    runs at the gyro rate), its integral held in a direction the allocator saturated in the
-   period before (``control_allocator_status``); never landed (flights start airborne);
+   period before (``control_allocator_status``), and held while PX4's land detector says
+   landed (only with ``takeoff``: other flights start airborne);
 5. the allocation (:func:`~quadcruise.control.px4allocation.allocate_into`): the normalised
    torque and thrust through the ``CA_ROTOR*`` geometry's normalised pseudo-inverse with
    PX4's sequential desaturation (``MC_AIRMODE``), each rotor's relative thrust clipped to
@@ -31,6 +32,11 @@ mission's reference converted at the edge from ENU/FLU, :mod:`quadcruise.control
    wrench (T, Mx, My, Mz) of the vehicle's own rotor layout (``rotors``), handed to the engine
    as the duties of its "+" equivalent (for a quadrotor whose layout the controller knows,
    the engine's mixer gives back these very rotor thrusts).
+
+With ``takeoff`` the flight starts on the ground in PX4's takeoff ramp and with
+``hover_estimator`` PX4's hover-thrust estimator runs (:mod:`quadcruise.control.px4hover`): both
+at the position loop (:func:`~quadcruise.control.px4kernel.px4_controller`); a NaN yaw setpoint
+holds the current yaw, as PX4's ``PositionControl`` does.
 
 PX4's default rate gains are for PX4's vehicles: in normalised torque, on a vehicle whose
 full torque over inertia is far larger than its rotor lag allows (the paper's 800 rad/s^2
@@ -143,12 +149,25 @@ class Px4(Controller):
         duties, 1 a rotor-plant vehicle (speed ``u w_max``).
     position_rate : float
         The position loop's rate [Hz] (EKF2's 100 Hz).
+    hover_estimator : bool
+        Run PX4's hover-thrust estimator (:mod:`quadcruise.control.px4hover`) where ``MPC_USE_HTE``
+        is 1, its estimate replacing ``MPC_THR_HOVER`` once valid and flying (``MPC_USE_HTE``,
+        ``HTE_*``); off by default (flights then fly ``MPC_THR_HOVER`` as before).
+    takeoff : bool
+        Start on the ground at the first step of PX4's takeoff ramp (``MPC_TKO_RAMP_T``,
+        ``MPC_TILTMAX_LND``), landed as PX4's land detector sees it until the thrust setpoint
+        lifts (the rate integral held while landed), flying when the ramp ends
+        (:func:`~quadcruise.control.px4kernel.px4_controller`). For a flight that starts on a
+        ground (``px4-check --fly``, :func:`quadcruise.workflows.px4fly.fly_takeoff`), not from a hover.
+    takeoff_speed_up : float
+        The climb rate the ramp ends at [m/s] (the flight task's ``vehicle_constraints.speed_up``);
+        0: ``MPC_Z_VEL_MAX_UP``.
 
     Examples
     --------
     >>> c = Px4()
     >>> c.gains().shape, c.memory().shape
-    ((242,), (113,))
+    ((253,), (133,))
     >>> Px4(thrust_curve=2.0)
     Traceback (most recent call last):
         ...
@@ -174,6 +193,9 @@ class Px4(Controller):
     rate_bandwidth: float = _f(15.0, "rad/s", "rotor lag the rate gains are designed for (0: PX4's)", "nonneg")
     thrust_curve: float = _f(0.0, "-", "the flown vehicle's thrust curve (1 - a) u + a u^2", between(0.0, 1.0))
     position_rate: float = _f(100.0, "Hz", "position loop rate", "pos")
+    hover_estimator: bool = _f(False, "-", "PX4's hover-thrust estimator (with MPC_USE_HTE = 1)", "flag")
+    takeoff: bool = _f(False, "-", "start on the ground in PX4's takeoff ramp, with its land detector", "flag")
+    takeoff_speed_up: float = _f(0.0, "m/s", "the takeoff ramp's target climb rate (0: MPC_Z_VEL_MAX_UP)", "nonneg")
 
     @property
     def function(self):
@@ -274,7 +296,7 @@ class Px4(Controller):
         Returns
         -------
         numpy.ndarray
-            :data:`PX4C_GAINS` (242) float64 entries: PX4's loops' gains in SI units, the
+            :data:`PX4C_GAINS` (253) float64 entries: PX4's loops' gains in SI units, the
             allocation, the vehicle's layout, the filters and the flags (see the row).
         """
         p = self.params
@@ -308,6 +330,17 @@ class Px4(Controller):
             hover_auto=float(self.hover_from_vehicle),
             designed=float(self.rate_bandwidth > 0.0),
             design=[rp.kp, rp.ki, rp.kd, rp.kp, rp.ki, rp.kd, yaw.kp, yaw.ki, yaw.kd],
+            hte=float(self.hover_estimator and p["MPC_USE_HTE"] == 1),
+            takeoff=float(self.takeoff),
+            tko_ramp_t=p["MPC_TKO_RAMP_T"],
+            tko_speed_up=self.takeoff_speed_up or p["MPC_Z_VEL_MAX_UP"],
+            tilt_lnd=math.radians(p["MPC_TILTMAX_LND"]),
+            hte_noise=p["HTE_HT_NOISE"],
+            hte_gate=p["HTE_ACC_GATE"],
+            hte_err_init=p["HTE_HT_ERR_INIT"],
+            hte_vxy=p["HTE_VXY_THR"],
+            hte_vz=p["HTE_VZ_THR"],
+            hte_range=p["HTE_THR_RANGE"],
         )
         return PX4C_GAINS.pack(values)
 

@@ -12,6 +12,8 @@ from quadcruise import layout as L
 from quadcruise.control.base import write_command
 from quadcruise.control.px4allocation import allocate_into
 from quadcruise.control.px4filters import alpha_of, lpf2p_apply, lpf2p_coefficients, lpf2p_reset
+from quadcruise.control.px4hover import HTE_HOVER, HTE_RATIO, HTE_STATE, HTE_VAR, hte_fuse, hte_noise_scale, hte_predict
+from quadcruise.control.px4hover import hte_reset_into as _hte_reset
 from quadcruise.control.px4loops import (
     G_RATE_D,
     G_RATE_I,
@@ -19,8 +21,12 @@ from quadcruise.control.px4loops import (
     G_THR_HOVER,
     G_THR_MIN,
     G_TILT_MAX,
+    G_VEL_P,
+    G_VMAX_UP,
+    ONE_G,
     PX4_GAINS,
     attitude_control,
+    hover_thrust_integral,
     position_control,
     rate_control,
 )
@@ -49,6 +55,17 @@ PX4C_GAINS = L.Row.of(
     "hover_auto",
     "designed",
     ("design", 9),
+    "hte",
+    "takeoff",
+    "tko_ramp_t",
+    "tko_speed_up",
+    "tilt_lnd",
+    "hte_noise",
+    "hte_gate",
+    "hte_err_init",
+    "hte_vxy",
+    "hte_vz",
+    "hte_range",
     parent=PX4_GAINS,
     prefix="X_",
 )
@@ -58,7 +75,9 @@ allocated-control rows (n x 4: the effectiveness times PX4's scale, roll, pitch,
 the vehicle's layout (n x 3: y / l, -x / l, direction, FLU), each rotor's range, ``MC_AIRMODE``,
 ``THR_MDL_FAC``, the vehicle's thrust curve, the gyro and D-term cutoffs [Hz], ``MPC_VELD_LP``
 [Hz], the position and attitude loops' periods [s], the two vehicle flags and the designed rate P, I, D per
-unit inertia (roll, pitch, yaw)."""
+unit inertia (roll, pitch, yaw); then the hover-thrust estimator's and the takeoff's flags, ``MPC_TKO_RAMP_T``
+[s], the ramp's target climb rate [m/s], ``MPC_TILTMAX_LND`` [rad], ``HTE_HT_NOISE``, ``HTE_ACC_GATE``,
+``HTE_HT_ERR_INIT``, ``HTE_VXY_THR``, ``HTE_VZ_THR`` [m/s] and ``HTE_THR_RANGE``."""
 (
     X_N_ROTORS,
     X_MIX,
@@ -77,6 +96,17 @@ unit inertia (roll, pitch, yaw)."""
     X_HOVER_AUTO,
     X_DESIGNED,
     X_DESIGN,
+    X_HTE,
+    X_TAKEOFF,
+    X_TKO_RAMP_T,
+    X_TKO_SPEED_UP,
+    X_TILT_LND,
+    X_HTE_NOISE,
+    X_HTE_GATE,
+    X_HTE_ERR_INIT,
+    X_HTE_VXY,
+    X_HTE_VZ,
+    X_HTE_RANGE,
 ) = PX4C_GAINS.offsets
 PX4C_MEMORY = L.Row.of(
     "px4 controller memory",
@@ -103,6 +133,19 @@ PX4C_MEMORY = L.Row.of(
     ("g", PX4_GAINS.size),
     ("sp", MAX_ROTORS),
     ("control", 6),
+    ("hte", HTE_STATE.size),
+    "hte_valid",
+    "hte_since",
+    "in_air",
+    "landed",
+    "tko_state",
+    "tko_progress",
+    "tilt",
+    "thr_z",
+    "hover_param",
+    "thr_min_param",
+    "vmax_up_param",
+    "acc_sp_z",
     prefix="Y_",
 )
 """The memory of :func:`px4_controller`: a flag set after period one, the rate integral, the
@@ -110,7 +153,12 @@ gyro filter's delays and coefficients, the D-term alpha and the period they are 
 raw rate and the filtered derivative, the velocity integral, derivative and last velocity, the
 next position-loop time and the last, the held attitude setpoint, thrust and yaw feed-forward,
 the allocator's saturation (positive, negative), the setpoint's angles (logged), the next
-attitude-loop time and its held rate setpoint, the loops' gains for this vehicle, and scratch."""
+attitude-loop time and its held rate setpoint, the loops' gains for this vehicle, scratch; then the
+hover-thrust estimator's state (:data:`~quadcruise.control.px4hover.HTE_STATE`), whether it is
+valid and since when its test passes, the land detector's in-air and landed flags, the takeoff
+state (4 ramp-up, 5 flight, PX4's numbers) and the ramp's progress, the tilt limit [rad], the last
+thrust setpoint's z (NED), the hover thrust, minimum thrust and climb limit as resolved, and the
+last acceleration setpoint's z (NED, for ``updateHoverThrust``)."""
 (
     Y_INIT,
     Y_INTEG,
@@ -135,6 +183,19 @@ attitude-loop time and its held rate setpoint, the loops' gains for this vehicle
     Y_G,
     Y_SP,
     Y_CONTROL,
+    Y_HTE,
+    Y_HTE_VALID,
+    Y_HTE_SINCE,
+    Y_IN_AIR,
+    Y_LANDED,
+    Y_TKO_STATE,
+    Y_TKO_PROGRESS,
+    Y_TILT,
+    Y_THR_Z,
+    Y_HOVER_PARAM,
+    Y_THR_MIN_PARAM,
+    Y_VMAX_UP_PARAM,
+    Y_ACC_SP_Z,
 ) = PX4C_MEMORY.offsets
 _EPS = 1.1920929e-07
 YAW_DESIGN_SHARE = 0.5
@@ -142,6 +203,7 @@ YAW_DESIGN_SHARE = 0.5
 a rotor's inertia (the Iris's ``J_rotor``) makes yaw torque through its acceleration, a fast path
 that the 40 Hz gyro filter's lag turns into a 47 Hz yaw oscillation at the full design (and not at half)."""
 _NG = PX4_GAINS.size
+_NH = HTE_STATE.size
 
 
 @njit(cache=True, inline="always")
@@ -209,6 +271,99 @@ def _saturation(mem, a, miss):
     return miss > _EPS or miss < -_EPS
 
 
+TAKEOFF_RAMPUP = 4
+"""``takeoff_status.takeoff_state`` while the takeoff ramp runs (PX4's ``TakeoffState::rampup``)."""
+TAKEOFF_FLIGHT = 5
+"""... and once flying (``TakeoffState::flight``)."""
+TILT_SLEW = 0.2
+"""The tilt limit's slew rate [rad/s] (``MulticopterPositionControl``'s ``_tilt_limit_slew_rate``)."""
+HTE_VALID_TIME = 2.0
+"""How long [s] the estimate's test must pass before PX4 calls it valid (``_valid_hysteresis``)."""
+
+
+@njit(cache=True, inline="always")
+def _ground_start(mem, gains, g):
+    """First period: the values the takeoff and the estimator change, as resolved, and their states
+    (on the ground in the ramp's first step with ``takeoff``, else flying)."""
+    mem[Y_HOVER_PARAM], mem[Y_THR_MIN_PARAM], mem[Y_VMAX_UP_PARAM] = g[G_THR_HOVER], g[G_THR_MIN], g[G_VMAX_UP]
+    takeoff = gains[X_TAKEOFF] != 0.0
+    mem[Y_LANDED] = 1.0 if takeoff else 0.0
+    mem[Y_IN_AIR] = 0.0 if takeoff else 1.0
+    mem[Y_TKO_STATE] = TAKEOFF_RAMPUP if takeoff else TAKEOFF_FLIGHT
+    mem[Y_TKO_PROGRESS] = 0.0
+    mem[Y_TILT] = gains[X_TILT_LND] if takeoff else g[G_TILT_MAX]
+    _hte_reset(mem[Y_HTE : Y_HTE + _NH], g[G_THR_HOVER], gains[X_HTE_ERR_INIT])
+    mem[Y_HTE_VALID] = 0.0
+    mem[Y_HTE_SINCE] = -1.0
+
+
+@njit(cache=True, inline="always")
+def _takeoff_step(mem, gains, g, dtp, altitude):
+    """One position-loop step of the land detector and the takeoff (before the position loop).
+
+    Land detector (``MulticopterLandDetector::_get_maybe_landed_state``): landed until the thrust
+    setpoint exceeds ``MPC_THR_MIN + 0.1 (hover - MPC_THR_MIN)``; in the air (the estimator's
+    ``_in_air``) once not landed and over 1 m above the ground. Takeoff (``TakeoffHandling``):
+    ramp-up becomes flight once the ramp's progress reaches 1, the progress grows by
+    ``dt / MPC_TKO_RAMP_T``, the climb limit goes from ``-g / MPC_Z_VEL_P_ACC`` (no thrust) to
+    the target (the flight task's climb rate, at most ``MPC_Z_VEL_MAX_UP``); until flight the
+    minimum thrust is 0 and the hover thrust the parameter; the tilt limit slews at 0.2 rad/s
+    between ``MPC_TILTMAX_LND`` and ``MPC_TILTMAX_AIR``. Returns whether flying."""
+    if mem[Y_LANDED] != 0.0:
+        low = mem[Y_THR_MIN_PARAM] + (g[G_THR_HOVER] - mem[Y_THR_MIN_PARAM]) * 0.1
+        if mem[Y_THRUST] > low:
+            mem[Y_LANDED] = 0.0
+    if mem[Y_LANDED] == 0.0 and altitude > 1.0:
+        mem[Y_IN_AIR] = 1.0
+    if gains[X_TAKEOFF] == 0.0:
+        return True
+    if mem[Y_TKO_STATE] == TAKEOFF_RAMPUP and mem[Y_TKO_PROGRESS] >= 1.0:
+        mem[Y_TKO_STATE] = TAKEOFF_FLIGHT
+    target = min(gains[X_TKO_SPEED_UP], mem[Y_VMAX_UP_PARAM])  # PX4: a flight task's faster climb is capped
+    limit = target
+    if mem[Y_TKO_STATE] == TAKEOFF_RAMPUP:
+        ramp = gains[X_TKO_RAMP_T]
+        mem[Y_TKO_PROGRESS] = mem[Y_TKO_PROGRESS] + dtp / ramp if ramp > dtp else 1.0
+        if mem[Y_TKO_PROGRESS] < 1.0:
+            start = -ONE_G / max(g[G_VEL_P + 2], 0.01)
+            limit = start + mem[Y_TKO_PROGRESS] * (target - start)
+    flying = mem[Y_TKO_STATE] >= TAKEOFF_FLIGHT
+    g[G_VMAX_UP] = min(limit, mem[Y_VMAX_UP_PARAM])
+    g[G_THR_MIN] = mem[Y_THR_MIN_PARAM] if flying else 0.0
+    if not flying:
+        g[G_THR_HOVER] = mem[Y_HOVER_PARAM]
+    goal = g[G_TILT_MAX] if flying else gains[X_TILT_LND]
+    step = TILT_SLEW * dtp
+    mem[Y_TILT] = min(max(goal, mem[Y_TILT] - step), mem[Y_TILT] + step)
+    return flying
+
+
+@njit(cache=True, inline="always")
+def _hover_estimate(mem, gains, t, dtp, vel, acc_up, thrust_up):
+    """One step of PX4's hover-thrust estimator module on a local position (after the position
+    loop): predict and fuse while in the air, valid after its test passed for 2 s."""
+    s = mem[Y_HTE : Y_HTE + _NH]
+    if mem[Y_IN_AIR] == 0.0 or not (0.001 < dtp < 1.0) or not math.isfinite(acc_up):
+        mem[Y_HTE_VALID], mem[Y_HTE_SINCE] = 0.0, -1.0
+        return
+    q = gains[X_HTE_NOISE] * gains[X_HTE_NOISE]
+    hte_predict(s, dtp, q)
+    scale = hte_noise_scale(vel[2], math.sqrt(vel[0] * vel[0] + vel[1] * vel[1]), gains[X_HTE_VZ], gains[X_HTE_VXY])
+    hover, span = mem[Y_HOVER_PARAM], gains[X_HTE_RANGE]  # MPC_THR_HOVER -+ HTE_THR_RANGE
+    lo, hi = min(max(hover - span, 0.0), 0.8), min(max(hover + span, 0.2), 0.9)
+    hte_fuse(s, acc_up, thrust_up, gains[X_HTE_GATE], scale, lo, hi, q)
+    ok = s[HTE_VAR] < 0.001
+    if mem[Y_HTE_VALID] == 0.0:
+        ok = ok and s[HTE_RATIO] < 1.0
+    if not ok:
+        mem[Y_HTE_VALID], mem[Y_HTE_SINCE] = 0.0, -1.0
+        return
+    if mem[Y_HTE_SINCE] < 0.0:
+        mem[Y_HTE_SINCE] = t
+    if t - mem[Y_HTE_SINCE] >= HTE_VALID_TIME - 1e-9:
+        mem[Y_HTE_VALID] = 1.0
+
+
 @njit(cache=True)
 def resolve_gains(gains, vp, g):
     """The loops' gains for one vehicle (what :func:`px4_controller` computes in its first period).
@@ -273,6 +428,7 @@ def px4_controller(t, dt, x, ref, vp, gains, mem, cmd):
     g = mem[Y_G : Y_G + _NG]
     if first:
         resolve_gains(gains, vp, g)
+        _ground_start(mem, gains, g)
     n = int(gains[X_N_ROTORS])
     # the state in PX4's frames
     pos = (x[L.Y], x[L.X], -x[L.Z])
@@ -292,10 +448,18 @@ def px4_controller(t, dt, x, ref, vp, gains, mem, cmd):
     r2, a2 = _gyro_axis(mem, 2, coef, raw[2], alpha_d, dt, first)
     # 2. the position loop, at its own rate
     period = gains[X_POS_PERIOD]
-    yaw_sp = 0.5 * math.pi - ref[L.REF_PSI]
+    psi_ref = ref[L.REF_PSI] if math.isfinite(ref[L.REF_PSI]) else x[L.PSI]  # NaN: hold the current yaw (PX4)
+    yaw_sp = 0.5 * math.pi - psi_ref
     yaw_sp = math.atan2(math.sin(yaw_sp), math.cos(yaw_sp))
     if first or t >= mem[Y_NEXT_POS] - 0.25 * dt:
         dtp = max(period, dt) if first else t - mem[Y_LAST_POS]
+        acc_up = math.nan if first else -(vel[2] - mem[Y_VEL_LAST + 2]) / dtp  # measured, up positive
+        flying = _takeoff_step(mem, gains, g, dtp, x[L.Z])
+        if flying and gains[X_HTE] != 0.0 and mem[Y_HTE_VALID] != 0.0:  # updateHoverThrust
+            new = mem[Y_HTE + HTE_HOVER]
+            if new != g[G_THR_HOVER]:
+                mem[Y_VEL_INT + 2] = hover_thrust_integral(mem[Y_VEL_INT + 2], g[G_THR_HOVER], new, mem[Y_ACC_SP_Z])
+                g[G_THR_HOVER] = new
         b = 2.0 * math.pi * gains[X_VELD_LP] * dtp
         alpha_v = b / (1.0 + b)
         vd0 = _vel_axis(mem, 0, vel[0], alpha_v, dtp, first)
@@ -304,16 +468,23 @@ def px4_controller(t, dt, x, ref, vp, gains, mem, cmd):
         pos_sp = (ref[L.REF_Y], ref[L.REF_X], -ref[L.REF_Z])
         vel_sp = (ref[L.REF_VY], ref[L.REF_VX], -ref[L.REF_VZ])
         acc_sp = (ref[L.REF_AY], ref[L.REF_AX], -ref[L.REF_AZ])
+        if mem[Y_TKO_STATE] == TAKEOFF_RAMPUP and math.isfinite(vel_sp[2]):  # no feed-forward in the ramp
+            acc_sp = (acc_sp[0], acc_sp[1], math.nan)
         vel_int = (mem[Y_VEL_INT], mem[Y_VEL_INT + 1], mem[Y_VEL_INT + 2])
-        _, _, thr, vel_int, valid = position_control(
-            pos, vel, (vd0, vd1, vd2), pos_sp, vel_sp, acc_sp, dtp, g, g[G_THR_HOVER], g[G_TILT_MAX], vel_int
+        tilt = g[G_TILT_MAX] if gains[X_TAKEOFF] == 0.0 else mem[Y_TILT]
+        _, acc_out, thr, vel_int, valid = position_control(
+            pos, vel, (vd0, vd1, vd2), pos_sp, vel_sp, acc_sp, dtp, g, g[G_THR_HOVER], tilt, vel_int
         )
+        if gains[X_HTE] != 0.0:  # on the thrust that made the acceleration just measured
+            _hover_estimate(mem, gains, t, dtp, vel, acc_up, -mem[Y_THR_Z])
         if valid:
             qd_new = body_z_to_attitude((-thr[0], -thr[1], -thr[2]), yaw_sp)
             for k in range(4):
                 mem[Y_QD + k] = qd_new[k]
             mem[Y_THRUST] = math.sqrt(thr[0] * thr[0] + thr[1] * thr[1] + thr[2] * thr[2])
-            _log_setpoint(mem, qd_new, ref[L.REF_PSI])
+            mem[Y_THR_Z] = thr[2]
+            mem[Y_ACC_SP_Z] = acc_out[2]
+            _log_setpoint(mem, qd_new, psi_ref)
             for a in range(3):
                 mem[Y_VEL_INT + a] = vel_int[a]
         elif first:  # level at the heading, hover thrust
@@ -321,8 +492,9 @@ def px4_controller(t, dt, x, ref, vp, gains, mem, cmd):
             for k in range(4):
                 mem[Y_QD + k] = qd_new[k]
             mem[Y_THRUST] = g[G_THR_HOVER]
-            _log_setpoint(mem, qd_new, ref[L.REF_PSI])
-        mem[Y_YAWSPEED] = -ref[L.REF_PSI_DOT]
+            mem[Y_THR_Z] = -g[G_THR_HOVER]
+            _log_setpoint(mem, qd_new, psi_ref)
+        mem[Y_YAWSPEED] = -ref[L.REF_PSI_DOT] if math.isfinite(ref[L.REF_PSI_DOT]) else 0.0
         nxt = mem[Y_NEXT_POS] + period
         mem[Y_NEXT_POS] = nxt if (not first and nxt > t) else t + period
         mem[Y_LAST_POS] = t
@@ -339,7 +511,8 @@ def px4_controller(t, dt, x, ref, vp, gains, mem, cmd):
     sat_pos = (mem[Y_SAT] != 0.0, mem[Y_SAT + 1] != 0.0, mem[Y_SAT + 2] != 0.0)
     sat_neg = (mem[Y_SAT + 3] != 0.0, mem[Y_SAT + 4] != 0.0, mem[Y_SAT + 5] != 0.0)
     integ = (mem[Y_INTEG], mem[Y_INTEG + 1], mem[Y_INTEG + 2])
-    torque, integ = rate_control((r0, r1, r2), rate_sp, (a0, a1, a2), dt, False, g, sat_pos, sat_neg, integ)
+    landed = mem[Y_LANDED] != 0.0
+    torque, integ = rate_control((r0, r1, r2), rate_sp, (a0, a1, a2), dt, landed, g, sat_pos, sat_neg, integ)
     for a in range(3):
         mem[Y_INTEG + a] = integ[a]
     # 5. allocation

@@ -274,10 +274,12 @@ def attitude_control(q, qd, yawspeed_sp, g):
 
 
 @njit(cache=True, inline="always")
-def hover_thrust_integral(vel_int_z, hover_old, hover_new):
+def hover_thrust_integral(vel_int_z, hover_old, hover_new, acc_sp_z):
     """``PositionControl::updateHoverThrust``: the vertical velocity integral [m/s^2] moved so
-    that a new hover thrust leaves the thrust output as it was."""
-    return vel_int_z + (hover_new - hover_old) * (ONE_G / hover_new)
+    that a new hover thrust leaves the thrust output as it was: with the last acceleration
+    setpoint ``a`` (NED z), the thrust ``a h / g - h`` is kept by adding
+    ``(a - g) h_old / h_new + g - a`` (at ``a = 0``: ``(h_new - h_old) g / h_new``)."""
+    return vel_int_z + (acc_sp_z - ONE_G) * hover_old / hover_new + ONE_G - acc_sp_z
 
 
 @njit(cache=True, error_model="numpy")
@@ -345,7 +347,8 @@ def position_control(pos, vel, vel_dot, pos_sp, vel_sp, acc_sp, dt, g, hover, ti
     vp1 = vp1 if math.isfinite(vp1) else 0.0
     vp2 = vp2 if math.isfinite(vp2) else 0.0
     v0, v1 = constrain_xy((vp0, vp1), (v0 - vp0, v1 - vp1), g[G_VMAX_XY])
-    v2 = min(max(v2, -g[G_VMAX_UP]), g[G_VMAX_DN])
+    lo, hi = -g[G_VMAX_UP], g[G_VMAX_DN]  # math::constrain: the lower bound wins (the takeoff ramp's lo > hi)
+    v2 = lo if v2 < lo else (hi if v2 > hi else v2)
     # velocity PID, D on the measured acceleration
     iz = min(max(vel_int[2], -ONE_G), ONE_G)
     e0, e1, e2 = v0 - vel[0], v1 - vel[1], v2 - vel[2]

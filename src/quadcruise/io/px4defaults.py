@@ -4,7 +4,8 @@ Read from PX4-Autopilot's parameter definitions of release v1.15 (``PARAM_DEFINE
 ``@min``/``@max``/``@unit``): ``src/modules/mc_rate_control/mc_rate_control_params.c``,
 ``src/modules/mc_att_control/mc_att_control_params.c``,
 ``src/modules/mc_pos_control/multicopter_position_control_gain_params.c``,
-``multicopter_position_control_limits_params.c`` and ``multicopter_position_control_params.c``.
+``multicopter_position_control_limits_params.c`` and ``multicopter_position_control_params.c``;
+the hover-thrust estimator's from ``src/modules/mc_hover_thrust_estimator/hover_thrust_estimator_params.yaml``.
 A bound PX4 does not declare is ``None`` (no limit). Angles and rates are in PX4's own units
 (deg, deg/s); the loops convert them (:func:`quadcruise.control.px4loops.px4_gains`).
 
@@ -101,6 +102,16 @@ _TABLE = {
     "MPC_THR_XY_MARG": Px4Param(0.3, "norm", 0.0, 0.5, FLOAT, "position"),
     "MPC_USE_HTE": Px4Param(1, "", 0, 1, INT32, "position"),
     "MPC_VELD_LP": Px4Param(5.0, "Hz", 0.0, 10.0, FLOAT, "position"),
+    # takeoff (multicopter_position_control_params.c, _limits_params.c): the ramp, the tilt limit on the ground
+    "MPC_TKO_RAMP_T": Px4Param(3.0, "s", 0.0, 5.0, FLOAT, "takeoff"),
+    "MPC_TILTMAX_LND": Px4Param(12.0, "deg", 5.0, 89.0, FLOAT, "takeoff"),
+    # mc_hover_thrust_estimator/hover_thrust_estimator_params.yaml
+    "HTE_HT_NOISE": Px4Param(0.0036, "norm/s", 0.0001, 1.0, FLOAT, "hover estimator"),
+    "HTE_ACC_GATE": Px4Param(3.0, "SD", 1.0, 10.0, FLOAT, "hover estimator"),
+    "HTE_HT_ERR_INIT": Px4Param(0.1, "norm", 0.0, 1.0, FLOAT, "hover estimator"),
+    "HTE_VXY_THR": Px4Param(10.0, "m/s", 1.0, 20.0, FLOAT, "hover estimator"),
+    "HTE_VZ_THR": Px4Param(2.0, "m/s", 1.0, 10.0, FLOAT, "hover estimator"),
+    "HTE_THR_RANGE": Px4Param(0.2, "norm", 0.01, 0.4, FLOAT, "hover estimator"),
     # sensors/vehicle_angular_velocity/imu_gyro_parameters.c
     "IMU_GYRO_CUTOFF": Px4Param(40.0, "Hz", 0.0, 1000.0, FLOAT, "filters"),
     "IMU_DGYRO_CUTOFF": Px4Param(30.0, "Hz", 0.0, 1000.0, FLOAT, "filters"),

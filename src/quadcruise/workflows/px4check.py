@@ -124,6 +124,8 @@ class Px4Check:
         What keeps the fit below 1, in words.
     command : str
         The command line that made it, if any.
+    flight : TakeoffFlight, optional
+        The log's takeoff flown and compared (``px4-check --fly``, :mod:`quadcruise.workflows.px4fly`).
     """
 
     log: str
@@ -132,6 +134,7 @@ class Px4Check:
     px4_version: str
     limits: list = field(default_factory=list)
     command: str = ""
+    flight: Any = None
 
     def to_json(self) -> dict:
         """The document ``check.json`` holds."""
@@ -145,6 +148,7 @@ class Px4Check:
             "good_fit_r2": GOOD_FIT,
             "loops": self.loops,
             "limits": self.limits,
+            **({"flight": self.flight.to_json()} if self.flight is not None else {}),
             "command": self.command,
         }
 
@@ -160,6 +164,10 @@ class Px4Check:
                 rmse = "-" if f["rmse"] is None else f"{f['rmse']:.3g}"
                 unit = _unit(loop, axis)
                 lines.append(f"{loop:<13} {axis:<8} {f['samples']:>5} {r2:>7} {rmse:>10}  {unit:<7} {info['output']}")
+        if self.flight is not None:
+            from quadcruise.workflows.px4fly import flight_table
+
+            lines.append(flight_table(self.flight))
         return "\n".join(lines)
 
     def write(self, folder: str | os.PathLike, *, force: bool = False) -> Path:
@@ -183,6 +191,10 @@ class Px4Check:
         out = check_output_dir(folder, force, inputs=[self.log])
         with atomic_dir(out) as tmp:
             (Path(tmp) / "check.json").write_text(json.dumps(self.to_json(), indent=2) + "\n")
+            if self.flight is not None:
+                from quadcruise.workflows.px4fly import write_flight
+
+                write_flight(self.flight, tmp)
             marker = {"workflow": "px4-check", "version": __version__, "command": self.command, "log": self.log}
             (Path(tmp) / MARKER).write_text(json.dumps(marker, indent=2) + "\n")
         return out
@@ -196,7 +208,7 @@ def _unit(loop: str, axis: str) -> str:
     return "m/s" if axis.startswith("v_") else "m/s^2"
 
 
-def _read(path: Path) -> tuple[dict, dict, dict]:
+def _read(path: Path, names: tuple = TOPICS) -> tuple[dict, dict, dict]:
     from pyulog import ULog
     from pyulog.core import ULogException
 
@@ -208,7 +220,7 @@ def _read(path: Path) -> tuple[dict, dict, dict]:
         raise InputError(f"{path}: no such file")
     check_ulog_framing(path)
     try:
-        log = ULog(str(path), message_name_filter_list=list(TOPICS))
+        log = ULog(str(path), message_name_filter_list=list(names))
     except (ULogException, struct.error, ValueError, IndexError) as exc:
         raise InputError(f"{path}: not a readable PX4 log ({exc})") from None
     topics: dict[str, dict[str, np.ndarray]] = {}
@@ -218,7 +230,7 @@ def _read(path: Path) -> tuple[dict, dict, dict]:
     raw = dict(log.initial_parameters)
     for _, name, value in log.changed_parameters:
         raw[name] = value
-    return topics, log.msg_info_dict, raw
+    return topics, {**log.msg_info_dict, "start_timestamp_us": int(log.start_timestamp)}, raw
 
 
 def _version(info: dict) -> str:
@@ -413,7 +425,8 @@ def _position(T: dict, g: np.ndarray, params: Px4Parameters, airborne) -> dict:
     ours = np.full((idx.size, 9), np.nan)
     for k in range(idx.size):
         if k > 0 and hover[k] != hover[k - 1]:
-            vel_int = (vel_int[0], vel_int[1], hover_thrust_integral(vel_int[2], hover[k - 1], hover[k]))
+            last_a = ours[k - 1, 5] if math.isfinite(ours[k - 1, 5]) else 0.0  # our acceleration setpoint before
+            vel_int = (vel_int[0], vel_int[1], hover_thrust_integral(vel_int[2], hover[k - 1], hover[k], last_a))
         dt = (t_us[idx[k]] - t_us[idx[k - 1]]) * 1e-6 if k > 0 else 0.0
         pos = (state["x"][k], state["y"][k], state["z"][k])
         vel = (state["vx"][k], state["vy"][k], state["vz"][k])
@@ -441,7 +454,9 @@ def _position(T: dict, g: np.ndarray, params: Px4Parameters, airborne) -> dict:
     }
 
 
-def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, command: str = "") -> Px4Check:
+def px4_check(
+    log: str | os.PathLike, params: Px4Parameters | None = None, command: str = "", fly: dict | None = None
+) -> Px4Check:
     """Feed a PX4 log's signals through the PX4 loops and compare their outputs with the log's.
 
     Parameters
@@ -452,6 +467,10 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
         The parameters to run with; the log's own by default.
     command : str
         The command line, recorded.
+    fly : dict, optional
+        Fly the log's takeoff too, with these keywords of
+        :func:`~quadcruise.workflows.px4fly.fly_takeoff` (``vehicle``, ``hover_estimator``,
+        ``thrust_curve``, ``until_s``): ``{}`` for its defaults.
 
     Returns
     -------
@@ -464,8 +483,17 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
         none of the loops' topics; one line naming the file.
     """
     path = Path(log)
-    T, info, raw = _read(path)
+    T, info, raw = _read(path, TOPICS + (("vehicle_constraints", "sensor_combined") if fly is not None else ()))
     params = read_params(path) if params is None else params
+    if fly is not None:  # a log without a takeoff is refused before any work
+        from quadcruise.workflows.px4fly import takeoff_segment
+
+        try:
+            until = fly.get("until_s")
+            start_us = int(info.get("start_timestamp_us", 0))
+            takeoff_segment(T, None if until is None else start_us + int(round(until * 1e6)), start_us)
+        except InputError as exc:
+            raise InputError(f"{path}: {exc}") from None
     g = px4_gains(params)
     if "vehicle_land_detected" not in T:
         raise InputError(f"{path}: no vehicle_land_detected topic: cannot tell when the vehicle was airborne")
@@ -524,7 +552,16 @@ def px4_check(log: str | os.PathLike, params: Px4Parameters | None = None, comma
         "position loop: the takeoff ramp and the land detector's setpoint overrides are not modelled (only flying "
         "samples are compared), and the D term uses the estimator's acceleration where PX4 differentiates the velocity",
     ]
-    return Px4Check(str(path), params, loops, version, limits, command)
+    flight = None
+    if fly is not None:
+        from quadcruise.workflows.px4fly import compare_takeoff, fly_takeoff
+
+        try:
+            flight = fly_takeoff(T, params, log_start_us=int(info.get("start_timestamp_us", 0)), **fly)
+        except InputError as exc:
+            raise InputError(f"{path}: {exc}") from None
+        compare_takeoff(flight, T)
+    return Px4Check(str(path), params, loops, version, limits, command, flight)
 
 
 def _rate_hz(t_us: np.ndarray) -> float:
