@@ -166,7 +166,7 @@ def test_px4_check_fly_writes_the_comparison(tmp_path):
     "args, message",
     [
         (["--vehicle", "m=1.0"], "error: --vehicle is for the flight: give --fly too"),
-        (["--fly", "--vehicle", "paper"], "--fly flies the rotor plant with a ground: give a rotor-plant vehicle"),
+        (["--fly", "--vehicle", "paper"], "--fly: the paper's plant has no ground"),
         (["--fly", "--vehicle", "m=-1"], "--vehicle 'm=-1': "),
         (["--fly", "--thrust-curve", "2"], "Invalid value for '--thrust-curve'"),
         (["--fly", "--thrust-curve", "nan"], "error: --thrust-curve nan: must be a number in [0, 1]"),

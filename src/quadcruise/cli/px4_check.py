@@ -129,14 +129,12 @@ def px4_check(
     flight = None
     if fly:
         from quadcruise.cli.vehicle import vehicle_from_option
-        from quadcruise.model.rotor_vehicle import RotorVehicle
+        from quadcruise.sim import plants
         from quadcruise.workflows.px4fly import jmavsim_iris
 
         vehicle = vehicle_from_option(vehicle_text, "--vehicle", base=jmavsim_iris()) or jmavsim_iris()
-        if not isinstance(vehicle, RotorVehicle):
-            raise InputError(
-                f"--vehicle {vehicle_text!r}: --fly flies the rotor plant with a ground: give a rotor-plant vehicle"
-            )
+        if "ground" in plants.of(vehicle).refuses:  # --fly takes off from the ground
+            raise InputError(f"--vehicle {vehicle_text!r}: --fly: {plants.of(vehicle).refuses['ground']}")
         flight = {"vehicle": vehicle, "thrust_curve": thrust_curve, "hover_estimator": not no_hte, "until_s": until}
     chosen = read_params(params) if params is not None else None
     check_output_dir(out, force, inputs=[log, params])
