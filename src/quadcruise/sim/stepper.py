@@ -49,6 +49,7 @@ from quadcruise.sim.rotor_batch import rotor_inputs
 from quadcruise.sim.rotor_flight import fly_rotor_pieces, paper_states, rotor_carry_width
 from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.threads import ThreadPlan
+from quadcruise.sim.track_figures import track_arrays
 
 STEP_PIECES_PER_THREAD = 1
 """A step is short: one range of vehicles per thread, as each kernel call has a fixed cost."""
@@ -96,6 +97,10 @@ class Stepper:
         Rotor plant: the yaw [rad] the initial quaternion's is read near.
     touchdown_speed : float or (N,) array, optional
         Rotor plant: with it, a ground at z = 0.
+    track : tuple of numpy.ndarray, optional
+        ``(rows, plan)``: the track checks' figures of each vehicle (:attr:`track`, updated at
+        every period and restored by :meth:`reset`) and the flight's plan
+        (:mod:`quadcruise.sim.track_figures`); none by default.
     """
 
     def __init__(
@@ -125,6 +130,7 @@ class Stepper:
         alloc=None,
         psi0=0.0,
         touchdown_speed=None,
+        track=None,
     ) -> None:
         if int(periods) != periods or periods < 1:
             raise InputError(f"periods must be a whole number >= 1, got {describe(periods)}")
@@ -197,6 +203,8 @@ class Stepper:
         self.disturbed = disturbance is not None
         self.full_dynamics, self.max_step = bool(full_dynamics), float(max_step)
         self.limits = (limits or Limits()).array()
+        self.track, self.track_plan = track_arrays(track, n)
+        self._track0 = self.track.copy()
         self._plan = ThreadPlan()  # one thread or all, for a step without a watcher
 
     @property
@@ -281,6 +289,7 @@ class Stepper:
         else:
             self.carry[rows] = fresh_carry(np.ascontiguousarray(start), self.sensor_delay)
         self.saturated[rows] = 0.0
+        self.track[rows] = self._track0[rows]
         self.status[rows] = int(ExitStatus.FINISHED)
         self.t_stop[rows] = np.nan
 
@@ -377,6 +386,8 @@ class Stepper:
             n_step=self.periods,
             clock=self.clock,
             carry=self.carry,
+            track=self.track,
+            track_plan=self.track_plan,
             log_x=self.log_x,
             log_cmd=self.log_cmd,
             log_ref=self.log_ref,

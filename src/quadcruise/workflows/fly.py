@@ -29,7 +29,7 @@ from quadcruise.missions import Mission, as_mission, stack_params
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
-from quadcruise.sim.chunked import simulate_watched, watch_again
+from quadcruise.sim.chunked import watch_again
 from quadcruise.sim.engine import simulate
 from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.result import SimResult
@@ -357,31 +357,32 @@ def fly(
         first_vehicle=first_vehicle,
         **engine_inputs(environment, sensors, n, dt),
     )
-    if watched:  # the log keeps every log_every-th period; the checks see every one
-        if rotor:  # the rotor plant's arrays (rotor_fly.py)
-            args, plant = rotor_engine_inputs(
-                grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, rotor_x0, meta
-            )
-        else:
-            args = (grid, x0, vehicle.rows(n), controller.function, gains, first.function, mp)
-            plant = dict(vp_ctrl=vp_ctrl, full_dynamics=full_dynamics)
-        options.update(plant)
+    watch = None
+    if watched:  # the log keeps every log_every-th period; the kernel's checks see every one
         mission_record = meta["mission"] if isinstance(meta["mission"], dict) else {}
         watch = TrackWatch(grid, mission_record, bound, steady, vertical)
-        result = simulate_watched(*args, watch=watch.feed, **options)
+    if rotor:  # rotor_fly.py
+        result = fly_rotor(
+            grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, x0=rotor_x0,
+            track=None if watch is None else watch.arrays, **options,
+        )  # fmt: skip
+    else:
+        args = (grid, x0, vehicle.rows(n), controller.function, gains, first.function, mp)
+        plain = dict(vp_ctrl=vp_ctrl, full_dynamics=full_dynamics)
+        result = simulate(*args, **plain, track=None if watch is None else watch.arrays, **options)
+    if watch is not None:
 
         def again(vehicles, periods, feed):  # the head of some vehicles, flown again (track_watch.py)
-            watch_again(*args, vehicles=vehicles, periods=periods, watch=feed, **options)
+            if rotor:  # the rotor plant's arrays (rotor_fly.py)
+                args, plant = rotor_engine_inputs(
+                    grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, rotor_x0
+                )
+            else:
+                args, plant = (grid, x0, vehicle.rows(n), controller.function, gains, first.function, mp), plain
+            watch_again(*args, vehicles=vehicles, periods=periods, watch=feed, **options, **plant)
 
         status, t_stop = watch.verdict(result.status, result.t_stop, again)
         result = dataclasses.replace(result, status=status, t_stop=t_stop)
-    elif rotor:  # the rotor plant's whole log (rotor_fly.py)
-        result = fly_rotor(
-            grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n, x0=rotor_x0, **options
-        )
-    else:
-        args = (grid, x0, vehicle.rows(n), controller.function, gains, first.function, mp)
-        result = simulate(*args, vp_ctrl=vp_ctrl, full_dynamics=full_dynamics, **options)
     result.meta["max_track_error_m"] = bound.tolist() if n > 1 else float(bound[0])
     result.meta["max_steady_error_m"] = steady.tolist() if n > 1 else float(steady[0])
     result.meta["max_altitude_error_m"] = vertical.tolist() if n > 1 else float(vertical[0])
