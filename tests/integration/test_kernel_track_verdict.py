@@ -218,3 +218,16 @@ def test_track_arrays_of_the_wrong_shape_are_refused():
     rows, off = no_track(3)  # checks off: rows of no width, untouched
     simulate(*args, track=(rows, off), **opts)
     assert rows.shape == (3, 0)
+
+
+def test_checks_turned_off_leave_the_engines_statuses():
+    # every bound infinite: no check, at any log_every (the kernel passes over them)
+    env = Environment(rotor_loss=RotorLoss(rotor=3, fraction=0.6, time=1.0))
+    kw = dict(environment=env, duration=6.0, max_track_error=np.inf, max_steady_error=np.inf)
+    on = quiet("circle", log_every=1, environment=env, duration=6.0)
+    assert on.status.tolist() != [FIN]  # with the checks, it does not finish well
+    for every in (1, 3, 6000):
+        off = quiet("circle", log_every=every, **kw)
+        assert off.status.tolist() == [FIN] and off.t_stop.tolist() == [6.0]
+    watch = TrackWatch(time_grid(1.0, 1e-3), {}, np.full(2, np.inf), np.full(2, np.inf), np.full(2, np.inf))
+    assert watch.plan[0] == 0.0
