@@ -289,7 +289,8 @@ class Stepper:
         else:
             self.carry[rows] = fresh_carry(np.ascontiguousarray(start), self.sensor_delay)
         self.saturated[rows] = 0.0
-        self.track[rows] = self._track0[rows]
+        if self.track.shape[1]:  # the track checks' figures, fresh
+            self.track[rows] = self._track0[rows]
         self.status[rows] = int(ExitStatus.FINISHED)
         self.t_stop[rows] = np.nan
 
