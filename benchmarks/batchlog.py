@@ -1,14 +1,14 @@
 """A batch's default log against ``log_every=1000``: wall time, CPU time and peak memory.
 
 ``python benchmarks/batchlog.py`` flies ``qc.fly("circle", n=2000, duration=10.0)`` as it comes
-(the log ``fly`` chooses, the track checks at every period as the flight goes) and the same call
-with ``log_every=1000`` (checks on the 11 logged instants), each call in a fresh process, in
+(the log ``fly`` chooses; the track checks at every period, in the kernel, either way) and the same
+call with ``log_every=1000``, each call in a fresh process, in
 alternating order (A B B A ...), and reports per call the wall time, the CPU time of the process
 during the call, its peak resident memory (``ru_maxrss``: the whole process, imports included)
 and the load average; then each variant's best and median and the ratio default / 1000.
 ``--full`` adds ``log_every=1`` (the whole log: about 6.2 GB at the default size). ``--chunk
 STEPS:PIECES`` (repeatable) adds the default call with other chunk sizes (``sim.chunked``'s
-``CHUNK_VEHICLE_STEPS`` and ``PIECES_PER_THREAD``), to choose them.
+``CHUNK_VEHICLE_STEPS`` and ``PIECES_PER_THREAD``: they size only the heads flown again now).
 
 Target (issue 26): the default costs at most 1.5 x the ``log_every=1000`` call, and its log
 stays within 1 GiB.

@@ -16,9 +16,6 @@ from quadcruise.control.design import PDGains, pd_from_poles
 from quadcruise.disturbances import Environment, RotorLoss, SensorNoise, Turbulence, with_drag
 from quadcruise.errors import LogWarning
 from quadcruise.missions import Circle, Step
-from quadcruise.sim.chunked import simulate_watched
-from quadcruise.sim.engine import simulate
-from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.status import ExitStatus
 from quadcruise.workflows import fly_inputs
 from quadcruise.workflows.fly_inputs import batch_log_every, hover_state, log_bytes
@@ -120,30 +117,6 @@ def test_one_mission_per_vehicle_and_a_turbulent_noisy_flight(monkeypatch):
     sensors = SensorNoise(position_std=0.05, delay=0.004)
     world = dict(vehicle=vehicle, environment=env, sensors=sensors, seed=3)
     same_verdict(*full_and_watched(monkeypatch, "circle", duration=4.0, **world))
-
-
-def test_the_chunked_flight_is_the_whole_flight_bit_for_bit_with_vehicles_stopping_mid_chunk():
-    # vehicles started ever closer to a tight position bound stop at different periods; chunks of
-    # 7 periods and a log of every 5th put stops on and next to the chunks' edges
-    n, v, c, m = 12, qc.Vehicle.paper(), NLPD(), Circle()
-    t = time_grid(1.0, 1e-3)
-    x0 = hover_state(v, n, m)
-    x0[:, 0] = np.linspace(1.0, 2.49, n)
-    x0[:, 3] = np.linspace(1.0, 6.0, n)  # moving outwards
-    args = (t, x0, v.rows(n), c.function, c.gains(), m.function, m.params())
-    opts = dict(memory=c.memory(), limits=Limits(max_position=2.5))
-    whole = simulate(*args, log_every=5, **opts)
-    assert len(set(whole.t_stop.round(6))) > 4  # stops at many instants
-    seen = np.zeros((n, t.size), dtype=int)
-
-    def watch(k0, first, stop, states, references):
-        seen[first:stop, k0 : k0 + states.shape[1]] += 1
-
-    for chunk in (7 * n, 64 * n, 10**6):
-        cut = simulate_watched(*args, log_every=5, watch=watch, chunk_vehicle_steps=chunk, **opts)
-        for name in ("states", "commands", "references", "final_state", "status", "t_stop", "memory"):
-            assert np.array_equal(getattr(whole, name), getattr(cut, name), equal_nan=True), (chunk, name)
-    assert (seen == 3).all()  # every vehicle's every instant, once per flight
 
 
 def test_the_default_log_of_a_large_batch_fits_and_a_single_flight_logs_every_period():

@@ -48,6 +48,7 @@ from quadcruise.sim.result import SimResult
 from quadcruise.sim.rng import next_normal
 from quadcruise.sim.status import STATUS_REASONS, ExitStatus
 from quadcruise.sim.threads import PIECES_PER_THREAD, fly_in_pieces
+from quadcruise.sim.track_figures import TP_ON, put_track, take_plan, take_track, track_arrays, track_period
 
 # exit status codes as plain ints, which the kernel compiles as constants (see sim/status.py)
 FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, TILT_BOUND, BAD_COMMAND, PITCH_SINGULAR = (
@@ -212,6 +213,8 @@ def _kernel(
     n_step,
     clock,
     carry,
+    track,
+    track_plan,
     log_x,
     log_cmd,
     log_ref,
@@ -250,6 +253,7 @@ def _kernel(
     ext = np.empty(L.EXT_SIZE)
     work = np.empty((WORK_ROWS, L.STATE_SIZE))
     mi, dmi, rngi = np.empty(mem.shape[1]), np.empty(dmem.shape[1]), np.empty(rng.shape[1], dtype=np.uint64)
+    watching, plan = track_plan[TP_ON] != 0.0, take_plan(track_plan)  # the track checks, or none
     for i in range(first, stop):
         k0 = clock[i, 0]
         if status[i] != FINISHED or k0 >= n_periods:  # stopped, or its grid flown
@@ -270,6 +274,7 @@ def _kernel(
         vpi, vci, gi, mpi, dpi, stdi = vp[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
         take(i, mem, dmem, rng, mi, dmi, rngi)
         clipped_s, limited_s = saturated[i, 0], saturated[i, 1]
+        fig = take_track(track, i, watching)
         max_position, max_speed, max_rate, max_tilt = limits[0], limits[1], limits[2], limits[3]
         code = FINISHED
         t_end = t_grid[n_periods]
@@ -296,6 +301,10 @@ def _kernel(
             for j in range(L.CMD_SIZE):
                 cmd[j] = 0.0
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
+            if watching:  # lost track, off track: at every period, whatever the log keeps
+                fig = track_period(
+                    k, t, x[L.X], x[L.Y], x[L.Z], ref[L.REF_X], ref[L.REF_X + 1], ref[L.REF_X + 2], fig, plan
+                )
             if k % log_every == 0:
                 log_row(log_x, i, rows, x)
                 log_row(log_cmd, i, rows, cmd)
@@ -358,6 +367,7 @@ def _kernel(
         for j in range(TRIG_WIDTH):
             carry[i, j] = work[TRIG, j]
         write_history(carry, i, TRIG_WIDTH, history)
+        put_track(track, i, watching, fig)
         close_vehicle(i, k_reached, steps, clipped_s, limited_s, code, t_end, clock, saturated, status, t_stop)
 
 
@@ -397,6 +407,7 @@ def simulate(
     log_every: int = 1,
     limits: Limits | None = None,
     meta: dict | None = None,
+    track: tuple | None = None,
 ) -> SimResult:
     """Fly N vehicles over the control instants ``t_grid`` and return a :class:`SimResult`.
 
@@ -445,6 +456,10 @@ def simulate(
         Divergence bounds.
     meta : dict
         Recorded in the result (config, seed, version).
+    track : tuple of numpy.ndarray, optional
+        ``(rows, plan)``: the track checks' running figures of each vehicle, updated in place at
+        every period whatever ``log_every`` keeps, and the flight's plan
+        (:mod:`quadcruise.sim.track_figures`); none by default.
 
     Returns
     -------
@@ -483,6 +498,7 @@ def simulate(
     status = np.zeros(n, dtype=np.int64)
     t_stop = np.empty(n)
     saturated = np.zeros((n, 2))
+    track_rows, track_plan = track_arrays(track, n)
     fly_vehicles(
         n,
         KernelArgs(
@@ -509,6 +525,8 @@ def simulate(
             n_step=n_periods,
             clock=np.zeros((n, 2), dtype=np.int64),
             carry=fresh_carry(x0, int(sensor_delay)),
+            track=track_rows,
+            track_plan=track_plan,
             log_x=log_x,
             log_cmd=log_cmd,
             log_ref=log_ref,

@@ -31,8 +31,9 @@ class KernelArgs(NamedTuple):
     ``mem``. Mission: ``mission``, ``mp``. Disturbance: ``disturbance``, ``disturbed`` (False:
     still air), ``dp``, ``dmem``, ``rng``. Sensors: ``sensor_std``, ``sensor_delay``. Options:
     ``full``, ``max_step``, ``log_every``, ``limits``. Resuming: ``n_step``, ``clock``,
-    ``carry``. Outputs: ``log_x``, ``log_cmd``, ``log_ref``, ``x_final``, ``status``,
-    ``t_stop``, ``saturated`` (and ``mem``, ``dmem``, ``rng`` written back).
+    ``carry``. Track checks: ``track`` (each vehicle's running figures, carried),
+    ``track_plan`` (:mod:`quadcruise.sim.track_figures`). Outputs: ``log_x``, ``log_cmd``,
+    ``log_ref``, ``x_final``, ``status``, ``t_stop``, ``saturated`` (and ``mem``, ``dmem``, ``rng`` written back).
     """
 
     t_grid: _f8v
@@ -58,6 +59,8 @@ class KernelArgs(NamedTuple):
     n_step: types.int64
     clock: _i8m
     carry: _f8m
+    track: _f8m
+    track_plan: _f8v
     log_x: _f8c
     log_cmd: _f8c
     log_ref: _f8c
@@ -107,6 +110,8 @@ class RotorKernelArgs(NamedTuple):
     n_step: types.int64
     clock: _i8m
     carry: _f8m
+    track: _f8m
+    track_plan: _f8v
     log_x: _f8c
     log_rotor: _f8c
     log_cmd: _f8c

@@ -15,6 +15,7 @@ from quadcruise.sim.inputs import Limits, batch_inputs
 from quadcruise.sim.kernel_args import RotorKernelArgs
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rotor_flight import fly_rotor_pieces, rotor_carry_width
+from quadcruise.sim.track_figures import track_arrays
 
 
 def rotor_inputs(
@@ -125,6 +126,7 @@ def fly_rotor_vehicles(
     touchdown_speed=None,
     rotor_names: tuple[str, ...] = (),
     meta: dict | None = None,
+    track: tuple | None = None,
 ) -> SimResult:
     """Fly N rotor-plant vehicles closed loop and return a :class:`SimResult` in the paper layout.
 
@@ -162,6 +164,8 @@ def fly_rotor_vehicles(
         The rotor state's column names (:func:`quadcruise.model.rotor_plant.state_names`).
     meta : dict, optional
         Recorded in the result.
+    track : tuple of numpy.ndarray, optional
+        ``(rows, plan)``: the track checks' figures and plan, as in :func:`quadcruise.simulate`.
 
     Returns
     -------
@@ -208,6 +212,7 @@ def fly_rotor_vehicles(
     t_stop = np.empty(n_vehicles)
     saturated = np.zeros((n_vehicles, 2))
     mem, dmem = inp["memory"], inp["disturbance_memory"]
+    track_rows, track_plan = track_arrays(track, n_vehicles)
     fly_rotor_pieces(
         n_vehicles,
         RotorKernelArgs(
@@ -237,6 +242,8 @@ def fly_rotor_vehicles(
             n_step=n_periods,
             clock=np.zeros((n_vehicles, 2), dtype=np.int64),
             carry=np.empty((n_vehicles, rotor_carry_width(sensor_delay))),
+            track=track_rows,
+            track_plan=track_plan,
             log_x=log_x,
             log_rotor=log_rotor,
             log_cmd=log_cmd,

@@ -79,6 +79,7 @@ from quadcruise.sim.rng import next_normal
 from quadcruise.sim.rotor_engine import ROTOR_WORK_ROWS, ground_contact, rotor_rk4_step
 from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.threads import PIECES_PER_THREAD, fly_in_pieces
+from quadcruise.sim.track_figures import TP_ON, put_track, take_plan, take_track, track_period
 
 FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, TILT_BOUND, BAD_COMMAND, CRASHED = (
     int(ExitStatus[name])
@@ -225,6 +226,8 @@ def _rotor_flight_kernel(
     n_step,
     clock,
     carry,
+    track,
+    track_plan,
     log_x,
     log_rotor,
     log_cmd,
@@ -263,6 +266,7 @@ def _rotor_flight_kernel(
     w_cmd = np.empty(n)
     work = np.empty((ROTOR_WORK_ROWS, size))
     mi, dmi, rngi = np.empty(mem.shape[1]), np.empty(dmem.shape[1]), np.empty(rng.shape[1], dtype=np.uint64)
+    watching, plan = track_plan[TP_ON] != 0.0, take_plan(track_plan)  # the track checks, or none
     max_position, max_speed, max_rate, cos_tilt = limits[0], limits[1], limits[2], math.cos(limits[3])
     for i in range(first, stop):
         k0 = clock[i, 0]
@@ -291,6 +295,7 @@ def _rotor_flight_kernel(
                 ext[j] = carry[i, C_EXT + j]
             read_history(carry, i, C_HISTORY, history)
         clipped_s, limited_s = saturated[i, 0], saturated[i, 1]
+        fig = take_track(track, i, watching)
         steps = clock[i, 1]
         code = FINISHED
         t_end = t_grid[n_periods]
@@ -314,6 +319,10 @@ def _rotor_flight_kernel(
             for j in range(L.CMD_SIZE):
                 cmd[j] = 0.0
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
+            if watching:  # lost track, off track: at every period, whatever the log keeps
+                fig = track_period(
+                    k, t, true[L.X], true[L.Y], true[L.Z], ref[L.REF_X], ref[L.REF_X + 1], ref[L.REF_X + 2], fig, plan
+                )
             if k % log_every == 0:
                 log_row(log_x, i, rows, true)
                 log_row(log_cmd, i, rows, cmd)
@@ -399,6 +408,7 @@ def _rotor_flight_kernel(
         for j in range(L.EXT_SIZE):
             carry[i, C_EXT + j] = ext[j]
         write_history(carry, i, C_HISTORY, history)
+        put_track(track, i, watching, fig)
         close_vehicle(i, k_reached, steps, clipped_s, limited_s, code, t_end, clock, saturated, status, t_stop)
 
 

@@ -47,6 +47,7 @@ from quadcruise.sim.plants import of_arrays
 from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.threads import ThreadPlan
+from quadcruise.sim.track_figures import track_arrays
 
 STEP_PIECES_PER_THREAD = 1
 """A step is short: one range of vehicles per thread, as each kernel call has a fixed cost."""
@@ -94,6 +95,10 @@ class Stepper:
         Rotor plant: the yaw [rad] the initial quaternion's is read near.
     touchdown_speed : float or (N,) array, optional
         Rotor plant: with it, a ground at z = 0.
+    track : tuple of numpy.ndarray, optional
+        ``(rows, plan)``: the track checks' figures of each vehicle (:attr:`track`, updated at
+        every period and restored by :meth:`reset`) and the flight's plan
+        (:mod:`quadcruise.sim.track_figures`); none by default.
     """
 
     def __init__(
@@ -123,6 +128,7 @@ class Stepper:
         alloc=None,
         psi0=0.0,
         touchdown_speed=None,
+        track=None,
     ) -> None:
         if int(periods) != periods or periods < 1:
             raise InputError(f"periods must be a whole number >= 1, got {describe(periods)}")
@@ -182,6 +188,8 @@ class Stepper:
         self.disturbed = disturbance is not None
         self.full_dynamics, self.max_step = bool(full_dynamics), float(max_step)
         self.limits = (limits or Limits()).array()
+        self.track, self.track_plan = track_arrays(track, n)
+        self._track0 = self.track.copy()
         self._plan = ThreadPlan()  # one thread or all, for a step without a watcher
 
     @property
@@ -268,6 +276,8 @@ class Stepper:
         self.clock[rows] = 0
         self.plant.restart(self, rows, start)
         self.saturated[rows] = 0.0
+        if self.track.shape[1]:  # the track checks' figures, fresh
+            self.track[rows] = self._track0[rows]
         self.status[rows] = int(ExitStatus.FINISHED)
         self.t_stop[rows] = np.nan
 
@@ -364,6 +374,8 @@ class Stepper:
             n_step=self.periods,
             clock=self.clock,
             carry=self.carry,
+            track=self.track,
+            track_plan=self.track_plan,
             log_x=self.log_x,
             log_cmd=self.log_cmd,
             log_ref=self.log_ref,

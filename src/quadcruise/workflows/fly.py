@@ -29,7 +29,7 @@ from quadcruise.missions import Mission, as_mission, stack_params
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.protocols import ControllerLike
-from quadcruise.sim.chunked import simulate_watched, watch_again
+from quadcruise.sim.chunked import watch_again
 from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.result import SimResult
 from quadcruise.workflows.fly_failures import (
@@ -343,18 +343,18 @@ def fly(
         x0=given, paper_x0=x0, meta=meta, full_dynamics=full_dynamics,
     )  # fmt: skip
     options.update(own)
-    if watched:  # the log keeps every log_every-th period; the checks see every one
+    watch = None
+    if watched:  # the log keeps every log_every-th period; the kernel's checks see every one
         mission_record = meta["mission"] if isinstance(meta["mission"], dict) else {}
         watch = TrackWatch(grid, mission_record, bound, steady, vertical)
-        result = simulate_watched(*args, watch=watch.feed, **options)
+    result = plant.fly(args, {**options, "track": None if watch is None else watch.arrays})
+    if watch is not None:
 
         def again(vehicles, periods, feed):  # the head of some vehicles, flown again (track_watch.py)
             watch_again(*args, vehicles=vehicles, periods=periods, watch=feed, **options)
 
         status, t_stop = watch.verdict(result.status, result.t_stop, again)
         result = dataclasses.replace(result, status=status, t_stop=t_stop)
-    else:  # the whole log
-        result = plant.fly(args, options)
     result.meta["max_track_error_m"] = bound.tolist() if n > 1 else float(bound[0])
     result.meta["max_steady_error_m"] = steady.tolist() if n > 1 else float(steady[0])
     result.meta["max_altitude_error_m"] = vertical.tolist() if n > 1 else float(vertical[0])

@@ -22,6 +22,7 @@ from quadcruise.missions import Mission
 from quadcruise.model.vehicle import Vehicle
 from quadcruise.sim.inputs import Limits
 from quadcruise.sim.plants.paper import hover_check
+from quadcruise.sim.track_figures import TRACK
 
 
 def default_duration(mission: Mission) -> float:
@@ -308,11 +309,10 @@ def batch_log_every(n: int, periods: int, extra: int = 0) -> int:
     return next((d for d in divisors if log_bytes(n, periods, d, extra) <= LOG_BUDGET), periods)
 
 
-WATCH_BYTES = 8 * 8 + 17 * 8 + 6 + 8 + 8
+WATCH_BYTES = 8 * TRACK.size
 """Bytes per vehicle that the track checks at every period keep, whatever the flight's length
-(:class:`~quadcruise.workflows.track_watch.TrackWatch`: 8 periods, 17 figures, 6 flags, the
-bounds' step response and its index); the head of a vehicle flown again is read in groups of
-at most :data:`~quadcruise.workflows.track_watch.HEAD_BYTES`."""
+(:data:`~quadcruise.sim.track_figures.TRACK`, the kernel's running figures: 34 floats); the head
+of a vehicle flown again is read in groups of at most :data:`~quadcruise.workflows.track_watch.HEAD_BYTES`."""
 
 
 def check_run_size(

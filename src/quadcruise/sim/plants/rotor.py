@@ -237,7 +237,7 @@ def rotor_engine_inputs(
     meta: dict | None = None,
 ) -> tuple[tuple, dict]:
     """The arrays of ``n`` rotor-plant flights, as :class:`~quadcruise.sim.stepper.Stepper`
-    (and so :func:`~quadcruise.sim.chunked.simulate_watched`) takes them, for :func:`quadcruise.fly`.
+    (and so :func:`~quadcruise.sim.chunked.watch_again`) takes them, for :func:`quadcruise.fly`.
 
     Parameters
     ----------
