@@ -197,14 +197,24 @@ def row_offsets(py_func, signature, argument: str) -> tuple[set[int], int]:
     parameter's name, followed into inlined helpers): the entries it reads or writes at offsets
     fixed at compile time (:func:`_index_values`), and how many reads and writes use an index
     computed at run time. A row read through offsets that numba folded as constants has none of
-    the latter."""
+    the latter. Of a 2-D array indexed by (row, column), the column: the offset within a row."""
     func_ir, typemap = typed_ir(py_func, signature)
     names = _aliases(func_ir, argument)
     values = _index_values(func_ir, typemap)
+    tuples = {
+        s.target.name: s.value.items
+        for block in func_ir.blocks.values()
+        for s in block.body
+        if isinstance(s, ir.Assign) and isinstance(s.value, ir.Expr) and s.value.op == "build_tuple"
+    }
     constant, computed = set(), 0
 
     def index(static, var):
         nonlocal computed
+        if isinstance(static, tuple):
+            static = static[-1]
+        if var is not None and var.name in tuples:
+            var = tuples[var.name][-1]
         if isinstance(static, int):
             constant.add(static)
             return

@@ -151,9 +151,12 @@ def state_names(n_rotors: int) -> tuple[str, ...]:
     return ROTOR_BODY_NAMES + tuple(f"w{i + 1}" for i in range(n_rotors))
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def rotor_derivative(x, w_cmd, rp, ext, dx):
     """Write dx/dt of one rotor-speed vehicle into ``dx`` (the equations of this module).
+
+    The RK4 step computes it stage by stage with :func:`rotor_stage`; this is the stage at the
+    state itself.
 
     Parameters
     ----------
@@ -167,8 +170,38 @@ def rotor_derivative(x, w_cmd, rp, ext, dx):
     ext : ndarray, shape (9 + n,)
         External force [N] (world), torque [N m] (body), wind [m/s] (world), rotor
         effectiveness [-].
-    dx : ndarray, shape (13 + n,)
+    dx : ndarray, shape (13 + n,), contiguous
         Output: the state's time derivative.
+    """
+    rotor_stages(x, w_cmd, rp, ext, 0.0, dx.reshape((1, dx.shape[0])), 1)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def rotor_stages(x, w_cmd, rp, ext, h, k, stages):
+    """The first ``stages`` (1 to 4) stages of a classical RK4 step of length h [s] from x:
+    ``k[s] = f(x + a_s k[s - 1])``, a_s = 0, h/2, h/2, h for s = 0, 1, 2, 3, with f the equations
+    of this module (``stages=1``: k[0] = f(x), the derivative).
+
+    Each stage state is formed entry by entry as it is read (scalars, no array of it), and a term
+    whose coefficient is zero is not computed (k_h and k_z: lift and inflow; k_flap; J_rotor;
+    c_D: parasitic drag), which leaves every sum as it was: the same numbers, fewer operations.
+    ``k`` is indexed by row and column, never sliced, and the stages are one loop in this body,
+    not a helper called per stage: a row view (``k[stage]``) or an array handed to a helper each
+    stage costs numba's reference counting of it (an atomic increment and decrement) each time,
+    which took more time than the arithmetic.
+
+    Parameters
+    ----------
+    x : ndarray, shape (13 + n,)
+        The state at the start of the step (:func:`rotor_derivative`'s ``x``).
+    w_cmd, rp, ext : ndarray
+        As :func:`rotor_derivative` takes them.
+    h : float
+        The step length [s] (not read with ``stages=1``).
+    k : ndarray, shape (>= stages, 13 + n)
+        Output: the stage derivatives, row s for stage s.
+    stages : int
+        How many stages, from the first.
     """
     n = int(rp[ROTOR_P_N_ROTORS])
     kf, km, kd, kz, kh, kflap = (
@@ -180,58 +213,83 @@ def rotor_derivative(x, w_cmd, rp, ext, dx):
         rp[ROTOR_P_K_FLAP],
     )
     tau_up, tau_down, j_rotor = rp[ROTOR_P_TAU_UP], rp[ROTOR_P_TAU_DOWN], rp[ROTOR_P_J_ROTOR]
-    qw, qx, qy, qz = x[QW], x[QX], x[QY], x[QZ]
-    p, q, r = x[RP], x[RQ], x[RR]
-    s = 2.0 / (qw * qw + qx * qx + qy * qy + qz * qz)  # R of q / |q|
-    r00, r01, r02 = 1.0 - s * (qy * qy + qz * qz), s * (qx * qy - qw * qz), s * (qx * qz + qw * qy)
-    r10, r11, r12 = s * (qx * qy + qw * qz), 1.0 - s * (qx * qx + qz * qz), s * (qy * qz - qw * qx)
-    r20, r21, r22 = s * (qx * qz - qw * qy), s * (qy * qz + qw * qx), 1.0 - s * (qx * qx + qy * qy)
-    ax, ay, az = x[RVX] - ext[EXT_WX], x[RVY] - ext[EXT_WY], x[RVZ] - ext[EXT_WZ]
-    ub = r00 * ax + r10 * ay + r20 * az  # airspeed, body frame: R^T (v - w)
-    vb = r01 * ax + r11 * ay + r21 * az
-    wb = r02 * ax + r12 * ay + r22 * az
-    fx = fy = fz = 0.0  # body force [N]
-    mx = my = mz = 0.0  # body moment [N m]
-    h = h_dot = 0.0  # rotors' angular momentum about body z
-    for i in range(n):
-        base = ROTOR_P_ROTORS + ARM_SIZE * i
-        px, py, pz, sign = rp[base + ARM_X], rp[base + ARM_Y], rp[base + ARM_Z], rp[base + ARM_S]
-        w = x[ROTOR_W1 + i]
-        e = ext[EXT_E1 + i]
-        lx = ub + q * pz - r * py  # airspeed at the hub: v_b + Omega x r_i
-        ly = vb + r * px - p * pz
-        lz = wb + p * py - q * px
-        f_x = -w * kd * lx  # rotor drag (H force) ...
-        f_y = -w * kd * ly
-        f_z = e * kf * w * w + kh * (lx * lx + ly * ly) - w * kz * lz  # ... thrust, lift, inflow
-        fx += f_x
-        fy += f_y
-        fz += f_z
-        mx += py * f_z - pz * f_y - kflap * w * ly  # r_i x F_i, and flapping
-        my += pz * f_x - px * f_z + kflap * w * lx
-        mz += px * f_y - py * f_x + sign * e * km * w * w  # and the rotor's drag moment
-        c = w_cmd[i]
-        w_dot = (c - w) / (tau_up if c > w else tau_down)
-        dx[ROTOR_W1 + i] = w_dot
-        h -= sign * j_rotor * w
-        h_dot -= sign * j_rotor * w_dot
-    speed = math.sqrt(ub * ub + vb * vb + wb * wb)  # parasitic drag
-    fx -= speed * rp[ROTOR_P_C_DX] * ub
-    fy -= speed * rp[ROTOR_P_C_DY] * vb
-    fz -= speed * rp[ROTOR_P_C_DZ] * wb
-    inv_m = 1.0 / rp[ROTOR_P_M]
-    dx[RX] = x[RVX]
-    dx[RY] = x[RVY]
-    dx[RZ] = x[RVZ]
-    dx[RVX] = (r00 * fx + r01 * fy + r02 * fz + ext[EXT_FX]) * inv_m
-    dx[RVY] = (r10 * fx + r11 * fy + r12 * fz + ext[EXT_FY]) * inv_m
-    dx[RVZ] = (r20 * fx + r21 * fy + r22 * fz + ext[EXT_FZ]) * inv_m - rp[ROTOR_P_G]
-    dx[QW] = -0.5 * (qx * p + qy * q + qz * r)  # q (x) (0, Omega) / 2
-    dx[QX] = 0.5 * (qw * p + qy * r - qz * q)
-    dx[QY] = 0.5 * (qw * q + qz * p - qx * r)
-    dx[QZ] = 0.5 * (qw * r + qx * q - qy * p)
+    cdx, cdy, cdz = rp[ROTOR_P_C_DX], rp[ROTOR_P_C_DY], rp[ROTOR_P_C_DZ]
     jxx, jyy, jzz = rp[ROTOR_P_JXX], rp[ROTOR_P_JYY], rp[ROTOR_P_JZZ]
-    lx_, ly_, lz_ = jxx * p, jyy * q, jzz * r + h  # body and rotors' angular momentum
-    dx[RP] = (mx + ext[EXT_TX] - (q * lz_ - r * ly_)) / jxx
-    dx[RQ] = (my + ext[EXT_TY] - (r * lx_ - p * lz_)) / jyy
-    dx[RR] = (mz + ext[EXT_TZ] - (p * ly_ - q * lx_) - h_dot) / jzz
+    inv_m, g = 1.0 / rp[ROTOR_P_M], rp[ROTOR_P_G]
+    lift_inflow = kh != 0.0 or kz != 0.0
+    body_drag = cdx != 0.0 or cdy != 0.0 or cdz != 0.0
+    for stage in range(stages):
+        if stage == 0:  # the stage state
+            a = 0.0
+            vx, vy, vz = x[RVX], x[RVY], x[RVZ]
+            qw, qx, qy, qz = x[QW], x[QX], x[QY], x[QZ]
+            p, q, r = x[RP], x[RQ], x[RR]
+        else:
+            a = h if stage == 3 else 0.5 * h
+            j = stage - 1
+            vx, vy, vz = x[RVX] + a * k[j, RVX], x[RVY] + a * k[j, RVY], x[RVZ] + a * k[j, RVZ]
+            qw, qx = x[QW] + a * k[j, QW], x[QX] + a * k[j, QX]
+            qy, qz = x[QY] + a * k[j, QY], x[QZ] + a * k[j, QZ]
+            p, q, r = x[RP] + a * k[j, RP], x[RQ] + a * k[j, RQ], x[RR] + a * k[j, RR]
+        s = 2.0 / (qw * qw + qx * qx + qy * qy + qz * qz)  # R of q / |q|
+        r00, r01, r02 = 1.0 - s * (qy * qy + qz * qz), s * (qx * qy - qw * qz), s * (qx * qz + qw * qy)
+        r10, r11, r12 = s * (qx * qy + qw * qz), 1.0 - s * (qx * qx + qz * qz), s * (qy * qz - qw * qx)
+        r20, r21, r22 = s * (qx * qz - qw * qy), s * (qy * qz + qw * qx), 1.0 - s * (qx * qx + qy * qy)
+        ax, ay, az = vx - ext[EXT_WX], vy - ext[EXT_WY], vz - ext[EXT_WZ]
+        ub = r00 * ax + r10 * ay + r20 * az  # airspeed, body frame: R^T (v - w)
+        vb = r01 * ax + r11 * ay + r21 * az
+        wb = r02 * ax + r12 * ay + r22 * az
+        fx = fy = fz = 0.0  # body force [N]
+        mx = my = mz = 0.0  # body moment [N m]
+        h_r = h_dot = 0.0  # rotors' angular momentum about body z
+        for i in range(n):
+            base = ROTOR_P_ROTORS + ARM_SIZE * i
+            px, py, pz, sign = rp[base + ARM_X], rp[base + ARM_Y], rp[base + ARM_Z], rp[base + ARM_S]
+            w = x[ROTOR_W1 + i]
+            if stage != 0:
+                w += a * k[stage - 1, ROTOR_W1 + i]
+            e = ext[EXT_E1 + i]
+            lx = ub + q * pz - r * py  # airspeed at the hub: v_b + Omega x r_i
+            ly = vb + r * px - p * pz
+            f_x = -w * kd * lx  # rotor drag (H force) ...
+            f_y = -w * kd * ly
+            f_z = e * kf * w * w  # ... thrust, lift, inflow
+            if lift_inflow:
+                lz = wb + p * py - q * px
+                f_z = f_z + kh * (lx * lx + ly * ly) - w * kz * lz
+            fx += f_x
+            fy += f_y
+            fz += f_z
+            m_x = py * f_z - pz * f_y  # r_i x F_i, and flapping
+            m_y = pz * f_x - px * f_z
+            if kflap != 0.0:
+                m_x -= kflap * w * ly
+                m_y += kflap * w * lx
+            mx += m_x
+            my += m_y
+            mz += px * f_y - py * f_x + sign * e * km * w * w  # and the rotor's drag moment
+            c = w_cmd[i]
+            w_dot = (c - w) / (tau_up if c > w else tau_down)
+            k[stage, ROTOR_W1 + i] = w_dot
+            if j_rotor != 0.0:
+                h_r -= sign * j_rotor * w
+                h_dot -= sign * j_rotor * w_dot
+        if body_drag:  # parasitic drag
+            speed = math.sqrt(ub * ub + vb * vb + wb * wb)
+            fx -= speed * cdx * ub
+            fy -= speed * cdy * vb
+            fz -= speed * cdz * wb
+        k[stage, RX] = vx
+        k[stage, RY] = vy
+        k[stage, RZ] = vz
+        k[stage, RVX] = (r00 * fx + r01 * fy + r02 * fz + ext[EXT_FX]) * inv_m
+        k[stage, RVY] = (r10 * fx + r11 * fy + r12 * fz + ext[EXT_FY]) * inv_m
+        k[stage, RVZ] = (r20 * fx + r21 * fy + r22 * fz + ext[EXT_FZ]) * inv_m - g
+        k[stage, QW] = -0.5 * (qx * p + qy * q + qz * r)  # q (x) (0, Omega) / 2
+        k[stage, QX] = 0.5 * (qw * p + qy * r - qz * q)
+        k[stage, QY] = 0.5 * (qw * q + qz * p - qx * r)
+        k[stage, QZ] = 0.5 * (qw * r + qx * q - qy * p)
+        lx_, ly_, lz_ = jxx * p, jyy * q, jzz * r + h_r  # body and rotors' angular momentum
+        k[stage, RP] = (mx + ext[EXT_TX] - (q * lz_ - r * ly_)) / jxx
+        k[stage, RQ] = (my + ext[EXT_TY] - (r * lx_ - p * lz_)) / jyy
+        k[stage, RR] = (mz + ext[EXT_TZ] - (p * ly_ - q * lx_) - h_dot) / jzz

@@ -41,7 +41,7 @@ from quadcruise.model.rotor_plant import (
     RX,
     RY,
     RZ,
-    rotor_derivative,
+    rotor_stages,
 )
 from quadcruise.sim.inputs import Limits
 from quadcruise.sim.period import body_bounds
@@ -53,14 +53,20 @@ FINISHED, NONFINITE, POSITION_BOUND, SPEED_BOUND, RATE_BOUND, CRASHED = (
     for name in ("FINISHED", "NONFINITE", "POSITION_BOUND", "SPEED_BOUND", "RATE_BOUND", "CRASHED")
 )
 
-ROTOR_WORK_ROWS = 5
-"""Rows of the RK4 workspace: the four stage derivatives and the stage state."""
+ROTOR_WORK_ROWS = 4
+"""Rows of the RK4 workspace: the four stage derivatives."""
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def rotor_rk4_step(x, w_cmd, rp, ext, h, work):
     """One classical Runge-Kutta step of length h [s] of the rotor plant, in place on x,
     then the quaternion scaled to unit length.
+
+    The stages are :func:`quadcruise.model.rotor_plant.rotor_stages`, which forms each stage
+    state as it reads it; ``work`` is only indexed, never sliced (a row view costs numba's
+    reference counting each time it is made: the step took twice as long with them). The
+    kernels call it, as the paper kernel calls :func:`quadcruise.sim.engine.rk4_step`: inlined
+    into them by numba, its arrays would be reference-counted at every substep.
 
     Parameters
     ----------
@@ -75,20 +81,10 @@ def rotor_rk4_step(x, w_cmd, rp, ext, h, work):
     h : float
         Step length [s].
     work : numpy.ndarray
-        (ROTOR_WORK_ROWS, 13 + n) scratch array.
+        (ROTOR_WORK_ROWS, 13 + n) scratch array: the stage derivatives.
     """
     size = x.shape[0]
-    xt = work[4]
-    for stage in range(4):
-        if stage == 0:
-            for j in range(size):
-                xt[j] = x[j]
-        else:
-            w = h if stage == 3 else 0.5 * h
-            k_in = work[stage - 1]
-            for j in range(size):
-                xt[j] = x[j] + w * k_in[j]
-        rotor_derivative(xt, w_cmd, rp, ext, work[stage])
+    rotor_stages(x, w_cmd, rp, ext, h, work, 4)
     c = h / 6.0
     for j in range(size):
         x[j] += c * (work[0, j] + 2.0 * (work[1, j] + work[2, j]) + work[3, j])
