@@ -18,9 +18,16 @@ from scipy.stats import chi2
 
 from quadcruise.estimation.ekf import E_SIZE, EP, EV, X_SIZE, XP, XV, heading_innovation, predict, update
 from quadcruise.fields import Validated, unit_field
+from quadcruise.layout import Row
 
-# offsets of the measurement settings row
-M_POS_H, M_POS_V, M_VEL_H, M_VEL_V, M_BARO, M_HEAD, M_BARO_OFF, M_G, M_SIZE = 0, 1, 2, 3, 4, 5, 6, 7, 8
+MEAS = Row.of(
+    "ekf measurement settings", "pos_h", "pos_v", "vel_h", "vel_v", "baro", "head", "baro_off", "g", prefix="M_"
+)
+"""The measurement settings row the compiled filter reads: GPS position and velocity stds
+(horizontal, vertical) [m], [m/s], barometer std [m], heading std [rad], the barometer's offset
+from z [m], gravity [m/s^2] (:meth:`EkfNoise.meas_row`)."""
+M_POS_H, M_POS_V, M_VEL_H, M_VEL_V, M_BARO, M_HEAD, M_BARO_OFF, M_G = MEAS.offsets
+M_SIZE = MEAS.size
 
 
 @dataclass(frozen=True)
@@ -79,6 +86,37 @@ class EkfNoise(Validated):
             (4,): gyro, accel, gyro bias walk, accel bias walk.
         """
         return np.array([self.gyro_noise, self.accel_noise, self.gyro_bias_walk, self.accel_bias_walk])
+
+    def meas_row(self, baro_offset: float = 0.0) -> np.ndarray:
+        """The measurement settings as the compiled filter reads them (:data:`MEAS`).
+
+        Parameters
+        ----------
+        baro_offset : float
+            The barometer's offset from z [m].
+
+        Returns
+        -------
+        numpy.ndarray
+            (M_SIZE,).
+
+        Examples
+        --------
+        >>> EkfNoise().meas_row()[M_G]
+        9.80665
+        """
+        return MEAS.pack(
+            {
+                "pos_h": self.gps_horizontal_std,
+                "pos_v": self.gps_vertical_std,
+                "vel_h": self.gps_velocity_std,
+                "vel_v": self.gps_vertical_velocity_std,
+                "baro": self.baro_std,
+                "head": self.heading_std,
+                "baro_off": baro_offset,
+                "g": self.gravity,
+            }
+        )
 
     def gates(self) -> np.ndarray:
         """The largest NIS accepted per degrees of freedom.
@@ -248,18 +286,7 @@ def run_ekf(
         raise ValueError("a magnetometer stream needs the world field")
     field = np.zeros(3) if field is None else np.asarray(field, float)
     s = settings
-    meas = np.array(
-        [
-            s.gps_horizontal_std,
-            s.gps_vertical_std,
-            s.gps_velocity_std,
-            s.gps_vertical_velocity_std,
-            s.baro_std,
-            s.heading_std,
-            baro_offset,
-            s.gravity,
-        ]
-    )
+    meas = s.meas_row(baro_offset)
     K = imu_t.size
     x, P = np.array(x0, float), np.array(P0, float)
     xs, sd = np.empty((K, X_SIZE)), np.empty((K, E_SIZE))

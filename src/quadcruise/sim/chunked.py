@@ -31,7 +31,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
+from quadcruise.layout import CMD_SIZE, OBSERVATION_SIZE, REF_SIZE, STATE_SIZE
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.stepper import Stepper
@@ -87,7 +87,7 @@ def simulate_watched(
     **options
         The other keywords of :func:`~quadcruise.sim.engine.simulate` (``memory``, ``vp_ctrl``,
         ``disturbance``, ``disturbance_params``, ``disturbance_memory``, ``seed``,
-        ``first_vehicle``, ``sensor_std``, ``sensor_delay``, ``full_dynamics``, ``max_step``,
+        ``first_vehicle``, ``sensor_std``, ``sensor_delay``, ``full_dynamics``, ``max_step``, ``observation``,
         ``limits``); or, for the rotor plant, :class:`~quadcruise.sim.stepper.Stepper`'s
         (``alloc``, ``psi0``, ``touchdown_speed``; ``vp`` the rotor parameter rows).
 
@@ -106,8 +106,10 @@ def simulate_watched(
     t_grid = s.t_grid
     n_log = n_periods // log_every + 1
     widths = (STATE_SIZE, CMD_SIZE, REF_SIZE) + ((s.state.shape[1],) if s.rotor else ())
+    widths += (OBSERVATION_SIZE,) if s.observation.active else ()
     logs = [np.empty((n, n_log, w)) for w in widths]  # every row is written below
     small = (s.log_x, s.log_cmd, s.log_ref) + ((s.log_rotor,) if s.rotor else ())
+    small += (s.log_obs,) if s.observation.active else ()
     held = None  # the row after the chunk of vehicles that stopped in its last period, and where it goes
     k0 = 0
     while k0 < n_periods:
@@ -142,6 +144,8 @@ def simulate_watched(
     rotor = {}
     if s.rotor:  # the rotor plant's own state, logged and final
         rotor = {"rotor_states": logs[3], "rotor_final_state": s.state, "rotor_names": tuple(rotor_names)}
+    if s.observation.active:
+        rotor["observations"] = logs[-1]
     return SimResult(
         t=t_grid[::log_every][:n_log].copy(),
         states=log_x,

@@ -44,6 +44,7 @@ from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from quadcruise.sim.engine import fly_vehicles, still_air
 from quadcruise.sim.inputs import Limits, batch_inputs, fresh_carry
 from quadcruise.sim.kernel_args import KernelArgs, RotorKernelArgs
+from quadcruise.sim.observe import Observation
 from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.rotor_batch import rotor_inputs
 from quadcruise.sim.rotor_flight import fly_rotor_pieces, paper_states, rotor_carry_width
@@ -96,6 +97,10 @@ class Stepper:
         Rotor plant: the yaw [rad] the initial quaternion's is read near.
     touchdown_speed : float or (N,) array, optional
         Rotor plant: with it, a ground at z = 0.
+    observation : Observation, optional
+        The vehicles' sensors and estimator (:mod:`quadcruise.sim.observe`): the controller sees
+        their estimate; their memories are restored by :meth:`reset`, their streams drawn again,
+        and :attr:`log_obs` holds the step's observation rows.
     """
 
     def __init__(
@@ -125,6 +130,7 @@ class Stepper:
         alloc=None,
         psi0=0.0,
         touchdown_speed=None,
+        observation: Observation | None = None,
     ) -> None:
         if int(periods) != periods or periods < 1:
             raise InputError(f"periods must be a whole number >= 1, got {describe(periods)}")
@@ -189,6 +195,11 @@ class Stepper:
         self.log_x = np.empty((n, rows, STATE_SIZE))
         self.log_cmd = np.empty((n, rows, CMD_SIZE))
         self.log_ref = np.empty((n, rows, REF_SIZE))
+        self.observation = (observation or Observation.none(n)).take(np.arange(n))  # its own copies
+        if self.observation.params.shape[0] != n:
+            raise InputError(f"Stepper: observation has {self.observation.params.shape[0]} rows, not {n}")
+        self._omem0, self._orng0 = self.observation.memory.copy(), self.observation.rng.copy()
+        self.log_obs = self.observation.log(n, rows)
         # the jit functions themselves: numba calls a jit function passed as an argument through
         # its own calling convention, which carries an exception raised in it to the caller
         # (not through its C wrapper, which would print the exception and carry on)
@@ -275,6 +286,8 @@ class Stepper:
             self.rng[rows] = rng
         elif self.drawn:
             self.rng[rows] = vehicle_states(self.seed if seed is None else seed, k, self.first_vehicle[rows])
+        self.observation.memory[rows] = self._omem0[rows]
+        self.observation.rng[rows] = self._orng0[rows]
         self.clock[rows] = 0
         if self.rotor:  # the rotor kernel starts a vehicle at period 0 afresh, its carry unread
             self._paper_state[rows] = paper_states(np.ascontiguousarray(start), self.vp[rows], self.psi0[rows])
@@ -371,6 +384,11 @@ class Stepper:
             rng=self.rng,
             sensor_std=self.sensor_std,
             sensor_delay=self.sensor_delay,
+            observer=self.observation.function,
+            observed=self.observation.active,
+            op=self.observation.params,
+            omem=self.observation.memory,
+            orng=self.observation.rng,
             max_step=self.max_step,
             log_every=1,
             limits=self.limits,
@@ -380,6 +398,7 @@ class Stepper:
             log_x=self.log_x,
             log_cmd=self.log_cmd,
             log_ref=self.log_ref,
+            log_obs=self.log_obs,
             x_final=self.state,
             status=self.status,
             t_stop=self.t_stop,

@@ -24,6 +24,7 @@ from quadcruise._version import __version__
 from quadcruise.control import controller_record
 from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import InputError, LogWarning, reject_unknown
+from quadcruise.estimation.stage import Ekf, Sensors
 from quadcruise.layout import STATE_SIZE
 from quadcruise.missions import Mission, as_mission, stack_params
 from quadcruise.model.rotor_vehicle import RotorVehicle
@@ -60,6 +61,7 @@ from quadcruise.workflows.fly_inputs import (
     per_vehicle_controllers,
     vehicle_indices,
 )
+from quadcruise.workflows.onboard import onboard_inputs, vehicle_gravity
 from quadcruise.workflows.rotor_fly import (
     as_vehicle,
     batch_equivalent,
@@ -90,7 +92,8 @@ def fly(
     controller_vehicle: Vehicle | None = None,
     full_dynamics: bool = False,
     environment: Environment | None = None,
-    sensors: SensorNoise | None = None,
+    sensors: SensorNoise | Sensors | None = None,
+    estimator: Ekf | None = None,
     seed: int = 0,
     first_vehicle: int | np.ndarray = 0,
     max_track_error: float | None = None,
@@ -147,9 +150,16 @@ def fly(
     environment : Environment or CustomDisturbance, optional
         Wind, gusts, turbulence, rotor loss, external force (any field may hold one value per
         vehicle). Wind acts through drag: give a vehicle with drag (:func:`~quadcruise.disturbances.with_drag`).
-    sensors : SensorNoise, optional
+    sensors : SensorNoise or Sensors, optional
         Noise on what the controller sees and its delay [s], turned into whole control periods
-        of this flight's ``dt``.
+        of this flight's ``dt``; or the sensor models the vehicle carries
+        (:class:`~quadcruise.estimation.Sensors`: IMU, GPS, barometer, magnetometer), sampled
+        in the compiled period (each rate a divisor of the control rate) and logged in the
+        result's ``observations`` (``to_pandas()``'s ``*_est`` and sensor columns).
+    estimator : Ekf, optional
+        The error-state EKF between the :class:`~quadcruise.estimation.Sensors` and the
+        controller (docs/sensors.md): the controller sees its estimate instead of the truth;
+        needs an IMU and a GPS. ``metrics()`` then reports the estimation error.
     seed : int
         Seed of every random draw (turbulence, sensor noise).
     first_vehicle : int or array of int
@@ -218,7 +228,8 @@ def fly(
     checks.instance(w, "limits", limits, Limits)
     full_dynamics = checks.flag(w, "full_dynamics", full_dynamics)
     checks.instance(w, "environment", environment, (Environment, CustomDisturbance))
-    checks.instance(w, "sensors", sensors, SensorNoise)
+    checks.instance(w, "sensors", sensors, (SensorNoise, Sensors))
+    checks.instance(w, "estimator", estimator, Ekf)
     check_wind_acts(vehicle, environment)  # rotor_fly.py
     seed = checks.whole(w, "seed", seed)
     first_vehicle = vehicle_indices(first_vehicle)
@@ -274,9 +285,13 @@ def fly(
             LogWarning,
             stacklevel=2,
         )
+    observation, onboard_record = onboard_inputs(
+        sensors, estimator, g=vehicle_gravity(rotor_batch(vehicle) if rotor else vehicle), n=n, dt=float(dt),
+        seed=seed, first_vehicle=first_vehicle, where=w,
+    )  # fmt: skip
     grid = time_grid(float(duration), float(dt))
     check_log_every(log_every, grid.size - 1)
-    if sensors is not None:
+    if isinstance(sensors, SensorNoise):
         sensors.check_fits(duration)
     if not rotor:  # a RotorVehicle that cannot lift itself cannot be made
         check_can_hover(vehicle)
@@ -310,8 +325,9 @@ def fly(
             if isinstance(environment, Environment)
             else {"custom": getattr(environment.function, "__name__", "disturbance")}
         )
-    if sensors is not None:
+    if isinstance(sensors, SensorNoise):
         meta["sensors"] = sensors.to_dict()
+    meta.update(onboard_record)  # sensor models and the estimator
     if controller_vehicle is not None:
         meta["controller_vehicle"] = (
             {"plant": "rotor", **controller_vehicle.to_dict()} if rotor else controller_vehicle.to_dict()
@@ -355,7 +371,8 @@ def fly(
         meta=meta,
         seed=seed,
         first_vehicle=first_vehicle,
-        **engine_inputs(environment, sensors, n, dt),
+        **engine_inputs(environment, sensors if isinstance(sensors, SensorNoise) else None, n, dt),
+        **({} if observation is None else {"observation": observation}),
     )
     if watched:  # the log keeps every log_every-th period; the checks see every one
         if rotor:  # the rotor plant's arrays (rotor_fly.py)

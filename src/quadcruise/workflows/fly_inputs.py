@@ -234,6 +234,7 @@ FLY_OPTIONS = (
     "full_dynamics",
     "environment",
     "sensors",
+    "estimator",
     "seed",
     "first_vehicle",
     "max_track_error",
