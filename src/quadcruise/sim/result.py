@@ -307,7 +307,9 @@ class SimResult:
         through ``THR_MDL_FAC`` (PX4's meanings). The info messages ``quadcruise_control_rate_hz``
         and ``quadcruise_log_rate_hz`` give the controller's rate and the log's own (a flight
         logged every k-th period: the timestamps are those instants, and ``SDLOG_PROFILE`` does not
-        claim the system-identification profile, which holds every command).
+        claim the system-identification profile, which holds every command). A flight on sensor
+        models adds their readings and its estimator's state and innovations, and its
+        ``sensor_combined`` is the IMU model's (:mod:`quadcruise.sim.px4_estimator`).
 
         Parameters
         ----------
@@ -406,6 +408,16 @@ class SimResult:
             system_type=system_type,
             setpoints=setpoints,
         )
+        if self.observations is not None and self.meta.get("sensor_models"):  # the sensors' own readings
+            from quadcruise.layout import O_PHI
+            from quadcruise.sim.px4 import attitude_ned_frd
+            from quadcruise.sim.px4_estimator import estimator_topics
+
+            obs = self.observations[vehicle][rows]
+            euler = [np.nan_to_num(obs[:, O_PHI + j]) for j in range(3)]
+            extra = estimator_topics(t, obs, self.meta["sensor_models"], attitude_ned_frd(*euler))
+            replaced = {topic.name for topic in extra}
+            topics = [topic for topic in topics if topic.name not in replaced] + extra
         info = {"sys_name": "quadcruise", "ver_sw": __version__, "ver_hw": "SIMULATION"}
         control_dt = float(self.meta.get("dt_s") or 0.0)
         log_dt = float(np.median(np.diff(t))) if len(t) > 1 else control_dt

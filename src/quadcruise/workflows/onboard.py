@@ -7,7 +7,7 @@ Examples
 >>> from quadcruise.estimation import Ekf, Sensors
 >>> obs, record = onboard_inputs(Sensors.typical(), Ekf(), g=9.81, n=1, dt=1e-3, seed=0, first_vehicle=0)
 >>> obs.active, sorted(record)
-(True, ['estimator', 'sensors'])
+(True, ['estimator', 'sensor_models'])
 """
 
 from __future__ import annotations
@@ -49,7 +49,9 @@ def onboard_inputs(
     Returns
     -------
     tuple
-        (Observation or None, ``{"sensors": ..., "estimator": ...}`` for the result's meta).
+        (Observation or None, ``{"sensor_models": ..., "estimator": ...}`` for the result's meta:
+        each sensor's fields, the filter's settings, as a scenario's ``[sensors]`` and
+        ``[estimator]`` tables read them back).
 
     Raises
     ------
@@ -65,7 +67,7 @@ def onboard_inputs(
         return None, {}
     check_estimator(sensors, estimator, f"{where} argument estimator:")
     obs = observation(sensors, estimator, n=n, dt=dt, seed=seed, first_vehicle=first_vehicle, g=float(g))
-    return obs, {"sensors": sensors.to_dict(), "estimator": None if estimator is None else estimator.to_dict()}
+    return obs, {"sensor_models": sensors.to_dict(), "estimator": None if estimator is None else estimator.to_dict()}
 
 
 def vehicle_gravity(vehicle: Any) -> float:
