@@ -59,6 +59,7 @@ def test_in_loop_ekf_is_run_ekf_fed_the_same_samples():
         baro=(t[baro_rows], o[baro_rows, NAMES.index("baro_alt")]),
         mag=(t[mag_rows], cols(o, "mag_x", "mag_y", "mag_z")[mag_rows]),
         field=sensors.mag.world_field(),
+        gps_sample_t=o[gps_rows, NAMES.index("gps_sample_t")],  # fused against the estimate of their time
     )
     in_loop = cols(
         o,

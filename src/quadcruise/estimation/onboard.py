@@ -13,12 +13,17 @@ At each control period k (instant t) of one vehicle, :func:`onboard`:
    (:func:`~quadcruise.estimation.ekf.predict`), then fuses the GPS fixes that have arrived, the
    barometer's and the magnetometer's readings (GPS position and velocity, altitude, heading, in
    that order, each gated), so the in-loop filter is :func:`~quadcruise.estimation.run.run_ekf`
-   fed the same samples (its reading k, covering ``[t_k, t_k+1]``, is the one read at t_k+1);
+   fed the same samples (its reading k, covering ``[t_k, t_k+1]``, is the one read at t_k+1). A
+   GPS fix arrives ``latency`` late: it is moved on by the estimate's change since the IMU
+   instant at or before it was taken (kept in a short history), so its innovation is taken
+   against the estimate of its own time, not against the present one (a cheap form of PX4's
+   delayed fusion horizon; ``Ekf(latency_compensation=False)`` fuses it as if it were fresh);
 3. writes what the controller sees (:data:`quadcruise.layout.STATE`): the estimate's position,
    velocity and ZYX Euler angles (yaw unwrapped), its body rates the gyro minus the estimated
-   bias through a first-order low-pass of cutoff ``rate_cutoff`` (PX4 filters the rates its rate
-   loop reads, ``IMU_GYRO_CUTOFF``), and F1..F4, the actuator state, as the truth (no sensor reads
-   it; PX4 knows its own commands). Between IMU instants it is held.
+   bias (through a first-order low-pass of cutoff ``rate_cutoff`` if one is given, as PX4
+   filters the rates its rate loop reads, ``IMU_GYRO_CUTOFF``), and F1..F4, the actuator
+   state, as the truth (no sensor reads it; PX4 knows its own commands). Between IMU instants
+   it is held.
 
 Its memory (:data:`MEMORY` ``(slots)``) carries the sensors' biases, the filter's state and
 covariance, the GPS queue and the log row, so a flight cut into calls is the flight flown in one;
@@ -67,7 +72,7 @@ from quadcruise.sensors.noise import noisy
 PARAMS = Row.of(
     "onboard parameters",
     *("imu_on", "gps_on", "baro_on", "mag_on", "ekf_on"),
-    *("imu_every", "gps_every", "baro_every", "mag_every", "gps_delay", "gps_slots"),
+    *("imu_every", "gps_every", "baro_every", "mag_every", "gps_delay", "gps_slots", "history"),
     ("imu", IMU_ROW.size),
     ("gps", GPS_ROW.size),
     ("baro", BARO_ROW.size),
@@ -81,7 +86,8 @@ PARAMS = Row.of(
     prefix="OP_",
 )
 """A vehicle's stage parameters: which sensors and whether the EKF run (1/0), each sensor's
-period in control periods, the GPS latency in periods and its queue's length, each sensor's
+period in control periods, the GPS latency in periods, its queue's length and the length of the
+estimate's history the GPS fixes are fused against (0: latency not compensated), each sensor's
 parameter row (:meth:`quadcruise.sensors.model.SensorModel.row`), the world magnetic field (ENU,
 [G]), the filter's densities (:meth:`~quadcruise.estimation.run.EkfNoise.noise_row`), measurement
 settings (:data:`~quadcruise.estimation.run.MEAS`), gates per degree of freedom, initial standard
@@ -90,15 +96,17 @@ IMU_SIZE, GPS_SIZE, BARO_SIZE, MAG_SIZE = IMU_ROW.size, GPS_ROW.size, BARO_ROW.s
 KERNEL_SIZE = L.OBSERVER_KERNEL.size
 (
     OP_IMU_ON, OP_GPS_ON, OP_BARO_ON, OP_MAG_ON, OP_EKF_ON,
-    OP_IMU_EVERY, OP_GPS_EVERY, OP_BARO_EVERY, OP_MAG_EVERY, OP_GPS_DELAY, OP_GPS_SLOTS,
+    OP_IMU_EVERY, OP_GPS_EVERY, OP_BARO_EVERY, OP_MAG_EVERY, OP_GPS_DELAY, OP_GPS_SLOTS, OP_HISTORY,
     OP_IMU, OP_GPS, OP_BARO, OP_MAG, OP_FIELD, OP_NOISE, OP_MEAS, OP_GATES, OP_P0, OP_RATE_ALPHA,
 ) = PARAMS.offsets  # fmt: skip
 
 GPS_ENTRY = 8
 """A queued GPS fix: its arrival period, its sample time [s], position [m] and velocity [m/s]."""
+HISTORY_ENTRY = 7
+"""An entry of the estimate's history: its IMU instant's period, position [m], velocity [m/s]."""
 
 
-def memory_row(slots: int) -> Row:
+def memory_row(slots: int, history: int = 0) -> Row:
     """The stage's memory with a GPS queue of ``slots`` fixes: the kernel's part
     (:data:`quadcruise.layout.OBSERVER_KERNEL`), then the IMU's state, its last reading, the
     trapezoid sum of the true specific force and rates over its period, its last instant [s],
@@ -106,12 +114,15 @@ def memory_row(slots: int) -> Row:
     covariance (15 x 15, row-major), the rates filter [rad/s], the yaw [rad] last written, the
     truth at the last IMU instant (position, velocity, Euler angles) and whether its errors are
     still to be logged, the pending barometer and magnetometer readings (a flag, then the value),
-    the log row, and the GPS queue (head, count, then ``slots`` entries of :data:`GPS_ENTRY`).
+    the log row, the GPS queue (head, count, then ``slots`` entries of :data:`GPS_ENTRY`) and the
+    estimate's history at the last ``history`` IMU instants (:data:`HISTORY_ENTRY` each).
 
     Parameters
     ----------
     slots : int
         The GPS queue's length.
+    history : int
+        The history's length.
 
     Returns
     -------
@@ -144,6 +155,7 @@ def memory_row(slots: int) -> Row:
         "gps_head",
         "gps_count",
         ("gps_queue", GPS_ENTRY * int(slots)),
+        *((("history", HISTORY_ENTRY * int(history)),) if history else ()),
         parent=L.OBSERVER_KERNEL,
         prefix="OM_",
     )
@@ -342,6 +354,18 @@ def fuse(t, k, op, om):
         log[L.O_GPS_COUNT] += 1.0
         if not ekf:
             continue
+        delta = np.zeros(6)  # the estimate's change since the fix was taken: the fix moved on by it
+        history = int(op[OP_HISTORY])
+        if history:
+            imu_every = int(op[OP_IMU_EVERY])
+            ks = int(om[at] - op[OP_GPS_DELAY])  # the period the fix was taken at
+            k_imu = (ks // imu_every) * imu_every  # the IMU instant at or before it
+            if k_imu < k:
+                h = OM_GPS_QUEUE + GPS_ENTRY * slots + HISTORY_ENTRY * ((k_imu // imu_every) % history)
+                if om[h] == k_imu:
+                    for i in range(3):
+                        delta[i] = xe[XP + i] - om[h + 1 + i]
+                        delta[3 + i] = xe[XV + i] - om[h + 4 + i]
         H3 = np.zeros((3, E_SIZE))
         r3, var3 = np.empty(3), np.empty(3)
         for part in range(2):  # position, then velocity
@@ -351,7 +375,7 @@ def fuse(t, k, op, om):
             var3[2] = meas[M_POS_V if part == 0 else M_VEL_V] ** 2
             for i in range(3):
                 H3[i, base + i] = 1.0
-                r3[i] = om[at + 2 + 3 * part + i] - xe[base + i]
+                r3[i] = om[at + 2 + 3 * part + i] + delta[3 * part + i] - xe[base + i]
                 log[L.O_INNOV + 3 * part + i] = r3[i]
                 log[L.O_INNOV_VAR + 3 * part + i] = P[base + i, base + i] + var3[i]
             log[L.O_NIS + part] = update(xe, P, H3, r3, var3, gates[3])
@@ -494,6 +518,12 @@ def onboard(t, k, logging, x, op, om, rng, seen, obs):
                     w = last[i] - om[OM_X + XBG + i]
                     om[OM_RATES + i] += a * (w - om[OM_RATES + i])
                 write_estimate(x, om)
+                history = int(op[OP_HISTORY])
+                if history:  # the estimate at this IMU instant, for the fixes taken now
+                    h = OM_GPS_QUEUE + GPS_ENTRY * int(op[OP_GPS_SLOTS]) + HISTORY_ENTRY * ((k // imu_every) % history)
+                    om[h] = k
+                    for i in range(6):
+                        om[h + 1 + i] = om[OM_X + XP + i]  # position, then velocity: the state's order
         elif not ekf and (om[OM_BARO_DUE] != 0.0 or om[OM_MAG_DUE] != 0.0 or arrived(k, op, om)):
             fuse(t, k, op, om)  # the GPS fixes that arrived, logged (no filter to fuse them)
         rng[0] = s
