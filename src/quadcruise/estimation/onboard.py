@@ -46,6 +46,7 @@ from quadcruise.estimation.ekf import (
     EP,
     ETH,
     EV,
+    WORK_ROWS,
     X_SIZE,
     XBA,
     XBG,
@@ -59,6 +60,7 @@ from quadcruise.estimation.ekf import (
     quat_mul,
     rot9,
     update,
+    update_states,
 )
 from quadcruise.estimation.run import M_BARO, M_BARO_OFF, M_G, M_HEAD, M_POS_H, M_POS_V, M_SIZE, M_VEL_H, M_VEL_V
 from quadcruise.layout import Row
@@ -342,6 +344,10 @@ def fuse(t, k, op, om):
     meas, gates = op[OP_MEAS : OP_MEAS + M_SIZE], op[OP_GATES : OP_GATES + 4]
     slots = int(op[OP_GPS_SLOTS])
     ekf = op[OP_EKF_ON] != 0.0
+    scratch = np.empty((WORK_ROWS + 1, E_SIZE))  # one allocation: the updates' scratch, the heading's H
+    work, H1 = scratch[:WORK_ROWS], scratch[WORK_ROWS : WORK_ROWS + 1]
+    rv = work[6]  # r (3), then var (3): a row update() leaves alone
+    r3, var3, r1, var1 = rv[0:3], rv[3:6], rv[6:7], rv[7:8]
     while om[OM_GPS_COUNT] > 0.0:
         at = OM_GPS_QUEUE + GPS_ENTRY * int(om[OM_GPS_HEAD])
         if om[at] > k:
@@ -366,33 +372,27 @@ def fuse(t, k, op, om):
                     for i in range(3):
                         delta[i] = xe[XP + i] - om[h + 1 + i]
                         delta[3 + i] = xe[XV + i] - om[h + 4 + i]
-        H3 = np.zeros((3, E_SIZE))
-        r3, var3 = np.empty(3), np.empty(3)
         for part in range(2):  # position, then velocity
-            H3[:, :] = 0.0
             base = XP if part == 0 else XV
             var3[0] = var3[1] = meas[M_POS_H if part == 0 else M_VEL_H] ** 2
             var3[2] = meas[M_POS_V if part == 0 else M_VEL_V] ** 2
             for i in range(3):
-                H3[i, base + i] = 1.0
                 r3[i] = om[at + 2 + 3 * part + i] + delta[3 * part + i] - xe[base + i]
                 log[L.O_INNOV + 3 * part + i] = r3[i]
                 log[L.O_INNOV_VAR + 3 * part + i] = P[base + i, base + i] + var3[i]
-            log[L.O_NIS + part] = update(xe, P, H3, r3, var3, gates[3])
+            log[L.O_NIS + part] = update_states(xe, P, EP if part == 0 else EV, r3, var3, gates[3], work)
     if om[OM_BARO_DUE] != 0.0:
         om[OM_BARO_DUE] = 0.0
         if ekf:
-            H1, r1, var1 = np.zeros((1, E_SIZE)), np.empty(1), np.empty(1)
-            H1[0, EP + 2] = 1.0
             r1[0] = om[OM_BARO] - meas[M_BARO_OFF] - xe[XP + 2]
             var1[0] = meas[M_BARO] ** 2
             log[L.O_INNOV + 6], log[L.O_INNOV_VAR + 6] = r1[0], P[EP + 2, EP + 2] + var1[0]
-            log[L.O_NIS + 2] = update(xe, P, H1, r1, var1, gates[1])
+            log[L.O_NIS + 2] = update_states(xe, P, EP + 2, r1, var1, gates[1], work)
     if om[OM_MAG_DUE] != 0.0:
         om[OM_MAG_DUE] = 0.0
         if ekf:
-            r, Hm = heading_innovation(xe, om[OM_MAG], om[OM_MAG + 1], om[OM_MAG + 2], op[OP_FIELD : OP_FIELD + 3])
-            r1, var1 = np.empty(1), np.empty(1)
+            Hm = H1
+            r = heading_innovation(xe, om[OM_MAG], om[OM_MAG + 1], om[OM_MAG + 2], op[OP_FIELD : OP_FIELD + 3], Hm)
             r1[0] = r
             var1[0] = meas[M_HEAD] ** 2
             hph = 0.0
@@ -400,7 +400,7 @@ def fuse(t, k, op, om):
                 for j in range(ETH, ETH + 3):
                     hph += Hm[0, i] * P[i, j] * Hm[0, j]
             log[L.O_INNOV + 7], log[L.O_INNOV_VAR + 7] = r, hph + var1[0]
-            log[L.O_NIS + 3] = update(xe, P, Hm, r1, var1, gates[1])
+            log[L.O_NIS + 3] = update(xe, P, Hm, r1, var1, gates[1], work)
 
 
 @njit(cache=True, inline="always")

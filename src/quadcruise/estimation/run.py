@@ -16,7 +16,19 @@ import numpy as np
 from numba import njit
 from scipy.stats import chi2
 
-from quadcruise.estimation.ekf import E_SIZE, EP, EV, X_SIZE, XP, XV, heading_innovation, predict, update
+from quadcruise.estimation.ekf import (
+    E_SIZE,
+    EP,
+    EV,
+    WORK_ROWS,
+    X_SIZE,
+    XP,
+    XV,
+    heading_innovation,
+    predict,
+    update,
+    update_states,
+)
 from quadcruise.fields import Validated, unit_field
 from quadcruise.layout import Row
 
@@ -167,12 +179,11 @@ def filter_series(
     """The filter over the streams, in place: see :func:`run_ekf` (``nis`` (4, max count),
     rows gps_pos, gps_vel, baro, mag; ``gps_s`` the fixes' sample times, or empty)."""
     ig = ib = im = 0
-    H3 = np.zeros((3, E_SIZE))
     var3 = np.empty(3)
     r3 = np.empty(3)
-    H1 = np.zeros((1, E_SIZE))
     var1 = np.empty(1)
     r1 = np.empty(1)
+    work = np.empty((WORK_ROWS, E_SIZE))
     for k in range(imu_t.shape[0]):
         t = imu_t[k] + 1e-9
         while ig < gps_t.shape[0] and gps_t[ig] <= t:
@@ -185,33 +196,28 @@ def filter_series(
                     for i in range(3):
                         delta[i] = x[XP + i] - xs[ks, XP + i]
                         delta[3 + i] = x[XV + i] - xs[ks, XV + i]
-            H3[:, :] = 0.0
             for i in range(3):
-                H3[i, EP + i] = 1.0
                 r3[i] = gps[ig, i] + delta[i] - x[XP + i]
             var3[0] = var3[1] = meas[M_POS_H] ** 2
             var3[2] = meas[M_POS_V] ** 2
-            nis[0, ig] = update(x, P, H3, r3, var3, gates[3])
-            H3[:, :] = 0.0
+            nis[0, ig] = update_states(x, P, EP, r3, var3, gates[3], work)
             for i in range(3):
-                H3[i, EV + i] = 1.0
                 r3[i] = gps[ig, 3 + i] + delta[3 + i] - x[XV + i]
             var3[0] = var3[1] = meas[M_VEL_H] ** 2
             var3[2] = meas[M_VEL_V] ** 2
-            nis[1, ig] = update(x, P, H3, r3, var3, gates[3])
+            nis[1, ig] = update_states(x, P, EV, r3, var3, gates[3], work)
             ig += 1
         while ib < baro_t.shape[0] and baro_t[ib] <= t:
-            H1[:, :] = 0.0
-            H1[0, EP + 2] = 1.0
             r1[0] = baro[ib] - meas[M_BARO_OFF] - x[XP + 2]
             var1[0] = meas[M_BARO] ** 2
-            nis[2, ib] = update(x, P, H1, r1, var1, gates[1])
+            nis[2, ib] = update_states(x, P, EP + 2, r1, var1, gates[1], work)
             ib += 1
         while im < mag_t.shape[0] and mag_t[im] <= t:
-            r, Hm = heading_innovation(x, mag[im, 0], mag[im, 1], mag[im, 2], field)
+            Hm = np.zeros((1, E_SIZE))
+            r = heading_innovation(x, mag[im, 0], mag[im, 1], mag[im, 2], field, Hm)
             r1[0] = r
             var1[0] = meas[M_HEAD] ** 2
-            nis[3, im] = update(x, P, Hm, r1, var1, gates[1])
+            nis[3, im] = update(x, P, Hm, r1, var1, gates[1], work)
             im += 1
         xs[k] = x
         for i in range(E_SIZE):
