@@ -46,7 +46,13 @@ switch-on biases, read at 250 Hz (a divisor of the default 1 kHz control rate; P
 rate loop at its gyro's rate, ``IMU_GYRO_RATEMAX`` 400 Hz by default)."""
 
 PRESETS = {
-    "imu": {"typical": TYPICAL_IMU, "bmi088": BMI088, "icm42688p": ICM42688P, "ideal": Imu()},
+    "imu": {
+        "typical": TYPICAL_IMU,
+        "bmi088": BMI088,
+        "bmi088_1khz": dataclasses.replace(BMI088, rate=1000.0),
+        "icm42688p": ICM42688P,
+        "ideal": Imu(),
+    },
     "gps": {"typical": Gps(rate=10.0, latency=0.1), "ideal": Gps(horizontal_std=0.0, vertical_std=0.0,
                                                                  velocity_std=0.0, vertical_velocity_std=0.0)},
     "baro": {"typical": Baro(rate=50.0, noise_std=0.1), "ideal": Baro(noise_std=0.0)},
@@ -55,7 +61,9 @@ PRESETS = {
 """Each sensor's models by name: ``typical`` is what ``fly --sensors imu,gps,baro,mag`` flies
 (GPS at 10 Hz, 0.1 s late, 0.5 m / 0.8 m; barometer 50 Hz, 0.1 m; magnetometer 50 Hz, 5 mG at a
 0.5 G field inclined 60 deg); the IMU presets carry their datasheets' sources
-(:mod:`quadcruise.sensors.imu`); ``ideal`` reads the truth without noise."""
+(:mod:`quadcruise.sensors.imu`), ``bmi088_1khz`` is the BMI088 read at 1 kHz (one of its gyro's
+output rates; the rate the default control period reads it at every period); ``ideal`` reads the
+truth without noise."""
 
 
 def _model(kind):
