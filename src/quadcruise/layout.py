@@ -262,3 +262,78 @@ EXT_SIZE = EXTERNAL.size
 #: (see :mod:`quadcruise.sim.rng`); x: the true state.
 DISTURBANCE_SIG = types.void(_f8, _f8, _vec, _vec, _vec, types.uint64[::1], _vec)
 DisturbanceType = types.FunctionType(DISTURBANCE_SIG)
+
+# --- the observation stage: sensors and an estimator in the period ---------------------
+#: ``observer(t, k, logging, x, op, omem, rng, seen, obs) -> None``: at the control instant t [s]
+#: (period k of the grid), from the true state x (STATE_SIZE, the paper layout), sample the
+#: vehicle's sensors and run its estimator, and write what the controller sees into ``seen``
+#: (STATE_SIZE); with ``logging``, write the period's log row into ``obs`` (OBSERVATION_SIZE).
+#: op: its parameters; omem: its memory, kept between periods (its first entries
+#: :data:`OBSERVER_KERNEL`, written by the kernel); rng: its own generator state (uint64).
+OBSERVER_SIG = types.void(_f8, types.int64, types.boolean, _vec, _vec, _vec, types.uint64[::1], _vec, _vec)
+ObserverType = types.FunctionType(OBSERVER_SIG)
+
+OBSERVER_KERNEL = Row.of("observer memory, the kernel's part", ("force", 3), ("rate", 3), prefix="OM_")
+"""The first entries of an observer's memory, written by the kernel at the end of each period (at
+period 0, at the start), from the plant's own derivative: the true specific force [m/s^2]
+(acceleration minus gravity, FLU body frame) and the body's angular velocity [rad/s] (FLU), what
+an IMU measures. (On the paper plant with its simplified kinematics, phi' = p, ..., the angular
+velocity of the frame R(phi, theta, psi) is not (p, q, r): it is taken from the Euler rates.)"""
+OM_FORCE, OM_RATE = OBSERVER_KERNEL.offsets
+
+_OBSERVATION_UNITS = {
+    **{f"{name}_est": _STATE_UNITS[name] for name in ("x", "y", "z", "vx", "vy", "vz", "phi", "theta", "psi")},
+    **{f"{name}_est": "rad/s" for name in ("p", "q", "r")},
+    **{f"q{c}_est": "-" for c in "wxyz"},
+    **{f"gyro_bias_{c}_est": "rad/s" for c in "xyz"},
+    **{f"accel_bias_{c}_est": "m/s^2" for c in "xyz"},
+    **{f"sd_{name}": unit for name, unit in (("x", "m"), ("y", "m"), ("z", "m"))},
+    **{f"sd_{name}": "m/s" for name in ("vx", "vy", "vz")},
+    **{f"sd_att_{c}": "rad" for c in "xyz"},
+    **{f"sd_gyro_bias_{c}": "rad/s" for c in "xyz"},
+    **{f"sd_accel_bias_{c}": "m/s^2" for c in "xyz"},
+    "nees_pos": "-",
+    "nees_vel": "-",
+    "nees_att": "-",
+    **{f"gyro_{c}": "rad/s" for c in "xyz"},
+    **{f"accel_{c}": "m/s^2" for c in "xyz"},
+    "imu_count": "-",
+    **{f"gps_{c}": "m" for c in "xyz"},
+    **{f"gps_v{c}": "m/s" for c in "xyz"},
+    "gps_sample_t": "s",
+    "gps_count": "-",
+    "baro_alt": "m",
+    "baro_count": "-",
+    **{f"mag_{c}": "G" for c in "xyz"},
+    "mag_count": "-",
+    **{f"innov_gps_{c}": "m" for c in "xyz"},
+    **{f"innov_gps_v{c}": "m/s" for c in "xyz"},
+    "innov_baro": "m",
+    "innov_heading": "rad",
+    **{f"innov_var_gps_{c}": "m^2" for c in "xyz"},
+    **{f"innov_var_gps_v{c}": "m^2/s^2" for c in "xyz"},
+    "innov_var_baro": "m^2",
+    "innov_var_heading": "rad^2",
+    "nis_gps_pos": "-",
+    "nis_gps_vel": "-",
+    "nis_baro": "-",
+    "nis_mag": "-",
+}
+OBSERVATION = Row.of("observation log", *_OBSERVATION_UNITS, prefix="O_")
+"""One logged row of the observation stage: the estimate as the controller sees it (``*_est``:
+position, velocity, ZYX Euler angles, body rates), its quaternion (w first, FLU body to ENU
+world) and biases, the error state's standard deviations (``sd_*``), the NEES of position,
+velocity and attitude against the truth at the last IMU sample (3 dof each), the last reading of
+each sensor with a running count of its samples (``*_count``; ``gps_*`` the last fix fused, taken
+at ``gps_sample_t``), and the last update's innovations (measured minus predicted), their
+variances and NIS (negative: refused by the gate) per stream; NaN where a stream has none yet."""
+OBSERVATION_SIZE = OBSERVATION.size
+OBSERVATION_NAMES = OBSERVATION.names
+OBSERVATION_UNITS = tuple(_OBSERVATION_UNITS[name] for name in OBSERVATION_NAMES)
+_O = {name: j for j, name in enumerate(OBSERVATION_NAMES)}
+O_X, O_VX, O_PHI, O_P, O_QW = _O["x_est"], _O["vx_est"], _O["phi_est"], _O["p_est"], _O["qw_est"]
+O_BG, O_BA, O_SD, O_NEES = _O["gyro_bias_x_est"], _O["accel_bias_x_est"], _O["sd_x"], _O["nees_pos"]
+O_GYRO, O_IMU_COUNT = _O["gyro_x"], _O["imu_count"]
+O_GPS, O_GPS_T, O_GPS_COUNT = _O["gps_x"], _O["gps_sample_t"], _O["gps_count"]
+O_BARO, O_BARO_COUNT, O_MAG, O_MAG_COUNT = _O["baro_alt"], _O["baro_count"], _O["mag_x"], _O["mag_count"]
+O_INNOV, O_INNOV_VAR, O_NIS = _O["innov_gps_x"], _O["innov_var_gps_x"], _O["nis_gps_pos"]

@@ -35,7 +35,7 @@ RANKS = {
     "quadcruise.control": 7,
     "quadcruise.disturbances": 8,
     "quadcruise.sensors": 8,
-    "quadcruise.estimation": 8,
+    "quadcruise.estimation": 8.5,
     "quadcruise.workflows": 9,
     "quadcruise.sysid": 9,
     "quadcruise.montecarlo": 10,

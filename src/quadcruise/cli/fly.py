@@ -23,6 +23,7 @@ from quadcruise.cli.common import (
 )
 from quadcruise.cli.fly_run import fly_and_report
 from quadcruise.cli.objects import PARAMS_OPTION, controller_for_vehicle, controller_with_params, flight_from_options
+from quadcruise.cli.onboard import onboard_options
 from quadcruise.cli.world import WORLD_OPTIONS, flight_world
 
 __all__ = ["fly"]
@@ -78,6 +79,19 @@ __all__ = ["fly"]
     callback=writable_with(".ulg"),
     help="Also write the flight as a PX4 log (ULog); a batch as PATH-0.ulg, PATH-1.ulg, ...",
 )
+@click.option(
+    "--sensors",
+    "sensors_text",
+    metavar="NAME[=PRESET],...",
+    help="Sensor models the vehicle carries: imu, gps, baro, mag (preset typical, or e.g. imu=bmi088); "
+    "the controller still sees the truth unless --estimator is given.",
+)
+@click.option(
+    "--estimator",
+    "estimator_text",
+    metavar="NAME",
+    help="The estimator between the sensors and the controller: ekf (needs imu and gps), or none.",
+)
 @WORLD_OPTIONS
 @RISE_OPTION
 @SETTLE_BAND_OPTION
@@ -99,6 +113,8 @@ def fly(
     report,
     animate,
     ulog,
+    sensors_text,
+    estimator_text,
     vehicle,
     controller_vehicle,
     wind,
@@ -162,6 +178,11 @@ def fly(
         ``--ulog``: path of a PX4 log (``.ulg``) of the flight to write as well
         (:meth:`~quadcruise.SimResult.to_ulog`); a batch of N vehicles is written as N files,
         ``PATH-0.ulg`` ... (:func:`~quadcruise.cli.fly_run.ulog_paths`). None: no log.
+    sensors_text : str or None
+        ``--sensors``: the sensor models, ``NAME[=PRESET],...``
+        (:func:`~quadcruise.cli.onboard.parse_sensors`); None: the scenario's, else none.
+    estimator_text : str or None
+        ``--estimator``: ``ekf`` or ``none``; None: the scenario's, else none.
     vehicle, controller_vehicle : str or None
         ``--vehicle``, ``--controller-vehicle``: the flown vehicle and the controller's model of
         it (:func:`~quadcruise.cli.objects.vehicle_from_option`); None: the scenario's, else
@@ -207,6 +228,8 @@ def fly(
         + ([f"--controller {controller}"] if controller else [])
         + ([f"--poles {position_poles}"] if position_poles else [])
         + ([f"--params {px4_params}"] if px4_params else [])
+        + ([f"--sensors {sensors_text}"] if sensors_text else [])
+        + ([f"--estimator {estimator_text}"] if estimator_text else [])
     )
     the_mission, the_controller, kwargs, scenario = flight_from_options(
         mission,
@@ -230,6 +253,7 @@ def fly(
         **overrides,
         **{k: v for k, v in flown.items() if v is not None},
     }
+    kwargs = onboard_options(sensors_text, estimator_text, kwargs)
     result = fly_and_report(
         the_mission,
         the_controller,

@@ -90,6 +90,9 @@ def scenario_document(meta: dict, *, title: str = "") -> dict:
         disturbances["sensor_noise"] = _part(meta["sensors"])
     if disturbances:
         doc["disturbances"] = disturbances
+    if meta.get("sensor_models"):  # the sensor models and the filter of a flight on an estimate
+        doc["sensors"] = {name: dict(fields) for name, fields in meta["sensor_models"].items()}
+        doc["estimator"] = dict(meta.get("estimator") or {"kind": "none"})
     simulation = {key: meta[k] for k, key in SIMULATION_FROM_META.items() if meta.get(k) is not None}
     if meta.get("log_every_chosen"):  # fly chose it (a batch's log within budget): it chooses it again,
         simulation.pop("log_every", None)

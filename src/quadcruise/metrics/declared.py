@@ -22,9 +22,10 @@ import re
 
 __all__ = ["KINDS", "METRICS", "Metric", "metric", "metric_names"]
 
-KINDS = ("flight", "transient", "steady", "input")
+KINDS = ("flight", "transient", "steady", "input", "estimate")
 """What a metric covers: the whole flight's error, the entry transient, the steady window after
-it, or the commands (effort, saturation)."""
+it, the commands (effort, saturation), or the estimate the controller flew on (a flight on
+sensors and an estimator only: docs/sensors.md)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -134,6 +135,29 @@ METRICS: tuple[Metric, ...] = (
     Metric(
         "controller_limited_s", "s", "controller limited", "time the controller flagged one of its own limits", "input"
     ),
+    Metric(
+        "estimate_position_rmse_m",
+        "m",
+        "estimate position error",
+        "RMS of the 3-D distance between the position the controller saw and the truth",
+        "estimate",
+    ),
+    Metric(
+        "estimate_attitude_rmse_deg",
+        "deg",
+        "estimate attitude error",
+        "RMS of the angle of the rotation between the attitude the controller saw and the truth",
+        "estimate",
+    ),
+    Metric(
+        "nees_position",
+        "",
+        "NEES position",
+        "mean NEES of the filter's position (3 dof: 3 when consistent, above: overconfident)",
+        "estimate",
+    ),
+    Metric("nees_velocity", "", "NEES velocity", "mean NEES of the filter's velocity (3 dof)", "estimate"),
+    Metric("nees_attitude", "", "NEES attitude", "mean NEES of the filter's attitude (3 dof)", "estimate"),
 )
 """Every metric, in the order of the tables' columns."""
 

@@ -15,6 +15,7 @@ import numpy as np
 from quadcruise.errors import InputError
 from quadcruise.metrics.conventions import metric_conventions, settling_column
 from quadcruise.metrics.declared import metric_names
+from quadcruise.metrics.estimate import estimate_metrics, flew_an_estimator
 from quadcruise.metrics.signals import control_effort, tracking_errors
 from quadcruise.metrics.step import StepInfo, step_info, transient_info
 from quadcruise.metrics.tracking import STEADY_BAND, TRANSIENT_MIN_ERROR, moving_reference, tracking_transient_batch
@@ -112,7 +113,9 @@ def flight_metrics(
         error over the flight [m]), ``steady_rmse_m``, ``steady_max_error_m``, ``axis``,
         ``rise_time_s``, ``settling_time_s``, ``settling_time_<band>pct_s``, ``overshoot_pct``,
         ``peak_time_s``, ``effort`` (:data:`EFFORT_DEFINITION` [s]; NaN without a vehicle),
-        ``duty_clipped_s``, ``controller_limited_s`` [s]; ``attrs["conventions"]`` records the
+        ``duty_clipped_s``, ``controller_limited_s`` [s]; after a flight on an estimator, its
+        estimation error (:func:`~quadcruise.metrics.estimate.estimate_metrics`: position [m],
+        attitude [deg], NEES); ``attrs["conventions"]`` records the
         conventions (:func:`metric_conventions`).
 
     Examples
@@ -181,6 +184,9 @@ def flight_metrics(
         if hover is not None:
             duties = result.commands[i, :, CMD_U1 : CMD_U1 + 4]
             row["effort"] = float(control_effort(t, duties - hover[i])["integral"])
+    if flew_an_estimator(result):  # a flight on its sensors' estimate: how far it was from the truth
+        for i, row in enumerate(rows):
+            row.update(estimate_metrics(result.states, result.observations, i))
     frame = pd.DataFrame(rows)
     frame.attrs["conventions"] = conventions
     return frame

@@ -16,9 +16,10 @@ stopped the flight; its error after the transient exceeded the spec's ``max_trac
 its rotor duties were clipped for longer than ``max_clipped_s``; it missed one of the
 spec's ``requirements``. A transient that did not settle is a metric (``not_settled``),
 not a failure."""
-METRICS = metric_names()
+METRICS = metric_names(kind=("flight", "transient", "steady", "input"))  # not yet the estimate's
 """The metrics summarised by quantiles (NaN where not applicable is left out), and those a
-requirement may name: every metric declared in :mod:`quadcruise.metrics.declared`."""
+requirement may name: every metric declared in :mod:`quadcruise.metrics.declared` but the
+estimate's (a sweep flies no estimator yet)."""
 COLUMNS = {
     "vehicle": np.int64,
     "status": np.int64,

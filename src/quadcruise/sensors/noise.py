@@ -32,7 +32,7 @@ from numba import njit
 from quadcruise.sim.rng import next_normal
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def sample_std(density, rate):
     """The standard deviation of one sample of white noise: ``density * sqrt(rate)``.
 
@@ -44,7 +44,7 @@ def sample_std(density, rate):
     return density * math.sqrt(rate)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def noisy(value, bias, std, s):
     """``value + bias + std * w`` with w standard normal: (the reading, the advanced state).
 
@@ -60,7 +60,7 @@ def noisy(value, bias, std, s):
     return value + bias + std * w, s
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def walk(bias, density, dt, s):
     """One step of a random walk: ``bias + density * sqrt(dt) * w`` (the new bias, the state).
 
@@ -76,7 +76,7 @@ def walk(bias, density, dt, s):
     return bias + density * math.sqrt(dt) * w, s
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def digitise(value, lsb, limit):
     """A reading clipped to ``[-limit, limit]`` (``limit`` 0: none) and rounded to a multiple of
     ``lsb`` (0: none), as an ADC gives it.

@@ -30,9 +30,11 @@ from quadcruise.model.plant import EULER_PITCH_LIMIT, derivative_at
 from quadcruise.sim.fastmath import TRIG_REFRESH, turned
 from quadcruise.sim.inputs import TRIG_WIDTH, Limits, batch_inputs, carry_width, fresh_carry, time_grid
 from quadcruise.sim.kernel_args import KERNEL_SIG, KernelArgs
+from quadcruise.sim.observe import Observation, paper_force
 from quadcruise.sim.period import (
     beyond,
     blank_logs,
+    blank_rows,
     body_bounds,
     close_vehicle,
     give_back,
@@ -206,6 +208,11 @@ def _kernel(
     rng,
     sensor_std,
     sensor_delay,
+    observer,
+    observed,
+    op,
+    omem,
+    orng,
     full,
     max_step,
     log_every,
@@ -218,6 +225,7 @@ def _kernel(
     log_x,
     log_cmd,
     log_ref,
+    log_obs,
     x_final,
     status,
     t_stop,
@@ -254,10 +262,12 @@ def _kernel(
     work = np.empty((WORK_ROWS, L.STATE_SIZE))
     mi, dmi, rngi = np.empty(mem.shape[1]), np.empty(dmem.shape[1]), np.empty(rng.shape[1], dtype=np.uint64)
     watching, plan = track_plan[TP_ON] != 0.0, take_plan(track_plan)  # the track checks, or none
+    omi, orngi, obs = np.empty(omem.shape[1]), np.empty(orng.shape[1], dtype=np.uint64), np.empty(L.OBSERVATION_SIZE)
     for i in range(first, stop):
         k0 = clock[i, 0]
         if status[i] != FINISHED or k0 >= n_periods:  # stopped, or its grid flown
             blank_logs(i, 0, 0, log_x, log_cmd, log_ref)
+            blank_rows(log_obs, i, 0)
             continue
         k1 = min(k0 + n_step, n_periods)
         k_reached = k1
@@ -273,6 +283,10 @@ def _kernel(
             work[TRIG, j] = carry[i, j]
         vpi, vci, gi, mpi, dpi, stdi = vp[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
         take(i, mem, dmem, rng, mi, dmi, rngi)
+        opi = op[i]
+        if observed:  # the observation stage's memory and stream (quadcruise.sim.observe)
+            take_row(omem, i, omi)
+            take_row(orng, i, orngi)
         clipped_s, limited_s = saturated[i, 0], saturated[i, 1]
         fig = take_track(track, i, watching)
         max_position, max_speed, max_rate, max_tilt = limits[0], limits[1], limits[2], limits[3]
@@ -286,18 +300,22 @@ def _kernel(
             t = t_grid[k]
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
             mission(t, mpi, ref)
-            # what the controller sees: the state sensor_delay periods ago, plus noise
-            newest = k % (sensor_delay + 1)  # in the ring buffer
-            oldest = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
-            for j in range(L.STATE_SIZE):
-                history[newest, j] = x[j]
-            state = rngi[0]
-            for j in range(L.STATE_SIZE):
-                seen[j] = history[oldest, j]
-                if stdi[j] != 0.0:
-                    draw, state = next_normal(state)
-                    seen[j] += stdi[j] * draw
-            rngi[0] = state
+            if observed:  # what the controller sees: the estimate from the vehicle's sensors
+                if k == 0:  # the specific force at the start (then at each period's end, below)
+                    paper_force(x, u, vpi, ext, full, work[K1], omi)
+                observer(t, k, k % log_every == 0, x, opi, omi, orngi, seen, obs)
+            else:  # what the controller sees: the state sensor_delay periods ago, plus noise
+                newest = k % (sensor_delay + 1)  # in the ring buffer
+                oldest = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
+                for j in range(L.STATE_SIZE):
+                    history[newest, j] = x[j]
+                state = rngi[0]
+                for j in range(L.STATE_SIZE):
+                    seen[j] = history[oldest, j]
+                    if stdi[j] != 0.0:
+                        draw, state = next_normal(state)
+                        seen[j] += stdi[j] * draw
+                rngi[0] = state
             for j in range(L.CMD_SIZE):
                 cmd[j] = 0.0
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
@@ -309,6 +327,8 @@ def _kernel(
                 log_row(log_x, i, rows, x)
                 log_row(log_cmd, i, rows, cmd)
                 log_row(log_ref, i, rows, ref)
+                if observed:
+                    log_row(log_obs, i, rows, obs)
                 rows += 1
                 rows_x = rows
             if k == n_periods:
@@ -332,6 +352,8 @@ def _kernel(
             for _ in range(n_sub):
                 rk4_step(x, u, vpi, ext, full, h, work, steps % TRIG_REFRESH == 0)
                 steps += 1
+            if observed:  # what the IMU will read at the next instant
+                paper_force(x, u, vpi, ext, full, work[K1], omi)
             finite = True
             for j in range(L.STATE_SIZE):
                 finite = finite and math.isfinite(x[j])
@@ -364,6 +386,10 @@ def _kernel(
         blank_logs(i, rows_x, rows, log_x, log_cmd, log_ref)  # rows after a stop: NaN
         put_row(x_final, i, x)
         give_back(i, mi, dmi, rngi, mem, dmem, rng)
+        if observed:
+            blank_rows(log_obs, i, rows)
+            put_row(omem, i, omi)
+            put_row(orng, i, orngi)
         for j in range(TRIG_WIDTH):
             carry[i, j] = work[TRIG, j]
         write_history(carry, i, TRIG_WIDTH, history)
@@ -408,6 +434,7 @@ def simulate(
     limits: Limits | None = None,
     meta: dict | None = None,
     track: tuple | None = None,
+    observation: Observation | None = None,
 ) -> SimResult:
     """Fly N vehicles over the control instants ``t_grid`` and return a :class:`SimResult`.
 
@@ -460,6 +487,11 @@ def simulate(
         ``(rows, plan)``: the track checks' running figures of each vehicle, updated in place at
         every period whatever ``log_every`` keeps, and the flight's plan
         (:mod:`quadcruise.sim.track_figures`); none by default.
+    observation : Observation, optional
+        The vehicles' sensors and estimator (:mod:`quadcruise.sim.observe`; built by
+        :func:`quadcruise.estimation.onboard.observation`): the controller then sees their
+        estimate instead of the truth (``sensor_std`` and ``sensor_delay`` are not used), and
+        the result's ``observations`` hold their log (the arrays given are not written).
 
     Returns
     -------
@@ -499,6 +531,8 @@ def simulate(
     t_stop = np.empty(n)
     saturated = np.zeros((n, 2))
     track_rows, track_plan = track_arrays(track, n)
+    obs = (observation or Observation.none(n)).take(np.arange(n))  # copies: the flight writes them
+    log_obs = obs.log(n, n_log)
     fly_vehicles(
         n,
         KernelArgs(
@@ -518,6 +552,11 @@ def simulate(
             rng=rng,
             sensor_std=std,
             sensor_delay=int(sensor_delay),
+            observer=obs.function,
+            observed=obs.active,
+            op=obs.params,
+            omem=obs.memory,
+            orng=obs.rng,
             full=bool(full_dynamics),
             max_step=float(max_step),
             log_every=int(log_every),
@@ -530,6 +569,7 @@ def simulate(
             log_x=log_x,
             log_cmd=log_cmd,
             log_ref=log_ref,
+            log_obs=log_obs,
             x_final=x_final,
             status=status,
             t_stop=t_stop,
@@ -549,6 +589,7 @@ def simulate(
         duty_clipped_s=saturated[:, 0].copy(),
         controller_limited_s=saturated[:, 1].copy(),
         meta=dict(meta or {}),
+        observations=log_obs if obs.active else None,
     )
 
 

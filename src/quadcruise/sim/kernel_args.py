@@ -13,7 +13,7 @@ from typing import NamedTuple
 
 from numba import types
 
-from quadcruise.layout import ControllerType, DisturbanceType, MissionType
+from quadcruise.layout import ControllerType, DisturbanceType, MissionType, ObserverType
 
 _f8v = types.float64[::1]
 _f8m = types.float64[:, ::1]
@@ -29,11 +29,14 @@ class KernelArgs(NamedTuple):
 
     Time: ``t_grid``. Plant: ``x0``, ``vp``. Controller: ``vp_ctrl``, ``controller``, ``gains``,
     ``mem``. Mission: ``mission``, ``mp``. Disturbance: ``disturbance``, ``disturbed`` (False:
-    still air), ``dp``, ``dmem``, ``rng``. Sensors: ``sensor_std``, ``sensor_delay``. Options:
+    still air), ``dp``, ``dmem``, ``rng``. Sensors: ``sensor_std``, ``sensor_delay`` (white noise on
+    the truth, and its delay); or the observation stage (:mod:`quadcruise.sim.observe`):
+    ``observer``, ``observed`` (False: skipped), ``op``, ``omem``, ``orng``, and its log ``log_obs``. Options:
     ``full``, ``max_step``, ``log_every``, ``limits``. Resuming: ``n_step``, ``clock``,
     ``carry``. Track checks: ``track`` (each vehicle's running figures, carried),
     ``track_plan`` (:mod:`quadcruise.sim.track_figures`). Outputs: ``log_x``, ``log_cmd``,
-    ``log_ref``, ``x_final``, ``status``, ``t_stop``, ``saturated`` (and ``mem``, ``dmem``, ``rng`` written back).
+    ``log_ref``, ``log_obs``, ``x_final``, ``status``, ``t_stop``, ``saturated`` (and ``mem``, ``dmem``,
+    ``rng``, ``omem``, ``orng`` written back).
     """
 
     t_grid: _f8v
@@ -52,6 +55,11 @@ class KernelArgs(NamedTuple):
     rng: _u8m
     sensor_std: _f8m
     sensor_delay: types.int64
+    observer: ObserverType
+    observed: types.boolean
+    op: _f8m
+    omem: _f8m
+    orng: _u8m
     full: types.boolean
     max_step: types.float64
     log_every: types.int64
@@ -64,6 +72,7 @@ class KernelArgs(NamedTuple):
     log_x: _f8c
     log_cmd: _f8c
     log_ref: _f8c
+    log_obs: _f8c
     x_final: _f8m
     status: _i8v
     t_stop: _f8v
@@ -102,6 +111,11 @@ class RotorKernelArgs(NamedTuple):
     rng: _u8m
     sensor_std: _f8m
     sensor_delay: types.int64
+    observer: ObserverType
+    observed: types.boolean
+    op: _f8m
+    omem: _f8m
+    orng: _u8m
     max_step: types.float64
     log_every: types.int64
     limits: _f8v
@@ -116,6 +130,7 @@ class RotorKernelArgs(NamedTuple):
     log_rotor: _f8c
     log_cmd: _f8c
     log_ref: _f8c
+    log_obs: _f8c
     x_final: _f8m
     seen_final: _f8m
     status: _i8v

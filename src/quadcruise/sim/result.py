@@ -24,7 +24,7 @@ import numpy as np
 
 from quadcruise.checks import describe
 from quadcruise.errors import InputError
-from quadcruise.layout import CMD_NAMES, REF_NAMES, STATE_NAMES
+from quadcruise.layout import CMD_NAMES, OBSERVATION_NAMES, REF_NAMES, STATE_NAMES
 from quadcruise.metrics.summary import Summary
 from quadcruise.sim.status import STATUS_REASONS, ExitStatus
 
@@ -74,6 +74,10 @@ class SimResult:
         The rotor state when each vehicle finished or stopped.
     rotor_names : tuple of str
         The columns of ``rotor_states``.
+    observations : ndarray, shape (N, L, OBSERVATION_SIZE), optional
+        A flight on sensors and an estimator: the log of its observation stage at each instant
+        (:data:`~quadcruise.layout.OBSERVATION_NAMES`: the estimate as the controller saw it,
+        ``x_est`` ..., its standard deviations, NEES, the sensors' readings, the innovations).
     """
 
     t: np.ndarray
@@ -91,6 +95,7 @@ class SimResult:
     rotor_states: np.ndarray | None = None
     rotor_final_state: np.ndarray | None = None
     rotor_names: tuple = ()
+    observations: np.ndarray | None = None
 
     @property
     def n(self) -> int:
@@ -153,19 +158,26 @@ class SimResult:
         ----------
         name : str
             A name of :data:`~quadcruise.layout.STATE_NAMES`, ``REF_NAMES`` or
-            ``CMD_NAMES`` (e.g. ``"z"``, ``"x_ref"``, ``"u1"``).
+            ``CMD_NAMES`` (e.g. ``"z"``, ``"x_ref"``, ``"u1"``), or of a flight on an estimator
+            ``OBSERVATION_NAMES`` (``"x_est"``).
 
         Returns
         -------
         ndarray, shape (N, L)
             The column, in its SI unit (a view, not a copy).
         """
-        for names, arr in ((STATE_NAMES, self.states), (REF_NAMES, self.references), (CMD_NAMES, self.commands)):
+        tables = [(STATE_NAMES, self.states), (REF_NAMES, self.references), (CMD_NAMES, self.commands)]
+        if self.observations is not None:
+            tables.append((OBSERVATION_NAMES, self.observations))
+        for names, arr in tables:
             if name in names:
                 return arr[:, :, names.index(name)]
-        raise InputError(f"unknown trace name {name!r}; known: {', '.join(STATE_NAMES + REF_NAMES + CMD_NAMES)}")
+        known = ", ".join(n for names, _ in tables for n in names)
+        raise InputError(f"unknown trace name {name!r}; known: {known}")
 
-    def to_pandas(self, vehicle: int | None = None, *, references: bool = True, commands: bool = True):
+    def to_pandas(
+        self, vehicle: int | None = None, *, references: bool = True, commands: bool = True, estimate: bool = True
+    ):
         """The traces, long-form: one row per vehicle and logged instant (per-flight metrics: :meth:`metrics`).
 
         Parameters
@@ -176,13 +188,17 @@ class SimResult:
             Include the reference columns.
         commands : bool
             Include the command columns.
+        estimate : bool
+            Include a flight's observation columns (``x_est`` ..., :data:`~quadcruise.layout.OBSERVATION_NAMES`),
+            if it flew on an estimator.
 
         Returns
         -------
         pandas.DataFrame
             Columns ``vehicle``, ``t`` [s], the 16 state names, then (optionally) the
             reference and the command names; for a rotor-plant vehicle then its quaternion
-            ``qw, qx, qy, qz`` and rotor speeds ``w1..wn`` [rad/s].
+            ``qw, qx, qy, qz`` and rotor speeds ``w1..wn`` [rad/s]; then, on an estimator, the
+            estimate beside the truth (``x_est`` ...).
         """
         import pandas as pd
 
@@ -199,6 +215,9 @@ class SimResult:
             extra = [j for j, name in enumerate(self.rotor_names) if name not in STATE_NAMES]
             blocks.append(self.rotor_states[:, :, extra])
             names += [self.rotor_names[j] for j in extra]
+        if estimate and self.observations is not None:
+            blocks.append(self.observations)
+            names += OBSERVATION_NAMES
         data = np.concatenate(blocks, axis=2)[list(picks)]
         n_sel, n_log, _ = data.shape
         frame = pd.DataFrame(data.reshape(n_sel * n_log, -1), columns=names)
@@ -229,6 +248,7 @@ class SimResult:
             commands=self.commands[:, keep],
             references=self.references[:, keep],
             rotor_states=None if self.rotor_states is None else self.rotor_states[:, keep],
+            observations=None if self.observations is None else self.observations[:, keep],
         )
 
     def metrics(self, **kwargs):
@@ -287,7 +307,9 @@ class SimResult:
         through ``THR_MDL_FAC`` (PX4's meanings). The info messages ``quadcruise_control_rate_hz``
         and ``quadcruise_log_rate_hz`` give the controller's rate and the log's own (a flight
         logged every k-th period: the timestamps are those instants, and ``SDLOG_PROFILE`` does not
-        claim the system-identification profile, which holds every command).
+        claim the system-identification profile, which holds every command). A flight on sensor
+        models adds their readings and its estimator's state and innovations, and its
+        ``sensor_combined`` is the IMU model's (:mod:`quadcruise.sim.px4_estimator`).
 
         Parameters
         ----------
@@ -386,6 +408,16 @@ class SimResult:
             system_type=system_type,
             setpoints=setpoints,
         )
+        if self.observations is not None and self.meta.get("sensor_models"):  # the sensors' own readings
+            from quadcruise.layout import O_PHI
+            from quadcruise.sim.px4 import attitude_ned_frd
+            from quadcruise.sim.px4_estimator import estimator_topics
+
+            obs = self.observations[vehicle][rows]
+            euler = [np.nan_to_num(obs[:, O_PHI + j]) for j in range(3)]
+            extra = estimator_topics(t, obs, self.meta["sensor_models"], attitude_ned_frd(*euler))
+            replaced = {topic.name for topic in extra}
+            topics = [topic for topic in topics if topic.name not in replaced] + extra
         info = {"sys_name": "quadcruise", "ver_sw": __version__, "ver_hw": "SIMULATION"}
         control_dt = float(self.meta.get("dt_s") or 0.0)
         log_dt = float(np.median(np.diff(t))) if len(t) > 1 else control_dt

@@ -13,6 +13,7 @@ from quadcruise.model.rotor_plant import ROTOR_P_N_ROTORS, ROTOR_W1
 from quadcruise.sim.engine import still_air
 from quadcruise.sim.inputs import Limits, batch_inputs
 from quadcruise.sim.kernel_args import RotorKernelArgs
+from quadcruise.sim.observe import Observation
 from quadcruise.sim.result import SimResult
 from quadcruise.sim.rotor_flight import fly_rotor_pieces, rotor_carry_width
 from quadcruise.sim.track_figures import track_arrays
@@ -127,6 +128,7 @@ def fly_rotor_vehicles(
     rotor_names: tuple[str, ...] = (),
     meta: dict | None = None,
     track: tuple | None = None,
+    observation: Observation | None = None,
 ) -> SimResult:
     """Fly N rotor-plant vehicles closed loop and return a :class:`SimResult` in the paper layout.
 
@@ -166,6 +168,8 @@ def fly_rotor_vehicles(
         Recorded in the result.
     track : tuple of numpy.ndarray, optional
         ``(rows, plan)``: the track checks' figures and plan, as in :func:`quadcruise.simulate`.
+    observation : Observation, optional
+        The vehicles' sensors and estimator, as :func:`quadcruise.simulate` takes them.
 
     Returns
     -------
@@ -213,6 +217,8 @@ def fly_rotor_vehicles(
     saturated = np.zeros((n_vehicles, 2))
     mem, dmem = inp["memory"], inp["disturbance_memory"]
     track_rows, track_plan = track_arrays(track, n_vehicles)
+    obs = (observation or Observation.none(n_vehicles)).take(np.arange(n_vehicles))  # copies
+    log_obs = obs.log(n_vehicles, n_log)
     fly_rotor_pieces(
         n_vehicles,
         RotorKernelArgs(
@@ -234,6 +240,11 @@ def fly_rotor_vehicles(
             rng=inp["rng"],
             sensor_std=inp["sensor_std"],
             sensor_delay=int(sensor_delay),
+            observer=obs.function,
+            observed=obs.active,
+            op=obs.params,
+            omem=obs.memory,
+            orng=obs.rng,
             max_step=float(max_step),
             log_every=int(log_every),
             limits=limits.array(),
@@ -248,6 +259,7 @@ def fly_rotor_vehicles(
             log_rotor=log_rotor,
             log_cmd=log_cmd,
             log_ref=log_ref,
+            log_obs=log_obs,
             x_final=x_final,
             seen_final=seen_final,
             status=status,
@@ -271,6 +283,7 @@ def fly_rotor_vehicles(
         rotor_states=log_rotor,
         rotor_final_state=x_final,
         rotor_names=tuple(rotor_names),
+        observations=log_obs if obs.active else None,
     )
 
 

@@ -61,6 +61,7 @@ from quadcruise.model.rotor_plant import (
 )
 from quadcruise.sim.engine import still_air
 from quadcruise.sim.kernel_args import ROTOR_KERNEL_SIG
+from quadcruise.sim.observe import rotor_force
 from quadcruise.sim.period import (
     blank_logs,
     blank_rows,
@@ -218,6 +219,11 @@ def _rotor_flight_kernel(
     rng,
     sensor_std,
     sensor_delay,
+    observer,
+    observed,
+    op,
+    omem,
+    orng,
     max_step,
     log_every,
     limits,
@@ -232,6 +238,7 @@ def _rotor_flight_kernel(
     log_rotor,
     log_cmd,
     log_ref,
+    log_obs,
     x_final,
     seen_final,
     status,
@@ -267,18 +274,24 @@ def _rotor_flight_kernel(
     work = np.empty((ROTOR_WORK_ROWS, size))
     mi, dmi, rngi = np.empty(mem.shape[1]), np.empty(dmem.shape[1]), np.empty(rng.shape[1], dtype=np.uint64)
     watching, plan = track_plan[TP_ON] != 0.0, take_plan(track_plan)  # the track checks, or none
+    omi, orngi, obs = np.empty(omem.shape[1]), np.empty(orng.shape[1], dtype=np.uint64), np.empty(L.OBSERVATION_SIZE)
     max_position, max_speed, max_rate, cos_tilt = limits[0], limits[1], limits[2], math.cos(limits[3])
     for i in range(first, stop):
         k0 = clock[i, 0]
         if status[i] != FINISHED or k0 >= n_periods:  # stopped, or its grid flown
             blank_logs(i, 0, 0, log_x, log_cmd, log_ref)
             blank_rows(log_rotor, i, 0)
+            blank_rows(log_obs, i, 0)
             continue
         k1 = min(k0 + n_step, n_periods)
         k_reached = k1
         take_row(x0, i, x)
         rpi, ai, vci, gi, mpi, dpi, stdi = rp[i], alloc[i], vp_ctrl[i], gains[i], mp[i], dp[i], sensor_std[i]
         take(i, mem, dmem, rng, mi, dmi, rngi)
+        opi = op[i]
+        if observed:  # the observation stage's memory and stream (quadcruise.sim.observe)
+            take_row(omem, i, omi)
+            take_row(orng, i, orngi)
         kf_ctrl = ai[4 * n]
         w_min, w_max = rpi[ROTOR_P_W_MIN], rpi[ROTOR_P_W_MAX]
         if k0 == 0:  # a fresh start: the true state of x0, seen through an empty delay line
@@ -304,18 +317,27 @@ def _rotor_flight_kernel(
             t = t_grid[k]
             dt = t_grid[k + 1] - t if k < n_periods else t - t_grid[k - 1]
             mission(t, mpi, ref)
-            # what the controller sees: the state sensor_delay periods ago, plus noise
-            newest = k % (sensor_delay + 1)  # in the ring buffer
-            oldest = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
-            for j in range(L.STATE_SIZE):
-                history[newest, j] = true[j]
-            state = rngi[0]
-            for j in range(L.STATE_SIZE):
-                seen[j] = history[oldest, j]
-                if stdi[j] != 0.0:
-                    draw, state = next_normal(state)
-                    seen[j] += stdi[j] * draw
-            rngi[0] = state
+            if observed:  # what the controller sees: the estimate from the vehicle's sensors
+                if k == 0:  # the specific force at the start (then at each period's end, below)
+                    for j in range(9):
+                        ext_r[j] = ext[j]
+                    for r in range(n):
+                        ext_r[9 + r] = ext[L.EXT_E1 + r] if r < 4 else 1.0
+                        w_cmd[r] = x[ROTOR_W1 + r]
+                    rotor_force(x, w_cmd, rpi, ext_r, work[0], omi)
+                observer(t, k, k % log_every == 0, true, opi, omi, orngi, seen, obs)
+            else:  # what the controller sees: the state sensor_delay periods ago, plus noise
+                newest = k % (sensor_delay + 1)  # in the ring buffer
+                oldest = (k + 1) % (sensor_delay + 1) if k >= sensor_delay else 0
+                for j in range(L.STATE_SIZE):
+                    history[newest, j] = true[j]
+                state = rngi[0]
+                for j in range(L.STATE_SIZE):
+                    seen[j] = history[oldest, j]
+                    if stdi[j] != 0.0:
+                        draw, state = next_normal(state)
+                        seen[j] += stdi[j] * draw
+                rngi[0] = state
             for j in range(L.CMD_SIZE):
                 cmd[j] = 0.0
             controller(t, dt, seen, ref, vci, gi, mi, cmd)
@@ -328,6 +350,8 @@ def _rotor_flight_kernel(
                 log_row(log_cmd, i, rows, cmd)
                 log_row(log_ref, i, rows, ref)
                 log_row(log_rotor, i, rows, x)
+                if observed:
+                    log_row(log_obs, i, rows, obs)
                 rows += 1
                 rows_x = rows
             if k == n_periods:
@@ -369,6 +393,8 @@ def _rotor_flight_kernel(
                 psi = paper_state(x, rpi, ext, psi, true)
                 break
             psi = paper_state(x, rpi, ext, psi, true)
+            if observed:  # what the IMU will read at the next instant
+                rotor_force(x, w_cmd, rpi, ext_r, work[0], omi)
             finite = True
             for j in range(size):
                 finite = finite and math.isfinite(x[j])
@@ -399,6 +425,10 @@ def _rotor_flight_kernel(
                 break
         blank_logs(i, rows_x, rows, log_x, log_cmd, log_ref)
         blank_rows(log_rotor, i, rows_x)
+        if observed:
+            blank_rows(log_obs, i, rows)
+            put_row(omem, i, omi)
+            put_row(orng, i, orngi)
         put_row(x_final, i, x)
         put_row(seen_final, i, true)
         give_back(i, mi, dmi, rngi, mem, dmem, rng)

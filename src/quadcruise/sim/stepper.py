@@ -43,6 +43,7 @@ from quadcruise.errors import InputError
 from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from quadcruise.sim.engine import still_air
 from quadcruise.sim.inputs import Limits
+from quadcruise.sim.observe import Observation, sensor_streams
 from quadcruise.sim.plants import of_arrays
 from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.status import ExitStatus
@@ -95,6 +96,10 @@ class Stepper:
         Rotor plant: the yaw [rad] the initial quaternion's is read near.
     touchdown_speed : float or (N,) array, optional
         Rotor plant: with it, a ground at z = 0.
+    observation : Observation, optional
+        The vehicles' sensors and estimator (:mod:`quadcruise.sim.observe`): the controller sees
+        their estimate; their memories are restored by :meth:`reset`, their streams drawn again,
+        and :attr:`log_obs` holds the step's observation rows.
     track : tuple of numpy.ndarray, optional
         ``(rows, plan)``: the track checks' figures of each vehicle (:attr:`track`, updated at
         every period and restored by :meth:`reset`) and the flight's plan
@@ -129,6 +134,7 @@ class Stepper:
         psi0=0.0,
         touchdown_speed=None,
         track=None,
+        observation: Observation | None = None,
     ) -> None:
         if int(periods) != periods or periods < 1:
             raise InputError(f"periods must be a whole number >= 1, got {describe(periods)}")
@@ -180,6 +186,11 @@ class Stepper:
         self.log_x = np.empty((n, rows, STATE_SIZE))
         self.log_cmd = np.empty((n, rows, CMD_SIZE))
         self.log_ref = np.empty((n, rows, REF_SIZE))
+        self.observation = (observation or Observation.none(n)).take(np.arange(n))  # its own copies
+        if self.observation.params.shape[0] != n:
+            raise InputError(f"Stepper: observation has {self.observation.params.shape[0]} rows, not {n}")
+        self._omem0, self._orng0 = self.observation.memory.copy(), self.observation.rng.copy()
+        self.log_obs = self.observation.log(n, rows)
         # the jit functions themselves: numba calls a jit function passed as an argument through
         # its own calling convention, which carries an exception raised in it to the caller
         # (not through its C wrapper, which would print the exception and carry on)
@@ -273,6 +284,11 @@ class Stepper:
             self.rng[rows] = rng
         elif self.drawn:
             self.rng[rows] = vehicle_states(self.seed if seed is None else seed, k, self.first_vehicle[rows])
+        self.observation.memory[rows] = self._omem0[rows]
+        if self.observation.active:  # the sensors' streams drawn again, as the disturbance's are
+            self.observation.rng[rows] = (
+                self._orng0[rows] if seed is None else sensor_streams(seed, k, self.first_vehicle[rows])
+            )
         self.clock[rows] = 0
         self.plant.restart(self, rows, start)
         self.saturated[rows] = 0.0
@@ -368,6 +384,11 @@ class Stepper:
             rng=self.rng,
             sensor_std=self.sensor_std,
             sensor_delay=self.sensor_delay,
+            observer=self.observation.function,
+            observed=self.observation.active,
+            op=self.observation.params,
+            omem=self.observation.memory,
+            orng=self.observation.rng,
             max_step=self.max_step,
             log_every=1,
             limits=self.limits,
@@ -379,6 +400,7 @@ class Stepper:
             log_x=self.log_x,
             log_cmd=self.log_cmd,
             log_ref=self.log_ref,
+            log_obs=self.log_obs,
             x_final=self.state,
             status=self.status,
             t_stop=self.t_stop,

@@ -24,7 +24,8 @@ from quadcruise._version import __version__
 from quadcruise.control import controller_record
 from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import InputError, LogWarning, reject_unknown
-from quadcruise.layout import STATE_SIZE
+from quadcruise.estimation.stage import Ekf, Sensors
+from quadcruise.layout import OBSERVATION_SIZE, STATE_SIZE
 from quadcruise.missions import Mission, as_mission, stack_params
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
@@ -58,6 +59,7 @@ from quadcruise.workflows.fly_inputs import (
     per_vehicle_controllers,
     vehicle_indices,
 )
+from quadcruise.workflows.onboard import onboard_inputs, vehicle_gravity
 from quadcruise.workflows.rotor_fly import as_vehicle, flight_setup
 from quadcruise.workflows.track_watch import TrackWatch
 
@@ -78,7 +80,8 @@ def fly(
     controller_vehicle: Vehicle | None = None,
     full_dynamics: bool = False,
     environment: Environment | None = None,
-    sensors: SensorNoise | None = None,
+    sensors: SensorNoise | Sensors | None = None,
+    estimator: Ekf | None = None,
     seed: int = 0,
     first_vehicle: int | np.ndarray = 0,
     max_track_error: float | None = None,
@@ -135,9 +138,16 @@ def fly(
     environment : Environment or CustomDisturbance, optional
         Wind, gusts, turbulence, rotor loss, external force (any field may hold one value per
         vehicle). Wind acts through drag: give a vehicle with drag (:func:`~quadcruise.disturbances.with_drag`).
-    sensors : SensorNoise, optional
+    sensors : SensorNoise or Sensors, optional
         Noise on what the controller sees and its delay [s], turned into whole control periods
-        of this flight's ``dt``.
+        of this flight's ``dt``; or the sensor models the vehicle carries
+        (:class:`~quadcruise.estimation.Sensors`: IMU, GPS, barometer, magnetometer), sampled
+        in the compiled period (each rate a divisor of the control rate) and logged in the
+        result's ``observations`` (``to_pandas()``'s ``*_est`` and sensor columns).
+    estimator : Ekf, optional
+        The error-state EKF between the :class:`~quadcruise.estimation.Sensors` and the
+        controller (docs/sensors.md): the controller sees its estimate instead of the truth;
+        needs an IMU and a GPS. ``metrics()`` then reports the estimation error.
     seed : int
         Seed of every random draw (turbulence, sensor noise).
     first_vehicle : int or array of int
@@ -207,7 +217,8 @@ def fly(
     checks.instance(w, "limits", limits, Limits)
     full_dynamics = checks.flag(w, "full_dynamics", full_dynamics)
     checks.instance(w, "environment", environment, (Environment, CustomDisturbance))
-    checks.instance(w, "sensors", sensors, SensorNoise)
+    checks.instance(w, "sensors", sensors, (SensorNoise, Sensors))
+    checks.instance(w, "estimator", estimator, Ekf)
     plant.check_environment(flown, environment)
     seed = checks.whole(w, "seed", seed)
     first_vehicle = vehicle_indices(first_vehicle)
@@ -240,6 +251,7 @@ def fly(
     duration = default_duration(first) if duration is None else duration
     d, h = duration, dt
     extra = plant.log_width(flown)  # a plant's own state logged beside the paper layout (rotor: 13 + n)
+    extra += OBSERVATION_SIZE if isinstance(sensors, Sensors) else 0  # and a flight on sensors their log
     steps = round(d / h) if 0 < h <= d < math.inf else 0
     chosen = log_every is None and n > 1 and steps > 0 and batch_log_every(n, steps, extra) > 1
     # a batch whose full log would not fit in LOG_BUDGET: a coarser log, checked at every period
@@ -259,9 +271,13 @@ def fly(
             LogWarning,
             stacklevel=2,
         )
+    observation, onboard_record = onboard_inputs(
+        sensors, estimator, g=vehicle_gravity(flown), n=n, dt=float(dt),
+        seed=seed, first_vehicle=first_vehicle, where=w,
+    )  # fmt: skip
     grid = time_grid(float(duration), float(dt))
     check_log_every(log_every, grid.size - 1)
-    if sensors is not None:
+    if isinstance(sensors, SensorNoise):
         sensors.check_fits(duration)
     plant.check_vehicles(flown)
     check_reference_fits(missions or [first], float(duration), limits or Limits())
@@ -294,8 +310,9 @@ def fly(
             if isinstance(environment, Environment)
             else {"custom": getattr(environment.function, "__name__", "disturbance")}
         )
-    if sensors is not None:
+    if isinstance(sensors, SensorNoise):
         meta["sensors"] = sensors.to_dict()
+    meta.update(onboard_record)  # sensor models and the estimator
     if controller_vehicle is not None:
         meta["controller_vehicle"] = plant.controller_record(controller_vehicle)
     gains, memory = (
@@ -336,7 +353,8 @@ def fly(
         meta=meta,
         seed=seed,
         first_vehicle=first_vehicle,
-        **engine_inputs(environment, sensors, n, dt),
+        **engine_inputs(environment, sensors if isinstance(sensors, SensorNoise) else None, n, dt),
+        **({} if observation is None else {"observation": observation}),
     )
     args, own = plant.flight(
         grid, vehicle, controller_vehicle, controller.function, gains, first, mp, n,

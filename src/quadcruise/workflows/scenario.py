@@ -1,7 +1,7 @@
 """Scenario files: a whole run described in TOML, validated with messages that name the
 file, the key and what is wrong. Loading parses data only (``tomllib``); it never runs code.
 
-A scenario has up to seven tables; every one is optional::
+A scenario has up to ten tables; every one is optional::
 
     title = "Circle in moderate turbulence"
 
@@ -29,6 +29,13 @@ A scenario has up to seven tables; every one is optional::
     turbulence = { intensity = "moderate", altitude = 10.0 }
     rotor_loss = { rotor = 1, fraction = 0.3, time = 5.0 }
     sensor_noise = { position_std = 0.01, delay = 0.005 }
+
+    [sensors]                 # sensor models the vehicle carries (docs/sensors.md)
+    imu = "bmi088"
+    gps = { preset = "typical", latency = 0.2 }
+
+    [estimator]               # between them and the controller
+    kind = "ekf"
 
     [simulation]
     duration = 30.0
@@ -84,6 +91,7 @@ from quadcruise.workflows.scenario_flight import (
     mission_table,
     simulation_table,
 )
+from quadcruise.workflows.scenario_onboard import check_sensor_tables, estimator_from_spec, sensors_from_spec
 from quadcruise.workflows.scenario_values import Where, check_keys
 from quadcruise.workflows.scenario_vehicle import VEHICLE_PRESETS, read_vehicle_file, vehicle_preset, vehicle_table
 
@@ -96,6 +104,8 @@ TABLES = (
     "montecarlo",
     "controller_vehicle",
     "compare",
+    "sensors",
+    "estimator",
 )
 
 
@@ -119,6 +129,10 @@ class Scenario:
     sensor_noise : SensorNoise or None
         Noise on what the controller sees (position [m], velocity [m/s], angle [rad] ...)
         and its delay [s], or None.
+    sensors : Sensors or None
+        The sensor models of ``[sensors]`` (:mod:`quadcruise.workflows.scenario_onboard`), or None.
+    estimator : Ekf or None
+        The filter of ``[estimator]``, or None.
     simulation : dict
         The checked ``[simulation]`` table: ``duration`` [s], ``dt`` [s], ``max_step`` [s],
         ``full_dynamics``, ``seed``, ``log_every``, ``n``, ``max_track_error`` [m],
@@ -149,6 +163,8 @@ class Scenario:
     mission: Mission | None = None
     environment: Any = None
     sensor_noise: Any = None
+    sensors: Any = None
+    estimator: Any = None
     simulation: dict = field(default_factory=dict)
     montecarlo: dict = field(default_factory=dict)
     compare: dict = field(default_factory=dict)
@@ -187,7 +203,7 @@ class Scenario:
             ``max_step``, ``full_dynamics``, ``seed``, ``log_every``, ``n``,
             ``max_track_error``, ``max_steady_error``, ``max_altitude_error``, ``x0`` (the initial
             state), ``controller_vehicle``,
-            ``environment`` and ``sensors`` the scenario gives.
+            ``environment``, ``sensors`` and ``estimator`` the scenario gives.
         """
         sim = self.simulation
         kw: dict[str, Any] = {"duration": sim.get("duration"), "dt": self.dt}
@@ -208,6 +224,10 @@ class Scenario:
             kw["environment"] = self.environment
         if self.sensor_noise is not None:
             kw["sensors"] = self.sensor_noise
+        if self.sensors is not None:
+            kw["sensors"] = self.sensors
+        if self.estimator is not None:
+            kw["estimator"] = self.estimator
         kw["vehicle"] = vehicle
         return kw
 
@@ -302,6 +322,9 @@ def scenario_from_dict(doc: dict, *, source: str = "scenario", base: Path | None
     mission = mission_table(where.at("mission"), doc.get("mission"), base) if "mission" in doc else None
     environment, noise = disturbances_table(where.at("disturbances"), doc.get("disturbances", {}))
     simulation = simulation_table(where.at("simulation"), doc.get("simulation", {}))
+    sensors = sensors_from_spec(doc.get("sensors", {}), where.at("sensors"))
+    estimator = estimator_from_spec(doc.get("estimator", {}), where.at("estimator"))
+    check_sensor_tables(where, sensors, noise)
     _consistent(where, doc, vehicle, model, mission, simulation)
     return Scenario(
         vehicle=vehicle,
@@ -310,6 +333,8 @@ def scenario_from_dict(doc: dict, *, source: str = "scenario", base: Path | None
         mission=mission,
         environment=environment,
         sensor_noise=noise,
+        sensors=sensors,
+        estimator=estimator,
         simulation=simulation,
         montecarlo=dict(doc.get("montecarlo", {})),
         compare=compared,
