@@ -27,7 +27,7 @@ from quadcruise.sim.status import ExitStatus
 from quadcruise.sim.stepper import Stepper
 from quadcruise.sim.track_figures import TRACK, fresh_track, no_track, track_plan
 from quadcruise.workflows.fly_inputs import engine_inputs, hover_state
-from quadcruise.workflows.rotor_fly import rotor_engine_inputs, rotor_flight_setup
+from quadcruise.workflows.rotor_fly import flight_setup, rotor_engine_inputs
 from quadcruise.workflows.track_watch import TrackWatch
 
 FIN, LOST, OFF = int(ExitStatus.FINISHED), int(ExitStatus.LOST_TRACK), int(ExitStatus.OFF_TRACK)
@@ -151,7 +151,7 @@ def test_the_figures_of_a_flight_cut_into_steps_are_those_of_one_call():
 
 def test_the_rotor_kernels_figures_cut_into_steps_are_those_of_one_call():
     n, iris = 4, RotorVehicle.preset("iris")
-    c, m = rotor_flight_setup(iris, None, "se3")[1], Circle()
+    c, m = flight_setup(iris, None, "se3")[1], Circle()
     t = time_grid(2.0, 1e-3)
     env = Environment(rotor_loss=RotorLoss(rotor=1, fraction=np.array([0.9, 0.0, 0.5, 0.0]), time=0.5))
     engine = engine_inputs(env, None, n, 1e-3)
