@@ -124,3 +124,40 @@ def test_writing_refuses_a_value_out_of_range_and_writes_nothing(tmp_path):
     assert not (tmp_path / "t.params").exists()
     with pytest.raises(InputError, match="NOT_A_PARAM is not a parameter of the PX4 loops"):
         Px4Parameters.defaults().with_values(NOT_A_PARAM=1.0)
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("1\t1\tMC_ROLL_P\t12.00001\t9\n", "MC_ROLL_P = 12.00001 1/s is outside PX4 v1.15's range [0, 12]"),
+        ("1\t1\tMC_ROLLRATE_P\t0.00999\t9\n", "MC_ROLLRATE_P = 0.00999 is outside PX4 v1.15's range [0.01, 0.5]"),
+        ("1\t1\tMPC_USE_HTE\t1\t9\n", "MPC_USE_HTE has type 9 but PX4 declares it INT32 (type 6)"),
+        ("1\t1\tMC_ROLL_P\t7\t6\n", "MC_ROLL_P has type 6 but PX4 declares it FLOAT (type 9)"),
+        ("a\t1\tMC_ROLL_P\t7\t9\n", "MC_ROLL_P: Vehicle-Id 'a' and Component-Id '1' must be whole numbers"),
+    ],
+    ids=["just-above-max", "just-below-min", "int-as-float", "float-as-int", "vehicle-id"],
+)
+def test_just_outside_a_bound_and_type_mismatches_are_refused_naming_the_value(tmp_path, text, message):
+    """A value one float32 step outside PX4's range is named as it was written (not rounded to
+    the bound it exceeds); a line whose MAV_PARAM_TYPE is not the one PX4 declares is refused,
+    as QGroundControl refuses it on load."""
+    (tmp_path / "f.params").write_text(text)
+    with pytest.raises(InputError) as caught:
+        read_params(tmp_path / "f.params")
+    said = str(caught.value)
+    assert said.startswith(f"{tmp_path / 'f.params'}, line 1: {message}") and "\n" not in said
+
+
+def test_values_exactly_at_the_bounds_and_qgc_file_quirks_are_read(tmp_path):
+    """PX4's @min and @max themselves pass; a byte-order mark, CRLF line ends, blank lines,
+    comments and another vehicle's id are read; integer widths 1-8 for an INT32 parameter too."""
+    text = (
+        "\ufeff# Onboard parameters for Vehicle 2\r\n\r\n# Vehicle-Id Component-Id Name Value Type\r\n"
+        "2\t1\tMC_ROLL_P\t12\t9\r\n2\t1\tMC_ROLLRATE_P\t0.01\t9\r\n2\t1\tMPC_TILTMAX_AIR\t89\t9\r\n"
+        "2\t1\tMC_AIRMODE\t2\t5\r\n2\t1\tIMU_INTEG_RATE\t1000\t6\r\n"
+    )
+    (tmp_path / "v2.params").write_bytes(text.encode("utf-8"))
+    p = read_params(tmp_path / "v2.params")
+    assert (p["MC_ROLL_P"], p["MC_ROLLRATE_P"], p["MPC_TILTMAX_AIR"]) == (12.0, 0.01, 89.0)
+    assert (p["MC_AIRMODE"], p["IMU_INTEG_RATE"]) == (2.0, 1000.0)
+    assert p.unused == ()

@@ -137,6 +137,12 @@ class Px4Parameters(Mapping):
         return Px4Parameters(merged, self.source, tuple(sorted(set(self.from_file) | set(values))), self.unused)
 
 
+def _num(value: float) -> str:
+    """A value as a message shows it: enough digits that one just outside a bound does not
+    read as the bound (``12.00001``, not ``12``)."""
+    return f"{value:.12g}"
+
+
 def _checked(name: str, value, where: str) -> float:
     """``value`` as a float if ``name`` is used and the value lies within PX4's range."""
     spec = PX4_PARAMETERS.get(name)
@@ -149,7 +155,7 @@ def _checked(name: str, value, where: str) -> float:
     if not math.isfinite(number):
         raise InputError(f"{where}: {name} = {value} is not a finite number")
     if spec.kind == INT32 and number != round(number):
-        raise InputError(f"{where}: {name} = {number:g} is not an integer (PX4 declares it INT32)")
+        raise InputError(f"{where}: {name} = {_num(number)} is not an integer (PX4 declares it INT32)")
     low = -math.inf if spec.minimum is None else spec.minimum
     high = math.inf if spec.maximum is None else spec.maximum
     # PX4 stores floats as float32: a bound is met when the float32 values meet it
@@ -158,7 +164,7 @@ def _checked(name: str, value, where: str) -> float:
         lo = "-inf" if spec.minimum is None else f"{spec.minimum:g}"
         hi = "inf" if spec.maximum is None else f"{spec.maximum:g}"
         unit = f" {spec.unit}" if spec.unit else ""
-        raise InputError(f"{where}: {name} = {number:g}{unit} is outside PX4 {RELEASE}'s range [{lo}, {hi}]")
+        raise InputError(f"{where}: {name} = {_num(number)}{unit} is outside PX4 {RELEASE}'s range [{lo}, {hi}]")
     return number
 
 
@@ -205,6 +211,7 @@ def parse_params_text(text: str, source: str = "<text>") -> Px4Parameters:
     """
     raw: dict[str, float] = {}
     lines: dict[str, int] = {}
+    text = text.removeprefix("\ufeff")  # a byte-order mark (a file saved by Windows' Notepad)
     for number, line in enumerate(text.splitlines(), start=1):
         stripped = line.strip()
         if not stripped or stripped.startswith("#"):
@@ -217,7 +224,12 @@ def parse_params_text(text: str, source: str = "<text>") -> Px4Parameters:
                 f"{where}: not a QGroundControl parameter line (Vehicle-Id Component-Id Name Value Type, "
                 f"tab separated): {stripped[:60]!r}"
             )
-        _, _, name, value, kind = fields
+        vehicle, component, name, value, kind = fields
+        if not (vehicle.isdigit() and component.isdigit()):
+            raise InputError(
+                f"{where}: {name}: Vehicle-Id {vehicle!r} and Component-Id {component!r} must be whole numbers "
+                "(a QGroundControl parameter line: Vehicle-Id Component-Id Name Value Type)"
+            )
         try:
             kind_number = int(kind)
         except ValueError:
@@ -232,6 +244,13 @@ def parse_params_text(text: str, source: str = "<text>") -> Px4Parameters:
             raise InputError(f"{where}: {name} = {value!r} is not a finite number")
         if kind_number in INTEGER_TYPES and parsed != round(parsed):
             raise InputError(f"{where}: {name} = {value!r} is not an integer (type {kind_number})")
+        spec = PX4_PARAMETERS.get(name)
+        if spec is not None and (spec.kind == INT32) != (kind_number in INTEGER_TYPES):
+            declared = "INT32 (type 6)" if spec.kind == INT32 else "FLOAT (type 9)"
+            raise InputError(
+                f"{where}: {name} has type {kind_number} but PX4 declares it {declared} "
+                "(QGroundControl refuses such a line as a type mismatch)"
+            )
         if name in raw:
             raise InputError(f"{where}: {name} is set twice (first on line {lines[name]})")
         raw[name], lines[name] = parsed, number
@@ -297,7 +316,7 @@ def read_params(path: str | os.PathLike) -> Px4Parameters:
     if kind == ".ulg":
         return _read_ulog_params(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
         raise InputError(f"{path}: not a text file: not a QGroundControl .params file") from None
     return parse_params_text(text, str(path))
