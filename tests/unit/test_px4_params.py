@@ -161,3 +161,32 @@ def test_values_exactly_at_the_bounds_and_qgc_file_quirks_are_read(tmp_path):
     assert (p["MC_ROLL_P"], p["MC_ROLLRATE_P"], p["MPC_TILTMAX_AIR"]) == (12.0, 0.01, 89.0)
     assert (p["MC_AIRMODE"], p["IMU_INTEG_RATE"]) == (2.0, 1000.0)
     assert p.unused == ()
+
+
+def test_px4s_own_constraints_are_applied_and_said():
+    """``MulticopterPositionControl::parameters_update`` (v1.15) constrains MPC_THR_HOVER into
+    [MPC_THR_MIN, MPC_THR_MAX] and MPC_TILTMAX_LND to at most MPC_TILTMAX_AIR; the px4
+    controller flies what PX4 flies, and the reader says it (the flown value named)."""
+    from quadcruise.control.px4 import Px4
+    from quadcruise.control.px4kernel import X_TILT_LND
+    from quadcruise.control.px4loops import G_THR_HOVER
+    from quadcruise.io.px4params import px4_constrained
+
+    base = Px4Parameters.defaults()
+    assert px4_constrained(base) == (dict(base), ())  # PX4's defaults are consistent
+    for given, flown in (
+        ({"MPC_THR_HOVER": 0.2, "MPC_THR_MIN": 0.4}, 0.4),
+        ({"MPC_THR_HOVER": 0.7, "MPC_THR_MAX": 0.6}, 0.6),
+        ({"MPC_THR_HOVER": 0.4, "MPC_THR_MIN": 0.4, "MPC_THR_MAX": 0.4}, 0.4),  # at the bounds: kept
+    ):
+        values, notes = px4_constrained(base.with_values(**given))
+        assert values["MPC_THR_HOVER"] == flown
+        assert len(notes) == (given["MPC_THR_HOVER"] != flown)
+        assert all(n.startswith(f"MPC_THR_HOVER = {given['MPC_THR_HOVER']:g} is outside") for n in notes)
+        gains = Px4.from_params(given).gains()
+        assert gains[G_THR_HOVER] == flown
+    values, notes = px4_constrained(base.with_values(MPC_TILTMAX_LND=60.0, MPC_TILTMAX_AIR=30.0))
+    assert values["MPC_TILTMAX_LND"] == 30.0 and "MPC_TILTMAX_LND = 60 deg is above" in notes[0]
+    gains = Px4.from_params({"MPC_TILTMAX_LND": 60.0, "MPC_TILTMAX_AIR": 30.0}).gains()
+    assert gains[X_TILT_LND] == pytest.approx(np.radians(30.0))
+    assert Px4.from_params({"MPC_TILTMAX_LND": 25.0}).gains()[X_TILT_LND] == pytest.approx(np.radians(25.0))

@@ -142,11 +142,13 @@ def controller_with_params(controller, name: str | None, path: str | None, param
     if poles_text is not None:
         raise InputError("--poles: the px4 controller takes its position gains from --params (MPC_XY_P, ...)")
     from quadcruise.control.px4 import Px4
-    from quadcruise.io.px4params import read_params
+    from quadcruise.io.px4params import px4_constrained, read_params
 
     read = read_params(path)
     believed = world.get("controller_vehicle") or world.get("vehicle")
     px4 = Px4.from_params(read, vehicle=believed)
+    for note in px4_constrained(read)[1]:  # what PX4's parameters_update changes, as PX4 says it
+        click.echo(f"note: {path}: {note}", err=True)
     if read.unused:
         names = ", ".join(read.unused)
         click.echo(

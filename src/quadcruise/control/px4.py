@@ -83,7 +83,7 @@ from quadcruise.control.px4loops import G_RATE_D, G_RATE_I, G_RATE_P, G_THR_HOVE
 from quadcruise.errors import InputError
 from quadcruise.fields import Check, between
 from quadcruise.fields import unit_field as _f
-from quadcruise.io.px4params import Px4Parameters, read_params
+from quadcruise.io.px4params import Px4Parameters, px4_constrained, read_params
 
 __all__ = ["Px4", "px4_controller", "PX4C_GAINS", "PX4C_MEMORY", "MAX_ROTORS"]
 
@@ -299,7 +299,7 @@ class Px4(Controller):
             :data:`PX4C_GAINS` (253) float64 entries: PX4's loops' gains in SI units, the
             allocation, the vehicle's layout, the filters and the flags (see the row).
         """
-        p = self.params
+        p = px4_constrained(self.params)[0]  # MPC_THR_HOVER, MPC_TILTMAX_LND as PX4 constrains them
         eff, layout = self.geometry()
         n = len(layout)
         mix, scale = mix_matrix(eff)

@@ -31,7 +31,15 @@ from quadcruise.errors import InputError
 from quadcruise.io.files import atomic_path
 from quadcruise.io.px4defaults import FLOAT, INT32, PX4_PARAMETERS, RELEASE
 
-__all__ = ["Px4Parameters", "read_params", "parse_params_text", "write_params", "params_text", "changed"]
+__all__ = [
+    "Px4Parameters",
+    "read_params",
+    "parse_params_text",
+    "write_params",
+    "params_text",
+    "changed",
+    "px4_constrained",
+]
 
 INTEGER_TYPES = frozenset(range(1, 9))
 """MAV_PARAM_TYPE of the integers (UINT8 .. INT64); 9 is REAL32, 10 REAL64."""
@@ -320,6 +328,53 @@ def read_params(path: str | os.PathLike) -> Px4Parameters:
     except UnicodeDecodeError:
         raise InputError(f"{path}: not a text file: not a QGroundControl .params file") from None
     return parse_params_text(text, str(path))
+
+
+def px4_constrained(values: Mapping[str, float]) -> tuple[dict[str, float], tuple[str, ...]]:
+    """The parameters as PX4 flies them after ``MulticopterPositionControl::parameters_update``
+    constrains them, and PX4's word for each change.
+
+    PX4 v1.15 sets (and commits) ``MPC_TILTMAX_LND`` to ``MPC_TILTMAX_AIR`` where it is larger
+    ("Land tilt has been constrained by max tilt") and ``MPC_THR_HOVER`` into
+    ``[MPC_THR_MIN, MPC_THR_MAX]`` (``math::constrain``: "Hover thrust has been constrained by
+    min/max"), each within its own range.
+
+    Parameters
+    ----------
+    values : Mapping of str to float
+        Every parameter the loops use (a :class:`Px4Parameters`).
+
+    Returns
+    -------
+    values : dict
+        The parameters, the constrained ones changed.
+    notes : tuple of str
+        One line per change, naming the parameter, its value and what PX4 flies.
+
+    Examples
+    --------
+    >>> v, notes = px4_constrained(Px4Parameters.defaults().with_values(MPC_THR_HOVER=0.2, MPC_THR_MIN=0.4))
+    >>> v["MPC_THR_HOVER"], notes[0][:60]
+    (0.4, 'MPC_THR_HOVER = 0.2 is outside [MPC_THR_MIN, MPC_THR_MAX] = ')
+    """
+    out = dict(values)
+    notes = []
+    air, lnd = out["MPC_TILTMAX_AIR"], out["MPC_TILTMAX_LND"]
+    if lnd > air:
+        out["MPC_TILTMAX_LND"] = air
+        notes.append(
+            f"MPC_TILTMAX_LND = {_num(lnd)} deg is above MPC_TILTMAX_AIR = {_num(air)} deg: PX4 constrains it "
+            f"to {_num(air)} deg (Land tilt has been constrained by max tilt)"
+        )
+    hover, low, high = out["MPC_THR_HOVER"], out["MPC_THR_MIN"], out["MPC_THR_MAX"]
+    if hover > high or hover < low:
+        flown = low if hover < low else high  # math::constrain(val, min, max)
+        out["MPC_THR_HOVER"] = flown
+        notes.append(
+            f"MPC_THR_HOVER = {_num(hover)} is outside [MPC_THR_MIN, MPC_THR_MAX] = [{_num(low)}, {_num(high)}]: "
+            f"PX4 constrains it to {_num(flown)} (Hover thrust has been constrained by min/max)"
+        )
+    return out, tuple(notes)
 
 
 def changed(values: Mapping[str, float]) -> dict[str, float]:
