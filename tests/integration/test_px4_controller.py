@@ -159,6 +159,35 @@ def test_a_geometry_that_is_not_the_vehicles_is_refused_in_one_line():
         Px4.from_params({"MC_ROLL_P": 13}, vehicle=v)
 
 
+def test_a_hexarotors_geometry_with_a_rotor_on_an_axis_is_its_own():
+    """A hexarotor x whose rotors 1 and 2 sit on the body's y axis: a .params file that writes
+    their PX as -1e-8 (float noise, as a geometry computed from angles gives) names the same
+    rotors as 0 does; a rotor truly on the other side is still refused."""
+    import math
+
+    angles, kms = (90, 270, 330, 150, 30, 210), (-0.05, 0.05, -0.05, 0.05, 0.05, -0.05)
+    frd = [
+        (0.25 * math.cos(math.radians(a)), 0.25 * math.sin(math.radians(a)), km)
+        for a, km in zip(angles, kms, strict=True)
+    ]
+    rotors = tuple((round(px, 9), round(-py, 9), 0.02, -1.0 if km > 0 else 1.0) for px, py, km in frd)
+    hexa = RotorVehicle.preset("iris").replace(m=2.2, rotors=rotors)
+
+    def params(noise, flip=None):
+        out = {"CA_ROTOR_COUNT": 6}
+        for i, (px, py, km) in enumerate(frd):
+            px = noise if abs(px) < 1e-9 else (-px if i == flip else px)
+            out.update({f"CA_ROTOR{i}_PX": px, f"CA_ROTOR{i}_PY": py, f"CA_ROTOR{i}_KM": km})
+        return out
+
+    exact = Px4.from_params(params(0.0), vehicle=hexa).geometry()[0]
+    for noise in (-1e-8, 1e-8):
+        noisy = Px4.from_params(params(noise), vehicle=hexa).geometry()[0]
+        np.testing.assert_allclose(noisy, exact, rtol=0, atol=1e-7)
+    with pytest.raises(InputError, match=r"CA_ROTOR2 .* is not the vehicle's rotor 3"):
+        Px4.from_params(params(0.0, flip=2), vehicle=hexa)
+
+
 def test_a_2000_vehicle_batch_flies():
     res = qc.fly("hover", "px4", vehicle="iris", n=2000, duration=2.0)
     assert res.n == 2000 and all(s == 0 for s in np.asarray(res.status))

@@ -276,10 +276,13 @@ class Px4(Controller):
         axes = np.array([[p[f"CA_ROTOR{i}_A{c}"] for c in "XYZ"] for i in range(n)])
         ct = np.array([p[f"CA_ROTOR{i}_CT"] for i in range(n)])
         km = np.array([p[f"CA_ROTOR{i}_KM"] for i in range(n)])
+        # a coordinate within a thousandth of the arm of an axis is on it (a file's -1e-8 is 0)
+        tol = 1e-3 * max(float(np.max(np.hypot(layout[:, 0], layout[:, 1]))), float(np.max(np.hypot(*pos[:, :2].T))))
+        side = lambda v: 0.0 if abs(v) <= tol else np.sign(v)  # noqa: E731
         for i in range(n):
             same = (
-                np.sign(pos[i, 0]) == np.sign(np.round(layout[i, 0], 9))
-                and np.sign(pos[i, 1]) == -np.sign(np.round(layout[i, 1], 9))
+                side(pos[i, 0]) == side(layout[i, 0])
+                and side(pos[i, 1]) == -side(layout[i, 1])
                 and np.sign(km[i]) == -np.sign(layout[i, 3])
             )
             if not same:
