@@ -211,6 +211,28 @@ def test_fly_params_flies_the_logs_parameters_and_lists_the_unused_once(tmp_path
     assert (tmp_path / "g" / "metrics.csv").read_text() == (out / "metrics.csv").read_text()
 
 
+def test_fly_params_with_c_says_which_wins(tmp_path):
+    """``-c`` changes the px4 controller's own fields over ``--params``; one that replaces the
+    file's parameters (``hover_from_vehicle``, ``rate_bandwidth``) says so, and ``-c params=``
+    beside ``--params`` (two sources of the same parameters) is refused before flying."""
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    (tmp_path / "a.params").write_text("1\t1\tMC_ROLL_P\t7\t9\n1\t1\tMPC_THR_HOVER\t0.45\t9\n")
+    (tmp_path / "b.params").write_text("1\t1\tMC_ROLL_P\t8\t9\n")
+    fly = ["fly", "hover", "--vehicle", "iris", "--duration", "0.2", "--params", str(tmp_path / "a.params")]
+    res = CliRunner().invoke(main, [*fly, "-c", f"params={tmp_path / 'b.params'}", "--out", str(tmp_path / "x")])
+    assert res.exit_code == 2 and "-c params=...: --params" in res.output and "give them once" in res.output
+    assert not (tmp_path / "x").exists()
+    res = CliRunner().invoke(main, [*fly, "-c", "hover_from_vehicle=true", "-c", "rate_bandwidth=15"])
+    assert res.exit_code == 0, res.output
+    assert "replaces" in res.stderr and "MPC_THR_HOVER (0.45)" in res.stderr
+    assert "-c rate_bandwidth=15: rate gains designed" in res.stderr
+    res = CliRunner().invoke(main, [*fly, "-c", "position_rate=50"])  # a field of its own: no word needed
+    assert res.exit_code == 0 and "replace" not in res.stderr
+
+
 @pytest.mark.parametrize(
     ("text", "args", "message"),
     [

@@ -154,7 +154,25 @@ def controller_with_params(controller, name: str | None, path: str | None, param
         click.echo(
             f"note: {len(read.unused)} parameters of {path} are not used by the px4 controller: {names}", err=True
         )
-    return controller_from_options(None, params, None, base=px4)
+    out = controller_from_options(None, params, None, base=px4)
+    if out.params is not px4.params:
+        raise InputError(
+            f"-c params=...: --params {path} gives the px4 controller's parameters; give them once "
+            "(one file, or a scenario's [controller] params)"
+        )
+    if out.hover_from_vehicle:  # the file's hover thrust not flown: said, not silently
+        click.echo(
+            f"note: -c hover_from_vehicle=true: the vehicle's hover thrust replaces {path}'s MPC_THR_HOVER "
+            f"({read['MPC_THR_HOVER']:g}), MPC_THR_MIN at most half of it",
+            err=True,
+        )
+    if out.rate_bandwidth > 0.0:
+        click.echo(
+            f"note: -c rate_bandwidth={out.rate_bandwidth:g}: rate gains designed for that rotor lag replace "
+            f"{path}'s MC_*RATE_P, _I, _D (and _K)",
+            err=True,
+        )
+    return out
 
 
 def mission_from_options(text: str, params: tuple[str, ...], smooth: bool):
