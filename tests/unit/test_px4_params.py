@@ -190,3 +190,32 @@ def test_px4s_own_constraints_are_applied_and_said():
     gains = Px4.from_params({"MPC_TILTMAX_LND": 60.0, "MPC_TILTMAX_AIR": 30.0}).gains()
     assert gains[X_TILT_LND] == pytest.approx(np.radians(30.0))
     assert Px4.from_params({"MPC_TILTMAX_LND": 25.0}).gains()[X_TILT_LND] == pytest.approx(np.radians(25.0))
+
+
+def _shared_log(name: str) -> Path:
+    for folder in (Path(__file__).resolve().parents[3] / "shared" / "px4-logs", Path("/work/shared/px4-logs")):
+        if (folder / name).is_file():
+            return folder / name
+    pytest.skip(f"the real PX4 log {name} is not on this machine")
+
+
+def test_a_log_of_another_release_says_what_it_lacks_and_its_older_names():
+    """A log holds every parameter of its release: the loops' parameters it lacks fly at PX4
+    v1.15's defaults, and the reader says so once, naming the release pyulog reads and them;
+    an older release's velocity gains (``MPC_XY_VEL_P``: thrust per m/s, not m/s^2 per m/s)
+    are said not converted. The v1.15 SITL log gets no note."""
+    assert read_params(LOG).notes == ()
+    small = _shared_log("sample_log_small.ulg")  # PX4 v1.11.2 (dev): ver_sw_release 0x010b0200
+    raw = ULog(str(small), message_name_filter_list=[]).initial_parameters
+    lacking = sorted(n for n in PX4_PARAMETERS if n not in raw and not n.startswith("CA_"))
+    assert lacking == ["HTE_THR_RANGE", "HTE_VXY_THR", "HTE_VZ_THR", "MPC_THR_XY_MARG"]
+    (note,) = read_params(small).notes
+    assert f"{small} is a log of PX4 v1.11.2 (dev), not PX4 v1.15: it has no {', '.join(lacking)}" in note
+    old = _shared_log("sample.ulg")  # no ver_sw_release; MPC_XY_VEL_P and no MPC_XY_VEL_P_ACC
+    renamed, release = read_params(old).notes
+    assert "MPC_XY_VEL_P, MPC_Z_VEL_D" in renamed and "not converted" in renamed
+    assert "a PX4 release it does not state" in release and "MPC_XY_VEL_P_ACC" in release
+    text = "1\t1\tMPC_XY_VEL_P\t0.09\t9\n1\t1\tMC_ROLL_P\t7\t9\n"  # a .params file: its older names only
+    (said,) = parse_params_text(text, "old.params").notes
+    assert said.startswith("old.params names MPC_XY_VEL_P, an older PX4 release's gains in other units")
+    assert parse_params_text("1\t1\tMC_ROLL_P\t7\t9\n").notes == ()  # a partial file of this release: nothing

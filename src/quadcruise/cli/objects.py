@@ -147,6 +147,8 @@ def controller_with_params(controller, name: str | None, path: str | None, param
     read = read_params(path)
     believed = world.get("controller_vehicle") or world.get("vehicle")
     px4 = Px4.from_params(read, vehicle=believed)
+    for note in read.notes:  # another release's log, older names
+        click.echo(f"note: {note}", err=True)
     for note in px4_constrained(read)[1]:  # what PX4's parameters_update changes, as PX4 says it
         click.echo(f"note: {path}: {note}", err=True)
     if read.unused:

@@ -62,6 +62,10 @@ class Px4Parameters(Mapping):
         The used parameters the source set.
     unused : tuple of str
         The source's parameters the loops do not use, sorted.
+    notes : tuple of str
+        What a reader should be told of the source once (:func:`read_params`): a log of another
+        PX4 release lacking parameters the loops use (flown at v1.15's defaults), older names
+        of the loops' parameters (not converted).
 
     Examples
     --------
@@ -74,6 +78,7 @@ class Px4Parameters(Mapping):
     source: str = "defaults"
     from_file: tuple = ()
     unused: tuple = field(default=())
+    notes: tuple = field(default=(), compare=False)
 
     @classmethod
     def defaults(cls) -> Px4Parameters:
@@ -142,7 +147,9 @@ class Px4Parameters(Mapping):
         merged = dict(self.values)
         for name, value in values.items():
             merged[name] = _checked(name, value, "argument")
-        return Px4Parameters(merged, self.source, tuple(sorted(set(self.from_file) | set(values))), self.unused)
+        return Px4Parameters(
+            merged, self.source, tuple(sorted(set(self.from_file) | set(values))), self.unused, self.notes
+        )
 
 
 def _num(value: float) -> str:
@@ -176,14 +183,42 @@ def _checked(name: str, value, where: str) -> float:
     return number
 
 
-def _collect(raw: dict, where_of, source: str) -> Px4Parameters:
+RENAMED = {
+    "MPC_XY_VEL_P": "MPC_XY_VEL_P_ACC",
+    "MPC_XY_VEL_I": "MPC_XY_VEL_I_ACC",
+    "MPC_XY_VEL_D": "MPC_XY_VEL_D_ACC",
+    "MPC_Z_VEL_P": "MPC_Z_VEL_P_ACC",
+    "MPC_Z_VEL_I": "MPC_Z_VEL_I_ACC",
+    "MPC_Z_VEL_D": "MPC_Z_VEL_D_ACC",
+}
+"""Older PX4 releases' names of parameters the loops use (the velocity gains were in thrust, not
+acceleration, before PX4 v1.11): read as unused, never converted, and said."""
+
+
+def _collect(raw: dict, where_of, source: str, release: str | None = None) -> Px4Parameters:
+    """The used parameters of ``raw`` checked, the others listed; ``release`` (a log's PX4
+    version, a log holding every parameter of its release) makes a note of the used ones it lacks."""
     values = {k: float(v.default) for k, v in PX4_PARAMETERS.items()}
     for name, value in raw.items():
         if name in PX4_PARAMETERS:
             values[name] = _checked(name, value, where_of(name))
     used = tuple(sorted(n for n in raw if n in PX4_PARAMETERS))
     unused = tuple(sorted(n for n in raw if n not in PX4_PARAMETERS))
-    return Px4Parameters(values, source, used, unused)
+    notes = []
+    old = sorted(n for n in raw if n in RENAMED and RENAMED[n] not in raw)
+    if old:
+        notes.append(
+            f"{source} names {', '.join(old)}, an older PX4 release's gains in other units (now "
+            f"{', '.join(RENAMED[n] for n in old)}): not converted, PX4 {RELEASE}'s defaults flown for them"
+        )
+    if release is not None:
+        lacking = sorted(n for n in PX4_PARAMETERS if n not in raw and not n.startswith("CA_"))
+        if lacking:
+            notes.append(
+                f"{source} is a log of {release}, not PX4 {RELEASE}: it has no {', '.join(lacking)}; "
+                f"PX4 {RELEASE}'s defaults are flown for them"
+            )
+    return Px4Parameters(values, source, used, unused, tuple(notes))
 
 
 def parse_params_text(text: str, source: str = "<text>") -> Px4Parameters:
@@ -283,7 +318,13 @@ def _read_ulog_params(path: Path) -> Px4Parameters:
         raw[name] = value
     if not raw:
         raise InputError(f"{path}: the log holds no parameters")
-    return _collect(raw, lambda n: f"{path}", str(path))
+    version = log.msg_info_dict.get("ver_sw_release")  # 0xMMmmppTT, TT: 0 dev, 64 alpha, 128 beta, 192 rc, 255
+    if isinstance(version, int) and version:
+        kind = {0: " (dev)", 64: " (alpha)", 128: " (beta)", 192: " (rc)", 255: ""}.get(version & 0xFF, "")
+        release = f"PX4 v{version >> 24}.{(version >> 16) & 0xFF}.{(version >> 8) & 0xFF}{kind}"
+    else:
+        release = "a PX4 release it does not state"
+    return _collect(raw, lambda n: f"{path}", str(path), release)
 
 
 def read_params(path: str | os.PathLike) -> Px4Parameters:
