@@ -288,6 +288,24 @@ def test_tune_px4_writes_tuned_params_that_fly_the_tuned_metrics_exactly(tmp_pat
         assert float(got[name]) == float(best[name]), name
 
 
+def test_tune_px4_on_the_paper_plant_says_why_there_is_no_tuned_params(tmp_path):
+    """On the paper plant px4 flies gains designed for the vehicle that PX4's parameters cannot
+    hold (the rate P below PX4's @min 0.01): no tuned.params, and the tune says so and why."""
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    out = tmp_path / "t"
+    args = ["tune", "step", "--controller", "px4", "--duration", "6", "--quiet", "--budget", "2", "--popsize", "5"]
+    res = CliRunner().invoke(
+        main, [*args, "--gains", "params.MPC_XY_P", "--target", "rise_time_s=1.5", "--out", str(out)]
+    )
+    assert res.exit_code in (0, 1), res.output
+    assert (out / "tune.json").is_file() and not (out / "tuned.params").exists()
+    assert f"note: no {out}/tuned.params: its gains are designed for the vehicle" in res.stderr
+    assert "MC_ROLLRATE_P = 0.009375 is outside PX4 v1.15's range [0.01, 0.5]" in res.stderr
+
+
 def test_px4s_parameters_are_searched_by_name_within_pxs_range():
     from quadcruise.tune.space import GainSpace, tunable_values
 

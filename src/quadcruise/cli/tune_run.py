@@ -10,6 +10,8 @@ from collections.abc import Callable
 
 import click
 
+from quadcruise.errors import InputError
+
 __all__ = ["command_line", "tune_command"]
 
 
@@ -218,7 +220,22 @@ def tune_command(
             echo(
                 f"wrote {path}: `quadcruise fly MISSION --params {path}` (with the same vehicle) flies the tuned gains"
             )
+        elif getattr(result.controller, "name", None) == "px4":  # no tuned.params: said, with why
+            echo(f"note: no {out}/tuned.params: {_why_no_params(result.controller, world)}", err=True)
     return result
+
+
+def _why_no_params(controller, world: dict) -> str:
+    """Why a tuned px4 controller has no PX4 parameter form (the paper plant's design)."""
+    from quadcruise.model.equivalent import paper_equivalent
+
+    believed = world.get("controller_vehicle") or world.get("vehicle")
+    reason = "its gains are designed for the vehicle (rate_bandwidth, hover_from_vehicle)"
+    try:
+        controller.resolved(paper_equivalent(believed))
+    except InputError as exc:  # the design is outside PX4's ranges
+        reason += f" and PX4's parameters cannot hold them ({str(exc).removeprefix('argument: ')})"
+    return reason + "; tune a rotor vehicle (--vehicle iris) or PX4's own parameters (--params FILE) for one"
 
 
 def _px4_form(controller) -> bool:
