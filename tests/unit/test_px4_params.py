@@ -219,3 +219,53 @@ def test_a_log_of_another_release_says_what_it_lacks_and_its_older_names():
     (said,) = parse_params_text(text, "old.params").notes
     assert said.startswith("old.params names MPC_XY_VEL_P, an older PX4 release's gains in other units")
     assert parse_params_text("1\t1\tMC_ROLL_P\t7\t9\n").notes == ()  # a partial file of this release: nothing
+
+
+def _ulog_bytes(params, changes) -> bytes:
+    """A minimal ULog as the format's specification lays it out (header, info, parameters, one
+    topic's format, subscription and data; parameter messages among the data are changes)."""
+    import struct
+
+    def msg(kind, payload):
+        return struct.pack("<HB", len(payload), ord(kind)) + payload
+
+    def kv(key, value):
+        return bytes([len(key)]) + key.encode() + value
+
+    out = b"ULog\x01\x12\x35" + bytes([1]) + struct.pack("<Q", 0) + msg("I", kv("char[3] sys_name", b"PX4"))
+    out += b"".join(msg("P", kv(f"float {n}", struct.pack("<f", v))) for n, v in params)
+    out += msg("F", b"topic_x:uint64_t timestamp;float a;") + msg("A", struct.pack("<BH", 0, 0) + b"topic_x")
+    for stamp, name, value in changes:
+        out += msg("D", struct.pack("<HQf", 0, stamp, 0.0))
+        out += msg("P", kv(f"float {name}", struct.pack("<f", value))) if name else b""
+    return out + msg("D", struct.pack("<HQf", 0, 20_000_000, 0.0))
+
+
+def test_a_log_that_changes_a_used_parameter_in_flight_says_so(tmp_path):
+    """pyulog reads the written log's changes; the reader takes the values at the log's end and
+    says which used parameters changed (a change to the same value, or of an unused one, is not said);
+    a log without parameters is refused in one line."""
+    path = tmp_path / "changed.ulg"
+    path.write_bytes(
+        _ulog_bytes(
+            [("MC_ROLL_P", 6.5), ("MC_PITCH_P", 6.5), ("SYS_X", 1.0)],
+            [
+                (1_000_000, None, 0.0),
+                (5_000_000, "MC_ROLL_P", 8.0),
+                (6_000_000, "MC_PITCH_P", 6.5),
+                (7_000_000, "SYS_X", 2.0),
+            ],
+        )
+    )
+    assert [(n, v) for _, n, v in ULog(str(path)).changed_parameters] == [
+        ("MC_ROLL_P", 8.0),
+        ("MC_PITCH_P", 6.5),
+        ("SYS_X", 2.0),
+    ]
+    p = read_params(path)
+    assert p["MC_ROLL_P"] == 8.0 and p["MC_PITCH_P"] == 6.5
+    assert f"{path} changes MC_ROLL_P during the log: the values at its end are used for the whole log" in p.notes
+    assert not any("MC_PITCH_P during" in n or "SYS_X during" in n for n in p.notes)
+    (tmp_path / "none.ulg").write_bytes(_ulog_bytes([], [(1_000_000, None, 0.0)]))
+    with pytest.raises(InputError, match=r"none.ulg: the log holds no parameters$"):
+        read_params(tmp_path / "none.ulg")

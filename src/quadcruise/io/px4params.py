@@ -18,6 +18,7 @@ say once which were not used.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import struct
@@ -314,7 +315,10 @@ def _read_ulog_params(path: Path) -> Px4Parameters:
     except (ULogException, struct.error, ValueError, IndexError) as exc:
         raise InputError(f"{path}: not a readable PX4 log ({exc})") from None
     raw = dict(log.initial_parameters)
+    moved = set()  # used parameters whose value changed in the log (pyulog without data: no times)
     for _, name, value in log.changed_parameters:
+        if name in PX4_PARAMETERS and name in raw and value != raw[name]:
+            moved.add(name)
         raw[name] = value
     if not raw:
         raise InputError(f"{path}: the log holds no parameters")
@@ -324,7 +328,14 @@ def _read_ulog_params(path: Path) -> Px4Parameters:
         release = f"PX4 v{version >> 24}.{(version >> 16) & 0xFF}.{(version >> 8) & 0xFF}{kind}"
     else:
         release = "a PX4 release it does not state"
-    return _collect(raw, lambda n: f"{path}", str(path), release)
+    read = _collect(raw, lambda n: f"{path}", str(path), release)
+    if moved:
+        note = (
+            f"{path} changes {', '.join(sorted(moved))} during the log: the values at its end are used "
+            "for the whole log"
+        )
+        read = dataclasses.replace(read, notes=(*read.notes, note))
+    return read
 
 
 def read_params(path: str | os.PathLike) -> Px4Parameters:
