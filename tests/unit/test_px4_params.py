@@ -269,3 +269,17 @@ def test_a_log_that_changes_a_used_parameter_in_flight_says_so(tmp_path):
     (tmp_path / "none.ulg").write_bytes(_ulog_bytes([], [(1_000_000, None, 0.0)]))
     with pytest.raises(InputError, match=r"none.ulg: the log holds no parameters$"):
         read_params(tmp_path / "none.ulg")
+
+
+def test_another_components_parameters_are_not_the_autopilots_and_two_vehicles_are_refused(tmp_path):
+    """QGroundControl saves every component's parameters: a gimbal's (Component-Id 154) of the
+    same name as the autopilot's is listed as unused, never flown nor "set twice"; a file of two
+    vehicles is refused naming both."""
+    text = "1\t1\tMC_ROLL_P\t7\t9\n1\t154\tMC_ROLL_P\t3\t9\n1\t154\tMNT_MODE_IN\t1\t6\n"
+    p = parse_params_text(text, "gimbal.params")
+    assert p["MC_ROLL_P"] == 7.0 and p.from_file == ("MC_ROLL_P",)
+    assert p.unused == ("MC_ROLL_P@component154", "MNT_MODE_IN@component154")
+    with pytest.raises(
+        InputError, match=r"^two.params, line 2: MC_ROLL_P: the file holds the parameters of vehicles 1"
+    ):
+        parse_params_text("1\t1\tMC_ROLL_P\t7\t9\n2\t1\tMC_ROLL_P\t8\t9\n", "two.params")

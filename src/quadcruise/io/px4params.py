@@ -240,8 +240,10 @@ def parse_params_text(text: str, source: str = "<text>") -> Px4Parameters:
     ------
     InputError
         One line naming the file, the line and the parameter: a line that is not five fields,
-        a type that is not MAV_PARAM_TYPE, a value that is not a number (or not an integer for
-        an integer type), a parameter twice, a used parameter outside PX4's range.
+        a type that is not MAV_PARAM_TYPE (or not the one PX4 declares), a value that is not a
+        number (or not an integer for an integer type), a parameter twice, parameters of two
+        vehicles, a used parameter outside PX4's range. Parameters of a component other than
+        the autopilot (Component-Id 1) are listed as unused, as ``NAME@componentID``.
 
     Examples
     --------
@@ -255,6 +257,7 @@ def parse_params_text(text: str, source: str = "<text>") -> Px4Parameters:
     """
     raw: dict[str, float] = {}
     lines: dict[str, int] = {}
+    vehicles: dict[int, int] = {}  # Vehicle-Id -> its first line
     text = text.removeprefix("\ufeff")  # a byte-order mark (a file saved by Windows' Notepad)
     for number, line in enumerate(text.splitlines(), start=1):
         stripped = line.strip()
@@ -288,6 +291,12 @@ def parse_params_text(text: str, source: str = "<text>") -> Px4Parameters:
             raise InputError(f"{where}: {name} = {value!r} is not a finite number")
         if kind_number in INTEGER_TYPES and parsed != round(parsed):
             raise InputError(f"{where}: {name} = {value!r} is not an integer (type {kind_number})")
+        vehicles.setdefault(int(vehicle), number)
+        if len(vehicles) > 1:
+            first = ", ".join(f"{v} (line {n})" for v, n in vehicles.items())
+            raise InputError(f"{where}: {name}: the file holds the parameters of vehicles {first}; give one vehicle's")
+        if int(component) != 1:  # another component's (a gimbal, a camera): not the autopilot's loops
+            name = f"{name}@component{int(component)}"
         spec = PX4_PARAMETERS.get(name)
         if spec is not None and (spec.kind == INT32) != (kind_number in INTEGER_TYPES):
             declared = "INT32 (type 6)" if spec.kind == INT32 else "FLOAT (type 9)"
