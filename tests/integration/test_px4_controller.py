@@ -233,6 +233,27 @@ def test_fly_params_with_c_says_which_wins(tmp_path):
     assert res.exit_code == 0 and "replace" not in res.stderr
 
 
+def test_fly_a_scenario_with_params_keeps_its_px4_fields(tmp_path):
+    """A scenario's px4 fields that set no PX4 parameter (thrust_curve, position_rate,
+    hover_estimator) stay when ``--params`` gives other parameters; ``-c`` still wins."""
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+    from quadcruise.workflows.scenario import load_scenario
+
+    (tmp_path / "a.params").write_text("1\t1\tMC_ROLL_P\t7\t9\n")
+    (tmp_path / "b.params").write_text("1\t1\tMC_ROLL_P\t8\t9\n")
+    first = ["fly", "hover", "--vehicle", "iris", "--duration", "0.2", "--params", str(tmp_path / "a.params")]
+    first += ["-c", "thrust_curve=0.5", "-c", "position_rate=50", "-c", "hover_estimator=true"]
+    assert CliRunner().invoke(main, [*first, "--out", str(tmp_path / "s")]).exit_code == 0
+    again = ["fly", str(tmp_path / "s" / "scenario.toml"), "--params", str(tmp_path / "b.params")]
+    res = CliRunner().invoke(main, [*again, "-c", "position_rate=80", "--out", str(tmp_path / "t")])
+    assert res.exit_code == 0, res.output
+    c = load_scenario(tmp_path / "t" / "scenario.toml").controller
+    assert c.params["MC_ROLL_P"] == 8.0 and (c.thrust_curve, c.hover_estimator) == (0.5, True)
+    assert c.position_rate == 80.0  # -c over the scenario's 50
+
+
 @pytest.mark.parametrize(
     ("text", "args", "message"),
     [

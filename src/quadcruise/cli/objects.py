@@ -107,7 +107,11 @@ def controller_for_vehicle(
     return controller_from_options(None, params, poles_text, base=designed)
 
 
-def controller_with_params(controller, name: str | None, path: str | None, params, poles_text, world):
+KEPT_PX4_FIELDS = ("thrust_curve", "position_rate", "hover_estimator", "takeoff", "takeoff_speed_up")
+"""The px4 fields a scenario's controller keeps under ``--params`` (those that set no PX4 parameter)."""
+
+
+def controller_with_params(controller, name: str | None, path: str | None, params, poles_text, world, scenario=None):
     """``--params``: the px4 controller with a log's or a ``.params`` file's PX4 parameters.
 
     Parameters
@@ -124,6 +128,9 @@ def controller_with_params(controller, name: str | None, path: str | None, param
         ``--poles`` (refused: the px4 controller has no PD position gains).
     world : dict
         :func:`quadcruise.cli.world.flight_world`'s: the controller's vehicle gives the rotor layout.
+    scenario : Scenario, optional
+        A scenario file read: a px4 ``[controller]`` of it keeps its fields that set no PX4
+        parameter (:data:`KEPT_PX4_FIELDS`: ``thrust_curve``, ``position_rate``, ...) under ``-c``.
 
     Returns
     -------
@@ -146,7 +153,9 @@ def controller_with_params(controller, name: str | None, path: str | None, param
 
     read = read_params(path)
     believed = world.get("controller_vehicle") or world.get("vehicle")
-    px4 = Px4.from_params(read, vehicle=believed)
+    kept = getattr(scenario, "controller", None)
+    kept = {f: getattr(kept, f) for f in KEPT_PX4_FIELDS} if getattr(kept, "name", None) == "px4" else {}
+    px4 = Px4.from_params(read, vehicle=believed, **kept)
     for note in read.notes:  # another release's log, older names
         click.echo(f"note: {note}", err=True)
     for note in px4_constrained(read)[1]:  # what PX4's parameters_update changes, as PX4 says it

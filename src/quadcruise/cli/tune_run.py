@@ -167,7 +167,9 @@ def tune_command(
     )
     plant = plants.of(world["vehicle"])
     if px4_params:
-        the_controller = controller_with_params(the_controller, controller, px4_params, controller_params, None, world)
+        the_controller = controller_with_params(
+            the_controller, controller, px4_params, controller_params, None, world, sc
+        )
     else:
         the_controller = controller_for_vehicle(the_controller, controller, controller_params, None, world, sc)
     the_controller = as_px4_parameters(the_controller, world, bool(px4_params))
