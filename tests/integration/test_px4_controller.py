@@ -289,6 +289,7 @@ def test_tune_px4_writes_tuned_params_that_fly_the_tuned_metrics_exactly(tmp_pat
     tuned = read_params(out / "tuned.params")
     doc = (out / "tuned.params").read_text()
     assert "# PX4 v1.15" in doc and "MC_ROLL_P\t" not in doc  # only what differs from PX4's defaults
+    assert "# tuned: MPC_XY_P, MPC_XY_VEL_P_ACC; the other lines are what the tune flew, not tuned" in doc
     from quadcruise.workflows.scenario import load_scenario
 
     values = load_scenario(out / "scenario.toml").controller.params  # the tuned controller, as the folder keeps it

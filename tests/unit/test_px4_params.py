@@ -283,3 +283,10 @@ def test_another_components_parameters_are_not_the_autopilots_and_two_vehicles_a
         InputError, match=r"^two.params, line 2: MC_ROLL_P: the file holds the parameters of vehicles 1"
     ):
         parse_params_text("1\t1\tMC_ROLL_P\t7\t9\n2\t1\tMC_ROLL_P\t8\t9\n", "two.params")
+
+
+def test_a_note_of_several_lines_is_written_as_comments(tmp_path):
+    path = write_params(tmp_path / "t.params", {"MC_ROLL_P": 7.0}, note="quadcruise tune step\ntuned: MC_ROLL_P")
+    text = path.read_text()
+    assert "# quadcruise tune step\n# tuned: MC_ROLL_P\n" in text
+    assert dict(read_params(path)) == dict(Px4Parameters.defaults().with_values(MC_ROLL_P=7.0))

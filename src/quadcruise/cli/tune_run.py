@@ -218,7 +218,13 @@ def tune_command(
 
             from quadcruise.io.px4params import write_params
 
-            path = write_params(Path(out) / "tuned.params", result.controller.params, note=command_line(mission, given))
+            searched = [g.removeprefix("params.") for g in result.gains]
+            note = (
+                f"{command_line(mission, given)}\n"
+                f"tuned: {', '.join(searched)}; the other lines are what the tune flew, not tuned "
+                "(the --params file's, or the design for the simulated vehicle: check those before loading)"
+            )
+            path = write_params(Path(out) / "tuned.params", result.controller.params, note=note)
             echo(
                 f"wrote {path}: `quadcruise fly MISSION --params {path}` (with the same vehicle) flies the tuned gains"
             )

@@ -467,7 +467,7 @@ def params_text(values: Mapping[str, float], vehicle_id: int = 1, component_id: 
     vehicle_id, component_id : int
         MAVLink ids (QGroundControl's first two columns).
     note : str
-        One more comment line (e.g. the command that made it).
+        More comment lines (e.g. the command that made it), each written as a comment.
 
     Returns
     -------
@@ -484,8 +484,7 @@ def params_text(values: Mapping[str, float], vehicle_id: int = 1, component_id: 
         "# Onboard parameters for Vehicle 1, written by quadcruise",
         f"# PX4 {RELEASE}: only the parameters that differ from its defaults",
     ]
-    if note:
-        lines.append(f"# {note}")
+    lines += [f"# {line}" for line in note.splitlines()]  # each line a comment
     lines += ["#", "# Vehicle-Id\tComponent-Id\tName\tValue\tType"]
     for name in sorted(diff):
         spec = PX4_PARAMETERS[name]
