@@ -254,6 +254,27 @@ def test_fly_a_scenario_with_params_keeps_its_px4_fields(tmp_path):
     assert c.position_rate == 80.0  # -c over the scenario's 50
 
 
+def test_compare_params_keeps_a_scenarios_px4_fields(tmp_path):
+    """``compare --params`` over a scenario's compared px4 (a controller, not a name) keeps its
+    fields that set no PX4 parameter; a name gets the file's px4 as it is; px4 added once."""
+    from quadcruise.cli.objects import with_px4_params
+
+    (tmp_path / "b.params").write_text("1\t1\tMC_ROLL_P\t8\t9\n")
+    world = {"vehicle": RotorVehicle.preset("iris")}
+    mine = Px4(thrust_curve=0.5, position_rate=50.0, hover_estimator=True)
+    out = with_px4_params({"mine": mine, "se3": "se3"}, str(tmp_path / "b.params"), world)
+    assert set(out) == {"mine", "se3"} and out["se3"] == "se3"
+    got = out["mine"]
+    assert got.params["MC_ROLL_P"] == 8.0 and (got.thrust_curve, got.position_rate, got.hover_estimator) == (
+        0.5,
+        50.0,
+        True,
+    )
+    named = with_px4_params("se3,px4", str(tmp_path / "b.params"), world)
+    assert named["px4"].thrust_curve == 1.0 and named["px4"].params["MC_ROLL_P"] == 8.0  # the rotor plant's
+    assert set(with_px4_params("se3", str(tmp_path / "b.params"), world)) == {"se3", "px4"}
+
+
 @pytest.mark.parametrize(
     ("text", "args", "message"),
     [

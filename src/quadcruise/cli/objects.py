@@ -268,7 +268,14 @@ def with_px4_params(chosen, path: str | None, world: dict):
     if isinstance(chosen, str):
         names = [n.strip() for n in chosen.split(",") if n.strip()]
         chosen = {n: n for n in names}
-    out = {label: (px4 if getattr(c, "name", c) == "px4" else c) for label, c in dict(chosen).items()}
-    if px4 not in out.values():
+    import dataclasses
+
+    def flown(c):  # a px4 of a scenario keeps its fields that set no PX4 parameter
+        if getattr(c, "name", c) != "px4":
+            return c
+        return px4 if isinstance(c, str) else dataclasses.replace(px4, **{f: getattr(c, f) for f in KEPT_PX4_FIELDS})
+
+    out = {label: flown(c) for label, c in dict(chosen).items()}
+    if not any(getattr(c, "name", c) == "px4" for c in out.values()):
         out["px4"] = px4
     return out
