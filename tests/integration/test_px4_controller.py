@@ -150,6 +150,8 @@ def test_a_geometry_that_is_not_the_vehicles_is_refused_in_one_line():
     v = RotorVehicle.preset("iris")
     with pytest.raises(InputError, match=r"CA_ROTOR_COUNT = 6, the vehicle has 4 rotors"):
         Px4.from_params({"CA_ROTOR_COUNT": 6}, vehicle=v)
+    with pytest.raises(InputError, match=r"CA_ROTOR_COUNT = 6, no rotor layout given: PX4's quadrotor x has 4 \("):
+        Px4.from_params({"CA_ROTOR_COUNT": 6})  # no vehicle: not "the vehicle has 4 rotors"
     swapped = {"CA_ROTOR_COUNT": 4}
     for i, (x, y, km) in enumerate([(1, -1, 0.05), (-1, -1, 0.05), (1, -1, -0.05), (-1, 1, -0.05)]):
         swapped.update({f"CA_ROTOR{i}_PX": x, f"CA_ROTOR{i}_PY": y, f"CA_ROTOR{i}_KM": km})

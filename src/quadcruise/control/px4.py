@@ -268,8 +268,9 @@ class Px4(Controller):
             axes = np.tile([0.0, 0.0, -1.0], (n, 1))
             return rotor_effectiveness(pos, axes, np.ones(n), -layout[:, 3] * 0.05), layout
         if count != n:
+            had = f"the vehicle has {n} rotors" if self.rotors else "no rotor layout given: PX4's quadrotor x has 4"
             raise InputError(
-                f"{p.source}: CA_ROTOR_COUNT = {count}, the vehicle has {n} rotors (give the vehicle's own "
+                f"{p.source}: CA_ROTOR_COUNT = {count}, {had} (give the vehicle's own "
                 "geometry, or set CA_ROTOR_COUNT = 0 to allocate on the vehicle's layout)"
             )
         pos = np.array([[p[f"CA_ROTOR{i}_P{c}"] for c in "XYZ"] for i in range(n)])
