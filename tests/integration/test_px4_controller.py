@@ -351,6 +351,22 @@ def test_tune_px4_on_the_paper_plant_says_why_there_is_no_tuned_params(tmp_path)
     assert "MC_ROLLRATE_P = 0.009375 is outside PX4 v1.15's range [0.01, 0.5]" in res.stderr
 
 
+def test_tune_refuses_an_integer_px4_parameter_before_searching(tmp_path):
+    """MC_AIRMODE, IMU_INTEG_RATE, ... are PX4 INT32 choices: --gains naming one is refused in
+    one line before any flight (it used to fail mid-search on the first non-integer candidate)."""
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    args = ["tune", "step", "--controller", "px4", "--vehicle", "iris", "--target", "rise_time_s=1.2", "--quiet"]
+    for name in ("IMU_INTEG_RATE", "MC_AIRMODE"):
+        res = CliRunner().invoke(
+            main, [*args, "--gains", f"params.MPC_XY_P,params.{name}", "--out", str(tmp_path / name)]
+        )
+        assert res.exit_code == 2 and f"--gains params.{name}: PX4 declares it an integer (INT32)" in res.output
+        assert res.output.count("\n") == 1 and not (tmp_path / name).exists()
+
+
 def test_px4s_parameters_are_searched_by_name_within_pxs_range():
     from quadcruise.tune.space import GainSpace, tunable_values
 

@@ -174,6 +174,7 @@ def tune_command(
         the_controller = controller_for_vehicle(the_controller, controller, controller_params, None, world, sc)
     the_controller = as_px4_parameters(the_controller, world, bool(px4_params))
     wanted["gains"] = parse_gains(gains, the_controller)
+    _refuse_integer_px4_gains(wanted["gains"], the_controller)
     environment = world["environment"]
     if wind_spread > 0 and plant.drag_for_wind and not any("wind acts only through drag" in line for line in notes):
         from quadcruise.disturbances import default_drag_text, with_drag
@@ -231,6 +232,23 @@ def tune_command(
         elif getattr(result.controller, "name", None) == "px4":  # no tuned.params: said, with why
             echo(f"note: no {out}/tuned.params: {_why_no_params(result.controller, world)}", err=True)
     return result
+
+
+def _refuse_integer_px4_gains(names, controller) -> None:
+    """A px4 parameter PX4 declares INT32 (``MC_AIRMODE``, ``IMU_INTEG_RATE``, ...) is a choice,
+    not a gain a continuous search can set: refused before the search, naming it."""
+    if getattr(controller, "name", None) != "px4" or not names:
+        return
+    from quadcruise.io.px4defaults import INT32, PX4_PARAMETERS
+
+    for name in names:
+        spec = PX4_PARAMETERS.get(name.removeprefix("params.")) if name.startswith("params.") else None
+        if spec is not None and spec.kind == INT32:
+            raise InputError(
+                f"--gains {name}: PX4 declares it an integer (INT32), which the search cannot set; "
+                f"tune with each value instead (a --params FILE setting it, e.g. "
+                f"{name.removeprefix('params.')} {spec.default:g})"
+            )
 
 
 def _why_no_params(controller, world: dict) -> str:
