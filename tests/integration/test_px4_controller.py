@@ -150,6 +150,8 @@ def test_a_geometry_that_is_not_the_vehicles_is_refused_in_one_line():
     v = RotorVehicle.preset("iris")
     with pytest.raises(InputError, match=r"CA_ROTOR_COUNT = 6, the vehicle has 4 rotors"):
         Px4.from_params({"CA_ROTOR_COUNT": 6}, vehicle=v)
+    with pytest.raises(InputError, match=r"CA_ROTOR_COUNT = 6, no rotor layout given: PX4's quadrotor x has 4 \("):
+        Px4.from_params({"CA_ROTOR_COUNT": 6})  # no vehicle: not "the vehicle has 4 rotors"
     swapped = {"CA_ROTOR_COUNT": 4}
     for i, (x, y, km) in enumerate([(1, -1, 0.05), (-1, -1, 0.05), (1, -1, -0.05), (-1, 1, -0.05)]):
         swapped.update({f"CA_ROTOR{i}_PX": x, f"CA_ROTOR{i}_PY": y, f"CA_ROTOR{i}_KM": km})
@@ -157,6 +159,35 @@ def test_a_geometry_that_is_not_the_vehicles_is_refused_in_one_line():
         Px4.from_params(swapped, vehicle=v)
     with pytest.raises(InputError, match=r"MC_ROLL_P = 13"):
         Px4.from_params({"MC_ROLL_P": 13}, vehicle=v)
+
+
+def test_a_hexarotors_geometry_with_a_rotor_on_an_axis_is_its_own():
+    """A hexarotor x whose rotors 1 and 2 sit on the body's y axis: a .params file that writes
+    their PX as -1e-8 (float noise, as a geometry computed from angles gives) names the same
+    rotors as 0 does; a rotor truly on the other side is still refused."""
+    import math
+
+    angles, kms = (90, 270, 330, 150, 30, 210), (-0.05, 0.05, -0.05, 0.05, 0.05, -0.05)
+    frd = [
+        (0.25 * math.cos(math.radians(a)), 0.25 * math.sin(math.radians(a)), km)
+        for a, km in zip(angles, kms, strict=True)
+    ]
+    rotors = tuple((round(px, 9), round(-py, 9), 0.02, -1.0 if km > 0 else 1.0) for px, py, km in frd)
+    hexa = RotorVehicle.preset("iris").replace(m=2.2, rotors=rotors)
+
+    def params(noise, flip=None):
+        out = {"CA_ROTOR_COUNT": 6}
+        for i, (px, py, km) in enumerate(frd):
+            px = noise if abs(px) < 1e-9 else (-px if i == flip else px)
+            out.update({f"CA_ROTOR{i}_PX": px, f"CA_ROTOR{i}_PY": py, f"CA_ROTOR{i}_KM": km})
+        return out
+
+    exact = Px4.from_params(params(0.0), vehicle=hexa).geometry()[0]
+    for noise in (-1e-8, 1e-8):
+        noisy = Px4.from_params(params(noise), vehicle=hexa).geometry()[0]
+        np.testing.assert_allclose(noisy, exact, rtol=0, atol=1e-7)
+    with pytest.raises(InputError, match=r"CA_ROTOR2 .* is not the vehicle's rotor 3"):
+        Px4.from_params(params(0.0, flip=2), vehicle=hexa)
 
 
 def test_a_2000_vehicle_batch_flies():
@@ -180,6 +211,70 @@ def test_fly_params_flies_the_logs_parameters_and_lists_the_unused_once(tmp_path
     again = CliRunner().invoke(main, ["fly", str(out / "scenario.toml"), "--out", str(tmp_path / "g")])
     assert again.exit_code == 0, again.output  # the folder's scenario flies the same flight
     assert (tmp_path / "g" / "metrics.csv").read_text() == (out / "metrics.csv").read_text()
+
+
+def test_fly_params_with_c_says_which_wins(tmp_path):
+    """``-c`` changes the px4 controller's own fields over ``--params``; one that replaces the
+    file's parameters (``hover_from_vehicle``, ``rate_bandwidth``) says so, and ``-c params=``
+    beside ``--params`` (two sources of the same parameters) is refused before flying."""
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    (tmp_path / "a.params").write_text("1\t1\tMC_ROLL_P\t7\t9\n1\t1\tMPC_THR_HOVER\t0.45\t9\n")
+    (tmp_path / "b.params").write_text("1\t1\tMC_ROLL_P\t8\t9\n")
+    fly = ["fly", "hover", "--vehicle", "iris", "--duration", "0.2", "--params", str(tmp_path / "a.params")]
+    res = CliRunner().invoke(main, [*fly, "-c", f"params={tmp_path / 'b.params'}", "--out", str(tmp_path / "x")])
+    assert res.exit_code == 2 and "-c params=...: --params" in res.output and "give them once" in res.output
+    assert not (tmp_path / "x").exists()
+    res = CliRunner().invoke(main, [*fly, "-c", "hover_from_vehicle=true", "-c", "rate_bandwidth=15"])
+    assert res.exit_code == 0, res.output
+    assert "replaces" in res.stderr and "MPC_THR_HOVER (0.45)" in res.stderr
+    assert "-c rate_bandwidth=15: rate gains designed" in res.stderr
+    res = CliRunner().invoke(main, [*fly, "-c", "position_rate=50"])  # a field of its own: no word needed
+    assert res.exit_code == 0 and "replace" not in res.stderr
+
+
+def test_fly_a_scenario_with_params_keeps_its_px4_fields(tmp_path):
+    """A scenario's px4 fields that set no PX4 parameter (thrust_curve, position_rate,
+    hover_estimator) stay when ``--params`` gives other parameters; ``-c`` still wins."""
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+    from quadcruise.workflows.scenario import load_scenario
+
+    (tmp_path / "a.params").write_text("1\t1\tMC_ROLL_P\t7\t9\n")
+    (tmp_path / "b.params").write_text("1\t1\tMC_ROLL_P\t8\t9\n")
+    first = ["fly", "hover", "--vehicle", "iris", "--duration", "0.2", "--params", str(tmp_path / "a.params")]
+    first += ["-c", "thrust_curve=0.5", "-c", "position_rate=50", "-c", "hover_estimator=true"]
+    assert CliRunner().invoke(main, [*first, "--out", str(tmp_path / "s")]).exit_code == 0
+    again = ["fly", str(tmp_path / "s" / "scenario.toml"), "--params", str(tmp_path / "b.params")]
+    res = CliRunner().invoke(main, [*again, "-c", "position_rate=80", "--out", str(tmp_path / "t")])
+    assert res.exit_code == 0, res.output
+    c = load_scenario(tmp_path / "t" / "scenario.toml").controller
+    assert c.params["MC_ROLL_P"] == 8.0 and (c.thrust_curve, c.hover_estimator) == (0.5, True)
+    assert c.position_rate == 80.0  # -c over the scenario's 50
+
+
+def test_compare_params_keeps_a_scenarios_px4_fields(tmp_path):
+    """``compare --params`` over a scenario's compared px4 (a controller, not a name) keeps its
+    fields that set no PX4 parameter; a name gets the file's px4 as it is; px4 added once."""
+    from quadcruise.cli.objects import with_px4_params
+
+    (tmp_path / "b.params").write_text("1\t1\tMC_ROLL_P\t8\t9\n")
+    world = {"vehicle": RotorVehicle.preset("iris")}
+    mine = Px4(thrust_curve=0.5, position_rate=50.0, hover_estimator=True)
+    out = with_px4_params({"mine": mine, "se3": "se3"}, str(tmp_path / "b.params"), world)
+    assert set(out) == {"mine", "se3"} and out["se3"] == "se3"
+    got = out["mine"]
+    assert got.params["MC_ROLL_P"] == 8.0 and (got.thrust_curve, got.position_rate, got.hover_estimator) == (
+        0.5,
+        50.0,
+        True,
+    )
+    named = with_px4_params("se3,px4", str(tmp_path / "b.params"), world)
+    assert named["px4"].thrust_curve == 1.0 and named["px4"].params["MC_ROLL_P"] == 8.0  # the rotor plant's
+    assert set(with_px4_params("se3", str(tmp_path / "b.params"), world)) == {"se3", "px4"}
 
 
 @pytest.mark.parametrize(
@@ -217,6 +312,7 @@ def test_tune_px4_writes_tuned_params_that_fly_the_tuned_metrics_exactly(tmp_pat
     tuned = read_params(out / "tuned.params")
     doc = (out / "tuned.params").read_text()
     assert "# PX4 v1.15" in doc and "MC_ROLL_P\t" not in doc  # only what differs from PX4's defaults
+    assert "# tuned: MPC_XY_P, MPC_XY_VEL_P_ACC; the other lines are what the tune flew, not tuned" in doc
     from quadcruise.workflows.scenario import load_scenario
 
     values = load_scenario(out / "scenario.toml").controller.params  # the tuned controller, as the folder keeps it
@@ -235,6 +331,40 @@ def test_tune_px4_writes_tuned_params_that_fly_the_tuned_metrics_exactly(tmp_pat
         got = next(csv.DictReader(f))
     for name in ("rmse_m", "rise_time_s", "settling_time_s", "overshoot_pct", "effort"):
         assert float(got[name]) == float(best[name]), name
+
+
+def test_tune_px4_on_the_paper_plant_says_why_there_is_no_tuned_params(tmp_path):
+    """On the paper plant px4 flies gains designed for the vehicle that PX4's parameters cannot
+    hold (the rate P below PX4's @min 0.01): no tuned.params, and the tune says so and why."""
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    out = tmp_path / "t"
+    args = ["tune", "step", "--controller", "px4", "--duration", "6", "--quiet", "--budget", "2", "--popsize", "5"]
+    res = CliRunner().invoke(
+        main, [*args, "--gains", "params.MPC_XY_P", "--target", "rise_time_s=1.5", "--out", str(out)]
+    )
+    assert res.exit_code in (0, 1), res.output
+    assert (out / "tune.json").is_file() and not (out / "tuned.params").exists()
+    assert f"note: no {out}/tuned.params: its gains are designed for the vehicle" in res.stderr
+    assert "MC_ROLLRATE_P = 0.009375 is outside PX4 v1.15's range [0.01, 0.5]" in res.stderr
+
+
+def test_tune_refuses_an_integer_px4_parameter_before_searching(tmp_path):
+    """MC_AIRMODE, IMU_INTEG_RATE, ... are PX4 INT32 choices: --gains naming one is refused in
+    one line before any flight (it used to fail mid-search on the first non-integer candidate)."""
+    from click.testing import CliRunner
+
+    from quadcruise.cli.main import main
+
+    args = ["tune", "step", "--controller", "px4", "--vehicle", "iris", "--target", "rise_time_s=1.2", "--quiet"]
+    for name in ("IMU_INTEG_RATE", "MC_AIRMODE"):
+        res = CliRunner().invoke(
+            main, [*args, "--gains", f"params.MPC_XY_P,params.{name}", "--out", str(tmp_path / name)]
+        )
+        assert res.exit_code == 2 and f"--gains params.{name}: PX4 declares it an integer (INT32)" in res.output
+        assert res.output.count("\n") == 1 and not (tmp_path / name).exists()
 
 
 def test_px4s_parameters_are_searched_by_name_within_pxs_range():

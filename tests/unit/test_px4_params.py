@@ -124,3 +124,169 @@ def test_writing_refuses_a_value_out_of_range_and_writes_nothing(tmp_path):
     assert not (tmp_path / "t.params").exists()
     with pytest.raises(InputError, match="NOT_A_PARAM is not a parameter of the PX4 loops"):
         Px4Parameters.defaults().with_values(NOT_A_PARAM=1.0)
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("1\t1\tMC_ROLL_P\t12.00001\t9\n", "MC_ROLL_P = 12.00001 1/s is outside PX4 v1.15's range [0, 12]"),
+        ("1\t1\tMC_ROLLRATE_P\t0.00999\t9\n", "MC_ROLLRATE_P = 0.00999 is outside PX4 v1.15's range [0.01, 0.5]"),
+        ("1\t1\tMPC_USE_HTE\t1\t9\n", "MPC_USE_HTE has type 9 but PX4 declares it INT32 (type 6)"),
+        ("1\t1\tMC_ROLL_P\t7\t6\n", "MC_ROLL_P has type 6 but PX4 declares it FLOAT (type 9)"),
+        ("a\t1\tMC_ROLL_P\t7\t9\n", "MC_ROLL_P: Vehicle-Id 'a' and Component-Id '1' must be whole numbers"),
+    ],
+    ids=["just-above-max", "just-below-min", "int-as-float", "float-as-int", "vehicle-id"],
+)
+def test_just_outside_a_bound_and_type_mismatches_are_refused_naming_the_value(tmp_path, text, message):
+    """A value one float32 step outside PX4's range is named as it was written (not rounded to
+    the bound it exceeds); a line whose MAV_PARAM_TYPE is not the one PX4 declares is refused,
+    as QGroundControl refuses it on load."""
+    (tmp_path / "f.params").write_text(text)
+    with pytest.raises(InputError) as caught:
+        read_params(tmp_path / "f.params")
+    said = str(caught.value)
+    assert said.startswith(f"{tmp_path / 'f.params'}, line 1: {message}") and "\n" not in said
+
+
+def test_values_exactly_at_the_bounds_and_qgc_file_quirks_are_read(tmp_path):
+    """PX4's @min and @max themselves pass; a byte-order mark, CRLF line ends, blank lines,
+    comments and another vehicle's id are read; integer widths 1-8 for an INT32 parameter too."""
+    text = (
+        "\ufeff# Onboard parameters for Vehicle 2\r\n\r\n# Vehicle-Id Component-Id Name Value Type\r\n"
+        "2\t1\tMC_ROLL_P\t12\t9\r\n2\t1\tMC_ROLLRATE_P\t0.01\t9\r\n2\t1\tMPC_TILTMAX_AIR\t89\t9\r\n"
+        "2\t1\tMC_AIRMODE\t2\t5\r\n2\t1\tIMU_INTEG_RATE\t1000\t6\r\n"
+    )
+    (tmp_path / "v2.params").write_bytes(text.encode("utf-8"))
+    p = read_params(tmp_path / "v2.params")
+    assert (p["MC_ROLL_P"], p["MC_ROLLRATE_P"], p["MPC_TILTMAX_AIR"]) == (12.0, 0.01, 89.0)
+    assert (p["MC_AIRMODE"], p["IMU_INTEG_RATE"]) == (2.0, 1000.0)
+    assert p.unused == ()
+
+
+def test_px4s_own_constraints_are_applied_and_said():
+    """``MulticopterPositionControl::parameters_update`` (v1.15) constrains MPC_THR_HOVER into
+    [MPC_THR_MIN, MPC_THR_MAX] and MPC_TILTMAX_LND to at most MPC_TILTMAX_AIR; the px4
+    controller flies what PX4 flies, and the reader says it (the flown value named)."""
+    from quadcruise.control.px4 import Px4
+    from quadcruise.control.px4kernel import X_TILT_LND
+    from quadcruise.control.px4loops import G_THR_HOVER
+    from quadcruise.io.px4params import px4_constrained
+
+    base = Px4Parameters.defaults()
+    assert px4_constrained(base) == (dict(base), ())  # PX4's defaults are consistent
+    for given, flown in (
+        ({"MPC_THR_HOVER": 0.2, "MPC_THR_MIN": 0.4}, 0.4),
+        ({"MPC_THR_HOVER": 0.7, "MPC_THR_MAX": 0.6}, 0.6),
+        ({"MPC_THR_HOVER": 0.4, "MPC_THR_MIN": 0.4, "MPC_THR_MAX": 0.4}, 0.4),  # at the bounds: kept
+    ):
+        values, notes = px4_constrained(base.with_values(**given))
+        assert values["MPC_THR_HOVER"] == flown
+        assert len(notes) == (given["MPC_THR_HOVER"] != flown)
+        assert all(n.startswith(f"MPC_THR_HOVER = {given['MPC_THR_HOVER']:g} is outside") for n in notes)
+        gains = Px4.from_params(given).gains()
+        assert gains[G_THR_HOVER] == flown
+    values, notes = px4_constrained(base.with_values(MPC_TILTMAX_LND=60.0, MPC_TILTMAX_AIR=30.0))
+    assert values["MPC_TILTMAX_LND"] == 30.0 and "MPC_TILTMAX_LND = 60 deg is above" in notes[0]
+    gains = Px4.from_params({"MPC_TILTMAX_LND": 60.0, "MPC_TILTMAX_AIR": 30.0}).gains()
+    assert gains[X_TILT_LND] == pytest.approx(np.radians(30.0))
+    assert Px4.from_params({"MPC_TILTMAX_LND": 25.0}).gains()[X_TILT_LND] == pytest.approx(np.radians(25.0))
+
+
+def _shared_log(name: str) -> Path:
+    for folder in (Path(__file__).resolve().parents[3] / "shared" / "px4-logs", Path("/work/shared/px4-logs")):
+        if (folder / name).is_file():
+            return folder / name
+    pytest.skip(f"the real PX4 log {name} is not on this machine")
+
+
+def test_a_log_of_another_release_says_what_it_lacks_and_its_older_names():
+    """A log holds every parameter of its release: the loops' parameters it lacks fly at PX4
+    v1.15's defaults, and the reader says so once, naming the release pyulog reads and them;
+    an older release's velocity gains (``MPC_XY_VEL_P``: thrust per m/s, not m/s^2 per m/s)
+    are said not converted. The v1.15 SITL log gets no note."""
+    assert read_params(LOG).notes == ()
+    small = _shared_log("sample_log_small.ulg")  # PX4 v1.11.2 (dev): ver_sw_release 0x010b0200
+    raw = ULog(str(small), message_name_filter_list=[]).initial_parameters
+    lacking = sorted(n for n in PX4_PARAMETERS if n not in raw and not n.startswith("CA_"))
+    assert lacking == ["HTE_THR_RANGE", "HTE_VXY_THR", "HTE_VZ_THR", "MPC_THR_XY_MARG"]
+    (note,) = read_params(small).notes
+    assert f"{small} is a log of PX4 v1.11.2 (dev), not PX4 v1.15: it has no {', '.join(lacking)}" in note
+    old = _shared_log("sample.ulg")  # no ver_sw_release; MPC_XY_VEL_P and no MPC_XY_VEL_P_ACC
+    renamed, release = read_params(old).notes
+    assert "MPC_XY_VEL_P, MPC_Z_VEL_D" in renamed and "not converted" in renamed
+    assert "a PX4 release it does not state" in release and "MPC_XY_VEL_P_ACC" in release
+    text = "1\t1\tMPC_XY_VEL_P\t0.09\t9\n1\t1\tMC_ROLL_P\t7\t9\n"  # a .params file: its older names only
+    (said,) = parse_params_text(text, "old.params").notes
+    assert said.startswith("old.params names MPC_XY_VEL_P, an older PX4 release's gains in other units")
+    assert parse_params_text("1\t1\tMC_ROLL_P\t7\t9\n").notes == ()  # a partial file of this release: nothing
+
+
+def _ulog_bytes(params, changes) -> bytes:
+    """A minimal ULog as the format's specification lays it out (header, info, parameters, one
+    topic's format, subscription and data; parameter messages among the data are changes)."""
+    import struct
+
+    def msg(kind, payload):
+        return struct.pack("<HB", len(payload), ord(kind)) + payload
+
+    def kv(key, value):
+        return bytes([len(key)]) + key.encode() + value
+
+    out = b"ULog\x01\x12\x35" + bytes([1]) + struct.pack("<Q", 0) + msg("I", kv("char[3] sys_name", b"PX4"))
+    out += b"".join(msg("P", kv(f"float {n}", struct.pack("<f", v))) for n, v in params)
+    out += msg("F", b"topic_x:uint64_t timestamp;float a;") + msg("A", struct.pack("<BH", 0, 0) + b"topic_x")
+    for stamp, name, value in changes:
+        out += msg("D", struct.pack("<HQf", 0, stamp, 0.0))
+        out += msg("P", kv(f"float {name}", struct.pack("<f", value))) if name else b""
+    return out + msg("D", struct.pack("<HQf", 0, 20_000_000, 0.0))
+
+
+def test_a_log_that_changes_a_used_parameter_in_flight_says_so(tmp_path):
+    """pyulog reads the written log's changes; the reader takes the values at the log's end and
+    says which used parameters changed (a change to the same value, or of an unused one, is not said);
+    a log without parameters is refused in one line."""
+    path = tmp_path / "changed.ulg"
+    path.write_bytes(
+        _ulog_bytes(
+            [("MC_ROLL_P", 6.5), ("MC_PITCH_P", 6.5), ("SYS_X", 1.0)],
+            [
+                (1_000_000, None, 0.0),
+                (5_000_000, "MC_ROLL_P", 8.0),
+                (6_000_000, "MC_PITCH_P", 6.5),
+                (7_000_000, "SYS_X", 2.0),
+            ],
+        )
+    )
+    assert [(n, v) for _, n, v in ULog(str(path)).changed_parameters] == [
+        ("MC_ROLL_P", 8.0),
+        ("MC_PITCH_P", 6.5),
+        ("SYS_X", 2.0),
+    ]
+    p = read_params(path)
+    assert p["MC_ROLL_P"] == 8.0 and p["MC_PITCH_P"] == 6.5
+    assert f"{path} changes MC_ROLL_P during the log: the values at its end are used for the whole log" in p.notes
+    assert not any("MC_PITCH_P during" in n or "SYS_X during" in n for n in p.notes)
+    (tmp_path / "none.ulg").write_bytes(_ulog_bytes([], [(1_000_000, None, 0.0)]))
+    with pytest.raises(InputError, match=r"none.ulg: the log holds no parameters$"):
+        read_params(tmp_path / "none.ulg")
+
+
+def test_another_components_parameters_are_not_the_autopilots_and_two_vehicles_are_refused(tmp_path):
+    """QGroundControl saves every component's parameters: a gimbal's (Component-Id 154) of the
+    same name as the autopilot's is listed as unused, never flown nor "set twice"; a file of two
+    vehicles is refused naming both."""
+    text = "1\t1\tMC_ROLL_P\t7\t9\n1\t154\tMC_ROLL_P\t3\t9\n1\t154\tMNT_MODE_IN\t1\t6\n"
+    p = parse_params_text(text, "gimbal.params")
+    assert p["MC_ROLL_P"] == 7.0 and p.from_file == ("MC_ROLL_P",)
+    assert p.unused == ("MC_ROLL_P@component154", "MNT_MODE_IN@component154")
+    with pytest.raises(
+        InputError, match=r"^two.params, line 2: MC_ROLL_P: the file holds the parameters of vehicles 1"
+    ):
+        parse_params_text("1\t1\tMC_ROLL_P\t7\t9\n2\t1\tMC_ROLL_P\t8\t9\n", "two.params")
+
+
+def test_a_note_of_several_lines_is_written_as_comments(tmp_path):
+    path = write_params(tmp_path / "t.params", {"MC_ROLL_P": 7.0}, note="quadcruise tune step\ntuned: MC_ROLL_P")
+    text = path.read_text()
+    assert "# quadcruise tune step\n# tuned: MC_ROLL_P\n" in text
+    assert dict(read_params(path)) == dict(Px4Parameters.defaults().with_values(MC_ROLL_P=7.0))

@@ -242,7 +242,7 @@ def fly(
     flown, notes = flight_world(**world, scenario=scenario)
     if px4_params:
         the_controller = controller_with_params(
-            the_controller, controller, px4_params, controller_params, position_poles, flown
+            the_controller, controller, px4_params, controller_params, position_poles, flown, scenario
         )
     else:
         the_controller = controller_for_vehicle(

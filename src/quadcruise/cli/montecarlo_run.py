@@ -147,7 +147,7 @@ def montecarlo_command(
             from quadcruise.model.vehicle import Vehicle as _PaperVehicle
 
             world["vehicle"] = _PaperVehicle.paper()
-        controller = controller_with_params(None, controller, px4_params, (), None, world)
+        controller = controller_with_params(None, controller, px4_params, (), None, world, sc)
     environment = None
     if wind is not None or turbulence is not None:
         environment = environment_from_options(wind, turbulence, sc.environment if sc is not None else None)

@@ -107,7 +107,11 @@ def controller_for_vehicle(
     return controller_from_options(None, params, poles_text, base=designed)
 
 
-def controller_with_params(controller, name: str | None, path: str | None, params, poles_text, world):
+KEPT_PX4_FIELDS = ("thrust_curve", "position_rate", "hover_estimator", "takeoff", "takeoff_speed_up")
+"""The px4 fields a scenario's controller keeps under ``--params`` (those that set no PX4 parameter)."""
+
+
+def controller_with_params(controller, name: str | None, path: str | None, params, poles_text, world, scenario=None):
     """``--params``: the px4 controller with a log's or a ``.params`` file's PX4 parameters.
 
     Parameters
@@ -124,6 +128,9 @@ def controller_with_params(controller, name: str | None, path: str | None, param
         ``--poles`` (refused: the px4 controller has no PD position gains).
     world : dict
         :func:`quadcruise.cli.world.flight_world`'s: the controller's vehicle gives the rotor layout.
+    scenario : Scenario, optional
+        A scenario file read: a px4 ``[controller]`` of it keeps its fields that set no PX4
+        parameter (:data:`KEPT_PX4_FIELDS`: ``thrust_curve``, ``position_rate``, ...) under ``-c``.
 
     Returns
     -------
@@ -142,17 +149,41 @@ def controller_with_params(controller, name: str | None, path: str | None, param
     if poles_text is not None:
         raise InputError("--poles: the px4 controller takes its position gains from --params (MPC_XY_P, ...)")
     from quadcruise.control.px4 import Px4
-    from quadcruise.io.px4params import read_params
+    from quadcruise.io.px4params import px4_constrained, read_params
 
     read = read_params(path)
     believed = world.get("controller_vehicle") or world.get("vehicle")
-    px4 = Px4.from_params(read, vehicle=believed)
+    kept = getattr(scenario, "controller", None)
+    kept = {f: getattr(kept, f) for f in KEPT_PX4_FIELDS} if getattr(kept, "name", None) == "px4" else {}
+    px4 = Px4.from_params(read, vehicle=believed, **kept)
+    for note in read.notes:  # another release's log, older names
+        click.echo(f"note: {note}", err=True)
+    for note in px4_constrained(read)[1]:  # what PX4's parameters_update changes, as PX4 says it
+        click.echo(f"note: {path}: {note}", err=True)
     if read.unused:
         names = ", ".join(read.unused)
         click.echo(
             f"note: {len(read.unused)} parameters of {path} are not used by the px4 controller: {names}", err=True
         )
-    return controller_from_options(None, params, None, base=px4)
+    out = controller_from_options(None, params, None, base=px4)
+    if out.params is not px4.params:
+        raise InputError(
+            f"-c params=...: --params {path} gives the px4 controller's parameters; give them once "
+            "(one file, or a scenario's [controller] params)"
+        )
+    if out.hover_from_vehicle:  # the file's hover thrust not flown: said, not silently
+        click.echo(
+            f"note: -c hover_from_vehicle=true: the vehicle's hover thrust replaces {path}'s MPC_THR_HOVER "
+            f"({read['MPC_THR_HOVER']:g}), MPC_THR_MIN at most half of it",
+            err=True,
+        )
+    if out.rate_bandwidth > 0.0:
+        click.echo(
+            f"note: -c rate_bandwidth={out.rate_bandwidth:g}: rate gains designed for that rotor lag replace "
+            f"{path}'s MC_*RATE_P, _I, _D (and _K)",
+            err=True,
+        )
+    return out
 
 
 def mission_from_options(text: str, params: tuple[str, ...], smooth: bool):
@@ -237,7 +268,14 @@ def with_px4_params(chosen, path: str | None, world: dict):
     if isinstance(chosen, str):
         names = [n.strip() for n in chosen.split(",") if n.strip()]
         chosen = {n: n for n in names}
-    out = {label: (px4 if getattr(c, "name", c) == "px4" else c) for label, c in dict(chosen).items()}
-    if px4 not in out.values():
+    import dataclasses
+
+    def flown(c):  # a px4 of a scenario keeps its fields that set no PX4 parameter
+        if getattr(c, "name", c) != "px4":
+            return c
+        return px4 if isinstance(c, str) else dataclasses.replace(px4, **{f: getattr(c, f) for f in KEPT_PX4_FIELDS})
+
+    out = {label: flown(c) for label, c in dict(chosen).items()}
+    if not any(getattr(c, "name", c) == "px4" for c in out.values()):
         out["px4"] = px4
     return out

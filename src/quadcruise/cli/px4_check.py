@@ -149,6 +149,8 @@ def px4_check(
         f"{result.log}: PX4 {result.px4_version}; loops of PX4 v1.15 with the parameters of {result.params.source}"
     )
     click.echo(result.table())
+    for note in result.params.notes:  # another release's log: what flies at v1.15's defaults
+        click.echo(f"note: {note}")
     unused = result.params.unused
     if 0 < len(unused) <= 12:
         click.echo(f"not used by the loops: {', '.join(unused)} (of {result.params.source})")

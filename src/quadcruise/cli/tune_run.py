@@ -10,6 +10,8 @@ from collections.abc import Callable
 
 import click
 
+from quadcruise.errors import InputError
+
 __all__ = ["command_line", "tune_command"]
 
 
@@ -165,11 +167,14 @@ def tune_command(
     )
     plant = plants.of(world["vehicle"])
     if px4_params:
-        the_controller = controller_with_params(the_controller, controller, px4_params, controller_params, None, world)
+        the_controller = controller_with_params(
+            the_controller, controller, px4_params, controller_params, None, world, sc
+        )
     else:
         the_controller = controller_for_vehicle(the_controller, controller, controller_params, None, world, sc)
     the_controller = as_px4_parameters(the_controller, world, bool(px4_params))
     wanted["gains"] = parse_gains(gains, the_controller)
+    _refuse_integer_px4_gains(wanted["gains"], the_controller)
     environment = world["environment"]
     if wind_spread > 0 and plant.drag_for_wind and not any("wind acts only through drag" in line for line in notes):
         from quadcruise.disturbances import default_drag_text, with_drag
@@ -214,11 +219,49 @@ def tune_command(
 
             from quadcruise.io.px4params import write_params
 
-            path = write_params(Path(out) / "tuned.params", result.controller.params, note=command_line(mission, given))
+            searched = [g.removeprefix("params.") for g in result.gains]
+            note = (
+                f"{command_line(mission, given)}\n"
+                f"tuned: {', '.join(searched)}; the other lines are what the tune flew, not tuned "
+                "(the --params file's, or the design for the simulated vehicle: check those before loading)"
+            )
+            path = write_params(Path(out) / "tuned.params", result.controller.params, note=note)
             echo(
                 f"wrote {path}: `quadcruise fly MISSION --params {path}` (with the same vehicle) flies the tuned gains"
             )
+        elif getattr(result.controller, "name", None) == "px4":  # no tuned.params: said, with why
+            echo(f"note: no {out}/tuned.params: {_why_no_params(result.controller, world)}", err=True)
     return result
+
+
+def _refuse_integer_px4_gains(names, controller) -> None:
+    """A px4 parameter PX4 declares INT32 (``MC_AIRMODE``, ``IMU_INTEG_RATE``, ...) is a choice,
+    not a gain a continuous search can set: refused before the search, naming it."""
+    if getattr(controller, "name", None) != "px4" or not names:
+        return
+    from quadcruise.io.px4defaults import INT32, PX4_PARAMETERS
+
+    for name in names:
+        spec = PX4_PARAMETERS.get(name.removeprefix("params.")) if name.startswith("params.") else None
+        if spec is not None and spec.kind == INT32:
+            raise InputError(
+                f"--gains {name}: PX4 declares it an integer (INT32), which the search cannot set; "
+                f"tune with each value instead (a --params FILE setting it, e.g. "
+                f"{name.removeprefix('params.')} {spec.default:g})"
+            )
+
+
+def _why_no_params(controller, world: dict) -> str:
+    """Why a tuned px4 controller has no PX4 parameter form (the paper plant's design)."""
+    from quadcruise.model.equivalent import paper_equivalent
+
+    believed = world.get("controller_vehicle") or world.get("vehicle")
+    reason = "its gains are designed for the vehicle (rate_bandwidth, hover_from_vehicle)"
+    try:
+        controller.resolved(paper_equivalent(believed))
+    except InputError as exc:  # the design is outside PX4's ranges
+        reason += f" and PX4's parameters cannot hold them ({str(exc).removeprefix('argument: ')})"
+    return reason + "; tune a rotor vehicle (--vehicle iris) or PX4's own parameters (--params FILE) for one"
 
 
 def _px4_form(controller) -> bool:

@@ -83,7 +83,7 @@ from quadcruise.control.px4loops import G_RATE_D, G_RATE_I, G_RATE_P, G_THR_HOVE
 from quadcruise.errors import InputError
 from quadcruise.fields import Check, between
 from quadcruise.fields import unit_field as _f
-from quadcruise.io.px4params import Px4Parameters, read_params
+from quadcruise.io.px4params import Px4Parameters, px4_constrained, read_params
 
 __all__ = ["Px4", "px4_controller", "PX4C_GAINS", "PX4C_MEMORY", "MAX_ROTORS"]
 
@@ -268,18 +268,22 @@ class Px4(Controller):
             axes = np.tile([0.0, 0.0, -1.0], (n, 1))
             return rotor_effectiveness(pos, axes, np.ones(n), -layout[:, 3] * 0.05), layout
         if count != n:
+            had = f"the vehicle has {n} rotors" if self.rotors else "no rotor layout given: PX4's quadrotor x has 4"
             raise InputError(
-                f"{p.source}: CA_ROTOR_COUNT = {count}, the vehicle has {n} rotors (give the vehicle's own "
+                f"{p.source}: CA_ROTOR_COUNT = {count}, {had} (give the vehicle's own "
                 "geometry, or set CA_ROTOR_COUNT = 0 to allocate on the vehicle's layout)"
             )
         pos = np.array([[p[f"CA_ROTOR{i}_P{c}"] for c in "XYZ"] for i in range(n)])
         axes = np.array([[p[f"CA_ROTOR{i}_A{c}"] for c in "XYZ"] for i in range(n)])
         ct = np.array([p[f"CA_ROTOR{i}_CT"] for i in range(n)])
         km = np.array([p[f"CA_ROTOR{i}_KM"] for i in range(n)])
+        # a coordinate within a thousandth of the arm of an axis is on it (a file's -1e-8 is 0)
+        tol = 1e-3 * max(float(np.max(np.hypot(layout[:, 0], layout[:, 1]))), float(np.max(np.hypot(*pos[:, :2].T))))
+        side = lambda v: 0.0 if abs(v) <= tol else np.sign(v)  # noqa: E731
         for i in range(n):
             same = (
-                np.sign(pos[i, 0]) == np.sign(np.round(layout[i, 0], 9))
-                and np.sign(pos[i, 1]) == -np.sign(np.round(layout[i, 1], 9))
+                side(pos[i, 0]) == side(layout[i, 0])
+                and side(pos[i, 1]) == -side(layout[i, 1])
                 and np.sign(km[i]) == -np.sign(layout[i, 3])
             )
             if not same:
@@ -299,7 +303,7 @@ class Px4(Controller):
             :data:`PX4C_GAINS` (253) float64 entries: PX4's loops' gains in SI units, the
             allocation, the vehicle's layout, the filters and the flags (see the row).
         """
-        p = self.params
+        p = px4_constrained(self.params)[0]  # MPC_THR_HOVER, MPC_TILTMAX_LND as PX4 constrains them
         eff, layout = self.geometry()
         n = len(layout)
         mix, scale = mix_matrix(eff)

@@ -18,6 +18,7 @@ say once which were not used.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import struct
@@ -31,7 +32,15 @@ from quadcruise.errors import InputError
 from quadcruise.io.files import atomic_path
 from quadcruise.io.px4defaults import FLOAT, INT32, PX4_PARAMETERS, RELEASE
 
-__all__ = ["Px4Parameters", "read_params", "parse_params_text", "write_params", "params_text", "changed"]
+__all__ = [
+    "Px4Parameters",
+    "read_params",
+    "parse_params_text",
+    "write_params",
+    "params_text",
+    "changed",
+    "px4_constrained",
+]
 
 INTEGER_TYPES = frozenset(range(1, 9))
 """MAV_PARAM_TYPE of the integers (UINT8 .. INT64); 9 is REAL32, 10 REAL64."""
@@ -54,6 +63,10 @@ class Px4Parameters(Mapping):
         The used parameters the source set.
     unused : tuple of str
         The source's parameters the loops do not use, sorted.
+    notes : tuple of str
+        What a reader should be told of the source once (:func:`read_params`): a log of another
+        PX4 release lacking parameters the loops use (flown at v1.15's defaults), older names
+        of the loops' parameters (not converted).
 
     Examples
     --------
@@ -66,6 +79,7 @@ class Px4Parameters(Mapping):
     source: str = "defaults"
     from_file: tuple = ()
     unused: tuple = field(default=())
+    notes: tuple = field(default=(), compare=False)
 
     @classmethod
     def defaults(cls) -> Px4Parameters:
@@ -134,7 +148,15 @@ class Px4Parameters(Mapping):
         merged = dict(self.values)
         for name, value in values.items():
             merged[name] = _checked(name, value, "argument")
-        return Px4Parameters(merged, self.source, tuple(sorted(set(self.from_file) | set(values))), self.unused)
+        return Px4Parameters(
+            merged, self.source, tuple(sorted(set(self.from_file) | set(values))), self.unused, self.notes
+        )
+
+
+def _num(value: float) -> str:
+    """A value as a message shows it: enough digits that one just outside a bound does not
+    read as the bound (``12.00001``, not ``12``)."""
+    return f"{value:.12g}"
 
 
 def _checked(name: str, value, where: str) -> float:
@@ -149,7 +171,7 @@ def _checked(name: str, value, where: str) -> float:
     if not math.isfinite(number):
         raise InputError(f"{where}: {name} = {value} is not a finite number")
     if spec.kind == INT32 and number != round(number):
-        raise InputError(f"{where}: {name} = {number:g} is not an integer (PX4 declares it INT32)")
+        raise InputError(f"{where}: {name} = {_num(number)} is not an integer (PX4 declares it INT32)")
     low = -math.inf if spec.minimum is None else spec.minimum
     high = math.inf if spec.maximum is None else spec.maximum
     # PX4 stores floats as float32: a bound is met when the float32 values meet it
@@ -158,18 +180,46 @@ def _checked(name: str, value, where: str) -> float:
         lo = "-inf" if spec.minimum is None else f"{spec.minimum:g}"
         hi = "inf" if spec.maximum is None else f"{spec.maximum:g}"
         unit = f" {spec.unit}" if spec.unit else ""
-        raise InputError(f"{where}: {name} = {number:g}{unit} is outside PX4 {RELEASE}'s range [{lo}, {hi}]")
+        raise InputError(f"{where}: {name} = {_num(number)}{unit} is outside PX4 {RELEASE}'s range [{lo}, {hi}]")
     return number
 
 
-def _collect(raw: dict, where_of, source: str) -> Px4Parameters:
+RENAMED = {
+    "MPC_XY_VEL_P": "MPC_XY_VEL_P_ACC",
+    "MPC_XY_VEL_I": "MPC_XY_VEL_I_ACC",
+    "MPC_XY_VEL_D": "MPC_XY_VEL_D_ACC",
+    "MPC_Z_VEL_P": "MPC_Z_VEL_P_ACC",
+    "MPC_Z_VEL_I": "MPC_Z_VEL_I_ACC",
+    "MPC_Z_VEL_D": "MPC_Z_VEL_D_ACC",
+}
+"""Older PX4 releases' names of parameters the loops use (the velocity gains were in thrust, not
+acceleration, before PX4 v1.11): read as unused, never converted, and said."""
+
+
+def _collect(raw: dict, where_of, source: str, release: str | None = None) -> Px4Parameters:
+    """The used parameters of ``raw`` checked, the others listed; ``release`` (a log's PX4
+    version, a log holding every parameter of its release) makes a note of the used ones it lacks."""
     values = {k: float(v.default) for k, v in PX4_PARAMETERS.items()}
     for name, value in raw.items():
         if name in PX4_PARAMETERS:
             values[name] = _checked(name, value, where_of(name))
     used = tuple(sorted(n for n in raw if n in PX4_PARAMETERS))
     unused = tuple(sorted(n for n in raw if n not in PX4_PARAMETERS))
-    return Px4Parameters(values, source, used, unused)
+    notes = []
+    old = sorted(n for n in raw if n in RENAMED and RENAMED[n] not in raw)
+    if old:
+        notes.append(
+            f"{source} names {', '.join(old)}, an older PX4 release's gains in other units (now "
+            f"{', '.join(RENAMED[n] for n in old)}): not converted, PX4 {RELEASE}'s defaults flown for them"
+        )
+    if release is not None:
+        lacking = sorted(n for n in PX4_PARAMETERS if n not in raw and not n.startswith("CA_"))
+        if lacking:
+            notes.append(
+                f"{source} is a log of {release}, not PX4 {RELEASE}: it has no {', '.join(lacking)}; "
+                f"PX4 {RELEASE}'s defaults are flown for them"
+            )
+    return Px4Parameters(values, source, used, unused, tuple(notes))
 
 
 def parse_params_text(text: str, source: str = "<text>") -> Px4Parameters:
@@ -190,8 +240,10 @@ def parse_params_text(text: str, source: str = "<text>") -> Px4Parameters:
     ------
     InputError
         One line naming the file, the line and the parameter: a line that is not five fields,
-        a type that is not MAV_PARAM_TYPE, a value that is not a number (or not an integer for
-        an integer type), a parameter twice, a used parameter outside PX4's range.
+        a type that is not MAV_PARAM_TYPE (or not the one PX4 declares), a value that is not a
+        number (or not an integer for an integer type), a parameter twice, parameters of two
+        vehicles, a used parameter outside PX4's range. Parameters of a component other than
+        the autopilot (Component-Id 1) are listed as unused, as ``NAME@componentID``.
 
     Examples
     --------
@@ -205,6 +257,8 @@ def parse_params_text(text: str, source: str = "<text>") -> Px4Parameters:
     """
     raw: dict[str, float] = {}
     lines: dict[str, int] = {}
+    vehicles: dict[int, int] = {}  # Vehicle-Id -> its first line
+    text = text.removeprefix("\ufeff")  # a byte-order mark (a file saved by Windows' Notepad)
     for number, line in enumerate(text.splitlines(), start=1):
         stripped = line.strip()
         if not stripped or stripped.startswith("#"):
@@ -217,7 +271,12 @@ def parse_params_text(text: str, source: str = "<text>") -> Px4Parameters:
                 f"{where}: not a QGroundControl parameter line (Vehicle-Id Component-Id Name Value Type, "
                 f"tab separated): {stripped[:60]!r}"
             )
-        _, _, name, value, kind = fields
+        vehicle, component, name, value, kind = fields
+        if not (vehicle.isdigit() and component.isdigit()):
+            raise InputError(
+                f"{where}: {name}: Vehicle-Id {vehicle!r} and Component-Id {component!r} must be whole numbers "
+                "(a QGroundControl parameter line: Vehicle-Id Component-Id Name Value Type)"
+            )
         try:
             kind_number = int(kind)
         except ValueError:
@@ -232,6 +291,19 @@ def parse_params_text(text: str, source: str = "<text>") -> Px4Parameters:
             raise InputError(f"{where}: {name} = {value!r} is not a finite number")
         if kind_number in INTEGER_TYPES and parsed != round(parsed):
             raise InputError(f"{where}: {name} = {value!r} is not an integer (type {kind_number})")
+        vehicles.setdefault(int(vehicle), number)
+        if len(vehicles) > 1:
+            first = ", ".join(f"{v} (line {n})" for v, n in vehicles.items())
+            raise InputError(f"{where}: {name}: the file holds the parameters of vehicles {first}; give one vehicle's")
+        if int(component) != 1:  # another component's (a gimbal, a camera): not the autopilot's loops
+            name = f"{name}@component{int(component)}"
+        spec = PX4_PARAMETERS.get(name)
+        if spec is not None and (spec.kind == INT32) != (kind_number in INTEGER_TYPES):
+            declared = "INT32 (type 6)" if spec.kind == INT32 else "FLOAT (type 9)"
+            raise InputError(
+                f"{where}: {name} has type {kind_number} but PX4 declares it {declared} "
+                "(QGroundControl refuses such a line as a type mismatch)"
+            )
         if name in raw:
             raise InputError(f"{where}: {name} is set twice (first on line {lines[name]})")
         raw[name], lines[name] = parsed, number
@@ -252,11 +324,27 @@ def _read_ulog_params(path: Path) -> Px4Parameters:
     except (ULogException, struct.error, ValueError, IndexError) as exc:
         raise InputError(f"{path}: not a readable PX4 log ({exc})") from None
     raw = dict(log.initial_parameters)
+    moved = set()  # used parameters whose value changed in the log (pyulog without data: no times)
     for _, name, value in log.changed_parameters:
+        if name in PX4_PARAMETERS and name in raw and value != raw[name]:
+            moved.add(name)
         raw[name] = value
     if not raw:
         raise InputError(f"{path}: the log holds no parameters")
-    return _collect(raw, lambda n: f"{path}", str(path))
+    version = log.msg_info_dict.get("ver_sw_release")  # 0xMMmmppTT, TT: 0 dev, 64 alpha, 128 beta, 192 rc, 255
+    if isinstance(version, int) and version:
+        kind = {0: " (dev)", 64: " (alpha)", 128: " (beta)", 192: " (rc)", 255: ""}.get(version & 0xFF, "")
+        release = f"PX4 v{version >> 24}.{(version >> 16) & 0xFF}.{(version >> 8) & 0xFF}{kind}"
+    else:
+        release = "a PX4 release it does not state"
+    read = _collect(raw, lambda n: f"{path}", str(path), release)
+    if moved:
+        note = (
+            f"{path} changes {', '.join(sorted(moved))} during the log: the values at its end are used "
+            "for the whole log"
+        )
+        read = dataclasses.replace(read, notes=(*read.notes, note))
+    return read
 
 
 def read_params(path: str | os.PathLike) -> Px4Parameters:
@@ -297,10 +385,57 @@ def read_params(path: str | os.PathLike) -> Px4Parameters:
     if kind == ".ulg":
         return _read_ulog_params(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError:
         raise InputError(f"{path}: not a text file: not a QGroundControl .params file") from None
     return parse_params_text(text, str(path))
+
+
+def px4_constrained(values: Mapping[str, float]) -> tuple[dict[str, float], tuple[str, ...]]:
+    """The parameters as PX4 flies them after ``MulticopterPositionControl::parameters_update``
+    constrains them, and PX4's word for each change.
+
+    PX4 v1.15 sets (and commits) ``MPC_TILTMAX_LND`` to ``MPC_TILTMAX_AIR`` where it is larger
+    ("Land tilt has been constrained by max tilt") and ``MPC_THR_HOVER`` into
+    ``[MPC_THR_MIN, MPC_THR_MAX]`` (``math::constrain``: "Hover thrust has been constrained by
+    min/max"), each within its own range.
+
+    Parameters
+    ----------
+    values : Mapping of str to float
+        Every parameter the loops use (a :class:`Px4Parameters`).
+
+    Returns
+    -------
+    values : dict
+        The parameters, the constrained ones changed.
+    notes : tuple of str
+        One line per change, naming the parameter, its value and what PX4 flies.
+
+    Examples
+    --------
+    >>> v, notes = px4_constrained(Px4Parameters.defaults().with_values(MPC_THR_HOVER=0.2, MPC_THR_MIN=0.4))
+    >>> v["MPC_THR_HOVER"], notes[0][:60]
+    (0.4, 'MPC_THR_HOVER = 0.2 is outside [MPC_THR_MIN, MPC_THR_MAX] = ')
+    """
+    out = dict(values)
+    notes = []
+    air, lnd = out["MPC_TILTMAX_AIR"], out["MPC_TILTMAX_LND"]
+    if lnd > air:
+        out["MPC_TILTMAX_LND"] = air
+        notes.append(
+            f"MPC_TILTMAX_LND = {_num(lnd)} deg is above MPC_TILTMAX_AIR = {_num(air)} deg: PX4 constrains it "
+            f"to {_num(air)} deg (Land tilt has been constrained by max tilt)"
+        )
+    hover, low, high = out["MPC_THR_HOVER"], out["MPC_THR_MIN"], out["MPC_THR_MAX"]
+    if hover > high or hover < low:
+        flown = low if hover < low else high  # math::constrain(val, min, max)
+        out["MPC_THR_HOVER"] = flown
+        notes.append(
+            f"MPC_THR_HOVER = {_num(hover)} is outside [MPC_THR_MIN, MPC_THR_MAX] = [{_num(low)}, {_num(high)}]: "
+            f"PX4 constrains it to {_num(flown)} (Hover thrust has been constrained by min/max)"
+        )
+    return out, tuple(notes)
 
 
 def changed(values: Mapping[str, float]) -> dict[str, float]:
@@ -332,7 +467,7 @@ def params_text(values: Mapping[str, float], vehicle_id: int = 1, component_id: 
     vehicle_id, component_id : int
         MAVLink ids (QGroundControl's first two columns).
     note : str
-        One more comment line (e.g. the command that made it).
+        More comment lines (e.g. the command that made it), each written as a comment.
 
     Returns
     -------
@@ -349,8 +484,7 @@ def params_text(values: Mapping[str, float], vehicle_id: int = 1, component_id: 
         "# Onboard parameters for Vehicle 1, written by quadcruise",
         f"# PX4 {RELEASE}: only the parameters that differ from its defaults",
     ]
-    if note:
-        lines.append(f"# {note}")
+    lines += [f"# {line}" for line in note.splitlines()]  # each line a comment
     lines += ["#", "# Vehicle-Id\tComponent-Id\tName\tValue\tType"]
     for name in sorted(diff):
         spec = PX4_PARAMETERS[name]

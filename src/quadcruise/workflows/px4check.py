@@ -145,6 +145,7 @@ class Px4Check:
             "parameters": self.params.source,
             "parameters_used": {k: self.params[k] for k in sorted(self.params)},
             "parameters_unused": list(self.params.unused),
+            "parameters_notes": list(self.params.notes),
             "good_fit_r2": GOOD_FIT,
             "loops": self.loops,
             "limits": self.limits,
