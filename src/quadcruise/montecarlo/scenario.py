@@ -82,7 +82,9 @@ def merge_scenario(path, given: dict) -> tuple[Scenario, dict]:
     """A scenario, and its ``[montecarlo]`` table (and ``[simulation]`` seed) under the options given explicitly."""
     sc = load_scenario(path)
     table = dict(sc.montecarlo)
-    known = ({f.name for f in dataclasses.fields(Population)} - {"environment", "noise"}) | set(SPEC_KEYS)
+    known = ({f.name for f in dataclasses.fields(Population)} - {"environment", "noise", "sensors", "estimator"}) | set(
+        SPEC_KEYS
+    )
     unknown = set(table) - known - {"n", "seed"}
     if unknown:
         raise InputError(
@@ -104,6 +106,8 @@ def sweep_spec(
     dt: float | None = None,
     environment=None,
     noise=None,
+    sensors=None,
+    estimator=None,
     scenario=None,
     requirements=(),
     max_track_error_m: float | None = None,
@@ -123,6 +127,8 @@ def sweep_spec(
         controller = sc.controller if controller is None else controller
         environment = environment if environment is not None else sc.environment
         noise = noise if noise is not None else sc.sensor_noise
+        sensors = sensors if sensors is not None else sc.sensors
+        estimator = estimator if estimator is not None else sc.estimator
         options.update(
             vehicle=sc.vehicle,
             controller_vehicle=sc.controller_vehicle,
@@ -151,6 +157,10 @@ def sweep_spec(
     mission = "circle" if mission is None else mission
     controller = "nlpd" if controller is None else controller
     pop = Population(
-        **given, environment=environment if environment is not None and environment.parts else None, noise=noise
+        **given,
+        environment=environment if environment is not None and environment.parts else None,
+        noise=noise,
+        sensors=sensors,
+        estimator=estimator,
     )
     return MonteCarloSpec(mission=mission, controller=controller, population=pop, seed=seed, **options), n
