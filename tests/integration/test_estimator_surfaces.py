@@ -147,9 +147,10 @@ def test_a_sweep_row_is_the_vehicle_flown_alone_on_the_sensors_it_drew():
     assert sweep.table["estimate_position_rmse_m"].notna().all()
     assert sweep.table["imu_noise_factor"].nunique() == 3
     row = sweep.table.iloc[2]
+    imu, gps = TYPICAL.imu, TYPICAL.gps
     own = Sensors(
-        imu=dataclasses.replace(TYPICAL.imu, **{f: getattr(TYPICAL.imu, f) * row["imu_noise_factor"] for f in IMU_FIELDS}),
-        gps=dataclasses.replace(TYPICAL.gps, **{f: getattr(TYPICAL.gps, f) * row["gps_noise_factor"] for f in GPS_FIELDS}),
+        imu=dataclasses.replace(imu, **{f: getattr(imu, f) * row["imu_noise_factor"] for f in IMU_FIELDS}),
+        gps=dataclasses.replace(gps, **{f: getattr(gps, f) * row["gps_noise_factor"] for f in GPS_FIELDS}),
         baro=TYPICAL.baro, mag=TYPICAL.mag,
     )  # fmt: skip
     matched = Ekf(noise=Ekf().settings(TYPICAL, qc.Vehicle.paper().g))  # the filter of the datasheet's sensors

@@ -38,7 +38,7 @@ def test_the_estimate_is_observed_and_the_truth_kept_in_info():
     obs0, info0 = est[0]
     assert not info0["estimated"].any()  # before the filter's first period: the truth's
     np.testing.assert_array_equal(obs0, info0["true_obs"])
-    for (o_est, i_est), (o_truth, i_truth) in zip(est[1:], truth[1:], strict=True):
+    for (_, i_est), (o_truth, i_truth) in zip(est[1:], truth[1:], strict=True):
         assert i_est["estimated"].all() and "true_obs" not in i_truth
         np.testing.assert_array_equal(i_est["true_obs"], o_truth)  # the same flight, observed two ways
     o, i = est[-1]
