@@ -222,3 +222,29 @@ def test_tune_cli_refuses_an_estimator_without_its_sensors(tmp_path):
               "--out", out)  # fmt: skip
     one_line_exit_2(res, "--estimator ekf needs the sensor 'imu'")
     assert not out.exists()
+
+
+# --- fly's figure and report ----------------------------------------------------------------
+def test_the_estimate_figure_draws_the_truth_and_the_estimate_of_the_traces():
+    from quadcruise.plots.estimate import plot_estimate
+
+    r = qc.fly("circle", sensors=TYPICAL, estimator=Ekf(), duration=2.0, log_every=10, seed=4)
+    fig = plot_estimate(r)
+    frame = r.to_pandas()
+    lines = fig.axes[0].get_lines()  # x solid, x dashed, y solid, ...
+    np.testing.assert_array_equal(lines[0].get_ydata(), frame["x"].to_numpy())
+    np.testing.assert_array_equal(lines[1].get_ydata(), frame["x_est"].to_numpy())
+    np.testing.assert_array_equal(fig.axes[1].get_lines()[2].get_ydata(), (frame["z"] - frame["z_est"]).to_numpy())
+    assert f"{r.metrics()['estimate_position_rmse_m'].iloc[0]:.3g} m" in fig.get_suptitle()
+
+
+def test_fly_writes_the_estimate_figure_and_report_section_only_on_an_estimator(tmp_path):
+    on = run("fly", "hover", "--duration", "1", "--sensors", "imu,gps", "--estimator", "ekf",
+             "--out", tmp_path / "on", "--report", tmp_path / "on.html")  # fmt: skip
+    off = run("fly", "hover", "--duration", "1", "--sensors", "imu,gps",
+              "--out", tmp_path / "off", "--report", tmp_path / "off.html")  # fmt: skip
+    assert on.exit_code == 0 and off.exit_code == 0, on.output + off.output
+    assert (tmp_path / "on" / "estimate.png").stat().st_size > 10_000
+    assert not (tmp_path / "off" / "estimate.png").exists()  # sensors logged, the controller on the truth
+    assert "estimate the controller flew on (imu, gps)" in (tmp_path / "on.html").read_text()
+    assert "estimate the controller flew on" not in (tmp_path / "off.html").read_text()
