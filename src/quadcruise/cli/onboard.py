@@ -6,8 +6,8 @@ Examples
 --------
 >>> parse_sensors("imu=bmi088,gps,baro,mag").names()
 ('imu', 'gps', 'baro', 'mag')
->>> parse_estimator("ekf").rate_cutoff
-40.0
+>>> parse_estimator("ekf").latency_compensation
+True
 >>> parse_sensors("imu,lidar")
 Traceback (most recent call last):
     ...

@@ -214,9 +214,8 @@ def predict(x, P, gx, gy, gz, ax, ay, az, dt, noise, gravity):
     c = 1.0 / math.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
     x[XQ], x[XQ + 1], x[XQ + 2], x[XQ + 3] = nw * c, nx * c, ny * c, nz * c
     # A = -R [f]x dt, B = -R dt, C = Exp(w dt)^T: the blocks of F
-    A = np.empty((3, 3))
-    B = np.empty((3, 3))
-    C = np.empty((3, 3))
+    blocks = np.empty((3, 3, 3))
+    A, B, C = blocks[0], blocks[1], blocks[2]
     for i in range(3):
         if i == 0:
             ri0, ri1, ri2 = r00, r01, r02
@@ -241,7 +240,7 @@ def predict(x, P, gx, gy, gz, ax, ay, az, dt, noise, gravity):
             P[EV + i, j] = v + A[i, 0] * t0 + A[i, 1] * t1 + A[i, 2] * t2 + B[i, 0] * b0 + B[i, 1] * b1 + B[i, 2] * b2
         for i in range(3):
             P[ETH + i, j] = C[i, 0] * t0 + C[i, 1] * t1 + C[i, 2] * t2 - dt * P[EBG + i, j]
-    for j in range(E_SIZE):  # then P <- P F^T, row by row
+    for j in range(EBG):  # then P <- P F^T, row by row (the bias rows below: by symmetry)
         t0, t1, t2 = P[j, ETH], P[j, ETH + 1], P[j, ETH + 2]
         b0, b1, b2 = P[j, EBA], P[j, EBA + 1], P[j, EBA + 2]
         for i in range(3):
@@ -250,6 +249,9 @@ def predict(x, P, gx, gy, gz, ax, ay, az, dt, noise, gravity):
             P[j, EV + i] = v + A[i, 0] * t0 + A[i, 1] * t1 + A[i, 2] * t2 + B[i, 0] * b0 + B[i, 1] * b1 + B[i, 2] * b2
         for i in range(3):
             P[j, ETH + i] = C[i, 0] * t0 + C[i, 1] * t1 + C[i, 2] * t2 - dt * P[j, EBG + i]
+    for j in range(EBG, E_SIZE):  # F leaves the bias columns as they are: (F P F^T)[b, :9] = (F P)[:9, b]^T
+        for c in range(EBG):
+            P[j, c] = P[c, j]
     for i in range(3):
         P[EV + i, EV + i] += noise[1] ** 2 * dt
         P[ETH + i, ETH + i] += noise[0] ** 2 * dt
@@ -293,42 +295,48 @@ def inject(x, P, dx):
 
 
 @njit(cache=True)
-def inverse_small(S):
-    """The inverse of a 1 x 1 or 3 x 3 matrix in closed form (cofactors), else numpy's.
+def inverse_small(S, out):
+    """The inverse of a 1 x 1 or 3 x 3 matrix in closed form (cofactors) into ``out``, else
+    numpy's.
 
     Examples
     --------
     >>> import numpy as np
-    >>> inverse_small(np.diag([2.0, 4.0, 5.0])).diagonal().tolist()
+    >>> inverse_small(np.diag([2.0, 4.0, 5.0]), np.empty((3, 3))).diagonal().tolist()
     [0.5, 0.25, 0.2]
     """
     m = S.shape[0]
     if m == 1:
-        out = np.empty((1, 1))
         out[0, 0] = 1.0 / S[0, 0]
         return out
     if m != 3:
-        return np.linalg.inv(S)
+        out[:, :] = np.linalg.inv(S)
+        return out
     a, b, c, d, e, f, g, h, i = S[0, 0], S[0, 1], S[0, 2], S[1, 0], S[1, 1], S[1, 2], S[2, 0], S[2, 1], S[2, 2]
     c00, c01, c02 = e * i - f * h, c * h - b * i, b * f - c * e
     c10, c11, c12 = f * g - d * i, a * i - c * g, c * d - a * f
     c20, c21, c22 = d * h - e * g, b * g - a * h, a * e - b * d
     det = a * c00 + b * c10 + c * c20
-    out = np.empty((3, 3))
     out[0, 0], out[0, 1], out[0, 2] = c00 / det, c01 / det, c02 / det
     out[1, 0], out[1, 1], out[1, 2] = c10 / det, c11 / det, c12 / det
     out[2, 0], out[2, 1], out[2, 2] = c20 / det, c21 / det, c22 / det
     return out
 
 
+WORK_ROWS = 9
+"""Rows of :func:`update`'s scratch (``(WORK_ROWS, 15)``): P H^T (3), the error's estimate, P h,
+the gain, S and its inverse (row-major)."""
+
+
 @njit(cache=True)
-def update(x, P, H, r, var, gate):
+def update(x, P, H, r, var, gate, work):
     """One Kalman update with the innovation ``r`` (m,), its Jacobian ``H`` (m, 15) and the
     measurement's variances ``var`` (m,); refused when the NIS passes ``gate``.
 
-    The Joseph form ``(I - K H) P (I - K H)^T + K R K^T``, expanded as
-    ``P - K (P H^T)^T - (P H^T) K^T + K S K^T`` (``S = H P H^T + R``) so that it costs
-    O(15^2 m) rather than dense 15 x 15 products.
+    The gate and the NIS are the whole measurement's (``S = H P H^T + R``); an accepted one is
+    fused a row at a time (R diagonal: the same as all at once), each in the Joseph form
+    ``(I - k h) P (I - k h)^T + k r k^T`` expanded as ``P - k (P h)^T - (P h) k^T + s k k^T``, so
+    that it costs O(15^2 m) and no dense 15 x 15 product; the error's estimate is injected once.
 
     Parameters
     ----------
@@ -342,6 +350,8 @@ def update(x, P, H, r, var, gate):
         (m,) measurement noise variances.
     gate : float
         Largest NIS accepted (a chi-square quantile with m degrees of freedom; inf: all).
+    work : numpy.ndarray
+        (WORK_ROWS, 15) scratch (the filter runs in the engine's period: no allocation).
 
     Returns
     -------
@@ -349,57 +359,130 @@ def update(x, P, H, r, var, gate):
         The NIS ``r^T S^-1 r``; negative when refused (its magnitude is the NIS).
     """
     m = r.shape[0]
-    PHt = np.zeros((E_SIZE, m))
-    for i in range(E_SIZE):
-        for a in range(m):
+    for a in range(m):  # P H^T, row a of work: P h_a
+        for i in range(E_SIZE):
             acc = 0.0
             for j in range(E_SIZE):
                 if H[a, j] != 0.0:
                     acc += P[i, j] * H[a, j]
-            PHt[i, a] = acc
-    S = np.zeros((m, m))
+            work[a, i] = acc
+    S = work[7, : m * m].reshape((m, m))
+    Si = work[8, : m * m].reshape((m, m))
     for a in range(m):
         for b in range(m):
             acc = 0.0
             for j in range(E_SIZE):
                 if H[a, j] != 0.0:
-                    acc += H[a, j] * PHt[j, b]
+                    acc += H[a, j] * work[b, j]
             S[a, b] = acc
         S[a, a] += var[a]
-    Si = inverse_small(S)
+    inverse_small(S, Si)
     nis = 0.0
     for a in range(m):
         for b in range(m):
             nis += r[a] * Si[a, b] * r[b]
     if nis > gate:
         return -nis
-    K = np.zeros((E_SIZE, m))
-    dx = np.zeros(E_SIZE)
+    # accepted: the m rows one after another (R diagonal: the same update as all at once)
+    dx, ph, k = work[3], work[4], work[5]
     for i in range(E_SIZE):
-        for a in range(m):
-            acc = 0.0
-            for b in range(m):
-                acc += PHt[i, b] * Si[b, a]
-            K[i, a] = acc
-            dx[i] += acc * r[a]
-    KS = np.zeros((E_SIZE, m))
-    for i in range(E_SIZE):
-        for a in range(m):
-            for b in range(m):
-                KS[i, a] += K[i, b] * S[b, a]
-    for i in range(E_SIZE):
-        for j in range(i, E_SIZE):
-            acc = P[i, j]
-            for a in range(m):
-                acc += KS[i, a] * K[j, a] - K[i, a] * PHt[j, a] - PHt[i, a] * K[j, a]
-            P[i, j] = acc
-            P[j, i] = acc
+        dx[i] = 0.0
+        ph[i] = work[0, i]
+    for a in range(m):
+        if a > 0:
+            for i in range(E_SIZE):
+                acc = 0.0
+                for j in range(E_SIZE):
+                    if H[a, j] != 0.0:
+                        acc += P[i, j] * H[a, j]
+                ph[i] = acc
+        s = var[a]
+        innov = r[a]
+        for j in range(E_SIZE):
+            if H[a, j] != 0.0:
+                s += H[a, j] * ph[j]
+                innov -= H[a, j] * dx[j]
+        for i in range(E_SIZE):
+            k[i] = ph[i] / s
+            dx[i] += k[i] * innov
+        for i in range(E_SIZE):  # Joseph: P - k ph^T - ph k^T + s k k^T
+            for j in range(i, E_SIZE):
+                v = P[i, j] + s * k[i] * k[j] - k[i] * ph[j] - ph[i] * k[j]
+                P[i, j] = v
+                P[j, i] = v
     inject(x, P, dx)
     return nis
 
 
 @njit(cache=True)
-def heading_innovation(x, mx, my, mz, field):
+def update_states(x, P, first, r, var, gate, work):
+    """:func:`update` for a measurement of ``m`` consecutive error states from ``first`` (the GPS's
+    position or velocity, the barometer's altitude: ``H`` unit rows), without forming ``H``: the
+    same gate, NIS and row-by-row Joseph update, at a fraction of the cost.
+
+    Parameters
+    ----------
+    x, P : numpy.ndarray
+        Nominal state (16,) and covariance (15, 15), updated when accepted.
+    first : int
+        The first error state measured.
+    r, var : numpy.ndarray
+        (m,) innovation and measurement variances.
+    gate : float
+        Largest NIS accepted.
+    work : numpy.ndarray
+        (WORK_ROWS, 15) scratch.
+
+    Returns
+    -------
+    float
+        The NIS; negative when refused.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x, P = np.r_[np.zeros(6), 1.0, np.zeros(9)], np.eye(15)
+    >>> nis = update_states(x, P, 2, np.array([1.0]), np.array([1.0]), np.inf, np.empty((WORK_ROWS, 15)))
+    >>> nis, x[2], P[2, 2]                   # half-way, half the variance
+    (0.5, 0.5, 0.5)
+    """
+    m = r.shape[0]
+    S = work[7, : m * m].reshape((m, m))
+    Si = work[8, : m * m].reshape((m, m))
+    for a in range(m):
+        for b in range(m):
+            S[a, b] = P[first + a, first + b]
+        S[a, a] += var[a]
+    inverse_small(S, Si)
+    nis = 0.0
+    for a in range(m):
+        for b in range(m):
+            nis += r[a] * Si[a, b] * r[b]
+    if nis > gate:
+        return -nis
+    dx, ph, k = work[3], work[4], work[5]
+    for i in range(E_SIZE):
+        dx[i] = 0.0
+    for a in range(m):
+        c = first + a
+        s = P[c, c] + var[a]
+        innov = r[a] - dx[c]
+        for i in range(E_SIZE):
+            ph[i] = P[i, c]
+            k[i] = ph[i] / s
+            dx[i] += k[i] * innov
+        for i in range(E_SIZE):  # Joseph: P - k ph^T - ph k^T + s k k^T
+            ki, pi = k[i], ph[i]
+            for j in range(i, E_SIZE):
+                v = P[i, j] + s * ki * k[j] - ki * ph[j] - pi * k[j]
+                P[i, j] = v
+                P[j, i] = v
+    inject(x, P, dx)
+    return nis
+
+
+@njit(cache=True)
+def heading_innovation(x, mx, my, mz, field, H):
     """The heading innovation of a magnetometer reading (FLU) and its Jacobian (15,).
 
     The reading turned into the world by the estimate, ``m = R m_b``, points its horizontal part
@@ -416,19 +499,24 @@ def heading_innovation(x, mx, my, mz, field):
         The reading [G].
     field : numpy.ndarray
         (3,) the world field [G], ENU.
+    H : numpy.ndarray
+        (1, 15) output: the Jacobian.
 
     Returns
     -------
-    tuple
-        (innovation [rad], H (1, 15)).
+    float
+        The innovation [rad].
     """
-    R = rotation(x[XQ : XQ + 4])
-    me = R[0, 0] * mx + R[0, 1] * my + R[0, 2] * mz
-    mn = R[1, 0] * mx + R[1, 1] * my + R[1, 2] * mz
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = rot9(x[XQ], x[XQ + 1], x[XQ + 2], x[XQ + 3])
+    me = r00 * mx + r01 * my + r02 * mz
+    mn = r10 * mx + r11 * my + r12 * mz
     r = math.atan2(me, mn) - math.atan2(field[0], field[1])
     r = (r + math.pi) % (2.0 * math.pi) - math.pi
     h2 = field[0] ** 2 + field[1] ** 2
-    hphi = np.array([-field[2] * field[0] / h2, -field[2] * field[1] / h2, 1.0])
-    H = np.zeros((1, E_SIZE))
-    H[0, ETH : ETH + 3] = hphi @ R
-    return r, H
+    h0, h1 = -field[2] * field[0] / h2, -field[2] * field[1] / h2  # (h0, h1, 1) R: the body frame's
+    for j in range(E_SIZE):
+        H[0, j] = 0.0
+    H[0, ETH] = h0 * r00 + h1 * r10 + r20
+    H[0, ETH + 1] = h0 * r01 + h1 * r11 + r21
+    H[0, ETH + 2] = h0 * r02 + h1 * r12 + r22
+    return r

@@ -13,12 +13,17 @@ At each control period k (instant t) of one vehicle, :func:`onboard`:
    (:func:`~quadcruise.estimation.ekf.predict`), then fuses the GPS fixes that have arrived, the
    barometer's and the magnetometer's readings (GPS position and velocity, altitude, heading, in
    that order, each gated), so the in-loop filter is :func:`~quadcruise.estimation.run.run_ekf`
-   fed the same samples (its reading k, covering ``[t_k, t_k+1]``, is the one read at t_k+1);
+   fed the same samples (its reading k, covering ``[t_k, t_k+1]``, is the one read at t_k+1). A
+   GPS fix arrives ``latency`` late: it is moved on by the estimate's change since the IMU
+   instant at or before it was taken (kept in a short history), so its innovation is taken
+   against the estimate of its own time, not against the present one (a cheap form of PX4's
+   delayed fusion horizon; ``Ekf(latency_compensation=False)`` fuses it as if it were fresh);
 3. writes what the controller sees (:data:`quadcruise.layout.STATE`): the estimate's position,
    velocity and ZYX Euler angles (yaw unwrapped), its body rates the gyro minus the estimated
-   bias through a first-order low-pass of cutoff ``rate_cutoff`` (PX4 filters the rates its rate
-   loop reads, ``IMU_GYRO_CUTOFF``), and F1..F4, the actuator state, as the truth (no sensor reads
-   it; PX4 knows its own commands). Between IMU instants it is held.
+   bias (through a first-order low-pass of cutoff ``rate_cutoff`` if one is given, as PX4
+   filters the rates its rate loop reads, ``IMU_GYRO_CUTOFF``), and F1..F4, the actuator
+   state, as the truth (no sensor reads it; PX4 knows its own commands). Between IMU instants
+   it is held.
 
 Its memory (:data:`MEMORY` ``(slots)``) carries the sensors' biases, the filter's state and
 covariance, the GPS queue and the log row, so a flight cut into calls is the flight flown in one;
@@ -41,6 +46,7 @@ from quadcruise.estimation.ekf import (
     EP,
     ETH,
     EV,
+    WORK_ROWS,
     X_SIZE,
     XBA,
     XBG,
@@ -54,6 +60,7 @@ from quadcruise.estimation.ekf import (
     quat_mul,
     rot9,
     update,
+    update_states,
 )
 from quadcruise.estimation.run import M_BARO, M_BARO_OFF, M_G, M_HEAD, M_POS_H, M_POS_V, M_SIZE, M_VEL_H, M_VEL_V
 from quadcruise.layout import Row
@@ -67,7 +74,7 @@ from quadcruise.sensors.noise import noisy
 PARAMS = Row.of(
     "onboard parameters",
     *("imu_on", "gps_on", "baro_on", "mag_on", "ekf_on"),
-    *("imu_every", "gps_every", "baro_every", "mag_every", "gps_delay", "gps_slots"),
+    *("imu_every", "gps_every", "baro_every", "mag_every", "gps_delay", "gps_slots", "history"),
     ("imu", IMU_ROW.size),
     ("gps", GPS_ROW.size),
     ("baro", BARO_ROW.size),
@@ -81,7 +88,8 @@ PARAMS = Row.of(
     prefix="OP_",
 )
 """A vehicle's stage parameters: which sensors and whether the EKF run (1/0), each sensor's
-period in control periods, the GPS latency in periods and its queue's length, each sensor's
+period in control periods, the GPS latency in periods, its queue's length and the length of the
+estimate's history the GPS fixes are fused against (0: latency not compensated), each sensor's
 parameter row (:meth:`quadcruise.sensors.model.SensorModel.row`), the world magnetic field (ENU,
 [G]), the filter's densities (:meth:`~quadcruise.estimation.run.EkfNoise.noise_row`), measurement
 settings (:data:`~quadcruise.estimation.run.MEAS`), gates per degree of freedom, initial standard
@@ -90,15 +98,17 @@ IMU_SIZE, GPS_SIZE, BARO_SIZE, MAG_SIZE = IMU_ROW.size, GPS_ROW.size, BARO_ROW.s
 KERNEL_SIZE = L.OBSERVER_KERNEL.size
 (
     OP_IMU_ON, OP_GPS_ON, OP_BARO_ON, OP_MAG_ON, OP_EKF_ON,
-    OP_IMU_EVERY, OP_GPS_EVERY, OP_BARO_EVERY, OP_MAG_EVERY, OP_GPS_DELAY, OP_GPS_SLOTS,
+    OP_IMU_EVERY, OP_GPS_EVERY, OP_BARO_EVERY, OP_MAG_EVERY, OP_GPS_DELAY, OP_GPS_SLOTS, OP_HISTORY,
     OP_IMU, OP_GPS, OP_BARO, OP_MAG, OP_FIELD, OP_NOISE, OP_MEAS, OP_GATES, OP_P0, OP_RATE_ALPHA,
 ) = PARAMS.offsets  # fmt: skip
 
 GPS_ENTRY = 8
 """A queued GPS fix: its arrival period, its sample time [s], position [m] and velocity [m/s]."""
+HISTORY_ENTRY = 7
+"""An entry of the estimate's history: its IMU instant's period, position [m], velocity [m/s]."""
 
 
-def memory_row(slots: int) -> Row:
+def memory_row(slots: int, history: int = 0) -> Row:
     """The stage's memory with a GPS queue of ``slots`` fixes: the kernel's part
     (:data:`quadcruise.layout.OBSERVER_KERNEL`), then the IMU's state, its last reading, the
     trapezoid sum of the true specific force and rates over its period, its last instant [s],
@@ -106,12 +116,15 @@ def memory_row(slots: int) -> Row:
     covariance (15 x 15, row-major), the rates filter [rad/s], the yaw [rad] last written, the
     truth at the last IMU instant (position, velocity, Euler angles) and whether its errors are
     still to be logged, the pending barometer and magnetometer readings (a flag, then the value),
-    the log row, and the GPS queue (head, count, then ``slots`` entries of :data:`GPS_ENTRY`).
+    the log row, the GPS queue (head, count, then ``slots`` entries of :data:`GPS_ENTRY`) and the
+    estimate's history at the last ``history`` IMU instants (:data:`HISTORY_ENTRY` each).
 
     Parameters
     ----------
     slots : int
         The GPS queue's length.
+    history : int
+        The history's length.
 
     Returns
     -------
@@ -144,6 +157,7 @@ def memory_row(slots: int) -> Row:
         "gps_head",
         "gps_count",
         ("gps_queue", GPS_ENTRY * int(slots)),
+        *((("history", HISTORY_ENTRY * int(history)),) if history else ()),
         parent=L.OBSERVER_KERNEL,
         prefix="OM_",
     )
@@ -330,6 +344,10 @@ def fuse(t, k, op, om):
     meas, gates = op[OP_MEAS : OP_MEAS + M_SIZE], op[OP_GATES : OP_GATES + 4]
     slots = int(op[OP_GPS_SLOTS])
     ekf = op[OP_EKF_ON] != 0.0
+    scratch = np.empty((WORK_ROWS + 1, E_SIZE))  # one allocation: the updates' scratch, the heading's H
+    work, H1 = scratch[:WORK_ROWS], scratch[WORK_ROWS : WORK_ROWS + 1]
+    rv = work[6]  # r (3), then var (3): a row update() leaves alone
+    r3, var3, r1, var1 = rv[0:3], rv[3:6], rv[6:7], rv[7:8]
     while om[OM_GPS_COUNT] > 0.0:
         at = OM_GPS_QUEUE + GPS_ENTRY * int(om[OM_GPS_HEAD])
         if om[at] > k:
@@ -342,33 +360,39 @@ def fuse(t, k, op, om):
         log[L.O_GPS_COUNT] += 1.0
         if not ekf:
             continue
-        H3 = np.zeros((3, E_SIZE))
-        r3, var3 = np.empty(3), np.empty(3)
+        delta = np.zeros(6)  # the estimate's change since the fix was taken: the fix moved on by it
+        history = int(op[OP_HISTORY])
+        if history:
+            imu_every = int(op[OP_IMU_EVERY])
+            ks = int(om[at] - op[OP_GPS_DELAY])  # the period the fix was taken at
+            k_imu = (ks // imu_every) * imu_every  # the IMU instant at or before it
+            if k_imu < k:
+                h = OM_GPS_QUEUE + GPS_ENTRY * slots + HISTORY_ENTRY * ((k_imu // imu_every) % history)
+                if om[h] == k_imu:
+                    for i in range(3):
+                        delta[i] = xe[XP + i] - om[h + 1 + i]
+                        delta[3 + i] = xe[XV + i] - om[h + 4 + i]
         for part in range(2):  # position, then velocity
-            H3[:, :] = 0.0
             base = XP if part == 0 else XV
             var3[0] = var3[1] = meas[M_POS_H if part == 0 else M_VEL_H] ** 2
             var3[2] = meas[M_POS_V if part == 0 else M_VEL_V] ** 2
             for i in range(3):
-                H3[i, base + i] = 1.0
-                r3[i] = om[at + 2 + 3 * part + i] - xe[base + i]
+                r3[i] = om[at + 2 + 3 * part + i] + delta[3 * part + i] - xe[base + i]
                 log[L.O_INNOV + 3 * part + i] = r3[i]
                 log[L.O_INNOV_VAR + 3 * part + i] = P[base + i, base + i] + var3[i]
-            log[L.O_NIS + part] = update(xe, P, H3, r3, var3, gates[3])
+            log[L.O_NIS + part] = update_states(xe, P, EP if part == 0 else EV, r3, var3, gates[3], work)
     if om[OM_BARO_DUE] != 0.0:
         om[OM_BARO_DUE] = 0.0
         if ekf:
-            H1, r1, var1 = np.zeros((1, E_SIZE)), np.empty(1), np.empty(1)
-            H1[0, EP + 2] = 1.0
             r1[0] = om[OM_BARO] - meas[M_BARO_OFF] - xe[XP + 2]
             var1[0] = meas[M_BARO] ** 2
             log[L.O_INNOV + 6], log[L.O_INNOV_VAR + 6] = r1[0], P[EP + 2, EP + 2] + var1[0]
-            log[L.O_NIS + 2] = update(xe, P, H1, r1, var1, gates[1])
+            log[L.O_NIS + 2] = update_states(xe, P, EP + 2, r1, var1, gates[1], work)
     if om[OM_MAG_DUE] != 0.0:
         om[OM_MAG_DUE] = 0.0
         if ekf:
-            r, Hm = heading_innovation(xe, om[OM_MAG], om[OM_MAG + 1], om[OM_MAG + 2], op[OP_FIELD : OP_FIELD + 3])
-            r1, var1 = np.empty(1), np.empty(1)
+            Hm = H1
+            r = heading_innovation(xe, om[OM_MAG], om[OM_MAG + 1], om[OM_MAG + 2], op[OP_FIELD : OP_FIELD + 3], Hm)
             r1[0] = r
             var1[0] = meas[M_HEAD] ** 2
             hph = 0.0
@@ -376,7 +400,7 @@ def fuse(t, k, op, om):
                 for j in range(ETH, ETH + 3):
                     hph += Hm[0, i] * P[i, j] * Hm[0, j]
             log[L.O_INNOV + 7], log[L.O_INNOV_VAR + 7] = r, hph + var1[0]
-            log[L.O_NIS + 3] = update(xe, P, Hm, r1, var1, gates[1])
+            log[L.O_NIS + 3] = update(xe, P, Hm, r1, var1, gates[1], work)
 
 
 @njit(cache=True, inline="always")
@@ -494,6 +518,12 @@ def onboard(t, k, logging, x, op, om, rng, seen, obs):
                     w = last[i] - om[OM_X + XBG + i]
                     om[OM_RATES + i] += a * (w - om[OM_RATES + i])
                 write_estimate(x, om)
+                history = int(op[OP_HISTORY])
+                if history:  # the estimate at this IMU instant, for the fixes taken now
+                    h = OM_GPS_QUEUE + GPS_ENTRY * int(op[OP_GPS_SLOTS]) + HISTORY_ENTRY * ((k // imu_every) % history)
+                    om[h] = k
+                    for i in range(6):
+                        om[h + 1 + i] = om[OM_X + XP + i]  # position, then velocity: the state's order
         elif not ekf and (om[OM_BARO_DUE] != 0.0 or om[OM_MAG_DUE] != 0.0 or arrived(k, op, om)):
             fuse(t, k, op, om)  # the GPS fixes that arrived, logged (no filter to fuse them)
         rng[0] = s

@@ -16,7 +16,19 @@ import numpy as np
 from numba import njit
 from scipy.stats import chi2
 
-from quadcruise.estimation.ekf import E_SIZE, EP, EV, X_SIZE, XP, XV, heading_innovation, predict, update
+from quadcruise.estimation.ekf import (
+    E_SIZE,
+    EP,
+    EV,
+    WORK_ROWS,
+    X_SIZE,
+    XP,
+    XV,
+    heading_innovation,
+    predict,
+    update,
+    update_states,
+)
 from quadcruise.fields import Validated, unit_field
 from quadcruise.layout import Row
 
@@ -162,47 +174,50 @@ class EkfRun:
 
 @njit(cache=True)
 def filter_series(
-    imu_t, imu, gps_t, gps, baro_t, baro, mag_t, mag, noise, meas, field, gates, x, P, stride, xs, sd, covs, nis
+    imu_t, imu, gps_t, gps, gps_s, baro_t, baro, mag_t, mag, noise, meas, field, gates, x, P, stride, xs, sd, covs, nis
 ):
     """The filter over the streams, in place: see :func:`run_ekf` (``nis`` (4, max count),
-    rows gps_pos, gps_vel, baro, mag)."""
+    rows gps_pos, gps_vel, baro, mag; ``gps_s`` the fixes' sample times, or empty)."""
     ig = ib = im = 0
-    H3 = np.zeros((3, E_SIZE))
     var3 = np.empty(3)
     r3 = np.empty(3)
-    H1 = np.zeros((1, E_SIZE))
     var1 = np.empty(1)
     r1 = np.empty(1)
+    work = np.empty((WORK_ROWS, E_SIZE))
     for k in range(imu_t.shape[0]):
         t = imu_t[k] + 1e-9
         while ig < gps_t.shape[0] and gps_t[ig] <= t:
-            H3[:, :] = 0.0
+            delta = np.zeros(6)  # the estimate's change since the fix was taken (its latency)
+            if gps_s.shape[0]:
+                ks = k
+                while ks > 0 and imu_t[ks] > gps_s[ig] + 1e-9:
+                    ks -= 1
+                if ks < k:
+                    for i in range(3):
+                        delta[i] = x[XP + i] - xs[ks, XP + i]
+                        delta[3 + i] = x[XV + i] - xs[ks, XV + i]
             for i in range(3):
-                H3[i, EP + i] = 1.0
-                r3[i] = gps[ig, i] - x[XP + i]
+                r3[i] = gps[ig, i] + delta[i] - x[XP + i]
             var3[0] = var3[1] = meas[M_POS_H] ** 2
             var3[2] = meas[M_POS_V] ** 2
-            nis[0, ig] = update(x, P, H3, r3, var3, gates[3])
-            H3[:, :] = 0.0
+            nis[0, ig] = update_states(x, P, EP, r3, var3, gates[3], work)
             for i in range(3):
-                H3[i, EV + i] = 1.0
-                r3[i] = gps[ig, 3 + i] - x[XV + i]
+                r3[i] = gps[ig, 3 + i] + delta[3 + i] - x[XV + i]
             var3[0] = var3[1] = meas[M_VEL_H] ** 2
             var3[2] = meas[M_VEL_V] ** 2
-            nis[1, ig] = update(x, P, H3, r3, var3, gates[3])
+            nis[1, ig] = update_states(x, P, EV, r3, var3, gates[3], work)
             ig += 1
         while ib < baro_t.shape[0] and baro_t[ib] <= t:
-            H1[:, :] = 0.0
-            H1[0, EP + 2] = 1.0
             r1[0] = baro[ib] - meas[M_BARO_OFF] - x[XP + 2]
             var1[0] = meas[M_BARO] ** 2
-            nis[2, ib] = update(x, P, H1, r1, var1, gates[1])
+            nis[2, ib] = update_states(x, P, EP + 2, r1, var1, gates[1], work)
             ib += 1
         while im < mag_t.shape[0] and mag_t[im] <= t:
-            r, Hm = heading_innovation(x, mag[im, 0], mag[im, 1], mag[im, 2], field)
+            Hm = np.zeros((1, E_SIZE))
+            r = heading_innovation(x, mag[im, 0], mag[im, 1], mag[im, 2], field, Hm)
             r1[0] = r
             var1[0] = meas[M_HEAD] ** 2
-            nis[3, im] = update(x, P, Hm, r1, var1, gates[1])
+            nis[3, im] = update(x, P, Hm, r1, var1, gates[1], work)
             im += 1
         xs[k] = x
         for i in range(E_SIZE):
@@ -234,6 +249,7 @@ def run_ekf(
     field: np.ndarray | None = None,
     baro_offset: float = 0.0,
     stride: int = 1,
+    gps_sample_t: np.ndarray | None = None,
 ) -> EkfRun:
     """Run the error-state EKF over one flight's sensor streams.
 
@@ -262,6 +278,10 @@ def run_ekf(
         The barometer's offset from the ENU z [m].
     stride : int
         Keep the full covariance every ``stride`` IMU samples.
+    gps_sample_t : numpy.ndarray, optional
+        (G,) when each fix was taken [s] (``gps``'s times being when it arrived): it is fused
+        against the estimate of the IMU instant at or before then, moved on to now (the
+        estimate's change since added to the fix); None: as if taken when it arrived.
 
     Returns
     -------
@@ -292,8 +312,9 @@ def run_ekf(
     xs, sd = np.empty((K, X_SIZE)), np.empty((K, E_SIZE))
     covs = np.empty(((K - 1) // stride + 1, E_SIZE, E_SIZE))
     nis = np.full((4, max(gps_t.size, baro_t.size, mag_t.size, 1)), np.nan)
+    gps_s = np.zeros(0) if gps_sample_t is None else np.ascontiguousarray(gps_sample_t, float)
     filter_series(
-        imu_t, imu, gps_t, gps_z, baro_t, baro_z, mag_t, mag_z, s.noise_row(), meas, field, s.gates(),
+        imu_t, imu, gps_t, gps_z, gps_s, baro_t, baro_z, mag_t, mag_z, s.noise_row(), meas, field, s.gates(),
         x, P, int(stride), xs, sd, covs, nis,
     )  # fmt: skip
     counts = (gps_t.size, gps_t.size, baro_t.size, mag_t.size)

@@ -46,7 +46,13 @@ switch-on biases, read at 250 Hz (a divisor of the default 1 kHz control rate; P
 rate loop at its gyro's rate, ``IMU_GYRO_RATEMAX`` 400 Hz by default)."""
 
 PRESETS = {
-    "imu": {"typical": TYPICAL_IMU, "bmi088": BMI088, "icm42688p": ICM42688P, "ideal": Imu()},
+    "imu": {
+        "typical": TYPICAL_IMU,
+        "bmi088": BMI088,
+        "bmi088_1khz": dataclasses.replace(BMI088, rate=1000.0),
+        "icm42688p": ICM42688P,
+        "ideal": Imu(),
+    },
     "gps": {"typical": Gps(rate=10.0, latency=0.1), "ideal": Gps(horizontal_std=0.0, vertical_std=0.0,
                                                                  velocity_std=0.0, vertical_velocity_std=0.0)},
     "baro": {"typical": Baro(rate=50.0, noise_std=0.1), "ideal": Baro(noise_std=0.0)},
@@ -55,7 +61,9 @@ PRESETS = {
 """Each sensor's models by name: ``typical`` is what ``fly --sensors imu,gps,baro,mag`` flies
 (GPS at 10 Hz, 0.1 s late, 0.5 m / 0.8 m; barometer 50 Hz, 0.1 m; magnetometer 50 Hz, 5 mG at a
 0.5 G field inclined 60 deg); the IMU presets carry their datasheets' sources
-(:mod:`quadcruise.sensors.imu`); ``ideal`` reads the truth without noise."""
+(:mod:`quadcruise.sensors.imu`), ``bmi088_1khz`` is the BMI088 read at 1 kHz (one of its gyro's
+output rates; the rate the default control period reads it at every period); ``ideal`` reads the
+truth without noise."""
 
 
 def _model(kind):
@@ -140,27 +148,35 @@ class Ekf(Validated):
     init_attitude_std : float
         Its attitude error std [rad] per axis.
     rate_cutoff : float
-        Cutoff of the first-order low-pass on the body rates the controller sees [Hz] (0: none;
-        PX4's ``IMU_GYRO_CUTOFF`` is 40 Hz by default).
+        Cutoff of a first-order low-pass on the body rates the controller sees [Hz]; 0 (the
+        default): none, the rates are the gyro's average over its period less the estimated bias
+        (already a low-pass, and half a period late). PX4 filters its rate loop's gyro at
+        ``IMU_GYRO_CUTOFF`` (40 Hz by default), for gains tuned with it; the paper's attitude
+        loop, whose derivative acts at some 500 rad/s, loses its margin to it (3 of 100 circles
+        of ``benchmarks/estimator_cost.py``'s batch diverged at 40 Hz, 1 without).
     gate : float
         The innovation gate's chi-square probability (1: no gate).
     noise_scale : float
         The filter's noise settings are the sensors' own, times this (1: a matched filter).
+    latency_compensation : bool
+        Fuse a late GPS fix against the estimate of the instant it was taken (its latency known),
+        rather than against the present one.
     noise : EkfNoise, optional
         The filter's noise settings given outright (then ``noise_scale`` and ``gate`` are not used).
 
     Examples
     --------
-    >>> Ekf().rate_cutoff
-    40.0
+    >>> Ekf().rate_cutoff, Ekf(rate_cutoff=40.0).rate_cutoff
+    (0.0, 40.0)
     """
 
     init_position_std: float = unit_field(0.1, "m", "initial position error std", "pos")
     init_velocity_std: float = unit_field(0.05, "m/s", "initial velocity error std", "pos")
     init_attitude_std: float = unit_field(math.radians(1.0), "rad", "initial attitude error std", "pos")
-    rate_cutoff: float = unit_field(40.0, "Hz", "rate low-pass cutoff", "nonneg")
+    rate_cutoff: float = unit_field(0.0, "Hz", "rate low-pass cutoff", "nonneg")
     gate: float = unit_field(0.999, "-", "innovation gate probability", "frac")
     noise_scale: float = unit_field(1.0, "-", "scale on the matched noise settings", "pos")
+    latency_compensation: bool = unit_field(True, "-", "fuse a late GPS fix at its own time", "flag")
     noise: EkfNoise | None = unit_field(None, "-", "the filter's noise settings", _model(EkfNoise))
     name = "ekf"
 
@@ -343,6 +359,8 @@ def observation(
     gps = sensors.gps
     delay = 0 if gps is None else int(math.ceil(gps.latency / dt - 1e-9))
     slots = 1 if gps is None else delay // every["gps"] + 2
+    compensate = estimator is not None and estimator.latency_compensation and gps is not None and delay > 0
+    history = delay // every.get("imu", 1) + 3 if compensate else 0
     ekf = estimator.settings(sensors, g) if estimator is not None else EkfNoise(gravity=g)
     values = {
         **{f"{name}_on": float(getattr(sensors, name) is not None) for name in ("imu", "gps", "baro", "mag")},
@@ -350,6 +368,7 @@ def observation(
         **{f"{name}_every": float(every.get(name, 1)) for name in ("imu", "gps", "baro", "mag")},
         "gps_delay": float(delay),
         "gps_slots": float(slots),
+        "history": float(history),
         "imu": (sensors.imu or Imu()).row(),
         "gps": (gps or Gps()).row(),
         "baro": (sensors.baro or Baro()).row(),
@@ -364,7 +383,7 @@ def observation(
     if estimator is not None and estimator.rate_cutoff > 0 and sensors.imu is not None:
         values["rate_alpha"] = 1.0 - math.exp(-2.0 * math.pi * estimator.rate_cutoff * every["imu"] * dt)
     params = PARAMS.pack(values, n=n)
-    memory = np.zeros((n, memory_row(slots).size))
+    memory = np.zeros((n, memory_row(slots, history).size))
     return Observation(onboard, params, memory, sensor_streams(seed, n, first_vehicle), True)
 
 
