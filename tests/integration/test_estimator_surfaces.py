@@ -248,3 +248,30 @@ def test_fly_writes_the_estimate_figure_and_report_section_only_on_an_estimator(
     assert not (tmp_path / "off" / "estimate.png").exists()  # sensors logged, the controller on the truth
     assert "estimate the controller flew on (imu, gps)" in (tmp_path / "on.html").read_text()
     assert "estimate the controller flew on" not in (tmp_path / "off.html").read_text()
+
+
+def test_estimator_none_overrides_a_scenarios_in_montecarlo_and_tune(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text('[mission]\nkind = "hover"\n[simulation]\nduration = 1.0\n[sensors]\nimu = "typical"\n'
+                    'gps = "typical"\n[estimator]\nkind = "ekf"\n[montecarlo]\nn = 2\n')  # fmt: skip
+    on = run("montecarlo", "--scenario", path, "--scheduler", "none", "--quiet")
+    off = run("montecarlo", "--scenario", path, "--scheduler", "none", "--quiet", "--estimator", "none")
+    assert on.exit_code == 0 and off.exit_code == 0, on.output + off.output
+    assert "filter consistency" in on.output and "filter consistency" not in off.output
+    out = tmp_path / "tuned"
+    res = run("tune", path, "--gains", "position.kp", "--minimize", "rmse_m", "--budget", "1", "--popsize", "5",
+              "--estimator", "none", "--out", out)  # fmt: skip
+    assert res.exit_code in (0, 1), res.output
+    assert 'kind = "none"' in (out / "scenario.toml").read_text()  # sensors logged, the truth flown
+
+
+def test_a_rotor_plant_sweep_flies_on_its_spread_sensors():
+    from quadcruise.estimation.stage import PRESETS
+
+    sensors = dataclasses.replace(TYPICAL, imu=PRESETS["imu"]["bmi088_1khz"])  # the iris needs a 1 kHz IMU
+    pop = Population(mass_spread=0.05, sensors=sensors, estimator=Ekf(), imu_noise_spread=0.2)
+    sweep = montecarlo("hover", "nlpd", pop, 3, 0, vehicle="iris", duration=2.0, scheduler="none")
+    tab = sweep.table
+    assert (tab["status"] == 0).all() and tab["imu_noise_factor"].nunique() == 3  # every flight finished
+    assert tab["estimate_position_rmse_m"].between(0.01, 1.0).all()
+    assert sweep.summary_data()["consistency"]["nees_position"]["flights"] == 3

@@ -149,7 +149,8 @@ def tune_command(
     kwargs: dict = {"duration": duration, "dt": 1e-3 if dt is None else dt}
     from quadcruise.cli.onboard import onboard_options
 
-    onboard = onboard_options(sensors, estimator, {})  # read before any work; the scenario's below
+    sensors_text, estimator_text = sensors, estimator
+    onboard = onboard_options(sensors_text, estimator_text, {})  # read before any work; the scenario's below
     sensors = parse_noise(noise)  # the white noise on the truth; the sensor models are onboard's
     sc = None
     if mission.lower().endswith(".toml"):
@@ -163,7 +164,7 @@ def tune_command(
         kwargs.update(duration=sc.duration if duration is None else duration, dt=sc.dt if dt is None else dt)
         sensors = sensors if sensors is not None else sc.sensor_noise
         scenario_onboard = {k: getattr(sc, k) for k in ("sensors", "estimator") if getattr(sc, k) is not None}
-        onboard = onboard_options(None, None, {**scenario_onboard, **onboard})
+        onboard = onboard_options(sensors_text, estimator_text, scenario_onboard)  # the options win
     else:
         the_mission = mission_from_options(mission, mission_params, False)
         the_controller = controller_from_options(

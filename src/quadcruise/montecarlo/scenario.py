@@ -116,7 +116,8 @@ def sweep_spec(
     log_every: int | None = None,
     **population,
 ) -> tuple[MonteCarloSpec, int]:
-    """The spec of a sweep and its number of flights; None means "not given"."""
+    """The spec of a sweep and its number of flights; None means "not given" (``estimator=False``:
+    none, over a scenario's)."""
     given = {key: value for key, value in {**population, "n": n, "seed": seed}.items() if value is not None}
     options: dict = dict(
         duration=duration, dt=1e-3 if dt is None else dt, requirements=requirements, max_track_error_m=max_track_error_m
@@ -154,6 +155,7 @@ def sweep_spec(
         options["controller_vehicle"] = controller_vehicle
     if log_every is not None:
         options["log_dt"] = log_every * options["dt"]
+    estimator = None if estimator is False else estimator  # False: none, whatever the scenario says
     mission = "circle" if mission is None else mission
     controller = "nlpd" if controller is None else controller
     pop = Population(
