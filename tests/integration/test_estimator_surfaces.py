@@ -275,3 +275,13 @@ def test_a_rotor_plant_sweep_flies_on_its_spread_sensors():
     assert (tab["status"] == 0).all() and tab["imu_noise_factor"].nunique() == 3  # every flight finished
     assert tab["estimate_position_rmse_m"].between(0.01, 1.0).all()
     assert sweep.summary_data()["consistency"]["nees_position"]["flights"] == 3
+
+
+def test_compare_population_flies_on_the_estimate_too(tmp_path):
+    res = run("compare", "hover", "--controllers", "nlpd,se3", "--duration", "1", "--sensors", "imu,gps",
+              "--estimator", "ekf", "--population", "3", "--out", tmp_path / "cmp")  # fmt: skip
+    assert res.exit_code == 0, res.output
+    assert "estimate_position_rmse_m p50" in res.output
+    table = (tmp_path / "cmp" / "population.csv").read_text()
+    assert "estimate_position_rmse_m p50" in table.splitlines()[0]
+    assert "[compare.population]" in (tmp_path / "cmp" / "scenario.toml").read_text()

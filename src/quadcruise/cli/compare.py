@@ -204,7 +204,13 @@ def compare(
     kwargs.update({k: v for k, v in (("duration", duration), ("dt", dt), ("log_every", log_every)) if v is not None})
     kwargs = onboard_options(sensors_text, estimator_text, kwargs)
     count, pop_seed, pop = population_from_options(
-        population, seed, mass_spread, scenario, kwargs.get("environment"), kwargs.get("sensors")
+        population,
+        seed,
+        mass_spread,
+        scenario,
+        kwargs.get("environment"),
+        kwargs.get("sensors"),
+        kwargs.get("estimator"),
     )
     if seed is not None or "seed" not in kwargs:  # the flights' seed: given, the scenario's, the population's
         kwargs["seed"] = pop_seed if seed is None else seed
