@@ -25,10 +25,11 @@ At each control period k (instant t) of one vehicle, :func:`onboard`:
    state, as the truth (no sensor reads it; PX4 knows its own commands). Between IMU instants
    it is held.
 
-Its memory (:data:`MEMORY` ``(slots)``) carries the sensors' biases, the filter's state and
-covariance, the GPS queue and the log row, so a flight cut into calls is the flight flown in one;
-its stream is the vehicle's own (:func:`sensor_streams`), apart from the disturbance's. At period 0
-it starts: the sensors switch on (their biases drawn), and the filter starts from the truth plus an
+Its memory (:func:`memory_row`) carries the sensors' biases, the filter's state and covariance,
+the GPS queue, the estimate's recent history and the log row, so a flight cut into calls is the
+flight flown in one; its stream is the vehicle's own
+(:func:`~quadcruise.sim.observe.sensor_streams`), apart from the disturbance's. At period 0 it
+starts: the sensors switch on (their biases drawn), and the filter starts from the truth plus an
 error drawn from its initial covariance (position, velocity, attitude; its bias estimates 0, their
 variances the sensors' switch-on spreads), so the NEES is chi-square from the first instant.
 """

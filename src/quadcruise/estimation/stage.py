@@ -31,14 +31,10 @@ from quadcruise.fields import Validated, unit_field
 from quadcruise.fields.checks import Check
 from quadcruise.sensors import BMI088, ICM42688P, Baro, Gps, Imu, Magnetometer
 from quadcruise.sensors.timing import periods_per_sample
-from quadcruise.sim.observe import Observation
+from quadcruise.sim.observe import Observation, sensor_streams
 
 SENSOR_NAMES = ("imu", "gps", "baro", "mag")
 """The sensors a vehicle may carry, by name (the fields of :class:`Sensors`)."""
-
-SENSOR_STREAM = 35
-"""The third entry of a vehicle's sensor stream's seed, ``SeedSequence([seed, i, 35])``: apart
-from its disturbance's stream ``(seed, i)``, so turning sensors on leaves the turbulence as it was."""
 
 TYPICAL_IMU = dataclasses.replace(BMI088, rate=250.0)
 """The IMU of ``Sensors.typical()``: :data:`~quadcruise.sensors.BMI088`'s noise, range and
@@ -288,29 +284,6 @@ def check_estimator(sensors: Sensors | None, estimator: Ekf | None, where: str =
             )
 
 
-def sensor_streams(seed: int, n: int, first_vehicle=0) -> np.ndarray:
-    """(n, 1) uint64: vehicle i's sensor stream from ``SeedSequence([seed, first_vehicle + i, 35])``.
-
-    Parameters
-    ----------
-    seed : int
-        The flight's seed, >= 0.
-    n : int
-        Vehicles.
-    first_vehicle : int or (n,) array of int
-        The vehicles' indices (as :func:`quadcruise.sim.rng.vehicle_states`).
-
-    Returns
-    -------
-    numpy.ndarray
-    """
-    ids = np.arange(n) + int(first_vehicle) if np.ndim(first_vehicle) == 0 else np.asarray(first_vehicle).ravel()
-    out = np.empty((n, 1), dtype=np.uint64)
-    for k, i in enumerate(ids):
-        out[k, 0] = np.random.SeedSequence([int(seed), int(i), SENSOR_STREAM]).generate_state(1, dtype=np.uint64)[0]
-    return out
-
-
 def observation(
     sensors: Sensors, estimator: Ekf | None, *, n: int, dt: float, seed: int, first_vehicle=0, g: float = 9.80665
 ) -> Observation:
@@ -329,7 +302,7 @@ def observation(
     seed : int
         The flight's seed.
     first_vehicle : int or (n,) array of int
-        The vehicles' indices (their streams: :func:`sensor_streams`).
+        The vehicles' indices (their streams: :func:`~quadcruise.sim.observe.sensor_streams`).
     g : float
         Gravity [m/s^2] the filter assumes.
 
@@ -387,4 +360,4 @@ def observation(
     return Observation(onboard, params, memory, sensor_streams(seed, n, first_vehicle), True)
 
 
-__all__ = ["PRESETS", "SENSOR_NAMES", "Ekf", "Sensors", "check_estimator", "observation", "sensor_streams"]
+__all__ = ["PRESETS", "SENSOR_NAMES", "Ekf", "Sensors", "check_estimator", "observation"]

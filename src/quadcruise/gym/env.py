@@ -348,7 +348,7 @@ class QuadVectorEnv(VectorEnv):
             disturbance_memory=None if env is None else env.memory(k),
         )
         if self.observed:  # the episode's own sensor stream, (seed, vehicle, episode) as the rest
-            from quadcruise.estimation.stage import sensor_streams
+            from quadcruise.sim.observe import sensor_streams
 
             s.observation.rng[rows] = sensor_streams(self._seed, k, ids)
             s.log_obs[rows] = np.nan  # no estimate yet: the filter starts in the episode's first period

@@ -136,6 +136,39 @@ class Observation(NamedTuple):
         return np.empty((n, n_log if self.active else 0, L.OBSERVATION_SIZE))
 
 
+SENSOR_STREAM = 35
+"""The third entry of a vehicle's sensor stream's seed, ``SeedSequence([seed, i, 35])``: apart
+from its disturbance's stream ``(seed, i)``, so turning sensors on leaves the turbulence as it was."""
+
+
+def sensor_streams(seed: int, n: int, first_vehicle=0) -> np.ndarray:
+    """(n, 1) uint64: vehicle i's sensor stream from ``SeedSequence([seed, first_vehicle + i, 35])``.
+
+    Parameters
+    ----------
+    seed : int
+        The flight's seed, >= 0.
+    n : int
+        Vehicles.
+    first_vehicle : int or (n,) array of int
+        The vehicles' indices (as :func:`quadcruise.sim.rng.vehicle_states`).
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Examples
+    --------
+    >>> bool((sensor_streams(1, 3)[2] == sensor_streams(1, 1, first_vehicle=2)[0]).all())
+    True
+    """
+    ids = np.arange(n) + int(first_vehicle) if np.ndim(first_vehicle) == 0 else np.asarray(first_vehicle).ravel()
+    out = np.empty((n, 1), dtype=np.uint64)
+    for k, i in enumerate(ids):
+        out[k, 0] = np.random.SeedSequence([int(seed), int(i), SENSOR_STREAM]).generate_state(1, dtype=np.uint64)[0]
+    return out
+
+
 @njit(cache=True, inline="always")
 def body_force(ax, ay, az, g, r00, r01, r02, r10, r11, r12, r20, r21, r22, om):
     """``R^T (a + g e_z)`` into ``om[OM_FORCE:OM_FORCE + 3]``: the specific force [m/s^2], FLU,
@@ -187,4 +220,4 @@ def rotor_force(xr, w_cmd, rp, ext_r, dx, om):
     )  # fmt: skip
 
 
-__all__ = ["Observation", "blind", "body_force", "paper_force", "rotor_force"]
+__all__ = ["SENSOR_STREAM", "Observation", "blind", "body_force", "paper_force", "rotor_force", "sensor_streams"]

@@ -44,7 +44,7 @@ from quadcruise.layout import CMD_SIZE, REF_SIZE, STATE_SIZE
 from quadcruise.sim.engine import fly_vehicles, still_air
 from quadcruise.sim.inputs import Limits, batch_inputs, fresh_carry
 from quadcruise.sim.kernel_args import KernelArgs, RotorKernelArgs
-from quadcruise.sim.observe import Observation
+from quadcruise.sim.observe import Observation, sensor_streams
 from quadcruise.sim.rng import vehicle_states
 from quadcruise.sim.rotor_batch import rotor_inputs
 from quadcruise.sim.rotor_flight import fly_rotor_pieces, paper_states, rotor_carry_width
@@ -287,7 +287,10 @@ class Stepper:
         elif self.drawn:
             self.rng[rows] = vehicle_states(self.seed if seed is None else seed, k, self.first_vehicle[rows])
         self.observation.memory[rows] = self._omem0[rows]
-        self.observation.rng[rows] = self._orng0[rows]
+        if self.observation.active:  # the sensors' streams drawn again, as the disturbance's are
+            self.observation.rng[rows] = (
+                self._orng0[rows] if seed is None else sensor_streams(seed, k, self.first_vehicle[rows])
+            )
         self.clock[rows] = 0
         if self.rotor:  # the rotor kernel starts a vehicle at period 0 afresh, its carry unread
             self._paper_state[rows] = paper_states(np.ascontiguousarray(start), self.vp[rows], self.psi0[rows])

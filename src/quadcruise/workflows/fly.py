@@ -25,7 +25,7 @@ from quadcruise.control import controller_record
 from quadcruise.disturbances import CustomDisturbance, Environment, SensorNoise
 from quadcruise.errors import InputError, LogWarning, reject_unknown
 from quadcruise.estimation.stage import Ekf, Sensors
-from quadcruise.layout import STATE_SIZE
+from quadcruise.layout import OBSERVATION_SIZE, STATE_SIZE
 from quadcruise.missions import Mission, as_mission, stack_params
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
@@ -266,6 +266,7 @@ def fly(
     duration = default_duration(first) if duration is None else duration
     d, h = duration, dt
     extra = (rotor_batch(vehicle)[0].n_rotors + 13) if rotor else 0  # a rotor flight logs its rotor state too
+    extra += OBSERVATION_SIZE if isinstance(sensors, Sensors) else 0  # and a flight on sensors their log
     steps = round(d / h) if 0 < h <= d < math.inf else 0
     chosen = log_every is None and n > 1 and steps > 0 and batch_log_every(n, steps, extra) > 1
     # a batch whose full log would not fit in LOG_BUDGET: a coarser log, checked at every period

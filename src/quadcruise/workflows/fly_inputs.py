@@ -268,7 +268,8 @@ def log_bytes(n: int, periods: int, log_every: int, extra: int = 0) -> int:
     log_every : int
         Log every this many periods.
     extra : int
-        More numbers logged per row (a rotor-plant flight's own state: 13 + rotors).
+        More numbers logged per row (a rotor-plant flight's own state: 13 + rotors; a flight on
+        sensors, their observation log: ``OBSERVATION_SIZE``).
 
     Returns
     -------
