@@ -30,6 +30,7 @@ from quadcruise.cli.compare_run import (
     write_comparison_ulogs,
 )
 from quadcruise.cli.objects import PARAMS_OPTION, with_px4_params
+from quadcruise.cli.onboard import onboard_options
 from quadcruise.cli.world import flight_world, note, world_options
 from quadcruise.io.files import check_output_dir
 
@@ -85,6 +86,18 @@ __all__ = ["compare"]
     callback=writable_with(".ulg"),
     help="Also write each controller's flight as a PX4 log: PATH-nlpd.ulg, PATH-se3.ulg, ...",
 )
+@click.option(
+    "--sensors",
+    "sensors_text",
+    metavar="NAME[=PRESET],...",
+    help="Sensor models every vehicle carries: imu, gps, baro, mag (preset typical, or e.g. imu=bmi088).",
+)
+@click.option(
+    "--estimator",
+    "estimator_text",
+    metavar="NAME",
+    help="The estimator every controller flies on: ekf (needs imu and gps), or none; the table says so.",
+)
 @RISE_OPTION
 @SETTLE_BAND_OPTION
 @friendly
@@ -107,6 +120,8 @@ def compare(
     log_every,
     report,
     ulog,
+    sensors_text,
+    estimator_text,
     rise,
     settle_bands,
 ):
@@ -157,6 +172,9 @@ def compare(
     ulog : str or None
         ``--ulog``: each controller's flight as a PX4 log, the controller's label before the
         suffix (:func:`~quadcruise.cli.compare_run.write_comparison_ulogs`); None: none.
+    sensors_text, estimator_text : str or None
+        ``--sensors``, ``--estimator``: the sensor models and the estimator every controller
+        flies on (:func:`~quadcruise.cli.onboard.onboard_options`); None: the scenario's, else none.
     rise : str
         ``--rise``: the rise-time convention, ``10-90`` or ``0-100`` (% of the step).
     settle_bands : tuple of float
@@ -184,8 +202,15 @@ def compare(
         **{k: v for k, v in world.items() if v is not None},
     }
     kwargs.update({k: v for k, v in (("duration", duration), ("dt", dt), ("log_every", log_every)) if v is not None})
+    kwargs = onboard_options(sensors_text, estimator_text, kwargs)
     count, pop_seed, pop = population_from_options(
-        population, seed, mass_spread, scenario, kwargs.get("environment"), kwargs.get("sensors")
+        population,
+        seed,
+        mass_spread,
+        scenario,
+        kwargs.get("environment"),
+        kwargs.get("sensors"),
+        kwargs.get("estimator"),
     )
     if seed is not None or "seed" not in kwargs:  # the flights' seed: given, the scenario's, the population's
         kwargs["seed"] = pop_seed if seed is None else seed

@@ -26,7 +26,13 @@ __all__ = [
 
 
 def population_from_options(
-    n: int | None, seed: int | None, mass_spread: float | None, scenario=None, environment=None, sensors=None
+    n: int | None,
+    seed: int | None,
+    mass_spread: float | None,
+    scenario=None,
+    environment=None,
+    sensors=None,
+    estimator=None,
 ):
     """The population that ``--population``, ``--seed`` and ``--mass-spread`` describe, a
     scenario's ``[compare] population`` changed by them; checked before anything flies.
@@ -41,8 +47,9 @@ def population_from_options(
         ``--mass-spread``: relative standard deviation of the mass; None: the scenario's, else 0.1.
     scenario : Scenario, optional
         Its ``compare_population`` (n, seed, the spreads) is the starting point.
-    environment, sensors : optional
-        The flights' disturbances and sensor noise, which the population meets too.
+    environment, sensors, estimator : optional
+        The flights' disturbances, sensor noise or sensor models and estimator, which the
+        population meets too.
 
     Returns
     -------
@@ -74,8 +81,15 @@ def population_from_options(
         return None, table.get("seed", 0), None
     count, pop_seed = table.pop("n"), table.pop("seed", 0)
     table.setdefault("mass_spread", 0.1)
+    from quadcruise.estimation.stage import Sensors
+
+    models = sensors if isinstance(sensors, Sensors) else None
     pop = Population(
-        **table, environment=environment if environment is not None and environment.parts else None, noise=sensors
+        **table,
+        environment=environment if environment is not None and environment.parts else None,
+        noise=None if models is not None else sensors,
+        sensors=models,
+        estimator=estimator,
     )
     pop.check_perturbs(
         count,
@@ -106,7 +120,8 @@ def population_record(n: int, seed: int, pop) -> dict:
     from quadcruise.montecarlo.api import Population
 
     default = Population()
-    fields = {f.name: getattr(pop, f.name) for f in dataclasses.fields(pop) if f.name not in ("environment", "noise")}
+    flights = ("environment", "noise", "sensors", "estimator")  # the flights' own, recorded with them
+    fields = {f.name: getattr(pop, f.name) for f in dataclasses.fields(pop) if f.name not in flights}
     kept = {k: v for k, v in fields.items() if k == "mass_spread" or v != getattr(default, k)}
     return {"n": int(n), "seed": int(seed), **kept}
 

@@ -54,6 +54,21 @@ __all__ = ["montecarlo", "montecarlo_command", "parse_noise"]
 @click.option("--offset", type=float, show_default="0", help="Std of the start position [m].")
 @click.option("--noise", metavar="position=STD,velocity=STD,angle=STD,rate=STD,delay=S", help="Sensor noise and delay.")
 @click.option(
+    "--sensors",
+    "sensors_text",
+    metavar="NAME[=PRESET],...",
+    help="Sensor models every vehicle carries: imu, gps, baro, mag (preset typical, or e.g. imu=bmi088).",
+)
+@click.option(
+    "--estimator",
+    "estimator_text",
+    metavar="NAME",
+    help="The estimator the controller flies on: ekf (needs imu and gps), or none; "
+    "the summary adds its error and NEES.",
+)
+@click.option("--imu-noise-spread", type=float, show_default="0", help="Relative std of each vehicle's IMU noise.")
+@click.option("--gps-noise-spread", type=float, show_default="0", help="Relative std of each vehicle's GPS noise.")
+@click.option(
     "--model-error/--no-model-error",
     default=None,
     show_default="model-error",
@@ -156,6 +171,12 @@ def montecarlo(**options):
         noise : str or None
             ``--noise``: sensor noise and delay, a :func:`parse_noise` spec; None: the
             scenario's, else none.
+        sensors_text, estimator_text : str or None
+            ``--sensors``, ``--estimator``: the sensor models and the estimator
+            (:mod:`quadcruise.cli.onboard`); None: the scenario's, else none.
+        imu_noise_spread, gps_noise_spread : float or None
+            ``--imu-noise-spread``, ``--gps-noise-spread``: relative standard deviations of
+            each vehicle's IMU and GPS noise (:mod:`quadcruise.montecarlo.sensor_spread`).
         model_error : bool or None
             ``--model-error``/``--no-model-error``: the controller computes with the nominal
             vehicle (True) or knows each vehicle's own parameters (False).

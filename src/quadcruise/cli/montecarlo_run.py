@@ -62,6 +62,10 @@ def montecarlo_command(
     mass_spread: float | None = None,
     inertia_spread: float | None = None,
     noise: str | None = None,
+    sensors_text: str | None = None,
+    estimator_text: str | None = None,
+    imu_noise_spread: float | None = None,
+    gps_noise_spread: float | None = None,
     thrust_spread: float | None = None,
     bandwidth_spread: float | None = None,
     yaw_arm_spread: float | None = None,
@@ -123,6 +127,13 @@ def montecarlo_command(
     from quadcruise.workflows.scenario import load_scenario
 
     sc = load_scenario(scenario) if scenario is not None else None
+    from quadcruise.cli.onboard import onboard_options
+
+    onboard = onboard_options(
+        sensors_text,
+        estimator_text,
+        {k: getattr(sc, k) for k in ("sensors", "estimator") if sc is not None and getattr(sc, k) is not None},
+    )  # checked before any work; given, else the scenario's
     identified = None
     if identification is not None:
         from pathlib import Path
@@ -164,6 +175,10 @@ def montecarlo_command(
             environment=environment,
             noise=parse_noise(noise),
             scenario=scenario,
+            sensors=onboard.get("sensors"),
+            estimator=onboard.get("estimator", False if estimator_text is not None else None),
+            imu_noise_spread=imu_noise_spread,
+            gps_noise_spread=gps_noise_spread,
             mass_spread=mass_spread,
             inertia_spread=inertia_spread,
             thrust_spread=thrust_spread,

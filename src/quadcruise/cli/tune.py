@@ -87,6 +87,16 @@ __all__ = ["tune"]
     help="Std of a random steady horizontal wind per vehicle [m/s].",
 )
 @click.option("--noise", metavar="position=STD,...,delay=S", help="Sensor noise and delay.")
+@click.option(
+    "--sensors",
+    metavar="NAME[=PRESET],...",
+    help="Sensor models every vehicle carries: imu, gps, baro, mag (preset typical, or e.g. imu=bmi088).",
+)
+@click.option(
+    "--estimator",
+    metavar="NAME",
+    help="The estimator the candidates fly on: ekf (needs imu and gps), or none (tunes with it in the loop).",
+)
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the search and the population.")
 @click.option("--budget", type=int, default=100, show_default=True, help="At most this many generations.")
 @click.option("--popsize", type=int, help="Candidates per generation (default: 15 per gain).")
@@ -148,6 +158,9 @@ def tune(**options):
         wind, noise : str or None
             ``--wind``: a :func:`~quadcruise.cli.wind.parse_wind` spec; ``--noise``: a
             :func:`~quadcruise.cli.montecarlo_run.parse_noise` spec.
+        sensors, estimator : str or None
+            ``--sensors``, ``--estimator``: the sensor models and the estimator every candidate
+            flies on (:mod:`quadcruise.cli.onboard`); None: the scenario's, else none.
         turbulence : str or None
             ``--turbulence``: Dryden turbulence added.
         vehicle, controller_vehicle : str or None

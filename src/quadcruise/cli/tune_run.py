@@ -67,6 +67,8 @@ def tune_command(
     wind: str | None = None,
     wind_spread: float = 0.0,
     noise: str | None = None,
+    sensors: str | None = None,
+    estimator: str | None = None,
     seed: int = 0,
     budget: int = 100,
     popsize: int | None = None,
@@ -107,6 +109,8 @@ def tune_command(
             wind=wind,
             wind_spread=wind_spread,
             noise=noise,
+            sensors=sensors,
+            estimator=estimator,
             seed=seed,
             budget=budget,
             popsize=popsize,
@@ -145,7 +149,11 @@ def tune_command(
     if out is not None:
         check_output_dir(out, force, inputs=(mission, vehicle, controller_vehicle, wind, turbulence))
     kwargs: dict = {"duration": duration, "dt": 1e-3 if dt is None else dt}
-    sensors = parse_noise(noise)
+    from quadcruise.cli.onboard import onboard_options
+
+    sensors_text, estimator_text = sensors, estimator
+    onboard = onboard_options(sensors_text, estimator_text, {})  # read before any work; the scenario's below
+    sensors = parse_noise(noise)  # the white noise on the truth; the sensor models are onboard's
     sc = None
     if mission.lower().endswith(".toml"):
         from quadcruise.workflows.scenario import load_scenario
@@ -157,6 +165,8 @@ def tune_command(
         the_controller = controller_from_options(controller, controller_params, None, base=sc.controller)
         kwargs.update(duration=sc.duration if duration is None else duration, dt=sc.dt if dt is None else dt)
         sensors = sensors if sensors is not None else sc.sensor_noise
+        scenario_onboard = {k: getattr(sc, k) for k in ("sensors", "estimator") if getattr(sc, k) is not None}
+        onboard = onboard_options(sensors_text, estimator_text, scenario_onboard)  # the options win
     else:
         the_mission = mission_from_options(mission, mission_params, False)
         the_controller = controller_from_options(
@@ -191,6 +201,8 @@ def tune_command(
         wind_spread=wind_spread,
         environment=environment if environment is not None and environment.parts else None,
         noise=sensors,
+        sensors=onboard.get("sensors"),
+        estimator=onboard.get("estimator"),
     )
     from quadcruise.cli.feedback import Bar
 

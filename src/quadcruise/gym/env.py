@@ -17,7 +17,7 @@ from quadcruise import checks
 from quadcruise.control import as_controller
 from quadcruise.control.setpoint import ACTION_CONTROLLERS, setpoint_gains
 from quadcruise.errors import ArgumentTypeError, InputError
-from quadcruise.gym.observe import OBS_SIZE, REF_SIZE, observe, references
+from quadcruise.gym.observe import OBS_SIZE, REF_SIZE, estimated_states, observe, references
 from quadcruise.gym.rotor import rotor_episodes
 from quadcruise.layout import F1, P_G, P_M, PSI, REF_PSI, REF_X, STATE_SIZE, X
 from quadcruise.missions import Circle, Mission, mission_from_name, stack_params
@@ -119,6 +119,21 @@ class QuadVectorEnv(VectorEnv):
         Divergence bounds; :data:`DEFAULT_LIMITS` by default.
     scales : dict, optional
         Action scales and loop gains (:data:`quadcruise.control.setpoint.DEFAULT_SCALES`).
+    sensors : Sensors, optional
+        The sensor models every vehicle carries (:class:`~quadcruise.estimation.Sensors`, each
+        rate a divisor of ``1 / dt``); the population's by default.
+    estimator : Ekf, optional
+        The filter between them and the action loops (:class:`~quadcruise.estimation.Ekf`): a
+        ``rates``, ``attitude`` or ``velocity`` action (or a baseline controller) is flown on its
+        estimate; the population's by default.
+    observe : {"truth", "estimate"}
+        What the observation is computed from: the true state, or the filter's estimate
+        (position, velocity, attitude, rates; the thrusts are the vehicle's own), with the
+        truth's observation in ``info["true_obs"]``. The reward and the tracking check always
+        read the truth. The estimate a step returns is the one the action loops flew that step
+        on (the filter's at the step's start, one period old). The filter starts in the
+        episode's first period: the observation a reset returns is the truth's
+        (``info["estimated"]`` False until then).
     """
 
     metadata: ClassVar[dict] = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
@@ -138,6 +153,9 @@ class QuadVectorEnv(VectorEnv):
         max_track_error: float = 2.0,
         limits: Limits | None = None,
         scales: dict | None = None,
+        sensors: Any = None,
+        estimator: Any = None,
+        observe: str = "truth",
     ) -> None:
         w = "make()"  # gymnasium.make and make_vec hand their keywords here: each checked before any work
         checks.whole(w, "num_envs", num_envs, 1)
@@ -193,6 +211,7 @@ class QuadVectorEnv(VectorEnv):
         # the drawn environment: a population's wind spread makes wind of still air
         self.plant.check_environment((self.nominal,), draw["environment"])
         self.sensors = None if population is None else population.noise
+        observation = self._observation(w, sensors, estimator, observe, float(dt))
         if self.baseline is not None:
             function, gains, memory, width = (self.baseline.function, self.baseline.gains(), self.baseline.memory(), 0)
         else:
@@ -216,6 +235,7 @@ class QuadVectorEnv(VectorEnv):
             **sens_kw,
             **draw["own"],  # the plant's own rows (rotor plant: allocation, initial yaw) and arrays
             **draw["fixed"],
+            **({} if observation is None else {"observation": observation}),
         )
         self.dt = float(dt)
         self.single_action_space = spaces.Box(-1.0, 1.0, (4,), dtype=np.float32)
@@ -226,10 +246,44 @@ class QuadVectorEnv(VectorEnv):
         self._obs = np.empty((n, OBS_SIZE), dtype=np.float32)
         self._reward = np.empty(n)
         self._lost = np.zeros(n, dtype=bool)
+        self._true_obs = np.empty((n, OBS_SIZE), dtype=np.float32)
+        self._estimated = np.zeros(n, dtype=bool)
         self._episode = np.zeros(n, dtype=np.int64)
         self._pending = np.zeros(n, dtype=bool)
         self._seed = 0
         self.returns = np.zeros(n)
+
+    def _observation(self, w: str, sensors, estimator, observe: str, dt: float):
+        """The vehicles' observation stage (None without sensor models), checked in one line."""
+        from quadcruise.workflows.onboard import onboard_inputs
+
+        if observe not in ("truth", "estimate"):
+            raise InputError(f"{w} argument observe: expected 'truth' or 'estimate', got {checks.describe(observe)}")
+        pop = self.population
+        if pop is not None and (pop.imu_noise_spread > 0 or pop.gps_noise_spread > 0):
+            raise InputError(
+                f"{w}: the population's imu_noise_spread and gps_noise_spread are not drawn per episode in the "
+                "environments; give them 0 (each vehicle's sensors differ through their own streams)"
+            )
+        sensors = sensors if sensors is not None else (None if pop is None else pop.sensors)
+        estimator = estimator if estimator is not None else (None if pop is None else pop.estimator)
+        if observe == "estimate" and estimator is None:
+            raise InputError(
+                f"{w} argument observe='estimate' needs an estimator: estimator=Ekf() and sensors=Sensors(...) "
+                "with an imu and a gps"
+            )
+        if sensors is not None and self.sensors is not None:
+            raise InputError(f"{w}: sensor models and the population's sensor noise: give one")
+        from quadcruise.estimation.stage import Sensors
+
+        if sensors is not None and not isinstance(sensors, Sensors):
+            raise InputError(f"{w} argument sensors: expected a Sensors, got {checks.describe(sensors)}")
+        n = self.num_envs
+        ids = np.arange(n) * EPISODE_STRIDE
+        g = float(self.nominal_eq.g)
+        obs, _ = onboard_inputs(sensors, estimator, g=g, n=n, dt=dt, seed=0, first_vehicle=ids, where=w)
+        self.observe_mode, self.observed = observe, obs is not None
+        return obs
 
     def _draw(self, seed: int, ids: np.ndarray, k: int) -> dict:
         """The vehicle rows, initial states, mission rows and environment of k episodes."""
@@ -281,6 +335,12 @@ class QuadVectorEnv(VectorEnv):
             rng=vehicle_states(self._seed, k, ids) if s.drawn else None,
             disturbance_memory=None if env is None else env.memory(k),
         )
+        if self.observed:  # the episode's own sensor stream, (seed, vehicle, episode) as the rest
+            from quadcruise.sim.observe import sensor_streams
+
+            s.observation.rng[rows] = sensor_streams(self._seed, k, ids)
+            s.log_obs[rows] = np.nan  # no estimate yet: the filter starts in the episode's first period
+            self._estimated[rows] = False
         self._episode[rows] += 1
         self.returns[rows] = 0.0
 
@@ -293,6 +353,18 @@ class QuadVectorEnv(VectorEnv):
         s = self.stepper
         references(s.mission, s.time, s.mp, self._ref)
         observe(s.paper_state, self._ref, s.vp_ctrl, self.max_track_error, self._obs, self._reward, self._lost)
+        if self.observe_mode == "estimate":  # the truth's kept for info; the policy sees the estimate's
+            self._true_obs[:] = self._obs
+            est, self._estimated[:] = estimated_states(s.paper_state, s.log_obs, self._estimated)
+            observe(
+                est,
+                self._ref,
+                s.vp_ctrl,
+                self.max_track_error,
+                self._obs,
+                np.empty(self.num_envs),
+                np.empty(self.num_envs, dtype=bool),
+            )
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         """Start every vehicle's episode again (``options={"reset_mask": mask}``: some of them).
@@ -324,7 +396,10 @@ class QuadVectorEnv(VectorEnv):
 
     def _info(self) -> dict:
         s = self.stepper
-        return {"status": s.status.copy(), "t": s.time.copy(), "episode_return": self.returns.copy()}
+        info = {"status": s.status.copy(), "t": s.time.copy(), "episode_return": self.returns.copy()}
+        if self.observe_mode == "estimate":
+            info.update(true_obs=self._true_obs.copy(), estimated=self._estimated.copy())
+        return info
 
     def check_action(self, actions) -> np.ndarray:
         """The actions as a (N, 4) float64 array, or one InputError line naming what is wrong.

@@ -10,10 +10,30 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
 from quadcruise.control.so3 import rotation_zyx
-from quadcruise.layout import F1, P_G, P_M, PHI, PSI, REF_AX, REF_PSI, REF_SIZE, REF_VX, REF_X, THETA, VX, P, X
+from quadcruise.layout import (
+    F1,
+    O_P,
+    O_PHI,
+    O_VX,
+    O_X,
+    P_G,
+    P_M,
+    PHI,
+    PSI,
+    REF_AX,
+    REF_PSI,
+    REF_SIZE,
+    REF_VX,
+    REF_X,
+    THETA,
+    VX,
+    P,
+    X,
+)
 
 OBS_NAMES = (
     "ex_b",
@@ -77,4 +97,44 @@ def observe(x, ref, vp, bound, obs, reward, lost):
         lost[i] = not dist <= bound
 
 
-__all__ = ["OBS_NAMES", "OBS_SIZE", "REF_SIZE", "REWARD_DISTANCE", "REWARD_RATE", "observe", "references"]
+def estimated_states(truth: np.ndarray, log_obs: np.ndarray, had: np.ndarray):
+    """The states a policy observes on the estimate: the truth with position, velocity, Euler
+    angles and body rates replaced by the filter's latest (the last logged row that holds one).
+
+    Parameters
+    ----------
+    truth : numpy.ndarray
+        (N, 16) the true states, paper layout.
+    log_obs : numpy.ndarray
+        (N, R, OBSERVATION_SIZE) the step's observation log (:attr:`quadcruise.sim.stepper.Stepper.log_obs`).
+    had : numpy.ndarray
+        (N,) bool: whether each vehicle had an estimate before (kept where this step logged none).
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        The (N, 16) states and (N,) whether each holds an estimate (else the truth's).
+    """
+    est = truth.copy()
+    if log_obs.shape[1] == 0:
+        return est, had
+    finite = np.isfinite(log_obs[:, :, O_X])
+    found = finite.any(axis=1)
+    last = log_obs.shape[1] - 1 - np.argmax(finite[:, ::-1], axis=1)
+    rows = np.flatnonzero(found)
+    pick = log_obs[rows, last[rows]]
+    for at, width, col in ((O_X, 3, X), (O_VX, 3, VX), (O_PHI, 3, PHI), (O_P, 3, P)):
+        est[rows, col : col + width] = pick[:, at : at + width]
+    return est, had | found
+
+
+__all__ = [
+    "OBS_NAMES",
+    "estimated_states",
+    "OBS_SIZE",
+    "REF_SIZE",
+    "REWARD_DISTANCE",
+    "REWARD_RATE",
+    "observe",
+    "references",
+]

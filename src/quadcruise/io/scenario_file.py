@@ -113,6 +113,8 @@ def montecarlo_document(spec: dict, n: int, *, title: str = "") -> dict:
         "controller_vehicle": spec.get("controller_vehicle"),
         "environment": population.get("environment"),
         "sensors": population.get("noise"),
+        "sensor_models": population.get("sensors"),
+        "estimator": population.get("estimator"),
         "duration_s": spec.get("duration"),
         "dt_s": spec.get("dt"),
         "max_step_s": spec.get("max_step"),
@@ -120,7 +122,7 @@ def montecarlo_document(spec: dict, n: int, *, title: str = "") -> dict:
     }
     doc = scenario_document(meta, title=title)
     table = {"n": int(n), "seed": spec["seed"]}
-    table.update({k: v for k, v in population.items() if k not in ("environment", "noise")})
+    table.update({k: v for k, v in population.items() if k not in ("environment", "noise", "sensors", "estimator")})
     table.update({k: spec[k] for k in SPEC_KEYS if spec.get(k) is not None})
     doc["montecarlo"] = _plain(table)
     return doc

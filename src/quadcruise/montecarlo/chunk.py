@@ -12,6 +12,7 @@ import numpy as np
 from quadcruise.errors import InputError, whole_number
 from quadcruise.layout import CMD_U1, REF_X, X
 from quadcruise.metrics.batch import flight_metrics_batch
+from quadcruise.metrics.estimate import estimate_metrics, flew_an_estimator
 from quadcruise.metrics.flight import FAILED_FLIGHT_METRICS, hover_duties
 from quadcruise.montecarlo.population import Draw
 from quadcruise.montecarlo.schema import COLUMNS, FAILURES, METRICS
@@ -50,6 +51,7 @@ def fly_chunk(spec: MonteCarloSpec, first, count: int, log_every: int | None = N
             first_vehicle=first,
             environment=draw.environment,
             sensors=draw.sensors,
+            estimator=draw.estimator,
             max_steady_error=spec.max_track_error_m,
             max_altitude_error=spec.max_altitude_error_m,
         )  # fly's own verdict, by the spec's bounds, at every period whatever the log keeps
@@ -128,6 +130,10 @@ def sweep_metrics(result, spec: MonteCarloSpec) -> dict[str, np.ndarray]:
             out[key][live] = got[key]
         out["settling_time_s"][live], out["settling_time_5pct_s"][live] = got["settling_s"][:2]
         not_settled[live] = (got["transient_axis"] >= 0) & np.isnan(got["settling_s"][2])
+        if flew_an_estimator(result):  # how far the estimate the controller flew on was from the truth
+            for i in live:
+                for key, value in estimate_metrics(result.states, result.observations, int(i)).items():
+                    out[key][i] = value
     diverged = stopped
     # lost track: fly's own status, the one rule of a flight alone (fly_chunk gives it the spec's
     # bounds): the error left the tracking bound (1 m + the mission's size) at some period, or

@@ -45,6 +45,8 @@ def compare_population(
         for metric in ("rmse_m", "max_error_m", "steady_rmse_m", "steady_max_error_m", "settling_time_5pct_s"):
             row[f"{metric} p50"] = s["metrics"][metric]["p50"]
             row[f"{metric} p95"] = s["metrics"][metric]["p95"]
+        if "estimate_position_rmse_m" in s["metrics"]:  # on the estimate: how far it was from the truth
+            row["estimate_position_rmse_m p50"] = s["metrics"]["estimate_position_rmse_m"]["p50"]
         rows[label] = row
     return pd.DataFrame.from_dict(rows, orient="index")
 

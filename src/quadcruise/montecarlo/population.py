@@ -35,6 +35,7 @@ from quadcruise.checks import describe
 from quadcruise.errors import ArgumentTypeError, InputError
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.model.vehicle import Vehicle
+from quadcruise.montecarlo.sensor_spread import SENSOR_SPREADS, check_sensors, drawn_sensors
 from quadcruise.sim import plants
 from quadcruise.sim.fastmath import seeded_draws
 
@@ -57,7 +58,8 @@ SLOTS = {
     "wind_x": 10,
     "wind_y": 11,
 }
-"""Which of the 16 unit draws of a vehicle feeds which quantity (:data:`ROTOR_SLOTS`: 12, 13; 14, 15 are spare)."""
+"""Which of the 16 unit draws of a vehicle feeds which quantity (:data:`ROTOR_SLOTS`: 12, 13; the sensors'
+spreads: 14, 15, :mod:`quadcruise.montecarlo.sensor_spread`)."""
 SPREADS = {
     "mass_spread": ("m",),
     "inertia_spread": ("Jxx", "Jyy", "Jzz"),
@@ -136,6 +138,16 @@ class Population:
         Parameters identified from a log, each vehicle's drawn from their estimate and
         covariance (:mod:`quadcruise.montecarlo.identified`; :meth:`from_identification`),
         instead of the nominal's; a spread of the same field is refused.
+    sensors : Sensors, optional
+        The sensor models every vehicle carries (:class:`~quadcruise.estimation.Sensors`; each
+        vehicle's readings from its own stream); not with ``noise``.
+    estimator : Ekf, optional
+        The filter every controller flies on (:class:`~quadcruise.estimation.Ekf`; needs
+        ``sensors`` with an IMU and a GPS): the sweep's table then holds the estimation error.
+    imu_noise_spread, gps_noise_spread : float
+        Relative standard deviations of each vehicle's IMU noise (densities, bias walks and
+        switch-on spreads) and GPS noise, the filter matched to the nominal sensors
+        (:mod:`quadcruise.montecarlo.sensor_spread`); same bounds as the vehicle's spreads.
 
     Raises
     ------
@@ -168,6 +180,10 @@ class Population:
     model_error: bool = True
     aero_spread: float = 0.0
     identified: Any = None
+    sensors: Any = None
+    estimator: Any = None
+    imu_noise_spread: float = 0.0
+    gps_noise_spread: float = 0.0
 
     @classmethod
     def from_identification(cls, source, **fields) -> Population:
@@ -199,7 +215,7 @@ class Population:
     def __post_init__(self) -> None:
         if self.distribution not in CLIP:
             raise InputError(f"population field 'distribution' must be normal or uniform, got {self.distribution!r}")
-        for name in (*ROTOR_SPREADS, "offset", "wind_spread"):
+        for name in (*ROTOR_SPREADS, *SENSOR_SPREADS, "offset", "wind_spread"):
             value = getattr(self, name)
             wrong_type = isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating))
             if wrong_type or not math.isfinite(value) or value < 0:
@@ -208,7 +224,7 @@ class Population:
                 )
             object.__setattr__(self, name, float(value))
             limit = 1.0 / CLIP[self.distribution]
-            if name in ROTOR_SPREADS and value >= limit:
+            if (name in ROTOR_SPREADS or name in SENSOR_SPREADS) and value >= limit:
                 raise InputError(
                     f"population field '{name}' = {value:g} is too large: with {self.distribution} "
                     f"draws it must be < {limit:.4f} so that every value stays positive"
@@ -228,6 +244,7 @@ class Population:
                 raise InputError("population field 'noise' must be a SensorNoise or None")
             if np.ndim(self.noise.std_vector()) > 1:
                 raise InputError("the population's sensor noise must be the same for every vehicle")
+        check_sensors(self.sensors, self.estimator, self.noise, {k: getattr(self, k) for k in SENSOR_SPREADS})
         object.__setattr__(self, "model_error", bool(self.model_error))
         if self.identified is not None:
             from quadcruise.montecarlo.identified import Identified
@@ -263,6 +280,8 @@ class Population:
             return True
         if self.environment is not None and self.environment.turbulence is not None:
             return True
+        if self.sensors is not None:  # each vehicle's readings from its own stream
+            return True
         return self.noise is not None and bool(np.any(np.asarray(self.noise.std_vector()) > 0))
 
     def check_perturbs(self, n: int, hint: str | None = None) -> None:
@@ -292,7 +311,7 @@ class Population:
         hint = hint or (
             "a spread (--mass-spread 0.1, --inertia-spread, --thrust-spread, --bandwidth-spread, "
             "--yaw-arm-spread, --aero-spread), a start --offset, a --wind-spread, turbulence (--turbulence moderate) "
-            "or sensor --noise"
+            "or sensor --noise or --sensors"
         )
         if n > 1 and not self.perturbs:
             raise InputError(
@@ -414,7 +433,17 @@ class Population:
             env = dataclasses.replace(env or Environment(), wind=ConstantWind(velocity=wind))
         if env is not None and not env.parts:
             env = None
-        return Draw(vehicle=vehicles, offsets=offsets, environment=env, sensors=self.noise, columns=cols)
+        sensors, estimator = self.noise, None
+        if self.sensors is not None:
+            spreads = (self.imu_noise_spread, self.gps_noise_spread)
+            g = float(np.ravel(nominal.g)[0])
+            sensors, estimator, spread_cols = drawn_sensors(self.sensors, self.estimator, *spreads, z, g)
+            cols.update(spread_cols)
+        else:
+            cols.update(imu_noise_factor=np.ones(count), gps_noise_factor=np.ones(count))
+        return Draw(
+            vehicle=vehicles, offsets=offsets, environment=env, sensors=sensors, columns=cols, estimator=estimator
+        )
 
     def _identified_draws(self, seed: int, first, count: int, nominal) -> dict[str, np.ndarray]:
         """The identified parameters drawn for vehicles first .. first + count - 1 (none: {})."""
@@ -478,10 +507,11 @@ class Population:
             Field name -> value; the environment and the noise as their ``to_dict()``.
         """
         out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
-        for key in ("environment", "noise", "identified"):
+        for key in ("environment", "noise", "identified", "sensors", "estimator"):
             out[key] = None if out[key] is None else out[key].to_dict()
-        if out["identified"] is None:
-            del out["identified"]  # a population without one: its configuration (and hash) as before
+        for key in ("identified", "sensors", "estimator", *SENSOR_SPREADS):
+            if not out[key]:
+                del out[key]  # a population without one: its configuration (and hash) as before
         return out
 
 
@@ -521,13 +551,16 @@ class Draw:
     environment : Environment or None
         The disturbances, with a per-vehicle steady wind [m/s] where one was drawn; None
         if there are none.
-    sensors : SensorNoise or None
-        The sensor noise and delay.
+    sensors : SensorNoise, Sensors, tuple of Sensors or None
+        The sensor noise and delay, or the sensor models (one per vehicle where spread).
     columns : dict of str to ndarray
         The drawn values as table columns: ``m`` [kg], ``Jxx``, ``Jyy``, ``Jzz``
         [kg m^2], ``K`` [N], ``omega`` [rad/s], ``d`` [m], ``dx0``, ``dy0``, ``dz0`` [m],
         ``wind_x``, ``wind_y`` [m/s]. For rotor-plant vehicles K = (n / 4) kf w_max^2 and
-        d = km / kf (their "+" equivalent's), omega = 1 / max(tau_up, tau_down) (the motors').
+        d = km / kf (their "+" equivalent's), omega = 1 / max(tau_up, tau_down) (the motors');
+        ``imu_noise_factor``, ``gps_noise_factor`` [-] (1 without a sensor spread).
+    estimator : Ekf or None
+        The filter the vehicles fly on.
     """
 
     vehicle: Vehicle
@@ -535,3 +568,4 @@ class Draw:
     environment: Any
     sensors: Any
     columns: dict
+    estimator: Any = None

@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from quadcruise import checks
-from quadcruise.montecarlo.schema import METRICS
+from quadcruise.montecarlo.schema import ESTIMATE_METRICS, METRICS
 
 __all__ = ["OPERATORS", "Requirement", "as_requirements", "check_metric", "metric_hint"]
 
@@ -90,7 +90,8 @@ def check_metric(where: str, name: str, value: Any) -> str:
     quadcruise.errors.InputError: tune() argument minimize must be a metric of the flights table, got str 'rmse'; did \
 you mean 'rmse_m'? metrics: rmse_m, ...
     """
-    metrics = f"metrics: {', '.join(METRICS)}"
+    estimate = [m for m in METRICS if m in ESTIMATE_METRICS]  # named by their stems: the line stays short
+    metrics = f"metrics: {', '.join(m for m in METRICS if m not in estimate)}, on an estimator estimate_*, nees_*"
     if not isinstance(value, str):
         checks.fail(where, name, value, "a metric's name (str)", hint=metrics)
     if value not in METRICS:

@@ -19,7 +19,8 @@ import numpy as np
 from quadcruise.errors import InputError
 from quadcruise.metrics.declared import metric
 from quadcruise.metrics.summary import Summary
-from quadcruise.montecarlo.schema import COLUMNS, FAILURES, METRICS, engine_stops
+from quadcruise.montecarlo.consistency import consistency_text, nees_consistency
+from quadcruise.montecarlo.schema import COLUMNS, ESTIMATE_METRICS, FAILURES, METRICS, engine_stops
 from quadcruise.montecarlo.spec import MonteCarloSpec
 
 __all__ = ["MonteCarloResult", "Traces", "FAILURES", "COLUMNS", "METRICS"]
@@ -159,7 +160,10 @@ class MonteCarloResult:
         }
         metrics = {}
         kept = ~(tab["diverged"].to_numpy(dtype=bool) | tab["lost_track"].to_numpy(dtype=bool))
+        flew_estimator = getattr(self.spec.population, "estimator", None) is not None
         for name in METRICS:
+            if name in ESTIMATE_METRICS and not flew_estimator:
+                continue  # a sweep on the truth: no estimate to measure
             v = tab[name].to_numpy(dtype=float)[kept]
             v = v[np.isfinite(v)]
             q = np.percentile(v, [5, 50, 95]) if v.size else [np.nan] * 3
@@ -186,6 +190,7 @@ class MonteCarloResult:
             "stopped": stops,
             "metrics": metrics,
             "metrics_over": int(np.count_nonzero(kept)),
+            **({"consistency": nees_consistency(tab, kept)} if flew_estimator else {}),
         }
 
     def summary_text(self, worst: int = 0) -> str:
@@ -234,12 +239,15 @@ class MonteCarloResult:
             + (f" ({left_out:,} that diverged or lost track left out)" if left_out else "")
             + ":"
         )
-        lines.append(f"  {'metric':<22}{'count':>8}{'p5':>11}{'p50':>11}{'p95':>11}{'max':>11}")
+        width = max(22, *(len(name) + 1 for name in s["metrics"]))
+        lines.append(f"  {'metric':<{width}}{'count':>8}{'p5':>11}{'p50':>11}{'p95':>11}{'max':>11}")
         for name, m in s["metrics"].items():
             lines.append(
-                f"  {name:<22}{m['count']:>8,}"
+                f"  {name:<{width}}{m['count']:>8,}"
                 + "".join(f"{'-' if m[k] is None else format(m[k], '.4g'):>11}" for k in ("p5", "p50", "p95", "max"))
             )
+        if "consistency" in s:
+            lines.append(consistency_text(s["consistency"]))
         if worst:
             lines += [f"worst {worst} (fly one alone again with --case VEHICLE):", self.worst_text(worst)]
         return "\n".join(lines)

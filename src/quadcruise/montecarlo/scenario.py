@@ -82,7 +82,9 @@ def merge_scenario(path, given: dict) -> tuple[Scenario, dict]:
     """A scenario, and its ``[montecarlo]`` table (and ``[simulation]`` seed) under the options given explicitly."""
     sc = load_scenario(path)
     table = dict(sc.montecarlo)
-    known = ({f.name for f in dataclasses.fields(Population)} - {"environment", "noise"}) | set(SPEC_KEYS)
+    known = ({f.name for f in dataclasses.fields(Population)} - {"environment", "noise", "sensors", "estimator"}) | set(
+        SPEC_KEYS
+    )
     unknown = set(table) - known - {"n", "seed"}
     if unknown:
         raise InputError(
@@ -104,6 +106,8 @@ def sweep_spec(
     dt: float | None = None,
     environment=None,
     noise=None,
+    sensors=None,
+    estimator=None,
     scenario=None,
     requirements=(),
     max_track_error_m: float | None = None,
@@ -112,7 +116,8 @@ def sweep_spec(
     log_every: int | None = None,
     **population,
 ) -> tuple[MonteCarloSpec, int]:
-    """The spec of a sweep and its number of flights; None means "not given"."""
+    """The spec of a sweep and its number of flights; None means "not given" (``estimator=False``:
+    none, over a scenario's)."""
     given = {key: value for key, value in {**population, "n": n, "seed": seed}.items() if value is not None}
     options: dict = dict(
         duration=duration, dt=1e-3 if dt is None else dt, requirements=requirements, max_track_error_m=max_track_error_m
@@ -123,6 +128,8 @@ def sweep_spec(
         controller = sc.controller if controller is None else controller
         environment = environment if environment is not None else sc.environment
         noise = noise if noise is not None else sc.sensor_noise
+        sensors = sensors if sensors is not None else sc.sensors
+        estimator = estimator if estimator is not None else sc.estimator
         options.update(
             vehicle=sc.vehicle,
             controller_vehicle=sc.controller_vehicle,
@@ -148,9 +155,14 @@ def sweep_spec(
         options["controller_vehicle"] = controller_vehicle
     if log_every is not None:
         options["log_dt"] = log_every * options["dt"]
+    estimator = None if estimator is False else estimator  # False: none, whatever the scenario says
     mission = "circle" if mission is None else mission
     controller = "nlpd" if controller is None else controller
     pop = Population(
-        **given, environment=environment if environment is not None and environment.parts else None, noise=noise
+        **given,
+        environment=environment if environment is not None and environment.parts else None,
+        noise=noise,
+        sensors=sensors,
+        estimator=estimator,
     )
     return MonteCarloSpec(mission=mission, controller=controller, population=pop, seed=seed, **options), n

@@ -182,6 +182,10 @@ class MonteCarloSpec:
         object.__setattr__(self, "duration", float(duration))
         if self.population.noise is not None:
             self.population.noise.check_fits(self.duration)
+        if self.population.sensors is not None:  # each sensor's rate against this dt, before any flight
+            from quadcruise.estimation.stage import observation
+
+            observation(self.population.sensors, self.population.estimator, n=1, dt=float(self.dt), seed=0)
         object.__setattr__(self, "dt", float(self.dt))
         for name in ("log_dt", "trace_dt", "settle_band"):
             value = getattr(self, name)

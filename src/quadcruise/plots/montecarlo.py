@@ -34,6 +34,8 @@ METRIC_LABELS = {
     "dz0": "start offset z [m]",
     "wind_x": "wind x [m/s]",
     "wind_y": "wind y [m/s]",
+    "imu_noise_factor": "IMU noise / nominal [-]",
+    "gps_noise_factor": "GPS noise / nominal [-]",
 }
 """Axis labels, with units, of the sweep table's columns."""
 

@@ -63,11 +63,13 @@ def flight_report(result, *, title: str | None = None, metrics=None) -> dict:
     dict
         ``title``, ``tables`` (the metrics, vehicles across for up to 6 vehicles, and the
         run: controller, mission, duration [s], dt [s], vehicles, seed, version),
-        ``figures`` (the flight, of vehicle 0 in a batch, and a batch's envelope),
+        ``figures`` (the flight, of vehicle 0 in a batch, a batch's envelope, and after a flight
+        on an estimator its estimate against the truth),
         ``flights`` (the 3-D view) and ``config`` (``result.meta``).
     """
     import pandas as pd
 
+    from quadcruise.metrics.estimate import flew_an_estimator
     from quadcruise.plots.flight import describe, plot_envelope, plot_flight
 
     meta = result.meta or {}
@@ -88,6 +90,13 @@ def flight_report(result, *, title: str | None = None, metrics=None) -> dict:
     figures = {(f"Flight of vehicle 0: {label}" if result.n > 1 else f"Flight: {label}"): plot_flight(result)}
     if result.n > 1:
         figures[f"All {result.n} vehicles"] = plot_envelope(result)
+    if flew_an_estimator(result):  # the controller flew on an estimate: it beside the truth
+        from quadcruise.plots.estimate import plot_estimate
+
+        estimator = (meta.get("estimator") or {}).get("kind", "estimator")
+        sensors = ", ".join(meta.get("sensor_models") or {})
+        caption = f"The {estimator}'s estimate the controller flew on ({sensors}), against the truth"
+        figures[caption + (" (vehicle 0)" if result.n > 1 else "")] = plot_estimate(result)
     metrics = result.metrics() if metrics is None else metrics
     return {
         "title": title or f"quadcruise: {label}",

@@ -467,7 +467,8 @@ class SimResult:
 
     def write(self, out: str | os.PathLike, *, fmt: str = "csv", force: bool = False, metrics=None) -> Path:
         """Write the flight's folder, whole or not at all: the traces (``traces.csv`` or
-        ``traces.parquet``), ``metrics.csv``, ``flight.png``, the configuration
+        ``traces.parquet``), ``metrics.csv``, ``flight.png`` (and ``estimate.png`` after a flight
+        on an estimator: :func:`~quadcruise.plots.estimate.plot_estimate`), the configuration
         (``quadcruise.json``: :attr:`meta`, and under ``metrics_conventions`` the conventions
         of the metrics written) and ``scenario.toml``, which ``quadcruise fly`` flies again to
         the same numbers (when the flight came from :func:`quadcruise.fly`).
@@ -490,6 +491,7 @@ class SimResult:
             The folder written.
         """
         from quadcruise.io.files import MARKER, atomic_dir, check_output_dir, check_table_format, write_table
+        from quadcruise.metrics.estimate import flew_an_estimator
         from quadcruise.plots.flight import plot_flight, save_figure
 
         check_table_format(fmt)
@@ -500,6 +502,10 @@ class SimResult:
             write_table(self.to_pandas(), tmp / "traces", fmt)
             metrics.to_csv(tmp / "metrics.csv", index=False)
             save_figure(plot_flight(self), tmp / "flight.png")
+            if flew_an_estimator(self):  # what the controller saw beside the truth
+                from quadcruise.plots.estimate import plot_estimate
+
+                save_figure(plot_estimate(self), tmp / "estimate.png")
             (tmp / MARKER).write_text(self.meta_json(metrics_conventions=metrics.attrs.get("conventions")) + "\n")
             if self.meta.get("workflow") == "fly" and "custom" not in (self.meta.get("environment") or {}):
                 (tmp / "scenario.toml").write_text(self.scenario_toml())

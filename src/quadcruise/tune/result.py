@@ -147,7 +147,8 @@ class TuneResult:
             dt=spec.dt,
             seed=spec.seed,
             environment=spec.population.environment,
-            sensors=spec.population.noise,
+            sensors=spec.population.noise if spec.population.sensors is None else spec.population.sensors,
+            estimator=spec.population.estimator,  # the estimator the search flew on, flown again
             log_every=spec.log_every,  # the search's log and bounds: its metrics, flown again
             max_steady_error=spec.max_track_error_m,
             max_altitude_error=spec.max_altitude_error_m,
@@ -366,7 +367,8 @@ class TuneResult:
 
         doc = scenario_document(self.response.meta, title=f"{self.controller.name} tuned on {self.spec.mission.name}")
         pop = self.spec.population
-        spreads = {k: getattr(pop, k) for k in (*SPREADS, "offset", "wind_spread") if getattr(pop, k)}
+        spread_names = (*SPREADS, "offset", "wind_spread", "imu_noise_spread", "gps_noise_spread")
+        spreads = {k: getattr(pop, k) for k in spread_names if getattr(pop, k)}
         if spreads or self.info["samples"] > 1:
             doc["montecarlo"] = {
                 **spreads,

@@ -36,6 +36,7 @@ from quadcruise.sim import plants
 from quadcruise.workflows.fly import fly
 from quadcruise.workflows.fly_failures import flight_warnings_named
 from quadcruise.workflows.fly_inputs import FLY_OPTIONS
+from quadcruise.workflows.onboard import onboard_inputs, vehicle_gravity
 from quadcruise.workflows.rotor_fly import as_vehicle, flight_setup
 
 __all__ = ["compare", "Comparison", "DEFAULT_CONTROLLERS"]
@@ -207,8 +208,29 @@ class Comparison:
 
         table = self.metrics(**metric_kw)
         text = metrics_text(table, [" ".join(map(str, c)) if isinstance(c, tuple) else c for c in table.index])
-        notes = conventions_text(table.attrs.get("conventions"))
+        notes = "\n".join(n for n in (conventions_text(table.attrs.get("conventions")), self.flown_on()) if n)
         return f"{text}\n{notes}" if notes else text
+
+    def flown_on(self) -> str:
+        """What the controllers read: "" on the truth; else a line naming the estimator and sensors.
+
+        Returns
+        -------
+        str
+            E.g. ``controllers flew on the estimate: ekf on imu, gps, baro, mag (estimate_*, nees_*:
+            its error against the truth)``; sensors without an estimator: the truth, sensors logged.
+        """
+        meta = next(iter(self.results.values())).meta
+        sensors = ", ".join(meta.get("sensor_models") or {})
+        if not sensors:
+            return ""
+        estimator = (meta.get("estimator") or {}).get("kind")
+        if estimator is None:
+            return f"controllers flew on the true state (sensors {sensors} logged, no estimator)"
+        return (
+            f"controllers flew on the estimate: {estimator} on {sensors} "
+            "(estimate_*, nees_*: its error against the truth, not the controllers')"
+        )
 
     def plot(self, vehicle: int = 0, *, title: str | None = None):
         """Overlay of the flights: top view, x, y, z and the position error against time.
@@ -262,6 +284,7 @@ class Comparison:
             "controllers": {label: controller_record(c) for label, c in self.controllers.items()},
             "metrics": rows,
             "metrics_conventions": plain(table.attrs.get("conventions")),
+            **({"flown_on": self.flown_on()} if self.flown_on() else {}),
             **({"population": plain(self.population)} if self.population else {}),
         }
 
@@ -360,7 +383,10 @@ def compare(
         ``progress(done, total)``: called with 0 before the first flight and after each
         controller's flight, with the number flown and the number of controllers.
     **fly_kw
-        Any other keyword of :func:`quadcruise.fly` (``max_step``, ``log_every``, ``x0``, ...).
+        Any other keyword of :func:`quadcruise.fly` (``max_step``, ``log_every``, ``x0``, ...);
+        with ``sensors`` (:class:`~quadcruise.estimation.Sensors`) and ``estimator``
+        (:class:`~quadcruise.estimation.Ekf`) every controller flies on the estimate, the same
+        sensor draws for each (one seed), and the table says so (:meth:`Comparison.flown_on`).
 
     Returns
     -------
@@ -381,6 +407,10 @@ def compare(
     checks.number(w, "duration", duration, "pos", unit="s", optional=True)
     checks.number(w, "dt", dt, "pos", unit="s")
     checks.callback(w, "progress", progress)
+    g = 9.81 if vehicle is None else vehicle_gravity(vehicle)  # sensors and estimator checked before any flight
+    onboard_inputs(
+        fly_kw.get("sensors"), fly_kw.get("estimator"), g=g, n=1, dt=float(dt), seed=0, first_vehicle=0, where=w
+    )
     if controllers is None:
         controllers = compared_names()
     chosen = labelled(controllers)

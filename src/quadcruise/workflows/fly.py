@@ -217,7 +217,7 @@ def fly(
     checks.instance(w, "limits", limits, Limits)
     full_dynamics = checks.flag(w, "full_dynamics", full_dynamics)
     checks.instance(w, "environment", environment, (Environment, CustomDisturbance))
-    checks.instance(w, "sensors", sensors, (SensorNoise, Sensors))
+    checks.instance(w, "sensors", sensors, (SensorNoise, Sensors, tuple))  # a tuple: one Sensors per vehicle
     checks.instance(w, "estimator", estimator, Ekf)
     plant.check_environment(flown, environment)
     seed = checks.whole(w, "seed", seed)

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from quadcruise.errors import InputError
+from quadcruise.estimation.onboard import PARAMS
 from quadcruise.estimation.stage import Ekf, Sensors, check_estimator, observation
 from quadcruise.sim.observe import Observation
 
@@ -28,9 +29,10 @@ def onboard_inputs(
 
     Parameters
     ----------
-    sensors : Sensors, SensorNoise or None
-        Sensor models (a :class:`Sensors`), or the white noise on the truth (handled by the
-        engine's ``sensor_std``: not here).
+    sensors : Sensors, tuple of Sensors, SensorNoise or None
+        Sensor models (a :class:`Sensors`, or one per vehicle: a population's spread sensors,
+        the same sensors and rates), or the white noise on the truth (handled by the engine's
+        ``sensor_std``: not here).
     estimator : Ekf or None
         The filter (needs :class:`Sensors` with an IMU and a GPS).
     g : float
@@ -61,6 +63,10 @@ def onboard_inputs(
     """
     if estimator is not None and not isinstance(estimator, Ekf):
         raise InputError(f"{where} argument estimator: expected an Ekf, got {type(estimator).__name__}")
+    if isinstance(sensors, (tuple, list)):
+        return _each_vehicle(
+            tuple(sensors), estimator, g=g, n=n, dt=dt, seed=seed, first_vehicle=first_vehicle, where=where
+        )
     if not isinstance(sensors, Sensors):
         if estimator is not None:
             check_estimator(None, estimator, f"{where} argument estimator:")
@@ -68,6 +74,30 @@ def onboard_inputs(
     check_estimator(sensors, estimator, f"{where} argument estimator:")
     obs = observation(sensors, estimator, n=n, dt=dt, seed=seed, first_vehicle=first_vehicle, g=float(g))
     return obs, {"sensor_models": sensors.to_dict(), "estimator": None if estimator is None else estimator.to_dict()}
+
+
+def _each_vehicle(sensors: tuple, estimator, *, g, n, dt, seed, first_vehicle, where) -> tuple[Observation, dict]:
+    """The observation stage of one :class:`Sensors` per vehicle (a population's spread sensors):
+    the same sensors carried at the same rates and latency, each vehicle's own models' rows; the
+    filter's settings the first's (give :attr:`Ekf.noise` to match it to another)."""
+    if len(sensors) != n or not all(isinstance(s, Sensors) for s in sensors):
+        raise InputError(f"{where} argument sensors: a sequence must hold one Sensors per vehicle ({n})")
+    first = sensors[0]
+    timing = [(name, getattr(first, name).rate) for name in first.names()]
+    for k, s in enumerate(sensors):
+        if [(name, getattr(s, name).rate) for name in s.names()] != timing or (
+            first.gps is not None and s.gps.latency != first.gps.latency
+        ):
+            raise InputError(
+                f"{where} argument sensors: vehicle {k} carries other sensors, rates or GPS latency than vehicle 0"
+            )
+    obs, record = onboard_inputs(first, estimator, g=g, n=n, dt=dt, seed=seed, first_vehicle=first_vehicle, where=where)
+    for name in first.names():  # each vehicle's own noise, bias and range
+        width = getattr(first, name).row().size
+        at = dict(zip((f for f, _ in PARAMS.fields), PARAMS.offsets, strict=True))[name]
+        obs.params[:, at : at + width] = np.stack([getattr(s, name).row() for s in sensors])
+    record["sensor_models_each"] = [s.to_dict() for s in sensors]
+    return obs, record
 
 
 def vehicle_gravity(vehicle: Any) -> float:
