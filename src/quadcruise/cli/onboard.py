@@ -16,10 +16,12 @@ quadcruise.errors.InputError: --sensors: unknown sensor 'lidar' (known: imu, gps
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from quadcruise.errors import InputError
-from quadcruise.estimation.stage import PRESETS, SENSOR_NAMES, Ekf, Sensors, check_estimator
-from quadcruise.workflows.scenario_onboard import ESTIMATORS, estimator_from_spec, sensors_from_spec
-from quadcruise.workflows.scenario_values import Where
+
+if TYPE_CHECKING:  # the estimator's modules load the engine: imported where a command needs them
+    from quadcruise.estimation.stage import Ekf, Sensors
 
 __all__ = ["onboard_options", "parse_estimator", "parse_sensors"]
 
@@ -43,6 +45,10 @@ def parse_sensors(text: str, option: str = "--sensors") -> Sensors:
     InputError
         An empty list, an unknown sensor or preset, a sensor named twice.
     """
+    from quadcruise.estimation.stage import PRESETS, SENSOR_NAMES
+    from quadcruise.workflows.scenario_onboard import sensors_from_spec
+    from quadcruise.workflows.scenario_values import Where
+
     spec: dict = {}
     for item in (part.strip() for part in text.split(",")):
         if not item:
@@ -80,6 +86,9 @@ def parse_estimator(text: str, option: str = "--estimator") -> Ekf | None:
     InputError
         Another name.
     """
+    from quadcruise.workflows.scenario_onboard import ESTIMATORS, estimator_from_spec
+    from quadcruise.workflows.scenario_values import Where
+
     name = text.strip().lower()
     if name not in ESTIMATORS:
         raise InputError(f"{option}: unknown estimator {text!r} (known: {', '.join(ESTIMATORS)})")
@@ -106,6 +115,8 @@ def onboard_options(sensors_text: str | None, estimator_text: str | None, kwargs
     ------
     InputError
     """
+    from quadcruise.estimation.stage import Sensors, check_estimator
+
     out = dict(kwargs)
     if sensors_text is not None:
         out["sensors"] = parse_sensors(sensors_text)
