@@ -512,3 +512,21 @@ def test_fly_ulog_of_a_designed_px4_holds_the_design_as_px4_parameters(tmp_path)
     back = CliRunner().invoke(main, ["fly", "hover", "--params", str(tmp_path / "p.ulg"), "--duration", "1"])
     assert back.exit_code == 2 and "MC_ROLLRATE_P = " in back.output and "outside PX4 v1.15's range" in back.output
     assert "Traceback" not in back.output
+
+
+def test_from_params_of_a_file_warns_its_notes_once_and_already_read_parameters_do_not():
+    """``Px4.from_params(LOG)``: one ParameterWarning with what ``--params`` prints (the unused
+    parameters); parameters already read (what the command line passes) warn nothing."""
+    from quadcruise.errors import ParameterWarning
+    from quadcruise.io.px4params import read_params
+
+    iris = RotorVehicle.preset("iris")
+    with pytest.warns(ParameterWarning) as caught:
+        Px4.from_params(LOG, vehicle=iris)
+    assert len(caught) == 1
+    text = str(caught[0].message)
+    assert "parameters of" in text and "not used by the px4 controller" in text and "BAT1_CAPACITY" in text
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ParameterWarning)
+        Px4.from_params(read_params(LOG), vehicle=iris)
+        Px4.from_params({"MC_ROLL_P": 7.0}, vehicle=iris)

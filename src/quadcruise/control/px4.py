@@ -64,6 +64,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import warnings
 from collections.abc import Mapping
 
 import numpy as np
@@ -80,7 +81,7 @@ from quadcruise.control.px4kernel import (
     resolve_gains,
 )
 from quadcruise.control.px4loops import G_RATE_D, G_RATE_I, G_RATE_P, G_THR_HOVER, G_THR_MIN, PX4_GAINS, px4_gains
-from quadcruise.errors import InputError
+from quadcruise.errors import InputError, ParameterWarning
 from quadcruise.fields import Check, between
 from quadcruise.fields import unit_field as _f
 from quadcruise.io.px4defaults import INT32, PX4_PARAMETERS
@@ -226,6 +227,14 @@ class Px4(Controller):
         ------
         InputError
             A bad file or value (one line naming it), or ``CA_ROTOR*`` that do not fit the vehicle.
+
+        Warns
+        -----
+        ParameterWarning
+            Once, for a file read here: its notes (another release's log, older names), the
+            values PX4 constrains (:func:`~quadcruise.io.px4params.px4_constrained`) and the
+            parameters the loops do not use, as ``--params`` prints them. Parameters already
+            read (a :class:`Px4Parameters`) are the caller's to tell.
         """
         from quadcruise.sim import plants
 
@@ -235,6 +244,14 @@ class Px4(Controller):
             p = Px4Parameters.defaults().with_values(**{str(k): v for k, v in params.items()})
         else:
             p = read_params(params)
+            told = [*p.notes, *(f"{p.source}: {note}" for note in px4_constrained(p)[1])]
+            if p.unused:
+                told.append(
+                    f"{len(p.unused)} parameters of {p.source} are not used by the px4 controller: "
+                    + ", ".join(p.unused)
+                )
+            if told:
+                warnings.warn("\n".join(told), ParameterWarning, stacklevel=2)
         base = {"params": p, "hover_from_vehicle": False, "rate_bandwidth": 0.0}
         if vehicle is not None:  # what PX4's CA_ROTOR* and THR_MDL_FAC say of the vehicle's plant
             base.update(plants.of(vehicle).px4_fields(vehicle))
