@@ -454,6 +454,7 @@ def test_fly_ulog_holds_the_px4_parameters_flown_and_fly_params_of_it_flies_them
         ],
     )
     assert first.exit_code == 0, first.output
+    assert "quadrotor x" not in first.stderr  # PX4's form: it flies back the same
     logged = ULog(str(tmp_path / "f.ulg"), message_name_filter_list=[]).initial_parameters
     assert logged["MC_ROLL_P"] == 7.25 and logged["MPC_XY_P"] == float(np.float32(1.1))  # PX4's float32
     assert logged["MC_PITCHRATE_P"] == float(np.float32(0.1612345678901))
@@ -499,6 +500,7 @@ def test_fly_ulog_of_a_designed_px4_holds_the_design_as_px4_parameters(tmp_path)
         ],
     )
     assert res.exit_code == 0, res.output
+    assert "allocates on PX4's quadrotor x, not the vehicle's rotors" in res.stderr  # said, not silent
     v = RotorVehicle.preset("iris")
     designed = dataclasses.replace(Px4(), **rotor_gains("px4", paper_equivalent(v).omega))
     plain = designed.resolved(paper_equivalent(v)).params
