@@ -67,6 +67,11 @@ class LogWarning(UserWarning):
     with ``log_every`` left to it); the flight and its checks are the same."""
 
 
+class ParameterWarning(UserWarning):
+    """What a PX4 parameter file read by ``Px4.from_params`` holds that a caller should know
+    once: parameters the loops do not use, values PX4 constrains, another release's names."""
+
+
 class FlightWarning(UserWarning):
     """How a flight went, when it went wrong: a vehicle that did not finish, rotor duties
     clipped. Workflows that fly several (compare, reproduce) say whose flight it was."""

@@ -417,3 +417,118 @@ def test_montecarlo_params_flies_px4_with_the_logs_parameters(tmp_path):
     bad.write_text("1\t1\tMC_ROLL_P\t13\t9\n")
     res = CliRunner().invoke(main, [*args[:6], str(bad), *args[7:], "--out", str(tmp_path / "n")])
     assert res.exit_code == 2 and "MC_ROLL_P = 13" in res.stderr and not (tmp_path / "n").exists()
+
+
+def _metrics(folder):
+    import csv
+
+    with open(folder / "metrics.csv") as f:
+        return next(csv.DictReader(f))
+
+
+def test_fly_ulog_holds_the_px4_parameters_flown_and_fly_params_of_it_flies_them(tmp_path):
+    """``fly --params P --ulog f.ulg``: pyulog reads the px4 controller's parameters in the log by
+    PX4's names and types (float32, INT32 as int); ``fly --params f.ulg`` flies the same metrics
+    exactly (the float64 values float32 does not hold ride in ``quadcruise_px4_params``)."""
+    from click.testing import CliRunner
+    from pyulog import ULog
+
+    from quadcruise.cli.main import main
+    from quadcruise.io.px4params import read_params
+
+    given = tmp_path / "p.params"
+    given.write_text("1\t1\tMC_ROLL_P\t7.25\t9\n1\t1\tMPC_XY_P\t1.1\t9\n1\t1\tMC_PITCHRATE_P\t0.1612345678901\t9\n")
+    common = ["--vehicle", "iris", "--duration", "3"]
+    first = CliRunner().invoke(
+        main,
+        [
+            "fly",
+            "step",
+            "--params",
+            str(given),
+            *common,
+            "--ulog",
+            str(tmp_path / "f.ulg"),
+            "--out",
+            str(tmp_path / "a"),
+        ],
+    )
+    assert first.exit_code == 0, first.output
+    assert "quadrotor x" not in first.stderr  # PX4's form: it flies back the same
+    logged = ULog(str(tmp_path / "f.ulg"), message_name_filter_list=[]).initial_parameters
+    assert logged["MC_ROLL_P"] == 7.25 and logged["MPC_XY_P"] == float(np.float32(1.1))  # PX4's float32
+    assert logged["MC_PITCHRATE_P"] == float(np.float32(0.1612345678901))
+    assert logged["MC_YAWRATE_P"] == float(np.float32(0.2))  # PX4's default, flown and logged
+    assert isinstance(logged["MPC_USE_HTE"], int) and isinstance(logged["MC_AIRMODE"], int)
+    read, want = read_params(tmp_path / "f.ulg"), read_params(given)
+    assert dict(read) == dict(want)  # every parameter, the allocation's (CA_*, THR_MDL_FAC) too
+    again = CliRunner().invoke(
+        main, ["fly", "step", "--params", str(tmp_path / "f.ulg"), *common, "--out", str(tmp_path / "b")]
+    )
+    assert again.exit_code == 0, again.output
+    a, b = _metrics(tmp_path / "a"), _metrics(tmp_path / "b")
+    for name in ("rmse_m", "overshoot_pct", "effort"):
+        assert float(a[name]) == float(b[name]), name
+    flown_default = CliRunner().invoke(
+        main, ["fly", "step", *common, "--controller", "px4", "--out", str(tmp_path / "c")]
+    )
+    assert float(_metrics(tmp_path / "c")["effort"]) != float(a["effort"]), flown_default.output  # it could differ
+
+
+def test_fly_ulog_of_a_designed_px4_holds_the_design_as_px4_parameters(tmp_path):
+    """``fly --controller px4 --ulog``: the rate gains designed for the vehicle and its hover
+    thrust are in the log as ``MC_*RATE_*`` and ``MPC_THR_HOVER``; on the paper plant, where
+    they lie outside PX4's range, ``fly --params`` of the log refuses it naming the parameter."""
+    from click.testing import CliRunner
+    from pyulog import ULog
+
+    from quadcruise.cli.main import main
+
+    res = CliRunner().invoke(
+        main,
+        [
+            "fly",
+            "hover",
+            "--controller",
+            "px4",
+            "--vehicle",
+            "iris",
+            "--duration",
+            "1",
+            "--ulog",
+            str(tmp_path / "i.ulg"),
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    assert "allocates on PX4's quadrotor x, not the vehicle's rotors" in res.stderr  # said, not silent
+    v = RotorVehicle.preset("iris")
+    designed = dataclasses.replace(Px4(), **rotor_gains("px4", paper_equivalent(v).omega))
+    plain = designed.resolved(paper_equivalent(v)).params
+    logged = ULog(str(tmp_path / "i.ulg"), message_name_filter_list=[]).initial_parameters
+    for name in ("MC_ROLLRATE_P", "MC_YAWRATE_I", "MPC_THR_HOVER"):
+        assert logged[name] == float(np.float32(plain[name])) and plain[name] != Px4().params[name], name
+    paper = CliRunner().invoke(
+        main, ["fly", "hover", "--controller", "px4", "--duration", "1", "--ulog", str(tmp_path / "p.ulg")]
+    )
+    assert paper.exit_code == 0, paper.output
+    back = CliRunner().invoke(main, ["fly", "hover", "--params", str(tmp_path / "p.ulg"), "--duration", "1"])
+    assert back.exit_code == 2 and "MC_ROLLRATE_P = " in back.output and "outside PX4 v1.15's range" in back.output
+    assert "Traceback" not in back.output
+
+
+def test_from_params_of_a_file_warns_its_notes_once_and_already_read_parameters_do_not():
+    """``Px4.from_params(LOG)``: one ParameterWarning with what ``--params`` prints (the unused
+    parameters); parameters already read (what the command line passes) warn nothing."""
+    from quadcruise.errors import ParameterWarning
+    from quadcruise.io.px4params import read_params
+
+    iris = RotorVehicle.preset("iris")
+    with pytest.warns(ParameterWarning) as caught:
+        Px4.from_params(LOG, vehicle=iris)
+    assert len(caught) == 1
+    text = str(caught[0].message)
+    assert "parameters of" in text and "not used by the px4 controller" in text and "BAT1_CAPACITY" in text
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ParameterWarning)
+        Px4.from_params(read_params(LOG), vehicle=iris)
+        Px4.from_params({"MC_ROLL_P": 7.0}, vehicle=iris)

@@ -79,6 +79,30 @@ def test_waypoint_table_is_relative_to_the_scenario(tmp_path):
     assert sc.mission.reference([2.0])[0, 0] == pytest.approx(1.0)
 
 
+def test_a_px4_params_file_is_relative_to_the_scenario(tmp_path, monkeypatch):
+    """``[controller] params = "x.params"`` beside the scenario flies from any working folder; a
+    missing one is one line naming the scenario file, the key and the file, exit 2."""
+    folder = tmp_path / "sc"
+    folder.mkdir()
+    (folder / "x.params").write_text("1\t1\tMC_ROLL_P\t7.25\t9\n")
+    text = '[mission]\nkind = "hover"\n[simulation]\nduration = 0.5\n[controller]\nname = "px4"\nparams = "{}"\n'
+    (folder / "s.toml").write_text(text.format("x.params"))
+    (folder / "m.toml").write_text(text.format("missing.params"))
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)  # not the scenario's folder: x.params is not here
+    sc = load_scenario(Path("..") / "sc" / "s.toml")
+    assert sc.controller.params["MC_ROLL_P"] == 7.25 and sc.controller.params.source == str(folder / "x.params")
+    res = CliRunner().invoke(main, ["fly", str(Path("..") / "sc" / "s.toml")])
+    assert res.exit_code == 0, res.output
+    bad = CliRunner().invoke(main, ["fly", str(Path("..") / "sc" / "m.toml")])
+    assert bad.exit_code == 2 and "Traceback" not in bad.output
+    assert bad.output.strip() == (
+        f"error: {Path('..') / 'sc' / 'm.toml'}: [controller] 'params' = 'missing.params': no such file "
+        f"{folder / 'missing.params'} (relative to the scenario's folder)"
+    )
+
+
 BAD = [
     ("[mision]\nkind = 'circle'\n", "unknown key 'mision'"),
     ("[mission]\nkind = 'circle'\nradiu = 2\n", "[mission] unknown key 'radiu'"),

@@ -290,3 +290,25 @@ def test_a_note_of_several_lines_is_written_as_comments(tmp_path):
     text = path.read_text()
     assert "# quadcruise tune step\n# tuned: MC_ROLL_P\n" in text
     assert dict(read_params(path)) == dict(Px4Parameters.defaults().with_values(MC_ROLL_P=7.0))
+
+
+def test_a_quadcruise_logs_exact_values_are_read_only_where_the_float32_is_theirs(tmp_path):
+    """The info ``quadcruise_px4_params`` gives the float64 a float32 parameter was rounded from;
+    a parameter section whose value is not that rounding (edited) wins."""
+    from quadcruise.io.ulog import Topic, write_ulog
+
+    topic = Topic("t", (("uint64_t", 0, "timestamp"),), {"timestamp": np.array([1])})
+    exact = "MC_PITCHRATE_P=0.1612345678901;MC_ROLLRATE_P=0.15"
+    path = tmp_path / "a.ulg"
+    write_ulog(
+        path,
+        [topic],
+        info={"quadcruise_px4_params": exact},
+        parameters={"MC_PITCHRATE_P": 0.1612345678901, "MC_ROLLRATE_P": 0.2, "MPC_USE_HTE": 0},
+    )
+    got = read_params(path)
+    assert got["MC_PITCHRATE_P"] == 0.1612345678901  # float32 in the section, exact back
+    assert got["MC_ROLLRATE_P"] == float(np.float32(0.2))  # the section's own value, not 0.15
+    plain = tmp_path / "b.ulg"
+    write_ulog(plain, [topic], parameters={"MC_PITCHRATE_P": 0.1612345678901, "MPC_USE_HTE": 0})
+    assert read_params(plain)["MC_PITCHRATE_P"] == float(np.float32(0.1612345678901))  # a PX4 log: its float32

@@ -64,6 +64,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import warnings
 from collections.abc import Mapping
 
 import numpy as np
@@ -80,9 +81,10 @@ from quadcruise.control.px4kernel import (
     resolve_gains,
 )
 from quadcruise.control.px4loops import G_RATE_D, G_RATE_I, G_RATE_P, G_THR_HOVER, G_THR_MIN, PX4_GAINS, px4_gains
-from quadcruise.errors import InputError
+from quadcruise.errors import InputError, ParameterWarning
 from quadcruise.fields import Check, between
 from quadcruise.fields import unit_field as _f
+from quadcruise.io.px4defaults import INT32, PX4_PARAMETERS
 from quadcruise.io.px4params import Px4Parameters, px4_constrained, read_params
 
 __all__ = ["Px4", "px4_controller", "PX4C_GAINS", "PX4C_MEMORY", "MAX_ROTORS"]
@@ -225,6 +227,14 @@ class Px4(Controller):
         ------
         InputError
             A bad file or value (one line naming it), or ``CA_ROTOR*`` that do not fit the vehicle.
+
+        Warns
+        -----
+        ParameterWarning
+            Once, for a file read here: its notes (another release's log, older names), the
+            values PX4 constrains (:func:`~quadcruise.io.px4params.px4_constrained`) and the
+            parameters the loops do not use, as ``--params`` prints them. Parameters already
+            read (a :class:`Px4Parameters`) are the caller's to tell.
         """
         from quadcruise.sim import plants
 
@@ -234,6 +244,14 @@ class Px4(Controller):
             p = Px4Parameters.defaults().with_values(**{str(k): v for k, v in params.items()})
         else:
             p = read_params(params)
+            told = [*p.notes, *(f"{p.source}: {note}" for note in px4_constrained(p)[1])]
+            if p.unused:
+                told.append(
+                    f"{len(p.unused)} parameters of {p.source} are not used by the px4 controller: "
+                    + ", ".join(p.unused)
+                )
+            if told:
+                warnings.warn("\n".join(told), ParameterWarning, stacklevel=2)
         base = {"params": p, "hover_from_vehicle": False, "rate_bandwidth": 0.0}
         if vehicle is not None:  # what PX4's CA_ROTOR* and THR_MDL_FAC say of the vehicle's plant
             base.update(plants.of(vehicle).px4_fields(vehicle))
@@ -383,6 +401,11 @@ class Px4(Controller):
         InputError
             A resolved value outside PX4's range (named).
         """
+        params = self.params.with_values(**self._design_values(vehicle))
+        return dataclasses.replace(self, params=params, hover_from_vehicle=False, rate_bandwidth=0.0)
+
+    def _design_values(self, vehicle) -> dict:
+        """The vehicle-dependent gains as PX4 parameters, unchecked (:meth:`resolved`)."""
         g = self.loop_gains(vehicle)
         values = {}
         if self.rate_bandwidth > 0.0:
@@ -393,5 +416,33 @@ class Px4(Controller):
         if self.hover_from_vehicle:
             values["MPC_THR_HOVER"] = float(g[G_THR_HOVER])
             values["MPC_THR_MIN"] = float(g[G_THR_MIN])
-        params = self.params.with_values(**values)
-        return dataclasses.replace(self, params=params, hover_from_vehicle=False, rate_bandwidth=0.0)
+        return values
+
+    def log_parameters(self, vehicle) -> dict:
+        """Every PX4 parameter this controller flies ``vehicle`` with, as a PX4 log holds them:
+        :attr:`params` with the vehicle-dependent design written in (:meth:`resolved`), by
+        PX4's names and types (``int`` for PX4's INT32, ``float`` else).
+
+        A design outside PX4's range is written as it is: reading the log back
+        (:func:`~quadcruise.io.px4params.read_params`) then refuses it, naming the parameter.
+
+        Parameters
+        ----------
+        vehicle : Vehicle
+            The paper vehicle it flies (a rotor vehicle's paper equivalent).
+
+        Returns
+        -------
+        dict
+            Name -> value.
+
+        Examples
+        --------
+        >>> import quadcruise as qc
+        >>> p = Px4(hover_from_vehicle=False, rate_bandwidth=0.0).log_parameters(qc.Vehicle.paper())
+        >>> p["MC_ROLLRATE_P"], p["CA_ROTOR_COUNT"]
+        (0.15, 0)
+        """
+        values = dict(self.params.values)
+        values.update(self._design_values(vehicle))
+        return {k: int(round(v)) if PX4_PARAMETERS[k].kind == INT32 else float(v) for k, v in values.items()}

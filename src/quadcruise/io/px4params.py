@@ -312,6 +312,21 @@ def parse_params_text(text: str, source: str = "<text>") -> Px4Parameters:
     return _collect(raw, lambda n: f"{source}, line {lines[n]}", source)
 
 
+def _exact_values(text, raw: dict) -> dict:
+    """A quadcruise log's exact float64 values (info ``quadcruise_px4_params``, ``NAME=repr;...``)
+    of the float32 parameters they round to: the section's value wins where it is not theirs."""
+    out = {}
+    for item in text.split(";") if isinstance(text, str) and text else ():
+        name, _, value = item.partition("=")
+        try:
+            number = float(value)
+        except ValueError:
+            continue
+        if name in raw and np.float32(number) == np.float32(raw[name]):
+            out[name] = number
+    return out
+
+
 def _read_ulog_params(path: Path) -> Px4Parameters:
     from pyulog import ULog
     from pyulog.core import ULogException
@@ -331,6 +346,7 @@ def _read_ulog_params(path: Path) -> Px4Parameters:
         raw[name] = value
     if not raw:
         raise InputError(f"{path}: the log holds no parameters")
+    raw.update(_exact_values(log.msg_info_dict.get("quadcruise_px4_params"), raw))
     version = log.msg_info_dict.get("ver_sw_release")  # 0xMMmmppTT, TT: 0 dev, 64 alpha, 128 beta, 192 rc, 255
     if isinstance(version, int) and version:
         kind = {0: " (dev)", 64: " (alpha)", 128: " (beta)", 192: " (rc)", 255: ""}.get(version & 0xFF, "")

@@ -313,6 +313,39 @@ def rotor_plant_parameters(rotors, kf: float, km: float, w_max: float) -> dict[s
     return out
 
 
+def controller_parameters(flown: dict) -> tuple[dict[str, float | int], str]:
+    """The px4 controller's PX4 parameters for a log's parameter section, and their exact values.
+
+    A ULog holds PX4's float parameters as float32 (PX4's own type); the exact float64 values
+    the flight flew go in the info message ``quadcruise_px4_params`` (``NAME=repr;...``, only
+    those float32 does not hold), which :func:`quadcruise.io.px4params.read_params` reads back
+    where the parameter section's float32 value is theirs rounded, as a ``.params`` file's
+    shortest repr reads back exactly. The allocation's (``CA_*``, ``THR_MDL_FAC``) are the
+    controller's, replacing the plant's (:func:`rotor_parameters`), as PX4 logs what it flew.
+
+    Parameters
+    ----------
+    flown : dict
+        Name -> value (``int`` for PX4's INT32), :meth:`quadcruise.control.px4.Px4.log_parameters`.
+
+    Returns
+    -------
+    params : dict
+        The parameters to add.
+    exact : str
+        The info message's value.
+
+    Examples
+    --------
+    >>> p, exact = controller_parameters({"MC_ROLL_P": 6.5, "MC_ROLLRATE_P": 0.15, "CA_ROTOR_COUNT": 0})
+    >>> p, exact
+    ({'MC_ROLL_P': 6.5, 'MC_ROLLRATE_P': 0.15, 'CA_ROTOR_COUNT': 0}, 'MC_ROLLRATE_P=0.15')
+    """
+    kept = dict(flown)  # PX4 logs the parameters it flew: the allocation's too
+    exact = ";".join(f"{k}={v!r}" for k, v in kept.items() if isinstance(v, float) and float(np.float32(v)) != v)
+    return kept, exact
+
+
 def _every(t: np.ndarray, rate_hz: float) -> np.ndarray:
     step = float(t[1] - t[0]) if len(t) > 1 else 1.0
     k = max(1, int(round(1.0 / (rate_hz * step)))) if np.isfinite(rate_hz) else 1

@@ -427,6 +427,13 @@ class SimResult:
             if log_dt > 1.000001 * control_dt:
                 profile_bits &= ~SYSID_PROFILE_BIT
         params["SDLOG_PROFILE"] = profile_bits
+        flown_px4 = self.meta.get("px4_parameters")  # the px4 controller's, as PX4 logs its own
+        if flown_px4:
+            from quadcruise.sim.px4 import controller_parameters
+
+            kept, exact = controller_parameters(flown_px4)
+            params.update(kept)
+            info["quadcruise_px4_params"] = exact
         write_ulog(path, topics, info=info, parameters=params)
         return Path(path)
 

@@ -315,6 +315,10 @@ def fly(
     meta.update(onboard_record)  # sensor models and the estimator
     if controller_vehicle is not None:
         meta["controller_vehicle"] = plant.controller_record(controller_vehicle)
+    if len(controllers) == 1 and hasattr(controller, "log_parameters") and len(flown) == 1:
+        from quadcruise.model.equivalent import paper_equivalent  # PX4's parameters as flown, for to_ulog
+
+        meta["px4_parameters"] = controller.log_parameters(paper_equivalent(controller_vehicle or flown[0]))
     gains, memory = (
         (controller.gains(), controller.memory())
         if len(controllers) == 1

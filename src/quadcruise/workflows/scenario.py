@@ -317,7 +317,7 @@ def scenario_from_dict(doc: dict, *, source: str = "scenario", base: Path | None
         if "controller_vehicle" in doc
         else None
     )
-    controller = controller_table(where.at("controller"), doc.get("controller")) if "controller" in doc else None
+    controller = controller_table(where.at("controller"), doc.get("controller"), base) if "controller" in doc else None
     compared = compare_table(where.at("compare"), doc.get("compare", {}))
     mission = mission_table(where.at("mission"), doc.get("mission"), base) if "mission" in doc else None
     environment, noise = disturbances_table(where.at("disturbances"), doc.get("disturbances", {}))

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Any
 
 from quadcruise.control import CONTROLLERS, Controller
@@ -40,8 +41,9 @@ def _poles(where: Where, key: str, value) -> list:
     return out
 
 
-def controller_table(where: Where, table: dict) -> Controller:
-    """``[controller]`` (or one of ``[compare]``'s): a built-in controller from its name, gains and poles."""
+def controller_table(where: Where, table: dict, base: Path | None = None) -> Controller:
+    """``[controller]`` (or one of ``[compare]``'s): a built-in controller from its name, gains and
+    poles; a relative file name (px4's ``params = "x500.params"``) is taken relative to ``base``."""
     name = table.get("name", "nlpd")
     if not isinstance(name, str) or name not in CONTROLLERS:
         raise where.error(f"unknown controller name {name!r} (known: {', '.join(CONTROLLERS)})")
@@ -61,6 +63,11 @@ def controller_table(where: Where, table: dict) -> Controller:
             design = pd_from_poles if len(poles) == 2 else pid_from_poles
             params[key[:-6]] = where.wrap(design, poles)
         elif isinstance(getattr(defaults, key), (tuple, Mapping)):  # px4's rotors and params: its own checks
+            if isinstance(value, str) and base is not None:  # a file beside the scenario, as a waypoint table
+                path = Path(value) if Path(value).is_absolute() else (base / value).resolve()
+                if not path.is_file():
+                    raise where.error(f"'{key}' = {value!r}: no such file {path} (relative to the scenario's folder)")
+                value = str(path)
             params[key] = value
         elif key in gain_fields:
             if not isinstance(value, dict):
