@@ -19,12 +19,12 @@ Euler angles' wrap at ±pi). The Iris has no RotorPy file: RotorPy's parameters 
 from quadcruise's preset (:func:`rotorpy_params`) with one motor time constant (RotorPy's
 ``tau_m``: tau_down set to tau_up = 12.5 ms) and no rotor inertia (RotorPy has none).
 
-Agreement measured (2026-12-07, this file's cases): position within 2e-14 m (crazyflie), 1.3e-13 m
-(hummingbird, iris) over 3 s. The figure is the two integrators' round-off and truncation
+Agreement measured (2026-12-07, this file's cases): position within 1.3e-13 to 1.4e-13 m on
+all three vehicles and both headings over 3 s. The figure is the two integrators' round-off and truncation
 (RK4 at 1e-4 s against DOP853 at 1e-12), not a model difference: no speed command is held
 (asserted), so the clip is not exercised. Required: 1e-9 m (issue 31). A plant 1 % heavier
 than the controller believes, flown by quadcruise against RotorPy's nominal vehicle, is
-millimetres off: the check can fail.
+2.6 to 2.8 cm off: the check can fail.
 """
 
 from __future__ import annotations
