@@ -22,7 +22,9 @@ from quadcruise's preset (:func:`rotorpy_params`) with one motor time constant (
 Agreement measured (2026-12-07, this file's cases): position within 1.3e-13 to 1.4e-13 m on
 all three vehicles and both headings over 3 s. The figure is the two integrators' round-off and truncation
 (RK4 at 1e-4 s against DOP853 at 1e-12), not a model difference: no speed command is held
-(asserted). The clip has its own case: the hummingbird started 1 m off the circle holds speed
+(asserted). RK4's truncation is fourth order: at fly's default substep (= dt, 2 ms) the
+difference is 1.2e-10 m (crazyflie), 4.6e-9 m (hummingbird), 2.0e-8 m (iris); table in
+docs/vehicles.md. The clip has its own case: the hummingbird started 1 m off the circle holds speed
 commands at 0 or w_max for 0.24 s and agrees within 5.3e-11 m, once se3's tilt limit (45 deg by
 default, quadcruise's: SE3Control has none) is lifted to 1.5 rad; with it, it acts for 34 ms and
 the flights differ by 6.4e-3 m. Required: 1e-9 m (issue 31). A plant 1 % heavier
