@@ -60,7 +60,8 @@ def test_a_paper_flight_through_simulate_is_the_engine_bit_for_bit():
     x0 = np.zeros(16)
     x0[Z], x0[F1 : F1 + 4] = 1.0, vp[0, P_M] * vp[0, P_G] / 4  # hovering
     args = (qc.time_grid(0.3, 1e-3), x0, vp, ctrl.function, ctrl.gains(), mission.function, mission.params())
-    ours, theirs = qc.simulate(*args, seed=1), engine.simulate(*args, seed=1)
+    kw = dict(seed=1, memory=ctrl.memory())  # nlpd's integrators
+    ours, theirs = qc.simulate(*args, **kw), engine.simulate(*args, **kw)
     for name in ("states", "commands", "references", "status", "t_stop", "memory", "duty_clipped_s"):
         assert np.array_equal(getattr(ours, name), getattr(theirs, name), equal_nan=True), name
     assert ours.rotor_states is None

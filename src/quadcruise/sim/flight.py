@@ -69,7 +69,8 @@ def simulate(
     >>> from quadcruise.missions import Hover
     >>> t, c, m, v = qc.time_grid(0.01, 1e-3), NLPD(), Hover(), qc.Vehicle.paper()
     >>> args = (t, np.zeros(16), v.rows(1), c.function, c.gains(), m.function, m.params())
-    >>> bool((qc.simulate(*args).states == paper_simulate(*args).states).all())
+    >>> mem = c.memory()  # nlpd's integrators: a controller's memory must be given
+    >>> bool((qc.simulate(*args, memory=mem).states == paper_simulate(*args, memory=mem).states).all())
     True
     >>> qc.simulate(*args, psi0=1.0)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
