@@ -53,7 +53,7 @@ _check_before_compiled_code()  # numba's stale cache dropped when compiled code 
 
 if TYPE_CHECKING:  # what the names are, for readers and type checkers
     from quadcruise.model.vehicle import Vehicle
-    from quadcruise.sim.engine import simulate
+    from quadcruise.sim.flight import simulate
     from quadcruise.sim.inputs import Limits, time_grid
     from quadcruise.sim.result import SimResult
     from quadcruise.sim.status import STATUS_REASONS, ExitStatus
@@ -75,7 +75,7 @@ if TYPE_CHECKING:  # what the names are, for readers and type checkers
 
 _LAZY = {
     "quadcruise.model.vehicle": ("Vehicle",),
-    "quadcruise.sim.engine": ("simulate",),
+    "quadcruise.sim.flight": ("simulate",),
     "quadcruise.sim.inputs": ("Limits", "time_grid"),
     "quadcruise.sim.result": ("SimResult",),
     "quadcruise.sim.status": ("STATUS_REASONS", "ExitStatus"),

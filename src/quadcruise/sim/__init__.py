@@ -2,7 +2,7 @@
 results. Controllers, missions and disturbances reach it as compiled functions, so it imports
 none of them."""
 
-from quadcruise.sim.engine import simulate
+from quadcruise.sim.flight import simulate
 from quadcruise.sim.inputs import Limits, time_grid
 from quadcruise.sim.result import SimResult
 

@@ -369,6 +369,25 @@ class Plant:
         """
         raise NotImplementedError
 
+    def check_arrays(self, where: str, args: tuple, options: dict) -> None:
+        """Check the arrays given to :func:`quadcruise.simulate` for this plant, beyond what
+        :meth:`fly` checks itself (none here: the paper plant's engine checks its own).
+
+        Parameters
+        ----------
+        where : str
+            The caller, e.g. ``"simulate()"``.
+        args : tuple
+            :meth:`flight`'s positional arguments, as given.
+        options : dict
+            The keywords given.
+
+        Raises
+        ------
+        InputError
+            One line naming the argument that does not fit the plant.
+        """
+
     def fly(self, args: tuple, options: dict) -> Any:
         """The flight with its whole log (at ``log_every``).
 

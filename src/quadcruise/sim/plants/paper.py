@@ -124,6 +124,10 @@ PAPER = PaperPlant(
         "spread (give a rotor-plant vehicle: iris, crazyflie, ...)",
         "ground": "the paper's plant has no ground to stand on or take off from (give a rotor-plant vehicle: "
         "iris, crazyflie, ...)",
+        **{
+            option: "the rotor plant's (give alloc, the rotor plant's allocation rows, with its rotor states and rows)"
+            for option in ("psi0", "touchdown_speed", "rotor_names")
+        },
     },
     drag_for_wind=True,
 )

@@ -32,9 +32,9 @@ from typing import Any
 import numpy as np
 
 from quadcruise.errors import InputError
-from quadcruise.layout import PSI, REF_PSI, REF_Z
+from quadcruise.layout import PARAMS, PSI, REF_PSI, REF_Z
 from quadcruise.model.equivalent import duty_to_thrust, paper_equivalent
-from quadcruise.model.rotor_plant import QW, QZ, ROTOR_BODY, ROTOR_PARAMS, ROTOR_W1, RZ, state_names
+from quadcruise.model.rotor_plant import QW, QZ, ROTOR_ARM, ROTOR_BODY, ROTOR_PARAMS, ROTOR_W1, RZ, state_names
 from quadcruise.model.rotor_plant import RP as RATE_P
 from quadcruise.model.rotor_vehicle import AERO_FIELDS, RotorVehicle
 from quadcruise.model.vehicle import Vehicle
@@ -404,6 +404,33 @@ class RotorPlant(Plant):
         """:func:`rotor_engine_inputs`, from the rotor states of ``x0`` (the given paper-layout
         initial states, or None: hovering at the mission's start)."""
         return rotor_engine_inputs(grid, vehicle, controller_vehicle, controller, gains, mission, mp, n, x0, meta)
+
+    def check_arrays(self, where: str, args: tuple, options: dict) -> None:
+        """The rotor plant's arrays: ``alloc`` of 4 n + 1 columns (n rotors), ``vp`` rows of
+        :meth:`~quadcruise.model.rotor_vehicle.RotorVehicle.row`'s width for n rotors, ``x0`` of
+        13 + n, ``vp_ctrl`` given (the controller's equivalent paper row)."""
+        alloc, vp_ctrl = options["alloc"], options.get("vp_ctrl")
+        width = np.shape(alloc)[-1] if np.ndim(alloc) else 0
+        n = (width - 1) // 4
+        if np.ndim(alloc) not in (1, 2) or width < 13 or (width - 1) % 4:
+            raise InputError(
+                f"{where} argument alloc: shape {np.shape(alloc)}; the rotor plant's allocation rows have 4 n + 1 "
+                "columns (n >= 3 rotors; quadcruise.model.equivalent.duty_to_thrust(v).ravel(), then kf)"
+            )
+        fits = {
+            "x0": (args[1], ROTOR_W1 + n, f"rotor states of {n} rotors"),
+            "vp": (args[2], ROTOR_PARAMS.size + ROTOR_ARM.size * n, f"RotorVehicle.row() rows of {n} rotors"),
+            "vp_ctrl": (vp_ctrl, PARAMS.size, "the controller's equivalent paper row (paper_equivalent(v).rows(1))"),
+        }
+        for name, (value, columns, what) in fits.items():
+            if value is None:
+                raise InputError(f"{where} argument {name} is needed on the rotor plant (alloc given): {what}")
+            shape = np.shape(value)
+            if len(shape) not in (1, 2) or shape[-1] != columns:
+                raise InputError(
+                    f"{where} argument {name}: shape {shape}; alloc is given (the rotor plant, {n} rotors): "
+                    f"{what}, {columns} columns"
+                )
 
     def fly(self, args: tuple, options: dict) -> SimResult:
         """:func:`~quadcruise.sim.rotor_batch.fly_rotor_vehicles`."""
