@@ -23,12 +23,11 @@ from quadcruise.cli.common import (
 )
 from quadcruise.cli.compare_run import (
     compared_from_options,
-    comparison_ulog_paths,
     echo_population_comparison,
     population_from_options,
     population_record,
-    write_comparison_ulogs,
 )
+from quadcruise.cli.compare_ulog import comparison_ulog_paths, write_comparison_ulogs
 from quadcruise.cli.objects import PARAMS_OPTION, with_px4_params
 from quadcruise.cli.onboard import onboard_options
 from quadcruise.cli.world import flight_world, note, world_options
@@ -171,7 +170,7 @@ def compare(
         ``--report``: path of a self-contained HTML report to write as well; None: no report.
     ulog : str or None
         ``--ulog``: each controller's flight as a PX4 log, the controller's label before the
-        suffix (:func:`~quadcruise.cli.compare_run.write_comparison_ulogs`); None: none.
+        suffix (:func:`~quadcruise.cli.compare_ulog.write_comparison_ulogs`); None: none.
     sensors_text, estimator_text : str or None
         ``--sensors``, ``--estimator``: the sensor models and the estimator every controller
         flies on (:func:`~quadcruise.cli.onboard.onboard_options`); None: the scenario's, else none.

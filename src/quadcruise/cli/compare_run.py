@@ -4,9 +4,6 @@ options and its help are in :mod:`quadcruise.cli.compare`."""
 
 from __future__ import annotations
 
-import re
-from pathlib import Path
-
 import click
 
 from quadcruise.cli.common import Bar
@@ -20,8 +17,6 @@ __all__ = [
     "echo_population_comparison",
     "population_from_options",
     "population_record",
-    "comparison_ulog_paths",
-    "write_comparison_ulogs",
 ]
 
 
@@ -227,65 +222,3 @@ def compared_from_options(mission: str, controllers: str | None, mission_params:
         or ({scenario.controller.name: scenario.controller} if scenario.controller is not None else default_compared())
     )
     return the_mission, chosen, scenario.fly_kwargs(drag=False), scenario
-
-
-def _labelled(path, label) -> Path:
-    """``PATH.ulg`` as ``PATH-LABEL.ulg``, the label's odd characters made ``_``."""
-    path = Path(path)
-    return path.with_name(f"{path.stem}-{re.sub(r'[^A-Za-z0-9._-]', '_', str(label))}{path.suffix}")
-
-
-def comparison_ulog_paths(cmp, path) -> list[Path]:
-    """The files :func:`write_comparison_ulogs` writes, in its order (said before writing them).
-
-    Parameters
-    ----------
-    cmp : Comparison
-        The flights.
-    path : str or os.PathLike
-        The path given (``.ulg``).
-
-    Returns
-    -------
-    list of pathlib.Path
-    """
-    from quadcruise.cli.fly_run import ulog_paths
-
-    return [p for label, result in cmp.results.items() for p in ulog_paths(_labelled(path, label), result.n)]
-
-
-def write_comparison_ulogs(cmp, path) -> list[Path]:
-    """Write each controller's flight as a PX4 log, all or none.
-
-    ``PATH.ulg`` becomes ``PATH-LABEL.ulg`` for each controller's label (characters other than
-    letters, digits, ``.``, ``_`` and ``-`` made ``_``); a flight of several vehicles is one file
-    per vehicle after that (:func:`~quadcruise.cli.fly_run.ulog_paths`).
-
-    Parameters
-    ----------
-    cmp : Comparison
-        The flights.
-    path : str or os.PathLike
-        The path given (``.ulg``).
-
-    Returns
-    -------
-    list of pathlib.Path
-        The files written.
-
-    Raises
-    ------
-    WriteError
-        A file that could not be written (named); none of the files is left.
-    """
-    from quadcruise.cli.fly_run import write_ulogs
-
-    written = []
-    try:
-        for label, result in cmp.results.items():
-            written += write_ulogs(result, _labelled(path, label))
-    except BaseException:
-        for done in written:
-            done.unlink(missing_ok=True)
-        raise
-    return written

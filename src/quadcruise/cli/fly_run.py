@@ -99,18 +99,8 @@ def fly_and_report(
     if ulog is not None:
         written = write_ulogs(result, ulog)
         click.echo(f"wrote PX4 log{'s' if len(written) > 1 else ''} " + ", ".join(map(str, written)))
-        record = result.meta.get("controller") or {}
-        if (
-            record.get("name") == "px4"
-            and not record.get("rotors")
-            and (result.meta.get("vehicle") or {}).get("plant") == "rotor"
-        ):
-            note(  # the by-name px4 allocates on PX4's quadrotor x; --params on the vehicle's rotors
-                f"{written[0]} holds the px4 design as PX4 parameters, but the px4 controller by name "
-                "allocates on PX4's quadrotor x, not the vehicle's rotors: fly --params of the log flies the "
-                "vehicle's rotors (as PX4 would), another flight; fly with --params FILE for a log that flies "
-                "back the same"
-            )
+        if result.meta.get("px4_parameters_note"):  # the by-name px4 on a vehicle it was designed for
+            note(f"{written[0]} {result.meta['px4_parameters_note']}")
     if report is not None:
         from quadcruise.report.html import write_html_report
         from quadcruise.report.sections import flight_report

@@ -17,16 +17,8 @@ PARAMS_OPTION = click.option(
     "(the default controller with this option); parameters the px4 controller does not use are listed once.",
 )
 
-__all__ = [
-    "with_px4_params",
-    "PARAMS_OPTION",
-    "controller_for_vehicle",
-    "controller_with_params",
-    "controller_from_options",
-    "controller_params",
-    "flight_from_options",
-    "mission_from_options",
-]
+__all__ = ["with_px4_params", "PARAMS_OPTION", "controller_for_vehicle", "controller_with_params"]
+__all__ += ["controller_from_options", "controller_params", "flight_from_options", "mission_from_options"]
 
 
 def _poles(text: str | None, option: str):

@@ -10,6 +10,7 @@ from collections.abc import Callable
 
 import click
 
+from quadcruise.cli.tune_px4 import as_px4_parameters, refuse_integer_px4_gains, write_tuned_params
 from quadcruise.errors import InputError
 
 __all__ = ["command_line", "tune_command"]
@@ -132,7 +133,7 @@ def tune_command(
         parse_targets,
     )
     from quadcruise.cli.world import flight_world
-    from quadcruise.errors import InputError, whole_number
+    from quadcruise.errors import whole_number
     from quadcruise.sim import plants
 
     if log_every is not None:
@@ -184,7 +185,7 @@ def tune_command(
         the_controller = controller_for_vehicle(the_controller, controller, controller_params, None, world, sc)
     the_controller = as_px4_parameters(the_controller, world, bool(px4_params))
     wanted["gains"] = parse_gains(gains, the_controller)
-    _refuse_integer_px4_gains(wanted["gains"], the_controller)
+    refuse_integer_px4_gains(wanted["gains"], the_controller)
     environment = world["environment"]
     if wind_spread > 0 and plant.drag_for_wind and not any("wind acts only through drag" in line for line in notes):
         from quadcruise.disturbances import default_drag_text, with_drag
@@ -226,97 +227,5 @@ def tune_command(
     if out is not None:
         result.write(out, force=True)
         echo(f"wrote {out}: `quadcruise fly {out}/scenario.toml` flies the tuned gains")
-        if _px4_form(result.controller):
-            from pathlib import Path
-
-            from quadcruise.io.px4params import write_params
-
-            searched = [g.removeprefix("params.") for g in result.gains]
-            note = (
-                f"{command_line(mission, given)}\n"
-                f"tuned: {', '.join(searched)}; the other lines are what the tune flew, not tuned "
-                "(the --params file's, or the design for the simulated vehicle: check those before loading)"
-            )
-            path = write_params(Path(out) / "tuned.params", result.controller.params, note=note)
-            echo(
-                f"wrote {path}: `quadcruise fly MISSION --params {path}` (with the same vehicle) flies the tuned gains"
-            )
-        elif getattr(result.controller, "name", None) == "px4":  # no tuned.params: said, with why
-            echo(f"note: no {out}/tuned.params: {_why_no_params(result.controller, world)}", err=True)
+        write_tuned_params(result, out, command_line(mission, given), world, echo)
     return result
-
-
-def _refuse_integer_px4_gains(names, controller) -> None:
-    """A px4 parameter PX4 declares INT32 (``MC_AIRMODE``, ``IMU_INTEG_RATE``, ...) is a choice,
-    not a gain a continuous search can set: refused before the search, naming it."""
-    if getattr(controller, "name", None) != "px4" or not names:
-        return
-    from quadcruise.io.px4defaults import INT32, PX4_PARAMETERS
-
-    for name in names:
-        spec = PX4_PARAMETERS.get(name.removeprefix("params.")) if name.startswith("params.") else None
-        if spec is not None and spec.kind == INT32:
-            raise InputError(
-                f"--gains {name}: PX4 declares it an integer (INT32), which the search cannot set; "
-                f"tune with each value instead (a --params FILE setting it, e.g. "
-                f"{name.removeprefix('params.')} {spec.default:g})"
-            )
-
-
-def _why_no_params(controller, world: dict) -> str:
-    """Why a tuned px4 controller has no PX4 parameter form (the paper plant's design)."""
-    from quadcruise.model.equivalent import paper_equivalent
-
-    believed = world.get("controller_vehicle") or world.get("vehicle")
-    reason = "its gains are designed for the vehicle (rate_bandwidth, hover_from_vehicle)"
-    try:
-        controller.resolved(paper_equivalent(believed))
-    except InputError as exc:  # the design is outside PX4's ranges
-        reason += f" and PX4's parameters cannot hold them ({str(exc).removeprefix('argument: ')})"
-    return reason + "; tune a rotor vehicle (--vehicle iris) or PX4's own parameters (--params FILE) for one"
-
-
-def _px4_form(controller) -> bool:
-    """A px4 controller flying PX4's parameters as they are (what ``--params`` reads back)."""
-    return getattr(controller, "name", None) == "px4" and not (
-        controller.hover_from_vehicle or controller.rate_bandwidth > 0.0
-    )
-
-
-def as_px4_parameters(controller, world: dict, given: bool):
-    """A px4 controller on a rotor-plant vehicle (or from ``--params``) in PX4's parameter form: its
-    vehicle-dependent design written as PX4 parameters and the vehicle's rotors, exactly what
-    ``fly --params tuned.params`` builds, so the tuned file flies the tuned flight.
-
-    Parameters
-    ----------
-    controller : Controller
-        The controller to tune.
-    world : dict
-        :func:`quadcruise.cli.world.flight_world`'s.
-    given : bool
-        ``--params`` was given.
-
-    Returns
-    -------
-    Controller
-        ``controller`` itself unless it is px4 on a rotor-plant vehicle or from ``--params``.
-
-    Raises
-    ------
-    InputError
-        A design value outside PX4's range (PX4 could not fly it).
-    """
-    from quadcruise.model.equivalent import paper_equivalent
-    from quadcruise.sim import plants
-
-    believed = world.get("controller_vehicle") or world.get("vehicle")
-    designs = believed is not None and plants.of(believed).designs_gains  # designed for the vehicle believed
-    if getattr(controller, "name", None) != "px4" or not (given or designs):
-        return controller
-    if _px4_form(controller) and (given or controller.rotors):
-        return controller
-    from quadcruise.control.px4 import Px4
-
-    plain = controller.resolved(paper_equivalent(believed))  # a paper vehicle is its own equivalent
-    return Px4.from_params(plain.params, vehicle=believed, position_rate=controller.position_rate)

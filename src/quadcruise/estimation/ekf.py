@@ -443,7 +443,7 @@ def update_states(x, P, first, r, var, gate, work):
     >>> import numpy as np
     >>> x, P = np.r_[np.zeros(6), 1.0, np.zeros(9)], np.eye(15)
     >>> nis = update_states(x, P, 2, np.array([1.0]), np.array([1.0]), np.inf, np.empty((WORK_ROWS, 15)))
-    >>> nis, x[2], P[2, 2]                   # half-way, half the variance
+    >>> nis, float(x[2]), float(P[2, 2])                  # half-way, half the variance
     (0.5, 0.5, 0.5)
     """
     m = r.shape[0]

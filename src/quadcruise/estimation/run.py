@@ -114,7 +114,7 @@ class EkfNoise(Validated):
 
         Examples
         --------
-        >>> EkfNoise().meas_row()[M_G]
+        >>> float(EkfNoise().meas_row()[M_G])
         9.80665
         """
         return MEAS.pack(

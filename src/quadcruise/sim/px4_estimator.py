@@ -144,8 +144,8 @@ def baro_pressure(altitude: np.ndarray) -> np.ndarray:
     --------
     >>> float(baro_pressure(np.array([0.0]))[0])
     101325.0
-    >>> round(float(baro_pressure(np.array([1000.0]))[0]))          # ISA: 89875 Pa at 1 km
-    89875
+    >>> round(float(baro_pressure(np.array([1000.0]))[0]) / 100.0, 1)   # hPa: ISA gives 898.7 hPa at 1 km
+    898.7
     """
     return _P1 * ((np.asarray(altitude, float) * _A + _T1) / _T1) ** (-_G / (_A * _R))
 

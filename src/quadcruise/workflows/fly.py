@@ -319,6 +319,12 @@ def fly(
         from quadcruise.model.equivalent import paper_equivalent  # PX4's parameters as flown, for to_ulog
 
         meta["px4_parameters"] = controller.log_parameters(paper_equivalent(controller_vehicle or flown[0]))
+        if not controller.rotors and plant.designs_gains:  # the by-name px4, designed for the vehicle
+            meta["px4_parameters_note"] = (
+                "holds the px4 design as PX4 parameters, but the px4 controller by name allocates on PX4's "
+                "quadrotor x, not the vehicle's rotors: fly --params of the log flies the vehicle's rotors (as "
+                "PX4 would), another flight; fly with --params FILE for a log that flies back the same"
+            )
     gains, memory = (
         (controller.gains(), controller.memory())
         if len(controllers) == 1

@@ -20,7 +20,7 @@ Examples
 >>> sensors_from_spec({"lidar": "typical"})
 Traceback (most recent call last):
     ...
-quadcruise.errors.InputError: unknown key 'lidar' (known: baro, gps, imu, mag)
+quadcruise.errors.InputError: sensors: unknown key 'lidar' (known: baro, gps, imu, mag)
 """
 
 from __future__ import annotations
