@@ -44,7 +44,7 @@ def test_a_rotor_flight_through_simulate_is_fly_rotor_vehicles_and_the_stepper()
     assert ours.rotor_states is not None and ours.rotor_states.shape == (N, t.size, 17)
     assert ours.ok.all()
     for name in ("states", "commands", "references", "rotor_states", "memory", "duty_clipped_s"):
-        assert np.array_equal(getattr(ours, name), getattr(direct, name)), name
+        assert np.array_equal(getattr(ours, name), getattr(direct, name), equal_nan=True), name
     assert ours.rotor_names == direct.rotor_names
 
     s = Stepper(t, x0, rp, function, gains, mission, mp, vp_ctrl=own["vp_ctrl"], alloc=own["alloc"],
@@ -99,3 +99,22 @@ def test_the_rotor_plants_own_options_are_refused_on_the_paper_plant(option):
     )
     with pytest.raises(InputError, match=rf"^simulate\(\) argument {option}: the rotor plant's \(give alloc"):
         qc.simulate(*args, **{option: 0.0})
+
+
+def test_a_law_given_no_memory_stops_with_a_bad_command_and_with_its_memory_flies():
+    """memory=None hands the law a NaN row (sim.inputs.MEMORY_GUARD): nlpd, which keeps three
+    values, stops at t = 0 with a non-finite command, the same on every run (it read past an empty
+    row before: numbers that changed from run to run); with its memory it flies the circle."""
+    from quadcruise.control import NLPD
+    from quadcruise.missions import Circle
+    from quadcruise.model.vehicle import Vehicle
+    from quadcruise.sim.inputs import time_grid
+
+    t, c, m, v = time_grid(0.5, 1e-3), NLPD(), Circle(), Vehicle.paper()
+    x0 = np.zeros(16)
+    x0[2], x0[12:] = 1.0, v.m * v.g / 4
+    args = (t, x0, v.rows(1), c.function, c.gains(), m.function, m.params())
+    for _ in range(2):
+        r = qc.simulate(*args)
+        assert r.status.tolist() == [int(qc.ExitStatus.BAD_COMMAND)] and r.t_stop.tolist() == [0.0]
+    assert qc.simulate(*args, memory=c.memory()).status.tolist() == [int(qc.ExitStatus.FINISHED)]

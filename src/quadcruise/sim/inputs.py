@@ -63,6 +63,13 @@ class Limits:
 TRIG_WIDTH = 6  # the carried sines and cosines of phi, theta, psi (the RK4 workspace row TRIG in use)
 
 
+MEMORY_GUARD = 256
+"""Width of the NaN memory row a controller or a disturbance gets when its memory is not given
+(``memory=None``): wider than any built-in law's (px4: 133), so that one which reads memory it was
+not handed reads NaN (its flight then stops with a bad command) instead of past the row's end,
+which would give numbers that change from run to run. Pass ``memory=controller.memory()``."""
+
+
 def carry_width(sensor_delay: int) -> int:
     """Width of the kernel's ``carry`` rows: the 6 carried sines and cosines of the angles,
     then the sensor-delay ring buffer of ``sensor_delay + 1`` states.
@@ -222,10 +229,17 @@ def batch_inputs(
         raise InputError("the initial state must be finite")
     gains = _batch("controller gains", gains, n, None)
     mp = _batch("mission parameters", mp, n, None)
-    mem = _batch("controller memory", np.zeros(0) if memory is None else memory, n, None)
+    # memory not given: a row of NaN (MEMORY_GUARD wide), so that a compiled law that reads memory it
+    # was not handed computes NaN and stops with a bad command instead of reading past an empty row
+    mem = _batch("controller memory", np.full(MEMORY_GUARD, np.nan) if memory is None else memory, n, None)
     vp_ctrl = vp if vp_ctrl is None else _batch("controller parameters", vp_ctrl, n, vp.shape[1])
     dp = _batch("disturbance parameters", np.zeros(0) if disturbance_params is None else disturbance_params, n, None)
-    dmem = _batch("disturbance memory", np.zeros(0) if disturbance_memory is None else disturbance_memory, n, None)
+    dmem = _batch(
+        "disturbance memory",
+        np.full(MEMORY_GUARD, np.nan) if disturbance_memory is None else disturbance_memory,
+        n,
+        None,
+    )
     std = _batch("sensor noise", np.zeros(STATE_SIZE) if sensor_std is None else sensor_std, n, STATE_SIZE)
     if not np.all(np.isfinite(std)) or np.any(std < 0):
         raise InputError("sensor noise standard deviations must be finite and >= 0")
