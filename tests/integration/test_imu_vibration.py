@@ -15,6 +15,8 @@ from quadcruise.errors import InputError
 from quadcruise.estimation import Ekf, Sensors
 from quadcruise.estimation.stage import PRESETS
 from quadcruise.model.rotor_vehicle import RotorVehicle
+from quadcruise.montecarlo.population import Population
+from quadcruise.montecarlo.spec import MonteCarloSpec
 from quadcruise.sensors import Imu
 from quadcruise.sim.observe import sensor_streams
 from quadcruise.sim.rng import next_unit
@@ -109,6 +111,13 @@ def test_the_paper_plant_refuses_a_vibration_in_one_line():
     text = str(e.value)
     assert "\n" not in text and "vibration" in text and text.startswith("fly() argument sensors: imu"), text
     qc.fly("hover", "nlpd", duration=0.1, sensors=Sensors(imu=Imu(vibration=0.0)))  # none: flown
+    for call in (
+        lambda: qc.compare("hover", controllers=["nlpd"], duration=0.1, sensors=Sensors(imu=Imu(vibration=2.0))),
+        lambda: MonteCarloSpec("hover", population=Population(sensors=Sensors(imu=Imu(vibration=2.0)))),
+    ):
+        with pytest.raises(InputError) as e:
+            call()
+        assert "\n" not in str(e.value) and "'vibration'" in str(e.value), str(e.value)
 
 
 def test_a_negative_vibration_is_refused():

@@ -227,9 +227,7 @@ def fly(
         checks.number(w, name, value, "pos", unit="m", optional=True, infinite=True)
     x0 = initial_states(x0)
     plant.refuse(w, "full_dynamics", full_dynamics)
-    for each in sensors if isinstance(sensors, tuple) else (sensors,):
-        imu = getattr(each, "imu", None)
-        plant.refuse(f"{w} argument sensors: imu", "vibration", imu is not None and imu.vibration > 0, label="field")
+    plant.refuse_sensors(f"{w} argument sensors", sensors)
     sizes = {
         s
         for s in (
