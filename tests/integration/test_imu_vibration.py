@@ -86,7 +86,7 @@ def test_zero_vibration_leaves_the_flight_as_it_was():
 
 
 def test_a_strong_vibration_raises_the_estimate_error():
-    """30 m/s^2 a rotor (PX4's guide: a problem): the filter, told the datasheet's noise only,
+    """30 m/s^2 a rotor (Flight Review's red: above g): the filter, told the datasheet's noise only,
     loses velocity accuracy and its velocity NEES rises (the vibration is noise it does not model)."""
     sensors = {k: PRESETS[k]["typical"] for k in ("gps", "baro", "mag")}
     imu = PRESETS["imu"]["bmi088_1khz"]
@@ -123,3 +123,11 @@ def test_the_paper_plant_refuses_a_vibration_in_one_line():
 def test_a_negative_vibration_is_refused():
     with pytest.raises(InputError, match="vibration"):
         Imu(vibration=-1.0)
+
+
+def test_a_scenario_sensors_table_takes_the_vibration():
+    from quadcruise.workflows.scenario_onboard import sensors_from_spec
+
+    assert sensors_from_spec({"imu": {"preset": "bmi088_1khz", "vibration": 10.0}}).imu.vibration == 10.0
+    with pytest.raises(InputError, match="imu field 'vibration'"):
+        sensors_from_spec({"imu": {"preset": "bmi088_1khz", "vibration": -1.0}})

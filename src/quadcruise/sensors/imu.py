@@ -71,8 +71,8 @@ class Imu(SensorModel):
         Each rotor's imbalance acceleration at the vehicle's hover speed [m/s^2], >= 0 (0: none;
         rotor plant only): rotor i shakes the body in its plane at its own angle with the amplitude
         ``vibration (w_i / w_hover)^2``, averaged over the IMU's period
-        (:func:`quadcruise.sim.observe.rotor_shake`). PX4's log review guide calls vibration
-        levels under about 15 m/s^2 (``accel_vibration_metric``) good and above 30 m/s^2 a problem.
+        (:func:`quadcruise.sim.observe.rotor_shake`). PX4's Flight Review shades its
+        ``accel_vibration_metric`` [m/s^2] green below g/2 (4.9), orange to g, red above.
 
     Examples
     --------
