@@ -14,6 +14,7 @@ from quadcruise import layout as L
 from quadcruise.errors import InputError
 from quadcruise.estimation import Ekf, Sensors
 from quadcruise.estimation.stage import PRESETS
+from quadcruise.gym.env import QuadVectorEnv
 from quadcruise.model.rotor_vehicle import RotorVehicle
 from quadcruise.montecarlo.population import Population
 from quadcruise.montecarlo.spec import MonteCarloSpec
@@ -114,10 +115,24 @@ def test_the_paper_plant_refuses_a_vibration_in_one_line():
     for call in (
         lambda: qc.compare("hover", controllers=["nlpd"], duration=0.1, sensors=Sensors(imu=Imu(vibration=2.0))),
         lambda: MonteCarloSpec("hover", population=Population(sensors=Sensors(imu=Imu(vibration=2.0)))),
+        lambda: QuadVectorEnv(1, controller="nlpd", mission="hover", sensors=Sensors(imu=Imu(vibration=2.0))),
     ):
         with pytest.raises(InputError) as e:
             call()
         assert "\n" not in str(e.value) and "'vibration'" in str(e.value), str(e.value)
+
+
+def test_a_chunked_flight_reads_the_same_vibration(monkeypatch):
+    """The rotors' angles and speeds carried in the observer's memory from one kernel call to the next."""
+    shaken = Sensors(imu=Imu(rate=250.0, vibration=5.0), gps=PRESETS["gps"]["typical"])
+    kw = dict(vehicle="iris", sensors=shaken, estimator=Ekf(), duration=1.0, seed=2, n=2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        whole = qc.fly("hover", "nlpd", **kw).decimate(10)  # one kernel call
+        monkeypatch.setattr("quadcruise.sim.chunked.CHUNK_VEHICLE_STEPS", 2 * 333)  # chunks of 333 periods
+        chunked = qc.fly("hover", "nlpd", log_every=10, **kw)
+    for name in ("states", "observations"):
+        np.testing.assert_array_equal(getattr(whole, name), getattr(chunked, name), err_msg=name)
 
 
 def test_a_negative_vibration_is_refused():
