@@ -273,13 +273,29 @@ DisturbanceType = types.FunctionType(DISTURBANCE_SIG)
 OBSERVER_SIG = types.void(_f8, types.int64, types.boolean, _vec, _vec, _vec, types.uint64[::1], _vec, _vec)
 ObserverType = types.FunctionType(OBSERVER_SIG)
 
-OBSERVER_KERNEL = Row.of("observer memory, the kernel's part", ("force", 3), ("rate", 3), prefix="OM_")
+MAX_VIBRATING_ROTORS = 12
+"""The rotors whose imbalance the IMU's vibration term carries (more are left still)."""
+OBSERVER_KERNEL = Row.of(
+    "observer memory, the kernel's part",
+    ("force", 3),
+    ("rate", 3),
+    ("shake", 3),
+    "vibration",
+    ("spin", MAX_VIBRATING_ROTORS),
+    ("phase", MAX_VIBRATING_ROTORS),
+    prefix="OM_",
+)
 """The first entries of an observer's memory, written by the kernel at the end of each period (at
 period 0, at the start), from the plant's own derivative: the true specific force [m/s^2]
 (acceleration minus gravity, FLU body frame) and the body's angular velocity [rad/s] (FLU), what
 an IMU measures. (On the paper plant with its simplified kinematics, phi' = p, ..., the angular
-velocity of the frame R(phi, theta, psi) is not (p, q, r): it is taken from the Euler rates.)"""
-OM_FORCE, OM_RATE = OBSERVER_KERNEL.offsets
+velocity of the frame R(phi, theta, psi) is not (p, q, r): it is taken from the Euler rates.)
+Then the rotor plant's vibration (:func:`quadcruise.sim.observe.rotor_shake`): the rotors'
+imbalance acceleration [m/s^2] averaged over the period just ended (FLU), each rotor's amplitude
+at hover [m/s^2] (written by the stage at switch-on; 0: none, nothing else is written), the
+rotors' speeds [rad/s] at the period's end and their angles [rad] (drawn by the stage at
+switch-on)."""
+OM_FORCE, OM_RATE, OM_SHAKE, OM_VIBRATION, OM_SPIN, OM_PHASE = OBSERVER_KERNEL.offsets
 
 _OBSERVATION_UNITS = {
     **{f"{name}_est": _STATE_UNITS[name] for name in ("x", "y", "z", "vx", "vy", "vz", "phi", "theta", "psi")},

@@ -67,10 +67,11 @@ from quadcruise.estimation.run import M_BARO, M_BARO_OFF, M_G, M_HEAD, M_POS_H, 
 from quadcruise.layout import Row
 from quadcruise.sensors.baro import BARO_ROW, baro_read
 from quadcruise.sensors.gps import GPS_OUTAGE_DURATION, GPS_OUTAGE_START, GPS_ROW, gps_read
-from quadcruise.sensors.imu import IMU_ROW, imu_read, imu_start
+from quadcruise.sensors.imu import IMU_ROW, IMU_VIBRATION, imu_read, imu_start
 from quadcruise.sensors.imu import STATE_SIZE as IMU_STATE_SIZE
 from quadcruise.sensors.mag import MAG_BIAS_STD, MAG_ROW, mag_read
 from quadcruise.sensors.noise import noisy
+from quadcruise.sim.rng import next_unit
 
 PARAMS = Row.of(
     "onboard parameters",
@@ -112,7 +113,8 @@ HISTORY_ENTRY = 7
 def memory_row(slots: int, history: int = 0) -> Row:
     """The stage's memory with a GPS queue of ``slots`` fixes: the kernel's part
     (:data:`quadcruise.layout.OBSERVER_KERNEL`), then the IMU's state, its last reading, the
-    trapezoid sum of the true specific force and rates over its period, its last instant [s],
+    trapezoid sum of the true specific force and rates over its period, the sum of the rotors'
+    vibration's period means (:func:`quadcruise.sim.observe.rotor_shake`), its last instant [s],
     the barometer's offset [m], the magnetometer's bias [G], the filter's state (16) and
     covariance (15 x 15, row-major), the rates filter [rad/s], the yaw [rad] last written, the
     truth at the last IMU instant (position, velocity, Euler angles) and whether its errors are
@@ -141,6 +143,7 @@ def memory_row(slots: int, history: int = 0) -> Row:
         ("imu", IMU_STATE_SIZE),
         ("imu_last", 6),
         ("imu_sum", 6),
+        ("shake_sum", 3),
         "t_imu",
         "baro_bias",
         ("mag_bias", 3),
@@ -165,8 +168,9 @@ def memory_row(slots: int, history: int = 0) -> Row:
 
 
 (
-    OM_IMU, OM_IMU_LAST, OM_IMU_SUM, OM_T_IMU, OM_BARO_BIAS, OM_MAG_BIAS, OM_X, OM_COV, OM_RATES, OM_PSI, OM_TRUTH,
-    OM_ERRORS_DUE, OM_BARO_DUE, OM_BARO, OM_MAG_DUE, OM_MAG, OM_LOG, OM_GPS_HEAD, OM_GPS_COUNT, OM_GPS_QUEUE,
+    OM_IMU, OM_IMU_LAST, OM_IMU_SUM, OM_SHAKE_SUM, OM_T_IMU, OM_BARO_BIAS, OM_MAG_BIAS, OM_X, OM_COV, OM_RATES,
+    OM_PSI, OM_TRUTH, OM_ERRORS_DUE, OM_BARO_DUE, OM_BARO, OM_MAG_DUE, OM_MAG, OM_LOG, OM_GPS_HEAD, OM_GPS_COUNT,
+    OM_GPS_QUEUE,
 ) = memory_row(1).offsets  # fmt: skip
 
 
@@ -253,7 +257,14 @@ def start(x, op, om, s):
     for j in (L.O_IMU_COUNT, L.O_GPS_COUNT, L.O_BARO_COUNT, L.O_MAG_COUNT):
         om[OM_LOG + j] = 0.0
     if op[OP_IMU_ON] != 0.0:
+        om[L.OM_VIBRATION] = op[OP_IMU + IMU_VIBRATION]
+        if om[L.OM_VIBRATION] != 0.0:  # the rotors' angles, uniform, first from the stream
+            for r in range(L.MAX_VIBRATING_ROTORS):
+                u, s = next_unit(s)
+                om[L.OM_PHASE + r] = 2.0 * math.pi * u
         s = imu_start(op[OP_IMU : OP_IMU + IMU_SIZE], om[OM_IMU : OM_IMU + IMU_STATE_SIZE], s)
+    else:
+        om[L.OM_VIBRATION] = 0.0
     if op[OP_BARO_ON] != 0.0:
         om[OM_BARO_BIAS], s = noisy(0.0, 0.0, op[OP_BARO + 2], s)  # the switch-on offset (Baro.bias_init)
     if op[OP_MAG_ON] != 0.0:
@@ -480,9 +491,13 @@ def onboard(t, k, logging, x, op, om, rng, seen, obs):
     log = om[OM_LOG : OM_LOG + L.OBSERVATION_SIZE]
     ekf = op[OP_EKF_ON] != 0.0
     imu_now = k % imu_every == 0
+    shaken = om[L.OM_VIBRATION] != 0.0
     if k > 0 and not imu_now:  # the trapezoid of the true rates and forces over the IMU period
         for i in range(6):
             om[OM_IMU_SUM + i] += om[L.OM_FORCE + i]  # force, then rate: OBSERVER_KERNEL's order
+        if shaken:  # the vibration's period means: their plain mean over the IMU period
+            for i in range(3):
+                om[OM_SHAKE_SUM + i] += om[L.OM_SHAKE + i]
     if imu_now or logging or not ekf or due(k, op):
         s = rng[0]
         if k == 0:
@@ -494,6 +509,10 @@ def onboard(t, k, logging, x, op, om, rng, seen, obs):
             for i in range(6):  # the average over the period, as PX4's sensor_combined gives it
                 v = om[L.OM_FORCE + i]
                 total[i] = v if k == 0 else (total[i] + 0.5 * v) / imu_every
+            if shaken and k > 0:  # the force read: the vibration's mean over the period added
+                for i in range(3):
+                    total[i] += (om[OM_SHAKE_SUM + i] + om[L.OM_SHAKE + i]) / imu_every
+                    om[OM_SHAKE_SUM + i] = 0.0
             s = imu_read(
                 op[OP_IMU : OP_IMU + IMU_SIZE], om[OM_IMU : OM_IMU + IMU_STATE_SIZE],
                 total[3], total[4], total[5], total[0], total[1], total[2], last, s,

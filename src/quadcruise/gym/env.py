@@ -281,6 +281,7 @@ class QuadVectorEnv(VectorEnv):
         n = self.num_envs
         ids = np.arange(n) * EPISODE_STRIDE
         g = float(self.nominal_eq.g)
+        self.plant.refuse_sensors(f"{w} argument sensors", sensors)
         obs, _ = onboard_inputs(sensors, estimator, g=g, n=n, dt=dt, seed=0, first_vehicle=ids, where=w)
         self.observe_mode, self.observed = observe, obs is not None
         return obs

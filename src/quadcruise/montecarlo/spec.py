@@ -224,6 +224,7 @@ class MonteCarloSpec:
         plant.check_controller_vehicle(flown, self.controller_vehicle, where="")
         plant.refuse("MonteCarloSpec", "full_dynamics", self.full_dynamics, label="field")
         plant.refuse("population", "aero_spread", self.population.aero_spread > 0, label="field")
+        plant.refuse_sensors("population field 'sensors'", self.population.sensors)
         with warnings.catch_warnings():  # fly() warns of a vehicle with little left for control
             warnings.simplefilter("ignore")
             plant.check_vehicles(flown)  # before any chunk flies: a nominal that cannot lift

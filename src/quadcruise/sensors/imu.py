@@ -67,6 +67,12 @@ class Imu(SensorModel):
         Standard deviation of each axis' scale-factor error [-], >= 0, drawn once.
     misalignment : float
         Standard deviation of each off-diagonal cross-axis term [rad], >= 0, drawn once.
+    vibration : float
+        Each rotor's imbalance acceleration at the vehicle's hover speed [m/s^2], >= 0 (0: none;
+        rotor plant only): rotor i shakes the body in its plane at its own angle with the amplitude
+        ``vibration (w_i / w_hover)^2``, averaged over the IMU's period
+        (:func:`quadcruise.sim.observe.rotor_shake`). PX4's Flight Review shades its
+        ``accel_vibration_metric`` [m/s^2] green below g/2 (4.9), orange to g, red above.
 
     Examples
     --------
@@ -89,6 +95,7 @@ class Imu(SensorModel):
     accel_lsb: float = unit_field(0.0, "m/s^2", "accelerometer resolution", "nonneg")
     scale_error: float = unit_field(0.0, "-", "scale-factor error std", "nonneg")
     misalignment: float = unit_field(0.0, "rad", "cross-axis misalignment std", "nonneg")
+    vibration: float = unit_field(0.0, "m/s^2", "each rotor's imbalance acceleration at hover", "nonneg")
     name = "imu"
 
     def measure(self, rates: np.ndarray, forces: np.ndarray, seed: int, vehicle: int = 0) -> tuple:
@@ -141,6 +148,7 @@ IMU_ROW = Imu.layout("IMU_")
     IMU_ACCEL_LSB,
     IMU_SCALE_ERROR,
     IMU_MISALIGNMENT,
+    IMU_VIBRATION,
 ) = IMU_ROW.offsets
 
 

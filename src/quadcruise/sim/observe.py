@@ -26,7 +26,27 @@ from numba import njit
 
 from quadcruise import layout as L
 from quadcruise.model.plant import derivative_at
-from quadcruise.model.rotor_plant import QW, QX, QY, QZ, ROTOR_P_G, RP, RQ, RR, RVX, RVY, RVZ, rotor_derivative
+from quadcruise.model.rotor_plant import (
+    ARM_S,
+    ARM_SIZE,
+    QW,
+    QX,
+    QY,
+    QZ,
+    ROTOR_P_G,
+    ROTOR_P_KF,
+    ROTOR_P_M,
+    ROTOR_P_N_ROTORS,
+    ROTOR_P_ROTORS,
+    ROTOR_W1,
+    RP,
+    RQ,
+    RR,
+    RVX,
+    RVY,
+    RVZ,
+    rotor_derivative,
+)
 
 
 @njit(L.OBSERVER_SIG, cache=True)
@@ -220,4 +240,54 @@ def rotor_force(xr, w_cmd, rp, ext_r, dx, om):
     )  # fmt: skip
 
 
-__all__ = ["SENSOR_STREAM", "Observation", "blind", "body_force", "paper_force", "rotor_force", "sensor_streams"]
+@njit(cache=True, inline="always")
+def rotor_shake(xr, rp, dt, om):
+    """The rotors' imbalance vibration averaged over the period ``dt`` [s] just ended, into
+    ``om[OM_SHAKE:OM_SHAKE + 3]`` (``dt = 0``: the start, the speeds kept and nothing else).
+
+    Rotor i's imbalance shakes the body in its plane at its angle phi_i about +z (advanced by
+    ``-s_i`` times the trapezoid of its speeds at the period's ends, ``s_i = +1`` a rotor that
+    spins clockwise seen from above), with
+    the amplitude ``a_i = A w_i^2 / w_h^2`` (A: ``om[OM_VIBRATION]``, each rotor's amplitude [m/s^2] at the
+    hover speed ``w_h^2 = m g / (n kf)``; w_i the period's mean speed). Over the period the
+    frequency is constant, so the average is exact in closed form:
+
+        mean a_i (cos phi, sin phi, 0) = a_i (sin phi_1 - sin phi_0, cos phi_0 - cos phi_1, 0) / (phi_1 - phi_0)
+
+    and the IMU averages these periods' means over its own period (an average, not a point
+    sample: a vibration near the IMU's rate aliases as a real averaged IMU's does). Nothing is
+    computed while A is 0."""
+    n = min(xr.shape[0] - ROTOR_W1, L.MAX_VIBRATING_ROTORS)
+    amplitude = om[L.OM_VIBRATION]
+    if dt > 0.0 and amplitude != 0.0:
+        scale = amplitude * rp[ROTOR_P_N_ROTORS] * rp[ROTOR_P_KF] / (rp[ROTOR_P_M] * rp[ROTOR_P_G])
+        sx = sy = 0.0
+        for r in range(n):
+            w = 0.5 * (om[L.OM_SPIN + r] + xr[ROTOR_W1 + r])
+            a = scale * w * w
+            p0 = om[L.OM_PHASE + r]
+            step = -rp[ROTOR_P_ROTORS + ARM_SIZE * r + ARM_S] * w * dt  # s = +1: clockwise from above
+            p1 = p0 + step
+            if abs(step) > 1e-12:
+                sx += a * (math.sin(p1) - math.sin(p0)) / step
+                sy += a * (math.cos(p0) - math.cos(p1)) / step
+            else:
+                sx += a * math.cos(p0)
+                sy += a * math.sin(p0)
+            om[L.OM_PHASE + r] = p1 - 2.0 * math.pi * math.floor(p1 / (2.0 * math.pi))
+        om[L.OM_SHAKE], om[L.OM_SHAKE + 1], om[L.OM_SHAKE + 2] = sx, sy, 0.0
+    if dt == 0.0 or amplitude != 0.0:
+        for r in range(n):
+            om[L.OM_SPIN + r] = xr[ROTOR_W1 + r]
+
+
+__all__ = [
+    "SENSOR_STREAM",
+    "Observation",
+    "blind",
+    "body_force",
+    "paper_force",
+    "rotor_force",
+    "rotor_shake",
+    "sensor_streams",
+]

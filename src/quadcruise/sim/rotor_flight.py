@@ -61,7 +61,7 @@ from quadcruise.model.rotor_plant import (
 )
 from quadcruise.sim.engine import still_air
 from quadcruise.sim.kernel_args import ROTOR_KERNEL_SIG
-from quadcruise.sim.observe import rotor_force
+from quadcruise.sim.observe import rotor_force, rotor_shake
 from quadcruise.sim.period import (
     blank_logs,
     blank_rows,
@@ -325,6 +325,7 @@ def _rotor_flight_kernel(
                         ext_r[9 + r] = ext[L.EXT_E1 + r] if r < 4 else 1.0
                         w_cmd[r] = x[ROTOR_W1 + r]
                     rotor_force(x, w_cmd, rpi, ext_r, work[0], omi)
+                    rotor_shake(x, rpi, 0.0, omi)
                 observer(t, k, k % log_every == 0, true, opi, omi, orngi, seen, obs)
             else:  # what the controller sees: the state sensor_delay periods ago, plus noise
                 newest = k % (sensor_delay + 1)  # in the ring buffer
@@ -395,6 +396,7 @@ def _rotor_flight_kernel(
             psi = paper_state(x, rpi, ext, psi, true)
             if observed:  # what the IMU will read at the next instant
                 rotor_force(x, w_cmd, rpi, ext_r, work[0], omi)
+                rotor_shake(x, rpi, dt, omi)
             finite = True
             for j in range(size):
                 finite = finite and math.isfinite(x[j])

@@ -411,6 +411,8 @@ def compare(
     onboard_inputs(
         fly_kw.get("sensors"), fly_kw.get("estimator"), g=g, n=1, dt=float(dt), seed=0, first_vehicle=0, where=w
     )
+    plant = plants.named("paper") if vehicle is None else plants.of(vehicle)
+    plant.refuse_sensors(f"{w} argument sensors", fly_kw.get("sensors"))
     if controllers is None:
         controllers = compared_names()
     chosen = labelled(controllers)

@@ -227,6 +227,7 @@ def fly(
         checks.number(w, name, value, "pos", unit="m", optional=True, infinite=True)
     x0 = initial_states(x0)
     plant.refuse(w, "full_dynamics", full_dynamics)
+    plant.refuse_sensors(f"{w} argument sensors", sensors)
     sizes = {
         s
         for s in (

@@ -101,6 +101,26 @@ class Plant:
             name = option if label == "argument" else f"'{option}'"
             raise InputError(f"{where} {label} {name}: {self.refuses[option]}")
 
+    def refuse_sensors(self, where: str, sensors: Any) -> None:
+        """Raise one InputError line if an IMU of ``sensors`` (a Sensors, a sequence of them, or
+        anything else: nothing to check) has a vibration term this plant refuses.
+
+        Parameters
+        ----------
+        where : str
+            The caller and its argument, e.g. ``"fly() argument sensors"``.
+        sensors : Any
+            The sensor models.
+
+        Raises
+        ------
+        InputError
+            ``"<where>: imu field 'vibration': <why>"``.
+        """
+        for each in sensors if isinstance(sensors, (tuple, list)) else (sensors,):
+            imu = getattr(each, "imu", None)
+            self.refuse(f"{where}: imu", "vibration", imu is not None and imu.vibration > 0, label="field")
+
     # --- the vehicles -------------------------------------------------------------------
     def vehicles(self, vehicle: Any) -> tuple:
         """The flown vehicle(s) as a tuple.

@@ -122,6 +122,8 @@ PAPER = PaperPlant(
     refuses={
         "aero_spread": "perturbs a rotor-plant vehicle's aerodynamic coefficients; the paper's vehicle has none to "
         "spread (give a rotor-plant vehicle: iris, crazyflie, ...)",
+        "vibration": "shakes the IMU at the rotors' speeds; the paper's plant has none (give a rotor-plant vehicle: "
+        "iris, crazyflie, ...)",
         "ground": "the paper's plant has no ground to stand on or take off from (give a rotor-plant vehicle: "
         "iris, crazyflie, ...)",
         **{
