@@ -29,6 +29,7 @@ import numpy as np
 
 from quadcruise import layout as L
 from quadcruise.io.ulog import Topic
+from quadcruise.sim.px4 import ENU_TO_NED, FLU_TO_FRD, SENSOR_COMBINED
 
 __all__ = ["ESTIMATOR_TOPICS", "HOME", "baro_pressure", "estimator_topics"]
 
@@ -37,21 +38,6 @@ HOME = (47.397742, 8.545594, 488.0)
 default home (``PX4_HOME_LAT``, ``PX4_HOME_LON``, ``PX4_HOME_ALT``)."""
 EARTH_RADIUS = 6378137.0
 """WGS84 equatorial radius [m]."""
-ENU_NED = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]])
-FLU_FRD = np.diag([1.0, -1.0, -1.0])
-
-SENSOR_COMBINED = (
-    ("uint64_t", 0, "timestamp"),
-    ("float", 3, "gyro_rad"),
-    ("uint32_t", 0, "gyro_integral_dt"),
-    ("int32_t", 0, "accelerometer_timestamp_relative"),
-    ("float", 3, "accelerometer_m_s2"),
-    ("uint32_t", 0, "accelerometer_integral_dt"),
-    ("uint8_t", 0, "accelerometer_clipping"),
-    ("uint8_t", 0, "gyro_clipping"),
-    ("uint8_t", 0, "accel_calibration_count"),
-    ("uint8_t", 0, "gyro_calibration_count"),
-)
 SENSOR_GPS = (
     ("uint64_t", 0, "timestamp"),
     ("uint64_t", 0, "timestamp_sample"),
@@ -192,8 +178,8 @@ def estimator_topics(t: np.ndarray, obs: np.ndarray, sensors: dict, attitude_q: 
                 SENSOR_COMBINED,
                 {
                     "timestamp": us[imu],
-                    "gyro_rad": _cols(obs, "gyro_x", "gyro_y", "gyro_z")[imu] @ FLU_FRD.T,
-                    "accelerometer_m_s2": _cols(obs, "accel_x", "accel_y", "accel_z")[imu] @ FLU_FRD.T,
+                    "gyro_rad": _cols(obs, "gyro_x", "gyro_y", "gyro_z")[imu] @ FLU_TO_FRD.T,
+                    "accelerometer_m_s2": _cols(obs, "accel_x", "accel_y", "accel_z")[imu] @ FLU_TO_FRD.T,
                     "gyro_integral_dt": np.full(imu.size, period),
                     "accelerometer_integral_dt": np.full(imu.size, period),
                 },
@@ -203,7 +189,7 @@ def estimator_topics(t: np.ndarray, obs: np.ndarray, sensors: dict, attitude_q: 
     if "gps" in sensors and fix.size:
         gps = sensors["gps"]
         enu = _cols(obs, "gps_x", "gps_y", "gps_z")[fix]
-        vel = _cols(obs, "gps_vx", "gps_vy", "gps_vz")[fix] @ ENU_NED.T
+        vel = _cols(obs, "gps_vx", "gps_vy", "gps_vz")[fix] @ ENU_TO_NED.T
         lat0, lon0, alt0 = HOME
         topics.append(
             Topic(
@@ -251,10 +237,10 @@ def estimator_topics(t: np.ndarray, obs: np.ndarray, sensors: dict, attitude_q: 
         o = obs[est]
         states = np.zeros((est.size, 24))
         states[:, 0:4] = attitude_q[est]
-        states[:, 4:7] = _cols(o, "vx_est", "vy_est", "vz_est") @ ENU_NED.T
-        states[:, 7:10] = _cols(o, "x_est", "y_est", "z_est") @ ENU_NED.T
-        states[:, 10:13] = _cols(o, "gyro_bias_x_est", "gyro_bias_y_est", "gyro_bias_z_est") @ FLU_FRD.T
-        states[:, 13:16] = _cols(o, "accel_bias_x_est", "accel_bias_y_est", "accel_bias_z_est") @ FLU_FRD.T
+        states[:, 4:7] = _cols(o, "vx_est", "vy_est", "vz_est") @ ENU_TO_NED.T
+        states[:, 7:10] = _cols(o, "x_est", "y_est", "z_est") @ ENU_TO_NED.T
+        states[:, 10:13] = _cols(o, "gyro_bias_x_est", "gyro_bias_y_est", "gyro_bias_z_est") @ FLU_TO_FRD.T
+        states[:, 13:16] = _cols(o, "accel_bias_x_est", "accel_bias_y_est", "accel_bias_z_est") @ FLU_TO_FRD.T
         sd = o[:, L.O_SD : L.O_SD + 15]  # ours: position, velocity, attitude, gyro bias, accel bias
         cov = np.zeros((est.size, 23))
         cov[:, 0:3] = sd[:, 6:9] ** 2  # a rotation's variance per body axis (FLU and FRD alike)
